@@ -1,0 +1,85 @@
+//! Stacked per-pose Jacobian blocks: the identification Jacobian of a whole
+//! pose pool in one contiguous, column-major faer matrix.
+
+use faer::{Mat, MatRef};
+
+/// The identification Jacobians of `n` poses stacked into one `t·n × p`
+/// matrix: the `t` rows of pose `i` are rows `t·i .. t·i + t`.
+///
+/// `t` is the number of measured coordinates per pose (3 for a point, 6 for a
+/// full pose) and `p` the number of unknown parameters. Column-major storage
+/// makes the batched products of the selection algorithms (`X · A` with a
+/// `p × k` matrix `A`) single dense GEMM calls.
+#[derive(Clone, Debug)]
+pub struct Blocks {
+    mat: Mat<f64>,
+    t: usize,
+}
+
+impl Blocks {
+    /// Wraps a stacked matrix. Panics if its row count is not a multiple of `t`
+    /// or `t` is 0 (an internal shape bug, not user input).
+    #[must_use]
+    pub fn new(mat: Mat<f64>, t: usize) -> Self {
+        assert!(
+            t > 0 && mat.nrows() % t == 0,
+            "rows must be a multiple of t"
+        );
+        Self { mat, t }
+    }
+
+    /// Builds blocks from a row-major buffer of `n·t` rows of `p` entries.
+    #[must_use]
+    pub fn from_row_major(rows: &[f64], t: usize, p: usize) -> Self {
+        assert!(p > 0 && rows.len() % (t * p) == 0);
+        let m = rows.len() / p;
+        Self::new(Mat::from_fn(m, p, |r, c| rows[r * p + c]), t)
+    }
+
+    /// Rows per pose.
+    #[must_use]
+    pub fn t(&self) -> usize {
+        self.t
+    }
+
+    /// Number of poses.
+    #[must_use]
+    pub fn n_poses(&self) -> usize {
+        self.mat.nrows() / self.t
+    }
+
+    /// Number of columns (unknown parameters).
+    #[must_use]
+    pub fn p(&self) -> usize {
+        self.mat.ncols()
+    }
+
+    /// The whole stacked matrix.
+    #[must_use]
+    pub fn mat(&self) -> MatRef<'_, f64> {
+        self.mat.as_ref()
+    }
+
+    /// The `t × p` block of pose `i`.
+    #[must_use]
+    pub fn block(&self, i: usize) -> MatRef<'_, f64> {
+        self.mat.as_ref().subrows(i * self.t, self.t)
+    }
+
+    /// Copies the blocks of the given poses, in order, into a new stacked matrix.
+    #[must_use]
+    pub fn select(&self, poses: &[usize]) -> Blocks {
+        let t = self.t;
+        let mat = Mat::from_fn(poses.len() * t, self.p(), |r, c| {
+            self.mat[(poses[r / t] * t + r % t, c)]
+        });
+        Blocks { mat, t }
+    }
+
+    /// `Xᵀ X` summed over the given poses (the information matrix of a design).
+    #[must_use]
+    pub fn information(&self, poses: &[usize]) -> Mat<f64> {
+        let x = self.select(poses);
+        x.mat.transpose() * &x.mat
+    }
+}

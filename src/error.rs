@@ -1,0 +1,115 @@
+//! Errors for bad input. Numerical outcomes (a singular design, a solver that
+//! stalls) are statuses in results, not errors; see the style notes in README.
+
+use thiserror::Error;
+
+/// Everything that can be wrong with what a user gave the library.
+#[derive(Debug, Error)]
+pub enum Error {
+    /// The named robot is not built in and is not a readable file.
+    #[error("unknown robot '{name}' (built-in robots: {known})")]
+    UnknownRobot {
+        /// The name given.
+        name: String,
+        /// Comma-separated list of the built-in robots.
+        known: String,
+    },
+    /// A joint vector with the wrong length.
+    #[error("expected {expected} joint angles, got {got}")]
+    JointCount {
+        /// Degrees of freedom of the robot.
+        expected: usize,
+        /// Length of the vector given.
+        got: usize,
+    },
+    /// A NaN or infinite joint angle.
+    #[error("joint angle q{joint} is not a finite number ({value})")]
+    NonFiniteAngle {
+        /// 1-based joint number.
+        joint: usize,
+        /// The value given.
+        value: f64,
+    },
+    /// Joint limits with lower > upper, or not finite.
+    #[error("joint q{joint}: invalid limits [{lo}, {hi}] (need finite lo <= hi)")]
+    InvalidLimits {
+        /// 1-based joint number.
+        joint: usize,
+        /// Lower limit given.
+        lo: f64,
+        /// Upper limit given.
+        hi: f64,
+    },
+    /// A lattice with fewer than 2 levels per joint.
+    #[error("a pose lattice needs at least 2 levels per joint, got {0}")]
+    TooFewLevels(usize),
+    /// A pose lattice too large to index.
+    #[error("a lattice of {levels}^{dof} poses is too large")]
+    LatticeTooLarge {
+        /// Levels per joint.
+        levels: usize,
+        /// Number of joints.
+        dof: usize,
+    },
+    /// Lattice digits of the wrong length or out of range.
+    #[error("invalid lattice digits {digits:?}: need {dof} digits, each in 0..{levels}")]
+    InvalidDigits {
+        /// Digits given.
+        digits: Vec<usize>,
+        /// Number of joints.
+        dof: usize,
+        /// Levels per joint.
+        levels: usize,
+    },
+    /// A lattice index outside the lattice, or a pose not in the (filtered) pool.
+    #[error("pose {index} is not in the pool ({reason})")]
+    PoseNotInPool {
+        /// The lattice index given.
+        index: usize,
+        /// Why: outside the lattice, or removed by the visibility filter.
+        reason: String,
+    },
+    /// A parameter name that the robot does not have.
+    #[error("unknown parameter '{0}'")]
+    UnknownParameter(String),
+    /// A parameter table entry that is not finite.
+    #[error("parameter {name} is not finite ({value})")]
+    NonFiniteParameter {
+        /// Parameter name, `<symbol>_<frame>`.
+        name: String,
+        /// The value.
+        value: f64,
+    },
+    /// Unknowns that the measurements cannot determine.
+    #[error("unidentifiable unknowns: {names:?} (numerical rank {rank} of {p})")]
+    Unidentifiable {
+        /// Names of the unknowns that are in the null space.
+        names: Vec<String>,
+        /// Numerical rank of the stacked Jacobian.
+        rank: usize,
+        /// Number of unknowns.
+        p: usize,
+    },
+    /// Any other invalid argument, with a message saying what and why.
+    #[error("{0}")]
+    Invalid(String),
+    /// File input/output.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// A malformed JSON or TOML file.
+    #[error("{path}: {message}")]
+    Parse {
+        /// The file.
+        path: String,
+        /// What is wrong, with its place.
+        message: String,
+    },
+}
+
+/// Result with the crate's [`Error`].
+pub type Result<T> = std::result::Result<T, Error>;

@@ -1,0 +1,507 @@
+//! Robot models: a serial chain of DH or Hayati frames with named parameters,
+//! real and nominal parameter tables, unknowns and joint limits.
+//!
+//! Each frame's transform is `Rz(q + γ) Tz(d) Tx(a) Rx(α)` (DH) or
+//! `Rz(q + γ) Tx(a) Rx(α) Ry(β)` (Hayati; `d` is kept in the table and applied
+//! as `Tz(d)` after `Rz`, so a Hayati frame with `d = 0` is exactly the
+//! paper's). A fixed frame has no `q`. The measured point is the origin of the
+//! last frame, expressed in the measurement frame ("coordinate zero").
+
+use crate::error::{Error, Result};
+use serde::Serialize;
+use std::f64::consts::PI;
+use std::fmt;
+
+/// Parameterization of one frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Convention {
+    /// Denavit–Hartenberg: `Rz(q+γ) Tz(d) Tx(a) Rx(α)`; has no β.
+    Dh,
+    /// Hayati: `Rz(q+γ) Tx(a) Rx(α) Ry(β)`, for nearly parallel consecutive axes.
+    Hayati,
+}
+
+/// The five parameter symbols of a frame, in the tables' column order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Symbol {
+    /// Joint-angle offset γ (radians).
+    Gamma,
+    /// Twist α about x (radians).
+    Alpha,
+    /// Length a along x (metres).
+    A,
+    /// Offset d along z (metres).
+    D,
+    /// Hayati twist β about y (radians).
+    Beta,
+}
+
+impl Symbol {
+    /// All symbols in column order.
+    pub const ALL: [Symbol; 5] = [
+        Symbol::Gamma,
+        Symbol::Alpha,
+        Symbol::A,
+        Symbol::D,
+        Symbol::Beta,
+    ];
+
+    /// Column of this symbol in a parameter table.
+    #[must_use]
+    pub fn column(self) -> usize {
+        self as usize
+    }
+
+    /// The name used in parameter names (`gamma`, `alpha`, `a`, `d`, `beta`).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Symbol::Gamma => "gamma",
+            Symbol::Alpha => "alpha",
+            Symbol::A => "a",
+            Symbol::D => "d",
+            Symbol::Beta => "beta",
+        }
+    }
+
+    /// Parses a symbol name.
+    #[must_use]
+    pub fn parse(s: &str) -> Option<Symbol> {
+        Symbol::ALL.into_iter().find(|x| x.name() == s)
+    }
+}
+
+impl fmt::Display for Symbol {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// One frame of the chain.
+#[derive(Clone, Debug, Serialize)]
+pub struct Frame {
+    /// Frame label used in parameter names (`a`, `0`, `1`, …).
+    pub label: String,
+    /// DH or Hayati.
+    pub convention: Convention,
+    /// Index (0-based) of the joint that drives this frame, or `None` if fixed.
+    pub joint: Option<usize>,
+}
+
+/// Values of all five parameters of every frame (`[γ, α, a, d, β]` per frame).
+/// A DH frame's β entry is ignored by the kinematics (the paper's tables write 10).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ParamTable {
+    /// One row per frame, columns in [`Symbol::ALL`] order.
+    pub rows: Vec<[f64; 5]>,
+}
+
+impl ParamTable {
+    /// Value of a parameter.
+    #[must_use]
+    pub fn get(&self, id: ParamId) -> f64 {
+        self.rows[id.frame][id.symbol.column()]
+    }
+
+    /// Sets a parameter.
+    pub fn set(&mut self, id: ParamId, v: f64) {
+        self.rows[id.frame][id.symbol.column()] = v;
+    }
+}
+
+/// Identifies one parameter: a frame and a symbol.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+pub struct ParamId {
+    /// Index of the frame in the chain.
+    pub frame: usize,
+    /// The symbol.
+    pub symbol: Symbol,
+}
+
+/// Which of a robot's two parameter tables to use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ParamSet {
+    /// The nominal (design) model, used to compute Jacobians for pose selection.
+    Nominal,
+    /// The real robot, used to simulate measurements.
+    Real,
+}
+
+impl ParamSet {
+    /// Parses `nominal` or `real`.
+    pub fn parse(s: &str) -> Result<ParamSet> {
+        match s {
+            "nominal" => Ok(ParamSet::Nominal),
+            "real" => Ok(ParamSet::Real),
+            _ => Err(Error::Invalid(format!(
+                "unknown parameter set '{s}' (expected 'nominal' or 'real')"
+            ))),
+        }
+    }
+}
+
+/// What is measured at each pose.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Measurement {
+    /// The position of the end point: 3 rows per pose.
+    Point,
+}
+
+impl Measurement {
+    /// Rows of the identification Jacobian per pose.
+    #[must_use]
+    pub fn rows(self) -> usize {
+        match self {
+            Measurement::Point => 3,
+        }
+    }
+}
+
+/// An immutable serial-chain robot model.
+#[derive(Clone, Debug, Serialize)]
+pub struct Robot {
+    /// Name (`puma560` for the built-in PUMA).
+    pub name: String,
+    /// Frames from the measurement frame to the end point.
+    pub frames: Vec<Frame>,
+    /// Parameters of the real robot (simulation truth).
+    pub real: ParamTable,
+    /// Nominal parameters (the model the Jacobians are computed with).
+    pub nominal: ParamTable,
+    /// The unknown parameters, frame-major, in column order.
+    pub unknowns: Vec<ParamId>,
+    /// Joint limits `[lo, hi]` in radians, one per joint.
+    pub limits: Vec<[f64; 2]>,
+    /// What is measured.
+    pub measurement: Measurement,
+}
+
+/// Names of the built-in robots.
+pub const BUILTIN: &[&str] = &["puma560"];
+
+impl Robot {
+    /// A built-in robot by name.
+    pub fn builtin(name: &str) -> Result<Robot> {
+        match name {
+            "puma560" | "puma" => Ok(Robot::puma560()),
+            _ => Err(Error::UnknownRobot {
+                name: name.to_string(),
+                known: BUILTIN.join(", "),
+            }),
+        }
+    }
+
+    /// The PUMA 560 of Sun & Hollerbach §V-A: Tables I (real) and II
+    /// (nominal), joint limits eq. (25), 27 unknowns.
+    ///
+    /// Frame `a` is a fixed Hayati frame from the measurement frame to the
+    /// base (20 m away), frame 0 is joint 1 (DH), frame 1 joint 2 (Hayati),
+    /// frames 2–5 joints 3–6 (DH), frame 6 the identity.
+    #[must_use]
+    pub fn puma560() -> Robot {
+        use Convention::{Dh, Hayati};
+        let frames: Vec<Frame> = [
+            ("a", Hayati, None),
+            ("0", Dh, Some(0)),
+            ("1", Hayati, Some(1)),
+            ("2", Dh, Some(2)),
+            ("3", Dh, Some(3)),
+            ("4", Dh, Some(4)),
+            ("5", Dh, Some(5)),
+            ("6", Dh, None),
+        ]
+        .into_iter()
+        .map(|(l, c, j)| Frame {
+            label: l.to_string(),
+            convention: c,
+            joint: j,
+        })
+        .collect();
+        // Table I (β = 10 marks "no β" in the paper; kept for display, ignored for DH).
+        let real = ParamTable {
+            rows: vec![
+                [PI / 2.0, PI / 100.0, 20.0, 0.0, PI / 100.0],
+                [0.0, -PI / 2.0, 0.0, 0.6858, 10.0],
+                [0.0, PI / 100.0, 0.4318, 0.0, PI / 100.0],
+                [0.0, PI / 2.0, -0.0203, 0.1491, 10.0],
+                [0.0, -PI / 2.0, 0.0, 0.4331, 10.0],
+                [0.0, PI / 2.0, 0.0, 0.0, 10.0],
+                [0.0, 0.0, 0.2, 0.1655, 10.0],
+                [0.0, 0.0, 0.0, 0.0, 10.0],
+            ],
+        };
+        // Table II.
+        let nominal = ParamTable {
+            rows: vec![
+                [1.6360, 0.1572, 19.8820, 0.0, -0.0123],
+                [-0.0367, -1.4524, 0.0603, 0.6713, 10.0],
+                [-0.1455, -0.2622, 0.3411, 0.0, -0.1963],
+                [0.0128, 1.6374, -0.1214, 0.0074, 10.0],
+                [0.0024, -1.3948, -0.1029, 0.3002, 10.0],
+                [0.1207, 1.6151, -0.0468, -0.0747, 10.0],
+                [0.0938, 0.0, 0.1322, 0.3083, 10.0],
+                [0.0, 0.0, 0.0, 0.0, 10.0],
+            ],
+        };
+        use Symbol::{A, Alpha, Beta, D, Gamma};
+        let per_frame: [&[Symbol]; 7] = [
+            &[Gamma, Alpha, A, Beta],
+            &[Gamma, Alpha, A, D],
+            &[Gamma, Alpha, A, Beta],
+            &[Gamma, Alpha, A, D],
+            &[Gamma, Alpha, A, D],
+            &[Gamma, Alpha, A, D],
+            &[Gamma, A, D],
+        ];
+        let unknowns = per_frame
+            .iter()
+            .enumerate()
+            .flat_map(|(f, syms)| {
+                syms.iter().map(move |&s| ParamId {
+                    frame: f,
+                    symbol: s,
+                })
+            })
+            .collect();
+        let deg = PI / 180.0;
+        let limits = [
+            [-250.0, 70.0],
+            [-110.0, 170.0],
+            [-133.0, 133.0],
+            [-100.0, 100.0],
+            [-142.0, 142.0],
+            [-176.0, 356.0],
+        ]
+        .iter()
+        .map(|[lo, hi]| [lo * deg, hi * deg])
+        .collect();
+        Robot {
+            name: "puma560".into(),
+            frames,
+            real,
+            nominal,
+            unknowns,
+            limits,
+            measurement: Measurement::Point,
+        }
+    }
+
+    /// Number of joints.
+    #[must_use]
+    pub fn dof(&self) -> usize {
+        self.limits.len()
+    }
+
+    /// Number of unknown parameters `p`.
+    #[must_use]
+    pub fn n_unknowns(&self) -> usize {
+        self.unknowns.len()
+    }
+
+    /// Rows of the identification Jacobian per pose.
+    #[must_use]
+    pub fn rows_per_pose(&self) -> usize {
+        self.measurement.rows()
+    }
+
+    /// The parameter table of a set.
+    #[must_use]
+    pub fn params(&self, set: ParamSet) -> &ParamTable {
+        match set {
+            ParamSet::Nominal => &self.nominal,
+            ParamSet::Real => &self.real,
+        }
+    }
+
+    /// Name of a parameter, `<symbol>_<frame>` (e.g. `gamma_a`, `d_3`).
+    #[must_use]
+    pub fn param_name(&self, id: ParamId) -> String {
+        format!("{}_{}", id.symbol.name(), self.frames[id.frame].label)
+    }
+
+    /// Names of the unknowns, in parameter-vector order.
+    #[must_use]
+    pub fn parameter_names(&self) -> Vec<String> {
+        self.unknowns.iter().map(|&u| self.param_name(u)).collect()
+    }
+
+    /// Looks a parameter up by name.
+    pub fn param_id(&self, name: &str) -> Result<ParamId> {
+        let bad = || Error::UnknownParameter(name.to_string());
+        let (sym, frame) = name.split_once('_').ok_or_else(bad)?;
+        let symbol = Symbol::parse(sym).ok_or_else(bad)?;
+        let frame = self
+            .frames
+            .iter()
+            .position(|f| f.label == frame)
+            .ok_or_else(bad)?;
+        if symbol == Symbol::Beta && self.frames[frame].convention == Convention::Dh {
+            return Err(bad());
+        }
+        Ok(ParamId { frame, symbol })
+    }
+
+    /// The unknowns' values in a table, in parameter-vector order.
+    #[must_use]
+    pub fn unknown_values(&self, table: &ParamTable) -> Vec<f64> {
+        self.unknowns.iter().map(|&u| table.get(u)).collect()
+    }
+
+    /// A copy of `table` with the unknowns set from `values`.
+    #[must_use]
+    pub fn with_unknowns(&self, table: &ParamTable, values: &[f64]) -> ParamTable {
+        assert_eq!(values.len(), self.unknowns.len());
+        let mut t = table.clone();
+        for (&u, &v) in self.unknowns.iter().zip(values) {
+            t.set(u, v);
+        }
+        t
+    }
+
+    /// A copy of this robot with a different set of unknowns (validated).
+    pub fn with_unknown_names(&self, names: &[&str]) -> Result<Robot> {
+        let mut ids = names
+            .iter()
+            .map(|n| self.param_id(n))
+            .collect::<Result<Vec<_>>>()?;
+        ids.sort();
+        ids.dedup();
+        let mut r = self.clone();
+        r.unknowns = ids;
+        r.validate()?;
+        Ok(r)
+    }
+
+    /// Checks internal consistency: joints numbered 0..dof once each, finite
+    /// parameters, valid limits, no β unknown on a DH frame, unknowns sorted.
+    pub fn validate(&self) -> Result<()> {
+        let mut seen = vec![false; self.dof()];
+        for f in &self.frames {
+            if let Some(j) = f.joint {
+                if j >= seen.len() || seen[j] {
+                    return Err(Error::Invalid(format!(
+                        "frame {}: joint index {j} is out of range or used twice",
+                        f.label
+                    )));
+                }
+                seen[j] = true;
+            }
+        }
+        if let Some(j) = seen.iter().position(|s| !s) {
+            return Err(Error::Invalid(format!("joint q{} drives no frame", j + 1)));
+        }
+        for (j, &[lo, hi]) in self.limits.iter().enumerate() {
+            if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+                return Err(Error::InvalidLimits {
+                    joint: j + 1,
+                    lo,
+                    hi,
+                });
+            }
+        }
+        for table in [&self.real, &self.nominal] {
+            if table.rows.len() != self.frames.len() {
+                return Err(Error::Invalid(format!(
+                    "parameter table has {} rows for {} frames",
+                    table.rows.len(),
+                    self.frames.len()
+                )));
+            }
+            for (fi, row) in table.rows.iter().enumerate() {
+                for s in Symbol::ALL {
+                    let used = !(s == Symbol::Beta && self.frames[fi].convention == Convention::Dh);
+                    if used && !row[s.column()].is_finite() {
+                        return Err(Error::NonFiniteParameter {
+                            name: self.param_name(ParamId {
+                                frame: fi,
+                                symbol: s,
+                            }),
+                            value: row[s.column()],
+                        });
+                    }
+                }
+            }
+        }
+        if self.unknowns.is_empty() {
+            return Err(Error::Invalid("the robot has no unknown parameters".into()));
+        }
+        for w in self.unknowns.windows(2) {
+            if w[0] >= w[1] {
+                return Err(Error::Invalid(
+                    "unknowns must be unique and frame-major".into(),
+                ));
+            }
+        }
+        for &u in &self.unknowns {
+            if u.symbol == Symbol::Beta && self.frames[u.frame].convention == Convention::Dh {
+                return Err(Error::Invalid(format!(
+                    "{} is not a parameter: frame {} is DH",
+                    self.param_name(u),
+                    self.frames[u.frame].label
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Validates a joint vector: length and finiteness (limits are not enforced:
+    /// kinematics is defined everywhere).
+    pub fn check_q(&self, q: &[f64]) -> Result<()> {
+        if q.len() != self.dof() {
+            return Err(Error::JointCount {
+                expected: self.dof(),
+                got: q.len(),
+            });
+        }
+        if let Some((j, &v)) = q.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(Error::NonFiniteAngle {
+                joint: j + 1,
+                value: v,
+            });
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn puma_has_27_unknowns_in_table_order() {
+        let r = Robot::puma560();
+        r.validate().unwrap();
+        let names = r.parameter_names();
+        assert_eq!(names.len(), 27);
+        assert_eq!(
+            &names[..5],
+            ["gamma_a", "alpha_a", "a_a", "beta_a", "gamma_0"]
+        );
+        assert_eq!(&names[24..], ["gamma_5", "a_5", "d_5"]);
+    }
+
+    #[test]
+    fn names_round_trip_and_bad_names_fail() {
+        let r = Robot::puma560();
+        for &u in &r.unknowns {
+            assert_eq!(r.param_id(&r.param_name(u)).unwrap(), u);
+        }
+        assert!(r.param_id("beta_2").is_err()); // frame 2 is DH
+        assert!(r.param_id("foo_1").is_err());
+        assert!(r.param_id("gamma_9").is_err());
+    }
+
+    #[test]
+    fn inverted_limits_are_rejected() {
+        let mut r = Robot::puma560();
+        r.limits[2] = [1.0, -1.0];
+        assert!(matches!(
+            r.validate(),
+            Err(Error::InvalidLimits { joint: 3, .. })
+        ));
+    }
+}

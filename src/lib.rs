@@ -6,6 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod blocks;
+pub mod design;
 pub mod error;
 pub mod kinematics;
 pub mod pool;

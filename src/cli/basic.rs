@@ -1,0 +1,172 @@
+//! `robots`, `fk`, `pool`: the kinematic core on the command line.
+
+use super::{emit, load_robot, parse_list};
+use activecal::kinematics::{Evaluator, position_checked};
+use activecal::pool::Lattice;
+use activecal::robot::{ParamSet, Robot};
+use anyhow::Result;
+use clap::Args;
+use serde_json::{Value, json};
+
+/// Arguments of the command.
+#[derive(Args)]
+pub struct RobotsArgs {
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Arguments of the command.
+#[derive(Args)]
+pub struct FkArgs {
+    /// Robot name (built-in).
+    #[arg(long, default_value = "puma560")]
+    pub robot: String,
+    /// Parameter set: nominal or real.
+    #[arg(long, default_value = "nominal")]
+    pub params: String,
+    /// Joint angles, comma separated (radians, or degrees with --deg).
+    #[arg(long, allow_hyphen_values = true)]
+    pub q: String,
+    /// Angles are in degrees.
+    #[arg(long)]
+    pub deg: bool,
+    /// Also print the identification Jacobian (3 × p).
+    #[arg(long)]
+    pub jacobian: bool,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Arguments of the command.
+#[derive(Args)]
+pub struct PoolArgs {
+    /// Robot name (built-in).
+    #[arg(long, default_value = "puma560")]
+    pub robot: String,
+    /// Lattice values per joint.
+    #[arg(long, default_value_t = 5)]
+    pub levels: usize,
+    /// Lattice digits of one pose (joint 1 first), comma separated.
+    #[arg(long)]
+    pub digits: Option<String>,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `robots`.
+pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
+    let robots: Vec<Value> = activecal::robot::BUILTIN
+        .iter()
+        .map(|n| {
+            let r = Robot::builtin(n).expect("built-in");
+            json!({
+                "name": r.name,
+                "dof": r.dof(),
+                "frames": r.frames,
+                "real": r.real.rows,
+                "nominal": r.nominal.rows,
+                "unknowns": r.parameter_names(),
+                "limits_deg": r.limits.iter().map(|l| [l[0].to_degrees(), l[1].to_degrees()]).collect::<Vec<_>>(),
+                "measurement": r.measurement,
+            })
+        })
+        .collect();
+    let v = json!({ "robots": robots });
+    emit(a.json, &v, || {
+        let mut s = String::new();
+        for n in activecal::robot::BUILTIN {
+            let r = Robot::builtin(n).expect("built-in");
+            s += &format!(
+                "{} ({} joints, {} unknowns)\n",
+                r.name,
+                r.dof(),
+                r.n_unknowns()
+            );
+            s += "frame  conv    joint       gamma       alpha           a           d        beta   (real | nominal)\n";
+            for (i, f) in r.frames.iter().enumerate() {
+                for (tag, t) in [("real", &r.real), ("nom ", &r.nominal)] {
+                    let row = t.rows[i];
+                    s += &format!(
+                        "{:>5}  {:<6}  {:>5} {tag} {:>10.4}  {:>10.4}  {:>10.4}  {:>10.4}  {:>10.4}\n",
+                        f.label,
+                        format!("{:?}", f.convention),
+                        f.joint.map_or("-".into(), |j| format!("q{}", j + 1)),
+                        row[0],
+                        row[1],
+                        row[2],
+                        row[3],
+                        row[4]
+                    );
+                }
+            }
+            s += &format!("unknowns: {}\n", r.parameter_names().join(" "));
+        }
+        s
+    });
+    Ok(())
+}
+
+/// Runs `fk`.
+pub fn cmd_fk(a: FkArgs) -> Result<()> {
+    let robot = load_robot(&a.robot)?;
+    let set = ParamSet::parse(&a.params)?;
+    let mut q: Vec<f64> = parse_list(&a.q, "--q")?;
+    if a.deg {
+        q.iter_mut().for_each(|v| *v = v.to_radians());
+    }
+    let table = robot.params(set);
+    let p = position_checked(&robot, table, &q)?;
+    let mut v = json!({ "robot": robot.name, "params": set, "q": q, "position": [p.x, p.y, p.z] });
+    let mut jac = vec![0.0; 3 * robot.n_unknowns()];
+    if a.jacobian {
+        Evaluator::new(&robot, table).eval(&q, &mut jac);
+        let n = robot.n_unknowns();
+        v["jacobian"] = json!(jac.chunks(n).collect::<Vec<_>>());
+        v["parameter_names"] = json!(robot.parameter_names());
+    }
+    emit(a.json, &v, || {
+        let mut s = format!("position: {:.12} {:.12} {:.12}\n", p.x, p.y, p.z);
+        if a.jacobian {
+            let n = robot.n_unknowns();
+            for (c, name) in robot.parameter_names().iter().enumerate() {
+                s += &format!(
+                    "{name:>8}: {:>14.8} {:>14.8} {:>14.8}\n",
+                    jac[c],
+                    jac[n + c],
+                    jac[2 * n + c]
+                );
+            }
+        }
+        s
+    });
+    Ok(())
+}
+
+/// Runs `pool`.
+pub fn cmd_pool(a: PoolArgs) -> Result<()> {
+    let robot = load_robot(&a.robot)?;
+    let lattice = Lattice::new(&robot, a.levels)?;
+    let mut v = json!({ "robot": robot.name, "levels": a.levels, "size": lattice.size() });
+    if let Some(d) = &a.digits {
+        let digits: Vec<usize> = parse_list(d, "--digits")?;
+        let index = lattice.index_of(&digits)?;
+        v["index"] = json!(index);
+        v["digits"] = json!(digits);
+        v["q"] = json!(lattice.q(index)?);
+    }
+    emit(a.json, &v, || {
+        let mut s = format!(
+            "lattice: {} levels per joint, {} poses\n",
+            a.levels,
+            lattice.size()
+        );
+        if let Some(i) = v.get("index") {
+            s += &format!("index: {i}\nq (rad): {}\n", v["q"]);
+        }
+        s
+    });
+    Ok(())
+}

@@ -6,10 +6,14 @@
 #![warn(missing_docs)]
 
 pub mod blocks;
+pub mod bound;
+pub mod criterion;
 pub mod design;
 pub mod error;
+pub mod identify;
 pub mod kinematics;
 pub mod pool;
 pub mod robot;
+pub mod select;
 
 pub use error::{Error, Result};

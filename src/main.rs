@@ -5,6 +5,7 @@ mod cli;
 
 use clap::{Parser, Subcommand};
 use cli::basic::{FkArgs, PoolArgs, RobotsArgs};
+use cli::select::{ScoreArgs, SelectArgs};
 
 #[derive(Parser)]
 #[command(
@@ -25,6 +26,10 @@ enum Command {
     Fk(FkArgs),
     /// Size of a pose lattice, or the index and angles of one lattice pose.
     Pool(PoolArgs),
+    /// Observability indices of a design (ln OI_D, OI, O1-O5, A-trace, rank).
+    Score(ScoreArgs),
+    /// Select the poses to measure (EAE, Fedorov, DETMAX or random search).
+    Select(SelectArgs),
 }
 
 fn main() {
@@ -33,6 +38,8 @@ fn main() {
         Command::Robots(a) => cli::basic::cmd_robots(a),
         Command::Fk(a) => cli::basic::cmd_fk(a),
         Command::Pool(a) => cli::basic::cmd_pool(a),
+        Command::Score(a) => cli::select::cmd_score(a),
+        Command::Select(a) => cli::select::cmd_select(a),
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");

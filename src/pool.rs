@@ -7,7 +7,7 @@ use crate::kinematics::{Evaluator, position};
 use crate::robot::{ParamTable, Robot};
 use nalgebra::Vector3;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// A joint-space lattice of `levels` values per joint: `linspace(lo, hi,
 /// levels)`, both ends included. Pose index `Σ digit_i · k^(n−1−i)`, joint 1
@@ -118,8 +118,8 @@ impl Lattice {
 
 /// A simple sensor-visibility region in the measurement frame: a pose is
 /// visible when its end point (at nominal parameters) lies inside.
-#[derive(Clone, Debug, Serialize)]
-#[serde(tag = "kind", rename_all = "lowercase")]
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
 pub enum Visibility {
     /// Every pose is visible.
     All,

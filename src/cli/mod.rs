@@ -1,6 +1,7 @@
 //! Shared helpers of the command-line subcommands; one file per command group.
 
 pub mod basic;
+pub mod select;
 
 use activecal::robot::Robot;
 use anyhow::Result;
@@ -33,5 +34,53 @@ pub fn emit(json_out: bool, value: &Value, text: impl FnOnce() -> String) {
         println!("{value}");
     } else {
         print!("{}", text());
+    }
+}
+
+/// Options that define a pose pool, shared by the commands that need one.
+#[derive(clap::Args, Clone, Debug)]
+pub struct PoolOpts {
+    /// Robot name (built-in).
+    #[arg(long, default_value = "puma560")]
+    pub robot: String,
+    /// Lattice values per joint.
+    #[arg(long, default_value_t = 5)]
+    pub levels: usize,
+    /// Parameter set the Jacobian is computed with: nominal or real.
+    #[arg(long, default_value = "nominal")]
+    pub params: String,
+    /// Sensor visibility region as JSON, e.g.
+    /// '{"kind":"box","min":[-30,-30,-30],"max":[30,30,30]}' or
+    /// '{"kind":"cone","apex":[0,0,0],"axis":[0,1,0],"half_angle":0.1,"max_range":40}'.
+    #[arg(long)]
+    pub visibility: Option<String>,
+}
+
+/// A robot, its pose pool and the pool's identification Jacobian.
+pub struct PoolCtx {
+    /// The robot.
+    pub robot: Robot,
+    /// The pool (lattice indices that survive the visibility filter).
+    pub pool: activecal::pool::Pool,
+    /// Identification Jacobian of every pool pose.
+    pub x: activecal::blocks::Blocks,
+}
+
+impl PoolOpts {
+    /// Builds the pool and its Jacobian.
+    pub fn load(&self) -> Result<PoolCtx> {
+        use activecal::pool::{Pool, Visibility};
+        let robot = load_robot(&self.robot)?;
+        let set = activecal::robot::ParamSet::parse(&self.params)?;
+        let pool = match &self.visibility {
+            None => Pool::full(&robot, self.levels)?,
+            Some(v) => {
+                let vis: Visibility =
+                    serde_json::from_str(v).map_err(|e| anyhow::anyhow!("--visibility: {e}"))?;
+                Pool::filtered(&robot, &robot.nominal, self.levels, &vis)?
+            }
+        };
+        let x = pool.jacobian(&robot, robot.params(set));
+        Ok(PoolCtx { robot, pool, x })
     }
 }

@@ -1,0 +1,493 @@
+//! The convex D-optimal relaxation as a certified upper bound on OI_D.
+//!
+//! For a pool of poses with Jacobian blocks `X_i` (`t × p`) and designs of
+//! `N` poses, the relaxation
+//!
+//! `maximise ln det M(w),  M(w) = Σ_i w_i X_iᵀX_i,  0 ≤ w_i ≤ 1,  Σ_i w_i = N`   (R)
+//!
+//! contains every `N`-pose design (`w` = its indicator vector), so its optimum
+//! `ln det M*` bounds `ln OI_D` of all of them from above. Every design then
+//! carries a certified gap, its D-efficiency
+//! `(det M_design / det M*)^{1/p}` ([`gap::DesignGap`]).
+//!
+//! The pipeline ([`relaxation_bound`]):
+//! 1. scale the Jacobian columns to a common size ([`variance::scale_columns`];
+//!    `ln det` shifts by the known `2·Σ ln s_j`);
+//! 2. a first-order solver ([`exchange`]) gives a warm point and its variances
+//!    `d_i = tr(X_i M(w)⁻¹ X_iᵀ)`;
+//! 3. Clarabel ([`conic`]) solves (R) on the candidates that can carry weight
+//!    (support ∪ the largest `d_i`); the optimality conditions
+//!    (`w_i = 1 ⇒ d_i ≥ c`, `0 < w_i < 1 ⇒ d_i = c`, `w_i = 0 ⇒ d_i ≤ c`) are
+//!    checked on the whole pool, violators added and (R) re-solved;
+//! 4. the bound reported is the certificate (eq. C, [`variance::certificate`])
+//!    `ln det M(w) + p·ln(S_N(w)/p)`, valid at any positive definite `M(w)`:
+//!    it never depends on a solver having converged. Solver objective values
+//!    are reported beside it but never used as the bound.
+
+pub mod conic;
+mod error;
+pub mod exchange;
+pub mod gap;
+pub mod variance;
+
+pub use error::BoundError;
+pub use gap::{DesignGap, design_gap};
+
+use crate::blocks::Blocks;
+use crate::pool::Pool;
+use crate::robot::{ParamSet, Robot};
+use conic::{ConicSettings, ConicStatus};
+use exchange::{ExchangeOutcome, ExchangeSettings, candidates, evaluate};
+use serde::{Deserialize, Serialize};
+use std::time::Instant;
+use variance::{VarianceWork, check_problem, make_feasible, nth_largest, scale_columns};
+
+/// Weight above which a pose counts as carrying relaxation weight in
+/// [`Bound::support_size`].
+pub const SUPPORT_TOL: f64 = 1e-6;
+
+/// Settings of [`relaxation_bound`]. Build with [`BoundSettings::builder`]
+/// (validated) or take [`BoundSettings::default`].
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(default)]
+pub struct BoundSettings {
+    /// Target certified gap `ln_bound − ln_primal`. Default 1e-7.
+    pub gap_tol: f64,
+    /// Solve (R) with Clarabel (true) or with the first-order solver alone
+    /// (false). Default true.
+    pub use_conic: bool,
+    /// First-order certificate gap at which screening stops and Clarabel
+    /// takes over. Default 1e-3.
+    pub screen_gap: f64,
+    /// Poses outside the support added to Clarabel's candidate set, by
+    /// largest `d_i`. Default 300.
+    pub screen_extra: usize,
+    /// Pools of at most this many poses go to Clarabel whole. Default 400.
+    pub direct_limit: usize,
+    /// Maximum Clarabel solves (screening rounds). Default 5.
+    pub max_rounds: usize,
+    /// Run the first-order solver from Clarabel's point when the certificate
+    /// gap is still above `gap_tol` after the last round. Default true.
+    pub polish: bool,
+    /// The first-order solver's settings (its `gap_tol` is overridden by
+    /// `screen_gap` or `gap_tol` as the stage needs).
+    pub first_order: ExchangeSettings,
+    /// Clarabel's settings.
+    pub conic: ConicSettings,
+}
+
+impl Default for BoundSettings {
+    fn default() -> Self {
+        Self {
+            gap_tol: 1e-7,
+            use_conic: true,
+            screen_gap: 1e-3,
+            screen_extra: 300,
+            direct_limit: 400,
+            max_rounds: 5,
+            polish: true,
+            first_order: ExchangeSettings::default(),
+            conic: ConicSettings::default(),
+        }
+    }
+}
+
+impl BoundSettings {
+    /// A builder starting from the defaults.
+    #[must_use]
+    pub fn builder() -> BoundSettingsBuilder {
+        BoundSettingsBuilder(Self::default())
+    }
+
+    /// Checks every field's range.
+    pub fn validate(&self) -> Result<(), BoundError> {
+        let pos = |name, v: f64| {
+            if v > 0.0 && v.is_finite() {
+                Ok(())
+            } else {
+                Err(BoundError::InvalidSetting {
+                    name,
+                    value: v.to_string(),
+                    reason: "must be finite and > 0",
+                })
+            }
+        };
+        pos("gap_tol", self.gap_tol)?;
+        pos("screen_gap", self.screen_gap)?;
+        if self.max_rounds == 0 {
+            return Err(BoundError::InvalidSetting {
+                name: "max_rounds",
+                value: "0".into(),
+                reason: "must be ≥ 1",
+            });
+        }
+        self.first_order.validate()?;
+        self.conic.validate()
+    }
+}
+
+/// Validated construction of [`BoundSettings`].
+#[derive(Clone, Debug)]
+pub struct BoundSettingsBuilder(BoundSettings);
+
+impl BoundSettingsBuilder {
+    /// Target certified gap (default 1e-7).
+    #[must_use]
+    pub fn gap_tol(mut self, v: f64) -> Self {
+        self.0.gap_tol = v;
+        self
+    }
+    /// Clarabel (true, default) or the first-order solver alone.
+    #[must_use]
+    pub fn use_conic(mut self, v: bool) -> Self {
+        self.0.use_conic = v;
+        self
+    }
+    /// Screening gap of the first-order stage (default 1e-3).
+    #[must_use]
+    pub fn screen_gap(mut self, v: f64) -> Self {
+        self.0.screen_gap = v;
+        self
+    }
+    /// Extra candidates for Clarabel (default 300).
+    #[must_use]
+    pub fn screen_extra(mut self, v: usize) -> Self {
+        self.0.screen_extra = v;
+        self
+    }
+    /// Pool size up to which Clarabel gets the whole pool (default 400).
+    #[must_use]
+    pub fn direct_limit(mut self, v: usize) -> Self {
+        self.0.direct_limit = v;
+        self
+    }
+    /// Maximum Clarabel solves (default 5).
+    #[must_use]
+    pub fn max_rounds(mut self, v: usize) -> Self {
+        self.0.max_rounds = v;
+        self
+    }
+    /// First-order polishing after Clarabel (default true).
+    #[must_use]
+    pub fn polish(mut self, v: bool) -> Self {
+        self.0.polish = v;
+        self
+    }
+    /// First-order solver settings.
+    #[must_use]
+    pub fn first_order(mut self, v: ExchangeSettings) -> Self {
+        self.0.first_order = v;
+        self
+    }
+    /// Clarabel settings.
+    #[must_use]
+    pub fn conic(mut self, v: ConicSettings) -> Self {
+        self.0.conic = v;
+        self
+    }
+    /// Validates and returns the settings.
+    pub fn build(self) -> Result<BoundSettings, BoundError> {
+        self.0.validate()?;
+        Ok(self.0)
+    }
+}
+
+/// How the bound ended. Every status carries a valid bound; only the gap to
+/// the best feasible point differs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BoundStatus {
+    /// `certificate_gap ≤ gap_tol`.
+    Certified,
+    /// `N` equals the pool size: the only feasible point is `w = 1`, and the
+    /// bound is `ln det` of the whole pool, exactly.
+    Exact,
+    /// The bound is valid but its gap is above `gap_tol` (Clarabel did not
+    /// converge, or the round or time limits were hit).
+    GapAboveTolerance,
+}
+
+/// What the Clarabel stage did.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct ConicSummary {
+    /// Status of the last Clarabel solve (`None` if Clarabel did not run).
+    pub status: Option<ConicStatus>,
+    /// Interior-point iterations of the last solve.
+    pub iterations: u32,
+    /// Clarabel solves (screening rounds).
+    pub rounds: usize,
+    /// Candidates in the last solve.
+    pub candidates: usize,
+    /// Whether the last solve was repeated without equilibration.
+    pub retried: bool,
+    /// Seconds in Clarabel, all rounds.
+    pub seconds: f64,
+    /// Clarabel's primal objective of the last solve, unscaled (an estimate,
+    /// not a bound).
+    pub ln_det_primal: Option<f64>,
+    /// Clarabel's dual objective of the last solve, unscaled (uncertified:
+    /// it bounds only the candidate subproblem, and only up to the solver's
+    /// residuals).
+    pub ln_det_dual: Option<f64>,
+    /// Pairwise steps of the first-order polish after Clarabel.
+    pub polish_steps: usize,
+}
+
+/// The certified upper bound on `ln OI_D` of every `N`-pose design of a pool.
+#[derive(Clone, Debug, Serialize)]
+pub struct Bound {
+    /// Upper bound on `ln det M` of every `N`-pose design (and on the
+    /// relaxation's optimum): the smallest certificate (eq. C) seen.
+    pub ln_bound: f64,
+    /// `ln det M(w)` at the feasible `weights`: a lower bound on the
+    /// relaxation's optimum.
+    pub ln_primal: f64,
+    /// `ln_bound − ln_primal ≥ 0`.
+    pub certificate_gap: f64,
+    /// How it ended.
+    pub status: BoundStatus,
+    /// Poses per design.
+    pub n: usize,
+    /// Unknowns.
+    pub p: usize,
+    /// Pool size.
+    pub pool_size: usize,
+    /// Feasible relaxation weights, one per pool pose.
+    pub weights: Vec<f64>,
+    /// Poses with weight above [`SUPPORT_TOL`].
+    pub support_size: usize,
+    /// First-order stage (screening, or the whole solve without Clarabel).
+    pub first_order: ExchangeSummary,
+    /// Clarabel stage.
+    pub conic: ConicSummary,
+    /// Wall-clock seconds, all stages.
+    pub seconds: f64,
+}
+
+/// What the first-order stage did.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct ExchangeSummary {
+    /// Rounds (full-pool variance evaluations).
+    pub rounds: usize,
+    /// Pairwise exchange steps.
+    pub steps: usize,
+    /// Its certificate gap when it stopped.
+    pub gap: f64,
+    /// Seconds.
+    pub seconds: f64,
+}
+
+impl Bound {
+    /// `log10` of the bound on OI_D.
+    #[must_use]
+    pub fn log10_bound(&self) -> f64 {
+        self.ln_bound / std::f64::consts::LN_10
+    }
+
+    /// Pool positions with weight above `tol`, ascending.
+    #[must_use]
+    pub fn support(&self, tol: f64) -> Vec<usize> {
+        (0..self.weights.len())
+            .filter(|&i| self.weights[i] > tol)
+            .collect()
+    }
+}
+
+/// The best valid bound and the best feasible point seen so far (scaled
+/// units).
+struct Best {
+    bound: f64,
+    ln_det: f64,
+    w: Vec<f64>,
+}
+
+impl Best {
+    fn gap(&self) -> f64 {
+        self.bound - self.ln_det
+    }
+}
+
+/// Bounds `ln OI_D` of every `n`-pose design drawn from the pool whose
+/// stacked Jacobian is `x`, by solving the relaxation (R) and certifying the
+/// result with eq. (C).
+///
+/// Errors (bad input): `n` larger than the pool, `n·t < p` (every design
+/// singular), a non-finite entry, a rank-deficient pool Jacobian, invalid
+/// settings. A solver that stalls gives a valid bound with status
+/// [`BoundStatus::GapAboveTolerance`].
+pub fn relaxation_bound(
+    x: &Blocks,
+    n: usize,
+    settings: &BoundSettings,
+) -> Result<Bound, BoundError> {
+    settings.validate()?;
+    check_problem(x, n)?;
+    let clock = Instant::now();
+    let sc = scale_columns(x, n)?;
+    let xs = &sc.x;
+    let pool = xs.n_poses();
+    let mut work = VarianceWork::default();
+    let mut scratch = Vec::new();
+
+    // --- first-order stage: screening (or the whole solve)
+    let mut fo_settings = settings.first_order.clone();
+    fo_settings.gap_tol = if settings.use_conic && pool > n {
+        settings.screen_gap.max(settings.gap_tol)
+    } else {
+        settings.gap_tol
+    };
+    let fo = exchange::solve_scaled(xs, n, None, &fo_settings);
+    let first_order = ExchangeSummary {
+        rounds: fo.rounds,
+        steps: fo.steps,
+        gap: fo.gap,
+        seconds: fo.seconds,
+    };
+    let mut best = Best {
+        bound: fo.ln_bound,
+        ln_det: fo.ln_det,
+        w: fo.weights.clone(),
+    };
+    let mut conic_summary = ConicSummary::default();
+
+    if pool == n {
+        return Ok(finish(best, &sc, n, BoundStatus::Exact, first_order, conic_summary, clock));
+    }
+
+    if settings.use_conic && best.gap() > settings.gap_tol {
+        // --- Clarabel on the candidates, screening rounds
+        let fo_eval = evaluate(xs, n, &fo.weights, &mut work, &mut scratch)
+            .expect("the first-order point is positive definite");
+        let mut cand = if pool <= settings.direct_limit {
+            (0..pool).collect()
+        } else {
+            candidates(&fo.weights, &fo_eval.d, settings.screen_extra)
+        };
+        let mut conic_w: Option<Vec<f64>> = None;
+        for round in 1..=settings.max_rounds {
+            let sub = xs.select(&cand);
+            // A rank-deficient candidate set cannot happen for a support of a
+            // positive definite M(w); if it does, keep what we have.
+            let Ok(sub_sc) = scale_columns(&sub, n.min(cand.len())) else {
+                break;
+            };
+            let out = conic::solve_scaled(&sub_sc, n, &settings.conic);
+            conic_summary.status = Some(out.status);
+            conic_summary.iterations = out.iterations;
+            conic_summary.rounds = round;
+            conic_summary.candidates = cand.len();
+            conic_summary.retried = out.retried;
+            conic_summary.seconds += out.seconds;
+            // Objective values of the candidate subproblem: `out` is in the
+            // units of the pool-scaled blocks; unscale to raw.
+            conic_summary.ln_det_primal = out
+                .ln_det_primal
+                .is_finite()
+                .then_some(out.ln_det_primal + sc.ln_scale);
+            conic_summary.ln_det_dual = out
+                .ln_det_dual
+                .is_finite()
+                .then_some(out.ln_det_dual + sc.ln_scale);
+            // Clamp and spread onto the pool; evaluate the certificate there.
+            let mut w = vec![0.0; pool];
+            for (k, &i) in cand.iter().enumerate() {
+                w[i] = out.weights[k];
+            }
+            make_feasible(&mut w, n);
+            let Some(e) = evaluate(xs, n, &w, &mut work, &mut scratch) else {
+                break; // No usable point from the solver: keep the first-order one.
+            };
+            best.bound = best.bound.min(e.bound);
+            if e.ln_det > best.ln_det {
+                best.ln_det = e.ln_det;
+                best.w.clone_from(&w);
+            }
+            conic_w = Some(w);
+            if best.gap() <= settings.gap_tol || !out.status.is_solved() {
+                break;
+            }
+            // Optimality conditions on the whole pool: a pose outside the
+            // candidates whose d_i exceeds c = the N-th largest d among the
+            // candidates would enter the top-N sum S_N.
+            let dk: Vec<f64> = cand.iter().map(|&i| e.d[i]).collect();
+            let c = nth_largest(&dk, n, &mut scratch);
+            let mut in_cand = vec![false; pool];
+            cand.iter().for_each(|&i| in_cand[i] = true);
+            let mut viol: Vec<usize> = (0..pool).filter(|&i| !in_cand[i] && e.d[i] > c).collect();
+            if viol.is_empty() {
+                break;
+            }
+            if viol.len() > settings.screen_extra.max(1) {
+                viol.select_nth_unstable_by(settings.screen_extra.max(1) - 1, |&a, &b| {
+                    e.d[b].total_cmp(&e.d[a])
+                });
+                viol.truncate(settings.screen_extra.max(1));
+            }
+            cand.extend(viol);
+            cand.sort_unstable();
+        }
+        // --- polish: first-order steps from Clarabel's point
+        if settings.polish && best.gap() > settings.gap_tol {
+            let mut s = settings.first_order.clone();
+            s.gap_tol = settings.gap_tol;
+            let start = conic_w.unwrap_or_else(|| best.w.clone());
+            let pol: ExchangeOutcome = exchange::solve_scaled(xs, n, Some(start), &s);
+            conic_summary.polish_steps = pol.steps;
+            best.bound = best.bound.min(pol.ln_bound);
+            if pol.ln_det > best.ln_det {
+                best.ln_det = pol.ln_det;
+                best.w = pol.weights;
+            }
+        }
+    }
+    let status = if best.gap() <= settings.gap_tol {
+        BoundStatus::Certified
+    } else {
+        BoundStatus::GapAboveTolerance
+    };
+    Ok(finish(best, &sc, n, status, first_order, conic_summary, clock))
+}
+
+fn finish(
+    best: Best,
+    sc: &variance::Scaled,
+    n: usize,
+    status: BoundStatus,
+    first_order: ExchangeSummary,
+    conic: ConicSummary,
+    clock: Instant,
+) -> Bound {
+    let ln_bound = best.bound + sc.ln_scale;
+    let ln_primal = best.ln_det + sc.ln_scale;
+    Bound {
+        certificate_gap: (ln_bound - ln_primal).max(0.0),
+        ln_bound,
+        ln_primal,
+        status,
+        n,
+        p: sc.x.p(),
+        pool_size: sc.x.n_poses(),
+        support_size: best.w.iter().filter(|&&v| v > SUPPORT_TOL).count(),
+        weights: best.w,
+        first_order,
+        conic,
+        seconds: clock.elapsed().as_secs_f64(),
+    }
+}
+
+/// The bound for a built-in robot's full lattice pool at a parameter set:
+/// builds the pool and its Jacobian and calls [`relaxation_bound`]. The
+/// benchmark entry point (`pool_bound(&Robot::puma560(), ParamSet::Nominal,
+/// 5, 30, &BoundSettings::default())` is the 15,625-pose PUMA problem).
+pub fn pool_bound(
+    robot: &Robot,
+    params: ParamSet,
+    levels: usize,
+    n: usize,
+    settings: &BoundSettings,
+) -> Result<(Pool, Blocks, Bound), BoundError> {
+    let pool = Pool::full(robot, levels)?;
+    let x = pool.jacobian(robot, robot.params(params));
+    let b = relaxation_bound(&x, n, settings)?;
+    Ok((pool, x, b))
+}

@@ -1,0 +1,308 @@
+//! The variance function d_i(w) = tr(X_i M(w)⁻¹ X_iᵀ) of a whole pool from one
+//! Cholesky factorisation and one triangular solve, the column scaling, and
+//! the solver-free certificate.
+//!
+//! With M = L Lᵀ and Y = X L⁻ᵀ, d_i is the squared Frobenius norm of the `t`
+//! rows of Y that belong to pose i. The certificate (eq. C below) turns any
+//! positive definite M(w) into an upper bound on the relaxation's optimum.
+
+use super::BoundError;
+use crate::blocks::Blocks;
+use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
+use faer::{Mat, MatRef, Par, Side};
+
+/// Eigenvalue ratio λ_min/λ_max of the column-scaled pool Gram matrix below
+/// which the pool counts as rank deficient (a singular-value ratio of 1e-6).
+pub const RANK_TOL: f64 = 1e-12;
+
+/// A column-scaled copy of a pool Jacobian, `X̃ = X·S⁻¹`.
+///
+/// `ln det M(w) = ln det M̃(w) + ln_scale` with `ln_scale = 2·Σ_j ln s_j`;
+/// the variances d_i are invariant under the scaling.
+#[derive(Clone, Debug)]
+pub struct Scaled {
+    /// The scaled blocks.
+    pub x: Blocks,
+    /// Column scale factors `s_j > 0`.
+    pub s: Vec<f64>,
+    /// `2·Σ_j ln s_j`, added to a scaled ln det to unscale it.
+    pub ln_scale: f64,
+}
+
+/// Checks the shape and entries of a relaxation problem: `1 ≤ N ≤ pool size`,
+/// `N·t ≥ p`, and every Jacobian entry finite.
+pub fn check_problem(x: &Blocks, n: usize) -> Result<(), BoundError> {
+    let (pool, t, p) = (x.n_poses(), x.t(), x.p());
+    if n > pool {
+        return Err(BoundError::TooManyPoses { n, pool });
+    }
+    if n * t < p || n == 0 {
+        return Err(BoundError::TooFewRows {
+            n,
+            t,
+            rows: n * t,
+            p,
+            need: p.div_ceil(t).max(1),
+        });
+    }
+    let m = x.mat();
+    for c in 0..m.ncols() {
+        for r in 0..m.nrows() {
+            let v = m[(r, c)];
+            if !v.is_finite() {
+                return Err(BoundError::NonFinite {
+                    row: r,
+                    col: c,
+                    value: v,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Scales every column so that the uniform design `w_i = N / pool` has an
+/// information matrix with unit diagonal: `s_j = ‖X_{:,j}‖·√(N / pool)`.
+///
+/// Errors with [`BoundError::RankDeficient`] on a zero column or when the
+/// scaled Gram matrix has `λ_min/λ_max ≤` [`RANK_TOL`].
+pub fn scale_columns(x: &Blocks, n: usize) -> Result<Scaled, BoundError> {
+    let m = x.mat();
+    let (rows, p) = (m.nrows(), m.ncols());
+    let f = (n as f64 / x.n_poses() as f64).sqrt();
+    let norms: Vec<f64> = (0..p).map(|c| m.col(c).norm_l2()).collect();
+    let zero = norms.iter().filter(|&&v| v == 0.0).count();
+    if zero > 0 {
+        return Err(BoundError::RankDeficient {
+            rank: p - zero,
+            p,
+            ratio: 0.0,
+        });
+    }
+    let s: Vec<f64> = norms.iter().map(|v| v * f).collect();
+    let scaled = Mat::from_fn(rows, p, |r, c| m[(r, c)] / s[c]);
+    let gram = scaled.transpose() * &scaled;
+    let eig = gram
+        .self_adjoint_eigenvalues(Side::Lower)
+        .map_err(|_| BoundError::RankDeficient {
+            rank: 0,
+            p,
+            ratio: 0.0,
+        })?;
+    let max = eig.iter().cloned().fold(0.0, f64::max);
+    let min = eig.iter().cloned().fold(f64::INFINITY, f64::min);
+    let ratio = if max > 0.0 { min / max } else { 0.0 };
+    if ratio <= RANK_TOL {
+        let rank = eig.iter().filter(|&&l| l > RANK_TOL * max).count();
+        return Err(BoundError::RankDeficient { rank, p, ratio });
+    }
+    Ok(Scaled {
+        x: Blocks::new(scaled, x.t()),
+        ln_scale: 2.0 * s.iter().map(|v| v.ln()).sum::<f64>(),
+        s,
+    })
+}
+
+/// The weighted information matrix `M(w) = Σ_i w_i X_iᵀ X_i` (poses with
+/// `w_i = 0` skipped), as one product of the weighted support rows.
+#[must_use]
+pub fn information(x: &Blocks, w: &[f64]) -> Mat<f64> {
+    assert_eq!(w.len(), x.n_poses(), "one weight per pose");
+    let t = x.t();
+    let support: Vec<usize> = (0..w.len()).filter(|&i| w[i] > 0.0).collect();
+    let m = x.mat();
+    let xs = Mat::from_fn(support.len() * t, x.p(), |r, c| {
+        let i = support[r / t];
+        w[i].sqrt() * m[(i * t + r % t, c)]
+    });
+    xs.transpose() * &xs
+}
+
+/// `ln det M` from a Cholesky factorisation, or `None` if `M` is not
+/// numerically positive definite.
+#[must_use]
+pub fn ln_det(m: MatRef<'_, f64>) -> Option<f64> {
+    let llt = m.llt(Side::Lower).ok()?;
+    let l = llt.L();
+    let v: f64 = (0..l.nrows()).map(|j| 2.0 * l[(j, j)].ln()).sum();
+    v.is_finite().then_some(v)
+}
+
+/// Reusable memory for [`variances_into`]: the `t·n × p` matrix Y.
+#[derive(Debug)]
+pub struct VarianceWork {
+    y: Mat<f64>,
+}
+
+impl Default for VarianceWork {
+    fn default() -> Self {
+        Self { y: Mat::zeros(0, 0) }
+    }
+}
+
+/// Variances of every pose under `M`: writes `d_i = tr(X_i M⁻¹ X_iᵀ)` into
+/// `d` and returns `ln det M` with `M⁻¹`, or `None` if `M` is not
+/// numerically positive definite.
+///
+/// One Cholesky `M = L Lᵀ`, one triangular solve `Y = X L⁻ᵀ` over the whole
+/// pool, and the row norms of Y.
+pub fn variances_into(
+    x: &Blocks,
+    m: MatRef<'_, f64>,
+    work: &mut VarianceWork,
+    d: &mut [f64],
+) -> Option<(f64, Mat<f64>)> {
+    use faer::linalg::solvers::DenseSolveCore;
+    assert_eq!(d.len(), x.n_poses(), "one variance per pose");
+    let llt = m.llt(Side::Lower).ok()?;
+    let l = llt.L();
+    let ln_det: f64 = (0..l.nrows()).map(|j| 2.0 * l[(j, j)].ln()).sum();
+    if !ln_det.is_finite() {
+        return None;
+    }
+    let xm = x.mat();
+    if work.y.nrows() != xm.nrows() || work.y.ncols() != xm.ncols() {
+        work.y = Mat::zeros(xm.nrows(), xm.ncols());
+    }
+    work.y.copy_from(xm);
+    // L Yᵀ = Xᵀ, i.e. Y = X L⁻ᵀ.
+    solve_lower_triangular_in_place(l, work.y.as_mut().transpose_mut(), Par::Seq);
+    let t = x.t();
+    d.iter_mut().for_each(|v| *v = 0.0);
+    for c in 0..xm.ncols() {
+        let col = work.y.col(c);
+        for (i, di) in d.iter_mut().enumerate() {
+            let mut s = 0.0;
+            for r in i * t..i * t + t {
+                s += col[r] * col[r];
+            }
+            *di += s;
+        }
+    }
+    if d.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    Some((ln_det, llt.inverse()))
+}
+
+/// `S_N`: the sum of the `n` largest entries of `d`. `scratch` is reused.
+#[must_use]
+pub fn top_sum(d: &[f64], n: usize, scratch: &mut Vec<f64>) -> f64 {
+    assert!(n >= 1 && n <= d.len());
+    scratch.clear();
+    scratch.extend_from_slice(d);
+    let k = n - 1;
+    scratch.select_nth_unstable_by(k, |a, b| b.total_cmp(a));
+    scratch[..n].iter().sum()
+}
+
+/// The `n`-th largest entry of `d` (the threshold `c` of the optimality
+/// conditions when the top `n` poses carry the weight).
+#[must_use]
+pub fn nth_largest(d: &[f64], n: usize, scratch: &mut Vec<f64>) -> f64 {
+    scratch.clear();
+    scratch.extend_from_slice(d);
+    let (_, v, _) = scratch.select_nth_unstable_by(n - 1, |a, b| b.total_cmp(a));
+    *v
+}
+
+/// The certificate (eq. C): for any positive definite `M` with variances
+/// `d_i`, and every feasible `w*` (`0 ≤ w* ≤ 1`, `Σ w* = N`),
+///
+/// `ln det M(w*) ≤ ln det M + p·ln(S_N / p)`,   (C)
+///
+/// where `S_N` is the sum of the `N` largest `d_i`.
+///
+/// Proof: with λ_k the eigenvalues of `M⁻¹ M(w*)`, the AM–GM inequality gives
+/// `ln det M(w*) − ln det M = Σ ln λ_k ≤ p·ln(Σ λ_k / p)`, and
+/// `Σ λ_k = tr(M⁻¹ M(w*)) = Σ_i w*_i d_i ≤ S_N`. `M` need not be feasible
+/// nor optimal; the bound is tight (`S_N = p`) exactly at the optimum.
+#[must_use]
+pub fn certificate(ln_det: f64, s_n: f64, p: usize) -> f64 {
+    ln_det + p as f64 * (s_n / p as f64).ln()
+}
+
+/// Moves `w` onto the feasible set `{0 ≤ w ≤ 1, Σ w = N}` keeping its support
+/// where possible: entries are clamped to `[0, 1]` (NaN to 0), an excess is
+/// removed by scaling down, a deficit is spread over the room `1 − w_i` of
+/// the support first, and of the other poses only if the support is full.
+pub fn make_feasible(w: &mut [f64], n: usize) {
+    assert!(n <= w.len());
+    for v in w.iter_mut() {
+        *v = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+    }
+    let nf = n as f64;
+    for _ in 0..3 {
+        let s: f64 = w.iter().sum();
+        if s > nf {
+            let f = nf / s;
+            w.iter_mut().for_each(|v| *v = (*v * f).min(1.0));
+        } else if s < nf {
+            let deficit = nf - s;
+            let room: f64 = w.iter().filter(|&&v| v > 0.0).map(|v| 1.0 - v).sum();
+            if room >= deficit {
+                let f = deficit / room;
+                w.iter_mut()
+                    .filter(|v| **v > 0.0)
+                    .for_each(|v| *v = (*v + f * (1.0 - *v)).min(1.0));
+            } else {
+                let rest = deficit - room;
+                w.iter_mut()
+                    .filter(|v| **v > 0.0)
+                    .for_each(|v| *v = 1.0);
+                let zeros = w.iter().filter(|&&v| v == 0.0).count();
+                let f = rest / zeros as f64;
+                w.iter_mut()
+                    .filter(|v| **v == 0.0)
+                    .for_each(|v| *v = f.min(1.0));
+            }
+        } else {
+            break;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn random_blocks(n: usize, t: usize, p: usize, seed: u64) -> Blocks {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let rows: Vec<f64> = (0..n * t * p).map(|_| rng.random::<f64>() - 0.5).collect();
+        Blocks::from_row_major(&rows, t, p)
+    }
+
+    #[test]
+    fn variances_match_direct_formula() {
+        let x = random_blocks(40, 3, 7, 1);
+        let w: Vec<f64> = (0..40).map(|i| 0.1 + 0.02 * i as f64).collect();
+        let m = information(&x, &w);
+        let mut d = vec![0.0; 40];
+        let (ld, minv) = variances_into(&x, m.as_ref(), &mut VarianceWork::default(), &mut d)
+            .expect("positive definite");
+        for i in [0, 17, 39] {
+            let b = x.block(i);
+            let direct = (b * &minv * b.transpose()).diagonal().column_vector().sum();
+            assert!((direct - d[i]).abs() < 1e-10 * direct.abs().max(1.0));
+        }
+        // Σ w_i d_i = tr(M⁻¹ M) = p.
+        let s: f64 = w.iter().zip(&d).map(|(a, b)| a * b).sum();
+        assert!((s - 7.0).abs() < 1e-10);
+        assert!((ld - ln_det(m.as_ref()).unwrap()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn make_feasible_keeps_support() {
+        let mut w = vec![0.5, 0.0, 0.9, 1.2, -0.1, 0.3];
+        make_feasible(&mut w, 3);
+        assert!((w.iter().sum::<f64>() - 3.0).abs() < 1e-12);
+        assert!(w.iter().all(|&v| (0.0..=1.0).contains(&v)));
+        assert_eq!(w[1], 0.0);
+        assert_eq!(w[4], 0.0);
+        let mut w = vec![0.9, 0.9, 0.0, 0.0];
+        make_feasible(&mut w, 3);
+        assert!((w.iter().sum::<f64>() - 3.0).abs() < 1e-12);
+        assert!(w.iter().all(|&v| (0.0..=1.0).contains(&v)));
+    }
+}

@@ -1,0 +1,239 @@
+//! `calibrate`: simulate measurements at a design's poses, identify the
+//! unknowns from the nominal parameters, validate on held-out poses, and
+//! optionally repeat over noise realisations (Monte-Carlo).
+
+use super::{emit, load_robot};
+use activecal::design::DesignFile;
+use activecal::identify::{
+    LmSettings, MonteCarloSettings, MonteCarloSummary, ValidationSet, monte_carlo, paper_tables,
+};
+use activecal::pool::Pool;
+use anyhow::Result;
+use clap::Args;
+use serde_json::{Map, Value, json};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Arguments of the command.
+#[derive(Args)]
+pub struct CalibrateArgs {
+    /// Robot name (built-in).
+    #[arg(long, default_value = "puma560")]
+    pub robot: String,
+    /// Design file (JSON with robot, levels, poses), as written by `select`.
+    #[arg(long)]
+    pub design: PathBuf,
+    /// Measurement noise σ per coordinate, metres.
+    #[arg(long, default_value_t = 0.01)]
+    pub noise: f64,
+    /// Seed of the noise and of the validation poses.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Noise realisations; more than 1 adds a Monte-Carlo summary.
+    #[arg(long, default_value_t = 1)]
+    pub trials: usize,
+    /// Held-out lattice poses (not in the design) for the validation RMS.
+    #[arg(long, default_value_t = 500)]
+    pub validation: usize,
+    /// Levenberg–Marquardt iteration limit.
+    #[arg(long, default_value_t = 200)]
+    pub max_iterations: usize,
+    /// Plain Levenberg–Marquardt steps, without geodesic acceleration.
+    #[arg(long)]
+    pub no_geodesic: bool,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `{name: value}` in parameter order.
+fn named(names: &[String], values: &[f64]) -> Value {
+    let m: Map<String, Value> = names
+        .iter()
+        .zip(values)
+        .map(|(n, v)| (n.clone(), json!(v)))
+        .collect();
+    Value::Object(m)
+}
+
+/// Runs `calibrate`.
+pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
+    let t0 = Instant::now();
+    let robot = load_robot(&a.robot)?;
+    let design = DesignFile::read(&a.design)?;
+    if design.robot != robot.name {
+        anyhow::bail!(
+            "{}: the design is for robot '{}', not '{}'",
+            a.design.display(),
+            design.robot,
+            robot.name
+        );
+    }
+    let pool = Pool::full(&robot, design.levels)?;
+    let positions = design
+        .positions_in(&robot, &pool)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?;
+    let qs: Vec<Vec<f64>> = positions.iter().map(|&k| pool.q(k)).collect();
+    let lm = LmSettings::default()
+        .with_max_iterations(a.max_iterations)
+        .with_geodesic(!a.no_geodesic);
+    let settings = MonteCarloSettings::default()
+        .with_trials(a.trials)
+        .with_sigma(a.noise)
+        .with_seed(a.seed)
+        .with_validation_poses(a.validation);
+    let settings = MonteCarloSettings { lm, ..settings };
+    settings.validate()?;
+    let validation = ValidationSet::sample(&robot, &pool, &positions, a.validation, a.seed)?;
+
+    // ---- one calibration: trial 0 of the seed --------------------------------
+    let tables = paper_tables(&robot, &qs, a.noise, a.seed, &settings.lm)?;
+    let id = &tables.identification;
+    let names = &id.names;
+    let truth = robot.unknown_values(&robot.real);
+    let residual: Vec<f64> = truth.iter().zip(&id.estimate).map(|(t, e)| t - e).collect();
+    let before = validation.rms(&robot, &robot.nominal);
+    let after = validation.rms(&robot, &id.table);
+
+    // ---- Monte-Carlo ------------------------------------------------------------
+    let t_mc = Instant::now();
+    let mc: Option<MonteCarloSummary> = if a.trials > 1 {
+        let name = a
+            .design
+            .file_stem()
+            .map_or("design".into(), |s| s.to_string_lossy().into_owned());
+        Some(monte_carlo(&robot, &name, &qs, &validation, &settings)?)
+    } else {
+        None
+    };
+    let mc_seconds = t_mc.elapsed().as_secs_f64();
+
+    let v = json!({
+        "robot": robot.name,
+        "design": a.design.display().to_string(),
+        "poses": qs.len(),
+        "noise": a.noise,
+        "seed": a.seed,
+        "status": id.status,
+        "stop": id.stop,
+        "converged": id.converged(),
+        "iterations": id.iterations,
+        "evaluations": id.evaluations,
+        "estimate": named(names, &id.estimate),
+        "residual": named(names, &residual),
+        "std": id.covariance.as_ref().map(|c| named(names, &c.std)),
+        "correlation": id.covariance.as_ref().map(|c| &c.correlation),
+        "sigma_hat": id.sigma_hat,
+        "rss": id.rss,
+        "initial_rss": id.initial_rss,
+        "rank": id.rank,
+        "unidentifiable": id.unidentifiable,
+        "validation_poses": validation.len(),
+        "validation_rms_before": before,
+        "validation_rms_after": after,
+        "monte_carlo": mc,
+        "monte_carlo_seconds": mc.as_ref().map(|_| mc_seconds),
+        "elapsed_seconds": t0.elapsed().as_secs_f64(),
+    });
+    emit(a.json, &v, || {
+        let mut s = format!(
+            "{}: {} poses, σ = {} m, seed {}\nstatus: {:?} ({:?}) after {} iterations, {} evaluations\n",
+            a.design.display(),
+            qs.len(),
+            a.noise,
+            a.seed,
+            id.status,
+            id.stop,
+            id.iterations,
+            id.evaluations
+        );
+        s += &format!(
+            "rss {:.6e} (start {:.6e}), σ̂ = {}, rank {}/{}\n",
+            id.rss,
+            id.initial_rss,
+            id.sigma_hat.map_or("-".into(), |v| format!("{v:.6}")),
+            id.rank,
+            names.len()
+        );
+        if !id.unidentifiable.is_empty() {
+            s += &format!("unidentifiable: {}\n", id.unidentifiable.join(" "));
+        }
+        s += "\nestimate (Table III)\n";
+        s += &tables.estimate.to_text(6);
+        s += "\nresidual = real − estimate (Table IV)\n";
+        s += &tables.residual.to_text(6);
+        if let Some(std) = &tables.std {
+            s += "\nstandard deviation\n";
+            s += &std.to_text(6);
+        }
+        s += &format!(
+            "\nvalidation ({} held-out poses): RMS position error {before:.6} m before, {after:.6} m after\n",
+            validation.len()
+        );
+        if let Some(mc) = &mc {
+            s += &mc_text(mc, mc_seconds);
+        }
+        s
+    });
+    Ok(())
+}
+
+/// Human-readable Monte-Carlo summary.
+fn mc_text(mc: &MonteCarloSummary, seconds: f64) -> String {
+    let mut s = format!(
+        "\nMonte-Carlo: {} trials ({} converged {:?}) in {seconds:.2} s\n",
+        mc.trials, mc.converged, mc.statuses
+    );
+    if let Some(it) = &mc.iterations {
+        s += &format!(
+            "iterations: median {} max {}\n",
+            it.median, it.max
+        );
+    }
+    if let (Some(n), Some(r)) = (mc.ln_det_information_nominal, mc.ln_det_information_real) {
+        s += &format!("ln det XᵀX: {n:.3} (nominal), {r:.3} (real)\n");
+    }
+    s += "    parameter          truth           bias            std           rmse  predicted std  rmse/pred\n";
+    for p in &mc.parameters {
+        s += &format!(
+            "{:>13} {:>14.6} {:>14.3e} {:>14.3e} {:>14.3e} {:>14.3e} {:>10.3}\n",
+            p.name,
+            p.truth,
+            p.bias,
+            p.std,
+            p.rmse,
+            p.predicted_std,
+            p.rmse / p.predicted_std
+        );
+    }
+    if let Some(r) = &mc.rmse_over_predicted {
+        s += &format!(
+            "rmse/predicted std: min {:.3} median {:.3} max {:.3}\n",
+            r.min, r.median, r.max
+        );
+    }
+    if let Some(g) = &mc.generalized_variance {
+        s += &format!(
+            "ln det C_emp − ln det C_pred = {:.3} (linear-Gaussian expectation {:.3} ± {:.3}, z = {:.2}; bootstrap sd {})\n",
+            g.ln_ratio,
+            g.expected,
+            g.sd_model,
+            g.z,
+            g.sd_bootstrap.map_or("-".into(), |v| format!("{v:.3}"))
+        );
+    }
+    if let Some(v) = &mc.validation_rms_after {
+        s += &format!(
+            "validation RMS ({} poses): before {:.6} m; after median {:.6} mean {:.6} p95 {:.6} max {:.6} m (predicted {})\n",
+            mc.validation_poses,
+            mc.validation_rms_before,
+            v.median,
+            v.mean,
+            v.p95,
+            v.max,
+            mc.validation_rms_predicted
+                .map_or("-".into(), |p| format!("{p:.6}"))
+        );
+    }
+    s
+}

@@ -1,0 +1,327 @@
+//! Small dense kernels shared by the update formulas: packed symmetric `t×t`
+//! blocks, Cholesky with a pivot floor, Gram-matrix updates, and the faer
+//! calls (always sequential, so results never depend on the thread count).
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt;
+use faer::linalg::evd::{self, ComputeEigenvectors};
+use faer::linalg::svd::{self, ComputeSvdVectors};
+use faer::diag::Diag;
+use faer::{Mat, MatMut, MatRef, Par};
+
+use super::MAX_T;
+
+/// Length of the packed lower triangle of a `t×t` symmetric matrix.
+#[inline]
+pub(crate) const fn packed_len(t: usize) -> usize {
+    t * (t + 1) / 2
+}
+
+/// Index of entry `(a, b)`, `b ≤ a`, in the packed lower triangle (by rows).
+#[inline]
+pub(crate) const fn pk(a: usize, b: usize) -> usize {
+    a * (a + 1) / 2 + b
+}
+
+/// Cholesky `A = L Lᵀ` in place of a row-major `n×n` symmetric matrix
+/// (lower triangle read and overwritten by `L`). Returns `ln det A` when every
+/// pivot `d_k = L_kk²` exceeds `floor`, else `Err(d_k)` for the first pivot
+/// that does not (NaN pivots fail too).
+#[inline]
+pub(crate) fn chol_in_place(a: &mut [f64], n: usize, floor: f64) -> Result<f64, f64> {
+    let mut ln_det = 0.0;
+    for k in 0..n {
+        let mut d = a[k * n + k];
+        for j in 0..k {
+            d -= a[k * n + j] * a[k * n + j];
+        }
+        if !(d > floor) {
+            return Err(d);
+        }
+        ln_det += d.ln();
+        let lkk = d.sqrt();
+        a[k * n + k] = lkk;
+        for i in k + 1..n {
+            let mut s = a[i * n + k];
+            for j in 0..k {
+                s -= a[i * n + j] * a[k * n + j];
+            }
+            a[i * n + k] = s / lkk;
+        }
+    }
+    Ok(ln_det)
+}
+
+/// Smallest LDLᵀ pivot of a Cholesky factor produced by [`chol_in_place`].
+#[inline]
+pub(crate) fn min_pivot(l: &[f64], n: usize) -> f64 {
+    (0..n)
+        .map(|k| l[k * n + k] * l[k * n + k])
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// `ln det(I + V)` for a packed PSD `t×t` block `V`: the add gain of
+/// eq. (17)/(20) in block form. `I + V ⪰ I`, so the only failure is non-finite
+/// input, reported as `-∞`.
+#[inline]
+pub(crate) fn ln_det_i_plus(v: &[f64], t: usize) -> f64 {
+    let mut a = [0.0f64; MAX_T * MAX_T];
+    for r in 0..t {
+        for c in 0..=r {
+            let x = v[pk(r, c)];
+            a[r * t + c] = if r == c { 1.0 + x } else { x };
+        }
+    }
+    chol_in_place(&mut a[..t * t], t, 0.0).unwrap_or(f64::NEG_INFINITY)
+}
+
+/// `ln det(I − V)` for a packed `t×t` block: the removal loss of
+/// eq. (21)/(22) in block form; `Err(pivot)` when a pivot is `≤ floor`.
+#[inline]
+pub(crate) fn ln_det_i_minus(v: &[f64], t: usize, floor: f64) -> Result<f64, f64> {
+    let mut a = [0.0f64; MAX_T * MAX_T];
+    for r in 0..t {
+        for c in 0..=r {
+            let x = v[pk(r, c)];
+            a[r * t + c] = if r == c { 1.0 - x } else { -x };
+        }
+    }
+    chol_in_place(&mut a[..t * t], t, floor)
+}
+
+/// `ln det` of the exchange system `[[I + V_in, W], [−Wᵀ, I − V_out]]`
+/// (`W = X_in M⁻¹ X_outᵀ`), by block elimination: the determinant is
+/// `det(A)·det(B)` with `A = I + V_in` and the Schur complement
+/// `B = I − V_out + Wᵀ A⁻¹ W`; `B` must be positive definite (pivots
+/// `> floor`) for the exchanged `M` to be. `w(a, b)` returns `W[a, b]`.
+#[inline]
+pub(crate) fn exchange_ln_det(
+    t: usize,
+    v_in: &[f64],
+    v_out: &[f64],
+    w: impl Fn(usize, usize) -> f64,
+    floor: f64,
+) -> Result<f64, f64> {
+    let mut a = [0.0f64; MAX_T * MAX_T];
+    for r in 0..t {
+        for c in 0..=r {
+            let x = v_in[pk(r, c)];
+            a[r * t + c] = if r == c { 1.0 + x } else { x };
+        }
+    }
+    let ln_a = chol_in_place(&mut a[..t * t], t, 0.0)?;
+    // Y = L_A⁻¹ W (t×t, row-major), forward substitution column by column.
+    let mut y = [0.0f64; MAX_T * MAX_T];
+    for c in 0..t {
+        for r in 0..t {
+            let mut s = w(r, c);
+            for j in 0..r {
+                s -= a[r * t + j] * y[j * t + c];
+            }
+            y[r * t + c] = s / a[r * t + r];
+        }
+    }
+    // B = I − V_out + Yᵀ Y (lower triangle).
+    let mut b = [0.0f64; MAX_T * MAX_T];
+    for r in 0..t {
+        for c in 0..=r {
+            let mut s = if r == c { 1.0 } else { 0.0 } - v_out[pk(r, c)];
+            for j in 0..t {
+                s += y[j * t + r] * y[j * t + c];
+            }
+            b[r * t + c] = s;
+        }
+    }
+    let ln_b = chol_in_place(&mut b[..t * t], t, floor)?;
+    Ok(ln_a + ln_b)
+}
+
+/// `M[a, b] += sign · Σ_r X[r, a] X[r, b]` for all `a, b`, computed on the
+/// lower triangle and mirrored so `M` stays exactly symmetric.
+pub(crate) fn add_gram(mut m: MatMut<'_, f64>, x: MatRef<'_, f64>, sign: f64) {
+    let p = m.nrows();
+    for b in 0..p {
+        for a in b..p {
+            let mut s = 0.0;
+            for r in 0..x.nrows() {
+                s += x[(r, a)] * x[(r, b)];
+            }
+            let v = m[(a, b)] + sign * s;
+            m[(a, b)] = v;
+            m[(b, a)] = v;
+        }
+    }
+}
+
+/// Copies the lower triangle onto the upper one.
+pub(crate) fn mirror_lower(mut m: MatMut<'_, f64>) {
+    let p = m.nrows();
+    for b in 0..p {
+        for a in b + 1..p {
+            m[(b, a)] = m[(a, b)];
+        }
+    }
+}
+
+/// Induced 1-norm (largest absolute column sum).
+pub(crate) fn norm1(m: MatRef<'_, f64>) -> f64 {
+    (0..m.ncols())
+        .map(|c| (0..m.nrows()).map(|r| m[(r, c)].abs()).sum::<f64>())
+        .fold(0.0, f64::max)
+}
+
+/// Cholesky factorization of a symmetric matrix with faer's `llt` kernel
+/// (sequential): returns `(M⁻¹, ln det M)` or `Err(())` when a pivot is not
+/// positive.
+pub(crate) fn cholesky_inverse(m: MatRef<'_, f64>) -> Result<(Mat<f64>, f64), ()> {
+    let p = m.nrows();
+    let par = Par::Seq;
+    let mut l = Mat::<f64>::zeros(p, p);
+    l.as_mut().copy_from_triangular_lower(m);
+    let req = llt::factor::cholesky_in_place_scratch::<f64>(p, par, Default::default())
+        .or(llt::inverse::inverse_scratch::<f64>(p, par));
+    let mut mem = MemBuffer::new(req);
+    let stack = MemStack::new(&mut mem);
+    llt::factor::cholesky_in_place(
+        l.as_mut(),
+        Default::default(),
+        par,
+        stack,
+        Default::default(),
+    )
+    .map_err(|_| ())?;
+    let mut ln_det = 0.0;
+    for i in 0..p {
+        let d = l[(i, i)];
+        if !(d > 0.0) || !d.is_finite() {
+            return Err(());
+        }
+        ln_det += 2.0 * d.ln();
+    }
+    let mut inv = Mat::<f64>::zeros(p, p);
+    llt::inverse::inverse(inv.as_mut(), l.as_ref(), par, stack);
+    mirror_lower(inv.as_mut());
+    Ok((inv, ln_det))
+}
+
+/// Reusable scratch for symmetric eigenvalue computations of one size.
+pub(crate) struct EigenScratch {
+    mem: MemBuffer,
+    s: Diag<f64>,
+}
+
+impl EigenScratch {
+    /// Scratch for `p×p` matrices.
+    pub(crate) fn new(p: usize) -> Self {
+        let req = evd::self_adjoint_evd_scratch::<f64>(
+            p,
+            ComputeEigenvectors::No,
+            Par::Seq,
+            Default::default(),
+        );
+        Self {
+            mem: MemBuffer::new(req),
+            s: Diag::zeros(p),
+        }
+    }
+
+    /// Eigenvalues of the symmetric matrix `m` (lower triangle read), in
+    /// nondecreasing order; `None` if the iteration fails.
+    pub(crate) fn eigenvalues(&mut self, m: MatRef<'_, f64>) -> Option<&[f64]> {
+        let p = m.nrows();
+        let stack = MemStack::new(&mut self.mem);
+        evd::self_adjoint_evd(m, self.s.as_mut(), None, Par::Seq, stack, Default::default())
+            .ok()?;
+        let col = self.s.column_vector();
+        let slice = col.try_as_col_major()?.as_slice();
+        Some(&slice[..p])
+    }
+}
+
+/// Singular values of `x` (nonincreasing), padded with zeros to `x.ncols()`
+/// when `x` has fewer rows than columns.
+pub(crate) fn singular_values(x: MatRef<'_, f64>) -> Vec<f64> {
+    let (m, n) = x.shape();
+    let k = m.min(n);
+    let mut out = vec![0.0; n];
+    if k == 0 {
+        return out;
+    }
+    let par = Par::Seq;
+    let req = svd::svd_scratch::<f64>(
+        m,
+        n,
+        ComputeSvdVectors::No,
+        ComputeSvdVectors::No,
+        par,
+        Default::default(),
+    );
+    let mut mem = MemBuffer::new(req);
+    let mut s = Diag::<f64>::zeros(k);
+    if svd::svd(
+        x,
+        s.as_mut(),
+        None,
+        None,
+        par,
+        MemStack::new(&mut mem),
+        Default::default(),
+    )
+    .is_err()
+    {
+        // The SVD iteration did not converge; fall back to the eigenvalues of
+        // XᵀX, which are σ².
+        let mut g = Mat::<f64>::zeros(n, n);
+        add_gram(g.as_mut(), x, 1.0);
+        let mut es = EigenScratch::new(n);
+        if let Some(ev) = es.eigenvalues(g.as_ref()) {
+            let mut sv: Vec<f64> = ev.iter().map(|&l| l.max(0.0).sqrt()).collect();
+            sv.sort_by(|a, b| b.total_cmp(a));
+            return sv;
+        }
+        return out;
+    }
+    let col = s.column_vector();
+    let sv = col
+        .try_as_col_major()
+        .expect("a fresh Diag is contiguous")
+        .as_slice();
+    for (o, &v) in out.iter_mut().zip(sv) {
+        *o = v.max(0.0);
+    }
+    out.sort_by(|a, b| b.total_cmp(a));
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chol_matches_known_determinant() {
+        // [[4, 2], [2, 3]]: det = 8.
+        let mut a = [4.0, 0.0, 2.0, 3.0];
+        let ld = chol_in_place(&mut a, 2, 0.0).unwrap();
+        assert!((ld - 8f64.ln()).abs() < 1e-14);
+        assert!((min_pivot(&a, 2) - 2.0).abs() < 1e-14);
+        let mut s = [1.0, 0.0, 1.0, 1.0];
+        assert!(chol_in_place(&mut s, 2, 1e-12).is_err());
+    }
+
+    #[test]
+    fn cholesky_inverse_reconstructs() {
+        for p in 1..12 {
+            let m = Mat::from_fn(p, p, |i, j| {
+                if i == j { p as f64 + 1.0 } else { 1.0 / (1.0 + (i + j) as f64) }
+            });
+            let (inv, _) = cholesky_inverse(m.as_ref()).unwrap();
+            let prod = &m * &inv;
+            for i in 0..p {
+                for j in 0..p {
+                    let e = if i == j { 1.0 } else { 0.0 };
+                    assert!((prod[(i, j)] - e).abs() < 1e-13);
+                }
+            }
+        }
+    }
+}

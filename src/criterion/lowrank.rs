@@ -1,0 +1,343 @@
+//! Signed low-rank updates of an inverse information matrix: the block form
+//! of the paper's eq. (4)–(22), and the row-by-row cascade as a reference.
+//!
+//! Adding the rows `Z₊` (`a×p`) and removing the rows `Z₋` (`b×p`) turns
+//! `M` into `M' = M + Z₊ᵀZ₊ − Z₋ᵀZ₋`. With `S = Z M⁻¹ Zᵀ` for
+//! `Z = [Z₊; Z₋]`, the matrix determinant lemma gives
+//!
+//! `det M' = det M · det [[I + S₊₊, S₊₋], [−S₋₊, I − S₋₋]]`
+//!
+//! (eq. (5)/(10) for one row, (17)–(22) for a block), and Woodbury gives
+//! `M'⁻¹ = M⁻¹ − F₊F₊ᵀ + F₋F₋ᵀ` (the block form of eq. (6)/(11)) with the
+//! factors `F₊`, `F₋` computed below.
+
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, MatMut, MatRef, Par};
+
+use super::dense::{chol_in_place, min_pivot};
+
+/// A numerically singular change: a pivot of the removal Schur complement
+/// was `≤ pivot_floor`. A numerical outcome, not an error.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Singular {
+    /// The offending pivot (the first `≤ pivot_floor`; may be negative).
+    pub pivot: f64,
+    /// The floor it was compared with.
+    pub pivot_floor: f64,
+}
+
+/// A computed signed low-rank update of `M⁻¹` and `ln det M`:
+/// `M'⁻¹ = M⁻¹ − F₊F₊ᵀ + F₋F₋ᵀ`, `ln det M' = ln det M + ln_det_ratio`.
+#[derive(Clone, Debug)]
+pub struct LowRank {
+    ln_det_ratio: f64,
+    min_pivot: f64,
+    f: Mat<f64>,
+    n_plus: usize,
+}
+
+impl LowRank {
+    /// `ln det M' − ln det M`.
+    #[must_use]
+    pub fn ln_det_ratio(&self) -> f64 {
+        self.ln_det_ratio
+    }
+
+    /// Smallest pivot of the removal Schur complement `B` (`+∞` when no row is
+    /// removed). Lies in `(0, 1]` for a pure removal; it bounds
+    /// `λ_min(B)` from above, where `M' ⪰ λ_min(B)·M`.
+    #[must_use]
+    pub fn min_pivot(&self) -> f64 {
+        self.min_pivot
+    }
+
+    /// The factors `[F₊ F₋]` (`p × (a+b)`).
+    #[must_use]
+    pub fn factors(&self) -> MatRef<'_, f64> {
+        self.f.as_ref()
+    }
+
+    /// Number of columns of `F₊` (rows added).
+    #[must_use]
+    pub fn n_plus(&self) -> usize {
+        self.n_plus
+    }
+
+    /// Rank of the update (`a + b`).
+    #[must_use]
+    pub fn rank(&self) -> usize {
+        self.f.ncols()
+    }
+
+    /// Applies the update to `M⁻¹` in place: `M⁻¹ ← M⁻¹ − F₊F₊ᵀ + F₋F₋ᵀ`,
+    /// computed on the lower triangle and mirrored (exactly symmetric).
+    pub fn apply_to_inverse(&self, mut m_inv: MatMut<'_, f64>) {
+        let p = m_inv.nrows();
+        assert!(m_inv.ncols() == p && self.f.nrows() == p, "shape mismatch");
+        let f = self.f.as_ref();
+        let a = self.n_plus;
+        for j in 0..p {
+            for i in j..p {
+                let mut minus = 0.0;
+                for c in 0..a {
+                    minus += f[(i, c)] * f[(j, c)];
+                }
+                let mut plus = 0.0;
+                for c in a..f.ncols() {
+                    plus += f[(i, c)] * f[(j, c)];
+                }
+                let v = m_inv[(i, j)] - minus + plus;
+                m_inv[(i, j)] = v;
+                m_inv[(j, i)] = v;
+            }
+        }
+    }
+}
+
+/// The block update (one step, not add-then-remove): adds the rows `plus`
+/// and removes the rows `minus` from the design whose inverse information
+/// matrix is `m_inv`.
+///
+/// Implements the matrix determinant lemma on the `(a+b)×(a+b)` system
+/// `[[I + S₊₊, S₊₋], [−S₋₊, I − S₋₋]]` (eq. (17)/(20) for `b = 0`,
+/// eq. (21)/(22) for `a = 0`, and the exchange for both) and the Woodbury
+/// identity, the block form of eq. (6)/(11).
+///
+/// Returns [`Singular`] when a pivot of the Cholesky factor of the removal
+/// Schur complement `B = I − S₋₋ + S₋₊(I + S₊₊)⁻¹S₊₋` is `≤ pivot_floor`
+/// (`B` is positive definite iff `M'` is, given `M` is). Use a floor `≥ 0`.
+pub fn woodbury(
+    m_inv: MatRef<'_, f64>,
+    plus: MatRef<'_, f64>,
+    minus: MatRef<'_, f64>,
+    pivot_floor: f64,
+) -> Result<LowRank, Singular> {
+    let p = m_inv.nrows();
+    assert!(m_inv.ncols() == p && plus.ncols() == p && minus.ncols() == p);
+    let a = plus.nrows();
+    let b = minus.nrows();
+    let k = a + b;
+    let par = Par::Seq;
+
+    // Z = [Z₊; Z₋], U = M⁻¹ Zᵀ (p×k), S = Z U (k×k).
+    let mut z = Mat::<f64>::zeros(k, p);
+    z.as_mut().subrows_mut(0, a).copy_from(plus);
+    z.as_mut().subrows_mut(a, b).copy_from(minus);
+    let mut u = Mat::<f64>::zeros(p, k);
+    matmul(u.as_mut(), Accum::Replace, m_inv, z.transpose(), 1.0, par);
+    let mut s = Mat::<f64>::zeros(k, k);
+    matmul(s.as_mut(), Accum::Replace, z.as_ref(), u.as_ref(), 1.0, par);
+    // S is symmetric in exact arithmetic; read S[i][j] with i ≥ j only.
+    let sym = |i: usize, j: usize| if i >= j { s[(i, j)] } else { s[(j, i)] };
+
+    // A = I + S₊₊ = L_A L_Aᵀ (row-major a×a). A ⪰ I, so it cannot fail for a
+    // positive definite M⁻¹; a failure means M⁻¹ itself is broken.
+    let mut la = vec![0.0; a * a];
+    for r in 0..a {
+        for c in 0..=r {
+            la[r * a + c] = sym(r, c) + if r == c { 1.0 } else { 0.0 };
+        }
+    }
+    let ln_a = chol_in_place(&mut la, a, 0.0).map_err(|pivot| Singular {
+        pivot,
+        pivot_floor: 0.0,
+    })?;
+
+    let mut f = Mat::<f64>::zeros(p, k);
+    // F₊ = U₊ L_A⁻ᵀ: each row solves L_A y = u (forward substitution).
+    for i in 0..p {
+        for r in 0..a {
+            let mut v = u[(i, r)];
+            for j in 0..r {
+                v -= la[r * a + j] * f[(i, j)];
+            }
+            f[(i, r)] = v / la[r * a + r];
+        }
+    }
+    if b == 0 {
+        return Ok(LowRank {
+            ln_det_ratio: ln_a,
+            min_pivot: f64::INFINITY,
+            f,
+            n_plus: a,
+        });
+    }
+
+    // Y = L_A⁻¹ S₊₋ (a×b).
+    let mut y = vec![0.0; a * b];
+    for c in 0..b {
+        for r in 0..a {
+            let mut v = sym(r, a + c);
+            for j in 0..r {
+                v -= la[r * a + j] * y[j * b + c];
+            }
+            y[r * b + c] = v / la[r * a + r];
+        }
+    }
+    // B = I − S₋₋ + Yᵀ Y: the Schur complement of the 2-block system. Its
+    // LDLᵀ pivots are the factors (1 − x_r' M_{·}⁻¹ x_r) of the cascade (22).
+    let mut lb = vec![0.0; b * b];
+    for r in 0..b {
+        for c in 0..=r {
+            let mut v = if r == c { 1.0 } else { 0.0 } - sym(a + r, a + c);
+            for j in 0..a {
+                v += y[j * b + r] * y[j * b + c];
+            }
+            lb[r * b + c] = v;
+        }
+    }
+    let ln_b = chol_in_place(&mut lb, b, pivot_floor).map_err(|pivot| Singular {
+        pivot,
+        pivot_floor,
+    })?;
+
+    // F₋ = (U₋ − F₊ Y) L_B⁻ᵀ. Derivation: after adding Z₊ the inverse is
+    // M₁⁻¹ = M⁻¹ − F₊F₊ᵀ, so M₁⁻¹Z₋ᵀ = U₋ − F₊ (L_A⁻¹S₊₋) = U₋ − F₊Y and
+    // Z₋M₁⁻¹Z₋ᵀ = S₋₋ − YᵀY; removing Z₋ from M₁ by eq. (11) in block form
+    // adds (M₁⁻¹Z₋ᵀ) B⁻¹ (M₁⁻¹Z₋ᵀ)ᵀ.
+    for i in 0..p {
+        for r in 0..b {
+            let mut v = u[(i, a + r)];
+            for j in 0..a {
+                v -= f[(i, j)] * y[j * b + r];
+            }
+            for j in 0..r {
+                v -= lb[r * b + j] * f[(i, a + j)];
+            }
+            f[(i, a + r)] = v / lb[r * b + r];
+        }
+    }
+    Ok(LowRank {
+        ln_det_ratio: ln_a + ln_b,
+        min_pivot: min_pivot(&lb, b),
+        f,
+        n_plus: a,
+    })
+}
+
+/// Result of the row-by-row cascade.
+#[derive(Clone, Debug)]
+pub struct Cascade {
+    /// `ln det M' − ln det M`.
+    pub ln_det_ratio: f64,
+    /// `M'⁻¹`.
+    pub m_inv: Mat<f64>,
+    /// Smallest removal factor `1 − x' M⁻¹ x` met (`+∞` if none).
+    pub min_pivot: f64,
+}
+
+/// The paper's cascade, a reference implementation of [`woodbury`]: adds the
+/// rows of `plus` one at a time, multiplying the determinant by
+/// `(1 + x' M⁻¹ x)` (eq. (20)) and updating `M⁻¹` by Sherman–Morrison
+/// (eq. (6)), then removes the rows of `minus` one at a time with
+/// `(1 − x' M⁻¹ x)` (eq. (22)) and eq. (11). `O(p²)` per row.
+///
+/// Returns [`Singular`] when a removal factor is `≤ pivot_floor`.
+pub fn cascade(
+    m_inv: MatRef<'_, f64>,
+    plus: MatRef<'_, f64>,
+    minus: MatRef<'_, f64>,
+    pivot_floor: f64,
+) -> Result<Cascade, Singular> {
+    let p = m_inv.nrows();
+    assert!(m_inv.ncols() == p && plus.ncols() == p && minus.ncols() == p);
+    let mut inv = m_inv.to_owned();
+    let mut ln = 0.0;
+    let mut min_piv = f64::INFINITY;
+    let mut u = vec![0.0; p];
+    let rows = (0..plus.nrows())
+        .map(|r| (plus.row(r), 1.0))
+        .chain((0..minus.nrows()).map(|r| (minus.row(r), -1.0)));
+    for (x, sign) in rows {
+        // u = M⁻¹ x, s = x' M⁻¹ x.
+        for (i, ui) in u.iter_mut().enumerate() {
+            *ui = (0..p).map(|j| inv[(i, j)] * x[j]).sum();
+        }
+        let s: f64 = (0..p).map(|j| x[j] * u[j]).sum();
+        let d = 1.0 + sign * s;
+        if sign < 0.0 {
+            if !(d > pivot_floor) {
+                return Err(Singular {
+                    pivot: d,
+                    pivot_floor,
+                });
+            }
+            min_piv = min_piv.min(d);
+        }
+        ln += d.ln();
+        // eq. (6): M⁻¹ − u uᵀ / (1 + s); eq. (11): M⁻¹ + u uᵀ / (1 − s).
+        for j in 0..p {
+            for i in j..p {
+                let v = inv[(i, j)] - sign * u[i] * u[j] / d;
+                inv[(i, j)] = v;
+                inv[(j, i)] = v;
+            }
+        }
+    }
+    Ok(Cascade {
+        ln_det_ratio: ln,
+        m_inv: inv,
+        min_pivot: min_piv,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::criterion::dense::cholesky_inverse;
+
+    fn lcg(seed: &mut u64) -> f64 {
+        *seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((*seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+
+    fn random(rows: usize, cols: usize, seed: &mut u64) -> Mat<f64> {
+        Mat::from_fn(rows, cols, |_, _| lcg(seed))
+    }
+
+    #[test]
+    fn block_equals_cascade_and_direct() {
+        let mut seed = 7;
+        for p in [1, 2, 5, 9, 27] {
+            for t in 1..=6 {
+                let x0 = random(3 * p + 6, p, &mut seed);
+                let m0 = x0.transpose() * &x0;
+                let (m0_inv, ld0) = cholesky_inverse(m0.as_ref()).unwrap();
+                let q = random(t, p, &mut seed);
+                let r = x0.as_ref().subrows(0, t).to_owned();
+                for (plus, minus) in [
+                    (q.as_ref(), r.as_ref().subrows(0, 0)),
+                    (q.as_ref().subrows(0, 0), r.as_ref()),
+                    (q.as_ref(), r.as_ref()),
+                ] {
+                    let m1 = &m0 + plus.transpose() * plus - minus.transpose() * minus;
+                    let (m1_inv, ld1) = cholesky_inverse(m1.as_ref()).unwrap();
+                    let w = woodbury(m0_inv.as_ref(), plus, minus, 0.0).unwrap();
+                    let c = cascade(m0_inv.as_ref(), plus, minus, 0.0).unwrap();
+                    let mut inv = m0_inv.clone();
+                    w.apply_to_inverse(inv.as_mut());
+                    let scale = m1_inv.norm_max();
+                    assert!((ld0 + w.ln_det_ratio() - ld1).abs() < 1e-9, "p={p} t={t}");
+                    assert!((w.ln_det_ratio() - c.ln_det_ratio).abs() < 1e-10);
+                    assert!((&inv - &m1_inv).norm_max() < 1e-8 * scale);
+                    assert!((&c.m_inv - &m1_inv).norm_max() < 1e-8 * scale);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn removing_an_essential_block_is_singular() {
+        // p = 3 and a design of exactly 3 rows: removing any row leaves rank 2.
+        let mut seed = 3;
+        let x = random(3, 3, &mut seed);
+        let m = x.transpose() * &x;
+        let (m_inv, _) = cholesky_inverse(m.as_ref()).unwrap();
+        let r = woodbury(m_inv.as_ref(), x.as_ref().subrows(0, 0), x.as_ref().subrows(1, 1), 1e-8);
+        assert!(r.is_err());
+        let c = cascade(m_inv.as_ref(), x.as_ref().subrows(0, 0), x.as_ref().subrows(1, 1), 1e-8);
+        assert!(c.is_err());
+    }
+}

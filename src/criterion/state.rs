@@ -1,0 +1,803 @@
+//! The information state of a design over a pose pool: `M = XᵀX (+ δI)`,
+//! `M⁻¹`, `ln det M`, updated by the paper's formulas (eq. (4)–(22)) in
+//! block form.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use faer::{Mat, MatRef};
+use serde::{Deserialize, Serialize};
+
+use super::dense::{EigenScratch, add_gram, cholesky_inverse, norm1};
+use super::lowrank::{LowRank, woodbury};
+use super::{CriterionError, MAX_T};
+use crate::blocks::Blocks;
+
+/// Settings of an [`InfoState`]; validated by [`InfoState::new`].
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct StateSettings {
+    /// Ridge `δ ≥ 0`: `M = XᵀX + δI`. Lets a selection start from fewer than
+    /// `p/t` poses. Default `0`.
+    pub ridge: f64,
+    /// Refactorize (recompute `M` from the design, Cholesky, `M⁻¹`,
+    /// `ln det M`) after this many updates, `≥ 1`. Default `64`.
+    pub refactor_every: usize,
+    /// Largest accepted condition number of `M` (see the module docs'
+    /// singularity rule), `> 1`. Default `1e13`.
+    pub max_condition: f64,
+}
+
+impl Default for StateSettings {
+    fn default() -> Self {
+        Self {
+            ridge: 0.0,
+            refactor_every: 64,
+            max_condition: 1e13,
+        }
+    }
+}
+
+impl StateSettings {
+    /// Sets [`ridge`](Self::ridge).
+    #[must_use]
+    pub fn with_ridge(mut self, ridge: f64) -> Self {
+        self.ridge = ridge;
+        self
+    }
+
+    /// Sets [`refactor_every`](Self::refactor_every).
+    #[must_use]
+    pub fn with_refactor_every(mut self, k: usize) -> Self {
+        self.refactor_every = k;
+        self
+    }
+
+    /// Sets [`max_condition`](Self::max_condition).
+    #[must_use]
+    pub fn with_max_condition(mut self, c: f64) -> Self {
+        self.max_condition = c;
+        self
+    }
+
+    /// Checks every field's range.
+    pub fn validate(&self) -> Result<(), CriterionError> {
+        if !(self.ridge.is_finite() && self.ridge >= 0.0) {
+            return Err(CriterionError::InvalidSetting {
+                name: "ridge",
+                value: self.ridge,
+                reason: "need a finite ridge >= 0",
+            });
+        }
+        if self.refactor_every == 0 {
+            return Err(CriterionError::InvalidSetting {
+                name: "refactor_every",
+                value: 0.0,
+                reason: "need at least 1",
+            });
+        }
+        if !(self.max_condition.is_finite() && self.max_condition > 1.0) {
+            return Err(CriterionError::InvalidSetting {
+                name: "max_condition",
+                value: self.max_condition,
+                reason: "need a finite value > 1",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Outcome of pricing or applying a change (numerical, not an error).
+#[must_use]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub enum Status {
+    /// `M` stays positive definite; `ln det M` changes by `delta_ln_det`.
+    /// For an update method, the change was applied.
+    Regular {
+        /// `ln det M' − ln det M`.
+        delta_ln_det: f64,
+    },
+    /// The change would make `M` numerically singular: a pivot of the
+    /// removal Schur complement was `≤ pivot_floor`
+    /// (`= κ̂(M)/max_condition`). For an update method, nothing was changed.
+    Singular {
+        /// The offending pivot (may be `≤ 0`).
+        pivot: f64,
+        /// The floor it was compared with.
+        pivot_floor: f64,
+    },
+}
+
+impl Status {
+    /// The change of `ln det M`, or `None` if singular.
+    #[must_use]
+    pub fn delta(&self) -> Option<f64> {
+        match *self {
+            Status::Regular { delta_ln_det } => Some(delta_ln_det),
+            Status::Singular { .. } => None,
+        }
+    }
+
+    /// Whether the change keeps `M` positive definite.
+    #[must_use]
+    pub fn is_regular(&self) -> bool {
+        matches!(self, Status::Regular { .. })
+    }
+}
+
+/// Errors of the maintained quantities against a fresh recomputation from the
+/// design (see the module docs on drift).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Drift {
+    /// `|ln det M (maintained) − ln det M (fresh)|`; `+∞` if the fresh `M`
+    /// cannot be factored.
+    pub ln_det: f64,
+    /// `max |M_fresh · M⁻¹ (maintained) − I|`.
+    pub inverse: f64,
+    /// `max |M (maintained) − M_fresh| / max |M_fresh|`.
+    pub information: f64,
+}
+
+const NOT_IN_DESIGN: usize = usize::MAX;
+
+static NEXT_ID: AtomicU64 = AtomicU64::new(1);
+
+fn fresh_id() -> u64 {
+    NEXT_ID.fetch_add(1, Ordering::Relaxed)
+}
+
+/// The information state of a design over a pool: design pose list (pool
+/// indices, no repeats), `M = XᵀX + δI` (`p×p`), `M⁻¹`, `ln det M`, and the
+/// number of updates since the last refactorization.
+///
+/// Every method that needs the Jacobian blocks takes the pool the state was
+/// built on; passing another pool of a different shape panics.
+#[derive(Debug)]
+pub struct InfoState {
+    id: u64,
+    t: usize,
+    p: usize,
+    n_pool: usize,
+    design: Vec<usize>,
+    position: Vec<usize>,
+    settings: StateSettings,
+    m: Mat<f64>,
+    m_inv: Mat<f64>,
+    ln_det: f64,
+    cond1: f64,
+    since_refactor: usize,
+    version: u64,
+    epoch: u64,
+    log_base: u64,
+    log: Vec<LowRank>,
+}
+
+impl Clone for InfoState {
+    /// Clones with a fresh identity, so caches keyed on a state (such as
+    /// [`PoolVariances`](super::PoolVariances)) never confuse two clones.
+    fn clone(&self) -> Self {
+        Self {
+            id: fresh_id(),
+            t: self.t,
+            p: self.p,
+            n_pool: self.n_pool,
+            design: self.design.clone(),
+            position: self.position.clone(),
+            settings: self.settings,
+            m: self.m.clone(),
+            m_inv: self.m_inv.clone(),
+            ln_det: self.ln_det,
+            cond1: self.cond1,
+            since_refactor: self.since_refactor,
+            version: self.version,
+            epoch: self.epoch,
+            log_base: self.log_base,
+            log: self.log.clone(),
+        }
+    }
+}
+
+/// A fresh factorization of `M`.
+struct Factored {
+    m: Mat<f64>,
+    m_inv: Mat<f64>,
+    ln_det: f64,
+    cond1: f64,
+}
+
+/// Number of eigenvalues of `m` above `λ_max / max_condition`.
+fn rank_estimate(m: MatRef<'_, f64>, max_condition: f64) -> usize {
+    let mut es = EigenScratch::new(m.nrows());
+    match es.eigenvalues(m) {
+        Some(ev) => {
+            let top = ev.iter().copied().fold(0.0, f64::max);
+            ev.iter().filter(|&&l| l * max_condition > top).count()
+        }
+        None => 0,
+    }
+}
+
+impl InfoState {
+    /// Builds the state of `design` (pool indices, no repeats, any order)
+    /// from scratch: `M` from the blocks, Cholesky (faer `llt`), `M⁻¹`,
+    /// `ln det M = 2 Σ ln L_ii`.
+    ///
+    /// Errors: bad input ([`CriterionError::PoseOutOfRange`],
+    /// [`DuplicatePose`](CriterionError::DuplicatePose),
+    /// [`NonFinite`](CriterionError::NonFinite) anywhere in the pool,
+    /// [`InvalidSetting`](CriterionError::InvalidSetting),
+    /// [`UnsupportedShape`](CriterionError::UnsupportedShape) for `t > 6` or
+    /// `p = 0`), or [`CriterionError::Singular`] when `M` is not positive
+    /// definite or its condition number exceeds `max_condition`.
+    pub fn new(
+        pool: &Blocks,
+        design: &[usize],
+        settings: StateSettings,
+    ) -> Result<Self, CriterionError> {
+        settings.validate()?;
+        let (t, p, n_pool) = (pool.t(), pool.p(), pool.n_poses());
+        if t > MAX_T || p == 0 {
+            return Err(CriterionError::UnsupportedShape {
+                reason: format!("need 1 <= t <= {MAX_T} rows per pose and p >= 1, got t={t}, p={p}"),
+            });
+        }
+        let x = pool.mat();
+        for c in 0..p {
+            for r in 0..x.nrows() {
+                let v = x[(r, c)];
+                if !v.is_finite() {
+                    return Err(CriterionError::NonFinite { row: r, col: c, value: v });
+                }
+            }
+        }
+        let mut position = vec![NOT_IN_DESIGN; n_pool];
+        for (k, &q) in design.iter().enumerate() {
+            if q >= n_pool {
+                return Err(CriterionError::PoseOutOfRange { pose: q, n_poses: n_pool });
+            }
+            if position[q] != NOT_IN_DESIGN {
+                return Err(CriterionError::DuplicatePose { pose: q });
+            }
+            position[q] = k;
+        }
+        let f = Self::factor(pool, design, settings.ridge, settings.max_condition, true)?;
+        Ok(Self {
+            id: fresh_id(),
+            t,
+            p,
+            n_pool,
+            design: design.to_vec(),
+            position,
+            settings,
+            m: f.m,
+            m_inv: f.m_inv,
+            ln_det: f.ln_det,
+            cond1: f.cond1,
+            since_refactor: 0,
+            version: 0,
+            epoch: 0,
+            log_base: 0,
+            log: Vec::new(),
+        })
+    }
+
+    /// `M = δI + Σ_{i∈design} X_iᵀX_i`, factored; with `check_condition`, a
+    /// condition number above `max_condition` (from the eigenvalues) is
+    /// singular too.
+    fn factor(
+        pool: &Blocks,
+        design: &[usize],
+        ridge: f64,
+        max_condition: f64,
+        check_condition: bool,
+    ) -> Result<Factored, CriterionError> {
+        let p = pool.p();
+        let mut m = Mat::<f64>::zeros(p, p);
+        for i in 0..p {
+            m[(i, i)] = ridge;
+        }
+        for &q in design {
+            add_gram(m.as_mut(), pool.block(q), 1.0);
+        }
+        let singular = |m: &Mat<f64>| CriterionError::Singular {
+            rank_estimate: rank_estimate(m.as_ref(), max_condition).min(p - 1),
+            p,
+        };
+        let Ok((m_inv, ln_det)) = cholesky_inverse(m.as_ref()) else {
+            return Err(singular(&m));
+        };
+        if check_condition {
+            let mut es = EigenScratch::new(p);
+            if let Some(ev) = es.eigenvalues(m.as_ref()) {
+                let lo = ev.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = ev.iter().copied().fold(0.0, f64::max);
+                if !(lo * max_condition > hi) {
+                    return Err(singular(&m));
+                }
+            }
+        }
+        let cond1 = norm1(m.as_ref()) * norm1(m_inv.as_ref());
+        Ok(Factored { m, m_inv, ln_det, cond1 })
+    }
+
+    fn check_pool(&self, pool: &Blocks) {
+        assert!(
+            pool.t() == self.t && pool.p() == self.p && pool.n_poses() == self.n_pool,
+            "InfoState used with a pool of another shape"
+        );
+    }
+
+    fn check_in_range(&self, q: usize) -> Result<(), CriterionError> {
+        if q >= self.n_pool {
+            return Err(CriterionError::PoseOutOfRange { pose: q, n_poses: self.n_pool });
+        }
+        Ok(())
+    }
+
+    fn check_addable(&self, q: usize) -> Result<(), CriterionError> {
+        self.check_in_range(q)?;
+        if self.position[q] != NOT_IN_DESIGN {
+            return Err(CriterionError::AlreadyInDesign { pose: q });
+        }
+        Ok(())
+    }
+
+    fn check_removable(&self, q: usize) -> Result<(), CriterionError> {
+        self.check_in_range(q)?;
+        if self.position[q] == NOT_IN_DESIGN {
+            return Err(CriterionError::NotInDesign { pose: q });
+        }
+        Ok(())
+    }
+
+    // ---------------------------------------------------------------- access
+
+    /// Identity of this state (fresh for every construction and clone); with
+    /// [`version`](Self::version) it keys caches.
+    #[must_use]
+    pub fn id(&self) -> u64 {
+        self.id
+    }
+
+    /// Rows per pose.
+    #[must_use]
+    pub fn t(&self) -> usize {
+        self.t
+    }
+
+    /// Number of parameters.
+    #[must_use]
+    pub fn p(&self) -> usize {
+        self.p
+    }
+
+    /// Number of poses in the pool.
+    #[must_use]
+    pub fn n_pool(&self) -> usize {
+        self.n_pool
+    }
+
+    /// Design poses (pool indices) in design order. Additions append,
+    /// removals keep the order of the rest, exchanges replace in place.
+    #[must_use]
+    pub fn design(&self) -> &[usize] {
+        &self.design
+    }
+
+    /// Position of pool pose `q` in [`design`](Self::design), if there.
+    #[must_use]
+    pub fn position_of(&self, q: usize) -> Option<usize> {
+        self.position.get(q).copied().filter(|&k| k != NOT_IN_DESIGN)
+    }
+
+    /// Whether pool pose `q` is in the design.
+    #[must_use]
+    pub fn contains(&self, q: usize) -> bool {
+        self.position_of(q).is_some()
+    }
+
+    /// The settings.
+    #[must_use]
+    pub fn settings(&self) -> &StateSettings {
+        &self.settings
+    }
+
+    /// The ridge `δ`.
+    #[must_use]
+    pub fn ridge(&self) -> f64 {
+        self.settings.ridge
+    }
+
+    /// `M = XᵀX + δI` (exactly symmetric).
+    #[must_use]
+    pub fn m(&self) -> MatRef<'_, f64> {
+        self.m.as_ref()
+    }
+
+    /// `M⁻¹` (exactly symmetric).
+    #[must_use]
+    pub fn m_inv(&self) -> MatRef<'_, f64> {
+        self.m_inv.as_ref()
+    }
+
+    /// `ln det M` (the log of the paper's `OI_D` when `δ = 0`).
+    #[must_use]
+    pub fn ln_det(&self) -> f64 {
+        self.ln_det
+    }
+
+    /// `κ̂(M) = ‖M‖₁‖M⁻¹‖₁`, an upper bound of the 2-norm condition number.
+    #[must_use]
+    pub fn condition_estimate(&self) -> f64 {
+        self.cond1
+    }
+
+    /// Pivot floor of the singularity rule: `κ̂(M) / max_condition`.
+    #[must_use]
+    pub fn pivot_floor(&self) -> f64 {
+        self.cond1 / self.settings.max_condition
+    }
+
+    /// Updates applied since the last refactorization.
+    #[must_use]
+    pub fn updates_since_refactor(&self) -> usize {
+        self.since_refactor
+    }
+
+    /// Counter of changes (updates and refactorizations) since construction.
+    #[must_use]
+    pub fn version(&self) -> u64 {
+        self.version
+    }
+
+    /// Counter of refactorizations since construction.
+    #[must_use]
+    pub fn epoch(&self) -> u64 {
+        self.epoch
+    }
+
+    /// The low-rank updates applied since the last refactorization, oldest
+    /// first, and the version before the first of them: update `k` took the
+    /// state from version `base + k` to `base + k + 1`.
+    #[must_use]
+    pub fn updates_since(&self) -> (u64, &[LowRank]) {
+        (self.log_base, &self.log)
+    }
+
+    // --------------------------------------------------------------- pricing
+
+    fn low_rank(
+        &self,
+        pool: &Blocks,
+        plus: Option<usize>,
+        minus: Option<usize>,
+    ) -> Result<LowRank, Status> {
+        let empty = pool.mat().subrows(0, 0);
+        let z_plus = plus.map_or(empty, |q| pool.block(q));
+        let z_minus = minus.map_or(empty, |q| pool.block(q));
+        woodbury(self.m_inv.as_ref(), z_plus, z_minus, self.pivot_floor()).map_err(|s| {
+            Status::Singular {
+                pivot: s.pivot,
+                pivot_floor: s.pivot_floor,
+            }
+        })
+    }
+
+    fn status_of(r: &Result<LowRank, Status>) -> Status {
+        match r {
+            Ok(lr) => Status::Regular { delta_ln_det: lr.ln_det_ratio() },
+            Err(s) => *s,
+        }
+    }
+
+    /// Gain of adding pool pose `q`: `ln det(I_t + X_q M⁻¹ X_qᵀ)` (matrix
+    /// determinant lemma; the block form of eq. (17)/(20)). Never singular.
+    pub fn price_add(&self, pool: &Blocks, q: usize) -> Result<Status, CriterionError> {
+        self.check_pool(pool);
+        self.check_addable(q)?;
+        Ok(Self::status_of(&self.low_rank(pool, Some(q), None)))
+    }
+
+    /// Loss of removing design pose `q`: `ln det(I_t − X_q M⁻¹ X_qᵀ)`
+    /// (block form of eq. (21)/(22)); [`Status::Singular`] when the result
+    /// would be numerically singular.
+    pub fn price_remove(&self, pool: &Blocks, q: usize) -> Result<Status, CriterionError> {
+        self.check_pool(pool);
+        self.check_removable(q)?;
+        Ok(Self::status_of(&self.low_rank(pool, None, Some(q))))
+    }
+
+    /// Change of `ln det M` when design pose `out` is replaced by pool pose
+    /// `inn`, in one step from the `2t×2t` system
+    /// `det [[I + S_ii, S_io], [−S_oi, I − S_oo]]`, `S_ab = X_a M⁻¹ X_bᵀ`.
+    pub fn price_exchange(
+        &self,
+        pool: &Blocks,
+        out: usize,
+        inn: usize,
+    ) -> Result<Status, CriterionError> {
+        self.check_pool(pool);
+        self.check_removable(out)?;
+        self.check_addable(inn)?;
+        Ok(Self::status_of(&self.low_rank(pool, Some(inn), Some(out))))
+    }
+
+    // --------------------------------------------------------------- updates
+
+    /// Applies a computed update: the design list, `M` by adding/subtracting
+    /// the Gram blocks, `M⁻¹` by Woodbury, `ln det M` by the determinant
+    /// lemma; refactorizes every `refactor_every` updates. An exchange puts
+    /// `plus` at the position of `minus`; an addition appends; a removal keeps
+    /// the order of the rest.
+    fn apply(&mut self, pool: &Blocks, lr: LowRank, plus: Option<usize>, minus: Option<usize>) {
+        match (plus, minus) {
+            (Some(inn), Some(out)) => {
+                let k = self.position[out];
+                self.design[k] = inn;
+                self.position[out] = NOT_IN_DESIGN;
+                self.position[inn] = k;
+            }
+            (Some(inn), None) => {
+                self.position[inn] = self.design.len();
+                self.design.push(inn);
+            }
+            (None, Some(out)) => {
+                let k = self.position[out];
+                self.design.remove(k);
+                self.position[out] = NOT_IN_DESIGN;
+                for (j, &d) in self.design.iter().enumerate().skip(k) {
+                    self.position[d] = j;
+                }
+            }
+            (None, None) => {}
+        }
+        if let Some(q) = plus {
+            add_gram(self.m.as_mut(), pool.block(q), 1.0);
+        }
+        if let Some(q) = minus {
+            add_gram(self.m.as_mut(), pool.block(q), -1.0);
+        }
+        lr.apply_to_inverse(self.m_inv.as_mut());
+        self.ln_det += lr.ln_det_ratio();
+        self.cond1 = norm1(self.m.as_ref()) * norm1(self.m_inv.as_ref());
+        self.version += 1;
+        self.log.push(lr);
+        self.since_refactor += 1;
+        if self.since_refactor >= self.settings.refactor_every {
+            // A failure here (possible only for a design at the edge of the
+            // singularity rule) keeps the updated values, which are finite,
+            // and retries after another `refactor_every` updates.
+            if self.refactorize(pool).is_err() {
+                self.since_refactor = 0;
+            }
+        }
+    }
+
+    fn apply_status(
+        &mut self,
+        pool: &Blocks,
+        plus: Option<usize>,
+        minus: Option<usize>,
+    ) -> Status {
+        match self.low_rank(pool, plus, minus) {
+            Ok(lr) => {
+                let delta = lr.ln_det_ratio();
+                self.apply(pool, lr, plus, minus);
+                Status::Regular { delta_ln_det: delta }
+            }
+            Err(s) => s,
+        }
+    }
+
+    /// Adds pool pose `q` to the design (appended). Always regular.
+    pub fn add(&mut self, pool: &Blocks, q: usize) -> Result<Status, CriterionError> {
+        self.check_pool(pool);
+        self.check_addable(q)?;
+        Ok(self.apply_status(pool, Some(q), None))
+    }
+
+    /// Removes design pose `q`, unless the result would be numerically
+    /// singular ([`Status::Singular`]; the state is then unchanged).
+    pub fn remove(&mut self, pool: &Blocks, q: usize) -> Result<Status, CriterionError> {
+        self.check_pool(pool);
+        self.check_removable(q)?;
+        Ok(self.apply_status(pool, None, Some(q)))
+    }
+
+    /// Replaces design pose `out` by pool pose `inn` (same design position)
+    /// in one rank-`2t` update, unless the result would be numerically
+    /// singular ([`Status::Singular`]; the state is then unchanged).
+    pub fn exchange(
+        &mut self,
+        pool: &Blocks,
+        out: usize,
+        inn: usize,
+    ) -> Result<Status, CriterionError> {
+        self.check_pool(pool);
+        self.check_removable(out)?;
+        self.check_addable(inn)?;
+        Ok(self.apply_status(pool, Some(inn), Some(out)))
+    }
+
+    // ------------------------------------------------------------- refactor
+
+    /// Recomputes `M` from the design (plus ridge), refactors it by Cholesky
+    /// and recomputes `M⁻¹` and `ln det M`, discarding accumulated rounding.
+    /// On [`CriterionError::Singular`] (Cholesky fails) the state is
+    /// unchanged.
+    pub fn refactorize(&mut self, pool: &Blocks) -> Result<(), CriterionError> {
+        self.check_pool(pool);
+        let f = Self::factor(
+            pool,
+            &self.design,
+            self.settings.ridge,
+            self.settings.max_condition,
+            false,
+        )?;
+        self.install(f);
+        Ok(())
+    }
+
+    fn install(&mut self, f: Factored) {
+        self.m = f.m;
+        self.m_inv = f.m_inv;
+        self.ln_det = f.ln_det;
+        self.cond1 = f.cond1;
+        self.since_refactor = 0;
+        self.version += 1;
+        self.epoch += 1;
+        self.log_base = self.version;
+        self.log.clear();
+    }
+
+    /// Sets the ridge `δ` (`M = XᵀX + δI`) and refactorizes; `set_ridge(0)`
+    /// drops it. On error (invalid `δ`, or [`CriterionError::Singular`]
+    /// under the construction rule) the state is unchanged.
+    pub fn set_ridge(&mut self, pool: &Blocks, ridge: f64) -> Result<(), CriterionError> {
+        self.check_pool(pool);
+        let settings = self.settings.with_ridge(ridge);
+        settings.validate()?;
+        let f = Self::factor(pool, &self.design, ridge, settings.max_condition, true)?;
+        self.settings = settings;
+        self.install(f);
+        Ok(())
+    }
+
+    /// Sets [`StateSettings::refactor_every`].
+    pub fn set_refactor_every(&mut self, k: usize) -> Result<(), CriterionError> {
+        let settings = self.settings.with_refactor_every(k);
+        settings.validate()?;
+        self.settings = settings;
+        Ok(())
+    }
+
+    /// Measures the drift of the maintained `M`, `M⁻¹` and `ln det M` against
+    /// a fresh recomputation from the design. Costs a factorization
+    /// (`O(p³ + |D|·t·p²)`); for tests and diagnostics.
+    #[must_use]
+    pub fn drift(&self, pool: &Blocks) -> Drift {
+        self.check_pool(pool);
+        let p = self.p;
+        let mut fresh = Mat::<f64>::zeros(p, p);
+        for i in 0..p {
+            fresh[(i, i)] = self.settings.ridge;
+        }
+        for &q in &self.design {
+            add_gram(fresh.as_mut(), pool.block(q), 1.0);
+        }
+        let ln_det = match cholesky_inverse(fresh.as_ref()) {
+            Ok((_, ld)) => (ld - self.ln_det).abs(),
+            Err(()) => f64::INFINITY,
+        };
+        let mut inverse: f64 = 0.0;
+        for j in 0..p {
+            for i in 0..p {
+                let mut s = 0.0;
+                for k in 0..p {
+                    s += fresh[(i, k)] * self.m_inv[(k, j)];
+                }
+                let e = if i == j { 1.0 } else { 0.0 };
+                inverse = inverse.max((s - e).abs());
+            }
+        }
+        let scale = fresh.norm_max();
+        let information = (&self.m - &fresh).norm_max() / if scale > 0.0 { scale } else { 1.0 };
+        Drift { ln_det, inverse, information }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lcg(seed: &mut u64) -> f64 {
+        *seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((*seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+
+    pub(crate) fn random_pool(n: usize, t: usize, p: usize, seed: u64) -> Blocks {
+        let mut s = seed;
+        Blocks::new(Mat::from_fn(n * t, p, |_, _| lcg(&mut s)), t)
+    }
+
+    fn direct(pool: &Blocks, design: &[usize]) -> (f64, Mat<f64>) {
+        let m = pool.information(design);
+        let (inv, ld) = cholesky_inverse(m.as_ref()).unwrap();
+        (ld, inv)
+    }
+
+    #[test]
+    fn updates_match_direct() {
+        let pool = random_pool(40, 3, 9, 11);
+        let mut st = InfoState::new(&pool, &[0, 1, 2, 3, 4], StateSettings::default()).unwrap();
+        let g = st.price_add(&pool, 7).unwrap().delta().unwrap();
+        assert!(st.add(&pool, 7).unwrap().is_regular());
+        let (ld, inv) = direct(&pool, &[0, 1, 2, 3, 4, 7]);
+        assert!((st.ln_det() - ld).abs() < 1e-10);
+        assert!((st.m_inv() - &inv).norm_max() < 1e-10 * inv.norm_max());
+        let (ld0, _) = direct(&pool, &[0, 1, 2, 3, 4]);
+        assert!((ld0 + g - ld).abs() < 1e-10);
+        assert!(st.exchange(&pool, 2, 20).unwrap().is_regular());
+        assert_eq!(st.design(), &[0, 1, 20, 3, 4, 7]);
+        assert!(st.remove(&pool, 1).unwrap().is_regular());
+        assert_eq!(st.design(), &[0, 20, 3, 4, 7]);
+        assert_eq!(st.position_of(7), Some(4));
+        let (ld, inv) = direct(&pool, &[0, 20, 3, 4, 7]);
+        assert!((st.ln_det() - ld).abs() < 1e-10);
+        assert!((st.m_inv() - &inv).norm_max() < 1e-10 * inv.norm_max());
+    }
+
+    #[test]
+    fn bad_input_and_singular() {
+        let pool = random_pool(10, 3, 9, 5);
+        let s = StateSettings::default();
+        assert!(matches!(
+            InfoState::new(&pool, &[0, 10], s),
+            Err(CriterionError::PoseOutOfRange { pose: 10, .. })
+        ));
+        assert!(matches!(
+            InfoState::new(&pool, &[1, 1, 2], s),
+            Err(CriterionError::DuplicatePose { pose: 1 })
+        ));
+        // Two poses: 6 rows for 9 parameters.
+        assert_eq!(
+            InfoState::new(&pool, &[0, 1], s).unwrap_err(),
+            CriterionError::Singular { rank_estimate: 6, p: 9 }
+        );
+        // With a ridge it works, and dropping the ridge is refused.
+        let mut st = InfoState::new(&pool, &[0, 1], s.with_ridge(1e-3)).unwrap();
+        assert!(matches!(st.set_ridge(&pool, 0.0), Err(CriterionError::Singular { .. })));
+        assert_eq!(st.ridge(), 1e-3);
+        st.add(&pool, 2).unwrap().delta().unwrap();
+        st.set_ridge(&pool, 0.0).unwrap();
+        // Exactly 9 rows: removing any pose is singular, state unchanged.
+        let before = st.ln_det();
+        let r = st.remove(&pool, 1).unwrap();
+        assert!(!r.is_regular(), "{r:?}");
+        assert_eq!(st.ln_det(), before);
+        assert_eq!(st.design(), &[0, 1, 2]);
+        assert!(matches!(st.remove(&pool, 5), Err(CriterionError::NotInDesign { pose: 5 })));
+        assert!(matches!(st.add(&pool, 0), Err(CriterionError::AlreadyInDesign { pose: 0 })));
+        assert!(StateSettings::default().with_ridge(f64::NAN).validate().is_err());
+    }
+
+    #[test]
+    fn refactorizes_periodically_and_drift_is_small() {
+        let pool = random_pool(60, 3, 12, 2);
+        let design: Vec<usize> = (0..10).collect();
+        let mut st = InfoState::new(&pool, &design, StateSettings::default().with_refactor_every(8))
+            .unwrap();
+        let mut next = 10;
+        for k in 0..100 {
+            let out = st.design()[k % st.design().len()];
+            if st.exchange(&pool, out, next).unwrap().is_regular() {
+                next = out;
+            }
+            assert!(st.updates_since_refactor() < 8);
+        }
+        assert!(st.epoch() >= 12);
+        let d = st.drift(&pool);
+        assert!(d.ln_det < 1e-10 && d.inverse < 1e-10 && d.information < 1e-14, "{d:?}");
+    }
+}

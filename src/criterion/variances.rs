@@ -1,0 +1,464 @@
+//! Batched pricing over a whole pool: the variance blocks
+//! `V_i = X_i M⁻¹ X_iᵀ` of every pool pose, kept up to date through the
+//! low-rank updates of the state, and the cross terms `W = X_pool M⁻¹ X_Dᵀ`
+//! that price every exchange.
+//!
+//! After an update `M'⁻¹ = M⁻¹ − F₊F₊ᵀ + F₋F₋ᵀ` (see
+//! [`lowrank`](super::lowrank)), `V_i' = V_i − P_i₊P_i₊ᵀ + P_i₋P_i₋ᵀ` with
+//! `P = X_pool [F₊ F₋]`: one `(n·t) × p × k` product instead of the
+//! `(n·t) × p × p` of a recomputation.
+//!
+//! Every per-candidate loop runs over fixed chunks of [`CHUNK`] poses in
+//! parallel (rayon); each chunk's arithmetic is sequential and the chunk
+//! boundaries do not depend on the number of threads, so results are
+//! bit-identical for any thread count.
+
+use faer::linalg::matmul::matmul;
+use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::{Accum, Mat, MatMut, MatRef, Par};
+use rayon::prelude::*;
+
+use super::dense::{exchange_ln_det, ln_det_i_minus, ln_det_i_plus, packed_len, pk};
+use super::lowrank::LowRank;
+use super::state::InfoState;
+use crate::blocks::Blocks;
+
+/// Poses per parallel work item.
+pub const CHUNK: usize = 64;
+
+/// `V_i = X_i M⁻¹ X_iᵀ` (packed lower triangle, `t(t+1)/2` numbers) for every
+/// pose of a pool, synchronized with an [`InfoState`].
+#[derive(Clone, Debug)]
+pub struct PoolVariances {
+    t: usize,
+    p: usize,
+    n: usize,
+    v: Vec<f64>,
+    key: Option<(u64, u64, u64)>,
+    work: Vec<f64>,
+    full_recomputes: usize,
+    incremental_updates: usize,
+}
+
+/// Computes `P = X · A` in parallel over fixed row chunks of `CHUNK` poses
+/// (sequential faer GEMM inside each), writing into the column-major
+/// workspace `work` (`n·t × k`), then calls `f(first_pose, X_c, P_c, out_c)`
+/// on each chunk with the matching chunk of `out` (`per_pose` entries a pose).
+fn chunked_product<F>(
+    x: MatRef<'_, f64>,
+    t: usize,
+    a: MatRef<'_, f64>,
+    work: &mut Vec<f64>,
+    out: &mut [f64],
+    per_pose: usize,
+    f: F,
+) where
+    F: Fn(usize, MatRef<'_, f64>, MatRef<'_, f64>, &mut [f64]) + Sync + Send,
+{
+    let rows = x.nrows();
+    let k = a.ncols();
+    assert!(out.len() == rows / t * per_pose);
+    if work.len() < rows * k {
+        work.resize(rows * k, 0.0);
+    }
+    let w = MatMut::from_column_major_slice_mut(&mut work[..rows * k], rows, k);
+    let chunk_rows = CHUNK * t;
+    let xs = x
+        .par_row_chunks(chunk_rows)
+        .zip(w.par_row_chunks_mut(chunk_rows));
+    if per_pose == 0 {
+        xs.enumerate().for_each(|(c, (xc, mut pc))| {
+            matmul(pc.rb_mut(), Accum::Replace, xc, a, 1.0, Par::Seq);
+            f(c * CHUNK, xc, pc.rb(), &mut []);
+        });
+    } else {
+        xs.zip(out.par_chunks_mut(CHUNK * per_pose))
+            .enumerate()
+            .for_each(|(c, ((xc, mut pc), oc))| {
+                matmul(pc.rb_mut(), Accum::Replace, xc, a, 1.0, Par::Seq);
+                f(c * CHUNK, xc, pc.rb(), oc);
+            });
+    }
+}
+
+impl PoolVariances {
+    /// Computes `V_i` for every pose of `pool` from the state's `M⁻¹`.
+    #[must_use]
+    pub fn new(pool: &Blocks, state: &InfoState) -> Self {
+        let mut pv = Self {
+            t: pool.t(),
+            p: pool.p(),
+            n: pool.n_poses(),
+            v: vec![0.0; pool.n_poses() * packed_len(pool.t())],
+            key: None,
+            work: Vec::new(),
+            full_recomputes: 0,
+            incremental_updates: 0,
+        };
+        pv.recompute(pool, state);
+        pv
+    }
+
+    fn check(&self, pool: &Blocks, state: &InfoState) {
+        assert!(
+            pool.t() == self.t
+                && pool.p() == self.p
+                && pool.n_poses() == self.n
+                && state.t() == self.t
+                && state.p() == self.p
+                && state.n_pool() == self.n,
+            "PoolVariances used with a pool or state of another shape"
+        );
+    }
+
+    /// Recomputes every `V_i` from scratch: `Y = X M⁻¹` by chunks, then the
+    /// row-block dot products `V_i[a,b] = Σ_k Y[ta+a,k] X[ti+b,k]`.
+    /// `O(n·t·p²)`.
+    pub fn recompute(&mut self, pool: &Blocks, state: &InfoState) {
+        self.check(pool, state);
+        let t = self.t;
+        let tp = packed_len(t);
+        let p = self.p;
+        chunked_product(
+            pool.mat(),
+            t,
+            state.m_inv(),
+            &mut self.work,
+            &mut self.v,
+            tp,
+            |_, xc, yc, vc| {
+                for (i, vi) in vc.chunks_mut(tp).enumerate() {
+                    vi.fill(0.0);
+                    for k in 0..p {
+                        for a in 0..t {
+                            let y = yc[(i * t + a, k)];
+                            for b in 0..=a {
+                                vi[pk(a, b)] += y * xc[(i * t + b, k)];
+                            }
+                        }
+                    }
+                }
+            },
+        );
+        self.key = Some((state.id(), state.epoch(), state.version()));
+        self.full_recomputes += 1;
+    }
+
+    /// Applies one low-rank update `M'⁻¹ = M⁻¹ − F₊F₊ᵀ + F₋F₋ᵀ`:
+    /// `V_i −= P₊P₊ᵀ − P₋P₋ᵀ` with `P = X_i F`. `O(n·t·p·k)`.
+    fn apply(&mut self, pool: &Blocks, lr: &LowRank) {
+        let t = self.t;
+        let tp = packed_len(t);
+        let f = lr.factors();
+        let a = lr.n_plus();
+        let k = f.ncols();
+        chunked_product(
+            pool.mat(),
+            t,
+            f,
+            &mut self.work,
+            &mut self.v,
+            tp,
+            |_, _, pc, vc| {
+                for (i, vi) in vc.chunks_mut(tp).enumerate() {
+                    for r in 0..t {
+                        for s in 0..=r {
+                            let mut d = 0.0;
+                            for c in 0..a {
+                                d -= pc[(i * t + r, c)] * pc[(i * t + s, c)];
+                            }
+                            for c in a..k {
+                                d += pc[(i * t + r, c)] * pc[(i * t + s, c)];
+                            }
+                            vi[pk(r, s)] += d;
+                        }
+                    }
+                }
+            },
+        );
+        self.incremental_updates += 1;
+    }
+
+    /// Brings the variances up to date with `state`: nothing if already
+    /// synchronized; the pending low-rank updates (one `X·F` product each) if
+    /// the state has only been updated since, unless their total rank reaches
+    /// `p`; otherwise (another state, a refactorization, a ridge change) a
+    /// full [`recompute`](Self::recompute).
+    pub fn sync(&mut self, pool: &Blocks, state: &InfoState) {
+        self.check(pool, state);
+        let now = (state.id(), state.epoch(), state.version());
+        if self.key == Some(now) {
+            return;
+        }
+        if let Some((id, epoch, version)) = self.key
+            && id == now.0
+            && epoch == now.1
+        {
+            let (base, log) = state.updates_since();
+            if version >= base && version < now.2 {
+                let pending = &log[(version - base) as usize..];
+                let total: usize = pending.iter().map(LowRank::rank).sum();
+                if total < self.p {
+                    for lr in pending {
+                        self.apply(pool, lr);
+                    }
+                    self.key = Some(now);
+                    return;
+                }
+            }
+        }
+        self.recompute(pool, state);
+    }
+
+    /// Rows per pose.
+    #[must_use]
+    pub fn t(&self) -> usize {
+        self.t
+    }
+
+    /// The packed lower triangle of `V_i` (`t(t+1)/2` numbers, by rows:
+    /// `(0,0), (1,0), (1,1), (2,0), …`).
+    #[must_use]
+    pub fn packed(&self, i: usize) -> &[f64] {
+        let tp = packed_len(self.t);
+        &self.v[i * tp..(i + 1) * tp]
+    }
+
+    /// Entry `(a, b)` of `V_i`.
+    #[must_use]
+    pub fn entry(&self, i: usize, a: usize, b: usize) -> f64 {
+        let (a, b) = if a >= b { (a, b) } else { (b, a) };
+        self.packed(i)[pk(a, b)]
+    }
+
+    /// Number of full recomputations so far.
+    #[must_use]
+    pub fn full_recomputes(&self) -> usize {
+        self.full_recomputes
+    }
+
+    /// Number of incremental (low-rank) updates so far.
+    #[must_use]
+    pub fn incremental_updates(&self) -> usize {
+        self.incremental_updates
+    }
+
+    /// Add gains `ln det(I + V_i)` (eq. (17)/(20) in block form) of the given
+    /// pool poses into `out` (same length). Parallel, allocation-free.
+    pub fn add_gains(&self, candidates: &[usize], out: &mut [f64]) {
+        assert_eq!(candidates.len(), out.len());
+        let t = self.t;
+        out.par_chunks_mut(CHUNK)
+            .zip(candidates.par_chunks(CHUNK))
+            .for_each(|(oc, cc)| {
+                for (o, &i) in oc.iter_mut().zip(cc) {
+                    *o = ln_det_i_plus(self.packed(i), t);
+                }
+            });
+    }
+
+    /// Removal losses `ln det(I − V_j)` (eq. (21)/(22) in block form) of the
+    /// given poses into `out`; `-∞` where a pivot is `≤ pivot_floor`
+    /// (numerically singular result).
+    pub fn remove_losses(&self, poses: &[usize], pivot_floor: f64, out: &mut [f64]) {
+        assert_eq!(poses.len(), out.len());
+        let t = self.t;
+        for (o, &j) in out.iter_mut().zip(poses) {
+            *o = ln_det_i_minus(self.packed(j), t, pivot_floor).unwrap_or(f64::NEG_INFINITY);
+        }
+    }
+
+    /// The cross terms `W = X_pool · (M⁻¹ X_outsᵀ)` (`n·t × |outs|·t`):
+    /// `W[t·i + a, t·o + b] = x_{i,a}' M⁻¹ x_{outs[o],b}`, the off-diagonal
+    /// blocks `S_io` of the exchange system. One product of cost
+    /// `O(n·t·p·|outs|·t)`; the returned view borrows an internal workspace.
+    pub fn cross_terms(
+        &mut self,
+        pool: &Blocks,
+        state: &InfoState,
+        outs: &[usize],
+    ) -> MatRef<'_, f64> {
+        self.check(pool, state);
+        let t = self.t;
+        let k = outs.len() * t;
+        let rows = self.n * t;
+        // A = M⁻¹ X_outsᵀ (p × k).
+        let mut xo = Mat::<f64>::zeros(k, self.p);
+        for (o, &j) in outs.iter().enumerate() {
+            xo.as_mut().subrows_mut(o * t, t).copy_from(pool.block(j));
+        }
+        let mut a = Mat::<f64>::zeros(self.p, k);
+        matmul(a.as_mut(), Accum::Replace, state.m_inv(), xo.transpose(), 1.0, Par::Seq);
+        chunked_product(pool.mat(), t, a.as_ref(), &mut self.work, &mut [], 0, |_, _, _, _| {});
+        MatRef::from_column_major_slice(&self.work[..rows * k], rows, k)
+    }
+
+    /// Exchange gains `ln det M' − ln det M` for removing design pose
+    /// `outs[o]` and adding pool pose `candidates[c]`, written candidate-major:
+    /// `out[c·|outs| + o]`. Computed from `V_in`, `V_out` and the cross terms
+    /// by [`exchange_gain`]; `-∞` where the result is numerically singular
+    /// (pivot `≤ pivot_floor`) and where the candidate is in the state's
+    /// design. Call [`sync`](Self::sync) first.
+    pub fn exchange_gains(
+        &mut self,
+        pool: &Blocks,
+        state: &InfoState,
+        outs: &[usize],
+        candidates: &[usize],
+        pivot_floor: f64,
+        out: &mut [f64],
+    ) {
+        let no = outs.len();
+        assert_eq!(out.len(), candidates.len() * no);
+        if no == 0 {
+            return;
+        }
+        let t = self.t;
+        let rows = self.n * t;
+        self.cross_terms(pool, state, outs);
+        let w = MatRef::from_column_major_slice(&self.work[..rows * no * t], rows, no * t);
+        let this = &*self;
+        out.par_chunks_mut(CHUNK * no)
+            .zip(candidates.par_chunks(CHUNK))
+            .for_each(|(oc, cc)| {
+                for (oi, &i) in oc.chunks_mut(no).zip(cc) {
+                    if state.contains(i) {
+                        oi.fill(f64::NEG_INFINITY);
+                        continue;
+                    }
+                    let v_in = this.packed(i);
+                    for (o, (g, &j)) in oi.iter_mut().zip(outs).enumerate() {
+                        *g = exchange_ln_det(
+                            t,
+                            v_in,
+                            this.packed(j),
+                            |a, b| w[(i * t + a, o * t + b)],
+                            pivot_floor,
+                        )
+                        .unwrap_or(f64::NEG_INFINITY);
+                    }
+                }
+            });
+    }
+}
+
+/// Exchange gain `ln det M' − ln det M` for removing pose `j` and adding pose
+/// `i`, from `V_i`, `V_j` (packed, see [`PoolVariances::packed`]) and the
+/// cross block `W_ij = X_i M⁻¹ X_jᵀ` (`t×t`): the determinant of
+/// `[[I + V_i, W_ij], [−W_ijᵀ, I − V_j]]` by block elimination,
+/// `det(I + V_i) · det(I − V_j + W_ijᵀ (I + V_i)⁻¹ W_ij)`.
+///
+/// `Err(pivot)` when a pivot of the second factor is `≤ pivot_floor`
+/// (numerically singular result).
+pub fn exchange_gain(
+    t: usize,
+    v_i: &[f64],
+    v_j: &[f64],
+    w_ij: MatRef<'_, f64>,
+    pivot_floor: f64,
+) -> Result<f64, f64> {
+    assert!(t <= super::MAX_T && w_ij.nrows() == t && w_ij.ncols() == t);
+    exchange_ln_det(t, v_i, v_j, |a, b| w_ij[(a, b)], pivot_floor)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::criterion::state::StateSettings;
+
+    fn lcg(seed: &mut u64) -> f64 {
+        *seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((*seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+
+    fn random_pool(n: usize, t: usize, p: usize, seed: u64) -> Blocks {
+        let mut s = seed;
+        Blocks::new(Mat::from_fn(n * t, p, |_, _| lcg(&mut s)), t)
+    }
+
+    fn direct_v(pool: &Blocks, state: &InfoState, i: usize) -> Mat<f64> {
+        let x = pool.block(i);
+        x * state.m_inv() * x.transpose()
+    }
+
+    #[test]
+    fn variances_follow_updates() {
+        for t in 1..=6 {
+            let p = 10;
+            let pool = random_pool(200, t, p, t as u64);
+            let design: Vec<usize> = (0..(p / t + 3)).collect();
+            let mut st = InfoState::new(&pool, &design, StateSettings::default()).unwrap();
+            let mut pv = PoolVariances::new(&pool, &st);
+            let _ = st.add(&pool, 150).unwrap();
+            pv.sync(&pool, &st);
+            let _ = st.exchange(&pool, 1, 151).unwrap();
+            pv.sync(&pool, &st);
+            let _ = st.remove(&pool, 0).unwrap();
+            pv.sync(&pool, &st);
+            // Updates of rank >= p are cheaper as a recomputation.
+            if 2 * t < p {
+                assert_eq!(pv.full_recomputes(), 1);
+                assert_eq!(pv.incremental_updates(), 3);
+            }
+            for i in [0, 1, 2, 77, 150, 151, 199] {
+                let v = direct_v(&pool, &st, i);
+                for a in 0..t {
+                    for b in 0..t {
+                        assert!((pv.entry(i, a, b) - v[(a, b)]).abs() < 1e-10, "t={t}");
+                    }
+                }
+            }
+            // Gains agree with the state's single-pose pricing.
+            let cands = [60usize, 61, 199];
+            let mut g = [0.0; 3];
+            pv.add_gains(&cands, &mut g);
+            for (c, &gi) in cands.iter().zip(&g) {
+                let s = st.price_add(&pool, *c).unwrap().delta().unwrap();
+                assert!((s - gi).abs() < 1e-11);
+            }
+            let outs = [st.design()[0], st.design()[2]];
+            let mut e = [0.0; 6];
+            pv.exchange_gains(&pool, &st, &outs, &cands, st.pivot_floor(), &mut e);
+            for (ci, c) in cands.iter().enumerate() {
+                for (oi, o) in outs.iter().enumerate() {
+                    let s = st.price_exchange(&pool, *o, *c).unwrap();
+                    match s.delta() {
+                        Some(d) => assert!((d - e[ci * 2 + oi]).abs() < 1e-10),
+                        None => assert_eq!(e[ci * 2 + oi], f64::NEG_INFINITY),
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn bit_identical_for_any_thread_count() {
+        let pool = random_pool(1000, 3, 27, 99);
+        let design: Vec<usize> = (0..12).collect();
+        let st = InfoState::new(&pool, &design, StateSettings::default()).unwrap();
+        let cands: Vec<usize> = (12..1000).collect();
+        let run = |threads: usize| {
+            let tp = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            tp.install(|| {
+                let mut st2 = st.clone();
+                let mut pv = PoolVariances::new(&pool, &st2);
+                let _ = st2.exchange(&pool, 3, 500).unwrap();
+                pv.sync(&pool, &st2);
+                let mut g = vec![0.0; cands.len()];
+                pv.add_gains(&cands, &mut g);
+                let outs = st2.design().to_vec();
+                let mut e = vec![0.0; cands.len() * outs.len()];
+                pv.exchange_gains(&pool, &st2, &outs, &cands, st2.pivot_floor(), &mut e);
+                (g, e)
+            })
+        };
+        let (g1, e1) = run(1);
+        for threads in [2, 3] {
+            let (g, e) = run(threads);
+            assert!(g.iter().zip(&g1).all(|(a, b)| a.to_bits() == b.to_bits()));
+            assert!(e.iter().zip(&e1).all(|(a, b)| a.to_bits() == b.to_bits()));
+        }
+    }
+}

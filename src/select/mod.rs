@@ -1,0 +1,181 @@
+//! Pose selection: random search, DETMAX, Fedorov exchange and the paper's
+//! exchange-add-exchange (§IV, §V-D), written once against the
+//! [`Criterion`](crate::criterion::Criterion) trait so the determinant
+//! criterion and the eigenvalue OI run through the same code.
+//!
+//! Every algorithm works on pool positions (rows of the pool's [`Blocks`]);
+//! poses removed by the pool's visibility filter are not in the pool, so they
+//! are never chosen. Fixed poses are in every design and never removed.
+//!
+//! # Starting below full rank
+//!
+//! When the initial design has too few rows for a non-singular `M`
+//! (`n0·t < p`, or degenerate poses), the state starts with a small ridge
+//! `M = XᵀX + δI`, `δ = 10⁻⁸ · tr(X_poolᵀX_pool)/(n_pool·p)` (a relative
+//! size far below any eigenvalue a full-rank design has, yet enough to
+//! factor). The ridge is dropped as soon as the design is non-singular
+//! without it (tried after every add step), so every reported value of a
+//! finished design is the ridge-free `ln det XᵀX`; trace rows taken while the
+//! ridge was on carry `ridge: true`.
+
+use crate::blocks::Blocks;
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+
+mod exchange;
+mod random;
+
+pub use exchange::{detmax, eae, fedorov, multistart, polish, Selection};
+pub use random::{design_rng, ln_det_direct, oi_from_ln_oid, random_design, random_search, RandomSearch};
+
+/// The selection algorithms.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Algorithm {
+    /// The paper's exchange-add-exchange (§IV).
+    Eae,
+    /// Fedorov exchange from a random `N`-pose design.
+    Fedorov,
+    /// DETMAX (Mitchell 1974) as the paper's §II describes it.
+    Detmax,
+    /// Best of many random designs (§V-C).
+    Random,
+}
+
+impl Algorithm {
+    /// Parses `eae`, `fedorov`, `detmax` or `random`.
+    pub fn parse(s: &str) -> Result<Algorithm> {
+        match s {
+            "eae" => Ok(Algorithm::Eae),
+            "fedorov" => Ok(Algorithm::Fedorov),
+            "detmax" => Ok(Algorithm::Detmax),
+            "random" => Ok(Algorithm::Random),
+            _ => Err(Error::Invalid(format!(
+                "unknown algorithm '{s}' (expected eae, fedorov, detmax or random)"
+            ))),
+        }
+    }
+}
+
+/// Settings of a selection run; check them with [`Settings::validate`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Settings {
+    /// Poses in the final design, `N` (default 30).
+    pub n: usize,
+    /// Initial random poses of EAE, `n0` (default 12), fixed poses included.
+    pub initial: usize,
+    /// Independent random starts; the best design is kept (default 1).
+    pub starts: usize,
+    /// Random designs drawn by [`Algorithm::Random`] (default 5,000).
+    pub designs: usize,
+    /// Follow the best start by a Fedorov polish (default false).
+    pub polish: bool,
+    /// Seed of every random choice (default 1).
+    pub seed: u64,
+    /// Pool positions that every design contains and no step removes.
+    pub fixed: Vec<usize>,
+    /// Largest number of exchange (or excursion) iterations per phase
+    /// (default 1,000).
+    pub max_iter: usize,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            n: 30,
+            initial: 12,
+            starts: 1,
+            designs: 5000,
+            polish: false,
+            seed: 1,
+            fixed: Vec::new(),
+            max_iter: 1000,
+        }
+    }
+}
+
+impl Settings {
+    /// Checks the settings against a pool: `N` within the pool, `N·t ≥ p`,
+    /// fixed poses in the pool, unique, and no more of them than `N`.
+    pub fn validate(&self, pool: &Blocks) -> Result<()> {
+        let (n_pool, t, p) = (pool.n_poses(), pool.t(), pool.p());
+        if n_pool == 0 {
+            return Err(Error::Invalid("the pose pool is empty".into()));
+        }
+        if self.n > n_pool {
+            return Err(Error::Invalid(format!(
+                "N = {} is larger than the pool ({n_pool} poses)",
+                self.n
+            )));
+        }
+        if self.n * t < p {
+            return Err(Error::Invalid(format!(
+                "N = {} poses give {} measurement rows, fewer than the {p} unknowns: every design would be singular (need N >= {})",
+                self.n,
+                self.n * t,
+                p.div_ceil(t)
+            )));
+        }
+        if let Some(&f) = self.fixed.iter().find(|&&f| f >= n_pool) {
+            return Err(Error::PoseNotInPool {
+                index: f,
+                reason: format!("pool position {f} >= pool size {n_pool}"),
+            });
+        }
+        crate::design::check_unique(&self.fixed)?;
+        if self.fixed.len() > self.n {
+            return Err(Error::Invalid(format!(
+                "{} fixed poses do not fit in a design of N = {}",
+                self.fixed.len(),
+                self.n
+            )));
+        }
+        if self.starts == 0 || self.designs == 0 || self.max_iter == 0 {
+            return Err(Error::Invalid("starts, designs and max_iter must be at least 1".into()));
+        }
+        if self.initial == 0 || self.initial > self.n {
+            return Err(Error::Invalid(format!(
+                "the initial design size must be in 1..=N, got {}",
+                self.initial
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Kind of a step in a trace.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StepKind {
+    /// The initial design.
+    Init,
+    /// A pose exchanged for another (EAE exchange step, Fedorov).
+    Exchange,
+    /// A pose added.
+    Add,
+    /// A pose removed.
+    Remove,
+    /// The ridge of a rank-deficient start dropped.
+    DropRidge,
+}
+
+/// One row of a trace (the paper's Fig. 4–6): the state after a step.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TraceRow {
+    /// Step number, 0 for the initial design.
+    pub step: usize,
+    /// What the step did.
+    pub kind: StepKind,
+    /// Pool position of the pose added, if any.
+    pub added: Option<usize>,
+    /// Pool position of the pose removed, if any.
+    pub removed: Option<usize>,
+    /// Design size after the step.
+    pub size: usize,
+    /// `ln OI_D = ln det M` after the step (ridge included while `ridge`).
+    pub ln_oid: f64,
+    /// The paper's OI, eq. (1), after the step.
+    pub oi: f64,
+    /// Whether the ridge of a rank-deficient start was still on.
+    pub ridge: bool,
+}

@@ -1,0 +1,450 @@
+//! Identification: exact recovery without noise from the nominal start,
+//! agreement with the linearised covariance, statuses for numerical outcomes,
+//! errors for bad input, determinism of the Monte-Carlo, and the command line.
+
+use activecal::design::DesignFile;
+use activecal::identify::{
+    IdentifyError, LmSettings, Measurements, MonteCarloSettings, Status, StopReason,
+    ValidationSet, compare_designs, identify, monte_carlo, paper_tables, simulate, trial_rng,
+};
+use activecal::kinematics::Evaluator;
+use activecal::pool::Pool;
+use activecal::robot::Robot;
+use nalgebra::DMatrix;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde_json::Value;
+use std::process::{Command, Output};
+
+/// `n` distinct pool positions drawn with a seeded ChaCha8 (partial Fisher–Yates).
+fn random_design(pool: &Pool, n: usize, seed: u64) -> Vec<usize> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut all: Vec<usize> = (0..pool.len()).collect();
+    for i in 0..n {
+        let j = rng.random_range(i..all.len());
+        all.swap(i, j);
+    }
+    all.truncate(n);
+    all
+}
+
+/// The 30-pose design of the acceptance tests, as pool positions in the
+/// 5-level PUMA lattice. To test with a selected (e.g. exchange-add-exchange)
+/// design instead, change this one line.
+fn acceptance_design(pool: &Pool) -> Vec<usize> {
+    random_design(pool, 30, 1)
+}
+
+/// Robot, pool and the joint vectors of the acceptance design.
+fn data() -> (Robot, Pool, Vec<usize>, Vec<Vec<f64>>) {
+    let robot = Robot::puma560();
+    let pool = Pool::full(&robot, 5).unwrap();
+    let design = acceptance_design(&pool);
+    let qs = design.iter().map(|&k| pool.q(k)).collect();
+    (robot, pool, design, qs)
+}
+
+fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+}
+
+#[test]
+fn zero_noise_recovers_real_parameters_from_nominal() {
+    let (robot, _, _, qs) = data();
+    let meas = simulate(&robot, &robot.real, &qs, 0.0, &mut trial_rng(0, 0)).unwrap();
+    let truth = robot.unknown_values(&robot.real);
+    let nominal = robot.unknown_values(&robot.nominal);
+    // The start really is far: up to ~0.3 rad and 0.15 m off.
+    assert!(max_abs_diff(&nominal, &truth) > 0.25);
+    let id = identify(&robot, &robot.nominal, &meas, &LmSettings::default()).unwrap();
+    assert_eq!(id.status, Status::Converged, "{:?}", id.stop);
+    let err = max_abs_diff(&id.estimate, &truth);
+    assert!(err <= 1e-9, "largest error {err:e}");
+    assert!(id.iterations >= 1 && id.iterations <= 30, "{} iterations", id.iterations);
+    assert!(id.rss < 1e-18 && id.initial_rss > 1.0);
+    assert!(id.rss_history.len() >= 2 && id.rss_history.len() <= id.iterations + 1);
+    assert!(id.rss_history.windows(2).all(|w| w[1] <= w[0]), "cost must never increase");
+    assert_eq!((id.rank, id.dof), (27, 90 - 27));
+    // The table carries the estimate, the other parameters stay nominal.
+    assert_eq!(robot.unknown_values(&id.table), id.estimate);
+    assert_eq!(id.table.rows[7], robot.nominal.rows[7]);
+}
+
+#[test]
+fn zero_noise_recovery_also_without_geodesic_and_from_twice_as_far() {
+    let (robot, _, _, qs) = data();
+    let meas = simulate(&robot, &robot.real, &qs, 0.0, &mut trial_rng(0, 0)).unwrap();
+    let truth = robot.unknown_values(&robot.real);
+    let nominal = robot.unknown_values(&robot.nominal);
+    let plain = identify(
+        &robot,
+        &robot.nominal,
+        &meas,
+        &LmSettings::default().with_geodesic(false),
+    )
+    .unwrap();
+    assert_eq!(plain.status, Status::Converged);
+    assert!(max_abs_diff(&plain.estimate, &truth) <= 1e-9);
+    // Start at real + 2·(nominal − real): up to ~0.6 rad off.
+    let far: Vec<f64> = truth
+        .iter()
+        .zip(&nominal)
+        .map(|(t, n)| t + 2.0 * (n - t))
+        .collect();
+    let start = robot.with_unknowns(&robot.nominal, &far);
+    let id = identify(&robot, &start, &meas, &LmSettings::default()).unwrap();
+    assert_eq!(id.status, Status::Converged);
+    let err = max_abs_diff(&id.estimate, &truth);
+    assert!(err <= 1e-9, "largest error {err:e} after {} iterations", id.iterations);
+}
+
+#[test]
+fn angles_are_reported_nearest_the_start() {
+    // A start shifted by 2π in γ_a is the same robot; the estimate stays on
+    // the start's branch instead of wandering.
+    let (robot, _, _, qs) = data();
+    let meas = simulate(&robot, &robot.real, &qs, 0.0, &mut trial_rng(0, 0)).unwrap();
+    let mut start = robot.nominal.clone();
+    start.rows[0][0] += std::f64::consts::TAU;
+    let id = identify(&robot, &start, &meas, &LmSettings::default()).unwrap();
+    assert_eq!(id.status, Status::Converged);
+    assert!((id.estimate[0] - (robot.real.rows[0][0] + std::f64::consts::TAU)).abs() < 1e-9);
+}
+
+/// σ̂² (XᵀX)⁻¹ computed independently: normal equations in nalgebra.
+fn reference_covariance(robot: &Robot, id: &activecal::identify::Identification, qs: &[Vec<f64>]) -> DMatrix<f64> {
+    let p = robot.n_unknowns();
+    let mut x = DMatrix::<f64>::zeros(3 * qs.len(), p);
+    let mut ev = Evaluator::new(robot, &id.table);
+    let mut block = vec![0.0; 3 * p];
+    for (i, q) in qs.iter().enumerate() {
+        ev.eval(q, &mut block);
+        for r in 0..3 {
+            for c in 0..p {
+                x[(3 * i + r, c)] = block[r * p + c];
+            }
+        }
+    }
+    let s2 = id.sigma_hat.unwrap().powi(2);
+    (x.transpose() * &x).try_inverse().unwrap() * s2
+}
+
+#[test]
+fn noisy_estimate_agrees_with_its_covariance() {
+    let (robot, _, _, qs) = data();
+    let sigma = 0.01;
+    let meas = simulate(&robot, &robot.real, &qs, sigma, &mut trial_rng(5, 0)).unwrap();
+    let id = identify(&robot, &robot.nominal, &meas, &LmSettings::default()).unwrap();
+    assert_eq!(id.status, Status::Converged);
+    // σ̂² ~ σ² χ²₆₃/63: relative sd of σ̂ ≈ 1/√126 ≈ 0.09; allow 4 sd.
+    let s = id.sigma_hat.unwrap();
+    assert!((s / sigma - 1.0).abs() < 0.36, "σ̂ = {s}");
+    let cov = id.covariance.as_ref().unwrap();
+    let truth = robot.unknown_values(&robot.real);
+    for (k, name) in id.names.iter().enumerate() {
+        let z = (id.estimate[k] - truth[k]) / cov.std[k];
+        // 27 parameters: P(any |z| > 5) ≈ 27 · 6e-7.
+        assert!(z.abs() < 5.0, "{name}: z = {z}");
+    }
+    // Covariance against the normal equations: relative agreement limited by
+    // cond(XᵀX)·ε in the reference.
+    let reference = reference_covariance(&robot, &id, &qs);
+    for i in 0..27 {
+        for j in 0..27 {
+            let tol = 1e-6 * (reference[(i, i)] * reference[(j, j)]).sqrt();
+            assert!(
+                (cov.matrix[i][j] - reference[(i, j)]).abs() <= tol,
+                "C[{i}][{j}] = {} vs {}",
+                cov.matrix[i][j],
+                reference[(i, j)]
+            );
+        }
+        assert!((cov.std[i] - reference[(i, i)].sqrt()).abs() <= 1e-6 * cov.std[i]);
+    }
+    // The correlation matrix is labelled, symmetric, with unit diagonal.
+    assert_eq!(cov.correlation.names, robot.parameter_names());
+    for i in 0..27 {
+        assert!((cov.correlation.matrix[i][i] - 1.0).abs() < 1e-12);
+        for j in 0..27 {
+            let c = cov.correlation.matrix[i][j];
+            assert!(c.abs() <= 1.0 + 1e-12);
+            assert!((c - cov.correlation.matrix[j][i]).abs() < 1e-12);
+        }
+    }
+}
+
+#[test]
+fn rank_deficient_designs_are_a_status() {
+    let (robot, pool, design, _) = data();
+    // 8 poses: 24 equations for 27 unknowns.
+    let qs: Vec<Vec<f64>> = design[..8].iter().map(|&k| pool.q(k)).collect();
+    let meas = simulate(&robot, &robot.real, &qs, 0.0, &mut trial_rng(0, 0)).unwrap();
+    let id = identify(&robot, &robot.nominal, &meas, &LmSettings::default()).unwrap();
+    assert_eq!(id.status, Status::RankDeficient);
+    assert!(id.rank <= 24 && !id.unidentifiable.is_empty());
+    assert!(id.covariance.is_none() && id.sigma_hat.is_none());
+    // 5 distinct poses measured 6 times each: 90 equations, rank ≤ 15.
+    let qs: Vec<Vec<f64>> = (0..30).map(|i| pool.q(design[i % 5])).collect();
+    let meas = simulate(&robot, &robot.real, &qs, 0.01, &mut trial_rng(0, 0)).unwrap();
+    let id = identify(&robot, &robot.nominal, &meas, &LmSettings::default()).unwrap();
+    assert_eq!(id.status, Status::RankDeficient);
+    assert!(id.rank <= 15, "rank {}", id.rank);
+    assert!(id.covariance.is_none());
+}
+
+#[test]
+fn iteration_limit_and_divergence_are_statuses() {
+    let (robot, _, _, qs) = data();
+    let meas = simulate(&robot, &robot.real, &qs, 0.01, &mut trial_rng(0, 0)).unwrap();
+    let id = identify(
+        &robot,
+        &robot.nominal,
+        &meas,
+        &LmSettings::default().with_max_iterations(2),
+    )
+    .unwrap();
+    assert_eq!((id.status, id.stop, id.iterations), (Status::MaxIterations, StopReason::MaxIterations, 2));
+    assert!(id.rss < id.initial_rss);
+    // Points 1e160 m away: finite input whose squared residuals overflow.
+    let far = Measurements::new(&robot, qs.clone(), vec![[1e160, 0.0, 0.0]; qs.len()]).unwrap();
+    let id = identify(&robot, &robot.nominal, &far, &LmSettings::default()).unwrap();
+    assert_eq!((id.status, id.stop), (Status::Diverged, StopReason::NonFinite));
+    assert_eq!(id.iterations, 0);
+    assert!(id.covariance.is_none());
+}
+
+#[test]
+fn bad_input_is_an_error() {
+    let (robot, _, _, qs) = data();
+    let good = simulate(&robot, &robot.real, &qs, 0.0, &mut trial_rng(0, 0)).unwrap();
+    let mut points = good.points().to_vec();
+    points[4][1] = f64::NAN;
+    let e = Measurements::new(&robot, qs.clone(), points).unwrap_err();
+    assert!(matches!(e, IdentifyError::NonFiniteMeasurement { pose: 4, coordinate: 'y', .. }), "{e}");
+    assert!(e.to_string().contains("measurement 4, coordinate y"));
+
+    let e = Measurements::new(&robot, qs.clone(), good.points()[..29].to_vec()).unwrap_err();
+    assert!(matches!(e, IdentifyError::MeasurementCount { poses: 30, measurements: 29 }));
+    assert!(e.to_string().contains("missing measurements"));
+
+    let mut short = qs.clone();
+    short[3].pop();
+    let e = Measurements::new(&robot, short, good.points().to_vec()).unwrap_err();
+    assert!(e.to_string().contains("pose 3: expected 6 joint angles, got 5"), "{e}");
+    let mut nan_q = qs.clone();
+    nan_q[2][0] = f64::INFINITY;
+    assert!(matches!(
+        Measurements::new(&robot, nan_q, good.points().to_vec()),
+        Err(IdentifyError::Pose { pose: 2, .. })
+    ));
+    assert!(matches!(Measurements::new(&robot, vec![], vec![]), Err(IdentifyError::Empty)));
+
+    // Measurements deserialized without the constructor are checked again.
+    let json = serde_json::json!({ "qs": [vec![0.0; 6]], "points": [] });
+    let raw: Measurements = serde_json::from_value(json).unwrap();
+    assert!(matches!(
+        identify(&robot, &robot.nominal, &raw, &LmSettings::default()),
+        Err(IdentifyError::MeasurementCount { .. })
+    ));
+
+    let mut start = robot.nominal.clone();
+    start.rows[2][1] = f64::NAN;
+    let e = identify(&robot, &start, &good, &LmSettings::default()).unwrap_err();
+    assert!(e.to_string().contains("alpha_1"), "{e}");
+
+    let bad = LmSettings::default().with_tolerances(-1.0, 1e-12, 1e-10);
+    let e = identify(&robot, &robot.nominal, &good, &bad).unwrap_err();
+    assert!(matches!(e, IdentifyError::Setting { name: "xtol", .. }));
+    assert!(simulate(&robot, &robot.real, &qs, -0.01, &mut trial_rng(0, 0)).is_err());
+    assert!(MonteCarloSettings::default().with_trials(0).validate().is_err());
+}
+
+#[test]
+fn designs_that_do_not_match_the_robot_are_errors() {
+    // The path `calibrate` takes: read, build the design's pool, place the poses.
+    let robot = Robot::puma560();
+    let pool = Pool::full(&robot, 5).unwrap();
+    let cases = [
+        (DesignFile::new("ur5", 5, vec![1, 2]), "robot 'ur5'"),
+        (DesignFile::new("puma560", 4, vec![1, 2]), "4-level lattice"),
+        (DesignFile::new("puma560", 5, vec![1, 15_625]), "pose 15625"),
+        (DesignFile::new("puma560", 5, vec![7, 7]), "more than once"),
+    ];
+    for (d, needle) in cases {
+        let e = d.positions_in(&robot, &pool).unwrap_err().to_string();
+        assert!(e.contains(needle), "'{e}' lacks '{needle}'");
+    }
+}
+
+#[test]
+fn monte_carlo_agrees_with_linear_theory() {
+    let (robot, pool, design, qs) = data();
+    let settings = MonteCarloSettings::default()
+        .with_trials(60)
+        .with_seed(11)
+        .with_validation_poses(200)
+        .with_bootstrap(50);
+    let validation = ValidationSet::sample(&robot, &pool, &design, 200, 11).unwrap();
+    assert!(validation.lattice_indices.iter().all(|i| !design.contains(i)));
+    let s = monte_carlo(&robot, "acceptance", &qs, &validation, &settings).unwrap();
+    assert_eq!((s.trials, s.converged), (60, 60));
+    // rmse/predicted for one parameter has relative sd ≈ 1/√120 ≈ 0.09; the
+    // median over 27 is much tighter.
+    let r = s.rmse_over_predicted.as_ref().unwrap();
+    assert!((0.85..1.15).contains(&r.median), "{r:?}");
+    assert!(r.max < 1.6, "{r:?}");
+    let g = s.generalized_variance.as_ref().unwrap();
+    assert!(g.z.abs() < 4.0, "{g:?}");
+    assert!(g.sd_bootstrap.unwrap() > 0.0);
+    // Calibration cuts the validation error from ~1 m to ~1 cm, as predicted.
+    let after = s.validation_rms_after.as_ref().unwrap();
+    assert!(s.validation_rms_before > 0.5);
+    assert!(after.max < 0.03, "{after:?}");
+    let predicted = s.validation_rms_predicted.unwrap();
+    assert!((after.median / predicted - 1.0).abs() < 0.3, "{} vs {predicted}", after.median);
+}
+
+#[test]
+fn monte_carlo_does_not_depend_on_thread_count() {
+    let (robot, pool, design, qs) = data();
+    let settings = MonteCarloSettings::default()
+        .with_trials(30)
+        .with_seed(3)
+        .with_validation_poses(50)
+        .with_bootstrap(20);
+    let run = |threads: usize| {
+        let tp = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        tp.install(|| {
+            let v = ValidationSet::sample(&robot, &pool, &design, 50, 3).unwrap();
+            serde_json::to_string(&monte_carlo(&robot, "d", &qs, &v, &settings).unwrap()).unwrap()
+        })
+    };
+    let one = run(1);
+    assert_eq!(one, run(3));
+    // And trial 0 is the single calibration `paper_tables` reports.
+    let t = paper_tables(&robot, &qs, 0.01, 3, &LmSettings::default()).unwrap();
+    let meas = simulate(&robot, &robot.real, &qs, 0.01, &mut trial_rng(3, 0)).unwrap();
+    let id = identify(&robot, &robot.nominal, &meas, &LmSettings::default()).unwrap();
+    assert_eq!(t.identification.estimate, id.estimate);
+}
+
+#[test]
+fn paper_tables_have_the_papers_layout() {
+    let (robot, _, _, qs) = data();
+    let t = paper_tables(&robot, &qs, 0.01, 2, &LmSettings::default()).unwrap();
+    assert_eq!(t.estimate.frames, ["a", "0", "1", "2", "3", "4", "5"]);
+    assert_eq!(t.estimate.symbols, ["gamma", "alpha", "a", "d", "beta"]);
+    // Not unknowns: d_a, β of DH frames, α_5.
+    assert!(t.estimate.rows[0][3].is_none() && t.estimate.rows[1][4].is_none());
+    assert!(t.estimate.rows[6][1].is_none() && t.estimate.rows[0][4].is_some());
+    let est = t.estimate.rows[2][2].unwrap(); // a_1
+    let res = t.residual.rows[2][2].unwrap();
+    assert!((res - (0.4318 - est)).abs() < 1e-15);
+    assert!(t.std.as_ref().unwrap().rows[0][0].unwrap() > 0.0);
+    let text = t.residual.to_text(6);
+    assert_eq!(text.lines().count(), 8);
+    assert!(text.lines().next().unwrap().contains("gamma"));
+}
+
+#[test]
+fn comparison_shares_validation_and_checks_designs() {
+    let (robot, pool, design, _) = data();
+    let other = random_design(&pool, 30, 2);
+    let settings = MonteCarloSettings::default()
+        .with_trials(3)
+        .with_validation_poses(40)
+        .with_bootstrap(0);
+    let c = compare_designs(
+        &robot,
+        &pool,
+        &[("a".into(), design.clone()), ("b".into(), other.clone())],
+        &settings,
+    )
+    .unwrap();
+    assert_eq!(c.designs.len(), 2);
+    assert_eq!(c.validation_indices.len(), 40);
+    assert!(c.validation_indices.iter().all(|i| !design.contains(i) && !other.contains(i)));
+    assert_eq!(c.designs[0].validation_rms_before, c.designs[1].validation_rms_before);
+    assert!(c.designs[0].generalized_variance.is_none()); // 3 trials ≤ 27 unknowns
+    let e = compare_designs(&robot, &pool, &[("x".into(), vec![99_999])], &settings).unwrap_err();
+    assert!(e.to_string().contains("design 'x'"), "{e}");
+    assert!(compare_designs(&robot, &pool, &[], &settings).is_err());
+}
+
+// ---- command line ------------------------------------------------------------
+
+fn run(args: &[&str]) -> Output {
+    Command::new(std::env::var("ACTIVECAL_BIN").unwrap_or(env!("CARGO_BIN_EXE_activecal").into()))
+        .args(args)
+        .output()
+        .expect("runs")
+}
+
+fn write_design(name: &str, d: &DesignFile) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("activecal-identify-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    d.write(&path, true).unwrap();
+    path
+}
+
+#[test]
+fn cli_calibrate_reports_estimate_and_monte_carlo() {
+    let (robot, pool, design, _) = data();
+    let indices = design.iter().map(|&k| pool.indices[k]).collect();
+    let path = write_design("good.json", &DesignFile::new(&robot.name, 5, indices));
+    let p = path.to_str().unwrap();
+    let out = run(&["calibrate", "--design", p, "--noise", "0", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    assert_eq!(v["converged"], true);
+    assert!(v["iterations"].as_u64().unwrap() >= 1);
+    for name in robot.parameter_names() {
+        assert!(v["residual"][&name].as_f64().unwrap().abs() < 1e-9, "{name}");
+        assert!(v["estimate"][&name].is_f64() && v["std"][&name].is_f64());
+    }
+    assert!(v["validation_rms_after"].as_f64().unwrap() < 1e-9);
+    assert!(v["validation_rms_before"].as_f64().unwrap() > 0.5);
+    assert!(v["monte_carlo"].is_null());
+
+    let out = run(&["calibrate", "--design", p, "--trials", "30", "--seed", "4", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let mc = &v["monte_carlo"];
+    assert_eq!(mc["trials"], 30);
+    assert_eq!(mc["parameters"].as_array().unwrap().len(), 27);
+    assert!(mc["generalized_variance"]["ln_ratio"].is_f64());
+    assert!(mc["validation_rms_after"]["median"].as_f64().unwrap() < 0.03);
+    // Text output: the two tables.
+    let out = run(&["calibrate", "--design", p, "--noise", "0.01"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("Table III") && text.contains("Table IV"), "{text}");
+}
+
+#[test]
+fn cli_calibrate_rejects_bad_designs_and_options() {
+    let bad_robot = write_design("ur5.json", &DesignFile::new("ur5", 5, vec![1, 2, 3]));
+    let bad_pose = write_design("pose.json", &DesignFile::new("puma560", 5, vec![1, 15_625]));
+    let cases: [(&[&str], &str); 4] = [
+        (&["--design", bad_robot.to_str().unwrap()], "robot 'ur5'"),
+        (&["--design", bad_pose.to_str().unwrap()], "pose 15625"),
+        (&["--design", "/nonexistent/d.json"], "/nonexistent/d.json"),
+        (
+            &["--design", bad_pose.to_str().unwrap(), "--robot", "foo"],
+            "unknown robot 'foo'",
+        ),
+    ];
+    for (args, needle) in cases {
+        let mut all = vec!["calibrate"];
+        all.extend_from_slice(args);
+        let out = run(&all);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{all:?}: {err}");
+        assert!(!err.contains("panicked") && err.contains(needle), "{all:?}: '{err}' lacks '{needle}'");
+    }
+    let good = write_design("ok.json", &DesignFile::new("puma560", 5, (0..30).map(|i| i * 500).collect()));
+    let out = run(&["calibrate", "--design", good.to_str().unwrap(), "--noise=-1"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("sigma = -1"), "{err}");
+}

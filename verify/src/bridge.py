@@ -1,0 +1,111 @@
+"""Pinocchio and MuJoCo side of activecal's verify crate.
+
+Loaded by verify/src/bridge.rs with PyModule::from_code into an interpreter
+embedded by pyo3. That interpreter is not in venv mode, so `init` first makes
+the project venv's site-packages importable (see shared/notes/python-bridge.md):
+site.addsitedir (which runs the .pth files Pinocchio relies on), those entries
+moved to the front of sys.path, sys.executable set to the venv's python, and
+MUJOCO_GL=disable (importing mujoco pulls in glfw, which spawns sys.executable).
+
+Every evaluation takes a list of joint configurations and returns, per
+configuration, the end point position [x, y, z] and the 3 x dof positional
+joint Jacobian flattened row-major (d position_r / d q_j at r * dof + j), both
+in the measurement (world) frame.
+"""
+
+import os
+import platform
+import site
+import sys
+
+pin = None
+mujoco = None
+np = None
+
+
+def init(site_packages, python_exe):
+    """Makes the venv importable, imports the libraries, returns their versions."""
+    global pin, mujoco, np
+    if pin is None:
+        os.environ["MUJOCO_GL"] = "disable"
+        before = list(sys.path)
+        site.addsitedir(site_packages)
+        added = [p for p in sys.path if p not in before]
+        sys.path[:] = added + before
+        sys.executable = python_exe
+        import numpy as _np
+        import pinocchio as _pin
+        import mujoco as _mujoco
+
+        np, pin, mujoco = _np, _pin, _mujoco
+    return {
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "pinocchio": pin.__version__,
+        "mujoco": mujoco.__version__,
+    }
+
+
+def pinocchio_model(placements, tool):
+    """A Pinocchio model: one revolute-z joint after each fixed placement
+    (R as a row-major 3x3 list, t as a 3-list), and an operational frame "ee"
+    at `tool` on the last joint."""
+    model = pin.Model()
+    parent = 0  # the universe: activecal's measurement frame
+    for k, (rot, trans) in enumerate(placements):
+        placement = pin.SE3(np.array(rot, dtype=float), np.array(trans, dtype=float))
+        parent = model.addJoint(parent, pin.JointModelRZ(), placement, "q%d" % (k + 1))
+    rot, trans = tool
+    ee = pin.SE3(np.array(rot, dtype=float), np.array(trans, dtype=float))
+    model.addFrame(pin.Frame("ee", parent, ee, pin.FrameType.OP_FRAME))
+    return model
+
+
+def pinocchio_eval(placements, tool, qs):
+    """End point positions and joint Jacobians from Pinocchio: forwardKinematics +
+    updateFramePlacements for the position, computeFrameJacobian in
+    LOCAL_WORLD_ALIGNED (origin at the frame, axes of the world) for the
+    Jacobian, whose top 3 rows are d position / d q."""
+    model = pinocchio_model(placements, tool)
+    data = model.createData()
+    fid = model.getFrameId("ee")
+    positions, jacobians = [], []
+    for q in qs:
+        q = np.array(q, dtype=float)
+        pin.forwardKinematics(model, data, q)
+        pin.updateFramePlacements(model, data)
+        positions.append(data.oMf[fid].translation.tolist())
+        jac = pin.computeFrameJacobian(model, data, q, fid, pin.LOCAL_WORLD_ALIGNED)
+        jacobians.append(jac[:3, :].reshape(-1).tolist())
+    return positions, jacobians
+
+
+def mujoco_eval(mjcf, qs):
+    """End point positions and joint Jacobians from MuJoCo: site_xpos after
+    mj_kinematics, and mj_jacSite after mj_comPos (mj_jacSite needs the
+    com-based quantities; after mj_kinematics alone it is wrong)."""
+    model = mujoco.MjModel.from_xml_string(mjcf)
+    data = mujoco.MjData(model)
+    sid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "ee")
+    if sid < 0:
+        raise ValueError("the MJCF has no site named 'ee'")
+    if model.nq != model.nv:
+        raise ValueError("expected hinge joints only (nq == nv)")
+    # Map activecal's joint k to MuJoCo's qpos and dof addresses through the
+    # joint names "q1".."qn" rather than assuming MuJoCo's ordering.
+    jids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "q%d" % (k + 1))
+            for k in range(model.njnt)]
+    if min(jids) < 0:
+        raise ValueError("the MJCF's joints must be named q1..qn")
+    qadr = [int(model.jnt_qposadr[j]) for j in jids]
+    vadr = [int(model.jnt_dofadr[j]) for j in jids]
+    jacp = np.zeros((3, model.nv))
+    positions, jacobians = [], []
+    for q in qs:
+        data.qpos[qadr] = q
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_comPos(model, data)
+        positions.append(data.site_xpos[sid].tolist())
+        mujoco.mj_jacSite(model, data, jacp, None, sid)
+        jacobians.append(jacp[:, vadr].reshape(-1).tolist())
+    return positions, jacobians

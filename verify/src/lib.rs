@@ -1,0 +1,129 @@
+//! Differential checks of activecal's kinematics against Pinocchio and
+//! MuJoCo, and the reference fixtures the root crate tests against.
+//!
+//! Without features this crate is pure Rust: the model builders
+//! ([`model::pinocchio_model_spec`], [`model::mjcf`]), the configurations
+//! ([`sample`]), the comparisons ([`compare`]) and the fixture format
+//! ([`fixture`]). With `live` it embeds Python through pyo3 ([`bridge`]) and
+//! runs the checks ([`check`]); `cargo run -p verify --features live --
+//! regen` rewrites `fixtures/`, `… -- check` prints the deviations.
+//!
+//! What is compared, at each configuration `q`: the end-point position
+//! `p(q)` in the measurement frame, and the positional joint Jacobian
+//! `∂p/∂q` (3 × dof), whose column `j` is also the identification-Jacobian
+//! column of the γ offset of the frame that joint `j` drives (`Rz(q+γ)`).
+//! Pinocchio: `forwardKinematics`, `computeFrameJacobian(…,
+//! LOCAL_WORLD_ALIGNED)` top rows; MuJoCo: `site_xpos`, `mj_jacSite` after
+//! `mj_kinematics` + `mj_comPos`.
+#![warn(missing_docs)]
+
+pub mod compare;
+pub mod fixture;
+pub mod model;
+pub mod sample;
+
+#[cfg(feature = "live")]
+pub mod bridge;
+#[cfg(feature = "live")]
+pub mod check;
+
+use activecal::robot::{Convention, Frame, Measurement, ParamId, ParamTable, Robot, Symbol};
+
+/// Largest deviation accepted between any two of activecal, Pinocchio,
+/// MuJoCo and the fixtures, for positions (m) and Jacobian entries (m/rad).
+///
+/// Why 1e-12: the values are at most about 21 m (the PUMA's tracker is 20 m
+/// from the base). Each implementation composes at most ~10 rigid transforms,
+/// some tens of floating-point operations per coordinate, each with a relative
+/// rounding error of ε = 1.1e-16, so a pessimistic bound is
+/// 100 · ε · 21 m ≈ 2e-13 m; the deviations observed are a few 1e-14 (see
+/// `verify/tests/live.rs`). A real kinematic mistake is many orders larger:
+/// a flipped α or a swapped Hayati rotation order moves the end point by
+/// centimetres to metres, and even a parameter off by 1e-9 moves it by
+/// ~1e-8 m at 20 m. So 1e-12 m is above rounding with margin and far below
+/// any error worth catching.
+pub const TOLERANCE: f64 = 1e-12;
+
+/// The built-in robots (`activecal::robot::BUILTIN`), which get fixtures.
+pub fn builtin_robots() -> activecal::Result<Vec<Robot>> {
+    activecal::robot::BUILTIN
+        .iter()
+        .map(|name| Robot::builtin(name))
+        .collect()
+}
+
+/// A 7-joint robot unlike the PUMA, to show the model builders and checks
+/// are not PUMA-specific: fixed frames at the base, between joints 3 and 4
+/// (a Hayati one) and at the tool; driven Hayati frames, one with `d ≠ 0`;
+/// a joint range wider than 2π; metre-scale offsets. Its unknowns are the
+/// seven joint offsets γ (it is not meant for calibration).
+#[must_use]
+pub fn synthetic_robot() -> Robot {
+    use Convention::{Dh, Hayati};
+    // (label, convention, joint, [γ, α, a, d, β]); β is ignored on DH frames.
+    let frames: [(&str, Convention, Option<usize>, [f64; 5]); 10] = [
+        ("base", Dh, None, [0.3, 0.2, 1.5, -0.4, 0.0]),
+        ("1", Dh, Some(0), [0.1, -1.5608, 0.05, 0.5, 0.0]),
+        ("2", Hayati, Some(1), [-0.2, 0.02, 0.6, 0.0, 0.03]),
+        ("3", Dh, Some(2), [0.05, 1.58, -0.03, 0.12, 0.0]),
+        ("mid", Hayati, None, [0.5, 0.4, 0.1, 0.2, -0.3]),
+        ("4", Dh, Some(3), [-0.07, -1.55, 0.0, 0.45, 0.0]),
+        ("5", Hayati, Some(4), [0.02, 0.9, 0.08, 0.07, -0.11]),
+        ("6", Dh, Some(5), [0.0, 1.5708, 0.0, 0.0, 0.0]),
+        ("7", Dh, Some(6), [0.13, -0.3, 0.02, 0.09, 0.0]),
+        ("tool", Dh, None, [0.2, 0.0, 0.05, 0.1, 0.0]),
+    ];
+    let nominal = ParamTable {
+        rows: frames.iter().map(|f| f.3).collect(),
+    };
+    // The "real" robot: every parameter perturbed by a few milli-units.
+    let real = ParamTable {
+        rows: nominal
+            .rows
+            .iter()
+            .enumerate()
+            .map(|(i, row)| {
+                let mut r = *row;
+                for (c, v) in r.iter_mut().enumerate() {
+                    *v += 1e-3 * (((7 * i + 3 * c) % 11) as f64 - 5.0);
+                }
+                r
+            })
+            .collect(),
+    };
+    let unknowns = frames
+        .iter()
+        .enumerate()
+        .filter(|(_, f)| f.2.is_some())
+        .map(|(frame, _)| ParamId {
+            frame,
+            symbol: Symbol::Gamma,
+        })
+        .collect();
+    let robot = Robot {
+        name: "synthetic7".into(),
+        frames: frames
+            .iter()
+            .map(|&(label, convention, joint, _)| Frame {
+                label: label.into(),
+                convention,
+                joint,
+            })
+            .collect(),
+        real,
+        nominal,
+        unknowns,
+        limits: vec![
+            [-3.0, 3.0],
+            [-1.9, 2.2],
+            [-2.5, 0.4],
+            [-3.5, 4.0],
+            [-2.0, 2.0],
+            [-1.0, 3.0],
+            [-3.1, 3.1],
+        ],
+        measurement: Measurement::Point,
+    };
+    robot.validate().expect("synthetic robot is valid");
+    robot
+}

@@ -20,5 +20,10 @@ fn main() {
         best = best.max(ld);
     }
     v.sort_by(|a, b| a.partial_cmp(b).unwrap());
-    println!("best log10 {} median {} min {}", best / std::f64::consts::LN_10, v[2500], v[0]);
+    println!(
+        "best log10 {} median {} min {}",
+        best / std::f64::consts::LN_10,
+        v[2500],
+        v[0]
+    );
 }

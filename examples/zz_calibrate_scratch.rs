@@ -11,7 +11,11 @@ pub fn load_robot(name: &str) -> Result<Robot> {
     Ok(r)
 }
 pub fn emit(json_out: bool, value: &Value, text: impl FnOnce() -> String) {
-    if json_out { println!("{value}"); } else { print!("{}", text()); }
+    if json_out {
+        println!("{value}");
+    } else {
+        print!("{}", text());
+    }
 }
 #[derive(Parser)]
 struct Cli {
@@ -19,7 +23,9 @@ struct Cli {
     a: calibrate::CalibrateArgs,
 }
 fn main() {
-    if let Err(e) = calibrate::cmd_calibrate(Cli::parse_from(std::env::args().filter(|a| a != "calibrate")).a) {
+    if let Err(e) =
+        calibrate::cmd_calibrate(Cli::parse_from(std::env::args().filter(|a| a != "calibrate")).a)
+    {
         eprintln!("error: {e:#}");
         std::process::exit(1);
     }

@@ -5,8 +5,12 @@ use activecal::robot::Robot;
 use rand::{RngExt, SeedableRng};
 fn random_design(n_pool: usize, n: usize, rng: &mut rand_chacha::ChaCha8Rng) -> Vec<usize> {
     let mut all: Vec<usize> = (0..n_pool).collect();
-    for i in 0..n { let j = rng.random_range(i..all.len()); all.swap(i, j); }
-    all.truncate(n); all
+    for i in 0..n {
+        let j = rng.random_range(i..all.len());
+        all.swap(i, j);
+    }
+    all.truncate(n);
+    all
 }
 fn main() {
     let dir = std::env::args().nth(1).unwrap();
@@ -25,16 +29,27 @@ fn main() {
     for _ in 1..100 {
         let d = random_design(pool.len(), 30, &mut rng);
         let v = lndet(&d);
-        if v > best.0 { best = (v, d); }
+        if v > best.0 {
+            best = (v, d);
+        }
     }
     let idx = |d: &[usize]| d.iter().map(|&k| pool.indices[k]).collect::<Vec<_>>();
     let mut a = DesignFile::new("puma560", 5, idx(&first));
-    a.extra.insert("ln_det_nominal".into(), lndet(&first).into());
-    a.extra.insert("how".into(), "random 30 poses, ChaCha8 seed 1, first draw".into());
-    a.write(&std::path::Path::new(&dir).join("random30.json"), true).unwrap();
+    a.extra
+        .insert("ln_det_nominal".into(), lndet(&first).into());
+    a.extra.insert(
+        "how".into(),
+        "random 30 poses, ChaCha8 seed 1, first draw".into(),
+    );
+    a.write(&std::path::Path::new(&dir).join("random30.json"), true)
+        .unwrap();
     let mut b = DesignFile::new("puma560", 5, idx(&best.1));
     b.extra.insert("ln_det_nominal".into(), best.0.into());
-    b.extra.insert("how".into(), "best of 100 random 30-pose designs by ln det XᵀX (nominal), ChaCha8 seed 1".into());
-    b.write(&std::path::Path::new(&dir).join("best100.json"), true).unwrap();
+    b.extra.insert(
+        "how".into(),
+        "best of 100 random 30-pose designs by ln det XᵀX (nominal), ChaCha8 seed 1".into(),
+    );
+    b.write(&std::path::Path::new(&dir).join("best100.json"), true)
+        .unwrap();
     println!("random {} best {}", lndet(&first), best.0);
 }

@@ -56,7 +56,10 @@ fn every_builtin_robot_has_fixtures_for_both_parameter_sets() {
     for robot in activecal::robot::BUILTIN {
         for set in ["nominal", "real"] {
             let want = format!("{robot}_{set}.json");
-            assert!(names.contains(&want), "fixtures/{want} is missing: run `{REGEN}`");
+            assert!(
+                names.contains(&want),
+                "fixtures/{want} is missing: run `{REGEN}`"
+            );
         }
     }
 }
@@ -79,7 +82,10 @@ fn position_and_joint_jacobian_match_pinocchio_fixtures() {
             f.param_set
         );
         // Enough samples to mean something: random ones plus the 2^dof corners.
-        assert!(f.samples.len() >= 100 + (1 << robot.dof()), "{name}: too few samples");
+        assert!(
+            f.samples.len() >= 100 + (1 << robot.dof()),
+            "{name}: too few samples"
+        );
         let dof = robot.dof();
         let mut ev = Evaluator::new(&robot, table);
         let mut jac = vec![0.0; 3 * dof];
@@ -88,7 +94,10 @@ fn position_and_joint_jacobian_match_pinocchio_fixtures() {
             robot.check_q(&s.q).unwrap();
             assert_eq!(s.jacobian.len(), 3 * dof, "{name}: sample {k}");
             let p = ev.joint_jacobian(&s.q, &mut jac);
-            let dp = (0..3).map(|r| (p[r] - s.position[r]).powi(2)).sum::<f64>().sqrt();
+            let dp = (0..3)
+                .map(|r| (p[r] - s.position[r]).powi(2))
+                .sum::<f64>()
+                .sqrt();
             let dj = jac
                 .iter()
                 .zip(&s.jacobian)

@@ -4,8 +4,8 @@
 
 use activecal::design::DesignFile;
 use activecal::identify::{
-    IdentifyError, LmSettings, Measurements, MonteCarloSettings, Status, StopReason,
-    ValidationSet, compare_designs, identify, monte_carlo, paper_tables, simulate, trial_rng,
+    IdentifyError, LmSettings, Measurements, MonteCarloSettings, Status, StopReason, ValidationSet,
+    compare_designs, identify, monte_carlo, paper_tables, simulate, trial_rng,
 };
 use activecal::kinematics::Evaluator;
 use activecal::pool::Pool;
@@ -45,7 +45,10 @@ fn data() -> (Robot, Pool, Vec<usize>, Vec<Vec<f64>>) {
 }
 
 fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }
 
 #[test]
@@ -60,10 +63,17 @@ fn zero_noise_recovers_real_parameters_from_nominal() {
     assert_eq!(id.status, Status::Converged, "{:?}", id.stop);
     let err = max_abs_diff(&id.estimate, &truth);
     assert!(err <= 1e-9, "largest error {err:e}");
-    assert!(id.iterations >= 1 && id.iterations <= 30, "{} iterations", id.iterations);
+    assert!(
+        id.iterations >= 1 && id.iterations <= 30,
+        "{} iterations",
+        id.iterations
+    );
     assert!(id.rss < 1e-18 && id.initial_rss > 1.0);
     assert!(id.rss_history.len() >= 2 && id.rss_history.len() <= id.iterations + 1);
-    assert!(id.rss_history.windows(2).all(|w| w[1] <= w[0]), "cost must never increase");
+    assert!(
+        id.rss_history.windows(2).all(|w| w[1] <= w[0]),
+        "cost must never increase"
+    );
     assert_eq!((id.rank, id.dof), (27, 90 - 27));
     // The table carries the estimate, the other parameters stay nominal.
     assert_eq!(robot.unknown_values(&id.table), id.estimate);
@@ -95,7 +105,11 @@ fn zero_noise_recovery_also_without_geodesic_and_from_twice_as_far() {
     let id = identify(&robot, &start, &meas, &LmSettings::default()).unwrap();
     assert_eq!(id.status, Status::Converged);
     let err = max_abs_diff(&id.estimate, &truth);
-    assert!(err <= 1e-9, "largest error {err:e} after {} iterations", id.iterations);
+    assert!(
+        err <= 1e-9,
+        "largest error {err:e} after {} iterations",
+        id.iterations
+    );
 }
 
 #[test]
@@ -112,7 +126,11 @@ fn angles_are_reported_nearest_the_start() {
 }
 
 /// σ̂² (XᵀX)⁻¹ computed independently: normal equations in nalgebra.
-fn reference_covariance(robot: &Robot, id: &activecal::identify::Identification, qs: &[Vec<f64>]) -> DMatrix<f64> {
+fn reference_covariance(
+    robot: &Robot,
+    id: &activecal::identify::Identification,
+    qs: &[Vec<f64>],
+) -> DMatrix<f64> {
     let p = robot.n_unknowns();
     let mut x = DMatrix::<f64>::zeros(3 * qs.len(), p);
     let mut ev = Evaluator::new(robot, &id.table);
@@ -203,12 +221,18 @@ fn iteration_limit_and_divergence_are_statuses() {
         &LmSettings::default().with_max_iterations(2),
     )
     .unwrap();
-    assert_eq!((id.status, id.stop, id.iterations), (Status::MaxIterations, StopReason::MaxIterations, 2));
+    assert_eq!(
+        (id.status, id.stop, id.iterations),
+        (Status::MaxIterations, StopReason::MaxIterations, 2)
+    );
     assert!(id.rss < id.initial_rss);
     // Points 1e160 m away: finite input whose squared residuals overflow.
     let far = Measurements::new(&robot, qs.clone(), vec![[1e160, 0.0, 0.0]; qs.len()]).unwrap();
     let id = identify(&robot, &robot.nominal, &far, &LmSettings::default()).unwrap();
-    assert_eq!((id.status, id.stop), (Status::Diverged, StopReason::NonFinite));
+    assert_eq!(
+        (id.status, id.stop),
+        (Status::Diverged, StopReason::NonFinite)
+    );
     assert_eq!(id.iterations, 0);
     assert!(id.covariance.is_none());
 }
@@ -220,24 +244,47 @@ fn bad_input_is_an_error() {
     let mut points = good.points().to_vec();
     points[4][1] = f64::NAN;
     let e = Measurements::new(&robot, qs.clone(), points).unwrap_err();
-    assert!(matches!(e, IdentifyError::NonFiniteMeasurement { pose: 4, coordinate: 'y', .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            IdentifyError::NonFiniteMeasurement {
+                pose: 4,
+                coordinate: 'y',
+                ..
+            }
+        ),
+        "{e}"
+    );
     assert!(e.to_string().contains("measurement 4, coordinate y"));
 
     let e = Measurements::new(&robot, qs.clone(), good.points()[..29].to_vec()).unwrap_err();
-    assert!(matches!(e, IdentifyError::MeasurementCount { poses: 30, measurements: 29 }));
+    assert!(matches!(
+        e,
+        IdentifyError::MeasurementCount {
+            poses: 30,
+            measurements: 29
+        }
+    ));
     assert!(e.to_string().contains("missing measurements"));
 
     let mut short = qs.clone();
     short[3].pop();
     let e = Measurements::new(&robot, short, good.points().to_vec()).unwrap_err();
-    assert!(e.to_string().contains("pose 3: expected 6 joint angles, got 5"), "{e}");
+    assert!(
+        e.to_string()
+            .contains("pose 3: expected 6 joint angles, got 5"),
+        "{e}"
+    );
     let mut nan_q = qs.clone();
     nan_q[2][0] = f64::INFINITY;
     assert!(matches!(
         Measurements::new(&robot, nan_q, good.points().to_vec()),
         Err(IdentifyError::Pose { pose: 2, .. })
     ));
-    assert!(matches!(Measurements::new(&robot, vec![], vec![]), Err(IdentifyError::Empty)));
+    assert!(matches!(
+        Measurements::new(&robot, vec![], vec![]),
+        Err(IdentifyError::Empty)
+    ));
 
     // Measurements deserialized without the constructor are checked again.
     let json = serde_json::json!({ "qs": [vec![0.0; 6]], "points": [] });
@@ -256,7 +303,12 @@ fn bad_input_is_an_error() {
     let e = identify(&robot, &robot.nominal, &good, &bad).unwrap_err();
     assert!(matches!(e, IdentifyError::Setting { name: "xtol", .. }));
     assert!(simulate(&robot, &robot.real, &qs, -0.01, &mut trial_rng(0, 0)).is_err());
-    assert!(MonteCarloSettings::default().with_trials(0).validate().is_err());
+    assert!(
+        MonteCarloSettings::default()
+            .with_trials(0)
+            .validate()
+            .is_err()
+    );
 }
 
 #[test]
@@ -280,19 +332,24 @@ fn designs_that_do_not_match_the_robot_are_errors() {
 fn monte_carlo_agrees_with_linear_theory() {
     let (robot, pool, design, qs) = data();
     let settings = MonteCarloSettings::default()
-        .with_trials(60)
+        .with_trials(120)
         .with_seed(11)
         .with_validation_poses(200)
         .with_bootstrap(50);
     let validation = ValidationSet::sample(&robot, &pool, &design, 200, 11).unwrap();
-    assert!(validation.lattice_indices.iter().all(|i| !design.contains(i)));
+    assert!(
+        validation
+            .lattice_indices
+            .iter()
+            .all(|i| !design.contains(i))
+    );
     let s = monte_carlo(&robot, "acceptance", &qs, &validation, &settings).unwrap();
-    assert_eq!((s.trials, s.converged), (60, 60));
-    // rmse/predicted for one parameter has relative sd ≈ 1/√120 ≈ 0.09; the
+    assert_eq!((s.trials, s.converged), (120, 120));
+    // rmse/predicted for one parameter has relative sd ≈ 1/√240 ≈ 0.065; the
     // median over 27 is much tighter.
     let r = s.rmse_over_predicted.as_ref().unwrap();
     assert!((0.85..1.15).contains(&r.median), "{r:?}");
-    assert!(r.max < 1.6, "{r:?}");
+    assert!(r.max < 1.4, "{r:?}");
     let g = s.generalized_variance.as_ref().unwrap();
     assert!(g.z.abs() < 4.0, "{g:?}");
     assert!(g.sd_bootstrap.unwrap() > 0.0);
@@ -301,7 +358,11 @@ fn monte_carlo_agrees_with_linear_theory() {
     assert!(s.validation_rms_before > 0.5);
     assert!(after.max < 0.03, "{after:?}");
     let predicted = s.validation_rms_predicted.unwrap();
-    assert!((after.median / predicted - 1.0).abs() < 0.3, "{} vs {predicted}", after.median);
+    assert!(
+        (after.median / predicted - 1.0).abs() < 0.3,
+        "{} vs {predicted}",
+        after.median
+    );
 }
 
 #[test]
@@ -313,7 +374,10 @@ fn monte_carlo_does_not_depend_on_thread_count() {
         .with_validation_poses(50)
         .with_bootstrap(20);
     let run = |threads: usize| {
-        let tp = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let tp = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         tp.install(|| {
             let v = ValidationSet::sample(&robot, &pool, &design, 50, 3).unwrap();
             serde_json::to_string(&monte_carlo(&robot, "d", &qs, &v, &settings).unwrap()).unwrap()
@@ -363,8 +427,15 @@ fn comparison_shares_validation_and_checks_designs() {
     .unwrap();
     assert_eq!(c.designs.len(), 2);
     assert_eq!(c.validation_indices.len(), 40);
-    assert!(c.validation_indices.iter().all(|i| !design.contains(i) && !other.contains(i)));
-    assert_eq!(c.designs[0].validation_rms_before, c.designs[1].validation_rms_before);
+    assert!(
+        c.validation_indices
+            .iter()
+            .all(|i| !design.contains(i) && !other.contains(i))
+    );
+    assert_eq!(
+        c.designs[0].validation_rms_before,
+        c.designs[1].validation_rms_before
+    );
     assert!(c.designs[0].generalized_variance.is_none()); // 3 trials ≤ 27 unknowns
     let e = compare_designs(&robot, &pool, &[("x".into(), vec![99_999])], &settings).unwrap_err();
     assert!(e.to_string().contains("design 'x'"), "{e}");
@@ -395,20 +466,40 @@ fn cli_calibrate_reports_estimate_and_monte_carlo() {
     let path = write_design("good.json", &DesignFile::new(&robot.name, 5, indices));
     let p = path.to_str().unwrap();
     let out = run(&["calibrate", "--design", p, "--noise", "0", "--json"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
     assert_eq!(v["converged"], true);
     assert!(v["iterations"].as_u64().unwrap() >= 1);
     for name in robot.parameter_names() {
-        assert!(v["residual"][&name].as_f64().unwrap().abs() < 1e-9, "{name}");
+        assert!(
+            v["residual"][&name].as_f64().unwrap().abs() < 1e-9,
+            "{name}"
+        );
         assert!(v["estimate"][&name].is_f64() && v["std"][&name].is_f64());
     }
     assert!(v["validation_rms_after"].as_f64().unwrap() < 1e-9);
     assert!(v["validation_rms_before"].as_f64().unwrap() > 0.5);
     assert!(v["monte_carlo"].is_null());
 
-    let out = run(&["calibrate", "--design", p, "--trials", "30", "--seed", "4", "--json"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = run(&[
+        "calibrate",
+        "--design",
+        p,
+        "--trials",
+        "30",
+        "--seed",
+        "4",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: Value = serde_json::from_slice(&out.stdout).unwrap();
     let mc = &v["monte_carlo"];
     assert_eq!(mc["trials"], 30);
@@ -418,7 +509,10 @@ fn cli_calibrate_reports_estimate_and_monte_carlo() {
     // Text output: the two tables.
     let out = run(&["calibrate", "--design", p, "--noise", "0.01"]);
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("Table III") && text.contains("Table IV"), "{text}");
+    assert!(
+        text.contains("Table III") && text.contains("Table IV"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -440,10 +534,21 @@ fn cli_calibrate_rejects_bad_designs_and_options() {
         let out = run(&all);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{all:?}: {err}");
-        assert!(!err.contains("panicked") && err.contains(needle), "{all:?}: '{err}' lacks '{needle}'");
+        assert!(
+            !err.contains("panicked") && err.contains(needle),
+            "{all:?}: '{err}' lacks '{needle}'"
+        );
     }
-    let good = write_design("ok.json", &DesignFile::new("puma560", 5, (0..30).map(|i| i * 500).collect()));
-    let out = run(&["calibrate", "--design", good.to_str().unwrap(), "--noise=-1"]);
+    let good = write_design(
+        "ok.json",
+        &DesignFile::new("puma560", 5, (0..30).map(|i| i * 500).collect()),
+    );
+    let out = run(&[
+        "calibrate",
+        "--design",
+        good.to_str().unwrap(),
+        "--noise=-1",
+    ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("sigma = -1"), "{err}");

@@ -91,7 +91,11 @@ pub fn conditioned(m: usize, p: usize, log10_cond: f64, rng: &mut CaseRng) -> DM
     let v = rng.orthonormal(p, p);
     let sigma = DMatrix::from_fn(p, p, |i, j| {
         if i == j {
-            let f = if p > 1 { i as f64 / (p - 1) as f64 } else { 0.0 };
+            let f = if p > 1 {
+                i as f64 / (p - 1) as f64
+            } else {
+                0.0
+            };
             10f64.powf(-f * log10_cond / 2.0)
         } else {
             0.0
@@ -160,7 +164,13 @@ pub fn direct_inverse(m: &DMatrix<f64>) -> Option<DMatrix<f64>> {
 /// Eigenvalues of a symmetric matrix (nalgebra), ascending.
 #[must_use]
 pub fn eigenvalues(m: &DMatrix<f64>) -> Vec<f64> {
-    let mut ev: Vec<f64> = m.clone().symmetric_eigen().eigenvalues.iter().copied().collect();
+    let mut ev: Vec<f64> = m
+        .clone()
+        .symmetric_eigen()
+        .eigenvalues
+        .iter()
+        .copied()
+        .collect();
     ev.sort_by(f64::total_cmp);
     ev
 }
@@ -181,7 +191,10 @@ pub fn cond2(m: &DMatrix<f64>) -> f64 {
 #[must_use]
 pub fn retained_fraction(m0: &DMatrix<f64>, m1: &DMatrix<f64>) -> f64 {
     let l = m0.clone().cholesky().expect("M0 positive definite").l();
-    let li = l.clone().try_inverse().expect("triangular factor invertible");
+    let li = l
+        .clone()
+        .try_inverse()
+        .expect("triangular factor invertible");
     let c = &li * m1 * li.transpose();
     let c = (&c + c.transpose()) * 0.5;
     eigenvalues(&c)[0]
@@ -227,14 +240,24 @@ pub struct Case {
 /// `t ∈ 1..=6`, `p ∈ 1..=40`, `κ(M) ∈ [1, 1e10]`, any seed.
 pub fn case() -> impl Strategy<Value = Case> {
     (1usize..=6, 1usize..=40, 0.0f64..=10.0, any::<u64>()).prop_map(|(t, p, log10_cond, seed)| {
-        Case { t, p, log10_cond, seed }
+        Case {
+            t,
+            p,
+            log10_cond,
+            seed,
+        }
     })
 }
 
 /// Like [`case`] with `κ(M) ≤ 1e3` (well conditioned).
 pub fn well_conditioned_case() -> impl Strategy<Value = Case> {
     (1usize..=6, 1usize..=40, 0.0f64..=3.0, any::<u64>()).prop_map(|(t, p, log10_cond, seed)| {
-        Case { t, p, log10_cond, seed }
+        Case {
+            t,
+            p,
+            log10_cond,
+            seed,
+        }
     })
 }
 

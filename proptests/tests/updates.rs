@@ -47,7 +47,10 @@ fn check_change(
             let k1 = cond2(&m1);
             let tol = ln_det_tol(m, p, k0, k1, ld1);
             let err = (ld0 + w.ln_det_ratio() - ld1).abs();
-            prop_assert!(err <= tol, "ln det error {err:e} > tol {tol:e} (κ0={k0:e}, κ1={k1:e})");
+            prop_assert!(
+                err <= tol,
+                "ln det error {err:e} > tol {tol:e} (κ0={k0:e}, κ1={k1:e})"
+            );
             let mut inv = fi.clone();
             w.apply_to_inverse(inv.as_mut());
             let direct = direct_inverse(&m1).unwrap();

@@ -10,8 +10,10 @@ use proptests::*;
 const STEPS: usize = 10_000;
 
 fn stacked(x: &DMatrix<f64>, t: usize, design: &[usize]) -> DMatrix<f64> {
-    let parts: Vec<DMatrix<f64>> =
-        design.iter().map(|&i| x.rows(i * t, t).into_owned()).collect();
+    let parts: Vec<DMatrix<f64>> = design
+        .iter()
+        .map(|&i| x.rows(i * t, t).into_owned())
+        .collect();
     let refs: Vec<&DMatrix<f64>> = parts.iter().collect();
     vstack(&refs)
 }

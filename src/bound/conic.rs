@@ -16,13 +16,11 @@
 //! The off-diagonal entries of the bottom-right block have no entries in `A`
 //! at all, so chordal decomposition can split the cone.
 
-use super::variance::{Scaled, check_problem, scale_columns};
 use super::BoundError;
+use super::variance::{Scaled, check_problem, scale_columns};
 use crate::blocks::Blocks;
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{
-    DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
-};
+use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -226,8 +224,12 @@ pub(crate) fn solve_scaled(sc: &Scaled, n: usize, s: &ConicSettings) -> ConicOut
         }
     }
     let m = sc.x.n_poses();
-    let (status, weights, pr, du) =
-        res.unwrap_or((ConicStatus::NumericalError, vec![0.0; m], f64::NAN, f64::NAN));
+    let (status, weights, pr, du) = res.unwrap_or((
+        ConicStatus::NumericalError,
+        vec![0.0; m],
+        f64::NAN,
+        f64::NAN,
+    ));
     ConicOutcome {
         weights,
         status,

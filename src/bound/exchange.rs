@@ -21,11 +21,11 @@
 //! `0 < w_i < 1` and `d_i ≤ c` where `w_i = 0`; a pairwise step exists exactly
 //! while they fail.
 
+use super::BoundError;
 use super::variance::{
     Scaled, VarianceWork, certificate, check_problem, information, make_feasible, scale_columns,
     top_sum, variances_into,
 };
-use super::BoundError;
 use crate::blocks::Blocks;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
@@ -64,8 +64,8 @@ impl Default for ExchangeSettings {
             gap_tol: 1e-7,
             max_rounds: 2000,
             time_limit: 60.0,
-            warmup_rounds: 6,
-            keep: 300,
+            warmup_rounds: 30,
+            keep: 1000,
             extra: 100,
             max_steps: 3000,
         }
@@ -83,10 +83,18 @@ impl ExchangeSettings {
             })
         };
         if !(self.gap_tol > 0.0 && self.gap_tol.is_finite()) {
-            return bad("first_order.gap_tol", self.gap_tol.to_string(), "must be finite and > 0");
+            return bad(
+                "first_order.gap_tol",
+                self.gap_tol.to_string(),
+                "must be finite and > 0",
+            );
         }
         if !(self.time_limit > 0.0) {
-            return bad("first_order.time_limit", self.time_limit.to_string(), "must be > 0");
+            return bad(
+                "first_order.time_limit",
+                self.time_limit.to_string(),
+                "must be > 0",
+            );
         }
         if self.max_rounds == 0 {
             return bad("first_order.max_rounds", "0".into(), "must be ≥ 1");
@@ -256,7 +264,12 @@ pub(crate) fn solve_scaled(
             rounds += 1;
             best_bound = best_bound.min(eval.bound);
             if std::env::var_os("BOUND_TRACE").is_some() {
-                eprintln!("warmup {rounds} t={:.3} ln_det={:.9} gap={:.3e}", clock.elapsed().as_secs_f64(), eval.ln_det, eval.bound - eval.ln_det);
+                eprintln!(
+                    "warmup {rounds} t={:.3} ln_det={:.9} gap={:.3e}",
+                    clock.elapsed().as_secs_f64(),
+                    eval.ln_det,
+                    eval.bound - eval.ln_det
+                );
             }
         }
         // Prune to the `keep` largest weights; widen if M becomes singular.
@@ -298,9 +311,26 @@ pub(crate) fn solve_scaled(
         }
         let cand = candidates(&w, &eval.d, s.extra);
         if std::env::var_os("BOUND_TRACE").is_some() {
-            eprintln!("round {rounds} t={:.3} ln_det={:.9} bound={:.9} gap={:.3e} support={} cand={} steps={steps}", clock.elapsed().as_secs_f64(), eval.ln_det, eval.bound, eval.bound - eval.ln_det, w.iter().filter(|&&v| v > 0.0).count(), cand.len());
+            eprintln!(
+                "round {rounds} t={:.3} ln_det={:.9} bound={:.9} gap={:.3e} support={} cand={} steps={steps}",
+                clock.elapsed().as_secs_f64(),
+                eval.ln_det,
+                eval.bound,
+                eval.bound - eval.ln_det,
+                w.iter().filter(|&&v| v > 0.0).count(),
+                cand.len()
+            );
         }
-        steps += exchange_round(x, &cand, &mut w, eval.minv, &eval.d, step_tol, s.max_steps, &mut pair);
+        steps += exchange_round(
+            x,
+            &cand,
+            &mut w,
+            eval.minv,
+            &eval.d,
+            step_tol,
+            s.max_steps,
+            &mut pair,
+        );
         // Rounding in the Woodbury updates can leave tiny negative weights.
         make_feasible(&mut w, n);
         match evaluate(x, n, &w, &mut work, &mut scratch) {
@@ -454,8 +484,22 @@ fn exchange_round(
                 pw.ut[(c, t + r)] = xk[(bj * t + r, c)];
             }
         }
-        matmul(pw.wm.as_mut(), Accum::Replace, minv.as_ref(), pw.ut.as_ref(), 1.0, Par::Seq);
-        matmul(pw.g.as_mut(), Accum::Replace, pw.ut.transpose(), pw.wm.as_ref(), 1.0, Par::Seq);
+        matmul(
+            pw.wm.as_mut(),
+            Accum::Replace,
+            minv.as_ref(),
+            pw.ut.as_ref(),
+            1.0,
+            Par::Seq,
+        );
+        matmul(
+            pw.g.as_mut(),
+            Accum::Replace,
+            pw.ut.transpose(),
+            pw.wm.as_ref(),
+            1.0,
+            Par::Seq,
+        );
         let g = DMatrix::from_fn(2 * t, 2 * t, |a, b| 0.5 * (pw.g[(a, b)] + pw.g[(b, a)]));
         // μ: eigenvalues of D G = those of the symmetric G^{1/2} D G^{1/2}.
         let eg = SymmetricEigen::new(g.clone());
@@ -476,7 +520,9 @@ fn exchange_round(
         }
         // R = δ (I + δ D G)⁻¹ D, symmetrised.
         let bmat = DMatrix::<f64>::identity(2 * t, 2 * t) + &dm * &g * delta;
-        let Some(binv) = bmat.try_inverse() else { break };
+        let Some(binv) = bmat.try_inverse() else {
+            break;
+        };
         let r = binv * &dm * delta;
         for a in 0..2 * t {
             for c in 0..2 * t {
@@ -495,8 +541,22 @@ fn exchange_round(
             w[j] -= delta;
         }
         // d_k −= tr(P_k R P_kᵀ), P = X_K W;  M⁻¹ −= W R Wᵀ   (X2)
-        matmul(pk.as_mut(), Accum::Replace, xk.as_ref(), pw.wm.as_ref(), 1.0, Par::Seq);
-        matmul(qk.as_mut(), Accum::Replace, pk.as_ref(), pw.r.as_ref(), 1.0, Par::Seq);
+        matmul(
+            pk.as_mut(),
+            Accum::Replace,
+            xk.as_ref(),
+            pw.wm.as_ref(),
+            1.0,
+            Par::Seq,
+        );
+        matmul(
+            qk.as_mut(),
+            Accum::Replace,
+            pk.as_ref(),
+            pw.r.as_ref(),
+            1.0,
+            Par::Seq,
+        );
         for (k, dkv) in dk.iter_mut().enumerate() {
             let mut s = 0.0;
             for c in 0..2 * t {
@@ -507,8 +567,22 @@ fn exchange_round(
             }
             *dkv -= s;
         }
-        matmul(pw.wr.as_mut(), Accum::Replace, pw.wm.as_ref(), pw.r.as_ref(), 1.0, Par::Seq);
-        matmul(minv.as_mut(), Accum::Add, pw.wr.as_ref(), pw.wm.transpose(), -1.0, Par::Seq);
+        matmul(
+            pw.wr.as_mut(),
+            Accum::Replace,
+            pw.wm.as_ref(),
+            pw.r.as_ref(),
+            1.0,
+            Par::Seq,
+        );
+        matmul(
+            minv.as_mut(),
+            Accum::Add,
+            pw.wr.as_ref(),
+            pw.wm.transpose(),
+            -1.0,
+            Par::Seq,
+        );
         steps += 1;
     }
     steps

@@ -351,7 +351,15 @@ pub fn relaxation_bound(
     let mut conic_summary = ConicSummary::default();
 
     if pool == n {
-        return Ok(finish(best, &sc, n, BoundStatus::Exact, first_order, conic_summary, clock));
+        return Ok(finish(
+            best,
+            &sc,
+            n,
+            BoundStatus::Exact,
+            first_order,
+            conic_summary,
+            clock,
+        ));
     }
 
     if settings.use_conic && best.gap() > settings.gap_tol {
@@ -445,7 +453,15 @@ pub fn relaxation_bound(
     } else {
         BoundStatus::GapAboveTolerance
     };
-    Ok(finish(best, &sc, n, status, first_order, conic_summary, clock))
+    Ok(finish(
+        best,
+        &sc,
+        n,
+        status,
+        first_order,
+        conic_summary,
+        clock,
+    ))
 }
 
 fn finish(

@@ -82,13 +82,13 @@ pub fn scale_columns(x: &Blocks, n: usize) -> Result<Scaled, BoundError> {
     let s: Vec<f64> = norms.iter().map(|v| v * f).collect();
     let scaled = Mat::from_fn(rows, p, |r, c| m[(r, c)] / s[c]);
     let gram = scaled.transpose() * &scaled;
-    let eig = gram
-        .self_adjoint_eigenvalues(Side::Lower)
-        .map_err(|_| BoundError::RankDeficient {
-            rank: 0,
-            p,
-            ratio: 0.0,
-        })?;
+    let eig =
+        gram.self_adjoint_eigenvalues(Side::Lower)
+            .map_err(|_| BoundError::RankDeficient {
+                rank: 0,
+                p,
+                ratio: 0.0,
+            })?;
     let max = eig.iter().cloned().fold(0.0, f64::max);
     let min = eig.iter().cloned().fold(f64::INFINITY, f64::min);
     let ratio = if max > 0.0 { min / max } else { 0.0 };
@@ -136,7 +136,9 @@ pub struct VarianceWork {
 
 impl Default for VarianceWork {
     fn default() -> Self {
-        Self { y: Mat::zeros(0, 0) }
+        Self {
+            y: Mat::zeros(0, 0),
+        }
     }
 }
 
@@ -247,9 +249,7 @@ pub fn make_feasible(w: &mut [f64], n: usize) {
                     .for_each(|v| *v = (*v + f * (1.0 - *v)).min(1.0));
             } else {
                 let rest = deficit - room;
-                w.iter_mut()
-                    .filter(|v| **v > 0.0)
-                    .for_each(|v| *v = 1.0);
+                w.iter_mut().filter(|v| **v > 0.0).for_each(|v| *v = 1.0);
                 let zeros = w.iter().filter(|&&v| v == 0.0).count();
                 let f = rest / zeros as f64;
                 w.iter_mut()

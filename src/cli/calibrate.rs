@@ -185,10 +185,7 @@ fn mc_text(mc: &MonteCarloSummary, seconds: f64) -> String {
         mc.trials, mc.converged, mc.statuses
     );
     if let Some(it) = &mc.iterations {
-        s += &format!(
-            "iterations: median {} max {}\n",
-            it.median, it.max
-        );
+        s += &format!("iterations: median {} max {}\n", it.median, it.max);
     }
     if let (Some(n), Some(r)) = (mc.ln_det_information_nominal, mc.ln_det_information_real) {
         s += &format!("ln det XᵀX: {n:.3} (nominal), {r:.3} (real)\n");

@@ -1,12 +1,12 @@
 //! `score` and `select`: observability of a design, and pose selection.
 
-use super::{emit, parse_list, PoolOpts};
+use super::{PoolOpts, emit, parse_list};
 use activecal::criterion::{DCriterion, Indices, OiCriterion};
 use activecal::design::DesignFile;
-use activecal::select::{multistart, Algorithm, Selection, Settings};
-use anyhow::{bail, Result};
+use activecal::select::{Algorithm, Selection, Settings, multistart};
+use anyhow::{Result, bail};
 use clap::Args;
-use serde_json::{json, Value};
+use serde_json::{Value, json};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -52,7 +52,18 @@ pub fn cmd_score(a: ScoreArgs) -> Result<()> {
     emit(a.json, &v, || {
         format!(
             "{} poses, rank {} of {}\nln OI_D {:.6}  log10 OI_D {:.6}\nOI {:.6}  O1 {:.6e}  O2 {:.6e}  O3 {:.6e}  O4 {:.6e}  O5 {:.6e}  tr(M^-1) {:.6e}\n",
-            lattice_poses.len(), ind.rank, ctx.x.p(), ind.ln_oid, ind.log10_oid, ind.oi, ind.o1, ind.o2, ind.o3, ind.o4, ind.o5, ind.a_trace
+            lattice_poses.len(),
+            ind.rank,
+            ctx.x.p(),
+            ind.ln_oid,
+            ind.log10_oid,
+            ind.oi,
+            ind.o1,
+            ind.o2,
+            ind.o3,
+            ind.o4,
+            ind.o5,
+            ind.a_trace
         )
     });
     Ok(())
@@ -102,7 +113,12 @@ pub struct SelectArgs {
 }
 
 /// Runs a selection with the named criterion.
-pub fn run_selection(x: &activecal::blocks::Blocks, criterion: &str, alg: Algorithm, s: &Settings) -> Result<Selection> {
+pub fn run_selection(
+    x: &activecal::blocks::Blocks,
+    criterion: &str,
+    alg: Algorithm,
+    s: &Settings,
+) -> Result<Selection> {
     Ok(match criterion {
         "det" => multistart(x, DCriterion::new, alg, s)?,
         "oi" => multistart(x, OiCriterion::new, alg, s)?,
@@ -159,7 +175,17 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     });
     if let Some(out) = &a.out {
         let mut d = DesignFile::new(&ctx.robot.name, a.pool.levels, poses.clone());
-        for k in ["ln_oid", "log10_oid", "oi", "algorithm", "criterion", "seed", "starts", "polish", "fixed"] {
+        for k in [
+            "ln_oid",
+            "log10_oid",
+            "oi",
+            "algorithm",
+            "criterion",
+            "seed",
+            "starts",
+            "polish",
+            "fixed",
+        ] {
             d.extra.insert(k.into(), v[k].clone());
         }
         d.write(out, a.force)?;
@@ -175,7 +201,11 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
             seconds,
             log10,
             sel.oi,
-            poses.iter().map(|p| p.to_string()).collect::<Vec<_>>().join(",")
+            poses
+                .iter()
+                .map(|p| p.to_string())
+                .collect::<Vec<_>>()
+                .join(",")
         )
     });
     Ok(())

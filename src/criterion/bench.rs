@@ -4,10 +4,10 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use super::CriterionError;
 use super::criteria::{Criterion, DCriterion, OiCriterion};
 use super::state::{InfoState, StateSettings};
 use super::variances::PoolVariances;
-use super::CriterionError;
 use crate::blocks::Blocks;
 
 /// Timings of [`bench_scan`], in nanoseconds per candidate pose (wall clock,
@@ -94,7 +94,9 @@ pub fn bench_scan(
 
     let mut ex = vec![0.0; cands.len()];
     let exch = match out_pose {
-        Some(o) => best_of(reps, || d.price_exchanges(pool, &state, &[o], &cands, &mut ex)),
+        Some(o) => best_of(reps, || {
+            d.price_exchanges(pool, &state, &[o], &cands, &mut ex)
+        }),
         None => f64::NAN,
     };
 

@@ -82,7 +82,10 @@ pub fn argmax(values: &[f64]) -> Option<usize> {
 
 fn check_outs(state: &InfoState, outs: &[usize]) {
     for &j in outs {
-        assert!(state.contains(j), "exchange out-pose {j} is not in the design");
+        assert!(
+            state.contains(j),
+            "exchange out-pose {j} is not in the design"
+        );
     }
 }
 
@@ -169,11 +172,12 @@ impl Criterion for DCriterion {
         let floor = state.pivot_floor();
         self.variances(pool, state)
             .exchange_gains(pool, state, outs, candidates, floor, out);
-        out.par_chunks_mut(CHUNK * outs.len().max(1)).for_each(|oc| {
-            for o in oc {
-                *o += base;
-            }
-        });
+        out.par_chunks_mut(CHUNK * outs.len().max(1))
+            .for_each(|oc| {
+                for o in oc {
+                    *o += base;
+                }
+            });
     }
 }
 
@@ -367,7 +371,10 @@ mod tests {
         let pool = random_pool(300, 3, 8, 17);
         let start: Vec<usize> = (0..6).collect();
         let mut designs = Vec::new();
-        for crit in [&mut DCriterion::new() as &mut dyn Criterion, &mut OiCriterion::new()] {
+        for crit in [
+            &mut DCriterion::new() as &mut dyn Criterion,
+            &mut OiCriterion::new(),
+        ] {
             let mut st = InfoState::new(&pool, &start, StateSettings::default()).unwrap();
             let s0 = crit.score(&pool, &st);
             let mut steps = 0;
@@ -418,7 +425,10 @@ mod tests {
                 assert!((to_oi(*x) - y).abs() < 1e-9 * y);
             }
         }
-        assert_eq!(argmax(&[f64::NEG_INFINITY, 1.0, 3.0, 3.0, f64::NAN]), Some(2));
+        assert_eq!(
+            argmax(&[f64::NEG_INFINITY, 1.0, 3.0, 3.0, f64::NAN]),
+            Some(2)
+        );
         assert_eq!(argmax(&[f64::NEG_INFINITY]), None);
     }
 }

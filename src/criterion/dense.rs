@@ -2,11 +2,11 @@
 //! blocks, Cholesky with a pivot floor, Gram-matrix updates, and the faer
 //! calls (always sequential, so results never depend on the thread count).
 
+use faer::diag::Diag;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt;
 use faer::linalg::evd::{self, ComputeEigenvectors};
 use faer::linalg::svd::{self, ComputeSvdVectors};
-use faer::diag::Diag;
 use faer::{Mat, MatMut, MatRef, Par};
 
 use super::MAX_T;
@@ -230,8 +230,15 @@ impl EigenScratch {
     pub(crate) fn eigenvalues(&mut self, m: MatRef<'_, f64>) -> Option<&[f64]> {
         let p = m.nrows();
         let stack = MemStack::new(&mut self.mem);
-        evd::self_adjoint_evd(m, self.s.as_mut(), None, Par::Seq, stack, Default::default())
-            .ok()?;
+        evd::self_adjoint_evd(
+            m,
+            self.s.as_mut(),
+            None,
+            Par::Seq,
+            stack,
+            Default::default(),
+        )
+        .ok()?;
         let col = self.s.column_vector();
         let slice = col.try_as_col_major()?.as_slice();
         Some(&slice[..p])
@@ -312,7 +319,11 @@ mod tests {
     fn cholesky_inverse_reconstructs() {
         for p in 1..12 {
             let m = Mat::from_fn(p, p, |i, j| {
-                if i == j { p as f64 + 1.0 } else { 1.0 / (1.0 + (i + j) as f64) }
+                if i == j {
+                    p as f64 + 1.0
+                } else {
+                    1.0 / (1.0 + (i + j) as f64)
+                }
             });
             let (inv, _) = cholesky_inverse(m.as_ref()).unwrap();
             let prod = &m * &inv;

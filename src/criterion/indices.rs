@@ -55,9 +55,17 @@ impl Indices {
         let s_max = sigma.iter().copied().fold(0.0, f64::max);
         let s_min = sigma.iter().copied().fold(f64::INFINITY, f64::min);
         let ln_oid: f64 = sigma.iter().map(|&s| 2.0 * s.ln()).sum();
-        let ln_oid = if ln_oid.is_nan() { f64::NEG_INFINITY } else { ln_oid };
+        let ln_oid = if ln_oid.is_nan() {
+            f64::NEG_INFINITY
+        } else {
+            ln_oid
+        };
         // Geometric mean of the σ_i: exp(ln OI_D / (2L)).
-        let geo = if p == 0 { 0.0 } else { (ln_oid / (2.0 * l)).exp() };
+        let geo = if p == 0 {
+            0.0
+        } else {
+            (ln_oid / (2.0 * l)).exp()
+        };
         let tol = (m.max(p) as f64) * f64::EPSILON * s_max;
         let recip: f64 = sigma.iter().map(|&s| 1.0 / s).sum();
         let recip2: f64 = sigma.iter().map(|&s| 1.0 / (s * s)).sum();
@@ -66,9 +74,17 @@ impl Indices {
             log10_oid: ln_oid / std::f64::consts::LN_10,
             oi: if p == 0 { 0.0 } else { geo / l },
             o1: if m == 0 { 0.0 } else { geo / (m as f64).sqrt() },
-            o2: if s_min > 0.0 { s_max / s_min } else { f64::INFINITY },
+            o2: if s_min > 0.0 {
+                s_max / s_min
+            } else {
+                f64::INFINITY
+            },
             o3: s_min,
-            o4: if s_max > 0.0 { s_min * s_min / s_max } else { 0.0 },
+            o4: if s_max > 0.0 {
+                s_min * s_min / s_max
+            } else {
+                0.0
+            },
             o5: 1.0 / recip,
             a_trace: recip2,
             rank: sigma.iter().filter(|&&s| s > tol).count(),
@@ -128,7 +144,9 @@ mod tests {
 
     #[test]
     fn design_and_information_agree() {
-        let x = Mat::from_fn(12, 4, |i, j| ((i * 7 + j * 3) % 11) as f64 - 5.0 + (i == j) as u8 as f64);
+        let x = Mat::from_fn(12, 4, |i, j| {
+            ((i * 7 + j * 3) % 11) as f64 - 5.0 + (i == j) as u8 as f64
+        });
         let pool = Blocks::new(x.clone(), 3);
         let a = Indices::from_design(&pool, &[0, 1, 2, 3]);
         let b = Indices::from_information((x.transpose() * &x).as_ref(), 12);

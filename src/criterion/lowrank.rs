@@ -186,10 +186,8 @@ pub fn woodbury(
             lb[r * b + c] = v;
         }
     }
-    let ln_b = chol_in_place(&mut lb, b, pivot_floor).map_err(|pivot| Singular {
-        pivot,
-        pivot_floor,
-    })?;
+    let ln_b =
+        chol_in_place(&mut lb, b, pivot_floor).map_err(|pivot| Singular { pivot, pivot_floor })?;
 
     // F₋ = (U₋ − F₊ Y) L_B⁻ᵀ. Derivation: after adding Z₊ the inverse is
     // M₁⁻¹ = M⁻¹ − F₊F₊ᵀ, so M₁⁻¹Z₋ᵀ = U₋ − F₊ (L_A⁻¹S₊₋) = U₋ − F₊Y and
@@ -335,9 +333,19 @@ mod tests {
         let x = random(3, 3, &mut seed);
         let m = x.transpose() * &x;
         let (m_inv, _) = cholesky_inverse(m.as_ref()).unwrap();
-        let r = woodbury(m_inv.as_ref(), x.as_ref().subrows(0, 0), x.as_ref().subrows(1, 1), 1e-8);
+        let r = woodbury(
+            m_inv.as_ref(),
+            x.as_ref().subrows(0, 0),
+            x.as_ref().subrows(1, 1),
+            1e-8,
+        );
         assert!(r.is_err());
-        let c = cascade(m_inv.as_ref(), x.as_ref().subrows(0, 0), x.as_ref().subrows(1, 1), 1e-8);
+        let c = cascade(
+            m_inv.as_ref(),
+            x.as_ref().subrows(0, 0),
+            x.as_ref().subrows(1, 1),
+            1e-8,
+        );
         assert!(c.is_err());
     }
 }

@@ -237,7 +237,9 @@ impl InfoState {
         let (t, p, n_pool) = (pool.t(), pool.p(), pool.n_poses());
         if t > MAX_T || p == 0 {
             return Err(CriterionError::UnsupportedShape {
-                reason: format!("need 1 <= t <= {MAX_T} rows per pose and p >= 1, got t={t}, p={p}"),
+                reason: format!(
+                    "need 1 <= t <= {MAX_T} rows per pose and p >= 1, got t={t}, p={p}"
+                ),
             });
         }
         let x = pool.mat();
@@ -245,14 +247,21 @@ impl InfoState {
             for r in 0..x.nrows() {
                 let v = x[(r, c)];
                 if !v.is_finite() {
-                    return Err(CriterionError::NonFinite { row: r, col: c, value: v });
+                    return Err(CriterionError::NonFinite {
+                        row: r,
+                        col: c,
+                        value: v,
+                    });
                 }
             }
         }
         let mut position = vec![NOT_IN_DESIGN; n_pool];
         for (k, &q) in design.iter().enumerate() {
             if q >= n_pool {
-                return Err(CriterionError::PoseOutOfRange { pose: q, n_poses: n_pool });
+                return Err(CriterionError::PoseOutOfRange {
+                    pose: q,
+                    n_poses: n_pool,
+                });
             }
             if position[q] != NOT_IN_DESIGN {
                 return Err(CriterionError::DuplicatePose { pose: q });
@@ -316,7 +325,12 @@ impl InfoState {
             }
         }
         let cond1 = norm1(m.as_ref()) * norm1(m_inv.as_ref());
-        Ok(Factored { m, m_inv, ln_det, cond1 })
+        Ok(Factored {
+            m,
+            m_inv,
+            ln_det,
+            cond1,
+        })
     }
 
     fn check_pool(&self, pool: &Blocks) {
@@ -328,7 +342,10 @@ impl InfoState {
 
     fn check_in_range(&self, q: usize) -> Result<(), CriterionError> {
         if q >= self.n_pool {
-            return Err(CriterionError::PoseOutOfRange { pose: q, n_poses: self.n_pool });
+            return Err(CriterionError::PoseOutOfRange {
+                pose: q,
+                n_poses: self.n_pool,
+            });
         }
         Ok(())
     }
@@ -386,7 +403,10 @@ impl InfoState {
     /// Position of pool pose `q` in [`design`](Self::design), if there.
     #[must_use]
     pub fn position_of(&self, q: usize) -> Option<usize> {
-        self.position.get(q).copied().filter(|&k| k != NOT_IN_DESIGN)
+        self.position
+            .get(q)
+            .copied()
+            .filter(|&k| k != NOT_IN_DESIGN)
     }
 
     /// Whether pool pose `q` is in the design.
@@ -484,7 +504,9 @@ impl InfoState {
 
     fn status_of(r: &Result<LowRank, Status>) -> Status {
         match r {
-            Ok(lr) => Status::Regular { delta_ln_det: lr.ln_det_ratio() },
+            Ok(lr) => Status::Regular {
+                delta_ln_det: lr.ln_det_ratio(),
+            },
             Err(s) => *s,
         }
     }
@@ -572,17 +594,14 @@ impl InfoState {
         }
     }
 
-    fn apply_status(
-        &mut self,
-        pool: &Blocks,
-        plus: Option<usize>,
-        minus: Option<usize>,
-    ) -> Status {
+    fn apply_status(&mut self, pool: &Blocks, plus: Option<usize>, minus: Option<usize>) -> Status {
         match self.low_rank(pool, plus, minus) {
             Ok(lr) => {
                 let delta = lr.ln_det_ratio();
                 self.apply(pool, lr, plus, minus);
-                Status::Regular { delta_ln_det: delta }
+                Status::Regular {
+                    delta_ln_det: delta,
+                }
             }
             Err(s) => s,
         }
@@ -701,7 +720,11 @@ impl InfoState {
         }
         let scale = fresh.norm_max();
         let information = (&self.m - &fresh).norm_max() / if scale > 0.0 { scale } else { 1.0 };
-        Drift { ln_det, inverse, information }
+        Drift {
+            ln_det,
+            inverse,
+            information,
+        }
     }
 }
 
@@ -763,11 +786,17 @@ mod tests {
         // Two poses: 6 rows for 9 parameters.
         assert_eq!(
             InfoState::new(&pool, &[0, 1], s).unwrap_err(),
-            CriterionError::Singular { rank_estimate: 6, p: 9 }
+            CriterionError::Singular {
+                rank_estimate: 6,
+                p: 9
+            }
         );
         // With a ridge it works, and dropping the ridge is refused.
         let mut st = InfoState::new(&pool, &[0, 1], s.with_ridge(1e-3)).unwrap();
-        assert!(matches!(st.set_ridge(&pool, 0.0), Err(CriterionError::Singular { .. })));
+        assert!(matches!(
+            st.set_ridge(&pool, 0.0),
+            Err(CriterionError::Singular { .. })
+        ));
         assert_eq!(st.ridge(), 1e-3);
         st.add(&pool, 2).unwrap().delta().unwrap();
         st.set_ridge(&pool, 0.0).unwrap();
@@ -777,17 +806,32 @@ mod tests {
         assert!(!r.is_regular(), "{r:?}");
         assert_eq!(st.ln_det(), before);
         assert_eq!(st.design(), &[0, 1, 2]);
-        assert!(matches!(st.remove(&pool, 5), Err(CriterionError::NotInDesign { pose: 5 })));
-        assert!(matches!(st.add(&pool, 0), Err(CriterionError::AlreadyInDesign { pose: 0 })));
-        assert!(StateSettings::default().with_ridge(f64::NAN).validate().is_err());
+        assert!(matches!(
+            st.remove(&pool, 5),
+            Err(CriterionError::NotInDesign { pose: 5 })
+        ));
+        assert!(matches!(
+            st.add(&pool, 0),
+            Err(CriterionError::AlreadyInDesign { pose: 0 })
+        ));
+        assert!(
+            StateSettings::default()
+                .with_ridge(f64::NAN)
+                .validate()
+                .is_err()
+        );
     }
 
     #[test]
     fn refactorizes_periodically_and_drift_is_small() {
         let pool = random_pool(60, 3, 12, 2);
         let design: Vec<usize> = (0..10).collect();
-        let mut st = InfoState::new(&pool, &design, StateSettings::default().with_refactor_every(8))
-            .unwrap();
+        let mut st = InfoState::new(
+            &pool,
+            &design,
+            StateSettings::default().with_refactor_every(8),
+        )
+        .unwrap();
         let mut next = 10;
         for k in 0..100 {
             let out = st.design()[k % st.design().len()];
@@ -798,6 +842,9 @@ mod tests {
         }
         assert!(st.epoch() >= 12);
         let d = st.drift(&pool);
-        assert!(d.ln_det < 1e-10 && d.inverse < 1e-10 && d.information < 1e-14, "{d:?}");
+        assert!(
+            d.ln_det < 1e-10 && d.inverse < 1e-10 && d.information < 1e-14,
+            "{d:?}"
+        );
     }
 }

@@ -288,8 +288,23 @@ impl PoolVariances {
             xo.as_mut().subrows_mut(o * t, t).copy_from(pool.block(j));
         }
         let mut a = Mat::<f64>::zeros(self.p, k);
-        matmul(a.as_mut(), Accum::Replace, state.m_inv(), xo.transpose(), 1.0, Par::Seq);
-        chunked_product(pool.mat(), t, a.as_ref(), &mut self.work, &mut [], 0, |_, _, _, _| {});
+        matmul(
+            a.as_mut(),
+            Accum::Replace,
+            state.m_inv(),
+            xo.transpose(),
+            1.0,
+            Par::Seq,
+        );
+        chunked_product(
+            pool.mat(),
+            t,
+            a.as_ref(),
+            &mut self.work,
+            &mut [],
+            0,
+            |_, _, _, _| {},
+        );
         MatRef::from_column_major_slice(&self.work[..rows * k], rows, k)
     }
 
@@ -440,7 +455,10 @@ mod tests {
         let st = InfoState::new(&pool, &design, StateSettings::default()).unwrap();
         let cands: Vec<usize> = (12..1000).collect();
         let run = |threads: usize| {
-            let tp = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let tp = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
             tp.install(|| {
                 let mut st2 = st.clone();
                 let mut pv = PoolVariances::new(&pool, &st2);

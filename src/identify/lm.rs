@@ -15,13 +15,13 @@
 //! `D` is MINPACK's scaling, `d_j = max over iterations of ‖J_{:,j}‖`, so the
 //! damping is invariant to the units of the unknowns (radians vs. metres).
 
+use super::dense::{SeqQr, inverse_information};
 use super::{IdentifyError, Measurements, Result};
 use crate::blocks::Blocks;
 use crate::kinematics::Evaluator;
 use crate::pool::identifiability;
 use crate::robot::{ParamTable, Robot, Symbol};
-use faer::linalg::solvers::SolveLstsq;
-use faer::{Mat, Par};
+use faer::Mat;
 use serde::{Deserialize, Serialize};
 
 /// Settings of the solver, with documented defaults; [`LmSettings::validate`]
@@ -91,7 +91,11 @@ impl LmSettings {
             value: value.to_string(),
             reason,
         };
-        for (name, v) in [("xtol", self.xtol), ("ftol", self.ftol), ("gtol", self.gtol)] {
+        for (name, v) in [
+            ("xtol", self.xtol),
+            ("ftol", self.ftol),
+            ("gtol", self.gtol),
+        ] {
             if !(v.is_finite() && (0.0..1.0).contains(&v)) {
                 return Err(bad(name, v, "a tolerance must be in [0, 1)"));
             }
@@ -399,35 +403,6 @@ pub fn predicted_covariance(
     }))
 }
 
-/// `(XᵀX)⁻¹` through the QR of the column-scaled `X D⁻¹ = Q R`:
-/// `(XᵀX)⁻¹ = D⁻¹ R⁻¹ R⁻ᵀ D⁻¹`, never forming `XᵀX`. `None` if a column is
-/// zero or `R` has a zero pivot.
-fn inverse_information(x: faer::MatRef<'_, f64>) -> Option<Mat<f64>> {
-    let p = x.ncols();
-    if x.nrows() < p {
-        return None;
-    }
-    let d: Vec<f64> = (0..p).map(|c| x.col(c).norm_l2()).collect();
-    if d.iter().any(|&v| !(v > 0.0 && v.is_finite())) {
-        return None;
-    }
-    let xs = Mat::from_fn(x.nrows(), p, |i, j| x[(i, j)] / d[j]);
-    let qr = xs.qr();
-    let r = qr.thin_R();
-    if (0..p).any(|i| r[(i, i)] == 0.0 || !r[(i, i)].is_finite()) {
-        return None;
-    }
-    let mut rinv = Mat::<f64>::identity(p, p);
-    faer::linalg::triangular_solve::solve_upper_triangular_in_place(
-        r,
-        rinv.as_mut(),
-        Par::Seq,
-    );
-    // (XsᵀXs)⁻¹ = R⁻¹ R⁻ᵀ; undo the scaling on both sides.
-    let inner = &rinv * rinv.transpose();
-    Some(Mat::from_fn(p, p, |i, j| inner[(i, j)] / (d[i] * d[j])))
-}
-
 fn covariance_from(inv: &Mat<f64>, s2: f64, names: &[String]) -> Covariance {
     let p = inv.nrows();
     let matrix: Vec<Vec<f64>> = (0..p)
@@ -558,9 +533,9 @@ fn levenberg_marquardt(prob: &mut Problem<'_>, theta0: &[f64], s: &LmSettings) -
                     0.0
                 }
             });
-            let qr = aug.qr();
-            let rhs = Mat::from_fn(m + p, 1, |i, _| if i < m { -r[i] } else { 0.0 });
-            let u = qr.solve_lstsq(&rhs);
+            let mut qr = SeqQr::new(aug);
+            let mut u = Mat::from_fn(m + p, 1, |i, _| if i < m { -r[i] } else { 0.0 });
+            qr.solve_lstsq_in_place(u.as_mut());
             let u: Vec<f64> = (0..p).map(|j| u[(j, 0)]).collect();
             let mut step: Vec<f64> = (0..p).map(|j| u[j] / d[j]).collect();
             let mut ok = u.iter().all(|v| v.is_finite());
@@ -576,18 +551,17 @@ fn levenberg_marquardt(prob: &mut Problem<'_>, theta0: &[f64], s: &LmSettings) -
                     let jv: Vec<f64> = (0..m)
                         .map(|i| (0..p).map(|j| jac[(i, j)] * step[j]).sum::<f64>())
                         .collect();
-                    let rhs = Mat::from_fn(m + p, 1, |i, _| {
+                    let mut a = Mat::from_fn(m + p, 1, |i, _| {
                         if i < m {
                             -(2.0 / GEO_H) * ((r_geo[i] - r[i]) / GEO_H - jv[i])
                         } else {
                             0.0
                         }
                     });
-                    let a = qr.solve_lstsq(&rhs);
+                    qr.solve_lstsq_in_place(a.as_mut());
                     let a_s: Vec<f64> = (0..p).map(|j| a[(j, 0)]).collect();
                     let un = norm(&u);
-                    if a_s.iter().all(|v| v.is_finite()) && 2.0 * norm(&a_s) <= GEO_ALPHA * un
-                    {
+                    if a_s.iter().all(|v| v.is_finite()) && 2.0 * norm(&a_s) <= GEO_ALPHA * un {
                         for j in 0..p {
                             step[j] += 0.5 * a_s[j] / d[j];
                         }
@@ -621,7 +595,11 @@ fn levenberg_marquardt(prob: &mut Problem<'_>, theta0: &[f64], s: &LmSettings) -
                     }
                 }
             }
-            let rho = if pred > 0.0 { actual / pred } else { f64::NEG_INFINITY };
+            let rho = if pred > 0.0 {
+                actual / pred
+            } else {
+                f64::NEG_INFINITY
+            };
             let accepted = rho > ACCEPT;
 
             // ---- tolerances (MINPACK's tests, on this trial) ----------------

@@ -17,6 +17,7 @@
 //! [`IdentifyError`]; a numerical outcome (no convergence, divergence, a rank
 //! deficient design) is the [`Status`] of the result.
 
+mod dense;
 pub mod lm;
 pub mod montecarlo;
 pub mod simulate;
@@ -31,7 +32,7 @@ pub use montecarlo::{
     ValidationSet, compare_designs, monte_carlo,
 };
 pub use simulate::{simulate, trial_rng};
-pub use tables::{ParamGrid, PaperTables, paper_tables};
+pub use tables::{PaperTables, ParamGrid, paper_tables};
 
 use crate::error::Error;
 use crate::robot::Robot;
@@ -55,7 +56,9 @@ pub enum IdentifyError {
         measurements: usize,
     },
     /// A measured coordinate that is NaN or infinite.
-    #[error("measurement {pose}, coordinate {coordinate}: not a finite number ({value}); missing or corrupt")]
+    #[error(
+        "measurement {pose}, coordinate {coordinate}: not a finite number ({value}); missing or corrupt"
+    )]
     NonFiniteMeasurement {
         /// 0-based pose number.
         pose: usize,

@@ -8,13 +8,14 @@
 //! [`trial_rng`]`(seed, t)` and results are reduced in trial order, so a
 //! summary depends on the seed only, never on the number of threads.
 
+use super::dense::{gram, ln_det_spd, product};
 use super::lm::{LmSettings, Status, identify, predicted_covariance};
 use super::simulate::{simulate, trial_rng};
 use super::{IdentifyError, Result};
 use crate::kinematics::position;
 use crate::pool::{Pool, jacobian_of};
 use crate::robot::{ParamTable, Robot};
-use faer::{Mat, Side};
+use faer::Mat;
 use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -223,7 +224,7 @@ impl ValidationSet {
         let x = jacobian_of(robot, &robot.real, self.qs.len(), |k, q| {
             q.copy_from_slice(&self.qs[k])
         });
-        let xc = x.mat() * c;
+        let xc = product(x.mat(), c.as_ref());
         let m = x.mat();
         let mut tr = 0.0;
         for j in 0..m.ncols() {
@@ -311,7 +312,8 @@ pub struct GeneralizedVariance {
     /// `(ln_ratio − expected) / sd_model`.
     pub z: f64,
     /// Bootstrap standard deviation of `ln det C_emp` over resampled trials
-    /// (`None` when no bootstrap was asked for).
+    /// (`None` when no bootstrap was asked for or there are fewer than `4p`
+    /// converged trials).
     pub sd_bootstrap: Option<f64>,
     /// `ln det C_emp`.
     pub ln_det_empirical: f64,
@@ -437,7 +439,7 @@ pub fn monte_carlo(
     let c_pred = predicted_covariance(robot, &robot.real, qs, settings.sigma)?;
     let ln_det_info = |table: &ParamTable| {
         let x = jacobian_of(robot, table, qs.len(), |k, q| q.copy_from_slice(&qs[k]));
-        ln_det_spd(&(x.mat().transpose() * x.mat()))
+        ln_det_spd(gram(x.mat()).as_ref())
     };
 
     // ---- per-parameter statistics ---------------------------------------------
@@ -567,22 +569,6 @@ pub fn compare_designs(
     })
 }
 
-/// `ln det` of a symmetric positive definite matrix, through the correlation
-/// form `ln det A = Σ ln A_ii + ln det(D^{-1/2} A D^{-1/2})` so that entries of
-/// very different scales do not matter. `None` if not positive definite.
-fn ln_det_spd(a: &Mat<f64>) -> Option<f64> {
-    let n = a.nrows();
-    let d: Vec<f64> = (0..n).map(|i| a[(i, i)]).collect();
-    if d.iter().any(|&v| !(v > 0.0 && v.is_finite())) {
-        return None;
-    }
-    let c = Mat::from_fn(n, n, |i, j| a[(i, j)] / (d[i] * d[j]).sqrt());
-    let llt = c.llt(Side::Lower).ok()?;
-    let l = llt.L();
-    let ln_det_c: f64 = (0..n).map(|i| 2.0 * l[(i, i)].ln()).sum();
-    Some(d.iter().map(|v| v.ln()).sum::<f64>() + ln_det_c)
-}
-
 /// Sample covariance (divisor `n − 1`) of the rows `idx` of `x`.
 fn sample_covariance(x: &[&[f64]], idx: &[usize]) -> Mat<f64> {
     let p = x[0].len();
@@ -620,8 +606,8 @@ fn generalized_variance(
     let r = estimates.len();
     let p = c_pred.nrows();
     let all: Vec<usize> = (0..r).collect();
-    let ln_emp = ln_det_spd(&sample_covariance(estimates, &all))?;
-    let ln_pred = ln_det_spd(c_pred)?;
+    let ln_emp = ln_det_spd(sample_covariance(estimates, &all).as_ref())?;
+    let ln_pred = ln_det_spd(c_pred.as_ref())?;
     let n = (r - 1) as f64;
     let (mut expected, mut var) = (-(p as f64) * n.ln(), 0.0);
     for i in 1..=p {
@@ -629,19 +615,33 @@ fn generalized_variance(
         expected += digamma(k) + std::f64::consts::LN_2;
         var += trigamma(k);
     }
-    let sd_bootstrap = (settings.bootstrap > 1).then(|| {
-        let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
-        rng.set_stream(BOOTSTRAP_STREAM);
-        let draws: Vec<Vec<usize>> = (0..settings.bootstrap)
-            .map(|_| (0..r).map(|_| rng.random_range(0..r)).collect())
-            .collect();
-        let vals: Vec<f64> = draws
-            .par_iter()
-            .filter_map(|idx| ln_det_spd(&sample_covariance(estimates, idx)))
-            .collect();
-        let m = vals.iter().sum::<f64>() / vals.len() as f64;
-        (vals.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (vals.len() as f64 - 1.0)).sqrt()
-    });
+    // A resample repeats trials (about 63% distinct), so it only estimates a
+    // p × p covariance well when r is several times p: skip the bootstrap
+    // below 4p trials, and skip resamples with at most 2p distinct trials.
+    let sd_bootstrap = (settings.bootstrap > 1 && r >= 4 * p)
+        .then(|| {
+            let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
+            rng.set_stream(BOOTSTRAP_STREAM);
+            let draws: Vec<Vec<usize>> = (0..settings.bootstrap)
+                .map(|_| (0..r).map(|_| rng.random_range(0..r)).collect())
+                .collect();
+            let vals: Vec<f64> = draws
+                .par_iter()
+                .filter(|idx| {
+                    let mut seen = vec![false; r];
+                    idx.iter().for_each(|&i| seen[i] = true);
+                    seen.iter().filter(|&&b| b).count() > 2 * p
+                })
+                .filter_map(|idx| ln_det_spd(sample_covariance(estimates, idx).as_ref()))
+                .collect();
+            if vals.len() < 2 {
+                return None;
+            }
+            let m = vals.iter().sum::<f64>() / vals.len() as f64;
+            let var = vals.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (vals.len() as f64 - 1.0);
+            Some(var.sqrt())
+        })
+        .flatten();
     let sd_model = var.sqrt();
     let ln_ratio = ln_emp - ln_pred;
     Some(GeneralizedVariance {
@@ -663,7 +663,8 @@ fn digamma(mut x: f64) -> f64 {
         x += 1.0;
     }
     let x2 = 1.0 / (x * x);
-    acc + x.ln() - 0.5 / x
+    acc + x.ln()
+        - 0.5 / x
         - x2 * (1.0 / 12.0 - x2 * (1.0 / 120.0 - x2 * (1.0 / 252.0 - x2 * (1.0 / 240.0))))
 }
 
@@ -694,19 +695,6 @@ mod tests {
         assert!((trigamma(1.0) - pi2 / 6.0).abs() < 1e-12);
         assert!((trigamma(0.5) - pi2 / 2.0).abs() < 1e-12);
         assert!((digamma(100.0) - 4.600_161_852_738_087).abs() < 1e-12);
-    }
-
-    #[test]
-    fn ln_det_handles_scales() {
-        let a = Mat::from_fn(3, 3, |i, j| {
-            let s = [1e-8, 1.0, 1e6];
-            let base = if i == j { 2.0 } else { 0.5 };
-            base * (s[i] * s[j]).sqrt()
-        });
-        // det = (Π s_i) · det([[2, .5, .5], [.5, 2, .5], [.5, .5, 2]]) = 1e-2 · 6.75
-        let want = (1e-2f64 * 6.75).ln();
-        assert!((ln_det_spd(&a).unwrap() - want).abs() < 1e-12);
-        assert!(ln_det_spd(&Mat::<f64>::zeros(2, 2)).is_none());
     }
 
     #[test]

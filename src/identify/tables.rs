@@ -1,9 +1,9 @@
 //! The paper's Tables III (estimates) and IV (residuals) for a design: one
 //! simulated calibration, laid out one row per frame and one column per symbol.
 
+use super::Result;
 use super::lm::{Identification, LmSettings, identify};
 use super::simulate::{simulate, trial_rng};
-use super::Result;
 use crate::robot::{ParamId, Robot, Symbol};
 use serde::Serialize;
 

@@ -3,7 +3,7 @@
 use super::random::{design_rng, oi_from_ln_oid, random_design};
 use super::{Algorithm, Settings, StepKind, TraceRow};
 use crate::blocks::Blocks;
-use crate::criterion::{argmax, Criterion, CriterionError, InfoState, StateSettings, Status};
+use crate::criterion::{Criterion, CriterionError, InfoState, StateSettings, Status, argmax};
 use crate::error::{Error, Result};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -59,9 +59,12 @@ impl<'a, C: Criterion> Run<'a, C> {
     fn new(pool: &'a Blocks, crit: &'a mut C, design: &[usize], fixed: &[usize]) -> Result<Self> {
         let state = match InfoState::new(pool, design, StateSettings::default()) {
             Ok(s) => s,
-            Err(CriterionError::Singular { .. }) => {
-                InfoState::new(pool, design, StateSettings::default().with_ridge(ridge_for(pool))).map_err(crit_err)?
-            }
+            Err(CriterionError::Singular { .. }) => InfoState::new(
+                pool,
+                design,
+                StateSettings::default().with_ridge(ridge_for(pool)),
+            )
+            .map_err(crit_err)?,
             Err(e) => return Err(crit_err(e)),
         };
         let mut mask = vec![false; pool.n_poses()];
@@ -111,7 +114,8 @@ impl<'a, C: Criterion> Run<'a, C> {
     fn best_removal(&mut self) -> Option<(usize, f64)> {
         let n = self.state.design().len();
         self.buf.resize(n, 0.0);
-        self.crit.price_removals(self.pool, &self.state, &mut self.buf);
+        self.crit
+            .price_removals(self.pool, &self.state, &mut self.buf);
         for (k, &j) in self.state.design().iter().enumerate() {
             if self.fixed[j] {
                 self.buf[k] = f64::NEG_INFINITY;
@@ -123,7 +127,8 @@ impl<'a, C: Criterion> Run<'a, C> {
     /// The pool pose whose addition gives the best score, with that score.
     fn best_add(&mut self) -> Option<(usize, f64)> {
         self.buf.resize(self.all.len(), 0.0);
-        self.crit.price_adds(self.pool, &self.state, &self.all, &mut self.buf);
+        self.crit
+            .price_adds(self.pool, &self.state, &self.all, &mut self.buf);
         argmax(&self.buf).map(|i| (self.all[i], self.buf[i]))
     }
 
@@ -133,7 +138,8 @@ impl<'a, C: Criterion> Run<'a, C> {
             return None;
         }
         self.buf.resize(self.all.len() * outs.len(), 0.0);
-        self.crit.price_exchanges(self.pool, &self.state, outs, &self.all, &mut self.buf);
+        self.crit
+            .price_exchanges(self.pool, &self.state, outs, &self.all, &mut self.buf);
         argmax(&self.buf).map(|k| (outs[k % outs.len()], self.all[k / outs.len()], self.buf[k]))
     }
 
@@ -153,8 +159,12 @@ impl<'a, C: Criterion> Run<'a, C> {
     fn exchange_phase(&mut self, max_iter: usize) {
         for _ in 0..max_iter {
             let cur = self.score();
-            let Some((out, _)) = self.best_removal() else { return };
-            let Some((_, inn, new)) = self.best_exchange(&[out]) else { return };
+            let Some((out, _)) = self.best_removal() else {
+                return;
+            };
+            let Some((_, inn, new)) = self.best_exchange(&[out]) else {
+                return;
+            };
             if !improves(new, cur) || !self.apply_exchange(out, inn) {
                 return;
             }
@@ -167,8 +177,16 @@ impl<'a, C: Criterion> Run<'a, C> {
     fn fedorov_phase(&mut self, max_iter: usize) {
         for _ in 0..max_iter {
             let cur = self.score();
-            let outs: Vec<usize> = self.state.design().iter().copied().filter(|&j| !self.fixed[j]).collect();
-            let Some((out, inn, new)) = self.best_exchange(&outs) else { return };
+            let outs: Vec<usize> = self
+                .state
+                .design()
+                .iter()
+                .copied()
+                .filter(|&j| !self.fixed[j])
+                .collect();
+            let Some((out, inn, new)) = self.best_exchange(&outs) else {
+                return;
+            };
             if !improves(new, cur) || !self.apply_exchange(out, inn) {
                 return;
             }
@@ -180,7 +198,9 @@ impl<'a, C: Criterion> Run<'a, C> {
     fn add_phase(&mut self, n: usize) {
         while self.state.design().len() < n {
             let cur = self.score();
-            let Some((inn, new)) = self.best_add() else { return };
+            let Some((inn, new)) = self.best_add() else {
+                return;
+            };
             // A D-criterion addition never decreases ln det; the OI of eq. (1)
             // is monotone in it too, but keep the paper's stopping rule.
             if !(new >= cur) && self.state.ridge() == 0.0 {
@@ -198,13 +218,20 @@ impl<'a, C: Criterion> Run<'a, C> {
     /// one; stop when the pose just added is the one removed.
     fn detmax_phase(&mut self, max_iter: usize) {
         for _ in 0..max_iter {
-            let Some((inn, _)) = self.best_add() else { return };
+            let Some((inn, _)) = self.best_add() else {
+                return;
+            };
             if self.state.add(self.pool, inn).is_err() {
                 return;
             }
             self.record(StepKind::Add, Some(inn), None);
-            let Some((out, _)) = self.best_removal() else { return };
-            if !matches!(self.state.remove(self.pool, out), Ok(Status::Regular { .. })) {
+            let Some((out, _)) = self.best_removal() else {
+                return;
+            };
+            if !matches!(
+                self.state.remove(self.pool, out),
+                Ok(Status::Regular { .. })
+            ) {
                 return;
             }
             self.record(StepKind::Remove, None, Some(out));
@@ -254,12 +281,22 @@ fn non_fixed(pool: &Blocks, fixed: &[usize]) -> Vec<usize> {
 }
 
 fn start_design(pool: &Blocks, s: &Settings, size: usize, rng: &mut ChaCha8Rng) -> Vec<usize> {
-    random_design(rng, &non_fixed(pool, &s.fixed), &s.fixed, size.max(s.fixed.len()))
+    random_design(
+        rng,
+        &non_fixed(pool, &s.fixed),
+        &s.fixed,
+        size.max(s.fixed.len()),
+    )
 }
 
 /// The paper's exchange-add-exchange (§IV): `n0` random initial poses (fixed
 /// ones included) → exchange steps → add steps up to `N` → exchange steps.
-pub fn eae<C: Criterion>(pool: &Blocks, crit: &mut C, s: &Settings, rng: &mut ChaCha8Rng) -> Result<Selection> {
+pub fn eae<C: Criterion>(
+    pool: &Blocks,
+    crit: &mut C,
+    s: &Settings,
+    rng: &mut ChaCha8Rng,
+) -> Result<Selection> {
     s.validate(pool)?;
     let init = start_design(pool, s, s.initial, rng);
     let mut run = Run::new(pool, crit, &init, &s.fixed)?;
@@ -270,7 +307,12 @@ pub fn eae<C: Criterion>(pool: &Blocks, crit: &mut C, s: &Settings, rng: &mut Ch
 }
 
 /// Fedorov exchange from a random `N`-pose design.
-pub fn fedorov<C: Criterion>(pool: &Blocks, crit: &mut C, s: &Settings, rng: &mut ChaCha8Rng) -> Result<Selection> {
+pub fn fedorov<C: Criterion>(
+    pool: &Blocks,
+    crit: &mut C,
+    s: &Settings,
+    rng: &mut ChaCha8Rng,
+) -> Result<Selection> {
     s.validate(pool)?;
     let init = start_design(pool, s, s.n, rng);
     let mut run = Run::new(pool, crit, &init, &s.fixed)?;
@@ -279,7 +321,12 @@ pub fn fedorov<C: Criterion>(pool: &Blocks, crit: &mut C, s: &Settings, rng: &mu
 }
 
 /// DETMAX from a random `N`-pose design.
-pub fn detmax<C: Criterion>(pool: &Blocks, crit: &mut C, s: &Settings, rng: &mut ChaCha8Rng) -> Result<Selection> {
+pub fn detmax<C: Criterion>(
+    pool: &Blocks,
+    crit: &mut C,
+    s: &Settings,
+    rng: &mut ChaCha8Rng,
+) -> Result<Selection> {
     s.validate(pool)?;
     let init = start_design(pool, s, s.n, rng);
     let mut run = Run::new(pool, crit, &init, &s.fixed)?;
@@ -288,7 +335,12 @@ pub fn detmax<C: Criterion>(pool: &Blocks, crit: &mut C, s: &Settings, rng: &mut
 }
 
 /// Fedorov polish of a finished design: its trace continues.
-pub fn polish<C: Criterion>(pool: &Blocks, crit: &mut C, sel: Selection, s: &Settings) -> Result<Selection> {
+pub fn polish<C: Criterion>(
+    pool: &Blocks,
+    crit: &mut C,
+    sel: Selection,
+    s: &Settings,
+) -> Result<Selection> {
     let mut run = Run::new(pool, crit, &sel.poses, &s.fixed)?;
     run.trace = sel.trace.clone();
     run.fedorov_phase(s.max_iter);
@@ -303,14 +355,26 @@ pub fn polish<C: Criterion>(pool: &Blocks, crit: &mut C, sel: Selection, s: &Set
 /// lowest start on ties), and optionally polishes it with Fedorov exchange.
 /// `make` builds one criterion per start. Deterministic for a seed whatever
 /// the number of threads.
-pub fn multistart<C, F>(pool: &Blocks, make: F, algorithm: Algorithm, s: &Settings) -> Result<Selection>
+pub fn multistart<C, F>(
+    pool: &Blocks,
+    make: F,
+    algorithm: Algorithm,
+    s: &Settings,
+) -> Result<Selection>
 where
     C: Criterion,
     F: Fn() -> C + Sync,
 {
     s.validate(pool)?;
     if algorithm == Algorithm::Random {
-        let r = super::random_search(pool, &non_fixed(pool, &s.fixed), &s.fixed, s.n, s.designs, s.seed);
+        let r = super::random_search(
+            pool,
+            &non_fixed(pool, &s.fixed),
+            &s.fixed,
+            s.n,
+            s.designs,
+            s.seed,
+        );
         if !r.best_ln_oid.is_finite() {
             return Err(Error::Invalid("every random design is singular".into()));
         }

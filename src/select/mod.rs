@@ -25,8 +25,10 @@ use serde::{Deserialize, Serialize};
 mod exchange;
 mod random;
 
-pub use exchange::{detmax, eae, fedorov, multistart, polish, Selection};
-pub use random::{design_rng, ln_det_direct, oi_from_ln_oid, random_design, random_search, RandomSearch};
+pub use exchange::{Selection, detmax, eae, fedorov, multistart, polish};
+pub use random::{
+    RandomSearch, design_rng, ln_det_direct, oi_from_ln_oid, random_design, random_search,
+};
 
 /// The selection algorithms.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -131,7 +133,9 @@ impl Settings {
             )));
         }
         if self.starts == 0 || self.designs == 0 || self.max_iter == 0 {
-            return Err(Error::Invalid("starts, designs and max_iter must be at least 1".into()));
+            return Err(Error::Invalid(
+                "starts, designs and max_iter must be at least 1".into(),
+            ));
         }
         if self.initial == 0 || self.initial > self.n {
             return Err(Error::Invalid(format!(

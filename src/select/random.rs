@@ -32,10 +32,19 @@ pub fn design_rng(seed: u64, k: u64) -> ChaCha8Rng {
 
 /// `n − fixed.len()` distinct pool positions drawn uniformly from `allowed`
 /// (pool positions that are not fixed), appended to `fixed`.
-pub fn random_design(rng: &mut ChaCha8Rng, allowed: &[usize], fixed: &[usize], n: usize) -> Vec<usize> {
+pub fn random_design(
+    rng: &mut ChaCha8Rng,
+    allowed: &[usize],
+    fixed: &[usize],
+    n: usize,
+) -> Vec<usize> {
     let mut d = fixed.to_vec();
     let k = n - fixed.len();
-    d.extend(rand::seq::index::sample(rng, allowed.len(), k).into_iter().map(|i| allowed[i]));
+    d.extend(
+        rand::seq::index::sample(rng, allowed.len(), k)
+            .into_iter()
+            .map(|i| allowed[i]),
+    );
     d
 }
 
@@ -65,7 +74,14 @@ pub fn oi_from_ln_oid(ln_oid: f64, p: usize) -> f64 {
 /// rest from `allowed`) in parallel and keeps the best. Deterministic for a
 /// seed whatever the thread count; ties go to the lowest design number.
 #[must_use]
-pub fn random_search(pool: &Blocks, allowed: &[usize], fixed: &[usize], n: usize, designs: usize, seed: u64) -> RandomSearch {
+pub fn random_search(
+    pool: &Blocks,
+    allowed: &[usize],
+    fixed: &[usize],
+    n: usize,
+    designs: usize,
+    seed: u64,
+) -> RandomSearch {
     let p = pool.p();
     let results: Vec<(Vec<usize>, f64)> = (0..designs)
         .into_par_iter()

@@ -32,7 +32,9 @@ static LOADED: PyOnceLock<Loaded> = PyOnceLock::new();
 pub fn venv_dir() -> PathBuf {
     match std::env::var_os("ACTIVECAL_VENV") {
         Some(v) if !v.is_empty() => PathBuf::from(v),
-        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(".venv"),
+        _ => Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("..")
+            .join(".venv"),
     }
 }
 
@@ -65,7 +67,10 @@ fn loaded(py: Python<'_>) -> Result<&Loaded> {
         let m = PyModule::from_code(py, &code, c"verify/src/bridge.py", c"activecal_bridge")?;
         let d = m
             .getattr("init")?
-            .call1((site.to_string_lossy().as_ref(), python.to_string_lossy().as_ref()))
+            .call1((
+                site.to_string_lossy().as_ref(),
+                python.to_string_lossy().as_ref(),
+            ))
             .with_context(|| format!("importing Pinocchio and MuJoCo from {}", site.display()))?;
         let d = d.cast::<PyDict>().map_err(PyErr::from)?;
         let get = |k: &str| -> Result<String> {

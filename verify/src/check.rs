@@ -2,12 +2,12 @@
 //! position and joint Jacobian against Pinocchio and MuJoCo, and the
 //! regeneration of `fixtures/`.
 
+use crate::TOLERANCE;
 use crate::bridge::Bridge;
 use crate::compare::{Deviation, activecal_kinematics, deviation};
 use crate::fixture::{self, Fixture, set_name};
 use crate::model::{mjcf_of_spec, pinocchio_model_spec};
 use crate::sample::configurations;
-use crate::TOLERANCE;
 use activecal::robot::{ParamSet, Robot};
 use anyhow::{Result, bail};
 use serde::Serialize;
@@ -40,7 +40,9 @@ impl CheckReport {
     /// Whether every deviation is within `tol`.
     #[must_use]
     pub fn passed(&self, tol: f64) -> bool {
-        self.pinocchio.within(tol) && self.mujoco.within(tol) && self.pinocchio_vs_mujoco.within(tol)
+        self.pinocchio.within(tol)
+            && self.mujoco.within(tol)
+            && self.pinocchio_vs_mujoco.within(tol)
     }
 }
 
@@ -91,7 +93,12 @@ pub fn check(
 /// The live check of a robot at one parameter set: [`LIVE_RANDOM`] random
 /// configurations within the limits plus all `2^dof` corners.
 pub fn check_live(bridge: &Bridge, robot: &Robot, set: ParamSet) -> Result<CheckReport> {
-    check(bridge, robot, set, &configurations(robot, LIVE_RANDOM, LIVE_SEED))
+    check(
+        bridge,
+        robot,
+        set,
+        &configurations(robot, LIVE_RANDOM, LIVE_SEED),
+    )
 }
 
 /// The fixture of a robot at one parameter set: Pinocchio's values at

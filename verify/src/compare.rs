@@ -72,7 +72,13 @@ pub fn deviation(a: &Kinematics, b: &Kinematics) -> Result<Deviation> {
         bail!("{} vs {} configurations", a.len(), b.len());
     }
     let mut dev = Deviation::default();
-    let max = |acc: f64, x: f64| if x.is_nan() || acc.is_nan() { f64::NAN } else { acc.max(x) };
+    let max = |acc: f64, x: f64| {
+        if x.is_nan() || acc.is_nan() {
+            f64::NAN
+        } else {
+            acc.max(x)
+        }
+    };
     for (pa, pb) in a.position.iter().zip(&b.position) {
         let d2: f64 = pa.iter().zip(pb).map(|(x, y)| (x - y) * (x - y)).sum();
         dev.position = max(dev.position, d2.sqrt());

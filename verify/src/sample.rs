@@ -102,11 +102,22 @@ mod tests {
             }
         }
         let corners = lattice_corners(&robot);
-        assert_eq!(corners[0], robot.limits.iter().map(|l| l[0]).collect::<Vec<_>>());
-        assert_eq!(corners[63], robot.limits.iter().map(|l| l[1]).collect::<Vec<_>>());
+        assert_eq!(
+            corners[0],
+            robot.limits.iter().map(|l| l[0]).collect::<Vec<_>>()
+        );
+        assert_eq!(
+            corners[63],
+            robot.limits.iter().map(|l| l[1]).collect::<Vec<_>>()
+        );
         // Corner 32 = 0b100000: only joint 1 at its upper limit.
         assert_eq!(corners[32][0], robot.limits[0][1]);
-        assert!(corners[32][1..].iter().zip(&robot.limits[1..]).all(|(v, l)| *v == l[0]));
+        assert!(
+            corners[32][1..]
+                .iter()
+                .zip(&robot.limits[1..])
+                .all(|(v, l)| *v == l[0])
+        );
         let mut sorted = corners.clone();
         sorted.sort_by(|a, b| a.partial_cmp(b).unwrap());
         sorted.dedup();

@@ -49,7 +49,9 @@ fn the_check_sees_a_flipped_alpha() {
     let truth = robot.params(ParamSet::Real);
     let spec = pinocchio_model_spec(&robot, truth).unwrap();
     let pin = bridge.pinocchio(&spec, &qs).unwrap();
-    let mj = bridge.mujoco(&mjcf_of_spec(&spec), spec.dof(), &qs).unwrap();
+    let mj = bridge
+        .mujoco(&mjcf_of_spec(&spec), spec.dof(), &qs)
+        .unwrap();
     for (f, row) in truth.rows.iter().enumerate() {
         if row[Symbol::Alpha.column()] == 0.0 {
             continue;
@@ -74,9 +76,16 @@ fn committed_fixtures_match_a_fresh_regeneration() {
     for robot in builtin_robots().unwrap() {
         for set in SETS {
             let fresh = make_fixture(&bridge, &robot, set).unwrap();
-            assert_eq!(fresh.to_json(), make_fixture(&bridge, &robot, set).unwrap().to_json());
+            assert_eq!(
+                fresh.to_json(),
+                make_fixture(&bridge, &robot, set).unwrap().to_json()
+            );
             let path = dir.join(fixture::file_name(&robot.name, set));
-            let stale = format!("{} is stale: run `{}`", path.display(), fixture::REGEN_COMMAND);
+            let stale = format!(
+                "{} is stale: run `{}`",
+                path.display(),
+                fixture::REGEN_COMMAND
+            );
             let file = Fixture::read(&path).unwrap();
             assert_eq!(file.params, fresh.params, "{stale}");
             assert_eq!(file.versions, fresh.versions, "{stale}");

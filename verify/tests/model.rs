@@ -94,7 +94,11 @@ fn spec_equals_activecal_joint_chain() {
             for (a, b) in pairs {
                 let d = (a.homogeneous() - b.to_homogeneous()).abs().max();
                 // Translations ≤ 20 m built by different formulas: rounding only.
-                assert!(d < 1e-13, "{} {set:?}: placements differ by {d:e}", robot.name);
+                assert!(
+                    d < 1e-13,
+                    "{} {set:?}: placements differ by {d:e}",
+                    robot.name
+                );
             }
         }
     }
@@ -114,7 +118,9 @@ fn joint_jacobian_is_the_gamma_column_of_the_identification_jacobian() {
             ev.eval(&q, &mut x);
             ev.joint_jacobian(&q, &mut jj);
             for (c, u) in robot.unknowns.iter().enumerate() {
-                let Some(j) = robot.frames[u.frame].joint else { continue };
+                let Some(j) = robot.frames[u.frame].joint else {
+                    continue;
+                };
                 if u.symbol != activecal::robot::Symbol::Gamma {
                     continue;
                 }
@@ -175,7 +181,8 @@ fn quaternions_reproduce_the_rotations() {
         let spec = pinocchio_model_spec(&robot, &robot.real).unwrap();
         for p in spec.placements.iter().chain([&spec.tool]) {
             let [w, x, y, z] = p.quat_wxyz();
-            let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z));
+            let q =
+                nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z));
             let m = q.to_rotation_matrix();
             for r in 0..3 {
                 for c in 0..3 {
@@ -216,7 +223,12 @@ fn fixture_text_round_trips_and_is_deterministic() {
     assert_eq!(back, f, "every f64 survives the text exactly");
     assert_eq!(back.samples.len(), 5 + 128);
     // One sample per line.
-    assert_eq!(text.lines().filter(|l| l.starts_with("    {\"q\":")).count(), 133);
+    assert_eq!(
+        text.lines()
+            .filter(|l| l.starts_with("    {\"q\":"))
+            .count(),
+        133
+    );
 }
 
 #[test]
@@ -227,10 +239,16 @@ fn committed_fixtures_are_canonical() {
     for robot in builtin_robots().unwrap() {
         for set in SETS {
             let path = dir.join(fixture::file_name(&robot.name, set));
-            let text = std::fs::read_to_string(&path)
-                .unwrap_or_else(|e| panic!("{}: {e} (run `{}`)", path.display(), fixture::REGEN_COMMAND));
+            let text = std::fs::read_to_string(&path).unwrap_or_else(|e| {
+                panic!("{}: {e} (run `{}`)", path.display(), fixture::REGEN_COMMAND)
+            });
             let f = Fixture::from_json(&text).unwrap();
-            assert_eq!(f.to_json(), text, "{} is not in canonical form", path.display());
+            assert_eq!(
+                f.to_json(),
+                text,
+                "{} is not in canonical form",
+                path.display()
+            );
             assert_eq!(f.robot, robot.name);
             assert_eq!(f.samples.len(), f.n_random + f.n_corners);
             assert_eq!(f.n_corners, 1 << robot.dof());

@@ -8,7 +8,11 @@ fn main() {
     let mut args = std::env::args().skip(1);
     let n: usize = args.next().map_or(30, |s| s.parse().expect("N"));
     let first_order_only = args.next().is_some_and(|s| s == "first-order");
+    let env = |k: &str, d: f64| std::env::var(k).map_or(d, |v| v.parse().unwrap());
     let settings = BoundSettings::builder()
+        .gap_tol(env("GAP_TOL", 1e-6))
+        .screen_gap(env("SCREEN_GAP", 1e-3))
+        .screen_extra(env("SCREEN_EXTRA", 300.0) as usize)
         .use_conic(!first_order_only)
         .build()
         .expect("valid settings");

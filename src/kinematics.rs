@@ -1,14 +1,17 @@
 //! Forward kinematics and the analytic identification Jacobian of a [`Robot`].
 //!
 //! A frame's transform is the product of elementary motions
-//! `Rz(q+γ) · Tz(d) · Tx(a) · Rx(α) · Ry(β)` (β only for Hayati frames). The
+//! `Rz(q+γ) · Tz(d) · Tx(a) · Rx(α) · Ry(β)` (β only for Hayati frames; a
+//! prismatic joint moves `Tz(q+d)` instead and leaves `Rz(γ)`). The
 //! derivative of the end point `p` with respect to each parameter is the
 //! velocity of `p` under the corresponding elementary motion, expressed in the
 //! measurement frame: for a rotation about a unit axis `u` through a point `o`
-//! it is `u × (p − o)`, for a translation along `u` it is `u`.
+//! it is `u × (p − o)`, for a translation along `u` it is `u`. For a full-pose
+//! measurement the orientation rows are the angular velocity of the end
+//! frame: `u` for a rotation about `u`, 0 for a translation.
 
 use crate::error::Result;
-use crate::robot::{Convention, ParamTable, Robot, Symbol};
+use crate::robot::{Convention, JointKind, ParamTable, Robot, Symbol};
 use nalgebra::{Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
 
 /// Axes and origins along one frame, in the measurement frame, needed by the
@@ -69,6 +72,16 @@ fn frame_q(joint: Option<usize>, q: &[f64]) -> f64 {
     joint.map_or(0.0, |j| q[j])
 }
 
+/// The frame's rotation about and translation along its base z axis:
+/// `(q + γ, d)` for a revolute or fixed frame, `(γ, q + d)` for a prismatic one.
+#[inline]
+fn z_motion(frame: &crate::robot::Frame, gamma: f64, d: f64, q: &[f64]) -> (f64, f64) {
+    match (frame.joint, frame.joint_kind) {
+        (Some(j), JointKind::Prismatic) => (gamma, q[j] + d),
+        (j, _) => (frame_q(j, q) + gamma, d),
+    }
+}
+
 /// Walks the chain, filling `axes` (one entry per frame) and returning the
 /// end-point transform `(R, p)`.
 fn walk(
@@ -81,9 +94,10 @@ fn walk(
     let mut o = Vector3::zeros();
     for ((frame, row), ax) in robot.frames.iter().zip(&table.rows).zip(axes.iter_mut()) {
         let [gamma, alpha, a, d, beta] = *row;
+        let (theta, d) = z_motion(frame, gamma, d, q);
         ax.o_base = o;
         ax.z = r.column(2).into_owned();
-        r = rot_z(&r, frame_q(frame.joint, q) + gamma);
+        r = rot_z(&r, theta);
         ax.x = r.column(0).into_owned();
         o += ax.z * d + ax.x * a;
         ax.o_twist = o;
@@ -110,6 +124,17 @@ pub fn position_checked(robot: &Robot, table: &ParamTable, q: &[f64]) -> Result<
     Ok(position(robot, table, q))
 }
 
+/// Orientation `R` (columns: the end frame's axes) and position `p` of the
+/// end frame in the measurement frame (no input checks; see
+/// [`Robot::check_q`]). An orientation residual for identification is
+/// `log(R_meas · R(θ)ᵀ)`, whose derivative is the orientation rows of
+/// [`Evaluator::eval`].
+#[must_use]
+pub fn pose(robot: &Robot, table: &ParamTable, q: &[f64]) -> (Matrix3<f64>, Vector3<f64>) {
+    let mut axes = vec![FrameAxes::default(); robot.frames.len()];
+    walk(robot, table, q, &mut axes)
+}
+
 /// Reusable scratch for [`Evaluator::eval`]: avoids an allocation per pose.
 #[derive(Clone, Debug)]
 pub struct Evaluator<'r> {
@@ -129,41 +154,68 @@ impl<'r> Evaluator<'r> {
         }
     }
 
-    /// End point at `q`, and the identification Jacobian `∂p/∂θ` (3 × p,
-    /// row-major, unknowns in [`Robot::unknowns`] order) written into `jac`.
+    /// End point at `q`, and the identification Jacobian `∂y/∂θ` (t × p,
+    /// row-major, `t = robot.rows_per_pose()`, unknowns in
+    /// [`Robot::unknowns`] order) written into `jac`: rows 0–2 the position,
+    /// rows 3–5 (full-pose robots) the orientation as an angular velocity.
     pub fn eval(&mut self, q: &[f64], jac: &mut [f64]) -> Vector3<f64> {
-        let p_len = self.robot.unknowns.len();
-        debug_assert_eq!(jac.len(), 3 * p_len);
-        let (_, p) = walk(self.robot, self.table, q, &mut self.axes);
-        for (c, u) in self.robot.unknowns.iter().enumerate() {
-            let ax = &self.axes[u.frame];
-            let col = match u.symbol {
-                Symbol::Gamma => ax.z.cross(&(p - ax.o_base)),
-                Symbol::D => ax.z,
-                Symbol::A => ax.x,
-                Symbol::Alpha => ax.x.cross(&(p - ax.o_twist)),
-                Symbol::Beta => ax.y.cross(&(p - ax.o_twist)),
-            };
-            for r in 0..3 {
-                jac[r * p_len + c] = col[r];
-            }
-        }
-        p
+        self.eval_pose(q, jac).1
     }
 
-    /// Geometric position Jacobian with respect to the joint angles (3 × dof,
-    /// row-major): column `j` is `z_j × (p − o_j)` for the frame driven by
-    /// joint `j`. It equals the identification-Jacobian column of that frame's γ.
+    /// As [`Evaluator::eval`], also returning the end frame's orientation
+    /// (see [`pose`]).
+    pub fn eval_pose(&mut self, q: &[f64], jac: &mut [f64]) -> (Matrix3<f64>, Vector3<f64>) {
+        let p_len = self.robot.unknowns.len();
+        let t = self.robot.rows_per_pose();
+        debug_assert_eq!(jac.len(), t * p_len);
+        let (rot, p) = walk(self.robot, self.table, q, &mut self.axes);
+        for (c, u) in self.robot.unknowns.iter().enumerate() {
+            let ax = &self.axes[u.frame];
+            // (linear velocity of p, angular velocity) of the elementary motion.
+            let (lin, ang) = match u.symbol {
+                Symbol::Gamma => (ax.z.cross(&(p - ax.o_base)), ax.z),
+                Symbol::D => (ax.z, Vector3::zeros()),
+                Symbol::A => (ax.x, Vector3::zeros()),
+                Symbol::Alpha => (ax.x.cross(&(p - ax.o_twist)), ax.x),
+                Symbol::Beta => (ax.y.cross(&(p - ax.o_twist)), ax.y),
+            };
+            for r in 0..3 {
+                jac[r * p_len + c] = lin[r];
+            }
+            if t == 6 {
+                for r in 0..3 {
+                    jac[(3 + r) * p_len + c] = ang[r];
+                }
+            }
+        }
+        (rot, p)
+    }
+
+    /// Geometric Jacobian with respect to the joint values (t × dof,
+    /// row-major, `t = robot.rows_per_pose()`): column `j` is, for the frame
+    /// driven by joint `j`, `z_j × (p − o_j)` over `z_j` if the joint is
+    /// revolute (the identification-Jacobian column of that frame's γ), and
+    /// `z_j` over 0 if it is prismatic (the column of its `d`). Rows 3–5
+    /// (angular velocity) exist for full-pose robots only.
     pub fn joint_jacobian(&mut self, q: &[f64], jac: &mut [f64]) -> Vector3<f64> {
         let dof = self.robot.dof();
-        debug_assert_eq!(jac.len(), 3 * dof);
+        let t = self.robot.rows_per_pose();
+        debug_assert_eq!(jac.len(), t * dof);
         let (_, p) = walk(self.robot, self.table, q, &mut self.axes);
         for (f, frame) in self.robot.frames.iter().enumerate() {
             if let Some(j) = frame.joint {
                 let ax = &self.axes[f];
-                let col = ax.z.cross(&(p - ax.o_base));
+                let (lin, ang) = match frame.joint_kind {
+                    JointKind::Revolute => (ax.z.cross(&(p - ax.o_base)), ax.z),
+                    JointKind::Prismatic => (ax.z, Vector3::zeros()),
+                };
                 for r in 0..3 {
-                    jac[r * dof + j] = col[r];
+                    jac[r * dof + j] = lin[r];
+                }
+                if t == 6 {
+                    for r in 0..3 {
+                        jac[(3 + r) * dof + j] = ang[r];
+                    }
                 }
             }
         }
@@ -171,15 +223,19 @@ impl<'r> Evaluator<'r> {
     }
 }
 
-/// The chain as fixed placements and revolute joints about z, the form
-/// Pinocchio and MuJoCo models are built from: `T(q) = P_0 Rz(q_0) P_1 Rz(q_1)
-/// … P_{n−1} Rz(q_{n−1}) · tool`.
+/// The chain as fixed placements and joints along z, the form Pinocchio and
+/// MuJoCo models are built from: `T(q) = P_0 M_0(q_0) P_1 M_1(q_1) …
+/// P_{n−1} M_{n−1}(q_{n−1}) · tool`, where `M_k(q) = Rz(q)` for a revolute
+/// joint and `Tz(q)` for a prismatic one (`kinds[k]`).
 #[derive(Clone, Debug)]
 pub struct JointChain {
     /// `placements[k]`: transform from joint k−1's moving frame (or the
-    /// measurement frame for k = 0) to joint k's frame before its rotation.
+    /// measurement frame for k = 0) to joint k's frame before its motion.
     /// Indexed by joint number.
     pub placements: Vec<Isometry3<f64>>,
+    /// Kind of each joint (indexed by joint number): revolute about z or
+    /// prismatic along z of its placement frame.
+    pub kinds: Vec<JointKind>,
     /// Transform from the last joint's moving frame to the end point frame.
     pub tool: Isometry3<f64>,
 }
@@ -211,11 +267,14 @@ fn iso_ry(th: f64) -> Isometry3<f64> {
 pub fn joint_chain(robot: &Robot, table: &ParamTable) -> JointChain {
     let mut acc = Isometry3::identity();
     let mut placements = vec![Isometry3::identity(); robot.dof()];
+    let mut kinds = vec![JointKind::Revolute; robot.dof()];
     for (frame, row) in robot.frames.iter().zip(&table.rows) {
         let [gamma, alpha, a, d, beta] = *row;
         acc *= iso_rz(gamma);
         if let Some(j) = frame.joint {
+            // Rz(q) and Tz(q) both act here, after Rz(γ) and before Tz(d).
             placements[j] = acc;
+            kinds[j] = frame.joint_kind;
             acc = Isometry3::identity();
         }
         acc *= Translation3::new(a, 0.0, d) * iso_rx(alpha);
@@ -225,6 +284,7 @@ pub fn joint_chain(robot: &Robot, table: &ParamTable) -> JointChain {
     }
     JointChain {
         placements,
+        kinds,
         tool: acc,
     }
 }

@@ -5,6 +5,7 @@ mod cli;
 
 use clap::{Parser, Subcommand};
 use cli::basic::{FkArgs, PoolArgs, RobotsArgs};
+use cli::bench::BenchArgs;
 use cli::select::{ScoreArgs, SelectArgs};
 
 #[derive(Parser)]
@@ -30,6 +31,8 @@ enum Command {
     Score(ScoreArgs),
     /// Select the poses to measure (EAE, Fedorov, DETMAX or random search).
     Select(SelectArgs),
+    /// Benchmark the hot paths (and with --scale the 10^6-pose pool).
+    Bench(BenchArgs),
 }
 
 fn main() {
@@ -40,6 +43,7 @@ fn main() {
         Command::Pool(a) => cli::basic::cmd_pool(a),
         Command::Score(a) => cli::select::cmd_score(a),
         Command::Select(a) => cli::select::cmd_select(a),
+        Command::Bench(a) => cli::bench::cmd_bench(a),
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");

@@ -267,19 +267,28 @@ where
     let p = robot.n_unknowns();
     let t = robot.rows_per_pose();
     let dof = robot.dof();
-    let mut rows = vec![0.0; n * t * p];
+    // Written straight into the column-major matrix, chunk by chunk of rows
+    // (no row-major copy: a 10⁶-pose pool's Jacobian is 650 MB already).
+    let mut mat = faer::Mat::<f64>::zeros(n * t, p);
     const CHUNK: usize = 256;
-    rows.par_chunks_mut(CHUNK * t * p)
+    mat.as_mut()
+        .par_row_chunks_mut(CHUNK * t)
         .enumerate()
-        .for_each(|(c, chunk)| {
+        .for_each(|(c, mut chunk)| {
             let mut ev = Evaluator::new(robot, table);
             let mut q = vec![0.0; dof];
-            for (k, block) in chunk.chunks_mut(t * p).enumerate() {
+            let mut jac = vec![0.0; t * p];
+            for k in 0..chunk.nrows() / t {
                 fill_q(c * CHUNK + k, &mut q);
-                ev.eval(&q, block);
+                ev.eval(&q, &mut jac);
+                for r in 0..t {
+                    for col in 0..p {
+                        chunk[(k * t + r, col)] = jac[r * p + col];
+                    }
+                }
             }
         });
-    Blocks::from_row_major(&rows, t, p)
+    Blocks::new(mat, t)
 }
 
 /// Result of an identifiability check.

@@ -4,16 +4,29 @@
 //! Each frame's transform is `Rz(q + γ) Tz(d) Tx(a) Rx(α)` (DH) or
 //! `Rz(q + γ) Tx(a) Rx(α) Ry(β)` (Hayati; `d` is kept in the table and applied
 //! as `Tz(d)` after `Rz`, so a Hayati frame with `d = 0` is exactly the
-//! paper's). A fixed frame has no `q`. The measured point is the origin of the
-//! last frame, expressed in the measurement frame ("coordinate zero").
+//! paper's). A frame driven by a prismatic joint moves along z instead:
+//! `Rz(γ) Tz(q + d) …`. A fixed frame has no `q`. The measured point is the
+//! origin of the last frame, expressed in the measurement frame ("coordinate
+//! zero"); a full-pose measurement ([`Measurement::Pose`]) adds the last
+//! frame's orientation.
+//!
+//! Robots come from [`Robot::builtin`] (the PUMA 560 of the paper, a UR5 and
+//! a Stanford arm), from a TOML description ([`file`]) or from a URDF file
+//! ([`crate::urdf`]); [`Robot::load`] accepts any of them.
+
+pub mod builtin;
+pub mod file;
+pub mod unknowns;
 
 use crate::error::{Error, Result};
-use serde::Serialize;
+use crate::pool::Visibility;
+use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 use std::fmt;
+use std::path::Path;
 
 /// Parameterization of one frame.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Convention {
     /// Denavit–Hartenberg: `Rz(q+γ) Tz(d) Tx(a) Rx(α)`; has no β.
@@ -79,6 +92,17 @@ impl fmt::Display for Symbol {
     }
 }
 
+/// How a joint drives its frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum JointKind {
+    /// Rotation about the frame's base z axis: `Rz(q + γ)`; `q` in radians.
+    #[default]
+    Revolute,
+    /// Translation along the frame's base z axis: `Tz(q + d)`; `q` in metres.
+    Prismatic,
+}
+
 /// One frame of the chain.
 #[derive(Clone, Debug, Serialize)]
 pub struct Frame {
@@ -88,6 +112,39 @@ pub struct Frame {
     pub convention: Convention,
     /// Index (0-based) of the joint that drives this frame, or `None` if fixed.
     pub joint: Option<usize>,
+    /// Revolute or prismatic; only meaningful when `joint` is `Some`
+    /// (fixed frames keep the default, revolute).
+    pub joint_kind: JointKind,
+}
+
+impl Frame {
+    /// A fixed frame (no joint).
+    #[must_use]
+    pub fn fixed(label: &str, convention: Convention) -> Frame {
+        Frame {
+            label: label.to_string(),
+            convention,
+            joint: None,
+            joint_kind: JointKind::Revolute,
+        }
+    }
+
+    /// A frame driven by joint `joint` (0-based) of the given kind.
+    #[must_use]
+    pub fn driven(label: &str, convention: Convention, joint: usize, kind: JointKind) -> Frame {
+        Frame {
+            label: label.to_string(),
+            convention,
+            joint: Some(joint),
+            joint_kind: kind,
+        }
+    }
+
+    /// Whether this frame is driven by a prismatic joint.
+    #[must_use]
+    pub fn is_prismatic(&self) -> bool {
+        self.joint.is_some() && self.joint_kind == JointKind::Prismatic
+    }
 }
 
 /// Values of all five parameters of every frame (`[γ, α, a, d, β]` per frame).
@@ -144,11 +201,16 @@ impl ParamSet {
 }
 
 /// What is measured at each pose.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Measurement {
     /// The position of the end point: 3 rows per pose.
     Point,
+    /// The position and orientation of the end frame: 6 rows per pose,
+    /// position first, then the orientation (an angular velocity: the rows of
+    /// a rotation parameter about unit axis `u` are `u`, those of a
+    /// translation parameter are 0).
+    Pose,
 }
 
 impl Measurement {
@@ -157,6 +219,16 @@ impl Measurement {
     pub fn rows(self) -> usize {
         match self {
             Measurement::Point => 3,
+            Measurement::Pose => 6,
+        }
+    }
+
+    /// `point` or `pose`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Measurement::Point => "point",
+            Measurement::Pose => "pose",
         }
     }
 }
@@ -174,23 +246,65 @@ pub struct Robot {
     pub nominal: ParamTable,
     /// The unknown parameters, frame-major, in column order.
     pub unknowns: Vec<ParamId>,
-    /// Joint limits `[lo, hi]` in radians, one per joint.
+    /// Joint limits `[lo, hi]`, one per joint: radians for a revolute joint,
+    /// metres for a prismatic one.
     pub limits: Vec<[f64; 2]>,
     /// What is measured.
     pub measurement: Measurement,
+    /// The region the sensor sees, if the description gives one (used to
+    /// filter pose pools when no other region is given).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub visibility: Option<Visibility>,
 }
 
-/// Names of the built-in robots.
-pub const BUILTIN: &[&str] = &["puma560"];
+/// Names of the built-in robots (point measurements; append `:pose` for the
+/// full-pose variant, see [`Robot::builtin`]).
+pub const BUILTIN: &[&str] = &["puma560", "ur5", "stanford"];
 
 impl Robot {
-    /// A built-in robot by name.
+    /// A built-in robot by name: `puma560` (or `puma`), `ur5`, `stanford`.
+    /// A name with the suffix `:pose` (`ur5:pose`) gives the same robot with
+    /// full-pose measurements and the three orientation unknowns more that
+    /// they identify (see [`builtin`]).
     pub fn builtin(name: &str) -> Result<Robot> {
-        match name {
-            "puma560" | "puma" => Ok(Robot::puma560()),
+        let (base, m) = match name.strip_suffix(":pose") {
+            Some(b) => (b, Measurement::Pose),
+            None => (name, Measurement::Point),
+        };
+        match (base, m) {
+            ("puma560" | "puma", Measurement::Point) => Ok(Robot::puma560()),
+            ("puma560" | "puma", Measurement::Pose) => Ok(builtin::puma560_pose()),
+            ("ur5", m) => Ok(builtin::ur5_with(m)),
+            ("stanford", m) => Ok(builtin::stanford_with(m)),
             _ => Err(Error::UnknownRobot {
                 name: name.to_string(),
                 known: BUILTIN.join(", "),
+            }),
+        }
+    }
+
+    /// A robot by built-in name (see [`Robot::builtin`]) or from a file: a
+    /// `.toml` description ([`file`]) or a `.urdf` file ([`crate::urdf`],
+    /// point measurements, unknowns chosen automatically). The result is
+    /// validated, and a file's unknowns are checked to be identifiable.
+    pub fn load(name_or_path: &str) -> Result<Robot> {
+        if let Ok(r) = Robot::builtin(name_or_path) {
+            return Ok(r);
+        }
+        let path = Path::new(name_or_path);
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("toml") => file::load(path),
+            Some("urdf") => crate::urdf::load(path, &crate::urdf::UrdfOptions::default()),
+            _ if path.exists() => Err(Error::Invalid(format!(
+                "{name_or_path}: unknown robot file type (expected a .toml description or a .urdf file)"
+            ))),
+            _ => Err(Error::UnknownRobot {
+                name: name_or_path.to_string(),
+                known: format!("{}; or a path to a .toml or .urdf file", BUILTIN.join(", ")),
             }),
         }
     }
@@ -219,6 +333,7 @@ impl Robot {
             label: l.to_string(),
             convention: c,
             joint: j,
+            joint_kind: JointKind::Revolute,
         })
         .collect();
         // Table I (β = 10 marks "no β" in the paper; kept for display, ignored for DH).
@@ -287,6 +402,7 @@ impl Robot {
             unknowns,
             limits,
             measurement: Measurement::Point,
+            visibility: None,
         }
     }
 
@@ -376,10 +492,32 @@ impl Robot {
         Ok(r)
     }
 
-    /// Checks internal consistency: joints numbered 0..dof once each, finite
-    /// parameters, valid limits, no β unknown on a DH frame, unknowns sorted.
+    /// Checks internal consistency: unique non-empty frame labels, joints
+    /// numbered 0..dof once each, prismatic only on driven frames, finite
+    /// parameters, valid limits, no β unknown on a DH frame, unknowns sorted
+    /// and naming existing frames.
     pub fn validate(&self) -> Result<()> {
         let mut seen = vec![false; self.dof()];
+        for (i, f) in self.frames.iter().enumerate() {
+            if f.label.is_empty() || f.label.chars().any(|c| c.is_whitespace() || c == ',') {
+                return Err(Error::Invalid(format!(
+                    "frame {i}: label '{}' must be non-empty, without spaces or commas",
+                    f.label
+                )));
+            }
+            if self.frames[..i].iter().any(|g| g.label == f.label) {
+                return Err(Error::Invalid(format!(
+                    "frame {}: the label is used by two frames",
+                    f.label
+                )));
+            }
+            if f.joint.is_none() && f.joint_kind == JointKind::Prismatic {
+                return Err(Error::Invalid(format!(
+                    "frame {}: a fixed frame cannot be prismatic",
+                    f.label
+                )));
+            }
+        }
         for f in &self.frames {
             if let Some(j) = f.joint {
                 if j >= seen.len() || seen[j] {
@@ -437,6 +575,14 @@ impl Robot {
             }
         }
         for &u in &self.unknowns {
+            if u.frame >= self.frames.len() {
+                return Err(Error::Invalid(format!(
+                    "unknown parameter {:?} refers to frame {} of {}",
+                    u.symbol,
+                    u.frame,
+                    self.frames.len()
+                )));
+            }
             if u.symbol == Symbol::Beta && self.frames[u.frame].convention == Convention::Dh {
                 return Err(Error::Invalid(format!(
                     "{} is not a parameter: frame {} is DH",

@@ -17,13 +17,26 @@
 //!   `|tr(M⁻¹δM)| ≲ (m + p)·u·κ(M)` in a typical direction (the worst case
 //!   has an extra factor `p`; observed errors sit far below either);
 //! * the update formulas start from the maintained `M⁻¹`, whose relative
-//!   error is of the same order `(m + p)·u·κ(M)`, and the determinant
-//!   lemma carries it into `ln det(I ± S)` amplified by at most
-//!   `‖(I ± S)⁻¹‖`, which the condition number of the result `κ(M')` bounds;
-//! * so both sides differ by `≲ c·(m + p)·u·(κ(M) + κ(M'))`, with `c = 8` as
-//!   a safety factor, plus `64·u·|ln det|` for the rounding of the sum itself.
+//!   error `r` is of the same order `(m + p)·u·κ(M)`; the determinant lemma
+//!   turns it into an error `≲ t·r·‖S‖·‖(I ± S)⁻¹‖` of `ln det(I ± S)`. For an
+//!   addition `‖S₊₊‖ ≤ g − 1` with `g = 1 + ‖X₊‖²‖M⁻¹‖`; for a removal
+//!   `‖(I − S₋₋)⁻¹‖ = 1/μ` with `μ = λ_min(I − S₋₋)`, the fraction of
+//!   information the worst direction retains (downdating cancels). So the
+//!   update errs by `≲ (m + p)·u·κ(M)·a` with the *amplification*
+//!   `a = g + 1/μ` (`μ` of the exchange's Schur complement for an exchange);
+//!   the small `t×t` factorizations add `t²·u·a`, covered by the same term;
+//! * so both sides differ by `≲ c·(m + p)·u·(κ(M)·a + κ(M'))`, with `c = 8`
+//!   (in units of `ε = 2u`) as a safety factor, plus `64·ε·|ln det|` for the
+//!   rounding of the sum itself.
+//!
+//! The amplification is inherent to updating: `κ(M)·a` can exceed both
+//! `κ(M)` and `κ(M')` (removing most of the information along a strong
+//! direction, or adding a block that dwarfs the design), while a direct
+//! factorization of `M'` only pays `κ(M')`. The state's singularity rule
+//! refuses changes with `κ̂(M)/d ≥ max_condition`, which caps it.
 
 use activecal::blocks::Blocks;
+use activecal::criterion::Status;
 use faer::Mat;
 use nalgebra::DMatrix;
 use proptest::prelude::*;
@@ -207,21 +220,59 @@ pub fn max_abs(m: &DMatrix<f64>) -> f64 {
 }
 
 /// Tolerance for `ln det` obtained by an update against a direct
-/// factorization (see the crate docs): `c·(m + p)·u·(κ(M) + κ(M'))` with
-/// `c = 8`, plus `64·u·|ln det|`.
+/// factorization (see the crate docs): `8·(m + p)·ε·(κ(M)·a + κ(M'))` plus
+/// `64·ε·|ln det|`, with `a ≥ 1` the amplification of the change
+/// ([`amplification`]).
 #[must_use]
-pub fn ln_det_tol(m: usize, p: usize, kappa_before: f64, kappa_after: f64, ln_det: f64) -> f64 {
-    8.0 * (m + p) as f64 * EPS * (kappa_before + kappa_after) + 64.0 * EPS * ln_det.abs()
+pub fn ln_det_tol(m: usize, p: usize, kappa_before: f64, kappa_after: f64, a: f64, ln_det: f64) -> f64 {
+    8.0 * (m + p) as f64 * EPS * (kappa_before * a + kappa_after) + 64.0 * EPS * ln_det.abs()
 }
 
 /// Tolerance for `max|M⁻¹(update) − M⁻¹(direct)|`, relative to
 /// `max(‖M⁻¹‖_max, ‖M'⁻¹‖_max)` (an addition subtracts `F₊F₊ᵀ ≈ M⁻¹ − M'⁻¹`
 /// from `M⁻¹`, so the absolute error scales with the larger of the two):
-/// the relative error of an inverse is `≲ (m + p)·u·κ`, hence
-/// `c·(m + p)·u·(κ(M) + κ(M'))` with `c = 8`.
+/// the relative error of an inverse is `≲ (m + p)·u·κ`, and the Woodbury
+/// factors carry the amplification `a` (see [`ln_det_tol`]), hence
+/// `8·(m + p)·ε·(κ(M)·a + κ(M'))`.
 #[must_use]
-pub fn inverse_tol(m: usize, p: usize, kappa_before: f64, kappa_after: f64) -> f64 {
-    8.0 * (m + p) as f64 * EPS * (kappa_before + kappa_after)
+pub fn inverse_tol(m: usize, p: usize, kappa_before: f64, kappa_after: f64, a: f64) -> f64 {
+    8.0 * (m + p) as f64 * EPS * (kappa_before * a + kappa_after)
+}
+
+/// The amplification `a = g + 1/μ` of changing `M` into
+/// `M' = M + X₊ᵀX₊ − X₋ᵀX₋`, computed directly: `g = 1 + ‖X₊‖_F²/λ_min(M)`
+/// (`≥ κ(I + S₊₊)`) and `μ = λ_min((M + X₊ᵀX₊)^-½ M' (M + X₊ᵀX₊)^-½)`
+/// (`1/μ = 0` when nothing is removed).
+#[must_use]
+pub fn amplification(m: &DMatrix<f64>, plus: &DMatrix<f64>, minus: &DMatrix<f64>) -> f64 {
+    let g = 1.0 + plus.norm_squared() / eigenvalues(m)[0];
+    if minus.nrows() == 0 {
+        return g;
+    }
+    let mid = m + gram(plus);
+    let after = &mid - gram(minus);
+    g + 1.0 / retained_fraction(&mid, &after).max(f64::MIN_POSITIVE)
+}
+
+/// The amplification of one applied update estimated from its status:
+/// `1 + ‖X₊‖_F²·‖M⁻¹‖₁ + 1/d` with `d` the smallest pivot of the removal
+/// Schur complement (`d ≥ μ`, exact for `t = 1`; an estimate of `1/μ`
+/// otherwise) and `‖M⁻¹‖₁ ≥ ‖M⁻¹‖₂` taken before the update. `1` for a
+/// refused update (nothing changed).
+#[must_use]
+pub fn step_amplification(status: &Status, added_frob2: f64, m_inv_norm1: f64) -> f64 {
+    match *status {
+        Status::Regular { min_pivot, .. } => 1.0 + added_frob2 * m_inv_norm1 + 1.0 / min_pivot,
+        Status::Singular { .. } => 1.0,
+    }
+}
+
+/// Induced 1-norm (largest absolute column sum).
+#[must_use]
+pub fn norm1(m: &DMatrix<f64>) -> f64 {
+    (0..m.ncols())
+        .map(|c| m.column(c).iter().map(|x| x.abs()).sum::<f64>())
+        .fold(0.0, f64::max)
 }
 
 /// A test case's shape and conditioning.

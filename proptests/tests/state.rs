@@ -43,9 +43,12 @@ proptest! {
         let mut pv = PoolVariances::new(&pool, &st);
         let n_ops = ops.len();
         // Errors accumulate over the updates (fewer than K = 64, so no
-        // refactorization) at the condition numbers met along the way.
+        // refactorization), each bounded by its κ̂(M)·a (see walk.rs).
         let mut kappa = st.condition_estimate();
         for (op, a, b) in ops {
+            let before = (st.condition_estimate(), st.m_inv());
+            let k_before = before.0;
+            let inv_norm = norm1(&to_nalgebra(before.1));
             let d = st.design().to_vec();
             let free: Vec<usize> = (0..n).filter(|i| !st.contains(*i)).collect();
             let out = d[a as usize % d.len()];
@@ -59,8 +62,11 @@ proptest! {
             if !s.is_regular() {
                 prop_assert_eq!(st.design(), &d[..]);
             }
+            let added = if op == 1 { 0.0 } else { x.rows(inn * c.t, c.t).norm_squared() };
+            kappa = kappa
+                .max(k_before * step_amplification(&s, added, inv_norm))
+                .max(st.condition_estimate());
             pv.sync(&pool, &st);
-            kappa = kappa.max(st.condition_estimate());
         }
         let xd = stacked(&x, c.t, st.design());
         let sv = xd.clone().svd(false, false).singular_values;
@@ -71,12 +77,12 @@ proptest! {
         // The drift bound for n_ops updates (see walk.rs): each adds at most
         // ln_det_tol at the largest κ̂ met.
         let k1 = kappa * (n_ops + 1) as f64;
-        let tol = ln_det_tol(xd.nrows(), c.p, k1, k1, ln_oid);
+        let tol = ln_det_tol(xd.nrows(), c.p, k1, k1, 1.0, ln_oid);
         prop_assert!((st.ln_det() - ln_oid).abs() <= tol,
             "ln det {} vs stacked {} (tol {tol:e})", st.ln_det(), ln_oid);
         let direct = direct_inverse(&m1).unwrap();
         let e = max_abs(&(to_nalgebra(st.m_inv()) - &direct)) / max_abs(&direct);
-        prop_assert!(e <= inverse_tol(xd.nrows(), c.p, k1, k1), "inverse error {e:e}");
+        prop_assert!(e <= inverse_tol(xd.nrows(), c.p, k1, k1, 1.0), "inverse error {e:e}");
         // Variances: |V_i| ≤ ‖X_i‖²‖M⁻¹‖, so compare relative to that scale.
         for i in 0..n {
             let xi = x.rows(i * c.t, c.t).into_owned();
@@ -85,7 +91,7 @@ proptest! {
             for a in 0..c.t {
                 for b in 0..c.t {
                     let e = (pv.entry(i, a, b) - v[(a, b)]).abs();
-                    prop_assert!(e <= inverse_tol(xd.nrows(), c.p, k1, k1) * scale.max(1e-300),
+                    prop_assert!(e <= inverse_tol(xd.nrows(), c.p, k1, k1, 1.0) * scale.max(1e-300),
                         "V[{i}]({a},{b}) off by {e:e}");
                 }
             }
@@ -116,6 +122,10 @@ proptest! {
             (direct_ln_det(&m), cond2(&m))
         };
         let m0_rows = rows;
+        let rows_of = |i: Option<usize>| match i {
+            Some(i) => x.rows(i * c.t, c.t).into_owned(),
+            None => DMatrix::zeros(0, c.p),
+        };
         let check = |price: f64, oi: f64, plus: Option<usize>, minus: Option<usize>| -> Result<(), TestCaseError> {
             let (ld, k1) = direct(plus, minus);
             if price == f64::NEG_INFINITY {
@@ -123,16 +133,17 @@ proptest! {
                 // λ_min(M0^-½ M1 M0^-½) is at the floor up to the rounding
                 // of the pivot, (m+p)·u·κ(M0) (see updates.rs).
                 prop_assert!(minus.is_some());
-                let mut m1 = m0.clone();
-                if let Some(i) = plus { m1 += gram(&x.rows(i * c.t, c.t).into_owned()); }
-                if let Some(j) = minus { m1 -= gram(&x.rows(j * c.t, c.t).into_owned()); }
-                let mu = retained_fraction(&m0, &m1);
-                let slack = 8.0 * (m0_rows + c.p) as f64 * EPS * k0;
+                let mid = &m0 + gram(&rows_of(plus));
+                let m1 = &mid - gram(&rows_of(minus));
+                let mu = retained_fraction(&mid, &m1);
+                let g = amplification(&m0, &rows_of(plus), &DMatrix::zeros(0, c.p));
+                let slack = 8.0 * (m0_rows + c.p) as f64 * EPS * k0 * g;
                 prop_assert!(mu <= st.pivot_floor() + slack, "refused with λ_min {mu:e}");
                 return Ok(());
             }
             let ld = ld.expect("priced finite but direct Cholesky fails");
-            let tol = ln_det_tol(rows + c.t, c.p, k0, k1, ld);
+            let g = amplification(&m0, &rows_of(plus), &rows_of(minus));
+            let tol = ln_det_tol(rows + c.t, c.p, k0, k1, g, ld);
             prop_assert!((price - ld).abs() <= tol, "price {price} vs direct {ld}");
             let p = c.p as f64;
             let want = (ld / (2.0 * p)).exp() / p;
@@ -247,6 +258,10 @@ proptest! {
         let k0 = cond2(&m0);
         let rows = k * c.t;
         let mut d = DCriterion::new();
+        let rows_of = |i: Option<usize>| match i {
+            Some(i) => x.rows(i * c.t, c.t).into_owned(),
+            None => DMatrix::zeros(0, c.p),
+        };
         let cands: Vec<usize> = (0..n).collect();
         let mut ex = vec![0.0; n * k];
         d.price_exchanges(&pool, &st, &design, &cands, &mut ex);
@@ -269,7 +284,8 @@ proptest! {
                     Some(delta) => {
                         let ld1 = direct_ln_det(&m1).expect("accepted but not PD");
                         let k1 = cond2(&m1);
-                        let tol = ln_det_tol(rows + c.t, c.p, k0, k1, ld1);
+                        let g = amplification(&m0, &rows_of(i), &rows_of(Some(j)));
+                        let tol = ln_det_tol(rows + c.t, c.p, k0, k1, g, ld1);
                         let ld0 = direct_ln_det(&m0).unwrap();
                         prop_assert!((ld0 + delta - ld1).abs() <= tol,
                             "Δ {delta} vs {} (tol {tol:e}, κ0 {k0:e}, κ1 {k1:e})", ld1 - ld0);
@@ -279,8 +295,10 @@ proptest! {
                         prop_assert!(price == f64::NEG_INFINITY || (price - s1.ln_det()).abs() <= tol);
                     }
                     None => {
-                        let mu = retained_fraction(&m0, &m1);
-                        let slack = 8.0 * (rows + c.p) as f64 * EPS * k0;
+                        let mid = &m0 + gram(&rows_of(i));
+                        let mu = retained_fraction(&mid, &m1);
+                        let g = amplification(&m0, &rows_of(i), &DMatrix::zeros(0, c.p));
+                        let slack = 8.0 * (rows + c.p) as f64 * EPS * k0 * g;
                         prop_assert!(mu <= st.pivot_floor() + slack,
                             "refused with λ_min {mu:e} > floor {:e}", st.pivot_floor());
                         prop_assert_eq!(s1.version(), st.version());

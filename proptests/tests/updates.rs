@@ -36,6 +36,7 @@ fn check_change(
     let k0 = cond2(&m0);
     let m1 = &m0 + gram(plus) - gram(minus);
     let floor = floor_of(&m0, &m0_inv);
+    let g = amplification(&m0, plus, minus);
     let (fi, fp, fm) = (to_faer(&m0_inv), to_faer(plus), to_faer(minus));
     let block = woodbury(fi.as_ref(), fp.as_ref(), fm.as_ref(), floor);
     let casc = cascade(fi.as_ref(), fp.as_ref(), fm.as_ref(), floor);
@@ -45,7 +46,7 @@ fn check_change(
             prop_assert!(ld1.is_some(), "update regular but direct Cholesky fails");
             let ld1 = ld1.unwrap();
             let k1 = cond2(&m1);
-            let tol = ln_det_tol(m, p, k0, k1, ld1);
+            let tol = ln_det_tol(m, p, k0, k1, g, ld1);
             let err = (ld0 + w.ln_det_ratio() - ld1).abs();
             prop_assert!(
                 err <= tol,
@@ -56,7 +57,7 @@ fn check_change(
             let direct = direct_inverse(&m1).unwrap();
             let scale = max_abs(&direct).max(max_abs(&m0_inv));
             let e_inv = max_abs(&(to_nalgebra(inv.as_ref()) - &direct)) / scale;
-            let tol_inv = inverse_tol(m, p, k0, k1);
+            let tol_inv = inverse_tol(m, p, k0, k1, g);
             prop_assert!(e_inv <= tol_inv, "inverse error {e_inv:e} > {tol_inv:e}");
             // Cascade == block form. The cascade removes row by row; its
             // factors are the LDLᵀ pivots of the block form, so it can only
@@ -70,7 +71,7 @@ fn check_change(
                     prop_assert!(e_inv <= tol_inv, "cascade inverse {e_inv:e} > {tol_inv:e}");
                 }
                 Err(s) => prop_assert!(
-                    s.pivot <= floor && w.min_pivot() <= floor + 8.0 * m as f64 * EPS * k0,
+                    s.pivot <= floor && w.min_pivot() <= floor + 8.0 * (m + p) as f64 * EPS * k0 * g,
                     "cascade rejected a clearly regular change: {s:?}, block pivot {}",
                     w.min_pivot()
                 ),
@@ -81,8 +82,12 @@ fn check_change(
             // Singular ⇒ the exact λ_min(M0^-½ M1 M0^-½) ≤ floor, up to the
             // rounding of the computed pivot, |δd| ≲ (m+p)·u·κ(M0) (see the
             // crate docs: ‖X_out‖²‖M0⁻¹‖ ≤ κ(M0) since X_outᵀX_out ⪯ M0).
-            let mu = retained_fraction(&m0, &m1);
-            let slack = 8.0 * (m + p) as f64 * EPS * k0;
+            // For an exchange, μ is relative to M0 + X₊ᵀX₊ and the pivot's
+            // rounding carries the addition's g.
+            let mid = &m0 + gram(plus);
+            let mu = retained_fraction(&mid, &m1);
+            let g = amplification(&m0, plus, &DMatrix::zeros(0, p));
+            let slack = 8.0 * (m + p) as f64 * EPS * k0 * g;
             prop_assert!(
                 mu <= s.pivot_floor + slack,
                 "singular status but λ_min = {mu:e} > floor {:e} + {slack:e}",

@@ -27,9 +27,10 @@ proptest! {
     ///
     /// Tolerance: the module's drift bound. Errors accumulate only over the
     /// updates since the last refactorization (at most `K`), each adding
-    /// `≲ (m+p)·u·κ(M)` to `ln det` and to the relative error of `M⁻¹`; so
-    /// `|Δ ln det| ≤ 4·K·(m+p)·ε·κ̂` with `κ̂ = max ‖M‖₁‖M⁻¹‖₁ ≥ κ₂` over
-    /// those updates (`ε = 2u`: the factor 4 is `c = 8` in units of `u`),
+    /// `≲ (m+p)·u·κ(M)·a` to `ln det` and to the relative error of `M⁻¹`
+    /// (`a` the update's amplification, see the crate docs); so
+    /// `|Δ ln det| ≤ 4·K·(m+p)·ε·B` with `B = max κ̂(M)·a` over those updates
+    /// (`κ̂ = ‖M‖₁‖M⁻¹‖₁ ≥ κ₂`; `ε = 2u`, so 4 is `c = 8` in units of `u`),
     /// plus `64·ε·|ln det|` for the sum itself; `M⁻¹` and `V_i` likewise,
     /// relative to the largest `‖M⁻¹‖_max` over the same window.
     #[test]
@@ -60,6 +61,8 @@ proptest! {
                 1 if d.len() > kmin => 1,
                 _ => 2,
             };
+            let k_before = st.condition_estimate();
+            let inv_norm1 = norm1(&to_nalgebra(st.m_inv()));
             let s = match op {
                 0 => st.add(&pool, inn).unwrap(),
                 1 => st.remove(&pool, out).unwrap(),
@@ -71,7 +74,10 @@ proptest! {
                 kappa = 0.0;
                 inv_norm = 0.0;
             }
-            kappa = kappa.max(st.condition_estimate());
+            let added = if op == 1 { 0.0 } else { x.rows(inn * t, t).norm_squared() };
+            kappa = kappa
+                .max(k_before * step_amplification(&s, added, inv_norm1))
+                .max(st.condition_estimate());
             inv_norm = inv_norm.max(to_nalgebra(st.m_inv()).amax());
             if step % 8 == 0 {
                 pv.sync(&pool, &st);

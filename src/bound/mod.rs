@@ -411,6 +411,16 @@ pub fn relaxation_bound(
                 best.w.clone_from(&w);
             }
             conic_w = Some(w);
+            if std::env::var_os("BOUND_TRACE").is_some() {
+                let dk: Vec<f64> = cand.iter().map(|&i| e.d[i]).collect();
+                let c = nth_largest(&dk, n, &mut scratch);
+                let mut in_cand = vec![false; pool];
+                cand.iter().for_each(|&i| in_cand[i] = true);
+                let v: Vec<f64> = (0..pool).filter(|&i| !in_cand[i] && e.d[i] > c).map(|i| e.d[i] - c).collect();
+                let ws = |th: f64| best.w.iter().filter(|&&x| x > th).count();
+                eprintln!("conic round {round}: cand={} status={:?} it={} secs={:.2} ln_det={:.10} bound={:.10} gap={:.3e} c={c:.6} violators={} maxviol={:.3e} w>1e-3:{} 1e-4:{} 1e-6:{} 1e-8:{}",
+                    cand.len(), out.status, out.iterations, out.seconds, e.ln_det, e.bound, e.bound - e.ln_det, v.len(), v.iter().cloned().fold(0.0, f64::max), ws(1e-3), ws(1e-4), ws(1e-6), ws(1e-8));
+            }
             if best.gap() <= settings.gap_tol || !out.status.is_solved() {
                 break;
             }

@@ -1,6 +1,7 @@
 //! Shared helpers of the command-line subcommands; one file per command group.
 
 pub mod basic;
+pub mod bench;
 pub mod select;
 
 use activecal::robot::Robot;

@@ -95,6 +95,11 @@ pub enum Status {
     Regular {
         /// `ln det M' − ln det M`.
         delta_ln_det: f64,
+        /// Smallest pivot `d` of the removal Schur complement (`+∞` when
+        /// nothing is removed; in `(0, 1]` for a pure removal). The rounding
+        /// error of the change is amplified by about `1/d`, and the singularity
+        /// rule keeps `κ̂(M)/d < max_condition`.
+        min_pivot: f64,
     },
     /// The change would make `M` numerically singular: a pivot of the
     /// removal Schur complement was `≤ pivot_floor`
@@ -112,7 +117,7 @@ impl Status {
     #[must_use]
     pub fn delta(&self) -> Option<f64> {
         match *self {
-            Status::Regular { delta_ln_det } => Some(delta_ln_det),
+            Status::Regular { delta_ln_det, .. } => Some(delta_ln_det),
             Status::Singular { .. } => None,
         }
     }
@@ -502,11 +507,16 @@ impl InfoState {
         })
     }
 
+    fn regular(lr: &LowRank) -> Status {
+        Status::Regular {
+            delta_ln_det: lr.ln_det_ratio(),
+            min_pivot: lr.min_pivot(),
+        }
+    }
+
     fn status_of(r: &Result<LowRank, Status>) -> Status {
         match r {
-            Ok(lr) => Status::Regular {
-                delta_ln_det: lr.ln_det_ratio(),
-            },
+            Ok(lr) => Self::regular(lr),
             Err(s) => *s,
         }
     }
@@ -597,11 +607,9 @@ impl InfoState {
     fn apply_status(&mut self, pool: &Blocks, plus: Option<usize>, minus: Option<usize>) -> Status {
         match self.low_rank(pool, plus, minus) {
             Ok(lr) => {
-                let delta = lr.ln_det_ratio();
+                let status = Self::regular(&lr);
                 self.apply(pool, lr, plus, minus);
-                Status::Regular {
-                    delta_ln_det: delta,
-                }
+                status
             }
             Err(s) => s,
         }

@@ -94,9 +94,12 @@ mod tests {
 
     #[test]
     fn streams_differ_and_repeat() {
-        let a: Vec<u64> = (0..4).map(|_| trial_rng(7, 3).random()).collect();
-        let b: Vec<u64> = (0..4).map(|_| trial_rng(7, 3).random()).collect();
-        assert_eq!(a, b);
+        let draw = |seed, trial| {
+            let mut rng = trial_rng(seed, trial);
+            (0..4).map(|_| rng.random::<u64>()).collect::<Vec<_>>()
+        };
+        assert_eq!(draw(7, 3), draw(7, 3));
+        assert_ne!(draw(7, 3)[0], draw(7, 3)[1]);
         let x: u64 = trial_rng(7, 3).random();
         let y: u64 = trial_rng(7, 4).random();
         let z: u64 = trial_rng(8, 3).random();

@@ -1,29 +1,17 @@
 use activecal::pool::Pool;
 use activecal::robot::Robot;
-use rand::SeedableRng;
+use activecal::select::{random_search};
 fn main() {
     let r = Robot::puma560();
     let pool = Pool::full(&r, 5).unwrap();
-    let t0 = std::time::Instant::now();
-    let x = pool.jacobian(&r, &r.nominal);
-    println!("jacobian {:?}", t0.elapsed());
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
-    let mut best = f64::MIN;
-    let mut v = vec![];
-    for _ in 0..5000 {
-        let d = rand::seq::index::sample(&mut rng, pool.len(), 30).into_vec();
-        let m = x.information(&d);
-        let llt = m.llt(faer::Side::Lower).unwrap();
-        let l = llt.L();
-        let ld: f64 = (0..27).map(|i| 2.0 * l[(i, i)].ln()).sum();
-        v.push(ld / std::f64::consts::LN_10);
-        best = best.max(ld);
+    let all: Vec<usize> = (0..pool.len()).collect();
+    for (name, table) in [("nominal", &r.nominal), ("real", &r.real)] {
+        let x = pool.jacobian(&r, table);
+        for n in [20, 25, 30] {
+            let rs = random_search(&x, &all, &[], n, 5000, 1);
+            let mut v = rs.ln_oid.clone(); v.sort_by(f64::total_cmp);
+            let l = std::f64::consts::LN_10;
+            println!("{name} N={n}: best {:.3} median {:.3} min {:.3}", rs.best_ln_oid / l, v[2500] / l, v[0] / l);
+        }
     }
-    v.sort_by(|a, b| a.partial_cmp(b).unwrap());
-    println!(
-        "best log10 {} median {} min {}",
-        best / std::f64::consts::LN_10,
-        v[2500],
-        v[0]
-    );
 }

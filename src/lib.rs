@@ -15,5 +15,6 @@ pub mod kinematics;
 pub mod pool;
 pub mod robot;
 pub mod select;
+pub mod urdf;
 
 pub use error::{Error, Result};

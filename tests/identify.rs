@@ -445,7 +445,7 @@ fn comparison_shares_validation_and_checks_designs() {
 // ---- command line ------------------------------------------------------------
 
 fn run(args: &[&str]) -> Output {
-    Command::new(std::env::var("ACTIVECAL_BIN").unwrap_or(env!("CARGO_BIN_EXE_activecal").into()))
+    Command::new(env!("CARGO_BIN_EXE_activecal"))
         .args(args)
         .output()
         .expect("runs")

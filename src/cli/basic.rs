@@ -19,7 +19,7 @@ pub struct RobotsArgs {
 /// Arguments of the command.
 #[derive(Args)]
 pub struct FkArgs {
-    /// Robot name (built-in).
+    /// Robot: a built-in name, or a .toml description or .urdf file.
     #[arg(long, default_value = "puma560")]
     pub robot: String,
     /// Parameter set: nominal or real.
@@ -31,7 +31,7 @@ pub struct FkArgs {
     /// Angles are in degrees.
     #[arg(long)]
     pub deg: bool,
-    /// Also print the identification Jacobian (3 × p).
+    /// Also print the identification Jacobian (t × p: 3 rows for a point, 6 for a pose).
     #[arg(long)]
     pub jacobian: bool,
     /// Print one JSON object.
@@ -42,7 +42,7 @@ pub struct FkArgs {
 /// Arguments of the command.
 #[derive(Args)]
 pub struct PoolArgs {
-    /// Robot name (built-in).
+    /// Robot: a built-in name, or a .toml description or .urdf file.
     #[arg(long, default_value = "puma560")]
     pub robot: String,
     /// Lattice values per joint.
@@ -120,7 +120,8 @@ pub fn cmd_fk(a: FkArgs) -> Result<()> {
     let table = robot.params(set);
     let p = position_checked(&robot, table, &q)?;
     let mut v = json!({ "robot": robot.name, "params": set, "q": q, "position": [p.x, p.y, p.z] });
-    let mut jac = vec![0.0; 3 * robot.n_unknowns()];
+    let t = robot.rows_per_pose();
+    let mut jac = vec![0.0; t * robot.n_unknowns()];
     if a.jacobian {
         Evaluator::new(&robot, table).eval(&q, &mut jac);
         let n = robot.n_unknowns();
@@ -132,12 +133,11 @@ pub fn cmd_fk(a: FkArgs) -> Result<()> {
         if a.jacobian {
             let n = robot.n_unknowns();
             for (c, name) in robot.parameter_names().iter().enumerate() {
-                s += &format!(
-                    "{name:>8}: {:>14.8} {:>14.8} {:>14.8}\n",
-                    jac[c],
-                    jac[n + c],
-                    jac[2 * n + c]
-                );
+                s += &format!("{name:>8}:");
+                for r in 0..t {
+                    s += &format!(" {:>14.8}", jac[r * n + c]);
+                }
+                s += "\n";
             }
         }
         s

@@ -22,9 +22,10 @@ where
         .collect()
 }
 
-/// Loads and validates a robot by name.
+/// Loads and validates a robot: a built-in name, or a `.toml` description or
+/// `.urdf` file ([`Robot::load`]).
 pub fn load_robot(name: &str) -> Result<Robot> {
-    let r = Robot::builtin(name)?;
+    let r = Robot::load(name)?;
     r.validate()?;
     Ok(r)
 }
@@ -41,7 +42,8 @@ pub fn emit(json_out: bool, value: &Value, text: impl FnOnce() -> String) {
 /// Options that define a pose pool, shared by the commands that need one.
 #[derive(clap::Args, Clone, Debug)]
 pub struct PoolOpts {
-    /// Robot name (built-in).
+    /// Robot: a built-in name (puma560, ur5, stanford; `:pose` for full-pose
+    /// measurements), or a .toml description or .urdf file.
     #[arg(long, default_value = "puma560")]
     pub robot: String,
     /// Lattice values per joint.
@@ -73,13 +75,15 @@ impl PoolOpts {
         use activecal::pool::{Pool, Visibility};
         let robot = load_robot(&self.robot)?;
         let set = activecal::robot::ParamSet::parse(&self.params)?;
-        let pool = match &self.visibility {
-            None => Pool::full(&robot, self.levels)?,
-            Some(v) => {
+        // --visibility, else the robot description's region, else every pose.
+        let pool = match (&self.visibility, &robot.visibility) {
+            (None, None) => Pool::full(&robot, self.levels)?,
+            (Some(v), _) => {
                 let vis: Visibility =
                     serde_json::from_str(v).map_err(|e| anyhow::anyhow!("--visibility: {e}"))?;
                 Pool::filtered(&robot, &robot.nominal, self.levels, &vis)?
             }
+            (None, Some(vis)) => Pool::filtered(&robot, &robot.nominal, self.levels, vis)?,
         };
         let x = pool.jacobian(&robot, robot.params(set));
         Ok(PoolCtx { robot, pool, x })

@@ -52,7 +52,68 @@ pub(crate) fn chol_in_place(a: &mut [f64], n: usize, floor: f64) -> Result<f64, 
     Ok(ln_det)
 }
 
-/// Smallest LDLᵀ pivot of a Cholesky factor produced by [`chol_in_place`].
+/// Cholesky with diagonal (complete symmetric) pivoting, `P A Pᵀ = L Lᵀ`, in
+/// place of a row-major `n×n` symmetric matrix whose *both* triangles are
+/// set; `L` ends in the lower triangle and `perm[k]` is the original index of
+/// position `k`. Returns `ln det A`, or `Err(d)` for the first pivot
+/// `d ≤ floor` — after choosing the largest remaining diagonal, so the first
+/// failing pivot is the largest remaining one.
+///
+/// Used for the removal Schur complement `B = I − S`: without pivoting, a
+/// small early pivot amplifies the rounding of the later ones (a projection
+/// `I − vvᵀ/‖v‖²` can show a zero pivot as `1e-11`); with pivoting the small
+/// pivots come last and carry only `≈ n·u·‖B‖` of rounding (Higham,
+/// *Accuracy and Stability*, §10.3), so the singularity test is reliable.
+#[inline]
+pub(crate) fn chol_pivoted_in_place(
+    a: &mut [f64],
+    n: usize,
+    floor: f64,
+    perm: &mut [usize],
+) -> Result<f64, f64> {
+    for (k, pk) in perm.iter_mut().enumerate().take(n) {
+        *pk = k;
+    }
+    let mut ln_det = 0.0;
+    for k in 0..n {
+        // Largest remaining diagonal entry (first on ties: deterministic).
+        let mut j = k;
+        for i in k + 1..n {
+            if a[i * n + i] > a[j * n + j] {
+                j = i;
+            }
+        }
+        if j != k {
+            perm.swap(k, j);
+            for c in 0..n {
+                a.swap(k * n + c, j * n + c);
+            }
+            for r in k..n {
+                a.swap(r * n + k, r * n + j);
+            }
+        }
+        let d = a[k * n + k];
+        if !(d > floor) {
+            return Err(d);
+        }
+        ln_det += d.ln();
+        let l = d.sqrt();
+        a[k * n + k] = l;
+        for i in k + 1..n {
+            a[i * n + k] /= l;
+        }
+        for i in k + 1..n {
+            let lik = a[i * n + k];
+            for c in k + 1..n {
+                a[i * n + c] -= lik * a[c * n + k];
+            }
+        }
+    }
+    Ok(ln_det)
+}
+
+/// Smallest LDLᵀ pivot of a Cholesky factor produced by [`chol_in_place`]
+/// or [`chol_pivoted_in_place`].
 #[inline]
 pub(crate) fn min_pivot(l: &[f64], n: usize) -> f64 {
     (0..n)
@@ -84,9 +145,11 @@ pub(crate) fn ln_det_i_minus(v: &[f64], t: usize, floor: f64) -> Result<f64, f64
         for c in 0..=r {
             let x = v[pk(r, c)];
             a[r * t + c] = if r == c { 1.0 - x } else { -x };
+            a[c * t + r] = a[r * t + c];
         }
     }
-    chol_in_place(&mut a[..t * t], t, floor)
+    let mut perm = [0usize; MAX_T];
+    chol_pivoted_in_place(&mut a[..t * t], t, floor, &mut perm[..t])
 }
 
 /// `ln det` of the exchange system `[[I + V_in, W], [−Wᵀ, I − V_out]]`
@@ -121,7 +184,7 @@ pub(crate) fn exchange_ln_det(
             y[r * t + c] = s / a[r * t + r];
         }
     }
-    // B = I − V_out + Yᵀ Y (lower triangle).
+    // B = I − V_out + Yᵀ Y (both triangles, for the pivoted factorization).
     let mut b = [0.0f64; MAX_T * MAX_T];
     for r in 0..t {
         for c in 0..=r {
@@ -130,9 +193,11 @@ pub(crate) fn exchange_ln_det(
                 s += y[j * t + r] * y[j * t + c];
             }
             b[r * t + c] = s;
+            b[c * t + r] = s;
         }
     }
-    let ln_b = chol_in_place(&mut b[..t * t], t, floor)?;
+    let mut perm = [0usize; MAX_T];
+    let ln_b = chol_pivoted_in_place(&mut b[..t * t], t, floor, &mut perm[..t])?;
     Ok(ln_a + ln_b)
 }
 
@@ -313,6 +378,41 @@ mod tests {
         assert!((min_pivot(&a, 2) - 2.0).abs() < 1e-14);
         let mut s = [1.0, 0.0, 1.0, 1.0];
         assert!(chol_in_place(&mut s, 2, 1e-12).is_err());
+    }
+
+    #[test]
+    fn pivoted_cholesky_reconstructs_and_detects_projections() {
+        // B = P A Pᵀ = L Lᵀ for a 4×4 SPD matrix.
+        let n = 4;
+        let a0: Vec<f64> = (0..n * n)
+            .map(|k| {
+                let (i, j) = (k / n, k % n);
+                if i == j { 1.0 + i as f64 } else { 0.3 / (1.0 + (i + j) as f64) }
+            })
+            .collect();
+        let mut a = a0.clone();
+        let mut perm = [0usize; 4];
+        let ld = chol_pivoted_in_place(&mut a, n, 0.0, &mut perm).unwrap();
+        let mut plain = a0.clone();
+        assert!((ld - chol_in_place(&mut plain, n, 0.0).unwrap()).abs() < 1e-13);
+        for i in 0..n {
+            for j in 0..n {
+                let s: f64 = (0..=i.min(j)).map(|k| a[i * n + k] * a[j * n + k]).sum();
+                assert!((s - a0[perm[i] * n + perm[j]]).abs() < 1e-13);
+            }
+        }
+        // I − v vᵀ/‖v‖² is singular; the pivoted factorization says so at a
+        // floor far below the unpivoted rounding.
+        let v = [1e-3, 1.0, 2e-3, 0.5, 1e-4, 0.7];
+        let nv: f64 = v.iter().map(|x| x * x).sum();
+        let mut b = vec![0.0; 36];
+        for i in 0..6 {
+            for j in 0..6 {
+                b[i * 6 + j] = if i == j { 1.0 } else { 0.0 } - v[i] * v[j] / nv;
+            }
+        }
+        let mut perm = [0usize; 6];
+        assert!(chol_pivoted_in_place(&mut b, 6, 1e-14, &mut perm).is_err());
     }
 
     #[test]

@@ -14,7 +14,7 @@
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 
-use super::dense::{chol_in_place, min_pivot};
+use super::dense::{chol_in_place, chol_pivoted_in_place, min_pivot};
 
 /// A numerically singular change: a pivot of the removal Schur complement
 /// was `≤ pivot_floor`. A numerical outcome, not an error.
@@ -175,7 +175,10 @@ pub fn woodbury(
         }
     }
     // B = I − S₋₋ + Yᵀ Y: the Schur complement of the 2-block system. Its
-    // LDLᵀ pivots are the factors (1 − x_r' M_{·}⁻¹ x_r) of the cascade (22).
+    // LDLᵀ pivots (unpivoted) are the factors (1 − x_r' M_{·}⁻¹ x_r) of the
+    // cascade (22). Factored with diagonal pivoting, P B Pᵀ = L_B L_Bᵀ, so a
+    // singular B shows as a last pivot of rounding size (see
+    // `chol_pivoted_in_place`).
     let mut lb = vec![0.0; b * b];
     for r in 0..b {
         for c in 0..=r {
@@ -184,20 +187,25 @@ pub fn woodbury(
                 v += y[j * b + r] * y[j * b + c];
             }
             lb[r * b + c] = v;
+            lb[c * b + r] = v;
         }
     }
-    let ln_b =
-        chol_in_place(&mut lb, b, pivot_floor).map_err(|pivot| Singular { pivot, pivot_floor })?;
+    let mut perm = vec![0usize; b];
+    let ln_b = chol_pivoted_in_place(&mut lb, b, pivot_floor, &mut perm)
+        .map_err(|pivot| Singular { pivot, pivot_floor })?;
 
     // F₋ = (U₋ − F₊ Y) L_B⁻ᵀ. Derivation: after adding Z₊ the inverse is
     // M₁⁻¹ = M⁻¹ − F₊F₊ᵀ, so M₁⁻¹Z₋ᵀ = U₋ − F₊ (L_A⁻¹S₊₋) = U₋ − F₊Y and
     // Z₋M₁⁻¹Z₋ᵀ = S₋₋ − YᵀY; removing Z₋ from M₁ by eq. (11) in block form
-    // adds (M₁⁻¹Z₋ᵀ) B⁻¹ (M₁⁻¹Z₋ᵀ)ᵀ.
+    // adds (M₁⁻¹Z₋ᵀ) B⁻¹ (M₁⁻¹Z₋ᵀ)ᵀ. With B = Pᵀ L_B L_Bᵀ P (perm[r] the
+    // original index of position r), B⁻¹ = Pᵀ L_B⁻ᵀ L_B⁻¹ P, so
+    // F₋ = (U₋ − F₊Y)Pᵀ L_B⁻ᵀ: permute the columns, then substitute.
     for i in 0..p {
         for r in 0..b {
-            let mut v = u[(i, a + r)];
+            let pr = perm[r];
+            let mut v = u[(i, a + pr)];
             for j in 0..a {
-                v -= f[(i, j)] * y[j * b + r];
+                v -= f[(i, j)] * y[j * b + pr];
             }
             for j in 0..r {
                 v -= lb[r * b + j] * f[(i, a + j)];

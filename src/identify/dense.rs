@@ -115,7 +115,7 @@ pub(crate) fn ln_det_spd(a: MatRef<'_, f64>) -> Option<f64> {
                 s -= l[i * n + k] * l[j * n + k];
             }
             if i == j {
-                if !(s > 0.0) {
+                if s.is_nan() || s <= 0.0 {
                     return None;
                 }
                 l[i * n + i] = s.sqrt();

@@ -7,7 +7,7 @@
 //! minimises `Σ ‖y_i − p(θ, q_i)‖²` over the unknowns θ (Sun & Hollerbach §V-E).
 //!
 //! * [`lm`]: the solver ([`identify`]), its settings, statuses and covariance.
-//! * [`simulate`]: noisy measurements of the real robot, seeded.
+//! * [`simulate`](mod@simulate): noisy measurements of the real robot, seeded.
 //! * [`montecarlo`]: repeated identification over noise realisations, and
 //!   held-out validation poses.
 //! * [`tables`]: estimates and residuals in the paper's table layout.

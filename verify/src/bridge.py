@@ -46,27 +46,30 @@ def init(site_packages, python_exe):
     }
 
 
-def pinocchio_model(placements, tool):
-    """A Pinocchio model: one revolute-z joint after each fixed placement
-    (R as a row-major 3x3 list, t as a 3-list), and an operational frame "ee"
-    at `tool` on the last joint."""
+JOINT_MODELS = {"revolute": lambda: pin.JointModelRZ(), "prismatic": lambda: pin.JointModelPZ()}
+
+
+def pinocchio_model(placements, kinds, tool):
+    """A Pinocchio model: after each fixed placement (R as a row-major 3x3
+    list, t as a 3-list) a joint about ("revolute") or along ("prismatic") its
+    z axis, and an operational frame "ee" at `tool` on the last joint."""
     model = pin.Model()
     parent = 0  # the universe: activecal's measurement frame
-    for k, (rot, trans) in enumerate(placements):
+    for k, ((rot, trans), kind) in enumerate(zip(placements, kinds)):
         placement = pin.SE3(np.array(rot, dtype=float), np.array(trans, dtype=float))
-        parent = model.addJoint(parent, pin.JointModelRZ(), placement, "q%d" % (k + 1))
+        parent = model.addJoint(parent, JOINT_MODELS[kind](), placement, "q%d" % (k + 1))
     rot, trans = tool
     ee = pin.SE3(np.array(rot, dtype=float), np.array(trans, dtype=float))
     model.addFrame(pin.Frame("ee", parent, ee, pin.FrameType.OP_FRAME))
     return model
 
 
-def pinocchio_eval(placements, tool, qs):
+def pinocchio_eval(placements, kinds, tool, qs):
     """End point positions and joint Jacobians from Pinocchio: forwardKinematics +
     updateFramePlacements for the position, computeFrameJacobian in
     LOCAL_WORLD_ALIGNED (origin at the frame, axes of the world) for the
     Jacobian, whose top 3 rows are d position / d q."""
-    model = pinocchio_model(placements, tool)
+    model = pinocchio_model(placements, kinds, tool)
     data = model.createData()
     fid = model.getFrameId("ee")
     positions, jacobians = [], []
@@ -90,7 +93,7 @@ def mujoco_eval(mjcf, qs):
     if sid < 0:
         raise ValueError("the MJCF has no site named 'ee'")
     if model.nq != model.nv:
-        raise ValueError("expected hinge joints only (nq == nv)")
+        raise ValueError("expected hinge and slide joints only (nq == nv)")
     # Map activecal's joint k to MuJoCo's qpos and dof addresses through the
     # joint names "q1".."qn" rather than assuming MuJoCo's ordering.
     jids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "q%d" % (k + 1))

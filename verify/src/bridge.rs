@@ -9,6 +9,7 @@
 use crate::compare::Kinematics;
 use crate::fixture::Versions;
 use crate::model::ModelSpec;
+use activecal::robot::JointKind;
 use anyhow::{Context, Result, bail};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
@@ -124,11 +125,19 @@ impl Bridge {
             .iter()
             .map(|p| (p.rotation, p.translation))
             .collect();
+        let kinds: Vec<&str> = spec
+            .kinds
+            .iter()
+            .map(|k| match k {
+                JointKind::Revolute => "revolute",
+                JointKind::Prismatic => "prismatic",
+            })
+            .collect();
         let tool = (spec.tool.rotation, spec.tool.translation);
         Python::attach(|py| {
             let r = module(py)?
                 .getattr("pinocchio_eval")?
-                .call1((placements, tool, qs.to_vec()))
+                .call1((placements, kinds, tool, qs.to_vec()))
                 .context("Pinocchio evaluation")?;
             unpack(&r, spec.dof(), qs.len())
         })

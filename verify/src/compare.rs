@@ -14,7 +14,8 @@ pub struct Kinematics {
     pub position: Vec<[f64; 3]>,
     /// `∂position/∂q` (3 × dof, row-major: entry `r·dof + j`), per
     /// configuration. Column `j` is also the identification-Jacobian column
-    /// of the γ of the frame driven by joint `j`.
+    /// of the γ of the frame driven by joint `j` if it is revolute (of its
+    /// `d` if prismatic).
     pub jacobian: Vec<Vec<f64>>,
 }
 
@@ -33,17 +34,18 @@ impl Kinematics {
 }
 
 /// activecal's own values: `kinematics::Evaluator::joint_jacobian`, which
-/// also returns the position.
+/// also returns the position (for a full-pose robot, the positional rows of
+/// its joint Jacobian).
 #[must_use]
 pub fn activecal_kinematics(robot: &Robot, table: &ParamTable, qs: &[Vec<f64>]) -> Kinematics {
     let dof = robot.dof();
     let mut ev = Evaluator::new(robot, table);
     let mut out = Kinematics::default();
+    let mut jac = vec![0.0; robot.rows_per_pose() * dof];
     for q in qs {
-        let mut jac = vec![0.0; 3 * dof];
         let p = ev.joint_jacobian(q, &mut jac);
         out.position.push([p.x, p.y, p.z]);
-        out.jacobian.push(jac);
+        out.jacobian.push(jac[..3 * dof].to_vec());
     }
     out
 }

@@ -11,7 +11,8 @@
 //! What is compared, at each configuration `q`: the end-point position
 //! `p(q)` in the measurement frame, and the positional joint Jacobian
 //! `∂p/∂q` (3 × dof), whose column `j` is also the identification-Jacobian
-//! column of the γ offset of the frame that joint `j` drives (`Rz(q+γ)`).
+//! column of the γ offset of the frame that joint `j` drives (`Rz(q+γ)`), or
+//! of its `d` if the joint is prismatic (`Tz(q+d)`).
 //! Pinocchio: `forwardKinematics`, `computeFrameJacobian(…,
 //! LOCAL_WORLD_ALIGNED)` top rows; MuJoCo: `site_xpos`, `mj_jacSite` after
 //! `mj_kinematics` + `mj_comPos`.
@@ -27,7 +28,9 @@ pub mod bridge;
 #[cfg(feature = "live")]
 pub mod check;
 
-use activecal::robot::{Convention, Frame, Measurement, ParamId, ParamTable, Robot, Symbol};
+use activecal::robot::{
+    Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot, Symbol,
+};
 
 /// Largest deviation accepted between any two of activecal, Pinocchio,
 /// MuJoCo and the fixtures, for positions (m) and Jacobian entries (m/rad).
@@ -53,29 +56,32 @@ pub fn builtin_robots() -> activecal::Result<Vec<Robot>> {
         .collect()
 }
 
-/// A 7-joint robot unlike the PUMA, to show the model builders and checks
-/// are not PUMA-specific: fixed frames at the base, between joints 3 and 4
-/// (a Hayati one) and at the tool; driven Hayati frames, one with `d ≠ 0`;
-/// a joint range wider than 2π; metre-scale offsets. Its unknowns are the
-/// seven joint offsets γ (it is not meant for calibration).
+/// A 7-joint robot unlike the built-in ones, to show the model builders and
+/// checks are not tied to them: fixed frames at the base, between joints 3
+/// and 4 (a Hayati one) and at the tool; driven Hayati frames, one of them a
+/// prismatic joint with `d ≠ 0`; a joint range wider than 2π; metre-scale
+/// offsets. Its unknowns are the joint offsets γ of the revolute frames and
+/// the `d` of the prismatic one (it is not meant for calibration).
 #[must_use]
 pub fn synthetic_robot() -> Robot {
     use Convention::{Dh, Hayati};
-    // (label, convention, joint, [γ, α, a, d, β]); β is ignored on DH frames.
-    let frames: [(&str, Convention, Option<usize>, [f64; 5]); 10] = [
-        ("base", Dh, None, [0.3, 0.2, 1.5, -0.4, 0.0]),
-        ("1", Dh, Some(0), [0.1, -1.5608, 0.05, 0.5, 0.0]),
-        ("2", Hayati, Some(1), [-0.2, 0.02, 0.6, 0.0, 0.03]),
-        ("3", Dh, Some(2), [0.05, 1.58, -0.03, 0.12, 0.0]),
-        ("mid", Hayati, None, [0.5, 0.4, 0.1, 0.2, -0.3]),
-        ("4", Dh, Some(3), [-0.07, -1.55, 0.0, 0.45, 0.0]),
-        ("5", Hayati, Some(4), [0.02, 0.9, 0.08, 0.07, -0.11]),
-        ("6", Dh, Some(5), [0.0, 1.5702, 0.0, 0.0, 0.0]),
-        ("7", Dh, Some(6), [0.13, -0.3, 0.02, 0.09, 0.0]),
-        ("tool", Dh, None, [0.2, 0.0, 0.05, 0.1, 0.0]),
+    use JointKind::{Prismatic as P, Revolute as R};
+    // (label, convention, joint, kind, [γ, α, a, d, β]); β is ignored on DH frames.
+    type Row = (&'static str, Convention, Option<usize>, JointKind, [f64; 5]);
+    let frames: [Row; 10] = [
+        ("base", Dh, None, R, [0.3, 0.2, 1.5, -0.4, 0.0]),
+        ("1", Dh, Some(0), R, [0.1, -1.5608, 0.05, 0.5, 0.0]),
+        ("2", Hayati, Some(1), R, [-0.2, 0.02, 0.6, 0.0, 0.03]),
+        ("3", Dh, Some(2), R, [0.05, 1.58, -0.03, 0.12, 0.0]),
+        ("mid", Hayati, None, R, [0.5, 0.4, 0.1, 0.2, -0.3]),
+        ("4", Dh, Some(3), R, [-0.07, -1.55, 0.0, 0.45, 0.0]),
+        ("5", Hayati, Some(4), P, [0.02, 0.9, 0.08, 0.07, -0.11]),
+        ("6", Dh, Some(5), R, [0.0, 1.5702, 0.0, 0.0, 0.0]),
+        ("7", Dh, Some(6), R, [0.13, -0.3, 0.02, 0.09, 0.0]),
+        ("tool", Dh, None, R, [0.2, 0.0, 0.05, 0.1, 0.0]),
     ];
     let nominal = ParamTable {
-        rows: frames.iter().map(|f| f.3).collect(),
+        rows: frames.iter().map(|f| f.4).collect(),
     };
     // The "real" robot: every parameter perturbed by a few milli-units.
     let real = ParamTable {
@@ -95,20 +101,25 @@ pub fn synthetic_robot() -> Robot {
     let unknowns = frames
         .iter()
         .enumerate()
-        .filter(|(_, f)| f.2.is_some())
-        .map(|(frame, _)| ParamId {
-            frame,
-            symbol: Symbol::Gamma,
+        .filter_map(|(frame, f)| match (f.2, f.3) {
+            (None, _) => None,
+            (Some(_), R) => Some(ParamId {
+                frame,
+                symbol: Symbol::Gamma,
+            }),
+            (Some(_), P) => Some(ParamId {
+                frame,
+                symbol: Symbol::D,
+            }),
         })
         .collect();
     let robot = Robot {
         name: "synthetic7".into(),
         frames: frames
             .iter()
-            .map(|&(label, convention, joint, _)| Frame {
-                label: label.into(),
-                convention,
-                joint,
+            .map(|&(label, convention, joint, kind, _)| match joint {
+                None => Frame::fixed(label, convention),
+                Some(j) => Frame::driven(label, convention, j, kind),
             })
             .collect(),
         real,
@@ -119,11 +130,12 @@ pub fn synthetic_robot() -> Robot {
             [-1.9, 2.2],
             [-2.5, 0.4],
             [-3.5, 4.0],
-            [-2.0, 2.0],
+            [-0.3, 0.4],
             [-1.0, 3.0],
             [-3.1, 3.1],
         ],
         measurement: Measurement::Point,
+        visibility: None,
     };
     robot.validate().expect("synthetic robot is valid");
     robot

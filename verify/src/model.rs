@@ -1,6 +1,7 @@
 //! Pinocchio and MuJoCo models of any [`Robot`]: fixed placements before
-//! revolute joints about z, and an end-effector frame at the measured point,
-//! `T(q) = P_0 Rz(q_0) P_1 Rz(q_1) … P_{n−1} Rz(q_{n−1}) · tool`.
+//! joints along z, and an end-effector frame at the measured point,
+//! `T(q) = P_0 M_0(q_0) P_1 M_1(q_1) … P_{n−1} M_{n−1}(q_{n−1}) · tool`, where
+//! `M_k(q) = Rz(q)` for a revolute joint and `Tz(q)` for a prismatic one.
 //!
 //! The placements are built here from the robot's DH / Hayati parameters,
 //! **independently of `activecal::kinematics`** (textbook homogeneous
@@ -9,9 +10,10 @@
 //! be copied into the references and the cross-check could not see it.
 //!
 //! Frame transform (see `activecal::robot`): DH `Rz(q+γ) Tz(d) Tx(a) Rx(α)`,
-//! Hayati the same followed by `Ry(β)`; a fixed frame has `q = 0`.
+//! Hayati the same followed by `Ry(β)`; a prismatic frame `Rz(γ) Tz(q+d) …`;
+//! a fixed frame has `q = 0`.
 
-use activecal::robot::{Convention, ParamTable, Robot};
+use activecal::robot::{Convention, JointKind, ParamTable, Robot};
 use anyhow::{Result, bail};
 use nalgebra::{Matrix3, Matrix4, Rotation3, UnitQuaternion, Vector3};
 use serde::Serialize;
@@ -65,16 +67,19 @@ impl Placement {
     }
 }
 
-/// A robot as fixed placements and revolute-z joints: what Pinocchio's
-/// `addJoint(parent, JointModelRZ(), placement)` and MuJoCo's nested bodies
-/// with hinge joints are built from.
+/// A robot as fixed placements and joints along z: what Pinocchio's
+/// `addJoint(parent, JointModelRZ() or JointModelPZ(), placement)` and
+/// MuJoCo's nested bodies with hinge or slide joints are built from.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ModelSpec {
     /// Robot name.
     pub robot: String,
     /// `placements[k]`: from joint k−1's moving frame (the measurement frame
-    /// for k = 0) to joint k's frame before its rotation `Rz(q_k)`.
+    /// for k = 0) to joint k's frame before its motion `M_k(q_k)`.
     pub placements: Vec<Placement>,
+    /// `kinds[k]`: joint k rotates about (revolute) or slides along
+    /// (prismatic) the z axis of its placement frame.
+    pub kinds: Vec<JointKind>,
     /// From the last joint's moving frame to the end-effector frame, whose
     /// origin is the measured point.
     pub tool: Placement,
@@ -93,8 +98,8 @@ impl ModelSpec {
     pub fn transform(&self, q: &[f64]) -> Matrix4<f64> {
         assert_eq!(q.len(), self.dof(), "joint vector length");
         let mut t = Matrix4::<f64>::identity();
-        for (p, &qk) in self.placements.iter().zip(q) {
-            t = t * p.homogeneous() * rz(qk);
+        for ((p, &kind), &qk) in self.placements.iter().zip(&self.kinds).zip(q) {
+            t = t * p.homogeneous() * joint_motion(kind, qk);
         }
         t * self.tool.homogeneous()
     }
@@ -121,6 +126,21 @@ fn rz(theta: f64) -> Matrix4<f64> {
     dh(theta, 0.0, 0.0, 0.0)
 }
 
+/// `Tz(s)` as a homogeneous matrix.
+#[must_use]
+fn tz(s: f64) -> Matrix4<f64> {
+    dh(0.0, s, 0.0, 0.0)
+}
+
+/// The motion of a joint at value `q`: `Rz(q)` or `Tz(q)`.
+#[must_use]
+pub fn joint_motion(kind: JointKind, q: f64) -> Matrix4<f64> {
+    match kind {
+        JointKind::Revolute => rz(q),
+        JointKind::Prismatic => tz(q),
+    }
+}
+
 /// `Ry(β)` as a homogeneous matrix.
 #[must_use]
 fn ry(beta: f64) -> Matrix4<f64> {
@@ -138,9 +158,10 @@ fn ry(beta: f64) -> Matrix4<f64> {
 /// The Pinocchio (and MuJoCo) model of `robot` with parameters `table`: one
 /// placement before each joint, in joint order, and the tool placement.
 ///
-/// Fixed frames are folded into the neighbouring placements; a driven frame
-/// `Rz(q+γ) B` contributes `Rz(γ)` to the placement before its joint and
-/// `B = Tz(d) Tx(a) Rx(α) [Ry(β)]` after it. Fails if joints do not drive
+/// Fixed frames are folded into the neighbouring placements; a revolute
+/// frame `Rz(q+γ) B` contributes `Rz(γ)` to the placement before its joint
+/// and `B = Tz(d) Tx(a) Rx(α) [Ry(β)]` after it, and so does a prismatic
+/// frame `Rz(γ) Tz(q) B`. Fails if joints do not drive
 /// frames in increasing joint order (0, 1, …, dof−1), the only layout a
 /// serial chain of nested bodies can express without renumbering.
 pub fn pinocchio_model_spec(robot: &Robot, table: &ParamTable) -> Result<ModelSpec> {
@@ -152,6 +173,7 @@ pub fn pinocchio_model_spec(robot: &Robot, table: &ParamTable) -> Result<ModelSp
         );
     }
     let mut placements = Vec::with_capacity(robot.dof());
+    let mut kinds = Vec::with_capacity(robot.dof());
     let mut acc = Matrix4::identity();
     for (frame, row) in robot.frames.iter().zip(&table.rows) {
         let [gamma, alpha, a, d, beta] = *row;
@@ -171,6 +193,7 @@ pub fn pinocchio_model_spec(robot: &Robot, table: &ParamTable) -> Result<ModelSp
                     );
                 }
                 placements.push(Placement::from_homogeneous(&(acc * rz(gamma))));
+                kinds.push(frame.joint_kind);
                 acc = dh(0.0, d, a, alpha) * twist;
             }
         }
@@ -185,6 +208,7 @@ pub fn pinocchio_model_spec(robot: &Robot, table: &ParamTable) -> Result<ModelSp
     Ok(ModelSpec {
         robot: robot.name.clone(),
         placements,
+        kinds,
         tool: Placement::from_homogeneous(&acc),
     })
 }
@@ -204,9 +228,10 @@ fn nums(xs: &[f64]) -> String {
 }
 
 /// An MJCF document for MuJoCo: nested bodies `link1 … linkN` with `pos` /
-/// `quat` from [`pinocchio_model_spec`], a hinge joint `q1 … qN` about the
-/// body's z axis in each, a unit inertial (MuJoCo refuses moving bodies
-/// without mass), and a site `ee` at the end effector. Numbers are printed
+/// `quat` from [`pinocchio_model_spec`], a joint `q1 … qN` along the body's
+/// z axis in each (`hinge` if revolute, `slide` if prismatic), a unit
+/// inertial (MuJoCo refuses moving bodies without mass), and a site `ee` at
+/// the end effector. Numbers are printed
 /// as the shortest decimal that round-trips, so the model is exact up to
 /// MuJoCo's quaternion normalization.
 pub fn mjcf(robot: &Robot, table: &ParamTable) -> Result<String> {
@@ -223,7 +248,7 @@ pub fn mjcf_of_spec(spec: &ModelSpec) -> String {
     writeln!(s, "  <option gravity=\"0 0 0\"/>").unwrap();
     writeln!(s, "  <worldbody>").unwrap();
     let mut indent = String::from("    ");
-    for (k, p) in spec.placements.iter().enumerate() {
+    for (k, (p, kind)) in spec.placements.iter().zip(&spec.kinds).enumerate() {
         writeln!(
             s,
             "{indent}<body name=\"link{}\" pos=\"{}\" quat=\"{}\">",
@@ -233,9 +258,13 @@ pub fn mjcf_of_spec(spec: &ModelSpec) -> String {
         )
         .unwrap();
         indent.push_str("  ");
+        let kind = match kind {
+            JointKind::Revolute => "hinge",
+            JointKind::Prismatic => "slide",
+        };
         writeln!(
             s,
-            "{indent}<joint name=\"q{}\" type=\"hinge\" pos=\"0 0 0\" axis=\"0 0 1\"/>",
+            "{indent}<joint name=\"q{}\" type=\"{kind}\" pos=\"0 0 0\" axis=\"0 0 1\"/>",
             k + 1
         )
         .unwrap();

@@ -3,7 +3,7 @@
 //! MJCF carries the spec exactly, and the fixture format round-trips.
 
 use activecal::kinematics::{Evaluator, joint_chain, position};
-use activecal::robot::{ParamSet, Robot};
+use activecal::robot::{JointKind, ParamSet, Robot};
 use nalgebra::{Matrix4, Vector3};
 use verify::compare::{Kinematics, activecal_kinematics, deviation};
 use verify::fixture::{self, Fixture, Versions};
@@ -19,34 +19,43 @@ fn robots() -> Vec<Robot> {
 
 const SETS: [ParamSet; 2] = [ParamSet::Nominal, ParamSet::Real];
 
-/// Position and geometric joint Jacobian (`z_j × (p − o_j)`) of the spec,
-/// evaluated with 4 × 4 matrices: a third implementation, sharing nothing
-/// with activecal's.
+/// Position and geometric joint Jacobian (`z_j × (p − o_j)` for a revolute
+/// joint, `z_j` for a prismatic one) of the spec, evaluated with 4 × 4
+/// matrices: a third implementation, sharing nothing with activecal's.
 fn spec_kinematics(spec: &ModelSpec, qs: &[Vec<f64>]) -> Kinematics {
     let dof = spec.dof();
     let mut out = Kinematics::default();
     for q in qs {
         let mut t = Matrix4::identity();
         let mut axes = Vec::new();
-        for (p, &qk) in spec.placements.iter().zip(q) {
+        for ((p, &kind), &qk) in spec.placements.iter().zip(&spec.kinds).zip(q) {
             t *= p.homogeneous();
             axes.push((
+                kind,
                 Vector3::new(t[(0, 2)], t[(1, 2)], t[(2, 2)]),
                 Vector3::new(t[(0, 3)], t[(1, 3)], t[(2, 3)]),
             ));
-            let (s, c) = qk.sin_cos();
-            let mut rz = Matrix4::identity();
-            rz[(0, 0)] = c;
-            rz[(0, 1)] = -s;
-            rz[(1, 0)] = s;
-            rz[(1, 1)] = c;
-            t *= rz;
+            let mut m = Matrix4::identity();
+            match kind {
+                JointKind::Revolute => {
+                    let (s, c) = qk.sin_cos();
+                    m[(0, 0)] = c;
+                    m[(0, 1)] = -s;
+                    m[(1, 0)] = s;
+                    m[(1, 1)] = c;
+                }
+                JointKind::Prismatic => m[(2, 3)] = qk,
+            }
+            t *= m;
         }
         t *= spec.tool.homogeneous();
         let p = Vector3::new(t[(0, 3)], t[(1, 3)], t[(2, 3)]);
         let mut jac = vec![0.0; 3 * dof];
-        for (j, (z, o)) in axes.iter().enumerate() {
-            let col = z.cross(&(p - o));
+        for (j, (kind, z, o)) in axes.iter().enumerate() {
+            let col = match kind {
+                JointKind::Revolute => z.cross(&(p - o)),
+                JointKind::Prismatic => *z,
+            };
             for r in 0..3 {
                 jac[r * dof + j] = col[r];
             }
@@ -86,6 +95,7 @@ fn spec_equals_activecal_joint_chain() {
             let spec = pinocchio_model_spec(&robot, table).unwrap();
             let chain = joint_chain(&robot, table);
             assert_eq!(spec.dof(), chain.placements.len());
+            assert_eq!(spec.kinds, chain.kinds);
             let pairs = spec
                 .placements
                 .iter()
@@ -160,6 +170,15 @@ fn mjcf_carries_the_spec_exactly() {
             let names: Vec<String> = (1..=dof).map(|k| format!("q{k}")).collect();
             assert_eq!(attrs(&xml, "joint", "name"), names);
             assert_eq!(attrs(&xml, "joint", "axis"), vec!["0 0 1"; dof]);
+            let types: Vec<&str> = spec
+                .kinds
+                .iter()
+                .map(|k| match k {
+                    JointKind::Revolute => "hinge",
+                    JointKind::Prismatic => "slide",
+                })
+                .collect();
+            assert_eq!(attrs(&xml, "joint", "type"), types);
             assert_eq!(attrs(&xml, "inertial", "mass").len(), dof);
             assert_eq!(attrs(&xml, "site", "name"), ["ee"]);
             assert_eq!(xml.matches("<body ").count(), dof);

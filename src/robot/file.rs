@@ -1,0 +1,548 @@
+//! Robot description files (TOML): frames, real and nominal parameter
+//! tables, unknowns, joint limits, the measurement and an optional sensor
+//! visibility region.
+//!
+//! ```toml
+//! name = "puma560"            # optional; default: the file name
+//! measurement = "point"       # "point" (3 rows per pose) or "pose" (6 rows)
+//! # unknowns = "auto"         # choose identifiable unknowns automatically
+//!
+//! [visibility]                # optional: see activecal::pool::Visibility
+//! kind = "box"
+//! min = [-30.0, -30.0, -30.0]
+//! max = [30.0, 30.0, 30.0]
+//!
+//! [[frame]]                   # frames in chain order, measurement frame first
+//! label = "a"                 # used in parameter names: gamma_a, d_3, …
+//! convention = "hayati"       # "dh" or "hayati"
+//! joint = "fixed"             # "revolute", "prismatic" or "fixed"
+//! #         gamma      alpha   a     d    beta   (radians, metres)
+//! real    = [1.5708,   0.0314, 20.0, 0.0, 0.0314]
+//! nominal = [1.6360,   0.1572, 19.882, 0.0, -0.0123]
+//! unknowns = ["gamma", "alpha", "a", "beta"]
+//!
+//! [[frame]]
+//! label = "0"
+//! convention = "dh"
+//! joint = "revolute"          # joints are numbered in frame order: q1, q2, …
+//! limits_deg = [-250, 70]     # or limits = [lo, hi] in radians (metres if prismatic)
+//! real    = [0.0, -1.5708, 0.0, 0.6858]       # a DH row may omit beta
+//! nominal = [-0.0367, -1.4524, 0.0603, 0.6713]
+//! unknowns = ["gamma", "alpha", "a", "d"]
+//! ```
+//!
+//! Instead of frames, a file may import a URDF: `urdf = "arm.urdf"` (relative
+//! to the file), with optional `tip = "link"`, `measurement`, `name` and
+//! `visibility`; its unknowns are chosen automatically (see [`crate::urdf`]).
+//!
+//! Every problem is an [`Error::Parse`] naming the file and the place:
+//! TOML syntax, unknown keys, missing or mistyped fields (with the TOML
+//! parser's line and column), and — with line, column and frame label — a
+//! non-finite value, a duplicate frame label, wrong row or limit lengths,
+//! inverted limits, an unknown symbol, no unknowns, and unknowns that are not
+//! identifiable ([`Robot::check_identifiable`]).
+
+use super::{Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot, Symbol};
+use crate::error::{Error, Result};
+use crate::pool::Visibility;
+use serde::{Deserialize, Serialize};
+use std::ops::Range;
+use std::path::Path;
+use toml::Spanned;
+
+/// Most frames a description may have.
+pub const MAX_FRAMES: usize = 100;
+
+/// Largest magnitude accepted for a parameter or limit (metres or radians;
+/// degrees for `limits_deg`): larger values are typing errors, and would
+/// overflow the kinematics.
+pub const MAX_ABS: f64 = 1e6;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileSpec {
+    name: Option<String>,
+    measurement: Option<Measurement>,
+    visibility: Option<Spanned<Visibility>>,
+    unknowns: Option<Spanned<String>>,
+    urdf: Option<Spanned<String>>,
+    tip: Option<Spanned<String>>,
+    #[serde(default)]
+    frame: Vec<FrameSpec>,
+}
+
+#[derive(Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+enum JointSpec {
+    Revolute,
+    Prismatic,
+    Fixed,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FrameSpec {
+    label: Spanned<String>,
+    convention: Convention,
+    joint: JointSpec,
+    limits: Option<Spanned<Vec<f64>>>,
+    limits_deg: Option<Spanned<Vec<f64>>>,
+    real: Spanned<Vec<f64>>,
+    nominal: Spanned<Vec<f64>>,
+    unknowns: Option<Spanned<Vec<Spanned<String>>>>,
+}
+
+/// The text being parsed, for turning byte spans into places.
+struct Ctx<'a> {
+    text: &'a str,
+    origin: &'a str,
+}
+
+impl Ctx<'_> {
+    /// `line L, column C` of a byte offset (both 1-based).
+    fn place(&self, offset: usize) -> (usize, usize) {
+        let before = self.text.get(..offset).unwrap_or(self.text);
+        let line = before.matches('\n').count() + 1;
+        let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+        (line, col)
+    }
+
+    fn at(&self, span: Range<usize>, msg: impl std::fmt::Display) -> Error {
+        let (line, col) = self.place(span.start);
+        Error::Parse {
+            path: self.origin.to_string(),
+            message: format!("line {line}, column {col}: {msg}"),
+        }
+    }
+
+    fn plain(&self, msg: impl std::fmt::Display) -> Error {
+        Error::Parse {
+            path: self.origin.to_string(),
+            message: msg.to_string(),
+        }
+    }
+}
+
+/// Reads and checks a robot description file (see the module docs).
+pub fn load(path: &Path) -> Result<Robot> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    parse(&text, &path.display().to_string(), path.parent())
+}
+
+/// Parses and checks a description. `origin` names it in errors (and gives
+/// the default robot name, its file stem); `dir` is where a `urdf = …` path
+/// is relative to (the current directory if `None`).
+pub fn parse(text: &str, origin: &str, dir: Option<&Path>) -> Result<Robot> {
+    let cx = Ctx { text, origin };
+    let spec: FileSpec = toml::from_str(text).map_err(|e| cx.plain(e.to_string().trim_end()))?;
+    let measurement = spec.measurement.unwrap_or(Measurement::Point);
+    let auto = match &spec.unknowns {
+        None => false,
+        Some(u) if u.get_ref() == "auto" => true,
+        Some(u) => {
+            return Err(cx.at(
+                u.span(),
+                format!(
+                    "top-level `unknowns` must be \"auto\", not \"{}\" (list a frame's unknowns in its [[frame]] table)",
+                    u.get_ref()
+                ),
+            ));
+        }
+    };
+    let visibility = match spec.visibility {
+        None => None,
+        Some(v) => {
+            check_visibility(v.get_ref()).map_err(|m| cx.at(v.span(), m))?;
+            Some(v.into_inner())
+        }
+    };
+    let default_name = Path::new(origin)
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("robot")
+        .to_string();
+
+    if let Some(urdf) = &spec.urdf {
+        if !spec.frame.is_empty() {
+            return Err(cx.at(
+                urdf.span(),
+                "give either `urdf = …` or [[frame]] tables, not both",
+            ));
+        }
+        let path = match dir {
+            Some(d) => d.join(urdf.get_ref()),
+            None => Path::new(urdf.get_ref()).to_path_buf(),
+        };
+        let opts = crate::urdf::UrdfOptions {
+            tip: spec.tip.as_ref().map(|t| t.get_ref().clone()),
+            measurement,
+            ..crate::urdf::UrdfOptions::default()
+        };
+        let mut r = crate::urdf::load(&path, &opts).map_err(|e| cx.at(urdf.span(), e))?;
+        if let Some(n) = spec.name {
+            r.name = n;
+        }
+        r.visibility = visibility;
+        return Ok(r);
+    }
+    if let Some(t) = &spec.tip {
+        return Err(cx.at(t.span(), "`tip` is only for `urdf = …` imports"));
+    }
+    if spec.frame.is_empty() {
+        return Err(cx.plain(
+            "no frames: describe the chain with [[frame]] tables, or import one with `urdf = \"file.urdf\"`",
+        ));
+    }
+    if spec.frame.len() > MAX_FRAMES {
+        return Err(cx.plain(format!(
+            "{} frames: at most {MAX_FRAMES} are supported",
+            spec.frame.len()
+        )));
+    }
+
+    let mut frames = Vec::with_capacity(spec.frame.len());
+    let mut real = Vec::with_capacity(spec.frame.len());
+    let mut nominal = Vec::with_capacity(spec.frame.len());
+    let mut limits = Vec::new();
+    let mut unknowns = Vec::new();
+    // Where each frame's unknowns were listed, to point at unidentifiable ones.
+    let mut unknown_spans: Vec<Option<Range<usize>>> = Vec::new();
+    for (i, f) in spec.frame.iter().enumerate() {
+        let label = f.label.get_ref();
+        if label.is_empty() || label.chars().any(|c| c.is_whitespace() || c == ',') {
+            return Err(cx.at(
+                f.label.span(),
+                format!("frame label '{label}' must be non-empty, without spaces or commas"),
+            ));
+        }
+        if let Some(g) = spec.frame[..i].iter().find(|g| g.label.get_ref() == label) {
+            let (line, _) = cx.place(g.label.span().start);
+            return Err(cx.at(
+                f.label.span(),
+                format!("duplicate frame label '{label}' (first used on line {line})"),
+            ));
+        }
+        let real_row = row(&cx, label, "real", &f.real, f.convention)?;
+        let nominal_row = row(&cx, label, "nominal", &f.nominal, f.convention)?;
+        let joint_no = limits.len() + 1;
+        let (joint, kind) = match f.joint {
+            JointSpec::Fixed => {
+                if let Some(l) = f.limits.as_ref().or(f.limits_deg.as_ref()) {
+                    return Err(cx.at(
+                        l.span(),
+                        format!("frame '{label}' is fixed: it has no joint limits"),
+                    ));
+                }
+                (None, JointKind::Revolute)
+            }
+            JointSpec::Revolute | JointSpec::Prismatic => {
+                let kind = if f.joint == JointSpec::Prismatic {
+                    JointKind::Prismatic
+                } else {
+                    JointKind::Revolute
+                };
+                limits.push(joint_limits(&cx, label, joint_no, kind, f)?);
+                (Some(joint_no - 1), kind)
+            }
+        };
+        frames.push(Frame {
+            label: label.clone(),
+            convention: f.convention,
+            joint,
+            joint_kind: kind,
+        });
+        real.push(real_row);
+        nominal.push(nominal_row);
+        unknown_spans.push(f.unknowns.as_ref().map(|u| u.span()));
+        for s in f.unknowns.iter().flat_map(|u| u.get_ref()) {
+            let symbol = Symbol::parse(s.get_ref()).ok_or_else(|| {
+                cx.at(
+                    s.span(),
+                    format!(
+                        "frame '{label}': unknown parameter symbol '{}' (expected gamma, alpha, a, d or beta)",
+                        s.get_ref()
+                    ),
+                )
+            })?;
+            if symbol == Symbol::Beta && f.convention == Convention::Dh {
+                return Err(cx.at(
+                    s.span(),
+                    format!("frame '{label}' is a DH frame: it has no beta"),
+                ));
+            }
+            let id = ParamId { frame: i, symbol };
+            if unknowns.contains(&id) {
+                return Err(cx.at(
+                    s.span(),
+                    format!("frame '{label}': '{}' is listed twice", s.get_ref()),
+                ));
+            }
+            unknowns.push(id);
+        }
+    }
+    if auto {
+        if let Some(span) = unknown_spans.iter().flatten().next() {
+            return Err(cx.at(
+                span.clone(),
+                "`unknowns = \"auto\"` at the top level and a frame's own `unknowns` list: give one or the other",
+            ));
+        }
+    } else if unknowns.is_empty() {
+        return Err(cx.plain(
+            "no unknowns: list each frame's unknown parameters (`unknowns = [\"gamma\", …]`) or set `unknowns = \"auto\"` at the top",
+        ));
+    }
+    unknowns.sort();
+    let mut robot = Robot {
+        name: spec.name.unwrap_or(default_name),
+        frames,
+        real: ParamTable { rows: real },
+        nominal: ParamTable { rows: nominal },
+        unknowns,
+        limits,
+        measurement,
+        visibility,
+    };
+    if auto {
+        robot.unknowns = robot.choose_unknowns(&[]).map_err(|e| cx.plain(e))?;
+        if robot.unknowns.is_empty() {
+            return Err(cx.plain("no parameter of this chain is identifiable"));
+        }
+    }
+    robot.validate().map_err(|e| cx.plain(e))?;
+    match robot.check_identifiable() {
+        Ok(_) => Ok(robot),
+        Err(Error::Unidentifiable { names, rank, p }) => {
+            let first = names
+                .first()
+                .and_then(|n| robot.param_id(n).ok())
+                .and_then(|id| unknown_spans[id.frame].clone());
+            let msg = format!(
+                "unknowns {} are not identifiable from {} measurements (numerical rank {rank} of {p} on a random design of the {}-level lattice at the nominal parameters): remove them, or set `unknowns = \"auto\"`",
+                names.join(", "),
+                robot.measurement.name(),
+                super::unknowns::DESIGN_LEVELS,
+            );
+            Err(match first {
+                Some(span) => cx.at(span, msg),
+                None => cx.plain(msg),
+            })
+        }
+        Err(e) => Err(cx.plain(e)),
+    }
+}
+
+/// A parameter row: 5 values, or 4 for a DH frame (β = 0), all finite.
+fn row(
+    cx: &Ctx<'_>,
+    label: &str,
+    which: &str,
+    v: &Spanned<Vec<f64>>,
+    conv: Convention,
+) -> Result<[f64; 5]> {
+    let vals = v.get_ref();
+    let ok_len = vals.len() == 5 || (vals.len() == 4 && conv == Convention::Dh);
+    if !ok_len {
+        let want = match conv {
+            Convention::Dh => "4 or 5 values [gamma, alpha, a, d(, beta)]",
+            Convention::Hayati => "5 values [gamma, alpha, a, d, beta]",
+        };
+        return Err(cx.at(
+            v.span(),
+            format!(
+                "frame '{label}': `{which}` has {} values, a {} frame needs {want}",
+                vals.len(),
+                match conv {
+                    Convention::Dh => "DH",
+                    Convention::Hayati => "Hayati",
+                }
+            ),
+        ));
+    }
+    let mut r = [0.0; 5];
+    for (k, &x) in vals.iter().enumerate() {
+        if !x.is_finite() {
+            return Err(cx.at(
+                v.span(),
+                format!(
+                    "frame '{label}': {which} {} is not a finite number ({x})",
+                    Symbol::ALL[k]
+                ),
+            ));
+        }
+        if x.abs() > MAX_ABS {
+            return Err(cx.at(
+                v.span(),
+                format!(
+                    "frame '{label}': {which} {} = {x} is out of range (|value| <= {MAX_ABS:e})",
+                    Symbol::ALL[k]
+                ),
+            ));
+        }
+        r[k] = x;
+    }
+    Ok(r)
+}
+
+fn joint_limits(
+    cx: &Ctx<'_>,
+    label: &str,
+    joint_no: usize,
+    kind: JointKind,
+    f: &FrameSpec,
+) -> Result<[f64; 2]> {
+    let (v, scale) = match (&f.limits, &f.limits_deg) {
+        (Some(_), Some(d)) => {
+            return Err(cx.at(
+                d.span(),
+                format!("frame '{label}': give `limits` or `limits_deg`, not both"),
+            ));
+        }
+        (None, None) => {
+            return Err(cx.at(
+                f.label.span(),
+                format!(
+                    "frame '{label}': joint q{joint_no} needs `limits = [lo, hi]` ({}) or `limits_deg`",
+                    match kind {
+                        JointKind::Revolute => "radians",
+                        JointKind::Prismatic => "metres",
+                    }
+                ),
+            ));
+        }
+        (Some(l), None) => (l, 1.0),
+        (None, Some(d)) => {
+            if kind == JointKind::Prismatic {
+                return Err(cx.at(
+                    d.span(),
+                    format!(
+                        "frame '{label}': joint q{joint_no} is prismatic: give `limits` in metres, not `limits_deg`"
+                    ),
+                ));
+            }
+            (d, std::f64::consts::PI / 180.0)
+        }
+    };
+    let vals = v.get_ref();
+    if vals.len() != 2 {
+        return Err(cx.at(
+            v.span(),
+            format!(
+                "frame '{label}': joint q{joint_no} limits need 2 values [lo, hi], got {}",
+                vals.len()
+            ),
+        ));
+    }
+    let (lo, hi) = (vals[0], vals[1]);
+    if !(lo.is_finite() && hi.is_finite()) || lo.abs() > MAX_ABS || hi.abs() > MAX_ABS {
+        return Err(cx.at(
+            v.span(),
+            format!(
+                "frame '{label}': joint q{joint_no} limits [{lo}, {hi}] are not finite numbers within ±{MAX_ABS:e}"
+            ),
+        ));
+    }
+    if lo > hi {
+        return Err(cx.at(
+            v.span(),
+            format!(
+                "frame '{label}': joint q{joint_no} has inverted limits [{lo}, {hi}] (need lo <= hi)"
+            ),
+        ));
+    }
+    Ok([lo * scale, hi * scale])
+}
+
+fn check_visibility(v: &Visibility) -> std::result::Result<(), String> {
+    let finite = match v {
+        Visibility::All => true,
+        Visibility::Cone {
+            apex,
+            axis,
+            half_angle,
+            max_range,
+        } => {
+            if axis.iter().all(|&x| x == 0.0) {
+                return Err("visibility: the cone axis is zero".into());
+            }
+            apex.iter().chain(axis).all(|x| x.is_finite())
+                && half_angle.is_finite()
+                && !max_range.is_nan()
+        }
+        Visibility::Box { min, max } => min.iter().chain(max).all(|x| x.is_finite()),
+    };
+    if finite {
+        Ok(())
+    } else {
+        Err("visibility: every number must be finite".into())
+    }
+}
+
+/// Writes a robot as a description that [`parse`] reads back to the same
+/// robot (tables bit for bit: numbers are written as the shortest decimals
+/// that round-trip; limits in radians or metres). A DH frame's β is written
+/// when finite (the paper's marker 10), omitted otherwise.
+#[must_use]
+pub fn to_toml(robot: &Robot) -> String {
+    let num = |x: f64| format!("{x:?}");
+    let list = |r: &[f64]| {
+        let v: Vec<String> = r.iter().map(|&x| num(x)).collect();
+        format!("[{}]", v.join(", "))
+    };
+    let mut s = String::new();
+    s += "# activecal robot description (see activecal::robot::file)\n";
+    s += &format!("name = {:?}\n", robot.name);
+    s += &format!("measurement = \"{}\"\n", robot.measurement.name());
+    for (i, f) in robot.frames.iter().enumerate() {
+        s += "\n[[frame]]\n";
+        s += &format!("label = {:?}\n", f.label);
+        s += &format!(
+            "convention = \"{}\"\n",
+            match f.convention {
+                Convention::Dh => "dh",
+                Convention::Hayati => "hayati",
+            }
+        );
+        let joint = match (f.joint, f.joint_kind) {
+            (None, _) => "fixed",
+            (Some(_), JointKind::Revolute) => "revolute",
+            (Some(_), JointKind::Prismatic) => "prismatic",
+        };
+        s += &format!("joint = \"{joint}\"\n");
+        if let Some(j) = f.joint {
+            s += &format!("limits = {}\n", list(&robot.limits[j]));
+        }
+        for (name, t) in [("real", &robot.real), ("nominal", &robot.nominal)] {
+            let r = &t.rows[i];
+            let n = if f.convention == Convention::Dh && !r[4].is_finite() {
+                4
+            } else {
+                5
+            };
+            s += &format!("{name} = {}\n", list(&r[..n]));
+        }
+        let syms: Vec<String> = robot
+            .unknowns
+            .iter()
+            .filter(|u| u.frame == i)
+            .map(|u| format!("\"{}\"", u.symbol))
+            .collect();
+        if !syms.is_empty() {
+            s += &format!("unknowns = [{}]\n", syms.join(", "));
+        }
+    }
+    if let Some(v) = &robot.visibility {
+        #[derive(Serialize)]
+        struct W<'a> {
+            visibility: &'a Visibility,
+        }
+        if let Ok(t) = toml::to_string(&W { visibility: v }) {
+            s += "\n";
+            s += &t;
+        }
+    }
+    s
+}

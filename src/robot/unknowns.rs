@@ -1,0 +1,228 @@
+//! Choosing identifiable unknowns, and checking them, on a random design of
+//! the pose lattice.
+//!
+//! A frame's *candidate* unknowns are its four structural parameters: γ, α,
+//! a, d for a DH frame and γ, α, a, β for a Hayati frame (a Hayati frame's d
+//! is the paper's fixed 0, redundant with the d of the next DH frame along
+//! the nearly parallel axes). Some candidates are redundant with others — the
+//! α of the last joint frame for point measurements, the location of a
+//! prismatic axis, a tool frame's translations — and
+//! [`Robot::choose_unknowns`] drops them: it walks the candidates in a
+//! preference order and keeps each one whose Jacobian column is not in the
+//! span of the columns kept before (a greedy column selection by
+//! Gram–Schmidt). For a generic chain the result has the textbook size
+//! ([`Robot::minimal_unknowns`]): `4R + 2P + 3` for points, `4R + 2P + 6`
+//! for full poses.
+//!
+//! The columns come from a random design of the 5-level pose lattice (each
+//! joint at one of 5 evenly spaced values of its range) at the nominal
+//! parameters, with a fixed seed, so the choice is reproducible.
+
+use super::{Convention, Measurement, ParamId, ParamTable, Robot, Symbol};
+use crate::blocks::Blocks;
+use crate::error::{Error, Result};
+use crate::pool::{Identifiability, jacobian_of, require_identifiable};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// Lattice levels of the random designs used here.
+pub const DESIGN_LEVELS: usize = 5;
+
+/// A candidate is kept when the component of its unit-norm column orthogonal
+/// to the kept columns has norm above this. On the built-in robots (point
+/// and pose) dependent columns leave at most 4e-16 (rounding) and the
+/// independent ones at least 0.09 (`tests/robots.rs` checks both), so 1e-8
+/// separates them by seven orders of magnitude on each side.
+pub const INDEPENDENCE_TOL: f64 = 1e-8;
+
+/// Seed of the design [`Robot::choose_unknowns`] uses.
+const CHOOSE_SEED: u64 = 0x5eed_0c00_5e00;
+/// Seed of the design [`Robot::check_identifiable`] uses (a different design,
+/// so the check does not merely repeat the choice).
+const CHECK_SEED: u64 = 0x5eed_c4ec_0001;
+
+impl Robot {
+    /// The structural candidate unknowns of every frame, frame-major: γ, α,
+    /// a, d for DH frames, γ, α, a, β for Hayati frames.
+    #[must_use]
+    pub fn candidate_unknowns(&self) -> Vec<ParamId> {
+        let mut v = Vec::with_capacity(4 * self.frames.len());
+        for (frame, f) in self.frames.iter().enumerate() {
+            let last = match f.convention {
+                Convention::Dh => Symbol::D,
+                Convention::Hayati => Symbol::Beta,
+            };
+            for symbol in [Symbol::Gamma, Symbol::Alpha, Symbol::A, last] {
+                v.push(ParamId { frame, symbol });
+            }
+        }
+        v
+    }
+
+    /// The number of independent kinematic parameters of a generic serial
+    /// chain with this robot's joints and measurement: `4R + 2P + 3` for point
+    /// measurements, `4R + 2P + 6` for full poses (R revolute, P prismatic
+    /// joints; Everett, Driels & Mooring 1987, less 3 for a point). Special
+    /// geometries (a measured point on the last joint axis, coaxial joints)
+    /// have fewer.
+    #[must_use]
+    pub fn minimal_unknowns(&self) -> usize {
+        let p = self.frames.iter().filter(|f| f.is_prismatic()).count();
+        let r = self.dof() - p;
+        4 * r
+            + 2 * p
+            + match self.measurement {
+                Measurement::Point => 3,
+                Measurement::Pose => 6,
+            }
+    }
+
+    /// A maximal identifiable set of unknowns: `preferred` first (in the given
+    /// order), then the [candidates](Robot::candidate_unknowns) frame-major,
+    /// each kept if its Jacobian column is independent of those kept before
+    /// (see the module documentation). Returned frame-major, as
+    /// [`Robot::unknowns`] must be. Errors if the kinematics is not finite on
+    /// the design (parameters too large).
+    pub fn choose_unknowns(&self, preferred: &[ParamId]) -> Result<Vec<ParamId>> {
+        let mut kept: Vec<ParamId> = self
+            .independence(preferred)?
+            .into_iter()
+            .filter(|&(_, r)| r > INDEPENDENCE_TOL)
+            .map(|(u, _)| u)
+            .collect();
+        kept.sort();
+        Ok(kept)
+    }
+
+    /// The greedy walk of [`Robot::choose_unknowns`]: every parameter it
+    /// considers, in walk order, with the norm of the part of its unit-norm
+    /// column orthogonal to the columns kept before it (0 for a zero
+    /// column). Those above [`INDEPENDENCE_TOL`] are kept.
+    pub fn independence(&self, preferred: &[ParamId]) -> Result<Vec<(ParamId, f64)>> {
+        let mut order: Vec<ParamId> = Vec::new();
+        for &u in preferred.iter().chain(&self.candidate_unknowns()) {
+            if u.frame < self.frames.len() && !order.contains(&u) {
+                order.push(u);
+            }
+        }
+        let mut all = order.clone();
+        all.sort();
+        let mut probe = self.clone();
+        probe.unknowns = all.clone();
+        let n = (2 * all.len()).max(40);
+        let x = design_jacobian(&probe, &self.nominal, n, CHOOSE_SEED)?;
+        let m = x.mat();
+        let rows = m.nrows();
+        let col = |k: usize| -> Vec<f64> { (0..rows).map(|r| m[(r, k)]).collect() };
+        let norms: Vec<f64> = (0..all.len())
+            .map(|k| col(k).iter().map(|v| v * v).sum::<f64>().sqrt())
+            .collect();
+        let scale = norms.iter().cloned().fold(0.0, f64::max);
+        let mut basis: Vec<Vec<f64>> = Vec::new();
+        let mut out = Vec::with_capacity(order.len());
+        for u in order {
+            let k = all.binary_search(&u).expect("all holds every candidate");
+            // A column that is zero up to rounding (α of the last frame for a
+            // point, say) is unidentifiable outright.
+            if !(norms[k] > 1e-12 * scale) {
+                out.push((u, 0.0));
+                continue;
+            }
+            let mut v: Vec<f64> = col(k).iter().map(|x| x / norms[k]).collect();
+            // Two passes of modified Gram–Schmidt ("twice is enough").
+            for _ in 0..2 {
+                for b in &basis {
+                    let d: f64 = b.iter().zip(&v).map(|(x, y)| x * y).sum();
+                    v.iter_mut().zip(b).for_each(|(y, x)| *y -= d * x);
+                }
+            }
+            let r = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if r > INDEPENDENCE_TOL {
+                v.iter_mut().for_each(|x| *x /= r);
+                basis.push(v);
+            }
+            out.push((u, r));
+        }
+        Ok(out)
+    }
+
+    /// Checks numerically that every unknown is identifiable: the stacked
+    /// Jacobian (nominal parameters) of a random design of the 5-level
+    /// lattice, `max(40, 2p)` poses with a fixed seed, has full column rank
+    /// ([`crate::pool::require_identifiable`]).
+    pub fn check_identifiable(&self) -> Result<Identifiability> {
+        if self.unknowns.is_empty() {
+            return Err(Error::Invalid("the robot has no unknown parameters".into()));
+        }
+        let n = (2 * self.n_unknowns()).max(40);
+        let x = design_jacobian(self, &self.nominal, n, CHECK_SEED)?;
+        require_identifiable(self, &x)
+    }
+
+    /// A copy measuring `m`, with its unknowns re-chosen by
+    /// [`Robot::choose_unknowns`] (the current unknowns preferred) and
+    /// checked. For full poses the last frame must be able to carry the tool's
+    /// orientation: a fixed DH last frame becomes a Hayati frame with β = 0
+    /// (the same transform), and a chain ending in a driven frame gets a
+    /// fixed Hayati identity frame `tool`.
+    pub fn with_measurement(&self, m: Measurement) -> Result<Robot> {
+        let mut r = self.clone();
+        r.measurement = m;
+        if r.frames.is_empty() {
+            return Err(Error::Invalid("the robot has no frames".into()));
+        }
+        if m == Measurement::Pose {
+            let last = r.frames.len() - 1;
+            if r.frames[last].joint.is_none() {
+                if r.frames[last].convention == Convention::Dh {
+                    r.frames[last].convention = Convention::Hayati;
+                    r.real.rows[last][4] = 0.0;
+                    r.nominal.rows[last][4] = 0.0;
+                }
+            } else {
+                let mut label = "tool".to_string();
+                while r.frames.iter().any(|f| f.label == label) {
+                    label.push('_');
+                }
+                r.frames
+                    .push(super::Frame::fixed(&label, Convention::Hayati));
+                r.real.rows.push([0.0; 5]);
+                r.nominal.rows.push([0.0; 5]);
+            }
+        }
+        r.unknowns = r.choose_unknowns(&self.unknowns)?;
+        r.validate()?;
+        r.check_identifiable()?;
+        Ok(r)
+    }
+}
+
+/// The stacked identification Jacobian of `n` random poses of the
+/// [`DESIGN_LEVELS`]-level lattice over the robot's limits, or an error if
+/// any entry is not finite.
+pub fn design_jacobian(robot: &Robot, table: &ParamTable, n: usize, seed: u64) -> Result<Blocks> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let k = DESIGN_LEVELS;
+    let qs: Vec<Vec<f64>> = (0..n)
+        .map(|_| {
+            robot
+                .limits
+                .iter()
+                .map(|&[lo, hi]| {
+                    let f = rng.random_range(0..k) as f64 / (k - 1) as f64;
+                    lo * (1.0 - f) + hi * f
+                })
+                .collect()
+        })
+        .collect();
+    let x = jacobian_of(robot, table, n, |i, q| q.copy_from_slice(&qs[i]));
+    let m = x.mat();
+    let finite = (0..m.ncols()).all(|c| (0..m.nrows()).all(|r| m[(r, c)].is_finite()));
+    if !finite {
+        return Err(Error::Invalid(format!(
+            "robot {}: the kinematics is not finite on the joint ranges (parameters or limits too large)",
+            robot.name
+        )));
+    }
+    Ok(x)
+}

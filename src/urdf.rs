@@ -1,0 +1,588 @@
+//! URDF import and export: a serial chain of a URDF file converted into the
+//! DH/Hayati frames of a [`Robot`], and a robot written as URDF.
+//!
+//! **Import.** The chain runs from the URDF's root link (the measurement
+//! frame) to a tip link (the measured point, or frame for full poses).
+//! Revolute and continuous joints become revolute joints, prismatic joints
+//! prismatic ones, fixed joints are folded into their neighbours; floating,
+//! planar, spherical and mimic joints are refused. With every joint at 0,
+//! each joint axis is a line in the root frame; the frames map one axis line
+//! to the next:
+//!
+//! * a fixed `base` frame maps the root frame to joint 1's axis (DH). When
+//!   the root z axis is nearly parallel to that axis — where a single DH or
+//!   Hayati frame would be singular if the two coincide — a fixed DH frame
+//!   `m` = `Rx(−π/2)` with no unknowns first turns z into the root's y axis;
+//! * the frame driven by joint k maps its axis to the axis of joint k + 1:
+//!   a DH frame, or a Hayati frame (d = 0) when the two axes are nearly
+//!   parallel, i.e. the angle between them (or their negatives) is below
+//!   [`UrdfOptions::parallel_threshold`], default [`PARALLEL_THRESHOLD`] =
+//!   10°. Below 10°, DH's d and γ are more than 1/sin 10° ≈ 5.8 times as
+//!   sensitive to an axis misalignment as the misalignment itself, and grow
+//!   without bound as the axes become parallel; above it, Hayati's
+//!   sensitivity 1/cos of the angle is below 1.02, so 10° keeps both well
+//!   conditioned;
+//! * the last joint frame maps its axis to a line through the tip: the tip's
+//!   z axis, or its x axis when z is nearly parallel to the last joint axis
+//!   (so that this frame is always DH and non-singular), and a fixed Hayati
+//!   frame `tool` rotates about and slides along that line and turns to the
+//!   tip's orientation.
+//!
+//! Each joint frame is labelled with its (sanitised) URDF joint name. The
+//! transforms are computed in closed form from the axis lines and then
+//! composed with exactly the kinematics of [`crate::kinematics`], so the
+//! imported nominal model reproduces the URDF's forward kinematics to
+//! rounding (tests/robots.rs checks it against a direct URDF evaluation).
+//!
+//! The unknowns are chosen by [`Robot::choose_unknowns`] (the `m` frame last,
+//! so it keeps none) and checked by [`Robot::check_identifiable`]: for a
+//! generic chain `4R + 2P + 3` for points and `4R + 2P + 6` for poses. The
+//! nominal table is the URDF; the real one is the nominal one with
+//! [`crate::robot::builtin::perturbation`] added to every unknown (unless
+//! [`UrdfOptions::perturb_real`] is false), so that calibration has something
+//! to find.
+//!
+//! **Export.** [`to_urdf`] writes the chain of [`crate::kinematics::joint_chain`]:
+//! one URDF joint per robot joint about (or along) z of its placement, and a
+//! fixed joint `tool` to the link `tip`. `fixtures/puma560.urdf` is the
+//! paper's nominal PUMA written this way.
+
+use crate::error::{Error, Result};
+use crate::kinematics::joint_chain;
+use crate::robot::builtin::perturbed;
+use crate::robot::{Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot};
+use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion, Vector3};
+use std::collections::HashMap;
+use std::f64::consts::{FRAC_PI_2, PI};
+use std::path::Path;
+
+/// Default angle (radians) below which two consecutive joint axes count as
+/// nearly parallel and get a Hayati frame: 10°.
+pub const PARALLEL_THRESHOLD: f64 = 10.0 * PI / 180.0;
+
+/// How to import a URDF.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UrdfOptions {
+    /// The tip link (measured point or frame). Default: the end of the chain
+    /// when the tree has a single leaf; required when it branches.
+    pub tip: Option<String>,
+    /// Point (default) or full-pose measurements.
+    pub measurement: Measurement,
+    /// Angle in radians below which consecutive axes are nearly parallel
+    /// (Hayati frame). Default [`PARALLEL_THRESHOLD`].
+    pub parallel_threshold: f64,
+    /// Make the real table the nominal one plus the built-in arms'
+    /// deterministic perturbation of every unknown (default true); if false
+    /// the real robot is the URDF.
+    pub perturb_real: bool,
+}
+
+impl Default for UrdfOptions {
+    fn default() -> Self {
+        Self {
+            tip: None,
+            measurement: Measurement::Point,
+            parallel_threshold: PARALLEL_THRESHOLD,
+            perturb_real: true,
+        }
+    }
+}
+
+/// Reads a URDF file and converts its chain (see the module docs).
+pub fn load(path: &Path, opts: &UrdfOptions) -> Result<Robot> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    parse(&text, &path.display().to_string(), opts)
+}
+
+/// Parses URDF text and converts its chain; `origin` names it in errors and
+/// gives the robot's name when the URDF has none.
+pub fn parse(text: &str, origin: &str, opts: &UrdfOptions) -> Result<Robot> {
+    let bad = |message: String| Error::Parse {
+        path: origin.to_string(),
+        message,
+    };
+    if !(opts.parallel_threshold > 0.0 && opts.parallel_threshold < FRAC_PI_2) {
+        return Err(Error::Invalid(format!(
+            "parallel_threshold must be in (0, π/2), got {}",
+            opts.parallel_threshold
+        )));
+    }
+    let urdf = urdf_rs::read_from_string(text).map_err(|e| bad(format!("not a valid URDF: {e}")))?;
+    let chain = extract_chain(&urdf, opts.tip.as_deref()).map_err(bad)?;
+    let name = if urdf.name.is_empty() {
+        Path::new(origin)
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("urdf")
+            .to_string()
+    } else {
+        urdf.name.clone()
+    };
+    let mut robot = convert(&chain, &name, opts);
+    // The aux frame `m` (if any) is frame 0 and goes last in the preference.
+    let preferred: Vec<ParamId> = robot
+        .candidate_unknowns()
+        .into_iter()
+        .filter(|u| robot.frames[u.frame].label != "m" || u.frame != 0)
+        .collect();
+    robot.unknowns = robot.choose_unknowns(&preferred).map_err(|e| bad(e.to_string()))?;
+    if robot.unknowns.is_empty() {
+        return Err(bad("no parameter of the chain is identifiable".into()));
+    }
+    if opts.perturb_real {
+        robot.real = perturbed(&robot.nominal, &robot.unknowns);
+    }
+    robot.validate().map_err(|e| bad(e.to_string()))?;
+    robot.check_identifiable().map_err(|e| bad(e.to_string()))?;
+    Ok(robot)
+}
+
+/// One URDF joint of the chain, fixed ones included.
+#[derive(Clone, Debug)]
+struct ChainJoint {
+    name: String,
+    /// `None` for a fixed joint.
+    kind: Option<JointKind>,
+    origin: Isometry3<f64>,
+    /// Unit axis in the joint frame.
+    axis: Vector3<f64>,
+    limits: [f64; 2],
+}
+
+fn iso_from_pose(p: &urdf_rs::Pose) -> Option<Isometry3<f64>> {
+    let (x, r) = (p.xyz.0, p.rpy.0);
+    if !x.iter().chain(&r).all(|v| v.is_finite()) {
+        return None;
+    }
+    let rot = Rotation3::from_euler_angles(r[0], r[1], r[2]);
+    Some(Isometry3::from_parts(
+        Translation3::new(x[0], x[1], x[2]),
+        UnitQuaternion::from_rotation_matrix(&rot),
+    ))
+}
+
+/// The joints from the root link to the tip, in order.
+fn extract_chain(
+    urdf: &urdf_rs::Robot,
+    tip: Option<&str>,
+) -> std::result::Result<Vec<ChainJoint>, String> {
+    let joints = &urdf.joints;
+    let mut by_child: HashMap<&str, usize> = HashMap::new();
+    let mut children: HashMap<&str, Vec<usize>> = HashMap::new();
+    for (i, j) in joints.iter().enumerate() {
+        if let Some(&k) = by_child.get(j.child.link.as_str()) {
+            return Err(format!(
+                "link '{}' is the child of two joints ('{}' and '{}')",
+                j.child.link, joints[k].name, j.name
+            ));
+        }
+        by_child.insert(&j.child.link, i);
+        children.entry(&j.parent.link).or_default().push(i);
+    }
+    let mut links: Vec<&str> = urdf.links.iter().map(|l| l.name.as_str()).collect();
+    for j in joints {
+        links.push(&j.parent.link);
+        links.push(&j.child.link);
+    }
+    links.sort_unstable();
+    links.dedup();
+    let roots: Vec<&str> = links
+        .iter()
+        .copied()
+        .filter(|l| !by_child.contains_key(l))
+        .collect();
+    let root = match roots.as_slice() {
+        [r] => *r,
+        [] => return Err("the joints form a loop: no link is the root".into()),
+        many => {
+            return Err(format!(
+                "{} root links ({}): the URDF must be one tree",
+                many.len(),
+                many.join(", ")
+            ));
+        }
+    };
+    let tip: &str = match tip {
+        Some(t) => {
+            if !links.contains(&t) {
+                return Err(format!("the tip link '{t}' is not in the URDF"));
+            }
+            t
+        }
+        None => {
+            let mut at = root;
+            for _ in 0..=joints.len() {
+                match children.get(at).map(Vec::as_slice) {
+                    None | Some([]) => break,
+                    Some([j]) => at = &joints[*j].child.link,
+                    Some(many) => {
+                        let names: Vec<&str> =
+                            many.iter().map(|&j| joints[j].child.link.as_str()).collect();
+                        return Err(format!(
+                            "the chain branches at link '{at}' (into {}): name the tip link (`tip`)",
+                            names.join(", ")
+                        ));
+                    }
+                }
+            }
+            at
+        }
+    };
+    // Walk up from the tip.
+    let mut path = Vec::new();
+    let mut at = tip;
+    while let Some(&j) = by_child.get(at) {
+        if path.len() > joints.len() {
+            return Err("the joints form a loop".into());
+        }
+        path.push(j);
+        at = &joints[j].parent.link;
+    }
+    if at != root {
+        return Err(format!("the tip link '{tip}' is not connected to the root '{root}'"));
+    }
+    path.reverse();
+    let mut out = Vec::with_capacity(path.len());
+    for &i in &path {
+        let j = &joints[i];
+        let origin = iso_from_pose(&j.origin)
+            .ok_or_else(|| format!("joint '{}': the origin is not finite", j.name))?;
+        use urdf_rs::JointType as T;
+        let kind = match j.joint_type {
+            T::Fixed => None,
+            T::Revolute | T::Continuous => Some(JointKind::Revolute),
+            T::Prismatic => Some(JointKind::Prismatic),
+            ref other => {
+                return Err(format!(
+                    "joint '{}' is {other:?}: a serial chain has only revolute, continuous, prismatic and fixed joints",
+                    j.name
+                ));
+            }
+        };
+        let mut axis = Vector3::from(j.axis.xyz.0);
+        let mut limits = [0.0; 2];
+        if let Some(kind) = kind {
+            if j.mimic.is_some() {
+                return Err(format!(
+                    "joint '{}' mimics another joint: it is not an independent joint",
+                    j.name
+                ));
+            }
+            let norm = axis.norm();
+            if !(norm.is_finite() && norm > 1e-9) {
+                return Err(format!(
+                    "joint '{}': the axis {:?} is zero or not finite",
+                    j.name, j.axis.xyz.0
+                ));
+            }
+            axis /= norm;
+            let (lo, hi) = (j.limit.lower, j.limit.upper);
+            limits = match (j.joint_type.clone(), kind) {
+                (T::Continuous, _) => [-PI, PI],
+                (_, JointKind::Revolute) if lo == f64::NEG_INFINITY && hi == f64::INFINITY => {
+                    [-PI, PI]
+                }
+                _ => [lo, hi],
+            };
+            let [lo, hi] = limits;
+            if lo.is_nan() || hi.is_nan() || !lo.is_finite() || !hi.is_finite() {
+                return Err(format!(
+                    "joint '{}': limits [{lo}, {hi}] are not finite",
+                    j.name
+                ));
+            }
+            if lo > hi {
+                return Err(format!(
+                    "joint '{}': inverted limits [{lo}, {hi}] (need lower <= upper)",
+                    j.name
+                ));
+            }
+            if lo == hi {
+                return Err(format!(
+                    "joint '{}': empty range [{lo}, {hi}] (is <limit lower=… upper=…> missing?)",
+                    j.name
+                ));
+            }
+        }
+        out.push(ChainJoint {
+            name: j.name.clone(),
+            kind,
+            origin,
+            axis,
+            limits,
+        });
+    }
+    if out.iter().all(|j| j.kind.is_none()) {
+        return Err(format!(
+            "no revolute or prismatic joint between the root '{root}' and the tip '{tip}'"
+        ));
+    }
+    Ok(out)
+}
+
+/// The transform of one of our frames at q = 0.
+fn frame_iso(conv: Convention, row: &[f64; 5]) -> Isometry3<f64> {
+    let [gamma, alpha, a, d, beta] = *row;
+    let rz = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), gamma);
+    let rx = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), alpha);
+    let mut t = Isometry3::from_parts(Translation3::identity(), rz)
+        * Isometry3::from_parts(Translation3::new(a, 0.0, d), rx);
+    if conv == Convention::Hayati {
+        t *= Isometry3::from_parts(
+            Translation3::identity(),
+            UnitQuaternion::from_axis_angle(&Vector3::y_axis(), beta),
+        );
+    }
+    t
+}
+
+/// The frame (convention and `[γ, α, a, d, β]`) from frame `z` (whose z axis
+/// is a joint axis, or the root's) to the line through `p` along unit `u`,
+/// and the frame it ends in (on the line, z along `u`).
+fn to_line(
+    z: &Isometry3<f64>,
+    p: &Vector3<f64>,
+    u: &Vector3<f64>,
+    threshold: f64,
+) -> (Convention, [f64; 5], Isometry3<f64>) {
+    let ez = z.rotation * Vector3::z();
+    let ex = z.rotation * Vector3::x();
+    let o = z.translation.vector;
+    let cross = ez.cross(u);
+    let angle_of = |xn: &Vector3<f64>| ex.cross(xn).dot(&ez).atan2(ex.dot(xn));
+    // Lengths below this (relative to the geometry's size) are zero.
+    let tiny = 1e-12 * (1.0 + o.norm() + p.norm());
+    let (conv, row) = if cross.norm() > threshold.sin() {
+        // DH: the common normal from the z axis to the line.
+        let w = o - p;
+        let b = ez.dot(u);
+        let (d1, e) = (ez.dot(&w), u.dot(&w));
+        let den = 1.0 - b * b;
+        let s1 = (b * e - d1) / den;
+        let s2 = (e - b * d1) / den;
+        let n = (p + u * s2) - (o + ez * s1);
+        let n = n - ez * ez.dot(&n);
+        let a = n.norm();
+        let xn = if a > tiny { n / a } else { cross.normalize() };
+        let alpha = cross.dot(&xn).atan2(ez.dot(u));
+        (Convention::Dh, [angle_of(&xn), alpha, a, s1, 0.0])
+    } else {
+        // Hayati: through the line's intersection with the plane ⟂ z at o.
+        let s2 = (o - p).dot(&ez) / u.dot(&ez);
+        let n = p + u * s2 - o;
+        let n = n - ez * ez.dot(&n);
+        let a = n.norm();
+        let xn = if a > tiny { n / a } else { ex };
+        let yn = ez.cross(&xn);
+        let (ux, uy, uz) = (u.dot(&xn), u.dot(&yn), u.dot(&ez));
+        let beta = ux.atan2((uy * uy + uz * uz).sqrt());
+        let alpha = (-uy).atan2(uz);
+        (Convention::Hayati, [angle_of(&xn), alpha, a, 0.0, beta])
+    };
+    let next = z * frame_iso(conv, &row);
+    (conv, row, next)
+}
+
+/// `R = Rz(γ) Rx(α) Ry(β)` → `(γ, α, β)`.
+fn zxy_angles(r: &Rotation3<f64>) -> (f64, f64, f64) {
+    let m = r.matrix();
+    let alpha = m[(2, 1)].atan2((m[(2, 0)].powi(2) + m[(2, 2)].powi(2)).sqrt());
+    let gamma = (-m[(0, 1)]).atan2(m[(1, 1)]);
+    let beta = (-m[(2, 0)]).atan2(m[(2, 2)]);
+    (gamma, alpha, beta)
+}
+
+/// A frame label from a URDF joint name: characters other than ASCII
+/// letters, digits, `_`, `-` and `.` become `_`; unique among `used`.
+fn label_for(name: &str, k: usize, used: &[String]) -> String {
+    let mut l: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if l.is_empty() {
+        l = format!("j{}", k + 1);
+    }
+    while used.contains(&l) {
+        l.push('_');
+    }
+    l
+}
+
+/// Converts the chain into frames (nominal = URDF; real = nominal, unknowns
+/// empty: the caller fills them).
+fn convert(chain: &[ChainJoint], name: &str, opts: &UrdfOptions) -> Robot {
+    let thr = opts.parallel_threshold;
+    // Axis lines and the tip at q = 0, in the root frame.
+    let mut t = Isometry3::identity();
+    let mut lines = Vec::new();
+    for j in chain {
+        t *= j.origin;
+        if let Some(kind) = j.kind {
+            lines.push((t.translation.vector, t.rotation * j.axis, kind, j));
+        }
+    }
+    let tip = t;
+    let mut frames: Vec<Frame> = Vec::new();
+    let mut rows: Vec<[f64; 5]> = Vec::new();
+    let mut limits = Vec::new();
+    let mut labels: Vec<String> = Vec::new();
+    let mut z = Isometry3::identity();
+    let (p1, u1) = (lines[0].0, lines[0].1);
+    if Vector3::z().cross(&u1).norm() <= thr.sin() {
+        let row = [0.0, -FRAC_PI_2, 0.0, 0.0, 0.0];
+        z *= frame_iso(Convention::Dh, &row);
+        frames.push(Frame::fixed("m", Convention::Dh));
+        rows.push(row);
+        labels.push("m".into());
+    }
+    let (conv, row, next) = to_line(&z, &p1, &u1, thr);
+    frames.push(Frame::fixed("base", conv));
+    rows.push(row);
+    labels.push("base".into());
+    z = next;
+    let n = lines.len();
+    for (k, &(_, _, kind, j)) in lines.iter().enumerate() {
+        let (p, u) = if k + 1 < n {
+            (lines[k + 1].0, lines[k + 1].1)
+        } else {
+            let tz = tip.rotation * Vector3::z();
+            let dir = if lines[k].1.cross(&tz).norm() > thr.sin() {
+                tz
+            } else {
+                tip.rotation * Vector3::x()
+            };
+            (tip.translation.vector, dir)
+        };
+        let (conv, row, next) = to_line(&z, &p, &u, thr);
+        let label = label_for(&j.name, k, &labels);
+        frames.push(Frame::driven(&label, conv, k, kind));
+        rows.push(row);
+        labels.push(label);
+        limits.push(j.limits);
+        z = next;
+    }
+    // The tool: from the last frame (z along a line through the tip) to the tip.
+    let rel = z.inverse() * tip;
+    let (gamma, alpha, beta) = zxy_angles(&rel.rotation.to_rotation_matrix());
+    let label = label_for("tool", n, &labels);
+    frames.push(Frame::fixed(&label, Convention::Hayati));
+    rows.push([gamma, alpha, 0.0, rel.translation.vector.z, beta]);
+    let nominal = ParamTable { rows };
+    Robot {
+        name: name.to_string(),
+        frames,
+        real: nominal.clone(),
+        nominal,
+        unknowns: Vec::new(),
+        limits,
+        measurement: opts.measurement,
+        visibility: None,
+    }
+}
+
+/// URDF `rpy` (fixed-axis roll, pitch, yaw: `R = Rz(yaw) Ry(pitch) Rx(roll)`)
+/// of a rotation, computed with `atan2` only (well conditioned everywhere).
+#[must_use]
+pub fn rpy(r: &Rotation3<f64>) -> [f64; 3] {
+    let m = r.matrix();
+    let cp = m[(0, 0)].hypot(m[(1, 0)]);
+    let pitch = (-m[(2, 0)]).atan2(cp);
+    if cp > 1e-12 {
+        [
+            m[(2, 1)].atan2(m[(2, 2)]),
+            pitch,
+            m[(1, 0)].atan2(m[(0, 0)]),
+        ]
+    } else {
+        [(-m[(1, 2)]).atan2(m[(1, 1)]), pitch, 0.0]
+    }
+}
+
+/// Writes the robot with parameter table `table` as URDF: root link
+/// `measurement`, links `link1…linkN`, joints `q1…qN` (revolute or prismatic
+/// about z of their origin, limits from [`Robot::limits`]) and a fixed joint
+/// `tool` to the link `tip`. Numbers are the shortest decimals that
+/// round-trip. Errors if the joints do not drive frames in increasing order.
+pub fn to_urdf(robot: &Robot, table: &ParamTable) -> Result<String> {
+    let order: Vec<usize> = robot.frames.iter().filter_map(|f| f.joint).collect();
+    if order.iter().enumerate().any(|(k, &j)| k != j) {
+        return Err(Error::Invalid(format!(
+            "robot {}: joints must drive frames in increasing order to be written as URDF",
+            robot.name
+        )));
+    }
+    let ch = joint_chain(robot, table);
+    let origin = |t: &Isometry3<f64>| {
+        let v = t.translation.vector;
+        let r = rpy(&t.rotation.to_rotation_matrix());
+        format!(
+            "<origin xyz=\"{:?} {:?} {:?}\" rpy=\"{:?} {:?} {:?}\"/>",
+            v.x, v.y, v.z, r[0], r[1], r[2]
+        )
+    };
+    let n = robot.dof();
+    let link = |k: usize| {
+        if k == 0 {
+            "measurement".to_string()
+        } else {
+            format!("link{k}")
+        }
+    };
+    let mut s = String::new();
+    s += "<?xml version=\"1.0\"?>\n";
+    s += &format!(
+        "<!-- {} ({:?} parameters) written by activecal::urdf::to_urdf -->\n",
+        robot.name,
+        if std::ptr::eq(table, &robot.nominal) {
+            "nominal"
+        } else if std::ptr::eq(table, &robot.real) {
+            "real"
+        } else {
+            "given"
+        }
+    );
+    s += &format!("<robot name=\"{}\">\n", xml_escape(&robot.name));
+    for k in 0..=n {
+        s += &format!("  <link name=\"{}\"/>\n", link(k));
+    }
+    s += "  <link name=\"tip\"/>\n";
+    for k in 0..n {
+        let kind = match ch.kinds[k] {
+            JointKind::Revolute => "revolute",
+            JointKind::Prismatic => "prismatic",
+        };
+        let [lo, hi] = robot.limits[k];
+        s += &format!("  <joint name=\"q{}\" type=\"{kind}\">\n", k + 1);
+        s += &format!("    <parent link=\"{}\"/>\n", link(k));
+        s += &format!("    <child link=\"{}\"/>\n", link(k + 1));
+        s += &format!("    {}\n", origin(&ch.placements[k]));
+        s += "    <axis xyz=\"0 0 1\"/>\n";
+        s += &format!(
+            "    <limit lower=\"{lo:?}\" upper=\"{hi:?}\" effort=\"0\" velocity=\"0\"/>\n"
+        );
+        s += "  </joint>\n";
+    }
+    s += "  <joint name=\"tool\" type=\"fixed\">\n";
+    s += &format!("    <parent link=\"{}\"/>\n", link(n));
+    s += "    <child link=\"tip\"/>\n";
+    s += &format!("    {}\n", origin(&ch.tool));
+    s += "  </joint>\n";
+    s += "</robot>\n";
+    Ok(s)
+}
+
+fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}

@@ -6,6 +6,8 @@ mod cli;
 use clap::{Parser, Subcommand};
 use cli::basic::{FkArgs, PoolArgs, RobotsArgs};
 use cli::bench::BenchArgs;
+use cli::calibrate::CalibrateArgs;
+use cli::reproduce::ReproduceArgs;
 use cli::select::{ScoreArgs, SelectArgs};
 
 #[derive(Parser)]
@@ -33,6 +35,10 @@ enum Command {
     Select(SelectArgs),
     /// Benchmark the hot paths (and with --scale the 10^6-pose pool).
     Bench(BenchArgs),
+    /// Reproduce the paper's experiment: report, tables and figures.
+    Reproduce(ReproduceArgs),
+    /// Simulate a calibration of a design (identification, validation, Monte-Carlo).
+    Calibrate(CalibrateArgs),
 }
 
 fn main() {
@@ -44,6 +50,8 @@ fn main() {
         Command::Score(a) => cli::select::cmd_score(a),
         Command::Select(a) => cli::select::cmd_select(a),
         Command::Bench(a) => cli::bench::cmd_bench(a),
+        Command::Reproduce(a) => cli::reproduce::cmd_reproduce(a),
+        Command::Calibrate(a) => cli::calibrate::cmd_calibrate(a),
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");

@@ -110,7 +110,8 @@ pub fn parse(text: &str, origin: &str, opts: &UrdfOptions) -> Result<Robot> {
             opts.parallel_threshold
         )));
     }
-    let urdf = urdf_rs::read_from_string(text).map_err(|e| bad(format!("not a valid URDF: {e}")))?;
+    let urdf =
+        urdf_rs::read_from_string(text).map_err(|e| bad(format!("not a valid URDF: {e}")))?;
     let chain = extract_chain(&urdf, opts.tip.as_deref()).map_err(bad)?;
     let name = if urdf.name.is_empty() {
         Path::new(origin)
@@ -128,7 +129,9 @@ pub fn parse(text: &str, origin: &str, opts: &UrdfOptions) -> Result<Robot> {
         .into_iter()
         .filter(|u| robot.frames[u.frame].label != "m" || u.frame != 0)
         .collect();
-    robot.unknowns = robot.choose_unknowns(&preferred).map_err(|e| bad(e.to_string()))?;
+    robot.unknowns = robot
+        .choose_unknowns(&preferred)
+        .map_err(|e| bad(e.to_string()))?;
     if robot.unknowns.is_empty() {
         return Err(bad("no parameter of the chain is identifiable".into()));
     }
@@ -219,8 +222,10 @@ fn extract_chain(
                     None | Some([]) => break,
                     Some([j]) => at = &joints[*j].child.link,
                     Some(many) => {
-                        let names: Vec<&str> =
-                            many.iter().map(|&j| joints[j].child.link.as_str()).collect();
+                        let names: Vec<&str> = many
+                            .iter()
+                            .map(|&j| joints[j].child.link.as_str())
+                            .collect();
                         return Err(format!(
                             "the chain branches at link '{at}' (into {}): name the tip link (`tip`)",
                             names.join(", ")
@@ -242,7 +247,9 @@ fn extract_chain(
         at = &joints[j].parent.link;
     }
     if at != root {
-        return Err(format!("the tip link '{tip}' is not connected to the root '{root}'"));
+        return Err(format!(
+            "the tip link '{tip}' is not connected to the root '{root}'"
+        ));
     }
     path.reverse();
     let mut out = Vec::with_capacity(path.len());

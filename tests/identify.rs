@@ -312,6 +312,17 @@ fn bad_input_is_an_error() {
 }
 
 #[test]
+fn full_pose_robots_are_refused() {
+    let mut robot = Robot::puma560();
+    robot.measurement = activecal::robot::Measurement::Pose;
+    let e = Measurements::new(&robot, vec![vec![0.0; 6]], vec![[0.0; 3]]).unwrap_err();
+    assert!(
+        matches!(e, IdentifyError::UnsupportedMeasurement { rows: 6, .. }),
+        "{e}"
+    );
+}
+
+#[test]
 fn designs_that_do_not_match_the_robot_are_errors() {
     // The path `calibrate` takes: read, build the design's pool, place the poses.
     let robot = Robot::puma560();

@@ -224,7 +224,14 @@ pub fn max_abs(m: &DMatrix<f64>) -> f64 {
 /// `64·ε·|ln det|`, with `a ≥ 1` the amplification of the change
 /// ([`amplification`]).
 #[must_use]
-pub fn ln_det_tol(m: usize, p: usize, kappa_before: f64, kappa_after: f64, a: f64, ln_det: f64) -> f64 {
+pub fn ln_det_tol(
+    m: usize,
+    p: usize,
+    kappa_before: f64,
+    kappa_after: f64,
+    a: f64,
+    ln_det: f64,
+) -> f64 {
     8.0 * (m + p) as f64 * EPS * (kappa_before * a + kappa_after) + 64.0 * EPS * ln_det.abs()
 }
 
@@ -272,6 +279,22 @@ pub fn step_amplification(status: &Status, added_frob2: f64, m_inv_norm1: f64) -
 pub fn norm1(m: &DMatrix<f64>) -> f64 {
     (0..m.ncols())
         .map(|c| m.column(c).iter().map(|x| x.abs()).sum::<f64>())
+        .fold(0.0, f64::max)
+}
+
+/// Induced 1-norm of a faer matrix (no copy).
+#[must_use]
+pub fn norm1_faer(m: faer::MatRef<'_, f64>) -> f64 {
+    (0..m.ncols())
+        .map(|c| m.col(c).iter().map(|x| x.abs()).sum::<f64>())
+        .fold(0.0, f64::max)
+}
+
+/// Largest absolute entry of a faer matrix (no copy).
+#[must_use]
+pub fn max_abs_faer(m: faer::MatRef<'_, f64>) -> f64 {
+    (0..m.ncols())
+        .flat_map(|c| m.col(c).iter().map(|x| x.abs()))
         .fold(0.0, f64::max)
 }
 

@@ -48,7 +48,7 @@ proptest! {
         for (op, a, b) in ops {
             let before = (st.condition_estimate(), st.m_inv());
             let k_before = before.0;
-            let inv_norm = norm1(&to_nalgebra(before.1));
+            let inv_norm = norm1_faer(before.1);
             let d = st.design().to_vec();
             let free: Vec<usize> = (0..n).filter(|i| !st.contains(*i)).collect();
             let out = d[a as usize % d.len()];

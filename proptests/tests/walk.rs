@@ -62,7 +62,7 @@ proptest! {
                 _ => 2,
             };
             let k_before = st.condition_estimate();
-            let inv_norm1 = norm1(&to_nalgebra(st.m_inv()));
+            let inv_norm1 = norm1_faer(st.m_inv());
             let s = match op {
                 0 => st.add(&pool, inn).unwrap(),
                 1 => st.remove(&pool, out).unwrap(),
@@ -78,7 +78,7 @@ proptest! {
             kappa = kappa
                 .max(k_before * step_amplification(&s, added, inv_norm1))
                 .max(st.condition_estimate());
-            inv_norm = inv_norm.max(to_nalgebra(st.m_inv()).amax());
+            inv_norm = inv_norm.max(max_abs_faer(st.m_inv()));
             if step % 8 == 0 {
                 pv.sync(&pool, &st);
             }

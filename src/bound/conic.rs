@@ -32,9 +32,9 @@ pub struct ConicSettings {
     pub max_iter: u32,
     /// Time limit in seconds for one solve. Default 120.
     pub time_limit: f64,
-    /// Absolute and relative duality-gap tolerance. Default 1e-10.
+    /// Absolute and relative duality-gap tolerance. Default 1e-9.
     pub tol_gap: f64,
-    /// Primal and dual feasibility tolerance. Default 1e-10.
+    /// Primal and dual feasibility tolerance. Default 1e-9.
     pub tol_feas: f64,
     /// Clarabel's data equilibration. Default true.
     pub equilibrate: bool,
@@ -52,8 +52,8 @@ impl Default for ConicSettings {
         Self {
             max_iter: 200,
             time_limit: 120.0,
-            tol_gap: 1e-10,
-            tol_feas: 1e-10,
+            tol_gap: 1e-9,
+            tol_feas: 1e-9,
             equilibrate: true,
             retry_without_equilibration: true,
             chordal: true,

@@ -51,7 +51,7 @@ pub const SUPPORT_TOL: f64 = 1e-6;
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(default)]
 pub struct BoundSettings {
-    /// Target certified gap `ln_bound − ln_primal`. Default 1e-7.
+    /// Target certified gap `ln_bound − ln_primal`. Default 1e-6.
     pub gap_tol: f64,
     /// Solve (R) with Clarabel (true) or with the first-order solver alone
     /// (false). Default true.
@@ -79,7 +79,7 @@ pub struct BoundSettings {
 impl Default for BoundSettings {
     fn default() -> Self {
         Self {
-            gap_tol: 1e-7,
+            gap_tol: 1e-6,
             use_conic: true,
             screen_gap: 1e-3,
             screen_extra: 300,
@@ -131,7 +131,7 @@ impl BoundSettings {
 pub struct BoundSettingsBuilder(BoundSettings);
 
 impl BoundSettingsBuilder {
-    /// Target certified gap (default 1e-7).
+    /// Target certified gap (default 1e-6).
     #[must_use]
     pub fn gap_tol(mut self, v: f64) -> Self {
         self.0.gap_tol = v;
@@ -416,10 +416,27 @@ pub fn relaxation_bound(
                 let c = nth_largest(&dk, n, &mut scratch);
                 let mut in_cand = vec![false; pool];
                 cand.iter().for_each(|&i| in_cand[i] = true);
-                let v: Vec<f64> = (0..pool).filter(|&i| !in_cand[i] && e.d[i] > c).map(|i| e.d[i] - c).collect();
+                let v: Vec<f64> = (0..pool)
+                    .filter(|&i| !in_cand[i] && e.d[i] > c)
+                    .map(|i| e.d[i] - c)
+                    .collect();
                 let ws = |th: f64| best.w.iter().filter(|&&x| x > th).count();
-                eprintln!("conic round {round}: cand={} status={:?} it={} secs={:.2} ln_det={:.10} bound={:.10} gap={:.3e} c={c:.6} violators={} maxviol={:.3e} w>1e-3:{} 1e-4:{} 1e-6:{} 1e-8:{}",
-                    cand.len(), out.status, out.iterations, out.seconds, e.ln_det, e.bound, e.bound - e.ln_det, v.len(), v.iter().cloned().fold(0.0, f64::max), ws(1e-3), ws(1e-4), ws(1e-6), ws(1e-8));
+                eprintln!(
+                    "conic round {round}: cand={} status={:?} it={} secs={:.2} ln_det={:.10} bound={:.10} gap={:.3e} c={c:.6} violators={} maxviol={:.3e} w>1e-3:{} 1e-4:{} 1e-6:{} 1e-8:{}",
+                    cand.len(),
+                    out.status,
+                    out.iterations,
+                    out.seconds,
+                    e.ln_det,
+                    e.bound,
+                    e.bound - e.ln_det,
+                    v.len(),
+                    v.iter().cloned().fold(0.0, f64::max),
+                    ws(1e-3),
+                    ws(1e-4),
+                    ws(1e-6),
+                    ws(1e-8)
+                );
             }
             if best.gap() <= settings.gap_tol || !out.status.is_solved() {
                 break;

@@ -3,13 +3,13 @@
 
 use super::emit;
 use activecal::blocks::Blocks;
-use activecal::criterion::{bench_scan, DCriterion};
+use activecal::criterion::{DCriterion, bench_scan};
 use activecal::pool::Pool;
 use activecal::robot::Robot;
-use activecal::select::{design_rng, eae, polish, Settings};
+use activecal::select::{Settings, design_rng, eae, polish};
 use anyhow::Result;
 use clap::Args;
-use serde_json::{json, Value};
+use serde_json::{Value, json};
 use std::time::Instant;
 
 /// Arguments of `bench`.
@@ -47,9 +47,11 @@ pub fn peak_mib() -> f64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
         .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .and_then(|l| l.split_whitespace().nth(1).and_then(|v| v.parse::<f64>().ok()))
+            s.lines().find(|l| l.starts_with("VmHWM:")).and_then(|l| {
+                l.split_whitespace()
+                    .nth(1)
+                    .and_then(|v| v.parse::<f64>().ok())
+            })
         })
         .map_or(0.0, |kb| kb / 1024.0)
 }
@@ -72,18 +74,59 @@ pub fn cmd_bench(a: BenchArgs) -> Result<()> {
         seed += 1;
         eae_run(&x, &s, seed)
     });
-    let (t_pol, pol) = time(reps.min(3), || polish(&x, &mut DCriterion::new(), sel.clone(), &s).expect("polish"));
+    let (t_pol, pol) = time(reps.min(3), || {
+        polish(&x, &mut DCriterion::new(), sel.clone(), &s).expect("polish")
+    });
     let polish_iters = pol.trace.len() - sel.trace.len();
     let mut rows: Vec<(String, f64, String)> = vec![
-        ("FK + Jacobian, whole 15,625 pool".into(), t_jac * 1e3, format!("{:.0} ns/pose", t_jac * 1e9 / pool.len() as f64)),
-        ("add-gain scan (maintained V_i)".into(), scan.add_gain_ns * scan.n_candidates as f64 * 1e-6, format!("{:.2} ns/candidate", scan.add_gain_ns)),
-        ("eigenvalue OI recomputed per candidate".into(), scan.oi_eigen_ns * scan.n_candidates as f64 * 1e-6, format!("{:.0} ns/candidate", scan.oi_eigen_ns)),
-        ("  speed-up of the update over eigen-recompute".into(), f64::NAN, format!("{:.0}x", scan.speedup)),
-        ("V_i full recompute (X M^-1 X^T)".into(), scan.variances_full_ns * scan.n_pool as f64 * 1e-6, format!("{:.2} ns/pose", scan.variances_full_ns)),
-        ("V_i rank-2t update after an exchange".into(), scan.variances_update_ns * scan.n_pool as f64 * 1e-6, format!("{:.2} ns/pose", scan.variances_update_ns)),
-        ("exchange prices, one out-pose".into(), scan.exchange_one_out_ns * scan.n_candidates as f64 * 1e-6, format!("{:.2} ns/candidate", scan.exchange_one_out_ns)),
-        ("one EAE start (12 -> 30 poses)".into(), t_eae * 1e3, format!("{} steps", sel.trace.len())),
-        ("Fedorov polish of an EAE design".into(), t_pol * 1e3, format!("{polish_iters} exchanges, {:.1} ms/iter", t_pol * 1e3 / (polish_iters + 1) as f64)),
+        (
+            "FK + Jacobian, whole 15,625 pool".into(),
+            t_jac * 1e3,
+            format!("{:.0} ns/pose", t_jac * 1e9 / pool.len() as f64),
+        ),
+        (
+            "add-gain scan (maintained V_i)".into(),
+            scan.add_gain_ns * scan.n_candidates as f64 * 1e-6,
+            format!("{:.2} ns/candidate", scan.add_gain_ns),
+        ),
+        (
+            "eigenvalue OI recomputed per candidate".into(),
+            scan.oi_eigen_ns * scan.n_candidates as f64 * 1e-6,
+            format!("{:.0} ns/candidate", scan.oi_eigen_ns),
+        ),
+        (
+            "  speed-up of the update over eigen-recompute".into(),
+            f64::NAN,
+            format!("{:.0}x", scan.speedup),
+        ),
+        (
+            "V_i full recompute (X M^-1 X^T)".into(),
+            scan.variances_full_ns * scan.n_pool as f64 * 1e-6,
+            format!("{:.2} ns/pose", scan.variances_full_ns),
+        ),
+        (
+            "V_i rank-2t update after an exchange".into(),
+            scan.variances_update_ns * scan.n_pool as f64 * 1e-6,
+            format!("{:.2} ns/pose", scan.variances_update_ns),
+        ),
+        (
+            "exchange prices, one out-pose".into(),
+            scan.exchange_one_out_ns * scan.n_candidates as f64 * 1e-6,
+            format!("{:.2} ns/candidate", scan.exchange_one_out_ns),
+        ),
+        (
+            "one EAE start (12 -> 30 poses)".into(),
+            t_eae * 1e3,
+            format!("{} steps", sel.trace.len()),
+        ),
+        (
+            "Fedorov polish of an EAE design".into(),
+            t_pol * 1e3,
+            format!(
+                "{polish_iters} exchanges, {:.1} ms/iter",
+                t_pol * 1e3 / (polish_iters + 1) as f64
+            ),
+        ),
     ];
     let mut v = json!({
         "threads": rayon::current_num_threads(),
@@ -95,23 +138,45 @@ pub fn cmd_bench(a: BenchArgs) -> Result<()> {
         let t0 = Instant::now();
         let xb = big.jacobian(&robot, &robot.nominal);
         let t_bj = t0.elapsed().as_secs_f64();
-        let sb = Settings { n: 145, ..Settings::default() };
+        let sb = Settings {
+            n: 145,
+            ..Settings::default()
+        };
         let t0 = Instant::now();
         let selb = eae(&xb, &mut DCriterion::new(), &sb, &mut design_rng(1, 0))?;
         let t_be = t0.elapsed().as_secs_f64();
-        rows.push(("10^6 pool: FK + Jacobian".into(), t_bj * 1e3, format!("{} poses", big.len())));
-        rows.push(("10^6 pool: one EAE start, N = 145".into(), t_be * 1e3, format!("log10 OI_D {:.3}", selb.ln_oid / std::f64::consts::LN_10)));
+        rows.push((
+            "10^6 pool: FK + Jacobian".into(),
+            t_bj * 1e3,
+            format!("{} poses", big.len()),
+        ));
+        rows.push((
+            "10^6 pool: one EAE start, N = 145".into(),
+            t_be * 1e3,
+            format!("log10 OI_D {:.3}", selb.ln_oid / std::f64::consts::LN_10),
+        ));
         v["scale"] = json!({"poses": big.len(), "jacobian_s": t_bj, "eae_s": t_be, "n": 145,
             "log10_oid": selb.ln_oid / std::f64::consts::LN_10, "steps": selb.trace.len(), "peak_mib": peak_mib()});
     }
     v["peak_mib"] = json!(peak_mib());
     let table = rows.clone();
-    v["table"] = Value::Array(rows.into_iter().map(|(n, ms, note)| json!({"what": n, "median_ms": ms, "note": note})).collect());
+    v["table"] = Value::Array(
+        rows.into_iter()
+            .map(|(n, ms, note)| json!({"what": n, "median_ms": ms, "note": note}))
+            .collect(),
+    );
     emit(a.json, &v, || {
-        let mut s = format!("activecal bench ({} threads, median of {reps})\n", rayon::current_num_threads());
+        let mut s = format!(
+            "activecal bench ({} threads, median of {reps})\n",
+            rayon::current_num_threads()
+        );
         s += &format!("{:<48} {:>12}  {}\n", "", "median ms", "");
         for (n, ms, note) in &table {
-            let ms = if ms.is_nan() { String::new() } else { format!("{ms:.3}") };
+            let ms = if ms.is_nan() {
+                String::new()
+            } else {
+                format!("{ms:.3}")
+            };
             s += &format!("{n:<48} {ms:>12}  {note}\n");
         }
         s += &format!("peak memory: {:.0} MiB\n", peak_mib());

@@ -2,7 +2,7 @@
 //! (plotters): the paper's Fig. 2 (random designs), Fig. 4–6 (traces), and
 //! the selected poses.
 
-use anyhow::{anyhow, Result};
+use anyhow::{Result, anyhow};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -38,8 +38,16 @@ macro_rules! both {
 }
 
 fn range(v: &[f64]) -> (f64, f64) {
-    let lo = v.iter().copied().filter(|x| x.is_finite()).fold(f64::INFINITY, f64::min);
-    let hi = v.iter().copied().filter(|x| x.is_finite()).fold(f64::NEG_INFINITY, f64::max);
+    let lo = v
+        .iter()
+        .copied()
+        .filter(|x| x.is_finite())
+        .fold(f64::INFINITY, f64::min);
+    let hi = v
+        .iter()
+        .copied()
+        .filter(|x| x.is_finite())
+        .fold(f64::NEG_INFINITY, f64::max);
     let pad = ((hi - lo) * 0.05).max(1e-12);
     (lo - pad, hi + pad)
 }
@@ -56,16 +64,31 @@ pub fn random_designs(base: &Path, oi: &[f64], best_eae_oi: f64) -> Result<()> {
             .y_label_area_size(60)
             .build_cartesian_2d(0f64..oi.len() as f64, lo..hi)
             .map_err(err)?;
-        c.configure_mesh().x_desc("design").y_desc("OI, eq. (1)").draw().map_err(err)?;
-        c.draw_series(oi.iter().enumerate().map(|(i, &v)| Circle::new((i as f64, v), 1, BLUE.filled())))
-            .map_err(err)?
-            .label("random designs")
-            .legend(|(x, y)| Circle::new((x, y), 3, BLUE.filled()));
-        c.draw_series(LineSeries::new([(0.0, eae), (oi.len() as f64, eae)], RED.stroke_width(2)))
-            .map_err(err)?
-            .label("EAE design")
-            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED));
-        c.configure_series_labels().border_style(BLACK).background_style(WHITE).draw().map_err(err)?;
+        c.configure_mesh()
+            .x_desc("design")
+            .y_desc("OI, eq. (1)")
+            .draw()
+            .map_err(err)?;
+        c.draw_series(
+            oi.iter()
+                .enumerate()
+                .map(|(i, &v)| Circle::new((i as f64, v), 1, BLUE.filled())),
+        )
+        .map_err(err)?
+        .label("random designs")
+        .legend(|(x, y)| Circle::new((x, y), 3, BLUE.filled()));
+        c.draw_series(LineSeries::new(
+            [(0.0, eae), (oi.len() as f64, eae)],
+            RED.stroke_width(2),
+        ))
+        .map_err(err)?
+        .label("EAE design")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED));
+        c.configure_series_labels()
+            .border_style(BLACK)
+            .background_style(WHITE)
+            .draw()
+            .map_err(err)?;
         let bins = 40usize;
         let (hlo, hhi) = range(oi);
         let w = (hhi - hlo) / bins as f64;
@@ -81,7 +104,12 @@ pub fn random_designs(base: &Path, oi: &[f64], best_eae_oi: f64) -> Result<()> {
             .y_label_area_size(50)
             .build_cartesian_2d(hlo..hhi, 0f64..top)
             .map_err(err)?;
-        h.configure_mesh().x_desc("OI").y_desc("designs").x_labels(4).draw().map_err(err)?;
+        h.configure_mesh()
+            .x_desc("OI")
+            .y_desc("designs")
+            .x_labels(4)
+            .draw()
+            .map_err(err)?;
         h.draw_series(counts.iter().enumerate().map(|(i, &n)| {
             let x0 = hlo + i as f64 * w;
             Rectangle::new([(x0, 0.0), (x0 + w, n as f64)], BLUE.mix(0.6).filled())
@@ -94,40 +122,99 @@ pub fn random_designs(base: &Path, oi: &[f64], best_eae_oi: f64) -> Result<()> {
 
 /// A per-iteration trace (Fig. 4: log10 OI_D; Fig. 5: OI; Fig. 6: 1/OI_D
 /// on a log scale). `series` are (label, values) drawn over their index.
-pub fn trace(base: &Path, title: &str, ylabel: &str, series: &[(&str, Vec<f64>)], log: bool) -> Result<()> {
-    fn draw<DB: DrawingBackend>(root: &Area<DB>, title: &str, ylabel: &str, series: &[(&str, Vec<f64>)], log: bool) -> Result<()> {
+pub fn trace(
+    base: &Path,
+    title: &str,
+    ylabel: &str,
+    series: &[(&str, Vec<f64>)],
+    log: bool,
+) -> Result<()> {
+    fn draw<DB: DrawingBackend>(
+        root: &Area<DB>,
+        title: &str,
+        ylabel: &str,
+        series: &[(&str, Vec<f64>)],
+        log: bool,
+    ) -> Result<()> {
         let all: Vec<f64> = series.iter().flat_map(|(_, v)| v.iter().copied()).collect();
-        let n = series.iter().map(|(_, v)| v.len()).max().unwrap_or(1).max(2) as f64;
+        let n = series
+            .iter()
+            .map(|(_, v)| v.len())
+            .max()
+            .unwrap_or(1)
+            .max(2) as f64;
         let colors = [RED, BLUE, GREEN, MAGENTA, BLACK];
         let mut b = ChartBuilder::on(root);
-        b.caption(title, ("sans-serif", 20)).margin(12).x_label_area_size(40).y_label_area_size(70);
+        b.caption(title, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(70);
         if log {
-            let lo = all.iter().copied().filter(|v| *v > 0.0).fold(f64::INFINITY, f64::min);
+            let lo = all
+                .iter()
+                .copied()
+                .filter(|v| *v > 0.0)
+                .fold(f64::INFINITY, f64::min);
             let hi = all.iter().copied().fold(0.0, f64::max);
-            let mut c = b.build_cartesian_2d(0f64..n - 1.0, (lo / 3.0..hi * 3.0).log_scale()).map_err(err)?;
-            c.configure_mesh().x_desc("iteration").y_desc(ylabel).y_label_formatter(&|v| format!("{v:.0e}")).draw().map_err(err)?;
+            let mut c = b
+                .build_cartesian_2d(0f64..n - 1.0, (lo / 3.0..hi * 3.0).log_scale())
+                .map_err(err)?;
+            c.configure_mesh()
+                .x_desc("iteration")
+                .y_desc(ylabel)
+                .y_label_formatter(&|v| format!("{v:.0e}"))
+                .draw()
+                .map_err(err)?;
             for (k, (label, v)) in series.iter().enumerate() {
                 let col = colors[k % colors.len()];
-                c.draw_series(LineSeries::new(v.iter().enumerate().map(|(i, &y)| (i as f64, y)), col.stroke_width(2)))
-                    .map_err(err)?
-                    .label(*label)
-                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], col));
-                c.draw_series(v.iter().enumerate().map(|(i, &y)| Circle::new((i as f64, y), 3, col.filled()))).map_err(err)?;
+                c.draw_series(LineSeries::new(
+                    v.iter().enumerate().map(|(i, &y)| (i as f64, y)),
+                    col.stroke_width(2),
+                ))
+                .map_err(err)?
+                .label(*label)
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], col));
+                c.draw_series(
+                    v.iter()
+                        .enumerate()
+                        .map(|(i, &y)| Circle::new((i as f64, y), 3, col.filled())),
+                )
+                .map_err(err)?;
             }
-            c.configure_series_labels().border_style(BLACK).background_style(WHITE).draw().map_err(err)?;
+            c.configure_series_labels()
+                .border_style(BLACK)
+                .background_style(WHITE)
+                .draw()
+                .map_err(err)?;
         } else {
             let (lo, hi) = range(&all);
             let mut c = b.build_cartesian_2d(0f64..n - 1.0, lo..hi).map_err(err)?;
-            c.configure_mesh().x_desc("iteration").y_desc(ylabel).draw().map_err(err)?;
+            c.configure_mesh()
+                .x_desc("iteration")
+                .y_desc(ylabel)
+                .draw()
+                .map_err(err)?;
             for (k, (label, v)) in series.iter().enumerate() {
                 let col = colors[k % colors.len()];
-                c.draw_series(LineSeries::new(v.iter().enumerate().map(|(i, &y)| (i as f64, y)), col.stroke_width(2)))
-                    .map_err(err)?
-                    .label(*label)
-                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], col));
-                c.draw_series(v.iter().enumerate().map(|(i, &y)| Circle::new((i as f64, y), 3, col.filled()))).map_err(err)?;
+                c.draw_series(LineSeries::new(
+                    v.iter().enumerate().map(|(i, &y)| (i as f64, y)),
+                    col.stroke_width(2),
+                ))
+                .map_err(err)?
+                .label(*label)
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], col));
+                c.draw_series(
+                    v.iter()
+                        .enumerate()
+                        .map(|(i, &y)| Circle::new((i as f64, y), 3, col.filled())),
+                )
+                .map_err(err)?;
             }
-            c.configure_series_labels().border_style(BLACK).background_style(WHITE).draw().map_err(err)?;
+            c.configure_series_labels()
+                .border_style(BLACK)
+                .background_style(WHITE)
+                .draw()
+                .map_err(err)?;
         }
         Ok(())
     }
@@ -137,7 +224,12 @@ pub fn trace(base: &Path, title: &str, ylabel: &str, series: &[(&str, Vec<f64>)]
 /// The selected poses as joint-angle lattice digits (parallel coordinates:
 /// one polyline per pose across joints 1–6), as in the paper's Fig. 3–5 (A).
 pub fn poses(base: &Path, title: &str, digits: &[Vec<usize>], levels: usize) -> Result<()> {
-    fn draw<DB: DrawingBackend>(root: &Area<DB>, title: &str, digits: &[Vec<usize>], levels: usize) -> Result<()> {
+    fn draw<DB: DrawingBackend>(
+        root: &Area<DB>,
+        title: &str,
+        digits: &[Vec<usize>],
+        levels: usize,
+    ) -> Result<()> {
         let dof = digits.first().map_or(6, Vec::len);
         let mut c = ChartBuilder::on(root)
             .caption(title, ("sans-serif", 20))
@@ -146,15 +238,30 @@ pub fn poses(base: &Path, title: &str, digits: &[Vec<usize>], levels: usize) -> 
             .y_label_area_size(50)
             .build_cartesian_2d(0.8f64..dof as f64 + 0.2, -0.3f64..levels as f64 - 0.7)
             .map_err(err)?;
-        c.configure_mesh().x_desc("joint").y_desc("lattice digit").x_labels(dof).y_labels(levels).draw().map_err(err)?;
+        c.configure_mesh()
+            .x_desc("joint")
+            .y_desc("lattice digit")
+            .x_labels(dof)
+            .y_labels(levels)
+            .draw()
+            .map_err(err)?;
         for (k, d) in digits.iter().enumerate() {
             // A small vertical offset per pose keeps coincident segments visible.
             let off = (k as f64 / digits.len().max(1) as f64 - 0.5) * 0.3;
             let col = HSLColor(k as f64 / digits.len().max(1) as f64 * 0.8, 0.8, 0.45);
-            c.draw_series(LineSeries::new(d.iter().enumerate().map(|(j, &v)| ((j + 1) as f64, v as f64 + off)), col.stroke_width(1)))
-                .map_err(err)?;
-            c.draw_series(d.iter().enumerate().map(|(j, &v)| Circle::new(((j + 1) as f64, v as f64 + off), 3, col.filled())))
-                .map_err(err)?;
+            c.draw_series(LineSeries::new(
+                d.iter()
+                    .enumerate()
+                    .map(|(j, &v)| ((j + 1) as f64, v as f64 + off)),
+                col.stroke_width(1),
+            ))
+            .map_err(err)?;
+            c.draw_series(
+                d.iter()
+                    .enumerate()
+                    .map(|(j, &v)| Circle::new(((j + 1) as f64, v as f64 + off), 3, col.filled())),
+            )
+            .map_err(err)?;
         }
         Ok(())
     }

@@ -2,6 +2,9 @@
 
 pub mod basic;
 pub mod bench;
+pub mod calibrate;
+pub mod figures;
+pub mod reproduce;
 pub mod select;
 
 use activecal::robot::Robot;
@@ -32,11 +35,10 @@ pub fn load_robot(name: &str) -> Result<Robot> {
 
 /// Prints `value` as one JSON line, or the human-readable `text`.
 pub fn emit(json_out: bool, value: &Value, text: impl FnOnce() -> String) {
-    if json_out {
-        println!("{value}");
-    } else {
-        print!("{}", text());
-    }
+    use std::io::Write;
+    let s = if json_out { format!("{value}\n") } else { text() };
+    // A closed pipe (`activecal ... | head`) is not an error worth a panic.
+    let _ = std::io::stdout().lock().write_all(s.as_bytes());
 }
 
 /// Options that define a pose pool, shared by the commands that need one.

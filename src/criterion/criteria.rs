@@ -18,10 +18,11 @@
 //! design, or a result that is numerically singular — is priced
 //! `f64::NEG_INFINITY`. Prices never are NaN for finite pools.
 
-use faer::{Mat, MatRef};
+use faer::MatRef;
 use rayon::prelude::*;
 
-use super::dense::{EigenScratch, add_gram, ln_det_i_minus, ln_det_i_plus};
+use super::MAX_T;
+use super::dense::{EigenScratch, add_gram, gather_block, ln_det_i_minus, ln_det_i_plus, view};
 use super::state::InfoState;
 use super::variances::{CHUNK, PoolVariances};
 use crate::blocks::Blocks;
@@ -196,14 +197,19 @@ pub struct OiCriterion;
 
 /// Per-chunk scratch of the OI criterion.
 struct OiScratch {
-    m: Mat<f64>,
+    p: usize,
+    /// The changed `M`, `p×p` column-major.
+    m: Vec<f64>,
+    block: Vec<f64>,
     eig: EigenScratch,
 }
 
 impl OiScratch {
     fn new(p: usize) -> Self {
         Self {
-            m: Mat::zeros(p, p),
+            p,
+            m: vec![0.0; p * p],
+            block: Vec::with_capacity(MAX_T * p),
             eig: EigenScratch::new(p),
         }
     }
@@ -217,14 +223,19 @@ impl OiScratch {
         minus: Option<usize>,
         max_condition: f64,
     ) -> f64 {
-        self.m.copy_from(m);
-        if let Some(i) = plus {
-            add_gram(self.m.as_mut(), pool.block(i), 1.0);
+        let p = self.p;
+        for (j, col) in self.m.chunks_exact_mut(p).enumerate() {
+            for (x, y) in col.iter_mut().zip(m.col(j).iter()) {
+                *x = *y;
+            }
         }
-        if let Some(j) = minus {
-            add_gram(self.m.as_mut(), pool.block(j), -1.0);
+        for (q, sign) in [(plus, 1.0), (minus, -1.0)] {
+            if let Some(q) = q {
+                gather_block(pool.block(q), &mut self.block);
+                add_gram(&mut self.m, p, &self.block, pool.t(), sign);
+            }
         }
-        oi_of(self.m.as_ref(), max_condition, &mut self.eig)
+        oi_of(view(&self.m, p), max_condition, &mut self.eig)
     }
 }
 
@@ -333,6 +344,7 @@ impl Criterion for OiCriterion {
 mod tests {
     use super::*;
     use crate::criterion::state::StateSettings;
+    use faer::Mat;
 
     fn lcg(seed: &mut u64) -> f64 {
         *seed = seed

@@ -201,44 +201,49 @@ pub(crate) fn exchange_ln_det(
     Ok(ln_a + ln_b)
 }
 
-/// `M[a, b] += sign · Σ_r X[r, a] X[r, b]` for all `a, b`, computed on the
-/// lower triangle and mirrored so `M` stays exactly symmetric.
-pub(crate) fn add_gram(mut m: MatMut<'_, f64>, x: MatRef<'_, f64>, sign: f64) {
-    let p = m.nrows();
+/// Copies a `t×p` block (any strides) into `out`, column-major with stride
+/// `t` (`out[a·t + r] = X[r, a]`), reusing `out`'s allocation.
+pub(crate) fn gather_block(x: MatRef<'_, f64>, out: &mut Vec<f64>) {
+    out.clear();
+    for a in 0..x.ncols() {
+        out.extend(x.col(a).iter().copied());
+    }
+}
+
+/// `M += sign · XᵀX` for a `t×p` block gathered by [`gather_block`], on a
+/// `p×p` column-major `M` (stride `p`). Each entry is computed once and
+/// written to both triangles, so `M` stays exactly symmetric.
+pub(crate) fn add_gram(m: &mut [f64], p: usize, xb: &[f64], t: usize, sign: f64) {
+    debug_assert!(m.len() == p * p && xb.len() == t * p);
     for b in 0..p {
+        let cb = &xb[b * t..b * t + t];
         for a in b..p {
-            let mut s = 0.0;
-            for r in 0..x.nrows() {
-                s += x[(r, a)] * x[(r, b)];
-            }
-            let v = m[(a, b)] + sign * s;
-            m[(a, b)] = v;
-            m[(b, a)] = v;
+            let ca = &xb[a * t..a * t + t];
+            let s: f64 = ca.iter().zip(cb).map(|(x, y)| x * y).sum();
+            let v = m[b * p + a] + sign * s;
+            m[b * p + a] = v;
+            m[a * p + b] = v;
         }
     }
 }
 
-/// Copies the lower triangle onto the upper one.
-pub(crate) fn mirror_lower(mut m: MatMut<'_, f64>) {
-    let p = m.nrows();
-    for b in 0..p {
-        for a in b + 1..p {
-            m[(b, a)] = m[(a, b)];
-        }
-    }
-}
-
-/// Induced 1-norm (largest absolute column sum).
-pub(crate) fn norm1(m: MatRef<'_, f64>) -> f64 {
-    (0..m.ncols())
-        .map(|c| (0..m.nrows()).map(|r| m[(r, c)].abs()).sum::<f64>())
+/// Induced 1-norm (largest absolute column sum) of a `p×p` column-major
+/// matrix.
+pub(crate) fn norm1(m: &[f64], p: usize) -> f64 {
+    m.chunks(p.max(1))
+        .map(|c| c.iter().map(|x| x.abs()).sum::<f64>())
         .fold(0.0, f64::max)
 }
 
+/// A `p×p` column-major slice viewed as a faer matrix.
+pub(crate) fn view(m: &[f64], p: usize) -> MatRef<'_, f64> {
+    MatRef::from_column_major_slice(m, p, p)
+}
+
 /// Cholesky factorization of a symmetric matrix with faer's `llt` kernel
-/// (sequential): returns `(M⁻¹, ln det M)` or `Err(())` when a pivot is not
-/// positive.
-pub(crate) fn cholesky_inverse(m: MatRef<'_, f64>) -> Result<(Mat<f64>, f64), ()> {
+/// (sequential): returns `(M⁻¹, ln det M)`, `M⁻¹` column-major with stride
+/// `p` and exactly symmetric, or `Err(())` when a pivot is not positive.
+pub(crate) fn cholesky_inverse(m: MatRef<'_, f64>) -> Result<(Vec<f64>, f64), ()> {
     let p = m.nrows();
     let par = Par::Seq;
     let mut l = Mat::<f64>::zeros(p, p);
@@ -263,9 +268,19 @@ pub(crate) fn cholesky_inverse(m: MatRef<'_, f64>) -> Result<(Mat<f64>, f64), ()
         }
         ln_det += 2.0 * d.ln();
     }
-    let mut inv = Mat::<f64>::zeros(p, p);
-    llt::inverse::inverse(inv.as_mut(), l.as_ref(), par, stack);
-    mirror_lower(inv.as_mut());
+    let mut inv = vec![0.0; p * p];
+    llt::inverse::inverse(
+        MatMut::from_column_major_slice_mut(&mut inv, p, p),
+        l.as_ref(),
+        par,
+        stack,
+    );
+    // The kernel writes the lower triangle; mirror it.
+    for j in 0..p {
+        for i in j + 1..p {
+            inv[i * p + j] = inv[j * p + i];
+        }
+    }
     Ok((inv, ln_det))
 }
 
@@ -343,10 +358,12 @@ pub(crate) fn singular_values(x: MatRef<'_, f64>) -> Vec<f64> {
     {
         // The SVD iteration did not converge; fall back to the eigenvalues of
         // XᵀX, which are σ².
-        let mut g = Mat::<f64>::zeros(n, n);
-        add_gram(g.as_mut(), x, 1.0);
+        let mut g = vec![0.0; n * n];
+        let mut xb = Vec::new();
+        gather_block(x, &mut xb);
+        add_gram(&mut g, n, &xb, m, 1.0);
         let mut es = EigenScratch::new(n);
-        if let Some(ev) = es.eigenvalues(g.as_ref()) {
+        if let Some(ev) = es.eigenvalues(view(&g, n)) {
             let mut sv: Vec<f64> = ev.iter().map(|&l| l.max(0.0).sqrt()).collect();
             sv.sort_by(|a, b| b.total_cmp(a));
             return sv;
@@ -370,6 +387,22 @@ mod tests {
     use super::*;
 
     #[test]
+    fn gram_is_symmetric_and_correct() {
+        let x = Mat::from_fn(3, 4, |i, j| (i * 4 + j) as f64 - 5.0);
+        let mut xb = Vec::new();
+        gather_block(x.as_ref(), &mut xb);
+        let mut m = vec![1.0; 16];
+        add_gram(&mut m, 4, &xb, 3, 1.0);
+        let want = x.transpose() * &x;
+        for i in 0..4 {
+            for j in 0..4 {
+                assert_eq!(m[j * 4 + i], 1.0 + want[(i, j)]);
+            }
+        }
+        assert_eq!(norm1(&[1.0, -2.0, 3.0, 0.5], 2), 3.5);
+    }
+
+    #[test]
     fn chol_matches_known_determinant() {
         // [[4, 2], [2, 3]]: det = 8.
         let mut a = [4.0, 0.0, 2.0, 3.0];
@@ -387,7 +420,11 @@ mod tests {
         let a0: Vec<f64> = (0..n * n)
             .map(|k| {
                 let (i, j) = (k / n, k % n);
-                if i == j { 1.0 + i as f64 } else { 0.3 / (1.0 + (i + j) as f64) }
+                if i == j {
+                    1.0 + i as f64
+                } else {
+                    0.3 / (1.0 + (i + j) as f64)
+                }
             })
             .collect();
         let mut a = a0.clone();
@@ -426,7 +463,7 @@ mod tests {
                 }
             });
             let (inv, _) = cholesky_inverse(m.as_ref()).unwrap();
-            let prod = &m * &inv;
+            let prod = &m * view(&inv, p);
             for i in 0..p {
                 for j in 0..p {
                     let e = if i == j { 1.0 } else { 0.0 };

@@ -32,7 +32,9 @@ pub struct Singular {
 pub struct LowRank {
     ln_det_ratio: f64,
     min_pivot: f64,
-    f: Mat<f64>,
+    /// `[F₊ F₋]`, `p × k` column-major with stride `p`.
+    f: Vec<f64>,
+    p: usize,
     n_plus: usize,
 }
 
@@ -54,7 +56,7 @@ impl LowRank {
     /// The factors `[F₊ F₋]` (`p × (a+b)`).
     #[must_use]
     pub fn factors(&self) -> MatRef<'_, f64> {
-        self.f.as_ref()
+        MatRef::from_column_major_slice(&self.f, self.p, self.rank())
     }
 
     /// Number of columns of `F₊` (rows added).
@@ -66,29 +68,48 @@ impl LowRank {
     /// Rank of the update (`a + b`).
     #[must_use]
     pub fn rank(&self) -> usize {
-        self.f.ncols()
+        self.f.len() / self.p.max(1)
     }
 
     /// Applies the update to `M⁻¹` in place: `M⁻¹ ← M⁻¹ − F₊F₊ᵀ + F₋F₋ᵀ`,
-    /// computed on the lower triangle and mirrored (exactly symmetric).
+    /// each entry computed once and written to both triangles (exactly
+    /// symmetric).
     pub fn apply_to_inverse(&self, mut m_inv: MatMut<'_, f64>) {
-        let p = m_inv.nrows();
-        assert!(m_inv.ncols() == p && self.f.nrows() == p, "shape mismatch");
-        let f = self.f.as_ref();
-        let a = self.n_plus;
+        let p = self.p;
+        assert!(m_inv.nrows() == p && m_inv.ncols() == p, "shape mismatch");
+        let mut buf = vec![0.0; p * p];
         for j in 0..p {
-            for i in j..p {
-                let mut minus = 0.0;
-                for c in 0..a {
-                    minus += f[(i, c)] * f[(j, c)];
+            for i in 0..p {
+                buf[j * p + i] = m_inv[(i, j)];
+            }
+        }
+        self.apply_to_col_major(&mut buf);
+        for j in 0..p {
+            for i in 0..p {
+                m_inv[(i, j)] = buf[j * p + i];
+            }
+        }
+    }
+
+    /// [`apply_to_inverse`](Self::apply_to_inverse) on a column-major `p×p`
+    /// slice (stride `p`): the state's fast path.
+    pub(crate) fn apply_to_col_major(&self, m_inv: &mut [f64]) {
+        let p = self.p;
+        assert_eq!(m_inv.len(), p * p, "shape mismatch");
+        // Lower triangle, one rank-1 term at a time (contiguous inner loop).
+        for (c, fc) in self.f.chunks_exact(p).enumerate() {
+            let sign = if c < self.n_plus { -1.0 } else { 1.0 };
+            for j in 0..p {
+                let s = sign * fc[j];
+                let col = &mut m_inv[j * p..(j + 1) * p];
+                for i in j..p {
+                    col[i] += s * fc[i];
                 }
-                let mut plus = 0.0;
-                for c in a..f.ncols() {
-                    plus += f[(i, c)] * f[(j, c)];
-                }
-                let v = m_inv[(i, j)] - minus + plus;
-                m_inv[(i, j)] = v;
-                m_inv[(j, i)] = v;
+            }
+        }
+        for j in 0..p {
+            for i in j + 1..p {
+                m_inv[i * p + j] = m_inv[j * p + i];
             }
         }
     }
@@ -103,9 +124,10 @@ impl LowRank {
 /// eq. (21)/(22) for `a = 0`, and the exchange for both) and the Woodbury
 /// identity, the block form of eq. (6)/(11).
 ///
-/// Returns [`Singular`] when a pivot of the Cholesky factor of the removal
-/// Schur complement `B = I − S₋₋ + S₋₊(I + S₊₊)⁻¹S₊₋` is `≤ pivot_floor`
-/// (`B` is positive definite iff `M'` is, given `M` is). Use a floor `≥ 0`.
+/// Returns [`Singular`] when a pivot of the (diagonally pivoted) Cholesky
+/// factor of the removal Schur complement
+/// `B = I − S₋₋ + S₋₊(I + S₊₊)⁻¹S₊₋` is `≤ pivot_floor` (`B` is positive
+/// definite iff `M'` is, given `M` is). Use a floor `≥ 0`.
 pub fn woodbury(
     m_inv: MatRef<'_, f64>,
     plus: MatRef<'_, f64>,
@@ -119,16 +141,30 @@ pub fn woodbury(
     let k = a + b;
     let par = Par::Seq;
 
-    // Z = [Z₊; Z₋], U = M⁻¹ Zᵀ (p×k), S = Z U (k×k).
+    // Z = [Z₊; Z₋], U = M⁻¹ Zᵀ (p×k), S = Z U (k×k), column-major.
     let mut z = Mat::<f64>::zeros(k, p);
     z.as_mut().subrows_mut(0, a).copy_from(plus);
     z.as_mut().subrows_mut(a, b).copy_from(minus);
-    let mut u = Mat::<f64>::zeros(p, k);
-    matmul(u.as_mut(), Accum::Replace, m_inv, z.transpose(), 1.0, par);
-    let mut s = Mat::<f64>::zeros(k, k);
-    matmul(s.as_mut(), Accum::Replace, z.as_ref(), u.as_ref(), 1.0, par);
+    let mut u = vec![0.0; p * k];
+    matmul(
+        MatMut::from_column_major_slice_mut(&mut u, p, k),
+        Accum::Replace,
+        m_inv,
+        z.transpose(),
+        1.0,
+        par,
+    );
+    let mut s = vec![0.0; k * k];
+    matmul(
+        MatMut::from_column_major_slice_mut(&mut s, k, k),
+        Accum::Replace,
+        z.as_ref(),
+        MatRef::from_column_major_slice(&u, p, k),
+        1.0,
+        par,
+    );
     // S is symmetric in exact arithmetic; read S[i][j] with i ≥ j only.
-    let sym = |i: usize, j: usize| if i >= j { s[(i, j)] } else { s[(j, i)] };
+    let sym = |i: usize, j: usize| if i >= j { s[j * k + i] } else { s[i * k + j] };
 
     // A = I + S₊₊ = L_A L_Aᵀ (row-major a×a). A ⪰ I, so it cannot fail for a
     // positive definite M⁻¹; a failure means M⁻¹ itself is broken.
@@ -143,15 +179,22 @@ pub fn woodbury(
         pivot_floor: 0.0,
     })?;
 
-    let mut f = Mat::<f64>::zeros(p, k);
-    // F₊ = U₊ L_A⁻ᵀ: each row solves L_A y = u (forward substitution).
-    for i in 0..p {
-        for r in 0..a {
-            let mut v = u[(i, r)];
-            for j in 0..r {
-                v -= la[r * a + j] * f[(i, j)];
+    // F (p×k column-major). F₊ = U₊ L_A⁻ᵀ: each row solves L_A y = u
+    // (forward substitution), column by column over the whole of F₊.
+    let mut f = vec![0.0; p * k];
+    for r in 0..a {
+        let (done, rest) = f.split_at_mut(r * p);
+        let fr = &mut rest[..p];
+        fr.copy_from_slice(&u[r * p..(r + 1) * p]);
+        for j in 0..r {
+            let l = la[r * a + j];
+            for (x, y) in fr.iter_mut().zip(&done[j * p..(j + 1) * p]) {
+                *x -= l * y;
             }
-            f[(i, r)] = v / la[r * a + r];
+        }
+        let d = la[r * a + r];
+        for x in fr.iter_mut() {
+            *x /= d;
         }
     }
     if b == 0 {
@@ -159,11 +202,12 @@ pub fn woodbury(
             ln_det_ratio: ln_a,
             min_pivot: f64::INFINITY,
             f,
+            p,
             n_plus: a,
         });
     }
 
-    // Y = L_A⁻¹ S₊₋ (a×b).
+    // Y = L_A⁻¹ S₊₋ (a×b, row-major).
     let mut y = vec![0.0; a * b];
     for c in 0..b {
         for r in 0..a {
@@ -197,26 +241,36 @@ pub fn woodbury(
     // F₋ = (U₋ − F₊ Y) L_B⁻ᵀ. Derivation: after adding Z₊ the inverse is
     // M₁⁻¹ = M⁻¹ − F₊F₊ᵀ, so M₁⁻¹Z₋ᵀ = U₋ − F₊ (L_A⁻¹S₊₋) = U₋ − F₊Y and
     // Z₋M₁⁻¹Z₋ᵀ = S₋₋ − YᵀY; removing Z₋ from M₁ by eq. (11) in block form
-    // adds (M₁⁻¹Z₋ᵀ) B⁻¹ (M₁⁻¹Z₋ᵀ)ᵀ. With B = Pᵀ L_B L_Bᵀ P (perm[r] the
+    // adds (M₁⁻¹Z₋ᵀ) B⁻¹ (M₁⁻¹Z₋ᵀ)ᵀ. With P B Pᵀ = L_B L_Bᵀ (perm[r] the
     // original index of position r), B⁻¹ = Pᵀ L_B⁻ᵀ L_B⁻¹ P, so
     // F₋ = (U₋ − F₊Y)Pᵀ L_B⁻ᵀ: permute the columns, then substitute.
-    for i in 0..p {
-        for r in 0..b {
-            let pr = perm[r];
-            let mut v = u[(i, a + pr)];
-            for j in 0..a {
-                v -= f[(i, j)] * y[j * b + pr];
+    for r in 0..b {
+        let pr = perm[r];
+        let (done, rest) = f.split_at_mut((a + r) * p);
+        let fr = &mut rest[..p];
+        fr.copy_from_slice(&u[(a + pr) * p..(a + pr + 1) * p]);
+        for j in 0..a {
+            let yj = y[j * b + pr];
+            for (x, w) in fr.iter_mut().zip(&done[j * p..(j + 1) * p]) {
+                *x -= yj * w;
             }
-            for j in 0..r {
-                v -= lb[r * b + j] * f[(i, a + j)];
+        }
+        for j in 0..r {
+            let l = lb[r * b + j];
+            for (x, w) in fr.iter_mut().zip(&done[(a + j) * p..(a + j + 1) * p]) {
+                *x -= l * w;
             }
-            f[(i, a + r)] = v / lb[r * b + r];
+        }
+        let d = lb[r * b + r];
+        for x in fr.iter_mut() {
+            *x /= d;
         }
     }
     Ok(LowRank {
         ln_det_ratio: ln_a + ln_b,
         min_pivot: min_pivot(&lb, b),
         f,
+        p,
         n_plus: a,
     })
 }
@@ -238,7 +292,9 @@ pub struct Cascade {
 /// (eq. (6)), then removes the rows of `minus` one at a time with
 /// `(1 − x' M⁻¹ x)` (eq. (22)) and eq. (11). `O(p²)` per row.
 ///
-/// Returns [`Singular`] when a removal factor is `≤ pivot_floor`.
+/// Returns [`Singular`] when a removal factor is `≤ pivot_floor`. Rows are
+/// removed in the given order, without pivoting, so a singular removal can
+/// show a larger rounding residue here than in [`woodbury`].
 pub fn cascade(
     m_inv: MatRef<'_, f64>,
     plus: MatRef<'_, f64>,
@@ -290,7 +346,7 @@ pub fn cascade(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::criterion::dense::cholesky_inverse;
+    use crate::criterion::dense::{cholesky_inverse, view};
 
     fn lcg(seed: &mut u64) -> f64 {
         *seed = seed
@@ -311,6 +367,7 @@ mod tests {
                 let x0 = random(3 * p + 6, p, &mut seed);
                 let m0 = x0.transpose() * &x0;
                 let (m0_inv, ld0) = cholesky_inverse(m0.as_ref()).unwrap();
+                let m0_inv = view(&m0_inv, p).to_owned();
                 let q = random(t, p, &mut seed);
                 let r = x0.as_ref().subrows(0, t).to_owned();
                 for (plus, minus) in [
@@ -320,6 +377,7 @@ mod tests {
                 ] {
                     let m1 = &m0 + plus.transpose() * plus - minus.transpose() * minus;
                     let (m1_inv, ld1) = cholesky_inverse(m1.as_ref()).unwrap();
+                    let m1_inv = view(&m1_inv, p).to_owned();
                     let w = woodbury(m0_inv.as_ref(), plus, minus, 0.0).unwrap();
                     let c = cascade(m0_inv.as_ref(), plus, minus, 0.0).unwrap();
                     let mut inv = m0_inv.clone();
@@ -341,6 +399,7 @@ mod tests {
         let x = random(3, 3, &mut seed);
         let m = x.transpose() * &x;
         let (m_inv, _) = cholesky_inverse(m.as_ref()).unwrap();
+        let m_inv = view(&m_inv, 3).to_owned();
         let r = woodbury(
             m_inv.as_ref(),
             x.as_ref().subrows(0, 0),

@@ -4,10 +4,10 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use faer::{Mat, MatRef};
+use faer::MatRef;
 use serde::{Deserialize, Serialize};
 
-use super::dense::{EigenScratch, add_gram, cholesky_inverse, norm1};
+use super::dense::{EigenScratch, add_gram, cholesky_inverse, gather_block, norm1, view};
 use super::lowrank::{LowRank, woodbury};
 use super::{CriterionError, MAX_T};
 use crate::blocks::Blocks;
@@ -165,8 +165,10 @@ pub struct InfoState {
     design: Vec<usize>,
     position: Vec<usize>,
     settings: StateSettings,
-    m: Mat<f64>,
-    m_inv: Mat<f64>,
+    /// `M`, `p×p` column-major (stride `p`), exactly symmetric.
+    m: Vec<f64>,
+    /// `M⁻¹`, same layout.
+    m_inv: Vec<f64>,
     ln_det: f64,
     cond1: f64,
     since_refactor: usize,
@@ -174,6 +176,8 @@ pub struct InfoState {
     epoch: u64,
     log_base: u64,
     log: Vec<LowRank>,
+    /// Scratch for a gathered Jacobian block.
+    block: Vec<f64>,
 }
 
 impl Clone for InfoState {
@@ -197,14 +201,15 @@ impl Clone for InfoState {
             epoch: self.epoch,
             log_base: self.log_base,
             log: self.log.clone(),
+            block: Vec::new(),
         }
     }
 }
 
 /// A fresh factorization of `M`.
 struct Factored {
-    m: Mat<f64>,
-    m_inv: Mat<f64>,
+    m: Vec<f64>,
+    m_inv: Vec<f64>,
     ln_det: f64,
     cond1: f64,
 }
@@ -291,6 +296,7 @@ impl InfoState {
             epoch: 0,
             log_base: 0,
             log: Vec::new(),
+            block: Vec::new(),
         })
     }
 
@@ -305,23 +311,17 @@ impl InfoState {
         check_condition: bool,
     ) -> Result<Factored, CriterionError> {
         let p = pool.p();
-        let mut m = Mat::<f64>::zeros(p, p);
-        for i in 0..p {
-            m[(i, i)] = ridge;
-        }
-        for &q in design {
-            add_gram(m.as_mut(), pool.block(q), 1.0);
-        }
-        let singular = |m: &Mat<f64>| CriterionError::Singular {
-            rank_estimate: rank_estimate(m.as_ref(), max_condition).min(p - 1),
+        let m = Self::information(pool, design, ridge);
+        let singular = |m: &[f64]| CriterionError::Singular {
+            rank_estimate: rank_estimate(view(m, p), max_condition).min(p - 1),
             p,
         };
-        let Ok((m_inv, ln_det)) = cholesky_inverse(m.as_ref()) else {
+        let Ok((m_inv, ln_det)) = cholesky_inverse(view(&m, p)) else {
             return Err(singular(&m));
         };
         if check_condition {
             let mut es = EigenScratch::new(p);
-            if let Some(ev) = es.eigenvalues(m.as_ref()) {
+            if let Some(ev) = es.eigenvalues(view(&m, p)) {
                 let lo = ev.iter().copied().fold(f64::INFINITY, f64::min);
                 let hi = ev.iter().copied().fold(0.0, f64::max);
                 if !(lo * max_condition > hi) {
@@ -329,13 +329,28 @@ impl InfoState {
                 }
             }
         }
-        let cond1 = norm1(m.as_ref()) * norm1(m_inv.as_ref());
+        let cond1 = norm1(&m, p) * norm1(&m_inv, p);
         Ok(Factored {
             m,
             m_inv,
             ln_det,
             cond1,
         })
+    }
+
+    /// `δI + Σ_{i∈design} X_iᵀX_i`, column-major, summed in design order.
+    fn information(pool: &Blocks, design: &[usize], ridge: f64) -> Vec<f64> {
+        let p = pool.p();
+        let mut m = vec![0.0; p * p];
+        for i in 0..p {
+            m[i * p + i] = ridge;
+        }
+        let mut xb = Vec::with_capacity(pool.t() * p);
+        for &q in design {
+            gather_block(pool.block(q), &mut xb);
+            add_gram(&mut m, p, &xb, pool.t(), 1.0);
+        }
+        m
     }
 
     fn check_pool(&self, pool: &Blocks) {
@@ -435,13 +450,13 @@ impl InfoState {
     /// `M = XᵀX + δI` (exactly symmetric).
     #[must_use]
     pub fn m(&self) -> MatRef<'_, f64> {
-        self.m.as_ref()
+        view(&self.m, self.p)
     }
 
     /// `M⁻¹` (exactly symmetric).
     #[must_use]
     pub fn m_inv(&self) -> MatRef<'_, f64> {
-        self.m_inv.as_ref()
+        view(&self.m_inv, self.p)
     }
 
     /// `ln det M` (the log of the paper's `OI_D` when `δ = 0`).
@@ -499,11 +514,9 @@ impl InfoState {
         let empty = pool.mat().subrows(0, 0);
         let z_plus = plus.map_or(empty, |q| pool.block(q));
         let z_minus = minus.map_or(empty, |q| pool.block(q));
-        woodbury(self.m_inv.as_ref(), z_plus, z_minus, self.pivot_floor()).map_err(|s| {
-            Status::Singular {
-                pivot: s.pivot,
-                pivot_floor: s.pivot_floor,
-            }
+        woodbury(self.m_inv(), z_plus, z_minus, self.pivot_floor()).map_err(|s| Status::Singular {
+            pivot: s.pivot,
+            pivot_floor: s.pivot_floor,
         })
     }
 
@@ -582,15 +595,16 @@ impl InfoState {
             }
             (None, None) => {}
         }
-        if let Some(q) = plus {
-            add_gram(self.m.as_mut(), pool.block(q), 1.0);
+        let (p, t) = (self.p, self.t);
+        for (q, sign) in [(plus, 1.0), (minus, -1.0)] {
+            if let Some(q) = q {
+                gather_block(pool.block(q), &mut self.block);
+                add_gram(&mut self.m, p, &self.block, t, sign);
+            }
         }
-        if let Some(q) = minus {
-            add_gram(self.m.as_mut(), pool.block(q), -1.0);
-        }
-        lr.apply_to_inverse(self.m_inv.as_mut());
+        lr.apply_to_col_major(&mut self.m_inv);
         self.ln_det += lr.ln_det_ratio();
-        self.cond1 = norm1(self.m.as_ref()) * norm1(self.m_inv.as_ref());
+        self.cond1 = norm1(&self.m, p) * norm1(&self.m_inv, p);
         self.version += 1;
         self.log.push(lr);
         self.since_refactor += 1;
@@ -704,30 +718,28 @@ impl InfoState {
     pub fn drift(&self, pool: &Blocks) -> Drift {
         self.check_pool(pool);
         let p = self.p;
-        let mut fresh = Mat::<f64>::zeros(p, p);
-        for i in 0..p {
-            fresh[(i, i)] = self.settings.ridge;
-        }
-        for &q in &self.design {
-            add_gram(fresh.as_mut(), pool.block(q), 1.0);
-        }
-        let ln_det = match cholesky_inverse(fresh.as_ref()) {
+        let fresh = Self::information(pool, &self.design, self.settings.ridge);
+        let ln_det = match cholesky_inverse(view(&fresh, p)) {
             Ok((_, ld)) => (ld - self.ln_det).abs(),
             Err(()) => f64::INFINITY,
         };
         let mut inverse: f64 = 0.0;
         for j in 0..p {
             for i in 0..p {
-                let mut s = 0.0;
-                for k in 0..p {
-                    s += fresh[(i, k)] * self.m_inv[(k, j)];
-                }
+                let s: f64 = (0..p)
+                    .map(|k| fresh[k * p + i] * self.m_inv[j * p + k])
+                    .sum();
                 let e = if i == j { 1.0 } else { 0.0 };
                 inverse = inverse.max((s - e).abs());
             }
         }
-        let scale = fresh.norm_max();
-        let information = (&self.m - &fresh).norm_max() / if scale > 0.0 { scale } else { 1.0 };
+        let scale = fresh.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let diff = self
+            .m
+            .iter()
+            .zip(&fresh)
+            .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+        let information = diff / if scale > 0.0 { scale } else { 1.0 };
         Drift {
             ln_det,
             inverse,
@@ -739,6 +751,7 @@ impl InfoState {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use faer::Mat;
 
     fn lcg(seed: &mut u64) -> f64 {
         *seed = seed
@@ -755,7 +768,7 @@ mod tests {
     fn direct(pool: &Blocks, design: &[usize]) -> (f64, Mat<f64>) {
         let m = pool.information(design);
         let (inv, ld) = cholesky_inverse(m.as_ref()).unwrap();
-        (ld, inv)
+        (ld, view(&inv, m.nrows()).to_owned())
     }
 
     #[test]

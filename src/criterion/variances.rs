@@ -23,6 +23,15 @@ use super::lowrank::LowRank;
 use super::state::InfoState;
 use crate::blocks::Blocks;
 
+/// Column `c` of a matrix with unit row stride, as a slice.
+#[inline]
+fn col(m: MatRef<'_, f64>, c: usize) -> &[f64] {
+    m.col(c)
+        .try_as_col_major()
+        .expect("unit row stride")
+        .as_slice()
+}
+
 /// Poses per parallel work item.
 pub const CHUNK: usize = 64;
 
@@ -127,13 +136,16 @@ impl PoolVariances {
             &mut self.v,
             tp,
             |_, xc, yc, vc| {
-                for (i, vi) in vc.chunks_mut(tp).enumerate() {
-                    vi.fill(0.0);
-                    for k in 0..p {
+                vc.fill(0.0);
+                // Column by column (contiguous), the same summation order
+                // over k for every pose.
+                for k in 0..p {
+                    let (yk, xk) = (col(yc, k), col(xc, k));
+                    for (i, vi) in vc.chunks_mut(tp).enumerate() {
+                        let (y, x) = (&yk[i * t..i * t + t], &xk[i * t..i * t + t]);
                         for a in 0..t {
-                            let y = yc[(i * t + a, k)];
                             for b in 0..=a {
-                                vi[pk(a, b)] += y * xc[(i * t + b, k)];
+                                vi[pk(a, b)] += y[a] * x[b];
                             }
                         }
                     }
@@ -160,17 +172,16 @@ impl PoolVariances {
             &mut self.v,
             tp,
             |_, _, pc, vc| {
-                for (i, vi) in vc.chunks_mut(tp).enumerate() {
-                    for r in 0..t {
-                        for s in 0..=r {
-                            let mut d = 0.0;
-                            for c in 0..a {
-                                d -= pc[(i * t + r, c)] * pc[(i * t + s, c)];
+                for c in 0..k {
+                    let sign = if c < a { -1.0 } else { 1.0 };
+                    let pcol = col(pc, c);
+                    for (i, vi) in vc.chunks_mut(tp).enumerate() {
+                        let q = &pcol[i * t..i * t + t];
+                        for r in 0..t {
+                            let sr = sign * q[r];
+                            for s in 0..=r {
+                                vi[pk(r, s)] += sr * q[s];
                             }
-                            for c in a..k {
-                                d += pc[(i * t + r, c)] * pc[(i * t + s, c)];
-                            }
-                            vi[pk(r, s)] += d;
                         }
                     }
                 }
@@ -332,6 +343,8 @@ impl PoolVariances {
         let rows = self.n * t;
         self.cross_terms(pool, state, outs);
         let w = MatRef::from_column_major_slice(&self.work[..rows * no * t], rows, no * t);
+        // Column slices of W, gathered once (not per candidate).
+        let wcols: Vec<&[f64]> = (0..no * t).map(|c| col(w, c)).collect();
         let this = &*self;
         out.par_chunks_mut(CHUNK * no)
             .zip(candidates.par_chunks(CHUNK))
@@ -347,7 +360,7 @@ impl PoolVariances {
                             t,
                             v_in,
                             this.packed(j),
-                            |a, b| w[(i * t + a, o * t + b)],
+                            |a, b| wcols[o * t + b][i * t + a],
                             pivot_floor,
                         )
                         .unwrap_or(f64::NEG_INFINITY);
@@ -373,7 +386,13 @@ pub fn exchange_gain(
     pivot_floor: f64,
 ) -> Result<f64, f64> {
     assert!(t <= super::MAX_T && w_ij.nrows() == t && w_ij.ncols() == t);
-    exchange_ln_det(t, v_i, v_j, |a, b| w_ij[(a, b)], pivot_floor)
+    let mut w = [0.0; super::MAX_T * super::MAX_T];
+    for a in 0..t {
+        for b in 0..t {
+            w[a * t + b] = w_ij[(a, b)];
+        }
+    }
+    exchange_ln_det(t, v_i, v_j, |a, b| w[a * t + b], pivot_floor)
 }
 
 #[cfg(test)]

@@ -388,6 +388,7 @@ pub fn predicted_covariance(
     qs: &[Vec<f64>],
     sigma: f64,
 ) -> Result<Option<Mat<f64>>> {
+    super::require_points(robot)?;
     for (i, q) in qs.iter().enumerate() {
         robot
             .check_q(q)

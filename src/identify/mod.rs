@@ -35,7 +35,7 @@ pub use simulate::{simulate, trial_rng};
 pub use tables::{PaperTables, ParamGrid, paper_tables};
 
 use crate::error::Error;
-use crate::robot::Robot;
+use crate::robot::{Measurement, Robot};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -93,6 +93,16 @@ pub enum IdentifyError {
         /// What is wrong.
         reason: String,
     },
+    /// A robot whose measurements are not points (3 rows per pose).
+    #[error(
+        "robot '{robot}' measures {rows} coordinates per pose; identification handles point measurements (3) only"
+    )]
+    UnsupportedMeasurement {
+        /// The robot's name.
+        robot: String,
+        /// Rows of its Jacobian per pose.
+        rows: usize,
+    },
     /// Invalid robot, parameter table or pool.
     #[error(transparent)]
     Model(#[from] Error),
@@ -100,6 +110,17 @@ pub enum IdentifyError {
 
 /// Result with an [`IdentifyError`].
 pub type Result<T> = std::result::Result<T, IdentifyError>;
+
+/// Errors unless the robot measures points (the only kind identified so far).
+pub(crate) fn require_points(robot: &Robot) -> Result<()> {
+    if robot.measurement != Measurement::Point {
+        return Err(IdentifyError::UnsupportedMeasurement {
+            robot: robot.name.clone(),
+            rows: robot.rows_per_pose(),
+        });
+    }
+    Ok(())
+}
 
 /// Points measured at known joint angles, validated against a robot: as many
 /// points as joint vectors, every joint vector of the robot's length and
@@ -128,6 +149,7 @@ impl Measurements {
 
     /// Re-checks the measurements against a robot (done by [`identify`]).
     pub fn check(&self, robot: &Robot) -> Result<()> {
+        require_points(robot)?;
         if self.qs.len() != self.points.len() {
             return Err(IdentifyError::MeasurementCount {
                 poses: self.qs.len(),

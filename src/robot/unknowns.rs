@@ -4,7 +4,8 @@
 //! A frame's *candidate* unknowns are its four structural parameters: γ, α,
 //! a, d for a DH frame and γ, α, a, β for a Hayati frame (a Hayati frame's d
 //! is the paper's fixed 0, redundant with the d of the next DH frame along
-//! the nearly parallel axes). Some candidates are redundant with others — the
+//! the nearly parallel axes; a fixed Hayati tool frame at the end keeps its
+//! d too). Some candidates are redundant with others — the
 //! α of the last joint frame for point measurements, the location of a
 //! prismatic axis, a tool frame's translations — and
 //! [`Robot::choose_unknowns`] drops them: it walks the candidates in a
@@ -43,18 +44,24 @@ const CHECK_SEED: u64 = 0x5eed_c4ec_0001;
 
 impl Robot {
     /// The structural candidate unknowns of every frame, frame-major: γ, α,
-    /// a, d for DH frames, γ, α, a, β for Hayati frames.
+    /// a, d for DH frames, γ, α, a, β for Hayati frames — and all five
+    /// (γ, α, a, d, β) for a fixed Hayati frame at the end of the chain (a
+    /// tool frame, whose `d` has no later frame to repeat it: it carries the
+    /// measured point's distance along the tool line).
     #[must_use]
     pub fn candidate_unknowns(&self) -> Vec<ParamId> {
-        let mut v = Vec::with_capacity(4 * self.frames.len());
+        use Symbol::{A, Alpha, Beta, D, Gamma};
+        let mut v = Vec::with_capacity(5 * self.frames.len());
+        let n = self.frames.len();
         for (frame, f) in self.frames.iter().enumerate() {
-            let last = match f.convention {
-                Convention::Dh => Symbol::D,
-                Convention::Hayati => Symbol::Beta,
+            let syms: &[Symbol] = match f.convention {
+                Convention::Dh => &[Gamma, Alpha, A, D],
+                Convention::Hayati if frame + 1 == n && f.joint.is_none() => {
+                    &[Gamma, Alpha, A, D, Beta]
+                }
+                Convention::Hayati => &[Gamma, Alpha, A, Beta],
             };
-            for symbol in [Symbol::Gamma, Symbol::Alpha, Symbol::A, last] {
-                v.push(ParamId { frame, symbol });
-            }
+            v.extend(syms.iter().map(|&symbol| ParamId { frame, symbol }));
         }
         v
     }

@@ -43,6 +43,24 @@ fn crit_err(e: CriterionError) -> Error {
     Error::Invalid(e.to_string())
 }
 
+impl Selection {
+    /// Pool positions of the initial design: the final design with every
+    /// traced change undone, in order.
+    #[must_use]
+    pub fn trace_initial(&self) -> Vec<usize> {
+        let mut d = self.poses.clone();
+        for r in self.trace.iter().rev() {
+            if let Some(a) = r.added {
+                d.retain(|&x| x != a);
+            }
+            if let Some(rm) = r.removed {
+                d.push(rm);
+            }
+        }
+        d
+    }
+}
+
 /// One search: the state, the criterion, and the trace.
 struct Run<'a, C: Criterion> {
     pool: &'a Blocks,

@@ -46,7 +46,11 @@ def init(site_packages, python_exe):
     }
 
 
-JOINT_MODELS = {"revolute": lambda: pin.JointModelRZ(), "prismatic": lambda: pin.JointModelPZ()}
+# Joint models by activecal's joint kind (built on use: pin is imported by init).
+JOINT_MODELS = {
+    "revolute": lambda: pin.JointModelRZ(),
+    "prismatic": lambda: pin.JointModelPZ(),
+}
 
 
 def pinocchio_model(placements, kinds, tool):

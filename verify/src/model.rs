@@ -161,9 +161,9 @@ fn ry(beta: f64) -> Matrix4<f64> {
 /// Fixed frames are folded into the neighbouring placements; a revolute
 /// frame `Rz(q+γ) B` contributes `Rz(γ)` to the placement before its joint
 /// and `B = Tz(d) Tx(a) Rx(α) [Ry(β)]` after it, and so does a prismatic
-/// frame `Rz(γ) Tz(q) B`. Fails if joints do not drive
-/// frames in increasing joint order (0, 1, …, dof−1), the only layout a
-/// serial chain of nested bodies can express without renumbering.
+/// frame `Rz(γ) Tz(q) B`. Fails if joints do not drive frames in increasing
+/// joint order (0, 1, …, dof−1), the only layout a serial chain of nested
+/// bodies can express without renumbering.
 pub fn pinocchio_model_spec(robot: &Robot, table: &ParamTable) -> Result<ModelSpec> {
     if table.rows.len() != robot.frames.len() {
         bail!(

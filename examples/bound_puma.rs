@@ -14,6 +14,10 @@ fn main() {
         .screen_gap(env("SCREEN_GAP", 1e-3))
         .screen_extra(env("SCREEN_EXTRA", 300.0) as usize)
         .use_conic(!first_order_only)
+        .conic(activecal::bound::conic::ConicSettings {
+            chordal_merge: std::env::var("MERGE").unwrap_or_else(|_| "clique_graph".into()),
+            ..Default::default()
+        })
         .build()
         .expect("valid settings");
     let t0 = std::time::Instant::now();

@@ -3,8 +3,9 @@
 //!
 //! **Import.** The chain runs from the URDF's root link (the measurement
 //! frame) to a tip link (the measured point, or frame for full poses).
-//! Revolute and continuous joints become revolute joints, prismatic joints
-//! prismatic ones, fixed joints are folded into their neighbours; floating,
+//! Revolute and continuous joints become revolute joints (a continuous joint
+//! gets the range [`CONTINUOUS_RANGE`]), prismatic joints prismatic ones,
+//! fixed joints are folded into their neighbours; floating,
 //! planar, spherical and mimic joints are refused. With every joint at 0,
 //! each joint axis is a line in the root frame; the frames map one axis line
 //! to the next:
@@ -59,6 +60,12 @@ use std::path::Path;
 /// Default angle (radians) below which two consecutive joint axes count as
 /// nearly parallel and get a Hayati frame: 10°.
 pub const PARALLEL_THRESHOLD: f64 = 10.0 * PI / 180.0;
+
+/// Range given to a continuous joint (and to a revolute joint whose URDF
+/// limits are infinite): ±170°. A lattice over ±180° would repeat its end
+/// poses (−180° and 180° are one pose), and with 3 levels see only two
+/// angles of the joint.
+pub const CONTINUOUS_RANGE: [f64; 2] = [-170.0 * PI / 180.0, 170.0 * PI / 180.0];
 
 /// How to import a URDF.
 #[derive(Clone, Debug, PartialEq)]
@@ -288,9 +295,9 @@ fn extract_chain(
             axis /= norm;
             let (lo, hi) = (j.limit.lower, j.limit.upper);
             limits = match (j.joint_type.clone(), kind) {
-                (T::Continuous, _) => [-PI, PI],
+                (T::Continuous, _) => CONTINUOUS_RANGE,
                 (_, JointKind::Revolute) if lo == f64::NEG_INFINITY && hi == f64::INFINITY => {
-                    [-PI, PI]
+                    CONTINUOUS_RANGE
                 }
                 _ => [lo, hi],
             };
@@ -497,21 +504,19 @@ fn convert(chain: &[ChainJoint], name: &str, opts: &UrdfOptions) -> Robot {
 }
 
 /// URDF `rpy` (fixed-axis roll, pitch, yaw: `R = Rz(yaw) Ry(pitch) Rx(roll)`)
-/// of a rotation, computed with `atan2` only (well conditioned everywhere).
+/// of a rotation. Yaw comes first from `atan2(R10, R00)` (any value will do
+/// at gimbal lock, where it is ill-determined), then pitch and roll from
+/// `Rz(−yaw) R = Ry(pitch) Rx(roll)`, whose entries are all of order 1, so
+/// the angles rebuild the rotation to rounding everywhere, gimbal lock
+/// included.
 #[must_use]
 pub fn rpy(r: &Rotation3<f64>) -> [f64; 3] {
     let m = r.matrix();
-    let cp = m[(0, 0)].hypot(m[(1, 0)]);
-    let pitch = (-m[(2, 0)]).atan2(cp);
-    if cp > 1e-12 {
-        [
-            m[(2, 1)].atan2(m[(2, 2)]),
-            pitch,
-            m[(1, 0)].atan2(m[(0, 0)]),
-        ]
-    } else {
-        [(-m[(1, 2)]).atan2(m[(1, 1)]), pitch, 0.0]
-    }
+    let yaw = m[(1, 0)].atan2(m[(0, 0)]);
+    let (sy, cy) = yaw.sin_cos();
+    let pitch = (-m[(2, 0)]).atan2(cy * m[(0, 0)] + sy * m[(1, 0)]);
+    let roll = (sy * m[(0, 2)] - cy * m[(1, 2)]).atan2(cy * m[(1, 1)] - sy * m[(0, 1)]);
+    [roll, pitch, yaw]
 }
 
 /// Writes the robot with parameter table `table` as URDF: root link

@@ -8,12 +8,9 @@ use activecal::bound::conic::{self, ConicSettings, ConicStatus};
 use activecal::bound::exchange::{self, ExchangeSettings};
 use activecal::bound::gap::{WEIGHT_TOL, design_ln_det, weights_ln_det};
 use activecal::bound::variance::{
-    VarianceWork, certificate, information, make_feasible, scale_columns, top_sum,
-    variances_into,
+    VarianceWork, certificate, information, make_feasible, scale_columns, top_sum, variances_into,
 };
-use activecal::bound::{
-    BoundError, BoundSettings, BoundStatus, design_gap, relaxation_bound,
-};
+use activecal::bound::{BoundError, BoundSettings, BoundStatus, design_gap, relaxation_bound};
 use activecal::pool::Pool;
 use activecal::robot::Robot;
 use faer::Mat;
@@ -29,7 +26,10 @@ fn puma_data() -> Blocks {
     let poses: Vec<usize> = (0..14).map(|k| k * 52).collect();
     let sub = x.select(&poses);
     let cols = 12;
-    Blocks::new(Mat::from_fn(sub.mat().nrows(), cols, |i, j| sub.mat()[(i, j)]), 3)
+    Blocks::new(
+        Mat::from_fn(sub.mat().nrows(), cols, |i, j| sub.mat()[(i, j)]),
+        3,
+    )
 }
 
 /// 14 random 3 × 10 blocks of different sizes.
@@ -84,15 +84,25 @@ fn small_pools_bound_the_enumerated_optimum_and_solvers_agree() {
 
             let b = relaxation_bound(&x, n, &BoundSettings::default()).unwrap();
             assert_eq!(b.status, BoundStatus::Certified, "{name} N={n}");
-            assert!(b.ln_bound >= best, "{name} N={n}: bound {} < optimum {best}", b.ln_bound);
-            assert!(b.ln_primal >= best - 1e-9, "relaxation contains every design");
+            assert!(
+                b.ln_bound >= best,
+                "{name} N={n}: bound {} < optimum {best}",
+                b.ln_bound
+            );
+            assert!(
+                b.ln_primal >= best - 1e-9,
+                "relaxation contains every design"
+            );
             assert!(b.certificate_gap <= 1e-6 && b.certificate_gap >= 0.0);
             assert!(b.ln_bound >= b.ln_primal);
             let sum: f64 = b.weights.iter().sum();
             assert!((sum - n as f64).abs() < 1e-9);
             assert!(b.weights.iter().all(|&w| (0.0..=1.0).contains(&w)));
             let lp = weights_ln_det(&x, &b.weights).unwrap();
-            assert!((lp - b.ln_primal).abs() < 1e-9, "ln_primal is ln det M(weights)");
+            assert!(
+                (lp - b.ln_primal).abs() < 1e-9,
+                "ln_primal is ln det M(weights)"
+            );
 
             let fo_settings = ExchangeSettings {
                 gap_tol: 1e-9,
@@ -171,16 +181,34 @@ fn bad_input_is_an_error() {
         relaxation_bound(&dup, 8, &s),
         Err(BoundError::RankDeficient { rank: 9, p: 10, .. })
     ));
-    let zero = Blocks::new(Mat::from_fn(m.nrows(), 10, |i, j| if j == 4 { 0.0 } else { m[(i, j)] }), 3);
-    assert!(matches!(relaxation_bound(&zero, 8, &s), Err(BoundError::RankDeficient { .. })));
-    let nan = Blocks::new(Mat::from_fn(m.nrows(), 10, |i, j| if (i, j) == (7, 2) { f64::NAN } else { m[(i, j)] }), 3);
+    let zero = Blocks::new(
+        Mat::from_fn(m.nrows(), 10, |i, j| if j == 4 { 0.0 } else { m[(i, j)] }),
+        3,
+    );
+    assert!(matches!(
+        relaxation_bound(&zero, 8, &s),
+        Err(BoundError::RankDeficient { .. })
+    ));
+    let nan = Blocks::new(
+        Mat::from_fn(m.nrows(), 10, |i, j| {
+            if (i, j) == (7, 2) {
+                f64::NAN
+            } else {
+                m[(i, j)]
+            }
+        }),
+        3,
+    );
     assert!(matches!(
         relaxation_bound(&nan, 8, &s),
         Err(BoundError::NonFinite { row: 7, col: 2, .. })
     ));
     assert!(matches!(
         BoundSettings::builder().gap_tol(0.0).build(),
-        Err(BoundError::InvalidSetting { name: "gap_tol", .. })
+        Err(BoundError::InvalidSetting {
+            name: "gap_tol",
+            ..
+        })
     ));
     assert!(matches!(
         exchange::solve(&x, 8, Some(&[1.0; 3]), &ExchangeSettings::default()),
@@ -211,7 +239,11 @@ fn a_stalled_solver_still_gives_a_valid_bound() {
     assert_eq!(b.status, BoundStatus::GapAboveTolerance);
     assert_eq!(b.conic.status, Some(ConicStatus::MaxIterations));
     assert!(b.certificate_gap > s.gap_tol);
-    assert!(b.ln_bound >= best, "still a bound: {} vs {best}", b.ln_bound);
+    assert!(
+        b.ln_bound >= best,
+        "still a bound: {} vs {best}",
+        b.ln_bound
+    );
     assert!(b.ln_primal <= b.ln_bound);
 }
 
@@ -264,7 +296,10 @@ fn screening_reaches_the_same_optimum_as_the_whole_pool() {
         },
     )
     .unwrap();
-    eprintln!("screen: bound {:.2}s {:?} {:?}; fo {:.2}s rounds {} steps {}", b.seconds, b.first_order, b.conic, fo.seconds, fo.rounds, fo.steps);
+    eprintln!(
+        "screen: bound {:.2}s {:?} {:?}; fo {:.2}s rounds {} steps {}",
+        b.seconds, b.first_order, b.conic, fo.seconds, fo.rounds, fo.steps
+    );
     assert!(fo.converged);
     assert!((fo.ln_det - b.ln_primal).abs() <= 1e-6);
     assert!(b.ln_bound >= fo.ln_det && fo.ln_bound >= b.ln_primal);

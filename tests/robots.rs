@@ -17,16 +17,12 @@ use activecal::identify::{LmSettings, identify, simulate, trial_rng};
 use activecal::kinematics::{Evaluator, pose, position};
 use activecal::pool::{Pool, require_identifiable};
 use activecal::robot::unknowns::INDEPENDENCE_TOL;
-use activecal::robot::{
-    Convention, JointKind, Measurement, ParamSet, ParamTable, Robot, file,
-};
+use activecal::robot::{Convention, JointKind, Measurement, ParamSet, ParamTable, Robot, file};
 use activecal::select::{Settings, design_rng, eae, ln_det_direct};
 use activecal::urdf::{self, UrdfOptions};
-use nalgebra::{
-    Isometry3, Matrix3, Rotation3, Translation3, Unit, UnitQuaternion, Vector3,
-};
+use nalgebra::{Isometry3, Matrix3, Translation3, Unit, UnitQuaternion, Vector3};
 use std::collections::HashMap;
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::FRAC_PI_2;
 use std::path::{Path, PathBuf};
 
 const ALL_BUILTIN: [&str; 6] = [
@@ -131,7 +127,10 @@ fn builtin_unknowns_have_the_textbook_count_and_are_identifiable() {
             .map(|w| w.1)
             .fold(0.0, f64::max);
         println!("{name}: smallest kept residual {kept:.2e}, largest dropped {dropped:.2e}");
-        assert!(kept > 1e-2 && dropped < 1e-14, "{name}: {kept:e} {dropped:e}");
+        assert!(
+            kept > 1e-2 && dropped < 1e-14,
+            "{name}: {kept:e} {dropped:e}"
+        );
     }
 }
 
@@ -144,11 +143,7 @@ fn puma_is_unchanged_and_its_pose_variant_only_adds_the_tool() {
     assert_eq!(p.unknowns, b.unknowns);
     assert_eq!(p.measurement, Measurement::Point);
     assert!(p.visibility.is_none());
-    assert!(
-        p.frames
-            .iter()
-            .all(|f| f.joint_kind == JointKind::Revolute)
-    );
+    assert!(p.frames.iter().all(|f| f.joint_kind == JointKind::Revolute));
     let pp = Robot::builtin("puma560:pose").unwrap();
     assert_eq!(pp.measurement, Measurement::Pose);
     assert_eq!(pp.rows_per_pose(), 6);
@@ -232,7 +227,9 @@ fn ur5_and_stanford_nominal_models_are_the_published_dh_tables() {
             let want = dh_fk(base, table, 0.1, &q);
             let (rot, p) = pose(&r, &r.nominal, &q);
             assert!((p - want.translation.vector).norm() < 1e-12, "{name} {q:?}");
-            let dr = (rot - want.rotation.to_rotation_matrix().into_inner()).abs().max();
+            let dr = (rot - want.rotation.to_rotation_matrix().into_inner())
+                .abs()
+                .max();
             assert!(dr < 1e-12, "{name} {q:?}: {dr:e}");
         }
     }
@@ -253,9 +250,21 @@ fn ur5_and_stanford_nominal_models_are_the_published_dh_tables() {
 // ---------------------------------------------------------------------------
 // Jacobians
 
-/// Rotation vector `log(a · bᵀ)`.
+/// Rotation vector `log(a · bᵀ)`, accurate for small angles too (an
+/// `acos` of the trace loses half the digits near 0).
 fn rot_log(a: &Matrix3<f64>, b: &Matrix3<f64>) -> Vector3<f64> {
-    Rotation3::from_matrix_unchecked(a * b.transpose()).scaled_axis()
+    let r = a * b.transpose();
+    let w = Vector3::new(
+        r[(2, 1)] - r[(1, 2)],
+        r[(0, 2)] - r[(2, 0)],
+        r[(1, 0)] - r[(0, 1)],
+    ) / 2.0;
+    let s = w.norm();
+    if s == 0.0 {
+        return Vector3::zeros();
+    }
+    let theta = s.atan2((r.trace() - 1.0) / 2.0);
+    w * (theta / s)
 }
 
 fn check_identification_jacobian(r: &Robot, table: &ParamTable, q: &[f64]) {
@@ -276,10 +285,20 @@ fn check_identification_jacobian(r: &Robot, table: &ParamTable, q: &[f64]) {
         let ang = rot_log(&rp, &rm) / (2.0 * h);
         for k in 0..3 {
             let e = (jac[k * p + c] - lin[k]).abs();
-            assert!(e < 1e-7, "{} {}: position row {k}: {e:e}", r.name, r.param_name(u));
+            assert!(
+                e < 1e-7,
+                "{} {}: position row {k}: {e:e}",
+                r.name,
+                r.param_name(u)
+            );
             if t == 6 {
                 let e = (jac[(3 + k) * p + c] - ang[k]).abs();
-                assert!(e < 1e-7, "{} {}: orientation row {k}: {e:e}", r.name, r.param_name(u));
+                assert!(
+                    e < 1e-7,
+                    "{} {}: orientation row {k}: {e:e}",
+                    r.name,
+                    r.param_name(u)
+                );
             }
         }
     }
@@ -297,9 +316,19 @@ fn check_identification_jacobian(r: &Robot, table: &ParamTable, q: &[f64]) {
         let lin = (pp - pm) / (2.0 * h);
         let ang = rot_log(&rp, &rm) / (2.0 * h);
         for k in 0..3 {
-            assert!((jj[k * dof + j] - lin[k]).abs() < 1e-7, "{} q{}", r.name, j + 1);
+            assert!(
+                (jj[k * dof + j] - lin[k]).abs() < 1e-7,
+                "{} q{}",
+                r.name,
+                j + 1
+            );
             if t == 6 {
-                assert!((jj[(3 + k) * dof + j] - ang[k]).abs() < 1e-7, "{} q{}", r.name, j + 1);
+                assert!(
+                    (jj[(3 + k) * dof + j] - ang[k]).abs() < 1e-7,
+                    "{} q{}",
+                    r.name,
+                    j + 1
+                );
             }
         }
     }
@@ -352,8 +381,11 @@ fn rpy_rotation(r: f64, p: f64, y: f64) -> UnitQuaternion<f64> {
 /// (normalised) axis.
 fn urdf_fk(path: &Path, tip: &str, q: &[f64]) -> Isometry3<f64> {
     let u = urdf_rs::read_file(path).unwrap();
-    let by_child: HashMap<&str, &urdf_rs::Joint> =
-        u.joints.iter().map(|j| (j.child.link.as_str(), j)).collect();
+    let by_child: HashMap<&str, &urdf_rs::Joint> = u
+        .joints
+        .iter()
+        .map(|j| (j.child.link.as_str(), j))
+        .collect();
     let mut chain = Vec::new();
     let mut at = tip;
     while let Some(j) = by_child.get(at) {
@@ -416,7 +448,10 @@ fn puma_urdf_fixture_is_the_nominal_model_and_imports_to_its_positions() {
         assert_eq!(r.dof(), 6);
         assert_eq!(r.limits, puma.limits);
         assert_eq!(r.n_unknowns(), r.minimal_unknowns());
-        assert_eq!(r.n_unknowns(), if m == Measurement::Point { 27 } else { 30 });
+        assert_eq!(
+            r.n_unknowns(),
+            if m == Measurement::Point { 27 } else { 30 }
+        );
         // Equal to the built-in model on the whole 5-level lattice and 2000
         // random joint vectors (rotations too: the tip is frame 6).
         let lattice = Pool::full(&puma, 5).unwrap();
@@ -497,13 +532,16 @@ fn urdf_conventions_follow_the_parallel_axes() {
             ("tool", Hayati),
         ]
     );
-    assert!(r.unknowns.iter().all(|u| u.frame != 0), "the m frame has no unknowns");
+    assert!(
+        r.unknowns.iter().all(|u| u.frame != 0),
+        "the m frame has no unknowns"
+    );
     let s = urdf_import("stanford.urdf", Measurement::Point);
     let boom = s.frames.iter().find(|f| f.label == "boom_slide").unwrap();
     assert_eq!(boom.joint_kind, JointKind::Prismatic);
     assert_eq!(boom.convention, Hayati); // the roll axis is coaxial with the boom
     assert_eq!(s.limits[2], [0.3, 1.0]);
-    assert_eq!(s.limits[5], [-PI, PI]); // continuous
+    assert_eq!(s.limits[5], urdf::CONTINUOUS_RANGE); // continuous
     // A threshold above 90° is refused; a tiny one turns Hayati frames into DH.
     let bad = UrdfOptions {
         parallel_threshold: 2.0,
@@ -558,11 +596,13 @@ fn urdf_err(text: &str, tip: Option<&str>) -> String {
     urdf::parse(text, "t.urdf", &o).unwrap_err().to_string()
 }
 
+/// A URDF of the given joints (links are implied by them).
 fn mini_urdf(joints: &str) -> String {
-    format!("<robot name=\"t\">\n<link name=\"a\"/><link name=\"b\"/><link name=\"c\"/><link name=\"d\"/>\n{joints}</robot>")
+    format!("<robot name=\"t\">\n{joints}</robot>")
 }
 
 const J_AB: &str = r#"<joint name="j1" type="revolute"><parent link="a"/><child link="b"/><origin xyz="0.3 0 0.2" rpy="0 0.4 0"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="0" velocity="0"/></joint>"#;
+const J_CD: &str = r#"<joint name="j3" type="fixed"><parent link="c"/><child link="d"/><origin xyz="0.1 0.05 0.2" rpy="0 0 0"/></joint>"#;
 const J_BC: &str = r#"<joint name="j2" type="revolute"><parent link="b"/><child link="c"/><origin xyz="0.5 0 0" rpy="1.2 0 0"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="0" velocity="0"/></joint>"#;
 
 #[test]
@@ -576,7 +616,11 @@ fn malformed_urdf_files_get_clear_errors() {
             None,
             "branches at link 'b'",
         ),
-        (mini_urdf(&format!("{J_AB}{J_BC}")), Some("zz"), "tip link 'zz' is not in the URDF"),
+        (
+            mini_urdf(&format!("{J_AB}{J_BC}")),
+            Some("zz"),
+            "tip link 'zz' is not in the URDF",
+        ),
         (
             mini_urdf(&J_AB.replace("revolute", "floating")),
             None,
@@ -588,7 +632,10 @@ fn malformed_urdf_files_get_clear_errors() {
             "joint 'j1': inverted limits [1, -1]",
         ),
         (
-            mini_urdf(&J_AB.replace("<limit lower=\"-1\" upper=\"1\" effort=\"0\" velocity=\"0\"/>", "<limit effort=\"0\" velocity=\"0\"/>")),
+            mini_urdf(&J_AB.replace(
+                "<limit lower=\"-1\" upper=\"1\" effort=\"0\" velocity=\"0\"/>",
+                "<limit effort=\"0\" velocity=\"0\"/>",
+            )),
             None,
             "joint 'j1': empty range",
         ),
@@ -610,7 +657,9 @@ fn malformed_urdf_files_get_clear_errors() {
             "root links",
         ),
         (
-            mini_urdf(r#"<joint name="f" type="fixed"><parent link="a"/><child link="b"/></joint>"#),
+            mini_urdf(
+                r#"<joint name="f" type="fixed"><parent link="a"/><child link="b"/></joint>"#,
+            ),
             None,
             "no revolute or prismatic joint",
         ),
@@ -628,8 +677,23 @@ fn malformed_urdf_files_get_clear_errors() {
         assert!(e.starts_with("t.urdf: "), "{e}");
         assert!(e.contains(want), "want '{want}' in: {e}");
     }
-    // A valid two-joint chain imports; its point sees 4·2 + 3 = 11 unknowns.
-    let ok = urdf::parse(&mini_urdf(&format!("{J_AB}{J_BC}")), "t", &UrdfOptions::default()).unwrap();
+    // A valid two-joint chain with a tip off the last axis imports; its point
+    // sees 4·2 + 3 = 11 unknowns. With the tip on the last axis (link c),
+    // joint 2 moves it only through parameter errors that push it off the
+    // axis: γ and α of joint 2's frame drop out, 9 remain.
+    let on_axis = urdf::parse(
+        &mini_urdf(&format!("{J_AB}{J_BC}")),
+        "t",
+        &UrdfOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(on_axis.n_unknowns(), 9);
+    let ok = urdf::parse(
+        &mini_urdf(&format!("{J_AB}{J_BC}{J_CD}")),
+        "t",
+        &UrdfOptions::default(),
+    )
+    .unwrap();
     assert_eq!(ok.n_unknowns(), 11);
 }
 
@@ -698,19 +762,34 @@ fn toml_fixtures_load() {
 
 #[test]
 fn load_accepts_names_and_files_and_explains_the_rest() {
-    for name in ["puma560", "puma", "ur5", "stanford", "ur5:pose", "puma:pose"] {
+    for name in [
+        "puma560",
+        "puma",
+        "ur5",
+        "stanford",
+        "ur5:pose",
+        "puma:pose",
+    ] {
         Robot::load(name).unwrap();
     }
     let e = Robot::load("kuka").unwrap_err().to_string();
-    assert!(e.contains("unknown robot 'kuka'") && e.contains("ur5") && e.contains(".urdf"), "{e}");
-    let e = Robot::load("/nonexistent/arm.toml").unwrap_err().to_string();
+    assert!(
+        e.contains("unknown robot 'kuka'") && e.contains("ur5") && e.contains(".urdf"),
+        "{e}"
+    );
+    let e = Robot::load("/nonexistent/arm.toml")
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with("/nonexistent/arm.toml:"), "{e}");
     let e = Robot::load(fixture("puma560_nominal.json").to_str().unwrap())
         .unwrap_err()
         .to_string();
     assert!(e.contains("unknown robot file type"), "{e}");
     let r = Robot::load(fixture("ur5.urdf").to_str().unwrap()).unwrap();
-    assert_eq!((r.name.as_str(), r.measurement, r.n_unknowns()), ("ur5", Measurement::Point, 27));
+    assert_eq!(
+        (r.name.as_str(), r.measurement, r.n_unknowns()),
+        ("ur5", Measurement::Point, 27)
+    );
 }
 
 /// Line (1-based) of the first line of `text` containing `needle`.
@@ -753,19 +832,27 @@ fn malformed_descriptions_get_errors_that_point_to_the_place() {
     let l = line_of(&base, "label = \"3\"");
     let t = replace_nth(&base, "label = \"3\"", 0, "label = \"3\"\ncolour = \"red\"");
     let e = toml_err(&t);
-    assert!(e.contains("unknown field `colour`") && e.contains(&format!("line {}", l + 1)), "{e}");
+    assert!(
+        e.contains("unknown field `colour`") && e.contains(&format!("line {}", l + 1)),
+        "{e}"
+    );
 
     // A missing table row.
     let t = replace_nth(&base, "nominal = ", 2, "");
     let e = toml_err(&t);
-    assert!(e.contains("missing field `nominal`") && e.contains("line"), "{e}");
+    assert!(
+        e.contains("missing field `nominal`") && e.contains("line"),
+        "{e}"
+    );
 
     // NaN in frame "3".
     let l = line_of(&base, "label = \"3\"") + 4;
     let t = replace_nth(&base, "real = ", 4, "real = [0.0, nan, 0.0, 0.4331, 10.0]");
     let e = toml_err(&t);
     assert!(
-        e.contains(&format!("line {l}, column 8: frame '3': real alpha is not a finite number (NaN)")),
+        e.contains(&format!(
+            "line {l}, column 8: frame '3': real alpha is not a finite number (NaN)"
+        )),
         "{e}"
     );
 
@@ -774,7 +861,10 @@ fn malformed_descriptions_get_errors_that_point_to_the_place() {
     let t = base.replace("label = \"4\"", "label = \"3\"");
     let e = toml_err(&t);
     assert!(
-        e.contains(&format!("line {l}, column 9: duplicate frame label '3' (first used on line {})", line_of(&base, "label = \"3\""))),
+        e.contains(&format!(
+            "line {l}, column 9: duplicate frame label '3' (first used on line {})",
+            line_of(&base, "label = \"3\"")
+        )),
         "{e}"
     );
 
@@ -795,7 +885,9 @@ fn malformed_descriptions_get_errors_that_point_to_the_place() {
     );
     let e = toml_err(&t);
     assert!(
-        e.contains(&format!("line {l}, column 12: unknowns alpha_5 are not identifiable from point measurements")),
+        e.contains(&format!(
+            "line {l}, column 12: unknowns alpha_5 are not identifiable from point measurements"
+        )),
         "{e}"
     );
 
@@ -804,7 +896,9 @@ fn malformed_descriptions_get_errors_that_point_to_the_place() {
     let t = replace_nth(&base, "limits = ", 2, "limits = [1.0, -1.0]");
     let e = toml_err(&t);
     assert!(
-        e.contains(&format!("line {l}, column 10: frame '2': joint q3 has inverted limits [1, -1]")),
+        e.contains(&format!(
+            "line {l}, column 10: frame '2': joint q3 has inverted limits [1, -1]"
+        )),
         "{e}"
     );
 
@@ -817,19 +911,35 @@ fn malformed_descriptions_get_errors_that_point_to_the_place() {
     assert!(toml_err(&t).contains("frame '0' is a DH frame: it has no beta"));
     let t = replace_nth(&base, "real = ", 0, "real = [1.0, 2.0, 3.0, 4.0]");
     assert!(toml_err(&t).contains("frame 'a': `real` has 4 values, a Hayati frame needs 5"));
-    let t = replace_nth(&base, "joint = \"fixed\"", 0, "joint = \"fixed\"\nlimits = [0.0, 1.0]");
+    let t = replace_nth(
+        &base,
+        "joint = \"fixed\"",
+        0,
+        "joint = \"fixed\"\nlimits = [0.0, 1.0]",
+    );
     assert!(toml_err(&t).contains("frame 'a' is fixed: it has no joint limits"));
-    let t = replace_nth(&base, "joint = \"revolute\"", 0, "joint = \"prismatic\"")
-        .replacen("limits = [", "limits_deg = [", 1);
+    let t = replace_nth(&base, "joint = \"revolute\"", 0, "joint = \"prismatic\"").replacen(
+        "limits = [",
+        "limits_deg = [",
+        1,
+    );
     assert!(toml_err(&t).contains("joint q1 is prismatic: give `limits` in metres"));
     let t = base.replace("measurement = \"point\"", "measurement = \"laser\"");
     assert!(toml_err(&t).contains("unknown variant `laser`"));
-    let t = base.replace("measurement = \"point\"", "measurement = \"point\"\nunknowns = \"auto\"");
+    let t = base.replace(
+        "measurement = \"point\"",
+        "measurement = \"point\"\nunknowns = \"auto\"",
+    );
     assert!(toml_err(&t).contains("give one or the other"));
     assert!(toml_err("name = \"x\"\n").contains("no frames"));
     let t = replace_nth(&base, "unknowns = ", 3, "unknowns = [\"gamma\", \"gamma\"]");
     assert!(toml_err(&t).contains("'gamma' is listed twice"));
-    let t = replace_nth(&base, "real = ", 1, "real = [0.0, -1.5707963267948966, 1e300, 0.6858, 10.0]");
+    let t = replace_nth(
+        &base,
+        "real = ",
+        1,
+        "real = [0.0, -1.5707963267948966, 1e300, 0.6858, 10.0]",
+    );
     assert!(toml_err(&t).contains("out of range"));
 }
 
@@ -842,13 +952,19 @@ fn auto_unknowns_for_a_description_are_the_builtin_choice() {
         .collect::<Vec<_>>()
         .join("\n")
         + "\n";
-    let t = t.replace("measurement = \"point\"", "measurement = \"point\"\nunknowns = \"auto\"");
+    let t = t.replace(
+        "measurement = \"point\"",
+        "measurement = \"point\"\nunknowns = \"auto\"",
+    );
     let r = file::parse(&t, "auto.toml", None).unwrap();
     assert_eq!(r.unknowns, puma.unknowns);
     assert_eq!(r.name, "puma560");
     // And with_measurement adds the tool orientation for full poses.
     let pp = puma.with_measurement(Measurement::Pose).unwrap();
-    assert_eq!(pp.unknowns, Robot::builtin("puma560:pose").unwrap().unknowns);
+    assert_eq!(
+        pp.unknowns,
+        Robot::builtin("puma560:pose").unwrap().unknowns
+    );
     let back = pp.with_measurement(Measurement::Point).unwrap();
     assert_eq!(back.unknowns, puma.unknowns);
 }
@@ -911,14 +1027,29 @@ fn select_and_score_run_on_every_robot() {
 fn bound_runs_on_every_robot_and_lies_above_the_selected_design() {
     for r in all_robots() {
         let (_, x) = pool_x(&r, 3);
-        let sel = eae(&x, &mut DCriterion::new(), &Settings::default(), &mut design_rng(1, 0)).unwrap();
-        let settings = BoundSettings::builder().use_conic(false).build().unwrap();
+        let sel = eae(
+            &x,
+            &mut DCriterion::new(),
+            &Settings::default(),
+            &mut design_rng(1, 0),
+        )
+        .unwrap();
+        // The bound is valid at any gap; a loose target keeps this test short.
+        let settings = BoundSettings::builder()
+            .use_conic(false)
+            .gap_tol(1e-2)
+            .build()
+            .unwrap();
         let b = relaxation_bound(&x, 30, &settings).unwrap_or_else(|e| panic!("{}: {e}", r.name));
         println!(
             "{}: bound {:.3} ≥ EAE {:.3} (gap {:.2e}, {:?}, {:.2} s)",
             r.name, b.ln_bound, sel.ln_oid, b.certificate_gap, b.status, b.seconds
         );
-        assert!(b.ln_bound.is_finite() && b.ln_bound >= sel.ln_oid - 1e-9, "{}", r.name);
+        assert!(
+            b.ln_bound.is_finite() && b.ln_bound >= sel.ln_oid - 1e-9,
+            "{}",
+            r.name
+        );
     }
 }
 
@@ -929,7 +1060,13 @@ fn point_calibration_recovers_the_real_robot() {
         .filter(|r| r.measurement == Measurement::Point)
     {
         let (pool, x) = pool_x(&r, 3);
-        let sel = eae(&x, &mut DCriterion::new(), &Settings::default(), &mut design_rng(1, 0)).unwrap();
+        let sel = eae(
+            &x,
+            &mut DCriterion::new(),
+            &Settings::default(),
+            &mut design_rng(1, 0),
+        )
+        .unwrap();
         let qs: Vec<Vec<f64>> = sel.poses.iter().map(|&k| pool.q(k)).collect();
         let meas = simulate(&r, &r.real, &qs, 0.0, &mut trial_rng(1, 0)).unwrap();
         let id = identify(&r, &r.nominal, &meas, &LmSettings::default()).unwrap();
@@ -956,7 +1093,13 @@ fn pose_identification_with_the_orientation_rows_recovers_the_real_robot() {
         .filter(|r| r.measurement == Measurement::Pose)
     {
         let (pool, x) = pool_x(&r, 3);
-        let sel = eae(&x, &mut DCriterion::new(), &Settings::default(), &mut design_rng(1, 0)).unwrap();
+        let sel = eae(
+            &x,
+            &mut DCriterion::new(),
+            &Settings::default(),
+            &mut design_rng(1, 0),
+        )
+        .unwrap();
         let qs: Vec<Vec<f64>> = sel.poses.iter().map(|&k| pool.q(k)).collect();
         let meas: Vec<(Matrix3<f64>, Vector3<f64>)> =
             qs.iter().map(|q| pose(&r, &r.real, q)).collect();

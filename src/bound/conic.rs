@@ -32,9 +32,9 @@ pub struct ConicSettings {
     pub max_iter: u32,
     /// Time limit in seconds for one solve. Default 120.
     pub time_limit: f64,
-    /// Absolute and relative duality-gap tolerance. Default 1e-9.
+    /// Absolute and relative duality-gap tolerance. Default 1e-10.
     pub tol_gap: f64,
-    /// Primal and dual feasibility tolerance. Default 1e-9.
+    /// Primal and dual feasibility tolerance. Default 1e-10.
     pub tol_feas: f64,
     /// Clarabel's data equilibration. Default true.
     pub equilibrate: bool,
@@ -43,6 +43,9 @@ pub struct ConicSettings {
     pub retry_without_equilibration: bool,
     /// Chordal decomposition of the PSD cone. Default true.
     pub chordal: bool,
+    /// Clarabel's clique merging after chordal decomposition: `"none"`,
+    /// `"parent_child"` or `"clique_graph"`. Default `"clique_graph"`.
+    pub chordal_merge: String,
     /// Clarabel's progress printing. Default false.
     pub verbose: bool,
 }
@@ -52,11 +55,12 @@ impl Default for ConicSettings {
         Self {
             max_iter: 200,
             time_limit: 120.0,
-            tol_gap: 1e-9,
-            tol_feas: 1e-9,
+            tol_gap: 1e-10,
+            tol_feas: 1e-10,
             equilibrate: true,
             retry_without_equilibration: true,
             chordal: true,
+            chordal_merge: "clique_graph".into(),
             verbose: false,
         }
     }
@@ -79,6 +83,13 @@ impl ConicSettings {
         pos("conic.time_limit", self.time_limit)?;
         pos("conic.tol_gap", self.tol_gap)?;
         pos("conic.tol_feas", self.tol_feas)?;
+        if !["none", "parent_child", "clique_graph"].contains(&self.chordal_merge.as_str()) {
+            return Err(BoundError::InvalidSetting {
+                name: "conic.chordal_merge",
+                value: self.chordal_merge.clone(),
+                reason: "must be none, parent_child or clique_graph",
+            });
+        }
         if self.max_iter == 0 {
             return Err(BoundError::InvalidSetting {
                 name: "conic.max_iter",
@@ -99,6 +110,7 @@ impl ConicSettings {
             tol_feas: self.tol_feas,
             equilibrate_enable: equilibrate,
             chordal_decomposition_enable: self.chordal,
+            chordal_decomposition_merge_method: self.chordal_merge.clone(),
             max_threads: 1,
             ..DefaultSettings::default()
         }

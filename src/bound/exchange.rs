@@ -46,10 +46,10 @@ pub struct ExchangeSettings {
     /// Wall-clock limit in seconds. Default 60.
     pub time_limit: f64,
     /// Capped multiplicative steps `w_i ← min(1, c·w_i d_i)` before the
-    /// exchange rounds, when no start is given. Default 6.
+    /// exchange rounds, when no start is given. Default 30.
     pub warmup_rounds: usize,
     /// After the warm-up, keep at most this many of the largest weights
-    /// (at least `N` and `⌈p/t⌉`). Default 300.
+    /// (at least `N` and `⌈p/t⌉`). Default 1000.
     pub keep: usize,
     /// Poses outside the support added to the candidate set each round, by
     /// largest `d_i`. Default 100.
@@ -233,6 +233,7 @@ pub(crate) fn solve_scaled(
     }
 
     // --- start: given weights, or uniform + capped multiplicative steps + pruning
+    let started = start.is_some();
     let mut w = match start {
         Some(mut w) => {
             make_feasible(&mut w, n);
@@ -252,7 +253,7 @@ pub(crate) fn solve_scaled(
     let mut rounds = 1;
     let support = w.iter().filter(|&&v| v > 0.0).count();
     let keep = s.keep.max(n).max(p.div_ceil(t));
-    if support > keep {
+    if !started && support > keep {
         for _ in 0..s.warmup_rounds {
             if !multiplicative_step(&mut w, &eval.d, n) {
                 break;

@@ -162,6 +162,7 @@ pub fn trace(
             c.configure_mesh()
                 .x_desc("iteration")
                 .y_desc(ylabel)
+                .y_labels(20)
                 .y_label_formatter(&|v| format!("{v:.0e}"))
                 .draw()
                 .map_err(err)?;

@@ -36,7 +36,11 @@ pub fn load_robot(name: &str) -> Result<Robot> {
 /// Prints `value` as one JSON line, or the human-readable `text`.
 pub fn emit(json_out: bool, value: &Value, text: impl FnOnce() -> String) {
     use std::io::Write;
-    let s = if json_out { format!("{value}\n") } else { text() };
+    let s = if json_out {
+        format!("{value}\n")
+    } else {
+        text()
+    };
     // A closed pipe (`activecal ... | head`) is not an error worth a panic.
     let _ = std::io::stdout().lock().write_all(s.as_bytes());
 }

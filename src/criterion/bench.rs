@@ -58,11 +58,42 @@ fn best_of<F: FnMut()>(reps: usize, mut f: F) -> f64 {
 /// exchange scan, on the design `design` of `pool` (with default
 /// [`StateSettings`]). Each measurement is the best of `reps` runs
 /// (`reps ≥ 1`); the OI scan dominates the cost (`O(p³)` per candidate).
+/// Runs inside a rayon pool of `rayon::current_num_threads()` threads, so
+/// the timings exclude the cold start of a parallel call made from outside a
+/// pool (run selection loops inside `ThreadPool::install` for the same
+/// reason).
 pub fn bench_scan(
     pool: &Blocks,
     design: &[usize],
     reps: usize,
 ) -> Result<ScanTimings, CriterionError> {
+    bench_scan_with_threads(pool, design, reps, rayon::current_num_threads())
+}
+
+/// [`bench_scan`] in a rayon pool of `threads` threads (`≥ 1`). With
+/// `threads = 1` the timings are the per-candidate arithmetic alone, free of
+/// thread wake-ups — the stable number on a loaded machine.
+pub fn bench_scan_with_threads(
+    pool: &Blocks,
+    design: &[usize],
+    reps: usize,
+    threads: usize,
+) -> Result<ScanTimings, CriterionError> {
+    // Measure inside a rayon pool, as a selection loop running in one sees
+    // it: a parallel call from a thread outside any pool also pays the
+    // wake-up of the pool's sleeping workers (up to a scheduler time slice,
+    // milliseconds, on a loaded machine), which would swamp a scan of
+    // ~0.5 ms.
+    match rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.max(1))
+        .build()
+    {
+        Ok(tp) => tp.install(|| scan(pool, design, reps)),
+        Err(_) => scan(pool, design, reps),
+    }
+}
+
+fn scan(pool: &Blocks, design: &[usize], reps: usize) -> Result<ScanTimings, CriterionError> {
     let state = InfoState::new(pool, design, StateSettings::default())?;
     let n = pool.n_poses();
     let cands: Vec<usize> = (0..n).filter(|&i| !state.contains(i)).collect();
@@ -116,4 +147,46 @@ pub fn bench_scan(
         oi_eigen_ns: oi_t / nc,
         speedup: oi_t / add,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::Mat;
+
+    fn random_pool(n: usize, t: usize, p: usize, seed: u64) -> Blocks {
+        let mut s = seed;
+        Blocks::new(
+            Mat::from_fn(n * t, p, |_, _| {
+                s = s
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+            }),
+            t,
+        )
+    }
+
+    #[test]
+    fn bench_scan_runs_on_a_small_pool() {
+        let pool = random_pool(300, 3, 9, 1);
+        let design: Vec<usize> = (0..6).collect();
+        let s = bench_scan(&pool, &design, 1).unwrap();
+        assert_eq!(s.n_candidates, 294);
+        assert!(s.add_gain_ns > 0.0 && s.oi_eigen_ns > 0.0 && s.speedup.is_finite());
+    }
+
+    /// The paper-sized scan (15,625 poses, p = 27, t = 3, 30-pose design) on
+    /// random data. Run with
+    /// `cargo test --release --lib criterion::bench -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn bench_scan_paper_size() {
+        let pool = random_pool(15_625, 3, 27, 42);
+        let design: Vec<usize> = (0..30).map(|i| i * 521).collect();
+        for threads in [1, 2] {
+            let s = bench_scan_with_threads(&pool, &design, 5, threads).unwrap();
+            println!("{}", serde_json::to_string_pretty(&s).unwrap());
+        }
+    }
 }

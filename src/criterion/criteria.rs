@@ -24,7 +24,10 @@ use rayon::prelude::*;
 use super::MAX_T;
 use super::dense::{EigenScratch, add_gram, gather_block, ln_det_i_minus, ln_det_i_plus, view};
 use super::state::InfoState;
-use super::variances::{CHUNK, PoolVariances};
+use super::variances::{PoolVariances, SCAN_CHUNK};
+
+/// Candidates per parallel work item of the OI criterion (`O(p³)` each).
+const OI_CHUNK: usize = 8;
 use crate::blocks::Blocks;
 
 /// A design criterion: scores an information state (higher is better) and
@@ -136,8 +139,8 @@ impl Criterion for DCriterion {
         let base = state.ln_det();
         let t = pool.t();
         let vars = &*self.variances(pool, state);
-        out.par_chunks_mut(CHUNK)
-            .zip(candidates.par_chunks(CHUNK))
+        out.par_chunks_mut(SCAN_CHUNK)
+            .zip(candidates.par_chunks(SCAN_CHUNK))
             .for_each(|(oc, cc)| {
                 for (o, &i) in oc.iter_mut().zip(cc) {
                     *o = if state.contains(i) {
@@ -173,12 +176,11 @@ impl Criterion for DCriterion {
         let floor = state.pivot_floor();
         self.variances(pool, state)
             .exchange_gains(pool, state, outs, candidates, floor, out);
-        out.par_chunks_mut(CHUNK * outs.len().max(1))
-            .for_each(|oc| {
-                for o in oc {
-                    *o += base;
-                }
-            });
+        out.par_chunks_mut(SCAN_CHUNK).for_each(|oc| {
+            for o in oc {
+                *o += base;
+            }
+        });
     }
 }
 
@@ -280,8 +282,8 @@ impl Criterion for OiCriterion {
     ) {
         assert_eq!(candidates.len(), out.len());
         let maxc = state.settings().max_condition;
-        out.par_chunks_mut(CHUNK)
-            .zip(candidates.par_chunks(CHUNK))
+        out.par_chunks_mut(OI_CHUNK)
+            .zip(candidates.par_chunks(OI_CHUNK))
             .for_each(|(oc, cc)| {
                 let mut s = OiScratch::new(state.p());
                 for (o, &i) in oc.iter_mut().zip(cc) {
@@ -298,8 +300,8 @@ impl Criterion for OiCriterion {
         assert_eq!(state.design().len(), out.len());
         let maxc = state.settings().max_condition;
         let design = state.design();
-        out.par_chunks_mut(CHUNK)
-            .zip(design.par_chunks(CHUNK))
+        out.par_chunks_mut(OI_CHUNK)
+            .zip(design.par_chunks(OI_CHUNK))
             .for_each(|(oc, dc)| {
                 let mut s = OiScratch::new(state.p());
                 for (o, &j) in oc.iter_mut().zip(dc) {
@@ -323,8 +325,8 @@ impl Criterion for OiCriterion {
             return;
         }
         let maxc = state.settings().max_condition;
-        out.par_chunks_mut(CHUNK * no)
-            .zip(candidates.par_chunks(CHUNK))
+        out.par_chunks_mut(OI_CHUNK * no)
+            .zip(candidates.par_chunks(OI_CHUNK))
             .for_each(|(oc, cc)| {
                 let mut s = OiScratch::new(state.p());
                 for (oi, &i) in oc.chunks_mut(no).zip(cc) {

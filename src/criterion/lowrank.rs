@@ -14,7 +14,7 @@
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 
-use super::dense::{chol_in_place, chol_pivoted_in_place, min_pivot};
+use super::dense::{chol_in_place, chol_pivoted_in_place, clear_upper_simd_state, min_pivot};
 
 /// A numerically singular change: a pivot of the removal Schur complement
 /// was `≤ pivot_floor`. A numerical outcome, not an error.
@@ -163,6 +163,7 @@ pub fn woodbury(
         1.0,
         par,
     );
+    clear_upper_simd_state();
     // S is symmetric in exact arithmetic; read S[i][j] with i ≥ j only.
     let sym = |i: usize, j: usize| if i >= j { s[j * k + i] } else { s[i * k + j] };
 

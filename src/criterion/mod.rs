@@ -84,7 +84,7 @@ pub mod lowrank;
 mod state;
 mod variances;
 
-pub use bench::{ScanTimings, bench_scan};
+pub use bench::{ScanTimings, bench_scan, bench_scan_with_threads};
 pub use criteria::{Criterion, DCriterion, OiCriterion, argmax};
 pub use indices::Indices;
 pub use state::{Drift, InfoState, StateSettings, Status};

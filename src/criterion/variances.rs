@@ -8,17 +8,20 @@
 //! `P = X_pool [F₊ F₋]`: one `(n·t) × p × k` product instead of the
 //! `(n·t) × p × p` of a recomputation.
 //!
-//! Every per-candidate loop runs over fixed chunks of [`CHUNK`] poses in
-//! parallel (rayon); each chunk's arithmetic is sequential and the chunk
-//! boundaries do not depend on the number of threads, so results are
-//! bit-identical for any thread count.
+//! Every per-candidate loop runs over fixed chunks ([`CHUNK`] poses for the
+//! products, [`SCAN_CHUNK`] candidates for the cheap scans) in parallel
+//! (rayon); each chunk's arithmetic is sequential and the chunk boundaries
+//! do not depend on the number of threads, so results are bit-identical for
+//! any thread count.
 
 use faer::linalg::matmul::matmul;
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
-use super::dense::{exchange_ln_det, ln_det_i_minus, ln_det_i_plus, packed_len, pk};
+use super::dense::{
+    clear_upper_simd_state, exchange_ln_det, ln_det_i_minus, ln_det_i_plus, packed_len, pk,
+};
 use super::lowrank::LowRank;
 use super::state::InfoState;
 use crate::blocks::Blocks;
@@ -32,8 +35,14 @@ fn col(m: MatRef<'_, f64>, c: usize) -> &[f64] {
         .as_slice()
 }
 
-/// Poses per parallel work item.
-pub const CHUNK: usize = 64;
+/// Poses per parallel work item of the products `X·A` (a 256-pose chunk of
+/// a `p = 27`, `t = 3` pool times `M⁻¹` is ≈ 1 Mflop).
+pub(crate) const CHUNK: usize = 256;
+
+/// Candidates per parallel work item of the cheap per-candidate loops
+/// (`O(t³)` each): large, so that a scan of a whole pool is a handful of
+/// tasks and thread wake-ups do not dominate.
+pub(crate) const SCAN_CHUNK: usize = 2048;
 
 /// `V_i = X_i M⁻¹ X_iᵀ` (packed lower triangle, `t(t+1)/2` numbers) for every
 /// pose of a pool, synchronized with an [`InfoState`].
@@ -78,6 +87,7 @@ fn chunked_product<F>(
     if per_pose == 0 {
         xs.enumerate().for_each(|(c, (xc, mut pc))| {
             matmul(pc.rb_mut(), Accum::Replace, xc, a, 1.0, Par::Seq);
+            clear_upper_simd_state();
             f(c * CHUNK, xc, pc.rb(), &mut []);
         });
     } else {
@@ -85,6 +95,7 @@ fn chunked_product<F>(
             .enumerate()
             .for_each(|(c, ((xc, mut pc), oc))| {
                 matmul(pc.rb_mut(), Accum::Replace, xc, a, 1.0, Par::Seq);
+                clear_upper_simd_state();
                 f(c * CHUNK, xc, pc.rb(), oc);
             });
     }
@@ -259,8 +270,8 @@ impl PoolVariances {
     pub fn add_gains(&self, candidates: &[usize], out: &mut [f64]) {
         assert_eq!(candidates.len(), out.len());
         let t = self.t;
-        out.par_chunks_mut(CHUNK)
-            .zip(candidates.par_chunks(CHUNK))
+        out.par_chunks_mut(SCAN_CHUNK)
+            .zip(candidates.par_chunks(SCAN_CHUNK))
             .for_each(|(oc, cc)| {
                 for (o, &i) in oc.iter_mut().zip(cc) {
                     *o = ln_det_i_plus(self.packed(i), t);
@@ -307,6 +318,7 @@ impl PoolVariances {
             1.0,
             Par::Seq,
         );
+        clear_upper_simd_state();
         chunked_product(
             pool.mat(),
             t,
@@ -346,8 +358,9 @@ impl PoolVariances {
         // Column slices of W, gathered once (not per candidate).
         let wcols: Vec<&[f64]> = (0..no * t).map(|c| col(w, c)).collect();
         let this = &*self;
-        out.par_chunks_mut(CHUNK * no)
-            .zip(candidates.par_chunks(CHUNK))
+        let per = (SCAN_CHUNK / no).max(16);
+        out.par_chunks_mut(per * no)
+            .zip(candidates.par_chunks(per))
             .for_each(|(oc, cc)| {
                 for (oi, &i) in oc.chunks_mut(no).zip(cc) {
                     if state.contains(i) {
@@ -469,10 +482,12 @@ mod tests {
 
     #[test]
     fn bit_identical_for_any_thread_count() {
-        let pool = random_pool(1000, 3, 27, 99);
+        // Several chunks of every kind: 5000 poses = 20 product chunks and 3
+        // scan chunks.
+        let pool = random_pool(5000, 3, 27, 99);
         let design: Vec<usize> = (0..12).collect();
         let st = InfoState::new(&pool, &design, StateSettings::default()).unwrap();
-        let cands: Vec<usize> = (12..1000).collect();
+        let cands: Vec<usize> = (12..5000).collect();
         let run = |threads: usize| {
             let tp = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)

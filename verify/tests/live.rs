@@ -15,6 +15,8 @@ use verify::sample::configurations;
 use verify::{TOLERANCE, builtin_robots, synthetic_robot};
 
 const SETS: [ParamSet; 2] = [ParamSet::Nominal, ParamSet::Real];
+// The issue asks for at least 1,000 random configurations (plus the corners).
+const _: () = assert!(LIVE_RANDOM >= 1000);
 
 fn check_robot(robot: &Robot) {
     let bridge = Bridge::new().expect("Python bridge (run scripts/setup)");
@@ -22,7 +24,6 @@ fn check_robot(robot: &Robot) {
         let report = check_live(&bridge, robot, set).unwrap();
         println!("{report}");
         assert_eq!(report.configurations, LIVE_RANDOM + (1 << robot.dof()));
-        assert!(LIVE_RANDOM >= 1000);
         assert!(report.passed(TOLERANCE), "{report}");
     }
 }

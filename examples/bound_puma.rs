@@ -11,8 +11,8 @@ fn main() {
     let env = |k: &str, d: f64| std::env::var(k).map_or(d, |v| v.parse().unwrap());
     let settings = BoundSettings::builder()
         .gap_tol(env("GAP_TOL", 1e-6))
-        .screen_gap(env("SCREEN_GAP", 1e-3))
-        .screen_extra(env("SCREEN_EXTRA", 300.0) as usize)
+        .screen_gap(env("SCREEN_GAP", 1e-2))
+        .screen_extra(env("SCREEN_EXTRA", 100.0) as usize)
         .use_conic(!first_order_only)
         .conic(activecal::bound::conic::ConicSettings {
             chordal_merge: std::env::var("MERGE").unwrap_or_else(|_| "clique_graph".into()),

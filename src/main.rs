@@ -6,6 +6,7 @@ mod cli;
 use clap::{Parser, Subcommand};
 use cli::basic::{FkArgs, PoolArgs, RobotsArgs};
 use cli::bench::BenchArgs;
+use cli::bound::{BoundArgs, GapArgs};
 use cli::calibrate::CalibrateArgs;
 use cli::reproduce::ReproduceArgs;
 use cli::select::{ScoreArgs, SelectArgs};
@@ -39,6 +40,10 @@ enum Command {
     Reproduce(ReproduceArgs),
     /// Simulate a calibration of a design (identification, validation, Monte-Carlo).
     Calibrate(CalibrateArgs),
+    /// Certified upper bound on OI_D of every N-pose design (convex relaxation).
+    Bound(BoundArgs),
+    /// A design's D-efficiency against the relaxation bound.
+    Gap(GapArgs),
 }
 
 fn main() {
@@ -52,6 +57,8 @@ fn main() {
         Command::Bench(a) => cli::bench::cmd_bench(a),
         Command::Reproduce(a) => cli::reproduce::cmd_reproduce(a),
         Command::Calibrate(a) => cli::calibrate::cmd_calibrate(a),
+        Command::Bound(a) => cli::bound::cmd_bound(a),
+        Command::Gap(a) => cli::bound::cmd_gap(a),
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");

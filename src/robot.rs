@@ -287,6 +287,10 @@ impl Robot {
     /// `.toml` description ([`file`]) or a `.urdf` file ([`crate::urdf`],
     /// point measurements, unknowns chosen automatically). The result is
     /// validated, and a file's unknowns are checked to be identifiable.
+    ///
+    /// A robot from a file is named by the path as given (not by the name
+    /// inside the file), so that design files, which record the robot's
+    /// name, load it again.
     pub fn load(name_or_path: &str) -> Result<Robot> {
         if let Ok(r) = Robot::builtin(name_or_path) {
             return Ok(r);
@@ -296,9 +300,18 @@ impl Robot {
             .extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
+        let named = |r: Result<Robot>| {
+            r.map(|mut r| {
+                r.name = name_or_path.to_string();
+                r
+            })
+        };
         match ext.as_deref() {
-            Some("toml") => file::load(path),
-            Some("urdf") => crate::urdf::load(path, &crate::urdf::UrdfOptions::default()),
+            Some("toml") => named(file::load(path)),
+            Some("urdf") => named(crate::urdf::load(
+                path,
+                &crate::urdf::UrdfOptions::default(),
+            )),
             _ if path.exists() => Err(Error::Invalid(format!(
                 "{name_or_path}: unknown robot file type (expected a .toml description or a .urdf file)"
             ))),

@@ -57,15 +57,23 @@ pub struct BoundSettings {
     /// (false). Default true.
     pub use_conic: bool,
     /// First-order certificate gap at which screening stops and Clarabel
-    /// takes over. Default 1e-3.
+    /// takes over. Default 1e-2.
     pub screen_gap: f64,
     /// Poses outside the support added to Clarabel's candidate set, by
-    /// largest `d_i`. Default 300.
+    /// largest `d_i`. Default 100.
     pub screen_extra: usize,
     /// Pools of at most this many poses go to Clarabel whole. Default 400.
     pub direct_limit: usize,
     /// Maximum Clarabel solves (screening rounds). Default 5.
     pub max_rounds: usize,
+    /// Most violators added to the candidates per round, by largest `d_i`.
+    /// Default 1000.
+    pub max_add: usize,
+    /// Clarabel's gap and feasibility tolerance in screening rounds: solves
+    /// whose purpose is to find the poses that violate the optimality
+    /// conditions outside the candidates. The last solve (no violator left,
+    /// or the whole pool) uses `conic.tol_gap`. Default 1e-7.
+    pub screen_tol: f64,
     /// After each Clarabel solve whose certificate gap is above `gap_tol`,
     /// run the first-order solver from its point (at most `polish_rounds`
     /// rounds) before adding violators and re-solving; if Clarabel fails,
@@ -85,10 +93,12 @@ impl Default for BoundSettings {
         Self {
             gap_tol: 1e-6,
             use_conic: true,
-            screen_gap: 1e-3,
-            screen_extra: 300,
+            screen_gap: 1e-2,
+            screen_extra: 100,
             direct_limit: 400,
             max_rounds: 5,
+            max_add: 1000,
+            screen_tol: 1e-7,
             polish: true,
             polish_rounds: 20,
             first_order: ExchangeSettings::default(),
@@ -119,6 +129,14 @@ impl BoundSettings {
         };
         pos("gap_tol", self.gap_tol)?;
         pos("screen_gap", self.screen_gap)?;
+        pos("screen_tol", self.screen_tol)?;
+        if self.max_add == 0 {
+            return Err(BoundError::InvalidSetting {
+                name: "max_add",
+                value: "0".into(),
+                reason: "must be ≥ 1",
+            });
+        }
         if self.polish_rounds == 0 {
             return Err(BoundError::InvalidSetting {
                 name: "polish_rounds",
@@ -155,13 +173,13 @@ impl BoundSettingsBuilder {
         self.0.use_conic = v;
         self
     }
-    /// Screening gap of the first-order stage (default 1e-3).
+    /// Screening gap of the first-order stage (default 1e-2).
     #[must_use]
     pub fn screen_gap(mut self, v: f64) -> Self {
         self.0.screen_gap = v;
         self
     }
-    /// Extra candidates for Clarabel (default 300).
+    /// Extra candidates for Clarabel (default 100).
     #[must_use]
     pub fn screen_extra(mut self, v: usize) -> Self {
         self.0.screen_extra = v;
@@ -171,6 +189,18 @@ impl BoundSettingsBuilder {
     #[must_use]
     pub fn direct_limit(mut self, v: usize) -> Self {
         self.0.direct_limit = v;
+        self
+    }
+    /// Clarabel tolerance of screening rounds (default 1e-7).
+    #[must_use]
+    pub fn screen_tol(mut self, v: f64) -> Self {
+        self.0.screen_tol = v;
+        self
+    }
+    /// Most violators added per round (default 1000).
+    #[must_use]
+    pub fn max_add(mut self, v: usize) -> Self {
+        self.0.max_add = v;
         self
     }
     /// Maximum Clarabel solves (default 5).
@@ -390,14 +420,23 @@ pub fn relaxation_bound(
             candidates(&fo.weights, &fo_eval.d, settings.screen_extra)
         };
         let mut conic_solved = false;
+        // The whole pool needs no screening: solve it once, accurately.
+        let mut last = cand.len() == pool;
         for round in 1..=settings.max_rounds {
+            let mut conic_settings = settings.conic.clone();
+            if !last && round < settings.max_rounds {
+                conic_settings.tol_gap = conic_settings.tol_gap.max(settings.screen_tol);
+                conic_settings.tol_feas = conic_settings.tol_feas.max(settings.screen_tol);
+            } else {
+                last = true;
+            }
             let sub = xs.select(&cand);
             // A rank-deficient candidate set cannot happen for a support of a
             // positive definite M(w); if it does, keep what we have.
             let Ok(sub_sc) = scale_columns(&sub, n.min(cand.len())) else {
                 break;
             };
-            let out = conic::solve_scaled(&sub_sc, n, &settings.conic);
+            let out = conic::solve_scaled(&sub_sc, n, &conic_settings);
             conic_summary.status = Some(out.status);
             conic_summary.iterations = out.iterations;
             conic_summary.rounds = round;
@@ -443,18 +482,27 @@ pub fn relaxation_bound(
             if best.gap() <= settings.gap_tol || !out.status.is_solved() {
                 break;
             }
+            if last && round == settings.max_rounds {
+                break;
+            }
             // Optimality conditions on the whole pool: a pose outside the
             // candidates whose d_i exceeds c = the N-th largest d among the
-            // candidates would enter the top-N sum S_N.
+            // candidates would enter the top-N sum S_N. (With w optimal on
+            // the candidates, their d_i satisfy the conditions with this c.)
             let dk: Vec<f64> = cand.iter().map(|&i| e.d[i]).collect();
             let c = nth_largest(&dk, n, &mut scratch);
             let mut in_cand = vec![false; pool];
             cand.iter().for_each(|&i| in_cand[i] = true);
             let mut viol: Vec<usize> = (0..pool).filter(|&i| !in_cand[i] && e.d[i] > c).collect();
             if viol.is_empty() {
-                // The candidates hold the optimum; what is left is the
-                // solver's accuracy. Pairwise steps from Clarabel's point
-                // equalise the variances of the near-tied poses.
+                if !last {
+                    // The candidates hold the optimum: solve them accurately.
+                    last = true;
+                    continue;
+                }
+                // What is left is the solver's accuracy. Pairwise steps
+                // from Clarabel's point equalise the variances of the
+                // near-tied poses.
                 if settings.polish {
                     let pol = polish(xs, n, &e_w, settings);
                     conic_summary.polish_steps += pol.steps;
@@ -466,14 +514,17 @@ pub fn relaxation_bound(
                 }
                 break;
             }
-            if viol.len() > settings.screen_extra.max(1) {
-                viol.select_nth_unstable_by(settings.screen_extra.max(1) - 1, |&a, &b| {
+            if viol.len() > settings.max_add {
+                viol.select_nth_unstable_by(settings.max_add - 1, |&a, &b| {
                     e.d[b].total_cmp(&e.d[a])
                 });
-                viol.truncate(settings.screen_extra.max(1));
+                viol.truncate(settings.max_add);
             }
             cand.extend(viol);
             cand.sort_unstable();
+            // The violators came from a point accurate enough to find them;
+            // the next solve is meant to be the last.
+            last = true;
         }
         // --- Clarabel failed: continue the first-order solver instead
         if settings.polish && !conic_solved && best.gap() > settings.gap_tol {

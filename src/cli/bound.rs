@@ -20,7 +20,7 @@ pub struct SolveOpts {
     pub first_order: bool,
     /// Poses outside the first-order support given to Clarabel, by largest
     /// variance.
-    #[arg(long, default_value_t = 300)]
+    #[arg(long, default_value_t = 100)]
     pub screen_extra: usize,
 }
 

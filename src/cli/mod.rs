@@ -2,6 +2,7 @@
 
 pub mod basic;
 pub mod bench;
+pub mod bound;
 pub mod calibrate;
 pub mod figures;
 pub mod reproduce;

@@ -107,6 +107,9 @@ pub struct SelectArgs {
     /// Overwrite --out if it exists.
     #[arg(long)]
     pub force: bool,
+    /// Also compute the relaxation bound and report the design's D-efficiency.
+    #[arg(long)]
+    pub gap: bool,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -173,6 +176,14 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         "starts": a.starts, "polish": a.polish, "best_start": sel.start,
         "fixed": fixed_lattice,
     });
+    let mut v = v;
+    if a.gap {
+        let bound = activecal::bound::relaxation_bound(&ctx.x, a.n, &activecal::bound::BoundSettings::default())?;
+        let g = activecal::bound::design_gap(&ctx.x, &sel.poses, &bound)?;
+        v["log10_bound"] = json!(g.log10_bound);
+        v["d_efficiency"] = json!(g.d_efficiency);
+        v["bound_status"] = json!(format!("{:?}", g.bound_status));
+    }
     if let Some(out) = &a.out {
         let mut d = DesignFile::new(&ctx.robot.name, a.pool.levels, poses.clone());
         for k in [

@@ -144,6 +144,10 @@ pub struct Drift {
 
 const NOT_IN_DESIGN: usize = usize::MAX;
 
+/// Low-rank updates kept for [`InfoState::updates_since`] (between
+/// `LOG_KEEP` and `2·LOG_KEEP` of the most recent ones).
+const LOG_KEEP: usize = 64;
+
 static NEXT_ID: AtomicU64 = AtomicU64::new(1);
 
 fn fresh_id() -> u64 {
@@ -495,9 +499,10 @@ impl InfoState {
         self.epoch
     }
 
-    /// The low-rank updates applied since the last refactorization, oldest
-    /// first, and the version before the first of them: update `k` took the
-    /// state from version `base + k` to `base + k + 1`.
+    /// The low-rank updates applied since the last refactorization (at most
+    /// the latest 128), oldest first, and the version before the first of
+    /// them: update `k` took the state from version `base + k` to
+    /// `base + k + 1`.
     #[must_use]
     pub fn updates_since(&self) -> (u64, &[LowRank]) {
         (self.log_base, &self.log)
@@ -607,6 +612,13 @@ impl InfoState {
         self.cond1 = norm1(&self.m, p) * norm1(&self.m_inv, p);
         self.version += 1;
         self.log.push(lr);
+        // Keep the log short when refactorizations are rare: a consumer more
+        // than LOG_KEEP updates behind recomputes anyway (the pending ranks
+        // exceed p).
+        if self.log.len() >= 2 * LOG_KEEP {
+            self.log.drain(..LOG_KEEP);
+            self.log_base += LOG_KEEP as u64;
+        }
         self.since_refactor += 1;
         if self.since_refactor >= self.settings.refactor_every {
             // A failure here (possible only for a design at the edge of the

@@ -1,0 +1,96 @@
+//! `reproduce` on a reduced setting: the report and figures exist, the
+//! Markdown tables parse, and the numbers equal those of the underlying
+//! commands run separately.
+
+use serde_json::Value;
+use std::process::Command;
+
+fn run_json(args: &[&str]) -> Value {
+    let out = Command::new(env!("CARGO_BIN_EXE_activecal")).args(args).output().unwrap();
+    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// Rows of the Markdown table that follows `heading`, as cells.
+fn table_after(md: &str, heading: &str) -> Vec<Vec<String>> {
+    let start = md.find(heading).unwrap_or_else(|| panic!("no '{heading}'"));
+    md[start..]
+        .lines()
+        .skip_while(|l| !l.starts_with('|'))
+        .take_while(|l| l.starts_with('|'))
+        .skip(2)
+        .map(|l| l.trim_matches('|').split('|').map(|c| c.trim().to_string()).collect())
+        .collect()
+}
+
+#[test]
+fn reduced_reproduce_matches_the_underlying_commands() {
+    let dir = std::env::temp_dir().join(format!("activecal-repro-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let d = dir.to_str().unwrap();
+    let common = ["--levels", "3", "--n", "15", "--initial", "10", "--seed", "5"];
+    let mut args = vec!["reproduce", "--out", d, "--designs", "200", "--starts", "2", "--trials", "10"];
+    args.extend(common);
+    let out = Command::new(env!("CARGO_BIN_EXE_activecal")).args(&args).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for f in ["fig2_random_designs", "fig3_initial_poses", "fig4_log10_oid", "fig4a_selected_poses", "fig5_oi", "fig6_inverse_oid"] {
+        for ext in ["png", "svg"] {
+            let meta = std::fs::metadata(dir.join(format!("{f}.{ext}"))).unwrap();
+            assert!(meta.len() > 1000, "{f}.{ext} is too small");
+        }
+    }
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+
+    // The summary table parses and agrees with report.json.
+    let summary = table_after(&md, "## Summary");
+    assert!(summary.len() >= 6);
+    for row in &summary {
+        assert_eq!(row.len(), 3, "{row:?}");
+    }
+    let eae_row = summary.iter().find(|r| r[0] == "EAE design, log10 OI_D").unwrap();
+    let eae_md: f64 = eae_row[2].parse().unwrap();
+    let eae_json = report["eae"]["log10_oid"].as_f64().unwrap();
+    assert!((eae_md - eae_json).abs() < 1e-4);
+    for (t, cols) in [("## Table III", 6), ("## Table IV", 6), ("## Designs and their", 3), ("## Monte-Carlo", 6)] {
+        let rows = table_after(&md, t);
+        assert!(!rows.is_empty(), "{t}");
+        assert!(rows.iter().all(|r| r.len() == cols), "{t}: {rows:?}");
+    }
+    assert_eq!(table_after(&md, "## Table III").len(), 7);
+
+    // The same numbers from the underlying commands.
+    let mut sel = vec!["select", "--algorithm", "eae", "--json"];
+    sel.extend(common);
+    let s = run_json(&sel);
+    assert_eq!(s["log10_oid"].as_f64().unwrap(), eae_json);
+    assert_eq!(s["poses"], report["eae"]["poses"]);
+    let mut ms = sel.clone();
+    ms.extend(["--starts", "2", "--polish"]);
+    let m = run_json(&ms);
+    assert_eq!(m["log10_oid"], report["multistart"]["log10_oid"]);
+    let b = run_json(&["bound", "--levels", "3", "--n", "15", "--json"]);
+    // Both are certified to a gap of 1e-6 in ln det; they may stop at
+    // different points inside it.
+    let (b1, b2) = (b["log10_bound"].as_f64().unwrap(), report["bound"]["log10_bound"].as_f64().unwrap());
+    assert!((b1 - b2).abs() < 1e-6, "{b1} vs {b2}");
+    let mut rnd = sel.clone();
+    rnd[2] = "random";
+    rnd.extend(["--designs", "200"]);
+    let r = run_json(&rnd);
+    // Same design; its ln det is computed by two Cholesky paths (the search's
+    // and the state's), equal to rounding: 1e-12 relative.
+    let (r1, r2) = (r["log10_oid"].as_f64().unwrap(), report["random"]["best_log10_oid"].as_f64().unwrap());
+    assert!((r1 - r2).abs() < 1e-12 * r2.abs(), "{r1} vs {r2}");
+    assert_eq!(r["poses"], report["random"]["best_poses"]);
+    // The bound is above every design.
+    for d in report["designs"].as_array().unwrap() {
+        assert!(d["log10_oid"].as_f64().unwrap() <= b1 + 1e-9);
+        assert!(d["d_efficiency"].as_f64().unwrap() <= 1.0 + 1e-9);
+    }
+    // Refuses to overwrite without --force.
+    let again = Command::new(env!("CARGO_BIN_EXE_activecal")).args(&args).output().unwrap();
+    assert!(!again.status.success());
+    assert!(String::from_utf8_lossy(&again.stderr).contains("--force"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -264,14 +264,6 @@ pub(crate) fn solve_scaled(
             }
             rounds += 1;
             best_bound = best_bound.min(eval.bound);
-            if std::env::var_os("BOUND_TRACE").is_some() {
-                eprintln!(
-                    "warmup {rounds} t={:.3} ln_det={:.9} gap={:.3e}",
-                    clock.elapsed().as_secs_f64(),
-                    eval.ln_det,
-                    eval.bound - eval.ln_det
-                );
-            }
         }
         // Prune to the `keep` largest weights; widen if M becomes singular.
         let mut k = keep;
@@ -311,17 +303,6 @@ pub(crate) fn solve_scaled(
             break;
         }
         let cand = candidates(&w, &eval.d, s.extra);
-        if std::env::var_os("BOUND_TRACE").is_some() {
-            eprintln!(
-                "round {rounds} t={:.3} ln_det={:.9} bound={:.9} gap={:.3e} support={} cand={} steps={steps}",
-                clock.elapsed().as_secs_f64(),
-                eval.ln_det,
-                eval.bound,
-                eval.bound - eval.ln_det,
-                w.iter().filter(|&&v| v > 0.0).count(),
-                cand.len()
-            );
-        }
         steps += exchange_round(
             x,
             &cand,

@@ -67,7 +67,7 @@ pub struct BoundSettings {
     /// Maximum Clarabel solves (screening rounds). Default 5.
     pub max_rounds: usize,
     /// Most violators added to the candidates per round, by largest `d_i`.
-    /// Default 1000.
+    /// Default 300.
     pub max_add: usize,
     /// Clarabel's gap and feasibility tolerance in screening rounds: solves
     /// whose purpose is to find the poses that violate the optimality
@@ -97,7 +97,7 @@ impl Default for BoundSettings {
             screen_extra: 100,
             direct_limit: 400,
             max_rounds: 5,
-            max_add: 1000,
+            max_add: 300,
             screen_tol: 1e-7,
             polish: true,
             polish_rounds: 20,
@@ -197,7 +197,7 @@ impl BoundSettingsBuilder {
         self.0.screen_tol = v;
         self
     }
-    /// Most violators added per round (default 1000).
+    /// Most violators added per round (default 300).
     #[must_use]
     pub fn max_add(mut self, v: usize) -> Self {
         self.0.max_add = v;
@@ -468,16 +468,6 @@ pub fn relaxation_bound(
                 best.w.clone_from(&w);
             }
             let e_w = w;
-            if std::env::var_os("BOUND_TRACE").is_some() {
-                eprintln!(
-                    "conic round {round}: cand={} {:?} it={} {:.2}s gap={:.3e}",
-                    cand.len(),
-                    out.status,
-                    out.iterations,
-                    out.seconds,
-                    e.bound - e.ln_det
-                );
-            }
             conic_solved |= out.status.is_solved();
             if best.gap() <= settings.gap_tol || !out.status.is_solved() {
                 break;

@@ -56,6 +56,17 @@ pub struct PoolArgs {
     pub json: bool,
 }
 
+/// Kind of each joint, by joint number.
+fn joint_kinds(r: &Robot) -> Vec<activecal::robot::JointKind> {
+    let mut k = vec![activecal::robot::JointKind::Revolute; r.dof()];
+    for f in &r.frames {
+        if let Some(j) = f.joint {
+            k[j] = f.joint_kind;
+        }
+    }
+    k
+}
+
 /// Runs `robots`.
 pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
     let robots: Vec<Value> = activecal::robot::BUILTIN
@@ -69,7 +80,13 @@ pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
                 "real": r.real.rows,
                 "nominal": r.nominal.rows,
                 "unknowns": r.parameter_names(),
-                "limits_deg": r.limits.iter().map(|l| [l[0].to_degrees(), l[1].to_degrees()]).collect::<Vec<_>>(),
+                // Revolute joints in degrees; prismatic ones have none (null): see `limits`.
+                "limits_deg": joint_kinds(&r).iter().zip(&r.limits).map(|(k, l)| match k {
+                    activecal::robot::JointKind::Revolute => Some([l[0].to_degrees(), l[1].to_degrees()]),
+                    activecal::robot::JointKind::Prismatic => None,
+                }).collect::<Vec<_>>(),
+                "limits": r.limits,
+                "joint_kinds": joint_kinds(&r),
                 "measurement": r.measurement,
             })
         })

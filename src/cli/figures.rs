@@ -120,6 +120,40 @@ pub fn random_designs(base: &Path, oi: &[f64], best_eae_oi: f64) -> Result<()> {
     both!(base, (1000, 450), |r| draw(r, oi, best_eae_oi))
 }
 
+/// Draws each series as a line with markers over its index, and a legend.
+fn lines<'a, DB, Y>(
+    c: &mut ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, Y>>,
+    series: &[(&str, Vec<f64>)],
+) -> Result<()>
+where
+    DB: DrawingBackend + 'a,
+    Y: plotters::coord::ranged1d::Ranged<ValueType = f64>,
+{
+    let colors = [RED, BLUE, GREEN, MAGENTA, BLACK];
+    for (k, (label, v)) in series.iter().enumerate() {
+        let col = colors[k % colors.len()];
+        c.draw_series(LineSeries::new(
+            v.iter().enumerate().map(|(i, &y)| (i as f64, y)),
+            col.stroke_width(2),
+        ))
+        .map_err(err)?
+        .label(*label)
+        .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], col));
+        c.draw_series(
+            v.iter()
+                .enumerate()
+                .map(|(i, &y)| Circle::new((i as f64, y), 3, col.filled())),
+        )
+        .map_err(err)?;
+    }
+    c.configure_series_labels()
+        .border_style(BLACK)
+        .background_style(WHITE)
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
 /// A per-iteration trace (Fig. 4: log10 OI_D; Fig. 5: OI; Fig. 6: 1/OI_D
 /// on a log scale). `series` are (label, values) drawn over their index.
 pub fn trace(
@@ -143,7 +177,6 @@ pub fn trace(
             .max()
             .unwrap_or(1)
             .max(2) as f64;
-        let colors = [RED, BLUE, GREEN, MAGENTA, BLACK];
         let mut b = ChartBuilder::on(root);
         b.caption(title, ("sans-serif", 20))
             .margin(12)
@@ -166,27 +199,7 @@ pub fn trace(
                 .y_label_formatter(&|v| format!("{v:.0e}"))
                 .draw()
                 .map_err(err)?;
-            for (k, (label, v)) in series.iter().enumerate() {
-                let col = colors[k % colors.len()];
-                c.draw_series(LineSeries::new(
-                    v.iter().enumerate().map(|(i, &y)| (i as f64, y)),
-                    col.stroke_width(2),
-                ))
-                .map_err(err)?
-                .label(*label)
-                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], col));
-                c.draw_series(
-                    v.iter()
-                        .enumerate()
-                        .map(|(i, &y)| Circle::new((i as f64, y), 3, col.filled())),
-                )
-                .map_err(err)?;
-            }
-            c.configure_series_labels()
-                .border_style(BLACK)
-                .background_style(WHITE)
-                .draw()
-                .map_err(err)?;
+            lines(&mut c, series)?;
         } else {
             let (lo, hi) = range(&all);
             let mut c = b.build_cartesian_2d(0f64..n - 1.0, lo..hi).map_err(err)?;
@@ -195,27 +208,7 @@ pub fn trace(
                 .y_desc(ylabel)
                 .draw()
                 .map_err(err)?;
-            for (k, (label, v)) in series.iter().enumerate() {
-                let col = colors[k % colors.len()];
-                c.draw_series(LineSeries::new(
-                    v.iter().enumerate().map(|(i, &y)| (i as f64, y)),
-                    col.stroke_width(2),
-                ))
-                .map_err(err)?
-                .label(*label)
-                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], col));
-                c.draw_series(
-                    v.iter()
-                        .enumerate()
-                        .map(|(i, &y)| Circle::new((i as f64, y), 3, col.filled())),
-                )
-                .map_err(err)?;
-            }
-            c.configure_series_labels()
-                .border_style(BLACK)
-                .background_style(WHITE)
-                .draw()
-                .map_err(err)?;
+            lines(&mut c, series)?;
         }
         Ok(())
     }

@@ -21,9 +21,8 @@ pub(crate) fn clear_upper_simd_state() {
     #[cfg(target_arch = "x86_64")]
     {
         #[target_feature(enable = "avx")]
-        unsafe fn zeroupper() {
-            // SAFETY: only called when AVX is available.
-            unsafe { core::arch::x86_64::_mm256_zeroupper() }
+        fn zeroupper() {
+            core::arch::x86_64::_mm256_zeroupper();
         }
         if std::arch::is_x86_feature_detected!("avx") {
             // SAFETY: AVX support was just checked.
@@ -165,7 +164,7 @@ pub(crate) fn ln_det_i_minus(v: &[f64], t: usize, floor: f64) -> Result<f64, f64
     for r in 0..t {
         for c in 0..=r {
             let x = v[pk(r, c)];
-            a[r * t + c] = if r == c { 1.0 - x } else { -x };
+            a[r * t + c] = if r == c { 1.0 + x } else { x };
             a[c * t + r] = a[r * t + c];
         }
     }

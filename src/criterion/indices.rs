@@ -23,7 +23,7 @@ pub struct Indices {
     /// `log10 OI_D`.
     pub log10_oid: f64,
     /// The paper's eq. (1), `OI = (σ_1⋯σ_L)^{1/L} / L`, the minimum-variance
-    /// index of its ref. [19]. Satisfies `OI_D = ((OI·L)^L)²` (§V-C).
+    /// index of its ref. \[19\]. Satisfies `OI_D = ((OI·L)^L)²` (§V-C).
     pub oi: f64,
     /// Borm & Menq's `O1 = (σ_1⋯σ_L)^{1/L} / √m`.
     pub o1: f64,

@@ -75,7 +75,7 @@ impl Robot {
     #[must_use]
     pub fn minimal_unknowns(&self) -> usize {
         let p = self.frames.iter().filter(|f| f.is_prismatic()).count();
-        let r = self.dof() - p;
+        let r = self.dof().saturating_sub(p);
         4 * r
             + 2 * p
             + match self.measurement {
@@ -106,11 +106,15 @@ impl Robot {
     /// column orthogonal to the columns kept before it (0 for a zero
     /// column). Those above [`INDEPENDENCE_TOL`] are kept.
     pub fn independence(&self, preferred: &[ParamId]) -> Result<Vec<(ParamId, f64)>> {
+        self.check_shape()?;
         let mut order: Vec<ParamId> = Vec::new();
         for &u in preferred.iter().chain(&self.candidate_unknowns()) {
             if u.frame < self.frames.len() && !order.contains(&u) {
                 order.push(u);
             }
+        }
+        if order.is_empty() {
+            return Ok(Vec::new());
         }
         let mut all = order.clone();
         all.sort();
@@ -131,7 +135,7 @@ impl Robot {
             let k = all.binary_search(&u).expect("all holds every candidate");
             // A column that is zero up to rounding (α of the last frame for a
             // point, say) is unidentifiable outright.
-            if !(norms[k] > 1e-12 * scale) {
+            if norms[k].is_nan() || norms[k] <= 1e-12 * scale {
                 out.push((u, 0.0));
                 continue;
             }
@@ -158,8 +162,16 @@ impl Robot {
     /// lattice, `max(40, 2p)` poses with a fixed seed, has full column rank
     /// ([`crate::pool::require_identifiable`]).
     pub fn check_identifiable(&self) -> Result<Identifiability> {
+        self.check_shape()?;
         if self.unknowns.is_empty() {
             return Err(Error::Invalid("the robot has no unknown parameters".into()));
+        }
+        if let Some(u) = self.unknowns.iter().find(|u| u.frame >= self.frames.len()) {
+            return Err(Error::Invalid(format!(
+                "an unknown refers to frame {} of {}",
+                u.frame,
+                self.frames.len()
+            )));
         }
         let n = (2 * self.n_unknowns()).max(40);
         let x = design_jacobian(self, &self.nominal, n, CHECK_SEED)?;
@@ -204,10 +216,45 @@ impl Robot {
     }
 }
 
+impl Robot {
+    /// The shape the kinematics needs (see [`Robot::validate`] for the
+    /// rest): a table row per frame, joint numbers within the limits.
+    fn check_shape(&self) -> Result<()> {
+        for t in [&self.real, &self.nominal] {
+            if t.rows.len() != self.frames.len() {
+                return Err(Error::Invalid(format!(
+                    "parameter table has {} rows for {} frames",
+                    t.rows.len(),
+                    self.frames.len()
+                )));
+            }
+        }
+        if let Some(f) = self
+            .frames
+            .iter()
+            .find(|f| f.joint.is_some_and(|j| j >= self.dof()))
+        {
+            return Err(Error::Invalid(format!(
+                "frame {}: joint index out of range ({} joint limits)",
+                f.label,
+                self.dof()
+            )));
+        }
+        Ok(())
+    }
+}
+
 /// The stacked identification Jacobian of `n` random poses of the
 /// [`DESIGN_LEVELS`]-level lattice over the robot's limits, or an error if
 /// any entry is not finite.
 pub fn design_jacobian(robot: &Robot, table: &ParamTable, n: usize, seed: u64) -> Result<Blocks> {
+    robot.check_shape()?;
+    if robot.unknowns.is_empty() || table.rows.len() != robot.frames.len() {
+        return Err(Error::Invalid(format!(
+            "robot {}: no unknowns, or a table that does not fit the frames",
+            robot.name
+        )));
+    }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let k = DESIGN_LEVELS;
     let qs: Vec<Vec<f64>> = (0..n)

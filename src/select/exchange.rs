@@ -307,6 +307,24 @@ fn start_design(pool: &Blocks, s: &Settings, size: usize, rng: &mut ChaCha8Rng) 
     )
 }
 
+/// Runs `phases` on a state started from a random design of `size` poses
+/// (fixed ones included) and finishes it.
+fn run_from_random<C: Criterion>(
+    pool: &Blocks,
+    crit: &mut C,
+    s: &Settings,
+    rng: &mut ChaCha8Rng,
+    size: usize,
+    algorithm: Algorithm,
+    phases: impl FnOnce(&mut Run<'_, C>),
+) -> Result<Selection> {
+    s.validate(pool)?;
+    let init = start_design(pool, s, size, rng);
+    let mut run = Run::new(pool, crit, &init, &s.fixed)?;
+    phases(&mut run);
+    run.finish(algorithm)
+}
+
 /// The paper's exchange-add-exchange (§IV): `n0` random initial poses (fixed
 /// ones included) → exchange steps → add steps up to `N` → exchange steps.
 pub fn eae<C: Criterion>(
@@ -315,13 +333,11 @@ pub fn eae<C: Criterion>(
     s: &Settings,
     rng: &mut ChaCha8Rng,
 ) -> Result<Selection> {
-    s.validate(pool)?;
-    let init = start_design(pool, s, s.initial, rng);
-    let mut run = Run::new(pool, crit, &init, &s.fixed)?;
-    run.exchange_phase(s.max_iter);
-    run.add_phase(s.n);
-    run.exchange_phase(s.max_iter);
-    run.finish(Algorithm::Eae)
+    run_from_random(pool, crit, s, rng, s.initial, Algorithm::Eae, |run| {
+        run.exchange_phase(s.max_iter);
+        run.add_phase(s.n);
+        run.exchange_phase(s.max_iter);
+    })
 }
 
 /// Fedorov exchange from a random `N`-pose design.
@@ -331,11 +347,9 @@ pub fn fedorov<C: Criterion>(
     s: &Settings,
     rng: &mut ChaCha8Rng,
 ) -> Result<Selection> {
-    s.validate(pool)?;
-    let init = start_design(pool, s, s.n, rng);
-    let mut run = Run::new(pool, crit, &init, &s.fixed)?;
-    run.fedorov_phase(s.max_iter);
-    run.finish(Algorithm::Fedorov)
+    run_from_random(pool, crit, s, rng, s.n, Algorithm::Fedorov, |run| {
+        run.fedorov_phase(s.max_iter)
+    })
 }
 
 /// DETMAX from a random `N`-pose design.
@@ -345,11 +359,9 @@ pub fn detmax<C: Criterion>(
     s: &Settings,
     rng: &mut ChaCha8Rng,
 ) -> Result<Selection> {
-    s.validate(pool)?;
-    let init = start_design(pool, s, s.n, rng);
-    let mut run = Run::new(pool, crit, &init, &s.fixed)?;
-    run.detmax_phase(s.max_iter);
-    run.finish(Algorithm::Detmax)
+    run_from_random(pool, crit, s, rng, s.n, Algorithm::Detmax, |run| {
+        run.detmax_phase(s.max_iter)
+    })
 }
 
 /// Fedorov polish of a finished design: its trace continues.

@@ -11,7 +11,7 @@
 //! frame's orientation.
 //!
 //! Robots come from [`Robot::builtin`] (the PUMA 560 of the paper, a UR5 and
-//! a Stanford arm), from a TOML description ([`file`]) or from a URDF file
+//! a Stanford arm), from a TOML description ([`file`](mod@file)) or from a URDF file
 //! ([`crate::urdf`]); [`Robot::load`] accepts any of them.
 
 pub mod builtin;
@@ -284,7 +284,7 @@ impl Robot {
     }
 
     /// A robot by built-in name (see [`Robot::builtin`]) or from a file: a
-    /// `.toml` description ([`file`]) or a `.urdf` file ([`crate::urdf`],
+    /// `.toml` description ([`file`](mod@file)) or a `.urdf` file ([`crate::urdf`],
     /// point measurements, unknowns chosen automatically). The result is
     /// validated, and a file's unknowns are checked to be identifiable.
     ///

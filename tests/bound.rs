@@ -284,7 +284,11 @@ fn screening_reaches_the_same_optimum_as_the_whole_pool() {
         .unwrap();
     let b = relaxation_bound(&x, n, &s).unwrap();
     assert_eq!(b.status, BoundStatus::Certified, "{:?}", b.conic);
-    assert!(b.conic.candidates < 400, "{} candidates", b.conic.candidates);
+    assert!(
+        b.conic.candidates < 400,
+        "{} candidates",
+        b.conic.candidates
+    );
     let whole = conic::solve(&x, n, &ConicSettings::default()).unwrap();
     let mut w = whole.weights.clone();
     make_feasible(&mut w, n);

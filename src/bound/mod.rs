@@ -74,10 +74,11 @@ pub struct BoundSettings {
     /// conditions outside the candidates. The last solve (no violator left,
     /// or the whole pool) uses `conic.tol_gap`. Default 1e-7.
     pub screen_tol: f64,
-    /// After each Clarabel solve whose certificate gap is above `gap_tol`,
-    /// run the first-order solver from its point (at most `polish_rounds`
-    /// rounds) before adding violators and re-solving; if Clarabel fails,
-    /// continue the first-order solver to `gap_tol`. Default true.
+    /// When the last Clarabel solve leaves no violator outside its
+    /// candidates but its certificate gap is still above `gap_tol` (solver
+    /// accuracy), run the first-order solver from its point for at most
+    /// `polish_rounds` rounds; when Clarabel fails, continue the first-order
+    /// solver to `gap_tol` instead. Default true.
     pub polish: bool,
     /// Round limit of each polish. Default 20.
     pub polish_rounds: usize,
@@ -262,6 +263,8 @@ pub struct ConicSummary {
     pub status: Option<ConicStatus>,
     /// Interior-point iterations of the last solve.
     pub iterations: u32,
+    /// Interior-point iterations of all solves.
+    pub total_iterations: u32,
     /// Clarabel solves (screening rounds).
     pub rounds: usize,
     /// Candidates in the last solve.
@@ -439,6 +442,7 @@ pub fn relaxation_bound(
             let out = conic::solve_scaled(&sub_sc, n, &conic_settings);
             conic_summary.status = Some(out.status);
             conic_summary.iterations = out.iterations;
+            conic_summary.total_iterations += out.iterations;
             conic_summary.rounds = round;
             conic_summary.candidates = cand.len();
             conic_summary.retried = out.retried;

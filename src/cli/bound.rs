@@ -87,6 +87,7 @@ fn bound_json(b: &Bound) -> Value {
         "solver": {
             "status": b.conic.status,
             "iterations": b.conic.iterations,
+            "total_iterations": b.conic.total_iterations,
             "rounds": b.conic.rounds,
             "candidates": b.conic.candidates,
             "retried_without_equilibration": b.conic.retried,

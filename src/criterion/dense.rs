@@ -164,7 +164,7 @@ pub(crate) fn ln_det_i_minus(v: &[f64], t: usize, floor: f64) -> Result<f64, f64
     for r in 0..t {
         for c in 0..=r {
             let x = v[pk(r, c)];
-            a[r * t + c] = if r == c { 1.0 + x } else { x };
+            a[r * t + c] = if r == c { 1.0 - x } else { -x };
             a[c * t + r] = a[r * t + c];
         }
     }

@@ -135,6 +135,17 @@ pub fn load(path: &Path) -> Result<Robot> {
 /// Parses and checks a description. `origin` names it in errors (and gives
 /// the default robot name, its file stem); `dir` is where a `urdf = …` path
 /// is relative to (the current directory if `None`).
+///
+/// ```
+/// use activecal::robot::{Robot, file};
+/// let text = file::to_toml(&Robot::stanford());
+/// let r = file::parse(&text, "stanford.toml", None).unwrap();
+/// assert_eq!(r.unknowns, Robot::stanford().unknowns);
+/// let bad = text.replacen("limits = [0.3, 1.0]", "limits = [1.0, 0.3]", 1);
+/// let e = file::parse(&bad, "stanford.toml", None).unwrap_err().to_string();
+/// assert!(e.contains("frame '3': joint q3 has inverted limits [1, 0.3]"), "{e}");
+/// assert!(e.starts_with("stanford.toml: line "), "{e}");
+/// ```
 pub fn parse(text: &str, origin: &str, dir: Option<&Path>) -> Result<Robot> {
     let cx = Ctx { text, origin };
     let spec: FileSpec = toml::from_str(text).map_err(|e| cx.plain(e.to_string().trim_end()))?;

@@ -184,6 +184,13 @@ impl Robot {
     /// orientation: a fixed DH last frame becomes a Hayati frame with β = 0
     /// (the same transform), and a chain ending in a driven frame gets a
     /// fixed Hayati identity frame `tool`.
+    ///
+    /// ```
+    /// use activecal::robot::{Measurement, Robot};
+    /// let pose = Robot::ur5().with_measurement(Measurement::Pose).unwrap();
+    /// assert_eq!((pose.rows_per_pose(), pose.n_unknowns()), (6, 30));
+    /// assert_eq!(pose.unknowns, Robot::builtin("ur5:pose").unwrap().unknowns);
+    /// ```
     pub fn with_measurement(&self, m: Measurement) -> Result<Robot> {
         let mut r = self.clone();
         r.measurement = m;

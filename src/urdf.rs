@@ -43,6 +43,12 @@
 //! [`UrdfOptions::perturb_real`] is false), so that calibration has something
 //! to find.
 //!
+//! Special geometries have fewer identifiable unknowns, and the chooser
+//! simply finds the smaller set: a tip on the last joint axis (the last
+//! joint's offset does not move it), or two consecutive revolute joints on
+//! one axis line (none of our frame types translates along y, so the second
+//! axis's lateral offset has no parameter).
+//!
 //! **Export.** [`to_urdf`] writes the chain of [`crate::kinematics::joint_chain`]:
 //! one URDF joint per robot joint about (or along) z of its placement, and a
 //! fixed joint `tool` to the link `tip`. `fixtures/puma560.urdf` is the

@@ -50,10 +50,10 @@ fn random_data(poses: usize, seed: u64) -> Blocks {
 fn enumerate(x: &Blocks, n: usize) -> (f64, Vec<usize>) {
     fn rec(x: &Blocks, n: usize, start: usize, cur: &mut Vec<usize>, best: &mut (f64, Vec<usize>)) {
         if cur.len() == n {
-            if let Some(v) = design_ln_det(x, cur) {
-                if v > best.0 {
-                    *best = (v, cur.clone());
-                }
+            if let Some(v) = design_ln_det(x, cur)
+                && v > best.0
+            {
+                *best = (v, cur.clone());
             }
             return;
         }

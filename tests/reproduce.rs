@@ -6,8 +6,15 @@ use serde_json::Value;
 use std::process::Command;
 
 fn run_json(args: &[&str]) -> Value {
-    let out = Command::new(env!("CARGO_BIN_EXE_activecal")).args(args).output().unwrap();
-    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    let out = Command::new(env!("CARGO_BIN_EXE_activecal"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
@@ -19,7 +26,12 @@ fn table_after(md: &str, heading: &str) -> Vec<Vec<String>> {
         .skip_while(|l| !l.starts_with('|'))
         .take_while(|l| l.starts_with('|'))
         .skip(2)
-        .map(|l| l.trim_matches('|').split('|').map(|c| c.trim().to_string()).collect())
+        .map(|l| {
+            l.trim_matches('|')
+                .split('|')
+                .map(|c| c.trim().to_string())
+                .collect()
+        })
         .collect()
 }
 
@@ -28,19 +40,53 @@ fn reduced_reproduce_matches_the_underlying_commands() {
     let dir = std::env::temp_dir().join(format!("activecal-repro-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let d = dir.to_str().unwrap();
-    let common = ["--levels", "3", "--n", "15", "--initial", "10", "--seed", "5"];
-    let mut args = vec!["reproduce", "--out", d, "--designs", "200", "--starts", "2", "--trials", "10"];
+    let common = [
+        "--levels",
+        "3",
+        "--n",
+        "15",
+        "--initial",
+        "10",
+        "--seed",
+        "5",
+    ];
+    let mut args = vec![
+        "reproduce",
+        "--out",
+        d,
+        "--designs",
+        "200",
+        "--starts",
+        "2",
+        "--trials",
+        "10",
+    ];
     args.extend(common);
-    let out = Command::new(env!("CARGO_BIN_EXE_activecal")).args(&args).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    for f in ["fig2_random_designs", "fig3_initial_poses", "fig4_log10_oid", "fig4a_selected_poses", "fig5_oi", "fig6_inverse_oid"] {
+    let out = Command::new(env!("CARGO_BIN_EXE_activecal"))
+        .args(&args)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "fig2_random_designs",
+        "fig3_initial_poses",
+        "fig4_log10_oid",
+        "fig4a_selected_poses",
+        "fig5_oi",
+        "fig6_inverse_oid",
+    ] {
         for ext in ["png", "svg"] {
             let meta = std::fs::metadata(dir.join(format!("{f}.{ext}"))).unwrap();
             assert!(meta.len() > 1000, "{f}.{ext} is too small");
         }
     }
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
-    let report: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
 
     // The summary table parses and agrees with report.json.
     let summary = table_after(&md, "## Summary");
@@ -48,11 +94,19 @@ fn reduced_reproduce_matches_the_underlying_commands() {
     for row in &summary {
         assert_eq!(row.len(), 3, "{row:?}");
     }
-    let eae_row = summary.iter().find(|r| r[0] == "EAE design, log10 OI_D").unwrap();
+    let eae_row = summary
+        .iter()
+        .find(|r| r[0] == "EAE design, log10 OI_D")
+        .unwrap();
     let eae_md: f64 = eae_row[2].parse().unwrap();
     let eae_json = report["eae"]["log10_oid"].as_f64().unwrap();
     assert!((eae_md - eae_json).abs() < 1e-4);
-    for (t, cols) in [("## Table III", 6), ("## Table IV", 6), ("## Designs and their", 3), ("## Monte-Carlo", 6)] {
+    for (t, cols) in [
+        ("## Table III", 6),
+        ("## Table IV", 6),
+        ("## Designs and their", 3),
+        ("## Monte-Carlo", 6),
+    ] {
         let rows = table_after(&md, t);
         assert!(!rows.is_empty(), "{t}");
         assert!(rows.iter().all(|r| r.len() == cols), "{t}: {rows:?}");
@@ -72,7 +126,10 @@ fn reduced_reproduce_matches_the_underlying_commands() {
     let b = run_json(&["bound", "--levels", "3", "--n", "15", "--json"]);
     // Both are certified to a gap of 1e-6 in ln det; they may stop at
     // different points inside it.
-    let (b1, b2) = (b["log10_bound"].as_f64().unwrap(), report["bound"]["log10_bound"].as_f64().unwrap());
+    let (b1, b2) = (
+        b["log10_bound"].as_f64().unwrap(),
+        report["bound"]["log10_bound"].as_f64().unwrap(),
+    );
     assert!((b1 - b2).abs() < 1e-6, "{b1} vs {b2}");
     let mut rnd = sel.clone();
     rnd[2] = "random";
@@ -80,7 +137,10 @@ fn reduced_reproduce_matches_the_underlying_commands() {
     let r = run_json(&rnd);
     // Same design; its ln det is computed by two Cholesky paths (the search's
     // and the state's), equal to rounding: 1e-12 relative.
-    let (r1, r2) = (r["log10_oid"].as_f64().unwrap(), report["random"]["best_log10_oid"].as_f64().unwrap());
+    let (r1, r2) = (
+        r["log10_oid"].as_f64().unwrap(),
+        report["random"]["best_log10_oid"].as_f64().unwrap(),
+    );
     assert!((r1 - r2).abs() < 1e-12 * r2.abs(), "{r1} vs {r2}");
     assert_eq!(r["poses"], report["random"]["best_poses"]);
     // The bound is above every design.
@@ -89,7 +149,10 @@ fn reduced_reproduce_matches_the_underlying_commands() {
         assert!(d["d_efficiency"].as_f64().unwrap() <= 1.0 + 1e-9);
     }
     // Refuses to overwrite without --force.
-    let again = Command::new(env!("CARGO_BIN_EXE_activecal")).args(&args).output().unwrap();
+    let again = Command::new(env!("CARGO_BIN_EXE_activecal"))
+        .args(&args)
+        .output()
+        .unwrap();
     assert!(!again.status.success());
     assert!(String::from_utf8_lossy(&again.stderr).contains("--force"));
     std::fs::remove_dir_all(&dir).unwrap();

@@ -353,8 +353,6 @@ fn problem(x: &Blocks, n: usize) -> (CscMatrix<f64>, Vec<f64>, Vec<f64>, Vec<Sup
 
 #[cfg(test)]
 mod tests {
-    use super::*;
-
     #[test]
     fn z_packing_is_column_major_lower() {
         let p = 5;

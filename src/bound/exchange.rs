@@ -89,7 +89,7 @@ impl ExchangeSettings {
                 "must be finite and > 0",
             );
         }
-        if !(self.time_limit > 0.0) {
+        if self.time_limit.is_nan() || self.time_limit <= 0.0 {
             return bad(
                 "first_order.time_limit",
                 self.time_limit.to_string(),
@@ -604,7 +604,7 @@ pub fn line_search(mu: &[f64], hi: f64) -> f64 {
             up = x;
         }
         let mut nx = x - f / d2phi(x);
-        if !(nx > lo && nx < up) || !f.is_finite() {
+        if !(nx > lo && nx < up && f.is_finite()) {
             nx = 0.5 * (lo + up);
         }
         if (nx - x).abs() <= 1e-15 * up.max(1e-300) || up - lo <= 1e-15 * up {

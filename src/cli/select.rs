@@ -178,7 +178,11 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     });
     let mut v = v;
     if a.gap {
-        let bound = activecal::bound::relaxation_bound(&ctx.x, a.n, &activecal::bound::BoundSettings::default())?;
+        let bound = activecal::bound::relaxation_bound(
+            &ctx.x,
+            a.n,
+            &activecal::bound::BoundSettings::default(),
+        )?;
         let g = activecal::bound::design_gap(&ctx.x, &sel.poses, &bound)?;
         v["log10_bound"] = json!(g.log10_bound);
         v["d_efficiency"] = json!(g.d_efficiency);

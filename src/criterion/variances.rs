@@ -351,35 +351,157 @@ impl PoolVariances {
         if no == 0 {
             return;
         }
-        let t = self.t;
-        let rows = self.n * t;
-        self.cross_terms(pool, state, outs);
-        let w = MatRef::from_column_major_slice(&self.work[..rows * no * t], rows, no * t);
-        // Column slices of W, gathered once (not per candidate).
-        let wcols: Vec<&[f64]> = (0..no * t).map(|c| col(w, c)).collect();
+        self.check(pool, state);
+        let (t, p) = (self.t, self.p);
+        let k = no * t;
+        // A = M⁻¹ X_outsᵀ (p × k).
+        let mut xo = Mat::<f64>::zeros(k, p);
+        for (o, &j) in outs.iter().enumerate() {
+            xo.as_mut().subrows_mut(o * t, t).copy_from(pool.block(j));
+        }
+        let mut a = Mat::<f64>::zeros(p, k);
+        matmul(
+            a.as_mut(),
+            Accum::Replace,
+            state.m_inv(),
+            xo.transpose(),
+            1.0,
+            Par::Seq,
+        );
+        clear_upper_simd_state();
+        let at = a.transpose();
+        let x = pool.mat();
         let this = &*self;
-        let per = (SCAN_CHUNK / no).max(16);
-        out.par_chunks_mut(per * no)
-            .zip(candidates.par_chunks(per))
-            .for_each(|(oc, cc)| {
-                for (oi, &i) in oc.chunks_mut(no).zip(cc) {
-                    if state.contains(i) {
-                        oi.fill(f64::NEG_INFINITY);
-                        continue;
+        // Fused and chunked: per task of PER candidates, gather their rows
+        // Xᵀ (p × PER·t), form Wᵀ = Aᵀ Xᵀ (k × PER·t) so that each candidate's
+        // cross terms with every out-pose are contiguous, then price the
+        // pairs. W never exists for the whole pool (it would be n·t × k,
+        // 34 MB for the PUMA, read with a stride per entry).
+        const PER: usize = 64;
+        out.par_chunks_mut(PER * no)
+            .zip(candidates.par_chunks(PER))
+            .for_each_init(
+                || (Mat::<f64>::zeros(p, PER * t), Mat::<f64>::zeros(k, PER * t)),
+                |(xg, wt), (oc, cc)| {
+                    let cols = cc.len() * t;
+                    for (ci, &i) in cc.iter().enumerate() {
+                        for r in 0..t {
+                            for c in 0..p {
+                                xg[(c, ci * t + r)] = x[(i * t + r, c)];
+                            }
+                        }
                     }
-                    let v_in = this.packed(i);
-                    for (o, (g, &j)) in oi.iter_mut().zip(outs).enumerate() {
-                        *g = exchange_ln_det(
+                    matmul(
+                        wt.as_mut().subcols_mut(0, cols),
+                        Accum::Replace,
+                        at,
+                        xg.as_ref().subcols(0, cols),
+                        1.0,
+                        Par::Seq,
+                    );
+                    clear_upper_simd_state();
+                    let wt = wt.as_ref();
+                    for (ci, (oi, &i)) in oc.chunks_mut(no).zip(cc).enumerate() {
+                        if state.contains(i) {
+                            oi.fill(f64::NEG_INFINITY);
+                            continue;
+                        }
+                        let wcol: [&[f64]; super::MAX_T] =
+                            std::array::from_fn(|r| if r < t { col(wt, ci * t + r) } else { &[] });
+                        exchange_row(
                             t,
-                            v_in,
-                            this.packed(j),
-                            |a, b| wcols[o * t + b][i * t + a],
+                            this.packed(i),
+                            outs,
+                            |j| this.packed(j),
+                            &wcol,
                             pivot_floor,
-                        )
-                        .unwrap_or(f64::NEG_INFINITY);
+                            oi,
+                        );
                     }
+                },
+            );
+    }
+}
+
+/// Exchange gains of one candidate `i` against every out-pose: `oi[o] =
+/// ln det [[I + V_i, W_io], [−W_ioᵀ, I − V_o]]`, by block elimination
+/// `det(I + V_i) · det(I − V_o + Yᵀ Y)`, `Y = L_A⁻¹ W_io`, with the Cholesky
+/// factor `L_A` of `I + V_i` computed once for all out-poses and one `ln` per
+/// pair (of the product of the second factor's pivots). `wcol[r][o·t + b]` is
+/// `W_io[r, b]`. A pivot `≤ pivot_floor` prices the pair `-∞`.
+fn exchange_row<'v>(
+    t: usize,
+    v_in: &[f64],
+    outs: &[usize],
+    v_of: impl Fn(usize) -> &'v [f64],
+    wcol: &[&[f64]; super::MAX_T],
+    floor: f64,
+    oi: &mut [f64],
+) {
+    use super::dense::pk;
+    const T: usize = super::MAX_T;
+    let mut la = [0.0f64; T * T];
+    for r in 0..t {
+        for c in 0..=r {
+            let x = v_in[pk(r, c)];
+            la[r * t + c] = if r == c { 1.0 + x } else { x };
+        }
+    }
+    let Ok(ln_a) = super::dense::chol_in_place(&mut la[..t * t], t, 0.0) else {
+        oi.fill(f64::NEG_INFINITY);
+        return;
+    };
+    for (o, (g, &j)) in oi.iter_mut().zip(outs).enumerate() {
+        let v_out = v_of(j);
+        // Y = L_A⁻¹ W (t×t, row-major), forward substitution per column.
+        let mut y = [0.0f64; T * T];
+        for c in 0..t {
+            for r in 0..t {
+                let mut s = wcol[r][o * t + c];
+                for q in 0..r {
+                    s -= la[r * t + q] * y[q * t + c];
                 }
-            });
+                y[r * t + c] = s / la[r * t + r];
+            }
+        }
+        // B = I − V_out + YᵀY, lower triangle; Cholesky pivots multiplied.
+        let mut b = [0.0f64; T * T];
+        for r in 0..t {
+            for c in 0..=r {
+                let mut s = if r == c { 1.0 } else { 0.0 } - v_out[pk(r, c)];
+                for q in 0..t {
+                    s += y[q * t + r] * y[q * t + c];
+                }
+                b[r * t + c] = s;
+            }
+        }
+        let mut det_b = 1.0;
+        let mut ok = true;
+        for kk in 0..t {
+            let mut d = b[kk * t + kk];
+            for q in 0..kk {
+                d -= b[kk * t + q] * b[kk * t + q];
+            }
+            if !(d > floor) {
+                ok = false;
+                break;
+            }
+            det_b *= d;
+            let l = d.sqrt();
+            b[kk * t + kk] = l;
+            for r in kk + 1..t {
+                let mut s = b[r * t + kk];
+                for q in 0..kk {
+                    s -= b[r * t + q] * b[kk * t + q];
+                }
+                b[r * t + kk] = s / l;
+            }
+        }
+        *g = if ok {
+            ln_a + det_b.ln()
+        } else {
+            f64::NEG_INFINITY
+        };
     }
 }
 

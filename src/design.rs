@@ -39,9 +39,9 @@ impl DesignFile {
 
     /// Reads and parses a design file.
     pub fn read(path: &Path) -> Result<DesignFile> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
             path: path.display().to_string(),
-            source,
+            cause,
         })?;
         serde_json::from_str(&text).map_err(|e| Error::Parse {
             path: path.display().to_string(),
@@ -59,9 +59,9 @@ impl DesignFile {
             )));
         }
         let text = serde_json::to_string_pretty(self).expect("a design serializes");
-        std::fs::write(path, text + "\n").map_err(|source| Error::Io {
+        std::fs::write(path, text + "\n").map_err(|cause| Error::Io {
             path: path.display().to_string(),
-            source,
+            cause,
         })
     }
 

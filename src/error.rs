@@ -94,12 +94,14 @@ pub enum Error {
     #[error("{0}")]
     Invalid(String),
     /// File input/output.
-    #[error("{path}: {source}")]
+    // Not a `#[source]`: the message already includes it, and the CLI prints
+    // error chains, which would repeat it.
+    #[error("{path}: {cause}")]
     Io {
         /// The file.
         path: String,
         /// The underlying error.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// A malformed JSON or TOML file.
     #[error("{path}: {message}")]

@@ -248,8 +248,8 @@ impl Pool {
         q
     }
 
-    /// Identification Jacobian of every pool pose (3 rows per pose, p
-    /// columns), computed in parallel; pose `k` at rows `3k..3k+3`.
+    /// Identification Jacobian of every pool pose (t rows per pose, p
+    /// columns), computed in parallel; pose `k` at rows `t·k..t·k+t`.
     #[must_use]
     pub fn jacobian(&self, robot: &Robot, table: &ParamTable) -> Blocks {
         jacobian_of(robot, table, self.len(), |k, q| {

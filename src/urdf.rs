@@ -103,9 +103,9 @@ impl Default for UrdfOptions {
 
 /// Reads a URDF file and converts its chain (see the module docs).
 pub fn load(path: &Path, opts: &UrdfOptions) -> Result<Robot> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+    let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
         path: path.display().to_string(),
-        source,
+        cause,
     })?;
     parse(&text, &path.display().to_string(), opts)
 }

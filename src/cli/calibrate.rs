@@ -17,7 +17,7 @@ use std::time::Instant;
 /// Arguments of the command.
 #[derive(Args)]
 pub struct CalibrateArgs {
-    /// Robot name (built-in).
+    /// Robot: a built-in name, or a .toml description or .urdf file.
     #[arg(long, default_value = "puma560")]
     pub robot: String,
     /// Design file (JSON with robot, levels, poses), as written by `select`.

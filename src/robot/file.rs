@@ -125,9 +125,9 @@ impl Ctx<'_> {
 
 /// Reads and checks a robot description file (see the module docs).
 pub fn load(path: &Path) -> Result<Robot> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+    let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
         path: path.display().to_string(),
-        source,
+        cause,
     })?;
     parse(&text, &path.display().to_string(), path.parent())
 }

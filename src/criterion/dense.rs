@@ -172,39 +172,45 @@ pub(crate) fn ln_det_i_minus(v: &[f64], t: usize, floor: f64) -> Result<f64, f64
     chol_pivoted_in_place(&mut a[..t * t], t, floor, &mut perm[..t])
 }
 
-/// `ln det` of the exchange system `[[I + V_in, W], [−Wᵀ, I − V_out]]`
-/// (`W = X_in M⁻¹ X_outᵀ`), by block elimination: the determinant is
-/// `det(A)·det(B)` with `A = I + V_in` and the Schur complement
-/// `B = I − V_out + Wᵀ A⁻¹ W`; `B` must be positive definite (pivots
-/// `> floor`) for the exchanged `M` to be. `w(a, b)` returns `W[a, b]`.
-#[inline]
-pub(crate) fn exchange_ln_det(
+/// First factor of the exchange determinant: the Cholesky factor of
+/// `I + V_in` (row-major lower triangle in `la`) and `ln det(I + V_in)`.
+pub(crate) fn exchange_in_factor(
     t: usize,
     v_in: &[f64],
+    la: &mut [f64; MAX_T * MAX_T],
+) -> Result<f64, f64> {
+    for r in 0..t {
+        for c in 0..=r {
+            let x = v_in[pk(r, c)];
+            la[r * t + c] = if r == c { 1.0 + x } else { x };
+        }
+    }
+    chol_in_place(&mut la[..t * t], t, 0.0)
+}
+
+/// Second factor of the exchange determinant: `ln det(I − V_out + YᵀY)`
+/// with `Y = L_A⁻¹ W` (`la` from [`exchange_in_factor`], `w(a, b)` the cross
+/// block `X_in M⁻¹ X_outᵀ`), by Cholesky, with one `ln` of the product of
+/// its pivots. `Err(pivot)` for a pivot `≤ floor`.
+pub(crate) fn exchange_out_ln_det(
+    t: usize,
+    la: &[f64; MAX_T * MAX_T],
     v_out: &[f64],
     w: impl Fn(usize, usize) -> f64,
     floor: f64,
 ) -> Result<f64, f64> {
-    let mut a = [0.0f64; MAX_T * MAX_T];
-    for r in 0..t {
-        for c in 0..=r {
-            let x = v_in[pk(r, c)];
-            a[r * t + c] = if r == c { 1.0 + x } else { x };
-        }
-    }
-    let ln_a = chol_in_place(&mut a[..t * t], t, 0.0)?;
     // Y = L_A⁻¹ W (t×t, row-major), forward substitution column by column.
     let mut y = [0.0f64; MAX_T * MAX_T];
     for c in 0..t {
         for r in 0..t {
             let mut s = w(r, c);
             for j in 0..r {
-                s -= a[r * t + j] * y[j * t + c];
+                s -= la[r * t + j] * y[j * t + c];
             }
-            y[r * t + c] = s / a[r * t + r];
+            y[r * t + c] = s / la[r * t + r];
         }
     }
-    // B = I − V_out + Yᵀ Y (both triangles, for the pivoted factorization).
+    // B = I − V_out + Yᵀ Y (lower triangle).
     let mut b = [0.0f64; MAX_T * MAX_T];
     for r in 0..t {
         for c in 0..=r {
@@ -213,12 +219,46 @@ pub(crate) fn exchange_ln_det(
                 s += y[j * t + r] * y[j * t + c];
             }
             b[r * t + c] = s;
-            b[c * t + r] = s;
         }
     }
-    let mut perm = [0usize; MAX_T];
-    let ln_b = chol_pivoted_in_place(&mut b[..t * t], t, floor, &mut perm[..t])?;
-    Ok(ln_a + ln_b)
+    // Cholesky of B; the pivots are in (floor, ~1+‖V‖], so their product
+    // (t ≤ 6 of them) neither overflows nor underflows.
+    let mut det = 1.0;
+    for k in 0..t {
+        let mut d = b[k * t + k];
+        for j in 0..k {
+            d -= b[k * t + j] * b[k * t + j];
+        }
+        if !(d > floor) {
+            return Err(d);
+        }
+        det *= d;
+        let l = d.sqrt();
+        b[k * t + k] = l;
+        for i in k + 1..t {
+            let mut s = b[i * t + k];
+            for j in 0..k {
+                s -= b[i * t + j] * b[k * t + j];
+            }
+            b[i * t + k] = s / l;
+        }
+    }
+    Ok(det.ln())
+}
+
+/// Exchange gain `ln det [[I + V_in, W], [−Wᵀ, I − V_out]]` by block
+/// elimination, `det(I + V_in) · det(I − V_out + Wᵀ(I + V_in)⁻¹W)`;
+/// `Err(pivot)` when the result is numerically singular.
+pub(crate) fn exchange_ln_det(
+    t: usize,
+    v_in: &[f64],
+    v_out: &[f64],
+    w: impl Fn(usize, usize) -> f64,
+    floor: f64,
+) -> Result<f64, f64> {
+    let mut la = [0.0f64; MAX_T * MAX_T];
+    let ln_a = exchange_in_factor(t, v_in, &mut la)?;
+    Ok(ln_a + exchange_out_ln_det(t, &la, v_out, w, floor)?)
 }
 
 /// Copies a `t×p` block (any strides) into `out`, column-major with stride

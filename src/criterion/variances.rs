@@ -20,7 +20,8 @@ use faer::{Accum, Mat, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
 use super::dense::{
-    clear_upper_simd_state, exchange_ln_det, ln_det_i_minus, ln_det_i_plus, packed_len, pk,
+    clear_upper_simd_state, exchange_in_factor, exchange_ln_det, exchange_out_ln_det,
+    ln_det_i_minus, ln_det_i_plus, packed_len, pk,
 };
 use super::lowrank::LowRank;
 use super::state::InfoState;
@@ -304,21 +305,7 @@ impl PoolVariances {
         let t = self.t;
         let k = outs.len() * t;
         let rows = self.n * t;
-        // A = M⁻¹ X_outsᵀ (p × k).
-        let mut xo = Mat::<f64>::zeros(k, self.p);
-        for (o, &j) in outs.iter().enumerate() {
-            xo.as_mut().subrows_mut(o * t, t).copy_from(pool.block(j));
-        }
-        let mut a = Mat::<f64>::zeros(self.p, k);
-        matmul(
-            a.as_mut(),
-            Accum::Replace,
-            state.m_inv(),
-            xo.transpose(),
-            1.0,
-            Par::Seq,
-        );
-        clear_upper_simd_state();
+        let a = out_projection(pool, state, outs);
         chunked_product(
             pool.mat(),
             t,
@@ -354,21 +341,7 @@ impl PoolVariances {
         self.check(pool, state);
         let (t, p) = (self.t, self.p);
         let k = no * t;
-        // A = M⁻¹ X_outsᵀ (p × k).
-        let mut xo = Mat::<f64>::zeros(k, p);
-        for (o, &j) in outs.iter().enumerate() {
-            xo.as_mut().subrows_mut(o * t, t).copy_from(pool.block(j));
-        }
-        let mut a = Mat::<f64>::zeros(p, k);
-        matmul(
-            a.as_mut(),
-            Accum::Replace,
-            state.m_inv(),
-            xo.transpose(),
-            1.0,
-            Par::Seq,
-        );
-        clear_upper_simd_state();
+        let a = out_projection(pool, state, outs);
         let at = a.transpose();
         let x = pool.mat();
         let this = &*self;
@@ -423,12 +396,32 @@ impl PoolVariances {
     }
 }
 
-/// Exchange gains of one candidate `i` against every out-pose: `oi[o] =
-/// ln det [[I + V_i, W_io], [−W_ioᵀ, I − V_o]]`, by block elimination
-/// `det(I + V_i) · det(I − V_o + Yᵀ Y)`, `Y = L_A⁻¹ W_io`, with the Cholesky
-/// factor `L_A` of `I + V_i` computed once for all out-poses and one `ln` per
-/// pair (of the product of the second factor's pivots). `wcol[r][o·t + b]` is
-/// `W_io[r, b]`. A pivot `≤ pivot_floor` prices the pair `-∞`.
+/// `A = M⁻¹ X_outsᵀ` (`p × |outs|·t`): the projection every cross term
+/// `W = X · A` of an exchange pricing starts from.
+fn out_projection(pool: &Blocks, state: &InfoState, outs: &[usize]) -> Mat<f64> {
+    let (t, p) = (pool.t(), pool.p());
+    let k = outs.len() * t;
+    let mut xo = Mat::<f64>::zeros(k, p);
+    for (o, &j) in outs.iter().enumerate() {
+        xo.as_mut().subrows_mut(o * t, t).copy_from(pool.block(j));
+    }
+    let mut a = Mat::<f64>::zeros(p, k);
+    matmul(
+        a.as_mut(),
+        Accum::Replace,
+        state.m_inv(),
+        xo.transpose(),
+        1.0,
+        Par::Seq,
+    );
+    clear_upper_simd_state();
+    a
+}
+
+/// Exchange gains of one candidate against every out-pose, `oi[o]`, with the
+/// factor of `I + V_in` computed once ([`exchange_in_factor`]) and one `ln`
+/// per pair ([`exchange_out_ln_det`]). `wcol[r][o·t + b]` is `W_io[r, b]`.
+/// A numerically singular pair is priced `-∞`.
 fn exchange_row<'v>(
     t: usize,
     v_in: &[f64],
@@ -438,70 +431,14 @@ fn exchange_row<'v>(
     floor: f64,
     oi: &mut [f64],
 ) {
-    use super::dense::pk;
-    const T: usize = super::MAX_T;
-    let mut la = [0.0f64; T * T];
-    for r in 0..t {
-        for c in 0..=r {
-            let x = v_in[pk(r, c)];
-            la[r * t + c] = if r == c { 1.0 + x } else { x };
-        }
-    }
-    let Ok(ln_a) = super::dense::chol_in_place(&mut la[..t * t], t, 0.0) else {
+    let mut la = [0.0f64; super::MAX_T * super::MAX_T];
+    let Ok(ln_a) = exchange_in_factor(t, v_in, &mut la) else {
         oi.fill(f64::NEG_INFINITY);
         return;
     };
     for (o, (g, &j)) in oi.iter_mut().zip(outs).enumerate() {
-        let v_out = v_of(j);
-        // Y = L_A⁻¹ W (t×t, row-major), forward substitution per column.
-        let mut y = [0.0f64; T * T];
-        for c in 0..t {
-            for r in 0..t {
-                let mut s = wcol[r][o * t + c];
-                for q in 0..r {
-                    s -= la[r * t + q] * y[q * t + c];
-                }
-                y[r * t + c] = s / la[r * t + r];
-            }
-        }
-        // B = I − V_out + YᵀY, lower triangle; Cholesky pivots multiplied.
-        let mut b = [0.0f64; T * T];
-        for r in 0..t {
-            for c in 0..=r {
-                let mut s = if r == c { 1.0 } else { 0.0 } - v_out[pk(r, c)];
-                for q in 0..t {
-                    s += y[q * t + r] * y[q * t + c];
-                }
-                b[r * t + c] = s;
-            }
-        }
-        let mut det_b = 1.0;
-        let mut ok = true;
-        for kk in 0..t {
-            let mut d = b[kk * t + kk];
-            for q in 0..kk {
-                d -= b[kk * t + q] * b[kk * t + q];
-            }
-            if !(d > floor) {
-                ok = false;
-                break;
-            }
-            det_b *= d;
-            let l = d.sqrt();
-            b[kk * t + kk] = l;
-            for r in kk + 1..t {
-                let mut s = b[r * t + kk];
-                for q in 0..kk {
-                    s -= b[r * t + q] * b[kk * t + q];
-                }
-                b[r * t + kk] = s / l;
-            }
-        }
-        *g = if ok {
-            ln_a + det_b.ln()
-        } else {
-            f64::NEG_INFINITY
-        };
+        *g = exchange_out_ln_det(t, &la, v_of(j), |r, c| wcol[r][o * t + c], floor)
+            .map_or(f64::NEG_INFINITY, |b| ln_a + b);
     }
 }
 

@@ -105,7 +105,7 @@ fn reduced_reproduce_matches_the_underlying_commands() {
         ("## Table III", 6),
         ("## Table IV", 6),
         ("## Designs and their", 3),
-        ("## Monte-Carlo", 6),
+        ("## Monte-Carlo", 8),
     ] {
         let rows = table_after(&md, t);
         assert!(!rows.is_empty(), "{t}");

@@ -154,21 +154,14 @@ where
     Ok(())
 }
 
-/// A per-iteration trace (Fig. 4: log10 OI_D; Fig. 5: OI; Fig. 6: 1/OI_D
-/// on a log scale). `series` are (label, values) drawn over their index.
-pub fn trace(
-    base: &Path,
-    title: &str,
-    ylabel: &str,
-    series: &[(&str, Vec<f64>)],
-    log: bool,
-) -> Result<()> {
+/// A per-iteration trace (Fig. 4: log10 OI_D; Fig. 5: OI; Fig. 6:
+/// log10 of 1/OI_D). `series` are (label, values) drawn over their index.
+pub fn trace(base: &Path, title: &str, ylabel: &str, series: &[(&str, Vec<f64>)]) -> Result<()> {
     fn draw<DB: DrawingBackend>(
         root: &Area<DB>,
         title: &str,
         ylabel: &str,
         series: &[(&str, Vec<f64>)],
-        log: bool,
     ) -> Result<()> {
         let all: Vec<f64> = series.iter().flat_map(|(_, v)| v.iter().copied()).collect();
         let n = series
@@ -182,37 +175,17 @@ pub fn trace(
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(70);
-        if log {
-            let lo = all
-                .iter()
-                .copied()
-                .filter(|v| *v > 0.0)
-                .fold(f64::INFINITY, f64::min);
-            let hi = all.iter().copied().fold(0.0, f64::max);
-            let mut c = b
-                .build_cartesian_2d(0f64..n - 1.0, (lo / 3.0..hi * 3.0).log_scale())
-                .map_err(err)?;
-            c.configure_mesh()
-                .x_desc("iteration")
-                .y_desc(ylabel)
-                .y_labels(20)
-                .y_label_formatter(&|v| format!("{v:.0e}"))
-                .draw()
-                .map_err(err)?;
-            lines(&mut c, series)?;
-        } else {
-            let (lo, hi) = range(&all);
-            let mut c = b.build_cartesian_2d(0f64..n - 1.0, lo..hi).map_err(err)?;
-            c.configure_mesh()
-                .x_desc("iteration")
-                .y_desc(ylabel)
-                .draw()
-                .map_err(err)?;
-            lines(&mut c, series)?;
-        }
+        let (lo, hi) = range(&all);
+        let mut c = b.build_cartesian_2d(0f64..n - 1.0, lo..hi).map_err(err)?;
+        c.configure_mesh()
+            .x_desc("iteration")
+            .y_desc(ylabel)
+            .draw()
+            .map_err(err)?;
+        lines(&mut c, series)?;
         Ok(())
     }
-    both!(base, (800, 500), |r| draw(r, title, ylabel, series, log))
+    both!(base, (800, 500), |r| draw(r, title, ylabel, series))
 }
 
 /// The selected poses as joint-angle lattice digits (parallel coordinates:

@@ -1,3 +1,6 @@
+//! The distribution of EAE results over 20 seeds (one start, and 8 starts with
+//! a Fedorov polish), and whether the eigenvalue-OI criterion picks the same
+//! designs as the determinant: `cargo run --release --example eae_seeds`.
 use activecal::criterion::{DCriterion, OiCriterion};
 use activecal::pool::Pool;
 use activecal::robot::Robot;

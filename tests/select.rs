@@ -254,3 +254,32 @@ fn bad_settings_are_errors() {
         .contains("do not fit")
     );
 }
+
+#[test]
+fn score_indices_agree_with_an_independent_cholesky_to_1e_10() {
+    // `score` computes ln OI_D from the singular values of the stacked X;
+    // here it is checked against ln det(XᵀX) by Cholesky. Both are backward
+    // stable: the relative error of ln det is ~p·ε·κ(X)²/|ln det| ≈
+    // 27·2e-16·1e8/60 ≈ 1e-8 at worst for κ(X) = 1e4, far less in practice;
+    // 1e-10 relative is what the issue asks and what these designs meet.
+    use activecal::criterion::Indices;
+    let x = puma_pool(5);
+    for seed in 0..20u64 {
+        let d = activecal::select::random_design(
+            &mut design_rng(seed, 0),
+            &(0..x.n_poses()).collect::<Vec<_>>(),
+            &[],
+            30,
+        );
+        let ind = Indices::from_design(&x, &d);
+        let chol = ln_det_direct(&x, &d).unwrap();
+        assert_eq!(ind.rank, 27);
+        assert!(
+            (ind.ln_oid - chol).abs() <= 1e-10 * chol.abs(),
+            "seed {seed}: {} vs {chol}",
+            ind.ln_oid
+        );
+        // OI_D = ((OI·L)^L)², in logs.
+        assert!((2.0 * 27.0 * (ind.oi * 27.0).ln() - ind.ln_oid).abs() < 1e-9);
+    }
+}

@@ -50,6 +50,20 @@ pub(crate) const fn pk(a: usize, b: usize) -> usize {
 #[inline]
 pub(crate) fn chol_in_place(a: &mut [f64], n: usize, floor: f64) -> Result<f64, f64> {
     let mut ln_det = 0.0;
+    chol_pivots_in_place(a, n, floor, |d| ln_det += d.ln())?;
+    Ok(ln_det)
+}
+
+/// The Cholesky factorization of [`chol_in_place`], handing each pivot
+/// `d_k = L_kk²` to `pivot` (so a caller can take their product and one `ln`
+/// instead of `n` of them); `Err(d_k)` for the first pivot `≤ floor`.
+#[inline]
+pub(crate) fn chol_pivots_in_place(
+    a: &mut [f64],
+    n: usize,
+    floor: f64,
+    mut pivot: impl FnMut(f64),
+) -> Result<(), f64> {
     for k in 0..n {
         let mut d = a[k * n + k];
         for j in 0..k {
@@ -58,7 +72,7 @@ pub(crate) fn chol_in_place(a: &mut [f64], n: usize, floor: f64) -> Result<f64, 
         if !(d > floor) {
             return Err(d);
         }
-        ln_det += d.ln();
+        pivot(d);
         let lkk = d.sqrt();
         a[k * n + k] = lkk;
         for i in k + 1..n {
@@ -69,7 +83,7 @@ pub(crate) fn chol_in_place(a: &mut [f64], n: usize, floor: f64) -> Result<f64, 
             a[i * n + k] = s / lkk;
         }
     }
-    Ok(ln_det)
+    Ok(())
 }
 
 /// Cholesky with diagonal (complete symmetric) pivoting, `P A Pᵀ = L Lᵀ`, in
@@ -224,25 +238,7 @@ pub(crate) fn exchange_out_ln_det(
     // Cholesky of B; the pivots are in (floor, ~1+‖V‖], so their product
     // (t ≤ 6 of them) neither overflows nor underflows.
     let mut det = 1.0;
-    for k in 0..t {
-        let mut d = b[k * t + k];
-        for j in 0..k {
-            d -= b[k * t + j] * b[k * t + j];
-        }
-        if !(d > floor) {
-            return Err(d);
-        }
-        det *= d;
-        let l = d.sqrt();
-        b[k * t + k] = l;
-        for i in k + 1..t {
-            let mut s = b[i * t + k];
-            for j in 0..k {
-                s -= b[i * t + j] * b[k * t + j];
-            }
-            b[i * t + k] = s / l;
-        }
-    }
+    chol_pivots_in_place(&mut b[..t * t], t, floor, |d| det *= d)?;
     Ok(det.ln())
 }
 

@@ -4,7 +4,7 @@
 use activecal::criterion::DCriterion;
 use activecal::pool::Pool;
 use activecal::robot::Robot;
-use activecal::select::{design_rng, eae, Settings};
+use activecal::select::{Settings, design_rng, eae};
 use std::time::Instant;
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -25,7 +25,15 @@ fn main() {
     let outside: Vec<f64> = (1..=15).map(|k| run(k).0).collect();
     let tp = rayon::ThreadPoolBuilder::new().build().unwrap();
     let inside: Vec<f64> = tp.install(|| (1..=15).map(|k| run(k).0).collect());
-    let single = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    let single = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
     let one: Vec<f64> = single.install(|| (1..=15).map(|k| run(k).0).collect());
-    println!("EAE ms, median of 15: main thread {:.1}, inside a pool {:.1}, one thread {:.1}", median(outside), median(inside), median(one));
+    println!(
+        "EAE ms, median of 15: main thread {:.1}, inside a pool {:.1}, one thread {:.1}",
+        median(outside),
+        median(inside),
+        median(one)
+    );
 }

@@ -45,6 +45,10 @@ pub(crate) const CHUNK: usize = 256;
 /// tasks and thread wake-ups do not dominate.
 pub(crate) const SCAN_CHUNK: usize = 2048;
 
+/// Up to this many out-poses, exchange pricing forms the whole cross-term
+/// matrix `W = X·A` at once; beyond, it works in candidate chunks.
+const SMALL_OUTS: usize = 2;
+
 /// `V_i = X_i M⁻¹ X_iᵀ` (packed lower triangle, `t(t+1)/2` numbers) for every
 /// pose of a pool, synchronized with an [`InfoState`].
 #[derive(Clone, Debug)]
@@ -342,6 +346,45 @@ impl PoolVariances {
         let (t, p) = (self.t, self.p);
         let k = no * t;
         let a = out_projection(pool, state, outs);
+        if no <= SMALL_OUTS {
+            // Few out-poses (the paper's exchange step has one): one dense
+            // product W = X·A (n·t × k, column-major), whose few columns a
+            // candidate reads in contiguous runs of t rows, beats gathering
+            // the candidates' rows per task.
+            let rows = self.n * t;
+            chunked_product(
+                pool.mat(),
+                t,
+                a.as_ref(),
+                &mut self.work,
+                &mut [],
+                0,
+                |_, _, _, _| {},
+            );
+            let w = MatRef::from_column_major_slice(&self.work[..rows * k], rows, k);
+            let wcols: Vec<&[f64]> = (0..k).map(|c| col(w, c)).collect();
+            let this = &*self;
+            out.par_chunks_mut(SCAN_CHUNK * no)
+                .zip(candidates.par_chunks(SCAN_CHUNK))
+                .for_each(|(oc, cc)| {
+                    for (oi, &i) in oc.chunks_mut(no).zip(cc) {
+                        if state.contains(i) {
+                            oi.fill(f64::NEG_INFINITY);
+                            continue;
+                        }
+                        exchange_row(
+                            t,
+                            this.packed(i),
+                            outs,
+                            |j| this.packed(j),
+                            |o, r, c| wcols[o * t + c][i * t + r],
+                            pivot_floor,
+                            oi,
+                        );
+                    }
+                });
+            return;
+        }
         let at = a.transpose();
         let x = pool.mat();
         let this = &*self;
@@ -386,7 +429,7 @@ impl PoolVariances {
                             this.packed(i),
                             outs,
                             |j| this.packed(j),
-                            &wcol,
+                            |o, r, c| wcol[r][o * t + c],
                             pivot_floor,
                             oi,
                         );
@@ -420,14 +463,14 @@ fn out_projection(pool: &Blocks, state: &InfoState, outs: &[usize]) -> Mat<f64> 
 
 /// Exchange gains of one candidate against every out-pose, `oi[o]`, with the
 /// factor of `I + V_in` computed once ([`exchange_in_factor`]) and one `ln`
-/// per pair ([`exchange_out_ln_det`]). `wcol[r][o·t + b]` is `W_io[r, b]`.
+/// per pair ([`exchange_out_ln_det`]). `w(o, r, b)` is `W_io[r, b]`.
 /// A numerically singular pair is priced `-∞`.
 fn exchange_row<'v>(
     t: usize,
     v_in: &[f64],
     outs: &[usize],
     v_of: impl Fn(usize) -> &'v [f64],
-    wcol: &[&[f64]; super::MAX_T],
+    w: impl Fn(usize, usize, usize) -> f64,
     floor: f64,
     oi: &mut [f64],
 ) {
@@ -437,7 +480,7 @@ fn exchange_row<'v>(
         return;
     };
     for (o, (g, &j)) in oi.iter_mut().zip(outs).enumerate() {
-        *g = exchange_out_ln_det(t, &la, v_of(j), |r, c| wcol[r][o * t + c], floor)
+        *g = exchange_out_ln_det(t, &la, v_of(j), |r, c| w(o, r, c), floor)
             .map_or(f64::NEG_INFINITY, |b| ln_a + b);
     }
 }

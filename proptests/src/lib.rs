@@ -141,6 +141,17 @@ pub fn to_blocks(x: &DMatrix<f64>, t: usize) -> Blocks {
     Blocks::new(to_faer(x), t)
 }
 
+/// The rows of the given poses (`t` rows each) of `x`, stacked in order.
+#[must_use]
+pub fn stacked(x: &DMatrix<f64>, t: usize, design: &[usize]) -> DMatrix<f64> {
+    let parts: Vec<DMatrix<f64>> = design
+        .iter()
+        .map(|&i| x.rows(i * t, t).into_owned())
+        .collect();
+    let refs: Vec<&DMatrix<f64>> = parts.iter().collect();
+    vstack(&refs)
+}
+
 /// Stacks matrices vertically.
 #[must_use]
 pub fn vstack(parts: &[&DMatrix<f64>]) -> DMatrix<f64> {

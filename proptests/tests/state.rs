@@ -18,15 +18,6 @@ fn pool_and_design(c: &Case, n: usize, extra: usize) -> (DMatrix<f64>, Vec<usize
     (x, (0..k.min(n)).collect())
 }
 
-fn stacked(x: &DMatrix<f64>, t: usize, design: &[usize]) -> DMatrix<f64> {
-    let parts: Vec<DMatrix<f64>> = design
-        .iter()
-        .map(|&i| x.rows(i * t, t).into_owned())
-        .collect();
-    let refs: Vec<&DMatrix<f64>> = parts.iter().collect();
-    vstack(&refs)
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(cases()))]
 

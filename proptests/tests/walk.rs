@@ -2,21 +2,11 @@
 //! direct recomputation.
 
 use activecal::criterion::{InfoState, PoolVariances, StateSettings};
-use nalgebra::DMatrix;
 use proptest::prelude::*;
 use proptests::*;
 
 /// Updates per walk.
 const STEPS: usize = 10_000;
-
-fn stacked(x: &DMatrix<f64>, t: usize, design: &[usize]) -> DMatrix<f64> {
-    let parts: Vec<DMatrix<f64>> = design
-        .iter()
-        .map(|&i| x.rows(i * t, t).into_owned())
-        .collect();
-    let refs: Vec<&DMatrix<f64>> = parts.iter().collect();
-    vstack(&refs)
-}
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(cases()))]

@@ -69,17 +69,7 @@ impl Default for ConicSettings {
 impl ConicSettings {
     /// Checks every field's range.
     pub fn validate(&self) -> Result<(), BoundError> {
-        let pos = |name, v: f64| {
-            if v > 0.0 && v.is_finite() {
-                Ok(())
-            } else {
-                Err(BoundError::InvalidSetting {
-                    name,
-                    value: v.to_string(),
-                    reason: "must be finite and > 0",
-                })
-            }
-        };
+        let pos = super::error::positive;
         pos("conic.time_limit", self.time_limit)?;
         pos("conic.tol_gap", self.tol_gap)?;
         pos("conic.tol_feas", self.tol_feas)?;

@@ -77,3 +77,17 @@ pub enum BoundError {
     #[error(transparent)]
     Input(#[from] crate::Error),
 }
+
+/// `Ok` when a setting is finite and positive, else
+/// [`BoundError::InvalidSetting`] naming it.
+pub(crate) fn positive(name: &'static str, v: f64) -> Result<(), BoundError> {
+    if v > 0.0 && v.is_finite() {
+        Ok(())
+    } else {
+        Err(BoundError::InvalidSetting {
+            name,
+            value: v.to_string(),
+            reason: "must be finite and > 0",
+        })
+    }
+}

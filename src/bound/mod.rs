@@ -117,17 +117,7 @@ impl BoundSettings {
 
     /// Checks every field's range.
     pub fn validate(&self) -> Result<(), BoundError> {
-        let pos = |name, v: f64| {
-            if v > 0.0 && v.is_finite() {
-                Ok(())
-            } else {
-                Err(BoundError::InvalidSetting {
-                    name,
-                    value: v.to_string(),
-                    reason: "must be finite and > 0",
-                })
-            }
-        };
+        let pos = error::positive;
         pos("gap_tol", self.gap_tol)?;
         pos("screen_gap", self.screen_gap)?;
         pos("screen_tol", self.screen_tol)?;

@@ -152,20 +152,7 @@ fn scan(pool: &Blocks, design: &[usize], reps: usize) -> Result<ScanTimings, Cri
 #[cfg(test)]
 mod tests {
     use super::*;
-    use faer::Mat;
-
-    fn random_pool(n: usize, t: usize, p: usize, seed: u64) -> Blocks {
-        let mut s = seed;
-        Blocks::new(
-            Mat::from_fn(n * t, p, |_, _| {
-                s = s
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-            }),
-            t,
-        )
-    }
+    use crate::criterion::test_util::random_pool;
 
     #[test]
     fn bench_scan_runs_on_a_small_pool() {

@@ -346,19 +346,7 @@ impl Criterion for OiCriterion {
 mod tests {
     use super::*;
     use crate::criterion::state::StateSettings;
-    use faer::Mat;
-
-    fn lcg(seed: &mut u64) -> f64 {
-        *seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((*seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    }
-
-    fn random_pool(n: usize, t: usize, p: usize, seed: u64) -> Blocks {
-        let mut s = seed;
-        Blocks::new(Mat::from_fn(n * t, p, |_, _| lcg(&mut s)), t)
-    }
+    use crate::criterion::test_util::random_pool;
 
     /// The paper's exchange step (§IV step 2), written once against the
     /// trait: remove the pose whose removal costs least, find its best

@@ -348,13 +348,7 @@ pub fn cascade(
 mod tests {
     use super::*;
     use crate::criterion::dense::{cholesky_inverse, view};
-
-    fn lcg(seed: &mut u64) -> f64 {
-        *seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((*seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    }
+    use crate::criterion::test_util::lcg;
 
     fn random(rows: usize, cols: usize, seed: &mut u64) -> Mat<f64> {
         Mat::from_fn(rows, cols, |_, _| lcg(seed))

@@ -85,6 +85,8 @@ mod dense;
 mod indices;
 pub mod lowrank;
 mod state;
+#[cfg(test)]
+mod test_util;
 mod variances;
 
 pub use bench::{ScanTimings, bench_scan, bench_scan_with_threads};

@@ -763,19 +763,8 @@ impl InfoState {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::criterion::test_util::random_pool;
     use faer::Mat;
-
-    fn lcg(seed: &mut u64) -> f64 {
-        *seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((*seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    }
-
-    pub(crate) fn random_pool(n: usize, t: usize, p: usize, seed: u64) -> Blocks {
-        let mut s = seed;
-        Blocks::new(Mat::from_fn(n * t, p, |_, _| lcg(&mut s)), t)
-    }
 
     fn direct(pool: &Blocks, design: &[usize]) -> (f64, Mat<f64>) {
         let m = pool.information(design);

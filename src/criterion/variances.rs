@@ -514,18 +514,7 @@ pub fn exchange_gain(
 mod tests {
     use super::*;
     use crate::criterion::state::StateSettings;
-
-    fn lcg(seed: &mut u64) -> f64 {
-        *seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((*seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    }
-
-    fn random_pool(n: usize, t: usize, p: usize, seed: u64) -> Blocks {
-        let mut s = seed;
-        Blocks::new(Mat::from_fn(n * t, p, |_, _| lcg(&mut s)), t)
-    }
+    use crate::criterion::test_util::random_pool;
 
     fn direct_v(pool: &Blocks, state: &InfoState, i: usize) -> Mat<f64> {
         let x = pool.block(i);

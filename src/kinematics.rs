@@ -126,9 +126,10 @@ pub fn position_checked(robot: &Robot, table: &ParamTable, q: &[f64]) -> Result<
 
 /// Orientation `R` (columns: the end frame's axes) and position `p` of the
 /// end frame in the measurement frame (no input checks; see
-/// [`Robot::check_q`]). An orientation residual for identification is
-/// `log(R_meas · R(θ)ᵀ)`, whose derivative is the orientation rows of
-/// [`Evaluator::eval`].
+/// [`Robot::check_q`]). The orientation residual of identification is
+/// `φ = log(R(θ) R_measᵀ)`, whose derivative is the orientation rows of
+/// [`Evaluator::eval`] premultiplied by `J_l⁻¹(φ)`
+/// ([`crate::identify::so3`]).
 #[must_use]
 pub fn pose(robot: &Robot, table: &ParamTable, q: &[f64]) -> (Matrix3<f64>, Vector3<f64>) {
     let mut axes = vec![FrameAxes::default(); robot.frames.len()];
@@ -157,7 +158,8 @@ impl<'r> Evaluator<'r> {
     /// End point at `q`, and the identification Jacobian `∂y/∂θ` (t × p,
     /// row-major, `t = robot.rows_per_pose()`, unknowns in
     /// [`Robot::unknowns`] order) written into `jac`: rows 0–2 the position,
-    /// rows 3–5 (full-pose robots) the orientation as an angular velocity.
+    /// rows 3–5 (full-pose robots) the orientation as an angular velocity
+    /// (base frame) times [`Robot::orientation_scale`].
     pub fn eval(&mut self, q: &[f64], jac: &mut [f64]) -> Vector3<f64> {
         self.eval_pose(q, jac).1
     }
@@ -169,6 +171,7 @@ impl<'r> Evaluator<'r> {
         let t = self.robot.rows_per_pose();
         debug_assert_eq!(jac.len(), t * p_len);
         let (rot, p) = walk(self.robot, self.table, q, &mut self.axes);
+        let w = self.robot.orientation_scale;
         for (c, u) in self.robot.unknowns.iter().enumerate() {
             let ax = &self.axes[u.frame];
             // (linear velocity of p, angular velocity) of the elementary motion.
@@ -184,7 +187,7 @@ impl<'r> Evaluator<'r> {
             }
             if t == 6 {
                 for r in 0..3 {
-                    jac[(3 + r) * p_len + c] = ang[r];
+                    jac[(3 + r) * p_len + c] = w * ang[r];
                 }
             }
         }

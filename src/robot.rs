@@ -251,11 +251,25 @@ pub struct Robot {
     pub limits: Vec<[f64; 2]>,
     /// What is measured.
     pub measurement: Measurement,
+    /// Metres per radian that make an orientation error comparable to a
+    /// position error (full-pose robots): the orientation rows of the
+    /// identification Jacobian and the orientation residuals of
+    /// identification are multiplied by it. Set it to `σ_position /
+    /// σ_orientation` of the sensor (e.g. 0.05 mm / 0.01° ≈ 0.29 m/rad for a
+    /// laser tracker with a 6-DoF probe), so that every weighted row carries
+    /// the same noise σ_position and `XᵀX` is the Fisher information up to
+    /// `σ²`. Default [`DEFAULT_ORIENTATION_SCALE`]; unused for points.
+    pub orientation_scale: f64,
     /// The region the sensor sees, if the description gives one (used to
     /// filter pose pools when no other region is given).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub visibility: Option<Visibility>,
 }
+
+/// Default [`Robot::orientation_scale`]: 1 m/rad, i.e. an orientation noise
+/// in radians equal to the position noise in metres (0.01 rad ≈ 0.57° beside
+/// 1 cm).
+pub const DEFAULT_ORIENTATION_SCALE: f64 = 1.0;
 
 /// Names of the built-in robots (point measurements; append `:pose` for the
 /// full-pose variant, see [`Robot::builtin`]).
@@ -415,6 +429,7 @@ impl Robot {
             unknowns,
             limits,
             measurement: Measurement::Point,
+            orientation_scale: DEFAULT_ORIENTATION_SCALE,
             visibility: None,
         }
     }
@@ -510,6 +525,12 @@ impl Robot {
     /// parameters, valid limits, no β unknown on a DH frame, unknowns sorted
     /// and naming existing frames.
     pub fn validate(&self) -> Result<()> {
+        if !(self.orientation_scale.is_finite() && self.orientation_scale > 0.0) {
+            return Err(Error::Invalid(format!(
+                "orientation_scale = {}: must be a finite number > 0 (metres per radian)",
+                self.orientation_scale
+            )));
+        }
         let mut seen = vec![false; self.dof()];
         for (i, f) in self.frames.iter().enumerate() {
             if f.label.is_empty() || f.label.chars().any(|c| c.is_whitespace() || c == ',') {

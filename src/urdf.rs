@@ -505,6 +505,7 @@ fn convert(chain: &[ChainJoint], name: &str, opts: &UrdfOptions) -> Robot {
         unknowns: Vec::new(),
         limits,
         measurement: opts.measurement,
+        orientation_scale: crate::robot::DEFAULT_ORIENTATION_SCALE,
         visibility: None,
     }
 }

@@ -246,6 +246,7 @@ fn any_robot() -> impl Strategy<Value = Robot> {
                 } else {
                     Measurement::Point
                 },
+                orientation_scale: activecal::robot::DEFAULT_ORIENTATION_SCALE,
                 visibility: None,
             }
         })

@@ -8,6 +8,7 @@ use activecal::identify::{
     LmSettings, MonteCarloSettings, MonteCarloSummary, ValidationSet, monte_carlo, paper_tables,
 };
 use activecal::pool::Pool;
+use activecal::robot::Measurement;
 use anyhow::Result;
 use clap::Args;
 use serde_json::{Map, Value, json};
@@ -23,7 +24,8 @@ pub struct CalibrateArgs {
     /// Design file (JSON with robot, levels, poses), as written by `select`.
     #[arg(long)]
     pub design: PathBuf,
-    /// Measurement noise σ per coordinate, metres.
+    /// Measurement noise σ per coordinate, metres. A full-pose robot's
+    /// orientation noise is σ / orientation_scale radians per axis.
     #[arg(long, default_value_t = 0.01)]
     pub noise: f64,
     /// Seed of the noise and of the validation poses.
@@ -94,6 +96,9 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     let residual: Vec<f64> = truth.iter().zip(&id.estimate).map(|(t, e)| t - e).collect();
     let before = validation.rms(&robot, &robot.nominal);
     let after = validation.rms(&robot, &id.table);
+    let rot_before = validation.orientation_rms(&robot, &robot.nominal);
+    let rot_after = validation.orientation_rms(&robot, &id.table);
+    let full = robot.measurement == Measurement::Pose;
 
     // ---- Monte-Carlo ------------------------------------------------------------
     let t_mc = Instant::now();
@@ -112,7 +117,9 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
         "robot": robot.name,
         "design": a.design.display().to_string(),
         "poses": qs.len(),
+        "measurement": robot.measurement,
         "noise": a.noise,
+        "orientation_noise": full.then(|| a.noise / robot.orientation_scale),
         "seed": a.seed,
         "status": id.status,
         "stop": id.stop,
@@ -131,16 +138,26 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
         "validation_poses": validation.len(),
         "validation_rms_before": before,
         "validation_rms_after": after,
+        "validation_orientation_rms_before": rot_before,
+        "validation_orientation_rms_after": rot_after,
         "monte_carlo": mc,
         "monte_carlo_seconds": mc.as_ref().map(|_| mc_seconds),
         "elapsed_seconds": t0.elapsed().as_secs_f64(),
     });
     emit(a.json, &v, || {
+        let noise = if full {
+            format!(
+                "σ = {} m and {:.3e} rad (full poses)",
+                a.noise,
+                a.noise / robot.orientation_scale
+            )
+        } else {
+            format!("σ = {} m", a.noise)
+        };
         let mut s = format!(
-            "{}: {} poses, σ = {} m, seed {}\nstatus: {:?} ({:?}) after {} iterations, {} evaluations\n",
+            "{}: {} poses, {noise}, seed {}\nstatus: {:?} ({:?}) after {} iterations, {} evaluations\n",
             a.design.display(),
             qs.len(),
-            a.noise,
             a.seed,
             id.status,
             id.stop,
@@ -170,6 +187,11 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
             "\nvalidation ({} held-out poses): RMS position error {before:.6} m before, {after:.6} m after\n",
             validation.len()
         );
+        if let (Some(b), Some(f)) = (rot_before, rot_after) {
+            s += &format!(
+                "validation: RMS orientation error {b:.6e} rad before, {f:.6e} rad after\n"
+            );
+        }
         if let Some(mc) = &mc {
             s += &mc_text(mc, mc_seconds);
         }
@@ -230,6 +252,18 @@ fn mc_text(mc: &MonteCarloSummary, seconds: f64) -> String {
             v.max,
             mc.validation_rms_predicted
                 .map_or("-".into(), |p| format!("{p:.6}"))
+        );
+    }
+    if let (Some(b), Some(v)) = (
+        mc.validation_orientation_rms_before,
+        &mc.validation_orientation_rms_after,
+    ) {
+        s += &format!(
+            "validation RMS orientation: before {b:.6e} rad; after median {:.6e} p95 {:.6e} rad (predicted {})\n",
+            v.median,
+            v.p95,
+            mc.validation_orientation_rms_predicted
+                .map_or("-".into(), |p| format!("{p:.6e}"))
         );
     }
     s

@@ -1,10 +1,17 @@
-//! Identification: estimate the unknown parameters from points measured at
-//! known joint angles, by Levenberg–Marquardt from the nominal parameters,
-//! with the estimate's covariance `σ̂² (XᵀX)⁻¹`; simulation of measurements;
-//! Monte-Carlo comparison of designs; the paper's Tables III and IV.
+//! Identification: estimate the unknown parameters from points (or full
+//! poses) measured at known joint angles, by Levenberg–Marquardt from the
+//! nominal parameters, with the estimate's covariance `σ̂² (XᵀX)⁻¹`;
+//! simulation of measurements; Monte-Carlo comparison of designs; the paper's
+//! Tables III and IV.
 //!
-//! The model is `y_i = p(θ, q_i) + ε_i`, `ε_i ~ N(0, σ² I₃)`, and the estimate
-//! minimises `Σ ‖y_i − p(θ, q_i)‖²` over the unknowns θ (Sun & Hollerbach §V-E).
+//! The point model is `y_i = p(θ, q_i) + ε_i`, `ε_i ~ N(0, σ² I₃)`, and the
+//! estimate minimises `Σ ‖y_i − p(θ, q_i)‖²` over the unknowns θ (Sun &
+//! Hollerbach §V-E). A full-pose robot also measures the end frame's
+//! orientation, `R_i = exp([η_i]×) R(θ, q_i)`, `η_i ~ N(0, (σ/w)² I₃)` with
+//! `w` = [`Robot::orientation_scale`], and the estimate minimises
+//! `Σ ‖y_i − p(θ, q_i)‖² + w² ‖log(R(θ, q_i) R_iᵀ)‖²`: every weighted row
+//! carries noise σ, and the weighted `XᵀX` that pose selection maximises is
+//! the Fisher information up to `σ²`.
 //!
 //! * [`lm`]: the solver ([`identify`]), its settings, statuses and covariance.
 //! * [`simulate`](mod@simulate): noisy measurements of the real robot, seeded.
@@ -21,6 +28,7 @@ mod dense;
 pub mod lm;
 pub mod montecarlo;
 pub mod simulate;
+pub mod so3;
 pub mod tables;
 
 pub use lm::{
@@ -93,15 +101,27 @@ pub enum IdentifyError {
         /// What is wrong.
         reason: String,
     },
-    /// A robot whose measurements are not points (3 rows per pose).
+    /// Orientations missing for a full-pose robot, or given for a point robot.
     #[error(
-        "robot '{robot}' measures {rows} coordinates per pose; identification handles point measurements (3) only"
+        "robot '{robot}' measures {expected} per pose, but {given} orientations were given for {poses} poses"
     )]
-    UnsupportedMeasurement {
+    OrientationCount {
         /// The robot's name.
         robot: String,
-        /// Rows of its Jacobian per pose.
-        rows: usize,
+        /// `points` or `full poses (position and orientation)`.
+        expected: &'static str,
+        /// Orientations given.
+        given: usize,
+        /// Poses given.
+        poses: usize,
+    },
+    /// A measured orientation that is not a rotation matrix.
+    #[error("measurement {pose}: the orientation is not a rotation matrix: {reason}")]
+    NotARotation {
+        /// 0-based pose number.
+        pose: usize,
+        /// What is wrong with it.
+        reason: String,
     },
     /// Invalid robot, parameter table or pool.
     #[error(transparent)]
@@ -111,24 +131,29 @@ pub enum IdentifyError {
 /// Result with an [`IdentifyError`].
 pub type Result<T> = std::result::Result<T, IdentifyError>;
 
-/// Errors unless the robot measures points (the only kind identified so far).
-pub(crate) fn require_points(robot: &Robot) -> Result<()> {
-    if robot.measurement != Measurement::Point {
-        return Err(IdentifyError::UnsupportedMeasurement {
-            robot: robot.name.clone(),
-            rows: robot.rows_per_pose(),
-        });
-    }
-    Ok(())
-}
+/// Largest `max |RᵀR − I|` accepted for a measured orientation: a rotation
+/// matrix written with 7 significant digits (a sensor's export) is
+/// orthonormal to about 1e-7; a matrix off by more than 1e-6 is not a
+/// rotation but a typing or unit error. Accepted matrices are projected to
+/// the nearest rotation before use.
+pub const ROTATION_TOLERANCE: f64 = 1e-6;
 
-/// Points measured at known joint angles, validated against a robot: as many
-/// points as joint vectors, every joint vector of the robot's length and
-/// finite, every coordinate finite.
+/// Points (and, for a full-pose robot, orientations) measured at known joint
+/// angles, validated against a robot: as many points as joint vectors, every
+/// joint vector of the robot's length and finite, every coordinate finite,
+/// and one rotation matrix per pose exactly when the robot measures full
+/// poses.
+///
+/// In JSON: `{"qs": [[q1, …], …], "points": [[x, y, z], …],
+/// "orientations": [[[r00, r01, r02], [r10, …], [r20, …]], …]}` (metres,
+/// radians; orientations row-major, base frame, omitted for points).
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
 pub struct Measurements {
     qs: Vec<Vec<f64>>,
     points: Vec<[f64; 3]>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    orientations: Vec<[[f64; 3]; 3]>,
 }
 
 impl Measurements {
@@ -142,14 +167,40 @@ impl Measurements {
     /// assert!(bad.unwrap_err().to_string().contains("coordinate y"));
     /// ```
     pub fn new(robot: &Robot, qs: Vec<Vec<f64>>, points: Vec<[f64; 3]>) -> Result<Self> {
-        let m = Self { qs, points };
+        Self::with_orientations(robot, qs, points, Vec::new())
+    }
+
+    /// Validates and wraps full-pose measurements: joint vectors, the
+    /// positions and the orientations (rotation matrices, row-major) measured
+    /// at them. For a point robot `orientations` must be empty.
+    ///
+    /// ```
+    /// use activecal::identify::Measurements;
+    /// use activecal::robot::Robot;
+    /// let robot = Robot::builtin("ur5:pose").unwrap();
+    /// let eye = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let ok = Measurements::with_orientations(&robot, vec![vec![0.0; 6]], vec![[0.0; 3]], vec![eye]);
+    /// assert!(ok.is_ok());
+    /// let missing = Measurements::new(&robot, vec![vec![0.0; 6]], vec![[0.0; 3]]);
+    /// assert!(missing.unwrap_err().to_string().contains("0 orientations"));
+    /// ```
+    pub fn with_orientations(
+        robot: &Robot,
+        qs: Vec<Vec<f64>>,
+        points: Vec<[f64; 3]>,
+        orientations: Vec<[[f64; 3]; 3]>,
+    ) -> Result<Self> {
+        let m = Self {
+            qs,
+            points,
+            orientations,
+        };
         m.check(robot)?;
         Ok(m)
     }
 
     /// Re-checks the measurements against a robot (done by [`identify`]).
     pub fn check(&self, robot: &Robot) -> Result<()> {
-        require_points(robot)?;
         if self.qs.len() != self.points.len() {
             return Err(IdentifyError::MeasurementCount {
                 poses: self.qs.len(),
@@ -172,6 +223,25 @@ impl Measurements {
                     value: p[c],
                 });
             }
+        }
+        let want = match robot.measurement {
+            Measurement::Point => 0,
+            Measurement::Pose => self.qs.len(),
+        };
+        if self.orientations.len() != want {
+            return Err(IdentifyError::OrientationCount {
+                robot: robot.name.clone(),
+                expected: match robot.measurement {
+                    Measurement::Point => "points",
+                    Measurement::Pose => "full poses (position and orientation)",
+                },
+                given: self.orientations.len(),
+                poses: self.qs.len(),
+            });
+        }
+        for (i, r) in self.orientations.iter().enumerate() {
+            so3::check_rotation(&matrix(r), ROTATION_TOLERANCE)
+                .map_err(|reason| IdentifyError::NotARotation { pose: i, reason })?;
         }
         Ok(())
     }
@@ -199,4 +269,21 @@ impl Measurements {
     pub fn points(&self) -> &[[f64; 3]] {
         &self.points
     }
+
+    /// Measured orientations (row-major rotation matrices), one per joint
+    /// vector for a full-pose robot, empty for a point robot.
+    #[must_use]
+    pub fn orientations(&self) -> &[[[f64; 3]; 3]] {
+        &self.orientations
+    }
+}
+
+/// A row-major `[[f64; 3]; 3]` as a matrix.
+pub(crate) fn matrix(r: &[[f64; 3]; 3]) -> nalgebra::Matrix3<f64> {
+    nalgebra::Matrix3::from_fn(|i, j| r[i][j])
+}
+
+/// A matrix as row-major `[[f64; 3]; 3]`.
+pub(crate) fn rows(m: &nalgebra::Matrix3<f64>) -> [[f64; 3]; 3] {
+    std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)]))
 }

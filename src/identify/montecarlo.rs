@@ -11,12 +11,13 @@
 use super::dense::{gram, ln_det_spd, product};
 use super::lm::{LmSettings, Status, identify, predicted_covariance};
 use super::simulate::{simulate, trial_rng};
+use super::so3;
 use super::{IdentifyError, Result};
-use crate::kinematics::position;
+use crate::kinematics::{pose, position};
 use crate::pool::{Pool, jacobian_of};
-use crate::robot::{ParamTable, Robot};
+use crate::robot::{Measurement, ParamTable, Robot};
 use faer::Mat;
-use nalgebra::Vector3;
+use nalgebra::{UnitQuaternion, Vector3};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -116,7 +117,8 @@ impl MonteCarloSettings {
     }
 }
 
-/// Held-out poses and the real robot's end points there.
+/// Held-out poses and the real robot's end points (and, for a full-pose
+/// robot, end orientations) there.
 #[derive(Clone, Debug, Serialize)]
 pub struct ValidationSet {
     /// Lattice indices of the poses, when they come from a pool.
@@ -125,6 +127,9 @@ pub struct ValidationSet {
     pub qs: Vec<Vec<f64>>,
     #[serde(skip)]
     truth: Vec<Vector3<f64>>,
+    /// True orientations; empty for a point robot.
+    #[serde(skip)]
+    truth_rot: Vec<UnitQuaternion<f64>>,
 }
 
 impl ValidationSet {
@@ -177,11 +182,18 @@ impl ValidationSet {
                 .check_q(q)
                 .map_err(|source| IdentifyError::Pose { pose: i, source })?;
         }
-        let truth = qs.iter().map(|q| position(robot, &robot.real, q)).collect();
+        let poses: Vec<_> = qs.iter().map(|q| pose(robot, &robot.real, q)).collect();
+        let truth = poses.iter().map(|(_, p)| *p).collect();
+        let truth_rot = if robot.measurement == Measurement::Pose {
+            poses.iter().map(|(r, _)| so3::to_quaternion(r)).collect()
+        } else {
+            Vec::new()
+        };
         Ok(ValidationSet {
             lattice_indices: Vec::new(),
             qs,
             truth,
+            truth_rot,
         })
     }
 
@@ -213,26 +225,62 @@ impl ValidationSet {
         (s / self.qs.len() as f64).sqrt()
     }
 
+    /// RMS orientation error `√(mean ∠(R(table, q) R(real, q)ᵀ)²)`, radians,
+    /// over the poses; `None` for a point robot (or an empty set).
+    #[must_use]
+    pub fn orientation_rms(&self, robot: &Robot, table: &ParamTable) -> Option<f64> {
+        if self.truth_rot.is_empty() {
+            return None;
+        }
+        let s: f64 = self
+            .qs
+            .iter()
+            .zip(&self.truth_rot)
+            .map(|(q, t)| {
+                let (r, _) = pose(robot, table, q);
+                so3::difference(&so3::to_quaternion(&r), t).norm_squared()
+            })
+            .sum();
+        Some((s / self.qs.len() as f64).sqrt())
+    }
+
     /// The RMS distance the linearised model predicts after calibration with
-    /// estimate covariance `c`: `√(tr(X_v C X_vᵀ) / n)`, `X_v` the Jacobian of
-    /// the validation poses at the real parameters.
+    /// estimate covariance `c`: `√(tr(X_v C X_vᵀ) / n)`, `X_v` the position
+    /// rows of the Jacobian of the validation poses at the real parameters.
     #[must_use]
     pub fn predicted_rms(&self, robot: &Robot, c: &Mat<f64>) -> f64 {
+        self.predicted_traces(robot, c).0
+    }
+
+    /// The RMS orientation error (radians) the linearised model predicts after
+    /// calibration with estimate covariance `c`, from the orientation rows
+    /// (divided by [`Robot::orientation_scale`]); `None` for a point robot.
+    #[must_use]
+    pub fn predicted_orientation_rms(&self, robot: &Robot, c: &Mat<f64>) -> Option<f64> {
+        (robot.measurement == Measurement::Pose).then(|| self.predicted_traces(robot, c).1)
+    }
+
+    /// `(√(tr_pos / n), √(tr_ori / n))`: the traces of `X_v C X_vᵀ` over
+    /// the position rows and over the unweighted orientation rows.
+    fn predicted_traces(&self, robot: &Robot, c: &Mat<f64>) -> (f64, f64) {
         if self.qs.is_empty() {
-            return 0.0;
+            return (0.0, 0.0);
         }
         let x = jacobian_of(robot, &robot.real, self.qs.len(), |k, q| {
             q.copy_from_slice(&self.qs[k])
         });
+        let t = x.t();
         let xc = product(x.mat(), c.as_ref());
         let m = x.mat();
-        let mut tr = 0.0;
+        let mut tr = [0.0, 0.0];
         for j in 0..m.ncols() {
             for i in 0..m.nrows() {
-                tr += xc[(i, j)] * m[(i, j)];
+                tr[usize::from(i % t >= 3)] += xc[(i, j)] * m[(i, j)];
             }
         }
-        (tr.max(0.0) / self.qs.len() as f64).sqrt()
+        let n = self.qs.len() as f64;
+        let w = robot.orientation_scale;
+        ((tr[0].max(0.0) / n).sqrt(), (tr[1].max(0.0) / n).sqrt() / w)
     }
 }
 
@@ -359,6 +407,18 @@ pub struct MonteCarloSummary {
     pub validation_rms_after: Option<Spread>,
     /// The RMS error after calibration that the predicted covariance implies.
     pub validation_rms_predicted: Option<f64>,
+    /// Full-pose robots: RMS orientation error (radians) on the validation
+    /// poses with the nominal model.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub validation_orientation_rms_before: Option<f64>,
+    /// Full-pose robots: RMS orientation error (radians) after calibration,
+    /// over trials.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub validation_orientation_rms_after: Option<Spread>,
+    /// Full-pose robots: the RMS orientation error (radians) the predicted
+    /// covariance implies.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub validation_orientation_rms_predicted: Option<f64>,
 }
 
 /// Several designs evaluated on the same noise seeds and validation poses.
@@ -378,6 +438,7 @@ struct Trial {
     iterations: usize,
     estimate: Vec<f64>,
     rms_after: f64,
+    orientation_rms_after: Option<f64>,
 }
 
 /// Runs `settings.trials` noisy identifications of the design `qs` (joint
@@ -411,11 +472,13 @@ pub fn monte_carlo(
             )?;
             let id = identify(robot, &robot.nominal, &meas, &settings.lm)?;
             let rms_after = validation.rms(robot, &id.table);
+            let orientation_rms_after = validation.orientation_rms(robot, &id.table);
             Ok(Trial {
                 status: id.status,
                 iterations: id.iterations,
                 estimate: id.estimate,
                 rms_after,
+                orientation_rms_after,
             })
         })
         .collect();
@@ -490,6 +553,10 @@ pub fn monte_carlo(
 
     let before = validation.rms(robot, &robot.nominal);
     let after: Vec<f64> = used.iter().map(|t| t.rms_after).collect();
+    let after_rot: Vec<f64> = used
+        .iter()
+        .filter_map(|t| t.orientation_rms_after)
+        .collect();
     Ok(MonteCarloSummary {
         design: name.to_string(),
         poses: qs.len(),
@@ -513,6 +580,11 @@ pub fn monte_carlo(
         validation_rms_before: before,
         validation_rms_after: Spread::of(&after),
         validation_rms_predicted: c_pred.as_ref().map(|c| validation.predicted_rms(robot, c)),
+        validation_orientation_rms_before: validation.orientation_rms(robot, &robot.nominal),
+        validation_orientation_rms_after: Spread::of(&after_rot),
+        validation_orientation_rms_predicted: c_pred
+            .as_ref()
+            .and_then(|c| validation.predicted_orientation_rms(robot, c)),
     })
 }
 

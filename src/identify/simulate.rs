@@ -1,13 +1,16 @@
-//! Simulated measurements: `y_i = p(θ_real, q_i) + ε_i`, `ε_i ~ N(0, σ² I₃)`.
+//! Simulated measurements: `y_i = p(θ_real, q_i) + ε_i`, `ε_i ~ N(0, σ² I₃)`,
+//! and for a full-pose robot `R_i = exp([η_i]×) R(θ_real, q_i)`,
+//! `η_i ~ N(0, (σ/w)² I₃)`, `w` = [`Robot::orientation_scale`].
 //!
 //! Normal deviates come from Box–Muller on the crate's ChaCha generator, not
 //! from `rand_distr`: the `rand_distr` in the registry (0.5) is built on
 //! `rand` 0.9's traits and does not accept a `rand` 0.10 generator, and two
 //! lines of Box–Muller are not worth a second `rand` in the build.
 
-use super::{Measurements, Result};
-use crate::kinematics::position;
-use crate::robot::{ParamTable, Robot};
+use super::{Measurements, Result, rows, so3};
+use crate::kinematics::pose;
+use crate::robot::{Measurement, ParamTable, Robot};
+use nalgebra::Vector3;
 use rand::{Rng, RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -37,7 +40,12 @@ pub(crate) fn fill_standard_normal<R: Rng + ?Sized>(rng: &mut R, out: &mut [f64]
 }
 
 /// Measurements of `table` (normally `robot.real`) at the joint vectors `qs`,
-/// with independent N(0, σ²) noise on every coordinate (σ = `sigma`, metres).
+/// with independent N(0, σ²) noise on every coordinate (σ = `sigma`, metres),
+/// and for a full-pose robot orientations turned by independent N(0, (σ/w)²)
+/// rotation vectors (radians, `w` = [`Robot::orientation_scale`]).
+///
+/// Draws: 3 normals per pose for points (x, y, z), 6 for full poses (x, y,
+/// z, then the rotation vector), in pose order.
 ///
 /// Errors on a joint vector that does not fit the robot or a `sigma` that is
 /// negative or not finite.
@@ -55,21 +63,26 @@ pub fn simulate<R: Rng + ?Sized>(
             reason: "the noise standard deviation must be finite and >= 0",
         });
     }
-    let mut noise = vec![0.0; 3 * qs.len()];
+    let t = robot.rows_per_pose();
+    let full = robot.measurement == Measurement::Pose;
+    let sigma_rot = sigma / robot.orientation_scale;
+    let mut noise = vec![0.0; t * qs.len()];
     fill_standard_normal(rng, &mut noise);
     let mut points = Vec::with_capacity(qs.len());
+    let mut orientations = Vec::new();
     for (i, q) in qs.iter().enumerate() {
         robot
             .check_q(q)
             .map_err(|source| super::IdentifyError::Pose { pose: i, source })?;
-        let p = position(robot, table, q);
-        points.push([
-            p.x + sigma * noise[3 * i],
-            p.y + sigma * noise[3 * i + 1],
-            p.z + sigma * noise[3 * i + 2],
-        ]);
+        let (rot, p) = pose(robot, table, q);
+        let z = &noise[t * i..t * (i + 1)];
+        points.push([p.x + sigma * z[0], p.y + sigma * z[1], p.z + sigma * z[2]]);
+        if full {
+            let eta = sigma_rot * Vector3::new(z[3], z[4], z[5]);
+            orientations.push(rows(&(so3::exp(&eta) * rot)));
+        }
     }
-    Measurements::new(robot, qs.to_vec(), points)
+    Measurements::with_orientations(robot, qs.to_vec(), points, orientations)
 }
 
 #[cfg(test)]

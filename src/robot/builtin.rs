@@ -91,6 +91,7 @@ fn assemble(
         unknowns,
         limits,
         measurement: m,
+        orientation_scale: super::DEFAULT_ORIENTATION_SCALE,
         visibility: None,
     };
     debug_assert!(r.validate().is_ok());

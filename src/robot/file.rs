@@ -5,6 +5,7 @@
 //! ```toml
 //! name = "puma560"            # optional; default: the file name
 //! measurement = "point"       # "point" (3 rows per pose) or "pose" (6 rows)
+//! # orientation_scale = 0.29  # pose only: metres per radian, σ_position / σ_orientation
 //! # unknowns = "auto"         # choose identifiable unknowns automatically
 //!
 //! [visibility]                # optional: see activecal::pool::Visibility
@@ -63,6 +64,7 @@ pub const MAX_ABS: f64 = 1e6;
 struct FileSpec {
     name: Option<String>,
     measurement: Option<Measurement>,
+    orientation_scale: Option<Spanned<f64>>,
     visibility: Option<Spanned<Visibility>>,
     unknowns: Option<Spanned<String>>,
     urdf: Option<Spanned<String>>,
@@ -150,6 +152,27 @@ pub fn parse(text: &str, origin: &str, dir: Option<&Path>) -> Result<Robot> {
     let cx = Ctx { text, origin };
     let spec: FileSpec = toml::from_str(text).map_err(|e| cx.plain(e.to_string().trim_end()))?;
     let measurement = spec.measurement.unwrap_or(Measurement::Point);
+    let orientation_scale = match &spec.orientation_scale {
+        None => crate::robot::DEFAULT_ORIENTATION_SCALE,
+        Some(s) if measurement != Measurement::Pose => {
+            return Err(cx.at(
+                s.span(),
+                "`orientation_scale` weighs orientation measurements: it needs `measurement = \"pose\"`",
+            ));
+        }
+        Some(s) => {
+            let v = *s.get_ref();
+            if !(v.is_finite() && v > 0.0 && v <= MAX_ABS) {
+                return Err(cx.at(
+                    s.span(),
+                    format!(
+                        "orientation_scale = {v}: must be a finite number > 0 (metres per radian)"
+                    ),
+                ));
+            }
+            v
+        }
+    };
     let auto = match &spec.unknowns {
         None => false,
         Some(u) if u.get_ref() == "auto" => true,
@@ -197,6 +220,7 @@ pub fn parse(text: &str, origin: &str, dir: Option<&Path>) -> Result<Robot> {
             r.name = n;
         }
         r.visibility = visibility;
+        r.orientation_scale = orientation_scale;
         return Ok(r);
     }
     if let Some(t) = &spec.tip {
@@ -315,6 +339,7 @@ pub fn parse(text: &str, origin: &str, dir: Option<&Path>) -> Result<Robot> {
         unknowns,
         limits,
         measurement,
+        orientation_scale,
         visibility,
     };
     if auto {
@@ -507,6 +532,9 @@ pub fn to_toml(robot: &Robot) -> String {
     s += "# activecal robot description (see activecal::robot::file)\n";
     s += &format!("name = {:?}\n", robot.name);
     s += &format!("measurement = \"{}\"\n", robot.measurement.name());
+    if robot.measurement == Measurement::Pose {
+        s += &format!("orientation_scale = {}\n", num(robot.orientation_scale));
+    }
     for (i, f) in robot.frames.iter().enumerate() {
         s += "\n[[frame]]\n";
         s += &format!("label = {:?}\n", f.label);

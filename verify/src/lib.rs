@@ -135,6 +135,7 @@ pub fn synthetic_robot() -> Robot {
             [-3.1, 3.1],
         ],
         measurement: Measurement::Point,
+        orientation_scale: activecal::robot::DEFAULT_ORIENTATION_SCALE,
         visibility: None,
     };
     robot.validate().expect("synthetic robot is valid");

@@ -1,0 +1,232 @@
+//! The whole command-line pipeline — `select`, `bound`, `gap` and
+//! `calibrate` — on every built-in arm and on imported URDFs, for point and
+//! for full-pose measurements: one test per robot, each going from a robot
+//! name or file to a calibrated model.
+//!
+//! Tolerances. Zero-noise calibration recovers the unknowns to ~1e-12 (the
+//! step tolerance is 1e-10 relative); 1e-8 separates that from a wrong
+//! residual or row, which stalls at ≥ 1e-6. The bound is solved to a gap of
+//! 1e-2 in ln det by the first-order solver alone (it is an upper bound at
+//! any gap; the exact solve is tested in `tests/bound.rs`), which keeps each
+//! robot's pipeline to a few seconds.
+
+use serde_json::Value;
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_activecal"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .output()
+        .expect("runs")
+}
+
+fn json_of(args: &[&str]) -> Value {
+    let out = run(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("one JSON object")
+}
+
+fn f(v: &Value, key: &str) -> f64 {
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{key} missing in {v}"))
+}
+
+/// A fresh scratch directory for one robot's files.
+fn scratch(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "activecal-cli-robots-{}-{}",
+        std::process::id(),
+        tag
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// select → bound → gap → calibrate (exact and noisy) for one robot with
+/// `p` unknowns. `exact`: the real robot differs from the nominal one in the
+/// unknowns only, so zero-noise calibration must return the real values;
+/// otherwise (a description with deviations in parameters that the minimal
+/// set absorbs) it must reproduce the real robot's positions.
+fn pipeline(robot: &str, tag: &str, pose: bool, p: usize) {
+    pipeline_with(robot, tag, pose, p, true);
+}
+
+fn pipeline_with(robot: &str, tag: &str, pose: bool, p: usize, exact: bool) {
+    let dir = scratch(tag);
+    let design = dir.join("design.json");
+    let d = design.to_str().unwrap();
+
+    // ---- select: a 30-pose design of the 3-level lattice, written to a file.
+    let sel = json_of(&[
+        "select", "--robot", robot, "--levels", "3", "--out", d, "--json",
+    ]);
+    assert_eq!(sel["poses"].as_array().unwrap().len(), 30, "{robot}");
+    let ln_oid = f(&sel, "ln_oid");
+    assert!(ln_oid.is_finite(), "{robot}: {sel}");
+    let file: Value = serde_json::from_str(&std::fs::read_to_string(&design).unwrap()).unwrap();
+    assert_eq!(file["robot"], robot);
+
+    // ---- bound over the same pool, and the design's gap to it.
+    let b = json_of(&[
+        "bound",
+        "--robot",
+        robot,
+        "--levels",
+        "3",
+        "--first-order",
+        "--gap-tol",
+        "1e-2",
+        "--json",
+    ]);
+    assert_eq!(b["p"].as_u64(), Some(p as u64), "{robot}");
+    let ln_bound = f(&b, "ln_bound");
+    assert!(
+        ln_bound >= ln_oid - 1e-9,
+        "{robot}: bound {ln_bound} < design {ln_oid}"
+    );
+    let g = json_of(&[
+        "gap",
+        "--design",
+        d,
+        "--first-order",
+        "--gap-tol",
+        "1e-2",
+        "--json",
+    ]);
+    let eff = f(&g, "d_efficiency");
+    assert!(eff > 0.0 && eff <= 1.0, "{robot}: D-efficiency {eff}");
+    println!("{robot}: p = {p}, ln OI_D {ln_oid:.3} ≤ bound {ln_bound:.3}, D-eff {eff:.4}");
+
+    // ---- calibrate without noise: the real unknowns, exactly.
+    let c = json_of(&[
+        "calibrate",
+        "--robot",
+        robot,
+        "--design",
+        d,
+        "--noise",
+        "0",
+        "--validation",
+        "50",
+        "--json",
+    ]);
+    assert_eq!(c["converged"], true, "{robot}: {c}");
+    assert_eq!(c["measurement"], if pose { "pose" } else { "point" });
+    let residual = c["residual"].as_object().unwrap();
+    assert_eq!(residual.len(), p);
+    let worst = residual
+        .values()
+        .map(|v| v.as_f64().unwrap().abs())
+        .fold(0.0, f64::max);
+    if exact {
+        assert!(worst < 1e-8, "{robot}: max |real − estimate| {worst:e}");
+    }
+    assert!(f(&c, "rss") < 1e-16, "{robot}: rss {}", c["rss"]);
+    assert!(f(&c, "validation_rms_after") < 1e-8, "{robot}");
+    assert!(f(&c, "validation_rms_before") > 1e-4, "{robot}");
+    if pose {
+        assert!(f(&c, "validation_orientation_rms_after") < 1e-8, "{robot}");
+        assert!(f(&c, "validation_orientation_rms_before") > 1e-4, "{robot}");
+    } else {
+        assert!(c["validation_orientation_rms_after"].is_null(), "{robot}");
+    }
+
+    // ---- calibrate with 0.2 mm noise, a few Monte-Carlo trials: the error
+    // after calibration is what the covariance predicts (within 50% on 10
+    // trials × 50 poses) and far below the nominal model's.
+    let c = json_of(&[
+        "calibrate",
+        "--robot",
+        robot,
+        "--design",
+        d,
+        "--noise",
+        "0.0002",
+        "--trials",
+        "10",
+        "--validation",
+        "50",
+        "--json",
+    ]);
+    let mc = &c["monte_carlo"];
+    assert_eq!(mc["converged"], 10, "{robot}: {mc}");
+    let after = f(&mc["validation_rms_after"], "median");
+    let predicted = f(mc, "validation_rms_predicted");
+    assert!(
+        (after / predicted - 1.0).abs() < 0.5,
+        "{robot}: {after} vs predicted {predicted}"
+    );
+    assert!(after < 0.2 * f(mc, "validation_rms_before"), "{robot}");
+    if pose {
+        let after = f(&mc["validation_orientation_rms_after"], "median");
+        let predicted = f(mc, "validation_orientation_rms_predicted");
+        assert!(
+            (after / predicted - 1.0).abs() < 0.5,
+            "{robot}: orientation {after} vs predicted {predicted}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn puma560_point() {
+    pipeline("puma560", "puma", false, 27);
+}
+
+#[test]
+fn puma560_pose() {
+    pipeline("puma560:pose", "puma-pose", true, 30);
+}
+
+#[test]
+fn ur5_point() {
+    pipeline("ur5", "ur5", false, 27);
+}
+
+#[test]
+fn ur5_pose() {
+    pipeline("ur5:pose", "ur5-pose", true, 30);
+}
+
+#[test]
+fn stanford_point() {
+    pipeline("stanford", "stanford", false, 25);
+}
+
+#[test]
+fn stanford_pose() {
+    pipeline("stanford:pose", "stanford-pose", true, 28);
+}
+
+#[test]
+fn imported_ur5_urdf_point() {
+    pipeline("fixtures/ur5.urdf", "ur5-urdf", false, 27);
+}
+
+#[test]
+fn imported_stanford_urdf_point() {
+    pipeline("fixtures/stanford.urdf", "stanford-urdf", false, 25);
+}
+
+/// A description that imports `ur5.urdf` with full-pose measurements and a
+/// visibility region.
+#[test]
+fn imported_ur5_urdf_pose() {
+    pipeline("fixtures/ur5_pose.toml", "ur5-urdf-pose", true, 30);
+}
+
+/// The hand-written SCARA description: parallel axes, a prismatic quill,
+/// and real deviations in parameters outside the automatic minimal set
+/// (which the unknowns absorb: the fit is exact, the values differ).
+#[test]
+fn scara_description_point() {
+    pipeline_with("fixtures/scara.toml", "scara", false, 17, false);
+}

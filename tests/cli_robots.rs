@@ -230,3 +230,221 @@ fn imported_ur5_urdf_pose() {
 fn scara_description_point() {
     pipeline_with("fixtures/scara.toml", "scara", false, 17, false);
 }
+
+/// Fails with exit code 1 or 2 (clap), a message containing `needle`, and no panic.
+fn fails_with(args: &[&str], needle: &str) {
+    let out = run(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        matches!(out.status.code(), Some(1 | 2)),
+        "{args:?}: status {:?}",
+        out.status
+    );
+    assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
+    assert!(err.contains(needle), "{args:?}: '{err}' lacks '{needle}'");
+}
+
+/// Real data: simulated full-pose measurements saved to a file and
+/// calibrated from it give the same estimate as the simulation run; the
+/// calibrated robot written as a description reproduces the real robot;
+/// nothing is overwritten without `--force`; bad measurement files are
+/// clear errors naming the file.
+#[test]
+fn calibrate_from_a_measurement_file_and_write_the_calibrated_robot() {
+    let dir = scratch("measurements");
+    let path = |n: &str| dir.join(n).to_str().unwrap().to_string();
+    let (design, meas, out1, out2) = (
+        path("d.json"),
+        path("m.json"),
+        path("cal1.toml"),
+        path("cal2.toml"),
+    );
+    json_of(&[
+        "select", "--robot", "ur5:pose", "--levels", "3", "--out", &design, "--json",
+    ]);
+    let sim = json_of(&[
+        "calibrate",
+        "--robot",
+        "ur5:pose",
+        "--design",
+        &design,
+        "--noise",
+        "0.001",
+        "--validation",
+        "20",
+        "--save-measurements",
+        &meas,
+        "--out",
+        &out1,
+        "--json",
+    ]);
+    let real = json_of(&[
+        "calibrate",
+        "--robot",
+        "ur5:pose",
+        "--measurements",
+        &meas,
+        "--out",
+        &out2,
+        "--json",
+    ]);
+    assert_eq!(real["converged"], true);
+    assert_eq!(real["poses"], 30);
+    // Same data, same solver: the same estimate to the last bit (JSON
+    // numbers round-trip f64 exactly).
+    assert_eq!(sim["estimate"], real["estimate"]);
+    assert_eq!(sim["std"], real["std"]);
+    assert!(f(&real, "rms_residual") < f(&real, "initial_rms_residual"));
+    // Both written models are the same robot; with 1 mm noise its positions
+    // are within a few mm of the real robot's (the nominal is ~1 cm off).
+    assert_eq!(
+        std::fs::read_to_string(&out1)
+            .unwrap()
+            .lines()
+            .skip(2)
+            .collect::<Vec<_>>(),
+        std::fs::read_to_string(&out2)
+            .unwrap()
+            .lines()
+            .skip(2)
+            .collect::<Vec<_>>()
+    );
+    let q = "0.3,-1.1,0.7,0.2,-0.5,1.0";
+    let fk = |robot: &str, params: &str| -> Vec<f64> {
+        let v = json_of(&[
+            "fk", "--robot", robot, "--q", q, "--params", params, "--json",
+        ]);
+        v["position"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    let (cal, truth, nominal) = (
+        fk(&out2, "nominal"),
+        fk("ur5:pose", "real"),
+        fk("ur5:pose", "nominal"),
+    );
+    let dist = |a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    };
+    println!(
+        "calibrated model {:.2e} m from the real robot, nominal {:.2e} m",
+        dist(&cal, &truth),
+        dist(&nominal, &truth)
+    );
+    assert!(dist(&cal, &truth) < 0.3 * dist(&nominal, &truth));
+
+    // Nothing is overwritten without asking, and the refusal comes first.
+    let before = std::fs::read_to_string(&out2).unwrap();
+    fails_with(
+        &[
+            "calibrate",
+            "--robot",
+            "ur5:pose",
+            "--measurements",
+            &meas,
+            "--out",
+            &out2,
+        ],
+        "pass --force",
+    );
+    assert_eq!(std::fs::read_to_string(&out2).unwrap(), before);
+    json_of(&[
+        "calibrate",
+        "--robot",
+        "ur5:pose",
+        "--measurements",
+        &meas,
+        "--out",
+        &out2,
+        "--force",
+        "--json",
+    ]);
+
+    // Bad measurement files.
+    let text = std::fs::read_to_string(&meas).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let bad = |name: &str, body: String| {
+        let p = path(name);
+        std::fs::write(&p, body).unwrap();
+        p
+    };
+    let not_json = bad("broken.json", text[..text.len() / 2].to_string());
+    fails_with(
+        &[
+            "calibrate",
+            "--robot",
+            "ur5:pose",
+            "--measurements",
+            &not_json,
+        ],
+        "broken.json: EOF",
+    );
+    let typo = bad("typo.json", text.replacen("\"points\"", "\"pionts\"", 1));
+    fails_with(
+        &["calibrate", "--robot", "ur5:pose", "--measurements", &typo],
+        "unknown field `pionts`",
+    );
+    v["orientations"][4][0][0] = serde_json::json!(-1.0);
+    let reflected = bad("reflected.json", v.to_string());
+    fails_with(
+        &[
+            "calibrate",
+            "--robot",
+            "ur5:pose",
+            "--measurements",
+            &reflected,
+        ],
+        "measurement 4: the orientation is not a rotation matrix",
+    );
+    fails_with(
+        &["calibrate", "--robot", "ur5", "--measurements", &meas],
+        "m.json: the measurements are of robot 'ur5:pose', not 'ur5'",
+    );
+    // Without the robot's name the file is checked on its content alone.
+    let mut anon: serde_json::Value = serde_json::from_str(&text).unwrap();
+    anon.as_object_mut().unwrap().remove("robot");
+    let anon = bad("anonymous.json", anon.to_string());
+    fails_with(
+        &["calibrate", "--robot", "ur5", "--measurements", &anon],
+        "anonymous.json: robot 'ur5' measures points",
+    );
+    json_of(&[
+        "calibrate",
+        "--robot",
+        "ur5:pose",
+        "--measurements",
+        &anon,
+        "--json",
+    ]);
+    fails_with(
+        &[
+            "calibrate",
+            "--robot",
+            "puma560:pose",
+            "--measurements",
+            &meas,
+        ],
+        "m.json: the measurements are of robot 'ur5:pose', not 'puma560:pose'",
+    );
+    fails_with(
+        &[
+            "calibrate",
+            "--robot",
+            "ur5:pose",
+            "--measurements",
+            &meas,
+            "--trials",
+            "5",
+        ],
+        "cannot be used with",
+    );
+    fails_with(&["calibrate", "--robot", "ur5:pose"], "--design");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,18 +1,21 @@
 //! `calibrate`: simulate measurements at a design's poses, identify the
 //! unknowns from the nominal parameters, validate on held-out poses, and
-//! optionally repeat over noise realisations (Monte-Carlo).
+//! optionally repeat over noise realisations (Monte-Carlo); or identify from
+//! a file of real measurements. Either way the calibrated robot can be
+//! written as a description file.
 
-use super::{emit, load_robot};
+use super::{emit, load_robot, refuse_overwrite, write_new};
 use activecal::design::DesignFile;
 use activecal::identify::{
-    LmSettings, MonteCarloSettings, MonteCarloSummary, ValidationSet, monte_carlo, paper_tables,
+    Identification, LmSettings, Measurements, MonteCarloSettings, MonteCarloSummary, ParamGrid,
+    ValidationSet, identify, monte_carlo, paper_tables, simulate, trial_rng,
 };
 use activecal::pool::Pool;
-use activecal::robot::Measurement;
-use anyhow::Result;
+use activecal::robot::{Measurement, Robot, file};
+use anyhow::{Result, bail};
 use clap::Args;
 use serde_json::{Map, Value, json};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Arguments of the command.
@@ -21,9 +24,26 @@ pub struct CalibrateArgs {
     /// Robot: a built-in name, or a .toml description or .urdf file.
     #[arg(long, default_value = "puma560")]
     pub robot: String,
-    /// Design file (JSON with robot, levels, poses), as written by `select`.
+    /// Design file (JSON with robot, levels, poses), as written by `select`:
+    /// measurements are simulated there.
+    #[arg(long, required_unless_present = "measurements")]
+    pub design: Option<PathBuf>,
+    /// Measurement file (JSON: `qs`, `points` and, for full-pose robots,
+    /// `orientations` as row-major rotation matrices): identify from these
+    /// real measurements instead of simulating a design.
+    #[arg(long, conflicts_with_all = ["design", "trials", "save_measurements"])]
+    pub measurements: Option<PathBuf>,
+    /// Write the simulated measurements (trial 0 of the seed) to this JSON
+    /// file, in the format `--measurements` reads.
     #[arg(long)]
-    pub design: PathBuf,
+    pub save_measurements: Option<PathBuf>,
+    /// Write the calibrated robot as a description (TOML) whose nominal and
+    /// real tables are the estimate.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Replace existing output files.
+    #[arg(long)]
+    pub force: bool,
     /// Measurement noise σ per coordinate, metres. A full-pose robot's
     /// orientation noise is σ / orientation_scale radians per axis.
     #[arg(long, default_value_t = 0.01)]
@@ -58,15 +78,136 @@ fn named(names: &[String], values: &[f64]) -> Value {
     Value::Object(m)
 }
 
+/// The robot calibrated by `id`, as a description: both tables are the
+/// estimate (the best knowledge of the real robot).
+fn calibrated_description(robot: &Robot, id: &Identification, source: &str) -> String {
+    let mut r = robot.clone();
+    r.nominal = id.table.clone();
+    r.real = id.table.clone();
+    let header = format!(
+        "# Calibrated by activecal from {source}: nominal = real = the estimate\n# ({:?}, {} iterations, σ̂ = {}).\n",
+        id.status,
+        id.iterations,
+        id.sigma_hat.map_or("-".into(), |v| format!("{v:.6e}"))
+    );
+    header + &file::to_toml(&r)
+}
+
 /// Runs `calibrate`.
 pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
-    let t0 = Instant::now();
+    for path in [&a.out, &a.save_measurements].into_iter().flatten() {
+        refuse_overwrite(path, a.force)?;
+    }
     let robot = load_robot(&a.robot)?;
-    let design = DesignFile::read(&a.design)?;
+    match (&a.design, &a.measurements) {
+        (_, Some(m)) => from_measurements(&a, &robot, m),
+        (Some(d), None) => from_design(&a, &robot, d),
+        (None, None) => bail!("give --design (simulate) or --measurements (real data)"),
+    }
+}
+
+/// Identification from a measurement file.
+fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()> {
+    let t0 = Instant::now();
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
+    let meas: Measurements =
+        serde_json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    meas.check(robot)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let lm = LmSettings::default()
+        .with_max_iterations(a.max_iterations)
+        .with_geodesic(!a.no_geodesic);
+    let id = identify(robot, &robot.nominal, &meas, &lm)?;
+    if let Some(out) = &a.out {
+        write_new(
+            out,
+            &calibrated_description(robot, &id, &path.display().to_string()),
+            a.force,
+        )?;
+    }
+    let names = &id.names;
+    let rows = (robot.rows_per_pose() * meas.len()) as f64;
+    let v = json!({
+        "robot": robot.name,
+        "measurements": path.display().to_string(),
+        "poses": meas.len(),
+        "measurement": robot.measurement,
+        "status": id.status,
+        "stop": id.stop,
+        "converged": id.converged(),
+        "iterations": id.iterations,
+        "evaluations": id.evaluations,
+        "estimate": named(names, &id.estimate),
+        "change": named(names, &id.estimate.iter().zip(&id.start).map(|(e, s)| e - s).collect::<Vec<_>>()),
+        "std": id.covariance.as_ref().map(|c| named(names, &c.std)),
+        "correlation": id.covariance.as_ref().map(|c| &c.correlation),
+        "sigma_hat": id.sigma_hat,
+        "rss": id.rss,
+        "initial_rss": id.initial_rss,
+        "rms_residual": (id.rss / rows).sqrt(),
+        "initial_rms_residual": (id.initial_rss / rows).sqrt(),
+        "rank": id.rank,
+        "unidentifiable": id.unidentifiable,
+        "out": a.out.as_ref().map(|p| p.display().to_string()),
+        "elapsed_seconds": t0.elapsed().as_secs_f64(),
+    });
+    emit(a.json, &v, || {
+        let mut s = format!(
+            "{}: {} measured {}s\n{}",
+            path.display(),
+            meas.len(),
+            robot.measurement.name(),
+            status_text(&id)
+        );
+        s += &format!(
+            "RMS weighted residual per row: {:.6e} (nominal model {:.6e})\n",
+            (id.rss / rows).sqrt(),
+            (id.initial_rss / rows).sqrt()
+        );
+        s += "\nestimate\n";
+        s += &ParamGrid::from_unknowns(robot, &id.estimate).to_text(6);
+        if let Some(c) = &id.covariance {
+            s += "\nstandard deviation (σ̂² (XᵀX)⁻¹)\n";
+            s += &ParamGrid::from_unknowns(robot, &c.std).to_text(6);
+        }
+        if let Some(out) = &a.out {
+            s += &format!("\ncalibrated robot written to {}\n", out.display());
+        }
+        s
+    });
+    Ok(())
+}
+
+/// Status, residual sum of squares, σ̂, rank and unidentifiable unknowns.
+fn status_text(id: &Identification) -> String {
+    let mut s = format!(
+        "status: {:?} ({:?}) after {} iterations, {} evaluations\n",
+        id.status, id.stop, id.iterations, id.evaluations
+    );
+    s += &format!(
+        "rss {:.6e} (start {:.6e}), σ̂ = {}, rank {}/{}\n",
+        id.rss,
+        id.initial_rss,
+        id.sigma_hat.map_or("-".into(), |v| format!("{v:.6}")),
+        id.rank,
+        id.names.len()
+    );
+    if !id.unidentifiable.is_empty() {
+        s += &format!("unidentifiable: {}\n", id.unidentifiable.join(" "));
+    }
+    s
+}
+
+/// Simulated calibration at a design's poses.
+fn from_design(a: &CalibrateArgs, robot: &Robot, design_path: &Path) -> Result<()> {
+    let t0 = Instant::now();
+    let robot = robot.clone();
+    let design = DesignFile::read(design_path)?;
     if design.robot != robot.name {
         anyhow::bail!(
             "{}: the design is for robot '{}', not '{}'",
-            a.design.display(),
+            design_path.display(),
             design.robot,
             robot.name
         );
@@ -74,7 +215,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     let pool = Pool::full(&robot, design.levels)?;
     let positions = design
         .positions_in(&robot, &pool)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?;
+        .map_err(|e| anyhow::anyhow!("{}: {e}", design_path.display()))?;
     let qs: Vec<Vec<f64>> = positions.iter().map(|&k| pool.q(k)).collect();
     let lm = LmSettings::default()
         .with_max_iterations(a.max_iterations)
@@ -91,6 +232,16 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     // ---- one calibration: trial 0 of the seed --------------------------------
     let tables = paper_tables(&robot, &qs, a.noise, a.seed, &settings.lm)?;
     let id = &tables.identification;
+    if let Some(path) = &a.save_measurements {
+        // The same draw as trial 0 of the seed, which `paper_tables` used.
+        let meas = simulate(&robot, &robot.real, &qs, a.noise, &mut trial_rng(a.seed, 0))?;
+        let text = serde_json::to_string_pretty(&meas)? + "\n";
+        write_new(path, &text, a.force)?;
+    }
+    if let Some(out) = &a.out {
+        let source = format!("simulated measurements at {}", design_path.display());
+        write_new(out, &calibrated_description(&robot, id, &source), a.force)?;
+    }
     let names = &id.names;
     let truth = robot.unknown_values(&robot.real);
     let residual: Vec<f64> = truth.iter().zip(&id.estimate).map(|(t, e)| t - e).collect();
@@ -103,8 +254,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     // ---- Monte-Carlo ------------------------------------------------------------
     let t_mc = Instant::now();
     let mc: Option<MonteCarloSummary> = if a.trials > 1 {
-        let name = a
-            .design
+        let name = design_path
             .file_stem()
             .map_or("design".into(), |s| s.to_string_lossy().into_owned());
         Some(monte_carlo(&robot, &name, &qs, &validation, &settings)?)
@@ -115,7 +265,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
 
     let v = json!({
         "robot": robot.name,
-        "design": a.design.display().to_string(),
+        "design": design_path.display().to_string(),
         "poses": qs.len(),
         "measurement": robot.measurement,
         "noise": a.noise,
@@ -155,26 +305,12 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
             format!("σ = {} m", a.noise)
         };
         let mut s = format!(
-            "{}: {} poses, {noise}, seed {}\nstatus: {:?} ({:?}) after {} iterations, {} evaluations\n",
-            a.design.display(),
+            "{}: {} poses, {noise}, seed {}\n{}",
+            design_path.display(),
             qs.len(),
             a.seed,
-            id.status,
-            id.stop,
-            id.iterations,
-            id.evaluations
+            status_text(id)
         );
-        s += &format!(
-            "rss {:.6e} (start {:.6e}), σ̂ = {}, rank {}/{}\n",
-            id.rss,
-            id.initial_rss,
-            id.sigma_hat.map_or("-".into(), |v| format!("{v:.6}")),
-            id.rank,
-            names.len()
-        );
-        if !id.unidentifiable.is_empty() {
-            s += &format!("unidentifiable: {}\n", id.unidentifiable.join(" "));
-        }
         s += "\nestimate (Table III)\n";
         s += &tables.estimate.to_text(6);
         s += "\nresidual = real − estimate (Table IV)\n";

@@ -34,6 +34,22 @@ pub fn load_robot(name: &str) -> Result<Robot> {
     Ok(r)
 }
 
+/// Errors if `path` exists and `force` is not set: nothing the user has is
+/// replaced without asking. Checked before any work is done.
+pub fn refuse_overwrite(path: &std::path::Path, force: bool) -> Result<()> {
+    if path.exists() && !force {
+        anyhow::bail!("{} exists; pass --force to overwrite it", path.display());
+    }
+    Ok(())
+}
+
+/// Writes `text` to `path` (see [`refuse_overwrite`]), naming the file in
+/// any error.
+pub fn write_new(path: &std::path::Path, text: &str, force: bool) -> Result<()> {
+    refuse_overwrite(path, force)?;
+    std::fs::write(path, text).map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))
+}
+
 /// Prints `value` as one JSON line, or the human-readable `text`.
 pub fn emit(json_out: bool, value: &Value, text: impl FnOnce() -> String) {
     use std::io::Write;

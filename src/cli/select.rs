@@ -132,9 +132,7 @@ pub fn run_selection(
 /// Runs `select`.
 pub fn cmd_select(a: SelectArgs) -> Result<()> {
     if let Some(out) = &a.out {
-        if out.exists() && !a.force {
-            bail!("{} exists; pass --force to overwrite it", out.display());
-        }
+        super::refuse_overwrite(out, a.force)?;
     }
     let alg = Algorithm::parse(&a.algorithm)?;
     let ctx = a.pool.load()?;

@@ -144,12 +144,15 @@ pub const ROTATION_TOLERANCE: f64 = 1e-6;
 /// and one rotation matrix per pose exactly when the robot measures full
 /// poses.
 ///
-/// In JSON: `{"qs": [[q1, …], …], "points": [[x, y, z], …],
-/// "orientations": [[[r00, r01, r02], [r10, …], [r20, …]], …]}` (metres,
-/// radians; orientations row-major, base frame, omitted for points).
+/// In JSON: `{"robot": "name", "qs": [[q1, …], …], "points": [[x, y, z],
+/// …], "orientations": [[[r00, r01, r02], [r10, …], [r20, …]], …]}`
+/// (metres, radians; orientations row-major, base frame, omitted for
+/// points; `robot` optional, checked against the robot when present).
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Measurements {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    robot: Option<String>,
     qs: Vec<Vec<f64>>,
     points: Vec<[f64; 3]>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -191,6 +194,7 @@ impl Measurements {
         orientations: Vec<[[f64; 3]; 3]>,
     ) -> Result<Self> {
         let m = Self {
+            robot: None,
             qs,
             points,
             orientations,
@@ -201,6 +205,14 @@ impl Measurements {
 
     /// Re-checks the measurements against a robot (done by [`identify`]).
     pub fn check(&self, robot: &Robot) -> Result<()> {
+        if let Some(name) = &self.robot {
+            if *name != robot.name {
+                return Err(IdentifyError::Model(Error::Invalid(format!(
+                    "the measurements are of robot '{name}', not '{}'",
+                    robot.name
+                ))));
+            }
+        }
         if self.qs.len() != self.points.len() {
             return Err(IdentifyError::MeasurementCount {
                 poses: self.qs.len(),
@@ -244,6 +256,20 @@ impl Measurements {
                 .map_err(|reason| IdentifyError::NotARotation { pose: i, reason })?;
         }
         Ok(())
+    }
+
+    /// Records the robot's name, so that [`Measurements::check`] refuses the
+    /// measurements for another robot (as [`simulate`] does).
+    #[must_use]
+    pub fn of_robot(mut self, name: &str) -> Self {
+        self.robot = Some(name.to_string());
+        self
+    }
+
+    /// The robot's name, if recorded.
+    #[must_use]
+    pub fn robot(&self) -> Option<&str> {
+        self.robot.as_deref()
     }
 
     /// Number of measured poses.

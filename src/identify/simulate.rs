@@ -82,7 +82,10 @@ pub fn simulate<R: Rng + ?Sized>(
             orientations.push(rows(&(so3::exp(&eta) * rot)));
         }
     }
-    Measurements::with_orientations(robot, qs.to_vec(), points, orientations)
+    Ok(
+        Measurements::with_orientations(robot, qs.to_vec(), points, orientations)?
+            .of_robot(&robot.name),
+    )
 }
 
 #[cfg(test)]

@@ -116,3 +116,49 @@ def mujoco_eval(mjcf, qs):
         mujoco.mj_jacSite(model, data, jacp, None, sid)
         jacobians.append(jacp[:, vadr].reshape(-1).tolist())
     return positions, jacobians
+
+
+def urdf_leaf_link(path):
+    """The URDF's one leaf link (a child of some joint, parent of none), read
+    with the standard library's XML parser, independently of activecal."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(path).getroot()
+    parents = {j.find("parent").get("link") for j in root.iter("joint")}
+    children = [j.find("child").get("link") for j in root.iter("joint")]
+    leaves = [c for c in children if c not in parents]
+    if len(leaves) != 1:
+        raise ValueError("%s: expected one leaf link, found %s" % (path, leaves))
+    return leaves[0]
+
+
+def pinocchio_urdf_eval(path, qs):
+    """Pinocchio loading a URDF file itself (buildModelFromUrdf): the leaf
+    link's placement in the root frame at each joint vector (actuated joints
+    in chain order; a continuous joint's q enters as (cos q, sin q)).
+    Returns the leaf's name and, per q, (rotation row-major 3x3, position)."""
+    model = pin.buildModelFromUrdf(path)
+    data = model.createData()
+    tip = urdf_leaf_link(path)
+    fid = model.getFrameId(tip)
+    if fid >= len(model.frames):
+        raise ValueError("Pinocchio has no frame for link %s" % tip)
+    joints = list(model.joints)[1:]
+    out = []
+    for q in qs:
+        if len(q) != len(joints):
+            raise ValueError("%d joint values for %d joints" % (len(q), len(joints)))
+        x = np.zeros(model.nq)
+        for j, v in zip(joints, q):
+            if j.nq == 1:
+                x[j.idx_q] = v
+            elif j.nq == 2:
+                x[j.idx_q] = np.cos(v)
+                x[j.idx_q + 1] = np.sin(v)
+            else:
+                raise ValueError("unsupported joint with nq = %d" % j.nq)
+        pin.forwardKinematics(model, data, x)
+        pin.updateFramePlacements(model, data)
+        m = data.oMf[fid]
+        out.append((m.rotation.tolist(), m.translation.tolist()))
+    return tip, out

@@ -156,6 +156,38 @@ impl Bridge {
     }
 }
 
+/// Poses of a URDF's leaf link computed by Pinocchio from the file itself.
+#[derive(Clone, Debug)]
+pub struct UrdfPoses {
+    /// The leaf link's name (found by the bridge from the XML, not by us).
+    pub tip: String,
+    /// Per joint vector: the rotation (row-major) and position of the leaf
+    /// link in the root link's frame.
+    pub poses: Vec<([[f64; 3]; 3], [f64; 3])>,
+}
+
+impl Bridge {
+    /// Pinocchio's `buildModelFromUrdf` on `path`, evaluated at `qs` (joint
+    /// values in chain order): the leaf link's placement.
+    pub fn pinocchio_urdf(&self, path: &Path, qs: &[Vec<f64>]) -> Result<UrdfPoses> {
+        Python::attach(|py| {
+            let r = module(py)?
+                .getattr("pinocchio_urdf_eval")?
+                .call1((path.to_string_lossy().as_ref(), qs.to_vec()))
+                .with_context(|| format!("Pinocchio loading {}", path.display()))?;
+            let (tip, poses): (String, Vec<([[f64; 3]; 3], [f64; 3])>) = r.extract()?;
+            if poses.len() != qs.len() {
+                bail!(
+                    "bridge returned {} poses for {} joint vectors",
+                    poses.len(),
+                    qs.len()
+                );
+            }
+            Ok(UrdfPoses { tip, poses })
+        })
+    }
+}
+
 fn unpack(r: &Bound<'_, PyAny>, dof: usize, n: usize) -> Result<Kinematics> {
     let (position, jacobian): (Vec<[f64; 3]>, Vec<Vec<f64>>) = r.extract()?;
     if position.len() != n || jacobian.len() != n || jacobian.iter().any(|j| j.len() != 3 * dof) {

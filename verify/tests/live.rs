@@ -2,8 +2,8 @@
 //! activecal's end-point position and joint Jacobian against Pinocchio and
 //! MuJoCo over 1,000 random configurations within the joint limits plus all
 //! `2^dof` limit corners, at both parameter sets, for every built-in robot
-//! and a synthetic 7-joint one; and the committed fixtures against a fresh
-//! regeneration. Tolerance: [`verify::TOLERANCE`] (1e-12 m, justified there).
+//! and a synthetic 7-joint one; URDF imports against Pinocchio loading the
+//! same URDF file; and the committed fixtures against a fresh regeneration. Tolerance: [`verify::TOLERANCE`] (1e-12 m, justified there).
 
 use activecal::robot::{ParamSet, Robot, Symbol};
 use verify::bridge::Bridge;
@@ -93,6 +93,49 @@ fn committed_fixtures_match_a_fresh_regeneration() {
             assert_eq!(file.configurations(), fresh.configurations(), "{stale}");
             let d = deviation(&file.kinematics(), &fresh.kinematics()).unwrap();
             assert!(d.within(TOLERANCE), "{stale}: {d:?}");
+        }
+    }
+}
+
+/// URDF import against Pinocchio loading the same file
+/// (`buildModelFromUrdf`): our imported model's end frame — position and
+/// orientation — equals the URDF's leaf link at 1,000 random configurations
+/// plus the limit corners, for each URDF fixture, point and full-pose
+/// imports alike. Same tolerance as the other live checks.
+#[test]
+fn urdf_imports_agree_with_pinocchio_loading_the_urdf() {
+    use activecal::kinematics::pose;
+    use activecal::robot::Measurement;
+    use activecal::urdf::{UrdfOptions, load};
+    let bridge = Bridge::new().unwrap();
+    let dir = fixture::default_dir();
+    for name in ["puma560.urdf", "ur5.urdf", "stanford.urdf"] {
+        let path = dir.join(name);
+        for m in [Measurement::Point, Measurement::Pose] {
+            let opts = UrdfOptions {
+                measurement: m,
+                ..UrdfOptions::default()
+            };
+            let robot = load(&path, &opts).unwrap();
+            let qs = configurations(&robot, LIVE_RANDOM, LIVE_SEED);
+            let lib = bridge.pinocchio_urdf(&path, &qs).unwrap();
+            let (mut dp, mut dr) = (0.0f64, 0.0f64);
+            for (q, (rot, pos)) in qs.iter().zip(&lib.poses) {
+                let (r, p) = pose(&robot, &robot.nominal, q);
+                for i in 0..3 {
+                    dp = dp.max((p[i] - pos[i]).abs());
+                    for j in 0..3 {
+                        dr = dr.max((r[(i, j)] - rot[i][j]).abs());
+                    }
+                }
+            }
+            println!(
+                "{name} ({}): tip '{}', {} configurations, max |Δp| {dp:.2e} m, max |ΔR| {dr:.2e}",
+                m.name(),
+                lib.tip,
+                qs.len()
+            );
+            assert!(dp < TOLERANCE && dr < TOLERANCE, "{name}: {dp:e} m, {dr:e}");
         }
     }
 }

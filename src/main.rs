@@ -24,7 +24,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// List the built-in robots with their parameter tables.
+    /// List the built-in robots with their parameter tables, or export a
+    /// robot as a description file.
     Robots(RobotsArgs),
     /// Forward kinematics (and identification Jacobian) at one joint vector.
     Fk(FkArgs),
@@ -38,7 +39,8 @@ enum Command {
     Bench(BenchArgs),
     /// Reproduce the paper's experiment: report, tables and figures.
     Reproduce(ReproduceArgs),
-    /// Simulate a calibration of a design (identification, validation, Monte-Carlo).
+    /// Calibrate: simulated at a design (identification, validation,
+    /// Monte-Carlo) or from a file of measurements.
     Calibrate(CalibrateArgs),
     /// Certified upper bound on OI_D of every N-pose design (convex relaxation).
     Bound(BoundArgs),

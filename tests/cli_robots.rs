@@ -448,3 +448,54 @@ fn calibrate_from_a_measurement_file_and_write_the_calibrated_robot() {
     fails_with(&["calibrate", "--robot", "ur5:pose"], "--design");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `robots --export` writes a description that loads back as the same robot;
+/// editing its `orientation_scale` changes the design criterion the way the
+/// weighting says (orientation rows × w), and exports never overwrite
+/// without `--force`.
+#[test]
+fn exported_descriptions_load_and_carry_the_orientation_scale() {
+    let dir = scratch("export");
+    let file = dir.join("ur5pose.toml");
+    let f_str = file.to_str().unwrap();
+    let out = run(&["robots", "--export", "ur5:pose", "--out", f_str]);
+    assert!(out.status.success() && out.stdout.is_empty());
+    let text = std::fs::read_to_string(&file).unwrap();
+    assert!(text.contains("orientation_scale = 1.0"), "{text}");
+    let score = |robot: &str| {
+        let v = json_of(&[
+            "score",
+            "--robot",
+            robot,
+            "--levels",
+            "3",
+            "--poses",
+            "0,5,17,40,77,101,150,222,300,333,400,444,500,555,600,650,700,710,720,728",
+            "--json",
+        ]);
+        f(&v, "ln_oid")
+    };
+    let builtin = score("ur5:pose");
+    assert_eq!(score(f_str), builtin, "the export is the same robot");
+    std::fs::write(
+        &file,
+        text.replace("orientation_scale = 1.0", "orientation_scale = 0.5"),
+    )
+    .unwrap();
+    let weighted = score(f_str);
+    // Halving the orientation rows lowers ln det XᵀX, and by at most
+    // 2p ln 2 (XᵀD²X ⪰ w² XᵀX with D = diag(1, 1, 1, w, w, w), p = 30).
+    assert!(weighted < builtin - 1.0, "{weighted} vs {builtin}");
+    assert!(weighted > builtin - 30.0 * 2.0 * std::f64::consts::LN_2);
+    fails_with(
+        &["robots", "--export", "ur5", "--out", f_str],
+        "pass --force",
+    );
+    assert!(
+        std::fs::read_to_string(&file)
+            .unwrap()
+            .contains("orientation_scale = 0.5")
+    );
+    fails_with(&["robots", "--export", "nosuch"], "unknown robot 'nosuch'");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -11,8 +11,19 @@ use serde_json::{Value, json};
 /// Arguments of the command.
 #[derive(Args)]
 pub struct RobotsArgs {
+    /// Write this robot (a built-in name, a .toml description or a .urdf
+    /// file) as a description file to start your own from: edit its tables,
+    /// unknowns, limits or `orientation_scale`, then pass it as `--robot`.
+    #[arg(long, value_name = "ROBOT")]
+    pub export: Option<String>,
+    /// File for `--export` (default: standard output).
+    #[arg(long, requires = "export")]
+    pub out: Option<std::path::PathBuf>,
+    /// Replace an existing `--out` file.
+    #[arg(long, requires = "out")]
+    pub force: bool,
     /// Print one JSON object.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "export")]
     pub json: bool,
 }
 
@@ -69,6 +80,14 @@ fn joint_kinds(r: &Robot) -> Vec<activecal::robot::JointKind> {
 
 /// Runs `robots`.
 pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
+    if let Some(name) = &a.export {
+        let text = activecal::robot::file::to_toml(&super::load_robot(name)?);
+        match &a.out {
+            Some(path) => super::write_new(path, &text, a.force)?,
+            None => print!("{text}"),
+        }
+        return Ok(());
+    }
     let robots: Vec<Value> = activecal::robot::BUILTIN
         .iter()
         .map(|n| {

@@ -131,6 +131,16 @@ fn reduced_reproduce_matches_the_underlying_commands() {
         report["bound"]["log10_bound"].as_f64().unwrap(),
     );
     assert!((b1 - b2).abs() < 1e-6, "{b1} vs {b2}");
+    // The Newton cross-check in the report, and `bound --solver newton`.
+    let nb = &report["bound"]["newton"];
+    assert_eq!(nb["status"], "Certified");
+    let b3 = nb["log10_bound"].as_f64().unwrap();
+    assert!((b3 - b2).abs() < 1e-6, "{b3} vs {b2}");
+    let bn = run_json(&[
+        "bound", "--levels", "3", "--n", "15", "--solver", "newton", "--json",
+    ]);
+    assert_eq!(bn["solver"]["solver"], "newton");
+    assert_eq!(bn["log10_bound"], nb["log10_bound"]);
     let mut rnd = sel.clone();
     rnd[2] = "random";
     rnd.extend(["--designs", "200"]);

@@ -28,6 +28,7 @@ pub mod conic;
 mod error;
 pub mod exchange;
 pub mod gap;
+pub mod newton;
 pub mod variance;
 
 pub use error::BoundError;
@@ -38,6 +39,7 @@ use crate::pool::Pool;
 use crate::robot::{ParamSet, Robot};
 use conic::{ConicSettings, ConicStatus};
 use exchange::{ExchangeOutcome, ExchangeSettings, candidates, evaluate};
+use newton::NewtonSettings;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 use variance::{VarianceWork, check_problem, make_feasible, nth_largest, scale_columns};
@@ -46,6 +48,32 @@ use variance::{VarianceWork, check_problem, make_feasible, nth_largest, scale_co
 /// [`Bound::support_size`].
 pub const SUPPORT_TOL: f64 = 1e-6;
 
+/// The solver of the candidate subproblems of (R).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum RelaxationSolver {
+    /// Clarabel on the PSD + exponential-cone form ([`conic`]).
+    #[default]
+    Clarabel,
+    /// The log-barrier Newton method on `ln det M(w)` itself ([`newton`]).
+    Newton,
+}
+
+impl RelaxationSolver {
+    /// Parses `clarabel` or `newton`.
+    pub fn parse(s: &str) -> Result<Self, BoundError> {
+        match s {
+            "clarabel" => Ok(Self::Clarabel),
+            "newton" => Ok(Self::Newton),
+            other => Err(BoundError::InvalidSetting {
+                name: "solver",
+                value: other.into(),
+                reason: "must be clarabel or newton",
+            }),
+        }
+    }
+}
+
 /// Settings of [`relaxation_bound`]. Build with [`BoundSettings::builder`]
 /// (validated) or take [`BoundSettings::default`].
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -53,9 +81,11 @@ pub const SUPPORT_TOL: f64 = 1e-6;
 pub struct BoundSettings {
     /// Target certified gap `ln_bound − ln_primal`. Default 1e-6.
     pub gap_tol: f64,
-    /// Solve (R) with Clarabel (true) or with the first-order solver alone
-    /// (false). Default true.
+    /// Solve (R) on candidate sets with `solver` (true) or with the
+    /// first-order solver alone (false). Default true.
     pub use_conic: bool,
+    /// The candidate-set solver: Clarabel (default) or Newton.
+    pub solver: RelaxationSolver,
     /// First-order certificate gap at which screening stops and Clarabel
     /// takes over. Default 1e-2.
     pub screen_gap: f64,
@@ -87,6 +117,8 @@ pub struct BoundSettings {
     pub first_order: ExchangeSettings,
     /// Clarabel's settings.
     pub conic: ConicSettings,
+    /// The Newton solver's settings.
+    pub newton: NewtonSettings,
 }
 
 impl Default for BoundSettings {
@@ -94,6 +126,7 @@ impl Default for BoundSettings {
         Self {
             gap_tol: 1e-6,
             use_conic: true,
+            solver: RelaxationSolver::Clarabel,
             screen_gap: 1e-2,
             screen_extra: 100,
             direct_limit: 400,
@@ -104,6 +137,7 @@ impl Default for BoundSettings {
             polish_rounds: 20,
             first_order: ExchangeSettings::default(),
             conic: ConicSettings::default(),
+            newton: NewtonSettings::default(),
         }
     }
 }
@@ -143,6 +177,7 @@ impl BoundSettings {
             });
         }
         self.first_order.validate()?;
+        self.newton.validate()?;
         self.conic.validate()
     }
 }
@@ -224,6 +259,18 @@ impl BoundSettingsBuilder {
         self.0.conic = v;
         self
     }
+    /// The candidate-set solver (default Clarabel).
+    #[must_use]
+    pub fn solver(mut self, v: RelaxationSolver) -> Self {
+        self.0.solver = v;
+        self
+    }
+    /// Newton solver settings.
+    #[must_use]
+    pub fn newton(mut self, v: NewtonSettings) -> Self {
+        self.0.newton = v;
+        self
+    }
     /// Validates and returns the settings.
     pub fn build(self) -> Result<BoundSettings, BoundError> {
         self.0.validate()?;
@@ -246,9 +293,11 @@ pub enum BoundStatus {
     GapAboveTolerance,
 }
 
-/// What the Clarabel stage did.
+/// What the candidate-set stage (Clarabel or Newton) did.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct ConicSummary {
+    /// Which solver ran.
+    pub solver: RelaxationSolver,
     /// Status of the last Clarabel solve (`None` if Clarabel did not run).
     pub status: Option<ConicStatus>,
     /// Interior-point iterations of the last solve.
@@ -429,7 +478,18 @@ pub fn relaxation_bound(
             let Ok(sub_sc) = scale_columns(&sub, n.min(cand.len())) else {
                 break;
             };
-            let out = conic::solve_scaled(&sub_sc, n, &conic_settings);
+            let out = match settings.solver {
+                RelaxationSolver::Clarabel => conic::solve_scaled(&sub_sc, n, &conic_settings),
+                RelaxationSolver::Newton => {
+                    let warm: Vec<f64> = cand.iter().map(|&i| best.w[i]).collect();
+                    let mut ns = settings.newton.clone();
+                    if !last {
+                        ns.tol = ns.tol.max(settings.screen_tol);
+                    }
+                    newton::solve_scaled(&sub_sc, n, Some(&warm), &ns, best.gap())
+                }
+            };
+            conic_summary.solver = settings.solver;
             conic_summary.status = Some(out.status);
             conic_summary.iterations = out.iterations;
             conic_summary.total_iterations += out.iterations;

@@ -4,6 +4,7 @@
 use super::emit;
 use activecal::blocks::Blocks;
 use activecal::criterion::{DCriterion, bench_scan};
+use activecal::identify::{LmSettings, identify, simulate, trial_rng};
 use activecal::pool::Pool;
 use activecal::robot::Robot;
 use activecal::select::{Settings, design_rng, eae, polish};
@@ -128,10 +129,37 @@ pub fn cmd_bench(a: BenchArgs) -> Result<()> {
             ),
         ),
     ];
+    // Identification: one Levenberg–Marquardt calibration of the EAE design
+    // from the nominal start, points (PUMA, σ = 1 cm) and full poses (UR5).
+    let lm = LmSettings::default();
+    let qs: Vec<Vec<f64>> = sel.poses.iter().map(|&k| pool.q(k)).collect();
+    let meas = simulate(&robot, &robot.real, &qs, 0.01, &mut trial_rng(1, 0))?;
+    let (t_lm, id) = time(reps, || identify(&robot, &robot.nominal, &meas, &lm));
+    let id = id?;
+    let ur5 = Robot::builtin("ur5:pose")?;
+    let pool6 = Pool::full(&ur5, 3)?;
+    let x6 = pool6.jacobian(&ur5, &ur5.nominal);
+    let sel6 = eae(&x6, &mut DCriterion::new(), &s, &mut design_rng(1, 0))?;
+    let qs6: Vec<Vec<f64>> = sel6.poses.iter().map(|&k| pool6.q(k)).collect();
+    let meas6 = simulate(&ur5, &ur5.real, &qs6, 0.001, &mut trial_rng(1, 0))?;
+    let (t_lm6, id6) = time(reps, || identify(&ur5, &ur5.nominal, &meas6, &lm));
+    let id6 = id6?;
+    rows.push((
+        "LM calibration, PUMA, 30 points (p = 27)".into(),
+        t_lm * 1e3,
+        format!("{} iterations", id.iterations),
+    ));
+    rows.push((
+        "LM calibration, UR5, 30 full poses (p = 30)".into(),
+        t_lm6 * 1e3,
+        format!("{} iterations", id6.iterations),
+    ));
     let mut v = json!({
         "threads": rayon::current_num_threads(),
         "jacobian_ms": t_jac * 1e3, "jacobian_ns_per_pose": t_jac * 1e9 / pool.len() as f64,
         "scan": scan, "eae_ms": t_eae * 1e3, "polish_ms": t_pol * 1e3, "polish_iterations": polish_iters,
+        "lm_point_ms": t_lm * 1e3, "lm_point_iterations": id.iterations,
+        "lm_pose_ms": t_lm6 * 1e3, "lm_pose_iterations": id6.iterations,
     });
     if a.scale {
         let big = Pool::full(&robot, 10)?;

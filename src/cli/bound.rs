@@ -2,7 +2,7 @@
 //! design's D-efficiency against it.
 
 use super::{PoolOpts, emit};
-use activecal::bound::{Bound, BoundSettings, design_gap, relaxation_bound};
+use activecal::bound::{Bound, BoundSettings, RelaxationSolver, design_gap, relaxation_bound};
 use activecal::design::DesignFile;
 use anyhow::Result;
 use clap::Args;
@@ -18,6 +18,10 @@ pub struct SolveOpts {
     /// Solve with the first-order solver alone (no Clarabel).
     #[arg(long)]
     pub first_order: bool,
+    /// Solver of the candidate subproblems: clarabel (conic form) or newton
+    /// (log-barrier Newton on ln det itself). Both are certified by eq. (C).
+    #[arg(long, default_value = "clarabel")]
+    pub solver: String,
     /// Poses outside the first-order support given to Clarabel, by largest
     /// variance.
     #[arg(long, default_value_t = 100)]
@@ -29,6 +33,7 @@ impl SolveOpts {
         Ok(BoundSettings::builder()
             .gap_tol(self.gap_tol)
             .use_conic(!self.first_order)
+            .solver(RelaxationSolver::parse(&self.solver)?)
             .screen_extra(self.screen_extra)
             .build()?)
     }
@@ -85,6 +90,7 @@ fn bound_json(b: &Bound) -> Value {
         "support_size": b.support_size,
         "seconds": b.seconds,
         "solver": {
+            "solver": b.conic.solver,
             "status": b.conic.status,
             "iterations": b.conic.iterations,
             "total_iterations": b.conic.total_iterations,
@@ -120,17 +126,28 @@ fn bound_text(b: &Bound) -> String {
     match b.conic.status {
         Some(st) => {
             s += &format!(
-                "clarabel   {st:?}, {} iterations, {} round(s), {} candidates, {:.2} s\n",
-                b.conic.iterations, b.conic.rounds, b.conic.candidates, b.conic.seconds
+                "{:<10} {st:?}, {} iterations, {} round(s), {} candidates, {:.2} s\n",
+                solver_name(b),
+                b.conic.iterations,
+                b.conic.rounds,
+                b.conic.candidates,
+                b.conic.seconds
             )
         }
-        None => s += "clarabel   not run\n",
+        None => s += &format!("{:<10} not run\n", solver_name(b)),
     }
     s += &format!(
         "first order {} rounds, {} steps, {:.2} s\ntotal      {:.2} s\n",
         b.first_order.rounds, b.first_order.steps, b.first_order.seconds, b.seconds
     );
     s
+}
+
+fn solver_name(b: &Bound) -> &'static str {
+    match b.conic.solver {
+        RelaxationSolver::Clarabel => "clarabel",
+        RelaxationSolver::Newton => "newton",
+    }
 }
 
 /// Runs `bound`.

@@ -4,7 +4,7 @@
 //! a Markdown report, a JSON summary and figures.
 
 use super::figures;
-use activecal::bound::{BoundSettings, design_gap, relaxation_bound};
+use activecal::bound::{BoundSettings, RelaxationSolver, design_gap, relaxation_bound};
 use activecal::criterion::{DCriterion, OiCriterion};
 use activecal::identify::{LmSettings, MonteCarloSettings, compare_designs, paper_tables};
 use activecal::pool::Pool;
@@ -185,6 +185,14 @@ pub fn cmd_reproduce(a: ReproduceArgs) -> Result<()> {
     // 5. The relaxation bound.
     steps.step("relaxation bound");
     let bound = relaxation_bound(&x, a.n, &BoundSettings::default())?;
+    // Cross-check: the same relaxation by the Newton barrier solver.
+    let newton = relaxation_bound(
+        &x,
+        a.n,
+        &BoundSettings::builder()
+            .solver(RelaxationSolver::Newton)
+            .build()?,
+    )?;
     let named: Vec<(&str, Vec<usize>)> = vec![
         ("EAE (paper settings)", e_det.poses.clone()),
         ("multi-start EAE + polish", best.poses.clone()),
@@ -305,7 +313,10 @@ pub fn cmd_reproduce(a: ReproduceArgs) -> Result<()> {
         "detmax": {"log10_oid": l10(det.ln_oid)},
         "bound": {"log10_bound": bound.log10_bound(), "ln_bound": bound.ln_bound, "ln_primal": bound.ln_primal,
                   "certificate_gap": bound.certificate_gap, "support_size": bound.support_size, "seconds": bound.seconds,
-                  "status": format!("{:?}", bound.status)},
+                  "status": format!("{:?}", bound.status),
+                  "newton": {"log10_bound": newton.log10_bound(), "ln_bound": newton.ln_bound, "ln_primal": newton.ln_primal,
+                             "certificate_gap": newton.certificate_gap, "seconds": newton.seconds,
+                             "status": format!("{:?}", newton.status)}},
         "designs": designs_json,
         "tables": {"estimate": tables.estimate, "residual": tables.residual, "std": tables.std,
                    "iterations": tables.identification.iterations, "status": format!("{:?}", tables.identification.status)},
@@ -434,6 +445,18 @@ is therefore about {:.0}x here, not 50,000x.",
         s["bound"]["certificate_gap"].as_f64().unwrap_or(f64::NAN),
         s["bound"]["support_size"],
         s["bound"]["seconds"].as_f64().unwrap_or(f64::NAN)
+    );
+    let nb = &s["bound"]["newton"];
+    let _ = writeln!(
+        m,
+        "Cross-check by the Newton barrier solver (`bound --solver newton`): ln bound {:.9} against Clarabel's {:.9}, ln primal {:.9} against {:.9}, status {}, certificate gap {:.2e}, {:.2} s.\n",
+        nb["ln_bound"].as_f64().unwrap_or(f64::NAN),
+        s["bound"]["ln_bound"].as_f64().unwrap_or(f64::NAN),
+        nb["ln_primal"].as_f64().unwrap_or(f64::NAN),
+        s["bound"]["ln_primal"].as_f64().unwrap_or(f64::NAN),
+        nb["status"].as_str().unwrap_or(""),
+        nb["certificate_gap"].as_f64().unwrap_or(f64::NAN),
+        nb["seconds"].as_f64().unwrap_or(f64::NAN)
     );
     for (title, grid) in [
         ("Table III: estimated parameters (EAE design)", &t.estimate),

@@ -26,6 +26,10 @@ pub struct SolveOpts {
     /// variance.
     #[arg(long, default_value_t = 100)]
     pub screen_extra: usize,
+    /// Most candidate-set solves (screening rounds); large pools may need
+    /// more than the default to certify.
+    #[arg(long, default_value_t = 10)]
+    pub max_rounds: usize,
 }
 
 impl SolveOpts {
@@ -35,6 +39,7 @@ impl SolveOpts {
             .use_conic(!self.first_order)
             .solver(RelaxationSolver::parse(&self.solver)?)
             .screen_extra(self.screen_extra)
+            .max_rounds(self.max_rounds)
             .build()?)
     }
 }

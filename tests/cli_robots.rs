@@ -66,8 +66,19 @@ fn pipeline_with(robot: &str, tag: &str, pose: bool, p: usize, exact: bool) {
 
     // ---- select: a 30-pose design of the 3-level lattice, written to a file.
     let sel = json_of(&[
-        "select", "--robot", robot, "--levels", "3", "--out", d, "--json",
+        "select",
+        "--robot",
+        robot,
+        "--levels",
+        "3",
+        "--out",
+        d,
+        "--gap",
+        "--gap-solver",
+        "newton",
+        "--json",
     ]);
+    assert_eq!(sel["bound_status"], "Certified", "{robot}");
     assert_eq!(sel["poses"].as_array().unwrap().len(), 30, "{robot}");
     let ln_oid = f(&sel, "ln_oid");
     assert!(ln_oid.is_finite(), "{robot}: {sel}");
@@ -103,6 +114,14 @@ fn pipeline_with(robot: &str, tag: &str, pose: bool, p: usize, exact: bool) {
     ]);
     let eff = f(&g, "d_efficiency");
     assert!(eff > 0.0 && eff <= 1.0, "{robot}: D-efficiency {eff}");
+    // `select --gap` (Newton, certified to 1e-6) and `gap` (first order,
+    // 1e-2) bound the same relaxation: their D-efficiencies differ by at
+    // most the looser gap, e^(1e-2/p) − 1 < 1e-2/p relative.
+    let eff_sel = f(&sel, "d_efficiency");
+    assert!(
+        eff_sel >= eff && eff_sel <= eff * (1.0 + 1e-2 / p as f64) + 1e-12,
+        "{robot}: {eff_sel} vs {eff}"
+    );
     println!("{robot}: p = {p}, ln OI_D {ln_oid:.3} ≤ bound {ln_bound:.3}, D-eff {eff:.4}");
 
     // ---- calibrate without noise: the real unknowns, exactly.

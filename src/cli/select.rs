@@ -110,6 +110,9 @@ pub struct SelectArgs {
     /// Also compute the relaxation bound and report the design's D-efficiency.
     #[arg(long)]
     pub gap: bool,
+    /// Solver of the bound for `--gap`: clarabel or newton (see `bound`).
+    #[arg(long, default_value = "clarabel", requires = "gap")]
+    pub gap_solver: String,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -135,6 +138,7 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         super::refuse_overwrite(out, a.force)?;
     }
     let alg = Algorithm::parse(&a.algorithm)?;
+    let gap_solver = activecal::bound::RelaxationSolver::parse(&a.gap_solver)?;
     let ctx = a.pool.load()?;
     let fixed_lattice: Vec<usize> = match &a.fixed {
         Some(f) => parse_list(f, "--fixed")?,
@@ -176,11 +180,10 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     });
     let mut v = v;
     if a.gap {
-        let bound = activecal::bound::relaxation_bound(
-            &ctx.x,
-            a.n,
-            &activecal::bound::BoundSettings::default(),
-        )?;
+        let settings = activecal::bound::BoundSettings::builder()
+            .solver(gap_solver)
+            .build()?;
+        let bound = activecal::bound::relaxation_bound(&ctx.x, a.n, &settings)?;
         let g = activecal::bound::design_gap(&ctx.x, &sel.poses, &bound)?;
         v["log10_bound"] = json!(g.log10_bound);
         v["d_efficiency"] = json!(g.d_efficiency);

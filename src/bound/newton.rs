@@ -91,32 +91,41 @@ fn derivatives(x: &Blocks, w: &[f64], q: &mut Mat<f64>, d: &mut [f64]) -> Option
     }
     let mut y = x.mat().to_owned();
     solve_lower_triangular_in_place(l, y.as_mut().transpose_mut(), Par::Seq);
-    let mut g = Mat::<f64>::zeros(n * t, n * t);
-    faer::linalg::matmul::matmul(
-        g.as_mut(),
-        faer::Accum::Replace,
-        y.as_ref(),
-        y.transpose(),
-        1.0,
-        Par::Seq,
-    );
-    for j in 0..n {
-        for i in j..n {
-            let mut s = 0.0;
-            for b in 0..t {
-                let col = g.col(j * t + b);
-                for a in 0..t {
-                    let v = col[i * t + a];
-                    s += v * v;
+    // G = Y Yᵀ one block of Q_CHUNK poses' columns at a time, so that memory
+    // stays at t·n × Q_CHUNK·t whatever the candidate count.
+    let mut g = Mat::<f64>::zeros(n * t, Q_CHUNK.min(n) * t);
+    for j0 in (0..n).step_by(Q_CHUNK) {
+        let j1 = (j0 + Q_CHUNK).min(n);
+        let w = (j1 - j0) * t;
+        faer::linalg::matmul::matmul(
+            g.as_mut().subcols_mut(0, w),
+            faer::Accum::Replace,
+            y.as_ref(),
+            y.as_ref().subrows(j0 * t, (j1 - j0) * t).transpose(),
+            1.0,
+            Par::Seq,
+        );
+        let gb = g.as_ref().subcols(0, w);
+        for j in j0..j1 {
+            for i in 0..n {
+                let mut s = 0.0;
+                for b in 0..t {
+                    let col = gb.col((j - j0) * t + b);
+                    for a in 0..t {
+                        let v = col[i * t + a];
+                        s += v * v;
+                    }
                 }
+                q[(i, j)] = s;
             }
-            q[(i, j)] = s;
-            q[(j, i)] = s;
+            d[j] = (0..t).map(|a| gb[(j * t + a, (j - j0) * t + a)]).sum();
         }
-        d[j] = (0..t).map(|a| g[(j * t + a, j * t + a)]).sum();
     }
     Some(ld)
 }
+
+/// Poses per column block of `G` in [`derivatives`].
+const Q_CHUNK: usize = 128;
 
 /// `F_μ` at `w` (`None` outside the domain).
 fn barrier_value(x: &Blocks, w: &[f64], mu: f64) -> Option<f64> {

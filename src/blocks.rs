@@ -22,7 +22,7 @@ impl Blocks {
     #[must_use]
     pub fn new(mat: Mat<f64>, t: usize) -> Self {
         assert!(
-            t > 0 && mat.nrows() % t == 0,
+            t > 0 && mat.nrows().is_multiple_of(t),
             "rows must be a multiple of t"
         );
         Self { mat, t }
@@ -31,7 +31,7 @@ impl Blocks {
     /// Builds blocks from a row-major buffer of `n·t` rows of `p` entries.
     #[must_use]
     pub fn from_row_major(rows: &[f64], t: usize, p: usize) -> Self {
-        assert!(p > 0 && rows.len() % (t * p) == 0);
+        assert!(p > 0 && rows.len().is_multiple_of(t * p));
         let m = rows.len() / p;
         Self::new(Mat::from_fn(m, p, |r, c| rows[r * p + c]), t)
     }

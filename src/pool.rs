@@ -403,7 +403,7 @@ mod tests {
             max_range: 100.0,
         };
         let some = Pool::filtered(&r, &r.nominal, 3, &vis).unwrap();
-        assert!(some.len() > 0 && some.len() < 729);
+        assert!(!some.is_empty() && some.len() < 729);
         for (k, &i) in some.indices.iter().enumerate() {
             assert_eq!(some.position_of(i).unwrap(), k);
             let p = position(&r, &r.nominal, &some.q(k));

@@ -361,7 +361,8 @@ fn pose_measurements_are_checked() {
     assert!(e.to_string().contains("measures points"), "{e}");
 
     // Not rotations: a reflection, a scaled matrix, a NaN — each named by pose.
-    let cases: [(fn(&mut [[f64; 3]; 3]), &str); 3] = [
+    type Spoil = fn(&mut [[f64; 3]; 3]);
+    let cases: [(Spoil, &str); 3] = [
         (|r| r[2].iter_mut().for_each(|v| *v = -*v), "reflection"),
         (|r| r[0][0] *= 1.001, "not orthonormal"),
         (|r| r[1][2] = f64::NAN, "not a finite number"),

@@ -225,7 +225,7 @@ fn any_robot() -> impl Strategy<Value = Robot> {
                 r.iter_mut().zip(dev).for_each(|(x, d)| *x += d);
                 real.push(r);
                 for (k, s) in Symbol::ALL.into_iter().enumerate() {
-                    if mask & (1 << k) != 0 && !(s == Symbol::Beta && !hayati) {
+                    if mask & (1 << k) != 0 && (s != Symbol::Beta || hayati) {
                         unknowns.push(ParamId {
                             frame: i,
                             symbol: s,

@@ -257,11 +257,9 @@ pub(crate) fn solve_scaled(
             for i in 0..n {
                 trial[i] = w[i] + s * delta[i];
             }
-            if let Some(f1) = barrier_value(x, &trial, mu) {
-                if f1 >= f0 + 0.25 * s * lambda2 {
-                    accepted = true;
-                    break;
-                }
+            if barrier_value(x, &trial, mu).is_some_and(|f1| f1 >= f0 + 0.25 * s * lambda2) {
+                accepted = true;
+                break;
             }
             s *= 0.5;
         }

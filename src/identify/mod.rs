@@ -205,13 +205,11 @@ impl Measurements {
 
     /// Re-checks the measurements against a robot (done by [`identify`]).
     pub fn check(&self, robot: &Robot) -> Result<()> {
-        if let Some(name) = &self.robot {
-            if *name != robot.name {
-                return Err(IdentifyError::Model(Error::Invalid(format!(
-                    "the measurements are of robot '{name}', not '{}'",
-                    robot.name
-                ))));
-            }
+        if let Some(name) = self.robot.as_ref().filter(|n| **n != robot.name) {
+            return Err(IdentifyError::Model(Error::Invalid(format!(
+                "the measurements are of robot '{name}', not '{}'",
+                robot.name
+            ))));
         }
         if self.qs.len() != self.points.len() {
             return Err(IdentifyError::MeasurementCount {

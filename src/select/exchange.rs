@@ -221,7 +221,8 @@ impl<'a, C: Criterion> Run<'a, C> {
             };
             // A D-criterion addition never decreases ln det; the OI of eq. (1)
             // is monotone in it too, but keep the paper's stopping rule.
-            if !(new >= cur) && self.state.ridge() == 0.0 {
+            let improves = new >= cur; // false for NaN
+            if !improves && self.state.ridge() == 0.0 {
                 return;
             }
             if self.state.add(self.pool, inn).is_err() {

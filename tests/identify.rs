@@ -390,6 +390,52 @@ fn pose_measurements_are_checked() {
     assert_eq!(back, good);
     let typo = text.replacen("\"orientations\"", "\"orientation\"", 1);
     assert!(serde_json::from_str::<Measurements>(&typo).is_err());
+
+    // Quaternions [w, x, y, z] instead of matrices: the same rotations to
+    // rounding (a few ulps of entries ≤ 1), hence the same estimate.
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let quats: Vec<[f64; 4]> = rots
+        .iter()
+        .map(|r| {
+            let m = nalgebra::Matrix3::from_fn(|i, j| r[i][j]);
+            let q = nalgebra::UnitQuaternion::from_matrix(&m);
+            [q.w, q.i, q.j, q.k]
+        })
+        .collect();
+    let obj = v.as_object_mut().unwrap();
+    obj.remove("orientations");
+    obj.insert("quaternions".into(), serde_json::json!(quats));
+    let from_q: Measurements = serde_json::from_value(v.clone()).unwrap();
+    for (a, b) in from_q.orientations().iter().zip(&rots) {
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!((a[i][j] - b[i][j]).abs() < 1e-14);
+            }
+        }
+    }
+    let lm = LmSettings::default();
+    let e1 = identify(&robot, &robot.nominal, &good, &lm)
+        .unwrap()
+        .estimate;
+    let e2 = identify(&robot, &robot.nominal, &from_q, &lm)
+        .unwrap()
+        .estimate;
+    // Both stop within LM's step tolerance (1e-10 relative, θ up to 2 m) of
+    // the same minimum, not at the same bits; the estimates' standard
+    // deviations are ~1e-4, so 1e-7 is "the same estimate".
+    assert!(max_abs_diff(&e1, &e2) < 1e-7, "{}", max_abs_diff(&e1, &e2));
+    let mut bad = v.clone();
+    bad["quaternions"][3] = serde_json::json!([1.0, 0.1, 0.0, 0.0]);
+    let e = serde_json::from_value::<Measurements>(bad)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("quaternion 3: norm"), "{e}");
+    let mut both = v;
+    both["orientations"] = serde_json::json!(rots);
+    let e = serde_json::from_value::<Measurements>(both)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("not both"), "{e}");
 }
 
 /// Simulated orientation noise is N(0, (σ/w)²) per axis of the rotation

@@ -148,8 +148,11 @@ pub const ROTATION_TOLERANCE: f64 = 1e-6;
 /// …], "orientations": [[[r00, r01, r02], [r10, …], [r20, …]], …]}`
 /// (metres, radians; orientations row-major, base frame, omitted for
 /// points; `robot` optional, checked against the robot when present).
+/// Instead of `orientations` a file may give `"quaternions": [[w, x, y, z],
+/// …]` (unit to [`ROTATION_TOLERANCE`], scalar first, as most trackers
+/// export them); they are read into rotation matrices.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, try_from = "MeasurementsFile")]
 pub struct Measurements {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     robot: Option<String>,
@@ -299,6 +302,50 @@ impl Measurements {
     #[must_use]
     pub fn orientations(&self) -> &[[[f64; 3]; 3]] {
         &self.orientations
+    }
+}
+
+/// The JSON form of [`Measurements`]: orientations as matrices or as
+/// quaternions.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MeasurementsFile {
+    #[serde(default)]
+    robot: Option<String>,
+    qs: Vec<Vec<f64>>,
+    points: Vec<[f64; 3]>,
+    #[serde(default)]
+    orientations: Vec<[[f64; 3]; 3]>,
+    #[serde(default)]
+    quaternions: Vec<[f64; 4]>,
+}
+
+impl TryFrom<MeasurementsFile> for Measurements {
+    type Error = String;
+
+    fn try_from(f: MeasurementsFile) -> std::result::Result<Self, String> {
+        if !f.quaternions.is_empty() && !f.orientations.is_empty() {
+            return Err("give `orientations` or `quaternions`, not both".into());
+        }
+        let mut orientations = f.orientations;
+        for (i, q) in f.quaternions.iter().enumerate() {
+            let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+            if !norm.is_finite() || (norm - 1.0).abs() > ROTATION_TOLERANCE {
+                return Err(format!(
+                    "quaternion {i}: norm {norm} is not 1 (to {ROTATION_TOLERANCE:e}); expected [w, x, y, z] of a rotation"
+                ));
+            }
+            let uq = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+                q[0], q[1], q[2], q[3],
+            ));
+            orientations.push(rows(uq.to_rotation_matrix().matrix()));
+        }
+        Ok(Self {
+            robot: f.robot,
+            qs: f.qs,
+            points: f.points,
+            orientations,
+        })
     }
 }
 

@@ -1,39 +1,9 @@
 //! The command line: documented outputs and clear errors (non-zero exit, no
 //! panic) on bad input.
 
-use serde_json::Value;
-use std::process::{Command, Output};
+mod common;
 
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_activecal"))
-        .args(args)
-        .output()
-        .expect("runs")
-}
-
-fn json_of(args: &[&str]) -> Value {
-    let out = run(args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("one JSON object")
-}
-
-/// Fails with exit code 1, a message containing `needle`, and no panic.
-fn fails_with(args: &[&str], needle: &str) {
-    let out = run(args);
-    let err = String::from_utf8_lossy(&out.stderr);
-    // 1: our error; 2: clap's usage error. Never success, never a signal.
-    assert!(
-        matches!(out.status.code(), Some(1 | 2)),
-        "{args:?}: status {:?}",
-        out.status
-    );
-    assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
-    assert!(err.contains(needle), "{args:?}: '{err}' lacks '{needle}'");
-}
+use common::{fails_with, json_of, run};
 
 #[test]
 fn pool_reports_paper_index() {

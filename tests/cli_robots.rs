@@ -10,27 +10,11 @@
 //! any gap; the exact solve is tested in `tests/bound.rs`), which keeps each
 //! robot's pipeline to a few seconds.
 
+mod common;
+
+use common::{fails_with, json_of, run};
 use serde_json::Value;
 use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_activecal"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .expect("runs")
-}
-
-fn json_of(args: &[&str]) -> Value {
-    let out = run(args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("one JSON object")
-}
 
 fn f(v: &Value, key: &str) -> f64 {
     v[key]
@@ -248,19 +232,6 @@ fn imported_ur5_urdf_pose() {
 #[test]
 fn scara_description_point() {
     pipeline_with("fixtures/scara.toml", "scara", false, 17, false);
-}
-
-/// Fails with exit code 1 or 2 (clap), a message containing `needle`, and no panic.
-fn fails_with(args: &[&str], needle: &str) {
-    let out = run(args);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        matches!(out.status.code(), Some(1 | 2)),
-        "{args:?}: status {:?}",
-        out.status
-    );
-    assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
-    assert!(err.contains(needle), "{args:?}: '{err}' lacks '{needle}'");
 }
 
 /// Real data: simulated full-pose measurements saved to a file and

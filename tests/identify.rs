@@ -14,7 +14,9 @@ use nalgebra::DMatrix;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::Value;
-use std::process::{Command, Output};
+mod common;
+
+use common::run;
 
 /// `n` distinct pool positions drawn with a seeded ChaCha8 (partial Fisher–Yates).
 fn random_design(pool: &Pool, n: usize, seed: u64) -> Vec<usize> {
@@ -680,13 +682,6 @@ fn comparison_shares_validation_and_checks_designs() {
 }
 
 // ---- command line ------------------------------------------------------------
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_activecal"))
-        .args(args)
-        .output()
-        .expect("runs")
-}
 
 fn write_design(name: &str, d: &DesignFile) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("activecal-identify-{}", std::process::id()));

@@ -2,21 +2,12 @@
 //! Markdown tables parse, and the numbers equal those of the underlying
 //! commands run separately.
 
+mod common;
+
 use serde_json::Value;
 use std::process::Command;
 
-fn run_json(args: &[&str]) -> Value {
-    let out = Command::new(env!("CARGO_BIN_EXE_activecal"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
-}
+use common::json_of as run_json;
 
 /// Rows of the Markdown table that follows `heading`, as cells.
 fn table_after(md: &str, heading: &str) -> Vec<Vec<String>> {

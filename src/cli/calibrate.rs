@@ -8,7 +8,7 @@ use super::{emit, load_robot, refuse_overwrite, write_new};
 use activecal::design::DesignFile;
 use activecal::identify::{
     Identification, LmSettings, Measurements, MonteCarloSettings, MonteCarloSummary, ParamGrid,
-    ValidationSet, identify, monte_carlo, paper_tables, simulate, trial_rng,
+    ValidationSet, identify, monte_carlo, paper_tables,
 };
 use activecal::pool::Pool;
 use activecal::robot::{Measurement, Robot, file};
@@ -233,9 +233,7 @@ fn from_design(a: &CalibrateArgs, robot: &Robot, design_path: &Path) -> Result<(
     let tables = paper_tables(&robot, &qs, a.noise, a.seed, &settings.lm)?;
     let id = &tables.identification;
     if let Some(path) = &a.save_measurements {
-        // The same draw as trial 0 of the seed, which `paper_tables` used.
-        let meas = simulate(&robot, &robot.real, &qs, a.noise, &mut trial_rng(a.seed, 0))?;
-        let text = serde_json::to_string_pretty(&meas)? + "\n";
+        let text = serde_json::to_string_pretty(&tables.measurements)? + "\n";
         write_new(path, &text, a.force)?;
     }
     if let Some(out) = &a.out {

@@ -241,7 +241,7 @@ impl<'a> Problem<'a> {
             rotations: meas
                 .orientations()
                 .iter()
-                .map(|r| so3::to_quaternion(&matrix(r)))
+                .map(|r| so3::nearest_rotation(&matrix(r)))
                 .collect(),
             block: vec![0.0; robot.rows_per_pose() * p],
         }

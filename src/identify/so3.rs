@@ -16,10 +16,18 @@ pub fn exp(v: &Vector3<f64>) -> Matrix3<f64> {
     Rotation3::new(*v).into_inner()
 }
 
-/// The nearest rotation to `m` as a unit quaternion (`m` a rotation matrix
-/// up to rounding: nalgebra's iterative polar projection).
+/// A rotation matrix (orthonormal to rounding, as the kinematics make it)
+/// as a unit quaternion: Shepperd's direct formula, then normalised.
 #[must_use]
 pub fn to_quaternion(m: &Matrix3<f64>) -> UnitQuaternion<f64> {
+    UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(*m))
+}
+
+/// The nearest rotation to a measured matrix `m` (orthonormal only to the
+/// measurement's precision, see `ROTATION_TOLERANCE`) as a unit quaternion:
+/// nalgebra's iterative projection.
+#[must_use]
+pub fn nearest_rotation(m: &Matrix3<f64>) -> UnitQuaternion<f64> {
     UnitQuaternion::from_matrix(m)
 }
 

@@ -1,9 +1,9 @@
 //! The paper's Tables III (estimates) and IV (residuals) for a design: one
 //! simulated calibration, laid out one row per frame and one column per symbol.
 
-use super::Result;
 use super::lm::{Identification, LmSettings, identify};
 use super::simulate::{simulate, trial_rng};
+use super::{Measurements, Result};
 use crate::robot::{ParamId, Robot, Symbol};
 use serde::Serialize;
 
@@ -95,6 +95,9 @@ pub struct PaperTables {
     pub std: Option<ParamGrid>,
     /// The full identification result.
     pub identification: Identification,
+    /// The simulated measurements it was identified from.
+    #[serde(skip)]
+    pub measurements: Measurements,
 }
 
 /// Simulates measurements of the real robot at `qs` with noise σ = `sigma`
@@ -123,5 +126,6 @@ pub fn paper_tables(
             .as_ref()
             .map(|c| ParamGrid::from_unknowns(robot, &c.std)),
         identification: id,
+        measurements: meas,
     })
 }

@@ -357,6 +357,28 @@ fn calibrate_from_a_measurement_file_and_write_the_calibrated_robot() {
         "--json",
     ]);
 
+    // An estimate that did not converge is reported but never written as a
+    // calibrated model, and the exit status says so.
+    let unconverged = path("unconverged.toml");
+    let out = run(&[
+        "calibrate",
+        "--robot",
+        "ur5:pose",
+        "--measurements",
+        &meas,
+        "--max-iterations",
+        "1",
+        "--out",
+        &unconverged,
+        "--json",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["converged"], false);
+    assert!(v["out"].is_null());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("was not written"));
+    assert!(!std::path::Path::new(&unconverged).exists());
+
     // Bad measurement files.
     let text = std::fs::read_to_string(&meas).unwrap();
     let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();

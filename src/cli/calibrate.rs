@@ -93,6 +93,39 @@ fn calibrated_description(robot: &Robot, id: &Identification, source: &str) -> S
     header + &file::to_toml(&r)
 }
 
+/// Writes the calibrated description to `--out` when identification
+/// converged; returns whether it wrote. A non-converged estimate is never
+/// written as a robot model (see [`refuse_unconverged`]).
+fn write_calibrated(
+    a: &CalibrateArgs,
+    robot: &Robot,
+    id: &Identification,
+    source: &str,
+) -> Result<bool> {
+    match &a.out {
+        Some(out) if id.converged() => {
+            write_new(out, &calibrated_description(robot, id, source), a.force)?;
+            Ok(true)
+        }
+        _ => Ok(false),
+    }
+}
+
+/// After the report is printed: an error (exit 1) when `--out` was asked for
+/// but the estimate did not converge, so that no script mistakes it for a
+/// calibrated model.
+fn refuse_unconverged(a: &CalibrateArgs, id: &Identification) -> Result<()> {
+    if let (Some(out), false) = (&a.out, id.converged()) {
+        bail!(
+            "identification ended {:?} ({:?}): {} was not written",
+            id.status,
+            id.stop,
+            out.display()
+        );
+    }
+    Ok(())
+}
+
 /// Runs `calibrate`.
 pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     for path in [&a.out, &a.save_measurements].into_iter().flatten() {
@@ -119,13 +152,7 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         .with_max_iterations(a.max_iterations)
         .with_geodesic(!a.no_geodesic);
     let id = identify(robot, &robot.nominal, &meas, &lm)?;
-    if let Some(out) = &a.out {
-        write_new(
-            out,
-            &calibrated_description(robot, &id, &path.display().to_string()),
-            a.force,
-        )?;
-    }
+    let written = write_calibrated(a, robot, &id, &path.display().to_string())?;
     let names = &id.names;
     let rows = (robot.rows_per_pose() * meas.len()) as f64;
     let v = json!({
@@ -149,7 +176,7 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         "initial_rms_residual": (id.initial_rss / rows).sqrt(),
         "rank": id.rank,
         "unidentifiable": id.unidentifiable,
-        "out": a.out.as_ref().map(|p| p.display().to_string()),
+        "out": a.out.as_ref().filter(|_| written).map(|p| p.display().to_string()),
         "elapsed_seconds": t0.elapsed().as_secs_f64(),
     });
     emit(a.json, &v, || {
@@ -171,12 +198,12 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
             s += "\nstandard deviation (σ̂² (XᵀX)⁻¹)\n";
             s += &ParamGrid::from_unknowns(robot, &c.std).to_text(6);
         }
-        if let Some(out) = &a.out {
+        if let Some(out) = a.out.as_ref().filter(|_| written) {
             s += &format!("\ncalibrated robot written to {}\n", out.display());
         }
         s
     });
-    Ok(())
+    refuse_unconverged(a, &id)
 }
 
 /// Status, residual sum of squares, σ̂, rank and unidentifiable unknowns.
@@ -236,10 +263,8 @@ fn from_design(a: &CalibrateArgs, robot: &Robot, design_path: &Path) -> Result<(
         let text = serde_json::to_string_pretty(&tables.measurements)? + "\n";
         write_new(path, &text, a.force)?;
     }
-    if let Some(out) = &a.out {
-        let source = format!("simulated measurements at {}", design_path.display());
-        write_new(out, &calibrated_description(&robot, id, &source), a.force)?;
-    }
+    let source = format!("simulated measurements at {}", design_path.display());
+    write_calibrated(a, &robot, id, &source)?;
     let names = &id.names;
     let truth = robot.unknown_values(&robot.real);
     let residual: Vec<f64> = truth.iter().zip(&id.estimate).map(|(t, e)| t - e).collect();
@@ -331,7 +356,7 @@ fn from_design(a: &CalibrateArgs, robot: &Robot, design_path: &Path) -> Result<(
         }
         s
     });
-    Ok(())
+    refuse_unconverged(a, id)
 }
 
 /// Human-readable Monte-Carlo summary.

@@ -1,8 +1,10 @@
-//! `bench`: medians of the hot paths on the PUMA pool, and the 10⁶-pose
-//! scale run (time and peak memory).
+//! `bench`: medians of the hot paths on the PUMA pool, identification, the
+//! relaxation bound by both solvers, and the 10⁶-pose scale run (time and
+//! peak memory).
 
 use super::emit;
 use activecal::blocks::Blocks;
+use activecal::bound::{BoundSettings, RelaxationSolver, relaxation_bound};
 use activecal::criterion::{DCriterion, bench_scan};
 use activecal::identify::{LmSettings, identify, simulate, trial_rng};
 use activecal::pool::Pool;
@@ -154,12 +156,32 @@ pub fn cmd_bench(a: BenchArgs) -> Result<()> {
         t_lm6 * 1e3,
         format!("{} iterations", id6.iterations),
     ));
+    // The relaxation bound on the same pool, by each candidate-set solver
+    // (one run each: seconds, not microseconds).
+    let mut bounds = Vec::new();
+    for solver in [RelaxationSolver::Clarabel, RelaxationSolver::Newton] {
+        let settings = BoundSettings::builder().solver(solver).build()?;
+        let b = relaxation_bound(&x, s.n, &settings)?;
+        rows.push((
+            format!("relaxation bound, {solver:?}"),
+            b.seconds * 1e3,
+            format!(
+                "candidate solves {:.2} s, certified gap {:.1e}",
+                b.conic.seconds, b.certificate_gap
+            ),
+        ));
+        bounds.push(
+            json!({"solver": solver, "seconds": b.seconds, "solver_seconds": b.conic.seconds,
+            "ln_bound": b.ln_bound, "certificate_gap": b.certificate_gap}),
+        );
+    }
     let mut v = json!({
         "threads": rayon::current_num_threads(),
         "jacobian_ms": t_jac * 1e3, "jacobian_ns_per_pose": t_jac * 1e9 / pool.len() as f64,
         "scan": scan, "eae_ms": t_eae * 1e3, "polish_ms": t_pol * 1e3, "polish_iterations": polish_iters,
         "lm_point_ms": t_lm * 1e3, "lm_point_iterations": id.iterations,
         "lm_pose_ms": t_lm6 * 1e3, "lm_pose_iterations": id6.iterations,
+        "bounds": bounds,
     });
     if a.scale {
         let big = Pool::full(&robot, 10)?;
@@ -183,8 +205,27 @@ pub fn cmd_bench(a: BenchArgs) -> Result<()> {
             t_be * 1e3,
             format!("log10 OI_D {:.3}", selb.ln_oid / std::f64::consts::LN_10),
         ));
+        let peak_eae = peak_mib();
+        // The bound over the 10⁶ poses for N = 30 (Newton: Clarabel's
+        // rounds on ~2,000 candidates take minutes each).
+        let settings = BoundSettings::builder()
+            .solver(RelaxationSolver::Newton)
+            .build()?;
+        let bb = relaxation_bound(&xb, s.n, &settings)?;
+        rows.push((
+            "10^6 pool: relaxation bound, N = 30 (Newton)".into(),
+            bb.seconds * 1e3,
+            format!(
+                "log10 {:.4}, gap {:.1e}, {} rounds",
+                bb.log10_bound(),
+                bb.certificate_gap,
+                bb.conic.rounds
+            ),
+        ));
         v["scale"] = json!({"poses": big.len(), "jacobian_s": t_bj, "eae_s": t_be, "n": 145,
-            "log10_oid": selb.ln_oid / std::f64::consts::LN_10, "steps": selb.trace.len(), "peak_mib": peak_mib()});
+            "log10_oid": selb.ln_oid / std::f64::consts::LN_10, "steps": selb.trace.len(), "peak_mib_eae": peak_eae,
+            "bound_s": bb.seconds, "bound_log10": bb.log10_bound(), "bound_gap": bb.certificate_gap,
+            "bound_status": bb.status, "peak_mib": peak_mib()});
     }
     v["peak_mib"] = json!(peak_mib());
     let table = rows.clone();

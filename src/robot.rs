@@ -305,11 +305,20 @@ impl Robot {
     /// A robot from a file is named by the path as given (not by the name
     /// inside the file), so that design files, which record the robot's
     /// name, load it again.
+    ///
+    /// As for built-in names, the suffix `:pose` asks for full-pose
+    /// measurements: `arm.urdf:pose` imports with [`Measurement::Pose`];
+    /// `arm.toml:pose` turns a point description into its full-pose variant
+    /// ([`Robot::with_measurement`]).
     pub fn load(name_or_path: &str) -> Result<Robot> {
         if let Ok(r) = Robot::builtin(name_or_path) {
             return Ok(r);
         }
-        let path = Path::new(name_or_path);
+        let (file_name, pose) = match name_or_path.strip_suffix(":pose") {
+            Some(f) if !Path::new(name_or_path).exists() => (f, true),
+            _ => (name_or_path, false),
+        };
+        let path = Path::new(file_name);
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
@@ -321,10 +330,21 @@ impl Robot {
             })
         };
         match ext.as_deref() {
+            Some("toml") if pose => named(file::load(path).and_then(|r| match r.measurement {
+                Measurement::Pose => Ok(r),
+                Measurement::Point => r.with_measurement(Measurement::Pose),
+            })),
             Some("toml") => named(file::load(path)),
             Some("urdf") => named(crate::urdf::load(
                 path,
-                &crate::urdf::UrdfOptions::default(),
+                &crate::urdf::UrdfOptions {
+                    measurement: if pose {
+                        Measurement::Pose
+                    } else {
+                        Measurement::Point
+                    },
+                    ..crate::urdf::UrdfOptions::default()
+                },
             )),
             _ if path.exists() => Err(Error::Invalid(format!(
                 "{name_or_path}: unknown robot file type (expected a .toml description or a .urdf file)"

@@ -226,6 +226,17 @@ fn imported_ur5_urdf_pose() {
     pipeline("fixtures/ur5_pose.toml", "ur5-urdf-pose", true, 30);
 }
 
+/// A URDF imported for full poses by the `:pose` suffix on its path.
+#[test]
+fn imported_stanford_urdf_pose_by_suffix() {
+    pipeline(
+        "fixtures/stanford.urdf:pose",
+        "stanford-urdf-pose",
+        true,
+        28,
+    );
+}
+
 /// The hand-written SCARA description: parallel axes, a prismatic quill,
 /// and real deviations in parameters outside the automatic minimal set
 /// (which the unknowns absorb: the fit is exact, the values differ).

@@ -836,6 +836,26 @@ fn load_accepts_names_and_files_and_explains_the_rest() {
         (r.name.as_str(), r.measurement, r.n_unknowns()),
         (path.to_str().unwrap(), Measurement::Point, 27)
     );
+    // `:pose` after a file, as after a built-in name: the URDF imported for
+    // full poses, a point description turned into its full-pose variant;
+    // the name keeps the suffix so that design files load the same robot.
+    let name = format!("{}:pose", path.to_str().unwrap());
+    let r = Robot::load(&name).unwrap();
+    let direct = urdf_import("ur5.urdf", Measurement::Pose);
+    assert_eq!(
+        (r.name.as_str(), r.measurement),
+        (name.as_str(), Measurement::Pose)
+    );
+    assert_eq!(r.unknowns, direct.unknowns);
+    assert_eq!(r.nominal, direct.nominal);
+    let scara = format!("{}:pose", fixture("scara.toml").to_str().unwrap());
+    let s = Robot::load(&scara).unwrap();
+    assert_eq!((s.rows_per_pose(), s.n_unknowns()), (6, 4 * 3 + 2 + 6));
+    s.check_identifiable().unwrap();
+    let e = Robot::load("/nonexistent/arm.urdf:pose")
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("/nonexistent/arm.urdf:"), "{e}");
 }
 
 /// Line (1-based) of the first line of `text` containing `needle`.

@@ -30,7 +30,8 @@ pub struct RobotsArgs {
 /// Arguments of the command.
 #[derive(Args)]
 pub struct FkArgs {
-    /// Robot: a built-in name, or a .toml description or .urdf file.
+    /// Robot: a built-in name, or a .toml description or .urdf file; append
+    /// `:pose` for full-pose measurements.
     #[arg(long, default_value = "puma560")]
     pub robot: String,
     /// Parameter set: nominal or real.
@@ -53,7 +54,8 @@ pub struct FkArgs {
 /// Arguments of the command.
 #[derive(Args)]
 pub struct PoolArgs {
-    /// Robot: a built-in name, or a .toml description or .urdf file.
+    /// Robot: a built-in name, or a .toml description or .urdf file; append
+    /// `:pose` for full-pose measurements.
     #[arg(long, default_value = "puma560")]
     pub robot: String,
     /// Lattice values per joint.

@@ -21,7 +21,8 @@ use std::time::Instant;
 /// Arguments of the command.
 #[derive(Args)]
 pub struct CalibrateArgs {
-    /// Robot: a built-in name, or a .toml description or .urdf file.
+    /// Robot: a built-in name, or a .toml description or .urdf file; append
+    /// `:pose` for full-pose measurements.
     #[arg(long, default_value = "puma560")]
     pub robot: String,
     /// Design file (JSON with robot, levels, poses), as written by `select`:

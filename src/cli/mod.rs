@@ -65,8 +65,8 @@ pub fn emit(json_out: bool, value: &Value, text: impl FnOnce() -> String) {
 /// Options that define a pose pool, shared by the commands that need one.
 #[derive(clap::Args, Clone, Debug)]
 pub struct PoolOpts {
-    /// Robot: a built-in name (puma560, ur5, stanford; `:pose` for full-pose
-    /// measurements), or a .toml description or .urdf file.
+    /// Robot: a built-in name (puma560, ur5, stanford), or a .toml
+    /// description or .urdf file; append `:pose` for full-pose measurements.
     #[arg(long, default_value = "puma560")]
     pub robot: String,
     /// Lattice values per joint.

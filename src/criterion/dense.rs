@@ -105,10 +105,25 @@ pub(crate) fn chol_pivoted_in_place(
     floor: f64,
     perm: &mut [usize],
 ) -> Result<f64, f64> {
+    let mut ln_det = 0.0;
+    chol_pivoted_pivots_in_place(a, n, floor, perm, |d| ln_det += d.ln())?;
+    Ok(ln_det)
+}
+
+/// The pivoted factorization of [`chol_pivoted_in_place`], handing each
+/// pivot `d_k` to `pivot` (for one `ln` of their product, as
+/// [`chol_pivots_in_place`] does); `Err(d)` for the first pivot `≤ floor`.
+#[inline]
+pub(crate) fn chol_pivoted_pivots_in_place(
+    a: &mut [f64],
+    n: usize,
+    floor: f64,
+    perm: &mut [usize],
+    mut pivot: impl FnMut(f64),
+) -> Result<(), f64> {
     for (k, pk) in perm.iter_mut().enumerate().take(n) {
         *pk = k;
     }
-    let mut ln_det = 0.0;
     for k in 0..n {
         // Largest remaining diagonal entry (first on ties: deterministic).
         let mut j = k;
@@ -130,7 +145,7 @@ pub(crate) fn chol_pivoted_in_place(
         if !(d > floor) {
             return Err(d);
         }
-        ln_det += d.ln();
+        pivot(d);
         let l = d.sqrt();
         a[k * n + k] = l;
         for i in k + 1..n {
@@ -143,7 +158,7 @@ pub(crate) fn chol_pivoted_in_place(
             }
         }
     }
-    Ok(ln_det)
+    Ok(())
 }
 
 /// Smallest LDLᵀ pivot of a Cholesky factor produced by [`chol_in_place`]
@@ -202,10 +217,25 @@ pub(crate) fn exchange_in_factor(
     chol_in_place(&mut la[..t * t], t, 0.0)
 }
 
+/// Size below which an unpivoted pivot of the exchange's Schur complement
+/// `B` is re-examined with pivoting ([`exchange_out_ln_det`]). `B` is
+/// dimensionless, `0 ⪯ B ⪯ I + YᵀY`, with pivots of order 0.01–1 away from
+/// singularity.
+pub(crate) const SUSPECT_PIVOT: f64 = 1e-6;
+
 /// Second factor of the exchange determinant: `ln det(I − V_out + YᵀY)`
 /// with `Y = L_A⁻¹ W` (`la` from [`exchange_in_factor`], `w(a, b)` the cross
-/// block `X_in M⁻¹ X_outᵀ`), by Cholesky, with one `ln` of the product of
-/// its pivots. `Err(pivot)` for a pivot `≤ floor`.
+/// block `X_in M⁻¹ X_outᵀ`), with one `ln` of the product of its pivots.
+/// `Err(pivot)` for a pivot `≤ floor`.
+///
+/// `B` is the removal Schur complement, singular exactly when the exchange
+/// loses rank, and the singularity test needs pivoting (see
+/// [`chol_pivoted_in_place`]): an unpivoted zero pivot can come out as
+/// `1e-8`. Pivoting every candidate costs 16% of the pricing, so the plain
+/// Cholesky runs first and its answer stands only when every pivot exceeds
+/// [`SUSPECT_PIVOT`] — a polluted zero needs an earlier pivot about that
+/// small to be amplified that far. Otherwise (and on refusal) the pivoted
+/// factorization decides, as the state's update does.
 pub(crate) fn exchange_out_ln_det(
     t: usize,
     la: &[f64; MAX_T * MAX_T],
@@ -224,21 +254,38 @@ pub(crate) fn exchange_out_ln_det(
             y[r * t + c] = s / la[r * t + r];
         }
     }
-    // B = I − V_out + Yᵀ Y (lower triangle).
-    let mut b = [0.0f64; MAX_T * MAX_T];
-    for r in 0..t {
-        for c in 0..=r {
-            let mut s = if r == c { 1.0 } else { 0.0 } - v_out[pk(r, c)];
-            for j in 0..t {
-                s += y[j * t + r] * y[j * t + c];
+    // B = I − V_out + Yᵀ Y; `upper` also fills the upper triangle, which
+    // only the pivoted factorization reads.
+    let fill = |b: &mut [f64; MAX_T * MAX_T], upper: bool| {
+        for r in 0..t {
+            for c in 0..=r {
+                let mut s = if r == c { 1.0 } else { 0.0 } - v_out[pk(r, c)];
+                for j in 0..t {
+                    s += y[j * t + r] * y[j * t + c];
+                }
+                b[r * t + c] = s;
+                if upper {
+                    b[c * t + r] = s;
+                }
             }
-            b[r * t + c] = s;
         }
-    }
-    // Cholesky of B; the pivots are in (floor, ~1+‖V‖], so their product
+    };
+    // The pivots are in (floor, ~1+‖Y‖²] (B ⪯ I + YᵀY), so their product
     // (t ≤ 6 of them) neither overflows nor underflows.
+    let mut b = [0.0f64; MAX_T * MAX_T];
+    fill(&mut b, false);
+    let (mut det, mut lo) = (1.0f64, f64::INFINITY);
+    let plain = chol_pivots_in_place(&mut b[..t * t], t, floor, |d| {
+        det *= d;
+        lo = lo.min(d);
+    });
+    if plain.is_ok() && lo > SUSPECT_PIVOT {
+        return Ok(det.ln());
+    }
+    fill(&mut b, true);
     let mut det = 1.0;
-    chol_pivots_in_place(&mut b[..t * t], t, floor, |d| det *= d)?;
+    let mut perm = [0usize; MAX_T];
+    chol_pivoted_pivots_in_place(&mut b[..t * t], t, floor, &mut perm[..t], |d| det *= d)?;
     Ok(det.ln())
 }
 

@@ -133,28 +133,28 @@ pub fn cmd_bench(a: BenchArgs) -> Result<()> {
     ];
     // Identification: one Levenberg–Marquardt calibration of the EAE design
     // from the nominal start, points (PUMA, σ = 1 cm) and full poses (UR5).
-    let lm = LmSettings::default();
-    let qs: Vec<Vec<f64>> = sel.poses.iter().map(|&k| pool.q(k)).collect();
-    let meas = simulate(&robot, &robot.real, &qs, 0.01, &mut trial_rng(1, 0))?;
-    let (t_lm, id) = time(reps, || identify(&robot, &robot.nominal, &meas, &lm));
-    let id = id?;
+    let lm_time = |r: &Robot, pool: &Pool, poses: &[usize], sigma: f64| -> Result<(f64, usize)> {
+        let qs: Vec<Vec<f64>> = poses.iter().map(|&k| pool.q(k)).collect();
+        let meas = simulate(r, &r.real, &qs, sigma, &mut trial_rng(1, 0))?;
+        let lm = LmSettings::default();
+        let (t, id) = time(reps, || identify(r, &r.nominal, &meas, &lm));
+        Ok((t, id?.iterations))
+    };
+    let (t_lm, it) = lm_time(&robot, &pool, &sel.poses, 0.01)?;
     let ur5 = Robot::builtin("ur5:pose")?;
     let pool6 = Pool::full(&ur5, 3)?;
     let x6 = pool6.jacobian(&ur5, &ur5.nominal);
     let sel6 = eae(&x6, &mut DCriterion::new(), &s, &mut design_rng(1, 0))?;
-    let qs6: Vec<Vec<f64>> = sel6.poses.iter().map(|&k| pool6.q(k)).collect();
-    let meas6 = simulate(&ur5, &ur5.real, &qs6, 0.001, &mut trial_rng(1, 0))?;
-    let (t_lm6, id6) = time(reps, || identify(&ur5, &ur5.nominal, &meas6, &lm));
-    let id6 = id6?;
+    let (t_lm6, it6) = lm_time(&ur5, &pool6, &sel6.poses, 0.001)?;
     rows.push((
         "LM calibration, PUMA, 30 points (p = 27)".into(),
         t_lm * 1e3,
-        format!("{} iterations", id.iterations),
+        format!("{it} iterations"),
     ));
     rows.push((
         "LM calibration, UR5, 30 full poses (p = 30)".into(),
         t_lm6 * 1e3,
-        format!("{} iterations", id6.iterations),
+        format!("{it6} iterations"),
     ));
     // The relaxation bound on the same pool, by each candidate-set solver
     // (one run each: seconds, not microseconds).
@@ -179,8 +179,8 @@ pub fn cmd_bench(a: BenchArgs) -> Result<()> {
         "threads": rayon::current_num_threads(),
         "jacobian_ms": t_jac * 1e3, "jacobian_ns_per_pose": t_jac * 1e9 / pool.len() as f64,
         "scan": scan, "eae_ms": t_eae * 1e3, "polish_ms": t_pol * 1e3, "polish_iterations": polish_iters,
-        "lm_point_ms": t_lm * 1e3, "lm_point_iterations": id.iterations,
-        "lm_pose_ms": t_lm6 * 1e3, "lm_pose_iterations": id6.iterations,
+        "lm_point_ms": t_lm * 1e3, "lm_point_iterations": it,
+        "lm_pose_ms": t_lm6 * 1e3, "lm_pose_iterations": it6,
         "bounds": bounds,
     });
     if a.scale {

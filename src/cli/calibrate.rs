@@ -79,6 +79,36 @@ fn named(names: &[String], values: &[f64]) -> Value {
     Value::Object(m)
 }
 
+/// The fields every calibration reports about its identification: status,
+/// iterations, estimate, standard deviations, correlation, σ̂, residual sums,
+/// rank.
+fn identification_json(id: &Identification) -> Map<String, Value> {
+    let names = &id.names;
+    json_map(json!({
+        "status": id.status,
+        "stop": id.stop,
+        "converged": id.converged(),
+        "iterations": id.iterations,
+        "evaluations": id.evaluations,
+        "estimate": named(names, &id.estimate),
+        "std": id.covariance.as_ref().map(|c| named(names, &c.std)),
+        "correlation": id.covariance.as_ref().map(|c| &c.correlation),
+        "sigma_hat": id.sigma_hat,
+        "rss": id.rss,
+        "initial_rss": id.initial_rss,
+        "rank": id.rank,
+        "unidentifiable": id.unidentifiable,
+    }))
+}
+
+/// The map inside a `json!({...})` object.
+fn json_map(v: Value) -> Map<String, Value> {
+    match v {
+        Value::Object(m) => m,
+        _ => Map::new(),
+    }
+}
+
 /// The robot calibrated by `id`, as a description: both tables are the
 /// estimate (the best knowledge of the real robot).
 fn calibrated_description(robot: &Robot, id: &Identification, source: &str) -> String {
@@ -156,30 +186,19 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     let written = write_calibrated(a, robot, &id, &path.display().to_string())?;
     let names = &id.names;
     let rows = (robot.rows_per_pose() * meas.len()) as f64;
-    let v = json!({
+    let mut v = identification_json(&id);
+    v.extend(json_map(json!({
         "robot": robot.name,
         "measurements": path.display().to_string(),
         "poses": meas.len(),
         "measurement": robot.measurement,
-        "status": id.status,
-        "stop": id.stop,
-        "converged": id.converged(),
-        "iterations": id.iterations,
-        "evaluations": id.evaluations,
-        "estimate": named(names, &id.estimate),
         "change": named(names, &id.estimate.iter().zip(&id.start).map(|(e, s)| e - s).collect::<Vec<_>>()),
-        "std": id.covariance.as_ref().map(|c| named(names, &c.std)),
-        "correlation": id.covariance.as_ref().map(|c| &c.correlation),
-        "sigma_hat": id.sigma_hat,
-        "rss": id.rss,
-        "initial_rss": id.initial_rss,
         "rms_residual": (id.rss / rows).sqrt(),
         "initial_rms_residual": (id.initial_rss / rows).sqrt(),
-        "rank": id.rank,
-        "unidentifiable": id.unidentifiable,
         "out": a.out.as_ref().filter(|_| written).map(|p| p.display().to_string()),
         "elapsed_seconds": t0.elapsed().as_secs_f64(),
-    });
+    })));
+    let v = Value::Object(v);
     emit(a.json, &v, || {
         let mut s = format!(
             "{}: {} measured {}s\n{}",
@@ -287,7 +306,8 @@ fn from_design(a: &CalibrateArgs, robot: &Robot, design_path: &Path) -> Result<(
     };
     let mc_seconds = t_mc.elapsed().as_secs_f64();
 
-    let v = json!({
+    let mut v = identification_json(id);
+    v.extend(json_map(json!({
         "robot": robot.name,
         "design": design_path.display().to_string(),
         "poses": qs.len(),
@@ -295,20 +315,7 @@ fn from_design(a: &CalibrateArgs, robot: &Robot, design_path: &Path) -> Result<(
         "noise": a.noise,
         "orientation_noise": full.then(|| a.noise / robot.orientation_scale),
         "seed": a.seed,
-        "status": id.status,
-        "stop": id.stop,
-        "converged": id.converged(),
-        "iterations": id.iterations,
-        "evaluations": id.evaluations,
-        "estimate": named(names, &id.estimate),
         "residual": named(names, &residual),
-        "std": id.covariance.as_ref().map(|c| named(names, &c.std)),
-        "correlation": id.covariance.as_ref().map(|c| &c.correlation),
-        "sigma_hat": id.sigma_hat,
-        "rss": id.rss,
-        "initial_rss": id.initial_rss,
-        "rank": id.rank,
-        "unidentifiable": id.unidentifiable,
         "validation_poses": validation.len(),
         "validation_rms_before": before,
         "validation_rms_after": after,
@@ -317,7 +324,8 @@ fn from_design(a: &CalibrateArgs, robot: &Robot, design_path: &Path) -> Result<(
         "monte_carlo": mc,
         "monte_carlo_seconds": mc.as_ref().map(|_| mc_seconds),
         "elapsed_seconds": t0.elapsed().as_secs_f64(),
-    });
+    })));
+    let v = Value::Object(v);
     emit(a.json, &v, || {
         let noise = if full {
             format!(

@@ -16,7 +16,7 @@ use rand_chacha::ChaCha8Rng;
 use serde_json::Value;
 mod common;
 
-use common::run;
+use common::{eae_design, run};
 
 /// `n` distinct pool positions drawn with a seeded ChaCha8 (partial Fisher–Yates).
 fn random_design(pool: &Pool, n: usize, seed: u64) -> Vec<usize> {
@@ -316,19 +316,11 @@ fn bad_input_is_an_error() {
 /// A full-pose robot (UR5, 30 unknowns) and a 30-pose selected design in
 /// its 3-level lattice, with orientation rows weighted by `w`.
 fn pose_data(w: f64) -> (Robot, Pool, Vec<usize>, Vec<Vec<f64>>) {
-    use activecal::criterion::DCriterion;
-    use activecal::select::{Settings, design_rng, eae};
     let mut robot = Robot::builtin("ur5:pose").unwrap();
     robot.orientation_scale = w;
     let pool = Pool::full(&robot, 3).unwrap();
     let x = pool.jacobian(&robot, &robot.nominal);
-    let sel = eae(
-        &x,
-        &mut DCriterion::new(),
-        &Settings::default(),
-        &mut design_rng(1, 0),
-    )
-    .unwrap();
+    let sel = eae_design(&x);
     let qs = sel.poses.iter().map(|&k| pool.q(k)).collect();
     (robot, pool, sel.poses, qs)
 }

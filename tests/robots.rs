@@ -10,16 +10,19 @@
 //! ε·|y|/h ≈ 5e-9 (rounding at 20 m), so analytic Jacobians are checked to
 //! 1e-7 absolute.
 
+mod common;
+
 use activecal::blocks::Blocks;
 use activecal::bound::{BoundSettings, relaxation_bound};
-use activecal::criterion::{DCriterion, Indices};
+use activecal::criterion::Indices;
 use activecal::identify::{LmSettings, identify, simulate, trial_rng};
 use activecal::kinematics::{Evaluator, pose, position};
 use activecal::pool::{Pool, require_identifiable};
 use activecal::robot::unknowns::INDEPENDENCE_TOL;
 use activecal::robot::{Convention, JointKind, Measurement, ParamSet, ParamTable, Robot, file};
-use activecal::select::{Settings, design_rng, eae, ln_det_direct};
+use activecal::select::ln_det_direct;
 use activecal::urdf::{self, UrdfOptions};
+use common::eae_design;
 use nalgebra::{Isometry3, Matrix3, Translation3, Unit, UnitQuaternion, Vector3};
 use std::collections::HashMap;
 use std::f64::consts::FRAC_PI_2;
@@ -1084,9 +1087,7 @@ fn pool_x(r: &Robot, levels: usize) -> (Pool, Blocks) {
 fn select_and_score_run_on_every_robot() {
     for r in all_robots() {
         let (_, x) = pool_x(&r, 3);
-        let s = Settings::default();
-        let sel = eae(&x, &mut DCriterion::new(), &s, &mut design_rng(1, 0))
-            .unwrap_or_else(|e| panic!("{}: {e}", r.name));
+        let sel = eae_design(&x);
         assert_eq!(sel.poses.len(), 30, "{}", r.name);
         let mut sorted = sel.poses.clone();
         sorted.sort_unstable();
@@ -1129,13 +1130,7 @@ fn select_and_score_run_on_every_robot() {
 fn bound_runs_on_every_robot_and_lies_above_the_selected_design() {
     for r in all_robots() {
         let (_, x) = pool_x(&r, 3);
-        let sel = eae(
-            &x,
-            &mut DCriterion::new(),
-            &Settings::default(),
-            &mut design_rng(1, 0),
-        )
-        .unwrap();
+        let sel = eae_design(&x);
         // The bound is valid at any gap; a loose target keeps this test short.
         let settings = BoundSettings::builder()
             .use_conic(false)
@@ -1170,13 +1165,7 @@ fn calibration_recovers_the_real_robot() {
             r.orientation_scale = 0.3;
         }
         let (pool, x) = pool_x(&r, 3);
-        let sel = eae(
-            &x,
-            &mut DCriterion::new(),
-            &Settings::default(),
-            &mut design_rng(1, 0),
-        )
-        .unwrap();
+        let sel = eae_design(&x);
         let qs: Vec<Vec<f64>> = sel.poses.iter().map(|&k| pool.q(k)).collect();
         let meas = simulate(&r, &r.real, &qs, 0.0, &mut trial_rng(1, 0)).unwrap();
         assert_eq!(

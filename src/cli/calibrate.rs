@@ -249,7 +249,6 @@ fn status_text(id: &Identification) -> String {
 /// Simulated calibration at a design's poses.
 fn from_design(a: &CalibrateArgs, robot: &Robot, design_path: &Path) -> Result<()> {
     let t0 = Instant::now();
-    let robot = robot.clone();
     let design = DesignFile::read(design_path)?;
     if design.robot != robot.name {
         anyhow::bail!(
@@ -259,9 +258,9 @@ fn from_design(a: &CalibrateArgs, robot: &Robot, design_path: &Path) -> Result<(
             robot.name
         );
     }
-    let pool = Pool::full(&robot, design.levels)?;
+    let pool = Pool::full(robot, design.levels)?;
     let positions = design
-        .positions_in(&robot, &pool)
+        .positions_in(robot, &pool)
         .map_err(|e| anyhow::anyhow!("{}: {e}", design_path.display()))?;
     let qs: Vec<Vec<f64>> = positions.iter().map(|&k| pool.q(k)).collect();
     let lm = LmSettings::default()
@@ -274,24 +273,24 @@ fn from_design(a: &CalibrateArgs, robot: &Robot, design_path: &Path) -> Result<(
         .with_validation_poses(a.validation);
     let settings = MonteCarloSettings { lm, ..settings };
     settings.validate()?;
-    let validation = ValidationSet::sample(&robot, &pool, &positions, a.validation, a.seed)?;
+    let validation = ValidationSet::sample(robot, &pool, &positions, a.validation, a.seed)?;
 
     // ---- one calibration: trial 0 of the seed --------------------------------
-    let tables = paper_tables(&robot, &qs, a.noise, a.seed, &settings.lm)?;
+    let tables = paper_tables(robot, &qs, a.noise, a.seed, &settings.lm)?;
     let id = &tables.identification;
     if let Some(path) = &a.save_measurements {
         let text = serde_json::to_string_pretty(&tables.measurements)? + "\n";
         write_new(path, &text, a.force)?;
     }
     let source = format!("simulated measurements at {}", design_path.display());
-    write_calibrated(a, &robot, id, &source)?;
+    write_calibrated(a, robot, id, &source)?;
     let names = &id.names;
     let truth = robot.unknown_values(&robot.real);
     let residual: Vec<f64> = truth.iter().zip(&id.estimate).map(|(t, e)| t - e).collect();
-    let before = validation.rms(&robot, &robot.nominal);
-    let after = validation.rms(&robot, &id.table);
-    let rot_before = validation.orientation_rms(&robot, &robot.nominal);
-    let rot_after = validation.orientation_rms(&robot, &id.table);
+    let before = validation.rms(robot, &robot.nominal);
+    let after = validation.rms(robot, &id.table);
+    let rot_before = validation.orientation_rms(robot, &robot.nominal);
+    let rot_after = validation.orientation_rms(robot, &id.table);
     let full = robot.measurement == Measurement::Pose;
 
     // ---- Monte-Carlo ------------------------------------------------------------
@@ -300,7 +299,7 @@ fn from_design(a: &CalibrateArgs, robot: &Robot, design_path: &Path) -> Result<(
         let name = design_path
             .file_stem()
             .map_or("design".into(), |s| s.to_string_lossy().into_owned());
-        Some(monte_carlo(&robot, &name, &qs, &validation, &settings)?)
+        Some(monte_carlo(robot, &name, &qs, &validation, &settings)?)
     } else {
         None
     };

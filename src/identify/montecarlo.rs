@@ -244,27 +244,18 @@ impl ValidationSet {
         Some((s / self.qs.len() as f64).sqrt())
     }
 
-    /// The RMS distance the linearised model predicts after calibration with
-    /// estimate covariance `c`: `√(tr(X_v C X_vᵀ) / n)`, `X_v` the position
-    /// rows of the Jacobian of the validation poses at the real parameters.
+    /// The RMS errors the linearised model predicts after calibration with
+    /// estimate covariance `c`, from one Jacobian `X_v` of the validation
+    /// poses at the real parameters: the position distance `√(tr_pos / n)`
+    /// and, for a full-pose robot, the orientation angle in radians
+    /// `√(tr_ori / n)`, where `tr_pos` and `tr_ori` are the traces of
+    /// `X_v C X_vᵀ` over the position rows and over the orientation rows
+    /// (divided by [`Robot::orientation_scale`]).
     #[must_use]
-    pub fn predicted_rms(&self, robot: &Robot, c: &Mat<f64>) -> f64 {
-        self.predicted_traces(robot, c).0
-    }
-
-    /// The RMS orientation error (radians) the linearised model predicts after
-    /// calibration with estimate covariance `c`, from the orientation rows
-    /// (divided by [`Robot::orientation_scale`]); `None` for a point robot.
-    #[must_use]
-    pub fn predicted_orientation_rms(&self, robot: &Robot, c: &Mat<f64>) -> Option<f64> {
-        (robot.measurement == Measurement::Pose).then(|| self.predicted_traces(robot, c).1)
-    }
-
-    /// `(√(tr_pos / n), √(tr_ori / n))`: the traces of `X_v C X_vᵀ` over
-    /// the position rows and over the unweighted orientation rows.
-    fn predicted_traces(&self, robot: &Robot, c: &Mat<f64>) -> (f64, f64) {
+    pub fn predicted_rms(&self, robot: &Robot, c: &Mat<f64>) -> (f64, Option<f64>) {
+        let pose = robot.measurement == Measurement::Pose;
         if self.qs.is_empty() {
-            return (0.0, 0.0);
+            return (0.0, pose.then_some(0.0));
         }
         let x = jacobian_of(robot, &robot.real, self.qs.len(), |k, q| {
             q.copy_from_slice(&self.qs[k])
@@ -280,7 +271,10 @@ impl ValidationSet {
         }
         let n = self.qs.len() as f64;
         let w = robot.orientation_scale;
-        ((tr[0].max(0.0) / n).sqrt(), (tr[1].max(0.0) / n).sqrt() / w)
+        (
+            (tr[0].max(0.0) / n).sqrt(),
+            pose.then(|| (tr[1].max(0.0) / n).sqrt() / w),
+        )
     }
 }
 
@@ -552,6 +546,7 @@ pub fn monte_carlo(
     };
 
     let before = validation.rms(robot, &robot.nominal);
+    let predicted = c_pred.as_ref().map(|c| validation.predicted_rms(robot, c));
     let after: Vec<f64> = used.iter().map(|t| t.rms_after).collect();
     let after_rot: Vec<f64> = used
         .iter()
@@ -579,12 +574,10 @@ pub fn monte_carlo(
         validation_poses: validation.len(),
         validation_rms_before: before,
         validation_rms_after: Spread::of(&after),
-        validation_rms_predicted: c_pred.as_ref().map(|c| validation.predicted_rms(robot, c)),
+        validation_rms_predicted: predicted.map(|p| p.0),
         validation_orientation_rms_before: validation.orientation_rms(robot, &robot.nominal),
         validation_orientation_rms_after: Spread::of(&after_rot),
-        validation_orientation_rms_predicted: c_pred
-            .as_ref()
-            .and_then(|c| validation.predicted_orientation_rms(robot, c)),
+        validation_orientation_rms_predicted: predicted.and_then(|p| p.1),
     })
 }
 

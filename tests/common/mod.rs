@@ -40,3 +40,17 @@ pub fn fails_with(args: &[&str], needle: &str) {
     assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
     assert!(err.contains(needle), "{args:?}: '{err}' lacks '{needle}'");
 }
+
+/// One exchange-add-exchange start with the default settings (30 poses,
+/// seed 1, D-criterion): the design the per-robot tests run on.
+pub fn eae_design(x: &activecal::blocks::Blocks) -> activecal::select::Selection {
+    use activecal::criterion::DCriterion;
+    use activecal::select::{Settings, design_rng, eae};
+    eae(
+        x,
+        &mut DCriterion::new(),
+        &Settings::default(),
+        &mut design_rng(1, 0),
+    )
+    .unwrap_or_else(|e| panic!("EAE: {e}"))
+}

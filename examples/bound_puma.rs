@@ -3,7 +3,7 @@
 //! `cargo run --release --example bound_puma -- [N] [first-order]`.
 
 use activecal::bound::{BoundSettings, pool_bound};
-use activecal::robot::{ParamSet, Robot};
+use activecal::model::{ParamSet, Robot};
 
 fn main() {
     let mut args = std::env::args().skip(1);

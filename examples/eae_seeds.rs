@@ -3,7 +3,7 @@
 //! designs as the determinant: `cargo run --release --example eae_seeds`.
 use activecal::criterion::{DCriterion, OiCriterion};
 use activecal::pool::Pool;
-use activecal::robot::Robot;
+use activecal::model::Robot;
 use activecal::select::*;
 use std::time::Instant;
 fn main() {

@@ -3,7 +3,7 @@
 //! injection): `cargo run --release --example eae_timing`.
 use activecal::criterion::DCriterion;
 use activecal::pool::Pool;
-use activecal::robot::Robot;
+use activecal::model::Robot;
 use activecal::select::{Settings, design_rng, eae};
 use std::time::Instant;
 

@@ -1,7 +1,10 @@
 //! Stacked per-pose Jacobian blocks: the identification Jacobian of a whole
 //! pose pool in one contiguous, column-major faer matrix.
 
+use crate::kinematics::Evaluator;
+use crate::model::{ParamTable, Robot};
 use faer::{Mat, MatRef};
+use rayon::prelude::*;
 
 /// The identification Jacobians of `n` poses stacked into one `t·n × p`
 /// matrix: the `t` rows of pose `i` are rows `t·i .. t·i + t`.
@@ -83,3 +86,37 @@ impl Blocks {
         x.mat.transpose() * &x.mat
     }
 }
+
+/// Identification Jacobian of `n` poses whose joint angles `fill_q(k, q)`
+/// writes, computed in parallel into one [`Blocks`].
+pub fn jacobian_of<F>(robot: &Robot, table: &ParamTable, n: usize, fill_q: F) -> Blocks
+where
+    F: Fn(usize, &mut [f64]) + Sync,
+{
+    let p = robot.n_unknowns();
+    let t = robot.rows_per_pose();
+    let dof = robot.dof();
+    // Written straight into the column-major matrix, chunk by chunk of rows
+    // (no row-major copy: a 10⁶-pose pool's Jacobian is 650 MB already).
+    let mut mat = faer::Mat::<f64>::zeros(n * t, p);
+    const CHUNK: usize = 256;
+    mat.as_mut()
+        .par_row_chunks_mut(CHUNK * t)
+        .enumerate()
+        .for_each(|(c, mut chunk)| {
+            let mut ev = Evaluator::new(robot, table);
+            let mut q = vec![0.0; dof];
+            let mut jac = vec![0.0; t * p];
+            for k in 0..chunk.nrows() / t {
+                fill_q(c * CHUNK + k, &mut q);
+                ev.eval(&q, &mut jac);
+                for r in 0..t {
+                    for col in 0..p {
+                        chunk[(k * t + r, col)] = jac[r * p + col];
+                    }
+                }
+            }
+        });
+    Blocks::new(mat, t)
+}
+

@@ -11,7 +11,7 @@
 //! frame: `u` for a rotation about `u`, 0 for a translation.
 
 use crate::error::Result;
-use crate::robot::{Convention, JointKind, ParamTable, Robot, Symbol};
+use crate::model::{Convention, JointKind, ParamTable, Robot, Symbol};
 use nalgebra::{Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
 
 /// Axes and origins along one frame, in the measurement frame, needed by the
@@ -75,7 +75,7 @@ fn frame_q(joint: Option<usize>, q: &[f64]) -> f64 {
 /// The frame's rotation about and translation along its base z axis:
 /// `(q + γ, d)` for a revolute or fixed frame, `(γ, q + d)` for a prismatic one.
 #[inline]
-fn z_motion(frame: &crate::robot::Frame, gamma: f64, d: f64, q: &[f64]) -> (f64, f64) {
+fn z_motion(frame: &crate::model::Frame, gamma: f64, d: f64, q: &[f64]) -> (f64, f64) {
     match (frame.joint, frame.joint_kind) {
         (Some(j), JointKind::Prismatic) => (gamma, q[j] + d),
         (j, _) => (frame_q(j, q) + gamma, d),
@@ -129,7 +129,7 @@ pub fn position_checked(robot: &Robot, table: &ParamTable, q: &[f64]) -> Result<
 /// [`Robot::check_q`]). The orientation residual of identification is
 /// `φ = log(R(θ) R_measᵀ)`, whose derivative is the orientation rows of
 /// [`Evaluator::eval`] premultiplied by `J_l⁻¹(φ)`
-/// ([`crate::identify::so3`]).
+/// ([`crate::measure::so3`]).
 #[must_use]
 pub fn pose(robot: &Robot, table: &ParamTable, q: &[f64]) -> (Matrix3<f64>, Vector3<f64>) {
     let mut axes = vec![FrameAxes::default(); robot.frames.len()];
@@ -295,7 +295,7 @@ pub fn joint_chain(robot: &Robot, table: &ParamTable) -> JointChain {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::robot::Robot;
+    use crate::model::Robot;
 
     fn q_sample(i: usize) -> [f64; 6] {
         let mut q = [0.0; 6];

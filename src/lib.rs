@@ -1,20 +1,23 @@
 //! activecal: choose the poses to measure for robot kinematic calibration,
 //! certify how close the choice is to optimal, and run the calibration.
 //!
-//! Data flows one way: [`robot`] model → [`pool`] of poses → Jacobian
-//! [`blocks`] → criterion state → selection algorithm → report.
+//! Data flows one way: [`model`] → [`kinematics`] → [`measure`] → Jacobian
+//! [`blocks`] → [`pool`] → [`observability`] → [`criterion`] state →
+//! [`select`] / [`bound`] → [`identify`] → report; [`io`] reads and writes
+//! files into and out of these types.
 #![warn(missing_docs)]
 
 pub mod blocks;
 pub mod bound;
 pub mod criterion;
-pub mod design;
 pub mod error;
 pub mod identify;
+pub mod io;
 pub mod kinematics;
+pub mod measure;
+pub mod model;
+pub mod observability;
 pub mod pool;
-pub mod robot;
 pub mod select;
-pub mod urdf;
 
 pub use error::{Error, Result};

@@ -15,7 +15,7 @@ use activecal::bound::{
     BoundError, BoundSettings, BoundStatus, RelaxationSolver, design_gap, relaxation_bound,
 };
 use activecal::pool::Pool;
-use activecal::robot::Robot;
+use activecal::model::Robot;
 use faer::Mat;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;

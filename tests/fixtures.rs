@@ -12,7 +12,7 @@
 //! adds no error. See `verify::TOLERANCE`.
 
 use activecal::kinematics::Evaluator;
-use activecal::robot::{ParamSet, Robot};
+use activecal::model::{ParamSet, Robot};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -53,7 +53,7 @@ fn every_builtin_robot_has_fixtures_for_both_parameter_sets() {
         .iter()
         .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
         .collect();
-    for robot in activecal::robot::BUILTIN {
+    for robot in activecal::model::BUILTIN {
         for set in ["nominal", "real"] {
             let want = format!("{robot}_{set}.json");
             assert!(

@@ -17,11 +17,13 @@ use activecal::bound::{BoundSettings, relaxation_bound};
 use activecal::criterion::Indices;
 use activecal::identify::{LmSettings, identify, simulate, trial_rng};
 use activecal::kinematics::{Evaluator, pose, position};
-use activecal::pool::{Pool, require_identifiable};
-use activecal::robot::unknowns::INDEPENDENCE_TOL;
-use activecal::robot::{Convention, JointKind, Measurement, ParamSet, ParamTable, Robot, file};
+use activecal::observability::require_identifiable;
+use activecal::pool::Pool;
+use activecal::observability::INDEPENDENCE_TOL;
+use activecal::io::robot_toml as file;
+use activecal::model::{Convention, JointKind, Measurement, ParamSet, ParamTable, Robot};
 use activecal::select::ln_det_direct;
-use activecal::urdf::{self, UrdfOptions};
+use activecal::io::urdf::{self, UrdfOptions};
 use common::eae_design;
 use nalgebra::{Isometry3, Matrix3, Translation3, Unit, UnitQuaternion, Vector3};
 use std::collections::HashMap;
@@ -145,7 +147,7 @@ fn puma_is_unchanged_and_its_pose_variant_only_adds_the_tool() {
     assert_eq!(p.nominal, b.nominal);
     assert_eq!(p.unknowns, b.unknowns);
     assert_eq!(p.measurement, Measurement::Point);
-    assert!(p.visibility.is_none());
+    assert!(activecal::io::load_description("puma560").unwrap().visibility.is_none());
     assert!(p.frames.iter().all(|f| f.joint_kind == JointKind::Revolute));
     let pp = Robot::builtin("puma560:pose").unwrap();
     assert_eq!(pp.measurement, Measurement::Pose);
@@ -775,7 +777,7 @@ fn toml_fixtures_load() {
     if std::env::var_os("ACTIVECAL_REGEN_ROBOT_FIXTURES").is_some() {
         std::fs::write(&path, file::to_toml(&puma)).unwrap();
     }
-    let r = Robot::load(path.to_str().unwrap()).unwrap();
+    let r = activecal::io::load_robot(path.to_str().unwrap()).unwrap();
     assert_eq!(
         (&r.real, &r.nominal, &r.unknowns, &r.limits),
         (&puma.real, &puma.nominal, &puma.unknowns, &puma.limits)
@@ -783,7 +785,7 @@ fn toml_fixtures_load() {
     // The hand-written SCARA: all axes parallel, a prismatic quill, automatic
     // unknowns: 4R + 2P + 3 = 17 of them, no d along the parallel axes but
     // the last frame's.
-    let s = Robot::load(fixture("scara.toml").to_str().unwrap()).unwrap();
+    let s = activecal::io::load_robot(fixture("scara.toml").to_str().unwrap()).unwrap();
     assert_eq!(s.dof(), 4);
     assert_eq!(s.frames[3].joint_kind, JointKind::Prismatic);
     assert!((s.limits[0][1] - 105f64.to_radians()).abs() < 1e-15);
@@ -798,12 +800,12 @@ fn toml_fixtures_load() {
     assert_eq!(s.minimal_unknowns(), 17);
     // A description importing a URDF, measured in full pose, with a region.
     let path = fixture("ur5_pose.toml");
-    let u = Robot::load(path.to_str().unwrap()).unwrap();
+    let u = activecal::io::load_robot(path.to_str().unwrap()).unwrap();
     assert_eq!(u.name, path.to_str().unwrap()); // loaded by path: named by it
     assert_eq!(file::load(&path).unwrap().name, "ur5-urdf:pose");
     assert_eq!(u.rows_per_pose(), 6);
     assert_eq!(u.n_unknowns(), 30);
-    assert!(u.visibility.is_some());
+    assert!(activecal::io::load_description(path.to_str().unwrap()).unwrap().visibility.is_some());
     let direct = urdf_import("ur5.urdf", Measurement::Pose);
     assert_eq!(u.nominal, direct.nominal);
 }
@@ -818,23 +820,23 @@ fn load_accepts_names_and_files_and_explains_the_rest() {
         "ur5:pose",
         "puma:pose",
     ] {
-        Robot::load(name).unwrap();
+        activecal::io::load_robot(name).unwrap();
     }
-    let e = Robot::load("kuka").unwrap_err().to_string();
+    let e = activecal::io::load_robot("kuka").unwrap_err().to_string();
     assert!(
         e.contains("unknown robot 'kuka'") && e.contains("ur5") && e.contains(".urdf"),
         "{e}"
     );
-    let e = Robot::load("/nonexistent/arm.toml")
+    let e = activecal::io::load_robot("/nonexistent/arm.toml")
         .unwrap_err()
         .to_string();
     assert!(e.starts_with("/nonexistent/arm.toml:"), "{e}");
-    let e = Robot::load(fixture("puma560_nominal.json").to_str().unwrap())
+    let e = activecal::io::load_robot(fixture("puma560_nominal.json").to_str().unwrap())
         .unwrap_err()
         .to_string();
     assert!(e.contains("unknown robot file type"), "{e}");
     let path = fixture("ur5.urdf");
-    let r = Robot::load(path.to_str().unwrap()).unwrap();
+    let r = activecal::io::load_robot(path.to_str().unwrap()).unwrap();
     assert_eq!(
         (r.name.as_str(), r.measurement, r.n_unknowns()),
         (path.to_str().unwrap(), Measurement::Point, 27)
@@ -843,7 +845,7 @@ fn load_accepts_names_and_files_and_explains_the_rest() {
     // full poses, a point description turned into its full-pose variant;
     // the name keeps the suffix so that design files load the same robot.
     let name = format!("{}:pose", path.to_str().unwrap());
-    let r = Robot::load(&name).unwrap();
+    let r = activecal::io::load_robot(&name).unwrap();
     let direct = urdf_import("ur5.urdf", Measurement::Pose);
     assert_eq!(
         (r.name.as_str(), r.measurement),
@@ -852,10 +854,10 @@ fn load_accepts_names_and_files_and_explains_the_rest() {
     assert_eq!(r.unknowns, direct.unknowns);
     assert_eq!(r.nominal, direct.nominal);
     let scara = format!("{}:pose", fixture("scara.toml").to_str().unwrap());
-    let s = Robot::load(&scara).unwrap();
+    let s = activecal::io::load_robot(&scara).unwrap();
     assert_eq!((s.rows_per_pose(), s.n_unknowns()), (6, 4 * 3 + 2 + 6));
     s.check_identifiable().unwrap();
-    let e = Robot::load("/nonexistent/arm.urdf:pose")
+    let e = activecal::io::load_robot("/nonexistent/arm.urdf:pose")
         .unwrap_err()
         .to_string();
     assert!(e.starts_with("/nonexistent/arm.urdf:"), "{e}");
@@ -919,7 +921,7 @@ fn orientation_scale_in_descriptions() {
         file::parse(&plain, "a.toml", None)
             .unwrap()
             .orientation_scale,
-        activecal::robot::DEFAULT_ORIENTATION_SCALE
+        activecal::model::DEFAULT_ORIENTATION_SCALE
     );
 }
 

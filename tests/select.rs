@@ -4,7 +4,7 @@
 use activecal::blocks::Blocks;
 use activecal::criterion::{DCriterion, OiCriterion};
 use activecal::pool::Pool;
-use activecal::robot::Robot;
+use activecal::model::Robot;
 use activecal::select::{
     Algorithm, Settings, StepKind, design_rng, detmax, eae, fedorov, ln_det_direct, multistart,
 };

@@ -1,14 +1,15 @@
-//! The robot-description loader (`activecal::robot::file`) and the URDF
-//! importer (`activecal::urdf`) never panic: on arbitrary text, on random
+//! The robot-description loader (`activecal::io::robot_toml`) and the URDF
+//! importer (`activecal::io::urdf`) never panic: on arbitrary text, on random
 //! edits of valid files, and on random robots written by `to_toml`, which
 //! must read back to the same kinematics bit for bit when they load at all.
 //! Whatever loads is valid and has identifiable unknowns.
 
 use activecal::kinematics::pose;
-use activecal::robot::{
-    Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot, Symbol, file,
+use activecal::model::{
+    Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot, Symbol,
 };
-use activecal::urdf::{self, UrdfOptions};
+use activecal::io::robot_toml as file;
+use activecal::io::urdf::{self, UrdfOptions};
 use proptest::prelude::*;
 use std::sync::OnceLock;
 
@@ -246,8 +247,7 @@ fn any_robot() -> impl Strategy<Value = Robot> {
                 } else {
                     Measurement::Point
                 },
-                orientation_scale: activecal::robot::DEFAULT_ORIENTATION_SCALE,
-                visibility: None,
+                orientation_scale: activecal::model::DEFAULT_ORIENTATION_SCALE,
             }
         })
 }

@@ -36,7 +36,7 @@ pub use gap::{DesignGap, design_gap};
 
 use crate::blocks::Blocks;
 use crate::pool::Pool;
-use crate::robot::{ParamSet, Robot};
+use crate::model::{ParamSet, Robot};
 use conic::{ConicSettings, ConicStatus};
 use exchange::{ExchangeOutcome, ExchangeSettings, candidates, evaluate};
 use newton::NewtonSettings;

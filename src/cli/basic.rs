@@ -3,7 +3,7 @@
 use super::{emit, load_robot, parse_list};
 use activecal::kinematics::{Evaluator, position_checked};
 use activecal::pool::Lattice;
-use activecal::robot::{ParamSet, Robot};
+use activecal::model::{ParamSet, Robot};
 use anyhow::Result;
 use clap::Args;
 use serde_json::{Value, json};
@@ -70,8 +70,8 @@ pub struct PoolArgs {
 }
 
 /// Kind of each joint, by joint number.
-fn joint_kinds(r: &Robot) -> Vec<activecal::robot::JointKind> {
-    let mut k = vec![activecal::robot::JointKind::Revolute; r.dof()];
+fn joint_kinds(r: &Robot) -> Vec<activecal::model::JointKind> {
+    let mut k = vec![activecal::model::JointKind::Revolute; r.dof()];
     for f in &r.frames {
         if let Some(j) = f.joint {
             k[j] = f.joint_kind;
@@ -83,14 +83,16 @@ fn joint_kinds(r: &Robot) -> Vec<activecal::robot::JointKind> {
 /// Runs `robots`.
 pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
     if let Some(name) = &a.export {
-        let text = activecal::robot::file::to_toml(&super::load_robot(name)?);
+        let d = activecal::io::load_description(name)?;
+        d.robot.validate()?;
+        let text = activecal::io::robot_toml::description_to_toml(&d.robot, d.visibility.as_ref());
         match &a.out {
             Some(path) => super::write_new(path, &text, a.force)?,
             None => print!("{text}"),
         }
         return Ok(());
     }
-    let robots: Vec<Value> = activecal::robot::BUILTIN
+    let robots: Vec<Value> = activecal::model::BUILTIN
         .iter()
         .map(|n| {
             let r = Robot::builtin(n).expect("built-in");
@@ -103,8 +105,8 @@ pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
                 "unknowns": r.parameter_names(),
                 // Revolute joints in degrees; prismatic ones have none (null): see `limits`.
                 "limits_deg": joint_kinds(&r).iter().zip(&r.limits).map(|(k, l)| match k {
-                    activecal::robot::JointKind::Revolute => Some([l[0].to_degrees(), l[1].to_degrees()]),
-                    activecal::robot::JointKind::Prismatic => None,
+                    activecal::model::JointKind::Revolute => Some([l[0].to_degrees(), l[1].to_degrees()]),
+                    activecal::model::JointKind::Prismatic => None,
                 }).collect::<Vec<_>>(),
                 "limits": r.limits,
                 "joint_kinds": joint_kinds(&r),
@@ -115,7 +117,7 @@ pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
     let v = json!({ "robots": robots });
     emit(a.json, &v, || {
         let mut s = String::new();
-        for n in activecal::robot::BUILTIN {
+        for n in activecal::model::BUILTIN {
             let r = Robot::builtin(n).expect("built-in");
             s += &format!(
                 "{} ({} joints, {} unknowns)\n",

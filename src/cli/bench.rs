@@ -8,7 +8,7 @@ use activecal::bound::{BoundSettings, RelaxationSolver, relaxation_bound};
 use activecal::criterion::{DCriterion, bench_scan};
 use activecal::identify::{LmSettings, identify, simulate, trial_rng};
 use activecal::pool::Pool;
-use activecal::robot::Robot;
+use activecal::model::Robot;
 use activecal::select::{Settings, design_rng, eae, polish};
 use anyhow::Result;
 use clap::Args;

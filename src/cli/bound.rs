@@ -3,7 +3,7 @@
 
 use super::{PoolOpts, emit};
 use activecal::bound::{Bound, BoundSettings, RelaxationSolver, design_gap, relaxation_bound};
-use activecal::design::DesignFile;
+use activecal::io::design::DesignFile;
 use anyhow::Result;
 use clap::Args;
 use serde_json::{Value, json};

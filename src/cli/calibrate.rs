@@ -5,13 +5,14 @@
 //! written as a description file.
 
 use super::{emit, load_robot, refuse_overwrite, write_new};
-use activecal::design::DesignFile;
+use activecal::io::design::DesignFile;
 use activecal::identify::{
     Identification, LmSettings, Measurements, MonteCarloSettings, MonteCarloSummary, ParamGrid,
     ValidationSet, identify, monte_carlo, paper_tables,
 };
 use activecal::pool::Pool;
-use activecal::robot::{Measurement, Robot, file};
+use activecal::io::robot_toml as file;
+use activecal::model::{Measurement, Robot};
 use anyhow::{Result, bail};
 use clap::Args;
 use serde_json::{Map, Value, json};

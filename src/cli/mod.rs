@@ -8,7 +8,7 @@ pub mod figures;
 pub mod reproduce;
 pub mod select;
 
-use activecal::robot::Robot;
+use activecal::model::Robot;
 use anyhow::Result;
 use serde_json::Value;
 
@@ -29,7 +29,7 @@ where
 /// Loads and validates a robot: a built-in name, or a `.toml` description or
 /// `.urdf` file ([`Robot::load`]).
 pub fn load_robot(name: &str) -> Result<Robot> {
-    let r = Robot::load(name)?;
+    let r = activecal::io::load_robot(name)?;
     r.validate()?;
     Ok(r)
 }
@@ -95,11 +95,14 @@ pub struct PoolCtx {
 impl PoolOpts {
     /// Builds the pool and its Jacobian.
     pub fn load(&self) -> Result<PoolCtx> {
-        use activecal::pool::{Pool, Visibility};
-        let robot = load_robot(&self.robot)?;
-        let set = activecal::robot::ParamSet::parse(&self.params)?;
+        use activecal::measure::Visibility;
+        use activecal::pool::Pool;
+        let activecal::io::Description { robot, visibility } =
+            activecal::io::load_description(&self.robot)?;
+        robot.validate()?;
+        let set = activecal::model::ParamSet::parse(&self.params)?;
         // --visibility, else the robot description's region, else every pose.
-        let pool = match (&self.visibility, &robot.visibility) {
+        let pool = match (&self.visibility, &visibility) {
             (None, None) => Pool::full(&robot, self.levels)?,
             (Some(v), _) => {
                 let vis: Visibility =

@@ -8,7 +8,7 @@ use activecal::bound::{BoundSettings, RelaxationSolver, design_gap, relaxation_b
 use activecal::criterion::{DCriterion, OiCriterion};
 use activecal::identify::{LmSettings, MonteCarloSettings, compare_designs, paper_tables};
 use activecal::pool::Pool;
-use activecal::robot::Robot;
+use activecal::model::Robot;
 use activecal::select::{
     Algorithm, Selection, Settings, design_rng, eae, multistart, random_search,
 };

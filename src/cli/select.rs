@@ -2,7 +2,7 @@
 
 use super::{PoolOpts, emit, parse_list};
 use activecal::criterion::{DCriterion, Indices, OiCriterion};
-use activecal::design::DesignFile;
+use activecal::io::design::DesignFile;
 use activecal::select::{Algorithm, Selection, Settings, multistart};
 use anyhow::{Result, bail};
 use clap::Args;
@@ -40,7 +40,7 @@ pub fn cmd_score(a: ScoreArgs) -> Result<()> {
         _ => bail!("give the design with --poses I1,I2,... or --design FILE"),
     };
     let ctx = opts.load()?;
-    activecal::design::check_unique(&lattice_poses)?;
+    activecal::io::design::check_unique(&lattice_poses)?;
     let positions = ctx.pool.positions_of(&lattice_poses)?;
     let ind = Indices::from_design(&ctx.x, &positions);
     let v = json!({
@@ -144,7 +144,7 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         Some(f) => parse_list(f, "--fixed")?,
         None => vec![],
     };
-    activecal::design::check_unique(&fixed_lattice)?;
+    activecal::io::design::check_unique(&fixed_lattice)?;
     let fixed = ctx.pool.positions_of(&fixed_lattice)?;
     let s = Settings {
         n: a.n,

@@ -16,11 +16,12 @@
 //! damping is invariant to the units of the unknowns (radians vs. metres).
 
 use super::dense::{SeqQr, inverse_information};
-use super::{IdentifyError, Measurements, Result, matrix, so3};
+use super::{IdentifyError, Measurements, Result, matrix};
+use crate::measure::so3;
 use crate::blocks::Blocks;
 use crate::kinematics::Evaluator;
-use crate::pool::identifiability;
-use crate::robot::{ParamTable, Robot, Symbol};
+use crate::observability::identifiability;
+use crate::model::{ParamTable, Robot, Symbol};
 use faer::Mat;
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
@@ -434,7 +435,7 @@ pub fn predicted_covariance(
             .check_q(q)
             .map_err(|source| IdentifyError::Pose { pose: i, source })?;
     }
-    let x = crate::pool::jacobian_of(robot, table, qs.len(), |k, q| q.copy_from_slice(&qs[k]));
+    let x = crate::blocks::jacobian_of(robot, table, qs.len(), |k, q| q.copy_from_slice(&qs[k]));
     if identifiability(robot, &x).rank < robot.n_unknowns() {
         return Ok(None);
     }

@@ -28,7 +28,7 @@ mod dense;
 pub mod lm;
 pub mod montecarlo;
 pub mod simulate;
-pub mod so3;
+
 pub mod tables;
 
 pub use lm::{
@@ -43,7 +43,7 @@ pub use simulate::{simulate, trial_rng};
 pub use tables::{PaperTables, ParamGrid, paper_tables};
 
 use crate::error::Error;
-use crate::robot::{Measurement, Robot};
+use crate::model::{Measurement, Robot};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -253,7 +253,7 @@ impl Measurements {
             });
         }
         for (i, r) in self.orientations.iter().enumerate() {
-            so3::check_rotation(&matrix(r), ROTATION_TOLERANCE)
+            crate::measure::so3::check_rotation(&matrix(r), ROTATION_TOLERANCE)
                 .map_err(|reason| IdentifyError::NotARotation { pose: i, reason })?;
         }
         Ok(())

@@ -7,9 +7,10 @@
 //! `rand` 0.9's traits and does not accept a `rand` 0.10 generator, and two
 //! lines of Box–Muller are not worth a second `rand` in the build.
 
-use super::{Measurements, Result, rows, so3};
+use super::{Measurements, Result, rows};
+use crate::measure::so3;
 use crate::kinematics::pose;
-use crate::robot::{Measurement, ParamTable, Robot};
+use crate::model::{Measurement, ParamTable, Robot};
 use nalgebra::Vector3;
 use rand::{Rng, RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -4,7 +4,7 @@
 use super::lm::{Identification, LmSettings, identify};
 use super::simulate::{simulate, trial_rng};
 use super::{Measurements, Result};
-use crate::robot::{ParamId, Robot, Symbol};
+use crate::model::{ParamId, Robot, Symbol};
 use serde::Serialize;
 
 /// Values laid out like the paper's parameter tables: one row per frame that

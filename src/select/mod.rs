@@ -124,7 +124,7 @@ impl Settings {
                 reason: format!("pool position {f} >= pool size {n_pool}"),
             });
         }
-        crate::design::check_unique(&self.fixed)?;
+        crate::io::design::check_unique(&self.fixed)?;
         if self.fixed.len() > self.n {
             return Err(Error::Invalid(format!(
                 "{} fixed poses do not fit in a design of N = {}",

@@ -9,7 +9,7 @@
 use crate::compare::Kinematics;
 use crate::fixture::Versions;
 use crate::model::ModelSpec;
-use activecal::robot::JointKind;
+use activecal::model::JointKind;
 use anyhow::{Context, Result, bail};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;

@@ -8,7 +8,7 @@ use crate::compare::{Deviation, activecal_kinematics, deviation};
 use crate::fixture::{self, Fixture, set_name};
 use crate::model::{mjcf_of_spec, pinocchio_model_spec};
 use crate::sample::configurations;
-use activecal::robot::{ParamSet, Robot};
+use activecal::model::{ParamSet, Robot};
 use anyhow::{Result, bail};
 use serde::Serialize;
 use std::fmt;

@@ -3,7 +3,7 @@
 //! deviations.
 
 use activecal::kinematics::Evaluator;
-use activecal::robot::{ParamTable, Robot};
+use activecal::model::{ParamTable, Robot};
 use anyhow::{Result, bail};
 use serde::{Deserialize, Serialize};
 

@@ -8,7 +8,7 @@
 //! `f64`, no timestamps.
 
 use crate::compare::{Deviation, Kinematics};
-use activecal::robot::{ParamSet, Robot};
+use activecal::model::{ParamSet, Robot};
 use anyhow::{Result, bail};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write;

@@ -28,7 +28,7 @@ pub mod bridge;
 #[cfg(feature = "live")]
 pub mod check;
 
-use activecal::robot::{
+use activecal::model::{
     Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot, Symbol,
 };
 
@@ -48,9 +48,9 @@ use activecal::robot::{
 /// any error worth catching.
 pub const TOLERANCE: f64 = 1e-12;
 
-/// The built-in robots (`activecal::robot::BUILTIN`), which get fixtures.
+/// The built-in robots (`activecal::model::BUILTIN`), which get fixtures.
 pub fn builtin_robots() -> activecal::Result<Vec<Robot>> {
-    activecal::robot::BUILTIN
+    activecal::model::BUILTIN
         .iter()
         .map(|name| Robot::builtin(name))
         .collect()
@@ -135,8 +135,7 @@ pub fn synthetic_robot() -> Robot {
             [-3.1, 3.1],
         ],
         measurement: Measurement::Point,
-        orientation_scale: activecal::robot::DEFAULT_ORIENTATION_SCALE,
-        visibility: None,
+        orientation_scale: activecal::model::DEFAULT_ORIENTATION_SCALE,
     };
     robot.validate().expect("synthetic robot is valid");
     robot

@@ -7,7 +7,7 @@
 //!
 //! Build with `PYO3_PYTHON=$PWD/.venv/bin/python` (scripts/test does).
 
-use activecal::robot::ParamSet;
+use activecal::model::ParamSet;
 use anyhow::{Result, bail};
 use std::path::PathBuf;
 use std::process::ExitCode;

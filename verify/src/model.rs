@@ -13,7 +13,7 @@
 //! Hayati the same followed by `Ry(β)`; a prismatic frame `Rz(γ) Tz(q+d) …`;
 //! a fixed frame has `q = 0`.
 
-use activecal::robot::{Convention, JointKind, ParamTable, Robot};
+use activecal::model::{Convention, JointKind, ParamTable, Robot};
 use anyhow::{Result, bail};
 use nalgebra::{Matrix3, Matrix4, Rotation3, UnitQuaternion, Vector3};
 use serde::Serialize;

@@ -4,7 +4,7 @@
 //! The generator is SplitMix64 written out here (not `rand`), so that the
 //! fixtures' configurations never change with a dependency upgrade.
 
-use activecal::robot::Robot;
+use activecal::model::Robot;
 
 /// SplitMix64 (Steele, Lea & Flood 2014): a 64-bit state advanced by the
 /// golden-ratio increment and mixed by two multiply-xorshift rounds.

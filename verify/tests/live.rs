@@ -5,7 +5,7 @@
 //! and a synthetic 7-joint one; URDF imports against Pinocchio loading the
 //! same URDF file; and the committed fixtures against a fresh regeneration. Tolerance: [`verify::TOLERANCE`] (1e-12 m, justified there).
 
-use activecal::robot::{ParamSet, Robot, Symbol};
+use activecal::model::{ParamSet, Robot, Symbol};
 use verify::bridge::Bridge;
 use verify::check::{LIVE_RANDOM, LIVE_SEED, check, check_live, make_fixture};
 use verify::compare::deviation;
@@ -105,8 +105,8 @@ fn committed_fixtures_match_a_fresh_regeneration() {
 #[test]
 fn urdf_imports_agree_with_pinocchio_loading_the_urdf() {
     use activecal::kinematics::pose;
-    use activecal::robot::Measurement;
-    use activecal::urdf::{UrdfOptions, load};
+    use activecal::model::Measurement;
+    use activecal::io::urdf::{UrdfOptions, load};
     let bridge = Bridge::new().unwrap();
     let dir = fixture::default_dir();
     for name in ["puma560.urdf", "ur5.urdf", "stanford.urdf"] {

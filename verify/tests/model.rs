@@ -3,7 +3,7 @@
 //! MJCF carries the spec exactly, and the fixture format round-trips.
 
 use activecal::kinematics::{Evaluator, joint_chain, position};
-use activecal::robot::{JointKind, ParamSet, Robot};
+use activecal::model::{JointKind, ParamSet, Robot};
 use nalgebra::{Matrix4, Vector3};
 use verify::compare::{Kinematics, activecal_kinematics, deviation};
 use verify::fixture::{self, Fixture, Versions};
@@ -131,7 +131,7 @@ fn joint_jacobian_is_the_gamma_column_of_the_identification_jacobian() {
                 let Some(j) = robot.frames[u.frame].joint else {
                     continue;
                 };
-                if u.symbol != activecal::robot::Symbol::Gamma {
+                if u.symbol != activecal::model::Symbol::Gamma {
                     continue;
                 }
                 for r in 0..3 {

@@ -19,10 +19,12 @@
 //! joint at one of 5 evenly spaced values of its range) at the nominal
 //! parameters, with a fixed seed, so the choice is reproducible.
 
-use super::{Convention, Measurement, ParamId, ParamTable, Robot, Symbol};
+use crate::model::{Convention, Measurement, ParamId, ParamTable, Robot, Symbol};
 use crate::blocks::Blocks;
 use crate::error::{Error, Result};
-use crate::pool::{Identifiability, jacobian_of, require_identifiable};
+use crate::blocks::jacobian_of;
+
+use serde::Serialize;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -41,6 +43,80 @@ const CHOOSE_SEED: u64 = 0x5eed_0c00_5e00;
 /// Seed of the design [`Robot::check_identifiable`] uses (a different design,
 /// so the check does not merely repeat the choice).
 const CHECK_SEED: u64 = 0x5eed_c4ec_0001;
+
+/// Result of an identifiability check.
+#[derive(Clone, Debug, Serialize)]
+pub struct Identifiability {
+    /// Numerical rank of the column-scaled stacked Jacobian.
+    pub rank: usize,
+    /// Number of unknowns.
+    pub p: usize,
+    /// Unknowns with a significant component in the numerical null space.
+    pub unidentifiable: Vec<String>,
+    /// Singular values of the column-scaled Jacobian, largest first.
+    pub singular_values: Vec<f64>,
+}
+
+/// Numerical rank of a stacked Jacobian and the unknowns it cannot determine.
+///
+/// Columns are scaled to unit norm first (rank is scale-invariant, the
+/// tolerance is not); a zero column is unidentifiable outright. Singular
+/// values below `max(rows, p) · ε · σ_max` count as zero, and an unknown is
+/// named when its entry in a null-space vector exceeds 1e-6 in magnitude.
+#[must_use]
+pub fn identifiability(robot: &Robot, x: &Blocks) -> Identifiability {
+    let m = x.mat();
+    let (rows, p) = (m.nrows(), m.ncols());
+    let norms: Vec<f64> = (0..p).map(|c| m.col(c).norm_l2()).collect();
+    let scaled = faer::Mat::from_fn(rows, p, |r, c| {
+        if norms[c] > 0.0 {
+            m[(r, c)] / norms[c]
+        } else {
+            0.0
+        }
+    });
+    let names = robot.parameter_names();
+    let svd = scaled.svd().expect("SVD of a finite matrix converges");
+    let s: Vec<f64> = (0..p.min(rows)).map(|i| svd.S()[i]).collect();
+    let smax = s.iter().cloned().fold(0.0, f64::max);
+    let tol = rows.max(p) as f64 * f64::EPSILON * smax.max(f64::MIN_POSITIVE);
+    let rank = s.iter().filter(|&&v| v > tol).count();
+    let v = svd.V();
+    let mut flagged = vec![false; p];
+    for k in rank..p {
+        for (c, f) in flagged.iter_mut().enumerate() {
+            if v[(c, k)].abs() > 1e-6 {
+                *f = true;
+            }
+        }
+    }
+    let unidentifiable = names
+        .into_iter()
+        .zip(flagged)
+        .filter(|(_, f)| *f)
+        .map(|(n, _)| n)
+        .collect();
+    Identifiability {
+        rank,
+        p,
+        unidentifiable,
+        singular_values: s,
+    }
+}
+
+/// Checks that every unknown is identifiable from `x`, or returns
+/// [`Error::Unidentifiable`] naming the ones that are not.
+pub fn require_identifiable(robot: &Robot, x: &Blocks) -> Result<Identifiability> {
+    let id = identifiability(robot, x);
+    if id.rank < id.p {
+        return Err(Error::Unidentifiable {
+            names: id.unidentifiable.clone(),
+            rank: id.rank,
+            p: id.p,
+        });
+    }
+    Ok(id)
+}
 
 impl Robot {
     /// The structural candidate unknowns of every frame, frame-major: γ, α,
@@ -211,7 +287,7 @@ impl Robot {
                     label.push('_');
                 }
                 r.frames
-                    .push(super::Frame::fixed(&label, Convention::Hayati));
+                    .push(crate::model::Frame::fixed(&label, Convention::Hayati));
                 r.real.rows.push([0.0; 5]);
                 r.nominal.rows.push([0.0; 5]);
             }

@@ -92,7 +92,6 @@ fn assemble(
         limits,
         measurement: m,
         orientation_scale: super::DEFAULT_ORIENTATION_SCALE,
-        visibility: None,
     };
     debug_assert!(r.validate().is_ok());
     r

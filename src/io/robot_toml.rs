@@ -8,7 +8,7 @@
 //! # orientation_scale = 0.29  # pose only: metres per radian, σ_position / σ_orientation
 //! # unknowns = "auto"         # choose identifiable unknowns automatically
 //!
-//! [visibility]                # optional: see activecal::pool::Visibility
+//! [visibility]                # optional: see activecal::measure::Visibility
 //! kind = "box"
 //! min = [-30.0, -30.0, -30.0]
 //! max = [30.0, 30.0, 30.0]
@@ -34,7 +34,7 @@
 //!
 //! Instead of frames, a file may import a URDF: `urdf = "arm.urdf"` (relative
 //! to the file), with optional `tip = "link"`, `measurement`, `name` and
-//! `visibility`; its unknowns are chosen automatically (see [`crate::urdf`]).
+//! `visibility`; its unknowns are chosen automatically (see [`super::urdf`]).
 //!
 //! Every problem is an [`Error::Parse`] naming the file and the place:
 //! TOML syntax, unknown keys, missing or mistyped fields (with the TOML
@@ -43,9 +43,10 @@
 //! inverted limits, an unknown symbol, no unknowns, and unknowns that are not
 //! identifiable ([`Robot::check_identifiable`]).
 
-use super::{Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot, Symbol};
+use super::Description;
 use crate::error::{Error, Result};
-use crate::pool::Visibility;
+use crate::measure::Visibility;
+use crate::model::{Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot, Symbol};
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
 use std::path::Path;
@@ -127,11 +128,21 @@ impl Ctx<'_> {
 
 /// Reads and checks a robot description file (see the module docs).
 pub fn load(path: &Path) -> Result<Robot> {
+    load_description(path).map(|d| d.robot)
+}
+
+/// Reads and checks a robot description file, with its visibility region.
+pub fn load_description(path: &Path) -> Result<Description> {
     let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
         path: path.display().to_string(),
         cause,
     })?;
-    parse(&text, &path.display().to_string(), path.parent())
+    parse_description(&text, &path.display().to_string(), path.parent())
+}
+
+/// Parses and checks a description's robot (see [`parse_description`]).
+pub fn parse(text: &str, origin: &str, dir: Option<&Path>) -> Result<Robot> {
+    parse_description(text, origin, dir).map(|d| d.robot)
 }
 
 /// Parses and checks a description. `origin` names it in errors (and gives
@@ -139,7 +150,8 @@ pub fn load(path: &Path) -> Result<Robot> {
 /// is relative to (the current directory if `None`).
 ///
 /// ```
-/// use activecal::robot::{Robot, file};
+/// use activecal::io::robot_toml as file;
+/// use activecal::model::Robot;
 /// let text = file::to_toml(&Robot::stanford());
 /// let r = file::parse(&text, "stanford.toml", None).unwrap();
 /// assert_eq!(r.unknowns, Robot::stanford().unknowns);
@@ -148,12 +160,12 @@ pub fn load(path: &Path) -> Result<Robot> {
 /// assert!(e.contains("frame '3': joint q3 has inverted limits [1, 0.3]"), "{e}");
 /// assert!(e.starts_with("stanford.toml: line "), "{e}");
 /// ```
-pub fn parse(text: &str, origin: &str, dir: Option<&Path>) -> Result<Robot> {
+pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result<Description> {
     let cx = Ctx { text, origin };
     let spec: FileSpec = toml::from_str(text).map_err(|e| cx.plain(e.to_string().trim_end()))?;
     let measurement = spec.measurement.unwrap_or(Measurement::Point);
     let orientation_scale = match &spec.orientation_scale {
-        None => crate::robot::DEFAULT_ORIENTATION_SCALE,
+        None => crate::model::DEFAULT_ORIENTATION_SCALE,
         Some(s) if measurement != Measurement::Pose => {
             return Err(cx.at(
                 s.span(),
@@ -210,18 +222,20 @@ pub fn parse(text: &str, origin: &str, dir: Option<&Path>) -> Result<Robot> {
             Some(d) => d.join(urdf.get_ref()),
             None => Path::new(urdf.get_ref()).to_path_buf(),
         };
-        let opts = crate::urdf::UrdfOptions {
+        let opts = super::urdf::UrdfOptions {
             tip: spec.tip.as_ref().map(|t| t.get_ref().clone()),
             measurement,
-            ..crate::urdf::UrdfOptions::default()
+            ..super::urdf::UrdfOptions::default()
         };
-        let mut r = crate::urdf::load(&path, &opts).map_err(|e| cx.at(urdf.span(), e))?;
+        let mut r = super::urdf::load(&path, &opts).map_err(|e| cx.at(urdf.span(), e))?;
         if let Some(n) = spec.name {
             r.name = n;
         }
-        r.visibility = visibility;
         r.orientation_scale = orientation_scale;
-        return Ok(r);
+        return Ok(Description {
+            robot: r,
+            visibility,
+        });
     }
     if let Some(t) = &spec.tip {
         return Err(cx.at(t.span(), "`tip` is only for `urdf = …` imports"));
@@ -340,7 +354,6 @@ pub fn parse(text: &str, origin: &str, dir: Option<&Path>) -> Result<Robot> {
         limits,
         measurement,
         orientation_scale,
-        visibility,
     };
     if auto {
         robot.unknowns = robot.choose_unknowns(&[]).map_err(|e| cx.plain(e))?;
@@ -350,7 +363,7 @@ pub fn parse(text: &str, origin: &str, dir: Option<&Path>) -> Result<Robot> {
     }
     robot.validate().map_err(|e| cx.plain(e))?;
     match robot.check_identifiable() {
-        Ok(_) => Ok(robot),
+        Ok(_) => Ok(Description { robot, visibility }),
         Err(Error::Unidentifiable { names, rank, p }) => {
             let first = names
                 .first()
@@ -360,7 +373,7 @@ pub fn parse(text: &str, origin: &str, dir: Option<&Path>) -> Result<Robot> {
                 "unknowns {} are not identifiable from {} measurements (numerical rank {rank} of {p} on a random design of the {}-level lattice at the nominal parameters): remove them, or set `unknowns = \"auto\"`",
                 names.join(", "),
                 robot.measurement.name(),
-                super::unknowns::DESIGN_LEVELS,
+                crate::observability::DESIGN_LEVELS,
             );
             Err(match first {
                 Some(span) => cx.at(span, msg),
@@ -523,13 +536,19 @@ fn check_visibility(v: &Visibility) -> std::result::Result<(), String> {
 /// when finite (the paper's marker 10), omitted otherwise.
 #[must_use]
 pub fn to_toml(robot: &Robot) -> String {
+    description_to_toml(robot, None)
+}
+
+/// As [`to_toml`], with a visibility region.
+#[must_use]
+pub fn description_to_toml(robot: &Robot, visibility: Option<&Visibility>) -> String {
     let num = |x: f64| format!("{x:?}");
     let list = |r: &[f64]| {
         let v: Vec<String> = r.iter().map(|&x| num(x)).collect();
         format!("[{}]", v.join(", "))
     };
     let mut s = String::new();
-    s += "# activecal robot description (see activecal::robot::file)\n";
+    s += "# activecal robot description (see activecal::io::robot_toml)\n";
     s += &format!("name = {:?}\n", robot.name);
     s += &format!("measurement = \"{}\"\n", robot.measurement.name());
     if robot.measurement == Measurement::Pose {
@@ -573,7 +592,7 @@ pub fn to_toml(robot: &Robot) -> String {
             s += &format!("unknowns = [{}]\n", syms.join(", "));
         }
     }
-    if let Some(v) = &robot.visibility {
+    if let Some(v) = visibility {
         #[derive(Serialize)]
         struct W<'a> {
             visibility: &'a Visibility,

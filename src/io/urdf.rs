@@ -39,7 +39,7 @@
 //! so it keeps none) and checked by [`Robot::check_identifiable`]: for a
 //! generic chain `4R + 2P + 3` for points and `4R + 2P + 6` for poses. The
 //! nominal table is the URDF; the real one is the nominal one with
-//! [`crate::robot::builtin::perturbation`] added to every unknown (unless
+//! [`crate::model::catalogue::perturbation`] added to every unknown (unless
 //! [`UrdfOptions::perturb_real`] is false), so that calibration has something
 //! to find.
 //!
@@ -56,8 +56,8 @@
 
 use crate::error::{Error, Result};
 use crate::kinematics::joint_chain;
-use crate::robot::builtin::perturbed;
-use crate::robot::{Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot};
+use crate::model::catalogue::perturbed;
+use crate::model::{Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot};
 use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion, Vector3};
 use std::collections::HashMap;
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -505,8 +505,7 @@ fn convert(chain: &[ChainJoint], name: &str, opts: &UrdfOptions) -> Robot {
         unknowns: Vec::new(),
         limits,
         measurement: opts.measurement,
-        orientation_scale: crate::robot::DEFAULT_ORIENTATION_SCALE,
-        visibility: None,
+        orientation_scale: crate::model::DEFAULT_ORIENTATION_SCALE,
     }
 }
 

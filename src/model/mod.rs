@@ -10,20 +10,17 @@
 //! zero"); a full-pose measurement ([`Measurement::Pose`]) adds the last
 //! frame's orientation.
 //!
-//! Robots come from [`Robot::builtin`] (the PUMA 560 of the paper, a UR5 and
-//! a Stanford arm), from a TOML description ([`file`](mod@file)) or from a URDF file
-//! ([`crate::urdf`]); [`Robot::load`] accepts any of them.
+//! The model imports no loader, no pool and no sensor: built-in arms are in
+//! [`catalogue`]; robots from files come from [`crate::io`] (TOML
+//! descriptions, URDF), which produces these types; the unknowns a
+//! measurement can identify are chosen in [`crate::observability`].
 
-pub mod builtin;
-pub mod file;
-pub mod unknowns;
+pub mod catalogue;
 
 use crate::error::{Error, Result};
-use crate::pool::Visibility;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 use std::fmt;
-use std::path::Path;
 
 /// Parameterization of one frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -260,10 +257,6 @@ pub struct Robot {
     /// the same noise σ_position and `XᵀX` is the Fisher information up to
     /// `σ²`. Default [`DEFAULT_ORIENTATION_SCALE`]; unused for points.
     pub orientation_scale: f64,
-    /// The region the sensor sees, if the description gives one (used to
-    /// filter pose pools when no other region is given).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub visibility: Option<Visibility>,
 }
 
 /// Default [`Robot::orientation_scale`]: 1 m/rad, i.e. an orientation noise
@@ -279,7 +272,7 @@ impl Robot {
     /// A built-in robot by name: `puma560` (or `puma`), `ur5`, `stanford`.
     /// A name with the suffix `:pose` (`ur5:pose`) gives the same robot with
     /// full-pose measurements and the three orientation unknowns more that
-    /// they identify (see [`builtin`]).
+    /// they identify (see [`catalogue`]).
     pub fn builtin(name: &str) -> Result<Robot> {
         let (base, m) = match name.strip_suffix(":pose") {
             Some(b) => (b, Measurement::Pose),
@@ -287,71 +280,12 @@ impl Robot {
         };
         match (base, m) {
             ("puma560" | "puma", Measurement::Point) => Ok(Robot::puma560()),
-            ("puma560" | "puma", Measurement::Pose) => Ok(builtin::puma560_pose()),
-            ("ur5", m) => Ok(builtin::ur5_with(m)),
-            ("stanford", m) => Ok(builtin::stanford_with(m)),
+            ("puma560" | "puma", Measurement::Pose) => Ok(catalogue::puma560_pose()),
+            ("ur5", m) => Ok(catalogue::ur5_with(m)),
+            ("stanford", m) => Ok(catalogue::stanford_with(m)),
             _ => Err(Error::UnknownRobot {
                 name: name.to_string(),
                 known: BUILTIN.join(", "),
-            }),
-        }
-    }
-
-    /// A robot by built-in name (see [`Robot::builtin`]) or from a file: a
-    /// `.toml` description ([`file`](mod@file)) or a `.urdf` file ([`crate::urdf`],
-    /// point measurements, unknowns chosen automatically). The result is
-    /// validated, and a file's unknowns are checked to be identifiable.
-    ///
-    /// A robot from a file is named by the path as given (not by the name
-    /// inside the file), so that design files, which record the robot's
-    /// name, load it again.
-    ///
-    /// As for built-in names, the suffix `:pose` asks for full-pose
-    /// measurements: `arm.urdf:pose` imports with [`Measurement::Pose`];
-    /// `arm.toml:pose` turns a point description into its full-pose variant
-    /// ([`Robot::with_measurement`]).
-    pub fn load(name_or_path: &str) -> Result<Robot> {
-        if let Ok(r) = Robot::builtin(name_or_path) {
-            return Ok(r);
-        }
-        let (file_name, pose) = match name_or_path.strip_suffix(":pose") {
-            Some(f) if !Path::new(name_or_path).exists() => (f, true),
-            _ => (name_or_path, false),
-        };
-        let path = Path::new(file_name);
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        let named = |r: Result<Robot>| {
-            r.map(|mut r| {
-                r.name = name_or_path.to_string();
-                r
-            })
-        };
-        match ext.as_deref() {
-            Some("toml") if pose => named(file::load(path).and_then(|r| match r.measurement {
-                Measurement::Pose => Ok(r),
-                Measurement::Point => r.with_measurement(Measurement::Pose),
-            })),
-            Some("toml") => named(file::load(path)),
-            Some("urdf") => named(crate::urdf::load(
-                path,
-                &crate::urdf::UrdfOptions {
-                    measurement: if pose {
-                        Measurement::Pose
-                    } else {
-                        Measurement::Point
-                    },
-                    ..crate::urdf::UrdfOptions::default()
-                },
-            )),
-            _ if path.exists() => Err(Error::Invalid(format!(
-                "{name_or_path}: unknown robot file type (expected a .toml description or a .urdf file)"
-            ))),
-            _ => Err(Error::UnknownRobot {
-                name: name_or_path.to_string(),
-                known: format!("{}; or a path to a .toml or .urdf file", BUILTIN.join(", ")),
             }),
         }
     }
@@ -450,7 +384,6 @@ impl Robot {
             limits,
             measurement: Measurement::Point,
             orientation_scale: DEFAULT_ORIENTATION_SCALE,
-            visibility: None,
         }
     }
 

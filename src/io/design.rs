@@ -7,7 +7,7 @@
 
 use crate::error::{Error, Result};
 use crate::pool::Pool;
-use crate::robot::Robot;
+use crate::model::Robot;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

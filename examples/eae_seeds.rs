@@ -2,8 +2,8 @@
 //! a Fedorov polish), and whether the eigenvalue-OI criterion picks the same
 //! designs as the determinant: `cargo run --release --example eae_seeds`.
 use activecal::criterion::{DCriterion, OiCriterion};
-use activecal::pool::Pool;
 use activecal::model::Robot;
+use activecal::pool::Pool;
 use activecal::select::*;
 use std::time::Instant;
 fn main() {

@@ -2,8 +2,8 @@
 //! pool (where the scans' parallel sections start without a cross-thread
 //! injection): `cargo run --release --example eae_timing`.
 use activecal::criterion::DCriterion;
-use activecal::pool::Pool;
 use activecal::model::Robot;
+use activecal::pool::Pool;
 use activecal::select::{Settings, design_rng, eae};
 use std::time::Instant;
 

@@ -119,4 +119,3 @@ where
         });
     Blocks::new(mat, t)
 }
-

@@ -11,8 +11,8 @@
 //! frame: `u` for a rotation about `u`, 0 for a translation.
 
 use crate::error::Result;
-use crate::model::{Convention, JointKind, ParamTable, Robot, Symbol};
-use nalgebra::{Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
+use crate::model::{JointKind, ParamTable, Robot, Symbol};
+use nalgebra::{Isometry3, Matrix3, Vector3};
 
 /// Axes and origins along one frame, in the measurement frame, needed by the
 /// Jacobian columns of its parameters.
@@ -66,22 +66,6 @@ fn rot_y(r: &Matrix3<f64>, th: f64) -> Matrix3<f64> {
     out
 }
 
-/// Joint value of a frame: `q[j]` for a driven frame, 0 for a fixed one.
-#[inline]
-fn frame_q(joint: Option<usize>, q: &[f64]) -> f64 {
-    joint.map_or(0.0, |j| q[j])
-}
-
-/// The frame's rotation about and translation along its base z axis:
-/// `(q + γ, d)` for a revolute or fixed frame, `(γ, q + d)` for a prismatic one.
-#[inline]
-fn z_motion(frame: &crate::model::Frame, gamma: f64, d: f64, q: &[f64]) -> (f64, f64) {
-    match (frame.joint, frame.joint_kind) {
-        (Some(j), JointKind::Prismatic) => (gamma, q[j] + d),
-        (j, _) => (frame_q(j, q) + gamma, d),
-    }
-}
-
 /// Walks the chain, filling `axes` (one entry per frame) and returning the
 /// end-point transform `(R, p)`.
 fn walk(
@@ -93,17 +77,16 @@ fn walk(
     let mut r = Matrix3::identity();
     let mut o = Vector3::zeros();
     for ((frame, row), ax) in robot.frames.iter().zip(&table.rows).zip(axes.iter_mut()) {
-        let [gamma, alpha, a, d, beta] = *row;
-        let (theta, d) = z_motion(frame, gamma, d, q);
+        let m = frame.motion(row, q);
         ax.o_base = o;
         ax.z = r.column(2).into_owned();
-        r = rot_z(&r, theta);
+        r = rot_z(&r, m.theta);
         ax.x = r.column(0).into_owned();
-        o += ax.z * d + ax.x * a;
+        o += ax.z * m.d + ax.x * m.a;
         ax.o_twist = o;
-        r = rot_x(&r, alpha);
+        r = rot_x(&r, m.alpha);
         ax.y = r.column(1).into_owned();
-        if frame.convention == Convention::Hayati {
+        if let Some(beta) = m.beta {
             r = rot_y(&r, beta);
         }
     }
@@ -243,27 +226,6 @@ pub struct JointChain {
     pub tool: Isometry3<f64>,
 }
 
-fn iso_rz(th: f64) -> Isometry3<f64> {
-    Isometry3::from_parts(
-        Translation3::identity(),
-        UnitQuaternion::from_axis_angle(&Vector3::z_axis(), th),
-    )
-}
-
-fn iso_rx(th: f64) -> Isometry3<f64> {
-    Isometry3::from_parts(
-        Translation3::identity(),
-        UnitQuaternion::from_axis_angle(&Vector3::x_axis(), th),
-    )
-}
-
-fn iso_ry(th: f64) -> Isometry3<f64> {
-    Isometry3::from_parts(
-        Translation3::identity(),
-        UnitQuaternion::from_axis_angle(&Vector3::y_axis(), th),
-    )
-}
-
 /// Splits the chain into fixed placements and joints (for the Pinocchio and
 /// MuJoCo cross-checks). Joints must drive frames in increasing joint order.
 #[must_use]
@@ -272,18 +234,15 @@ pub fn joint_chain(robot: &Robot, table: &ParamTable) -> JointChain {
     let mut placements = vec![Isometry3::identity(); robot.dof()];
     let mut kinds = vec![JointKind::Revolute; robot.dof()];
     for (frame, row) in robot.frames.iter().zip(&table.rows) {
-        let [gamma, alpha, a, d, beta] = *row;
-        acc *= iso_rz(gamma);
+        let m = frame.motion_at_zero(row);
+        acc *= m.rotation_z();
         if let Some(j) = frame.joint {
             // Rz(q) and Tz(q) both act here, after Rz(γ) and before Tz(d).
             placements[j] = acc;
             kinds[j] = frame.joint_kind;
             acc = Isometry3::identity();
         }
-        acc *= Translation3::new(a, 0.0, d) * iso_rx(alpha);
-        if frame.convention == Convention::Hayati {
-            acc *= iso_ry(beta);
-        }
+        m.apply_after_rotation_z(&mut acc);
     }
     JointChain {
         placements,
@@ -295,6 +254,14 @@ pub fn joint_chain(robot: &Robot, table: &ParamTable) -> JointChain {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::{Translation3, UnitQuaternion};
+
+    fn iso_rz(th: f64) -> Isometry3<f64> {
+        Isometry3::from_parts(
+            Translation3::identity(),
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), th),
+        )
+    }
     use crate::model::Robot;
 
     fn q_sample(i: usize) -> [f64; 6] {

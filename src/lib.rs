@@ -14,6 +14,7 @@ pub mod error;
 pub mod identify;
 pub mod io;
 pub mod kinematics;
+pub(crate) mod linalg;
 pub mod measure;
 pub mod model;
 pub mod observability;

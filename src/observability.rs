@@ -19,14 +19,14 @@
 //! joint at one of 5 evenly spaced values of its range) at the nominal
 //! parameters, with a fixed seed, so the choice is reproducible.
 
-use crate::model::{Convention, Measurement, ParamId, ParamTable, Robot, Symbol};
 use crate::blocks::Blocks;
-use crate::error::{Error, Result};
 use crate::blocks::jacobian_of;
+use crate::error::{Error, Result};
+use crate::model::{Convention, Measurement, ParamId, ParamTable, Robot, Symbol};
 
-use serde::Serialize;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
 
 /// Lattice levels of the random designs used here.
 pub const DESIGN_LEVELS: usize = 5;

@@ -14,8 +14,8 @@ use activecal::bound::variance::{
 use activecal::bound::{
     BoundError, BoundSettings, BoundStatus, RelaxationSolver, design_gap, relaxation_bound,
 };
-use activecal::pool::Pool;
 use activecal::model::Robot;
+use activecal::pool::Pool;
 use faer::Mat;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;

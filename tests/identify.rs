@@ -2,14 +2,14 @@
 //! agreement with the linearised covariance, statuses for numerical outcomes,
 //! errors for bad input, determinism of the Monte-Carlo, and the command line.
 
-use activecal::io::design::DesignFile;
 use activecal::identify::{
     IdentifyError, LmSettings, Measurements, MonteCarloSettings, Status, StopReason, ValidationSet,
     compare_designs, identify, monte_carlo, paper_tables, simulate, trial_rng,
 };
+use activecal::io::design::DesignFile;
 use activecal::kinematics::Evaluator;
-use activecal::pool::Pool;
 use activecal::model::Robot;
+use activecal::pool::Pool;
 use nalgebra::DMatrix;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;

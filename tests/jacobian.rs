@@ -2,9 +2,9 @@
 //! over the whole 15,625-pose PUMA lattice, at both parameter sets.
 
 use activecal::kinematics::position;
+use activecal::model::{ParamSet, Robot};
 use activecal::observability::identifiability;
 use activecal::pool::Pool;
-use activecal::model::{ParamSet, Robot};
 
 #[test]
 fn analytic_jacobian_matches_central_differences_on_whole_lattice() {
@@ -91,6 +91,7 @@ fn alpha_5_is_named_unidentifiable() {
     let id = identifiability(&robot, &x.select(design));
     assert_eq!(id.rank, 27);
     assert_eq!(id.unidentifiable, vec!["alpha_5".to_string()]);
-    let err = activecal::observability::require_identifiable(&robot, &x.select(design)).unwrap_err();
+    let err =
+        activecal::observability::require_identifiable(&robot, &x.select(design)).unwrap_err();
     assert!(err.to_string().contains("alpha_5"));
 }

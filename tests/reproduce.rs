@@ -38,7 +38,9 @@ fn compare_golden(gold: &Value, report: &Value, path: &str, bound_tol: f64, p: f
             }
         }
         Value::Array(a) => {
-            let b = report.as_array().unwrap_or_else(|| panic!("{path}: not an array"));
+            let b = report
+                .as_array()
+                .unwrap_or_else(|| panic!("{path}: not an array"));
             assert_eq!(a.len(), b.len(), "{path}: length");
             for (i, (g, r)) in a.iter().zip(b).enumerate() {
                 compare_golden(g, r, &format!("{path}[{i}]"), bound_tol, p);
@@ -63,10 +65,15 @@ fn compare_golden(gold: &Value, report: &Value, path: &str, bound_tol: f64, p: f
             } else {
                 1e-9 * g.abs().max(r.abs()) + 1e-15
             };
-            assert!((g - r).abs() <= tol, "{path}: golden {g}, now {r} (tolerance {tol:e})");
+            assert!(
+                (g - r).abs() <= tol,
+                "{path}: golden {g}, now {r} (tolerance {tol:e})"
+            );
         }
         Value::String(g) => {
-            let r = report.as_str().unwrap_or_else(|| panic!("{path}: not a string"));
+            let r = report
+                .as_str()
+                .unwrap_or_else(|| panic!("{path}: not a string"));
             assert!(g.eq_ignore_ascii_case(r), "{path}: golden {g}, now {r}");
         }
         other => assert_eq!(other, report, "{path}"),
@@ -145,8 +152,10 @@ fn reduced_reproduce_matches_the_underlying_commands() {
 
     // Same seeds, same results as before the restructuring.
     let gold: Value = serde_json::from_str(include_str!("golden/reproduce_levels3.json")).unwrap();
-    let gap = |v: &Value| v["bound"]["certificate_gap"].as_f64().unwrap()
-        + v["bound"]["newton"]["certificate_gap"].as_f64().unwrap();
+    let gap = |v: &Value| {
+        v["bound"]["certificate_gap"].as_f64().unwrap()
+            + v["bound"]["newton"]["certificate_gap"].as_f64().unwrap()
+    };
     let p = report["settings"]["p"].as_f64().unwrap();
     compare_golden(&gold, &report, "", gap(&gold) + gap(&report), p);
 

@@ -16,14 +16,14 @@ use activecal::blocks::Blocks;
 use activecal::bound::{BoundSettings, relaxation_bound};
 use activecal::criterion::Indices;
 use activecal::identify::{LmSettings, identify, simulate, trial_rng};
+use activecal::io::robot_toml as file;
+use activecal::io::urdf::{self, UrdfOptions};
 use activecal::kinematics::{Evaluator, pose, position};
+use activecal::model::{Convention, JointKind, Measurement, ParamSet, ParamTable, Robot};
+use activecal::observability::INDEPENDENCE_TOL;
 use activecal::observability::require_identifiable;
 use activecal::pool::Pool;
-use activecal::observability::INDEPENDENCE_TOL;
-use activecal::io::robot_toml as file;
-use activecal::model::{Convention, JointKind, Measurement, ParamSet, ParamTable, Robot};
 use activecal::select::ln_det_direct;
-use activecal::io::urdf::{self, UrdfOptions};
 use common::eae_design;
 use nalgebra::{Isometry3, Matrix3, Translation3, Unit, UnitQuaternion, Vector3};
 use std::collections::HashMap;
@@ -147,7 +147,12 @@ fn puma_is_unchanged_and_its_pose_variant_only_adds_the_tool() {
     assert_eq!(p.nominal, b.nominal);
     assert_eq!(p.unknowns, b.unknowns);
     assert_eq!(p.measurement, Measurement::Point);
-    assert!(activecal::io::load_description("puma560").unwrap().visibility.is_none());
+    assert!(
+        activecal::io::load_description("puma560")
+            .unwrap()
+            .visibility
+            .is_none()
+    );
     assert!(p.frames.iter().all(|f| f.joint_kind == JointKind::Revolute));
     let pp = Robot::builtin("puma560:pose").unwrap();
     assert_eq!(pp.measurement, Measurement::Pose);
@@ -805,7 +810,12 @@ fn toml_fixtures_load() {
     assert_eq!(file::load(&path).unwrap().name, "ur5-urdf:pose");
     assert_eq!(u.rows_per_pose(), 6);
     assert_eq!(u.n_unknowns(), 30);
-    assert!(activecal::io::load_description(path.to_str().unwrap()).unwrap().visibility.is_some());
+    assert!(
+        activecal::io::load_description(path.to_str().unwrap())
+            .unwrap()
+            .visibility
+            .is_some()
+    );
     let direct = urdf_import("ur5.urdf", Measurement::Pose);
     assert_eq!(u.nominal, direct.nominal);
 }

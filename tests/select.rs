@@ -3,8 +3,8 @@
 
 use activecal::blocks::Blocks;
 use activecal::criterion::{DCriterion, OiCriterion};
-use activecal::pool::Pool;
 use activecal::model::Robot;
+use activecal::pool::Pool;
 use activecal::select::{
     Algorithm, Settings, StepKind, design_rng, detmax, eae, fedorov, ln_det_direct, multistart,
 };

@@ -4,12 +4,12 @@
 //! must read back to the same kinematics bit for bit when they load at all.
 //! Whatever loads is valid and has identifiable unknowns.
 
+use activecal::io::robot_toml as file;
+use activecal::io::urdf::{self, UrdfOptions};
 use activecal::kinematics::pose;
 use activecal::model::{
     Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot, Symbol,
 };
-use activecal::io::robot_toml as file;
-use activecal::io::urdf::{self, UrdfOptions};
 use proptest::prelude::*;
 use std::sync::OnceLock;
 

@@ -7,10 +7,11 @@
 //! relaxation optimum `M*`, since `ln_bound ≥ ln det M*`), and which of its
 //! poses carry relaxation weight.
 
-use super::variance::{information, ln_det};
+use super::variance::information;
 use super::{Bound, BoundError, BoundStatus};
 use crate::blocks::Blocks;
-use faer::Mat;
+use crate::linalg::chol::ln_det_spd_equilibrated;
+
 use serde::Serialize;
 
 /// Relaxation weight above which a design pose is reported as weighted.
@@ -48,14 +49,7 @@ pub struct DesignGap {
 /// computed on unit-norm columns and unscaled; `None` if singular.
 #[must_use]
 pub fn design_ln_det(x: &Blocks, design: &[usize]) -> Option<f64> {
-    let m = x.information(design);
-    let p = m.nrows();
-    let s: Vec<f64> = (0..p).map(|j| m[(j, j)].sqrt()).collect();
-    if s.iter().any(|&v| !(v > 0.0 && v.is_finite())) {
-        return None;
-    }
-    let scaled = Mat::from_fn(p, p, |r, c| m[(r, c)] / (s[r] * s[c]));
-    Some(ln_det(scaled.as_ref())? + 2.0 * s.iter().map(|v| v.ln()).sum::<f64>())
+    ln_det_spd_equilibrated(x.information(design).as_ref())
 }
 
 /// The gap report of a design (pool positions) against the bound for its
@@ -117,12 +111,5 @@ pub fn design_gap(x: &Blocks, design: &[usize], bound: &Bound) -> Result<DesignG
 /// singular. For checks and reports.
 #[must_use]
 pub fn weights_ln_det(x: &Blocks, w: &[f64]) -> Option<f64> {
-    let m = information(x, w);
-    let p = m.nrows();
-    let s: Vec<f64> = (0..p).map(|j| m[(j, j)].sqrt()).collect();
-    if s.iter().any(|&v| !(v > 0.0 && v.is_finite())) {
-        return None;
-    }
-    let scaled = Mat::from_fn(p, p, |r, c| m[(r, c)] / (s[r] * s[c]));
-    Some(ln_det(scaled.as_ref())? + 2.0 * s.iter().map(|v| v.ln()).sum::<f64>())
+    ln_det_spd_equilibrated(information(x, w).as_ref())
 }

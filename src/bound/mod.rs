@@ -35,8 +35,8 @@ pub use error::BoundError;
 pub use gap::{DesignGap, design_gap};
 
 use crate::blocks::Blocks;
-use crate::pool::Pool;
 use crate::model::{ParamSet, Robot};
+use crate::pool::Pool;
 use conic::{ConicSettings, ConicStatus};
 use exchange::{ExchangeOutcome, ExchangeSettings, candidates, evaluate};
 use newton::NewtonSettings;

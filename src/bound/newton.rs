@@ -26,8 +26,9 @@
 //! on the number of threads.
 
 use super::conic::{ConicOutcome, ConicStatus};
-use super::variance::{Scaled, information, ln_det};
+use super::variance::{Scaled, information};
 use crate::blocks::Blocks;
+use crate::linalg::chol::ln_det_spd;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::{Mat, Par, Side};
 use serde::{Deserialize, Serialize};
@@ -85,10 +86,7 @@ fn derivatives(x: &Blocks, w: &[f64], q: &mut Mat<f64>, d: &mut [f64]) -> Option
     let m = information(x, w);
     let llt = m.llt(Side::Lower).ok()?;
     let l = llt.L();
-    let ld: f64 = (0..l.nrows()).map(|j| 2.0 * l[(j, j)].ln()).sum();
-    if !ld.is_finite() {
-        return None;
-    }
+    let ld = crate::linalg::chol::ln_det_of_factor(l)?;
     let mut y = x.mat().to_owned();
     solve_lower_triangular_in_place(l, y.as_mut().transpose_mut(), Par::Seq);
     // G = Y Yᵀ one block of Q_CHUNK poses' columns at a time, so that memory
@@ -132,7 +130,7 @@ fn barrier_value(x: &Blocks, w: &[f64], mu: f64) -> Option<f64> {
     if w.iter().any(|&v| !(v > 0.0 && v < 1.0)) {
         return None;
     }
-    let ld = ln_det(information(x, w).as_ref())?;
+    let ld = ln_det_spd(information(x, w).as_ref())?;
     Some(ld + mu * w.iter().map(|&v| v.ln() + (1.0 - v).ln()).sum::<f64>())
 }
 
@@ -165,7 +163,7 @@ pub(crate) fn solve_scaled(
     };
     if n_design >= n {
         let w = vec![1.0; n];
-        return match ln_det(information(x, &w).as_ref()) {
+        return match ln_det_spd(information(x, &w).as_ref()) {
             Some(ld) => ConicOutcome {
                 ln_det_primal: ld + sc.ln_scale,
                 ln_det_dual: ld + sc.ln_scale,
@@ -274,7 +272,7 @@ pub(crate) fn solve_scaled(
         }
         std::mem::swap(&mut w, &mut trial);
     }
-    let ld = ln_det(information(x, &w).as_ref()).unwrap_or(ld);
+    let ld = ln_det_spd(information(x, &w).as_ref()).unwrap_or(ld);
     ConicOutcome {
         ln_det_primal: ld + sc.ln_scale,
         ln_det_dual: ld + 2.0 * n as f64 * mu + sc.ln_scale,

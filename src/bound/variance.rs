@@ -8,6 +8,7 @@
 
 use super::BoundError;
 use crate::blocks::Blocks;
+use crate::linalg::chol::ln_det_of_factor;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::{Mat, MatRef, Par, Side};
 
@@ -118,16 +119,6 @@ pub fn information(x: &Blocks, w: &[f64]) -> Mat<f64> {
     xs.transpose() * &xs
 }
 
-/// `ln det M` from a Cholesky factorisation, or `None` if `M` is not
-/// numerically positive definite.
-#[must_use]
-pub fn ln_det(m: MatRef<'_, f64>) -> Option<f64> {
-    let llt = m.llt(Side::Lower).ok()?;
-    let l = llt.L();
-    let v: f64 = (0..l.nrows()).map(|j| 2.0 * l[(j, j)].ln()).sum();
-    v.is_finite().then_some(v)
-}
-
 /// Reusable memory for [`variances_into`]: the `t·n × p` matrix Y.
 #[derive(Debug)]
 pub struct VarianceWork {
@@ -158,10 +149,7 @@ pub fn variances_into(
     assert_eq!(d.len(), x.n_poses(), "one variance per pose");
     let llt = m.llt(Side::Lower).ok()?;
     let l = llt.L();
-    let ln_det: f64 = (0..l.nrows()).map(|j| 2.0 * l[(j, j)].ln()).sum();
-    if !ln_det.is_finite() {
-        return None;
-    }
+    let ln_det = ln_det_of_factor(l)?;
     let xm = x.mat();
     if work.y.nrows() != xm.nrows() || work.y.ncols() != xm.ncols() {
         work.y = Mat::zeros(xm.nrows(), xm.ncols());
@@ -289,7 +277,7 @@ mod tests {
         // Σ w_i d_i = tr(M⁻¹ M) = p.
         let s: f64 = w.iter().zip(&d).map(|(a, b)| a * b).sum();
         assert!((s - 7.0).abs() < 1e-10);
-        assert!((ld - ln_det(m.as_ref()).unwrap()).abs() < 1e-12);
+        assert!((ld - crate::linalg::chol::ln_det_spd(m.as_ref()).unwrap()).abs() < 1e-12);
     }
 
     #[test]

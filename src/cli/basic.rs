@@ -2,8 +2,8 @@
 
 use super::{emit, load_robot, parse_list};
 use activecal::kinematics::{Evaluator, position_checked};
-use activecal::pool::Lattice;
 use activecal::model::{ParamSet, Robot};
+use activecal::pool::Lattice;
 use anyhow::Result;
 use clap::Args;
 use serde_json::{Value, json};

@@ -5,14 +5,14 @@
 //! written as a description file.
 
 use super::{emit, load_robot, refuse_overwrite, write_new};
-use activecal::io::design::DesignFile;
 use activecal::identify::{
     Identification, LmSettings, Measurements, MonteCarloSettings, MonteCarloSummary, ParamGrid,
     ValidationSet, identify, monte_carlo, paper_tables,
 };
-use activecal::pool::Pool;
+use activecal::io::design::DesignFile;
 use activecal::io::robot_toml as file;
 use activecal::model::{Measurement, Robot};
+use activecal::pool::Pool;
 use anyhow::{Result, bail};
 use clap::Args;
 use serde_json::{Map, Value, json};

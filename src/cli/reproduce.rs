@@ -7,8 +7,8 @@ use super::figures;
 use activecal::bound::{BoundSettings, RelaxationSolver, design_gap, relaxation_bound};
 use activecal::criterion::{DCriterion, OiCriterion};
 use activecal::identify::{LmSettings, MonteCarloSettings, compare_designs, paper_tables};
-use activecal::pool::Pool;
 use activecal::model::Robot;
+use activecal::pool::Pool;
 use activecal::select::{
     Algorithm, Selection, Settings, design_rng, eae, multistart, random_search,
 };

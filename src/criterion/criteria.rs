@@ -21,10 +21,11 @@
 use faer::MatRef;
 use rayon::prelude::*;
 
-use super::MAX_T;
-use super::dense::{EigenScratch, add_gram, gather_block, ln_det_i_minus, ln_det_i_plus, view};
 use super::state::InfoState;
 use super::variances::{PoolVariances, SCAN_CHUNK};
+use crate::linalg::eigen::EigenScratch;
+use crate::linalg::gram::{add_gram, gather_block, view};
+use crate::linalg::small::{STACK_T, ln_det_i_minus, ln_det_i_plus};
 
 /// Candidates per parallel work item of the OI criterion (`O(p³)` each).
 const OI_CHUNK: usize = 8;
@@ -211,7 +212,7 @@ impl OiScratch {
         Self {
             p,
             m: vec![0.0; p * p],
-            block: Vec::with_capacity(MAX_T * p),
+            block: Vec::with_capacity(STACK_T * p),
             eig: EigenScratch::new(p),
         }
     }

@@ -9,8 +9,8 @@
 use faer::MatRef;
 use serde::Serialize;
 
-use super::dense::{EigenScratch, singular_values};
 use crate::blocks::Blocks;
+use crate::linalg::eigen::{EigenScratch, singular_values};
 
 /// The singular-value indices of one design. Smaller-is-better indices are
 /// marked; all others are larger-is-better. Infinite values (a singular

@@ -14,7 +14,8 @@
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 
-use super::dense::{chol_in_place, chol_pivoted_in_place, clear_upper_simd_state, min_pivot};
+use crate::linalg::simd::clear_upper_simd_state;
+use crate::linalg::small::{chol_in_place, chol_pivoted_in_place, min_pivot};
 
 /// A numerically singular change: a pivot of the removal Schur complement
 /// was `≤ pivot_floor`. A numerical outcome, not an error.
@@ -347,8 +348,9 @@ pub fn cascade(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::criterion::dense::{cholesky_inverse, view};
     use crate::criterion::test_util::lcg;
+    use crate::linalg::chol::cholesky_inverse;
+    use crate::linalg::gram::view;
 
     fn random(rows: usize, cols: usize, seed: &mut u64) -> Mat<f64> {
         Mat::from_fn(rows, cols, |_, _| lcg(seed))

@@ -81,7 +81,6 @@
 
 mod bench;
 mod criteria;
-mod dense;
 mod indices;
 pub mod lowrank;
 mod state;
@@ -96,9 +95,6 @@ pub use state::{Drift, InfoState, StateSettings, Status};
 pub use variances::{PoolVariances, exchange_gain};
 
 use thiserror::Error;
-
-/// Largest number of rows per pose (`t`) the per-candidate kernels support.
-pub const MAX_T: usize = 6;
 
 /// Bad input to the criterion engine, and the one numerical failure that
 /// leaves nothing to work with: an information matrix that cannot be factored.

@@ -19,13 +19,14 @@ use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
-use super::dense::{
-    clear_upper_simd_state, exchange_in_factor, exchange_ln_det, exchange_out_ln_det,
-    ln_det_i_minus, ln_det_i_plus, packed_len, pk,
-};
 use super::lowrank::LowRank;
 use super::state::InfoState;
 use crate::blocks::Blocks;
+use crate::linalg::simd::clear_upper_simd_state;
+use crate::linalg::small::{
+    BlockScratch, exchange_in_factor, exchange_ln_det, exchange_out_ln_det, ln_det_i_minus,
+    ln_det_i_plus, packed_len, pk,
+};
 
 /// Column `c` of a matrix with unit row stride, as a slice.
 #[inline]
@@ -422,14 +423,14 @@ impl PoolVariances {
                             oi.fill(f64::NEG_INFINITY);
                             continue;
                         }
-                        let wcol: [&[f64]; super::MAX_T] =
-                            std::array::from_fn(|r| if r < t { col(wt, ci * t + r) } else { &[] });
+                        // Column ci·t + r of Wᵀ holds row r of every W_ij.
+                        let base = ci * t;
                         exchange_row(
                             t,
                             this.packed(i),
                             outs,
                             |j| this.packed(j),
-                            |o, r, c| wcol[r][o * t + c],
+                            |o, r, c| col(wt, base + r)[o * t + c],
                             pivot_floor,
                             oi,
                         );
@@ -474,7 +475,7 @@ fn exchange_row<'v>(
     floor: f64,
     oi: &mut [f64],
 ) {
-    let mut la = [0.0f64; super::MAX_T * super::MAX_T];
+    let mut la = BlockScratch::new(t * t);
     let Ok(ln_a) = exchange_in_factor(t, v_in, &mut la) else {
         oi.fill(f64::NEG_INFINITY);
         return;
@@ -500,8 +501,8 @@ pub fn exchange_gain(
     w_ij: MatRef<'_, f64>,
     pivot_floor: f64,
 ) -> Result<f64, f64> {
-    assert!(t <= super::MAX_T && w_ij.nrows() == t && w_ij.ncols() == t);
-    let mut w = [0.0; super::MAX_T * super::MAX_T];
+    assert!(w_ij.nrows() == t && w_ij.ncols() == t);
+    let mut w = BlockScratch::new(t * t);
     for a in 0..t {
         for b in 0..t {
             w[a * t + b] = w_ij[(a, b)];

@@ -17,11 +17,11 @@
 
 use super::dense::{SeqQr, inverse_information};
 use super::{IdentifyError, Measurements, Result, matrix};
-use crate::measure::so3;
 use crate::blocks::Blocks;
 use crate::kinematics::Evaluator;
-use crate::observability::identifiability;
+use crate::measure::so3;
 use crate::model::{ParamTable, Robot, Symbol};
+use crate::observability::identifiability;
 use faer::Mat;
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};

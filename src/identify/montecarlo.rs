@@ -11,12 +11,12 @@
 use super::dense::{gram, ln_det_spd, product};
 use super::lm::{LmSettings, Status, identify, predicted_covariance};
 use super::simulate::{simulate, trial_rng};
-use crate::measure::so3;
 use super::{IdentifyError, Result};
-use crate::kinematics::{pose, position};
 use crate::blocks::jacobian_of;
-use crate::pool::Pool;
+use crate::kinematics::{pose, position};
+use crate::measure::so3;
 use crate::model::{Measurement, ParamTable, Robot};
+use crate::pool::Pool;
 use faer::Mat;
 use nalgebra::{UnitQuaternion, Vector3};
 use rand::{RngExt, SeedableRng};

@@ -8,8 +8,8 @@
 //! lines of Box–Muller are not worth a second `rand` in the build.
 
 use super::{Measurements, Result, rows};
-use crate::measure::so3;
 use crate::kinematics::pose;
+use crate::measure::so3;
 use crate::model::{Measurement, ParamTable, Robot};
 use nalgebra::Vector3;
 use rand::{Rng, RngExt, SeedableRng};

@@ -6,8 +6,8 @@
 //! `select` (algorithm, seed, criterion values) are kept as extra information.
 
 use crate::error::{Error, Result};
-use crate::pool::Pool;
 use crate::model::Robot;
+use crate::pool::Pool;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

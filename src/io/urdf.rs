@@ -57,7 +57,9 @@
 use crate::error::{Error, Result};
 use crate::kinematics::joint_chain;
 use crate::model::catalogue::perturbed;
-use crate::model::{Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot};
+use crate::model::{
+    Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot, frame_transform,
+};
 use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion, Vector3};
 use std::collections::HashMap;
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -343,22 +345,6 @@ fn extract_chain(
     Ok(out)
 }
 
-/// The transform of one of our frames at q = 0.
-fn frame_iso(conv: Convention, row: &[f64; 5]) -> Isometry3<f64> {
-    let [gamma, alpha, a, d, beta] = *row;
-    let rz = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), gamma);
-    let rx = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), alpha);
-    let mut t = Isometry3::from_parts(Translation3::identity(), rz)
-        * Isometry3::from_parts(Translation3::new(a, 0.0, d), rx);
-    if conv == Convention::Hayati {
-        t *= Isometry3::from_parts(
-            Translation3::identity(),
-            UnitQuaternion::from_axis_angle(&Vector3::y_axis(), beta),
-        );
-    }
-    t
-}
-
 /// The frame (convention and `[γ, α, a, d, β]`) from frame `z` (whose z axis
 /// is a joint axis, or the root's) to the line through `p` along unit `u`,
 /// and the frame it ends in (on the line, z along `u`).
@@ -402,7 +388,7 @@ fn to_line(
         let alpha = (-uy).atan2(uz);
         (Convention::Hayati, [angle_of(&xn), alpha, a, 0.0, beta])
     };
-    let next = z * frame_iso(conv, &row);
+    let next = z * frame_transform(conv, &row);
     (conv, row, next)
 }
 
@@ -459,7 +445,7 @@ fn convert(chain: &[ChainJoint], name: &str, opts: &UrdfOptions) -> Robot {
     let (p1, u1) = (lines[0].0, lines[0].1);
     if Vector3::z().cross(&u1).norm() <= thr.sin() {
         let row = [0.0, -FRAC_PI_2, 0.0, 0.0, 0.0];
-        z *= frame_iso(Convention::Dh, &row);
+        z *= frame_transform(Convention::Dh, &row);
         frames.push(Frame::fixed("m", Convention::Dh));
         rows.push(row);
         labels.push("m".into());

@@ -16,6 +16,9 @@
 //! measurement can identify are chosen in [`crate::observability`].
 
 pub mod catalogue;
+pub mod frame;
+
+pub use frame::{FrameMotion, frame_transform};
 
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};

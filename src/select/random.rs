@@ -2,7 +2,7 @@
 //! one by `ln OI_D`, and the whole distribution (the paper's Fig. 2).
 
 use crate::blocks::Blocks;
-use faer::Side;
+
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -52,11 +52,7 @@ pub fn random_design(
 /// definite (singular design).
 #[must_use]
 pub fn ln_det_direct(pool: &Blocks, poses: &[usize]) -> Option<f64> {
-    let m = pool.information(poses);
-    let llt = m.llt(Side::Lower).ok()?;
-    let l = llt.L();
-    let v: f64 = (0..m.nrows()).map(|i| 2.0 * l[(i, i)].ln()).sum();
-    v.is_finite().then_some(v)
+    crate::linalg::chol::ln_det_spd(pool.information(poses).as_ref())
 }
 
 /// The paper's OI, eq. (1), from `ln OI_D` of a full-rank design with `p`

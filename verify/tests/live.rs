@@ -104,9 +104,9 @@ fn committed_fixtures_match_a_fresh_regeneration() {
 /// imports alike. Same tolerance as the other live checks.
 #[test]
 fn urdf_imports_agree_with_pinocchio_loading_the_urdf() {
+    use activecal::io::urdf::{UrdfOptions, load};
     use activecal::kinematics::pose;
     use activecal::model::Measurement;
-    use activecal::io::urdf::{UrdfOptions, load};
     let bridge = Bridge::new().unwrap();
     let dir = fixture::default_dir();
     for name in ["puma560.urdf", "ur5.urdf", "stanford.urdf"] {

@@ -1,35 +1,60 @@
-//! Small dense kernels shared by the update formulas: packed symmetric `t×t`
-//! blocks, Cholesky with a pivot floor, Gram-matrix updates, and the faer
-//! calls (always sequential, so results never depend on the thread count).
+//! Kernels on small `t×t` blocks (`t` = rows per pose): packed symmetric
+//! storage, Cholesky in place with a pivot floor (plain and pivoted), and the
+//! block determinants of the add, remove and exchange updates, eqs.
+//! (17)–(22). Row-major, sequential, no allocation for `t ≤`
+//! [`STACK_T`]; larger blocks (several markers per pose) use the heap.
 
-use faer::diag::Diag;
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::cholesky::llt;
-use faer::linalg::evd::{self, ComputeEigenvectors};
-use faer::linalg::svd::{self, ComputeSvdVectors};
-use faer::{Mat, MatMut, MatRef, Par};
+/// Largest rows-per-pose `t` whose `t×t` scratch lives on the stack (a
+/// point is 3, a full pose 6); larger blocks are allocated.
+pub(crate) const STACK_T: usize = 6;
 
-use super::MAX_T;
+/// Scratch of `len` values: on the stack up to `N`, on the heap above, so
+/// that the kernels take any `t` without a cap and without allocating in
+/// the common case.
+pub(crate) enum Scratch<T: Copy + Default, const N: usize> {
+    /// Up to `N` values, the first `.1` in use.
+    Stack([T; N], usize),
+    /// More than `N` values.
+    Heap(Vec<T>),
+}
 
-/// Clears the upper halves of the vector registers (`vzeroupper`) after a
-/// faer/gemm kernel. Some of gemm's x86 AVX-512 micro-kernels return with
-/// dirty upper register state; until it is cleared every later SSE
-/// instruction of this thread pays a transition penalty (measured: the add
-/// scan slowed 10×, `ln` 7×). Cheap; a no-op without AVX.
-#[inline]
-pub(crate) fn clear_upper_simd_state() {
-    #[cfg(target_arch = "x86_64")]
-    {
-        #[target_feature(enable = "avx")]
-        fn zeroupper() {
-            core::arch::x86_64::_mm256_zeroupper();
-        }
-        if std::arch::is_x86_feature_detected!("avx") {
-            // SAFETY: AVX support was just checked.
-            unsafe { zeroupper() }
+impl<T: Copy + Default, const N: usize> Scratch<T, N> {
+    /// `len` values, all `T::default()`.
+    #[inline]
+    pub(crate) fn new(len: usize) -> Self {
+        if len <= N {
+            Scratch::Stack([T::default(); N], len)
+        } else {
+            Scratch::Heap(vec![T::default(); len])
         }
     }
 }
+
+impl<T: Copy + Default, const N: usize> std::ops::Deref for Scratch<T, N> {
+    type Target = [T];
+    #[inline]
+    fn deref(&self) -> &[T] {
+        match self {
+            Scratch::Stack(a, n) => &a[..*n],
+            Scratch::Heap(v) => v,
+        }
+    }
+}
+
+impl<T: Copy + Default, const N: usize> std::ops::DerefMut for Scratch<T, N> {
+    #[inline]
+    fn deref_mut(&mut self) -> &mut [T] {
+        match self {
+            Scratch::Stack(a, n) => &mut a[..*n],
+            Scratch::Heap(v) => v,
+        }
+    }
+}
+
+/// A `t×t` block's scratch.
+pub(crate) type BlockScratch = Scratch<f64, { STACK_T * STACK_T }>;
+/// A permutation of `t` rows.
+pub(crate) type PermScratch = Scratch<usize, STACK_T>;
 
 /// Length of the packed lower triangle of a `t×t` symmetric matrix.
 #[inline]
@@ -175,21 +200,21 @@ pub(crate) fn min_pivot(l: &[f64], n: usize) -> f64 {
 /// input, reported as `-∞`.
 #[inline]
 pub(crate) fn ln_det_i_plus(v: &[f64], t: usize) -> f64 {
-    let mut a = [0.0f64; MAX_T * MAX_T];
+    let mut a = BlockScratch::new(t * t);
     for r in 0..t {
         for c in 0..=r {
             let x = v[pk(r, c)];
             a[r * t + c] = if r == c { 1.0 + x } else { x };
         }
     }
-    chol_in_place(&mut a[..t * t], t, 0.0).unwrap_or(f64::NEG_INFINITY)
+    chol_in_place(&mut a, t, 0.0).unwrap_or(f64::NEG_INFINITY)
 }
 
 /// `ln det(I − V)` for a packed `t×t` block: the removal loss of
 /// eq. (21)/(22) in block form; `Err(pivot)` when a pivot is `≤ floor`.
 #[inline]
 pub(crate) fn ln_det_i_minus(v: &[f64], t: usize, floor: f64) -> Result<f64, f64> {
-    let mut a = [0.0f64; MAX_T * MAX_T];
+    let mut a = BlockScratch::new(t * t);
     for r in 0..t {
         for c in 0..=r {
             let x = v[pk(r, c)];
@@ -197,17 +222,13 @@ pub(crate) fn ln_det_i_minus(v: &[f64], t: usize, floor: f64) -> Result<f64, f64
             a[c * t + r] = a[r * t + c];
         }
     }
-    let mut perm = [0usize; MAX_T];
-    chol_pivoted_in_place(&mut a[..t * t], t, floor, &mut perm[..t])
+    let mut perm = PermScratch::new(t);
+    chol_pivoted_in_place(&mut a, t, floor, &mut perm)
 }
 
 /// First factor of the exchange determinant: the Cholesky factor of
 /// `I + V_in` (row-major lower triangle in `la`) and `ln det(I + V_in)`.
-pub(crate) fn exchange_in_factor(
-    t: usize,
-    v_in: &[f64],
-    la: &mut [f64; MAX_T * MAX_T],
-) -> Result<f64, f64> {
+pub(crate) fn exchange_in_factor(t: usize, v_in: &[f64], la: &mut [f64]) -> Result<f64, f64> {
     for r in 0..t {
         for c in 0..=r {
             let x = v_in[pk(r, c)];
@@ -238,13 +259,13 @@ pub(crate) const SUSPECT_PIVOT: f64 = 1e-6;
 /// factorization decides, as the state's update does.
 pub(crate) fn exchange_out_ln_det(
     t: usize,
-    la: &[f64; MAX_T * MAX_T],
+    la: &[f64],
     v_out: &[f64],
     w: impl Fn(usize, usize) -> f64,
     floor: f64,
 ) -> Result<f64, f64> {
     // Y = L_A⁻¹ W (t×t, row-major), forward substitution column by column.
-    let mut y = [0.0f64; MAX_T * MAX_T];
+    let mut y = BlockScratch::new(t * t);
     for c in 0..t {
         for r in 0..t {
             let mut s = w(r, c);
@@ -256,7 +277,7 @@ pub(crate) fn exchange_out_ln_det(
     }
     // B = I − V_out + Yᵀ Y; `upper` also fills the upper triangle, which
     // only the pivoted factorization reads.
-    let fill = |b: &mut [f64; MAX_T * MAX_T], upper: bool| {
+    let fill = |b: &mut [f64], upper: bool| {
         for r in 0..t {
             for c in 0..=r {
                 let mut s = if r == c { 1.0 } else { 0.0 } - v_out[pk(r, c)];
@@ -271,11 +292,11 @@ pub(crate) fn exchange_out_ln_det(
         }
     };
     // The pivots are in (floor, ~1+‖Y‖²] (B ⪯ I + YᵀY), so their product
-    // (t ≤ 6 of them) neither overflows nor underflows.
-    let mut b = [0.0f64; MAX_T * MAX_T];
+    // (t of them, each at most ~1+‖Y‖², so for any practical t) neither overflows nor underflows.
+    let mut b = BlockScratch::new(t * t);
     fill(&mut b, false);
     let (mut det, mut lo) = (1.0f64, f64::INFINITY);
-    let plain = chol_pivots_in_place(&mut b[..t * t], t, floor, |d| {
+    let plain = chol_pivots_in_place(&mut b, t, floor, |d| {
         det *= d;
         lo = lo.min(d);
     });
@@ -284,8 +305,8 @@ pub(crate) fn exchange_out_ln_det(
     }
     fill(&mut b, true);
     let mut det = 1.0;
-    let mut perm = [0usize; MAX_T];
-    chol_pivoted_pivots_in_place(&mut b[..t * t], t, floor, &mut perm[..t], |d| det *= d)?;
+    let mut perm = PermScratch::new(t);
+    chol_pivoted_pivots_in_place(&mut b, t, floor, &mut perm, |d| det *= d)?;
     Ok(det.ln())
 }
 
@@ -299,216 +320,14 @@ pub(crate) fn exchange_ln_det(
     w: impl Fn(usize, usize) -> f64,
     floor: f64,
 ) -> Result<f64, f64> {
-    let mut la = [0.0f64; MAX_T * MAX_T];
+    let mut la = BlockScratch::new(t * t);
     let ln_a = exchange_in_factor(t, v_in, &mut la)?;
     Ok(ln_a + exchange_out_ln_det(t, &la, v_out, w, floor)?)
-}
-
-/// Copies a `t×p` block (any strides) into `out`, column-major with stride
-/// `t` (`out[a·t + r] = X[r, a]`), reusing `out`'s allocation.
-pub(crate) fn gather_block(x: MatRef<'_, f64>, out: &mut Vec<f64>) {
-    out.clear();
-    for a in 0..x.ncols() {
-        out.extend(x.col(a).iter().copied());
-    }
-}
-
-/// `M += sign · XᵀX` for a `t×p` block gathered by [`gather_block`], on a
-/// `p×p` column-major `M` (stride `p`). Each entry is computed once and
-/// written to both triangles, so `M` stays exactly symmetric.
-pub(crate) fn add_gram(m: &mut [f64], p: usize, xb: &[f64], t: usize, sign: f64) {
-    debug_assert!(m.len() == p * p && xb.len() == t * p);
-    for b in 0..p {
-        let cb = &xb[b * t..b * t + t];
-        for a in b..p {
-            let ca = &xb[a * t..a * t + t];
-            let s: f64 = ca.iter().zip(cb).map(|(x, y)| x * y).sum();
-            let v = m[b * p + a] + sign * s;
-            m[b * p + a] = v;
-            m[a * p + b] = v;
-        }
-    }
-}
-
-/// Induced 1-norm (largest absolute column sum) of a `p×p` column-major
-/// matrix.
-pub(crate) fn norm1(m: &[f64], p: usize) -> f64 {
-    m.chunks(p.max(1))
-        .map(|c| c.iter().map(|x| x.abs()).sum::<f64>())
-        .fold(0.0, f64::max)
-}
-
-/// A `p×p` column-major slice viewed as a faer matrix.
-pub(crate) fn view(m: &[f64], p: usize) -> MatRef<'_, f64> {
-    MatRef::from_column_major_slice(m, p, p)
-}
-
-/// Cholesky factorization of a symmetric matrix with faer's `llt` kernel
-/// (sequential): returns `(M⁻¹, ln det M)`, `M⁻¹` column-major with stride
-/// `p` and exactly symmetric, or `Err(())` when a pivot is not positive.
-pub(crate) fn cholesky_inverse(m: MatRef<'_, f64>) -> Result<(Vec<f64>, f64), ()> {
-    let p = m.nrows();
-    let par = Par::Seq;
-    let mut l = Mat::<f64>::zeros(p, p);
-    l.as_mut().copy_from_triangular_lower(m);
-    let req = llt::factor::cholesky_in_place_scratch::<f64>(p, par, Default::default())
-        .or(llt::inverse::inverse_scratch::<f64>(p, par));
-    let mut mem = MemBuffer::new(req);
-    let stack = MemStack::new(&mut mem);
-    llt::factor::cholesky_in_place(
-        l.as_mut(),
-        Default::default(),
-        par,
-        stack,
-        Default::default(),
-    )
-    .map_err(|_| {
-        clear_upper_simd_state();
-    })?;
-    clear_upper_simd_state();
-    let mut ln_det = 0.0;
-    for i in 0..p {
-        let d = l[(i, i)];
-        if !(d > 0.0) || !d.is_finite() {
-            return Err(());
-        }
-        ln_det += 2.0 * d.ln();
-    }
-    let mut inv = vec![0.0; p * p];
-    llt::inverse::inverse(
-        MatMut::from_column_major_slice_mut(&mut inv, p, p),
-        l.as_ref(),
-        par,
-        stack,
-    );
-    clear_upper_simd_state();
-    // The kernel writes the lower triangle; mirror it.
-    for j in 0..p {
-        for i in j + 1..p {
-            inv[i * p + j] = inv[j * p + i];
-        }
-    }
-    Ok((inv, ln_det))
-}
-
-/// Reusable scratch for symmetric eigenvalue computations of one size.
-pub(crate) struct EigenScratch {
-    mem: MemBuffer,
-    s: Diag<f64>,
-}
-
-impl EigenScratch {
-    /// Scratch for `p×p` matrices.
-    pub(crate) fn new(p: usize) -> Self {
-        let req = evd::self_adjoint_evd_scratch::<f64>(
-            p,
-            ComputeEigenvectors::No,
-            Par::Seq,
-            Default::default(),
-        );
-        Self {
-            mem: MemBuffer::new(req),
-            s: Diag::zeros(p),
-        }
-    }
-
-    /// Eigenvalues of the symmetric matrix `m` (lower triangle read), in
-    /// nondecreasing order; `None` if the iteration fails.
-    pub(crate) fn eigenvalues(&mut self, m: MatRef<'_, f64>) -> Option<&[f64]> {
-        let p = m.nrows();
-        let stack = MemStack::new(&mut self.mem);
-        let r = evd::self_adjoint_evd(
-            m,
-            self.s.as_mut(),
-            None,
-            Par::Seq,
-            stack,
-            Default::default(),
-        );
-        clear_upper_simd_state();
-        r.ok()?;
-        let col = self.s.column_vector();
-        let slice = col.try_as_col_major()?.as_slice();
-        Some(&slice[..p])
-    }
-}
-
-/// Singular values of `x` (nonincreasing), padded with zeros to `x.ncols()`
-/// when `x` has fewer rows than columns.
-pub(crate) fn singular_values(x: MatRef<'_, f64>) -> Vec<f64> {
-    let (m, n) = x.shape();
-    let k = m.min(n);
-    let mut out = vec![0.0; n];
-    if k == 0 {
-        return out;
-    }
-    let par = Par::Seq;
-    let req = svd::svd_scratch::<f64>(
-        m,
-        n,
-        ComputeSvdVectors::No,
-        ComputeSvdVectors::No,
-        par,
-        Default::default(),
-    );
-    let mut mem = MemBuffer::new(req);
-    let mut s = Diag::<f64>::zeros(k);
-    let r = svd::svd(
-        x,
-        s.as_mut(),
-        None,
-        None,
-        par,
-        MemStack::new(&mut mem),
-        Default::default(),
-    );
-    clear_upper_simd_state();
-    if r.is_err() {
-        // The SVD iteration did not converge; fall back to the eigenvalues of
-        // XᵀX, which are σ².
-        let mut g = vec![0.0; n * n];
-        let mut xb = Vec::new();
-        gather_block(x, &mut xb);
-        add_gram(&mut g, n, &xb, m, 1.0);
-        let mut es = EigenScratch::new(n);
-        if let Some(ev) = es.eigenvalues(view(&g, n)) {
-            let mut sv: Vec<f64> = ev.iter().map(|&l| l.max(0.0).sqrt()).collect();
-            sv.sort_by(|a, b| b.total_cmp(a));
-            return sv;
-        }
-        return out;
-    }
-    let col = s.column_vector();
-    let sv = col
-        .try_as_col_major()
-        .expect("a fresh Diag is contiguous")
-        .as_slice();
-    for (o, &v) in out.iter_mut().zip(sv) {
-        *o = v.max(0.0);
-    }
-    out.sort_by(|a, b| b.total_cmp(a));
-    out
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn gram_is_symmetric_and_correct() {
-        let x = Mat::from_fn(3, 4, |i, j| (i * 4 + j) as f64 - 5.0);
-        let mut xb = Vec::new();
-        gather_block(x.as_ref(), &mut xb);
-        let mut m = vec![1.0; 16];
-        add_gram(&mut m, 4, &xb, 3, 1.0);
-        let want = x.transpose() * &x;
-        for i in 0..4 {
-            for j in 0..4 {
-                assert_eq!(m[j * 4 + i], 1.0 + want[(i, j)]);
-            }
-        }
-        assert_eq!(norm1(&[1.0, -2.0, 3.0, 0.5], 2), 3.5);
-    }
 
     #[test]
     fn chol_matches_known_determinant() {
@@ -558,26 +377,5 @@ mod tests {
         }
         let mut perm = [0usize; 6];
         assert!(chol_pivoted_in_place(&mut b, 6, 1e-14, &mut perm).is_err());
-    }
-
-    #[test]
-    fn cholesky_inverse_reconstructs() {
-        for p in 1..12 {
-            let m = Mat::from_fn(p, p, |i, j| {
-                if i == j {
-                    p as f64 + 1.0
-                } else {
-                    1.0 / (1.0 + (i + j) as f64)
-                }
-            });
-            let (inv, _) = cholesky_inverse(m.as_ref()).unwrap();
-            let prod = &m * view(&inv, p);
-            for i in 0..p {
-                for j in 0..p {
-                    let e = if i == j { 1.0 } else { 0.0 };
-                    assert!((prod[(i, j)] - e).abs() < 1e-13);
-                }
-            }
-        }
     }
 }

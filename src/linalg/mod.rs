@@ -1,0 +1,17 @@
+//! The one home of dense kernels: every module that factors, inverts or
+//! updates a matrix uses these, and none keeps a copy.
+//!
+//! - [`chol`]: Cholesky of `p×p` SPD matrices, `ln det`, inverse;
+//! - [`small`]: `t×t` block kernels of the rank-t updates (eqs. (17)–(22));
+//! - [`gram`]: `M ± XᵀX` on `p×p` slices;
+//! - [`eigen`]: eigenvalues and singular values;
+//! - [`simd`]: register hygiene after faer's kernels.
+//!
+//! Every kernel is sequential, so a result never depends on the thread
+//! count.
+
+pub mod chol;
+pub mod eigen;
+pub mod gram;
+pub mod simd;
+pub mod small;

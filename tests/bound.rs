@@ -5,7 +5,7 @@
 
 use activecal::blocks::Blocks;
 use activecal::bound::conic::{self, ConicSettings, ConicStatus};
-use activecal::bound::exchange::{self, ExchangeSettings};
+use activecal::bound::first_order::{self, ExchangeSettings};
 use activecal::bound::gap::{WEIGHT_TOL, design_ln_det, weights_ln_det};
 use activecal::bound::newton::NewtonSettings;
 use activecal::bound::variance::{
@@ -111,7 +111,7 @@ fn small_pools_bound_the_enumerated_optimum_and_solvers_agree() {
                 gap_tol: 1e-9,
                 ..ExchangeSettings::default()
             };
-            let fo = exchange::solve(&x, n, None, &fo_settings).unwrap();
+            let fo = first_order::solve(&x, n, None, &fo_settings).unwrap();
             assert!(fo.converged, "{name} N={n}: first-order gap {}", fo.gap);
             assert!(fo.ln_bound >= best);
             let co = conic::solve(&x, n, &ConicSettings::default()).unwrap();
@@ -214,7 +214,7 @@ fn bad_input_is_an_error() {
         })
     ));
     assert!(matches!(
-        exchange::solve(&x, 8, Some(&[1.0; 3]), &ExchangeSettings::default()),
+        first_order::solve(&x, 8, Some(&[1.0; 3]), &ExchangeSettings::default()),
         Err(BoundError::InvalidWeights(_))
     ));
 }
@@ -259,7 +259,7 @@ fn active_box_constraints_are_respected() {
     assert_eq!(b.status, BoundStatus::Certified);
     let full = b.weights.iter().filter(|&&w| w > 1.0 - 1e-6).count();
     assert!(full >= 10, "{full} weights at 1");
-    let fo = exchange::solve(
+    let fo = first_order::solve(
         &x,
         n,
         None,
@@ -298,7 +298,7 @@ fn screening_reaches_the_same_optimum_as_the_whole_pool() {
     let whole_ln_det = weights_ln_det(&x, &w).unwrap();
     assert!((whole_ln_det - b.ln_primal).abs() <= 1e-6);
     assert!(b.ln_bound >= whole_ln_det);
-    let fo = exchange::solve(
+    let fo = first_order::solve(
         &x,
         n,
         None,

@@ -26,7 +26,7 @@
 
 pub mod conic;
 mod error;
-pub mod exchange;
+pub mod first_order;
 pub mod gap;
 pub mod newton;
 pub mod variance;
@@ -38,7 +38,7 @@ use crate::blocks::Blocks;
 use crate::model::{ParamSet, Robot};
 use crate::pool::Pool;
 use conic::{ConicSettings, ConicStatus};
-use exchange::{ExchangeOutcome, ExchangeSettings, candidates, evaluate};
+use first_order::{ExchangeOutcome, ExchangeSettings, candidates, evaluate};
 use newton::NewtonSettings;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
@@ -427,7 +427,7 @@ pub fn relaxation_bound(
     } else {
         settings.gap_tol
     };
-    let fo = exchange::solve_scaled(xs, n, None, &fo_settings);
+    let fo = first_order::solve_scaled(xs, n, None, &fo_settings);
     let first_order = ExchangeSummary {
         rounds: fo.rounds,
         steps: fo.steps,
@@ -575,7 +575,7 @@ pub fn relaxation_bound(
         if settings.polish && !conic_solved && best.gap() > settings.gap_tol {
             let mut s = settings.first_order.clone();
             s.gap_tol = settings.gap_tol;
-            let pol: ExchangeOutcome = exchange::solve_scaled(xs, n, Some(best.w.clone()), &s);
+            let pol: ExchangeOutcome = first_order::solve_scaled(xs, n, Some(best.w.clone()), &s);
             conic_summary.polish_steps += pol.steps;
             best.bound = best.bound.min(pol.ln_bound);
             if pol.ln_det > best.ln_det {
@@ -606,7 +606,7 @@ fn polish(xs: &Blocks, n: usize, w: &[f64], settings: &BoundSettings) -> Exchang
     let mut s = settings.first_order.clone();
     s.gap_tol = settings.gap_tol;
     s.max_rounds = settings.polish_rounds;
-    exchange::solve_scaled(xs, n, Some(w.to_vec()), &s)
+    first_order::solve_scaled(xs, n, Some(w.to_vec()), &s)
 }
 
 fn finish(

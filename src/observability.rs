@@ -76,7 +76,16 @@ pub fn identifiability(robot: &Robot, x: &Blocks) -> Identifiability {
         }
     });
     let names = robot.parameter_names();
-    let svd = scaled.svd().expect("SVD of a finite matrix converges");
+    // The thin SVD: U is rows × p, not rows × rows, so memory stays
+    // O(rows · p) (a full U of 30,000 measured points would take 65 GB).
+    // With fewer rows than unknowns the full SVD is small and gives the whole
+    // null space (a thin V would stop at `rows` columns).
+    let svd = if rows >= p {
+        scaled.thin_svd()
+    } else {
+        scaled.svd()
+    }
+    .expect("SVD of a finite matrix converges");
     let s: Vec<f64> = (0..p.min(rows)).map(|i| svd.S()[i]).collect();
     let smax = s.iter().cloned().fold(0.0, f64::max);
     let tol = rows.max(p) as f64 * f64::EPSILON * smax.max(f64::MIN_POSITIVE);

@@ -2,6 +2,7 @@
 //! files and their pools. Loaders are one-way producers of model types: the
 //! model never imports them.
 
+pub mod atomic;
 pub mod design;
 pub mod robot_toml;
 pub mod urdf;

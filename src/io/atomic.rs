@@ -1,0 +1,287 @@
+//! Outputs that are never half-written and never overwrite without asking.
+//!
+//! A file is written to a temporary file in the target's own directory,
+//! flushed to disk, and renamed over the target: a reader (or a crash, or a
+//! `SIGKILL`) sees either the old file or the new one, never a mixture, and
+//! the old file is not lost until the new one is complete. A directory of
+//! outputs (`reproduce`) is built aside and swapped in ([`replace_dir`]).
+//!
+//! [`check_outputs`] refuses, before any work is done, an output that exists
+//! (without `force`), that is a directory, whose directory does not exist,
+//! that is one of the command's inputs, or that two outputs share.
+
+use crate::error::{Error, Result};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// One output of a command, for [`check_outputs`].
+#[derive(Clone, Copy, Debug)]
+pub struct Output<'a> {
+    /// The option that names it (`--out`, `--save-measurements`), for
+    /// messages.
+    pub option: &'a str,
+    /// The path given.
+    pub path: &'a Path,
+}
+
+fn invalid(msg: String) -> Error {
+    Error::Invalid(msg)
+}
+
+/// A path's identity for comparisons: canonical when it exists, else its
+/// canonical parent joined with the file name, else as given.
+fn identity(path: &Path) -> PathBuf {
+    if let Ok(c) = path.canonicalize() {
+        return c;
+    }
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    match (parent.canonicalize(), path.file_name()) {
+        (Ok(p), Some(f)) => p.join(f),
+        _ => path.to_path_buf(),
+    }
+}
+
+/// Checks a command's output files before it does any work: each must name
+/// a file (not a directory) in an existing directory, must not exist unless
+/// `force`, must not be one of `inputs`, and no two outputs may be the same
+/// file. The error names the option and the path.
+pub fn check_outputs(outputs: &[Output<'_>], inputs: &[&Path], force: bool) -> Result<()> {
+    for (k, o) in outputs.iter().enumerate() {
+        let shown = o.path.display();
+        if o.path.is_dir() {
+            return Err(invalid(format!(
+                "{} {shown}: is a directory; give a file name",
+                o.option
+            )));
+        }
+        if o.path.file_name().is_none() {
+            return Err(invalid(format!("{} {shown}: not a file name", o.option)));
+        }
+        let parent = match o.path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        if !parent.is_dir() {
+            return Err(invalid(format!(
+                "{} {shown}: the directory {} does not exist",
+                o.option,
+                parent.display()
+            )));
+        }
+        let id = identity(o.path);
+        if let Some(i) = inputs.iter().find(|i| identity(i) == id) {
+            return Err(invalid(format!(
+                "{} {shown}: is an input of this command ({}); choose another file",
+                o.option,
+                i.display()
+            )));
+        }
+        if let Some(other) = outputs[..k].iter().find(|p| identity(p.path) == id) {
+            return Err(invalid(format!(
+                "{} and {} name the same file {shown}",
+                other.option, o.option
+            )));
+        }
+        if o.path.exists() && !force {
+            return Err(invalid(format!(
+                "{} {shown}: exists; pass --force to overwrite it",
+                o.option
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// A temporary path beside `path`, unique to this process and call.
+fn temporary_beside(path: &Path) -> PathBuf {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let name = path
+        .file_name()
+        .map_or_else(|| "output".into(), |f| f.to_string_lossy().into_owned());
+    path.with_file_name(format!(".{name}.tmp-{}-{n}", std::process::id()))
+}
+
+fn io_error(path: &Path, cause: std::io::Error) -> Error {
+    Error::Io {
+        path: path.display().to_string(),
+        cause,
+    }
+}
+
+/// Writes `bytes` to `path` atomically: a temporary file in the same
+/// directory, flushed to disk, then renamed over `path`. On any error the
+/// temporary file is removed and `path` is untouched.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let tmp = temporary_beside(path);
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        drop(f);
+        std::fs::rename(&tmp, path)
+    })();
+    result.map_err(|cause| {
+        let _ = std::fs::remove_file(&tmp);
+        io_error(path, cause)
+    })
+}
+
+/// A directory being built aside for [`replace_dir`]: `.NAME.tmp-PID-N`
+/// beside the target.
+#[derive(Debug)]
+pub struct StagedDir {
+    staging: PathBuf,
+    target: PathBuf,
+}
+
+impl StagedDir {
+    /// Creates an empty staging directory beside `target`.
+    pub fn new(target: &Path) -> Result<StagedDir> {
+        let staging = temporary_beside(target);
+        std::fs::create_dir(&staging).map_err(|e| io_error(&staging, e))?;
+        Ok(StagedDir {
+            staging,
+            target: target.to_path_buf(),
+        })
+    }
+
+    /// Where to write the outputs.
+    #[must_use]
+    pub fn path(&self) -> &Path {
+        &self.staging
+    }
+
+    /// Swaps the staged directory in for the target (see [`replace_dir`]).
+    pub fn commit(self) -> Result<()> {
+        let r = replace_dir(&self.staging, &self.target);
+        std::mem::forget(self);
+        r
+    }
+}
+
+impl Drop for StagedDir {
+    fn drop(&mut self) {
+        // Not committed (an error on the way): nothing half-built remains.
+        let _ = std::fs::remove_dir_all(&self.staging);
+    }
+}
+
+/// Replaces directory `target` by `staging`: the old target (if any) is
+/// renamed aside, `staging` renamed to `target`, then the old one removed.
+/// At every moment one complete directory exists: the old one (under its
+/// name or, for the instant between the two renames, as `.NAME.old-PID`) or
+/// the new one.
+pub fn replace_dir(staging: &Path, target: &Path) -> Result<()> {
+    let old = if target.exists() {
+        let name = target
+            .file_name()
+            .map_or_else(|| "output".into(), |f| f.to_string_lossy().into_owned());
+        let old = target.with_file_name(format!(".{name}.old-{}", std::process::id()));
+        std::fs::rename(target, &old).map_err(|e| io_error(target, e))?;
+        Some(old)
+    } else {
+        None
+    };
+    if let Err(e) = std::fs::rename(staging, target) {
+        if let Some(o) = &old {
+            let _ = std::fs::rename(o, target);
+        }
+        return Err(io_error(target, e));
+    }
+    if let Some(o) = old {
+        let _ = std::fs::remove_dir_all(o);
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let d =
+            std::env::temp_dir().join(format!("activecal-atomic-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    #[test]
+    fn writes_replace_and_leave_no_temporary() {
+        let d = scratch("write");
+        let f = d.join("a.json");
+        write_atomic(&f, b"one").unwrap();
+        write_atomic(&f, b"two").unwrap();
+        assert_eq!(std::fs::read(&f).unwrap(), b"two");
+        let names: Vec<_> = std::fs::read_dir(&d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names.len(), 1, "{names:?}");
+        // A write into a missing directory fails and creates nothing.
+        assert!(write_atomic(&d.join("no/such/dir.json"), b"x").is_err());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn outputs_are_checked_before_work() {
+        let d = scratch("check");
+        let input = d.join("in.json");
+        std::fs::write(&input, "{}").unwrap();
+        fn out(p: &Path) -> Output<'_> {
+            Output {
+                option: "--out",
+                path: p,
+            }
+        }
+        let e =
+            |o: &[Output<'_>], force| check_outputs(o, &[&input], force).unwrap_err().to_string();
+        assert!(e(&[out(&d)], true).contains("is a directory"));
+        assert!(e(&[out(&d.join("missing/x.json"))], false).contains("does not exist"));
+        assert!(e(&[out(&input)], true).contains("is an input"));
+        // The same file by another spelling is still the input.
+        let other = d.join(".").join("in.json");
+        assert!(e(&[out(&other)], true).contains("is an input"));
+        assert!(e(&[out(&input)], false).contains("is an input"));
+        let new = d.join("new.json");
+        let second = Output {
+            option: "--save-measurements",
+            path: &new,
+        };
+        assert!(e(&[out(&new), second], true).contains("name the same file"));
+        std::fs::write(&new, "old").unwrap();
+        assert!(e(&[out(&new)], false).contains("--force"));
+        check_outputs(&[out(&new)], &[&input], true).unwrap();
+        check_outputs(&[out(&d.join("fresh.json"))], &[&input], false).unwrap();
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn a_staged_directory_replaces_the_old_one_whole() {
+        let d = scratch("dir");
+        let target = d.join("report");
+        std::fs::create_dir(&target).unwrap();
+        std::fs::write(target.join("old.txt"), "old").unwrap();
+        let staged = StagedDir::new(&target).unwrap();
+        std::fs::write(staged.path().join("new.txt"), "new").unwrap();
+        staged.commit().unwrap();
+        assert!(target.join("new.txt").exists());
+        assert!(
+            !target.join("old.txt").exists(),
+            "no old file beside the new ones"
+        );
+        // An abandoned staging directory is removed and the target kept.
+        let staged = StagedDir::new(&target).unwrap();
+        let path = staged.path().to_path_buf();
+        drop(staged);
+        assert!(!path.exists());
+        assert!(target.join("new.txt").exists());
+        assert_eq!(std::fs::read_dir(&d).unwrap().count(), 1);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+}

@@ -188,6 +188,7 @@ pub fn solve(x: &Blocks, n: usize, settings: &ConicSettings) -> Result<ConicOutc
 /// Solves problem (R) on the already scaled blocks `sc.x` (objective values
 /// unscaled with `sc.ln_scale`).
 pub(crate) fn solve_scaled(sc: &Scaled, n: usize, s: &ConicSettings) -> ConicOutcome {
+    crate::linalg::blas::single_threaded();
     let clock = Instant::now();
     let (a, b, q, cones) = problem(&sc.x, n);
     let p_mat = CscMatrix::zeros((q.len(), q.len()));

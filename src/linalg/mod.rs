@@ -5,11 +5,13 @@
 //! - [`small`]: `t×t` block kernels of the rank-t updates (eqs. (17)–(22));
 //! - [`gram`]: `M ± XᵀX` on `p×p` slices;
 //! - [`eigen`]: eigenvalues and singular values;
-//! - [`simd`]: register hygiene after faer's kernels.
+//! - [`simd`]: register hygiene after faer's kernels;
+//! - [`blas`]: the system BLAS kept on one thread.
 //!
 //! Every kernel is sequential, so a result never depends on the thread
 //! count.
 
+pub mod blas;
 pub mod chol;
 pub mod eigen;
 pub mod gram;

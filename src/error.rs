@@ -90,6 +90,21 @@ pub enum Error {
         /// Number of unknowns.
         p: usize,
     },
+    /// A structure whose estimated memory exceeds the budget
+    /// ([`crate::resources::MemoryBudget`]), refused before allocating it.
+    #[error(
+        "{what} would need {needed} of memory, above the limit of {limit} ({source_of_limit}); use a smaller pool (fewer --levels or poses) or raise the limit"
+    )]
+    TooLarge {
+        /// What was to be allocated.
+        what: String,
+        /// Its estimated size.
+        needed: String,
+        /// The budget.
+        limit: String,
+        /// Where the budget comes from.
+        source_of_limit: String,
+    },
     /// Any other invalid argument, with a message saying what and why.
     #[error("{0}")]
     Invalid(String),

@@ -19,6 +19,7 @@ pub mod measure;
 pub mod model;
 pub mod observability;
 pub mod pool;
+pub mod resources;
 pub mod select;
 
 pub use error::{Error, Result};

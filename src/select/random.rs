@@ -79,24 +79,24 @@ pub fn random_search(
     seed: u64,
 ) -> RandomSearch {
     let p = pool.p();
-    let results: Vec<(Vec<usize>, f64)> = (0..designs)
+    // Only the values are kept (8 bytes a design); the best design is drawn
+    // again from its own seed, so no design list is held in memory.
+    let ln_oid: Vec<f64> = (0..designs)
         .into_par_iter()
         .map(|k| {
             let d = random_design(&mut design_rng(seed, k as u64), allowed, fixed, n);
-            let v = ln_det_direct(pool, &d).unwrap_or(f64::NEG_INFINITY);
-            (d, v)
+            ln_det_direct(pool, &d).unwrap_or(f64::NEG_INFINITY)
         })
         .collect();
     let mut best = 0;
-    for (k, r) in results.iter().enumerate() {
-        if r.1 > results[best].1 {
+    for (k, &v) in ln_oid.iter().enumerate() {
+        if v > ln_oid[best] {
             best = k;
         }
     }
-    let ln_oid: Vec<f64> = results.iter().map(|r| r.1).collect();
     RandomSearch {
-        best: results[best].0.clone(),
-        best_ln_oid: results[best].1,
+        best: random_design(&mut design_rng(seed, best as u64), allowed, fixed, n),
+        best_ln_oid: ln_oid[best],
         oi: ln_oid.iter().map(|&v| oi_from_ln_oid(v, p)).collect(),
         ln_oid,
     }

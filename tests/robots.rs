@@ -662,7 +662,7 @@ fn malformed_urdf_files_get_clear_errors() {
                 "{J_AB}{J_BC}<joint name=\"j3\" type=\"fixed\"><parent link=\"b\"/><child link=\"d\"/></joint>"
             )),
             None,
-            "branches at link 'b'",
+            "candidate tips: c (2 joints), d (1 joint)",
         ),
         (
             mini_urdf(&format!("{J_AB}{J_BC}")),

@@ -33,8 +33,11 @@
 //! ```
 //!
 //! Instead of frames, a file may import a URDF: `urdf = "arm.urdf"` (relative
-//! to the file), with optional `tip = "link"`, `measurement`, `name` and
-//! `visibility`; its unknowns are chosen automatically (see [`super::urdf`]).
+//! to the file), with optional `base = "link"` (default: the URDF's root),
+//! `tip = "link"` (required when the URDF is a tree), a table `[lock]` of
+//! joints made fixed at a value (`torso_lift_joint = 0.15`, radians or
+//! metres), `measurement`, `name` and `visibility`; its unknowns are chosen
+//! automatically (see [`super::urdf`]).
 //!
 //! Every problem is an [`Error::Parse`] naming the file and the place:
 //! TOML syntax, unknown keys, missing or mistyped fields (with the TOML
@@ -69,7 +72,9 @@ struct FileSpec {
     visibility: Option<Spanned<Visibility>>,
     unknowns: Option<Spanned<String>>,
     urdf: Option<Spanned<String>>,
+    base: Option<Spanned<String>>,
     tip: Option<Spanned<String>>,
+    lock: Option<Spanned<std::collections::BTreeMap<String, f64>>>,
     #[serde(default)]
     frame: Vec<FrameSpec>,
 }
@@ -223,7 +228,13 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
             None => Path::new(urdf.get_ref()).to_path_buf(),
         };
         let opts = super::urdf::UrdfOptions {
+            base: spec.base.as_ref().map(|t| t.get_ref().clone()),
             tip: spec.tip.as_ref().map(|t| t.get_ref().clone()),
+            lock: spec
+                .lock
+                .as_ref()
+                .map(|l| l.get_ref().iter().map(|(k, v)| (k.clone(), *v)).collect())
+                .unwrap_or_default(),
             measurement,
             ..super::urdf::UrdfOptions::default()
         };
@@ -239,6 +250,12 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
     }
     if let Some(t) = &spec.tip {
         return Err(cx.at(t.span(), "`tip` is only for `urdf = …` imports"));
+    }
+    if let Some(t) = &spec.base {
+        return Err(cx.at(t.span(), "`base` is only for `urdf = …` imports"));
+    }
+    if let Some(t) = &spec.lock {
+        return Err(cx.at(t.span(), "`lock` is only for `urdf = …` imports"));
     }
     if spec.frame.is_empty() {
         return Err(cx.plain(

@@ -78,9 +78,19 @@ pub const CONTINUOUS_RANGE: [f64; 2] = [-170.0 * PI / 180.0, 170.0 * PI / 180.0]
 /// How to import a URDF.
 #[derive(Clone, Debug, PartialEq)]
 pub struct UrdfOptions {
+    /// The base link: the measurement frame's end of the chain (the sensor
+    /// measures in the base's frame up to the unknown base transform).
+    /// Default: the URDF's root link.
+    pub base: Option<String>,
     /// The tip link (measured point or frame). Default: the end of the chain
-    /// when the tree has a single leaf; required when it branches.
+    /// when the tree below the base has a single leaf; required when it
+    /// branches (the error lists the candidate tips). A chain whose last
+    /// moving joint looks like a gripper's (mimic, finger or jaw, a short
+    /// prismatic end joint) is refused unless the tip is named.
     pub tip: Option<String>,
+    /// Joints made fixed at a value (radians or metres): `(name, value)`.
+    /// Each must be a moving joint of the chain.
+    pub lock: Vec<(String, f64)>,
     /// Point (default) or full-pose measurements.
     pub measurement: Measurement,
     /// Angle in radians below which consecutive axes are nearly parallel
@@ -95,7 +105,9 @@ pub struct UrdfOptions {
 impl Default for UrdfOptions {
     fn default() -> Self {
         Self {
+            base: None,
             tip: None,
+            lock: Vec::new(),
             measurement: Measurement::Point,
             parallel_threshold: PARALLEL_THRESHOLD,
             perturb_real: true,
@@ -127,7 +139,8 @@ pub fn parse(text: &str, origin: &str, opts: &UrdfOptions) -> Result<Robot> {
     }
     let urdf =
         urdf_rs::read_from_string(text).map_err(|e| bad(format!("not a valid URDF: {e}")))?;
-    let chain = extract_chain(&urdf, opts.tip.as_deref()).map_err(bad)?;
+    let chain =
+        extract_chain(&urdf, opts.base.as_deref(), opts.tip.as_deref(), &opts.lock).map_err(bad)?;
     let name = if urdf.name.is_empty() {
         Path::new(origin)
             .file_stem()
@@ -182,10 +195,59 @@ fn iso_from_pose(p: &urdf_rs::Pose) -> Option<Isometry3<f64>> {
     ))
 }
 
-/// The joints from the root link to the tip, in order.
+/// Most moving joints an imported chain may have (as many as a TOML
+/// description's frames, [`super::robot_toml::MAX_FRAMES`]): the choice of
+/// unknowns grows with the cube of the chain's length.
+pub const MAX_CHAIN_JOINTS: usize = 100;
+
+/// Links listed at most in an error message.
+const LIST_AT_MOST: usize = 12;
+
+fn list_names<S: AsRef<str>>(names: &[S]) -> String {
+    let mut v: Vec<&str> = names.iter().map(AsRef::as_ref).take(LIST_AT_MOST).collect();
+    if names.len() > LIST_AT_MOST {
+        v.push("…");
+    }
+    v.join(", ")
+}
+
+/// Whether a moving joint looks like a gripper's: a finger, jaw or gripper
+/// joint or child link, or a short prismatic joint (stroke below 0.1 m).
+fn gripper_reason(j: &urdf_rs::Joint) -> Option<String> {
+    let words = [
+        "finger", "jaw", "gripper", "claw", "grip", "hand_l", "hand_r", "knuckle",
+    ];
+    let lower = |x: &str| x.to_ascii_lowercase();
+    for name in [&j.name, &j.child.link] {
+        if let Some(w) = words.iter().find(|w| lower(name).contains(*w)) {
+            return Some(format!(
+                "'{name}' names a {}",
+                w.trim_end_matches("_l").trim_end_matches("_r")
+            ));
+        }
+    }
+    if j.joint_type == urdf_rs::JointType::Prismatic && (j.limit.upper - j.limit.lower).abs() < 0.1
+    {
+        return Some(format!(
+            "it is a short prismatic joint ({:.3} m of stroke)",
+            (j.limit.upper - j.limit.lower).abs()
+        ));
+    }
+    None
+}
+
+fn is_moving(j: &urdf_rs::Joint) -> bool {
+    use urdf_rs::JointType as T;
+    matches!(j.joint_type, T::Revolute | T::Continuous | T::Prismatic)
+}
+
+/// The joints from the base link (default: the URDF's root) to the tip, in
+/// order, with the locked joints made fixed at their values.
 fn extract_chain(
     urdf: &urdf_rs::Robot,
+    base: Option<&str>,
     tip: Option<&str>,
+    lock: &[(String, f64)],
 ) -> std::result::Result<Vec<ChainJoint>, String> {
     let joints = &urdf.joints;
     let mut by_child: HashMap<&str, usize> = HashMap::new();
@@ -207,6 +269,27 @@ fn extract_chain(
     }
     links.sort_unstable();
     links.dedup();
+    // A loop: walking up from some link comes back to it. Name its joints.
+    for &start in &links {
+        let mut at = start;
+        let mut seen: Vec<usize> = Vec::new();
+        while let Some(&j) = by_child.get(at) {
+            if let Some(k) = seen.iter().position(|&s| s == j) {
+                let mut cycle: Vec<&str> = seen[k..]
+                    .iter()
+                    .rev()
+                    .map(|&s| joints[s].name.as_str())
+                    .collect();
+                cycle.push(cycle[0]);
+                return Err(format!(
+                    "the joints form a loop ({}): a URDF must be a tree",
+                    cycle.join(" → ")
+                ));
+            }
+            seen.push(j);
+            at = &joints[j].parent.link;
+        }
+    }
     let roots: Vec<&str> = links
         .iter()
         .copied()
@@ -219,60 +302,173 @@ fn extract_chain(
             return Err(format!(
                 "{} root links ({}): the URDF must be one tree",
                 many.len(),
-                many.join(", ")
+                list_names(many)
             ));
         }
     };
-    let tip: &str = match tip {
-        Some(t) => {
-            if !links.contains(&t) {
-                return Err(format!("the tip link '{t}' is not in the URDF"));
-            }
-            t
+    let unknown_link = |what: &str, l: &str| {
+        format!(
+            "the {what} link '{l}' is not in the URDF (its links: {})",
+            list_names(&links)
+        )
+    };
+    let base = match base {
+        Some(b) if !links.contains(&b) => return Err(unknown_link("base", b)),
+        Some(b) => b,
+        None => root,
+    };
+    // The moving joints from `base` down to `link`, if `link` is below it.
+    let path_from_base = |link: &str| -> Option<Vec<usize>> {
+        let mut path = Vec::new();
+        let mut at = link;
+        while at != base {
+            let &j = by_child.get(at)?;
+            path.push(j);
+            at = &joints[j].parent.link;
         }
+        path.reverse();
+        Some(path)
+    };
+    let explicit_tip = tip.is_some();
+    let tip: &str = match tip {
+        Some(t) if !links.contains(&t) => return Err(unknown_link("tip", t)),
+        Some(t) => t,
         None => {
-            let mut at = root;
-            for _ in 0..=joints.len() {
-                match children.get(at).map(Vec::as_slice) {
-                    None | Some([]) => break,
-                    Some([j]) => at = &joints[*j].child.link,
-                    Some(many) => {
-                        let names: Vec<&str> = many
-                            .iter()
-                            .map(|&j| joints[j].child.link.as_str())
-                            .collect();
-                        return Err(format!(
-                            "the chain branches at link '{at}' (into {}): name the tip link (`tip`)",
-                            names.join(", ")
-                        ));
+            // The leaves below the base, with their moving-joint counts.
+            let mut leaves: Vec<(&str, usize)> = Vec::new();
+            let mut stack = vec![base];
+            while let Some(l) = stack.pop() {
+                match children.get(l) {
+                    None => {
+                        // Every leaf with a joint above it; one without a
+                        // moving joint is refused later with its reason.
+                        if let Some(p) = path_from_base(l).filter(|p| !p.is_empty()) {
+                            leaves.push((l, p.iter().filter(|&&j| is_moving(&joints[j])).count()));
+                        }
                     }
+                    Some(js) => stack.extend(js.iter().map(|&j| joints[j].child.link.as_str())),
                 }
             }
-            at
+            leaves.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(b.0)));
+            match leaves.as_slice() {
+                [] => {
+                    return Err(format!(
+                        "no revolute or prismatic joint below the base link '{base}'"
+                    ));
+                }
+                [(l, _)] => l,
+                many => {
+                    let c: Vec<String> = many
+                        .iter()
+                        .map(|(l, n)| format!("{l} ({n} joint{})", if *n == 1 { "" } else { "s" }))
+                        .collect();
+                    return Err(format!(
+                        "the URDF is a tree with {} branches below '{base}': choose the measured link with --tip (or `tip = \"…\"` in a description); candidate tips: {}",
+                        many.len(),
+                        list_names(&c)
+                    ));
+                }
+            }
         }
     };
-    // Walk up from the tip.
-    let mut path = Vec::new();
-    let mut at = tip;
-    while let Some(&j) = by_child.get(at) {
-        if path.len() > joints.len() {
-            return Err("the joints form a loop".into());
-        }
-        path.push(j);
-        at = &joints[j].parent.link;
-    }
-    if at != root {
+    let Some(path) = path_from_base(tip) else {
         return Err(format!(
-            "the tip link '{tip}' is not connected to the root '{root}'"
+            "the tip link '{tip}' is not below the base link '{base}'"
+        ));
+    };
+    for (name, value) in lock {
+        let Some(j) = joints.iter().find(|j| &j.name == name) else {
+            return Err(format!(
+                "--lock {name}: there is no joint '{name}' in the URDF"
+            ));
+        };
+        if !path.iter().any(|&i| joints[i].name == *name) {
+            let on: Vec<&str> = path
+                .iter()
+                .filter(|&&i| is_moving(&joints[i]))
+                .map(|&i| joints[i].name.as_str())
+                .collect();
+            return Err(format!(
+                "--lock {name}: the joint is not on the chain from '{base}' to '{tip}' (its joints: {})",
+                list_names(&on)
+            ));
+        }
+        if !is_moving(j) {
+            return Err(format!("--lock {name}: the joint is fixed already"));
+        }
+        if !value.is_finite() {
+            return Err(format!("--lock {name}={value}: not a finite number"));
+        }
+    }
+    let locked = |name: &str| lock.iter().find(|(n, _)| n == name).map(|&(_, v)| v);
+    let moving: Vec<usize> = path
+        .iter()
+        .copied()
+        .filter(|&i| is_moving(&joints[i]) && locked(&joints[i].name).is_none())
+        .collect();
+    if moving.len() > MAX_CHAIN_JOINTS {
+        return Err(format!(
+            "the chain from '{base}' to '{tip}' has {} moving joints ('{}' … '{}'), more than {MAX_CHAIN_JOINTS}: choose a shorter chain with --base/--tip or lock joints",
+            moving.len(),
+            joints[moving[0]].name,
+            joints[moving[moving.len() - 1]].name
         ));
     }
-    path.reverse();
+    if let Some(&last) = moving.last() {
+        let j = &joints[last];
+        let parent = &j.parent.link;
+        if j.mimic.is_some() {
+            return Err(format!(
+                "joint '{}' mimics another joint (a gripper's, usually): end the chain before it with --tip {parent}, or lock it with --lock {}=0",
+                j.name, j.name
+            ));
+        }
+        if !explicit_tip {
+            if let Some(why) = gripper_reason(j) {
+                return Err(format!(
+                    "the chain's last moving joint '{}' looks like a gripper's ({why}): measure the arm's flange with --tip {parent}, or keep the joint still with --lock {}=VALUE, or name this tip explicitly with --tip {tip}",
+                    j.name, j.name
+                ));
+            }
+        }
+    }
     let mut out = Vec::with_capacity(path.len());
     for &i in &path {
         let j = &joints[i];
-        let origin = iso_from_pose(&j.origin)
+        let mut origin = iso_from_pose(&j.origin)
             .ok_or_else(|| format!("joint '{}': the origin is not finite", j.name))?;
         use urdf_rs::JointType as T;
+        if let Some(v) = locked(&j.name) {
+            // A locked joint is a fixed one at its value: its motion folds
+            // into the origin.
+            let axis = Vector3::from(j.axis.xyz.0);
+            let n = axis.norm();
+            if !(n.is_finite() && n > 1e-9) {
+                return Err(format!(
+                    "joint '{}': the axis is zero or not finite",
+                    j.name
+                ));
+            }
+            let u = nalgebra::Unit::new_normalize(axis);
+            origin *= match j.joint_type {
+                T::Prismatic => Isometry3::from_parts(
+                    Translation3::from(u.into_inner() * v),
+                    UnitQuaternion::identity(),
+                ),
+                _ => Isometry3::from_parts(
+                    Translation3::identity(),
+                    UnitQuaternion::from_axis_angle(&u, v),
+                ),
+            };
+            out.push(ChainJoint {
+                name: j.name.clone(),
+                kind: None,
+                origin,
+                axis: Vector3::z(),
+                limits: [0.0; 2],
+            });
+            continue;
+        }
         let kind = match j.joint_type {
             T::Fixed => None,
             T::Revolute | T::Continuous => Some(JointKind::Revolute),
@@ -289,8 +485,8 @@ fn extract_chain(
         if let Some(kind) = kind {
             if j.mimic.is_some() {
                 return Err(format!(
-                    "joint '{}' mimics another joint: it is not an independent joint",
-                    j.name
+                    "joint '{}' mimics another joint: it is not an independent joint (lock it with --lock {}=VALUE, or end the chain before it with --tip)",
+                    j.name, j.name
                 ));
             }
             let norm = axis.norm();
@@ -339,7 +535,7 @@ fn extract_chain(
     }
     if out.iter().all(|j| j.kind.is_none()) {
         return Err(format!(
-            "no revolute or prismatic joint between the root '{root}' and the tip '{tip}'"
+            "no revolute or prismatic joint between the base '{base}' and the tip '{tip}'"
         ));
     }
     Ok(out)

@@ -1,0 +1,303 @@
+//! Chains from URDF trees: `base`, `tip` and `lock` on FIGAROH's TIAGo and
+//! UR10 (trees with a mobile base, head, hand, camera mounts) and on small
+//! hand-made trees; each imported chain reproduces a direct evaluation of the
+//! URDF from the base link to the tip, and each bad choice is refused with a
+//! message naming what is wrong and what to do.
+
+use activecal::io::urdf::{self, MAX_CHAIN_JOINTS, UrdfOptions};
+use activecal::kinematics::pose;
+use activecal::model::Robot;
+use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures")
+        .join(name)
+}
+
+fn opts(base: Option<&str>, tip: Option<&str>, lock: &[(&str, f64)]) -> UrdfOptions {
+    UrdfOptions {
+        base: base.map(str::to_string),
+        tip: tip.map(str::to_string),
+        lock: lock.iter().map(|(n, v)| (n.to_string(), *v)).collect(),
+        ..UrdfOptions::default()
+    }
+}
+
+fn rpy(r: f64, p: f64, y: f64) -> UnitQuaternion<f64> {
+    UnitQuaternion::from_axis_angle(&Vector3::z_axis(), y)
+        * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), p)
+        * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), r)
+}
+
+/// Direct URDF kinematics from `base` to `tip`, independent of the importer:
+/// `Π origin_k · motion_k(q_k)`, with each moving joint's value taken from
+/// `q` by name.
+fn urdf_fk(path: &Path, base: &str, tip: &str, q: &HashMap<String, f64>) -> Isometry3<f64> {
+    let u = urdf_rs::read_file(path).unwrap();
+    let by_child: HashMap<&str, &urdf_rs::Joint> = u
+        .joints
+        .iter()
+        .map(|j| (j.child.link.as_str(), j))
+        .collect();
+    let mut chain = Vec::new();
+    let mut at = tip;
+    while at != base {
+        let j = by_child[at];
+        chain.push(j);
+        at = &j.parent.link;
+    }
+    chain.reverse();
+    let mut t = Isometry3::identity();
+    for j in chain {
+        let [x, y, z] = j.origin.xyz.0;
+        let [r, p, yw] = j.origin.rpy.0;
+        t *= Isometry3::from_parts(Translation3::new(x, y, z), rpy(r, p, yw));
+        let axis = Unit::new_normalize(Vector3::from(j.axis.xyz.0));
+        use urdf_rs::JointType as T;
+        match j.joint_type {
+            T::Revolute | T::Continuous => {
+                t *= UnitQuaternion::from_axis_angle(&axis, q[&j.name]);
+            }
+            T::Prismatic => t *= Translation3::from(axis.into_inner() * q[&j.name]),
+            _ => {}
+        }
+    }
+    t
+}
+
+/// The imported robot's driven frames carry the URDF joint names (sanitised;
+/// these have no characters to sanitise) in joint order.
+fn joint_names(r: &Robot) -> Vec<String> {
+    let mut v = vec![String::new(); r.dof()];
+    for f in &r.frames {
+        if let Some(j) = f.joint {
+            v[j] = f.label.clone();
+        }
+    }
+    v
+}
+
+/// Imported FK equals direct FK at a few configurations inside the limits.
+/// The import converts axis lines to DH/Hayati frames in closed form
+/// (normalisations, atan2; a near-parallel pair's parameters are up to
+/// 1/sin 10° ≈ 5.8 times as sensitive as the axes) and composes ~20
+/// transforms of up to 1.5 m (TIAGo): rounding of 2e-16 · 1.5 m amplified
+/// ~1,000-fold is ~3e-13 m, and 1.6e-12 m is the largest seen; 1e-11 m
+/// bounds it, while any wrong frame or joint moves the tip by millimetres.
+fn assert_matches_urdf(r: &Robot, path: &Path, base: &str, tip: &str, extra: &[(&str, f64)]) {
+    let names = joint_names(r);
+    for k in 0..7 {
+        let q: Vec<f64> = r
+            .limits
+            .iter()
+            .enumerate()
+            .map(|(j, &[lo, hi])| lo + (hi - lo) * (0.13 + 0.11 * ((k * 3 + j * 5) % 7) as f64))
+            .collect();
+        let mut by_name: HashMap<String, f64> =
+            names.iter().cloned().zip(q.iter().copied()).collect();
+        for (n, v) in extra {
+            by_name.insert(n.to_string(), *v);
+        }
+        let want = urdf_fk(path, base, tip, &by_name);
+        let (rot, p) = pose(r, &r.nominal, &q);
+        let dp = (p - want.translation.vector).norm();
+        let dr = (rot - want.rotation.to_rotation_matrix().into_inner())
+            .abs()
+            .max();
+        assert!(dp < 1e-11 && dr < 1e-11, "{}: {dp:e} m, {dr:e}", r.name);
+    }
+}
+
+fn err(path: &Path, o: &UrdfOptions) -> String {
+    urdf::load(path, o).unwrap_err().to_string()
+}
+
+#[test]
+fn tiago_arm_chains_by_base_tip_and_lock() {
+    let path = fixture("figaroh/tiago.urdf");
+    // A tree: without a tip, the error lists the candidates and says how.
+    let e = err(&path, &UrdfOptions::default());
+    assert!(e.contains("--tip") && e.contains("candidate tips"), "{e}");
+    // Root to the arm tool: the torso's prismatic lift and seven arm joints.
+    let r = urdf::load(&path, &opts(None, Some("arm_tool_link"), &[])).unwrap();
+    let mut want: Vec<String> = vec!["torso_lift_joint".into()];
+    want.extend((1..=7).map(|k| format!("arm_{k}_joint")));
+    assert_eq!(joint_names(&r), want);
+    assert_matches_urdf(&r, &path, "base_footprint", "arm_tool_link", &[]);
+    // From the torso: seven joints, the lift no longer in the chain.
+    let r = urdf::load(
+        &path,
+        &opts(Some("torso_lift_link"), Some("arm_tool_link"), &[]),
+    )
+    .unwrap();
+    assert_eq!(joint_names(&r), want[1..].to_vec());
+    assert_matches_urdf(&r, &path, "torso_lift_link", "arm_tool_link", &[]);
+    // The lift locked at 0.12 m: a fixed frame at that height.
+    let lock = [("torso_lift_joint", 0.12)];
+    let r = urdf::load(&path, &opts(None, Some("arm_tool_link"), &lock)).unwrap();
+    assert_eq!(joint_names(&r), want[1..].to_vec());
+    assert_matches_urdf(&r, &path, "base_footprint", "arm_tool_link", &lock);
+}
+
+#[test]
+fn ur10_on_its_support_chains_from_any_base() {
+    let path = fixture("figaroh/ur10_robot.urdf");
+    let arm: Vec<String> = [
+        "shoulder_pan_joint",
+        "shoulder_lift_joint",
+        "elbow_joint",
+        "wrist_1_joint",
+        "wrist_2_joint",
+        "wrist_3_joint",
+    ]
+    .map(String::from)
+    .to_vec();
+    for base in [None, Some("base_link")] {
+        let r = urdf::load(&path, &opts(base, Some("wrist_3_link"), &[])).unwrap();
+        assert_eq!(joint_names(&r), arm);
+        assert_matches_urdf(&r, &path, base.unwrap_or("world"), "wrist_3_link", &[]);
+    }
+}
+
+#[test]
+fn bad_chains_are_refused_with_what_to_do() {
+    let tiago = fixture("figaroh/tiago.urdf");
+    for (o, want) in [
+        (
+            opts(Some("nowhere"), None, &[]),
+            "the base link 'nowhere' is not in the URDF",
+        ),
+        (
+            opts(None, Some("nowhere"), &[]),
+            "the tip link 'nowhere' is not in the URDF",
+        ),
+        (
+            opts(Some("arm_3_link"), Some("head_2_link"), &[]),
+            "the tip link 'head_2_link' is not below the base link 'arm_3_link'",
+        ),
+        (
+            opts(None, Some("arm_tool_link"), &[("head_1_joint", 0.0)]),
+            "--lock head_1_joint: the joint is not on the chain",
+        ),
+        (
+            opts(None, Some("arm_tool_link"), &[("no_such_joint", 0.0)]),
+            "there is no joint 'no_such_joint'",
+        ),
+        (
+            opts(None, Some("arm_tool_link"), &[("arm_tool_joint", 0.0)]),
+            "the joint is fixed already",
+        ),
+    ] {
+        let e = err(&tiago, &o);
+        assert!(e.contains(want), "want '{want}' in: {e}");
+    }
+}
+
+fn joint(name: &str, kind: &str, parent: &str, child: &str, limits: (f64, f64)) -> String {
+    format!(
+        r#"<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/><origin xyz="0.1 0.2 0.3" rpy="0.3 0.2 0.1"/><axis xyz="0 0 1"/><limit lower="{}" upper="{}" effort="0" velocity="0"/></joint>"#,
+        limits.0, limits.1
+    )
+}
+
+fn parse_err(text: &str, o: &UrdfOptions) -> String {
+    urdf::parse(text, "t.urdf", o).unwrap_err().to_string()
+}
+
+#[test]
+fn grippers_loops_and_long_chains_are_never_taken_silently() {
+    let arm = [
+        joint("j1", "revolute", "a", "b", (-1.0, 1.0)),
+        joint("j2", "revolute", "b", "c", (-1.0, 1.0)),
+        joint("j3", "revolute", "c", "d", (-1.0, 1.0)),
+    ]
+    .concat();
+    // A single leaf whose last joint is a short prismatic jaw.
+    let jaw = joint("finger_joint", "prismatic", "d", "e", (0.0, 0.04));
+    let text = format!("<robot name=\"t\">{arm}{jaw}</robot>");
+    let e = parse_err(&text, &UrdfOptions::default());
+    assert!(
+        e.contains("'finger_joint' looks like a gripper's") && e.contains("--tip d"),
+        "{e}"
+    );
+    // Named explicitly, or the jaw locked, the chain is taken.
+    urdf::parse(&text, "t.urdf", &opts(None, Some("e"), &[])).unwrap();
+    let r = urdf::parse(
+        &text,
+        "t.urdf",
+        &opts(None, None, &[("finger_joint", 0.02)]),
+    )
+    .unwrap();
+    assert_eq!(r.dof(), 3);
+    // A prismatic end joint of the same stroke under a neutral name is still
+    // a jaw (short stroke).
+    let text2 = format!(
+        "<robot name=\"t\">{arm}{}</robot>",
+        joint("slide", "prismatic", "d", "e", (0.0, 0.04))
+    );
+    assert!(parse_err(&text2, &UrdfOptions::default()).contains("short prismatic joint"));
+    // A loop beside the tree: the message names its joints.
+    let looped = format!(
+        "<robot name=\"t\">{arm}{}{}</robot>",
+        joint("k1", "revolute", "x", "y", (-1.0, 1.0)),
+        joint("k2", "revolute", "y", "x", (-1.0, 1.0))
+    );
+    let e = parse_err(&looped, &UrdfOptions::default());
+    assert!(
+        e.contains("the joints form a loop") && e.contains("k1") && e.contains("k2"),
+        "{e}"
+    );
+    // A chain longer than the cap: refused with the count and the ends.
+    let n = MAX_CHAIN_JOINTS + 1;
+    let long: String = (0..n)
+        .map(|k| {
+            joint(
+                &format!("q{k}"),
+                "revolute",
+                &format!("l{k}"),
+                &format!("l{}", k + 1),
+                (-1.0, 1.0),
+            )
+        })
+        .collect();
+    let e = parse_err(
+        &format!("<robot name=\"t\">{long}</robot>"),
+        &UrdfOptions::default(),
+    );
+    assert!(
+        e.contains(&format!("has {n} moving joints ('q0' … 'q{}')", n - 1)),
+        "{e}"
+    );
+}
+
+#[test]
+fn descriptions_choose_the_chain_too() {
+    let urdf_path = fixture("figaroh/tiago.urdf");
+    let text = format!(
+        "urdf = {:?}\nbase = \"base_footprint\"\ntip = \"arm_tool_link\"\n\n[lock]\ntorso_lift_joint = 0.12\n",
+        urdf_path.to_str().unwrap()
+    );
+    let r = activecal::io::robot_toml::parse(&text, "tiago.toml", None).unwrap();
+    let direct = urdf::load(
+        &urdf_path,
+        &opts(
+            Some("base_footprint"),
+            Some("arm_tool_link"),
+            &[("torso_lift_joint", 0.12)],
+        ),
+    )
+    .unwrap();
+    assert_eq!(r.nominal, direct.nominal);
+    assert_eq!(joint_names(&r), joint_names(&direct));
+    // The keys belong to URDF imports only; the message points at the line.
+    let e = activecal::io::robot_toml::parse("base = \"x\"\n", "a.toml", None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("a.toml: line 1") && e.contains("`base` is only for"),
+        "{e}"
+    );
+}

@@ -206,7 +206,9 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
     let visibility = match spec.visibility {
         None => None,
         Some(v) => {
-            check_visibility(v.get_ref()).map_err(|m| cx.at(v.span(), m))?;
+            v.get_ref()
+                .validate()
+                .map_err(|m| cx.at(v.span(), format!("visibility: {m}")))?;
             Some(v.into_inner())
         }
     };
@@ -520,31 +522,6 @@ fn joint_limits(
         ));
     }
     Ok([lo * scale, hi * scale])
-}
-
-fn check_visibility(v: &Visibility) -> std::result::Result<(), String> {
-    let finite = match v {
-        Visibility::All => true,
-        Visibility::Cone {
-            apex,
-            axis,
-            half_angle,
-            max_range,
-        } => {
-            if axis.iter().all(|&x| x == 0.0) {
-                return Err("visibility: the cone axis is zero".into());
-            }
-            apex.iter().chain(axis).all(|x| x.is_finite())
-                && half_angle.is_finite()
-                && !max_range.is_nan()
-        }
-        Visibility::Box { min, max } => min.iter().chain(max).all(|x| x.is_finite()),
-    };
-    if finite {
-        Ok(())
-    } else {
-        Err("visibility: every number must be finite".into())
-    }
 }
 
 /// Writes a robot as a description that [`parse`] reads back to the same

@@ -225,16 +225,24 @@ impl Change {
     /// smallest eigenvalue is `μ`: `8·t²·ε·κ_a·(1 + 1/μ)`.
     #[must_use]
     pub fn tol(&self, rows: usize) -> f64 {
+        self.tol_after(rows, self.before.kappa_scaled)
+    }
+
+    /// [`tol`](Self::tol) for an update that starts from an inverse which
+    /// is not freshly factored: `kappa_in` replaces `κ_s(M)` as the relative
+    /// error of the input `M⁻¹` in units of `8·(m + p)·ε`. After updates
+    /// from a fresh factorization of `M₀`, the absolute error of `M⁻¹` stays
+    /// at the size of `M₀⁻¹`'s, so relative to the current `M` it is
+    /// `κ_s(M₀)·G` with `G = λ_max(M₀^-½ M M₀^-½)` ([`growth`]): how much
+    /// the information grew in its strongest direction (the cancellation
+    /// in `M⁻¹ − F₊F₊ᵀ`).
+    #[must_use]
+    pub fn tol_after(&self, rows: usize, kappa_in: f64) -> f64 {
         let after = self.after.as_ref().expect("a regular change");
         let a = self.amplification();
         let t = self.t as f64;
-        update_tol(
-            rows,
-            self.before.m.n,
-            self.before.kappa_scaled,
-            a,
-            after.ln_det,
-        ) + 8.0 * t * t * EPS * self.kappa_a * a
+        update_tol(rows, self.before.m.n, kappa_in, a, after.ln_det)
+            + 8.0 * t * t * EPS * self.kappa_a * a
     }
 
     /// Slack on the retained fraction `μ` when judging a refusal: the
@@ -244,6 +252,15 @@ impl Change {
     pub fn refusal_slack(&self, rows: usize) -> f64 {
         8.0 * (rows + self.before.m.n) as f64 * EPS * self.before.kappa_scaled * self.g
     }
+}
+
+/// `G = λ_max(M₀^-½ M M₀^-½)`: the growth of the information `M` over the
+/// freshly factored `M₀` in its strongest direction (see
+/// [`Change::tol_after`]).
+#[must_use]
+pub fn growth(m0: &Reference, m: &DdMat) -> f64 {
+    let ev = eigenvalues(&m0.ldlt.congruence(m));
+    ev.last().copied().unwrap_or(1.0).max(1.0)
 }
 
 /// The error bound of an update (see the module docs):

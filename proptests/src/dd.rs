@@ -189,7 +189,9 @@ impl DdMat {
         let n = m.nrows();
         Self {
             n,
-            a: (0..n * n).map(|k| Dd::from_f64(m[(k / n, k % n)])).collect(),
+            a: (0..n * n)
+                .map(|k| Dd::from_f64(m[(k / n, k % n)]))
+                .collect(),
         }
     }
 
@@ -235,7 +237,11 @@ impl DdMat {
     #[must_use]
     pub fn norm1(&self) -> f64 {
         (0..self.n)
-            .map(|j| (0..self.n).map(|i| self.get(i, j).to_f64().abs()).sum::<f64>())
+            .map(|j| {
+                (0..self.n)
+                    .map(|i| self.get(i, j).to_f64().abs())
+                    .sum::<f64>()
+            })
             .fold(0.0, f64::max)
     }
 
@@ -423,7 +429,11 @@ mod tests {
             let want = ln_det_hilbert(n);
             // The closed form sums O(n²) logs in f64: 0.5 ulp each.
             let tol = 4.0 * (n * n) as f64 * f64::EPSILON * want.abs();
-            assert!((f.ln_det() - want).abs() <= tol, "n={n}: {} vs {want}", f.ln_det());
+            assert!(
+                (f.ln_det() - want).abs() <= tol,
+                "n={n}: {} vs {want}",
+                f.ln_det()
+            );
         }
     }
 
@@ -445,7 +455,10 @@ mod tests {
                     * c;
                 let got = inv.get(i as usize - 1, j as usize - 1).to_f64();
                 // κ(H_10)·2⁻¹⁰⁴ ≈ 1e-18 relative.
-                assert!((got - want).abs() <= 1e-15 * want.abs(), "({i},{j}): {got} vs {want}");
+                assert!(
+                    (got - want).abs() <= 1e-15 * want.abs(),
+                    "({i},{j}): {got} vs {want}"
+                );
             }
         }
     }
@@ -465,7 +478,9 @@ mod tests {
     #[test]
     fn congruence_gives_generalized_eigenvalues() {
         // A = diag(1, 2, 3), M = diag(2, 2, 2): eigenvalues 1/2, 1, 3/2.
-        let a = DdMat::from_f64(&DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![1.0, 2.0, 3.0])));
+        let a = DdMat::from_f64(&DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![
+            1.0, 2.0, 3.0,
+        ])));
         let m = DdMat::from_f64(&(DMatrix::identity(3, 3) * 2.0));
         let c = m.ldlt().unwrap().congruence(&a);
         let mut ev: Vec<f64> = c.symmetric_eigen().eigenvalues.iter().copied().collect();

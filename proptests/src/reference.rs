@@ -179,7 +179,9 @@ impl Change {
             // (van der Sluis), so κ_a is that of D(I + S)D.
             let a = DMatrix::identity(s.nrows(), s.nrows()) + &s;
             let d: Vec<f64> = (0..a.nrows()).map(|i| a[(i, i)].sqrt()).collect();
-            let ev = eigenvalues(&DMatrix::from_fn(a.nrows(), a.ncols(), |i, j| a[(i, j)] / (d[i] * d[j])));
+            let ev = eigenvalues(&DMatrix::from_fn(a.nrows(), a.ncols(), |i, j| {
+                a[(i, j)] / (d[i] * d[j])
+            }));
             (g, ev.last().unwrap() / ev[0].max(f64::MIN_POSITIVE))
         };
         let mut mid = m.clone();

@@ -45,98 +45,135 @@ fn oi_d_from_updates_equals_stacked() {
         prop::collection::vec((0u8..3, any::<u32>(), any::<u32>()), 1..12),
     )
         .prop_map(|(t, p, log10_cond, graded, seed, ops)| {
-            (GradedCase { t: t.min(p), p, log10_cond, graded, seed }, ops)
+            (
+                GradedCase {
+                    t: t.min(p),
+                    p,
+                    log10_cond,
+                    graded,
+                    seed,
+                },
+                ops,
+            )
         });
-    run_property("oi_d_from_updates_equals_stacked", cases_or(96), strat, |(c, ops), guard| {
-        // Twice the minimal design plus 6 poses: the removals rarely reach
-        // the minimal size, where 1/μ (and the bound) explodes.
-        let k = 2 * c.p.div_ceil(c.t) + 6;
-        let n = k + 9;
-        let mut rng = CaseRng::new(c.seed);
-        let s = c.scales(&mut rng);
-        // All poses from one conditioned matrix: a new pose adds
-        // information of the design's own size (G = O(1); outliers are
-        // state_reference's graded_updates_and_prices, one update each).
-        let x = scale_columns(&conditioned(n * c.t, c.p, c.log10_cond, &mut rng), &s);
-        let design: Vec<usize> = (0..k).collect();
-        let pool = to_blocks(&x, c.t);
-        let Ok(mut st) = InfoState::new(&pool, &design, StateSettings::default()) else {
-            return Err(TestCaseError::reject("refused at construction (state_reference checks why)"));
-        };
-        let mut pv = PoolVariances::new(&pool, &st);
-        let r0 = Reference::of_rows(&stacked(&x, c.t, &design), 0.0).unwrap();
-        let p = c.p;
-        let mut bound = 8.0 * (k * c.t + p) as f64 * EPS * r0.kappa_scaled + 64.0 * EPS * r0.ln_det.abs();
-        for (op, a, b) in ops {
-            let d = st.design().to_vec();
-            let free: Vec<usize> = (0..n).filter(|i| !st.contains(*i)).collect();
-            let out = d[a as usize % d.len()];
-            let inn = free[b as usize % free.len()];
-            let (plus, minus) = match op {
-                0 => (Some(inn), None),
-                1 => (None, Some(out)),
-                _ => (Some(inn), Some(out)),
+    run_property(
+        "oi_d_from_updates_equals_stacked",
+        cases_or(96),
+        strat,
+        |(c, ops), guard| {
+            // Twice the minimal design plus 6 poses: the removals rarely reach
+            // the minimal size, where 1/μ (and the bound) explodes.
+            let k = 2 * c.p.div_ceil(c.t) + 6;
+            let n = k + 9;
+            let mut rng = CaseRng::new(c.seed);
+            let s = c.scales(&mut rng);
+            // All poses from one conditioned matrix: a new pose adds
+            // information of the design's own size (G = O(1); outliers are
+            // state_reference's graded_updates_and_prices, one update each).
+            let x = scale_columns(&conditioned(n * c.t, c.p, c.log10_cond, &mut rng), &s);
+            let design: Vec<usize> = (0..k).collect();
+            let pool = to_blocks(&x, c.t);
+            let Ok(mut st) = InfoState::new(&pool, &design, StateSettings::default()) else {
+                return Err(TestCaseError::reject(
+                    "refused at construction (state_reference checks why)",
+                ));
             };
-            let rows_of = |i: Option<usize>| match i {
-                Some(i) => x.rows(i * c.t, c.t).into_owned(),
-                None => DMatrix::zeros(0, p),
-            };
-            let m_now = DdMat::gram(&stacked(&x, c.t, &d));
-            let ch = Change::of(&m_now, &rows_of(plus), &rows_of(minus));
-            let g = growth(&r0, &m_now);
-            let rows = d.len() * c.t;
-            let st_status = match op {
-                0 => st.add(&pool, inn).unwrap(),
-                1 => st.remove(&pool, out).unwrap(),
-                _ => st.exchange(&pool, out, inn).unwrap(),
-            };
-            if st_status.is_regular() {
-                prop_assert!(ch.after.is_some(), "accepted a change the reference finds singular");
-                bound += ch.tol_after(rows + c.t, r0.kappa_scaled * g);
-            } else {
-                // A refused change leaves the design as it was, and the
-                // reference keeps at most a floor-sized fraction (the floor
-                // from the reference's κ̂, 1% for the state's own rounding).
-                prop_assert_eq!(st.design(), &d[..]);
-                let floor = 1.01 * ch.before.kappa_1 / 1e13;
-                let slack = guard.tol(ch.refusal_slack(rows) * g);
-                prop_assert!(ch.mu <= floor + slack, "refused with μ {:e} > {floor:e}", ch.mu);
+            let mut pv = PoolVariances::new(&pool, &st);
+            let r0 = Reference::of_rows(&stacked(&x, c.t, &design), 0.0).unwrap();
+            let p = c.p;
+            let mut bound =
+                8.0 * (k * c.t + p) as f64 * EPS * r0.kappa_scaled + 64.0 * EPS * r0.ln_det.abs();
+            for (op, a, b) in ops {
+                let d = st.design().to_vec();
+                let free: Vec<usize> = (0..n).filter(|i| !st.contains(*i)).collect();
+                let out = d[a as usize % d.len()];
+                let inn = free[b as usize % free.len()];
+                let (plus, minus) = match op {
+                    0 => (Some(inn), None),
+                    1 => (None, Some(out)),
+                    _ => (Some(inn), Some(out)),
+                };
+                let rows_of = |i: Option<usize>| match i {
+                    Some(i) => x.rows(i * c.t, c.t).into_owned(),
+                    None => DMatrix::zeros(0, p),
+                };
+                let m_now = DdMat::gram(&stacked(&x, c.t, &d));
+                let ch = Change::of(&m_now, &rows_of(plus), &rows_of(minus));
+                let g = growth(&r0, &m_now);
+                let rows = d.len() * c.t;
+                let st_status = match op {
+                    0 => st.add(&pool, inn).unwrap(),
+                    1 => st.remove(&pool, out).unwrap(),
+                    _ => st.exchange(&pool, out, inn).unwrap(),
+                };
+                if st_status.is_regular() {
+                    prop_assert!(
+                        ch.after.is_some(),
+                        "accepted a change the reference finds singular"
+                    );
+                    bound += ch.tol_after(rows + c.t, r0.kappa_scaled * g);
+                } else {
+                    // A refused change leaves the design as it was, and the
+                    // reference keeps at most a floor-sized fraction (the floor
+                    // from the reference's κ̂, 1% for the state's own rounding).
+                    prop_assert_eq!(st.design(), &d[..]);
+                    let floor = 1.01 * ch.before.kappa_1 / 1e13;
+                    let slack = guard.tol(ch.refusal_slack(rows) * g);
+                    prop_assert!(
+                        ch.mu <= floor + slack,
+                        "refused with μ {:e} > {floor:e}",
+                        ch.mu
+                    );
+                }
+                pv.sync(&pool, &st);
             }
-            pv.sync(&pool, &st);
-        }
-        let xd = stacked(&x, c.t, st.design());
-        let r = Reference::of_rows(&xd, 0.0).unwrap();
-        let tol = guard.tol(bound);
-        let e = (st.ln_det() - r.ln_det).abs();
-        guard.observe(e, bound);
-        prop_assert!(e <= tol, "ln det {} vs reference {} (tol {tol:e})", st.ln_det(), r.ln_det);
-        let e = r.inverse_error(&to_nalgebra(st.m_inv()), &r0.inv);
-        prop_assert!(e <= tol, "inverse error {e:e}");
-        // Variances: V_i = X_i M⁻¹ X_iᵀ, whose error is that of M⁻¹ in the
-        // scaled norm times ‖X_i D⁻¹‖², relative to the larger of M⁻¹, M₀⁻¹.
-        let inv_scale = r.scaled_max(&r.inv).max(r.scaled_max(&r0.inv));
-        for i in 0..n {
-            let xi = x.rows(i * c.t, c.t).into_owned();
-            let v = &xi * &r.inv * xi.transpose();
-            let xs = DMatrix::from_fn(c.t, p, |a, j| xi[(a, j)] / r.col_scale[j]);
-            let scale = xs.norm_squared() * inv_scale;
-            for a in 0..c.t {
-                for b in 0..c.t {
-                    let e = (pv.entry(i, a, b) - v[(a, b)]).abs();
-                    prop_assert!(e <= tol * scale.max(1e-300), "V[{i}]({a},{b}) off by {e:e}");
+            let xd = stacked(&x, c.t, st.design());
+            let r = Reference::of_rows(&xd, 0.0).unwrap();
+            let tol = guard.tol(bound);
+            let e = (st.ln_det() - r.ln_det).abs();
+            guard.observe(e, bound);
+            prop_assert!(
+                e <= tol,
+                "ln det {} vs reference {} (tol {tol:e})",
+                st.ln_det(),
+                r.ln_det
+            );
+            let e = r.inverse_error(&to_nalgebra(st.m_inv()), &r0.inv);
+            prop_assert!(e <= tol, "inverse error {e:e}");
+            // Variances: V_i = X_i M⁻¹ X_iᵀ, whose error is that of M⁻¹ in the
+            // scaled norm times ‖X_i D⁻¹‖², relative to the larger of M⁻¹, M₀⁻¹.
+            let inv_scale = r.scaled_max(&r.inv).max(r.scaled_max(&r0.inv));
+            for i in 0..n {
+                let xi = x.rows(i * c.t, c.t).into_owned();
+                let v = &xi * &r.inv * xi.transpose();
+                let xs = DMatrix::from_fn(c.t, p, |a, j| xi[(a, j)] / r.col_scale[j]);
+                let scale = xs.norm_squared() * inv_scale;
+                for a in 0..c.t {
+                    for b in 0..c.t {
+                        let e = (pv.entry(i, a, b) - v[(a, b)]).abs();
+                        prop_assert!(e <= tol * scale.max(1e-300), "V[{i}]({a},{b}) off by {e:e}");
+                    }
                 }
             }
-        }
-        let ix = Indices::from_design(&pool, st.design());
-        // The indices come from the singular values of the raw stacked X,
-        // which err by ε·σ_max absolute (not scale-invariant): each ln σ_i²
-        // by 2·(m+p)·ε·√κ(M) relative, p of them.
-        let b_svd = 16.0 * (p * (xd.nrows() + p)) as f64 * EPS * r.kappa.sqrt() + 64.0 * EPS * r.ln_det.abs();
-        prop_assert!((ix.ln_oid - r.ln_det).abs() <= guard.tol(b_svd), "indices ln OI_D {} vs {}", ix.ln_oid, r.ln_det);
-        let l = c.p as f64;
-        prop_assert!((ix.ln_oid - 2.0 * l * (ix.oi * l).ln()).abs() <= 1e-12 * ix.ln_oid.abs().max(1.0));
-        Ok(())
-    });
+            let ix = Indices::from_design(&pool, st.design());
+            // The indices come from the singular values of the raw stacked X,
+            // which err by ε·σ_max absolute (not scale-invariant): each ln σ_i²
+            // by 2·(m+p)·ε·√κ(M) relative, p of them.
+            let b_svd = 16.0 * (p * (xd.nrows() + p)) as f64 * EPS * r.kappa.sqrt()
+                + 64.0 * EPS * r.ln_det.abs();
+            prop_assert!(
+                (ix.ln_oid - r.ln_det).abs() <= guard.tol(b_svd),
+                "indices ln OI_D {} vs {}",
+                ix.ln_oid,
+                r.ln_det
+            );
+            let l = c.p as f64;
+            prop_assert!(
+                (ix.ln_oid - 2.0 * l * (ix.oi * l).ln()).abs() <= 1e-12 * ix.ln_oid.abs().max(1.0)
+            );
+            Ok(())
+        },
+    );
 }
 
 proptest! {

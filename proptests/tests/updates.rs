@@ -123,7 +123,11 @@ fn design_and_block(c: &GradedCase, rows: usize, scale: f64) -> (DMatrix<f64>, D
 /// Adding a `t`-row block: eq. (17)/(20) and Woodbury vs the reference.
 #[test]
 fn add_block() {
-    let strat = (graded_case(), 0usize..=8, prop::sample::select(vec![1e-3, 1.0, 1e3]));
+    let strat = (
+        graded_case(),
+        0usize..=8,
+        prop::sample::select(vec![1e-3, 1.0, 1e3]),
+    );
     run_property("add_block", cases(), strat, |(c, extra, scale), g| {
         let (x0, q) = design_and_block(&c, c.p + extra, scale);
         check_change(&x0, &q, &DMatrix::zeros(0, c.p), g)
@@ -146,7 +150,11 @@ fn remove_block() {
 /// system) vs the reference, and the cascade (add rows, then remove rows).
 #[test]
 fn exchange_block() {
-    let strat = (graded_case(), 0usize..=40, prop::sample::select(vec![1e-2, 1.0, 1e2]));
+    let strat = (
+        graded_case(),
+        0usize..=40,
+        prop::sample::select(vec![1e-2, 1.0, 1e2]),
+    );
     run_property("exchange_block", cases(), strat, |(c, extra, scale), g| {
         let (x0, q) = design_and_block(&c, c.p + c.t + extra, scale);
         let r = x0.rows(x0.nrows() - c.t, c.t).into_owned();
@@ -159,35 +167,43 @@ fn exchange_block() {
 /// form; the cascade either refuses or gets the determinant ratio right.
 #[test]
 fn remove_essential_block_is_singular() {
-    run_property("remove_essential_block_is_singular", cases(), graded_case(), |c, guard| {
-        let rows = c.p.max(c.t);
-        prop_assume!(c.log10_cond <= 6.0);
-        let (x0, _) = design_and_block(&c, rows, 1.0);
-        let t = c.t.min(x0.nrows());
-        let r = x0.rows(x0.nrows() - t, t).into_owned();
-        let Some(before) = reference::Reference::of(&DdMat::gram(&x0)) else {
-            return Err(TestCaseError::reject("not positive definite"));
-        };
-        let floor = before.kappa_1 / MAX_CONDITION;
-        let (fi, fr) = (to_faer(&before.inv), to_faer(&r));
-        let empty = faer::Mat::<f64>::zeros(0, c.p);
-        // The block form factors B = I − S with diagonal pivoting, so the zero
-        // pivot carries only rounding and is always caught.
-        prop_assert!(woodbury(fi.as_ref(), empty.as_ref(), fr.as_ref(), floor).is_err());
-        // The cascade removes rows in the given order: a small early factor
-        // amplifies the rounding of the last (zero) one, which may then pass
-        // the floor. What it must get right is the determinant: the exact
-        // ratio det(I − S) is 0, and a perturbation E of S changes it by at
-        // most t·‖E‖ (all eigenvalues of I − S lie in [0, 1]), with
-        // ‖E‖ ≲ (m+p)·u·κ_s(M0) (see the reference module).
-        let m = x0.nrows();
-        if let Ok(casc) = cascade(fi.as_ref(), empty.as_ref(), fr.as_ref(), floor) {
-            let bound = guard.tol(8.0 * (t * (m + c.p)) as f64 * EPS * before.kappa_scaled);
-            prop_assert!(casc.ln_det_ratio.exp() <= bound,
-                "cascade det ratio {:e} > {bound:e}", casc.ln_det_ratio.exp());
-        }
-        Ok(())
-    });
+    run_property(
+        "remove_essential_block_is_singular",
+        cases(),
+        graded_case(),
+        |c, guard| {
+            let rows = c.p.max(c.t);
+            prop_assume!(c.log10_cond <= 6.0);
+            let (x0, _) = design_and_block(&c, rows, 1.0);
+            let t = c.t.min(x0.nrows());
+            let r = x0.rows(x0.nrows() - t, t).into_owned();
+            let Some(before) = reference::Reference::of(&DdMat::gram(&x0)) else {
+                return Err(TestCaseError::reject("not positive definite"));
+            };
+            let floor = before.kappa_1 / MAX_CONDITION;
+            let (fi, fr) = (to_faer(&before.inv), to_faer(&r));
+            let empty = faer::Mat::<f64>::zeros(0, c.p);
+            // The block form factors B = I − S with diagonal pivoting, so the zero
+            // pivot carries only rounding and is always caught.
+            prop_assert!(woodbury(fi.as_ref(), empty.as_ref(), fr.as_ref(), floor).is_err());
+            // The cascade removes rows in the given order: a small early factor
+            // amplifies the rounding of the last (zero) one, which may then pass
+            // the floor. What it must get right is the determinant: the exact
+            // ratio det(I − S) is 0, and a perturbation E of S changes it by at
+            // most t·‖E‖ (all eigenvalues of I − S lie in [0, 1]), with
+            // ‖E‖ ≲ (m+p)·u·κ_s(M0) (see the reference module).
+            let m = x0.nrows();
+            if let Ok(casc) = cascade(fi.as_ref(), empty.as_ref(), fr.as_ref(), floor) {
+                let bound = guard.tol(8.0 * (t * (m + c.p)) as f64 * EPS * before.kappa_scaled);
+                prop_assert!(
+                    casc.ln_det_ratio.exp() <= bound,
+                    "cascade det ratio {:e} > {bound:e}",
+                    casc.ln_det_ratio.exp()
+                );
+            }
+            Ok(())
+        },
+    );
 }
 
 use proptests::reference;

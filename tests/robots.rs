@@ -16,14 +16,15 @@ use activecal::blocks::Blocks;
 use activecal::bound::{BoundSettings, relaxation_bound};
 use activecal::criterion::Indices;
 use activecal::identify::{LmSettings, identify, simulate, trial_rng};
-use activecal::kinematics::{Evaluator, pose, position};
+use activecal::io::robot_toml as file;
+use activecal::io::urdf::{self, UrdfOptions};
+use activecal::kinematics::{pose, position};
+use activecal::measure::JacobianEvaluator;
+use activecal::model::{Convention, JointKind, Measurement, ParamSet, ParamTable, Robot};
+use activecal::observability::INDEPENDENCE_TOL;
 use activecal::observability::require_identifiable;
 use activecal::pool::Pool;
-use activecal::observability::INDEPENDENCE_TOL;
-use activecal::io::robot_toml as file;
-use activecal::model::{Convention, JointKind, Measurement, ParamSet, ParamTable, Robot};
 use activecal::select::ln_det_direct;
-use activecal::io::urdf::{self, UrdfOptions};
 use common::eae_design;
 use nalgebra::{Isometry3, Matrix3, Translation3, Unit, UnitQuaternion, Vector3};
 use std::collections::HashMap;
@@ -147,7 +148,12 @@ fn puma_is_unchanged_and_its_pose_variant_only_adds_the_tool() {
     assert_eq!(p.nominal, b.nominal);
     assert_eq!(p.unknowns, b.unknowns);
     assert_eq!(p.measurement, Measurement::Point);
-    assert!(activecal::io::load_description("puma560").unwrap().visibility.is_none());
+    assert!(
+        activecal::io::load_description("puma560")
+            .unwrap()
+            .visibility
+            .is_none()
+    );
     assert!(p.frames.iter().all(|f| f.joint_kind == JointKind::Revolute));
     let pp = Robot::builtin("puma560:pose").unwrap();
     assert_eq!(pp.measurement, Measurement::Pose);
@@ -275,7 +281,7 @@ fn rot_log(a: &Matrix3<f64>, b: &Matrix3<f64>) -> Vector3<f64> {
 fn check_identification_jacobian(r: &Robot, table: &ParamTable, q: &[f64]) {
     let (p, t) = (r.n_unknowns(), r.rows_per_pose());
     let mut jac = vec![0.0; t * p];
-    let (rot0, p0) = Evaluator::new(r, table).eval_pose(q, &mut jac);
+    let (rot0, p0) = JacobianEvaluator::new(r, table).eval_pose(q, &mut jac);
     let (rot1, p1) = pose(r, table, q);
     assert_eq!((rot0, p0), (rot1, p1));
     let h = 1e-6;
@@ -310,7 +316,7 @@ fn check_identification_jacobian(r: &Robot, table: &ParamTable, q: &[f64]) {
     // Joint Jacobian: revolute and prismatic columns, orientation rows.
     let dof = r.dof();
     let mut jj = vec![0.0; t * dof];
-    Evaluator::new(r, table).joint_jacobian(q, &mut jj);
+    JacobianEvaluator::new(r, table).joint_jacobian(q, &mut jj);
     for j in 0..dof {
         let mut qp = q.to_vec();
         qp[j] += h;
@@ -361,7 +367,7 @@ fn pool_jacobian_has_six_rows_per_pose_for_pose_robots() {
         assert_eq!(x.t(), r.rows_per_pose());
         assert_eq!(x.n_poses(), 64);
         let mut jac = vec![0.0; x.t() * r.n_unknowns()];
-        Evaluator::new(&r, &r.nominal).eval(&pool.q(37), &mut jac);
+        JacobianEvaluator::new(&r, &r.nominal).eval(&pool.q(37), &mut jac);
         let b = x.block(37);
         for row in 0..x.t() {
             for c in 0..r.n_unknowns() {
@@ -805,7 +811,12 @@ fn toml_fixtures_load() {
     assert_eq!(file::load(&path).unwrap().name, "ur5-urdf:pose");
     assert_eq!(u.rows_per_pose(), 6);
     assert_eq!(u.n_unknowns(), 30);
-    assert!(activecal::io::load_description(path.to_str().unwrap()).unwrap().visibility.is_some());
+    assert!(
+        activecal::io::load_description(path.to_str().unwrap())
+            .unwrap()
+            .visibility
+            .is_some()
+    );
     let direct = urdf_import("ur5.urdf", Measurement::Pose);
     assert_eq!(u.nominal, direct.nominal);
 }

@@ -1,7 +1,8 @@
 //! Stacked per-pose Jacobian blocks: the identification Jacobian of a whole
 //! pose pool in one contiguous, column-major faer matrix.
 
-use crate::kinematics::Evaluator;
+use crate::kinematics::{Evaluator, Motion};
+use crate::measure::sensor_for;
 use crate::model::{ParamTable, Robot};
 use faer::{Mat, MatRef};
 use rayon::prelude::*;
@@ -88,13 +89,16 @@ impl Blocks {
 }
 
 /// Identification Jacobian of `n` poses whose joint angles `fill_q(k, q)`
-/// writes, computed in parallel into one [`Blocks`].
+/// writes, computed in parallel into one [`Blocks`]: per pose, the chain's
+/// per-unknown motions ([`Evaluator::motions`]) made into rows by the robot's
+/// sensor ([`crate::measure::Sensor::motion_rows`], one call per pose).
 pub fn jacobian_of<F>(robot: &Robot, table: &ParamTable, n: usize, fill_q: F) -> Blocks
 where
     F: Fn(usize, &mut [f64]) + Sync,
 {
     let p = robot.n_unknowns();
-    let t = robot.rows_per_pose();
+    let sensor = sensor_for(robot);
+    let t = sensor.rows();
     let dof = robot.dof();
     // Written straight into the column-major matrix, chunk by chunk of rows
     // (no row-major copy: a 10⁶-pose pool's Jacobian is 650 MB already).
@@ -106,10 +110,12 @@ where
         .for_each(|(c, mut chunk)| {
             let mut ev = Evaluator::new(robot, table);
             let mut q = vec![0.0; dof];
+            let mut motions = vec![Motion::default(); p];
             let mut jac = vec![0.0; t * p];
             for k in 0..chunk.nrows() / t {
                 fill_q(c * CHUNK + k, &mut q);
-                ev.eval(&q, &mut jac);
+                let end = ev.motions(&q, &mut motions);
+                sensor.motion_rows(&end, &[], &motions, &mut jac, p);
                 for r in 0..t {
                     for col in 0..p {
                         chunk[(k * t + r, col)] = jac[r * p + col];

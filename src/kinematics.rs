@@ -6,9 +6,11 @@
 //! derivative of the end point `p` with respect to each parameter is the
 //! velocity of `p` under the corresponding elementary motion, expressed in the
 //! measurement frame: for a rotation about a unit axis `u` through a point `o`
-//! it is `u × (p − o)`, for a translation along `u` it is `u`. For a full-pose
-//! measurement the orientation rows are the angular velocity of the end
-//! frame: `u` for a rotation about `u`, 0 for a translation.
+//! it is `u × (p − o)`, for a translation along `u` it is `u`; the angular
+//! velocity of the end frame is `u` for a rotation about `u`, 0 for a
+//! translation. [`Evaluator::motions`] gives both per unknown ([`Motion`]);
+//! which rows a measurement makes of them is the sensor's business
+//! ([`crate::measure::Sensor`]): this module knows no sensor.
 
 use crate::error::Result;
 use crate::model::{JointKind, ParamTable, Robot, Symbol};
@@ -109,17 +111,38 @@ pub fn position_checked(robot: &Robot, table: &ParamTable, q: &[f64]) -> Result<
 
 /// Orientation `R` (columns: the end frame's axes) and position `p` of the
 /// end frame in the measurement frame (no input checks; see
-/// [`Robot::check_q`]). The orientation residual of identification is
-/// `φ = log(R(θ) R_measᵀ)`, whose derivative is the orientation rows of
-/// [`Evaluator::eval`] premultiplied by `J_l⁻¹(φ)`
-/// ([`crate::measure::so3`]).
+/// [`Robot::check_q`]).
 #[must_use]
 pub fn pose(robot: &Robot, table: &ParamTable, q: &[f64]) -> (Matrix3<f64>, Vector3<f64>) {
     let mut axes = vec![FrameAxes::default(); robot.frames.len()];
     walk(robot, table, q, &mut axes)
 }
 
-/// Reusable scratch for [`Evaluator::eval`]: avoids an allocation per pose.
+/// The end frame of the chain: orientation `R` (columns: the end frame's
+/// axes) and position `p` of the end point, in the measurement frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EndFrame {
+    /// Orientation `R`.
+    pub rotation: Matrix3<f64>,
+    /// Position `p`.
+    pub position: Vector3<f64>,
+}
+
+/// The first-order motion of the end frame under one parameter's (or one
+/// joint's) elementary motion, in the measurement frame: for a rotation about
+/// a unit axis `u` through `o`, `lin = u × (p − o)` and `ang = u`; for a
+/// translation along `u`, `lin = u` and `ang = 0`. A sensor turns these into
+/// its Jacobian rows ([`crate::measure::Sensor::motion_rows`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Motion {
+    /// Linear velocity of the end point.
+    pub lin: Vector3<f64>,
+    /// Angular velocity of the end frame.
+    pub ang: Vector3<f64>,
+}
+
+/// Reusable scratch for walking one robot's chain many times: avoids an
+/// allocation per pose.
 #[derive(Clone, Debug)]
 pub struct Evaluator<'r> {
     robot: &'r Robot,
@@ -138,74 +161,72 @@ impl<'r> Evaluator<'r> {
         }
     }
 
-    /// End point at `q`, and the identification Jacobian `∂y/∂θ` (t × p,
-    /// row-major, `t = robot.rows_per_pose()`, unknowns in
-    /// [`Robot::unknowns`] order) written into `jac`: rows 0–2 the position,
-    /// rows 3–5 (full-pose robots) the orientation as an angular velocity
-    /// (base frame) times [`Robot::orientation_scale`].
-    pub fn eval(&mut self, q: &[f64], jac: &mut [f64]) -> Vector3<f64> {
-        self.eval_pose(q, jac).1
+    /// The end frame at `q` (see [`pose`]).
+    pub fn end_frame(&mut self, q: &[f64]) -> EndFrame {
+        let (rotation, position) = walk(self.robot, self.table, q, &mut self.axes);
+        EndFrame { rotation, position }
     }
 
-    /// As [`Evaluator::eval`], also returning the end frame's orientation
-    /// (see [`pose`]).
-    pub fn eval_pose(&mut self, q: &[f64], jac: &mut [f64]) -> (Matrix3<f64>, Vector3<f64>) {
-        let p_len = self.robot.unknowns.len();
-        let t = self.robot.rows_per_pose();
-        debug_assert_eq!(jac.len(), t * p_len);
-        let (rot, p) = walk(self.robot, self.table, q, &mut self.axes);
-        let w = self.robot.orientation_scale;
-        for (c, u) in self.robot.unknowns.iter().enumerate() {
+    /// The end frame at `q`, and in `out` (one entry per unknown, in
+    /// [`Robot::unknowns`] order) the [`Motion`] of each unknown: the
+    /// columns of the identification Jacobian before a sensor picks its rows.
+    pub fn motions(&mut self, q: &[f64], out: &mut [Motion]) -> EndFrame {
+        debug_assert_eq!(out.len(), self.robot.unknowns.len());
+        let end = self.end_frame(q);
+        let p = end.position;
+        for (m, u) in out.iter_mut().zip(&self.robot.unknowns) {
             let ax = &self.axes[u.frame];
-            // (linear velocity of p, angular velocity) of the elementary motion.
-            let (lin, ang) = match u.symbol {
-                Symbol::Gamma => (ax.z.cross(&(p - ax.o_base)), ax.z),
-                Symbol::D => (ax.z, Vector3::zeros()),
-                Symbol::A => (ax.x, Vector3::zeros()),
-                Symbol::Alpha => (ax.x.cross(&(p - ax.o_twist)), ax.x),
-                Symbol::Beta => (ax.y.cross(&(p - ax.o_twist)), ax.y),
+            *m = match u.symbol {
+                Symbol::Gamma => Motion {
+                    lin: ax.z.cross(&(p - ax.o_base)),
+                    ang: ax.z,
+                },
+                Symbol::D => Motion {
+                    lin: ax.z,
+                    ang: Vector3::zeros(),
+                },
+                Symbol::A => Motion {
+                    lin: ax.x,
+                    ang: Vector3::zeros(),
+                },
+                Symbol::Alpha => Motion {
+                    lin: ax.x.cross(&(p - ax.o_twist)),
+                    ang: ax.x,
+                },
+                Symbol::Beta => Motion {
+                    lin: ax.y.cross(&(p - ax.o_twist)),
+                    ang: ax.y,
+                },
             };
-            for r in 0..3 {
-                jac[r * p_len + c] = lin[r];
-            }
-            if t == 6 {
-                for r in 0..3 {
-                    jac[(3 + r) * p_len + c] = w * ang[r];
-                }
-            }
         }
-        (rot, p)
+        end
     }
 
-    /// Geometric Jacobian with respect to the joint values (t × dof,
-    /// row-major, `t = robot.rows_per_pose()`): column `j` is, for the frame
-    /// driven by joint `j`, `z_j × (p − o_j)` over `z_j` if the joint is
-    /// revolute (the identification-Jacobian column of that frame's γ), and
-    /// `z_j` over 0 if it is prismatic (the column of its `d`). Rows 3–5
-    /// (angular velocity) exist for full-pose robots only.
-    pub fn joint_jacobian(&mut self, q: &[f64], jac: &mut [f64]) -> Vector3<f64> {
-        let dof = self.robot.dof();
-        let t = self.robot.rows_per_pose();
-        debug_assert_eq!(jac.len(), t * dof);
-        let (_, p) = walk(self.robot, self.table, q, &mut self.axes);
+    /// The end frame at `q`, and in `out` (one entry per joint) the
+    /// [`Motion`] of each joint: for the frame driven by joint `j`, `z_j × (p
+    /// − o_j)` and `z_j` if revolute (the motion of that frame's γ), `z_j`
+    /// and 0 if prismatic (the motion of its `d`). The geometric Jacobian is
+    /// a sensor's rows of these.
+    pub fn joint_motions(&mut self, q: &[f64], out: &mut [Motion]) -> EndFrame {
+        debug_assert_eq!(out.len(), self.robot.dof());
+        let end = self.end_frame(q);
+        let p = end.position;
         for (f, frame) in self.robot.frames.iter().enumerate() {
             if let Some(j) = frame.joint {
                 let ax = &self.axes[f];
-                let (lin, ang) = match frame.joint_kind {
-                    JointKind::Revolute => (ax.z.cross(&(p - ax.o_base)), ax.z),
-                    JointKind::Prismatic => (ax.z, Vector3::zeros()),
+                out[j] = match frame.joint_kind {
+                    JointKind::Revolute => Motion {
+                        lin: ax.z.cross(&(p - ax.o_base)),
+                        ang: ax.z,
+                    },
+                    JointKind::Prismatic => Motion {
+                        lin: ax.z,
+                        ang: Vector3::zeros(),
+                    },
                 };
-                for r in 0..3 {
-                    jac[r * dof + j] = lin[r];
-                }
-                if t == 6 {
-                    for r in 0..3 {
-                        jac[(3 + r) * dof + j] = ang[r];
-                    }
-                }
             }
         }
-        p
+        end
     }
 }
 
@@ -292,18 +313,16 @@ mod tests {
     }
 
     #[test]
-    fn gamma_columns_equal_joint_jacobian() {
+    fn gamma_motions_equal_joint_motions() {
         let r = Robot::puma560();
         let mut ev = Evaluator::new(&r, &r.nominal);
-        let p = r.n_unknowns();
-        let mut jac = vec![0.0; 3 * p];
-        let mut jj = vec![0.0; 18];
+        let mut m = vec![Motion::default(); r.n_unknowns()];
+        let mut mj = vec![Motion::default(); r.dof()];
         let q = q_sample(3);
-        ev.eval(&q, &mut jac);
-        ev.joint_jacobian(&q, &mut jj);
+        let e1 = ev.motions(&q, &mut m);
+        let e2 = ev.joint_motions(&q, &mut mj);
+        assert_eq!(e1, e2);
         // gamma_0 is unknown index 4 and drives joint 0.
-        for row in 0..3 {
-            assert_eq!(jac[row * p + 4], jj[row * 6]);
-        }
+        assert_eq!(m[4], mj[0]);
     }
 }

@@ -161,12 +161,7 @@ impl Robot {
     pub fn minimal_unknowns(&self) -> usize {
         let p = self.frames.iter().filter(|f| f.is_prismatic()).count();
         let r = self.dof().saturating_sub(p);
-        4 * r
-            + 2 * p
-            + match self.measurement {
-                Measurement::Point => 3,
-                Measurement::Pose => 6,
-            }
+        4 * r + 2 * p + crate::measure::sensor_for(self).observed_dof()
     }
 
     /// A maximal identifiable set of unknowns: `preferred` first (in the given
@@ -282,7 +277,7 @@ impl Robot {
         if r.frames.is_empty() {
             return Err(Error::Invalid("the robot has no frames".into()));
         }
-        if m == Measurement::Pose {
+        if crate::measure::sensor_of(m, r.orientation_scale).observes_orientation() {
             let last = r.frames.len() - 1;
             if r.frames[last].joint.is_none() {
                 if r.frames[last].convention == Convention::Dh {

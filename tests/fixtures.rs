@@ -11,7 +11,7 @@
 //! stored numbers are the shortest decimals that round-trip, so reading them
 //! adds no error. See `verify::TOLERANCE`.
 
-use activecal::kinematics::Evaluator;
+use activecal::measure::JacobianEvaluator;
 use activecal::model::{ParamSet, Robot};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -87,7 +87,7 @@ fn position_and_joint_jacobian_match_pinocchio_fixtures() {
             "{name}: too few samples"
         );
         let dof = robot.dof();
-        let mut ev = Evaluator::new(&robot, table);
+        let mut ev = JacobianEvaluator::new(&robot, table);
         // Full-pose robots have 6 rows; the fixtures hold the first 3.
         let mut jac = vec![0.0; robot.rows_per_pose() * dof];
         let (mut worst_p, mut worst_j) = (0.0f64, 0.0f64);

@@ -7,7 +7,7 @@ use activecal::identify::{
     compare_designs, identify, monte_carlo, paper_tables, simulate, trial_rng,
 };
 use activecal::io::design::DesignFile;
-use activecal::kinematics::Evaluator;
+use activecal::measure::JacobianEvaluator;
 use activecal::model::Robot;
 use activecal::pool::Pool;
 use nalgebra::DMatrix;
@@ -135,7 +135,7 @@ fn reference_covariance(
 ) -> DMatrix<f64> {
     let p = robot.n_unknowns();
     let mut x = DMatrix::<f64>::zeros(3 * qs.len(), p);
-    let mut ev = Evaluator::new(robot, &id.table);
+    let mut ev = JacobianEvaluator::new(robot, &id.table);
     let mut block = vec![0.0; 3 * p];
     for (i, q) in qs.iter().enumerate() {
         ev.eval(q, &mut block);

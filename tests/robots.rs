@@ -18,7 +18,8 @@ use activecal::criterion::Indices;
 use activecal::identify::{LmSettings, identify, simulate, trial_rng};
 use activecal::io::robot_toml as file;
 use activecal::io::urdf::{self, UrdfOptions};
-use activecal::kinematics::{Evaluator, pose, position};
+use activecal::kinematics::{pose, position};
+use activecal::measure::JacobianEvaluator;
 use activecal::model::{Convention, JointKind, Measurement, ParamSet, ParamTable, Robot};
 use activecal::observability::INDEPENDENCE_TOL;
 use activecal::observability::require_identifiable;
@@ -280,7 +281,7 @@ fn rot_log(a: &Matrix3<f64>, b: &Matrix3<f64>) -> Vector3<f64> {
 fn check_identification_jacobian(r: &Robot, table: &ParamTable, q: &[f64]) {
     let (p, t) = (r.n_unknowns(), r.rows_per_pose());
     let mut jac = vec![0.0; t * p];
-    let (rot0, p0) = Evaluator::new(r, table).eval_pose(q, &mut jac);
+    let (rot0, p0) = JacobianEvaluator::new(r, table).eval_pose(q, &mut jac);
     let (rot1, p1) = pose(r, table, q);
     assert_eq!((rot0, p0), (rot1, p1));
     let h = 1e-6;
@@ -315,7 +316,7 @@ fn check_identification_jacobian(r: &Robot, table: &ParamTable, q: &[f64]) {
     // Joint Jacobian: revolute and prismatic columns, orientation rows.
     let dof = r.dof();
     let mut jj = vec![0.0; t * dof];
-    Evaluator::new(r, table).joint_jacobian(q, &mut jj);
+    JacobianEvaluator::new(r, table).joint_jacobian(q, &mut jj);
     for j in 0..dof {
         let mut qp = q.to_vec();
         qp[j] += h;
@@ -366,7 +367,7 @@ fn pool_jacobian_has_six_rows_per_pose_for_pose_robots() {
         assert_eq!(x.t(), r.rows_per_pose());
         assert_eq!(x.n_poses(), 64);
         let mut jac = vec![0.0; x.t() * r.n_unknowns()];
-        Evaluator::new(&r, &r.nominal).eval(&pool.q(37), &mut jac);
+        JacobianEvaluator::new(&r, &r.nominal).eval(&pool.q(37), &mut jac);
         let b = x.block(37);
         for row in 0..x.t() {
             for c in 0..r.n_unknowns() {

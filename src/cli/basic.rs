@@ -1,7 +1,8 @@
 //! `robots`, `fk`, `pool`: the kinematic core on the command line.
 
 use super::{emit, load_robot, parse_list};
-use activecal::kinematics::{Evaluator, position_checked};
+use activecal::kinematics::position_checked;
+use activecal::measure::JacobianEvaluator;
 use activecal::model::{ParamSet, Robot};
 use activecal::pool::Lattice;
 use anyhow::Result;
@@ -163,7 +164,7 @@ pub fn cmd_fk(a: FkArgs) -> Result<()> {
     let t = robot.rows_per_pose();
     let mut jac = vec![0.0; t * robot.n_unknowns()];
     if a.jacobian {
-        Evaluator::new(&robot, table).eval(&q, &mut jac);
+        JacobianEvaluator::new(&robot, table).eval(&q, &mut jac);
         let n = robot.n_unknowns();
         v["jacobian"] = json!(jac.chunks(n).collect::<Vec<_>>());
         v["parameter_names"] = json!(robot.parameter_names());

@@ -11,7 +11,7 @@ use activecal::identify::{
 };
 use activecal::io::design::DesignFile;
 use activecal::io::robot_toml as file;
-use activecal::model::{Measurement, Robot};
+use activecal::model::Robot;
 use activecal::pool::Pool;
 use anyhow::{Result, bail};
 use clap::Args;
@@ -292,7 +292,7 @@ fn from_design(a: &CalibrateArgs, robot: &Robot, design_path: &Path) -> Result<(
     let after = validation.rms(robot, &id.table);
     let rot_before = validation.orientation_rms(robot, &robot.nominal);
     let rot_after = validation.orientation_rms(robot, &id.table);
-    let full = robot.measurement == Measurement::Pose;
+    let full = activecal::measure::sensor_for(robot).observes_orientation();
 
     // ---- Monte-Carlo ------------------------------------------------------------
     let t_mc = Instant::now();

@@ -14,16 +14,21 @@
 //!
 //! `D` is MINPACK's scaling, `d_j = max over iterations of ‖J_{:,j}‖`, so the
 //! damping is invariant to the units of the unknowns (radians vs. metres).
+//!
+//! The loop ([`levenberg_marquardt`]) sees only a [`Residuals`]: no
+//! kinematics, no sensor. [`identify`] poses the calibration problem
+//! ([`Calibration`]) and reads rank and covariance off the solution;
+//! [`identify_robust`] wraps the problem in a robust loss ([`super::loss`])
+//! and solves it by IRLS ([`irls`]).
 
 use super::dense::{SeqQr, inverse_information};
-use super::{IdentifyError, Measurements, Result, matrix};
+use super::loss::{Loss, Robust};
+use super::residual::{Calibration, Residuals};
+use super::{IdentifyError, Measurements, Result};
 use crate::blocks::Blocks;
-use crate::kinematics::Evaluator;
-use crate::measure::so3;
 use crate::model::{ParamTable, Robot, Symbol};
 use crate::observability::identifiability;
 use faer::Mat;
-use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
 /// Settings of the solver, with documented defaults; [`LmSettings::validate`]
@@ -218,91 +223,6 @@ impl Identification {
     }
 }
 
-/// Residuals (and optionally the Jacobian) at θ: per pose `p(θ, q_i) − y_i`
-/// and, for a full-pose robot, `w log(R(θ, q_i) R_iᵀ)` (`w` =
-/// [`Robot::orientation_scale`]), whose exact Jacobian is the evaluator's
-/// (already weighted) orientation rows premultiplied by `J_l⁻¹(φ)`.
-struct Problem<'a> {
-    robot: &'a Robot,
-    base: &'a ParamTable,
-    meas: &'a Measurements,
-    /// The measured orientations as unit quaternions (projected once).
-    rotations: Vec<UnitQuaternion<f64>>,
-    /// Row-major t × p scratch for one pose.
-    block: Vec<f64>,
-}
-
-impl<'a> Problem<'a> {
-    fn new(robot: &'a Robot, base: &'a ParamTable, meas: &'a Measurements) -> Self {
-        let p = robot.n_unknowns();
-        Self {
-            robot,
-            base,
-            meas,
-            rotations: meas
-                .orientations()
-                .iter()
-                .map(|r| so3::nearest_rotation(&matrix(r)))
-                .collect(),
-            block: vec![0.0; robot.rows_per_pose() * p],
-        }
-    }
-
-    fn t(&self) -> usize {
-        self.robot.rows_per_pose()
-    }
-
-    fn m(&self) -> usize {
-        self.t() * self.meas.len()
-    }
-
-    /// Writes the residual into `r` and, if given, the Jacobian into `jac`.
-    /// Returns whether everything is finite.
-    fn eval(&mut self, theta: &[f64], r: &mut [f64], mut jac: Option<&mut Mat<f64>>) -> bool {
-        let p = theta.len();
-        let t = self.t();
-        let w = self.robot.orientation_scale;
-        let table = self.robot.with_unknowns(self.base, theta);
-        let mut ev = Evaluator::new(self.robot, &table);
-        let mut finite = true;
-        for (i, (q, y)) in self.meas.qs().iter().zip(self.meas.points()).enumerate() {
-            let (rot, pos) = ev.eval_pose(q, &mut self.block);
-            for c in 0..3 {
-                r[t * i + c] = pos[c] - y[c];
-            }
-            if t == 6 {
-                let model = so3::to_quaternion(&rot);
-                let phi = so3::difference(&model, &self.rotations[i]);
-                for c in 0..3 {
-                    r[t * i + 3 + c] = w * phi[c];
-                }
-                if jac.is_some() {
-                    // Orientation rows: J_l⁻¹(φ) times the evaluator's rows.
-                    let jinv = so3::left_jacobian_inverse(&phi);
-                    for k in 0..p {
-                        let v = Vector3::from_fn(|c, _| self.block[(3 + c) * p + k]);
-                        let u = jinv * v;
-                        for c in 0..3 {
-                            self.block[(3 + c) * p + k] = u[c];
-                        }
-                    }
-                }
-            }
-            for c in 0..t {
-                finite &= r[t * i + c].is_finite();
-                if let Some(j) = jac.as_deref_mut() {
-                    for k in 0..p {
-                        let x = self.block[c * p + k];
-                        finite &= x.is_finite();
-                        j[(t * i + c, k)] = x;
-                    }
-                }
-            }
-        }
-        finite
-    }
-}
-
 /// `x` shifted by a multiple of 2π into (−π, π].
 fn wrap_angle(x: f64) -> f64 {
     use std::f64::consts::{PI, TAU};
@@ -344,6 +264,89 @@ pub fn identify(
     meas: &Measurements,
     settings: &LmSettings,
 ) -> Result<Identification> {
+    let (names, theta0) = check_inputs(robot, start, meas, settings)?;
+    let mut prob = Calibration::new(robot, start, meas)?;
+    let out = levenberg_marquardt(&mut prob, &theta0, settings);
+    Ok(finish(robot, start, names, theta0, out))
+}
+
+/// As [`identify`], minimising `½ Σ_i ρ(‖r_i‖²)` over the poses `i` for a
+/// robust `loss` ([`super::loss`]) by iteratively reweighted least squares
+/// ([`irls`]). Rank and covariance are those of the weighted problem at the
+/// estimate (down-weighted poses count less); the residual sums
+/// (`rss`, `sigma_hat`) are weighted too. With [`super::loss::L2`] the
+/// result equals [`identify`]'s.
+pub fn identify_robust<L: Loss>(
+    robot: &Robot,
+    start: &ParamTable,
+    meas: &Measurements,
+    settings: &LmSettings,
+    loss: L,
+) -> Result<Identification> {
+    let (names, theta0) = check_inputs(robot, start, meas, settings)?;
+    let mut prob = Robust::new(Calibration::new(robot, start, meas)?, loss);
+    let out = irls(
+        &mut prob,
+        &theta0,
+        settings,
+        IRLS_ITERATIONS,
+        IRLS_TOLERANCE,
+    );
+    Ok(finish(robot, start, names, theta0, out))
+}
+
+/// Most IRLS rounds of [`identify_robust`].
+pub const IRLS_ITERATIONS: usize = 50;
+/// [`identify_robust`] stops when no `√w` of a pose changes by more than
+/// this between rounds.
+pub const IRLS_TOLERANCE: f64 = 1e-9;
+
+/// Iteratively reweighted least squares: Levenberg–Marquardt on `prob` with
+/// its weights frozen, then [`Robust::reweight`] at the estimate, until no
+/// `√w_b` changes by more than `tol` or `rounds` rounds are done. Returns
+/// the last round's solution, which minimises the least squares weighted by
+/// the weights it was solved with (its `evaluations` and `iterations` summed
+/// over rounds, `initial_rss` that of the first round).
+pub fn irls<R: Residuals, L: Loss>(
+    prob: &mut Robust<R, L>,
+    theta0: &[f64],
+    settings: &LmSettings,
+    rounds: usize,
+    tol: f64,
+) -> Solution {
+    let mut theta = theta0.to_vec();
+    let (mut evaluations, mut iterations) = (0, 0);
+    let mut initial_rss = None;
+    let mut round = 0;
+    loop {
+        let mut sol = levenberg_marquardt(prob, &theta, settings);
+        round += 1;
+        evaluations += sol.evaluations;
+        iterations += sol.iterations;
+        let initial = *initial_rss.get_or_insert(sol.initial_rss);
+        let change = if sol.finite {
+            prob.reweight(&sol.theta)
+        } else {
+            None
+        };
+        if change.is_none_or(|c| c <= tol) || round >= rounds {
+            sol.evaluations = evaluations;
+            sol.iterations = iterations;
+            sol.initial_rss = initial;
+            return sol;
+        }
+        theta.clone_from(&sol.theta);
+    }
+}
+
+/// Validates the inputs of [`identify`]; returns the unknowns' names and
+/// start values.
+fn check_inputs(
+    robot: &Robot,
+    start: &ParamTable,
+    meas: &Measurements,
+    settings: &LmSettings,
+) -> Result<(Vec<String>, Vec<f64>)> {
     settings.validate()?;
     robot.validate()?;
     meas.check(robot)?;
@@ -363,10 +366,20 @@ pub fn identify(
         }
         .into());
     }
+    Ok((names, theta0))
+}
+
+/// The identification report of a solution: angles wrapped near the start,
+/// rank, status and covariance at the estimate.
+fn finish(
+    robot: &Robot,
+    start: &ParamTable,
+    names: Vec<String>,
+    theta0: Vec<f64>,
+    mut out: Solution,
+) -> Identification {
     let p = theta0.len();
-    let mut prob = Problem::new(robot, start, meas);
-    let m = prob.m();
-    let mut out = levenberg_marquardt(&mut prob, &theta0, settings);
+    let m = out.jac.nrows();
     // Angles live on the circle: report the representative nearest the start
     // (the kinematics depend on them through sin and cos only, so the
     // residual and the Jacobian are unchanged).
@@ -400,7 +413,7 @@ pub fn identify(
         (Some(inv), Some(s)) => Some(covariance_from(&inv, s * s, &names)),
         _ => None,
     };
-    Ok(Identification {
+    Identification {
         status,
         stop: out.stop,
         iterations: out.iterations,
@@ -418,7 +431,7 @@ pub fn identify(
         rank,
         unidentifiable,
         covariance,
-    })
+    }
 }
 
 /// `σ² (XᵀX)⁻¹` with `X` the identification Jacobian of `table` at `qs`: the
@@ -469,18 +482,29 @@ fn covariance_from(inv: &Mat<f64>, s2: f64, names: &[String]) -> Covariance {
     }
 }
 
-/// Internal result of the iteration.
-struct LmOutcome {
-    theta: Vec<f64>,
-    jac: Mat<f64>,
-    finite: bool,
-    stop: StopReason,
-    iterations: usize,
-    evaluations: usize,
-    initial_rss: f64,
-    rss: f64,
-    history: Vec<f64>,
-    lambda: f64,
+/// What [`levenberg_marquardt`] returns: the solver's state at the end.
+#[derive(Clone, Debug)]
+pub struct Solution {
+    /// Parameters at the end.
+    pub theta: Vec<f64>,
+    /// Jacobian at `theta` (`m × n`).
+    pub jac: Mat<f64>,
+    /// Whether the residual and the Jacobian at `theta` are finite.
+    pub finite: bool,
+    /// Which rule stopped the iteration.
+    pub stop: StopReason,
+    /// Outer iterations (Jacobian evaluations after the first).
+    pub iterations: usize,
+    /// Residual evaluations, including rejected and geodesic trial points.
+    pub evaluations: usize,
+    /// `‖r‖²` at the start.
+    pub initial_rss: f64,
+    /// `‖r‖²` at `theta`.
+    pub rss: f64,
+    /// `‖r‖²` after each accepted step (first entry: start).
+    pub history: Vec<f64>,
+    /// Final damping `λ` (scaled units).
+    pub lambda: f64,
 }
 
 /// Ceiling on the scaled damping: past it a step is ~1e-32 of a gradient step.
@@ -492,18 +516,25 @@ const ACCEPT: f64 = 1e-4;
 const GEO_H: f64 = 0.1;
 const GEO_ALPHA: f64 = 0.75;
 
-/// The loop: one outer iteration per Jacobian, inner trials raising the
-/// damping until a step is accepted or a tolerance is met.
-fn levenberg_marquardt(prob: &mut Problem<'_>, theta0: &[f64], s: &LmSettings) -> LmOutcome {
+/// Levenberg–Marquardt on any [`Residuals`] from `theta0`: one outer
+/// iteration per Jacobian, inner trials raising the damping until a step is
+/// accepted or a tolerance is met (settings are not validated here; see
+/// [`LmSettings::validate`]).
+pub fn levenberg_marquardt<R: Residuals + ?Sized>(
+    prob: &mut R,
+    theta0: &[f64],
+    s: &LmSettings,
+) -> Solution {
     let p = theta0.len();
-    let m = prob.m();
+    debug_assert_eq!(p, prob.n_params());
+    let m = prob.n_residuals();
     let mut theta = theta0.to_vec();
     let mut r = vec![0.0; m];
     let mut jac = Mat::<f64>::zeros(m, p);
     let mut evaluations = 1;
     let finite = prob.eval(&theta, &mut r, Some(&mut jac));
     let rss0 = sumsq(&r);
-    let mut out = LmOutcome {
+    let mut out = Solution {
         theta: theta.clone(),
         jac: jac.clone(),
         finite: finite && rss0.is_finite(),
@@ -716,9 +747,9 @@ mod tests {
             .collect();
         // σ = 0.15 m → orientation noise 0.3 rad per axis.
         let meas = simulate(&robot, &robot.real, &qs, 0.15, &mut trial_rng(2, 0)).unwrap();
-        let mut prob = Problem::new(&robot, &robot.nominal, &meas);
+        let mut prob = Calibration::new(&robot, &robot.nominal, &meas).unwrap();
         let theta = robot.unknown_values(&robot.nominal);
-        let (m, p) = (prob.m(), theta.len());
+        let (m, p) = (prob.n_residuals(), theta.len());
         let mut r = vec![0.0; m];
         let mut jac = Mat::<f64>::zeros(m, p);
         assert!(prob.eval(&theta, &mut r, Some(&mut jac)));

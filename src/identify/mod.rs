@@ -13,7 +13,13 @@
 //! carries noise σ, and the weighted `XᵀX` that pose selection maximises is
 //! the Fisher information up to `σ²`.
 //!
-//! * [`lm`]: the solver ([`identify`]), its settings, statuses and covariance.
+//! * [`residual`]: the problem apart from the solver: the [`Residuals`]
+//!   trait and the calibration problem ([`Calibration`]: robot, sensor,
+//!   measurements).
+//! * [`lm`]: the solver, generic over [`Residuals`] ([`levenberg_marquardt`]),
+//!   and [`identify`] with its settings, statuses and covariance.
+//! * [`loss`]: robust losses (Huber, Cauchy) wrapping any [`Residuals`],
+//!   solved by IRLS ([`identify_robust`]).
 //! * [`simulate`](mod@simulate): noisy measurements of the real robot, seeded.
 //! * [`montecarlo`]: repeated identification over noise realisations, and
 //!   held-out validation poses.
@@ -26,24 +32,29 @@
 
 mod dense;
 pub mod lm;
+pub mod loss;
 pub mod montecarlo;
+pub mod residual;
 pub mod simulate;
 
 pub mod tables;
 
 pub use lm::{
-    Correlation, Covariance, Identification, LmSettings, Status, StopReason, identify,
-    predicted_covariance,
+    Correlation, Covariance, Identification, LmSettings, Solution, Status, StopReason, identify,
+    identify_robust, irls, levenberg_marquardt, predicted_covariance,
 };
+pub use loss::{Cauchy, Huber, L2, Loss, Robust};
 pub use montecarlo::{
     Comparison, GeneralizedVariance, MonteCarloSettings, MonteCarloSummary, ParameterStats, Spread,
     ValidationSet, compare_designs, monte_carlo,
 };
+pub use residual::{Calibration, Residuals};
 pub use simulate::{simulate, trial_rng};
 pub use tables::{PaperTables, ParamGrid, paper_tables};
 
 use crate::error::Error;
-use crate::model::{Measurement, Robot};
+use crate::measure::Observation;
+use crate::model::Robot;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -237,17 +248,23 @@ impl Measurements {
                 });
             }
         }
-        let want = match robot.measurement {
-            Measurement::Point => 0,
-            Measurement::Pose => self.qs.len(),
+        let sensor = crate::measure::sensor_for(robot);
+        if sensor.points_per_pose() != 1 {
+            return Err(IdentifyError::Model(Error::Invalid(format!(
+                "robot '{}' measures {} points per pose; measurement files hold one",
+                robot.name,
+                sensor.points_per_pose()
+            ))));
+        }
+        let want = if sensor.observes_orientation() {
+            self.qs.len()
+        } else {
+            0
         };
         if self.orientations.len() != want {
             return Err(IdentifyError::OrientationCount {
                 robot: robot.name.clone(),
-                expected: match robot.measurement {
-                    Measurement::Point => "points",
-                    Measurement::Pose => "full poses (position and orientation)",
-                },
+                expected: sensor.describe(),
                 given: self.orientations.len(),
                 poses: self.qs.len(),
             });
@@ -295,6 +312,16 @@ impl Measurements {
     #[must_use]
     pub fn points(&self) -> &[[f64; 3]] {
         &self.points
+    }
+
+    /// Pose `i`'s observation, as a sensor reads it
+    /// ([`crate::measure::Sensor::encode`]). Panics if `i ≥ len()`.
+    #[must_use]
+    pub fn observation(&self, i: usize) -> Observation<'_> {
+        Observation {
+            points: std::slice::from_ref(&self.points[i]),
+            orientation: self.orientations.get(i),
+        }
     }
 
     /// Measured orientations (row-major rotation matrices), one per joint

@@ -15,7 +15,8 @@ use super::{IdentifyError, Result};
 use crate::blocks::jacobian_of;
 use crate::kinematics::{pose, position};
 use crate::measure::so3;
-use crate::model::{Measurement, ParamTable, Robot};
+use crate::measure::{RowKind, sensor_for};
+use crate::model::{ParamTable, Robot};
 use crate::pool::Pool;
 use faer::Mat;
 use nalgebra::{UnitQuaternion, Vector3};
@@ -185,7 +186,7 @@ impl ValidationSet {
         }
         let poses: Vec<_> = qs.iter().map(|q| pose(robot, &robot.real, q)).collect();
         let truth = poses.iter().map(|(_, p)| *p).collect();
-        let truth_rot = if robot.measurement == Measurement::Pose {
+        let truth_rot = if sensor_for(robot).observes_orientation() {
             poses.iter().map(|(r, _)| so3::to_quaternion(r)).collect()
         } else {
             Vec::new()
@@ -254,7 +255,8 @@ impl ValidationSet {
     /// (divided by [`Robot::orientation_scale`]).
     #[must_use]
     pub fn predicted_rms(&self, robot: &Robot, c: &Mat<f64>) -> (f64, Option<f64>) {
-        let pose = robot.measurement == Measurement::Pose;
+        let sensor = sensor_for(robot);
+        let pose = sensor.observes_orientation();
         if self.qs.is_empty() {
             return (0.0, pose.then_some(0.0));
         }
@@ -264,16 +266,27 @@ impl ValidationSet {
         let t = x.t();
         let xc = product(x.mat(), c.as_ref());
         let m = x.mat();
+        // Traces over the position rows and over the orientation rows (the
+        // latter carry the orientation weight w, divided out below).
+        let kinds = sensor.row_kinds();
+        let weights = sensor.weights();
         let mut tr = [0.0, 0.0];
         for j in 0..m.ncols() {
             for i in 0..m.nrows() {
-                tr[usize::from(i % t >= 3)] += xc[(i, j)] * m[(i, j)];
+                tr[usize::from(kinds[i % t] == RowKind::Orientation)] += xc[(i, j)] * m[(i, j)];
             }
         }
         let n = self.qs.len() as f64;
-        let w = robot.orientation_scale;
+        // Position rows per measured point: 3 (several markers per pose share
+        // the distance mean over points).
+        let per_pose = kinds.iter().filter(|&&k| k == RowKind::Position).count() as f64 / 3.0;
+        let w = weights
+            .iter()
+            .zip(kinds)
+            .find(|&(_, &k)| k == RowKind::Orientation)
+            .map_or(1.0, |(w, _)| *w);
         (
-            (tr[0].max(0.0) / n).sqrt(),
+            (tr[0].max(0.0) / (n * per_pose)).sqrt(),
             pose.then(|| (tr[1].max(0.0) / n).sqrt() / w),
         )
     }

@@ -7,11 +7,10 @@
 //! `rand` 0.9's traits and does not accept a `rand` 0.10 generator, and two
 //! lines of Box–Muller are not worth a second `rand` in the build.
 
-use super::{Measurements, Result, rows};
-use crate::kinematics::pose;
-use crate::measure::so3;
-use crate::model::{Measurement, ParamTable, Robot};
-use nalgebra::Vector3;
+use super::{Measurements, Result};
+use crate::kinematics::Evaluator;
+use crate::measure::sensor_for;
+use crate::model::{ParamTable, Robot};
 use rand::{Rng, RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -64,24 +63,30 @@ pub fn simulate<R: Rng + ?Sized>(
             reason: "the noise standard deviation must be finite and >= 0",
         });
     }
-    let t = robot.rows_per_pose();
-    let full = robot.measurement == Measurement::Pose;
-    let sigma_rot = sigma / robot.orientation_scale;
+    // The sensor's prediction, moved along its manifold by σ z_r / w_r per
+    // row r (w_r its weight: position rows 1, orientation rows w).
+    let sensor = sensor_for(robot);
+    let t = sensor.rows();
     let mut noise = vec![0.0; t * qs.len()];
     fill_standard_normal(rng, &mut noise);
+    let mut ev = Evaluator::new(robot, table);
+    let mut value = vec![0.0; sensor.value_len()];
+    let mut delta = vec![0.0; t];
     let mut points = Vec::with_capacity(qs.len());
     let mut orientations = Vec::new();
     for (i, q) in qs.iter().enumerate() {
         robot
             .check_q(q)
             .map_err(|source| super::IdentifyError::Pose { pose: i, source })?;
-        let (rot, p) = pose(robot, table, q);
+        sensor.predict(&ev.end_frame(q), &[], &mut value);
         let z = &noise[t * i..t * (i + 1)];
-        points.push([p.x + sigma * z[0], p.y + sigma * z[1], p.z + sigma * z[2]]);
-        if full {
-            let eta = sigma_rot * Vector3::new(z[3], z[4], z[5]);
-            orientations.push(rows(&(so3::exp(&eta) * rot)));
+        for ((d, z), w) in delta.iter_mut().zip(z).zip(sensor.weights()) {
+            *d = sigma * z / w;
         }
+        sensor.retract(&mut value, &delta);
+        let obs = sensor.decode(&value);
+        points.extend(obs.points);
+        orientations.extend(obs.orientation);
     }
     Ok(
         Measurements::with_orientations(robot, qs.to_vec(), points, orientations)?

@@ -2,7 +2,7 @@
 //! any source (activecal, Pinocchio, MuJoCo, a fixture), and their largest
 //! deviations.
 
-use activecal::kinematics::Evaluator;
+use activecal::measure::JacobianEvaluator;
 use activecal::model::{ParamTable, Robot};
 use anyhow::{Result, bail};
 use serde::{Deserialize, Serialize};
@@ -33,13 +33,13 @@ impl Kinematics {
     }
 }
 
-/// activecal's own values: `kinematics::Evaluator::joint_jacobian`, which
+/// activecal's own values: `measure::JacobianEvaluator::joint_jacobian`, which
 /// also returns the position (for a full-pose robot, the positional rows of
 /// its joint Jacobian).
 #[must_use]
 pub fn activecal_kinematics(robot: &Robot, table: &ParamTable, qs: &[Vec<f64>]) -> Kinematics {
     let dof = robot.dof();
-    let mut ev = Evaluator::new(robot, table);
+    let mut ev = JacobianEvaluator::new(robot, table);
     let mut out = Kinematics::default();
     let mut jac = vec![0.0; robot.rows_per_pose() * dof];
     for q in qs {

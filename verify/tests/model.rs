@@ -2,7 +2,8 @@
 //! MuJoCo reproduces activecal's kinematics (and its `joint_chain`), the
 //! MJCF carries the spec exactly, and the fixture format round-trips.
 
-use activecal::kinematics::{Evaluator, joint_chain, position};
+use activecal::kinematics::{joint_chain, position};
+use activecal::measure::JacobianEvaluator;
 use activecal::model::{JointKind, ParamSet, Robot};
 use nalgebra::{Matrix4, Vector3};
 use verify::compare::{Kinematics, activecal_kinematics, deviation};
@@ -122,7 +123,7 @@ fn joint_jacobian_is_the_gamma_column_of_the_identification_jacobian() {
     let dof = robot.dof();
     for set in SETS {
         let table = robot.params(set);
-        let mut ev = Evaluator::new(&robot, table);
+        let mut ev = JacobianEvaluator::new(&robot, table);
         for q in configurations(&robot, 20, 3) {
             let (mut x, mut jj) = (vec![0.0; 3 * p], vec![0.0; 3 * dof]);
             ev.eval(&q, &mut x);

@@ -1,0 +1,197 @@
+//! The measurement seam: what a sensor observes of the end frame, how a
+//! measured value differs from a predicted one, and the rows it contributes
+//! to the identification Jacobian.
+//!
+//! The kinematics ([`crate::kinematics::Evaluator`]) know nothing of
+//! sensors: at a joint vector they give the end frame `(R, p)` and, for every
+//! unknown, the [`Motion`] it induces, i.e. the linear velocity of the end
+//! point and the angular velocity of the end frame under that parameter's
+//! elementary motion. A [`Sensor`] turns these into its measurement
+//! (prediction), its residual and its Jacobian rows, with its row weights.
+//!
+//! # Values
+//! A measured or predicted value of one pose is a flat slice of
+//! [`Sensor::value_len`] numbers in the sensor's own layout (a point: `x y
+//! z`; a pose: `x y z` then the unit quaternion `w x y z`). Residuals have
+//! [`Sensor::rows`] entries (any number: K markers give 3K) and are already
+//! weighted, so that every row carries the same noise σ.
+//!
+//! # Unknowns of a sensor's own
+//! A sensor may carry unknowns of its own, e.g. one marker offset `o_k`
+//! (a 3-vector in the end frame) per marker. They are
+//! [`Sensor::n_own_params`] columns appended after the robot's unknowns in
+//! the parameter vector and in every Jacobian: `θ = [θ_robot, θ_sensor]`.
+//! Their current values are passed as `own` to [`Sensor::predict`],
+//! [`Sensor::motion_rows`] and [`Sensor::own_rows`]; the latter writes their
+//! columns (for a marker `p_k = p + R o_k`: `∂p_k/∂o_k = R`). The robot's
+//! columns of a marker are `lin + ang × (R o_k)`, from the same [`Motion`]s.
+//! Point and pose sensors have no unknowns of their own (`own` is empty).
+
+use crate::kinematics::{EndFrame, Motion};
+use crate::model::{Measurement, Robot};
+use std::fmt;
+
+use super::point::PointSensor;
+use super::pose::PoseSensor;
+
+/// What a row of a residual measures, for reports that split errors into
+/// distances and angles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RowKind {
+    /// A position coordinate, metres.
+    Position,
+    /// An orientation coordinate (a rotation-vector component), radians
+    /// before weighting.
+    Orientation,
+}
+
+/// One pose's observation as measurement files hold it: measured points
+/// (base frame, metres) and, for sensors that see orientation, a rotation
+/// matrix (row-major, base frame).
+#[derive(Clone, Copy, Debug)]
+pub struct Observation<'a> {
+    /// Measured points, [`Sensor::points_per_pose`] of them.
+    pub points: &'a [[f64; 3]],
+    /// Measured orientation, present exactly when
+    /// [`Sensor::observes_orientation`].
+    pub orientation: Option<&'a [[f64; 3]; 3]>,
+}
+
+/// An owned [`Observation`], as a simulation produces it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObservationBuf {
+    /// Measured points.
+    pub points: Vec<[f64; 3]>,
+    /// Measured orientation, row-major.
+    pub orientation: Option<[[f64; 3]; 3]>,
+}
+
+/// A sensor: rows per pose, prediction, residual, Jacobian rows and weights.
+///
+/// Implementations: [`PointSensor`] (3 rows, the end point) and
+/// [`PoseSensor`] (6 rows, the end point and the end frame's orientation).
+/// [`sensor_for`] picks one from [`Robot::measurement`].
+///
+/// The hot path, the pool Jacobian of up to 10⁶ poses, calls
+/// [`Sensor::motion_rows`] once per pose; every other method is per pose or
+/// per identification.
+pub trait Sensor: fmt::Debug + Send + Sync {
+    /// The measurement kind this sensor implements.
+    fn kind(&self) -> Measurement;
+
+    /// What a pose's measurement is, for messages (`points`, `full poses
+    /// (position and orientation)`).
+    fn describe(&self) -> &'static str;
+
+    /// Rows of the residual and of the identification Jacobian per pose (`t`).
+    fn rows(&self) -> usize;
+
+    /// Kind of each of the [`Sensor::rows`] rows.
+    fn row_kinds(&self) -> &[RowKind];
+
+    /// Weight of each row: residual and Jacobian rows are multiplied by it so
+    /// that every row carries the same noise σ (1 for positions,
+    /// [`Robot::orientation_scale`] for orientations).
+    fn weights(&self) -> &[f64];
+
+    /// Degrees of freedom of the end frame the sensor observes (3 for a
+    /// point, 6 for a pose or three markers off a line): with the robot's
+    /// joints they give the number of independent kinematic parameters.
+    fn observed_dof(&self) -> usize;
+
+    /// Whether the measurement includes the end frame's orientation (so
+    /// that an orientation error of the model is observable).
+    fn observes_orientation(&self) -> bool;
+
+    /// Points measured per pose.
+    fn points_per_pose(&self) -> usize;
+
+    /// Length of one pose's measured or predicted value.
+    fn value_len(&self) -> usize;
+
+    /// Number of unknowns of the sensor's own, appended after the robot's
+    /// (see the module documentation). Default 0.
+    fn n_own_params(&self) -> usize {
+        0
+    }
+
+    /// Names of the sensor's own unknowns (`n_own_params` of them). Default none.
+    fn own_param_names(&self) -> Vec<String> {
+        Vec::new()
+    }
+
+    /// Writes an observation in the sensor's value layout into `out`
+    /// (`value_len` entries), projecting it onto the measurement manifold
+    /// where needed (a measured rotation onto the nearest rotation). The
+    /// observation has the shape the sensor expects (checked by the caller).
+    fn encode(&self, obs: &Observation<'_>, out: &mut [f64]);
+
+    /// The observation a value stands for (the inverse of
+    /// [`Sensor::encode`] up to rounding).
+    fn decode(&self, value: &[f64]) -> ObservationBuf;
+
+    /// The predicted value (`value_len` entries) for end frame `end` and the
+    /// sensor's own unknowns `own`.
+    fn predict(&self, end: &EndFrame, own: &[f64], out: &mut [f64]);
+
+    /// Moves a value by `delta` (`rows` entries, unweighted: metres and
+    /// radians) along the measurement manifold: simulated noise.
+    fn retract(&self, value: &mut [f64], delta: &[f64]);
+
+    /// The weighted residual `predicted ⊖ measured` (`rows` entries).
+    fn residual(&self, predicted: &[f64], measured: &[f64], out: &mut [f64]);
+
+    /// The identification-Jacobian rows of the kinematic columns at zero
+    /// residual (the design Jacobian `X` that pose selection uses): column
+    /// `c` of the `rows × motions.len()` block is the weighted derivative of
+    /// the measurement under `motions[c]`. Written row-major into `out` with
+    /// row stride `ld ≥ motions.len()` (so that own columns can follow).
+    fn motion_rows(
+        &self,
+        end: &EndFrame,
+        own: &[f64],
+        motions: &[Motion],
+        out: &mut [f64],
+        ld: usize,
+    );
+
+    /// The exact derivative of [`Sensor::residual`] against `measured` with
+    /// respect to the motions (for Levenberg–Marquardt), same layout as
+    /// [`Sensor::motion_rows`]. Default: [`Sensor::motion_rows`], exact for
+    /// residuals linear in the prediction (points).
+    fn residual_rows(
+        &self,
+        end: &EndFrame,
+        own: &[f64],
+        motions: &[Motion],
+        measured: &[f64],
+        out: &mut [f64],
+        ld: usize,
+    ) {
+        let _ = measured;
+        self.motion_rows(end, own, motions, out, ld);
+    }
+
+    /// The columns of the sensor's own unknowns (`rows × n_own_params`),
+    /// row-major with row stride `ld` into `out`. Default: nothing (no own
+    /// unknowns).
+    fn own_rows(&self, end: &EndFrame, own: &[f64], out: &mut [f64], ld: usize) {
+        let _ = (end, own, out, ld);
+    }
+}
+
+/// The sensor of a measurement kind, with the robot's weights.
+#[must_use]
+pub fn sensor_of(kind: Measurement, orientation_scale: f64) -> Box<dyn Sensor> {
+    match kind {
+        Measurement::Point => Box::new(PointSensor::new()),
+        Measurement::Pose => Box::new(PoseSensor::new(orientation_scale)),
+    }
+}
+
+/// The sensor a robot is measured with ([`Robot::measurement`], weighted by
+/// [`Robot::orientation_scale`]).
+#[must_use]
+pub fn sensor_for(robot: &Robot) -> Box<dyn Sensor> {
+    sensor_of(robot.measurement, robot.orientation_scale)
+}

@@ -34,9 +34,9 @@ pub struct FkArgs {
     /// `:pose` for full-pose measurements.
     #[arg(long, default_value = "puma560")]
     pub robot: String,
-    /// Parameter set: nominal or real.
-    #[arg(long, default_value = "nominal")]
-    pub params: String,
+    /// Parameter set.
+    #[arg(long, value_enum, default_value_t = ParamSet::Nominal)]
+    pub params: ParamSet,
     /// Joint angles, comma separated (radians, or degrees with --deg).
     #[arg(long, allow_hyphen_values = true)]
     pub q: String,
@@ -152,7 +152,7 @@ pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
 /// Runs `fk`.
 pub fn cmd_fk(a: FkArgs) -> Result<()> {
     let robot = load_robot(&a.robot)?;
-    let set = ParamSet::parse(&a.params)?;
+    let set = a.params;
     let mut q: Vec<f64> = parse_list(&a.q, "--q")?;
     if a.deg {
         q.iter_mut().for_each(|v| *v = v.to_radians());

@@ -4,13 +4,12 @@
 //! a file of real measurements. Either way the calibrated robot can be
 //! written as a description file.
 
-use super::{emit, load_robot, refuse_overwrite, write_new};
+use super::{emit, refuse_overwrite, write_new};
 use activecal::io::design::DesignFile;
 use activecal::identify::{
     Identification, LmSettings, Measurements, MonteCarloSettings, MonteCarloSummary, ParamGrid,
     ValidationSet, identify, monte_carlo, paper_tables,
 };
-use activecal::pool::Pool;
 use activecal::io::robot_toml as file;
 use activecal::model::{Measurement, Robot};
 use anyhow::{Result, bail};
@@ -163,10 +162,11 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     for path in [&a.out, &a.save_measurements].into_iter().flatten() {
         refuse_overwrite(path, a.force)?;
     }
-    let robot = load_robot(&a.robot)?;
+    let desc = super::load_description(&a.robot)?;
+    let robot = &desc.robot;
     match (&a.design, &a.measurements) {
-        (_, Some(m)) => from_measurements(&a, &robot, m),
-        (Some(d), None) => from_design(&a, &robot, d),
+        (_, Some(m)) => from_measurements(&a, robot, m),
+        (Some(d), None) => from_design(&a, robot, desc.visibility.as_ref(), d),
         (None, None) => bail!("give --design (simulate) or --measurements (real data)"),
     }
 }
@@ -190,6 +190,7 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     let mut v = identification_json(&id);
     v.extend(json_map(json!({
         "robot": robot.name,
+        "chain": activecal::report::chain(robot),
         "measurements": path.display().to_string(),
         "poses": meas.len(),
         "measurement": robot.measurement,
@@ -248,22 +249,29 @@ fn status_text(id: &Identification) -> String {
 }
 
 /// Simulated calibration at a design's poses.
-fn from_design(a: &CalibrateArgs, robot: &Robot, design_path: &Path) -> Result<()> {
+///
+/// The measurements are simulated at the design's stored joint values; the
+/// held-out validation poses come from the design's own pool (the same pool,
+/// filters included, that `select` chose it from), outside the design.
+fn from_design(
+    a: &CalibrateArgs,
+    robot: &Robot,
+    described: Option<&activecal::measure::Visibility>,
+    design_path: &Path,
+) -> Result<()> {
     let t0 = Instant::now();
+    let in_file = |e: activecal::Error| anyhow::anyhow!("{}: {e}", design_path.display());
     let design = DesignFile::read(design_path)?;
-    if design.robot != robot.name {
-        anyhow::bail!(
-            "{}: the design is for robot '{}', not '{}'",
-            design_path.display(),
-            design.robot,
-            robot.name
-        );
+    design.check_robot(robot).map_err(in_file)?;
+    let mut spec = design.spec().map_err(in_file)?;
+    if design.pool.is_none() {
+        // An old file names only its lattice: the pool `select` used had the
+        // robot description's visibility region.
+        spec.filters = super::filters(None, described)?;
     }
-    let pool = Pool::full(robot, design.levels)?;
-    let positions = design
-        .positions_in(robot, &pool)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", design_path.display()))?;
-    let qs: Vec<Vec<f64>> = positions.iter().map(|&k| pool.q(k)).collect();
+    let pool = spec.build(robot, &robot.nominal)?;
+    let qs = design.joint_values(robot).map_err(in_file)?;
+    let positions = design.positions_found_in(robot, &pool).map_err(in_file)?;
     let lm = LmSettings::default()
         .with_max_iterations(a.max_iterations)
         .with_geodesic(!a.no_geodesic);
@@ -309,7 +317,10 @@ fn from_design(a: &CalibrateArgs, robot: &Robot, design_path: &Path) -> Result<(
     let mut v = identification_json(id);
     v.extend(json_map(json!({
         "robot": robot.name,
+        "chain": activecal::report::chain(robot),
         "design": design_path.display().to_string(),
+        "pool": pool.spec,
+        "pool_size": pool.len(),
         "poses": qs.len(),
         "measurement": robot.measurement,
         "noise": a.noise,

@@ -1,0 +1,329 @@
+//! Typed reports of the commands: what `select`, `score`, `bound` and `gap`
+//! found, with pool positions translated to stable pose ids. Each derives
+//! `Serialize`; the command line prints them as text or JSON and never
+//! rebuilds them. (The bound's summary is [`BoundReport`]; the paper's
+//! experiment is [`crate::experiment::paper::PaperReport`].)
+
+use crate::blocks::Blocks;
+use crate::bound::{Bound, BoundReport, DesignGap, SUPPORT_TOL};
+use crate::criterion::Indices;
+use crate::model::{ParamSet, Robot};
+use crate::pool::{Pool, PoolSpec};
+use crate::select::{Algorithm, CriterionKind, Selection, Settings, StepKind};
+use serde::Serialize;
+
+/// The chain a report used: the label of every frame a joint drives, in
+/// joint order.
+#[must_use]
+pub fn chain(robot: &Robot) -> Vec<String> {
+    robot
+        .frames
+        .iter()
+        .filter(|f| f.joint.is_some())
+        .map(|f| f.label.clone())
+        .collect()
+}
+
+/// The pool a report refers to: robot, chain and spec.
+#[derive(Clone, Debug, Serialize)]
+pub struct PoolInfo {
+    /// Robot name or description path.
+    pub robot: String,
+    /// Driven frames of the robot ([`chain`]).
+    pub chain: Vec<String>,
+    /// Lattice values per joint, when the pool is a lattice.
+    pub levels: Option<usize>,
+    /// How the pool was made.
+    pub pool: PoolSpec,
+}
+
+impl PoolInfo {
+    /// The description of `pool` for `robot`.
+    #[must_use]
+    pub fn new(robot: &Robot, pool: &Pool) -> Self {
+        Self {
+            robot: robot.name.clone(),
+            chain: chain(robot),
+            levels: pool.spec.levels(),
+            pool: pool.spec.clone(),
+        }
+    }
+}
+
+/// `score`: the observability indices of a design.
+#[derive(Clone, Debug, Serialize)]
+pub struct ScoreReport {
+    /// The pool.
+    #[serde(flatten)]
+    pub pool: PoolInfo,
+    /// Pose ids of the design.
+    pub poses: Vec<usize>,
+    /// The indices.
+    #[serde(flatten)]
+    pub indices: Indices,
+    /// Unknowns.
+    pub p: usize,
+    /// `rank < p`.
+    pub singular: bool,
+}
+
+impl ScoreReport {
+    /// Scores the design whose Jacobian is `x_design` (one block per pose).
+    #[must_use]
+    pub fn new(pool: PoolInfo, poses: Vec<usize>, x_design: &Blocks) -> Self {
+        let all: Vec<usize> = (0..x_design.n_poses()).collect();
+        let indices = Indices::from_design(x_design, &all);
+        Self {
+            pool,
+            poses,
+            p: x_design.p(),
+            singular: indices.rank < x_design.p(),
+            indices,
+        }
+    }
+}
+
+/// One step of a selection trace, with pose ids.
+#[derive(Clone, Debug, Serialize)]
+pub struct TraceStep {
+    /// Step number, 0 for the initial design.
+    pub step: usize,
+    /// What the step did.
+    pub kind: StepKind,
+    /// Id of the pose added.
+    pub added: Option<usize>,
+    /// Id of the pose removed.
+    pub removed: Option<usize>,
+    /// Design size after the step.
+    pub size: usize,
+    /// `ln OI_D` after the step.
+    pub ln_oid: f64,
+    /// `log10 OI_D` after the step.
+    pub log10_oid: f64,
+    /// The paper's OI after the step.
+    pub oi: f64,
+    /// Whether the ridge was on.
+    pub ridge: bool,
+}
+
+/// `select`: the chosen design, how it was found, and (with `--gap`) its
+/// D-efficiency.
+#[derive(Clone, Debug, Serialize)]
+pub struct SelectReport {
+    /// The pool.
+    #[serde(flatten)]
+    pub pool: PoolInfo,
+    /// Poses in the pool.
+    pub pool_size: usize,
+    /// Pose ids of the design, in the order they entered.
+    pub poses: Vec<usize>,
+    /// `ln OI_D` of the design.
+    pub ln_oid: f64,
+    /// `log10 OI_D`.
+    pub log10_oid: f64,
+    /// The paper's OI.
+    pub oi: f64,
+    /// One row per step.
+    pub trace: Vec<TraceStep>,
+    /// Wall-clock seconds of the selection.
+    pub seconds: f64,
+    /// The algorithm.
+    pub algorithm: Algorithm,
+    /// The criterion.
+    pub criterion: CriterionKind,
+    /// Seed.
+    pub seed: u64,
+    /// Starts.
+    pub starts: usize,
+    /// Fedorov polish.
+    pub polish: bool,
+    /// The start that won.
+    pub best_start: usize,
+    /// Ids of the fixed poses.
+    pub fixed: Vec<usize>,
+    /// `log10` of the relaxation bound (`--gap`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub log10_bound: Option<f64>,
+    /// D-efficiency against the bound (`--gap`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub d_efficiency: Option<f64>,
+    /// The bound's status (`--gap`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bound_status: Option<crate::bound::BoundStatus>,
+}
+
+impl SelectReport {
+    /// The report of `sel`, chosen from `pool` with settings `s`.
+    #[must_use]
+    pub fn new(
+        robot: &Robot,
+        pool: &Pool,
+        sel: &Selection,
+        criterion: CriterionKind,
+        s: &Settings,
+        seconds: f64,
+    ) -> Self {
+        let id = |k: usize| pool.id(k);
+        let l10 = |v: f64| v / std::f64::consts::LN_10;
+        Self {
+            pool: PoolInfo::new(robot, pool),
+            pool_size: pool.len(),
+            poses: pool.ids_of(&sel.poses),
+            ln_oid: sel.ln_oid,
+            log10_oid: l10(sel.ln_oid),
+            oi: sel.oi,
+            trace: sel
+                .trace
+                .iter()
+                .map(|r| TraceStep {
+                    step: r.step,
+                    kind: r.kind,
+                    added: r.added.map(id),
+                    removed: r.removed.map(id),
+                    size: r.size,
+                    ln_oid: r.ln_oid,
+                    log10_oid: l10(r.ln_oid),
+                    oi: r.oi,
+                    ridge: r.ridge,
+                })
+                .collect(),
+            seconds,
+            algorithm: sel.algorithm,
+            criterion,
+            seed: s.seed,
+            starts: s.starts,
+            polish: s.polish,
+            best_start: sel.start,
+            fixed: pool.ids_of(&s.fixed),
+            log10_bound: None,
+            d_efficiency: None,
+            bound_status: None,
+        }
+    }
+
+    /// Adds the design's gap to a bound.
+    pub fn set_gap(&mut self, g: &DesignGap) {
+        self.log10_bound = Some(g.log10_bound);
+        self.d_efficiency = Some(g.d_efficiency);
+        self.bound_status = Some(g.bound_status);
+    }
+}
+
+/// A pose carrying relaxation weight.
+#[derive(Clone, Debug, Serialize)]
+pub struct WeightedPose {
+    /// Pose id.
+    pub pose: usize,
+    /// Its weight.
+    pub w: f64,
+}
+
+/// `bound`: the certified bound over a pool.
+#[derive(Clone, Debug, Serialize)]
+pub struct BoundCommandReport {
+    /// The bound.
+    #[serde(flatten)]
+    pub bound: BoundReport,
+    /// The pool.
+    #[serde(flatten)]
+    pub pool: PoolInfo,
+    /// Parameter set of the Jacobian.
+    pub params: ParamSet,
+    /// The settings the bound was computed with.
+    pub settings: crate::bound::BoundSettings,
+    /// Poses with weight above [`SUPPORT_TOL`] (when asked for).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub support: Option<Vec<WeightedPose>>,
+}
+
+impl BoundCommandReport {
+    /// The report of bound `b` over `pool`.
+    #[must_use]
+    pub fn new(
+        robot: &Robot,
+        pool: &Pool,
+        b: &Bound,
+        params: ParamSet,
+        settings: crate::bound::BoundSettings,
+        with_support: bool,
+    ) -> Self {
+        Self {
+            bound: BoundReport::from(b),
+            pool: PoolInfo::new(robot, pool),
+            params,
+            settings,
+            support: with_support.then(|| {
+                b.support(SUPPORT_TOL)
+                    .into_iter()
+                    .map(|k| WeightedPose {
+                        pose: pool.id(k),
+                        w: b.weights[k],
+                    })
+                    .collect()
+            }),
+        }
+    }
+}
+
+/// `gap`: a design's D-efficiency against the bound over its pool.
+#[derive(Clone, Debug, Serialize)]
+pub struct GapReport {
+    /// The pool.
+    #[serde(flatten)]
+    pub pool: PoolInfo,
+    /// Parameter set of the Jacobian.
+    pub params: ParamSet,
+    /// Pose ids of the design.
+    pub poses: Vec<usize>,
+    /// Poses in the design.
+    pub n: usize,
+    /// Unknowns.
+    pub p: usize,
+    /// `ln OI_D` of the design; `None` when singular.
+    pub ln_oid: Option<f64>,
+    /// `log10 OI_D`; `None` when singular.
+    pub log10_oid: Option<f64>,
+    /// Whether the design is singular.
+    pub singular: bool,
+    /// The bound on `ln OI_D`.
+    pub ln_bound: f64,
+    /// Its `log10`.
+    pub log10_bound: f64,
+    /// D-efficiency (eq. G).
+    pub d_efficiency: f64,
+    /// Ids of the design poses with relaxation weight.
+    pub weighted_poses: Vec<usize>,
+    /// Relaxation weight of every design pose.
+    pub weights: Vec<f64>,
+    /// The bound.
+    pub bound: BoundReport,
+}
+
+impl GapReport {
+    /// The report of gap `g` of the design `poses` (ids) to bound `b`.
+    #[must_use]
+    pub fn new(
+        pool: PoolInfo,
+        params: ParamSet,
+        poses: Vec<usize>,
+        g: &DesignGap,
+        b: &Bound,
+    ) -> Self {
+        Self {
+            pool,
+            params,
+            weighted_poses: g.weighted.iter().map(|&k| poses[k]).collect(),
+            poses,
+            n: g.n,
+            p: g.p,
+            ln_oid: g.ln_oid,
+            log10_oid: g.log10_oid,
+            singular: g.ln_oid.is_none(),
+            ln_bound: g.ln_bound,
+            log10_bound: g.log10_bound,
+            d_efficiency: g.d_efficiency,
+            weights: g.weights.clone(),
+            bound: BoundReport::from(b),
+        }
+    }
+}

@@ -11,10 +11,12 @@ use activecal::identify::{
     ValidationSet, identify, monte_carlo, paper_tables,
 };
 use activecal::io::robot_toml as file;
+use activecal::report::{
+    IdentificationReport, MeasuredCalibrationReport, SimulatedCalibrationReport,
+};
 use activecal::model::{Measurement, Robot};
 use anyhow::{Result, bail};
 use clap::Args;
-use serde_json::{Map, Value, json};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -67,46 +69,6 @@ pub struct CalibrateArgs {
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
-}
-
-/// `{name: value}` in parameter order.
-fn named(names: &[String], values: &[f64]) -> Value {
-    let m: Map<String, Value> = names
-        .iter()
-        .zip(values)
-        .map(|(n, v)| (n.clone(), json!(v)))
-        .collect();
-    Value::Object(m)
-}
-
-/// The fields every calibration reports about its identification: status,
-/// iterations, estimate, standard deviations, correlation, σ̂, residual sums,
-/// rank.
-fn identification_json(id: &Identification) -> Map<String, Value> {
-    let names = &id.names;
-    json_map(json!({
-        "status": id.status,
-        "stop": id.stop,
-        "converged": id.converged(),
-        "iterations": id.iterations,
-        "evaluations": id.evaluations,
-        "estimate": named(names, &id.estimate),
-        "std": id.covariance.as_ref().map(|c| named(names, &c.std)),
-        "correlation": id.covariance.as_ref().map(|c| &c.correlation),
-        "sigma_hat": id.sigma_hat,
-        "rss": id.rss,
-        "initial_rss": id.initial_rss,
-        "rank": id.rank,
-        "unidentifiable": id.unidentifiable,
-    }))
-}
-
-/// The map inside a `json!({...})` object.
-fn json_map(v: Value) -> Map<String, Value> {
-    match v {
-        Value::Object(m) => m,
-        _ => Map::new(),
-    }
 }
 
 /// The robot calibrated by `id`, as a description: both tables are the
@@ -185,22 +147,20 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         .with_geodesic(!a.no_geodesic);
     let id = identify(robot, &robot.nominal, &meas, &lm)?;
     let written = write_calibrated(a, robot, &id, &path.display().to_string())?;
-    let names = &id.names;
+    let mut report = MeasuredCalibrationReport::new(
+        robot,
+        &id,
+        path.display().to_string(),
+        meas.len(),
+    );
+    report.out = a
+        .out
+        .as_ref()
+        .filter(|_| written)
+        .map(|p| p.display().to_string());
+    report.elapsed_seconds = t0.elapsed().as_secs_f64();
+    let v = serde_json::to_value(&report)?;
     let rows = (robot.rows_per_pose() * meas.len()) as f64;
-    let mut v = identification_json(&id);
-    v.extend(json_map(json!({
-        "robot": robot.name,
-        "chain": activecal::report::chain(robot),
-        "measurements": path.display().to_string(),
-        "poses": meas.len(),
-        "measurement": robot.measurement,
-        "change": named(names, &id.estimate.iter().zip(&id.start).map(|(e, s)| e - s).collect::<Vec<_>>()),
-        "rms_residual": (id.rss / rows).sqrt(),
-        "initial_rms_residual": (id.initial_rss / rows).sqrt(),
-        "out": a.out.as_ref().filter(|_| written).map(|p| p.display().to_string()),
-        "elapsed_seconds": t0.elapsed().as_secs_f64(),
-    })));
-    let v = Value::Object(v);
     emit(a.json, &v, || {
         let mut s = format!(
             "{}: {} measured {}s\n{}",
@@ -293,7 +253,6 @@ fn from_design(
     }
     let source = format!("simulated measurements at {}", design_path.display());
     write_calibrated(a, robot, id, &source)?;
-    let names = &id.names;
     let truth = robot.unknown_values(&robot.real);
     let residual: Vec<f64> = truth.iter().zip(&id.estimate).map(|(t, e)| t - e).collect();
     let before = validation.rms(robot, &robot.nominal);
@@ -314,29 +273,34 @@ fn from_design(
     };
     let mc_seconds = t_mc.elapsed().as_secs_f64();
 
-    let mut v = identification_json(id);
-    v.extend(json_map(json!({
-        "robot": robot.name,
-        "chain": activecal::report::chain(robot),
-        "design": design_path.display().to_string(),
-        "pool": pool.spec,
-        "pool_size": pool.len(),
-        "poses": qs.len(),
-        "measurement": robot.measurement,
-        "noise": a.noise,
-        "orientation_noise": full.then(|| a.noise / robot.orientation_scale),
-        "seed": a.seed,
-        "residual": named(names, &residual),
-        "validation_poses": validation.len(),
-        "validation_rms_before": before,
-        "validation_rms_after": after,
-        "validation_orientation_rms_before": rot_before,
-        "validation_orientation_rms_after": rot_after,
-        "monte_carlo": mc,
-        "monte_carlo_seconds": mc.as_ref().map(|_| mc_seconds),
-        "elapsed_seconds": t0.elapsed().as_secs_f64(),
-    })));
-    let v = Value::Object(v);
+    let report = SimulatedCalibrationReport {
+        identification: IdentificationReport::from(id),
+        robot: robot.name.clone(),
+        chain: activecal::report::chain(robot),
+        design: design_path.display().to_string(),
+        pool: pool.spec.clone(),
+        pool_size: pool.len(),
+        poses: qs.len(),
+        measurement: robot.measurement,
+        noise: a.noise,
+        orientation_noise: full.then(|| a.noise / robot.orientation_scale),
+        seed: a.seed,
+        residual: id
+            .names
+            .iter()
+            .cloned()
+            .zip(residual.iter().copied())
+            .collect(),
+        validation_poses: validation.len(),
+        validation_rms_before: before,
+        validation_rms_after: after,
+        validation_orientation_rms_before: rot_before,
+        validation_orientation_rms_after: rot_after,
+        monte_carlo_seconds: mc.as_ref().map(|_| mc_seconds),
+        monte_carlo: mc.clone(),
+        elapsed_seconds: t0.elapsed().as_secs_f64(),
+    };
+    let v = serde_json::to_value(&report)?;
     emit(a.json, &v, || {
         let noise = if full {
             format!(

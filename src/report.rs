@@ -423,7 +423,12 @@ impl MeasuredCalibrationReport {
         poses: usize,
     ) -> Self {
         let rows = (robot.rows_per_pose() * poses) as f64;
-        let change: Vec<f64> = id.estimate.iter().zip(&id.start).map(|(e, s)| e - s).collect();
+        let change: Vec<f64> = id
+            .estimate
+            .iter()
+            .zip(&id.start)
+            .map(|(e, s)| e - s)
+            .collect();
         Self {
             identification: IdentificationReport::from(id),
             robot: robot.name.clone(),
@@ -485,4 +490,94 @@ pub struct SimulatedCalibrationReport {
     pub monte_carlo_seconds: Option<f64>,
     /// Wall-clock seconds.
     pub elapsed_seconds: f64,
+}
+
+/// `fk`: forward kinematics (and the identification Jacobian) at one joint
+/// vector.
+#[derive(Clone, Debug, Serialize)]
+pub struct FkReport {
+    /// Robot name or description path.
+    pub robot: String,
+    /// Driven frames.
+    pub chain: Vec<String>,
+    /// Parameter set.
+    pub params: ParamSet,
+    /// Joint values, radians (or metres).
+    pub q: Vec<f64>,
+    /// End point.
+    pub position: [f64; 3],
+    /// Identification Jacobian, `t` rows of `p` (when asked for).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jacobian: Option<Vec<Vec<f64>>>,
+    /// Names of its columns (when the Jacobian is asked for).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub parameter_names: Option<Vec<String>>,
+}
+
+impl FkReport {
+    /// Forward kinematics of `robot` at `q` with table `params`, and the
+    /// Jacobian when `jacobian` is set.
+    pub fn new(
+        robot: &Robot,
+        params: ParamSet,
+        q: Vec<f64>,
+        jacobian: bool,
+    ) -> crate::Result<Self> {
+        let table = robot.params(params);
+        let p = crate::kinematics::position_checked(robot, table, &q)?;
+        let jac = jacobian.then(|| {
+            let n = robot.n_unknowns();
+            let mut jac = vec![0.0; robot.rows_per_pose() * n];
+            crate::kinematics::Evaluator::new(robot, table).eval(&q, &mut jac);
+            jac.chunks(n.max(1)).map(<[f64]>::to_vec).collect()
+        });
+        Ok(Self {
+            robot: robot.name.clone(),
+            chain: chain(robot),
+            params,
+            q,
+            position: [p.x, p.y, p.z],
+            parameter_names: jac.as_ref().map(|_| robot.parameter_names()),
+            jacobian: jac,
+        })
+    }
+}
+
+/// `pool`: the size of a lattice, and one pose of it.
+#[derive(Clone, Debug, Serialize)]
+pub struct LatticeReport {
+    /// Robot name or description path.
+    pub robot: String,
+    /// Driven frames.
+    pub chain: Vec<String>,
+    /// Values per joint.
+    pub levels: usize,
+    /// Lattice poses.
+    pub size: usize,
+    /// Index of the pose asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub index: Option<usize>,
+    /// Its digits.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub digits: Option<Vec<usize>>,
+    /// Its joint values.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub q: Option<Vec<f64>>,
+}
+
+impl LatticeReport {
+    /// The lattice of `levels` for `robot`, and the pose of `digits` if given.
+    pub fn new(robot: &Robot, levels: usize, digits: Option<Vec<usize>>) -> crate::Result<Self> {
+        let lattice = crate::pool::Lattice::new(robot, levels)?;
+        let index = digits.as_ref().map(|d| lattice.index_of(d)).transpose()?;
+        Ok(Self {
+            robot: robot.name.clone(),
+            chain: chain(robot),
+            levels,
+            size: lattice.size(),
+            q: index.map(|i| lattice.q(i)).transpose()?,
+            index,
+            digits,
+        })
+    }
 }

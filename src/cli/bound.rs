@@ -131,8 +131,14 @@ pub fn cmd_bound(a: BoundArgs) -> Result<()> {
     let settings = a.solve.settings()?;
     let ctx = a.pool.load()?;
     let b = relaxation_bound(&ctx.x, a.n, &settings)?;
-    let report =
-        BoundCommandReport::new(&ctx.robot, &ctx.pool, &b, a.pool.params, settings, a.weights);
+    let report = BoundCommandReport::new(
+        &ctx.robot,
+        &ctx.pool,
+        &b,
+        a.pool.params,
+        settings,
+        a.weights,
+    );
     emit_report(a.json, &report, || {
         let mut s = bound_text(&b);
         if let Some(support) = &report.support {

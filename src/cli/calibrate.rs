@@ -5,16 +5,16 @@
 //! written as a description file.
 
 use super::{emit, refuse_overwrite, write_new};
-use activecal::io::design::DesignFile;
 use activecal::identify::{
     Identification, LmSettings, Measurements, MonteCarloSettings, MonteCarloSummary, ParamGrid,
     ValidationSet, identify, monte_carlo, paper_tables,
 };
+use activecal::io::design::DesignFile;
 use activecal::io::robot_toml as file;
+use activecal::model::{Measurement, Robot};
 use activecal::report::{
     IdentificationReport, MeasuredCalibrationReport, SimulatedCalibrationReport,
 };
-use activecal::model::{Measurement, Robot};
 use anyhow::{Result, bail};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -147,12 +147,8 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         .with_geodesic(!a.no_geodesic);
     let id = identify(robot, &robot.nominal, &meas, &lm)?;
     let written = write_calibrated(a, robot, &id, &path.display().to_string())?;
-    let mut report = MeasuredCalibrationReport::new(
-        robot,
-        &id,
-        path.display().to_string(),
-        meas.len(),
-    );
+    let mut report =
+        MeasuredCalibrationReport::new(robot, &id, path.display().to_string(), meas.len());
     report.out = a
         .out
         .as_ref()

@@ -467,7 +467,9 @@ pub fn run(
         random_oi: rs.oi.clone(),
         eae_oi: e_det.oi,
         eae_trace_oi: e_det.trace.iter().map(|r| r.oi).collect(),
-        eae_oi_trace_oi: e_oi.as_ref().map(|o| o.trace.iter().map(|r| r.oi).collect()),
+        eae_oi_trace_oi: e_oi
+            .as_ref()
+            .map(|o| o.trace.iter().map(|r| r.oi).collect()),
         initial_digits: digits(&e_det.trace_initial())?,
         selected_digits: digits(&e_det.poses)?,
     };
@@ -706,7 +708,10 @@ is therefore about {:.0}x here, not 50,000x.",
                 "Table III: estimated parameters (EAE design)",
                 &self.tables.estimate,
             ),
-            ("Table IV: residuals, real − estimate", &self.tables.residual),
+            (
+                "Table IV: residuals, real − estimate",
+                &self.tables.residual,
+            ),
         ] {
             let _ = writeln!(m, "## {title}\n");
             let _ = writeln!(m, "| frame | gamma | alpha | a | d | beta |");

@@ -144,7 +144,9 @@ impl PoolSource {
     /// Writes the configuration of candidate `id` into `q`.
     fn fill(&self, lattice: Option<&Lattice>, id: usize, q: &mut [f64]) {
         match self {
-            PoolSource::Lattice { .. } => lattice.expect("a lattice source has its lattice").q_into(id, q),
+            PoolSource::Lattice { .. } => lattice
+                .expect("a lattice source has its lattice")
+                .q_into(id, q),
         }
     }
 

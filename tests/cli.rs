@@ -239,7 +239,7 @@ fn calibrate_uses_the_design_pool_with_its_visibility_filter() {
 /// `score`, `gap` and `calibrate`, with the lattice's joint values.
 #[test]
 fn old_design_files_still_load() {
-    let old = "fixtures/design_v0_puma560_levels3.json";
+    let old = "fixtures/designs/puma560_levels3_v0.json";
     let ids: Vec<&str> = vec![
         "0", "13", "26", "40", "53", "67", "80", "94", "107", "121", "134", "148", "161", "175",
         "188", "202", "215", "229", "242", "256", "269", "283", "296", "310", "323", "337", "350",

@@ -11,6 +11,7 @@ pub mod blocks;
 pub mod bound;
 pub mod criterion;
 pub mod error;
+pub mod experiment;
 pub mod identify;
 pub mod io;
 pub mod kinematics;
@@ -19,6 +20,7 @@ pub mod measure;
 pub mod model;
 pub mod observability;
 pub mod pool;
+pub mod report;
 pub mod resources;
 pub mod select;
 

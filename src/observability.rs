@@ -266,7 +266,7 @@ impl Robot {
     /// fixed Hayati identity frame `tool`.
     ///
     /// ```
-    /// use activecal::robot::{Measurement, Robot};
+    /// use activecal::model::{Measurement, Robot};
     /// let pose = Robot::ur5().with_measurement(Measurement::Pose).unwrap();
     /// assert_eq!((pose.rows_per_pose(), pose.n_unknowns()), (6, 30));
     /// assert_eq!(pose.unknowns, Robot::builtin("ur5:pose").unwrap().unknowns);

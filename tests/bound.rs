@@ -467,5 +467,10 @@ fn a_stalled_newton_solve_still_gives_a_valid_bound() {
         let e = BoundSettings::builder().newton(bad).build().unwrap_err();
         assert!(e.to_string().contains("newton."), "{e}");
     }
-    assert!(RelaxationSolver::parse("gurobi").is_err());
+    assert!(serde_json::from_str::<RelaxationSolver>("\"gurobi\"").is_err());
+    assert!(<RelaxationSolver as clap::ValueEnum>::from_str("gurobi", false).is_err());
+    assert_eq!(
+        <RelaxationSolver as clap::ValueEnum>::from_str("newton", false),
+        Ok(RelaxationSolver::Newton)
+    );
 }

@@ -81,7 +81,7 @@ fn bad_input_is_a_clear_error() {
     fails_with(&["fk", "--q", "0,x,0,0,0,0"], "cannot parse 'x'");
     fails_with(
         &["fk", "--q", "0,0,0,0,0,0", "--params", "guess"],
-        "unknown parameter set",
+        "possible values: nominal, real",
     );
     fails_with(&["pool", "--levels", "1"], "at least 2 levels");
     fails_with(
@@ -142,11 +142,11 @@ fn select_errors_are_clear() {
     );
     fails_with(
         &["select", "--levels", "3", "--algorithm", "magic"],
-        "unknown algorithm",
+        "possible values: eae, fedorov, detmax, random",
     );
     fails_with(
         &["select", "--levels", "3", "--criterion", "magic"],
-        "unknown criterion",
+        "possible values: det, oi",
     );
     // A box far from the robot leaves nothing.
     let far = r#"{"kind":"box","min":[100,100,100],"max":[200,200,200]}"#;
@@ -196,4 +196,152 @@ fn score_reports_singular_designs() {
     assert!(v["rank"].as_u64().unwrap() < 27);
     fails_with(&["score", "--poses", "1,1,2"], "more than once");
     fails_with(&["score", "--poses", "1,99999"], "not in the pool");
+}
+
+/// `calibrate --design` draws its validation poses from the design's own
+/// pool, with the visibility filter `select` applied (it used to rebuild
+/// the unfiltered lattice, so poses the sensor cannot see were validated).
+#[test]
+fn calibrate_uses_the_design_pool_with_its_visibility_filter() {
+    let dir = std::env::temp_dir().join(format!("activecal-calvis-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let design = dir.join("vis.json");
+    let d = design.to_str().unwrap();
+    let half = r#"{"kind":"box","min":[-100,-100,-100],"max":[100,100,0.5]}"#;
+    let sel = json_of(&[
+        "select",
+        "--levels",
+        "3",
+        "--visibility",
+        half,
+        "--out",
+        d,
+        "--json",
+    ]);
+    let pool_size = sel["pool_size"].as_u64().unwrap() as usize;
+    assert!(pool_size < 729, "the box should hide some poses");
+    assert_eq!(sel["pool"]["filters"][0]["visibility"]["kind"], "box");
+    let file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&design).unwrap()).unwrap();
+    assert_eq!(file["pool"], sel["pool"]);
+    assert_eq!(file["q"].as_array().unwrap().len(), 30);
+    // Every pose outside the design but in the filtered pool validates.
+    let free = pool_size - 30;
+    let v = json_of(&[
+        "calibrate",
+        "--design",
+        d,
+        "--validation",
+        &free.to_string(),
+        "--json",
+    ]);
+    assert_eq!(v["pool_size"].as_u64().unwrap() as usize, pool_size);
+    assert_eq!(v["validation_poses"].as_u64().unwrap() as usize, free);
+    assert_eq!(v["pool"], sel["pool"]);
+    assert_eq!(v["chain"].as_array().unwrap().len(), 6);
+    // One more is more than the sensor sees (the unfiltered lattice has 699).
+    fails_with(
+        &[
+            "calibrate",
+            "--design",
+            d,
+            "--validation",
+            &(free + 1).to_string(),
+        ],
+        "more validation poses than pool poses",
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A design file of the old format (lattice indices only) still loads in
+/// `score`, `gap` and `calibrate`, with the lattice's joint values.
+#[test]
+fn old_design_files_still_load() {
+    let old = "fixtures/designs/puma560_levels3_v0.json";
+    let ids: Vec<&str> = vec![
+        "0", "13", "26", "40", "53", "67", "80", "94", "107", "121", "134", "148", "161", "175",
+        "188", "202", "215", "229", "242", "256", "269", "283", "296", "310", "323", "337", "350",
+        "364", "377", "391",
+    ];
+    let s = json_of(&["score", "--design", old, "--json"]);
+    let by_ids = json_of(&[
+        "score",
+        "--levels",
+        "3",
+        "--poses",
+        &ids.join(","),
+        "--json",
+    ]);
+    assert_eq!(s["poses"].as_array().unwrap().len(), 30);
+    assert_eq!(s["ln_oid"], by_ids["ln_oid"]);
+    assert_eq!(s["levels"], 3);
+    let g = json_of(&[
+        "gap",
+        "--design",
+        old,
+        "--first-order",
+        "--gap-tol",
+        "1e-3",
+        "--json",
+    ]);
+    assert_eq!(g["poses"], s["poses"]);
+    assert_eq!(g["bound"]["status"], "certified");
+    let c = json_of(&["calibrate", "--design", old, "--validation", "50", "--json"]);
+    assert_eq!(c["poses"], 30);
+    assert_eq!(c["pool_size"], 729);
+}
+
+/// A design's stored joint values are what `score` uses: a pose moved off
+/// the lattice changes the score, and `gap` (which needs the pool's poses)
+/// says which pose is not in the pool.
+#[test]
+fn stored_joint_values_are_scored() {
+    let dir = std::env::temp_dir().join(format!("activecal-qdesign-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("d.json");
+    let p = path.to_str().unwrap();
+    json_of(&[
+        "select", "--levels", "3", "--seed", "2", "--out", p, "--json",
+    ]);
+    let before = json_of(&["score", "--design", p, "--json"]);
+    let mut file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    file["q"][0][1] = serde_json::json!(0.123);
+    std::fs::write(&path, file.to_string()).unwrap();
+    let after = json_of(&["score", "--design", p, "--json"]);
+    assert_ne!(before["ln_oid"], after["ln_oid"]);
+    fails_with(
+        &["gap", "--design", p, "--first-order"],
+        "other joint values",
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The bound's status is spelled the same (serde, lowercase) in every report.
+#[test]
+fn bound_status_is_lowercase_everywhere() {
+    let b = json_of(&[
+        "bound",
+        "--levels",
+        "3",
+        "--n",
+        "15",
+        "--first-order",
+        "--gap-tol",
+        "1e-3",
+        "--json",
+    ]);
+    assert_eq!(b["status"], "certified");
+    let s = json_of(&[
+        "select",
+        "--levels",
+        "3",
+        "--n",
+        "15",
+        "--gap",
+        "--gap-solver",
+        "newton",
+        "--json",
+    ]);
+    assert_eq!(s["bound_status"], "certified");
 }

@@ -62,7 +62,7 @@ fn pipeline_with(robot: &str, tag: &str, pose: bool, p: usize, exact: bool) {
         "newton",
         "--json",
     ]);
-    assert_eq!(sel["bound_status"], "Certified", "{robot}");
+    assert_eq!(sel["bound_status"], "certified", "{robot}");
     assert_eq!(sel["poses"].as_array().unwrap().len(), 30, "{robot}");
     let ln_oid = f(&sel, "ln_oid");
     assert!(ln_oid.is_finite(), "{robot}: {sel}");

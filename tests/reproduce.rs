@@ -204,7 +204,7 @@ fn reduced_reproduce_matches_the_underlying_commands() {
     assert!((b1 - b2).abs() < 1e-6, "{b1} vs {b2}");
     // The Newton cross-check in the report, and `bound --solver newton`.
     let nb = &report["bound"]["newton"];
-    assert_eq!(nb["status"], "Certified");
+    assert_eq!(nb["status"], "certified");
     let b3 = nb["log10_bound"].as_f64().unwrap();
     assert!((b3 - b2).abs() < 1e-6, "{b3} vs {b2}");
     let bn = run_json(&[

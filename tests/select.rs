@@ -283,3 +283,46 @@ fn score_indices_agree_with_an_independent_cholesky_to_1e_10() {
         assert!((2.0 * 27.0 * (ind.oi * 27.0).ln() - ind.ln_oid).abs() < 1e-9);
     }
 }
+
+/// Multi-start keeps the start with the best score of the criterion that
+/// drove it; with the D criterion that score is ln OI_D, so the result is
+/// the one ranked by ln det.
+#[test]
+fn multistart_ranks_starts_by_the_criterion_score() {
+    use activecal::criterion::{Criterion, InfoState, StateSettings};
+    let x = puma_pool(3);
+    let s = Settings {
+        n: 15,
+        initial: 10,
+        starts: 4,
+        seed: 3,
+        ..Settings::default()
+    };
+    let d = multistart(&x, DCriterion::new, Algorithm::Eae, &s).unwrap();
+    assert_eq!(d.start_score, d.start_ln_oid);
+    assert_eq!(d.score, d.ln_oid);
+    let best = d
+        .start_ln_oid
+        .iter()
+        .cloned()
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert_eq!(d.start_ln_oid[d.start], best);
+    assert_eq!(d.start_score.len(), 4);
+
+    let o = multistart(&x, OiCriterion::new, Algorithm::Eae, &s).unwrap();
+    let best = o
+        .start_score
+        .iter()
+        .cloned()
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert_eq!(o.start_score[o.start], best);
+    assert_eq!(o.score, best);
+    // The score is the criterion's own, recomputed from the design.
+    let state = InfoState::new(&x, &o.poses, StateSettings::default()).unwrap();
+    let again = OiCriterion::new().score(&x, &state);
+    assert!(
+        (again - o.score).abs() <= 1e-9 * again.abs(),
+        "{again} vs {}",
+        o.score
+    );
+}

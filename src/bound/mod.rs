@@ -49,7 +49,7 @@ use variance::{VarianceWork, check_problem, make_feasible, nth_largest, scale_co
 pub const SUPPORT_TOL: f64 = 1e-6;
 
 /// The solver of the candidate subproblems of (R).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 pub enum RelaxationSolver {
     /// Clarabel on the PSD + exponential-cone form ([`conic`]).
@@ -57,21 +57,6 @@ pub enum RelaxationSolver {
     Clarabel,
     /// The log-barrier Newton method on `ln det M(w)` itself ([`newton`]).
     Newton,
-}
-
-impl RelaxationSolver {
-    /// Parses `clarabel` or `newton`.
-    pub fn parse(s: &str) -> Result<Self, BoundError> {
-        match s {
-            "clarabel" => Ok(Self::Clarabel),
-            "newton" => Ok(Self::Newton),
-            other => Err(BoundError::InvalidSetting {
-                name: "solver",
-                value: other.into(),
-                reason: "must be clarabel or newton",
-            }),
-        }
-    }
 }
 
 /// Settings of [`relaxation_bound`]. Build with [`BoundSettings::builder`]
@@ -310,6 +295,7 @@ pub struct ConicSummary {
     /// Candidates in the last solve.
     pub candidates: usize,
     /// Whether the last solve was repeated without equilibration.
+    #[serde(rename = "retried_without_equilibration")]
     pub retried: bool,
     /// Seconds in Clarabel, all rounds.
     pub seconds: f64,
@@ -353,6 +339,56 @@ pub struct Bound {
     pub conic: ConicSummary,
     /// Wall-clock seconds, all stages.
     pub seconds: f64,
+}
+
+/// The summary of a [`Bound`] that every report prints: the bound, its
+/// status and what each stage did (the weights left out). Serialised the
+/// same way everywhere: the status in snake case (`certified`).
+#[derive(Clone, Debug, Serialize)]
+pub struct BoundReport {
+    /// See [`Bound::ln_bound`].
+    pub ln_bound: f64,
+    /// `log10` of the bound on OI_D.
+    pub log10_bound: f64,
+    /// See [`Bound::ln_primal`].
+    pub ln_primal: f64,
+    /// See [`Bound::certificate_gap`].
+    pub certificate_gap: f64,
+    /// How it ended.
+    pub status: BoundStatus,
+    /// Poses per design.
+    pub n: usize,
+    /// Unknowns.
+    pub p: usize,
+    /// Pool size.
+    pub pool_size: usize,
+    /// Poses with weight above [`SUPPORT_TOL`].
+    pub support_size: usize,
+    /// Wall-clock seconds, all stages.
+    pub seconds: f64,
+    /// The candidate-set stage.
+    pub solver: ConicSummary,
+    /// The first-order stage.
+    pub first_order: ExchangeSummary,
+}
+
+impl From<&Bound> for BoundReport {
+    fn from(b: &Bound) -> Self {
+        Self {
+            ln_bound: b.ln_bound,
+            log10_bound: b.log10_bound(),
+            ln_primal: b.ln_primal,
+            certificate_gap: b.certificate_gap,
+            status: b.status,
+            n: b.n,
+            p: b.p,
+            pool_size: b.pool_size,
+            support_size: b.support_size,
+            seconds: b.seconds,
+            solver: b.conic.clone(),
+            first_order: b.first_order.clone(),
+        }
+    }
 }
 
 /// What the first-order stage did.

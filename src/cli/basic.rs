@@ -1,10 +1,8 @@
 //! `robots`, `fk`, `pool`: the kinematic core on the command line.
 
-use super::{emit, load_robot, parse_list};
-use activecal::kinematics::position_checked;
-use activecal::measure::JacobianEvaluator;
+use super::{emit, emit_report, load_robot, parse_list};
 use activecal::model::{ParamSet, Robot};
-use activecal::pool::Lattice;
+use activecal::report::{FkReport, LatticeReport};
 use anyhow::Result;
 use clap::Args;
 use serde_json::{Value, json};
@@ -35,9 +33,9 @@ pub struct FkArgs {
     /// `:pose` for full-pose measurements.
     #[arg(long, default_value = "puma560")]
     pub robot: String,
-    /// Parameter set: nominal or real.
-    #[arg(long, default_value = "nominal")]
-    pub params: String,
+    /// Parameter set.
+    #[arg(long, value_enum, default_value_t = ParamSet::Nominal)]
+    pub params: ParamSet,
     /// Joint angles, comma separated (radians, or degrees with --deg).
     #[arg(long, allow_hyphen_values = true)]
     pub q: String,
@@ -153,61 +151,41 @@ pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
 /// Runs `fk`.
 pub fn cmd_fk(a: FkArgs) -> Result<()> {
     let robot = load_robot(&a.robot)?;
-    let set = ParamSet::parse(&a.params)?;
     let mut q: Vec<f64> = parse_list(&a.q, "--q")?;
     if a.deg {
         q.iter_mut().for_each(|v| *v = v.to_radians());
     }
-    let table = robot.params(set);
-    let p = position_checked(&robot, table, &q)?;
-    let mut v = json!({ "robot": robot.name, "params": set, "q": q, "position": [p.x, p.y, p.z] });
-    let t = robot.rows_per_pose();
-    let mut jac = vec![0.0; t * robot.n_unknowns()];
-    if a.jacobian {
-        JacobianEvaluator::new(&robot, table).eval(&q, &mut jac);
-        let n = robot.n_unknowns();
-        v["jacobian"] = json!(jac.chunks(n).collect::<Vec<_>>());
-        v["parameter_names"] = json!(robot.parameter_names());
-    }
-    emit(a.json, &v, || {
-        let mut s = format!("position: {:.12} {:.12} {:.12}\n", p.x, p.y, p.z);
-        if a.jacobian {
-            let n = robot.n_unknowns();
-            for (c, name) in robot.parameter_names().iter().enumerate() {
+    let r = FkReport::new(&robot, a.params, q, a.jacobian)?;
+    emit_report(a.json, &r, || {
+        let [x, y, z] = r.position;
+        let mut s = format!("position: {x:.12} {y:.12} {z:.12}\n");
+        if let (Some(jac), Some(names)) = (&r.jacobian, &r.parameter_names) {
+            for (c, name) in names.iter().enumerate() {
                 s += &format!("{name:>8}:");
-                for r in 0..t {
-                    s += &format!(" {:>14.8}", jac[r * n + c]);
+                for row in jac {
+                    s += &format!(" {:>14.8}", row[c]);
                 }
                 s += "\n";
             }
         }
         s
-    });
-    Ok(())
+    })
 }
 
 /// Runs `pool`.
 pub fn cmd_pool(a: PoolArgs) -> Result<()> {
     let robot = load_robot(&a.robot)?;
-    let lattice = Lattice::new(&robot, a.levels)?;
-    let mut v = json!({ "robot": robot.name, "levels": a.levels, "size": lattice.size() });
-    if let Some(d) = &a.digits {
-        let digits: Vec<usize> = parse_list(d, "--digits")?;
-        let index = lattice.index_of(&digits)?;
-        v["index"] = json!(index);
-        v["digits"] = json!(digits);
-        v["q"] = json!(lattice.q(index)?);
-    }
-    emit(a.json, &v, || {
-        let mut s = format!(
-            "lattice: {} levels per joint, {} poses\n",
-            a.levels,
-            lattice.size()
-        );
-        if let Some(i) = v.get("index") {
-            s += &format!("index: {i}\nq (rad): {}\n", v["q"]);
+    let digits: Option<Vec<usize>> = a
+        .digits
+        .as_deref()
+        .map(|d| parse_list(d, "--digits"))
+        .transpose()?;
+    let r = LatticeReport::new(&robot, a.levels, digits)?;
+    emit_report(a.json, &r, || {
+        let mut s = format!("lattice: {} levels per joint, {} poses\n", r.levels, r.size);
+        if let (Some(i), Some(q)) = (r.index, &r.q) {
+            s += &format!("index: {i}\nq (rad): {q:?}\n");
         }
         s
-    });
-    Ok(())
+    })
 }

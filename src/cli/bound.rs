@@ -1,12 +1,13 @@
 //! `bound` and `gap`: the certified D-optimal relaxation bound on OI_D, and a
 //! design's D-efficiency against it.
 
-use super::{PoolOpts, emit};
+use super::{PoolOpts, build_pool, emit_report, filters, load_description};
 use activecal::bound::{Bound, BoundSettings, RelaxationSolver, design_gap, relaxation_bound};
 use activecal::io::design::DesignFile;
+use activecal::model::ParamSet;
+use activecal::report::{BoundCommandReport, GapReport, PoolInfo};
 use anyhow::Result;
 use clap::Args;
-use serde_json::{Value, json};
 use std::path::PathBuf;
 
 /// Options of the relaxation solve shared by `bound` and `gap`.
@@ -20,8 +21,8 @@ pub struct SolveOpts {
     pub first_order: bool,
     /// Solver of the candidate subproblems: clarabel (conic form) or newton
     /// (log-barrier Newton on ln det itself). Both are certified by eq. (C).
-    #[arg(long, default_value = "clarabel")]
-    pub solver: String,
+    #[arg(long, value_enum, default_value_t = RelaxationSolver::Clarabel)]
+    pub solver: RelaxationSolver,
     /// Poses outside the first-order support given to Clarabel, by largest
     /// variance.
     #[arg(long, default_value_t = 100)]
@@ -37,7 +38,7 @@ impl SolveOpts {
         Ok(BoundSettings::builder()
             .gap_tol(self.gap_tol)
             .use_conic(!self.first_order)
-            .solver(RelaxationSolver::parse(&self.solver)?)
+            .solver(self.solver)
             .screen_extra(self.screen_extra)
             .max_rounds(self.max_rounds)
             .build()?)
@@ -68,9 +69,9 @@ pub struct GapArgs {
     /// The design file (JSON with robot, levels, poses).
     #[arg(long)]
     pub design: PathBuf,
-    /// Parameter set the Jacobian is computed with: nominal or real.
-    #[arg(long, default_value = "nominal")]
-    pub params: String,
+    /// Parameter set the Jacobian is computed with.
+    #[arg(long, value_enum, default_value_t = ParamSet::Nominal)]
+    pub params: ParamSet,
     /// Sensor visibility region as JSON (see `bound --help`).
     #[arg(long)]
     pub visibility: Option<String>,
@@ -79,36 +80,6 @@ pub struct GapArgs {
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
-}
-
-/// The JSON summary of a bound.
-fn bound_json(b: &Bound) -> Value {
-    json!({
-        "ln_bound": b.ln_bound,
-        "log10_bound": b.log10_bound(),
-        "ln_primal": b.ln_primal,
-        "certificate_gap": b.certificate_gap,
-        "status": b.status,
-        "n": b.n,
-        "p": b.p,
-        "pool_size": b.pool_size,
-        "support_size": b.support_size,
-        "seconds": b.seconds,
-        "solver": {
-            "solver": b.conic.solver,
-            "status": b.conic.status,
-            "iterations": b.conic.iterations,
-            "total_iterations": b.conic.total_iterations,
-            "rounds": b.conic.rounds,
-            "candidates": b.conic.candidates,
-            "retried_without_equilibration": b.conic.retried,
-            "seconds": b.conic.seconds,
-            "ln_det_primal": b.conic.ln_det_primal,
-            "ln_det_dual": b.conic.ln_det_dual,
-            "polish_steps": b.conic.polish_steps,
-        },
-        "first_order": b.first_order,
-    })
 }
 
 fn bound_text(b: &Bound) -> String {
@@ -160,70 +131,50 @@ pub fn cmd_bound(a: BoundArgs) -> Result<()> {
     let settings = a.solve.settings()?;
     let ctx = a.pool.load()?;
     let b = relaxation_bound(&ctx.x, a.n, &settings)?;
-    let mut v = bound_json(&b);
-    v["robot"] = json!(ctx.robot.name);
-    v["levels"] = json!(a.pool.levels);
-    v["params"] = json!(a.pool.params);
-    v["settings"] = json!(settings);
-    let support: Vec<(usize, f64)> = b
-        .support(activecal::bound::SUPPORT_TOL)
-        .into_iter()
-        .map(|k| (ctx.pool.indices[k], b.weights[k]))
-        .collect();
-    if a.weights {
-        v["support"] = json!(
-            support
-                .iter()
-                .map(|&(pose, w)| json!({"pose": pose, "w": w}))
-                .collect::<Vec<_>>()
-        );
-    }
-    emit(a.json, &v, || {
+    let report = BoundCommandReport::new(
+        &ctx.robot,
+        &ctx.pool,
+        &b,
+        a.pool.params,
+        settings,
+        a.weights,
+    );
+    emit_report(a.json, &report, || {
         let mut s = bound_text(&b);
-        if a.weights {
+        if let Some(support) = &report.support {
             s += "pose      weight\n";
-            for (pose, w) in &support {
-                s += &format!("{pose:>6}  {w:.6}\n");
+            for w in support {
+                s += &format!("{:>6}  {:.6}\n", w.pose, w.w);
             }
         }
         s
-    });
-    Ok(())
+    })
 }
 
-/// Runs `gap`.
+/// Runs `gap`: the bound over the design's own pool (with `--visibility`
+/// replacing its filters when given).
 pub fn cmd_gap(a: GapArgs) -> Result<()> {
     let settings = a.solve.settings()?;
     let d = DesignFile::read(&a.design)?;
-    let opts = PoolOpts {
-        robot: d.robot.clone(),
-        levels: d.levels,
-        params: a.params.clone(),
-        visibility: a.visibility.clone(),
-    };
-    let ctx = opts.load()?;
-    let positions = d.positions_in(&ctx.robot, &ctx.pool)?;
+    let desc = load_description(&d.robot)?;
+    let mut spec = d.spec()?;
+    if d.pool.is_none() || a.visibility.is_some() {
+        spec.filters = filters(a.visibility.as_deref(), desc.visibility.as_ref())?;
+    }
+    let ctx = build_pool(desc.robot, &spec, a.params)?;
+    let positions = d
+        .positions_in(&ctx.robot, &ctx.pool)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?;
     let b = relaxation_bound(&ctx.x, positions.len(), &settings)?;
     let g = design_gap(&ctx.x, &positions, &b)?;
-    let weighted: Vec<usize> = g.weighted.iter().map(|&k| d.poses[k]).collect();
-    let v = json!({
-        "robot": ctx.robot.name,
-        "levels": d.levels,
-        "params": a.params,
-        "poses": d.poses,
-        "n": g.n,
-        "p": g.p,
-        "ln_oid": g.ln_oid,
-        "log10_oid": g.log10_oid,
-        "singular": g.ln_oid.is_none(),
-        "ln_bound": g.ln_bound,
-        "log10_bound": g.log10_bound,
-        "d_efficiency": g.d_efficiency,
-        "weighted_poses": weighted,
-        "weights": g.weights,
-        "bound": bound_json(&b),
-    });
-    emit(a.json, &v, || {
+    let report = GapReport::new(
+        PoolInfo::new(&ctx.robot, &ctx.pool),
+        a.params,
+        d.poses.clone(),
+        &g,
+        &b,
+    );
+    emit_report(a.json, &report, || {
         let oid = g
             .log10_oid
             .map_or("singular (-inf)".to_string(), |l| format!("{l:.6}"));
@@ -238,10 +189,9 @@ pub fn cmd_gap(a: GapArgs) -> Result<()> {
             b.certificate_gap,
             g.d_efficiency,
             activecal::bound::gap::WEIGHT_TOL,
-            weighted.len(),
+            report.weighted_poses.len(),
             g.n,
-            weighted
+            report.weighted_poses
         )
-    });
-    Ok(())
+    })
 }

@@ -4,7 +4,7 @@
 //! a file of real measurements. Either way the calibrated robot can be
 //! written as a description file.
 
-use super::{emit, load_robot, refuse_overwrite, write_new};
+use super::{emit, refuse_overwrite, write_new};
 use activecal::identify::{
     Identification, LmSettings, Measurements, MonteCarloSettings, MonteCarloSummary, ParamGrid,
     ValidationSet, identify, monte_carlo, paper_tables,
@@ -12,10 +12,11 @@ use activecal::identify::{
 use activecal::io::design::DesignFile;
 use activecal::io::robot_toml as file;
 use activecal::model::Robot;
-use activecal::pool::Pool;
+use activecal::report::{
+    IdentificationReport, MeasuredCalibrationReport, SimulatedCalibrationReport,
+};
 use anyhow::{Result, bail};
 use clap::Args;
-use serde_json::{Map, Value, json};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -68,46 +69,6 @@ pub struct CalibrateArgs {
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
-}
-
-/// `{name: value}` in parameter order.
-fn named(names: &[String], values: &[f64]) -> Value {
-    let m: Map<String, Value> = names
-        .iter()
-        .zip(values)
-        .map(|(n, v)| (n.clone(), json!(v)))
-        .collect();
-    Value::Object(m)
-}
-
-/// The fields every calibration reports about its identification: status,
-/// iterations, estimate, standard deviations, correlation, σ̂, residual sums,
-/// rank.
-fn identification_json(id: &Identification) -> Map<String, Value> {
-    let names = &id.names;
-    json_map(json!({
-        "status": id.status,
-        "stop": id.stop,
-        "converged": id.converged(),
-        "iterations": id.iterations,
-        "evaluations": id.evaluations,
-        "estimate": named(names, &id.estimate),
-        "std": id.covariance.as_ref().map(|c| named(names, &c.std)),
-        "correlation": id.covariance.as_ref().map(|c| &c.correlation),
-        "sigma_hat": id.sigma_hat,
-        "rss": id.rss,
-        "initial_rss": id.initial_rss,
-        "rank": id.rank,
-        "unidentifiable": id.unidentifiable,
-    }))
-}
-
-/// The map inside a `json!({...})` object.
-fn json_map(v: Value) -> Map<String, Value> {
-    match v {
-        Value::Object(m) => m,
-        _ => Map::new(),
-    }
 }
 
 /// The robot calibrated by `id`, as a description: both tables are the
@@ -163,10 +124,11 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     for path in [&a.out, &a.save_measurements].into_iter().flatten() {
         refuse_overwrite(path, a.force)?;
     }
-    let robot = load_robot(&a.robot)?;
+    let desc = super::load_description(&a.robot)?;
+    let robot = &desc.robot;
     match (&a.design, &a.measurements) {
-        (_, Some(m)) => from_measurements(&a, &robot, m),
-        (Some(d), None) => from_design(&a, &robot, d),
+        (_, Some(m)) => from_measurements(&a, robot, m),
+        (Some(d), None) => from_design(&a, robot, desc.visibility.as_ref(), d),
         (None, None) => bail!("give --design (simulate) or --measurements (real data)"),
     }
 }
@@ -185,21 +147,16 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         .with_geodesic(!a.no_geodesic);
     let id = identify(robot, &robot.nominal, &meas, &lm)?;
     let written = write_calibrated(a, robot, &id, &path.display().to_string())?;
-    let names = &id.names;
+    let mut report =
+        MeasuredCalibrationReport::new(robot, &id, path.display().to_string(), meas.len());
+    report.out = a
+        .out
+        .as_ref()
+        .filter(|_| written)
+        .map(|p| p.display().to_string());
+    report.elapsed_seconds = t0.elapsed().as_secs_f64();
+    let v = serde_json::to_value(&report)?;
     let rows = (robot.rows_per_pose() * meas.len()) as f64;
-    let mut v = identification_json(&id);
-    v.extend(json_map(json!({
-        "robot": robot.name,
-        "measurements": path.display().to_string(),
-        "poses": meas.len(),
-        "measurement": robot.measurement,
-        "change": named(names, &id.estimate.iter().zip(&id.start).map(|(e, s)| e - s).collect::<Vec<_>>()),
-        "rms_residual": (id.rss / rows).sqrt(),
-        "initial_rms_residual": (id.initial_rss / rows).sqrt(),
-        "out": a.out.as_ref().filter(|_| written).map(|p| p.display().to_string()),
-        "elapsed_seconds": t0.elapsed().as_secs_f64(),
-    })));
-    let v = Value::Object(v);
     emit(a.json, &v, || {
         let mut s = format!(
             "{}: {} measured {}s\n{}",
@@ -248,22 +205,29 @@ fn status_text(id: &Identification) -> String {
 }
 
 /// Simulated calibration at a design's poses.
-fn from_design(a: &CalibrateArgs, robot: &Robot, design_path: &Path) -> Result<()> {
+///
+/// The measurements are simulated at the design's stored joint values; the
+/// held-out validation poses come from the design's own pool (the same pool,
+/// filters included, that `select` chose it from), outside the design.
+fn from_design(
+    a: &CalibrateArgs,
+    robot: &Robot,
+    described: Option<&activecal::measure::Visibility>,
+    design_path: &Path,
+) -> Result<()> {
     let t0 = Instant::now();
+    let in_file = |e: activecal::Error| anyhow::anyhow!("{}: {e}", design_path.display());
     let design = DesignFile::read(design_path)?;
-    if design.robot != robot.name {
-        anyhow::bail!(
-            "{}: the design is for robot '{}', not '{}'",
-            design_path.display(),
-            design.robot,
-            robot.name
-        );
+    design.check_robot(robot).map_err(in_file)?;
+    let mut spec = design.spec().map_err(in_file)?;
+    if design.pool.is_none() {
+        // An old file names only its lattice: the pool `select` used had the
+        // robot description's visibility region.
+        spec.filters = super::filters(None, described)?;
     }
-    let pool = Pool::full(robot, design.levels)?;
-    let positions = design
-        .positions_in(robot, &pool)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", design_path.display()))?;
-    let qs: Vec<Vec<f64>> = positions.iter().map(|&k| pool.q(k)).collect();
+    let pool = spec.build(robot, &robot.nominal)?;
+    let qs = design.joint_values(robot).map_err(in_file)?;
+    let positions = design.positions_found_in(robot, &pool).map_err(in_file)?;
     let lm = LmSettings::default()
         .with_max_iterations(a.max_iterations)
         .with_geodesic(!a.no_geodesic);
@@ -285,7 +249,6 @@ fn from_design(a: &CalibrateArgs, robot: &Robot, design_path: &Path) -> Result<(
     }
     let source = format!("simulated measurements at {}", design_path.display());
     write_calibrated(a, robot, id, &source)?;
-    let names = &id.names;
     let truth = robot.unknown_values(&robot.real);
     let residual: Vec<f64> = truth.iter().zip(&id.estimate).map(|(t, e)| t - e).collect();
     let before = validation.rms(robot, &robot.nominal);
@@ -306,26 +269,34 @@ fn from_design(a: &CalibrateArgs, robot: &Robot, design_path: &Path) -> Result<(
     };
     let mc_seconds = t_mc.elapsed().as_secs_f64();
 
-    let mut v = identification_json(id);
-    v.extend(json_map(json!({
-        "robot": robot.name,
-        "design": design_path.display().to_string(),
-        "poses": qs.len(),
-        "measurement": robot.measurement,
-        "noise": a.noise,
-        "orientation_noise": full.then(|| a.noise / robot.orientation_scale),
-        "seed": a.seed,
-        "residual": named(names, &residual),
-        "validation_poses": validation.len(),
-        "validation_rms_before": before,
-        "validation_rms_after": after,
-        "validation_orientation_rms_before": rot_before,
-        "validation_orientation_rms_after": rot_after,
-        "monte_carlo": mc,
-        "monte_carlo_seconds": mc.as_ref().map(|_| mc_seconds),
-        "elapsed_seconds": t0.elapsed().as_secs_f64(),
-    })));
-    let v = Value::Object(v);
+    let report = SimulatedCalibrationReport {
+        identification: IdentificationReport::from(id),
+        robot: robot.name.clone(),
+        chain: activecal::report::chain(robot),
+        design: design_path.display().to_string(),
+        pool: pool.spec.clone(),
+        pool_size: pool.len(),
+        poses: qs.len(),
+        measurement: robot.measurement,
+        noise: a.noise,
+        orientation_noise: full.then(|| a.noise / robot.orientation_scale),
+        seed: a.seed,
+        residual: id
+            .names
+            .iter()
+            .cloned()
+            .zip(residual.iter().copied())
+            .collect(),
+        validation_poses: validation.len(),
+        validation_rms_before: before,
+        validation_rms_after: after,
+        validation_orientation_rms_before: rot_before,
+        validation_orientation_rms_after: rot_after,
+        monte_carlo_seconds: mc.as_ref().map(|_| mc_seconds),
+        monte_carlo: mc.clone(),
+        elapsed_seconds: t0.elapsed().as_secs_f64(),
+    };
+    let v = serde_json::to_value(&report)?;
     emit(a.json, &v, || {
         let noise = if full {
             format!(

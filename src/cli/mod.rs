@@ -8,7 +8,9 @@ pub mod figures;
 pub mod reproduce;
 pub mod select;
 
-use activecal::model::Robot;
+use activecal::measure::Visibility;
+use activecal::model::{ParamSet, Robot};
+use activecal::pool::{Pool, PoolFilter, PoolSource, PoolSpec};
 use anyhow::Result;
 use serde_json::Value;
 
@@ -62,6 +64,17 @@ pub fn emit(json_out: bool, value: &Value, text: impl FnOnce() -> String) {
     let _ = std::io::stdout().lock().write_all(s.as_bytes());
 }
 
+/// Prints a typed report as one JSON line, or the human-readable `text`.
+pub fn emit_report<T: serde::Serialize>(
+    json_out: bool,
+    report: &T,
+    text: impl FnOnce() -> String,
+) -> Result<()> {
+    let v = serde_json::to_value(report)?;
+    emit(json_out, &v, text);
+    Ok(())
+}
+
 /// Options that define a pose pool, shared by the commands that need one.
 #[derive(clap::Args, Clone, Debug)]
 pub struct PoolOpts {
@@ -72,9 +85,9 @@ pub struct PoolOpts {
     /// Lattice values per joint.
     #[arg(long, default_value_t = 5)]
     pub levels: usize,
-    /// Parameter set the Jacobian is computed with: nominal or real.
-    #[arg(long, default_value = "nominal")]
-    pub params: String,
+    /// Parameter set the Jacobian is computed with.
+    #[arg(long, value_enum, default_value_t = ParamSet::Nominal)]
+    pub params: ParamSet,
     /// Sensor visibility region as JSON, e.g.
     /// '{"kind":"box","min":[-30,-30,-30],"max":[30,30,30]}' or
     /// '{"kind":"cone","apex":[0,0,0],"axis":[0,1,0],"half_angle":0.1,"max_range":40}'.
@@ -86,32 +99,59 @@ pub struct PoolOpts {
 pub struct PoolCtx {
     /// The robot.
     pub robot: Robot,
-    /// The pool (lattice indices that survive the visibility filter).
-    pub pool: activecal::pool::Pool,
+    /// The pool.
+    pub pool: Pool,
     /// Identification Jacobian of every pool pose.
     pub x: activecal::blocks::Blocks,
 }
 
+/// The filters of a pool: `--visibility`, else the robot description's
+/// region, else none.
+pub fn filters(
+    visibility: Option<&str>,
+    described: Option<&Visibility>,
+) -> Result<Vec<PoolFilter>> {
+    Ok(match (visibility, described) {
+        (Some(v), _) => {
+            let vis: Visibility =
+                serde_json::from_str(v).map_err(|e| anyhow::anyhow!("--visibility: {e}"))?;
+            vec![PoolFilter::Visibility(vis)]
+        }
+        (None, Some(vis)) => vec![PoolFilter::Visibility(vis.clone())],
+        (None, None) => vec![],
+    })
+}
+
+/// Loads a robot with its description's visibility region (validated).
+pub fn load_description(name: &str) -> Result<activecal::io::Description> {
+    let d = activecal::io::load_description(name)?;
+    d.robot.validate()?;
+    Ok(d)
+}
+
+/// Builds the pool of `spec` for `robot` ([`PoolSpec::build`], filters at the
+/// nominal model) and its Jacobian at `params`.
+pub fn build_pool(robot: Robot, spec: &PoolSpec, params: ParamSet) -> Result<PoolCtx> {
+    let pool = spec.build(&robot, &robot.nominal)?;
+    let x = pool.jacobian(&robot, robot.params(params));
+    Ok(PoolCtx { robot, pool, x })
+}
+
 impl PoolOpts {
-    /// Builds the pool and its Jacobian.
+    /// The pool these options describe, for a robot description.
+    pub fn spec(&self, described: Option<&Visibility>) -> Result<PoolSpec> {
+        Ok(PoolSpec {
+            source: PoolSource::Lattice {
+                levels: self.levels,
+            },
+            filters: filters(self.visibility.as_deref(), described)?,
+        })
+    }
+
+    /// Loads the robot, builds the pool and its Jacobian.
     pub fn load(&self) -> Result<PoolCtx> {
-        use activecal::measure::Visibility;
-        use activecal::pool::Pool;
-        let activecal::io::Description { robot, visibility } =
-            activecal::io::load_description(&self.robot)?;
-        robot.validate()?;
-        let set = activecal::model::ParamSet::parse(&self.params)?;
-        // --visibility, else the robot description's region, else every pose.
-        let pool = match (&self.visibility, &visibility) {
-            (None, None) => Pool::full(&robot, self.levels)?,
-            (Some(v), _) => {
-                let vis: Visibility =
-                    serde_json::from_str(v).map_err(|e| anyhow::anyhow!("--visibility: {e}"))?;
-                Pool::filtered(&robot, &robot.nominal, self.levels, &vis)?
-            }
-            (None, Some(vis)) => Pool::filtered(&robot, &robot.nominal, self.levels, vis)?,
-        };
-        let x = pool.jacobian(&robot, robot.params(set));
-        Ok(PoolCtx { robot, pool, x })
+        let d = load_description(&self.robot)?;
+        let spec = self.spec(d.visibility.as_ref())?;
+        build_pool(d.robot, &spec, self.params)
     }
 }

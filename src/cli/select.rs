@@ -1,12 +1,11 @@
 //! `score` and `select`: observability of a design, and pose selection.
 
-use super::{PoolOpts, emit, parse_list};
-use activecal::criterion::{DCriterion, Indices, OiCriterion};
+use super::{PoolOpts, emit_report, load_description, parse_list};
 use activecal::io::design::DesignFile;
-use activecal::select::{Algorithm, Selection, Settings, multistart};
+use activecal::report::{PoolInfo, ScoreReport, SelectReport};
+use activecal::select::{Algorithm, CriterionKind, Settings, select};
 use anyhow::{Result, bail};
 use clap::Args;
-use serde_json::{Value, json};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -15,10 +14,11 @@ use std::time::Instant;
 pub struct ScoreArgs {
     #[command(flatten)]
     pub pool: PoolOpts,
-    /// Lattice indices of the design, comma separated.
+    /// Pose ids (lattice indices) of the design, comma separated.
     #[arg(long)]
     pub poses: Option<String>,
-    /// A design file (JSON with robot, levels, poses) instead of --poses.
+    /// A design file (as `select --out` writes) instead of --poses: its
+    /// stored joint values are scored.
     #[arg(long, conflicts_with = "poses")]
     pub design: Option<PathBuf>,
     /// Print one JSON object.
@@ -28,33 +28,48 @@ pub struct ScoreArgs {
 
 /// Runs `score`.
 pub fn cmd_score(a: ScoreArgs) -> Result<()> {
-    let mut opts = a.pool.clone();
-    let lattice_poses: Vec<usize> = match (&a.poses, &a.design) {
-        (Some(p), None) => parse_list(p, "--poses")?,
+    let report = match (&a.poses, &a.design) {
+        (Some(p), None) => {
+            let ids: Vec<usize> = parse_list(p, "--poses")?;
+            activecal::io::design::check_unique(&ids)?;
+            let ctx = a.pool.load()?;
+            let positions = ctx.pool.positions_of(&ids)?;
+            ScoreReport::new(
+                PoolInfo::new(&ctx.robot, &ctx.pool),
+                ids,
+                &ctx.x.select(&positions),
+            )
+        }
         (None, Some(path)) => {
             let d = DesignFile::read(path)?;
-            opts.robot = d.robot.clone();
-            opts.levels = d.levels;
-            d.poses
+            let desc = load_description(&d.robot)?;
+            let robot = desc.robot;
+            let qs = d
+                .joint_values(&robot)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            let x = activecal::blocks::jacobian_of(
+                &robot,
+                robot.params(a.pool.params),
+                qs.len(),
+                |k, q| q.copy_from_slice(&qs[k]),
+            );
+            let info = PoolInfo {
+                robot: robot.name.clone(),
+                chain: activecal::report::chain(&robot),
+                levels: d.spec()?.levels(),
+                pool: d.spec()?,
+            };
+            ScoreReport::new(info, d.poses.clone(), &x)
         }
         _ => bail!("give the design with --poses I1,I2,... or --design FILE"),
     };
-    let ctx = opts.load()?;
-    activecal::io::design::check_unique(&lattice_poses)?;
-    let positions = ctx.pool.positions_of(&lattice_poses)?;
-    let ind = Indices::from_design(&ctx.x, &positions);
-    let v = json!({
-        "robot": ctx.robot.name, "levels": opts.levels, "poses": lattice_poses,
-        "ln_oid": ind.ln_oid, "log10_oid": ind.log10_oid, "oi": ind.oi, "o1": ind.o1, "o2": ind.o2,
-        "o3": ind.o3, "o4": ind.o4, "o5": ind.o5, "a_trace": ind.a_trace, "rank": ind.rank,
-        "p": ctx.x.p(), "singular": ind.rank < ctx.x.p(),
-    });
-    emit(a.json, &v, || {
+    emit_report(a.json, &report, || {
+        let ind = &report.indices;
         format!(
             "{} poses, rank {} of {}\nln OI_D {:.6}  log10 OI_D {:.6}\nOI {:.6}  O1 {:.6e}  O2 {:.6e}  O3 {:.6e}  O4 {:.6e}  O5 {:.6e}  tr(M^-1) {:.6e}\n",
-            lattice_poses.len(),
+            report.poses.len(),
             ind.rank,
-            ctx.x.p(),
+            report.p,
             ind.ln_oid,
             ind.log10_oid,
             ind.oi,
@@ -65,8 +80,7 @@ pub fn cmd_score(a: ScoreArgs) -> Result<()> {
             ind.o5,
             ind.a_trace
         )
-    });
-    Ok(())
+    })
 }
 
 /// Arguments of `select`.
@@ -77,13 +91,13 @@ pub struct SelectArgs {
     /// Poses in the design.
     #[arg(long, default_value_t = 30)]
     pub n: usize,
-    /// eae, fedorov, detmax or random.
-    #[arg(long, default_value = "eae")]
-    pub algorithm: String,
+    /// The selection algorithm.
+    #[arg(long, value_enum, default_value_t = Algorithm::Eae)]
+    pub algorithm: Algorithm,
     /// Initial random poses of EAE (fixed poses included).
     #[arg(long, default_value_t = 12)]
     pub initial: usize,
-    /// Independent random starts; the best is kept.
+    /// Independent random starts; the best (by the criterion) is kept.
     #[arg(long, default_value_t = 1)]
     pub starts: usize,
     /// Random designs drawn by --algorithm random.
@@ -95,12 +109,12 @@ pub struct SelectArgs {
     /// Seed of every random choice.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Lattice indices of poses every design must contain.
+    /// Pose ids (lattice indices) every design must contain.
     #[arg(long)]
     pub fixed: Option<String>,
     /// det (ln OI_D, with O(p²) updates) or oi (the paper's eigenvalue OI, recomputed).
-    #[arg(long, default_value = "det")]
-    pub criterion: String,
+    #[arg(long, value_enum, default_value_t = CriterionKind::Det)]
+    pub criterion: CriterionKind,
     /// Write the design file here.
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -110,26 +124,12 @@ pub struct SelectArgs {
     /// Also compute the relaxation bound and report the design's D-efficiency.
     #[arg(long)]
     pub gap: bool,
-    /// Solver of the bound for `--gap`: clarabel or newton (see `bound`).
-    #[arg(long, default_value = "clarabel", requires = "gap")]
-    pub gap_solver: String,
+    /// Solver of the bound for `--gap` (see `bound`).
+    #[arg(long, value_enum, default_value_t = activecal::bound::RelaxationSolver::Clarabel, requires = "gap")]
+    pub gap_solver: activecal::bound::RelaxationSolver,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
-}
-
-/// Runs a selection with the named criterion.
-pub fn run_selection(
-    x: &activecal::blocks::Blocks,
-    criterion: &str,
-    alg: Algorithm,
-    s: &Settings,
-) -> Result<Selection> {
-    Ok(match criterion {
-        "det" => multistart(x, DCriterion::new, alg, s)?,
-        "oi" => multistart(x, OiCriterion::new, alg, s)?,
-        other => bail!("unknown criterion '{other}' (expected det or oi)"),
-    })
 }
 
 /// Runs `select`.
@@ -137,15 +137,13 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     if let Some(out) = &a.out {
         super::refuse_overwrite(out, a.force)?;
     }
-    let alg = Algorithm::parse(&a.algorithm)?;
-    let gap_solver = activecal::bound::RelaxationSolver::parse(&a.gap_solver)?;
     let ctx = a.pool.load()?;
-    let fixed_lattice: Vec<usize> = match &a.fixed {
+    let fixed_ids: Vec<usize> = match &a.fixed {
         Some(f) => parse_list(f, "--fixed")?,
         None => vec![],
     };
-    activecal::io::design::check_unique(&fixed_lattice)?;
-    let fixed = ctx.pool.positions_of(&fixed_lattice)?;
+    activecal::io::design::check_unique(&fixed_ids)?;
+    let fixed = ctx.pool.positions_of(&fixed_ids)?;
     let s = Settings {
         n: a.n,
         initial: a.initial.max(fixed.len()).min(a.n),
@@ -157,40 +155,20 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         ..Settings::default()
     };
     let t0 = Instant::now();
-    let sel = run_selection(&ctx.x, &a.criterion, alg, &s)?;
+    let sel = select(&ctx.x, a.criterion, a.algorithm, &s)?;
     let seconds = t0.elapsed().as_secs_f64();
-    let lat = |k: usize| ctx.pool.indices[k];
-    let poses: Vec<usize> = sel.poses.iter().map(|&k| lat(k)).collect();
-    let trace: Vec<Value> = sel
-        .trace
-        .iter()
-        .map(|r| {
-            json!({"step": r.step, "kind": r.kind, "added": r.added.map(lat), "removed": r.removed.map(lat),
-                   "size": r.size, "ln_oid": r.ln_oid, "log10_oid": r.ln_oid / std::f64::consts::LN_10,
-                   "oi": r.oi, "ridge": r.ridge})
-        })
-        .collect();
-    let log10 = sel.ln_oid / std::f64::consts::LN_10;
-    let v = json!({
-        "robot": ctx.robot.name, "levels": a.pool.levels, "poses": poses,
-        "ln_oid": sel.ln_oid, "log10_oid": log10, "oi": sel.oi, "trace": trace,
-        "seconds": seconds, "algorithm": alg, "criterion": a.criterion, "seed": a.seed,
-        "starts": a.starts, "polish": a.polish, "best_start": sel.start,
-        "fixed": fixed_lattice,
-    });
-    let mut v = v;
+    let mut report = SelectReport::new(&ctx.robot, &ctx.pool, &sel, a.criterion, &s, seconds);
     if a.gap {
         let settings = activecal::bound::BoundSettings::builder()
-            .solver(gap_solver)
+            .solver(a.gap_solver)
             .build()?;
         let bound = activecal::bound::relaxation_bound(&ctx.x, a.n, &settings)?;
         let g = activecal::bound::design_gap(&ctx.x, &sel.poses, &bound)?;
-        v["log10_bound"] = json!(g.log10_bound);
-        v["d_efficiency"] = json!(g.d_efficiency);
-        v["bound_status"] = json!(format!("{:?}", g.bound_status));
+        report.set_gap(&g);
     }
     if let Some(out) = &a.out {
-        let mut d = DesignFile::new(&ctx.robot.name, a.pool.levels, poses.clone());
+        let mut d = DesignFile::from_pool(&ctx.robot, &ctx.pool, &sel.poses);
+        let v = serde_json::to_value(&report)?;
         for k in [
             "ln_oid",
             "log10_oid",
@@ -206,23 +184,24 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         }
         d.write(out, a.force)?;
     }
-    emit(a.json, &v, || {
+    emit_report(a.json, &report, || {
         format!(
-            "{alg:?} ({} criterion, seed {}, {} start(s){}): {} poses in {:.3} s\nlog10 OI_D {:.4}  OI {:.6}\nposes: {}\n",
-            a.criterion,
+            "{:?} ({:?} criterion, seed {}, {} start(s){}): {} poses in {:.3} s\nlog10 OI_D {:.4}  OI {:.6}\nposes: {}\n",
+            report.algorithm,
+            report.criterion,
             a.seed,
             a.starts,
             if a.polish { ", Fedorov polish" } else { "" },
-            poses.len(),
+            report.poses.len(),
             seconds,
-            log10,
-            sel.oi,
-            poses
+            report.log10_oid,
+            report.oi,
+            report
+                .poses
                 .iter()
                 .map(|p| p.to_string())
                 .collect::<Vec<_>>()
                 .join(",")
         )
-    });
-    Ok(())
+    })
 }

@@ -248,7 +248,7 @@ fn norm(v: &[f64]) -> f64 {
 /// ```
 /// use activecal::identify::{identify, simulate, trial_rng, LmSettings};
 /// use activecal::pool::Pool;
-/// use activecal::robot::Robot;
+/// use activecal::model::Robot;
 /// let robot = Robot::puma560();
 /// let pool = Pool::full(&robot, 5).unwrap();
 /// let qs: Vec<Vec<f64>> = (0..40).map(|k| pool.q(k * 389)).collect();

@@ -178,7 +178,7 @@ impl Measurements {
     ///
     /// ```
     /// use activecal::identify::Measurements;
-    /// use activecal::robot::Robot;
+    /// use activecal::model::Robot;
     /// let robot = Robot::puma560();
     /// let bad = Measurements::new(&robot, vec![vec![0.0; 6]], vec![[0.0, f64::NAN, 0.0]]);
     /// assert!(bad.unwrap_err().to_string().contains("coordinate y"));
@@ -193,7 +193,7 @@ impl Measurements {
     ///
     /// ```
     /// use activecal::identify::Measurements;
-    /// use activecal::robot::Robot;
+    /// use activecal::model::Robot;
     /// let robot = Robot::builtin("ur5:pose").unwrap();
     /// let eye = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     /// let ok = Measurements::with_orientations(&robot, vec![vec![0.0; 6]], vec![[0.0; 3]], vec![eye]);

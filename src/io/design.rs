@@ -1,38 +1,75 @@
 //! Design files: the poses chosen for a calibration, as JSON that `select`
 //! writes and `score`, `gap` and `calibrate` read.
 //!
-//! The required keys are `robot`, `levels` and `poses` (lattice indices), so a
-//! hand-written file with only these three is accepted; other keys written by
-//! `select` (algorithm, seed, criterion values) are kept as extra information.
+//! A design names the pool it was chosen from (`pool`, a [`PoolSpec`]) and
+//! carries each pose's id in that pool (`poses`) and its joint values (`q`,
+//! radians or metres), so it survives a change of pool: `score` and
+//! `calibrate` use the stored joint values, and poses need not lie on any
+//! lattice.
+//!
+//! Old files, `{"robot", "levels", "poses": [lattice indices]}`, still load:
+//! their pool is the unfiltered `levels`-value lattice and their joint values
+//! are the lattice's. Other keys written by `select` (algorithm, seed,
+//! criterion values) are kept as extra information.
 
 use crate::error::{Error, Result};
 use crate::model::Robot;
-use crate::pool::Pool;
+use crate::pool::{Lattice, Pool, PoolSpec};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+/// Joint values of a stored pose and of a pool pose agree to this, absolute
+/// (a JSON round trip of an `f64` is exact; this only absorbs hand edits
+/// written with fewer digits).
+const Q_TOL: f64 = 1e-9;
+
 /// A design as stored on disk.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DesignFile {
     /// Robot name (built-in) or path of its description.
     pub robot: String,
-    /// Lattice values per joint of the pool the indices refer to.
-    pub levels: usize,
-    /// Lattice indices of the chosen poses.
+    /// The pool the poses were chosen from (absent in old files: the
+    /// unfiltered lattice of `levels`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pool: Option<PoolSpec>,
+    /// Lattice values per joint, when the pool is a lattice (kept for old
+    /// readers).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub levels: Option<usize>,
+    /// Id of each pose in its pool (the lattice index for lattice poses).
     pub poses: Vec<usize>,
+    /// Joint values of each pose (absent in old files: the lattice's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub q: Option<Vec<Vec<f64>>>,
     /// Anything else (algorithm, seed, ln_oid, ...), kept as written.
     #[serde(flatten)]
     pub extra: serde_json::Map<String, serde_json::Value>,
 }
 
 impl DesignFile {
-    /// A design with no extra information.
+    /// The design made of pool positions `positions` of `pool`, for `robot`.
+    #[must_use]
+    pub fn from_pool(robot: &Robot, pool: &Pool, positions: &[usize]) -> Self {
+        Self {
+            robot: robot.name.clone(),
+            pool: Some(pool.spec.clone()),
+            levels: pool.spec.levels(),
+            poses: pool.ids_of(positions),
+            q: Some(positions.iter().map(|&k| pool.q(k)).collect()),
+            extra: serde_json::Map::new(),
+        }
+    }
+
+    /// An old-style design: lattice indices of a `levels`-value lattice, no
+    /// stored joint values.
     #[must_use]
     pub fn new(robot: &str, levels: usize, poses: Vec<usize>) -> Self {
         Self {
             robot: robot.to_string(),
-            levels,
+            pool: None,
+            levels: Some(levels),
             poses,
+            q: None,
             extra: serde_json::Map::new(),
         }
     }
@@ -43,10 +80,15 @@ impl DesignFile {
             path: path.display().to_string(),
             cause,
         })?;
-        serde_json::from_str(&text).map_err(|e| Error::Parse {
+        let d: DesignFile = serde_json::from_str(&text).map_err(|e| Error::Parse {
             path: path.display().to_string(),
             message: e.to_string(),
-        })
+        })?;
+        d.check_shape().map_err(|e| Error::Parse {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        Ok(d)
     }
 
     /// Writes the design as pretty JSON. An existing file is only replaced
@@ -65,25 +107,129 @@ impl DesignFile {
         })
     }
 
-    /// Checks the design against a robot and its pool, returning the pool
-    /// positions of its poses: the robot name must match, every index must be
-    /// in the pool, and no pose may repeat.
-    pub fn positions_in(&self, robot: &Robot, pool: &Pool) -> Result<Vec<usize>> {
+    /// The pool the design was chosen from.
+    pub fn spec(&self) -> Result<PoolSpec> {
+        match (&self.pool, self.levels) {
+            (Some(s), _) => Ok(s.clone()),
+            (None, Some(levels)) => Ok(PoolSpec::lattice(levels)),
+            (None, None) => Err(Error::Invalid(
+                "the design names no pool (neither 'pool' nor 'levels')".into(),
+            )),
+        }
+    }
+
+    /// Errors on a file whose parts disagree: a repeated id, or a joint
+    /// value list of another length than the ids.
+    fn check_shape(&self) -> Result<()> {
+        check_unique(&self.poses)?;
+        if let Some(q) = &self.q
+            && q.len() != self.poses.len()
+        {
+            return Err(Error::Invalid(format!(
+                "the design has {} pose ids but {} joint vectors",
+                self.poses.len(),
+                q.len()
+            )));
+        }
+        if self.pool.is_none() && self.levels.is_none() {
+            return Err(Error::Invalid(
+                "the design names no pool (neither 'pool' nor 'levels')".into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Errors unless the design is for `robot`.
+    pub fn check_robot(&self, robot: &Robot) -> Result<()> {
         if self.robot != robot.name {
             return Err(Error::Invalid(format!(
                 "the design is for robot '{}', not '{}'",
                 self.robot, robot.name
             )));
         }
-        if self.levels != pool.lattice.levels {
+        Ok(())
+    }
+
+    /// Joint values of the design's poses: the stored ones, else (old files)
+    /// the lattice's. Checked against the robot: one value per joint, all
+    /// finite.
+    pub fn joint_values(&self, robot: &Robot) -> Result<Vec<Vec<f64>>> {
+        self.check_robot(robot)?;
+        self.check_shape()?;
+        let qs = match &self.q {
+            Some(q) => q.clone(),
+            None => {
+                let levels = self.levels.expect("checked by check_shape");
+                let lattice = Lattice::new(robot, levels)?;
+                self.poses
+                    .iter()
+                    .map(|&i| lattice.q(i))
+                    .collect::<Result<_>>()?
+            }
+        };
+        for q in &qs {
+            if q.len() != robot.dof() {
+                return Err(Error::JointCount {
+                    expected: robot.dof(),
+                    got: q.len(),
+                });
+            }
+            if let Some(j) = q.iter().position(|v| !v.is_finite()) {
+                return Err(Error::NonFiniteAngle {
+                    joint: j + 1,
+                    value: q[j],
+                });
+            }
+        }
+        Ok(qs)
+    }
+
+    /// Checks the design against a robot and its pool, returning the pool
+    /// positions of its poses: the robot name must match, every id must be
+    /// in the pool with the stored joint values, and no pose may repeat.
+    pub fn positions_in(&self, robot: &Robot, pool: &Pool) -> Result<Vec<usize>> {
+        let qs = self.joint_values(robot)?;
+        if let (Some(mine), Some(theirs)) = (self.spec()?.levels(), pool.spec.levels())
+            && mine != theirs
+        {
             return Err(Error::Invalid(format!(
-                "the design refers to a {}-level lattice, the pool has {} levels",
-                self.levels, pool.lattice.levels
+                "the design refers to a {mine}-level lattice, the pool has {theirs} levels"
             )));
         }
-        check_unique(&self.poses)?;
-        pool.positions_of(&self.poses)
+        self.poses
+            .iter()
+            .zip(&qs)
+            .map(|(&id, q)| {
+                let k = pool.position_of(id)?;
+                if !same_q(pool.config(k), q) {
+                    return Err(Error::PoseNotInPool {
+                        index: id,
+                        reason: "the pool's pose of this id has other joint values".into(),
+                    });
+                }
+                Ok(k)
+            })
+            .collect()
     }
+
+    /// Pool positions of the design poses that are in `pool` (same id, same
+    /// joint values); poses outside it are skipped.
+    pub fn positions_found_in(&self, robot: &Robot, pool: &Pool) -> Result<Vec<usize>> {
+        let qs = self.joint_values(robot)?;
+        Ok(self
+            .poses
+            .iter()
+            .zip(&qs)
+            .filter_map(|(&id, q)| {
+                let k = pool.position_of(id).ok()?;
+                same_q(pool.config(k), q).then_some(k)
+            })
+            .collect())
+    }
+}
+
+fn same_q(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() <= Q_TOL)
 }
 
 /// Errors on a repeated pose index.
@@ -110,6 +256,7 @@ mod tests {
         let r = Robot::puma560();
         let pool = Pool::full(&r, 5).unwrap();
         assert_eq!(d.positions_in(&r, &pool).unwrap(), vec![1982, 0]);
+        assert_eq!(d.joint_values(&r).unwrap()[0], pool.q(1982));
         let bad: DesignFile =
             serde_json::from_str(r#"{"robot":"puma560","levels":5,"poses":[15625]}"#).unwrap();
         assert!(bad.positions_in(&r, &pool).is_err());
@@ -127,14 +274,38 @@ mod tests {
     }
 
     #[test]
+    fn stored_joint_values_are_used_and_checked() {
+        let r = Robot::puma560();
+        let pool = Pool::full(&r, 3).unwrap();
+        let mut d = DesignFile::from_pool(&r, &pool, &[5, 7]);
+        assert_eq!(d.poses, vec![5, 7]);
+        assert_eq!(d.levels, Some(3));
+        // A pose in no lattice: its stored values are what counts.
+        let off = vec![0.1, 0.2, 0.3, 0.4, 0.5, 0.6];
+        d.q.as_mut().unwrap()[1] = off.clone();
+        assert_eq!(d.joint_values(&r).unwrap()[1], off);
+        assert!(d.positions_in(&r, &pool).is_err());
+        assert_eq!(d.positions_found_in(&r, &pool).unwrap(), vec![5]);
+        d.q.as_mut().unwrap()[1] = vec![0.0; 5];
+        assert!(d.joint_values(&r).is_err());
+        d.q.as_mut().unwrap().pop();
+        assert!(d.joint_values(&r).is_err());
+    }
+
+    #[test]
     fn write_refuses_to_overwrite() {
         let dir = std::env::temp_dir().join(format!("activecal-design-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("d.json");
-        let d = DesignFile::new("puma560", 5, vec![1, 2, 3]);
+        let r = Robot::puma560();
+        let pool = Pool::full(&r, 3).unwrap();
+        let d = DesignFile::from_pool(&r, &pool, &[1, 2, 3]);
         d.write(&path, true).unwrap();
         assert!(d.write(&path, false).is_err());
-        assert_eq!(DesignFile::read(&path).unwrap(), d);
+        let back = DesignFile::read(&path).unwrap();
+        assert_eq!(back.poses, d.poses);
+        assert_eq!(back.q, d.q);
+        assert_eq!(back.spec().unwrap().levels(), Some(3));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -178,26 +178,13 @@ pub struct ParamId {
 }
 
 /// Which of a robot's two parameter tables to use.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum ParamSet {
     /// The nominal (design) model, used to compute Jacobians for pose selection.
     Nominal,
     /// The real robot, used to simulate measurements.
     Real,
-}
-
-impl ParamSet {
-    /// Parses `nominal` or `real`.
-    pub fn parse(s: &str) -> Result<ParamSet> {
-        match s {
-            "nominal" => Ok(ParamSet::Nominal),
-            "real" => Ok(ParamSet::Real),
-            _ => Err(Error::Invalid(format!(
-                "unknown parameter set '{s}' (expected 'nominal' or 'real')"
-            ))),
-        }
-    }
 }
 
 /// What is measured at each pose.

@@ -24,10 +24,17 @@ pub struct Selection {
     pub algorithm: Algorithm,
     /// Name of the criterion that drove the search (`D` or `OI`).
     pub criterion: String,
+    /// The driving criterion's own score of the design
+    /// ([`Criterion::score`]; `ln OI_D` for the D criterion).
+    pub score: f64,
     /// Index of the start that won (multi-start), 0 otherwise.
     pub start: usize,
     /// `ln OI_D` of every start, in start order.
     pub start_ln_oid: Vec<f64>,
+    /// The criterion's score of every start, in start order: the starts are
+    /// ranked by it (`-∞` for a start that failed). A random search ranks
+    /// its designs by `ln OI_D` and holds the kept design's score only.
+    pub start_score: Vec<f64>,
 }
 
 /// Relative improvement below which a step counts as no improvement: a
@@ -269,6 +276,7 @@ impl<'a, C: Criterion> Run<'a, C> {
             )));
         }
         let ln_oid = self.state.ln_det();
+        let score = self.score();
         Ok(Selection {
             poses: self.state.design().to_vec(),
             ln_oid,
@@ -276,8 +284,10 @@ impl<'a, C: Criterion> Run<'a, C> {
             trace: self.trace,
             algorithm,
             criterion: self.crit.name().to_string(),
+            score,
             start: 0,
             start_ln_oid: vec![ln_oid],
+            start_score: vec![score],
         })
     }
 }
@@ -378,12 +388,14 @@ pub fn polish<C: Criterion>(
     let mut out = run.finish(sel.algorithm)?;
     out.start = sel.start;
     out.start_ln_oid = sel.start_ln_oid;
+    out.start_score = sel.start_score;
     Ok(out)
 }
 
 /// Runs `algorithm` from `s.starts` independent random starts in parallel
-/// (start `k` draws from ChaCha stream `k` of `s.seed`), keeps the best (the
-/// lowest start on ties), and optionally polishes it with Fedorov exchange.
+/// (start `k` draws from ChaCha stream `k` of `s.seed`), keeps the best by
+/// the criterion's own score ([`Criterion::score`]; the lowest start on
+/// ties), and optionally polishes it with Fedorov exchange.
 /// `make` builds one criterion per start. Deterministic for a seed whatever
 /// the number of threads.
 pub fn multistart<C, F>(
@@ -435,18 +447,21 @@ where
     };
     let mut best: Option<Selection> = None;
     let mut lns = Vec::with_capacity(results.len());
+    let mut scores = Vec::with_capacity(results.len());
     let mut first_err = None;
     for (k, r) in results.into_iter().enumerate() {
         match r {
             Ok(mut sel) => {
                 lns.push(sel.ln_oid);
+                scores.push(sel.score);
                 sel.start = k;
-                if best.as_ref().is_none_or(|b| sel.ln_oid > b.ln_oid) {
+                if best.as_ref().is_none_or(|b| sel.score > b.score) {
                     best = Some(sel);
                 }
             }
             Err(e) => {
                 lns.push(f64::NEG_INFINITY);
+                scores.push(f64::NEG_INFINITY);
                 first_err.get_or_insert(e);
             }
         }
@@ -455,6 +470,7 @@ where
         return Err(first_err.expect("at least one start"));
     };
     sel.start_ln_oid = lns;
+    sel.start_score = scores;
     finish_polish(pool, make, sel, s)
 }
 

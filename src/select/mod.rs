@@ -19,6 +19,7 @@
 //! ridge was on carry `ridge: true`.
 
 use crate::blocks::Blocks;
+use crate::criterion::{DCriterion, OiCriterion};
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
@@ -31,7 +32,7 @@ pub use random::{
 };
 
 /// The selection algorithms.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Algorithm {
     /// The paper's exchange-add-exchange (§IV).
@@ -44,18 +45,27 @@ pub enum Algorithm {
     Random,
 }
 
-impl Algorithm {
-    /// Parses `eae`, `fedorov`, `detmax` or `random`.
-    pub fn parse(s: &str) -> Result<Algorithm> {
-        match s {
-            "eae" => Ok(Algorithm::Eae),
-            "fedorov" => Ok(Algorithm::Fedorov),
-            "detmax" => Ok(Algorithm::Detmax),
-            "random" => Ok(Algorithm::Random),
-            _ => Err(Error::Invalid(format!(
-                "unknown algorithm '{s}' (expected eae, fedorov, detmax or random)"
-            ))),
-        }
+/// The criterion a selection maximises.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum CriterionKind {
+    /// `ln OI_D = ln det M`, priced by O(p²) updates ([`DCriterion`]).
+    #[default]
+    Det,
+    /// The paper's eigenvalue OI, eq. (1), recomputed ([`OiCriterion`]).
+    Oi,
+}
+
+/// [`multistart`] with the criterion `kind`.
+pub fn select(
+    pool: &Blocks,
+    kind: CriterionKind,
+    algorithm: Algorithm,
+    s: &Settings,
+) -> Result<Selection> {
+    match kind {
+        CriterionKind::Det => multistart(pool, DCriterion::new, algorithm, s),
+        CriterionKind::Oi => multistart(pool, OiCriterion::new, algorithm, s),
     }
 }
 

@@ -1,0 +1,3 @@
+//! Experiments: whole pipelines that return typed reports.
+
+pub mod paper;

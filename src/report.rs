@@ -1,0 +1,583 @@
+//! Typed reports of the commands: what `select`, `score`, `bound` and `gap`
+//! found, with pool positions translated to stable pose ids. Each derives
+//! `Serialize`; the command line prints them as text or JSON and never
+//! rebuilds them. (The bound's summary is [`BoundReport`]; the paper's
+//! experiment is [`crate::experiment::paper::PaperReport`].)
+
+use crate::blocks::Blocks;
+use crate::bound::{Bound, BoundReport, DesignGap, SUPPORT_TOL};
+use crate::criterion::Indices;
+use crate::model::{ParamSet, Robot};
+use crate::pool::{Pool, PoolSpec};
+use crate::select::{Algorithm, CriterionKind, Selection, Settings, StepKind};
+use serde::Serialize;
+
+/// The chain a report used: the label of every frame a joint drives, in
+/// joint order.
+#[must_use]
+pub fn chain(robot: &Robot) -> Vec<String> {
+    robot
+        .frames
+        .iter()
+        .filter(|f| f.joint.is_some())
+        .map(|f| f.label.clone())
+        .collect()
+}
+
+/// The pool a report refers to: robot, chain and spec.
+#[derive(Clone, Debug, Serialize)]
+pub struct PoolInfo {
+    /// Robot name or description path.
+    pub robot: String,
+    /// Driven frames of the robot ([`chain`]).
+    pub chain: Vec<String>,
+    /// Lattice values per joint, when the pool is a lattice.
+    pub levels: Option<usize>,
+    /// How the pool was made.
+    pub pool: PoolSpec,
+}
+
+impl PoolInfo {
+    /// The description of `pool` for `robot`.
+    #[must_use]
+    pub fn new(robot: &Robot, pool: &Pool) -> Self {
+        Self {
+            robot: robot.name.clone(),
+            chain: chain(robot),
+            levels: pool.spec.levels(),
+            pool: pool.spec.clone(),
+        }
+    }
+}
+
+/// `score`: the observability indices of a design.
+#[derive(Clone, Debug, Serialize)]
+pub struct ScoreReport {
+    /// The pool.
+    #[serde(flatten)]
+    pub pool: PoolInfo,
+    /// Pose ids of the design.
+    pub poses: Vec<usize>,
+    /// The indices.
+    #[serde(flatten)]
+    pub indices: Indices,
+    /// Unknowns.
+    pub p: usize,
+    /// `rank < p`.
+    pub singular: bool,
+}
+
+impl ScoreReport {
+    /// Scores the design whose Jacobian is `x_design` (one block per pose).
+    #[must_use]
+    pub fn new(pool: PoolInfo, poses: Vec<usize>, x_design: &Blocks) -> Self {
+        let all: Vec<usize> = (0..x_design.n_poses()).collect();
+        let indices = Indices::from_design(x_design, &all);
+        Self {
+            pool,
+            poses,
+            p: x_design.p(),
+            singular: indices.rank < x_design.p(),
+            indices,
+        }
+    }
+}
+
+/// One step of a selection trace, with pose ids.
+#[derive(Clone, Debug, Serialize)]
+pub struct TraceStep {
+    /// Step number, 0 for the initial design.
+    pub step: usize,
+    /// What the step did.
+    pub kind: StepKind,
+    /// Id of the pose added.
+    pub added: Option<usize>,
+    /// Id of the pose removed.
+    pub removed: Option<usize>,
+    /// Design size after the step.
+    pub size: usize,
+    /// `ln OI_D` after the step.
+    pub ln_oid: f64,
+    /// `log10 OI_D` after the step.
+    pub log10_oid: f64,
+    /// The paper's OI after the step.
+    pub oi: f64,
+    /// Whether the ridge was on.
+    pub ridge: bool,
+}
+
+/// `select`: the chosen design, how it was found, and (with `--gap`) its
+/// D-efficiency.
+#[derive(Clone, Debug, Serialize)]
+pub struct SelectReport {
+    /// The pool.
+    #[serde(flatten)]
+    pub pool: PoolInfo,
+    /// Poses in the pool.
+    pub pool_size: usize,
+    /// Pose ids of the design, in the order they entered.
+    pub poses: Vec<usize>,
+    /// `ln OI_D` of the design.
+    pub ln_oid: f64,
+    /// `log10 OI_D`.
+    pub log10_oid: f64,
+    /// The paper's OI.
+    pub oi: f64,
+    /// One row per step.
+    pub trace: Vec<TraceStep>,
+    /// Wall-clock seconds of the selection.
+    pub seconds: f64,
+    /// The algorithm.
+    pub algorithm: Algorithm,
+    /// The criterion.
+    pub criterion: CriterionKind,
+    /// Seed.
+    pub seed: u64,
+    /// Starts.
+    pub starts: usize,
+    /// Fedorov polish.
+    pub polish: bool,
+    /// The start that won.
+    pub best_start: usize,
+    /// Ids of the fixed poses.
+    pub fixed: Vec<usize>,
+    /// `log10` of the relaxation bound (`--gap`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub log10_bound: Option<f64>,
+    /// D-efficiency against the bound (`--gap`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub d_efficiency: Option<f64>,
+    /// The bound's status (`--gap`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bound_status: Option<crate::bound::BoundStatus>,
+}
+
+impl SelectReport {
+    /// The report of `sel`, chosen from `pool` with settings `s`.
+    #[must_use]
+    pub fn new(
+        robot: &Robot,
+        pool: &Pool,
+        sel: &Selection,
+        criterion: CriterionKind,
+        s: &Settings,
+        seconds: f64,
+    ) -> Self {
+        let id = |k: usize| pool.id(k);
+        let l10 = |v: f64| v / std::f64::consts::LN_10;
+        Self {
+            pool: PoolInfo::new(robot, pool),
+            pool_size: pool.len(),
+            poses: pool.ids_of(&sel.poses),
+            ln_oid: sel.ln_oid,
+            log10_oid: l10(sel.ln_oid),
+            oi: sel.oi,
+            trace: sel
+                .trace
+                .iter()
+                .map(|r| TraceStep {
+                    step: r.step,
+                    kind: r.kind,
+                    added: r.added.map(id),
+                    removed: r.removed.map(id),
+                    size: r.size,
+                    ln_oid: r.ln_oid,
+                    log10_oid: l10(r.ln_oid),
+                    oi: r.oi,
+                    ridge: r.ridge,
+                })
+                .collect(),
+            seconds,
+            algorithm: sel.algorithm,
+            criterion,
+            seed: s.seed,
+            starts: s.starts,
+            polish: s.polish,
+            best_start: sel.start,
+            fixed: pool.ids_of(&s.fixed),
+            log10_bound: None,
+            d_efficiency: None,
+            bound_status: None,
+        }
+    }
+
+    /// Adds the design's gap to a bound.
+    pub fn set_gap(&mut self, g: &DesignGap) {
+        self.log10_bound = Some(g.log10_bound);
+        self.d_efficiency = Some(g.d_efficiency);
+        self.bound_status = Some(g.bound_status);
+    }
+}
+
+/// A pose carrying relaxation weight.
+#[derive(Clone, Debug, Serialize)]
+pub struct WeightedPose {
+    /// Pose id.
+    pub pose: usize,
+    /// Its weight.
+    pub w: f64,
+}
+
+/// `bound`: the certified bound over a pool.
+#[derive(Clone, Debug, Serialize)]
+pub struct BoundCommandReport {
+    /// The bound.
+    #[serde(flatten)]
+    pub bound: BoundReport,
+    /// The pool.
+    #[serde(flatten)]
+    pub pool: PoolInfo,
+    /// Parameter set of the Jacobian.
+    pub params: ParamSet,
+    /// The settings the bound was computed with.
+    pub settings: crate::bound::BoundSettings,
+    /// Poses with weight above [`SUPPORT_TOL`] (when asked for).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub support: Option<Vec<WeightedPose>>,
+}
+
+impl BoundCommandReport {
+    /// The report of bound `b` over `pool`.
+    #[must_use]
+    pub fn new(
+        robot: &Robot,
+        pool: &Pool,
+        b: &Bound,
+        params: ParamSet,
+        settings: crate::bound::BoundSettings,
+        with_support: bool,
+    ) -> Self {
+        Self {
+            bound: BoundReport::from(b),
+            pool: PoolInfo::new(robot, pool),
+            params,
+            settings,
+            support: with_support.then(|| {
+                b.support(SUPPORT_TOL)
+                    .into_iter()
+                    .map(|k| WeightedPose {
+                        pose: pool.id(k),
+                        w: b.weights[k],
+                    })
+                    .collect()
+            }),
+        }
+    }
+}
+
+/// `gap`: a design's D-efficiency against the bound over its pool.
+#[derive(Clone, Debug, Serialize)]
+pub struct GapReport {
+    /// The pool.
+    #[serde(flatten)]
+    pub pool: PoolInfo,
+    /// Parameter set of the Jacobian.
+    pub params: ParamSet,
+    /// Pose ids of the design.
+    pub poses: Vec<usize>,
+    /// Poses in the design.
+    pub n: usize,
+    /// Unknowns.
+    pub p: usize,
+    /// `ln OI_D` of the design; `None` when singular.
+    pub ln_oid: Option<f64>,
+    /// `log10 OI_D`; `None` when singular.
+    pub log10_oid: Option<f64>,
+    /// Whether the design is singular.
+    pub singular: bool,
+    /// The bound on `ln OI_D`.
+    pub ln_bound: f64,
+    /// Its `log10`.
+    pub log10_bound: f64,
+    /// D-efficiency (eq. G).
+    pub d_efficiency: f64,
+    /// Ids of the design poses with relaxation weight.
+    pub weighted_poses: Vec<usize>,
+    /// Relaxation weight of every design pose.
+    pub weights: Vec<f64>,
+    /// The bound.
+    pub bound: BoundReport,
+}
+
+impl GapReport {
+    /// The report of gap `g` of the design `poses` (ids) to bound `b`.
+    #[must_use]
+    pub fn new(
+        pool: PoolInfo,
+        params: ParamSet,
+        poses: Vec<usize>,
+        g: &DesignGap,
+        b: &Bound,
+    ) -> Self {
+        Self {
+            pool,
+            params,
+            weighted_poses: g.weighted.iter().map(|&k| poses[k]).collect(),
+            poses,
+            n: g.n,
+            p: g.p,
+            ln_oid: g.ln_oid,
+            log10_oid: g.log10_oid,
+            singular: g.ln_oid.is_none(),
+            ln_bound: g.ln_bound,
+            log10_bound: g.log10_bound,
+            d_efficiency: g.d_efficiency,
+            weights: g.weights.clone(),
+            bound: BoundReport::from(b),
+        }
+    }
+}
+
+/// `{name: value}`, in name order.
+fn named(names: &[String], values: &[f64]) -> std::collections::BTreeMap<String, f64> {
+    names.iter().cloned().zip(values.iter().copied()).collect()
+}
+
+/// What every calibration reports about its identification.
+#[derive(Clone, Debug, Serialize)]
+pub struct IdentificationReport {
+    /// Outcome.
+    pub status: crate::identify::Status,
+    /// Which rule stopped the iteration.
+    pub stop: crate::identify::StopReason,
+    /// Whether the status is converged.
+    pub converged: bool,
+    /// Outer iterations.
+    pub iterations: usize,
+    /// Residual evaluations.
+    pub evaluations: usize,
+    /// The estimate, by unknown.
+    pub estimate: std::collections::BTreeMap<String, f64>,
+    /// Standard deviations, by unknown (full rank only).
+    pub std: Option<std::collections::BTreeMap<String, f64>>,
+    /// The labelled correlation matrix (full rank only).
+    pub correlation: Option<crate::identify::Correlation>,
+    /// `σ̂`.
+    pub sigma_hat: Option<f64>,
+    /// Residual sum of squares at the estimate.
+    pub rss: f64,
+    /// Residual sum of squares at the start.
+    pub initial_rss: f64,
+    /// Numerical rank.
+    pub rank: usize,
+    /// Unknowns in the null space.
+    pub unidentifiable: Vec<String>,
+}
+
+impl From<&crate::identify::Identification> for IdentificationReport {
+    fn from(id: &crate::identify::Identification) -> Self {
+        let names = &id.names;
+        Self {
+            status: id.status,
+            stop: id.stop,
+            converged: id.converged(),
+            iterations: id.iterations,
+            evaluations: id.evaluations,
+            estimate: named(names, &id.estimate),
+            std: id.covariance.as_ref().map(|c| named(names, &c.std)),
+            correlation: id.covariance.as_ref().map(|c| c.correlation.clone()),
+            sigma_hat: id.sigma_hat,
+            rss: id.rss,
+            initial_rss: id.initial_rss,
+            rank: id.rank,
+            unidentifiable: id.unidentifiable.clone(),
+        }
+    }
+}
+
+/// `calibrate --measurements`: identification from measured data.
+#[derive(Clone, Debug, Serialize)]
+pub struct MeasuredCalibrationReport {
+    /// The identification.
+    #[serde(flatten)]
+    pub identification: IdentificationReport,
+    /// Robot name or description path.
+    pub robot: String,
+    /// Driven frames.
+    pub chain: Vec<String>,
+    /// The measurement file.
+    pub measurements: String,
+    /// Measured poses.
+    pub poses: usize,
+    /// What was measured.
+    pub measurement: crate::model::Measurement,
+    /// Estimate − start, by unknown.
+    pub change: std::collections::BTreeMap<String, f64>,
+    /// RMS weighted residual per row at the estimate.
+    pub rms_residual: f64,
+    /// RMS weighted residual per row of the nominal model.
+    pub initial_rms_residual: f64,
+    /// The calibrated description written, if any.
+    pub out: Option<String>,
+    /// Wall-clock seconds.
+    pub elapsed_seconds: f64,
+}
+
+impl MeasuredCalibrationReport {
+    /// The report of `id`, identified from `poses` measured poses in `file`.
+    #[must_use]
+    pub fn new(
+        robot: &Robot,
+        id: &crate::identify::Identification,
+        file: String,
+        poses: usize,
+    ) -> Self {
+        let rows = (robot.rows_per_pose() * poses) as f64;
+        let change: Vec<f64> = id
+            .estimate
+            .iter()
+            .zip(&id.start)
+            .map(|(e, s)| e - s)
+            .collect();
+        Self {
+            identification: IdentificationReport::from(id),
+            robot: robot.name.clone(),
+            chain: chain(robot),
+            measurements: file,
+            poses,
+            measurement: robot.measurement,
+            change: named(&id.names, &change),
+            rms_residual: (id.rss / rows).sqrt(),
+            initial_rms_residual: (id.initial_rss / rows).sqrt(),
+            out: None,
+            elapsed_seconds: 0.0,
+        }
+    }
+}
+
+/// `calibrate --design`: simulated calibration at a design, validated on
+/// held-out poses of the design's pool.
+#[derive(Clone, Debug, Serialize)]
+pub struct SimulatedCalibrationReport {
+    /// The identification (trial 0 of the seed).
+    #[serde(flatten)]
+    pub identification: IdentificationReport,
+    /// Robot name or description path.
+    pub robot: String,
+    /// Driven frames.
+    pub chain: Vec<String>,
+    /// The design file.
+    pub design: String,
+    /// The design's pool.
+    pub pool: PoolSpec,
+    /// Poses in that pool.
+    pub pool_size: usize,
+    /// Poses in the design.
+    pub poses: usize,
+    /// What is measured.
+    pub measurement: crate::model::Measurement,
+    /// Noise σ per coordinate, metres.
+    pub noise: f64,
+    /// Orientation noise, radians (full-pose robots).
+    pub orientation_noise: Option<f64>,
+    /// Seed.
+    pub seed: u64,
+    /// Real − estimate, by unknown.
+    pub residual: std::collections::BTreeMap<String, f64>,
+    /// Held-out validation poses.
+    pub validation_poses: usize,
+    /// Validation RMS position error of the nominal model.
+    pub validation_rms_before: f64,
+    /// Validation RMS position error of the estimate.
+    pub validation_rms_after: f64,
+    /// Validation RMS orientation error of the nominal model.
+    pub validation_orientation_rms_before: Option<f64>,
+    /// Validation RMS orientation error of the estimate.
+    pub validation_orientation_rms_after: Option<f64>,
+    /// Monte-Carlo summary (`--trials` > 1).
+    pub monte_carlo: Option<crate::identify::MonteCarloSummary>,
+    /// Seconds of the Monte-Carlo.
+    pub monte_carlo_seconds: Option<f64>,
+    /// Wall-clock seconds.
+    pub elapsed_seconds: f64,
+}
+
+/// `fk`: forward kinematics (and the identification Jacobian) at one joint
+/// vector.
+#[derive(Clone, Debug, Serialize)]
+pub struct FkReport {
+    /// Robot name or description path.
+    pub robot: String,
+    /// Driven frames.
+    pub chain: Vec<String>,
+    /// Parameter set.
+    pub params: ParamSet,
+    /// Joint values, radians (or metres).
+    pub q: Vec<f64>,
+    /// End point.
+    pub position: [f64; 3],
+    /// Identification Jacobian, `t` rows of `p` (when asked for).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jacobian: Option<Vec<Vec<f64>>>,
+    /// Names of its columns (when the Jacobian is asked for).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub parameter_names: Option<Vec<String>>,
+}
+
+impl FkReport {
+    /// Forward kinematics of `robot` at `q` with table `params`, and the
+    /// Jacobian when `jacobian` is set.
+    pub fn new(
+        robot: &Robot,
+        params: ParamSet,
+        q: Vec<f64>,
+        jacobian: bool,
+    ) -> crate::Result<Self> {
+        let table = robot.params(params);
+        let p = crate::kinematics::position_checked(robot, table, &q)?;
+        let jac = jacobian.then(|| {
+            let n = robot.n_unknowns();
+            let mut jac = vec![0.0; robot.rows_per_pose() * n];
+            crate::measure::JacobianEvaluator::new(robot, table).eval(&q, &mut jac);
+            jac.chunks(n.max(1)).map(<[f64]>::to_vec).collect()
+        });
+        Ok(Self {
+            robot: robot.name.clone(),
+            chain: chain(robot),
+            params,
+            q,
+            position: [p.x, p.y, p.z],
+            parameter_names: jac.as_ref().map(|_| robot.parameter_names()),
+            jacobian: jac,
+        })
+    }
+}
+
+/// `pool`: the size of a lattice, and one pose of it.
+#[derive(Clone, Debug, Serialize)]
+pub struct LatticeReport {
+    /// Robot name or description path.
+    pub robot: String,
+    /// Driven frames.
+    pub chain: Vec<String>,
+    /// Values per joint.
+    pub levels: usize,
+    /// Lattice poses.
+    pub size: usize,
+    /// Index of the pose asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub index: Option<usize>,
+    /// Its digits.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub digits: Option<Vec<usize>>,
+    /// Its joint values.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub q: Option<Vec<f64>>,
+}
+
+impl LatticeReport {
+    /// The lattice of `levels` for `robot`, and the pose of `digits` if given.
+    pub fn new(robot: &Robot, levels: usize, digits: Option<Vec<usize>>) -> crate::Result<Self> {
+        let lattice = crate::pool::Lattice::new(robot, levels)?;
+        let index = digits.as_ref().map(|d| lattice.index_of(d)).transpose()?;
+        Ok(Self {
+            robot: robot.name.clone(),
+            chain: chain(robot),
+            levels,
+            size: lattice.size(),
+            q: index.map(|i| lattice.q(i)).transpose()?,
+            index,
+            digits,
+        })
+    }
+}

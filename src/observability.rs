@@ -22,7 +22,7 @@
 use crate::blocks::Blocks;
 use crate::blocks::jacobian_of;
 use crate::error::{Error, Result};
-use crate::model::{Convention, Measurement, ParamId, ParamTable, Robot, Symbol};
+use crate::model::{Convention, MeasurementKind, ParamId, ParamTable, Robot, Symbol};
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -266,12 +266,12 @@ impl Robot {
     /// fixed Hayati identity frame `tool`.
     ///
     /// ```
-    /// use activecal::model::{Measurement, Robot};
-    /// let pose = Robot::ur5().with_measurement(Measurement::Pose).unwrap();
+    /// use activecal::model::{MeasurementKind, Robot};
+    /// let pose = Robot::ur5().with_measurement(MeasurementKind::Pose).unwrap();
     /// assert_eq!((pose.rows_per_pose(), pose.n_unknowns()), (6, 30));
     /// assert_eq!(pose.unknowns, Robot::builtin("ur5:pose").unwrap().unknowns);
     /// ```
-    pub fn with_measurement(&self, m: Measurement) -> Result<Robot> {
+    pub fn with_measurement(&self, m: MeasurementKind) -> Result<Robot> {
         let mut r = self.clone();
         r.measurement = m;
         if r.frames.is_empty() {

@@ -400,7 +400,7 @@ pub struct MeasuredCalibrationReport {
     /// Measured poses.
     pub poses: usize,
     /// What was measured.
-    pub measurement: crate::model::Measurement,
+    pub measurement: crate::model::MeasurementKind,
     /// Estimate − start, by unknown.
     pub change: std::collections::BTreeMap<String, f64>,
     /// RMS weighted residual per row at the estimate.
@@ -465,7 +465,7 @@ pub struct SimulatedCalibrationReport {
     /// Poses in the design.
     pub poses: usize,
     /// What is measured.
-    pub measurement: crate::model::Measurement,
+    pub measurement: crate::model::MeasurementKind,
     /// Noise σ per coordinate, metres.
     pub noise: f64,
     /// Orientation noise, radians (full-pose robots).

@@ -686,7 +686,7 @@ fn write_design(name: &str, d: &DesignFile) -> std::path::PathBuf {
 #[test]
 fn cli_calibrate_reports_estimate_and_monte_carlo() {
     let (robot, pool, design, _) = data();
-    let indices = design.iter().map(|&k| pool.indices[k]).collect();
+    let indices = design.iter().map(|&k| pool.ids[k]).collect();
     let path = write_design("good.json", &DesignFile::new(&robot.name, 5, indices));
     let p = path.to_str().unwrap();
     let out = run(&["calibrate", "--design", p, "--noise", "0", "--json"]);

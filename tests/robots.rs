@@ -20,7 +20,7 @@ use activecal::io::robot_toml as file;
 use activecal::io::urdf::{self, UrdfOptions};
 use activecal::kinematics::{pose, position};
 use activecal::measure::JacobianEvaluator;
-use activecal::model::{Convention, JointKind, Measurement, ParamSet, ParamTable, Robot};
+use activecal::model::{Convention, JointKind, MeasurementKind, ParamSet, ParamTable, Robot};
 use activecal::observability::INDEPENDENCE_TOL;
 use activecal::observability::require_identifiable;
 use activecal::pool::Pool;
@@ -67,7 +67,7 @@ impl Lcg {
     }
 }
 
-fn urdf_import(name: &str, m: Measurement) -> Robot {
+fn urdf_import(name: &str, m: MeasurementKind) -> Robot {
     let o = UrdfOptions {
         measurement: m,
         ..UrdfOptions::default()
@@ -83,7 +83,7 @@ fn all_robots() -> Vec<Robot> {
         .map(|n| Robot::builtin(n).unwrap())
         .collect();
     for f in ["ur5.urdf", "stanford.urdf"] {
-        for m in [Measurement::Point, Measurement::Pose] {
+        for m in [MeasurementKind::Point, MeasurementKind::Pose] {
             let mut r = urdf_import(f, m);
             r.name = format!("{f}:{}", m.name());
             v.push(r);
@@ -147,7 +147,7 @@ fn puma_is_unchanged_and_its_pose_variant_only_adds_the_tool() {
     assert_eq!(p.real, b.real);
     assert_eq!(p.nominal, b.nominal);
     assert_eq!(p.unknowns, b.unknowns);
-    assert_eq!(p.measurement, Measurement::Point);
+    assert_eq!(p.measurement, MeasurementKind::Point);
     assert!(
         activecal::io::load_description("puma560")
             .unwrap()
@@ -156,7 +156,7 @@ fn puma_is_unchanged_and_its_pose_variant_only_adds_the_tool() {
     );
     assert!(p.frames.iter().all(|f| f.joint_kind == JointKind::Revolute));
     let pp = Robot::builtin("puma560:pose").unwrap();
-    assert_eq!(pp.measurement, Measurement::Pose);
+    assert_eq!(pp.measurement, MeasurementKind::Pose);
     assert_eq!(pp.rows_per_pose(), 6);
     for i in 0..7 {
         assert_eq!(pp.real.rows[i], p.real.rows[i]);
@@ -492,14 +492,14 @@ fn puma_urdf_fixture_is_the_nominal_model_and_imports_to_its_positions() {
         stored, text,
         "fixtures/puma560.urdf is stale: rerun with ACTIVECAL_REGEN_ROBOT_FIXTURES=1"
     );
-    for m in [Measurement::Point, Measurement::Pose] {
+    for m in [MeasurementKind::Point, MeasurementKind::Pose] {
         let r = urdf_import("puma560.urdf", m);
         assert_eq!(r.dof(), 6);
         assert_eq!(r.limits, puma.limits);
         assert_eq!(r.n_unknowns(), r.minimal_unknowns());
         assert_eq!(
             r.n_unknowns(),
-            if m == Measurement::Point { 27 } else { 30 }
+            if m == MeasurementKind::Point { 27 } else { 30 }
         );
         // Equal to the built-in model on the whole 5-level lattice and 2000
         // random joint vectors (rotations too: the tip is frame 6).
@@ -530,7 +530,7 @@ fn urdf_imports_reproduce_direct_urdf_kinematics() {
         ("stanford.urdf", "target"),
         ("puma560.urdf", "tip"),
     ] {
-        for m in [Measurement::Point, Measurement::Pose] {
+        for m in [MeasurementKind::Point, MeasurementKind::Pose] {
             let r = urdf_import(file, m);
             r.validate().unwrap();
             // Generic chains: the textbook number of unknowns.
@@ -560,7 +560,7 @@ fn urdf_imports_reproduce_direct_urdf_kinematics() {
 fn urdf_conventions_follow_the_parallel_axes() {
     // UR5: shoulder, elbow and wrist-1 axes are parallel → Hayati for the
     // frames of joints 2 and 3; the root z is joint 1's axis → the `m` frame.
-    let r = urdf_import("ur5.urdf", Measurement::Point);
+    let r = urdf_import("ur5.urdf", MeasurementKind::Point);
     let conv: Vec<(&str, Convention)> = r
         .frames
         .iter()
@@ -585,7 +585,7 @@ fn urdf_conventions_follow_the_parallel_axes() {
         r.unknowns.iter().all(|u| u.frame != 0),
         "the m frame has no unknowns"
     );
-    let s = urdf_import("stanford.urdf", Measurement::Point);
+    let s = urdf_import("stanford.urdf", MeasurementKind::Point);
     let boom = s.frames.iter().find(|f| f.label == "boom_slide").unwrap();
     assert_eq!(boom.joint_kind, JointKind::Prismatic);
     assert_eq!(boom.convention, Hayati); // the roll axis is coaxial with the boom
@@ -817,7 +817,7 @@ fn toml_fixtures_load() {
             .visibility
             .is_some()
     );
-    let direct = urdf_import("ur5.urdf", Measurement::Pose);
+    let direct = urdf_import("ur5.urdf", MeasurementKind::Pose);
     assert_eq!(u.nominal, direct.nominal);
 }
 
@@ -850,17 +850,17 @@ fn load_accepts_names_and_files_and_explains_the_rest() {
     let r = activecal::io::load_robot(path.to_str().unwrap()).unwrap();
     assert_eq!(
         (r.name.as_str(), r.measurement, r.n_unknowns()),
-        (path.to_str().unwrap(), Measurement::Point, 27)
+        (path.to_str().unwrap(), MeasurementKind::Point, 27)
     );
     // `:pose` after a file, as after a built-in name: the URDF imported for
     // full poses, a point description turned into its full-pose variant;
     // the name keeps the suffix so that design files load the same robot.
     let name = format!("{}:pose", path.to_str().unwrap());
     let r = activecal::io::load_robot(&name).unwrap();
-    let direct = urdf_import("ur5.urdf", Measurement::Pose);
+    let direct = urdf_import("ur5.urdf", MeasurementKind::Pose);
     assert_eq!(
         (r.name.as_str(), r.measurement),
-        (name.as_str(), Measurement::Pose)
+        (name.as_str(), MeasurementKind::Pose)
     );
     assert_eq!(r.unknowns, direct.unknowns);
     assert_eq!(r.nominal, direct.nominal);
@@ -1078,12 +1078,12 @@ fn auto_unknowns_for_a_description_are_the_builtin_choice() {
     assert_eq!(r.unknowns, puma.unknowns);
     assert_eq!(r.name, "puma560");
     // And with_measurement adds the tool orientation for full poses.
-    let pp = puma.with_measurement(Measurement::Pose).unwrap();
+    let pp = puma.with_measurement(MeasurementKind::Pose).unwrap();
     assert_eq!(
         pp.unknowns,
         Robot::builtin("puma560:pose").unwrap().unknowns
     );
-    let back = pp.with_measurement(Measurement::Point).unwrap();
+    let back = pp.with_measurement(MeasurementKind::Point).unwrap();
     assert_eq!(back.unknowns, puma.unknowns);
 }
 
@@ -1173,7 +1173,7 @@ fn bound_runs_on_every_robot_and_lies_above_the_selected_design() {
 #[test]
 fn calibration_recovers_the_real_robot() {
     for mut r in all_robots() {
-        if r.measurement == Measurement::Pose {
+        if r.measurement == MeasurementKind::Pose {
             // A weight other than 1 exercises the scaling of the rows.
             r.orientation_scale = 0.3;
         }
@@ -1183,7 +1183,7 @@ fn calibration_recovers_the_real_robot() {
         let meas = simulate(&r, &r.real, &qs, 0.0, &mut trial_rng(1, 0)).unwrap();
         assert_eq!(
             meas.orientations().len(),
-            if r.measurement == Measurement::Pose {
+            if r.measurement == MeasurementKind::Pose {
                 30
             } else {
                 0

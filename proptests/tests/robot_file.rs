@@ -8,7 +8,7 @@ use activecal::io::robot_toml as file;
 use activecal::io::urdf::{self, UrdfOptions};
 use activecal::kinematics::pose;
 use activecal::model::{
-    Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot, Symbol,
+    Convention, Frame, JointKind, MeasurementKind, ParamId, ParamTable, Robot, Symbol,
 };
 use proptest::prelude::*;
 use std::sync::OnceLock;
@@ -243,9 +243,9 @@ fn any_robot() -> impl Strategy<Value = Robot> {
                 unknowns,
                 limits,
                 measurement: if pose_m {
-                    Measurement::Pose
+                    MeasurementKind::Pose
                 } else {
-                    Measurement::Point
+                    MeasurementKind::Point
                 },
                 orientation_scale: activecal::model::DEFAULT_ORIENTATION_SCALE,
             }
@@ -289,7 +289,7 @@ proptest! {
     #[test]
     fn edited_urdf_never_panics(edits in prop::collection::vec(edit(URDF_LINES), 1..4)) {
         let text = apply(puma_urdf(), &edits);
-        for m in [Measurement::Point, Measurement::Pose] {
+        for m in [MeasurementKind::Point, MeasurementKind::Pose] {
             let o = UrdfOptions { measurement: m, ..UrdfOptions::default() };
             if let Ok(r) = urdf::parse(&text, "fuzz.urdf", &o) {
                 check_loaded(&r);

@@ -21,11 +21,11 @@
 //! [`identify_robust`] wraps the problem in a robust loss ([`super::loss`])
 //! and solves it by IRLS ([`irls`]).
 
-use super::dense::{SeqQr, inverse_information};
 use super::loss::{Loss, Robust};
 use super::residual::{Calibration, Residuals};
 use super::{IdentifyError, Measurements, Result};
 use crate::blocks::Blocks;
+use crate::linalg::qr::{SeqQr, inverse_information};
 use crate::model::{ParamTable, Robot, Symbol};
 use crate::observability::identifiability;
 use faer::Mat;

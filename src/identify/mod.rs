@@ -30,7 +30,6 @@
 //! [`IdentifyError`]; a numerical outcome (no convergence, divergence, a rank
 //! deficient design) is the [`Status`] of the result.
 
-mod dense;
 pub mod lm;
 pub mod loss;
 pub mod montecarlo;

@@ -8,12 +8,13 @@
 //! [`trial_rng`]`(seed, t)` and results are reduced in trial order, so a
 //! summary depends on the seed only, never on the number of threads.
 
-use super::dense::{gram, ln_det_spd, product};
 use super::lm::{LmSettings, Status, identify, predicted_covariance};
 use super::simulate::{simulate, trial_rng};
 use super::{IdentifyError, Result};
 use crate::blocks::jacobian_of;
 use crate::kinematics::{pose, position};
+use crate::linalg::chol::ln_det_spd_equilibrated as ln_det_spd;
+use crate::linalg::gram::{gram_of as gram, product};
 use crate::measure::so3;
 use crate::measure::{RowKind, sensor_for};
 use crate::model::{ParamTable, Robot};
@@ -37,7 +38,7 @@ const BOOTSTRAP_STREAM: u64 = u64::MAX - 1;
 pub struct MonteCarloSettings {
     /// Noise realisations `R`. Default 200.
     pub trials: usize,
-    /// Measurement noise σ per coordinate, metres. Default 0.01 (paper §V).
+    /// MeasurementKind noise σ per coordinate, metres. Default 0.01 (paper §V).
     pub sigma: f64,
     /// Seed of the noise, the validation poses and the bootstrap. Default 0.
     pub seed: u64,
@@ -173,7 +174,7 @@ impl ValidationSet {
         free.sort_unstable();
         let qs = free.iter().map(|&k| pool.q(k)).collect();
         let mut v = Self::from_qs(robot, qs)?;
-        v.lattice_indices = free.iter().map(|&k| pool.indices[k]).collect();
+        v.lattice_indices = free.iter().map(|&k| pool.ids[k]).collect();
         Ok(v)
     }
 

@@ -9,7 +9,7 @@ pub mod urdf;
 
 use crate::error::{Error, Result};
 use crate::measure::Visibility;
-use crate::model::{BUILTIN, Measurement, Robot};
+use crate::model::{BUILTIN, MeasurementKind, Robot};
 use std::path::Path;
 
 /// A robot as a description gives it: the model and the sensor's visibility
@@ -33,7 +33,7 @@ pub struct Description {
 /// again.
 ///
 /// As for built-in names, the suffix `:pose` asks for full-pose
-/// measurements: `arm.urdf:pose` imports with [`Measurement::Pose`];
+/// measurements: `arm.urdf:pose` imports with [`MeasurementKind::Pose`];
 /// `arm.toml:pose` turns a point description into its full-pose variant
 /// ([`Robot::with_measurement`]).
 pub fn load_robot(name_or_path: &str) -> Result<Robot> {
@@ -60,8 +60,8 @@ pub fn load_description(name_or_path: &str) -> Result<Description> {
     let mut d = match ext.as_deref() {
         Some("toml") => {
             let mut d = robot_toml::load_description(path)?;
-            if pose && d.robot.measurement == Measurement::Point {
-                d.robot = d.robot.with_measurement(Measurement::Pose)?;
+            if pose && d.robot.measurement == MeasurementKind::Point {
+                d.robot = d.robot.with_measurement(MeasurementKind::Pose)?;
             }
             d
         }
@@ -70,9 +70,9 @@ pub fn load_description(name_or_path: &str) -> Result<Description> {
                 path,
                 &urdf::UrdfOptions {
                     measurement: if pose {
-                        Measurement::Pose
+                        MeasurementKind::Pose
                     } else {
-                        Measurement::Point
+                        MeasurementKind::Point
                     },
                     ..urdf::UrdfOptions::default()
                 },

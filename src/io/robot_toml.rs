@@ -49,7 +49,9 @@
 use super::Description;
 use crate::error::{Error, Result};
 use crate::measure::Visibility;
-use crate::model::{Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot, Symbol};
+use crate::model::{
+    Convention, Frame, JointKind, MeasurementKind, ParamId, ParamTable, Robot, Symbol,
+};
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
 use std::path::Path;
@@ -67,7 +69,7 @@ pub const MAX_ABS: f64 = 1e6;
 #[serde(deny_unknown_fields)]
 struct FileSpec {
     name: Option<String>,
-    measurement: Option<Measurement>,
+    measurement: Option<MeasurementKind>,
     orientation_scale: Option<Spanned<f64>>,
     visibility: Option<Spanned<Visibility>>,
     unknowns: Option<Spanned<String>>,
@@ -168,10 +170,10 @@ pub fn parse(text: &str, origin: &str, dir: Option<&Path>) -> Result<Robot> {
 pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result<Description> {
     let cx = Ctx { text, origin };
     let spec: FileSpec = toml::from_str(text).map_err(|e| cx.plain(e.to_string().trim_end()))?;
-    let measurement = spec.measurement.unwrap_or(Measurement::Point);
+    let measurement = spec.measurement.unwrap_or(MeasurementKind::Point);
     let orientation_scale = match &spec.orientation_scale {
         None => crate::model::DEFAULT_ORIENTATION_SCALE,
-        Some(s) if measurement != Measurement::Pose => {
+        Some(s) if measurement != MeasurementKind::Pose => {
             return Err(cx.at(
                 s.span(),
                 "`orientation_scale` weighs orientation measurements: it needs `measurement = \"pose\"`",
@@ -545,7 +547,7 @@ pub fn description_to_toml(robot: &Robot, visibility: Option<&Visibility>) -> St
     s += "# activecal robot description (see activecal::io::robot_toml)\n";
     s += &format!("name = {:?}\n", robot.name);
     s += &format!("measurement = \"{}\"\n", robot.measurement.name());
-    if robot.measurement == Measurement::Pose {
+    if robot.measurement == MeasurementKind::Pose {
         s += &format!("orientation_scale = {}\n", num(robot.orientation_scale));
     }
     for (i, f) in robot.frames.iter().enumerate() {

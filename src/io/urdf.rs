@@ -58,7 +58,7 @@ use crate::error::{Error, Result};
 use crate::kinematics::joint_chain;
 use crate::model::catalogue::perturbed;
 use crate::model::{
-    Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot, frame_transform,
+    Convention, Frame, JointKind, MeasurementKind, ParamId, ParamTable, Robot, frame_transform,
 };
 use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion, Vector3};
 use std::collections::HashMap;
@@ -92,7 +92,7 @@ pub struct UrdfOptions {
     /// Each must be a moving joint of the chain.
     pub lock: Vec<(String, f64)>,
     /// Point (default) or full-pose measurements.
-    pub measurement: Measurement,
+    pub measurement: MeasurementKind,
     /// Angle in radians below which consecutive axes are nearly parallel
     /// (Hayati frame). Default [`PARALLEL_THRESHOLD`].
     pub parallel_threshold: f64,
@@ -108,7 +108,7 @@ impl Default for UrdfOptions {
             base: None,
             tip: None,
             lock: Vec::new(),
-            measurement: Measurement::Point,
+            measurement: MeasurementKind::Point,
             parallel_threshold: PARALLEL_THRESHOLD,
             perturb_real: true,
         }

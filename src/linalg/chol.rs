@@ -117,4 +117,18 @@ mod tests {
             }
         }
     }
+    #[test]
+    fn ln_det_handles_scales() {
+        let a = Mat::from_fn(3, 3, |i, j| {
+            let s = [1e-8f64, 1.0, 1e6];
+            let base = if i == j { 2.0 } else { 0.5 };
+            base * (s[i] * s[j]).sqrt()
+        });
+        // det = (Π s_i) · det([[2, .5, .5], [.5, 2, .5], [.5, .5, 2]]) = 1e-2 · 6.75
+        let want = (1e-2f64 * 6.75).ln();
+        assert!((ln_det_spd_equilibrated(a.as_ref()).unwrap() - want).abs() < 1e-12);
+        assert!(ln_det_spd_equilibrated(Mat::<f64>::zeros(2, 2).as_ref()).is_none());
+        let indefinite = Mat::from_fn(2, 2, |i, j| if i == j { 1.0 } else { 2.0 });
+        assert!(ln_det_spd_equilibrated(indefinite.as_ref()).is_none());
+    }
 }

@@ -2,7 +2,7 @@
 //! `t×p` block, `M ± XᵀX` updates that keep `M` exactly symmetric, the
 //! induced 1-norm, and faer views of the slices.
 
-use faer::MatRef;
+use faer::{Mat, MatRef, Par};
 
 /// Copies a `t×p` block (any strides) into `out`, column-major with stride
 /// `t` (`out[a·t + r] = X[r, a]`), reusing `out`'s allocation.
@@ -41,6 +41,27 @@ pub(crate) fn norm1(m: &[f64], p: usize) -> f64 {
 /// A `p×p` column-major slice viewed as a faer matrix.
 pub(crate) fn view(m: &[f64], p: usize) -> MatRef<'_, f64> {
     MatRef::from_column_major_slice(m, p, p)
+}
+
+/// `AᵀA` (sequential).
+pub(crate) fn gram_of(a: MatRef<'_, f64>) -> Mat<f64> {
+    let mut out = Mat::<f64>::zeros(a.ncols(), a.ncols());
+    faer::linalg::matmul::matmul(
+        out.as_mut(),
+        faer::Accum::Replace,
+        a.transpose(),
+        a,
+        1.0,
+        Par::Seq,
+    );
+    out
+}
+
+/// `A B` (sequential).
+pub(crate) fn product(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
+    let mut out = Mat::<f64>::zeros(a.nrows(), b.ncols());
+    faer::linalg::matmul::matmul(out.as_mut(), faer::Accum::Replace, a, b, 1.0, Par::Seq);
+    out
 }
 
 #[cfg(test)]

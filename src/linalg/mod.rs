@@ -3,7 +3,8 @@
 //!
 //! - [`chol`]: Cholesky of `p×p` SPD matrices, `ln det`, inverse;
 //! - [`small`]: `t×t` block kernels of the rank-t updates (eqs. (17)–(22));
-//! - [`gram`]: `M ± XᵀX` on `p×p` slices;
+//! - [`gram`]: `M ± XᵀX` on `p×p` slices, `AᵀA` and products;
+//! - [`qr`]: Householder QR, least squares and `(XᵀX)⁻¹` for identification;
 //! - [`eigen`]: eigenvalues and singular values;
 //! - [`simd`]: register hygiene after faer's kernels;
 //! - [`blas`]: the system BLAS kept on one thread.
@@ -15,5 +16,6 @@ pub mod blas;
 pub mod chol;
 pub mod eigen;
 pub mod gram;
+pub mod qr;
 pub mod simd;
 pub mod small;

@@ -28,7 +28,7 @@
 //! Point and pose sensors have no unknowns of their own (`own` is empty).
 
 use crate::kinematics::{EndFrame, Motion};
-use crate::model::{Measurement, Robot};
+use crate::model::{MeasurementKind, Robot};
 use std::fmt;
 
 use super::point::PointSensor;
@@ -77,7 +77,7 @@ pub struct ObservationBuf {
 /// per identification.
 pub trait Sensor: fmt::Debug + Send + Sync {
     /// The measurement kind this sensor implements.
-    fn kind(&self) -> Measurement;
+    fn kind(&self) -> MeasurementKind;
 
     /// What a pose's measurement is, for messages (`points`, `full poses
     /// (position and orientation)`).
@@ -182,10 +182,10 @@ pub trait Sensor: fmt::Debug + Send + Sync {
 
 /// The sensor of a measurement kind, with the robot's weights.
 #[must_use]
-pub fn sensor_of(kind: Measurement, orientation_scale: f64) -> Box<dyn Sensor> {
+pub fn sensor_of(kind: MeasurementKind, orientation_scale: f64) -> Box<dyn Sensor> {
     match kind {
-        Measurement::Point => Box::new(PointSensor::new()),
-        Measurement::Pose => Box::new(PoseSensor::new(orientation_scale)),
+        MeasurementKind::Point => Box::new(PointSensor::new()),
+        MeasurementKind::Pose => Box::new(PoseSensor::new(orientation_scale)),
     }
 }
 

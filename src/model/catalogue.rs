@@ -16,7 +16,7 @@
 //! `t`) rotate about axes through the measured point, so the point variant
 //! sees the same real robot.
 
-use super::{Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot, Symbol};
+use super::{Convention, Frame, JointKind, MeasurementKind, ParamId, ParamTable, Robot, Symbol};
 use std::f64::consts::FRAC_PI_2;
 
 /// The deterministic perturbation added to parameter `(frame, symbol)` of a
@@ -62,7 +62,7 @@ fn assemble(
     point_unknowns: Vec<ParamId>,
     pose_extra: Vec<ParamId>,
     limits: Vec<[f64; 2]>,
-    m: Measurement,
+    m: MeasurementKind,
 ) -> Robot {
     let nominal = ParamTable {
         rows: frames.iter().map(|f| f.4).collect(),
@@ -72,8 +72,8 @@ fn assemble(
     pose_unknowns.sort();
     let real = perturbed(&nominal, &pose_unknowns);
     let (name, unknowns) = match m {
-        Measurement::Point => (name.to_string(), point_unknowns),
-        Measurement::Pose => (format!("{name}:pose"), pose_unknowns),
+        MeasurementKind::Point => (name.to_string(), point_unknowns),
+        MeasurementKind::Pose => (format!("{name}:pose"), pose_unknowns),
     };
     let r = Robot {
         name,
@@ -109,14 +109,14 @@ impl Robot {
     /// [`ur5_with`].
     #[must_use]
     pub fn ur5() -> Robot {
-        ur5_with(Measurement::Point)
+        ur5_with(MeasurementKind::Point)
     }
 
     /// A Stanford arm measured at a point (25 unknowns); see
     /// [`stanford_with`].
     #[must_use]
     pub fn stanford() -> Robot {
-        stanford_with(Measurement::Point)
+        stanford_with(MeasurementKind::Point)
     }
 }
 
@@ -142,7 +142,7 @@ impl Robot {
 /// [−170, 170]; q2 ∈ [−180, 0] (upper arm above the mounting plane); q3 ∈
 /// [−160, 160] (elbow clear of the upper arm).
 #[must_use]
-pub fn ur5_with(m: Measurement) -> Robot {
+pub fn ur5_with(m: MeasurementKind) -> Robot {
     use Convention::{Dh, Hayati};
     use JointKind::Revolute as R;
     let frames: [FrameRow; 8] = [
@@ -201,7 +201,7 @@ pub fn ur5_with(m: Measurement) -> Robot {
 /// Ranges, chosen for calibration pools: q1, q4, q6 ∈ [−170°, 170°], q2, q5
 /// ∈ [−90°, 90°], boom q3 ∈ [0.3, 1.0] m.
 #[must_use]
-pub fn stanford_with(m: Measurement) -> Robot {
+pub fn stanford_with(m: MeasurementKind) -> Robot {
     use Convention::{Dh, Hayati};
     use JointKind::{Prismatic as P, Revolute as R};
     let frames: [FrameRow; 8] = [
@@ -250,7 +250,7 @@ pub fn stanford_with(m: Measurement) -> Robot {
 pub fn puma560_pose() -> Robot {
     let mut r = Robot::puma560();
     r.name = "puma560:pose".into();
-    r.measurement = Measurement::Pose;
+    r.measurement = MeasurementKind::Pose;
     r.frames[7].convention = Convention::Hayati;
     r.real.rows[7][4] = 0.0;
     r.nominal.rows[7][4] = 0.0;

@@ -7,7 +7,7 @@
 //! paper's). A frame driven by a prismatic joint moves along z instead:
 //! `Rz(γ) Tz(q + d) …`. A fixed frame has no `q`. The measured point is the
 //! origin of the last frame, expressed in the measurement frame ("coordinate
-//! zero"); a full-pose measurement ([`Measurement::Pose`]) adds the last
+//! zero"); a full-pose measurement ([`MeasurementKind::Pose`]) adds the last
 //! frame's orientation.
 //!
 //! The model imports no loader, no pool and no sensor: built-in arms are in
@@ -190,7 +190,7 @@ pub enum ParamSet {
 /// What is measured at each pose.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
-pub enum Measurement {
+pub enum MeasurementKind {
     /// The position of the end point: 3 rows per pose.
     Point,
     /// The position and orientation of the end frame: 6 rows per pose,
@@ -200,13 +200,13 @@ pub enum Measurement {
     Pose,
 }
 
-impl Measurement {
+impl MeasurementKind {
     /// Rows of the identification Jacobian per pose.
     #[must_use]
     pub fn rows(self) -> usize {
         match self {
-            Measurement::Point => 3,
-            Measurement::Pose => 6,
+            MeasurementKind::Point => 3,
+            MeasurementKind::Pose => 6,
         }
     }
 
@@ -214,8 +214,8 @@ impl Measurement {
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {
-            Measurement::Point => "point",
-            Measurement::Pose => "pose",
+            MeasurementKind::Point => "point",
+            MeasurementKind::Pose => "pose",
         }
     }
 }
@@ -237,7 +237,7 @@ pub struct Robot {
     /// metres for a prismatic one.
     pub limits: Vec<[f64; 2]>,
     /// What is measured.
-    pub measurement: Measurement,
+    pub measurement: MeasurementKind,
     /// Metres per radian that make an orientation error comparable to a
     /// position error (full-pose robots): the orientation rows of the
     /// identification Jacobian and the orientation residuals of
@@ -265,12 +265,12 @@ impl Robot {
     /// they identify (see [`catalogue`]).
     pub fn builtin(name: &str) -> Result<Robot> {
         let (base, m) = match name.strip_suffix(":pose") {
-            Some(b) => (b, Measurement::Pose),
-            None => (name, Measurement::Point),
+            Some(b) => (b, MeasurementKind::Pose),
+            None => (name, MeasurementKind::Point),
         };
         match (base, m) {
-            ("puma560" | "puma", Measurement::Point) => Ok(Robot::puma560()),
-            ("puma560" | "puma", Measurement::Pose) => Ok(catalogue::puma560_pose()),
+            ("puma560" | "puma", MeasurementKind::Point) => Ok(Robot::puma560()),
+            ("puma560" | "puma", MeasurementKind::Pose) => Ok(catalogue::puma560_pose()),
             ("ur5", m) => Ok(catalogue::ur5_with(m)),
             ("stanford", m) => Ok(catalogue::stanford_with(m)),
             _ => Err(Error::UnknownRobot {
@@ -372,7 +372,7 @@ impl Robot {
             nominal,
             unknowns,
             limits,
-            measurement: Measurement::Point,
+            measurement: MeasurementKind::Point,
             orientation_scale: DEFAULT_ORIENTATION_SCALE,
         }
     }

@@ -112,7 +112,7 @@ impl PoolSpec {
             spec: self.clone(),
             dof,
             q,
-            indices: ids,
+            ids,
             lattice,
         })
     }
@@ -169,7 +169,7 @@ pub struct Pool {
     q: Vec<f64>,
     /// Stable id of each pool pose, ascending (the lattice index for lattice
     /// poses).
-    pub indices: Vec<usize>,
+    pub ids: Vec<usize>,
     lattice: Option<Lattice>,
 }
 
@@ -196,13 +196,13 @@ impl Pool {
     /// Number of pool poses.
     #[must_use]
     pub fn len(&self) -> usize {
-        self.indices.len()
+        self.ids.len()
     }
 
     /// Whether the pool is empty.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.indices.is_empty()
+        self.ids.is_empty()
     }
 
     /// Number of joints.
@@ -220,20 +220,20 @@ impl Pool {
     /// Stable id of pool pose `k`.
     #[must_use]
     pub fn id(&self, k: usize) -> usize {
-        self.indices[k]
+        self.ids[k]
     }
 
     /// Stable ids of pool poses.
     #[must_use]
     pub fn ids_of(&self, positions: &[usize]) -> Vec<usize> {
-        positions.iter().map(|&k| self.indices[k]).collect()
+        positions.iter().map(|&k| self.ids[k]).collect()
     }
 
     /// Position in the pool of a pose id, or an error saying why it is not
     /// there.
     pub fn position_of(&self, id: usize) -> Result<usize> {
         self.spec.source.check_id(self.lattice.as_ref(), id)?;
-        self.indices
+        self.ids
             .binary_search(&id)
             .map_err(|_| Error::PoseNotInPool {
                 index: id,
@@ -332,14 +332,14 @@ mod tests {
         let some = Pool::filtered(&r, &r.nominal, 3, &vis).unwrap();
         assert!(!some.is_empty() && some.len() < 729);
         let lattice = some.lattice().unwrap().clone();
-        for (k, &i) in some.indices.iter().enumerate() {
+        for (k, &i) in some.ids.iter().enumerate() {
             assert_eq!(some.position_of(i).unwrap(), k);
             assert_eq!(some.q(k), lattice.q(i).unwrap());
             let p = position(&r, &r.nominal, &some.q(k));
             assert!(vis.sees(&p));
         }
         let hidden = (0..729)
-            .find(|i| some.indices.binary_search(i).is_err())
+            .find(|i| some.ids.binary_search(i).is_err())
             .unwrap();
         assert!(some.position_of(hidden).is_err());
         assert!(some.position_of(729).is_err());

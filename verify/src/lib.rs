@@ -29,7 +29,7 @@ pub mod bridge;
 pub mod check;
 
 use activecal::model::{
-    Convention, Frame, JointKind, Measurement, ParamId, ParamTable, Robot, Symbol,
+    Convention, Frame, JointKind, MeasurementKind, ParamId, ParamTable, Robot, Symbol,
 };
 
 /// Largest deviation accepted between any two of activecal, Pinocchio,
@@ -134,7 +134,7 @@ pub fn synthetic_robot() -> Robot {
             [-1.0, 3.0],
             [-3.1, 3.1],
         ],
-        measurement: Measurement::Point,
+        measurement: MeasurementKind::Point,
         orientation_scale: activecal::model::DEFAULT_ORIENTATION_SCALE,
     };
     robot.validate().expect("synthetic robot is valid");

@@ -106,12 +106,12 @@ fn committed_fixtures_match_a_fresh_regeneration() {
 fn urdf_imports_agree_with_pinocchio_loading_the_urdf() {
     use activecal::io::urdf::{UrdfOptions, load};
     use activecal::kinematics::pose;
-    use activecal::model::Measurement;
+    use activecal::model::MeasurementKind;
     let bridge = Bridge::new().unwrap();
     let dir = fixture::default_dir();
     for name in ["puma560.urdf", "ur5.urdf", "stanford.urdf"] {
         let path = dir.join(name);
-        for m in [Measurement::Point, Measurement::Pose] {
+        for m in [MeasurementKind::Point, MeasurementKind::Pose] {
             let opts = UrdfOptions {
                 measurement: m,
                 ..UrdfOptions::default()

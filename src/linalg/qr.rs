@@ -1,6 +1,6 @@
-//! Small dense kernels of identification, all sequential (`Par::Seq`) so that
-//! a result never depends on the number of threads: Householder QR with
-//! least-squares solves, `(XᵀX)⁻¹` from a scaled QR, `ln det` of an SPD matrix.
+//! Householder QR for identification, sequential (`Par::Seq`) so that a
+//! result never depends on the number of threads: least-squares solves and
+//! `(XᵀX)⁻¹` from a column-scaled QR.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::qr::no_pivoting::{factor, solve};
@@ -96,62 +96,10 @@ pub(crate) fn inverse_information(x: MatRef<'_, f64>) -> Option<Mat<f64>> {
     }))
 }
 
-/// `ln det` of a symmetric positive definite matrix, through the correlation
-/// form `ln det A = Σ ln A_ii + ln det(D^{-1/2} A D^{-1/2})` so that entries
-/// of very different scales do not matter. `None` if not positive definite.
-pub(crate) fn ln_det_spd(a: MatRef<'_, f64>) -> Option<f64> {
-    let n = a.nrows();
-    let d: Vec<f64> = (0..n).map(|i| a[(i, i)]).collect();
-    if d.iter().any(|&v| !(v > 0.0 && v.is_finite())) {
-        return None;
-    }
-    // Cholesky of the correlation matrix, row by row (n is ~27).
-    let mut l = vec![0.0; n * n];
-    let mut ln_det = d.iter().map(|v| v.ln()).sum::<f64>();
-    for i in 0..n {
-        for j in 0..=i {
-            let mut s = a[(i, j)] / (d[i] * d[j]).sqrt();
-            for k in 0..j {
-                s -= l[i * n + k] * l[j * n + k];
-            }
-            if i == j {
-                if s.is_nan() || s <= 0.0 {
-                    return None;
-                }
-                l[i * n + i] = s.sqrt();
-                ln_det += s.ln();
-            } else {
-                l[i * n + j] = s / l[j * n + j];
-            }
-        }
-    }
-    Some(ln_det)
-}
-
-/// `AᵀA` (sequential).
-pub(crate) fn gram(a: MatRef<'_, f64>) -> Mat<f64> {
-    let mut out = Mat::<f64>::zeros(a.ncols(), a.ncols());
-    faer::linalg::matmul::matmul(
-        out.as_mut(),
-        faer::Accum::Replace,
-        a.transpose(),
-        a,
-        1.0,
-        Par::Seq,
-    );
-    out
-}
-
-/// `A B` (sequential).
-pub(crate) fn product(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
-    let mut out = Mat::<f64>::zeros(a.nrows(), b.ncols());
-    faer::linalg::matmul::matmul(out.as_mut(), faer::Accum::Replace, a, b, 1.0, Par::Seq);
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::linalg::gram::{gram_of as gram, product};
 
     fn test_matrix(m: usize, n: usize) -> Mat<f64> {
         // Pseudo-random entries in [−0.5, 0.5), columns scaled 1e-2 … 10.
@@ -196,20 +144,5 @@ mod tests {
         let mut z = a.clone();
         z.col_mut(3).fill(0.0);
         assert!(inverse_information(z.as_ref()).is_none());
-    }
-
-    #[test]
-    fn ln_det_handles_scales() {
-        let a = Mat::from_fn(3, 3, |i, j| {
-            let s = [1e-8f64, 1.0, 1e6];
-            let base = if i == j { 2.0 } else { 0.5 };
-            base * (s[i] * s[j]).sqrt()
-        });
-        // det = (Π s_i) · det([[2, .5, .5], [.5, 2, .5], [.5, .5, 2]]) = 1e-2 · 6.75
-        let want = (1e-2f64 * 6.75).ln();
-        assert!((ln_det_spd(a.as_ref()).unwrap() - want).abs() < 1e-12);
-        assert!(ln_det_spd(Mat::<f64>::zeros(2, 2).as_ref()).is_none());
-        let indefinite = Mat::from_fn(2, 2, |i, j| if i == j { 1.0 } else { 2.0 });
-        assert!(ln_det_spd(indefinite.as_ref()).is_none());
     }
 }

@@ -4,7 +4,7 @@
 //! a file of real measurements. Either way the calibrated robot can be
 //! written as a description file.
 
-use super::{emit, refuse_overwrite, write_new};
+use super::{emit, write_new};
 use activecal::identify::{
     Identification, LmSettings, Measurements, MonteCarloSettings, MonteCarloSummary, ParamGrid,
     ValidationSet, identify, monte_carlo, paper_tables,
@@ -121,9 +121,23 @@ fn refuse_unconverged(a: &CalibrateArgs, id: &Identification) -> Result<()> {
 
 /// Runs `calibrate`.
 pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
-    for path in [&a.out, &a.save_measurements].into_iter().flatten() {
-        refuse_overwrite(path, a.force)?;
-    }
+    let outputs: Vec<(&str, &std::path::Path)> = [
+        ("--out", a.out.as_deref()),
+        ("--save-measurements", a.save_measurements.as_deref()),
+    ]
+    .into_iter()
+    .filter_map(|(o, p)| p.map(|p| (o, p)))
+    .collect();
+    let robot_path = std::path::Path::new(a.robot.trim_end_matches(":pose"));
+    let inputs: Vec<&std::path::Path> = [
+        a.design.as_deref(),
+        a.measurements.as_deref(),
+        Some(robot_path),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    super::check_outputs(&outputs, &inputs, a.force)?;
     let desc = super::load_description(&a.robot)?;
     let robot = &desc.robot;
     match (&a.design, &a.measurements) {

@@ -39,9 +39,22 @@ pub fn load_robot(name: &str) -> Result<Robot> {
 /// Errors if `path` exists and `force` is not set: nothing the user has is
 /// replaced without asking. Checked before any work is done.
 pub fn refuse_overwrite(path: &std::path::Path, force: bool) -> Result<()> {
-    if path.exists() && !force {
-        anyhow::bail!("{} exists; pass --force to overwrite it", path.display());
-    }
+    check_outputs(&[("--out", path)], &[], force)
+}
+
+/// Checks a command's outputs before any work (see
+/// [`activecal::io::atomic::check_outputs`]): each is a file in an existing
+/// directory, not an input, not another output, and new unless `force`.
+pub fn check_outputs(
+    outputs: &[(&str, &std::path::Path)],
+    inputs: &[&std::path::Path],
+    force: bool,
+) -> Result<()> {
+    let outs: Vec<activecal::io::atomic::Output<'_>> = outputs
+        .iter()
+        .map(|&(option, path)| activecal::io::atomic::Output { option, path })
+        .collect();
+    activecal::io::atomic::check_outputs(&outs, inputs, force)?;
     Ok(())
 }
 
@@ -49,7 +62,8 @@ pub fn refuse_overwrite(path: &std::path::Path, force: bool) -> Result<()> {
 /// any error.
 pub fn write_new(path: &std::path::Path, text: &str, force: bool) -> Result<()> {
     refuse_overwrite(path, force)?;
-    std::fs::write(path, text).map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))
+    activecal::io::atomic::write_atomic(path, text.as_bytes())?;
+    Ok(())
 }
 
 /// Prints `value` as one JSON line, or the human-readable `text`.

@@ -7,7 +7,7 @@
 
 use super::figures;
 use activecal::experiment::paper::{self, PaperReport, PaperSettings};
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
@@ -93,32 +93,49 @@ impl ReproduceArgs {
 
 /// Runs `reproduce`.
 pub fn cmd_reproduce(a: ReproduceArgs) -> Result<()> {
+    // Every input is checked before any work or any file is made.
+    let settings = a.settings();
+    settings.validate()?;
     if a.out.exists() {
+        if !a.out.is_dir() {
+            bail!("--out {}: exists and is not a directory", a.out.display());
+        }
         let non_empty = std::fs::read_dir(&a.out)
             .map(|mut d| d.next().is_some())
             .unwrap_or(true);
         if non_empty && !a.force {
             bail!(
-                "{} exists and is not empty; pass --force to replace its files",
+                "--out {}: exists and is not empty; pass --force to replace it",
                 a.out.display()
             );
         }
     }
-    let settings = a.settings();
-    settings.validate()?;
-    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    if let Some(parent) = a.out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        if !parent.is_dir() {
+            bail!(
+                "--out {}: the directory {} does not exist",
+                a.out.display(),
+                parent.display()
+            );
+        }
+    }
+    // Built aside and swapped in whole: an interrupted run leaves the old
+    // report as it was, never new figures beside an old report.
+    let staged = activecal::io::atomic::StagedDir::new(&a.out)?;
     let clock = Instant::now();
     let steps = Steps::new(paper::STEPS + 2);
     let report = paper::run(&settings, |msg| steps.step(msg))?;
     steps.step("figures");
-    draw_figures(&a.out, &report, a.levels)?;
+    let out = staged.path();
+    draw_figures(out, &report, a.levels)?;
     steps.step("report");
-    let out = &a.out;
     std::fs::write(
         out.join("report.json"),
         serde_json::to_string_pretty(&report)? + "\n",
     )?;
     std::fs::write(out.join("report.md"), report.markdown())?;
+    staged.commit()?;
+    let out = &a.out;
     steps.bar.finish_and_clear();
     println!(
         "wrote {}/report.md, report.json and figures in {:.1} s",

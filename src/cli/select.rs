@@ -135,6 +135,7 @@ pub struct SelectArgs {
 /// Runs `select`.
 pub fn cmd_select(a: SelectArgs) -> Result<()> {
     if let Some(out) = &a.out {
+        // Checked before the search: an existing file, a missing directory.
         super::refuse_overwrite(out, a.force)?;
     }
     let ctx = a.pool.load()?;

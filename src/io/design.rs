@@ -94,17 +94,16 @@ impl DesignFile {
     /// Writes the design as pretty JSON. An existing file is only replaced
     /// when `overwrite` is set: nothing the user has is lost without asking.
     pub fn write(&self, path: &Path, overwrite: bool) -> Result<()> {
-        if path.exists() && !overwrite {
-            return Err(Error::Invalid(format!(
-                "{} exists; pass --force to overwrite it",
-                path.display()
-            )));
-        }
+        super::atomic::check_outputs(
+            &[super::atomic::Output {
+                option: "--out",
+                path,
+            }],
+            &[],
+            overwrite,
+        )?;
         let text = serde_json::to_string_pretty(self).expect("a design serializes");
-        std::fs::write(path, text + "\n").map_err(|cause| Error::Io {
-            path: path.display().to_string(),
-            cause,
-        })
+        super::atomic::write_atomic(path, (text + "\n").as_bytes())
     }
 
     /// The pool the design was chosen from.

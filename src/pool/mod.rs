@@ -93,6 +93,10 @@ impl PoolSpec {
     /// model the sensor region is known in, usually the nominal one). A pool
     /// that the filters leave empty is an error.
     pub fn build(&self, robot: &Robot, table: &ParamTable) -> Result<Pool> {
+        let n = match self.source {
+            PoolSource::Lattice { levels } => Lattice::new(robot, levels)?.size(),
+        };
+        check_memory(robot, n)?;
         let (ids, lattice) = self.source.generate(robot, |q| {
             self.filters.iter().all(|f| f.keeps(robot, table, q))
         })?;
@@ -116,6 +120,29 @@ impl PoolSpec {
             lattice,
         })
     }
+}
+
+/// Bytes a pool of `n` candidates takes through selection: its id and joint
+/// values, its identification Jacobian (`t·p` values a pose), and one
+/// workspace of the Jacobian's size (the pool variances' `Y = X L⁻ᵀ`, the
+/// bound's scaled copy).
+#[must_use]
+pub fn memory_estimate(robot: &Robot, n: usize) -> u64 {
+    let per_pose = 8 * (1 + robot.dof() + 2 * robot.rows_per_pose() * robot.n_unknowns());
+    crate::resources::bytes_of(n, per_pose)
+}
+
+/// Refuses, before anything is allocated, a pool whose
+/// [`memory_estimate`] exceeds the memory budget.
+fn check_memory(robot: &Robot, n: usize) -> Result<()> {
+    crate::resources::MemoryBudget::from_env()?.check(
+        &format!(
+            "a pool of {n} poses (its {}×{} Jacobian and one workspace of that size)",
+            n.saturating_mul(robot.rows_per_pose()),
+            robot.n_unknowns()
+        ),
+        memory_estimate(robot, n),
+    )
 }
 
 impl PoolSource {

@@ -20,6 +20,22 @@ use cli::select::{ScoreArgs, SelectArgs};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// The base link of a URDF tree's chain (default: the URDF's root);
+    /// for every command that takes --robot.
+    #[arg(long, global = true, value_name = "LINK")]
+    base: Option<String>,
+    /// The measured link of a URDF tree's chain (required on a tree; the
+    /// error lists the candidates).
+    #[arg(long, global = true, value_name = "LINK")]
+    tip: Option<String>,
+    /// Joints made fixed at a value: JOINT=VALUE,… (radians or metres).
+    #[arg(
+        long,
+        global = true,
+        value_name = "JOINT=VALUE,...",
+        allow_hyphen_values = true
+    )]
+    lock: Option<String>,
 }
 
 #[derive(Subcommand)]
@@ -50,6 +66,10 @@ enum Command {
 
 fn main() {
     let cli = Cli::parse();
+    if let Err(e) = cli::set_chain_choice(cli.base, cli.tip, cli.lock.as_deref()) {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
     let r = match cli.command {
         Command::Robots(a) => cli::basic::cmd_robots(a),
         Command::Fk(a) => cli::basic::cmd_fk(a),

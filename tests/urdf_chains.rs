@@ -301,3 +301,78 @@ fn descriptions_choose_the_chain_too() {
         "{e}"
     );
 }
+
+#[test]
+fn the_command_line_chooses_the_chain_and_records_it() {
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_activecal"))
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let tiago = "fixtures/figaroh/tiago.urdf";
+    let out = run(&[
+        "fk",
+        "--robot",
+        tiago,
+        "--tip",
+        "arm_tool_link",
+        "--lock",
+        "torso_lift_joint=0.1",
+        "--q",
+        "0,0,0,0,0,0,0",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let chain: Vec<String> = (1..=7).map(|k| format!("arm_{k}_joint")).collect();
+    assert_eq!(v["chain"], serde_json::json!(chain));
+    // The name records the chain, so a design file loads the same one.
+    let name = v["robot"].as_str().unwrap();
+    assert_eq!(
+        name,
+        format!("{tiago}#tip=arm_tool_link;lock=torso_lift_joint:0.1")
+    );
+    let again = run(&["fk", "--robot", name, "--q", "0,0,0,0,0,0,0", "--json"]);
+    let w: serde_json::Value = serde_json::from_slice(&again.stdout).unwrap();
+    assert_eq!(w["position"], v["position"]);
+    for (args, want) in [
+        (
+            vec![
+                "fk",
+                "--robot",
+                "puma560",
+                "--tip",
+                "x",
+                "--q",
+                "0,0,0,0,0,0",
+            ],
+            "not of a built-in robot",
+        ),
+        (
+            vec![
+                "fk",
+                "--robot",
+                tiago,
+                "--tip",
+                "arm_tool_link",
+                "--lock",
+                "torso",
+                "--q",
+                "0",
+            ],
+            "expected JOINT=VALUE",
+        ),
+        (vec!["fk", "--robot", tiago, "--q", "0"], "candidate tips"),
+    ] {
+        let out = run(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(want), "{args:?}: want '{want}' in {err}");
+    }
+}

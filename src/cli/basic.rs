@@ -82,7 +82,7 @@ fn joint_kinds(r: &Robot) -> Vec<activecal::model::JointKind> {
 /// Runs `robots`.
 pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
     if let Some(name) = &a.export {
-        let d = activecal::io::load_description(name)?;
+        let d = super::load_description(name)?;
         d.robot.validate()?;
         let text = activecal::io::robot_toml::description_to_toml(&d.robot, d.visibility.as_ref());
         match &a.out {

@@ -28,10 +28,37 @@ where
         .collect()
 }
 
+/// The chain chosen by `--base`, `--tip` and `--lock` (global options).
+static CHAIN: std::sync::OnceLock<activecal::io::ChainChoice> = std::sync::OnceLock::new();
+
+/// Records the global chain options (once, before the command runs).
+pub fn set_chain_choice(
+    base: Option<String>,
+    tip: Option<String>,
+    lock: Option<&str>,
+) -> Result<()> {
+    let lock = match lock {
+        Some(l) => activecal::io::ChainChoice::parse_lock(l)?,
+        None => Vec::new(),
+    };
+    let _ = CHAIN.set(activecal::io::ChainChoice { base, tip, lock });
+    Ok(())
+}
+
+/// A `--robot` name with the chain options appended as its `#…` fragment
+/// (unless it names a chain already, as a design file's robot does), so
+/// that reports and design files record the chain.
+pub fn with_chain(name: &str) -> String {
+    match CHAIN.get() {
+        Some(c) if !c.is_empty() && !name.contains('#') => format!("{name}{}", c.fragment()),
+        _ => name.to_string(),
+    }
+}
+
 /// Loads and validates a robot: a built-in name, or a `.toml` description or
-/// `.urdf` file ([`Robot::load`]).
+/// `.urdf` file ([`activecal::io::load_robot`]), with the chain options.
 pub fn load_robot(name: &str) -> Result<Robot> {
-    let r = activecal::io::load_robot(name)?;
+    let r = activecal::io::load_robot(&with_chain(name))?;
     r.validate()?;
     Ok(r)
 }
@@ -138,7 +165,7 @@ pub fn filters(
 
 /// Loads a robot with its description's visibility region (validated).
 pub fn load_description(name: &str) -> Result<activecal::io::Description> {
-    let d = activecal::io::load_description(name)?;
+    let d = activecal::io::load_description(&with_chain(name))?;
     d.robot.validate()?;
     Ok(d)
 }

@@ -40,9 +40,112 @@ pub fn load_robot(name_or_path: &str) -> Result<Robot> {
     load_description(name_or_path).map(|d| d.robot)
 }
 
-/// As [`load_robot`], with the description's visibility region.
+/// Which chain of a URDF tree to take: the `#…` part of a robot name
+/// (`arm.urdf#base=torso;tip=tool;lock=lift:0.1,head:0`), which the
+/// command line's `--base`, `--tip` and `--lock` write, so that a design
+/// file's robot name loads the same chain again.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ChainChoice {
+    /// The base link (default: the URDF's root).
+    pub base: Option<String>,
+    /// The tip link (required on a tree).
+    pub tip: Option<String>,
+    /// Joints made fixed at a value.
+    pub lock: Vec<(String, f64)>,
+}
+
+impl ChainChoice {
+    /// Whether nothing is chosen.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.base.is_none() && self.tip.is_none() && self.lock.is_empty()
+    }
+
+    /// The `#…` fragment of a robot name (empty when nothing is chosen).
+    #[must_use]
+    pub fn fragment(&self) -> String {
+        let mut parts = Vec::new();
+        if let Some(b) = &self.base {
+            parts.push(format!("base={b}"));
+        }
+        if let Some(t) = &self.tip {
+            parts.push(format!("tip={t}"));
+        }
+        if !self.lock.is_empty() {
+            let l: Vec<String> = self.lock.iter().map(|(n, v)| format!("{n}:{v}")).collect();
+            parts.push(format!("lock={}", l.join(",")));
+        }
+        if parts.is_empty() {
+            String::new()
+        } else {
+            format!("#{}", parts.join(";"))
+        }
+    }
+
+    /// Parses `JOINT=VALUE,…` (the `--lock` option) or `JOINT:VALUE,…` (in a
+    /// name's fragment).
+    pub fn parse_lock(text: &str) -> Result<Vec<(String, f64)>> {
+        text.split(',')
+            .filter(|s| !s.trim().is_empty())
+            .map(|item| {
+                let (n, v) = item
+                    .split_once('=')
+                    .or_else(|| item.split_once(':'))
+                    .ok_or_else(|| {
+                        Error::Invalid(format!(
+                            "--lock {item}: expected JOINT=VALUE (radians or metres)"
+                        ))
+                    })?;
+                let v: f64 = v.trim().parse().map_err(|_| {
+                    Error::Invalid(format!("--lock {item}: '{}' is not a number", v.trim()))
+                })?;
+                if !v.is_finite() {
+                    return Err(Error::Invalid(format!(
+                        "--lock {item}: not a finite number"
+                    )));
+                }
+                Ok((n.trim().to_string(), v))
+            })
+            .collect()
+    }
+
+    fn parse_fragment(frag: &str) -> Result<ChainChoice> {
+        let mut c = ChainChoice::default();
+        for part in frag.split(';').filter(|p| !p.is_empty()) {
+            match part.split_once('=') {
+                Some(("base", v)) => c.base = Some(v.to_string()),
+                Some(("tip", v)) => c.tip = Some(v.to_string()),
+                Some(("lock", v)) => c.lock = ChainChoice::parse_lock(v)?,
+                _ => {
+                    return Err(Error::Invalid(format!(
+                        "robot name: unknown chain choice '{part}' after '#' (expected base=LINK, tip=LINK or lock=JOINT:VALUE,…)"
+                    )));
+                }
+            }
+        }
+        Ok(c)
+    }
+}
+
+/// As [`load_robot`], with the description's visibility region. A `#…`
+/// fragment chooses the chain of a URDF tree ([`ChainChoice`]).
 pub fn load_description(name_or_path: &str) -> Result<Description> {
+    let (head, chain) = match name_or_path.rsplit_once('#') {
+        Some((h, f)) if f.contains('=') => (h, ChainChoice::parse_fragment(f)?),
+        _ => (name_or_path, ChainChoice::default()),
+    };
+    let mut d = load_head(head, &chain)?;
+    d.robot.name = name_or_path.to_string();
+    Ok(d)
+}
+
+fn load_head(name_or_path: &str, chain: &ChainChoice) -> Result<Description> {
     if let Ok(robot) = Robot::builtin(name_or_path) {
+        if !chain.is_empty() {
+            return Err(Error::Invalid(format!(
+                "{name_or_path}: --base, --tip and --lock choose the chain of a URDF file, not of a built-in robot"
+            )));
+        }
         return Ok(Description {
             robot,
             visibility: None,
@@ -57,7 +160,12 @@ pub fn load_description(name_or_path: &str) -> Result<Description> {
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    let mut d = match ext.as_deref() {
+    if !chain.is_empty() && ext.as_deref() != Some("urdf") {
+        return Err(Error::Invalid(format!(
+            "{name_or_path}: --base, --tip and --lock choose the chain of a .urdf file (in a description, use its `base`, `tip` and [lock] keys)"
+        )));
+    }
+    let d = match ext.as_deref() {
         Some("toml") => {
             let mut d = robot_toml::load_description(path)?;
             if pose && d.robot.measurement == MeasurementKind::Point {
@@ -74,6 +182,9 @@ pub fn load_description(name_or_path: &str) -> Result<Description> {
                     } else {
                         MeasurementKind::Point
                     },
+                    base: chain.base.clone(),
+                    tip: chain.tip.clone(),
+                    lock: chain.lock.clone(),
                     ..urdf::UrdfOptions::default()
                 },
             )?,
@@ -91,6 +202,5 @@ pub fn load_description(name_or_path: &str) -> Result<Description> {
             });
         }
     };
-    d.robot.name = name_or_path.to_string();
     Ok(d)
 }

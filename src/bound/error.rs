@@ -33,6 +33,23 @@ pub enum BoundError {
         /// Smallest `N` with `N·t ≥ p`.
         need: usize,
     },
+    /// The certified upper bound came out below the primal value it must
+    /// bound: a solver or certificate bug, never reported as "certified
+    /// with gap 0".
+    #[error(
+        "internal error: the certificate ln bound {ln_bound} is below the primal ln det {ln_primal} \
+         by {excess:.3e} (more than rounding, {tolerance:.1e}); the bound is not valid"
+    )]
+    CertificateBelowPrimal {
+        /// The certificate's value.
+        ln_bound: f64,
+        /// The primal value.
+        ln_primal: f64,
+        /// `ln_primal − ln_bound`.
+        excess: f64,
+        /// The rounding allowance.
+        tolerance: f64,
+    },
     /// The whole pool does not determine the unknowns: every design is
     /// singular, and the relaxation's optimum is −∞.
     #[error(

@@ -478,7 +478,7 @@ pub fn relaxation_bound(
     let mut conic_summary = ConicSummary::default();
 
     if pool == n {
-        return Ok(finish(
+        return finish(
             best,
             &sc,
             n,
@@ -486,7 +486,7 @@ pub fn relaxation_bound(
             first_order,
             conic_summary,
             clock,
-        ));
+        );
     }
 
     if settings.use_conic && best.gap() > settings.gap_tol {
@@ -625,15 +625,7 @@ pub fn relaxation_bound(
     } else {
         BoundStatus::GapAboveTolerance
     };
-    Ok(finish(
-        best,
-        &sc,
-        n,
-        status,
-        first_order,
-        conic_summary,
-        clock,
-    ))
+    finish(best, &sc, n, status, first_order, conic_summary, clock)
 }
 
 /// First-order polish from a feasible point, limited to
@@ -653,11 +645,11 @@ fn finish(
     first_order: ExchangeSummary,
     conic: ConicSummary,
     clock: Instant,
-) -> Bound {
+) -> Result<Bound, BoundError> {
     let ln_bound = best.bound + sc.ln_scale;
     let ln_primal = best.ln_det + sc.ln_scale;
-    Bound {
-        certificate_gap: (ln_bound - ln_primal).max(0.0),
+    Ok(Bound {
+        certificate_gap: certificate_gap(ln_bound, ln_primal)?,
         ln_bound,
         ln_primal,
         status,
@@ -669,7 +661,28 @@ fn finish(
         first_order,
         conic,
         seconds: clock.elapsed().as_secs_f64(),
+    })
+}
+
+/// `ln_bound − ln_primal`, or an error when the bound is below the primal by
+/// more than rounding. Both are sums of `p` logarithms of Cholesky pivots of
+/// matrices with entries of order 1 (column-scaled), each with a relative
+/// error of a few `p·ε`; `1e-9·max(1, |ln_primal|)` is ~1,000 times that for
+/// p ≤ 45, and any real defect (a wrong dual, a bad certificate) is many
+/// orders larger. Within rounding the gap is reported as it is (possibly a
+/// tiny negative number), never clamped.
+fn certificate_gap(ln_bound: f64, ln_primal: f64) -> Result<f64, BoundError> {
+    let gap = ln_bound - ln_primal;
+    let tolerance = 1e-9 * ln_primal.abs().max(1.0);
+    if !(gap >= -tolerance) {
+        return Err(BoundError::CertificateBelowPrimal {
+            ln_bound,
+            ln_primal,
+            excess: -gap,
+            tolerance,
+        });
     }
+    Ok(gap)
 }
 
 /// The bound for a built-in robot's full lattice pool at a parameter set:
@@ -687,4 +700,23 @@ pub fn pool_bound(
     let x = pool.jacobian(robot, robot.params(params));
     let b = relaxation_bound(&x, n, settings)?;
     Ok((pool, x, b))
+}
+
+#[cfg(test)]
+mod certificate_tests {
+    use super::*;
+
+    #[test]
+    fn a_certificate_below_its_primal_is_an_error_not_a_zero_gap() {
+        assert_eq!(certificate_gap(44.0, 43.5).unwrap(), 0.5);
+        // Rounding below the primal is reported as it is, not clamped.
+        let g = certificate_gap(43.5 - 1e-12, 43.5).unwrap();
+        assert!(g < 0.0 && g > -2e-12);
+        let e = certificate_gap(43.0, 43.5).unwrap_err().to_string();
+        assert!(
+            e.contains("below the primal") && e.contains("5.000e-1"),
+            "{e}"
+        );
+        assert!(certificate_gap(f64::NAN, 43.5).is_err());
+    }
 }

@@ -182,7 +182,10 @@ fn identification_jacobian_matches_pinocchio_central_differences() {
         assert_eq!(f.params, robot.nominal.rows, "{stale}");
         assert_eq!(f.rows, robot.rows_per_pose(), "{stale}");
         assert_eq!(f.orientation_scale, robot.orientation_scale, "{stale}");
-        assert_eq!(f.step, STEP, "{name}: the tolerance is derived for h = {STEP}");
+        assert_eq!(
+            f.step, STEP,
+            "{name}: the tolerance is derived for h = {STEP}"
+        );
         assert!(f.samples.len() >= 20, "{name}: too few samples");
         let (t, p) = (f.rows, f.unknowns.len());
         let l = size(&f);
@@ -196,7 +199,10 @@ fn identification_jacobian_matches_pinocchio_central_differences() {
             // agrees with Pinocchio's to rounding (see tests/fixtures.rs for
             // the 1e-12 m tolerance).
             let (_, pos) = pose(&robot, &robot.nominal, &s.q);
-            let dp = (0..3).map(|r| (pos[r] - s.position[r]).powi(2)).sum::<f64>().sqrt();
+            let dp = (0..3)
+                .map(|r| (pos[r] - s.position[r]).powi(2))
+                .sum::<f64>()
+                .sqrt();
             assert!(dp <= 1e-12, "{name}: sample {k}: end point off by {dp:e} m");
             for (e, (a, b)) in j.iter().zip(&s.jacobian).enumerate() {
                 let d = (a - b).abs();

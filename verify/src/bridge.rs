@@ -183,11 +183,18 @@ impl Bridge {
         type Side = (Vec<PyPlacement>, PyPlacement);
         let side = |s: &ModelSpec| -> Side {
             (
-                s.placements.iter().map(|p| (p.rotation, p.translation)).collect(),
+                s.placements
+                    .iter()
+                    .map(|p| (p.rotation, p.translation))
+                    .collect(),
                 (s.tool.rotation, s.tool.translation),
             )
         };
-        let pairs: Vec<(Side, Side)> = plus.iter().zip(minus).map(|(p, m)| (side(p), side(m))).collect();
+        let pairs: Vec<(Side, Side)> = plus
+            .iter()
+            .zip(minus)
+            .map(|(p, m)| (side(p), side(m)))
+            .collect();
         let kinds = kind_names(&plus[0].kinds);
         Python::attach(|py| {
             let r = module(py)?
@@ -322,7 +329,11 @@ impl Bridge {
                 f64,
             ) = r.extract()?;
             if weights.len() != x.n_poses() {
-                bail!("cvxpy returned {} weights for {} poses", weights.len(), x.n_poses());
+                bail!(
+                    "cvxpy returned {} weights for {} poses",
+                    weights.len(),
+                    x.n_poses()
+                );
             }
             Ok(CvxSolution {
                 status,

@@ -229,7 +229,11 @@ pub fn activecal_jacobians(robot: &Robot, table: &ParamTable, qs: &[Vec<f64>]) -
 
 /// The parameter tables at `θ ± h` for every unknown, in column order.
 #[must_use]
-pub fn perturbed_tables(robot: &Robot, table: &ParamTable, h: f64) -> Vec<(ParamTable, ParamTable)> {
+pub fn perturbed_tables(
+    robot: &Robot,
+    table: &ParamTable,
+    h: f64,
+) -> Vec<(ParamTable, ParamTable)> {
     robot
         .unknowns
         .iter()
@@ -290,8 +294,14 @@ impl IdDeviation {
 }
 
 /// Compares `ours` with `reference` entry by entry; NaN gives a NaN deviation.
-pub fn id_deviation(robot: &Robot, reference: &IdJacobians, ours: &IdJacobians) -> Result<IdDeviation> {
-    if (reference.t, reference.p) != (ours.t, ours.p) || reference.jacobian.len() != ours.jacobian.len() {
+pub fn id_deviation(
+    robot: &Robot,
+    reference: &IdJacobians,
+    ours: &IdJacobians,
+) -> Result<IdDeviation> {
+    if (reference.t, reference.p) != (ours.t, ours.p)
+        || reference.jacobian.len() != ours.jacobian.len()
+    {
         bail!(
             "{} configurations of {}×{} vs {} of {}×{}",
             reference.jacobian.len(),
@@ -379,7 +389,13 @@ pub struct IdFixture {
 
 impl IdFixture {
     /// A fixture from Pinocchio's values.
-    pub fn new(source: &Source, robot: &Robot, versions: Versions, qs: &[Vec<f64>], fd: &IdJacobians) -> Result<IdFixture> {
+    pub fn new(
+        source: &Source,
+        robot: &Robot,
+        versions: Versions,
+        qs: &[Vec<f64>],
+        fd: &IdJacobians,
+    ) -> Result<IdFixture> {
         if fd.jacobian.len() != qs.len() || fd.position.len() != qs.len() {
             bail!("{} configurations, {} values", qs.len(), fd.jacobian.len());
         }
@@ -470,7 +486,11 @@ impl IdFixture {
         let f: IdFixture =
             serde_json::from_str(&text).with_context(|| path.display().to_string())?;
         if f.format != FORMAT {
-            bail!("{}: format {} (this build reads {FORMAT})", path.display(), f.format);
+            bail!(
+                "{}: format {} (this build reads {FORMAT})",
+                path.display(),
+                f.format
+            );
         }
         Ok(f)
     }

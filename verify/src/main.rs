@@ -77,7 +77,12 @@ fn check(json: bool) -> Result<bool> {
     let mut id_reports = Vec::new();
     for source in idjac::sources() {
         let robot = source.robot()?;
-        id_reports.push(idjac::live::check(&bridge, &robot, IDJAC_CONFIGS, IDJAC_SEED)?);
+        id_reports.push(idjac::live::check(
+            &bridge,
+            &robot,
+            IDJAC_CONFIGS,
+            IDJAC_SEED,
+        )?);
     }
     let ok = reports.iter().all(|r| r.passed(TOLERANCE))
         && id_reports.iter().all(|r| r.within(idjac::REL_TOL));

@@ -243,7 +243,7 @@ impl Bridge {
                 .getattr("pinocchio_urdf_eval")?
                 .call1((path.to_string_lossy().as_ref(), qs.to_vec()))
                 .with_context(|| format!("Pinocchio loading {}", path.display()))?;
-            let (tip, poses): (String, Vec<([[f64; 3]; 3], [f64; 3])>) = r.extract()?;
+            let (tip, poses): (String, Vec<PyPlacement>) = r.extract()?;
             if poses.len() != qs.len() {
                 bail!(
                     "bridge returned {} poses for {} joint vectors",

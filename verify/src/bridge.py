@@ -162,3 +162,106 @@ def pinocchio_urdf_eval(path, qs):
         m = data.oMf[fid]
         out.append((m.rotation.tolist(), m.translation.tolist()))
     return tip, out
+
+
+def pinocchio_end_frames(model, qs):
+    """The "ee" frame's placement (rotation 3x3, translation 3) at each q."""
+    data = model.createData()
+    fid = model.getFrameId("ee")
+    out = []
+    for q in qs:
+        pin.forwardKinematics(model, data, np.array(q, dtype=float))
+        pin.updateFramePlacements(model, data)
+        m = data.oMf[fid]
+        out.append((m.rotation.copy(), m.translation.copy()))
+    return out
+
+
+def pinocchio_central_differences(pairs, kinds, qs, h):
+    """Central differences of the end frame over model parameters.
+
+    `pairs[c]` holds the models of parameter c at theta + h and theta - h, each
+    as (placements, tool) in the form of `pinocchio_model`. Per configuration
+    and parameter, 6 numbers: the position rows (p(+h) - p(-h)) / 2h and the
+    orientation rows pin.log3(R(+h) R(-h)^T) / 2h, an angular velocity in the
+    world (measurement) frame. Returns a list over q of lists over c."""
+    n = len(qs)
+    out = np.zeros((n, len(pairs), 6))
+    for c, ((pl_p, tool_p), (pl_m, tool_m)) in enumerate(pairs):
+        plus = pinocchio_end_frames(pinocchio_model(pl_p, kinds, tool_p), qs)
+        minus = pinocchio_end_frames(pinocchio_model(pl_m, kinds, tool_m), qs)
+        for k, ((rp, tp), (rm, tm)) in enumerate(zip(plus, minus)):
+            out[k, c, :3] = (tp - tm) / (2.0 * h)
+            out[k, c, 3:] = pin.log3(rp @ rm.T) / (2.0 * h)
+    return out.tolist()
+
+
+# --- The relaxation (R) of activecal's bound, solved and certified from outside.
+#
+#   maximise ln det M(w),  M(w) = sum_i w_i X_i^T X_i,  0 <= w_i <= 1,  sum w = N
+#
+# X is the stacked Jacobian (m poses of t rows, p columns). Both functions scale
+# the columns to a common size first, X~ = X S^-1 with s_j = |X[:, j]| / sqrt(m):
+# ln det M(w) = ln det M~(w) + 2 sum_j ln s_j exactly, and the variances d_i are
+# unchanged, so the scaling only helps conditioning (the PUMA's columns differ
+# by the 20 m tracker distance).
+
+
+def _scaled(x, t, p):
+    X = np.array(x, dtype=float).reshape(-1, p)
+    if X.shape[0] % t:
+        raise ValueError("%d rows are not a multiple of t = %d" % (X.shape[0], t))
+    m = X.shape[0] // t
+    s = np.linalg.norm(X, axis=0) / np.sqrt(m)
+    return X / s, m, 2.0 * np.sum(np.log(s))
+
+
+def relaxation_cvxpy(x, t, p, n_design, solver, eps):
+    """Solves (R) with cvxpy's log_det and the named solver ("CLARABEL" or
+    "SCS") at tolerance eps. Returns (status, ln det objective unscaled,
+    weights clipped to [0, 1], solve seconds as cvxpy reports them, wall
+    seconds including cvxpy's compilation)."""
+    import time
+
+    import cvxpy as cp
+
+    Xs, m, ln_scale = _scaled(x, t, p)
+    B = Xs.reshape(m, t, p)
+    G = np.einsum("itp,itq->ipq", B, B).reshape(m, p * p)
+    w = cp.Variable(m)
+    M = cp.reshape(G.T @ w, (p, p), order="C")
+    M = (M + M.T) / 2
+    prob = cp.Problem(cp.Maximize(cp.log_det(M)), [w >= 0, w <= 1, cp.sum(w) == n_design])
+    start = time.perf_counter()
+    if solver == "CLARABEL":
+        prob.solve(solver=cp.CLARABEL, tol_gap_abs=eps, tol_gap_rel=eps, tol_feas=eps,
+                   max_iter=500)
+    elif solver == "SCS":
+        prob.solve(solver=cp.SCS, eps_abs=eps, eps_rel=eps, max_iters=200000)
+    else:
+        raise ValueError("unknown solver %s" % solver)
+    wall = time.perf_counter() - start
+    solve_time = prob.solver_stats.solve_time
+    value = prob.value + ln_scale if prob.value is not None else float("nan")
+    wv = np.clip(np.asarray(w.value, dtype=float), 0.0, 1.0)
+    return (prob.status, float(value), wv.tolist(),
+            float(solve_time if solve_time is not None else float("nan")), wall)
+
+
+def relaxation_certificate(x, t, p, weights, n_design):
+    """The certificate (activecal's eq. C), recomputed in numpy: with
+    M = M(w), d_i = tr(X_i M^-1 X_i^T) and S_N the sum of the N largest d_i,
+    every feasible w* has ln det M(w*) <= ln det M + p ln(S_N / p) (AM-GM on
+    the eigenvalues of M^-1 M(w*), whose sum is sum_i w*_i d_i <= S_N).
+    Returns (ln det M(w), S_N, the bound, sum of w)."""
+    Xs, m, ln_scale = _scaled(x, t, p)
+    w = np.asarray(weights, dtype=float)
+    if w.shape != (m,):
+        raise ValueError("%d weights for %d poses" % (w.size, m))
+    M = Xs.T @ (np.repeat(w, t)[:, None] * Xs)
+    L = np.linalg.cholesky(M)
+    ln_det = 2.0 * np.sum(np.log(np.diag(L))) + ln_scale
+    Y = np.linalg.solve(L, Xs.T)  # L^-1 X~^T: d_i = squared norm of pose i's columns
+    d = (Y * Y).T.reshape(m, t, p).sum(axis=(1, 2))
+    s_n = float(np.sort(d)[::-1][:n_design].sum())
+    return float(ln_det), s_n, float(ln_det + p * np.log(s_n / p)), float(w.sum())

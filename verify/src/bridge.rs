@@ -156,6 +156,74 @@ impl Bridge {
     }
 }
 
+/// Central differences of Pinocchio's end frame over model parameters: per
+/// configuration, per parameter, `[∂p/∂θ (3), ω (3)]` — the position rows
+/// `(p(θ+h) − p(θ−h)) / 2h` and the orientation rows
+/// `log3(R(θ+h) R(θ−h)ᵀ) / 2h` (an angular velocity in the measurement
+/// frame, unscaled).
+pub type CentralDifferences = Vec<Vec<[f64; 6]>>;
+
+impl Bridge {
+    /// [`CentralDifferences`] from the model specs of every parameter at
+    /// `θ + h` (`plus[c]`) and `θ − h` (`minus[c]`), which must share their
+    /// joint kinds, evaluated at `qs`.
+    pub fn pinocchio_central_differences(
+        &self,
+        plus: &[ModelSpec],
+        minus: &[ModelSpec],
+        qs: &[Vec<f64>],
+        h: f64,
+    ) -> Result<CentralDifferences> {
+        if plus.len() != minus.len() || plus.is_empty() {
+            bail!("{} models at +h, {} at −h", plus.len(), minus.len());
+        }
+        if plus.iter().chain(minus).any(|s| s.kinds != plus[0].kinds) {
+            bail!("the perturbed models do not share their joints");
+        }
+        type Side = (Vec<PyPlacement>, PyPlacement);
+        let side = |s: &ModelSpec| -> Side {
+            (
+                s.placements
+                    .iter()
+                    .map(|p| (p.rotation, p.translation))
+                    .collect(),
+                (s.tool.rotation, s.tool.translation),
+            )
+        };
+        let pairs: Vec<(Side, Side)> = plus
+            .iter()
+            .zip(minus)
+            .map(|(p, m)| (side(p), side(m)))
+            .collect();
+        let kinds = kind_names(&plus[0].kinds);
+        Python::attach(|py| {
+            let r = module(py)?
+                .getattr("pinocchio_central_differences")?
+                .call1((pairs, kinds, qs.to_vec(), h))
+                .context("Pinocchio central differences")?;
+            let out: CentralDifferences = r.extract()?;
+            if out.len() != qs.len() || out.iter().any(|k| k.len() != plus.len()) {
+                bail!("bridge returned central differences of the wrong shape");
+            }
+            Ok(out)
+        })
+    }
+}
+
+/// A placement as the bridge passes it: (rotation row-major, translation).
+type PyPlacement = ([[f64; 3]; 3], [f64; 3]);
+
+/// activecal's joint kinds as bridge.py's names.
+fn kind_names(kinds: &[JointKind]) -> Vec<&'static str> {
+    kinds
+        .iter()
+        .map(|k| match k {
+            JointKind::Revolute => "revolute",
+            JointKind::Prismatic => "prismatic",
+        })
+        .collect()
+}
+
 /// Poses of a URDF's leaf link computed by Pinocchio from the file itself.
 #[derive(Clone, Debug)]
 pub struct UrdfPoses {
@@ -175,7 +243,7 @@ impl Bridge {
                 .getattr("pinocchio_urdf_eval")?
                 .call1((path.to_string_lossy().as_ref(), qs.to_vec()))
                 .with_context(|| format!("Pinocchio loading {}", path.display()))?;
-            let (tip, poses): (String, Vec<([[f64; 3]; 3], [f64; 3])>) = r.extract()?;
+            let (tip, poses): (String, Vec<PyPlacement>) = r.extract()?;
             if poses.len() != qs.len() {
                 bail!(
                     "bridge returned {} poses for {} joint vectors",
@@ -194,4 +262,109 @@ fn unpack(r: &Bound<'_, PyAny>, dof: usize, n: usize) -> Result<Kinematics> {
         bail!("bridge returned values of the wrong shape");
     }
     Ok(Kinematics { position, jacobian })
+}
+
+/// cvxpy's solution of the relaxation (R) (see `bridge.py`).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CvxSolution {
+    /// cvxpy's status (`optimal`, `optimal_inaccurate`, …).
+    pub status: String,
+    /// The solver's objective, unscaled: its estimate of `max ln det M(w)`.
+    pub ln_det: f64,
+    /// The weights, clipped to `[0, 1]`.
+    pub weights: Vec<f64>,
+    /// The solver's own time (cvxpy's `solver_stats.solve_time`), seconds.
+    pub solve_seconds: f64,
+    /// Wall time of `Problem.solve`, compilation included, seconds.
+    pub wall_seconds: f64,
+}
+
+/// The certificate of activecal's eq. (C) recomputed in numpy at some weights.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct NumpyCertificate {
+    /// `ln det M(w)`.
+    pub ln_det: f64,
+    /// `S_N`: the sum of the `N` largest variances `d_i = tr(X_i M⁻¹ X_iᵀ)`.
+    pub s_n: f64,
+    /// `ln det M(w) + p·ln(S_N/p)`: an upper bound on the relaxation's optimum.
+    pub bound: f64,
+    /// `Σ w_i`.
+    pub weight_sum: f64,
+}
+
+/// The stacked Jacobian as a flat row-major list.
+fn row_major(x: &activecal::blocks::Blocks) -> Vec<f64> {
+    let m = x.mat();
+    let mut out = Vec::with_capacity(m.nrows() * m.ncols());
+    for r in 0..m.nrows() {
+        for c in 0..m.ncols() {
+            out.push(m[(r, c)]);
+        }
+    }
+    out
+}
+
+impl Bridge {
+    /// Solves the relaxation `max ln det Σ w_i X_iᵀX_i, 0 ≤ w ≤ 1, Σ w = n`
+    /// with cvxpy's `log_det` and `solver` (`"CLARABEL"` or `"SCS"`) at
+    /// tolerance `eps`.
+    pub fn relaxation_cvxpy(
+        &self,
+        x: &activecal::blocks::Blocks,
+        n: usize,
+        solver: &str,
+        eps: f64,
+    ) -> Result<CvxSolution> {
+        let flat = row_major(x);
+        Python::attach(|py| {
+            let r = module(py)?
+                .getattr("relaxation_cvxpy")?
+                .call1((flat, x.t(), x.p(), n, solver, eps))
+                .with_context(|| format!("cvxpy with {solver}"))?;
+            let (status, ln_det, weights, solve_seconds, wall_seconds): (
+                String,
+                f64,
+                Vec<f64>,
+                f64,
+                f64,
+            ) = r.extract()?;
+            if weights.len() != x.n_poses() {
+                bail!(
+                    "cvxpy returned {} weights for {} poses",
+                    weights.len(),
+                    x.n_poses()
+                );
+            }
+            Ok(CvxSolution {
+                status,
+                ln_det,
+                weights,
+                solve_seconds,
+                wall_seconds,
+            })
+        })
+    }
+
+    /// The certificate (eq. C) at `weights`, computed in numpy.
+    pub fn relaxation_certificate(
+        &self,
+        x: &activecal::blocks::Blocks,
+        weights: &[f64],
+        n: usize,
+    ) -> Result<NumpyCertificate> {
+        let flat = row_major(x);
+        Python::attach(|py| {
+            let r = module(py)?
+                .getattr("relaxation_certificate")?
+                .call1((flat, x.t(), x.p(), weights.to_vec(), n))
+                .context("numpy certificate")?;
+            let (ln_det, s_n, bound, weight_sum): (f64, f64, f64, f64) = r.extract()?;
+            Ok(NumpyCertificate {
+                ln_det,
+                s_n,
+                bound,
+                weight_sum,
+            })
+        })
+    }
 }

@@ -20,6 +20,7 @@
 
 pub mod compare;
 pub mod fixture;
+pub mod idjac;
 pub mod model;
 pub mod sample;
 

@@ -5,6 +5,11 @@
 //! cargo run -p verify --features live -- check [--json]      # print deviations
 //! ```
 //!
+//! `regen` writes `fixtures/<robot>_<set>.json` (positions and joint
+//! Jacobians) and `fixtures/idjac/<robot>.json` (Pinocchio's
+//! finite-difference identification Jacobians, [`verify::idjac`]); with
+//! `--out DIR` the latter go to `DIR/idjac/`.
+//!
 //! Build with `PYO3_PYTHON=$PWD/.venv/bin/python` (scripts/test does).
 
 use activecal::model::ParamSet;
@@ -14,7 +19,12 @@ use std::process::ExitCode;
 use std::time::Instant;
 use verify::bridge::Bridge;
 use verify::check::{check_live, regenerate};
-use verify::{TOLERANCE, builtin_robots, fixture, synthetic_robot};
+use verify::{TOLERANCE, builtin_robots, fixture, idjac, synthetic_robot};
+
+/// Configurations of the identification-Jacobian check.
+const IDJAC_CONFIGS: usize = 200;
+/// Their seed.
+const IDJAC_SEED: u64 = 20_251_117;
 
 const USAGE: &str = "usage: verify regen [--out DIR] | verify check [--json]";
 
@@ -44,7 +54,9 @@ fn run(args: Vec<String>) -> Result<bool> {
 
 fn regen(dir: PathBuf) -> Result<bool> {
     let bridge = Bridge::new()?;
-    for path in regenerate(&bridge, &dir)? {
+    let mut paths = regenerate(&bridge, &dir)?;
+    paths.extend(idjac::live::regenerate(&bridge, &dir.join("idjac"))?);
+    for path in paths {
         let size = std::fs::metadata(&path)?.len();
         println!("wrote {} ({size} bytes)", path.display());
     }
@@ -62,13 +74,26 @@ fn check(json: bool) -> Result<bool> {
             reports.push(check_live(&bridge, robot, set)?);
         }
     }
-    let ok = reports.iter().all(|r| r.passed(TOLERANCE));
+    let mut id_reports = Vec::new();
+    for source in idjac::sources() {
+        let robot = source.robot()?;
+        id_reports.push(idjac::live::check(
+            &bridge,
+            &robot,
+            IDJAC_CONFIGS,
+            IDJAC_SEED,
+        )?);
+    }
+    let ok = reports.iter().all(|r| r.passed(TOLERANCE))
+        && id_reports.iter().all(|r| r.within(idjac::REL_TOL));
     if json {
         let out = serde_json::json!({
             "versions": bridge.versions(),
             "tolerance": TOLERANCE,
             "passed": ok,
             "reports": reports,
+            "identification_jacobian_rel_tol": idjac::REL_TOL,
+            "identification_jacobian": id_reports,
         });
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
@@ -79,6 +104,27 @@ fn check(json: bool) -> Result<bool> {
         );
         for r in &reports {
             print!("{r}");
+        }
+        println!(
+            "identification Jacobian, Pinocchio central differences (h = {:e}) vs activecal, \
+             {IDJAC_CONFIGS} configurations, tolerance {:e}·L:",
+            idjac::STEP,
+            idjac::REL_TOL
+        );
+        for r in &id_reports {
+            println!(
+                "  {:<22} {}x{:<3} L {:6.2}  max|ΔJ| {:8.2e}  relative {:8.2e}  orientation rows {:8.2e}  (q#{} row {} {})",
+                r.robot,
+                r.shape[0],
+                r.shape[1],
+                r.size,
+                r.absolute,
+                r.relative,
+                r.orientation,
+                r.worst.0,
+                r.worst.1,
+                r.worst.2
+            );
         }
         println!(
             "{} in {:.2} s",

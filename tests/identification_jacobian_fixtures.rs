@@ -24,7 +24,7 @@
 use activecal::blocks::jacobian_of;
 use activecal::io::urdf::{UrdfOptions, load};
 use activecal::kinematics::pose;
-use activecal::model::{Measurement, Robot};
+use activecal::model::{MeasurementKind, Robot};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -41,7 +41,7 @@ enum Source {
     Urdf {
         path: String,
         tip: String,
-        measurement: Measurement,
+        measurement: MeasurementKind,
         orientation_scale: f64,
     },
 }
@@ -147,7 +147,7 @@ fn every_robot_has_point_and_pose_fixtures() {
         }
     }
     // The two example-robot-data arms, each in both forms.
-    let urdf: Vec<(String, Measurement)> = fixture_files()
+    let urdf: Vec<(String, MeasurementKind)> = fixture_files()
         .iter()
         .filter_map(|p| match read(p).source {
             Source::Urdf {
@@ -157,7 +157,7 @@ fn every_robot_has_point_and_pose_fixtures() {
         })
         .collect();
     for arm in ["panda.urdf", "kinova.urdf"] {
-        for m in [Measurement::Point, Measurement::Pose] {
+        for m in [MeasurementKind::Point, MeasurementKind::Pose] {
             assert!(
                 urdf.iter()
                     .any(|(p, mm)| p.ends_with(&format!("example-robot-data/{arm}")) && *mm == m),

@@ -55,7 +55,7 @@
 use crate::fixture::Versions;
 use activecal::blocks::{Blocks, jacobian_of};
 use activecal::io::urdf::{UrdfOptions, load};
-use activecal::model::{Measurement, ParamTable, Robot};
+use activecal::model::{MeasurementKind, ParamTable, Robot};
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write;
@@ -97,7 +97,7 @@ pub enum Source {
         /// The tip link.
         tip: String,
         /// `point` or `pose`.
-        measurement: Measurement,
+        measurement: MeasurementKind,
         /// The orientation scale set on the imported robot.
         orientation_scale: f64,
     },
@@ -140,8 +140,8 @@ impl Source {
                     .file_stem()
                     .map_or_else(|| "urdf".into(), |s| s.to_string_lossy().into_owned());
                 match measurement {
-                    Measurement::Point => stem,
-                    Measurement::Pose => format!("{stem}_pose"),
+                    MeasurementKind::Point => stem,
+                    MeasurementKind::Pose => format!("{stem}_pose"),
                 }
             }
         }
@@ -178,14 +178,14 @@ pub fn sources() -> Vec<Source> {
         ("panda.urdf", "panda_hand_tcp"),
         ("kinova.urdf", "j2s6s200_end_effector"),
     ] {
-        for m in [Measurement::Point, Measurement::Pose] {
+        for m in [MeasurementKind::Point, MeasurementKind::Pose] {
             out.push(Source::Urdf {
                 path: format!("fixtures/example-robot-data/{file}"),
                 tip: tip.into(),
                 measurement: m,
                 orientation_scale: match m {
-                    Measurement::Point => activecal::model::DEFAULT_ORIENTATION_SCALE,
-                    Measurement::Pose => URDF_ORIENTATION_SCALE,
+                    MeasurementKind::Point => activecal::model::DEFAULT_ORIENTATION_SCALE,
+                    MeasurementKind::Pose => URDF_ORIENTATION_SCALE,
                 },
             });
         }

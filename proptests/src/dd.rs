@@ -24,9 +24,10 @@ pub struct Dd {
     pub lo: f64,
 }
 
-/// `ln 2` in double-double (QD's constant).
+/// `ln 2` in double-double (QD's constant): the high part is `f64`'s
+/// `LN_2`, the low part the rounding error it leaves.
 pub const LN2: Dd = Dd {
-    hi: 6.931_471_805_599_453e-1,
+    hi: std::f64::consts::LN_2,
     lo: 2.319_046_813_846_299_6e-17,
 };
 

@@ -34,6 +34,9 @@
 //! direction, or adding a block that dwarfs the design), while a direct
 //! factorization of `M'` only pays `κ(M')`. The state's singularity rule
 //! refuses changes with `κ̂(M)/d ≥ max_condition`, which caps it.
+// Index loops mirror the matrix formulas they check; `!(x > 0)` is true
+// for NaN on purpose.
+#![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod dd;
 pub mod reference;

@@ -674,7 +674,7 @@ fn finish(
 fn certificate_gap(ln_bound: f64, ln_primal: f64) -> Result<f64, BoundError> {
     let gap = ln_bound - ln_primal;
     let tolerance = 1e-9 * ln_primal.abs().max(1.0);
-    if !(gap >= -tolerance) {
+    if gap.is_nan() || gap < -tolerance {
         return Err(BoundError::CertificateBelowPrimal {
             ln_bound,
             ln_primal,

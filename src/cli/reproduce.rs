@@ -110,14 +110,16 @@ pub fn cmd_reproduce(a: ReproduceArgs) -> Result<()> {
             );
         }
     }
-    if let Some(parent) = a.out.parent().filter(|p| !p.as_os_str().is_empty()) {
-        if !parent.is_dir() {
-            bail!(
-                "--out {}: the directory {} does not exist",
-                a.out.display(),
-                parent.display()
-            );
-        }
+    if let Some(parent) = a
+        .out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty() && !p.is_dir())
+    {
+        bail!(
+            "--out {}: the directory {} does not exist",
+            a.out.display(),
+            parent.display()
+        );
     }
     // Built aside and swapped in whole: an interrupted run leaves the old
     // report as it was, never new figures beside an old report.

@@ -423,13 +423,11 @@ fn extract_chain(
                 j.name, j.name
             ));
         }
-        if !explicit_tip {
-            if let Some(why) = gripper_reason(j) {
-                return Err(format!(
-                    "the chain's last moving joint '{}' looks like a gripper's ({why}): measure the arm's flange with --tip {parent}, or keep the joint still with --lock {}=VALUE, or name this tip explicitly with --tip {tip}",
-                    j.name, j.name
-                ));
-            }
+        if let Some(why) = gripper_reason(j).filter(|_| !explicit_tip) {
+            return Err(format!(
+                "the chain's last moving joint '{}' looks like a gripper's ({why}): measure the arm's flange with --tip {parent}, or keep the joint still with --lock {}=VALUE, or name this tip explicitly with --tip {tip}",
+                j.name, j.name
+            ));
         }
     }
     let mut out = Vec::with_capacity(path.len());

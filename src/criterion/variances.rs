@@ -502,7 +502,8 @@ pub fn exchange_gain(
     pivot_floor: f64,
 ) -> Result<f64, f64> {
     assert!(w_ij.nrows() == t && w_ij.ncols() == t);
-    let mut w = BlockScratch::new(t * t);
+    let mut w_buf = BlockScratch::new(t * t);
+    let w: &mut [f64] = &mut w_buf;
     for a in 0..t {
         for b in 0..t {
             w[a * t + b] = w_ij[(a, b)];

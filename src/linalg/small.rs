@@ -200,21 +200,23 @@ pub(crate) fn min_pivot(l: &[f64], n: usize) -> f64 {
 /// input, reported as `-∞`.
 #[inline]
 pub(crate) fn ln_det_i_plus(v: &[f64], t: usize) -> f64 {
-    let mut a = BlockScratch::new(t * t);
+    let mut a_buf = BlockScratch::new(t * t);
+    let a: &mut [f64] = &mut a_buf;
     for r in 0..t {
         for c in 0..=r {
             let x = v[pk(r, c)];
             a[r * t + c] = if r == c { 1.0 + x } else { x };
         }
     }
-    chol_in_place(&mut a, t, 0.0).unwrap_or(f64::NEG_INFINITY)
+    chol_in_place(a, t, 0.0).unwrap_or(f64::NEG_INFINITY)
 }
 
 /// `ln det(I − V)` for a packed `t×t` block: the removal loss of
 /// eq. (21)/(22) in block form; `Err(pivot)` when a pivot is `≤ floor`.
 #[inline]
 pub(crate) fn ln_det_i_minus(v: &[f64], t: usize, floor: f64) -> Result<f64, f64> {
-    let mut a = BlockScratch::new(t * t);
+    let mut a_buf = BlockScratch::new(t * t);
+    let a: &mut [f64] = &mut a_buf;
     for r in 0..t {
         for c in 0..=r {
             let x = v[pk(r, c)];
@@ -223,7 +225,7 @@ pub(crate) fn ln_det_i_minus(v: &[f64], t: usize, floor: f64) -> Result<f64, f64
         }
     }
     let mut perm = PermScratch::new(t);
-    chol_pivoted_in_place(&mut a, t, floor, &mut perm)
+    chol_pivoted_in_place(a, t, floor, &mut perm)
 }
 
 /// First factor of the exchange determinant: the Cholesky factor of
@@ -265,7 +267,8 @@ pub(crate) fn exchange_out_ln_det(
     floor: f64,
 ) -> Result<f64, f64> {
     // Y = L_A⁻¹ W (t×t, row-major), forward substitution column by column.
-    let mut y = BlockScratch::new(t * t);
+    let mut y_buf = BlockScratch::new(t * t);
+    let y: &mut [f64] = &mut y_buf;
     for c in 0..t {
         for r in 0..t {
             let mut s = w(r, c);
@@ -293,20 +296,21 @@ pub(crate) fn exchange_out_ln_det(
     };
     // The pivots are in (floor, ~1+‖Y‖²] (B ⪯ I + YᵀY), so their product
     // (t of them, each at most ~1+‖Y‖², so for any practical t) neither overflows nor underflows.
-    let mut b = BlockScratch::new(t * t);
-    fill(&mut b, false);
+    let mut b_buf = BlockScratch::new(t * t);
+    let b: &mut [f64] = &mut b_buf;
+    fill(b, false);
     let (mut det, mut lo) = (1.0f64, f64::INFINITY);
-    let plain = chol_pivots_in_place(&mut b, t, floor, |d| {
+    let plain = chol_pivots_in_place(b, t, floor, |d| {
         det *= d;
         lo = lo.min(d);
     });
     if plain.is_ok() && lo > SUSPECT_PIVOT {
         return Ok(det.ln());
     }
-    fill(&mut b, true);
+    fill(b, true);
     let mut det = 1.0;
     let mut perm = PermScratch::new(t);
-    chol_pivoted_pivots_in_place(&mut b, t, floor, &mut perm, |d| det *= d)?;
+    chol_pivoted_pivots_in_place(b, t, floor, &mut perm, |d| det *= d)?;
     Ok(det.ln())
 }
 

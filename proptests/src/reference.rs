@@ -318,6 +318,9 @@ impl Guard {
     }
 }
 
+/// The seed of [`run_property`] when `PROPTEST_RNG_SEED` is not set.
+pub const FIXED_SEED: u64 = 0x5eed_ac7e_ca1;
+
 /// Runs a property over `cases` cases of `strategy` (seed from
 /// `PROPTEST_RNG_SEED` when set), then fails unless at most
 /// [`MAX_LOOSE_FRACTION`] of the cases had an error bound above [`CAP`].
@@ -333,11 +336,18 @@ pub fn run_property<S: Strategy>(
     test: impl Fn(S::Value, &Guard) -> TestCaseResult,
 ) {
     let guard = Guard::default();
-    let config = Config {
+    let mut config = Config {
         cases,
         failure_persistence: None,
         ..Config::default()
     };
+    // A fixed seed unless PROPTEST_RNG_SEED asks for another: the guard
+    // counts a fraction of random cases (about 2 % loose on average), and a
+    // suite must not pass or fail by the draw. Other seeds are explored by
+    // setting the variable (20 seeds were run when the guard was set up).
+    if std::env::var_os("PROPTEST_RNG_SEED").is_none() {
+        config.rng_seed = proptest::test_runner::RngSeed::Fixed(FIXED_SEED);
+    }
     let mut runner = TestRunner::new(config);
     let result = runner.run(&strategy, |v| {
         let r = test(v, &guard);

@@ -31,7 +31,7 @@ pub struct CalibrateArgs {
     /// measurements are simulated there.
     #[arg(long, required_unless_present = "measurements")]
     pub design: Option<PathBuf>,
-    /// MeasurementKind file (JSON: `qs`, `points` and, for full-pose robots,
+    /// Measurement file (JSON: `qs`, `points` and, for full-pose robots,
     /// `orientations` as row-major rotation matrices): identify from these
     /// real measurements instead of simulating a design.
     #[arg(long, conflicts_with_all = ["design", "trials", "save_measurements"])]
@@ -47,7 +47,7 @@ pub struct CalibrateArgs {
     /// Replace existing output files.
     #[arg(long)]
     pub force: bool,
-    /// MeasurementKind noise σ per coordinate, metres. A full-pose robot's
+    /// Measurement noise σ per coordinate, metres. A full-pose robot's
     /// orientation noise is σ / orientation_scale radians per axis.
     #[arg(long, default_value_t = 0.01)]
     pub noise: f64,

@@ -41,7 +41,7 @@ pub struct ReproduceArgs {
     /// Monte-Carlo calibration trials per design.
     #[arg(long, default_value_t = 200)]
     pub trials: usize,
-    /// MeasurementKind noise σ per coordinate, metres (the paper: 1 cm).
+    /// Measurement noise σ per coordinate, metres (the paper: 1 cm).
     #[arg(long, default_value_t = 0.01)]
     pub noise: f64,
     /// Seed of every random choice.

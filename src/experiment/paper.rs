@@ -70,7 +70,7 @@ pub struct PaperSettings {
     pub starts: usize,
     /// Monte-Carlo calibration trials per design (200).
     pub trials: usize,
-    /// MeasurementKind noise σ per coordinate, metres (the paper: 0.01).
+    /// Measurement noise σ per coordinate, metres (the paper: 0.01).
     pub noise: f64,
     /// Seed of every random choice (1).
     pub seed: u64,

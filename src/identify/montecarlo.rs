@@ -38,7 +38,7 @@ const BOOTSTRAP_STREAM: u64 = u64::MAX - 1;
 pub struct MonteCarloSettings {
     /// Noise realisations `R`. Default 200.
     pub trials: usize,
-    /// MeasurementKind noise σ per coordinate, metres. Default 0.01 (paper §V).
+    /// Measurement noise σ per coordinate, metres. Default 0.01 (paper §V).
     pub sigma: f64,
     /// Seed of the noise, the validation poses and the bootstrap. Default 0.
     pub seed: u64,

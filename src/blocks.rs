@@ -96,7 +96,9 @@ pub fn jacobian_of<F>(robot: &Robot, table: &ParamTable, n: usize, fill_q: F) ->
 where
     F: Fn(usize, &mut [f64]) + Sync,
 {
-    let p = robot.n_unknowns();
+    let n_kin = robot.n_unknowns();
+    let p = robot.n_params();
+    let own = table.marker_values();
     let sensor = sensor_for(robot);
     let t = sensor.rows();
     let dof = robot.dof();
@@ -110,12 +112,15 @@ where
         .for_each(|(c, mut chunk)| {
             let mut ev = Evaluator::new(robot, table);
             let mut q = vec![0.0; dof];
-            let mut motions = vec![Motion::default(); p];
+            let mut motions = vec![Motion::default(); n_kin];
             let mut jac = vec![0.0; t * p];
             for k in 0..chunk.nrows() / t {
                 fill_q(c * CHUNK + k, &mut q);
                 let end = ev.motions(&q, &mut motions);
-                sensor.motion_rows(&end, &[], &motions, &mut jac, p);
+                sensor.motion_rows(&end, &own, &motions, &mut jac, p);
+                if p > n_kin {
+                    sensor.own_rows(&end, &own, &mut jac[n_kin..], p);
+                }
                 for r in 0..t {
                     for col in 0..p {
                         chunk[(k * t + r, col)] = jac[r * p + col];

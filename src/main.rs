@@ -8,6 +8,7 @@ use cli::basic::{FkArgs, PoolArgs, RobotsArgs};
 use cli::bench::BenchArgs;
 use cli::bound::{BoundArgs, GapArgs};
 use cli::calibrate::CalibrateArgs;
+use cli::measured::EvaluateArgs;
 use cli::reproduce::ReproduceArgs;
 use cli::select::{ScoreArgs, SelectArgs};
 
@@ -58,6 +59,9 @@ enum Command {
     /// Calibrate: simulated at a design (identification, validation,
     /// Monte-Carlo) or from a file of measurements.
     Calibrate(CalibrateArgs),
+    /// A model's errors on measured data (mm and degrees, per pose), without
+    /// fitting: the nominal model, or a calibrated description.
+    Evaluate(EvaluateArgs),
     /// Certified upper bound on OI_D of every N-pose design (convex relaxation).
     Bound(BoundArgs),
     /// A design's D-efficiency against the relaxation bound.
@@ -79,6 +83,7 @@ fn main() {
         Command::Bench(a) => cli::bench::cmd_bench(a),
         Command::Reproduce(a) => cli::reproduce::cmd_reproduce(a),
         Command::Calibrate(a) => cli::calibrate::cmd_calibrate(a),
+        Command::Evaluate(a) => cli::measured::cmd_evaluate(a),
         Command::Bound(a) => cli::bound::cmd_bound(a),
         Command::Gap(a) => cli::bound::cmd_gap(a),
     };

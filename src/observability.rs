@@ -151,17 +151,23 @@ impl Robot {
         v
     }
 
-    /// The number of independent kinematic parameters of a generic serial
-    /// chain with this robot's joints and measurement: `4R + 2P + 3` for point
+    /// The number of independent parameters of a generic serial chain with
+    /// this robot's joints and measurement: `4R + 2P + 3` for point
     /// measurements, `4R + 2P + 6` for full poses (R revolute, P prismatic
-    /// joints; Everett, Driels & Mooring 1987, less 3 for a point). Special
+    /// joints; Everett, Driels & Mooring 1987, less 3 for a point), and for
+    /// `K` markers `4R + 2P + d − 3 + 3K` with `d` the frame freedoms they see
+    /// (3, 5, 6 for one, two, three or more markers): the offsets replace the
+    /// tool translation. Special
     /// geometries (a measured point on the last joint axis, coaxial joints)
     /// have fewer.
     #[must_use]
     pub fn minimal_unknowns(&self) -> usize {
         let p = self.frames.iter().filter(|f| f.is_prismatic()).count();
         let r = self.dof().saturating_sub(p);
-        4 * r + 2 * p + crate::measure::sensor_for(self).observed_dof()
+        let sensor = crate::measure::sensor_for(self);
+        // Marker offsets take the tool translation (3) and add their own.
+        let own = sensor.n_own_params();
+        4 * r + 2 * p + sensor.observed_dof() + own - if own > 0 { 3 } else { 0 }
     }
 
     /// A maximal identifiable set of unknowns: `preferred` first (in the given
@@ -210,6 +216,22 @@ impl Robot {
             .collect();
         let scale = norms.iter().cloned().fold(0.0, f64::max);
         let mut basis: Vec<Vec<f64>> = Vec::new();
+        // A marker sensor's own offsets come first: always unknown, they take
+        // the tool translation that the robot's candidates would repeat.
+        for k in all.len()..m.ncols() {
+            let mut v = col(k);
+            for _ in 0..2 {
+                for b in &basis {
+                    let d: f64 = b.iter().zip(&v).map(|(x, y)| x * y).sum();
+                    v.iter_mut().zip(b).for_each(|(y, x)| *y -= d * x);
+                }
+            }
+            let r = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if r > 0.0 {
+                v.iter_mut().for_each(|x| *x /= r);
+                basis.push(v);
+            }
+        }
         let mut out = Vec::with_capacity(order.len());
         for u in order {
             let k = all.binary_search(&u).expect("all holds every candidate");
@@ -274,6 +296,17 @@ impl Robot {
     pub fn with_measurement(&self, m: MeasurementKind) -> Result<Robot> {
         let mut r = self.clone();
         r.measurement = m;
+        let k = m.markers();
+        for t in [&mut r.real, &mut r.nominal] {
+            if k == 0 {
+                t.markers.clear();
+            } else if t.markers.len() != k {
+                return Err(Error::Invalid(format!(
+                    "{k} markers need {k} offsets in each parameter table (Robot::with_markers), not {}",
+                    t.markers.len()
+                )));
+            }
+        }
         if r.frames.is_empty() {
             return Err(Error::Invalid("the robot has no frames".into()));
         }
@@ -304,6 +337,41 @@ impl Robot {
 }
 
 impl Robot {
+    /// A copy measured by `offsets.len()` markers ([`MeasurementKind::Markers`])
+    /// at these offsets in the last frame (nominal and real alike), its
+    /// unknowns re-chosen as in [`Robot::with_measurement`] with the offsets'
+    /// columns taken first. Errors on no offsets or a non-finite one.
+    ///
+    /// ```
+    /// use activecal::model::Robot;
+    /// let ur5 = Robot::ur5();
+    /// let m = ur5.with_markers(&[[0.1, 0.0, 0.05], [0.0, 0.1, 0.05], [0.0, 0.0, 0.15]]).unwrap();
+    /// // The offsets take the tool translation: 3 orientation unknowns more
+    /// // than the point robot's 27 less 3, plus 9 offsets.
+    /// assert_eq!((m.rows_per_pose(), m.n_params()), (9, ur5.n_unknowns() + 3 + 9 - 3));
+    /// ```
+    pub fn with_markers(&self, offsets: &[[f64; 3]]) -> Result<Robot> {
+        if offsets.is_empty() {
+            return Err(Error::Invalid(
+                "a marker sensor needs at least one marker".into(),
+            ));
+        }
+        if let Some(k) = offsets
+            .iter()
+            .position(|o| o.iter().any(|v| !v.is_finite()))
+        {
+            return Err(Error::Invalid(format!(
+                "marker {}: the offset {:?} is not finite",
+                k + 1,
+                offsets[k]
+            )));
+        }
+        let mut r = self.clone();
+        r.real.markers = offsets.to_vec();
+        r.nominal.markers = offsets.to_vec();
+        r.with_measurement(MeasurementKind::Markers(offsets.len()))
+    }
+
     /// The shape the kinematics needs (see [`Robot::validate`] for the
     /// rest): a table row per frame, joint numbers within the limits.
     fn check_shape(&self) -> Result<()> {

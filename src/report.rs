@@ -526,7 +526,7 @@ impl FkReport {
         let table = robot.params(params);
         let p = crate::kinematics::position_checked(robot, table, &q)?;
         let jac = jacobian.then(|| {
-            let n = robot.n_unknowns();
+            let n = robot.n_params();
             let mut jac = vec![0.0; robot.rows_per_pose() * n];
             crate::measure::JacobianEvaluator::new(robot, table).eval(&q, &mut jac);
             jac.chunks(n.max(1)).map(<[f64]>::to_vec).collect()

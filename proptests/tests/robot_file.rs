@@ -238,8 +238,8 @@ fn any_robot() -> impl Strategy<Value = Robot> {
             Robot {
                 name: "random".into(),
                 frames: fr,
-                real: ParamTable { rows: real },
-                nominal: ParamTable { rows: nominal },
+                real: ParamTable::from_rows(real),
+                nominal: ParamTable::from_rows(nominal),
                 unknowns,
                 limits,
                 measurement: if pose_m {

@@ -6,15 +6,13 @@
 
 use super::{emit, write_new};
 use activecal::identify::{
-    Identification, LmSettings, Measurements, MonteCarloSettings, MonteCarloSummary, ParamGrid,
-    ValidationSet, identify, monte_carlo, paper_tables,
+    Identification, LmSettings, MonteCarloSettings, MonteCarloSummary, ValidationSet, monte_carlo,
+    paper_tables,
 };
 use activecal::io::design::DesignFile;
 use activecal::io::robot_toml as file;
 use activecal::model::Robot;
-use activecal::report::{
-    IdentificationReport, MeasuredCalibrationReport, SimulatedCalibrationReport,
-};
+use activecal::report::{IdentificationReport, SimulatedCalibrationReport};
 use anyhow::{Result, bail};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -31,9 +29,13 @@ pub struct CalibrateArgs {
     /// measurements are simulated there.
     #[arg(long, required_unless_present = "measurements")]
     pub design: Option<PathBuf>,
-    /// Measurement file (JSON: `qs`, `points` and, for full-pose robots,
-    /// `orientations` as row-major rotation matrices): identify from these
-    /// real measurements instead of simulating a design.
+    /// Measurement file: identify from these real measurements instead of
+    /// simulating a design. CSV (`x1,y1,z1`, `x2,y2,z2`… for several
+    /// markers, optional `phix1,phiy1,phiz1` roll-pitch-yaw or
+    /// `qw1,qx1,qy1,qz1`, one column per joint named as in the URDF; metres
+    /// and radians) or JSON (`qs`, `points`, optional `orientations` or
+    /// `quaternions`, `markers`). Several markers per pose calibrate a
+    /// marker sensor with one offset per marker; orientations a full pose.
     #[arg(long, conflicts_with_all = ["design", "trials", "save_measurements"])]
     pub measurements: Option<PathBuf>,
     /// Write the simulated measurements (trial 0 of the seed) to this JSON
@@ -66,6 +68,33 @@ pub struct CalibrateArgs {
     /// Plain Levenberg–Marquardt steps, without geodesic acceleration.
     #[arg(long)]
     pub no_geodesic: bool,
+    /// Loss of the fit (with --measurements): l2, or huber / cauchy with
+    /// --loss-scale; poses the robust loss down-weights are named.
+    #[arg(long, value_enum, default_value = "l2", requires = "measurements")]
+    pub loss: super::measured::LossKind,
+    /// Scale of a robust loss: a pose's residual norm (metres) where it
+    /// turns robust.
+    #[arg(long, requires = "measurements")]
+    pub loss_scale: Option<f64>,
+    /// Unknowns to fix at their nominal values (comma-separated names, as
+    /// in the estimate), with --measurements.
+    #[arg(long, value_delimiter = ',', requires = "measurements")]
+    pub fix: Vec<String>,
+    /// Parameters to estimate besides the chosen unknowns (names such as
+    /// `d_arm_3_joint`), with --measurements.
+    #[arg(long, value_delimiter = ',', requires = "measurements")]
+    pub free: Vec<String>,
+    /// Held-out validation: fit on a random 1 − F of the poses, evaluate on
+    /// the rest (with --measurements; --splits times, seeded by --seed).
+    #[arg(long, value_name = "F", requires = "measurements")]
+    pub holdout: Option<f64>,
+    /// Random splits of --holdout.
+    #[arg(long, default_value_t = 4, requires = "holdout")]
+    pub splits: usize,
+    /// With --holdout: also fit a model pruned to the parameters with
+    /// |t| >= 2 and compare held-out errors.
+    #[arg(long, requires = "holdout")]
+    pub compare_pruned: bool,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -150,55 +179,43 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
 /// Identification from a measurement file.
 fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()> {
     let t0 = Instant::now();
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
-    let meas: Measurements =
-        serde_json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    meas.check(robot)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let lm = LmSettings::default()
         .with_max_iterations(a.max_iterations)
         .with_geodesic(!a.no_geodesic);
-    let id = identify(robot, &robot.nominal, &meas, &lm)?;
-    let written = write_calibrated(a, robot, &id, &path.display().to_string())?;
-    let mut report =
-        MeasuredCalibrationReport::new(robot, &id, path.display().to_string(), meas.len());
-    report.out = a
+    let o = super::measured::MeasuredOptions {
+        lm,
+        loss: super::measured::loss_choice(a.loss, a.loss_scale)?,
+        fix: &a.fix,
+        free: &a.free,
+        holdout: a
+            .holdout
+            .map(|fraction| activecal::identify::HoldoutSettings {
+                fraction,
+                splits: a.splits,
+                seed: a.seed,
+                prune: a.compare_pruned,
+            }),
+        json: a.json,
+    };
+    let (fitted, f, mut report) =
+        super::measured::calibrate_measured(robot, path, &o, &|| t0.elapsed().as_secs_f64())?;
+    let id = &f.id;
+    let written = write_calibrated(a, &fitted, id, &path.display().to_string())?;
+    report.base.out = a
         .out
         .as_ref()
         .filter(|_| written)
         .map(|p| p.display().to_string());
-    report.elapsed_seconds = t0.elapsed().as_secs_f64();
-    let v = serde_json::to_value(&report)?;
-    let rows = (robot.rows_per_pose() * meas.len()) as f64;
-    emit(a.json, &v, || {
-        let mut s = format!(
-            "{}: {} measured {}s\n{}",
-            path.display(),
-            meas.len(),
-            robot.measurement.name(),
-            status_text(&id)
-        );
-        s += &format!(
-            "RMS weighted residual per row: {:.6e} (nominal model {:.6e})\n",
-            (id.rss / rows).sqrt(),
-            (id.initial_rss / rows).sqrt()
-        );
-        s += "\nestimate\n";
-        s += &ParamGrid::from_unknowns(robot, &id.estimate).to_text(6);
-        if let Some(c) = &id.covariance {
-            s += "\nstandard deviation (σ̂² (XᵀX)⁻¹)\n";
-            s += &ParamGrid::from_unknowns(robot, &c.std).to_text(6);
-        }
+    super::emit_report(a.json, &report, || {
+        let mut s = super::measured::measured_text(&report, id, &status_text(id));
         if let Some(out) = a.out.as_ref().filter(|_| written) {
             s += &format!("\ncalibrated robot written to {}\n", out.display());
         }
         s
-    });
-    refuse_unconverged(a, &id)
+    })?;
+    refuse_unconverged(a, id)
 }
 
-/// Status, residual sum of squares, σ̂, rank and unidentifiable unknowns.
 fn status_text(id: &Identification) -> String {
     let mut s = format!(
         "status: {:?} ({:?}) after {} iterations, {} evaluations\n",

@@ -5,6 +5,7 @@ pub mod bench;
 pub mod bound;
 pub mod calibrate;
 pub mod figures;
+pub mod measured;
 pub mod reproduce;
 pub mod select;
 

@@ -449,7 +449,7 @@ pub fn predicted_covariance(
             .map_err(|source| IdentifyError::Pose { pose: i, source })?;
     }
     let x = crate::blocks::jacobian_of(robot, table, qs.len(), |k, q| q.copy_from_slice(&qs[k]));
-    if identifiability(robot, &x).rank < robot.n_unknowns() {
+    if identifiability(robot, &x).rank < robot.n_params() {
         return Ok(None);
     }
     Ok(inverse_information(x.mat()).map(|inv| {

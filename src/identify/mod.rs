@@ -21,6 +21,11 @@
 //! * [`loss`]: robust losses (Huber, Cauchy) wrapping any [`Residuals`],
 //!   solved by IRLS ([`identify_robust`]).
 //! * [`simulate`](mod@simulate): noisy measurements of the real robot, seeded.
+//! * [`evaluation`]: a model's errors on data in mm and degrees, no fitting.
+//! * [`fit`](mod@fit): one call from data to a fit with a run-time loss,
+//!   parameter significance, fixed/freed unknowns and held-out splits.
+//! * [`start`]: the sensor a measurement set calls for (markers, full
+//!   poses) and where identification starts.
 //! * [`montecarlo`]: repeated identification over noise realisations, and
 //!   held-out validation poses.
 //! * [`tables`]: estimates and residuals in the paper's table layout.
@@ -30,14 +35,22 @@
 //! [`IdentifyError`]; a numerical outcome (no convergence, divergence, a rank
 //! deficient design) is the [`Status`] of the result.
 
+pub mod evaluation;
+pub mod fit;
 pub mod lm;
 pub mod loss;
 pub mod montecarlo;
 pub mod residual;
 pub mod simulate;
+pub mod start;
 
 pub mod tables;
 
+pub use evaluation::{SampleResidual, residuals};
+pub use fit::{
+    Fit, HoldoutSettings, LossChoice, ParameterTrust, SplitResult, fit, holdout, trust,
+    with_fixed_and_free,
+};
 pub use lm::{
     Correlation, Covariance, Identification, LmSettings, Solution, Status, StopReason, identify,
     identify_robust, irls, levenberg_marquardt, predicted_covariance,
@@ -49,6 +62,7 @@ pub use montecarlo::{
 };
 pub use residual::{Calibration, Residuals};
 pub use simulate::{simulate, trial_rng};
+pub use start::{Start, for_measurements};
 pub use tables::{PaperTables, ParamGrid, paper_tables};
 
 use crate::error::Error;
@@ -65,13 +79,28 @@ pub enum IdentifyError {
     Empty,
     /// Joint vectors and measured points of different counts.
     #[error(
-        "{poses} poses but {measurements} measured points: every pose needs exactly one measurement (missing measurements?)"
+        "{poses} poses but {measurements} measured points: every pose needs exactly {per_pose} (missing measurements?)"
     )]
     MeasurementCount {
         /// Number of joint vectors.
         poses: usize,
         /// Number of measured points.
         measurements: usize,
+        /// Points per pose (markers).
+        per_pose: usize,
+    },
+    /// Several markers per pose given for a robot whose sensor sees another
+    /// number: never flattened into one point.
+    #[error(
+        "the measurements hold {given} marker(s) per pose but robot '{robot}' measures {expected}: several markers are never merged into one point; calibrate with a {given}-marker sensor (a measurement file with {given} markers does that by itself in `calibrate` and `evaluate`)"
+    )]
+    MarkerCount {
+        /// The robot's name.
+        robot: String,
+        /// Markers per pose in the measurements.
+        given: usize,
+        /// Points per pose of the robot's sensor.
+        expected: usize,
     },
     /// A measured coordinate that is NaN or infinite.
     #[error(
@@ -157,7 +186,9 @@ pub const ROTATION_TOLERANCE: f64 = 1e-6;
 /// In JSON: `{"robot": "name", "qs": [[q1, …], …], "points": [[x, y, z],
 /// …], "orientations": [[[r00, r01, r02], [r10, …], [r20, …]], …]}`
 /// (metres, radians; orientations row-major, base frame, omitted for
-/// points; `robot` optional, checked against the robot when present).
+/// points; `robot` optional, checked against the robot when present). With
+/// `K` markers per pose (`"markers": K`, default 1) `points` holds `K` points
+/// per pose, pose-major (pose 1's markers 1…K, then pose 2's).
 /// Instead of `orientations` a file may give `"quaternions": [[w, x, y, z],
 /// …]` (unit to [`ROTATION_TOLERANCE`], scalar first, as most trackers
 /// export them); they are read into rotation matrices.
@@ -167,9 +198,19 @@ pub struct Measurements {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     robot: Option<String>,
     qs: Vec<Vec<f64>>,
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    markers: usize,
     points: Vec<[f64; 3]>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     orientations: Vec<[[f64; 3]; 3]>,
+}
+
+fn one() -> usize {
+    1
+}
+
+fn is_one(k: &usize) -> bool {
+    *k == 1
 }
 
 impl Measurements {
@@ -206,14 +247,63 @@ impl Measurements {
         points: Vec<[f64; 3]>,
         orientations: Vec<[[f64; 3]; 3]>,
     ) -> Result<Self> {
+        let markers = robot.measurement.markers().max(1);
         let m = Self {
             robot: None,
             qs,
+            markers,
             points,
             orientations,
         };
         m.check(robot)?;
         Ok(m)
+    }
+
+    /// Wraps measurements without a robot to check them against: joint
+    /// vectors, `markers` points per pose (pose-major) and orientations, as a
+    /// file reader has them. [`Measurements::check`] validates them against
+    /// the robot they are used with (as [`identify`] does).
+    #[must_use]
+    pub fn unchecked(
+        qs: Vec<Vec<f64>>,
+        markers: usize,
+        points: Vec<[f64; 3]>,
+        orientations: Vec<[[f64; 3]; 3]>,
+    ) -> Self {
+        Self {
+            robot: None,
+            qs,
+            markers,
+            points,
+            orientations,
+        }
+    }
+
+    /// Markers (points) per pose.
+    #[must_use]
+    pub fn markers(&self) -> usize {
+        self.markers
+    }
+
+    /// The measurements of the given poses (in that order), e.g. a
+    /// training or held-out split. Panics on an index out of range.
+    #[must_use]
+    pub fn subset(&self, poses: &[usize]) -> Self {
+        let k = self.markers;
+        Self {
+            robot: self.robot.clone(),
+            qs: poses.iter().map(|&i| self.qs[i].clone()).collect(),
+            markers: k,
+            points: poses
+                .iter()
+                .flat_map(|&i| self.points[k * i..k * (i + 1)].iter().copied())
+                .collect(),
+            orientations: if self.orientations.is_empty() {
+                Vec::new()
+            } else {
+                poses.iter().map(|&i| self.orientations[i]).collect()
+            },
+        }
     }
 
     /// Re-checks the measurements against a robot (done by [`identify`]).
@@ -224,10 +314,19 @@ impl Measurements {
                 robot.name
             ))));
         }
-        if self.qs.len() != self.points.len() {
+        let sensor = crate::measure::sensor_for(robot);
+        if sensor.points_per_pose() != self.markers {
+            return Err(IdentifyError::MarkerCount {
+                robot: robot.name.clone(),
+                given: self.markers,
+                expected: sensor.points_per_pose(),
+            });
+        }
+        if self.qs.len().checked_mul(self.markers) != Some(self.points.len()) {
             return Err(IdentifyError::MeasurementCount {
                 poses: self.qs.len(),
                 measurements: self.points.len(),
+                per_pose: self.markers,
             });
         }
         if self.qs.is_empty() {
@@ -241,21 +340,13 @@ impl Measurements {
         for (i, p) in self.points.iter().enumerate() {
             if let Some(c) = (0..3).find(|&c| !p[c].is_finite()) {
                 return Err(IdentifyError::NonFiniteMeasurement {
-                    pose: i,
+                    pose: i / self.markers,
                     coordinate: ['x', 'y', 'z'][c],
                     value: p[c],
                 });
             }
         }
-        let sensor = crate::measure::sensor_for(robot);
-        if sensor.points_per_pose() != 1 {
-            return Err(IdentifyError::Model(Error::Invalid(format!(
-                "robot '{}' measures {} points per pose; measurement files hold one",
-                robot.name,
-                sensor.points_per_pose()
-            ))));
-        }
-        let want = if sensor.observes_orientation() {
+        let want = if sensor.measures_orientation() {
             self.qs.len()
         } else {
             0
@@ -307,7 +398,8 @@ impl Measurements {
         &self.qs
     }
 
-    /// Measured points, one per joint vector.
+    /// Measured points, [`Measurements::markers`] per joint vector
+    /// (pose-major).
     #[must_use]
     pub fn points(&self) -> &[[f64; 3]] {
         &self.points
@@ -317,8 +409,9 @@ impl Measurements {
     /// ([`crate::measure::Sensor::encode`]). Panics if `i ≥ len()`.
     #[must_use]
     pub fn observation(&self, i: usize) -> Observation<'_> {
+        let k = self.markers;
         Observation {
-            points: std::slice::from_ref(&self.points[i]),
+            points: &self.points[k * i..k * (i + 1)],
             orientation: self.orientations.get(i),
         }
     }
@@ -339,6 +432,8 @@ struct MeasurementsFile {
     #[serde(default)]
     robot: Option<String>,
     qs: Vec<Vec<f64>>,
+    #[serde(default = "one")]
+    markers: usize,
     points: Vec<[f64; 3]>,
     #[serde(default)]
     orientations: Vec<[[f64; 3]; 3]>,
@@ -366,9 +461,13 @@ impl TryFrom<MeasurementsFile> for Measurements {
             ));
             orientations.push(rows(uq.to_rotation_matrix().matrix()));
         }
+        if f.markers == 0 {
+            return Err("`markers` must be at least 1 (points per pose)".into());
+        }
         Ok(Self {
             robot: f.robot,
             qs: f.qs,
+            markers: f.markers,
             points: f.points,
             orientations,
         })

@@ -66,7 +66,7 @@ impl<'a> Calibration<'a> {
         for (i, out) in measured.chunks_mut(vl).enumerate() {
             sensor.encode(&meas.observation(i), out);
         }
-        let n = robot.n_unknowns() + sensor.n_own_params();
+        let n = robot.n_params();
         Ok(Self {
             robot,
             base,
@@ -92,7 +92,7 @@ impl Residuals for Calibration<'_> {
     }
 
     fn n_params(&self) -> usize {
-        self.robot.n_unknowns() + self.sensor.n_own_params()
+        self.robot.n_params()
     }
 
     fn block_rows(&self) -> usize {
@@ -104,8 +104,8 @@ impl Residuals for Calibration<'_> {
         let p = self.robot.n_unknowns();
         let t = self.sensor.rows();
         let vl = self.sensor.value_len();
-        let (theta_robot, own) = theta.split_at(p);
-        let table = self.robot.with_unknowns(self.base, theta_robot);
+        let table = self.robot.with_unknowns(self.base, theta);
+        let own = &theta[p..];
         let mut ev = Evaluator::new(self.robot, &table);
         let mut finite = true;
         for (i, q) in self.qs.iter().enumerate() {

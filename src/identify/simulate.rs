@@ -70,6 +70,7 @@ pub fn simulate<R: Rng + ?Sized>(
     let mut noise = vec![0.0; t * qs.len()];
     fill_standard_normal(rng, &mut noise);
     let mut ev = Evaluator::new(robot, table);
+    let own = table.marker_values();
     let mut value = vec![0.0; sensor.value_len()];
     let mut delta = vec![0.0; t];
     let mut points = Vec::with_capacity(qs.len());
@@ -78,7 +79,7 @@ pub fn simulate<R: Rng + ?Sized>(
         robot
             .check_q(q)
             .map_err(|source| super::IdentifyError::Pose { pose: i, source })?;
-        sensor.predict(&ev.end_frame(q), &[], &mut value);
+        sensor.predict(&ev.end_frame(q), &own, &mut value);
         let z = &noise[t * i..t * (i + 1)];
         for ((d, z), w) in delta.iter_mut().zip(z).zip(sensor.weights()) {
             *d = sigma * z / w;

@@ -21,10 +21,11 @@ pub struct ParamGrid {
 }
 
 impl ParamGrid {
-    /// Lays out one value per unknown (in the robot's order).
+    /// Lays out one value per unknown (in the robot's order; the values of
+    /// marker offsets that may follow are not part of the grid).
     #[must_use]
     pub fn from_unknowns(robot: &Robot, values: &[f64]) -> ParamGrid {
-        assert_eq!(values.len(), robot.n_unknowns());
+        assert!(values.len() == robot.n_unknowns() || values.len() == robot.n_params());
         let frames: Vec<usize> = {
             let mut f: Vec<usize> = robot.unknowns.iter().map(|u| u.frame).collect();
             f.dedup();
@@ -61,13 +62,18 @@ impl ParamGrid {
     #[must_use]
     pub fn to_text(&self, decimals: usize) -> String {
         let w = decimals + 6;
-        let mut s = format!("{:>5}", "frame");
+        let lw = self
+            .frames
+            .iter()
+            .map(|l| l.chars().count())
+            .fold(5, usize::max);
+        let mut s = format!("{:>lw$}", "frame");
         for sym in &self.symbols {
             s += &format!(" {sym:>w$}");
         }
         s.push('\n');
         for (label, row) in self.frames.iter().zip(&self.rows) {
-            s += &format!("{label:>5}");
+            s += &format!("{label:>lw$}");
             for v in row {
                 match v {
                     Some(v) => s += &format!(" {v:>w$.decimals$}"),

@@ -4,7 +4,9 @@
 
 pub mod atomic;
 pub mod design;
+pub mod measurements;
 pub mod robot_toml;
+pub mod table;
 pub mod urdf;
 
 use crate::error::{Error, Result};

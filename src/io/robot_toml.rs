@@ -4,7 +4,7 @@
 //!
 //! ```toml
 //! name = "puma560"            # optional; default: the file name
-//! measurement = "point"       # "point" (3 rows per pose) or "pose" (6 rows)
+//! measurement = "point"       # "point" (3 rows per pose), "pose" (6 rows) or "markers" (3 per marker)
 //! # orientation_scale = 0.29  # pose only: metres per radian, σ_position / σ_orientation
 //! # unknowns = "auto"         # choose identifiable unknowns automatically
 //!
@@ -31,6 +31,12 @@
 //! nominal = [-0.0367, -1.4524, 0.0603, 0.6713]
 //! unknowns = ["gamma", "alpha", "a", "d"]
 //! ```
+//!
+//! With `measurement = "markers"`, one `[[marker]]` table per marker gives
+//! its offset in the last frame (metres), e.g. `nominal = [0.0, 0.05,
+//! 0.45]` and optionally `real = […]` (default: the nominal); every offset
+//! is an unknown of its own (see [`crate::measure::markers`]). `calibrate
+//! --out` writes the estimated offsets this way.
 //!
 //! Instead of frames, a file may import a URDF: `urdf = "arm.urdf"` (relative
 //! to the file), with optional `base = "link"` (default: the URDF's root),
@@ -69,7 +75,9 @@ pub const MAX_ABS: f64 = 1e6;
 #[serde(deny_unknown_fields)]
 struct FileSpec {
     name: Option<String>,
-    measurement: Option<MeasurementKind>,
+    measurement: Option<MeasurementSpec>,
+    #[serde(default)]
+    marker: Vec<MarkerSpec>,
     orientation_scale: Option<Spanned<f64>>,
     visibility: Option<Spanned<Visibility>>,
     unknowns: Option<Spanned<String>>,
@@ -79,6 +87,21 @@ struct FileSpec {
     lock: Option<Spanned<std::collections::BTreeMap<String, f64>>>,
     #[serde(default)]
     frame: Vec<FrameSpec>,
+}
+
+#[derive(Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+enum MeasurementSpec {
+    Point,
+    Pose,
+    Markers,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MarkerSpec {
+    nominal: Spanned<Vec<f64>>,
+    real: Option<Spanned<Vec<f64>>>,
 }
 
 #[derive(Deserialize, Clone, Copy, PartialEq, Eq)]
@@ -170,7 +193,12 @@ pub fn parse(text: &str, origin: &str, dir: Option<&Path>) -> Result<Robot> {
 pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result<Description> {
     let cx = Ctx { text, origin };
     let spec: FileSpec = toml::from_str(text).map_err(|e| cx.plain(e.to_string().trim_end()))?;
-    let measurement = spec.measurement.unwrap_or(MeasurementKind::Point);
+    let measurement = match spec.measurement {
+        None | Some(MeasurementSpec::Point) => MeasurementKind::Point,
+        Some(MeasurementSpec::Pose) => MeasurementKind::Pose,
+        Some(MeasurementSpec::Markers) => MeasurementKind::Markers(spec.marker.len()),
+    };
+    let markers = marker_offsets(&cx, &spec.marker, measurement)?;
     let orientation_scale = match &spec.orientation_scale {
         None => crate::model::DEFAULT_ORIENTATION_SCALE,
         Some(s) if measurement != MeasurementKind::Pose => {
@@ -239,10 +267,18 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
                 .as_ref()
                 .map(|l| l.get_ref().iter().map(|(k, v)| (k.clone(), *v)).collect())
                 .unwrap_or_default(),
-            measurement,
+            measurement: if markers.is_some() {
+                MeasurementKind::Point
+            } else {
+                measurement
+            },
             ..super::urdf::UrdfOptions::default()
         };
         let mut r = super::urdf::load(&path, &opts).map_err(|e| cx.at(urdf.span(), e))?;
+        if let Some((nominal, real)) = &markers {
+            r = r.with_markers(nominal).map_err(|e| cx.plain(e))?;
+            r.real.markers.clone_from(real);
+        }
         if let Some(n) = spec.name {
             r.name = n;
         }
@@ -369,13 +405,17 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
     let mut robot = Robot {
         name: spec.name.unwrap_or(default_name),
         frames,
-        real: ParamTable { rows: real },
-        nominal: ParamTable { rows: nominal },
+        real: ParamTable::from_rows(real),
+        nominal: ParamTable::from_rows(nominal),
         unknowns,
         limits,
         measurement,
         orientation_scale,
     };
+    if let Some((nominal, real)) = markers {
+        robot.nominal.markers = nominal;
+        robot.real.markers = real;
+    }
     if auto {
         robot.unknowns = robot.choose_unknowns(&[]).map_err(|e| cx.plain(e))?;
         if robot.unknowns.is_empty() {
@@ -403,6 +443,55 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
         }
         Err(e) => Err(cx.plain(e)),
     }
+}
+
+/// The nominal and real marker offsets of `[[marker]]` tables, for a
+/// `measurement = "markers"` file (`None` otherwise); tables without that
+/// measurement, or that measurement without tables, are errors.
+fn marker_offsets(
+    cx: &Ctx<'_>,
+    specs: &[MarkerSpec],
+    measurement: MeasurementKind,
+) -> Result<Option<(Vec<[f64; 3]>, Vec<[f64; 3]>)>> {
+    if measurement.markers() == 0 {
+        return match specs.first() {
+            Some(m) => Err(cx.at(
+                m.nominal.span(),
+                "[[marker]] tables need `measurement = \"markers\"`",
+            )),
+            None => Ok(None),
+        };
+    }
+    if specs.is_empty() {
+        return Err(cx.plain(
+            "`measurement = \"markers\"` needs one [[marker]] table per marker, with its offset `nominal = [x, y, z]` in the last frame (metres)",
+        ));
+    }
+    let offset = |k: usize, v: &Spanned<Vec<f64>>| -> Result<[f64; 3]> {
+        match v.get_ref().as_slice() {
+            &[x, y, z] if [x, y, z].iter().all(|c| c.is_finite() && c.abs() <= MAX_ABS) => {
+                Ok([x, y, z])
+            }
+            other => Err(cx.at(
+                v.span(),
+                format!(
+                    "marker {}: the offset must be 3 finite numbers [x, y, z] (metres, |value| <= {MAX_ABS:e}), not {other:?}",
+                    k + 1
+                ),
+            )),
+        }
+    };
+    let mut nominal = Vec::with_capacity(specs.len());
+    let mut real = Vec::with_capacity(specs.len());
+    for (k, m) in specs.iter().enumerate() {
+        let n = offset(k, &m.nominal)?;
+        nominal.push(n);
+        real.push(match &m.real {
+            Some(r) => offset(k, r)?,
+            None => n,
+        });
+    }
+    Ok(Some((nominal, real)))
 }
 
 /// A parameter row: 5 values, or 4 for a DH frame (β = 0), all finite.
@@ -549,6 +638,9 @@ pub fn description_to_toml(robot: &Robot, visibility: Option<&Visibility>) -> St
     s += &format!("measurement = \"{}\"\n", robot.measurement.name());
     if robot.measurement == MeasurementKind::Pose {
         s += &format!("orientation_scale = {}\n", num(robot.orientation_scale));
+    }
+    for (n, r) in robot.nominal.markers.iter().zip(&robot.real.markers) {
+        s += &format!("\n[[marker]]\nnominal = {}\nreal = {}\n", list(n), list(r));
     }
     for (i, f) in robot.frames.iter().enumerate() {
         s += "\n[[frame]]\n";

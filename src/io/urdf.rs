@@ -676,7 +676,7 @@ fn convert(chain: &[ChainJoint], name: &str, opts: &UrdfOptions) -> Robot {
     let label = label_for("tool", n, &labels);
     frames.push(Frame::fixed(&label, Convention::Hayati));
     rows.push([gamma, alpha, 0.0, rel.translation.vector.z, beta]);
-    let nominal = ParamTable { rows };
+    let nominal = ParamTable::from_rows(rows);
     Robot {
         name: name.to_string(),
         frames,

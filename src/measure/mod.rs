@@ -5,6 +5,7 @@
 //! [`JacobianEvaluator`] joins the kinematics' per-unknown motions and a
 //! sensor's rows into the identification Jacobian of one pose.
 
+pub mod markers;
 pub mod point;
 pub mod pose;
 pub mod sensor;
@@ -28,6 +29,8 @@ pub struct JacobianEvaluator<'r> {
     unweighted: Box<dyn Sensor>,
     motions: Vec<Motion>,
     joints: Vec<Motion>,
+    /// The sensor's own parameters (marker offsets) in `table`.
+    own: Vec<f64>,
 }
 
 impl<'r> JacobianEvaluator<'r> {
@@ -40,6 +43,7 @@ impl<'r> JacobianEvaluator<'r> {
             unweighted: sensor_of(robot.measurement, 1.0),
             motions: vec![Motion::default(); robot.n_unknowns()],
             joints: vec![Motion::default(); robot.dof()],
+            own: table.marker_values(),
         }
     }
 
@@ -50,8 +54,9 @@ impl<'r> JacobianEvaluator<'r> {
     }
 
     /// End point at `q`, and the identification Jacobian `∂y/∂θ` (t × p,
-    /// row-major, `t` = the sensor's rows, unknowns in [`Robot::unknowns`]
-    /// order) at zero residual written into `jac` (see
+    /// row-major, `t` = the sensor's rows, `p` = [`Robot::n_params`]: the
+    /// unknowns in [`Robot::unknowns`] order, then the sensor's own) at zero
+    /// residual written into `jac` (see
     /// [`Sensor::motion_rows`]: rows 0–2 the position, for a full pose rows
     /// 3–5 the angular velocity times [`Robot::orientation_scale`]).
     pub fn eval(&mut self, q: &[f64], jac: &mut [f64]) -> Vector3<f64> {
@@ -61,10 +66,13 @@ impl<'r> JacobianEvaluator<'r> {
     /// As [`JacobianEvaluator::eval`], also returning the end frame's
     /// orientation.
     pub fn eval_pose(&mut self, q: &[f64], jac: &mut [f64]) -> (Matrix3<f64>, Vector3<f64>) {
-        let p = self.motions.len();
+        let n = self.motions.len();
+        let p = n + self.own.len();
         debug_assert_eq!(jac.len(), self.sensor.rows() * p);
         let end = self.ev.motions(q, &mut self.motions);
-        self.sensor.motion_rows(&end, &[], &self.motions, jac, p);
+        self.sensor
+            .motion_rows(&end, &self.own, &self.motions, jac, p);
+        self.sensor.own_rows(&end, &self.own, &mut jac[n..], p);
         (end.rotation, end.position)
     }
 
@@ -78,7 +86,7 @@ impl<'r> JacobianEvaluator<'r> {
         debug_assert_eq!(jac.len(), self.sensor.rows() * dof);
         let end = self.ev.joint_motions(q, &mut self.joints);
         self.unweighted
-            .motion_rows(&end, &[], &self.joints, jac, dof);
+            .motion_rows(&end, &self.own, &self.joints, jac, dof);
         end.position
     }
 }

@@ -31,6 +31,7 @@ use crate::kinematics::{EndFrame, Motion};
 use crate::model::{MeasurementKind, Robot};
 use std::fmt;
 
+use super::markers::MarkerSensor;
 use super::point::PointSensor;
 use super::pose::PoseSensor;
 
@@ -68,8 +69,9 @@ pub struct ObservationBuf {
 
 /// A sensor: rows per pose, prediction, residual, Jacobian rows and weights.
 ///
-/// Implementations: [`PointSensor`] (3 rows, the end point) and
-/// [`PoseSensor`] (6 rows, the end point and the end frame's orientation).
+/// Implementations: [`PointSensor`] (3 rows, the end point),
+/// [`PoseSensor`] (6 rows, the end point and the end frame's orientation)
+/// and [`MarkerSensor`] (`3K` rows, `K` markers with their own offsets).
 /// [`sensor_for`] picks one from [`Robot::measurement`].
 ///
 /// The hot path, the pool Jacobian of up to 10⁶ poses, calls
@@ -102,6 +104,14 @@ pub trait Sensor: fmt::Debug + Send + Sync {
     /// Whether the measurement includes the end frame's orientation (so
     /// that an orientation error of the model is observable).
     fn observes_orientation(&self) -> bool;
+
+    /// Whether a measured value holds an orientation (a rotation per pose
+    /// in measurement files). Default: [`Sensor::observes_orientation`];
+    /// several markers observe the orientation through their positions
+    /// without measuring one.
+    fn measures_orientation(&self) -> bool {
+        self.observes_orientation()
+    }
 
     /// Points measured per pose.
     fn points_per_pose(&self) -> usize;
@@ -186,6 +196,7 @@ pub fn sensor_of(kind: MeasurementKind, orientation_scale: f64) -> Box<dyn Senso
     match kind {
         MeasurementKind::Point => Box::new(PointSensor::new()),
         MeasurementKind::Pose => Box::new(PoseSensor::new(orientation_scale)),
+        MeasurementKind::Markers(k) => Box::new(MarkerSensor::new(k)),
     }
 }
 

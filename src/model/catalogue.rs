@@ -64,9 +64,7 @@ fn assemble(
     limits: Vec<[f64; 2]>,
     m: MeasurementKind,
 ) -> Robot {
-    let nominal = ParamTable {
-        rows: frames.iter().map(|f| f.4).collect(),
-    };
+    let nominal = ParamTable::from_rows(frames.iter().map(|f| f.4).collect());
     let mut pose_unknowns = point_unknowns.clone();
     pose_unknowns.extend(pose_extra);
     pose_unknowns.sort();
@@ -74,6 +72,7 @@ fn assemble(
     let (name, unknowns) = match m {
         MeasurementKind::Point => (name.to_string(), point_unknowns),
         MeasurementKind::Pose => (format!("{name}:pose"), pose_unknowns),
+        MeasurementKind::Markers(_) => unreachable!("built-in robots measure points or poses"),
     };
     let r = Robot {
         name,

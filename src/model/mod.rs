@@ -147,15 +147,38 @@ impl Frame {
     }
 }
 
-/// Values of all five parameters of every frame (`[γ, α, a, d, β]` per frame).
+/// Values of all five parameters of every frame (`[γ, α, a, d, β]` per frame),
+/// and the offsets of the markers a [`MeasurementKind::Markers`] sensor sees.
 /// A DH frame's β entry is ignored by the kinematics (the paper's tables write 10).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct ParamTable {
     /// One row per frame, columns in [`Symbol::ALL`] order.
     pub rows: Vec<[f64; 5]>,
+    /// Marker offsets `o_k` in the last frame (metres), one per marker of a
+    /// [`MeasurementKind::Markers`] robot, empty otherwise: marker `k` is at
+    /// `p + R o_k`. They are always unknown (the sensor's own unknowns,
+    /// after the robot's in the parameter vector).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub markers: Vec<[f64; 3]>,
 }
 
 impl ParamTable {
+    /// A table of frame rows, without markers.
+    #[must_use]
+    pub fn from_rows(rows: Vec<[f64; 5]>) -> Self {
+        Self {
+            rows,
+            markers: Vec::new(),
+        }
+    }
+
+    /// The marker offsets as one flat vector `[o_1x, o_1y, o_1z, o_2x, …]`
+    /// (the sensor's own parameters, see [`crate::measure::Sensor::n_own_params`]).
+    #[must_use]
+    pub fn marker_values(&self) -> Vec<f64> {
+        self.markers.iter().flatten().copied().collect()
+    }
+
     /// Value of a parameter.
     #[must_use]
     pub fn get(&self, id: ParamId) -> f64 {
@@ -198,6 +221,11 @@ pub enum MeasurementKind {
     /// a rotation parameter about unit axis `u` are `u`, those of a
     /// translation parameter are 0).
     Pose,
+    /// `K ≥ 1` markers fixed to the last frame, each measured as a point:
+    /// `3K` rows per pose. Marker `k` sits at `p + R o_k` with its own offset
+    /// `o_k` ([`ParamTable::markers`]), three unknowns per marker after the
+    /// robot's.
+    Markers(usize),
 }
 
 impl MeasurementKind {
@@ -207,15 +235,27 @@ impl MeasurementKind {
         match self {
             MeasurementKind::Point => 3,
             MeasurementKind::Pose => 6,
+            MeasurementKind::Markers(k) => 3 * k,
         }
     }
 
-    /// `point` or `pose`.
+    /// `point`, `pose` or `markers`.
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {
             MeasurementKind::Point => "point",
             MeasurementKind::Pose => "pose",
+            MeasurementKind::Markers(_) => "markers",
+        }
+    }
+
+    /// Markers per pose: `K` for [`MeasurementKind::Markers`], else 0
+    /// (the end point itself is measured, with no offset unknowns).
+    #[must_use]
+    pub fn markers(self) -> usize {
+        match self {
+            MeasurementKind::Markers(k) => k,
+            _ => 0,
         }
     }
 }
@@ -308,31 +348,27 @@ impl Robot {
         })
         .collect();
         // Table I (β = 10 marks "no β" in the paper; kept for display, ignored for DH).
-        let real = ParamTable {
-            rows: vec![
-                [PI / 2.0, PI / 100.0, 20.0, 0.0, PI / 100.0],
-                [0.0, -PI / 2.0, 0.0, 0.6858, 10.0],
-                [0.0, PI / 100.0, 0.4318, 0.0, PI / 100.0],
-                [0.0, PI / 2.0, -0.0203, 0.1491, 10.0],
-                [0.0, -PI / 2.0, 0.0, 0.4331, 10.0],
-                [0.0, PI / 2.0, 0.0, 0.0, 10.0],
-                [0.0, 0.0, 0.2, 0.1655, 10.0],
-                [0.0, 0.0, 0.0, 0.0, 10.0],
-            ],
-        };
+        let real = ParamTable::from_rows(vec![
+            [PI / 2.0, PI / 100.0, 20.0, 0.0, PI / 100.0],
+            [0.0, -PI / 2.0, 0.0, 0.6858, 10.0],
+            [0.0, PI / 100.0, 0.4318, 0.0, PI / 100.0],
+            [0.0, PI / 2.0, -0.0203, 0.1491, 10.0],
+            [0.0, -PI / 2.0, 0.0, 0.4331, 10.0],
+            [0.0, PI / 2.0, 0.0, 0.0, 10.0],
+            [0.0, 0.0, 0.2, 0.1655, 10.0],
+            [0.0, 0.0, 0.0, 0.0, 10.0],
+        ]);
         // Table II.
-        let nominal = ParamTable {
-            rows: vec![
-                [1.6360, 0.1572, 19.8820, 0.0, -0.0123],
-                [-0.0367, -1.4524, 0.0603, 0.6713, 10.0],
-                [-0.1455, -0.2622, 0.3411, 0.0, -0.1963],
-                [0.0128, 1.6374, -0.1214, 0.0074, 10.0],
-                [0.0024, -1.3948, -0.1029, 0.3002, 10.0],
-                [0.1207, 1.6151, -0.0468, -0.0747, 10.0],
-                [0.0938, 0.0, 0.1322, 0.3083, 10.0],
-                [0.0, 0.0, 0.0, 0.0, 10.0],
-            ],
-        };
+        let nominal = ParamTable::from_rows(vec![
+            [1.6360, 0.1572, 19.8820, 0.0, -0.0123],
+            [-0.0367, -1.4524, 0.0603, 0.6713, 10.0],
+            [-0.1455, -0.2622, 0.3411, 0.0, -0.1963],
+            [0.0128, 1.6374, -0.1214, 0.0074, 10.0],
+            [0.0024, -1.3948, -0.1029, 0.3002, 10.0],
+            [0.1207, 1.6151, -0.0468, -0.0747, 10.0],
+            [0.0938, 0.0, 0.1322, 0.3083, 10.0],
+            [0.0, 0.0, 0.0, 0.0, 10.0],
+        ]);
         use Symbol::{A, Alpha, Beta, D, Gamma};
         let per_frame: [&[Symbol]; 7] = [
             &[Gamma, Alpha, A, Beta],
@@ -383,10 +419,19 @@ impl Robot {
         self.limits.len()
     }
 
-    /// Number of unknown parameters `p`.
+    /// Number of unknown kinematic parameters (the robot's, without the
+    /// sensor's own marker offsets; see [`Robot::n_params`]).
     #[must_use]
     pub fn n_unknowns(&self) -> usize {
         self.unknowns.len()
+    }
+
+    /// Number of parameters identified, `p`: the robot's unknowns, then three
+    /// offset coordinates per marker of a [`MeasurementKind::Markers`]
+    /// sensor. The width of every identification Jacobian.
+    #[must_use]
+    pub fn n_params(&self) -> usize {
+        self.unknowns.len() + 3 * self.measurement.markers()
     }
 
     /// Rows of the identification Jacobian per pose.
@@ -410,10 +455,15 @@ impl Robot {
         format!("{}_{}", id.symbol.name(), self.frames[id.frame].label)
     }
 
-    /// Names of the unknowns, in parameter-vector order.
+    /// Names of the identified parameters, in parameter-vector order: the
+    /// unknowns, then the marker offsets (`marker1_x`, `marker1_y`, …).
     #[must_use]
     pub fn parameter_names(&self) -> Vec<String> {
-        self.unknowns.iter().map(|&u| self.param_name(u)).collect()
+        let mut v: Vec<String> = self.unknowns.iter().map(|&u| self.param_name(u)).collect();
+        for k in 1..=self.measurement.markers() {
+            v.extend(["x", "y", "z"].map(|c| format!("marker{k}_{c}")));
+        }
+        v
     }
 
     /// Looks a parameter up by name.
@@ -432,19 +482,28 @@ impl Robot {
         Ok(ParamId { frame, symbol })
     }
 
-    /// The unknowns' values in a table, in parameter-vector order.
+    /// The identified parameters' values in a table, in parameter-vector
+    /// order ([`Robot::n_params`] of them: unknowns, then marker offsets).
     #[must_use]
     pub fn unknown_values(&self, table: &ParamTable) -> Vec<f64> {
-        self.unknowns.iter().map(|&u| table.get(u)).collect()
+        let mut v: Vec<f64> = self.unknowns.iter().map(|&u| table.get(u)).collect();
+        v.extend(table.marker_values());
+        v
     }
 
-    /// A copy of `table` with the unknowns set from `values`.
+    /// A copy of `table` with the identified parameters set from `values`
+    /// ([`Robot::n_params`] entries, or just the robot's unknowns: the
+    /// markers then keep their values).
     #[must_use]
     pub fn with_unknowns(&self, table: &ParamTable, values: &[f64]) -> ParamTable {
-        assert_eq!(values.len(), self.unknowns.len());
+        let p = self.unknowns.len();
+        assert!(values.len() == p || values.len() == self.n_params());
         let mut t = table.clone();
         for (&u, &v) in self.unknowns.iter().zip(values) {
             t.set(u, v);
+        }
+        for (o, c) in t.markers.iter_mut().zip(values[p..].chunks_exact(3)) {
+            o.copy_from_slice(c);
         }
         t
     }
@@ -539,6 +598,26 @@ impl Robot {
                         });
                     }
                 }
+            }
+        }
+        for (which, table) in [("real", &self.real), ("nominal", &self.nominal)] {
+            let k = self.measurement.markers();
+            if table.markers.len() != k {
+                return Err(Error::Invalid(format!(
+                    "the {which} table has {} marker offsets for a sensor of {k} markers",
+                    table.markers.len()
+                )));
+            }
+            if let Some(i) = table
+                .markers
+                .iter()
+                .position(|o| o.iter().any(|v| !v.is_finite()))
+            {
+                return Err(Error::Invalid(format!(
+                    "{which} marker {}: the offset {:?} is not finite",
+                    i + 1,
+                    table.markers[i]
+                )));
             }
         }
         if self.unknowns.is_empty() {

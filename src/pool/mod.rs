@@ -128,7 +128,7 @@ impl PoolSpec {
 /// bound's scaled copy).
 #[must_use]
 pub fn memory_estimate(robot: &Robot, n: usize) -> u64 {
-    let per_pose = 8 * (1 + robot.dof() + 2 * robot.rows_per_pose() * robot.n_unknowns());
+    let per_pose = 8 * (1 + robot.dof() + 2 * robot.rows_per_pose() * robot.n_params());
     crate::resources::bytes_of(n, per_pose)
 }
 
@@ -139,7 +139,7 @@ fn check_memory(robot: &Robot, n: usize) -> Result<()> {
         &format!(
             "a pool of {n} poses (its {}×{} Jacobian and one workspace of that size)",
             n.saturating_mul(robot.rows_per_pose()),
-            robot.n_unknowns()
+            robot.n_params()
         ),
         memory_estimate(robot, n),
     )

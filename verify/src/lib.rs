@@ -81,9 +81,7 @@ pub fn synthetic_robot() -> Robot {
         ("7", Dh, Some(6), R, [0.13, -0.3, 0.02, 0.09, 0.0]),
         ("tool", Dh, None, R, [0.2, 0.0, 0.05, 0.1, 0.0]),
     ];
-    let nominal = ParamTable {
-        rows: frames.iter().map(|f| f.4).collect(),
-    };
+    let nominal = ParamTable::from_rows(frames.iter().map(|f| f.4).collect());
     // The "real" robot: every parameter perturbed by a few milli-units.
     let real = ParamTable {
         rows: nominal
@@ -98,6 +96,7 @@ pub fn synthetic_robot() -> Robot {
                 r
             })
             .collect(),
+        ..ParamTable::default()
     };
     let unknowns = frames
         .iter()

@@ -1,0 +1,404 @@
+//! `calibrate --measurements` (identification from real data, with a loss,
+//! fixed or freed unknowns, parameter significance and held-out splits) and
+//! `evaluate` (a model's errors on data, no fitting): rendering only; the
+//! work is in `activecal::identify`.
+
+use super::emit_report;
+use activecal::identify::evaluation::Residuals;
+use activecal::identify::{
+    Fit, HoldoutSettings, Identification, LmSettings, LossChoice, Measurements, ParameterTrust,
+    SplitResult, fit, for_measurements, holdout, residuals, trust, with_fixed_and_free,
+};
+use activecal::model::Robot;
+use anyhow::{Result, bail};
+use serde::Serialize;
+use std::path::Path;
+
+/// The loss options of `calibrate`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LossKind {
+    /// Least squares.
+    L2,
+    /// Huber: quadratic up to the scale, linear beyond.
+    Huber,
+    /// Cauchy: down-weights gross outliers towards zero.
+    Cauchy,
+}
+
+/// The loss of `--loss KIND --loss-scale S`.
+pub fn loss_choice(kind: LossKind, scale: Option<f64>) -> Result<LossChoice> {
+    let need = |s: Option<f64>| -> Result<f64> {
+        match s {
+            Some(s) if s.is_finite() && s > 0.0 => Ok(s),
+            Some(s) => bail!("--loss-scale {s}: must be a finite number > 0 (metres)"),
+            None => bail!(
+                "--loss {kind:?} needs --loss-scale (metres: the residual norm of one pose where the loss turns robust, e.g. 3 times the sensor noise)"
+            ),
+        }
+    };
+    Ok(match kind {
+        LossKind::L2 => {
+            if scale.is_some() {
+                bail!("--loss-scale is for --loss huber or cauchy");
+            }
+            LossChoice::L2
+        }
+        LossKind::Huber => LossChoice::Huber {
+            scale: need(scale)?,
+        },
+        LossKind::Cauchy => LossChoice::Cauchy {
+            scale: need(scale)?,
+        },
+    })
+}
+
+/// Reads a measurement file (CSV or JSON) for `robot`, printing its notes to
+/// stderr unless `quiet`.
+pub fn read_measurements(
+    path: &Path,
+    robot: &Robot,
+    quiet: bool,
+) -> Result<(Measurements, Vec<String>)> {
+    let f = activecal::io::measurements::read(path, robot)?;
+    if !quiet {
+        for n in &f.notes {
+            eprintln!("note: {n}");
+        }
+    }
+    Ok((f.measurements, f.notes))
+}
+
+/// What `calibrate --measurements` does beyond the plain fit.
+pub struct MeasuredOptions<'a> {
+    /// Levenberg–Marquardt settings.
+    pub lm: LmSettings,
+    /// The loss.
+    pub loss: LossChoice,
+    /// Unknowns to fix.
+    pub fix: &'a [String],
+    /// Parameters to free.
+    pub free: &'a [String],
+    /// Held-out validation, if asked.
+    pub holdout: Option<HoldoutSettings>,
+    /// JSON output (notes to stderr are silenced).
+    pub json: bool,
+}
+
+/// `calibrate --measurements`' JSON report.
+#[derive(Serialize)]
+pub struct MeasuredReport {
+    /// The plain identification report (status, estimate, covariance, …).
+    #[serde(flatten)]
+    pub base: activecal::report::MeasuredCalibrationReport,
+    /// The loss.
+    pub loss: LossChoice,
+    /// Errors of the fitted model on the data, mm and degrees.
+    pub residuals: Residuals,
+    /// Errors of the nominal model on the data.
+    pub nominal_residuals: Residuals,
+    /// Each parameter's estimate, change, σ, t and verdict.
+    pub parameters: Vec<ParameterTrust>,
+    /// Poses the robust loss down-weighted: `[pose, weight]`.
+    pub downweighted: Vec<(usize, f64)>,
+    /// Held-out validation, if asked.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub holdout: Option<HoldoutReport>,
+    /// What was adapted to the data (sensor, markers, ignored columns).
+    pub notes: Vec<String>,
+}
+
+/// Held-out figures over splits.
+#[derive(Serialize)]
+pub struct HoldoutReport {
+    /// The settings.
+    pub settings: HoldoutSettings,
+    /// Held-out position RMS (mm): mean and per split.
+    pub position_rms_mm: Stat,
+    /// Held-out orientation RMS (degrees), full poses only.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orientation_rms_deg: Option<Stat>,
+    /// The nominal model's held-out position RMS (mm), mean over splits.
+    pub nominal_position_rms_mm: f64,
+    /// The fitted model's position RMS on its training poses, mean.
+    pub fitted_position_rms_mm: f64,
+    /// The pruned model (|t| ≥ 2 kept): unknowns per split and held-out
+    /// position RMS.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pruned: Option<PrunedReport>,
+    /// Every split.
+    pub splits: Vec<SplitResult>,
+}
+
+/// A figure over splits.
+#[derive(Serialize)]
+pub struct Stat {
+    /// Mean over splits.
+    pub mean: f64,
+    /// Each split's value.
+    pub per_split: Vec<f64>,
+}
+
+impl Stat {
+    fn of(v: Vec<f64>) -> Stat {
+        Stat {
+            mean: v.iter().sum::<f64>() / v.len().max(1) as f64,
+            per_split: v,
+        }
+    }
+}
+
+/// The pruned model's held-out figures.
+#[derive(Serialize)]
+pub struct PrunedReport {
+    /// Parameters identified per split.
+    pub n_params: Vec<usize>,
+    /// Held-out position RMS (mm).
+    pub position_rms_mm: Stat,
+    /// Held-out orientation RMS (degrees).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orientation_rms_deg: Option<Stat>,
+}
+
+fn holdout_report(settings: HoldoutSettings, splits: Vec<SplitResult>) -> HoldoutReport {
+    let mean = |v: &mut dyn Iterator<Item = f64>| {
+        let x: Vec<f64> = v.collect();
+        x.iter().sum::<f64>() / x.len().max(1) as f64
+    };
+    let ori = |f: &dyn Fn(&SplitResult) -> Option<f64>| -> Option<Stat> {
+        splits
+            .iter()
+            .map(f)
+            .collect::<Option<Vec<f64>>>()
+            .map(Stat::of)
+    };
+    let pruned = settings.prune.then(|| PrunedReport {
+        n_params: splits
+            .iter()
+            .filter_map(|s| s.pruned.as_ref().map(|p| p.0))
+            .collect(),
+        position_rms_mm: Stat::of(
+            splits
+                .iter()
+                .filter_map(|s| s.pruned.as_ref().map(|p| p.1.position_rms_mm))
+                .collect(),
+        ),
+        orientation_rms_deg: ori(&|s| s.pruned.as_ref().and_then(|p| p.1.orientation_rms_deg)),
+    });
+    HoldoutReport {
+        settings,
+        position_rms_mm: Stat::of(splits.iter().map(|s| s.held_out.position_rms_mm).collect()),
+        orientation_rms_deg: ori(&|s| s.held_out.orientation_rms_deg),
+        nominal_position_rms_mm: mean(&mut splits.iter().map(|s| s.nominal.position_rms_mm)),
+        fitted_position_rms_mm: mean(&mut splits.iter().map(|s| s.fitted.position_rms_mm)),
+        pruned,
+        splits,
+    }
+}
+
+/// Identification from a measurement file; returns the fit (for `--out`)
+/// and the robot it was fitted as.
+pub fn calibrate_measured(
+    robot: &Robot,
+    path: &Path,
+    o: &MeasuredOptions<'_>,
+    elapsed: &dyn Fn() -> f64,
+) -> Result<(Robot, Fit, MeasuredReport)> {
+    let (meas, mut notes) = read_measurements(path, robot, o.json)?;
+    let start = for_measurements(robot, &meas, &o.lm)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    notes.extend(start.notes.iter().cloned());
+    if !o.json {
+        for n in &start.notes {
+            eprintln!("note: {n}");
+        }
+    }
+    let r = with_fixed_and_free(&start.robot, o.fix, o.free)?;
+    let f = fit(&r, &start.table, &meas, &o.lm, o.loss)?;
+    let res = residuals(&r, &f.id.table, &meas)?;
+    let nominal = residuals(&r, &r.nominal, &meas)?;
+    let params = trust(&r, &r.nominal, &f.id);
+    let ho = match &o.holdout {
+        Some(h) => {
+            let (fix, free) = (o.fix.to_vec(), o.free.to_vec());
+            let prep = move |x: &Robot| with_fixed_and_free(x, &fix, &free);
+            Some(holdout_report(
+                *h,
+                holdout(robot, &meas, &o.lm, o.loss, h, &prep)?,
+            ))
+        }
+        None => None,
+    };
+    let mut base = activecal::report::MeasuredCalibrationReport::new(
+        &r,
+        &f.id,
+        path.display().to_string(),
+        meas.len(),
+    );
+    base.elapsed_seconds = elapsed();
+    let report = MeasuredReport {
+        base,
+        loss: o.loss,
+        residuals: res,
+        nominal_residuals: nominal,
+        parameters: params,
+        downweighted: f.downweighted(),
+        holdout: ho,
+        notes,
+    };
+    Ok((r, f, report))
+}
+
+/// The text form of a measured calibration.
+pub fn measured_text(r: &MeasuredReport, id: &Identification, status: &str) -> String {
+    let mut s = format!(
+        "{}: {} measured poses ({}), {} parameters\n{status}",
+        r.base.measurements,
+        r.base.poses,
+        r.base.measurement.name(),
+        id.names.len()
+    );
+    s += &format!("fitted:  {}\n", r.residuals.summary());
+    s += &format!("nominal: {}\n", r.nominal_residuals.summary());
+    if !r.downweighted.is_empty() {
+        let v: Vec<String> = r
+            .downweighted
+            .iter()
+            .map(|(i, w)| format!("pose {i} (weight {w:.3})"))
+            .collect();
+        s += &format!("down-weighted by the {:?} loss: {}\n", r.loss, v.join(", "));
+    }
+    s += &format!(
+        "\n{:<24} {:>13} {:>13} {:>11} {:>10} {:>7}  verdict\n",
+        "parameter", "nominal", "estimate", "change", "σ", "t"
+    );
+    for p in &r.parameters {
+        s += &format!(
+            "{:<24} {:>13.6} {:>13.6} {:>11.6} {:>10} {:>7}  {}\n",
+            p.name,
+            p.nominal,
+            p.estimate,
+            p.change,
+            p.std.map_or("-".into(), |v| format!("{v:.6}")),
+            p.t.map_or("-".into(), |v| format!("{v:.2}")),
+            p.verdict
+        );
+    }
+    if let Some(h) = &r.holdout {
+        s += &format!(
+            "\nheld out ({} splits, {:.0} % held out each, seed {}): position RMS {:.3} mm (per split {}), nominal {:.3} mm, fitted on training {:.3} mm\n",
+            h.settings.splits,
+            100.0 * h.settings.fraction,
+            h.settings.seed,
+            h.position_rms_mm.mean,
+            join(&h.position_rms_mm.per_split, 3),
+            h.nominal_position_rms_mm,
+            h.fitted_position_rms_mm
+        );
+        if let Some(o) = &h.orientation_rms_deg {
+            s += &format!(
+                "held out orientation RMS {:.4}° (per split {})\n",
+                o.mean,
+                join(&o.per_split, 4)
+            );
+        }
+        if let Some(p) = &h.pruned {
+            s += &format!(
+                "pruned to |t| >= 2 ({} parameters per split): held-out position RMS {:.3} mm (per split {})",
+                join(&p.n_params.iter().map(|&v| v as f64).collect::<Vec<_>>(), 0),
+                p.position_rms_mm.mean,
+                join(&p.position_rms_mm.per_split, 3)
+            );
+            if let Some(o) = &p.orientation_rms_deg {
+                s += &format!(", orientation {:.4}°", o.mean);
+            }
+            s += &format!(
+                "\n  → {} model generalises better on held-out poses\n",
+                if p.position_rms_mm.mean < h.position_rms_mm.mean {
+                    "the pruned"
+                } else {
+                    "the full"
+                }
+            );
+        }
+    }
+    s
+}
+
+fn join(v: &[f64], d: usize) -> String {
+    v.iter()
+        .map(|x| format!("{x:.d$}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Arguments of `evaluate`.
+#[derive(clap::Args)]
+pub struct EvaluateArgs {
+    /// The model: a built-in name, a .toml description (e.g. what
+    /// `calibrate --out` wrote) or a .urdf file; append `:pose` for full
+    /// poses. Its nominal table is evaluated.
+    #[arg(long)]
+    pub robot: String,
+    /// Measurement file: CSV (x1,y1,z1…, optional phix1,phiy1,phiz1 or
+    /// qw1…qz1, one column per joint by name) or JSON.
+    #[arg(long)]
+    pub measurements: std::path::PathBuf,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `evaluate`'s report.
+#[derive(Serialize)]
+struct EvaluateReport {
+    robot: String,
+    chain: Vec<String>,
+    measurements: String,
+    poses: usize,
+    residuals: Residuals,
+    notes: Vec<String>,
+}
+
+/// Runs `evaluate`: the model's errors on the data, no fitting.
+pub fn cmd_evaluate(a: EvaluateArgs) -> Result<()> {
+    let robot = super::load_robot(&a.robot)?;
+    let (meas, notes) = read_measurements(&a.measurements, &robot, a.json)?;
+    let res = residuals(&robot, &robot.nominal, &meas).map_err(|e| {
+        anyhow::anyhow!(
+            "{}: {e}{}",
+            a.measurements.display(),
+            if meas.markers() > 1 {
+                " (a model for several markers carries their offsets: evaluate the description `calibrate --out` wrote)"
+            } else {
+                ""
+            }
+        )
+    })?;
+    let report = EvaluateReport {
+        robot: robot.name.clone(),
+        chain: activecal::report::chain(&robot),
+        measurements: a.measurements.display().to_string(),
+        poses: meas.len(),
+        residuals: res,
+        notes,
+    };
+    emit_report(a.json, &report, || {
+        let mut s = format!(
+            "{} on {} ({} poses): {}\n",
+            report.robot,
+            report.measurements,
+            report.poses,
+            report.residuals.summary()
+        );
+        s += "pose  position error (mm)  orientation error (deg)\n";
+        for p in &report.residuals.per_sample {
+            s += &format!(
+                "{:>4}  {:<20}  {}\n",
+                p.pose,
+                join(&p.position_mm, 3),
+                p.orientation_deg.map_or("-".into(), |v| format!("{v:.4}"))
+            );
+        }
+        s
+    })
+}

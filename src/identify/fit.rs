@@ -1,0 +1,315 @@
+//! Calibrating from measured data as one call: a loss chosen at run time,
+//! the samples it down-weighted, each parameter's significance, and
+//! held-out validation over random splits (optionally against a model
+//! pruned to its significant parameters).
+
+use super::evaluation::{Residuals, residuals};
+use super::start::for_measurements;
+use super::{
+    Calibration, Cauchy, Huber, Identification, IdentifyError, LmSettings, Loss, Measurements,
+    Result, Robust, identify, identify_robust,
+};
+use crate::model::{ParamTable, Robot};
+use rand::SeedableRng;
+use rand::seq::SliceRandom;
+use serde::Serialize;
+
+/// The loss of a fit, chosen at run time.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum LossChoice {
+    /// Least squares.
+    L2,
+    /// Huber with this scale (metres of a pose's weighted residual norm).
+    Huber {
+        /// The scale.
+        scale: f64,
+    },
+    /// Cauchy with this scale (metres).
+    Cauchy {
+        /// The scale.
+        scale: f64,
+    },
+}
+
+/// A weight below this marks a sample as down-weighted in reports.
+pub const DOWNWEIGHTED: f64 = 0.999;
+
+/// A fit: the identification and each pose's final loss weight (all 1 for
+/// least squares).
+#[derive(Clone, Debug)]
+pub struct Fit {
+    /// The identification.
+    pub id: Identification,
+    /// The loss weight `ρ'(‖r_i‖²)` of each pose at the estimate.
+    pub weights: Vec<f64>,
+}
+
+impl Fit {
+    /// Poses (0-based) whose weight is below [`DOWNWEIGHTED`], with it.
+    #[must_use]
+    pub fn downweighted(&self) -> Vec<(usize, f64)> {
+        self.weights
+            .iter()
+            .enumerate()
+            .filter(|(_, w)| **w < DOWNWEIGHTED)
+            .map(|(i, &w)| (i, w))
+            .collect()
+    }
+}
+
+/// Identifies `robot` from `meas` starting at `start` with `loss`.
+pub fn fit(
+    robot: &Robot,
+    start: &ParamTable,
+    meas: &Measurements,
+    lm: &LmSettings,
+    loss: LossChoice,
+) -> Result<Fit> {
+    fn weights<L: Loss>(
+        robot: &Robot,
+        start: &ParamTable,
+        meas: &Measurements,
+        theta: &[f64],
+        loss: L,
+    ) -> Result<Vec<f64>> {
+        let mut p = Robust::new(Calibration::new(robot, start, meas)?, loss);
+        p.reweight(theta);
+        Ok(p.weights())
+    }
+    let (id, w) = match loss {
+        LossChoice::L2 => {
+            let id = identify(robot, start, meas, lm)?;
+            let w = vec![1.0; meas.len()];
+            (id, w)
+        }
+        LossChoice::Huber { scale } => {
+            let l = Huber::new(scale)?;
+            let id = identify_robust(robot, start, meas, lm, l)?;
+            let w = weights(robot, start, meas, &id.estimate, l)?;
+            (id, w)
+        }
+        LossChoice::Cauchy { scale } => {
+            let l = Cauchy::new(scale)?;
+            let id = identify_robust(robot, start, meas, lm, l)?;
+            let w = weights(robot, start, meas, &id.estimate, l)?;
+            (id, w)
+        }
+    };
+    Ok(Fit { id, weights: w })
+}
+
+/// |t| at or above which a parameter's change from nominal is called
+/// significant (about 95 % two-sided for a normal estimate).
+pub const T_SIGNIFICANT: f64 = 2.0;
+
+/// How far one parameter's estimate can be trusted.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct ParameterTrust {
+    /// Parameter name.
+    pub name: String,
+    /// Nominal value (metres or radians).
+    pub nominal: f64,
+    /// Estimate.
+    pub estimate: f64,
+    /// Estimate − nominal.
+    pub change: f64,
+    /// Standard deviation of the estimate, when the fit has a covariance.
+    pub std: Option<f64>,
+    /// `change / std`.
+    pub t: Option<f64>,
+    /// A plain verdict.
+    pub verdict: &'static str,
+}
+
+/// Each identified parameter's estimate against `nominal`, with its
+/// standard deviation, `t = change/σ` and a verdict.
+#[must_use]
+pub fn trust(robot: &Robot, nominal: &ParamTable, id: &Identification) -> Vec<ParameterTrust> {
+    let nom = robot.unknown_values(nominal);
+    let n_kin = robot.n_unknowns();
+    id.names
+        .iter()
+        .enumerate()
+        .map(|(k, name)| {
+            let change = id.estimate[k] - nom[k];
+            let std = id.covariance.as_ref().map(|c| c.std[k]);
+            let t = std.filter(|s| *s > 0.0).map(|s| change / s);
+            let verdict = if k >= n_kin {
+                "marker offset: always estimated"
+            } else {
+                match t {
+                    Some(t) if t.abs() >= T_SIGNIFICANT => {
+                        "significant: the data move it from nominal"
+                    }
+                    Some(_) => "not significant: consistent with nominal (a candidate to fix)",
+                    None => "no covariance (rank-deficient or no residual degrees of freedom)",
+                }
+            };
+            ParameterTrust {
+                name: name.clone(),
+                nominal: nom[k],
+                estimate: id.estimate[k],
+                change,
+                std,
+                t,
+                verdict,
+            }
+        })
+        .collect()
+}
+
+/// The robot with its unknowns changed: `fix` removed (kept at their
+/// values), `free` added (any structural parameter by name). Marker offsets
+/// cannot be fixed. The result is checked to be identifiable.
+pub fn with_fixed_and_free(robot: &Robot, fix: &[String], free: &[String]) -> Result<Robot> {
+    if fix.is_empty() && free.is_empty() {
+        return Ok(robot.clone());
+    }
+    let mut ids = robot.unknowns.clone();
+    for name in fix {
+        if name.starts_with("marker") {
+            return Err(setting(
+                "--fix",
+                name,
+                "marker offsets are always estimated",
+            ));
+        }
+        let id = robot.param_id(name)?;
+        let Some(pos) = ids.iter().position(|&u| u == id) else {
+            return Err(setting(
+                "--fix",
+                name,
+                "not an unknown of this robot (see the estimate's names)",
+            ));
+        };
+        ids.remove(pos);
+    }
+    for name in free {
+        let id = robot.param_id(name)?;
+        if !ids.contains(&id) {
+            ids.push(id);
+        }
+    }
+    ids.sort();
+    let mut r = robot.clone();
+    r.unknowns = ids;
+    r.validate()?;
+    r.check_identifiable()?;
+    Ok(r)
+}
+
+fn setting(option: &'static str, name: &str, reason: &'static str) -> IdentifyError {
+    IdentifyError::Setting {
+        name: option,
+        value: name.to_string(),
+        reason,
+    }
+}
+
+/// Held-out validation settings.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct HoldoutSettings {
+    /// Fraction of the poses held out per split, in (0, 1).
+    pub fraction: f64,
+    /// Number of random splits.
+    pub splits: usize,
+    /// Seed of the splits.
+    pub seed: u64,
+    /// Also fit a model pruned to the significant parameters (|t| ≥ 2 on
+    /// the split's training fit) and evaluate it on the same held-out poses.
+    pub prune: bool,
+}
+
+/// One split's figures.
+#[derive(Clone, Debug, Serialize)]
+pub struct SplitResult {
+    /// Poses fitted.
+    pub train: usize,
+    /// Poses held out.
+    pub test: usize,
+    /// Errors of the fitted model on the poses it was fitted to.
+    pub fitted: Residuals,
+    /// Errors of the fitted model on the held-out poses.
+    pub held_out: Residuals,
+    /// Errors of the nominal model on the held-out poses.
+    pub nominal: Residuals,
+    /// The pruned model's held-out errors and its unknowns' count.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pruned: Option<(usize, Residuals)>,
+}
+
+/// Fits on a random `1 − fraction` of the poses and evaluates on the rest,
+/// `splits` times. `prepare` turns the robot adapted to the data
+/// ([`for_measurements`]) into the one fitted (e.g.
+/// [`with_fixed_and_free`]).
+pub fn holdout(
+    robot: &Robot,
+    meas: &Measurements,
+    lm: &LmSettings,
+    loss: LossChoice,
+    settings: &HoldoutSettings,
+    prepare: &dyn Fn(&Robot) -> Result<Robot>,
+) -> Result<Vec<SplitResult>> {
+    let n = meas.len();
+    let test = (settings.fraction * n as f64).round() as usize;
+    if !(settings.fraction > 0.0 && settings.fraction < 1.0) || test == 0 || test >= n {
+        return Err(IdentifyError::Setting {
+            name: "--holdout",
+            value: format!("{} of {n} poses", settings.fraction),
+            reason: "the held-out fraction must be in (0, 1) and leave at least one pose on each side",
+        });
+    }
+    if settings.splits == 0 {
+        return Err(IdentifyError::Setting {
+            name: "--splits",
+            value: "0".into(),
+            reason: "at least one split",
+        });
+    }
+    let mut out = Vec::with_capacity(settings.splits);
+    for s in 0..settings.splits {
+        let mut idx: Vec<usize> = (0..n).collect();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(settings.seed.wrapping_add(s as u64));
+        idx.shuffle(&mut rng);
+        let (te, tr) = idx.split_at(test);
+        let (mut tr, mut te) = (tr.to_vec(), te.to_vec());
+        tr.sort_unstable();
+        te.sort_unstable();
+        let (mtr, mte) = (meas.subset(&tr), meas.subset(&te));
+        let start = for_measurements(robot, &mtr, lm)?;
+        let r = prepare(&start.robot)?;
+        let f = fit(&r, &start.table, &mtr, lm, loss)?;
+        let fitted = residuals(&r, &f.id.table, &mtr)?;
+        let held_out = residuals(&r, &f.id.table, &mte)?;
+        let nominal = residuals(&r, &r.nominal, &mte)?;
+        let pruned = if settings.prune {
+            let keep: Vec<String> = trust(&r, &r.nominal, &f.id)
+                .into_iter()
+                .filter(|p| {
+                    p.name.starts_with("marker") || p.t.is_some_and(|t| t.abs() >= T_SIGNIFICANT)
+                })
+                .map(|p| p.name)
+                .collect();
+            let fix: Vec<String> = r
+                .parameter_names()
+                .into_iter()
+                .filter(|n| !keep.contains(n))
+                .collect();
+            let rp = with_fixed_and_free(&r, &fix, &[])?;
+            let fp = fit(&rp, &start.table, &mtr, lm, loss)?;
+            Some((rp.n_params(), residuals(&rp, &fp.id.table, &mte)?))
+        } else {
+            None
+        };
+        out.push(SplitResult {
+            train: tr.len(),
+            test: te.len(),
+            fitted,
+            held_out,
+            nominal,
+            pruned,
+        });
+    }
+    Ok(out)
+}

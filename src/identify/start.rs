@@ -1,0 +1,118 @@
+//! The sensor a measurement set calls for, and where identification starts.
+//!
+//! Measurement files say what they measured: `K` markers per pose, or a
+//! point with an orientation. [`for_measurements`] gives the robot measured
+//! that way (never flattening several markers into one point) and a start
+//! table:
+//!
+//! * the robot's own sensor when it already fits the data: start at the
+//!   nominal table;
+//! * orientations for a point robot: its full-pose variant
+//!   ([`Robot::with_measurement`]);
+//! * `K > 1` markers for a point robot: a `K`-marker robot
+//!   ([`Robot::with_markers`]). The offsets are unknown, so the start is
+//!   found in two steps: the point robot is fitted to marker 1 alone (its
+//!   end point becomes marker 1), then each offset is the mean of `Rᵢᵀ (y_ik −
+//!   pᵢ)` over the poses at that fit, the least-squares offset for the
+//!   fitted chain. The `K`-marker robot's nominal table is the robot's with
+//!   these offsets; identification starts from the fit with these offsets.
+
+use super::{IdentifyError, LmSettings, Measurements, Result, identify};
+use crate::kinematics::Evaluator;
+use crate::model::{MeasurementKind, ParamTable, Robot};
+use nalgebra::Vector3;
+
+/// A robot fitted to a measurement set's sensor, with where to start.
+#[derive(Clone, Debug)]
+pub struct Start {
+    /// The robot, measured as the data were.
+    pub robot: Robot,
+    /// The table identification starts from.
+    pub table: ParamTable,
+    /// What was changed, for the report (empty when nothing was).
+    pub notes: Vec<String>,
+}
+
+/// The robot measured as `meas` were, and the start of identification (see
+/// the module documentation). Errors when the data cannot be of this robot
+/// (several markers for a full-pose robot, a joint count that differs).
+pub fn for_measurements(robot: &Robot, meas: &Measurements, lm: &LmSettings) -> Result<Start> {
+    let k = meas.markers();
+    let has_orientation = !meas.orientations().is_empty();
+    let have = crate::measure::sensor_for(robot);
+    if k == have.points_per_pose() && has_orientation == have.measures_orientation() && k == 1
+        || (k > 1 && robot.measurement == MeasurementKind::Markers(k))
+    {
+        return Ok(Start {
+            robot: robot.clone(),
+            table: robot.nominal.clone(),
+            notes: Vec::new(),
+        });
+    }
+    match (robot.measurement, k, has_orientation) {
+        (MeasurementKind::Point, 1, true) => {
+            let r = robot.with_measurement(MeasurementKind::Pose)?;
+            Ok(Start {
+                table: r.nominal.clone(),
+                notes: vec![format!(
+                    "the measurements hold orientations: robot '{}' calibrated from full poses ({} unknowns)",
+                    robot.name,
+                    r.n_params()
+                )],
+                robot: r,
+            })
+        }
+        (MeasurementKind::Point, k, false) if k > 1 => markers_start(robot, meas, lm),
+        _ => {
+            // Not a combination we adapt: the check names what differs.
+            meas.check(robot)?;
+            Err(IdentifyError::MarkerCount {
+                robot: robot.name.clone(),
+                given: k,
+                expected: have.points_per_pose(),
+            })
+        }
+    }
+}
+
+/// Each marker's least-squares offset for a chain: the mean over poses of
+/// `Rᵢᵀ (y_ik − pᵢ)`.
+fn mean_offsets(robot: &Robot, table: &ParamTable, meas: &Measurements) -> Vec<[f64; 3]> {
+    let k = meas.markers();
+    let mut ev = Evaluator::new(robot, table);
+    let mut sum = vec![Vector3::zeros(); k];
+    for (i, q) in meas.qs().iter().enumerate() {
+        let e = ev.end_frame(q);
+        for (j, s) in sum.iter_mut().enumerate() {
+            let y = Vector3::from(meas.points()[k * i + j]);
+            *s += e.rotation.transpose() * (y - e.position);
+        }
+    }
+    sum.iter().map(|s| (s / meas.len() as f64).into()).collect()
+}
+
+/// The two-step start of a `K`-marker fit from a point robot.
+fn markers_start(point: &Robot, meas: &Measurements, lm: &LmSettings) -> Result<Start> {
+    let k = meas.markers();
+    let n = meas.len();
+    let first: Vec<[f64; 3]> = (0..n).map(|i| meas.points()[k * i]).collect();
+    let m1 = Measurements::unchecked(meas.qs().to_vec(), 1, first, Vec::new());
+    let fit = identify(point, &point.nominal, &m1, lm)?;
+    let offsets = mean_offsets(point, &fit.table, meas);
+    let mut robot = point.with_markers(&offsets)?;
+    // The nominal model's own best offsets: what "nominal" means for
+    // markers whose offsets were never known.
+    robot.nominal.markers = mean_offsets(point, &point.nominal, meas);
+    let mut table = fit.table.clone();
+    table.markers.clone_from(&offsets);
+    Ok(Start {
+        notes: vec![format!(
+            "{k} markers per pose: a {k}-marker sensor with 3 offset unknowns per marker ({} unknowns in all); started from a fit of marker 1 alone ({:?}, RMS {:.3} mm per point) and the offsets it implies",
+            robot.n_params(),
+            fit.status,
+            1e3 * (fit.rss / n as f64).sqrt()
+        )],
+        robot,
+        table,
+    })
+}

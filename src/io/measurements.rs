@@ -1,0 +1,310 @@
+//! Measurement files: JSON (the [`Measurements`] format) and CSV as users
+//! export them from a tracker or a motion-capture system.
+//!
+//! # CSV
+//! A header names the columns, in any order:
+//! * `x1,y1,z1` — the measured point (metres, sensor frame); `x2,y2,z2`, …
+//!   for more markers on the same pose (`x,y,z` is read as marker 1). `K`
+//!   markers make a `K`-marker measurement ([`crate::measure::markers`]):
+//!   never flattened into one point.
+//! * optionally the orientation of a full pose (one marker only):
+//!   `phix1,phiy1,phiz1` (roll, pitch, yaw in radians, `R = Rz(phiz) ·
+//!   Ry(phiy) · Rx(phix)`) or `qw1,qx1,qy1,qz1` (a unit quaternion, scalar
+//!   first).
+//! * one column per joint, named as the robot's joint (the URDF joint name,
+//!   the frame label of a description, or `q1`, `q2`, … by joint order):
+//!   radians for revolute joints, metres for prismatic ones.
+//!
+//! A missing joint column is an error naming it; other columns are listed
+//! in a note, never silently dropped. A non-numeric cell is an error naming
+//! the line and column; a non-finite value one naming the row.
+
+use super::table::parse_csv;
+use crate::error::{Error, Result};
+use crate::identify::{Measurements, ROTATION_TOLERANCE};
+use crate::model::Robot;
+use nalgebra::{Quaternion, Rotation3, UnitQuaternion};
+use std::path::Path;
+
+/// Largest magnitude of a roll, pitch or yaw angle read from a file:
+/// angles are radians; a value beyond 2π is almost surely in degrees.
+pub const MAX_ANGLE: f64 = 2.0 * std::f64::consts::PI;
+
+/// Measurements read from a file, with notes about what was read.
+#[derive(Clone, Debug)]
+pub struct MeasurementFile {
+    /// The measurements (not yet checked against a robot's sensor: see
+    /// [`Measurements::check`]).
+    pub measurements: Measurements,
+    /// What the reader noticed (columns ignored, the sensor the file implies).
+    pub notes: Vec<String>,
+}
+
+/// The name of each joint of `robot`, by joint number: the label of the
+/// frame it drives (a URDF import labels frames by joint name).
+#[must_use]
+pub fn joint_names(robot: &Robot) -> Vec<String> {
+    let mut names = vec![String::new(); robot.dof()];
+    for f in &robot.frames {
+        if let Some(j) = f.joint.filter(|&j| j < names.len()) {
+            names[j].clone_from(&f.label);
+        }
+    }
+    names
+}
+
+/// Reads a measurement file for `robot`: CSV when the name ends in `.csv`,
+/// otherwise JSON ([`Measurements`]). The joint columns of a CSV are matched
+/// to the robot's joints by name.
+pub fn read(path: &Path, robot: &Robot) -> Result<MeasurementFile> {
+    let origin = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
+        path: origin.clone(),
+        cause: e,
+    })?;
+    let is_csv = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+    if is_csv {
+        parse_csv_measurements(&text, &origin, robot)
+    } else {
+        let measurements: Measurements = serde_json::from_str(&text).map_err(|e| Error::Parse {
+            path: origin,
+            message: e.to_string(),
+        })?;
+        Ok(MeasurementFile {
+            measurements,
+            notes: Vec::new(),
+        })
+    }
+}
+
+/// Parses measurement CSV `text` (see the module documentation).
+pub fn parse_csv_measurements(text: &str, origin: &str, robot: &Robot) -> Result<MeasurementFile> {
+    let t = parse_csv(text, origin)?;
+    let err = |message: String| Error::Parse {
+        path: origin.to_string(),
+        message,
+    };
+    let mut used = vec![false; t.columns.len()];
+    let take = |name: &str, used: &mut Vec<bool>| -> Option<usize> {
+        let c = t.column(name)?;
+        used[c] = true;
+        Some(c)
+    };
+    // Markers: x1,y1,z1, x2,…; plain x,y,z count as marker 1.
+    let mut marker_cols: Vec<[usize; 3]> = Vec::new();
+    for k in 1.. {
+        let names = [format!("x{k}"), format!("y{k}"), format!("z{k}")];
+        let found: Vec<Option<usize>> = names.iter().map(|n| t.column(n)).collect();
+        let found = if k == 1 && found.iter().all(Option::is_none) {
+            ["x", "y", "z"].iter().map(|n| t.column(n)).collect()
+        } else {
+            found
+        };
+        match found.iter().filter(|c| c.is_some()).count() {
+            0 => break,
+            3 => {
+                let cols = [found[0].unwrap(), found[1].unwrap(), found[2].unwrap()];
+                cols.iter().for_each(|&c| used[c] = true);
+                marker_cols.push(cols);
+            }
+            _ => {
+                let missing: Vec<&str> = names
+                    .iter()
+                    .zip(&found)
+                    .filter(|(_, f)| f.is_none())
+                    .map(|(n, _)| n.as_str())
+                    .collect();
+                return Err(err(format!(
+                    "marker {k}: column(s) {} missing (a marker needs x{k}, y{k} and z{k})",
+                    missing.join(", ")
+                )));
+            }
+        }
+    }
+    if marker_cols.is_empty() {
+        return Err(err(format!(
+            "no measured point: expected columns x1, y1, z1 (metres); the header has {}",
+            t.columns.join(", ")
+        )));
+    }
+    let rpy: Vec<Option<usize>> = ["phix1", "phiy1", "phiz1"]
+        .iter()
+        .map(|n| take(n, &mut used))
+        .collect();
+    let quat: Vec<Option<usize>> = ["qw1", "qx1", "qy1", "qz1"]
+        .iter()
+        .map(|n| take(n, &mut used))
+        .collect();
+    let has_rpy = rpy.iter().any(Option::is_some);
+    let has_quat = quat.iter().any(Option::is_some);
+    if has_rpy && has_quat {
+        return Err(err(
+            "both phix1/phiy1/phiz1 and qw1/qx1/qy1/qz1: give the orientation one way".into(),
+        ));
+    }
+    if (has_rpy && rpy.iter().any(Option::is_none))
+        || (has_quat && quat.iter().any(Option::is_none))
+    {
+        return Err(err(
+            "an incomplete orientation: give all of phix1, phiy1, phiz1 (roll, pitch, yaw) or all of qw1, qx1, qy1, qz1".into(),
+        ));
+    }
+    if (has_rpy || has_quat) && marker_cols.len() > 1 {
+        return Err(err(format!(
+            "an orientation with {} markers: a full pose has one measured point (orientations with several markers are not supported)",
+            marker_cols.len()
+        )));
+    }
+    // Joints by name (or q1…qN).
+    let names = joint_names(robot);
+    let mut joint_cols = Vec::with_capacity(names.len());
+    for (j, n) in names.iter().enumerate() {
+        let alias = format!("q{}", j + 1);
+        match take(n, &mut used).or_else(|| take(&alias, &mut used)) {
+            Some(c) => joint_cols.push(c),
+            None => {
+                return Err(err(format!(
+                    "no column for joint '{n}' (joint {} of robot '{}'; name the column '{n}' or '{alias}'); the header has {}",
+                    j + 1,
+                    robot.name,
+                    t.columns.join(", ")
+                )));
+            }
+        }
+    }
+    let mut notes = Vec::new();
+    let extra: Vec<&str> = t
+        .columns
+        .iter()
+        .zip(&used)
+        .filter(|(_, u)| !**u)
+        .map(|(c, _)| c.as_str())
+        .collect();
+    if !extra.is_empty() {
+        notes.push(format!(
+            "{origin}: column(s) not used (not a marker, orientation or joint of robot '{}'): {}",
+            robot.name,
+            extra.join(", ")
+        ));
+    }
+    if marker_cols.len() > 1 {
+        notes.push(format!(
+            "{origin}: {} markers per pose: a {}-marker sensor with an offset of its own per marker",
+            marker_cols.len(),
+            marker_cols.len()
+        ));
+    }
+    let n = t.rows.len();
+    let mut qs = Vec::with_capacity(n);
+    let mut points = Vec::with_capacity(n * marker_cols.len());
+    let mut orientations = Vec::new();
+    for (row, &line) in t.rows.iter().zip(&t.lines) {
+        let at = |c: usize| -> Result<f64> {
+            let v = row[c];
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(err(format!(
+                    "line {line}, column {} ('{}'): {v} is not a finite number",
+                    c + 1,
+                    t.columns[c]
+                )))
+            }
+        };
+        qs.push(
+            joint_cols
+                .iter()
+                .map(|&c| at(c))
+                .collect::<Result<Vec<f64>>>()?,
+        );
+        for cols in &marker_cols {
+            points.push([at(cols[0])?, at(cols[1])?, at(cols[2])?]);
+        }
+        if has_rpy {
+            let a: Vec<f64> = rpy.iter().map(|c| at(c.unwrap())).collect::<Result<_>>()?;
+            if let Some((i, v)) = a.iter().enumerate().find(|(_, v)| v.abs() > MAX_ANGLE) {
+                let c = rpy[i].unwrap();
+                return Err(err(format!(
+                    "line {line}, column {} ('{}'): angle {v} is out of range (radians, |angle| <= 2π; degrees?)",
+                    c + 1,
+                    t.columns[c]
+                )));
+            }
+            // R = Rz(phiz) Ry(phiy) Rx(phix): nalgebra's roll-pitch-yaw.
+            let r = Rotation3::from_euler_angles(a[0], a[1], a[2]);
+            orientations.push(crate::identify::rows(r.matrix()));
+        }
+        if has_quat {
+            let v: Vec<f64> = quat.iter().map(|c| at(c.unwrap())).collect::<Result<_>>()?;
+            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if (norm - 1.0).abs() > ROTATION_TOLERANCE {
+                return Err(err(format!(
+                    "line {line}: quaternion (qw1, qx1, qy1, qz1) has norm {norm}, not 1 (to {ROTATION_TOLERANCE:e})"
+                )));
+            }
+            let uq = UnitQuaternion::from_quaternion(Quaternion::new(v[0], v[1], v[2], v[3]));
+            orientations.push(crate::identify::rows(uq.to_rotation_matrix().matrix()));
+        }
+    }
+    Ok(MeasurementFile {
+        measurements: Measurements::unchecked(qs, marker_cols.len(), points, orientations),
+        notes,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ur5() -> Robot {
+        Robot::builtin("ur5:pose").unwrap()
+    }
+
+    #[test]
+    fn rpy_is_rz_ry_rx_and_joints_match_by_name_in_any_order() {
+        let text = "q6,q5,q4,q3,q2,q1,x1,y1,z1,phix1,phiy1,phiz1,temp\n6,5,4,3,2,1,0.1,0.2,0.3,0.3,-0.2,1.1,20\n";
+        let f = parse_csv_measurements(text, "m.csv", &ur5()).unwrap();
+        let m = &f.measurements;
+        assert_eq!(m.qs()[0], [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+        assert_eq!(m.points()[0], [0.1, 0.2, 0.3]);
+        let (x, y, z) = (0.3f64, -0.2f64, 1.1f64);
+        let rz = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::z_axis(), z);
+        let ry = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::y_axis(), y);
+        let rx = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::x_axis(), x);
+        let want = crate::identify::rows((rz * ry * rx).matrix());
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!((m.orientations()[0][i][j] - want[i][j]).abs() < 1e-15);
+            }
+        }
+        assert!(f.notes[0].contains("temp"), "{:?}", f.notes);
+        m.check(&ur5()).unwrap();
+    }
+
+    #[test]
+    fn bad_files_name_the_place() {
+        let r = ur5();
+        let e = |t: &str| {
+            parse_csv_measurements(t, "m.csv", &r)
+                .unwrap_err()
+                .to_string()
+        };
+        assert!(
+            e("q1,q2,q3,q4,q5,x1,y1,z1\n1,2,3,4,5,0,0,0\n").contains("no column for joint 'q6'")
+        );
+        assert!(
+            e("q1,q2,q3,q4,q5,q6,x1,y1,z1\n1,2,3,4,5,6,0,zero,0\n")
+                .contains("line 2, column 8 ('y1'): cannot read 'zero'")
+        );
+        assert!(
+            e("q1,q2,q3,q4,q5,q6,x1,y1,z1,phix1,phiy1,phiz1\n1,2,3,4,5,6,0,0,0,0,90,0\n")
+                .contains("line 2, column 11 ('phiy1'): angle 90 is out of range")
+        );
+        assert!(e("q1,q2,q3,q4,q5,q6,x1,y1\n1,2,3,4,5,6,0,0\n").contains("z1 missing"));
+        assert!(
+            e("q1,q2,q3,q4,q5,q6,x1,y1,z1\n1,2,3,4,5,nan,0,0,0\n").contains("line 2, column 6")
+        );
+    }
+}

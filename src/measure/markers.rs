@@ -1,0 +1,264 @@
+//! The marker sensor: `K` points fixed to the last frame, each measured as a
+//! position (a motion-capture rig with several markers on a plate, a laser
+//! tracker with several targets). `3K` rows per pose.
+//!
+//! Marker `k` sits at `m_k = p + R o_k`, with `(R, p)` the end frame and
+//! `o_k` its offset in the end frame, an unknown of the sensor's own (see
+//! [`super::sensor`]): the offsets are never known to the precision of a
+//! calibration, so each marker brings three unknowns and the robot's tool
+//! translation, which they absorb, is not among the robot's unknowns.
+//!
+//! Under an elementary motion of the chain with linear velocity `v` of `p`
+//! and angular velocity `ω` of the end frame, marker `k` moves with
+//! `v + ω × (R o_k)`: its rows of the robot's columns. Its rows of its own
+//! offset's columns are `∂m_k/∂o_k = R`; of another marker's offset, zero.
+//!
+//! Several markers are never flattened into one point: a file with `K`
+//! markers per pose is read by this sensor with `K` offsets (see
+//! [`crate::io::measurements`]).
+
+use super::sensor::{Observation, ObservationBuf, RowKind, Sensor};
+use crate::kinematics::{EndFrame, Motion};
+use crate::model::MeasurementKind;
+use nalgebra::Vector3;
+
+/// Measures `K` marker points per pose, `3K` rows, with `3K` offset
+/// unknowns of its own.
+#[derive(Clone, Debug)]
+pub struct MarkerSensor {
+    k: usize,
+    kinds: Vec<RowKind>,
+    ones: Vec<f64>,
+}
+
+impl MarkerSensor {
+    /// A sensor of `k ≥ 1` markers.
+    #[must_use]
+    pub fn new(k: usize) -> Self {
+        let k = k.max(1);
+        Self {
+            k,
+            kinds: vec![RowKind::Position; 3 * k],
+            ones: vec![1.0; 3 * k],
+        }
+    }
+
+    /// Marker `k`'s offset rotated into the base frame, `R o_k`.
+    fn lever(end: &EndFrame, own: &[f64], k: usize) -> Vector3<f64> {
+        end.rotation * Vector3::new(own[3 * k], own[3 * k + 1], own[3 * k + 2])
+    }
+}
+
+impl Sensor for MarkerSensor {
+    fn kind(&self) -> MeasurementKind {
+        MeasurementKind::Markers(self.k)
+    }
+
+    fn describe(&self) -> &'static str {
+        "marker points"
+    }
+
+    fn rows(&self) -> usize {
+        3 * self.k
+    }
+
+    fn row_kinds(&self) -> &[RowKind] {
+        &self.kinds
+    }
+
+    fn weights(&self) -> &[f64] {
+        &self.ones
+    }
+
+    /// One marker sees a point (3), two a point and a direction (5), three
+    /// or more off a line the whole frame (6).
+    fn observed_dof(&self) -> usize {
+        match self.k {
+            1 => 3,
+            2 => 5,
+            _ => 6,
+        }
+    }
+
+    fn observes_orientation(&self) -> bool {
+        self.k > 1
+    }
+
+    fn measures_orientation(&self) -> bool {
+        false
+    }
+
+    fn points_per_pose(&self) -> usize {
+        self.k
+    }
+
+    fn value_len(&self) -> usize {
+        3 * self.k
+    }
+
+    fn n_own_params(&self) -> usize {
+        3 * self.k
+    }
+
+    fn own_param_names(&self) -> Vec<String> {
+        (1..=self.k)
+            .flat_map(|k| ["x", "y", "z"].map(|c| format!("marker{k}_{c}")))
+            .collect()
+    }
+
+    fn encode(&self, obs: &Observation<'_>, out: &mut [f64]) {
+        for (o, p) in out.chunks_exact_mut(3).zip(obs.points) {
+            o.copy_from_slice(p);
+        }
+    }
+
+    fn decode(&self, value: &[f64]) -> ObservationBuf {
+        ObservationBuf {
+            points: value.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+            orientation: None,
+        }
+    }
+
+    fn predict(&self, end: &EndFrame, own: &[f64], out: &mut [f64]) {
+        for k in 0..self.k {
+            let m = end.position + Self::lever(end, own, k);
+            out[3 * k..3 * k + 3].copy_from_slice(m.as_slice());
+        }
+    }
+
+    fn retract(&self, value: &mut [f64], delta: &[f64]) {
+        for (v, d) in value.iter_mut().zip(delta) {
+            *v += d;
+        }
+    }
+
+    fn residual(&self, predicted: &[f64], measured: &[f64], out: &mut [f64]) {
+        for ((o, p), m) in out.iter_mut().zip(predicted).zip(measured) {
+            *o = p - m;
+        }
+    }
+
+    fn motion_rows(
+        &self,
+        end: &EndFrame,
+        own: &[f64],
+        motions: &[Motion],
+        out: &mut [f64],
+        ld: usize,
+    ) {
+        for k in 0..self.k {
+            let l = Self::lever(end, own, k);
+            let rows = &mut out[3 * k * ld..];
+            for (c, m) in motions.iter().enumerate() {
+                let v = m.lin + m.ang.cross(&l);
+                rows[c] = v.x;
+                rows[ld + c] = v.y;
+                rows[2 * ld + c] = v.z;
+            }
+        }
+    }
+
+    fn own_rows(&self, end: &EndFrame, _own: &[f64], out: &mut [f64], ld: usize) {
+        let r = &end.rotation;
+        for k in 0..self.k {
+            for i in 0..3 {
+                let row = &mut out[(3 * k + i) * ld..];
+                for j in 0..self.k {
+                    for c in 0..3 {
+                        row[3 * j + c] = if j == k { r[(i, c)] } else { 0.0 };
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Rotation3;
+
+    fn frame() -> EndFrame {
+        EndFrame {
+            rotation: *Rotation3::from_euler_angles(0.3, -0.7, 1.1).matrix(),
+            position: Vector3::new(0.4, -0.2, 0.9),
+        }
+    }
+
+    /// Each Jacobian row is the derivative of the prediction: checked by
+    /// central differences of `predict` under a rigid motion of the end
+    /// frame (robot columns) and under each offset coordinate (own columns).
+    /// Step 1e-6 on O(1) quantities: truncation O(h²) ≈ 1e-12, rounding
+    /// ε/h ≈ 1e-10; 1e-8 separates a right row from any wrong one (O(0.1)).
+    #[test]
+    fn rows_are_derivatives_of_the_prediction() {
+        let s = MarkerSensor::new(3);
+        let own = [0.1, 0.0, 0.45, -0.05, 0.12, 0.5, 0.0, -0.1, 0.55];
+        let end = frame();
+        let motions = [
+            Motion {
+                lin: Vector3::new(0.3, -0.1, 0.2),
+                ang: Vector3::new(0.0, 0.0, 0.0),
+            },
+            Motion {
+                lin: Vector3::new(0.0, 0.5, 0.0),
+                ang: Vector3::new(0.2, -0.4, 0.7),
+            },
+        ];
+        let (p, n) = (motions.len(), motions.len() + 9);
+        let mut jac = vec![0.0; 9 * n];
+        s.motion_rows(&end, &own, &motions, &mut jac, n);
+        s.own_rows(&end, &own, &mut jac[p..], n);
+        let h = 1e-6;
+        let moved = |c: usize, eps: f64, own: &[f64]| {
+            let mut e = end;
+            if c < p {
+                let m = &motions[c];
+                let w = eps * m.ang;
+                e.rotation = Rotation3::new(w).matrix() * e.rotation;
+                e.position += eps * m.lin;
+            }
+            let mut out = [0.0; 9];
+            s.predict(&e, own, &mut out);
+            out
+        };
+        for c in 0..n {
+            let (mut op, mut om) = (own, own);
+            if c >= p {
+                op[c - p] += h;
+                om[c - p] -= h;
+            }
+            let (fp, fm) = if c < p {
+                (moved(c, h, &own), moved(c, -h, &own))
+            } else {
+                (moved(c, 0.0, &op), moved(c, 0.0, &om))
+            };
+            for r in 0..9 {
+                let fd = (fp[r] - fm[r]) / (2.0 * h);
+                assert!(
+                    (jac[r * n + c] - fd).abs() < 1e-8,
+                    "row {r} col {c}: {} vs {fd}",
+                    jac[r * n + c]
+                );
+            }
+        }
+        // Own columns of other markers are exactly zero.
+        assert_eq!(jac[p + 3], 0.0);
+    }
+
+    #[test]
+    fn encode_decode_round_trip() {
+        let s = MarkerSensor::new(2);
+        let pts = [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]];
+        let mut v = [0.0; 6];
+        s.encode(
+            &Observation {
+                points: &pts,
+                orientation: None,
+            },
+            &mut v,
+        );
+        assert_eq!(s.decode(&v).points, pts.to_vec());
+        assert_eq!(s.own_param_names()[4], "marker2_y");
+    }
+}

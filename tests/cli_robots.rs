@@ -430,13 +430,29 @@ fn calibrate_from_a_measurement_file_and_write_the_calibrated_robot() {
         &["calibrate", "--robot", "ur5", "--measurements", &meas],
         "m.json: the measurements are of robot 'ur5:pose', not 'ur5'",
     );
-    // Without the robot's name the file is checked on its content alone.
+    // Without the robot's name the file is read on its content alone: its
+    // orientations make the point robot's calibration a full-pose one (by
+    // construction, with a note), fitting the same 30 unknowns as ur5:pose.
     let mut anon: serde_json::Value = serde_json::from_str(&text).unwrap();
     anon.as_object_mut().unwrap().remove("robot");
     let anon = bad("anonymous.json", anon.to_string());
-    fails_with(
-        &["calibrate", "--robot", "ur5", "--measurements", &anon],
-        "anonymous.json: robot 'ur5' measures points",
+    let adapted = json_of(&[
+        "calibrate",
+        "--robot",
+        "ur5",
+        "--measurements",
+        &anon,
+        "--json",
+    ]);
+    assert_eq!(adapted["measurement"], "pose");
+    assert_eq!(adapted["parameters"].as_array().unwrap().len(), 30);
+    assert!(
+        adapted["notes"][0]
+            .as_str()
+            .unwrap()
+            .contains("calibrated from full poses"),
+        "{}",
+        adapted["notes"]
     );
     json_of(&[
         "calibrate",

@@ -264,7 +264,8 @@ fn bad_input_is_an_error() {
         e,
         IdentifyError::MeasurementCount {
             poses: 30,
-            measurements: 29
+            measurements: 29,
+            per_pose: 1
         }
     ));
     assert!(e.to_string().contains("missing measurements"));

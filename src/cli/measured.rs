@@ -213,7 +213,8 @@ pub fn calibrate_measured(
         }
     }
     let r = with_fixed_and_free(&start.robot, o.fix, o.free)?;
-    let f = fit(&r, &start.table, &meas, &o.lm, o.loss)?;
+    let f = fit(&r, &start.table, &meas, &o.lm, o.loss)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let res = residuals(&r, &f.id.table, &meas)?;
     let nominal = residuals(&r, &r.nominal, &meas)?;
     let params = trust(&r, &r.nominal, &f.id);

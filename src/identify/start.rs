@@ -37,6 +37,12 @@ pub struct Start {
 /// the module documentation). Errors when the data cannot be of this robot
 /// (several markers for a full-pose robot, a joint count that differs).
 pub fn for_measurements(robot: &Robot, meas: &Measurements, lm: &LmSettings) -> Result<Start> {
+    if let Some(name) = meas.robot().filter(|n| *n != robot.name) {
+        return Err(IdentifyError::Model(crate::Error::Invalid(format!(
+            "the measurements are of robot '{name}', not '{}'",
+            robot.name
+        ))));
+    }
     let k = meas.markers();
     let has_orientation = !meas.orientations().is_empty();
     let have = crate::measure::sensor_for(robot);

@@ -291,9 +291,7 @@ mod tests {
                 .unwrap_err()
                 .to_string()
         };
-        assert!(
-            e("q1,q2,q3,q4,q5,x1,y1,z1\n1,2,3,4,5,0,0,0\n").contains("no column for joint 'q6'")
-        );
+        assert!(e("q1,q2,q3,q4,q5,x1,y1,z1\n1,2,3,4,5,0,0,0\n").contains("joint 6 of robot"));
         assert!(
             e("q1,q2,q3,q4,q5,q6,x1,y1,z1\n1,2,3,4,5,6,0,zero,0\n")
                 .contains("line 2, column 8 ('y1'): cannot read 'zero'")

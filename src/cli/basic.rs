@@ -159,6 +159,16 @@ pub fn cmd_fk(a: FkArgs) -> Result<()> {
     emit_report(a.json, &r, || {
         let [x, y, z] = r.position;
         let mut s = format!("position: {x:.12} {y:.12} {z:.12}\n");
+        if let Some(o) = &r.orientation {
+            let [ro, pi, ya] = o.rpy;
+            let [w, qx, qy, qz] = o.quaternion;
+            s += &format!(
+                "orientation rpy (rad, R = Rz·Ry·Rx): {ro:.12} {pi:.12} {ya:.12}\nquaternion (w x y z): {w:.12} {qx:.12} {qy:.12} {qz:.12}\n"
+            );
+        }
+        for (k, m) in r.markers.iter().flatten().enumerate() {
+            s += &format!("marker {}: {:.12} {:.12} {:.12}\n", k + 1, m[0], m[1], m[2]);
+        }
         if let (Some(jac), Some(names)) = (&r.jacobian, &r.parameter_names) {
             for (c, name) in names.iter().enumerate() {
                 s += &format!("{name:>8}:");

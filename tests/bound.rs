@@ -226,6 +226,7 @@ fn a_stalled_solver_still_gives_a_valid_bound() {
     let (best, _) = enumerate(&x, n);
     let s = BoundSettings::builder()
         .polish(false)
+        .solver(RelaxationSolver::Clarabel)
         .first_order(ExchangeSettings {
             max_rounds: 1,
             warmup_rounds: 0,

@@ -53,9 +53,11 @@ pub const SUPPORT_TOL: f64 = 1e-6;
 #[serde(rename_all = "snake_case")]
 pub enum RelaxationSolver {
     /// Clarabel on the PSD + exponential-cone form ([`conic`]).
-    #[default]
     Clarabel,
-    /// The log-barrier Newton method on `ln det M(w)` itself ([`newton`]).
+    /// The log-barrier Newton method on `ln det M(w)` itself ([`newton`]):
+    /// the default, 5–15 times faster than Clarabel on every pool measured
+    /// (PUMA, UR5 full pose, a four-marker TIAGo) with a tighter certificate.
+    #[default]
     Newton,
 }
 
@@ -69,7 +71,7 @@ pub struct BoundSettings {
     /// Solve (R) on candidate sets with `solver` (true) or with the
     /// first-order solver alone (false). Default true.
     pub use_conic: bool,
-    /// The candidate-set solver: Clarabel (default) or Newton.
+    /// The candidate-set solver: Newton (default) or Clarabel.
     pub solver: RelaxationSolver,
     /// First-order certificate gap at which screening stops and Clarabel
     /// takes over. Default 1e-2.
@@ -112,7 +114,7 @@ impl Default for BoundSettings {
         Self {
             gap_tol: 1e-6,
             use_conic: true,
-            solver: RelaxationSolver::Clarabel,
+            solver: RelaxationSolver::Newton,
             screen_gap: 1e-2,
             screen_extra: 100,
             direct_limit: 400,

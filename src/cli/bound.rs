@@ -21,12 +21,16 @@ pub struct SolveOpts {
     pub first_order: bool,
     /// Solver of the candidate subproblems: clarabel (conic form) or newton
     /// (log-barrier Newton on ln det itself). Both are certified by eq. (C).
-    #[arg(long, value_enum, default_value_t = RelaxationSolver::Clarabel)]
+    #[arg(long, value_enum, default_value_t = RelaxationSolver::Newton)]
     pub solver: RelaxationSolver,
     /// Poses outside the first-order support given to Clarabel, by largest
     /// variance.
     #[arg(long, default_value_t = 100)]
     pub screen_extra: usize,
+    /// First-order certificate gap (ln det) at which screening stops and the
+    /// candidate-set solver takes over.
+    #[arg(long, default_value_t = 1e-2)]
+    pub screen_gap: f64,
     /// Most candidate-set solves (screening rounds); large pools may need
     /// more than the default to certify.
     #[arg(long, default_value_t = 10)]
@@ -40,6 +44,7 @@ impl SolveOpts {
             .use_conic(!self.first_order)
             .solver(self.solver)
             .screen_extra(self.screen_extra)
+            .screen_gap(self.screen_gap)
             .max_rounds(self.max_rounds)
             .build()?)
     }

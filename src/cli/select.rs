@@ -125,7 +125,7 @@ pub struct SelectArgs {
     #[arg(long)]
     pub gap: bool,
     /// Solver of the bound for `--gap` (see `bound`).
-    #[arg(long, value_enum, default_value_t = activecal::bound::RelaxationSolver::Clarabel, requires = "gap")]
+    #[arg(long, value_enum, default_value_t = activecal::bound::RelaxationSolver::Newton, requires = "gap")]
     pub gap_solver: activecal::bound::RelaxationSolver,
     /// Print one JSON object.
     #[arg(long)]

@@ -8,7 +8,7 @@ use crate::blocks::Blocks;
 use crate::bound::{Bound, BoundReport, DesignGap, SUPPORT_TOL};
 use crate::criterion::Indices;
 use crate::model::{ParamSet, Robot};
-use crate::pool::{Pool, PoolSpec};
+use crate::pool::{Pool, PoolSpec, PoolStats};
 use crate::select::{Algorithm, CriterionKind, Selection, Settings, StepKind};
 use serde::Serialize;
 
@@ -35,6 +35,10 @@ pub struct PoolInfo {
     pub levels: Option<usize>,
     /// How the pool was made.
     pub pool: PoolSpec,
+    /// What building it did: candidates, what each filter removed, notes
+    /// (absent when no pool was built).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pool_stats: Option<PoolStats>,
 }
 
 impl PoolInfo {
@@ -46,6 +50,7 @@ impl PoolInfo {
             chain: chain(robot),
             levels: pool.spec.levels(),
             pool: pool.spec.clone(),
+            pool_stats: Some(pool.stats.clone()),
         }
     }
 }

@@ -1,7 +1,7 @@
 //! `bound` and `gap`: the certified D-optimal relaxation bound on OI_D, and a
 //! design's D-efficiency against it.
 
-use super::{PoolOpts, build_pool, emit_report, filters, load_description};
+use super::{PoolOpts, emit_report, filters, load_description};
 use activecal::bound::{Bound, BoundSettings, RelaxationSolver, design_gap, relaxation_bound};
 use activecal::io::design::DesignFile;
 use activecal::model::ParamSet;
@@ -140,7 +140,7 @@ pub fn cmd_bound(a: BoundArgs) -> Result<()> {
         a.weights,
     );
     emit_report(a.json, &report, || {
-        let mut s = bound_text(&b);
+        let mut s = super::pool_stats_text(&ctx.pool.stats) + &bound_text(&b);
         if let Some(support) = &report.support {
             s += "pose      weight\n";
             for w in support {
@@ -161,7 +161,10 @@ pub fn cmd_gap(a: GapArgs) -> Result<()> {
     if d.pool.is_none() || a.visibility.is_some() {
         spec.filters = filters(a.visibility.as_deref(), desc.visibility.as_ref())?;
     }
-    let ctx = build_pool(desc.robot, &spec, a.params)?;
+    let pool = d
+        .build_pool(&spec, &desc.robot, &desc.robot.nominal)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?;
+    let ctx = super::with_jacobian(desc.robot, pool, a.params);
     let positions = d
         .positions_in(&ctx.robot, &ctx.pool)
         .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?;

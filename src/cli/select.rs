@@ -58,6 +58,7 @@ pub fn cmd_score(a: ScoreArgs) -> Result<()> {
                 chain: activecal::report::chain(&robot),
                 levels: d.spec()?.levels(),
                 pool: d.spec()?,
+                pool_stats: None,
             };
             ScoreReport::new(info, d.poses.clone(), &x)
         }
@@ -186,23 +187,24 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         d.write(out, a.force)?;
     }
     emit_report(a.json, &report, || {
-        format!(
-            "{:?} ({:?} criterion, seed {}, {} start(s){}): {} poses in {:.3} s\nlog10 OI_D {:.4}  OI {:.6}\nposes: {}\n",
-            report.algorithm,
-            report.criterion,
-            a.seed,
-            a.starts,
-            if a.polish { ", Fedorov polish" } else { "" },
-            report.poses.len(),
-            seconds,
-            report.log10_oid,
-            report.oi,
-            report
-                .poses
-                .iter()
-                .map(|p| p.to_string())
-                .collect::<Vec<_>>()
-                .join(",")
-        )
+        super::pool_stats_text(&ctx.pool.stats)
+            + &format!(
+                "{:?} ({:?} criterion, seed {}, {} start(s){}): {} poses in {:.3} s\nlog10 OI_D {:.4}  OI {:.6}\nposes: {}\n",
+                report.algorithm,
+                report.criterion,
+                a.seed,
+                a.starts,
+                if a.polish { ", Fedorov polish" } else { "" },
+                report.poses.len(),
+                seconds,
+                report.log10_oid,
+                report.oi,
+                report
+                    .poses
+                    .iter()
+                    .map(|p| p.to_string())
+                    .collect::<Vec<_>>()
+                    .join(",")
+            )
     })
 }

@@ -245,28 +245,32 @@ impl PoolSpec {
             )));
         }
         let dof = robot.dof();
-        if let Some(k) = rows.qs.iter().position(|q| q.len() != dof) {
+        if let Some(k) = rows
+            .qs
+            .iter()
+            .position(|q| q.len() != dof || q.iter().any(|v| !v.is_finite()))
+        {
             return Err(Error::Invalid(format!(
-                "configuration {k} of the pool has {} joint values, the robot {dof}",
+                "configuration {k} of the pool has {} joint values (the robot {dof}), or one is not finite",
                 rows.qs[k].len()
             )));
         }
-        self.build_inner(robot, table, Some(&rows.qs), rows.notes)
+        self.build_inner(robot, table, Some(rows.qs), rows.notes)
     }
 
     fn build_inner(
         &self,
         robot: &Robot,
         table: &ParamTable,
-        rows: Option<&[Vec<f64>]>,
+        rows: Option<Vec<Vec<f64>>>,
         notes: Vec<String>,
     ) -> Result<Pool> {
         let n = match self.source.declared_size(robot)? {
             Some(n) => n,
-            None => rows.map_or(0, <[Vec<f64>]>::len),
+            None => rows.as_ref().map_or(0, Vec::len),
         };
         check_memory(robot, n)?;
-        let cands = match (&self.source, rows) {
+        let cands = match (&self.source, rows.as_deref()) {
             (PoolSource::Lattice { levels }, _) => {
                 Candidates::Lattice(Lattice::new(robot, *levels)?)
             }
@@ -376,6 +380,7 @@ impl PoolSpec {
             lattice,
             source_size,
             stats,
+            listed: rows,
         })
     }
 }
@@ -422,6 +427,8 @@ pub struct Pool {
     source_size: usize,
     /// What the build did (candidates, removals per filter, notes).
     pub stats: PoolStats,
+    /// Every configuration of a file source, before filtering, in id order.
+    listed: Option<Vec<Vec<f64>>>,
 }
 
 impl Pool {
@@ -442,6 +449,15 @@ impl Pool {
         PoolSpec::lattice(levels)
             .with_filter(PoolFilter::Visibility(vis.clone()))
             .build(robot, table)
+    }
+
+    /// Every configuration of a [`PoolSource::File`] source, before
+    /// filtering, in id order (what a design file stores so that it needs
+    /// no access to the file); `None` for the other sources, which their
+    /// spec regenerates.
+    #[must_use]
+    pub fn listed(&self) -> Option<&[Vec<f64>]> {
+        self.listed.as_deref()
     }
 
     /// Number of pool poses.

@@ -55,6 +55,49 @@ impl PoolInfo {
     }
 }
 
+/// Poses measured before a selection (`--existing`): the prior information
+/// `M0 = Σ XᵢᵀXᵢ` every reported `ln OI_D` and bound then includes.
+#[derive(Clone, Debug, Serialize)]
+pub struct ExistingReport {
+    /// The file they were read from.
+    pub file: String,
+    /// Poses in it.
+    pub poses: usize,
+    /// Numerical rank of their stacked Jacobian.
+    pub rank: usize,
+    /// `ln det M0`; `None` when `M0` is singular (rank < p).
+    pub ln_det: Option<f64>,
+    /// `log10 det M0`; `None` when singular.
+    pub log10_det: Option<f64>,
+    /// What the reader ignored (columns, keys).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
+}
+
+impl ExistingReport {
+    /// The report of the poses in `file`, whose identification Jacobian is
+    /// `x`, and the prior made of them.
+    #[must_use]
+    pub fn new(
+        file: String,
+        x: &Blocks,
+        prior: &crate::criterion::Prior,
+        notes: Vec<String>,
+    ) -> Self {
+        let all: Vec<usize> = (0..x.n_poses()).collect();
+        let rank = Indices::from_design(x, &all).rank;
+        let ln_det = if rank == x.p() { prior.ln_det() } else { None };
+        Self {
+            file,
+            poses: x.n_poses(),
+            rank,
+            ln_det,
+            log10_det: ln_det.map(|v| v / std::f64::consts::LN_10),
+            notes,
+        }
+    }
+}
+
 /// `score`: the observability indices of a design.
 #[derive(Clone, Debug, Serialize)]
 pub struct ScoreReport {
@@ -155,6 +198,18 @@ pub struct SelectReport {
     /// The bound's status (`--gap`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bound_status: Option<crate::bound::BoundStatus>,
+    /// The poses measured before (`--existing`): `ln_oid`, the trace and
+    /// the bound are then of `M0 + XᵀX`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub existing: Option<ExistingReport>,
+    /// With `--existing`: `ln det XᵀX` of the new poses alone (`None` when
+    /// they are singular without the prior).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ln_oid_new_only: Option<Option<f64>>,
+    /// With `--existing`: `ln_oid − ln det M0`, what the new poses add
+    /// (`None` when `M0` is singular).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ln_gain: Option<Option<f64>>,
 }
 
 impl SelectReport {
@@ -203,7 +258,18 @@ impl SelectReport {
             log10_bound: None,
             d_efficiency: None,
             bound_status: None,
+            existing: None,
+            ln_oid_new_only: None,
+            ln_gain: None,
         }
+    }
+
+    /// Records the poses measured before (the prior of the selection) and
+    /// `ln det XᵀX` of the new poses alone.
+    pub fn set_existing(&mut self, existing: ExistingReport, ln_oid_new_only: Option<f64>) {
+        self.ln_gain = Some(existing.ln_det.map(|l0| self.ln_oid - l0));
+        self.ln_oid_new_only = Some(ln_oid_new_only);
+        self.existing = Some(existing);
     }
 
     /// Adds the design's gap to a bound.
@@ -239,6 +305,10 @@ pub struct BoundCommandReport {
     /// Poses with weight above [`SUPPORT_TOL`] (when asked for).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub support: Option<Vec<WeightedPose>>,
+    /// The poses measured before (`--existing`), whose information the
+    /// relaxation includes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub existing: Option<ExistingReport>,
 }
 
 impl BoundCommandReport {
@@ -266,6 +336,7 @@ impl BoundCommandReport {
                     })
                     .collect()
             }),
+            existing: None,
         }
     }
 }
@@ -302,6 +373,10 @@ pub struct GapReport {
     pub weights: Vec<f64>,
     /// The bound.
     pub bound: BoundReport,
+    /// The poses measured before, when the design was chosen on top of
+    /// them (`ln_oid` and the bound then include their information).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub existing: Option<ExistingReport>,
 }
 
 impl GapReport {
@@ -329,6 +404,7 @@ impl GapReport {
             d_efficiency: g.d_efficiency,
             weights: g.weights.clone(),
             bound: BoundReport::from(b),
+            existing: None,
         }
     }
 }

@@ -274,9 +274,9 @@ fn filter_stats_count_what_each_filter_removed() {
     let all = PoolSpec::of(spec.source.clone())
         .build(&r, &r.nominal)
         .unwrap();
-    for id in 0..2000 {
+    for (id, &k) in kept.iter().enumerate() {
         let p = activecal::kinematics::position(&r, &r.nominal, all.config(id));
-        assert_eq!(cone.sees(&p), kept[id], "id {id}");
+        assert_eq!(cone.sees(&p), k, "id {id}");
     }
     // A filter that removes everything is named.
     let none = Visibility::Box {

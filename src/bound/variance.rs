@@ -129,7 +129,8 @@ pub fn scale_columns_with_prior(
             .map(|(j, v)| ((v * f).powi(2) + m0[(j, j)].max(0.0)).sqrt())
             .collect(),
     };
-    let zero = s.iter().filter(|&&v| !(v > 0.0)).count();
+    // `v.is_nan()` too: a NaN scale is no scale.
+    let zero = s.iter().filter(|&&v| v <= 0.0 || v.is_nan()).count();
     if zero > 0 {
         return Err(BoundError::RankDeficient {
             rank: p - zero,

@@ -2,7 +2,9 @@
 //! design's D-efficiency against it.
 
 use super::{PoolOpts, emit_report, filters, load_description};
-use activecal::bound::{Bound, BoundSettings, RelaxationSolver, design_gap, relaxation_bound};
+use activecal::bound::{
+    Bound, BoundSettings, RelaxationSolver, design_gap_with_prior, relaxation_bound_with_prior,
+};
 use activecal::io::design::DesignFile;
 use activecal::model::ParamSet;
 use activecal::report::{BoundCommandReport, GapReport, PoolInfo};
@@ -58,6 +60,10 @@ pub struct BoundArgs {
     /// Also list the poses carrying relaxation weight (lattice index, weight).
     #[arg(long)]
     pub weights: bool,
+    /// Poses already measured (see `select --existing`): the relaxation
+    /// maximises ln det(M0 + Σ w_i X_iᵀX_i) with M0 their information.
+    #[arg(long, value_name = "FILE")]
+    pub existing: Option<PathBuf>,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -130,8 +136,14 @@ fn solver_name(b: &Bound) -> &'static str {
 pub fn cmd_bound(a: BoundArgs) -> Result<()> {
     let settings = a.solve.settings()?;
     let ctx = a.pool.load()?;
-    let b = relaxation_bound(&ctx.x, a.n, &settings)?;
-    let report = BoundCommandReport::new(
+    let existing = a
+        .existing
+        .as_deref()
+        .map(|p| super::load_existing(p, &ctx.robot, a.pool.params))
+        .transpose()?;
+    let prior = existing.as_ref().map(|e| &e.prior);
+    let b = relaxation_bound_with_prior(&ctx.x, prior, a.n, &settings)?;
+    let mut report = BoundCommandReport::new(
         &ctx.robot,
         &ctx.pool,
         &b,
@@ -139,8 +151,13 @@ pub fn cmd_bound(a: BoundArgs) -> Result<()> {
         settings,
         a.weights,
     );
+    report.existing = existing.map(|e| e.report);
     emit_report(a.json, &report, || {
-        let mut s = super::pool_stats_text(&ctx.pool.stats) + &bound_text(&b);
+        let mut s = super::pool_stats_text(&ctx.pool.stats);
+        if let Some(e) = &report.existing {
+            s += &super::existing_text(e);
+        }
+        s += &bound_text(&b);
         if let Some(support) = &report.support {
             s += "pose      weight\n";
             for w in support {
@@ -168,20 +185,41 @@ pub fn cmd_gap(a: GapArgs) -> Result<()> {
     let positions = d
         .positions_in(&ctx.robot, &ctx.pool)
         .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?;
-    let b = relaxation_bound(&ctx.x, positions.len(), &settings)?;
-    let g = design_gap(&ctx.x, &positions, &b)?;
-    let report = GapReport::new(
+    // A design chosen on top of existing poses is scored, and bounded, with
+    // their information (stored in the design file).
+    let existing = d
+        .existing
+        .as_ref()
+        .map(|e| {
+            super::existing_from(
+                e.path.clone(),
+                e.q.clone(),
+                Vec::new(),
+                &ctx.robot,
+                a.params,
+            )
+        })
+        .transpose()?;
+    let prior = existing.as_ref().map(|e| &e.prior);
+    let b = relaxation_bound_with_prior(&ctx.x, prior, positions.len(), &settings)?;
+    let g = design_gap_with_prior(&ctx.x, prior, &positions, &b)?;
+    let mut report = GapReport::new(
         PoolInfo::new(&ctx.robot, &ctx.pool),
         a.params,
         d.poses.clone(),
         &g,
         &b,
     );
+    report.existing = existing.map(|e| e.report);
     emit_report(a.json, &report, || {
         let oid = g
             .log10_oid
             .map_or("singular (-inf)".to_string(), |l| format!("{l:.6}"));
-        format!(
+        let head = report
+            .existing
+            .as_ref()
+            .map_or(String::new(), super::existing_text);
+        head + &format!(
             "design {} ({} poses, p = {})\nlog10 OI_D     {oid}\nlog10 bound    {:.6}  ({:?}, gap {:.1e})\nD-efficiency  >= {:.6}\n\
              poses with relaxation weight > {}: {} of {}: {:?}\n",
             a.design.display(),

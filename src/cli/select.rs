@@ -128,6 +128,12 @@ pub struct SelectArgs {
     /// Solver of the bound for `--gap` (see `bound`).
     #[arg(long, value_enum, default_value_t = activecal::bound::RelaxationSolver::Clarabel, requires = "gap")]
     pub gap_solver: activecal::bound::RelaxationSolver,
+    /// Poses already measured: a CSV or JSON of joint configurations (as
+    /// --pool file: reads them) or a JSON measurement file. The new poses
+    /// maximise ln det(M0 + XᵀX) with M0 the information of these, and
+    /// --gap reports the D-efficiency against the bound with M0.
+    #[arg(long, value_name = "FILE")]
+    pub existing: Option<PathBuf>,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -140,6 +146,12 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         super::refuse_overwrite(out, a.force)?;
     }
     let ctx = a.pool.load()?;
+    let existing = a
+        .existing
+        .as_deref()
+        .map(|p| super::load_existing(p, &ctx.robot, a.pool.params))
+        .transpose()?;
+    let prior = existing.as_ref().map(|e| e.prior.clone());
     let fixed_ids: Vec<usize> = match &a.fixed {
         Some(f) => parse_list(f, "--fixed")?,
         None => vec![],
@@ -154,22 +166,35 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         polish: a.polish,
         seed: a.seed,
         fixed,
+        prior: prior.clone(),
         ..Settings::default()
     };
     let t0 = Instant::now();
     let sel = select(&ctx.x, a.criterion, a.algorithm, &s)?;
     let seconds = t0.elapsed().as_secs_f64();
     let mut report = SelectReport::new(&ctx.robot, &ctx.pool, &sel, a.criterion, &s, seconds);
+    if let Some(e) = &existing {
+        let alone = activecal::select::ln_det_direct(&ctx.x, &sel.poses);
+        report.set_existing(e.report.clone(), alone);
+    }
     if a.gap {
         let settings = activecal::bound::BoundSettings::builder()
             .solver(a.gap_solver)
             .build()?;
-        let bound = activecal::bound::relaxation_bound(&ctx.x, a.n, &settings)?;
-        let g = activecal::bound::design_gap(&ctx.x, &sel.poses, &bound)?;
+        let bound =
+            activecal::bound::relaxation_bound_with_prior(&ctx.x, prior.as_ref(), a.n, &settings)?;
+        let g =
+            activecal::bound::design_gap_with_prior(&ctx.x, prior.as_ref(), &sel.poses, &bound)?;
         report.set_gap(&g);
     }
     if let Some(out) = &a.out {
         let mut d = DesignFile::from_pool(&ctx.robot, &ctx.pool, &sel.poses);
+        d.existing = existing
+            .as_ref()
+            .map(|e| activecal::io::design::ExistingPoses {
+                path: e.report.file.clone(),
+                q: e.qs.clone(),
+            });
         let v = serde_json::to_value(&report)?;
         for k in [
             "ln_oid",
@@ -187,24 +212,49 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         d.write(out, a.force)?;
     }
     emit_report(a.json, &report, || {
-        super::pool_stats_text(&ctx.pool.stats)
-            + &format!(
-                "{:?} ({:?} criterion, seed {}, {} start(s){}): {} poses in {:.3} s\nlog10 OI_D {:.4}  OI {:.6}\nposes: {}\n",
-                report.algorithm,
-                report.criterion,
-                a.seed,
-                a.starts,
-                if a.polish { ", Fedorov polish" } else { "" },
-                report.poses.len(),
-                seconds,
-                report.log10_oid,
-                report.oi,
-                report
-                    .poses
-                    .iter()
-                    .map(|p| p.to_string())
-                    .collect::<Vec<_>>()
-                    .join(",")
-            )
+        let mut s = super::pool_stats_text(&ctx.pool.stats);
+        if let Some(e) = &report.existing {
+            s += &super::existing_text(e);
+        }
+        s += &format!(
+            "{:?} ({:?} criterion, seed {}, {} start(s){}): {} poses in {:.3} s\nlog10 OI_D {:.4}{}  OI {:.6}\nposes: {}\n",
+            report.algorithm,
+            report.criterion,
+            a.seed,
+            a.starts,
+            if a.polish { ", Fedorov polish" } else { "" },
+            report.poses.len(),
+            seconds,
+            report.log10_oid,
+            if report.existing.is_some() {
+                " (existing + new poses)"
+            } else {
+                ""
+            },
+            report.oi,
+            report
+                .poses
+                .iter()
+                .map(|p| p.to_string())
+                .collect::<Vec<_>>()
+                .join(",")
+        );
+        if let Some(Some(g)) = report.ln_gain {
+            s += &format!(
+                "the new poses add {:.4} to log10 det M0\n",
+                g / std::f64::consts::LN_10
+            );
+        }
+        if let (Some(b), Some(eff)) = (report.log10_bound, report.d_efficiency) {
+            s += &format!(
+                "log10 bound {b:.4}{}  D-efficiency >= {eff:.6}\n",
+                if report.existing.is_some() {
+                    " (with the existing poses' information)"
+                } else {
+                    ""
+                }
+            );
+        }
+        s
     })
 }

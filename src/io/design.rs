@@ -47,9 +47,23 @@ pub struct DesignFile {
     /// file (lattice and sampled pools are regenerated from their spec).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pool_qs: Option<Vec<Vec<f64>>>,
+    /// Poses measured before the design was chosen (`select --existing`):
+    /// their file and joint values, so that `gap` scores the design on top
+    /// of the same prior information without the file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub existing: Option<ExistingPoses>,
     /// Anything else (algorithm, seed, ln_oid, ...), kept as written.
     #[serde(flatten)]
     pub extra: serde_json::Map<String, serde_json::Value>,
+}
+
+/// Poses measured before a design was chosen, as a design file stores them.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ExistingPoses {
+    /// The file they were read from (informational).
+    pub path: String,
+    /// Their joint values.
+    pub q: Vec<Vec<f64>>,
 }
 
 impl DesignFile {
@@ -63,6 +77,7 @@ impl DesignFile {
             poses: pool.ids_of(positions),
             q: Some(positions.iter().map(|&k| pool.q(k)).collect()),
             pool_qs: pool.listed().map(<[Vec<f64>]>::to_vec),
+            existing: None,
             extra: serde_json::Map::new(),
         }
     }
@@ -78,6 +93,7 @@ impl DesignFile {
             poses,
             q: None,
             pool_qs: None,
+            existing: None,
             extra: serde_json::Map::new(),
         }
     }

@@ -98,6 +98,81 @@ impl ExistingReport {
     }
 }
 
+/// One pose of a refined design (`select --refine`).
+#[derive(Clone, Debug, Serialize)]
+pub struct RefinedPoseReport {
+    /// Id of the pool pose it started from.
+    pub pose: usize,
+    /// Joint values after refinement.
+    pub q: Vec<f64>,
+    /// Increase of `ln OI_D` from moving it.
+    pub ln_gain: f64,
+    /// Largest joint move.
+    pub max_move: f64,
+}
+
+/// `select --refine`: the design moved off the pool, and how it compares
+/// with the pool's certified bound.
+#[derive(Clone, Debug, Serialize)]
+pub struct RefinementReport {
+    /// `ln OI_D` before (the pool design).
+    pub ln_oid_before: f64,
+    /// `ln OI_D` after.
+    pub ln_oid: f64,
+    /// `log10 OI_D` after.
+    pub log10_oid: f64,
+    /// `ln_oid − ln_oid_before`.
+    pub ln_gain: f64,
+    /// Every pose.
+    pub poses: Vec<RefinedPoseReport>,
+    /// Passes over the poses.
+    pub sweeps: usize,
+    /// Objective evaluations.
+    pub evaluations: usize,
+    /// With `--gap`: `exp((ln_oid − ln_bound)/p)` against the pool's bound;
+    /// above 1 when the refined design beats every pool design.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub d_efficiency_vs_pool_bound: Option<f64>,
+    /// With `--gap`: whether the refined design exceeds the pool's certified
+    /// bound (no design of the pool can reach it; a continuous design can).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exceeds_pool_bound: Option<bool>,
+}
+
+impl RefinementReport {
+    /// The report of `r`, refined from pool positions `positions`.
+    #[must_use]
+    pub fn new(pool: &Pool, positions: &[usize], r: &crate::select::Refinement) -> Self {
+        Self {
+            ln_oid_before: r.ln_oid_before,
+            ln_oid: r.ln_oid,
+            log10_oid: r.ln_oid / std::f64::consts::LN_10,
+            ln_gain: r.gain,
+            poses: r
+                .poses
+                .iter()
+                .map(|p| RefinedPoseReport {
+                    pose: pool.id(positions[p.index]),
+                    q: p.q.clone(),
+                    ln_gain: p.gain,
+                    max_move: p.max_move,
+                })
+                .collect(),
+            sweeps: r.sweeps,
+            evaluations: r.evaluations,
+            d_efficiency_vs_pool_bound: None,
+            exceeds_pool_bound: None,
+        }
+    }
+
+    /// Compares the refined design with the pool's bound `ln_bound` for `p`
+    /// unknowns.
+    pub fn set_bound(&mut self, ln_bound: f64, p: usize) {
+        self.d_efficiency_vs_pool_bound = Some(((self.ln_oid - ln_bound) / p as f64).exp());
+        self.exceeds_pool_bound = Some(self.ln_oid > ln_bound);
+    }
+}
+
 /// `score`: the observability indices of a design.
 #[derive(Clone, Debug, Serialize)]
 pub struct ScoreReport {
@@ -210,6 +285,9 @@ pub struct SelectReport {
     /// (`None` when `M0` is singular).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ln_gain: Option<Option<f64>>,
+    /// With `--refine`: the design moved continuously off the pool.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub refinement: Option<RefinementReport>,
 }
 
 impl SelectReport {
@@ -261,6 +339,7 @@ impl SelectReport {
             existing: None,
             ln_oid_new_only: None,
             ln_gain: None,
+            refinement: None,
         }
     }
 
@@ -377,6 +456,14 @@ pub struct GapReport {
     /// them (`ln_oid` and the bound then include their information).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub existing: Option<ExistingReport>,
+    /// Whether the design was refined off the pool (`select --refine`):
+    /// the bound is then the pool's, which does not bound it, and
+    /// `d_efficiency` may exceed 1.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub refined: bool,
+    /// For a refined design: whether it exceeds the pool's certified bound.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exceeds_bound: Option<bool>,
 }
 
 impl GapReport {
@@ -405,6 +492,8 @@ impl GapReport {
             weights: g.weights.clone(),
             bound: BoundReport::from(b),
             existing: None,
+            refined: false,
+            exceeds_bound: None,
         }
     }
 }

@@ -54,6 +54,19 @@ pub fn design_ln_det(x: &Blocks, design: &[usize]) -> Option<f64> {
     ln_det_spd_equilibrated(x.information(design).as_ref())
 }
 
+/// [`design_ln_det`] on top of prior information: `ln det(M0 + Σ X_iᵀX_i)`.
+#[must_use]
+pub fn design_ln_det_with_prior(
+    x: &Blocks,
+    prior: Option<&Prior>,
+    design: &[usize],
+) -> Option<f64> {
+    match prior {
+        None => design_ln_det(x, design),
+        Some(pr) => ln_det_spd_equilibrated((x.information(design) + pr.matrix()).as_ref()),
+    }
+}
+
 /// The gap report of a design (pool positions) against the bound for its
 /// size. Errors when the design's size differs from the bound's `n`, a
 /// position is outside the pool, or a pose repeats.
@@ -108,10 +121,7 @@ pub fn design_gap_with_prior(
             )));
         }
     }
-    let ln_oid = match prior {
-        None => design_ln_det(x, design),
-        Some(pr) => ln_det_spd_equilibrated((x.information(design) + pr.matrix()).as_ref()),
-    };
+    let ln_oid = design_ln_det_with_prior(x, prior, design);
     let p = bound.p as f64;
     let d_efficiency = ln_oid.map_or(0.0, |l| ((l - bound.ln_bound) / p).exp());
     let weights: Vec<f64> = design.iter().map(|&i| bound.weights[i]).collect();

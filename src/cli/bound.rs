@@ -182,9 +182,14 @@ pub fn cmd_gap(a: GapArgs) -> Result<()> {
         .build_pool(&spec, &desc.robot, &desc.robot.nominal)
         .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?;
     let ctx = super::with_jacobian(desc.robot, pool, a.params);
-    let positions = d
-        .positions_in(&ctx.robot, &ctx.pool)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?;
+    // A refined design's poses are off the pool: it is scored from its
+    // joint values against the bound of the pool it started from.
+    let positions = if d.refined {
+        Vec::new()
+    } else {
+        d.positions_in(&ctx.robot, &ctx.pool)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?
+    };
     // A design chosen on top of existing poses is scored, and bounded, with
     // their information (stored in the design file).
     let existing = d
@@ -201,8 +206,37 @@ pub fn cmd_gap(a: GapArgs) -> Result<()> {
         })
         .transpose()?;
     let prior = existing.as_ref().map(|e| &e.prior);
-    let b = relaxation_bound_with_prior(&ctx.x, prior, positions.len(), &settings)?;
-    let g = design_gap_with_prior(&ctx.x, prior, &positions, &b)?;
+    let b = relaxation_bound_with_prior(&ctx.x, prior, d.poses.len(), &settings)?;
+    let g = if d.refined {
+        let qs = d
+            .joint_values(&ctx.robot)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?;
+        let xd = activecal::blocks::jacobian_of(
+            &ctx.robot,
+            ctx.robot.params(a.params),
+            qs.len(),
+            |k, q| q.copy_from_slice(&qs[k]),
+        );
+        let all: Vec<usize> = (0..qs.len()).collect();
+        // The pool's bound is for the pool's Jacobian; the design's own
+        // Jacobian is scored against its value.
+        let ln = activecal::bound::gap::design_ln_det_with_prior(&xd, prior, &all);
+        activecal::bound::DesignGap {
+            n: qs.len(),
+            p: b.p,
+            ln_oid: ln,
+            log10_oid: ln.map(|l| l / std::f64::consts::LN_10),
+            ln_bound: b.ln_bound,
+            log10_bound: b.log10_bound(),
+            d_efficiency: ln.map_or(0.0, |l| ((l - b.ln_bound) / b.p as f64).exp()),
+            bound_status: b.status,
+            certificate_gap: b.certificate_gap,
+            weighted: Vec::new(),
+            weights: Vec::new(),
+        }
+    } else {
+        design_gap_with_prior(&ctx.x, prior, &positions, &b)?
+    };
     let mut report = GapReport::new(
         PoolInfo::new(&ctx.robot, &ctx.pool),
         a.params,
@@ -211,14 +245,24 @@ pub fn cmd_gap(a: GapArgs) -> Result<()> {
         &b,
     );
     report.existing = existing.map(|e| e.report);
+    if d.refined {
+        report.refined = true;
+        report.exceeds_bound = g.ln_oid.map(|l| l > b.ln_bound);
+    }
     emit_report(a.json, &report, || {
         let oid = g
             .log10_oid
             .map_or("singular (-inf)".to_string(), |l| format!("{l:.6}"));
-        let head = report
+        let mut head = report
             .existing
             .as_ref()
             .map_or(String::new(), super::existing_text);
+        if let Some(ex) = report.exceeds_bound {
+            head += &format!(
+                "refined design (poses off the pool): the pool's bound does not bound it; it {} that bound\n",
+                if ex { "EXCEEDS" } else { "stays below" }
+            );
+        }
         head + &format!(
             "design {} ({} poses, p = {})\nlog10 OI_D     {oid}\nlog10 bound    {:.6}  ({:?}, gap {:.1e})\nD-efficiency  >= {:.6}\n\
              poses with relaxation weight > {}: {} of {}: {:?}\n",

@@ -52,6 +52,11 @@ pub struct DesignFile {
     /// of the same prior information without the file.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub existing: Option<ExistingPoses>,
+    /// Whether the poses were refined off the pool (`select --refine`):
+    /// their ids name the pool poses they started from, their joint values
+    /// are the refined ones.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub refined: bool,
     /// Anything else (algorithm, seed, ln_oid, ...), kept as written.
     #[serde(flatten)]
     pub extra: serde_json::Map<String, serde_json::Value>,
@@ -78,6 +83,7 @@ impl DesignFile {
             q: Some(positions.iter().map(|&k| pool.q(k)).collect()),
             pool_qs: pool.listed().map(<[Vec<f64>]>::to_vec),
             existing: None,
+            refined: false,
             extra: serde_json::Map::new(),
         }
     }
@@ -94,6 +100,7 @@ impl DesignFile {
             q: None,
             pool_qs: None,
             existing: None,
+            refined: false,
             extra: serde_json::Map::new(),
         }
     }

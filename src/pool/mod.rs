@@ -102,8 +102,9 @@ pub enum PoolFilter {
 }
 
 impl PoolFilter {
-    /// Whether the configuration `q` passes.
-    fn keeps(&self, robot: &Robot, table: &ParamTable, q: &[f64]) -> bool {
+    /// Whether the configuration `q` passes (evaluated at `table`).
+    #[must_use]
+    pub fn keeps(&self, robot: &Robot, table: &ParamTable, q: &[f64]) -> bool {
         match self {
             PoolFilter::Visibility(v) => v.sees(&position(robot, table, q)),
         }

@@ -8,7 +8,7 @@ use crate::blocks::Blocks;
 use crate::bound::{Bound, BoundReport, DesignGap, SUPPORT_TOL};
 use crate::criterion::Indices;
 use crate::model::{ParamSet, Robot};
-use crate::pool::{Pool, PoolSpec};
+use crate::pool::{Pool, PoolSpec, PoolStats};
 use crate::select::{Algorithm, CriterionKind, Selection, Settings, StepKind};
 use serde::Serialize;
 
@@ -35,6 +35,10 @@ pub struct PoolInfo {
     pub levels: Option<usize>,
     /// How the pool was made.
     pub pool: PoolSpec,
+    /// What building it did: candidates, what each filter removed, notes
+    /// (absent when no pool was built).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pool_stats: Option<PoolStats>,
 }
 
 impl PoolInfo {
@@ -46,7 +50,126 @@ impl PoolInfo {
             chain: chain(robot),
             levels: pool.spec.levels(),
             pool: pool.spec.clone(),
+            pool_stats: Some(pool.stats.clone()),
         }
+    }
+}
+
+/// Poses measured before a selection (`--existing`): the prior information
+/// `M0 = Σ XᵢᵀXᵢ` every reported `ln OI_D` and bound then includes.
+#[derive(Clone, Debug, Serialize)]
+pub struct ExistingReport {
+    /// The file they were read from.
+    pub file: String,
+    /// Poses in it.
+    pub poses: usize,
+    /// Numerical rank of their stacked Jacobian.
+    pub rank: usize,
+    /// `ln det M0`; `None` when `M0` is singular (rank < p).
+    pub ln_det: Option<f64>,
+    /// `log10 det M0`; `None` when singular.
+    pub log10_det: Option<f64>,
+    /// What the reader ignored (columns, keys).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
+}
+
+impl ExistingReport {
+    /// The report of the poses in `file`, whose identification Jacobian is
+    /// `x`, and the prior made of them.
+    #[must_use]
+    pub fn new(
+        file: String,
+        x: &Blocks,
+        prior: &crate::criterion::Prior,
+        notes: Vec<String>,
+    ) -> Self {
+        let all: Vec<usize> = (0..x.n_poses()).collect();
+        let rank = Indices::from_design(x, &all).rank;
+        let ln_det = if rank == x.p() { prior.ln_det() } else { None };
+        Self {
+            file,
+            poses: x.n_poses(),
+            rank,
+            ln_det,
+            log10_det: ln_det.map(|v| v / std::f64::consts::LN_10),
+            notes,
+        }
+    }
+}
+
+/// One pose of a refined design (`select --refine`).
+#[derive(Clone, Debug, Serialize)]
+pub struct RefinedPoseReport {
+    /// Id of the pool pose it started from.
+    pub pose: usize,
+    /// Joint values after refinement.
+    pub q: Vec<f64>,
+    /// Increase of `ln OI_D` from moving it.
+    pub ln_gain: f64,
+    /// Largest joint move.
+    pub max_move: f64,
+}
+
+/// `select --refine`: the design moved off the pool, and how it compares
+/// with the pool's certified bound.
+#[derive(Clone, Debug, Serialize)]
+pub struct RefinementReport {
+    /// `ln OI_D` before (the pool design).
+    pub ln_oid_before: f64,
+    /// `ln OI_D` after.
+    pub ln_oid: f64,
+    /// `log10 OI_D` after.
+    pub log10_oid: f64,
+    /// `ln_oid − ln_oid_before`.
+    pub ln_gain: f64,
+    /// Every pose.
+    pub poses: Vec<RefinedPoseReport>,
+    /// Passes over the poses.
+    pub sweeps: usize,
+    /// Objective evaluations.
+    pub evaluations: usize,
+    /// With `--gap`: `exp((ln_oid − ln_bound)/p)` against the pool's bound;
+    /// above 1 when the refined design beats every pool design.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub d_efficiency_vs_pool_bound: Option<f64>,
+    /// With `--gap`: whether the refined design exceeds the pool's certified
+    /// bound (no design of the pool can reach it; a continuous design can).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exceeds_pool_bound: Option<bool>,
+}
+
+impl RefinementReport {
+    /// The report of `r`, refined from pool positions `positions`.
+    #[must_use]
+    pub fn new(pool: &Pool, positions: &[usize], r: &crate::select::Refinement) -> Self {
+        Self {
+            ln_oid_before: r.ln_oid_before,
+            ln_oid: r.ln_oid,
+            log10_oid: r.ln_oid / std::f64::consts::LN_10,
+            ln_gain: r.gain,
+            poses: r
+                .poses
+                .iter()
+                .map(|p| RefinedPoseReport {
+                    pose: pool.id(positions[p.index]),
+                    q: p.q.clone(),
+                    ln_gain: p.gain,
+                    max_move: p.max_move,
+                })
+                .collect(),
+            sweeps: r.sweeps,
+            evaluations: r.evaluations,
+            d_efficiency_vs_pool_bound: None,
+            exceeds_pool_bound: None,
+        }
+    }
+
+    /// Compares the refined design with the pool's bound `ln_bound` for `p`
+    /// unknowns.
+    pub fn set_bound(&mut self, ln_bound: f64, p: usize) {
+        self.d_efficiency_vs_pool_bound = Some(((self.ln_oid - ln_bound) / p as f64).exp());
+        self.exceeds_pool_bound = Some(self.ln_oid > ln_bound);
     }
 }
 
@@ -150,6 +273,21 @@ pub struct SelectReport {
     /// The bound's status (`--gap`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bound_status: Option<crate::bound::BoundStatus>,
+    /// The poses measured before (`--existing`): `ln_oid`, the trace and
+    /// the bound are then of `M0 + XᵀX`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub existing: Option<ExistingReport>,
+    /// With `--existing`: `ln det XᵀX` of the new poses alone (`None` when
+    /// they are singular without the prior).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ln_oid_new_only: Option<Option<f64>>,
+    /// With `--existing`: `ln_oid − ln det M0`, what the new poses add
+    /// (`None` when `M0` is singular).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ln_gain: Option<Option<f64>>,
+    /// With `--refine`: the design moved continuously off the pool.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub refinement: Option<RefinementReport>,
 }
 
 impl SelectReport {
@@ -198,7 +336,19 @@ impl SelectReport {
             log10_bound: None,
             d_efficiency: None,
             bound_status: None,
+            existing: None,
+            ln_oid_new_only: None,
+            ln_gain: None,
+            refinement: None,
         }
+    }
+
+    /// Records the poses measured before (the prior of the selection) and
+    /// `ln det XᵀX` of the new poses alone.
+    pub fn set_existing(&mut self, existing: ExistingReport, ln_oid_new_only: Option<f64>) {
+        self.ln_gain = Some(existing.ln_det.map(|l0| self.ln_oid - l0));
+        self.ln_oid_new_only = Some(ln_oid_new_only);
+        self.existing = Some(existing);
     }
 
     /// Adds the design's gap to a bound.
@@ -234,6 +384,10 @@ pub struct BoundCommandReport {
     /// Poses with weight above [`SUPPORT_TOL`] (when asked for).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub support: Option<Vec<WeightedPose>>,
+    /// The poses measured before (`--existing`), whose information the
+    /// relaxation includes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub existing: Option<ExistingReport>,
 }
 
 impl BoundCommandReport {
@@ -261,6 +415,7 @@ impl BoundCommandReport {
                     })
                     .collect()
             }),
+            existing: None,
         }
     }
 }
@@ -297,6 +452,18 @@ pub struct GapReport {
     pub weights: Vec<f64>,
     /// The bound.
     pub bound: BoundReport,
+    /// The poses measured before, when the design was chosen on top of
+    /// them (`ln_oid` and the bound then include their information).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub existing: Option<ExistingReport>,
+    /// Whether the design was refined off the pool (`select --refine`):
+    /// the bound is then the pool's, which does not bound it, and
+    /// `d_efficiency` may exceed 1.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub refined: bool,
+    /// For a refined design: whether it exceeds the pool's certified bound.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exceeds_bound: Option<bool>,
 }
 
 impl GapReport {
@@ -324,6 +491,9 @@ impl GapReport {
             d_efficiency: g.d_efficiency,
             weights: g.weights.clone(),
             bound: BoundReport::from(b),
+            existing: None,
+            refined: false,
+            exceeds_bound: None,
         }
     }
 }

@@ -190,7 +190,7 @@ pub fn solve(x: &Blocks, n: usize, settings: &ConicSettings) -> Result<ConicOutc
 pub(crate) fn solve_scaled(sc: &Scaled, n: usize, s: &ConicSettings) -> ConicOutcome {
     crate::linalg::blas::single_threaded();
     let clock = Instant::now();
-    let (a, b, q, cones) = problem(&sc.x, n);
+    let (a, b, q, cones) = problem(sc, n);
     let p_mat = CscMatrix::zeros((q.len(), q.len()));
     let mut iterations = 0;
     let mut retried = false;
@@ -256,7 +256,11 @@ fn tri(r: usize, c: usize) -> usize {
 /// Rows: `Σw = N` (zero cone), `w ≥ 0` and `1 − w ≥ 0` (nonnegative cone),
 /// `p` exponential cones, one PSD cone of side `2p`.
 #[allow(clippy::type_complexity)]
-fn problem(x: &Blocks, n: usize) -> (CscMatrix<f64>, Vec<f64>, Vec<f64>, Vec<SupportedConeT<f64>>) {
+fn problem(
+    sc: &Scaled,
+    n: usize,
+) -> (CscMatrix<f64>, Vec<f64>, Vec<f64>, Vec<SupportedConeT<f64>>) {
+    let x = &sc.x;
     let (m, t, p) = (x.n_poses(), x.t(), x.p());
     let nz = p * (p + 1) / 2;
     let nvar = m + nz + p;
@@ -330,6 +334,16 @@ fn problem(x: &Blocks, n: usize) -> (CscMatrix<f64>, Vec<f64>, Vec<f64>, Vec<Sup
     }
     for j in 0..p {
         b[exp0 + 3 * j + 1] = 1.0;
+    }
+    // A prior is the constant part of the PSD block: s = b − A x puts
+    // M0 + Σ w_i X_iᵀX_i in its top-left corner.
+    if let Some(m0) = &sc.m0 {
+        for c in 0..p {
+            for r in 0..=c {
+                let v = 0.5 * (m0[(r, c)] + m0[(c, r)]);
+                b[psd0 + tri(r, c)] = if r == c { v } else { sqrt2 * v };
+            }
+        }
     }
     let mut q = vec![0.0; nvar];
     q[m + nz..].iter_mut().for_each(|v| *v = -1.0);

@@ -23,7 +23,7 @@
 
 use super::BoundError;
 use super::variance::{
-    Scaled, VarianceWork, certificate, check_problem, information, make_feasible, scale_columns,
+    Scaled, VarianceWork, certificate_with_prior, check_problem, make_feasible, scale_columns,
     top_sum, variances_into,
 };
 use crate::blocks::Blocks;
@@ -149,7 +149,7 @@ pub fn solve(
         check_start(w, x.n_poses())?;
     }
     let sc = scale_columns(x, n)?;
-    let mut out = solve_scaled(&sc.x, n, start.map(<[f64]>::to_vec), settings);
+    let mut out = solve_scaled(&sc, n, start.map(<[f64]>::to_vec), settings);
     unscale(&mut out, &sc);
     Ok(out)
 }
@@ -183,22 +183,24 @@ pub(crate) struct Evaluation {
     pub minv: Mat<f64>,
 }
 
-/// Evaluates `M(w)`, its variances and the certificate on the whole pool, or
-/// `None` if `M(w)` is not positive definite.
+/// Evaluates `M(w)` (prior included), its variances and the certificate
+/// (eq. C0) on the whole pool, or `None` if `M(w)` is not positive definite.
 pub(crate) fn evaluate(
-    x: &Blocks,
+    sc: &Scaled,
     n: usize,
     w: &[f64],
     work: &mut VarianceWork,
     scratch: &mut Vec<f64>,
 ) -> Option<Evaluation> {
-    let m = information(x, w);
+    let x = &sc.x;
+    let m = sc.information(w);
     let mut d = vec![0.0; x.n_poses()];
     let (ln_det, minv) = variances_into(x, m.as_ref(), work, &mut d)?;
     let s_n = top_sum(&d, n, scratch);
+    let c0 = sc.prior_trace(minv.as_ref());
     Some(Evaluation {
         ln_det,
-        bound: certificate(ln_det, s_n, x.p()),
+        bound: certificate_with_prior(ln_det, c0, s_n, x.p()),
         d,
         minv,
     })
@@ -207,11 +209,12 @@ pub(crate) fn evaluate(
 /// The solver on already scaled blocks (ln det values in scaled units).
 /// Input must have passed [`check_problem`] and [`scale_columns`].
 pub(crate) fn solve_scaled(
-    x: &Blocks,
+    sc: &Scaled,
     n: usize,
     start: Option<Vec<f64>>,
     s: &ExchangeSettings,
 ) -> ExchangeOutcome {
+    let x = &sc.x;
     let clock = Instant::now();
     let pool = x.n_poses();
     let (t, p) = (x.t(), x.p());
@@ -219,7 +222,7 @@ pub(crate) fn solve_scaled(
     let mut scratch = Vec::new();
     if n == pool {
         let w = vec![1.0; pool];
-        let e = evaluate(x, n, &w, &mut work, &mut scratch).expect("full-rank pool");
+        let e = evaluate(sc, n, &w, &mut work, &mut scratch).expect("full-rank pool");
         return ExchangeOutcome {
             weights: w,
             ln_det: e.ln_det,
@@ -241,12 +244,12 @@ pub(crate) fn solve_scaled(
         }
         None => vec![n as f64 / pool as f64; pool],
     };
-    let mut eval = match evaluate(x, n, &w, &mut work, &mut scratch) {
+    let mut eval = match evaluate(sc, n, &w, &mut work, &mut scratch) {
         Some(e) => e,
         None => {
             // A start with a singular M: fall back to the uniform design.
             w = vec![n as f64 / pool as f64; pool];
-            evaluate(x, n, &w, &mut work, &mut scratch).expect("full-rank pool")
+            evaluate(sc, n, &w, &mut work, &mut scratch).expect("full-rank pool")
         }
     };
     let mut best_bound = eval.bound;
@@ -258,7 +261,7 @@ pub(crate) fn solve_scaled(
             if !multiplicative_step(&mut w, &eval.d, n) {
                 break;
             }
-            match evaluate(x, n, &w, &mut work, &mut scratch) {
+            match evaluate(sc, n, &w, &mut work, &mut scratch) {
                 Some(e) => eval = e,
                 None => break,
             }
@@ -270,7 +273,7 @@ pub(crate) fn solve_scaled(
         loop {
             let mut pruned = prune(&w, k);
             make_feasible(&mut pruned, n);
-            if let Some(e) = evaluate(x, n, &pruned, &mut work, &mut scratch) {
+            if let Some(e) = evaluate(sc, n, &pruned, &mut work, &mut scratch) {
                 w = pruned;
                 eval = e;
                 rounds += 1;
@@ -315,7 +318,7 @@ pub(crate) fn solve_scaled(
         );
         // Rounding in the Woodbury updates can leave tiny negative weights.
         make_feasible(&mut w, n);
-        match evaluate(x, n, &w, &mut work, &mut scratch) {
+        match evaluate(sc, n, &w, &mut work, &mut scratch) {
             Some(e) => eval = e,
             None => {
                 // Should not happen (the line search keeps M positive

@@ -10,6 +10,7 @@
 use super::variance::information;
 use super::{Bound, BoundError, BoundStatus};
 use crate::blocks::Blocks;
+use crate::criterion::Prior;
 use crate::linalg::chol::ln_det_spd_equilibrated;
 
 use serde::Serialize;
@@ -24,7 +25,8 @@ pub struct DesignGap {
     pub n: usize,
     /// Unknowns.
     pub p: usize,
-    /// `ln det M_design`; `None` when the design is singular.
+    /// `ln det M_design` (`ln det(M0 + M_design)` with a prior); `None`
+    /// when the design is singular.
     pub ln_oid: Option<f64>,
     /// `log10 det M_design`; `None` when singular.
     pub log10_oid: Option<f64>,
@@ -52,10 +54,43 @@ pub fn design_ln_det(x: &Blocks, design: &[usize]) -> Option<f64> {
     ln_det_spd_equilibrated(x.information(design).as_ref())
 }
 
+/// [`design_ln_det`] on top of prior information: `ln det(M0 + Σ X_iᵀX_i)`.
+#[must_use]
+pub fn design_ln_det_with_prior(
+    x: &Blocks,
+    prior: Option<&Prior>,
+    design: &[usize],
+) -> Option<f64> {
+    match prior {
+        None => design_ln_det(x, design),
+        Some(pr) => ln_det_spd_equilibrated((x.information(design) + pr.matrix()).as_ref()),
+    }
+}
+
 /// The gap report of a design (pool positions) against the bound for its
 /// size. Errors when the design's size differs from the bound's `n`, a
 /// position is outside the pool, or a pose repeats.
 pub fn design_gap(x: &Blocks, design: &[usize], bound: &Bound) -> Result<DesignGap, BoundError> {
+    design_gap_with_prior(x, None, design, bound)
+}
+
+/// [`design_gap`] on top of prior information: the design's
+/// `ln det(M0 + Σ X_iᵀX_i)` against a bound computed with the same prior
+/// ([`super::relaxation_bound_with_prior`]). A bound made with a prior used
+/// without one, or the reverse, is an error.
+pub fn design_gap_with_prior(
+    x: &Blocks,
+    prior: Option<&Prior>,
+    design: &[usize],
+    bound: &Bound,
+) -> Result<DesignGap, BoundError> {
+    if prior.is_some() != bound.with_prior {
+        return Err(BoundError::InvalidDesign(format!(
+            "the bound was computed {} prior information, the design is scored {} it",
+            if bound.with_prior { "with" } else { "without" },
+            if prior.is_some() { "with" } else { "without" },
+        )));
+    }
     if design.len() != bound.n {
         return Err(BoundError::InvalidDesign(format!(
             "the design has {} poses, the bound is for N = {}",
@@ -86,7 +121,7 @@ pub fn design_gap(x: &Blocks, design: &[usize], bound: &Bound) -> Result<DesignG
             )));
         }
     }
-    let ln_oid = design_ln_det(x, design);
+    let ln_oid = design_ln_det_with_prior(x, prior, design);
     let p = bound.p as f64;
     let d_efficiency = ln_oid.map_or(0.0, |l| ((l - bound.ln_bound) / p).exp());
     let weights: Vec<f64> = design.iter().map(|&i| bound.weights[i]).collect();

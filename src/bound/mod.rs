@@ -23,6 +23,13 @@
 //!    `ln det M(w) + p·ln(S_N(w)/p)`, valid at any positive definite `M(w)`:
 //!    it never depends on a solver having converged. Solver objective values
 //!    are reported beside it but never used as the bound.
+//!
+//! **Prior information** ([`relaxation_bound_with_prior`]): with poses
+//! already measured, `M(w) = M0 + Σ_i w_i X_iᵀX_i` in (R); every stage
+//! carries `M0` (the scaled `M̃0` of [`variance::Scaled`], the constant of
+//! Clarabel's PSD block, Newton's `ln det`), and the certificate becomes
+//! eq. (C0) `ln det M(w) + p·ln((tr(M(w)⁻¹M0) + S_N)/p)`, which equals (C)
+//! when `M0 = 0`. `N·t < p` is then allowed.
 
 pub mod conic;
 mod error;
@@ -32,9 +39,10 @@ pub mod newton;
 pub mod variance;
 
 pub use error::BoundError;
-pub use gap::{DesignGap, design_gap};
+pub use gap::{DesignGap, design_gap, design_gap_with_prior};
 
 use crate::blocks::Blocks;
+use crate::criterion::Prior;
 use crate::model::{ParamSet, Robot};
 use crate::pool::Pool;
 use conic::{ConicSettings, ConicStatus};
@@ -42,7 +50,9 @@ use first_order::{ExchangeOutcome, ExchangeSettings, candidates, evaluate};
 use newton::NewtonSettings;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
-use variance::{VarianceWork, check_problem, make_feasible, nth_largest, scale_columns};
+use variance::{
+    VarianceWork, check_problem_with_prior, make_feasible, nth_largest, scale_columns_with_prior,
+};
 
 /// Weight above which a pose counts as carrying relaxation weight in
 /// [`Bound::support_size`].
@@ -341,6 +351,8 @@ pub struct Bound {
     pub conic: ConicSummary,
     /// Wall-clock seconds, all stages.
     pub seconds: f64,
+    /// Whether the relaxation included prior information `M0`.
+    pub with_prior: bool,
 }
 
 /// The summary of a [`Bound`] that every report prints: the bound, its
@@ -372,6 +384,8 @@ pub struct BoundReport {
     pub solver: ConicSummary,
     /// The first-order stage.
     pub first_order: ExchangeSummary,
+    /// Whether the relaxation included prior information `M0`.
+    pub with_prior: bool,
 }
 
 impl From<&Bound> for BoundReport {
@@ -389,6 +403,7 @@ impl From<&Bound> for BoundReport {
             seconds: b.seconds,
             solver: b.conic.clone(),
             first_order: b.first_order.clone(),
+            with_prior: b.with_prior,
         }
     }
 }
@@ -449,10 +464,33 @@ pub fn relaxation_bound(
     n: usize,
     settings: &BoundSettings,
 ) -> Result<Bound, BoundError> {
+    relaxation_bound_with_prior(x, None, n, settings)
+}
+
+/// [`relaxation_bound`] on top of prior information `M0` (poses already
+/// measured): bounds `ln det(M0 + Σ_{design} X_iᵀX_i)` of every `n`-pose
+/// design, certified by eq. (C0). With `prior = None` it is
+/// [`relaxation_bound`]. Errors also on a prior of another size than the
+/// pool's `p`, and when `M0` plus the whole pool is rank deficient.
+pub fn relaxation_bound_with_prior(
+    x: &Blocks,
+    prior: Option<&Prior>,
+    n: usize,
+    settings: &BoundSettings,
+) -> Result<Bound, BoundError> {
     settings.validate()?;
-    check_problem(x, n)?;
+    if let Some(pr) = prior
+        && pr.p() != x.p()
+    {
+        return Err(BoundError::InvalidDesign(format!(
+            "the prior information is for {} unknowns, the pool has {}",
+            pr.p(),
+            x.p()
+        )));
+    }
+    check_problem_with_prior(x, n, prior.is_some())?;
     let clock = Instant::now();
-    let sc = scale_columns(x, n)?;
+    let sc = scale_columns_with_prior(x, prior.map(Prior::matrix), n)?;
     let xs = &sc.x;
     let pool = xs.n_poses();
     let mut work = VarianceWork::default();
@@ -465,7 +503,7 @@ pub fn relaxation_bound(
     } else {
         settings.gap_tol
     };
-    let fo = first_order::solve_scaled(xs, n, None, &fo_settings);
+    let fo = first_order::solve_scaled(&sc, n, None, &fo_settings);
     let first_order = ExchangeSummary {
         rounds: fo.rounds,
         steps: fo.steps,
@@ -493,7 +531,7 @@ pub fn relaxation_bound(
 
     if settings.use_conic && best.gap() > settings.gap_tol {
         // --- Clarabel on the candidates, screening rounds
-        let fo_eval = evaluate(xs, n, &fo.weights, &mut work, &mut scratch)
+        let fo_eval = evaluate(&sc, n, &fo.weights, &mut work, &mut scratch)
             .expect("the first-order point is positive definite");
         let mut cand = if pool <= settings.direct_limit {
             (0..pool).collect()
@@ -514,7 +552,8 @@ pub fn relaxation_bound(
             let sub = xs.select(&cand);
             // A rank-deficient candidate set cannot happen for a support of a
             // positive definite M(w); if it does, keep what we have.
-            let Ok(sub_sc) = scale_columns(&sub, n.min(cand.len())) else {
+            let sub_prior = sc.m0.as_ref().map(|m| m.as_ref());
+            let Ok(sub_sc) = scale_columns_with_prior(&sub, sub_prior, n.min(cand.len())) else {
                 break;
             };
             let out = match settings.solver {
@@ -552,7 +591,7 @@ pub fn relaxation_bound(
                 w[i] = out.weights[k];
             }
             make_feasible(&mut w, n);
-            let Some(e) = evaluate(xs, n, &w, &mut work, &mut scratch) else {
+            let Some(e) = evaluate(&sc, n, &w, &mut work, &mut scratch) else {
                 break; // No usable point from the solver: keep the first-order one.
             };
             best.bound = best.bound.min(e.bound);
@@ -587,7 +626,7 @@ pub fn relaxation_bound(
                 // from Clarabel's point equalise the variances of the
                 // near-tied poses.
                 if settings.polish {
-                    let pol = polish(xs, n, &e_w, settings);
+                    let pol = polish(&sc, n, &e_w, settings);
                     conic_summary.polish_steps += pol.steps;
                     best.bound = best.bound.min(pol.ln_bound);
                     if pol.ln_det > best.ln_det {
@@ -613,7 +652,7 @@ pub fn relaxation_bound(
         if settings.polish && !conic_solved && best.gap() > settings.gap_tol {
             let mut s = settings.first_order.clone();
             s.gap_tol = settings.gap_tol;
-            let pol: ExchangeOutcome = first_order::solve_scaled(xs, n, Some(best.w.clone()), &s);
+            let pol: ExchangeOutcome = first_order::solve_scaled(&sc, n, Some(best.w.clone()), &s);
             conic_summary.polish_steps += pol.steps;
             best.bound = best.bound.min(pol.ln_bound);
             if pol.ln_det > best.ln_det {
@@ -632,11 +671,11 @@ pub fn relaxation_bound(
 
 /// First-order polish from a feasible point, limited to
 /// `settings.polish_rounds` rounds.
-fn polish(xs: &Blocks, n: usize, w: &[f64], settings: &BoundSettings) -> ExchangeOutcome {
+fn polish(sc: &variance::Scaled, n: usize, w: &[f64], settings: &BoundSettings) -> ExchangeOutcome {
     let mut s = settings.first_order.clone();
     s.gap_tol = settings.gap_tol;
     s.max_rounds = settings.polish_rounds;
-    first_order::solve_scaled(xs, n, Some(w.to_vec()), &s)
+    first_order::solve_scaled(sc, n, Some(w.to_vec()), &s)
 }
 
 fn finish(
@@ -663,6 +702,7 @@ fn finish(
         first_order,
         conic,
         seconds: clock.elapsed().as_secs_f64(),
+        with_prior: sc.m0.is_some(),
     })
 }
 

@@ -26,8 +26,7 @@
 //! on the number of threads.
 
 use super::conic::{ConicOutcome, ConicStatus};
-use super::variance::{Scaled, information};
-use crate::blocks::Blocks;
+use super::variance::Scaled;
 use crate::linalg::chol::ln_det_spd;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::{Mat, Par, Side};
@@ -81,9 +80,10 @@ impl NewtonSettings {
 
 /// `ln det M(w)`, the variances `d` and the matrix `Q` at `w`, or `None` if
 /// `M(w)` is not numerically positive definite.
-fn derivatives(x: &Blocks, w: &[f64], q: &mut Mat<f64>, d: &mut [f64]) -> Option<f64> {
+fn derivatives(sc: &Scaled, w: &[f64], q: &mut Mat<f64>, d: &mut [f64]) -> Option<f64> {
+    let x = &sc.x;
     let (n, t) = (x.n_poses(), x.t());
-    let m = information(x, w);
+    let m = sc.information(w);
     let llt = m.llt(Side::Lower).ok()?;
     let l = llt.L();
     let ld = crate::linalg::chol::ln_det_of_factor(l)?;
@@ -126,11 +126,11 @@ fn derivatives(x: &Blocks, w: &[f64], q: &mut Mat<f64>, d: &mut [f64]) -> Option
 const Q_CHUNK: usize = 128;
 
 /// `F_μ` at `w` (`None` outside the domain).
-fn barrier_value(x: &Blocks, w: &[f64], mu: f64) -> Option<f64> {
+fn barrier_value(sc: &Scaled, w: &[f64], mu: f64) -> Option<f64> {
     if w.iter().any(|&v| !(v > 0.0 && v < 1.0)) {
         return None;
     }
-    let ld = ln_det_spd(information(x, w).as_ref())?;
+    let ld = ln_det_spd(sc.information(w).as_ref())?;
     Some(ld + mu * w.iter().map(|&v| v.ln() + (1.0 - v).ln()).sum::<f64>())
 }
 
@@ -163,7 +163,7 @@ pub(crate) fn solve_scaled(
     };
     if n_design >= n {
         let w = vec![1.0; n];
-        return match ln_det_spd(information(x, &w).as_ref()) {
+        return match ln_det_spd(sc.information(&w).as_ref()) {
             Some(ld) => ConicOutcome {
                 ln_det_primal: ld + sc.ln_scale,
                 ln_det_dual: ld + sc.ln_scale,
@@ -204,7 +204,7 @@ pub(crate) fn solve_scaled(
     let mut ld = f64::NAN;
     let ones = Mat::<f64>::from_fn(n, 1, |_, _| 1.0);
     while (steps as usize) < settings.max_steps {
-        let Some(l) = derivatives(x, &w, &mut q, &mut d) else {
+        let Some(l) = derivatives(sc, &w, &mut q, &mut d) else {
             return fail(w, ConicStatus::NumericalError, steps);
         };
         ld = l;
@@ -255,7 +255,7 @@ pub(crate) fn solve_scaled(
             for i in 0..n {
                 trial[i] = w[i] + s * delta[i];
             }
-            if barrier_value(x, &trial, mu).is_some_and(|f1| f1 >= f0 + 0.25 * s * lambda2) {
+            if barrier_value(sc, &trial, mu).is_some_and(|f1| f1 >= f0 + 0.25 * s * lambda2) {
                 accepted = true;
                 break;
             }
@@ -272,7 +272,7 @@ pub(crate) fn solve_scaled(
         }
         std::mem::swap(&mut w, &mut trial);
     }
-    let ld = ln_det_spd(information(x, &w).as_ref()).unwrap_or(ld);
+    let ld = ln_det_spd(sc.information(&w).as_ref()).unwrap_or(ld);
     ConicOutcome {
         ln_det_primal: ld + sc.ln_scale,
         ln_det_dual: ld + 2.0 * n as f64 * mu + sc.ln_scale,

@@ -16,7 +16,8 @@ use faer::{Mat, MatRef, Par, Side};
 /// which the pool counts as rank deficient (a singular-value ratio of 1e-6).
 pub const RANK_TOL: f64 = 1e-12;
 
-/// A column-scaled copy of a pool Jacobian, `X̃ = X·S⁻¹`.
+/// A column-scaled copy of a pool Jacobian, `X̃ = X·S⁻¹`, and of a prior
+/// `M̃0 = S⁻¹ M0 S⁻¹` when there is one.
 ///
 /// `ln det M(w) = ln det M̃(w) + ln_scale` with `ln_scale = 2·Σ_j ln s_j`;
 /// the variances d_i are invariant under the scaling.
@@ -28,16 +29,52 @@ pub struct Scaled {
     pub s: Vec<f64>,
     /// `2·Σ_j ln s_j`, added to a scaled ln det to unscale it.
     pub ln_scale: f64,
+    /// The scaled prior information `M̃0`, if any.
+    pub m0: Option<Mat<f64>>,
+}
+
+impl Scaled {
+    /// `M̃(w) = M̃0 + Σ_i w_i X̃_iᵀX̃_i` ([`information`] plus the prior).
+    #[must_use]
+    pub fn information(&self, w: &[f64]) -> Mat<f64> {
+        let m = information(&self.x, w);
+        match &self.m0 {
+            Some(m0) => m + m0,
+            None => m,
+        }
+    }
+
+    /// `tr(M⁻¹ M̃0)`, the prior's share of `tr(M⁻¹ M̃(w*))` in the
+    /// certificate (0 without a prior).
+    #[must_use]
+    pub fn prior_trace(&self, m_inv: MatRef<'_, f64>) -> f64 {
+        let Some(m0) = &self.m0 else { return 0.0 };
+        let p = m0.nrows();
+        let mut s = 0.0;
+        for c in 0..p {
+            for r in 0..p {
+                s += m_inv[(r, c)] * m0[(c, r)];
+            }
+        }
+        s
+    }
 }
 
 /// Checks the shape and entries of a relaxation problem: `1 ≤ N ≤ pool size`,
 /// `N·t ≥ p`, and every Jacobian entry finite.
 pub fn check_problem(x: &Blocks, n: usize) -> Result<(), BoundError> {
+    check_problem_with_prior(x, n, false)
+}
+
+/// [`check_problem`]; with a prior (`with_prior`), `N·t < p` is allowed (the
+/// prior may supply the missing rank; [`scale_columns_with_prior`] checks
+/// that it does).
+pub fn check_problem_with_prior(x: &Blocks, n: usize, with_prior: bool) -> Result<(), BoundError> {
     let (pool, t, p) = (x.n_poses(), x.t(), x.p());
     if n > pool {
         return Err(BoundError::TooManyPoses { n, pool });
     }
-    if n * t < p || n == 0 {
+    if (n * t < p && !with_prior) || n == 0 {
         return Err(BoundError::TooFewRows {
             n,
             t,
@@ -68,11 +105,32 @@ pub fn check_problem(x: &Blocks, n: usize) -> Result<(), BoundError> {
 /// Errors with [`BoundError::RankDeficient`] on a zero column or when the
 /// scaled Gram matrix has `λ_min/λ_max ≤` [`RANK_TOL`].
 pub fn scale_columns(x: &Blocks, n: usize) -> Result<Scaled, BoundError> {
+    scale_columns_with_prior(x, None, n)
+}
+
+/// [`scale_columns`] with a prior `M0`: `s_j = √(‖X_{:,j}‖²·N/pool +
+/// M0_jj)`, so that `M0` plus the uniform design has unit diagonal; the
+/// rank test is on that matrix (a direction the pool cannot see is fine
+/// when the prior sees it).
+pub fn scale_columns_with_prior(
+    x: &Blocks,
+    m0: Option<MatRef<'_, f64>>,
+    n: usize,
+) -> Result<Scaled, BoundError> {
     let m = x.mat();
     let (rows, p) = (m.nrows(), m.ncols());
     let f = (n as f64 / x.n_poses() as f64).sqrt();
     let norms: Vec<f64> = (0..p).map(|c| m.col(c).norm_l2()).collect();
-    let zero = norms.iter().filter(|&&v| v == 0.0).count();
+    let s: Vec<f64> = match m0 {
+        None => norms.iter().map(|v| v * f).collect(),
+        Some(m0) => norms
+            .iter()
+            .enumerate()
+            .map(|(j, v)| ((v * f).powi(2) + m0[(j, j)].max(0.0)).sqrt())
+            .collect(),
+    };
+    // `v.is_nan()` too: a NaN scale is no scale.
+    let zero = s.iter().filter(|&&v| v <= 0.0 || v.is_nan()).count();
     if zero > 0 {
         return Err(BoundError::RankDeficient {
             rank: p - zero,
@@ -80,9 +138,12 @@ pub fn scale_columns(x: &Blocks, n: usize) -> Result<Scaled, BoundError> {
             ratio: 0.0,
         });
     }
-    let s: Vec<f64> = norms.iter().map(|v| v * f).collect();
     let scaled = Mat::from_fn(rows, p, |r, c| m[(r, c)] / s[c]);
-    let gram = scaled.transpose() * &scaled;
+    let m0s = m0.map(|m0| Mat::from_fn(p, p, |r, c| m0[(r, c)] / (s[r] * s[c])));
+    let gram = match &m0s {
+        None => scaled.transpose() * &scaled,
+        Some(m0s) => scaled.transpose() * &scaled * f * f + m0s,
+    };
     let eig =
         gram.self_adjoint_eigenvalues(Side::Lower)
             .map_err(|_| BoundError::RankDeficient {
@@ -101,6 +162,7 @@ pub fn scale_columns(x: &Blocks, n: usize) -> Result<Scaled, BoundError> {
         x: Blocks::new(scaled, x.t()),
         ln_scale: 2.0 * s.iter().map(|v| v.ln()).sum::<f64>(),
         s,
+        m0: m0s,
     })
 }
 
@@ -207,9 +269,29 @@ pub fn nth_largest(d: &[f64], n: usize, scratch: &mut Vec<f64>) -> f64 {
 /// `ln det M(w*) − ln det M = Σ ln λ_k ≤ p·ln(Σ λ_k / p)`, and
 /// `Σ λ_k = tr(M⁻¹ M(w*)) = Σ_i w*_i d_i ≤ S_N`. `M` need not be feasible
 /// nor optimal; the bound is tight (`S_N = p`) exactly at the optimum.
+///
+/// **With a prior** (`M(w) = M0 + Σ w_i X_iᵀX_i`, eq. C0) the same steps
+/// give `Σ λ_k = tr(M⁻¹M0) + Σ_i w*_i d_i ≤ c0 + S_N`, so
+///
+/// `ln det M(w*) ≤ ln det M + p·ln((c0 + S_N) / p)`,  `c0 = tr(M⁻¹M0)`,   (C0)
+///
+/// and `s_n` below is `c0 + S_N` ([`certificate_with_prior`]). It is tight at
+/// the optimum too: there `w*` maximises the linearisation `Σ w_i d_i` over
+/// the feasible set (the KKT conditions), so `S_N = Σ w*_i d_i = p − c0`.
+/// Since `p·ln(x/p) ≤ x − p`, (C0) is never weaker than the Lagrangian
+/// (linearisation) bound `ln det M + c0 + S_N − p`, which is the dual
+/// function `ln det M + Σ_i (d_i − λ)₊ + Nλ − Σ_i w_i d_i` at its best `λ`
+/// (the `N`-th largest `d_i`) for a feasible `M = M(w)`.
 #[must_use]
 pub fn certificate(ln_det: f64, s_n: f64, p: usize) -> f64 {
     ln_det + p as f64 * (s_n / p as f64).ln()
+}
+
+/// Eq. (C0): the certificate with a prior, from `ln det M`, `c0 =
+/// tr(M⁻¹M0)` and `S_N`; equals [`certificate`] when `c0 = 0`.
+#[must_use]
+pub fn certificate_with_prior(ln_det: f64, c0: f64, s_n: f64, p: usize) -> f64 {
+    certificate(ln_det, c0 + s_n, p)
 }
 
 /// Moves `w` onto the feasible set `{0 ≤ w ≤ 1, Σ w = N}` keeping its support

@@ -1,8 +1,10 @@
 //! `bound` and `gap`: the certified D-optimal relaxation bound on OI_D, and a
 //! design's D-efficiency against it.
 
-use super::{PoolOpts, build_pool, emit_report, filters, load_description};
-use activecal::bound::{Bound, BoundSettings, RelaxationSolver, design_gap, relaxation_bound};
+use super::{PoolOpts, emit_report, filters, load_description};
+use activecal::bound::{
+    Bound, BoundSettings, RelaxationSolver, design_gap_with_prior, relaxation_bound_with_prior,
+};
 use activecal::io::design::DesignFile;
 use activecal::model::ParamSet;
 use activecal::report::{BoundCommandReport, GapReport, PoolInfo};
@@ -63,6 +65,10 @@ pub struct BoundArgs {
     /// Also list the poses carrying relaxation weight (lattice index, weight).
     #[arg(long)]
     pub weights: bool,
+    /// Poses already measured (see `select --existing`): the relaxation
+    /// maximises ln det(M0 + Σ w_i X_iᵀX_i) with M0 their information.
+    #[arg(long, value_name = "FILE")]
+    pub existing: Option<PathBuf>,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -135,8 +141,14 @@ fn solver_name(b: &Bound) -> &'static str {
 pub fn cmd_bound(a: BoundArgs) -> Result<()> {
     let settings = a.solve.settings()?;
     let ctx = a.pool.load()?;
-    let b = relaxation_bound(&ctx.x, a.n, &settings)?;
-    let report = BoundCommandReport::new(
+    let existing = a
+        .existing
+        .as_deref()
+        .map(|p| super::load_existing(p, &ctx.robot, a.pool.params))
+        .transpose()?;
+    let prior = existing.as_ref().map(|e| &e.prior);
+    let b = relaxation_bound_with_prior(&ctx.x, prior, a.n, &settings)?;
+    let mut report = BoundCommandReport::new(
         &ctx.robot,
         &ctx.pool,
         &b,
@@ -144,8 +156,13 @@ pub fn cmd_bound(a: BoundArgs) -> Result<()> {
         settings,
         a.weights,
     );
+    report.existing = existing.map(|e| e.report);
     emit_report(a.json, &report, || {
-        let mut s = bound_text(&b);
+        let mut s = super::pool_stats_text(&ctx.pool.stats);
+        if let Some(e) = &report.existing {
+            s += &super::existing_text(e);
+        }
+        s += &bound_text(&b);
         if let Some(support) = &report.support {
             s += "pose      weight\n";
             for w in support {
@@ -166,24 +183,92 @@ pub fn cmd_gap(a: GapArgs) -> Result<()> {
     if d.pool.is_none() || a.visibility.is_some() {
         spec.filters = filters(a.visibility.as_deref(), desc.visibility.as_ref())?;
     }
-    let ctx = build_pool(desc.robot, &spec, a.params)?;
-    let positions = d
-        .positions_in(&ctx.robot, &ctx.pool)
+    let pool = d
+        .build_pool(&spec, &desc.robot, &desc.robot.nominal)
         .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?;
-    let b = relaxation_bound(&ctx.x, positions.len(), &settings)?;
-    let g = design_gap(&ctx.x, &positions, &b)?;
-    let report = GapReport::new(
+    let ctx = super::with_jacobian(desc.robot, pool, a.params);
+    // A refined design's poses are off the pool: it is scored from its
+    // joint values against the bound of the pool it started from.
+    let positions = if d.refined {
+        Vec::new()
+    } else {
+        d.positions_in(&ctx.robot, &ctx.pool)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?
+    };
+    // A design chosen on top of existing poses is scored, and bounded, with
+    // their information (stored in the design file).
+    let existing = d
+        .existing
+        .as_ref()
+        .map(|e| {
+            super::existing_from(
+                e.path.clone(),
+                e.q.clone(),
+                Vec::new(),
+                &ctx.robot,
+                a.params,
+            )
+        })
+        .transpose()?;
+    let prior = existing.as_ref().map(|e| &e.prior);
+    let b = relaxation_bound_with_prior(&ctx.x, prior, d.poses.len(), &settings)?;
+    let g = if d.refined {
+        let qs = d
+            .joint_values(&ctx.robot)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?;
+        let xd = activecal::blocks::jacobian_of(
+            &ctx.robot,
+            ctx.robot.params(a.params),
+            qs.len(),
+            |k, q| q.copy_from_slice(&qs[k]),
+        );
+        let all: Vec<usize> = (0..qs.len()).collect();
+        // The pool's bound is for the pool's Jacobian; the design's own
+        // Jacobian is scored against its value.
+        let ln = activecal::bound::gap::design_ln_det_with_prior(&xd, prior, &all);
+        activecal::bound::DesignGap {
+            n: qs.len(),
+            p: b.p,
+            ln_oid: ln,
+            log10_oid: ln.map(|l| l / std::f64::consts::LN_10),
+            ln_bound: b.ln_bound,
+            log10_bound: b.log10_bound(),
+            d_efficiency: ln.map_or(0.0, |l| ((l - b.ln_bound) / b.p as f64).exp()),
+            bound_status: b.status,
+            certificate_gap: b.certificate_gap,
+            weighted: Vec::new(),
+            weights: Vec::new(),
+        }
+    } else {
+        design_gap_with_prior(&ctx.x, prior, &positions, &b)?
+    };
+    let mut report = GapReport::new(
         PoolInfo::new(&ctx.robot, &ctx.pool),
         a.params,
         d.poses.clone(),
         &g,
         &b,
     );
+    report.existing = existing.map(|e| e.report);
+    if d.refined {
+        report.refined = true;
+        report.exceeds_bound = g.ln_oid.map(|l| l > b.ln_bound);
+    }
     emit_report(a.json, &report, || {
         let oid = g
             .log10_oid
             .map_or("singular (-inf)".to_string(), |l| format!("{l:.6}"));
-        format!(
+        let mut head = report
+            .existing
+            .as_ref()
+            .map_or(String::new(), super::existing_text);
+        if let Some(ex) = report.exceeds_bound {
+            head += &format!(
+                "refined design (poses off the pool): the pool's bound does not bound it; it {} that bound\n",
+                if ex { "EXCEEDS" } else { "stays below" }
+            );
+        }
+        head + &format!(
             "design {} ({} poses, p = {})\nlog10 OI_D     {oid}\nlog10 bound    {:.6}  ({:?}, gap {:.1e})\nD-efficiency  >= {:.6}\n\
              poses with relaxation weight > {}: {} of {}: {:?}\n",
             a.design.display(),

@@ -256,7 +256,9 @@ fn from_design(
         // robot description's visibility region.
         spec.filters = super::filters(None, described)?;
     }
-    let pool = spec.build(robot, &robot.nominal)?;
+    let pool = design
+        .build_pool(&spec, robot, &robot.nominal)
+        .map_err(in_file)?;
     let qs = design.joint_values(robot).map_err(in_file)?;
     let positions = design.positions_found_in(robot, &pool).map_err(in_file)?;
     let lm = LmSettings::default()

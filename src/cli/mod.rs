@@ -117,6 +117,51 @@ pub fn emit_report<T: serde::Serialize>(
     Ok(())
 }
 
+/// Where the candidate poses come from (`--pool`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum PoolKind {
+    /// The joint-space lattice (`--levels`).
+    Lattice,
+    /// Uniform random samples inside the joint limits (`--count`, `--pool-seed`).
+    Random,
+    /// Sobol points inside the joint limits (`--count`, `--pool-seed` to scramble).
+    Sobol,
+    /// Joint configurations from a CSV or JSON file.
+    File(std::path::PathBuf),
+}
+
+/// Parses `--pool`: `lattice`, `random`, `sobol`, `file:PATH`, or a path
+/// ending in `.csv` or `.json`.
+pub fn parse_pool_kind(s: &str) -> std::result::Result<PoolKind, String> {
+    match s {
+        "lattice" => Ok(PoolKind::Lattice),
+        "random" => Ok(PoolKind::Random),
+        "sobol" => Ok(PoolKind::Sobol),
+        _ => {
+            if let Some(p) = s.strip_prefix("file:") {
+                if p.is_empty() {
+                    return Err("file: needs a path, e.g. file:poses.csv".into());
+                }
+                return Ok(PoolKind::File(p.into()));
+            }
+            let lower = s.to_ascii_lowercase();
+            if lower.ends_with(".csv") || lower.ends_with(".json") {
+                return Ok(PoolKind::File(s.into()));
+            }
+            Err(format!(
+                "unknown pool '{s}': use lattice, random, sobol, or file:PATH (a CSV or JSON of joint configurations)"
+            ))
+        }
+    }
+}
+
+/// Samples of a random or Sobol pool when `--count` is not given (2¹²: a
+/// whole number of Sobol strata).
+pub const DEFAULT_COUNT: usize = 4096;
+
+/// Lattice values per joint when `--levels` is not given.
+pub const DEFAULT_LEVELS: usize = 5;
+
 /// Options that define a pose pool, shared by the commands that need one.
 #[derive(clap::Args, Clone, Debug)]
 pub struct PoolOpts {
@@ -124,9 +169,22 @@ pub struct PoolOpts {
     /// description or .urdf file; append `:pose` for full-pose measurements.
     #[arg(long, default_value = "puma560")]
     pub robot: String,
-    /// Lattice values per joint.
-    #[arg(long, default_value_t = 5)]
-    pub levels: usize,
+    /// Candidate poses: lattice (--levels), random or sobol (--count,
+    /// --pool-seed) inside the joint limits, or file:PATH, a CSV with a
+    /// header of joint names (or q1..qN) or JSON {"qs": [[...]]} of joint
+    /// configurations (a PATH ending in .csv or .json also works).
+    #[arg(long, value_name = "lattice|random|sobol|file:PATH", default_value = "lattice", value_parser = parse_pool_kind)]
+    pub pool: PoolKind,
+    /// Lattice values per joint (--pool lattice) [default: 5].
+    #[arg(long)]
+    pub levels: Option<usize>,
+    /// Samples of --pool random or sobol [default: 4096].
+    #[arg(long)]
+    pub count: Option<usize>,
+    /// Seed of --pool random [default: 0], or of the scramble of --pool
+    /// sobol (without it, the plain Sobol sequence).
+    #[arg(long)]
+    pub pool_seed: Option<u64>,
     /// Parameter set the Jacobian is computed with.
     #[arg(long, value_enum, default_value_t = ParamSet::Nominal)]
     pub params: ParamSet,
@@ -135,6 +193,71 @@ pub struct PoolOpts {
     /// '{"kind":"cone","apex":[0,0,0],"axis":[0,1,0],"half_angle":0.1,"max_range":40}'.
     #[arg(long)]
     pub visibility: Option<String>,
+}
+
+/// Poses measured before a selection (`--existing`): their prior
+/// information `M0` and its report.
+pub struct Existing {
+    /// `M0 = Σ XᵢᵀXᵢ` of the poses, at the pool's parameters.
+    pub prior: activecal::criterion::Prior,
+    /// What the file held.
+    pub report: activecal::report::ExistingReport,
+    /// Their joint values (a design file stores them).
+    pub qs: Vec<Vec<f64>>,
+}
+
+/// Reads the poses of `--existing FILE` (a CSV or JSON of joint
+/// configurations, or a JSON measurement file: the same reader as
+/// `--pool file:…`) and makes their prior information at `params`.
+pub fn load_existing(path: &std::path::Path, robot: &Robot, params: ParamSet) -> Result<Existing> {
+    let c = activecal::pool::read_configurations(path, robot)
+        .map_err(|e| anyhow::anyhow!("--existing: {e}"))?;
+    existing_from(path.display().to_string(), c.qs, c.notes, robot, params)
+}
+
+/// The prior information of poses `qs` (from `file`) at `params`.
+pub fn existing_from(
+    file: String,
+    qs: Vec<Vec<f64>>,
+    notes: Vec<String>,
+    robot: &Robot,
+    params: ParamSet,
+) -> Result<Existing> {
+    activecal::resources::MemoryBudget::from_env()?.check(
+        &format!("the Jacobian of {} existing poses", qs.len()),
+        activecal::pool::memory_estimate(robot, qs.len()),
+    )?;
+    if let Some(k) = qs.iter().position(|q| q.len() != robot.dof()) {
+        anyhow::bail!(
+            "{file}: existing pose {} has {} joint values, the robot {}",
+            k + 1,
+            qs[k].len(),
+            robot.dof()
+        );
+    }
+    let x = activecal::blocks::jacobian_of(robot, robot.params(params), qs.len(), |k, q| {
+        q.copy_from_slice(&qs[k]);
+    });
+    let prior = activecal::criterion::Prior::from_blocks(&x)
+        .map_err(|e| anyhow::anyhow!("{file}: the existing poses' Jacobian: {e}"))?;
+    let report = activecal::report::ExistingReport::new(file, &x, &prior, notes);
+    Ok(Existing { prior, report, qs })
+}
+
+/// Text lines about the existing poses of a report.
+pub fn existing_text(e: &activecal::report::ExistingReport) -> String {
+    let mut s = format!(
+        "existing: {} poses from {} (rank {}), log10 det M0 {}\n",
+        e.poses,
+        e.file,
+        e.rank,
+        e.log10_det
+            .map_or("singular (-inf)".to_string(), |v| format!("{v:.4}"))
+    );
+    for n in &e.notes {
+        s += &format!("note: {n}\n");
+    }
+    s
 }
 
 /// A robot, its pose pool and the pool's identification Jacobian.
@@ -175,17 +298,63 @@ pub fn load_description(name: &str) -> Result<activecal::io::Description> {
 /// nominal model) and its Jacobian at `params`.
 pub fn build_pool(robot: Robot, spec: &PoolSpec, params: ParamSet) -> Result<PoolCtx> {
     let pool = spec.build(&robot, &robot.nominal)?;
+    Ok(with_jacobian(robot, pool, params))
+}
+
+/// A built pool with its Jacobian at `params`.
+pub fn with_jacobian(robot: Robot, pool: Pool, params: ParamSet) -> PoolCtx {
     let x = pool.jacobian(&robot, robot.params(params));
-    Ok(PoolCtx { robot, pool, x })
+    PoolCtx { robot, pool, x }
+}
+
+/// One line per filter (what it removed) and per note of a pool's build.
+pub fn pool_stats_text(st: &activecal::pool::PoolStats) -> String {
+    let mut s = format!("pool: {} candidates", st.candidates);
+    for f in &st.filters {
+        s += &format!(", {} filter removed {} of {}", f.filter, f.removed, f.seen);
+    }
+    s += &format!(", {} kept\n", st.kept);
+    for n in &st.notes {
+        s += &format!("note: {n}\n");
+    }
+    s
 }
 
 impl PoolOpts {
+    /// The pool source these options describe; an option that does not
+    /// apply to the chosen pool is an error.
+    pub fn source(&self) -> Result<PoolSource> {
+        let lattice = matches!(self.pool, PoolKind::Lattice);
+        let sampled = matches!(self.pool, PoolKind::Random | PoolKind::Sobol);
+        if self.levels.is_some() && !lattice {
+            anyhow::bail!("--levels applies to --pool lattice only");
+        }
+        if !sampled && (self.count.is_some() || self.pool_seed.is_some()) {
+            anyhow::bail!("--count and --pool-seed apply to --pool random or sobol only");
+        }
+        let count = self.count.unwrap_or(DEFAULT_COUNT);
+        Ok(match &self.pool {
+            PoolKind::Lattice => PoolSource::Lattice {
+                levels: self.levels.unwrap_or(DEFAULT_LEVELS),
+            },
+            PoolKind::Random => PoolSource::Random {
+                count,
+                seed: self.pool_seed.unwrap_or(0),
+            },
+            PoolKind::Sobol => PoolSource::Sobol {
+                count,
+                seed: self.pool_seed,
+            },
+            PoolKind::File(p) => PoolSource::File {
+                path: p.display().to_string(),
+            },
+        })
+    }
+
     /// The pool these options describe, for a robot description.
     pub fn spec(&self, described: Option<&Visibility>) -> Result<PoolSpec> {
         Ok(PoolSpec {
-            source: PoolSource::Lattice {
-                levels: self.levels,
-            },
+            source: self.source()?,
             filters: filters(self.visibility.as_deref(), described)?,
         })
     }

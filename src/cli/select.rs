@@ -58,6 +58,7 @@ pub fn cmd_score(a: ScoreArgs) -> Result<()> {
                 chain: activecal::report::chain(&robot),
                 levels: d.spec()?.levels(),
                 pool: d.spec()?,
+                pool_stats: None,
             };
             ScoreReport::new(info, d.poses.clone(), &x)
         }
@@ -127,6 +128,22 @@ pub struct SelectArgs {
     /// Solver of the bound for `--gap` (see `bound`).
     #[arg(long, value_enum, default_value_t = activecal::bound::RelaxationSolver::Newton, requires = "gap")]
     pub gap_solver: activecal::bound::RelaxationSolver,
+    /// Poses already measured: a CSV or JSON of joint configurations (as
+    /// --pool file: reads them) or a JSON measurement file. The new poses
+    /// maximise ln det(M0 + XᵀX) with M0 the information of these, and
+    /// --gap reports the D-efficiency against the bound with M0.
+    #[arg(long, value_name = "FILE")]
+    pub existing: Option<PathBuf>,
+    /// Move each selected pose continuously in joint space (within the
+    /// limits and the pool's filters) to increase ln OI_D; the gain is
+    /// reported per pose and in total, and with --gap against the pool's
+    /// bound (which a refined design may exceed). --out then stores the
+    /// refined joint values.
+    #[arg(long)]
+    pub refine: bool,
+    /// Passes over the poses of --refine (fewer when a pass gains nothing).
+    #[arg(long, default_value_t = 3, requires = "refine")]
+    pub refine_sweeps: usize,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -139,6 +156,12 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         super::refuse_overwrite(out, a.force)?;
     }
     let ctx = a.pool.load()?;
+    let existing = a
+        .existing
+        .as_deref()
+        .map(|p| super::load_existing(p, &ctx.robot, a.pool.params))
+        .transpose()?;
+    let prior = existing.as_ref().map(|e| e.prior.clone());
     let fixed_ids: Vec<usize> = match &a.fixed {
         Some(f) => parse_list(f, "--fixed")?,
         None => vec![],
@@ -153,22 +176,64 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         polish: a.polish,
         seed: a.seed,
         fixed,
+        prior: prior.clone(),
         ..Settings::default()
     };
     let t0 = Instant::now();
     let sel = select(&ctx.x, a.criterion, a.algorithm, &s)?;
     let seconds = t0.elapsed().as_secs_f64();
     let mut report = SelectReport::new(&ctx.robot, &ctx.pool, &sel, a.criterion, &s, seconds);
+    if let Some(e) = &existing {
+        let alone = activecal::select::ln_det_direct(&ctx.x, &sel.poses);
+        report.set_existing(e.report.clone(), alone);
+    }
+    let mut pool_bound = None;
     if a.gap {
         let settings = activecal::bound::BoundSettings::builder()
             .solver(a.gap_solver)
             .build()?;
-        let bound = activecal::bound::relaxation_bound(&ctx.x, a.n, &settings)?;
-        let g = activecal::bound::design_gap(&ctx.x, &sel.poses, &bound)?;
+        let bound =
+            activecal::bound::relaxation_bound_with_prior(&ctx.x, prior.as_ref(), a.n, &settings)?;
+        let g =
+            activecal::bound::design_gap_with_prior(&ctx.x, prior.as_ref(), &sel.poses, &bound)?;
         report.set_gap(&g);
+        pool_bound = Some(bound.ln_bound);
     }
+    let refined = if a.refine {
+        let qs: Vec<Vec<f64>> = sel.poses.iter().map(|&k| ctx.pool.q(k)).collect();
+        let r = activecal::select::refine(
+            &ctx.robot,
+            ctx.robot.params(a.pool.params),
+            &ctx.robot.nominal,
+            &ctx.pool.spec.filters,
+            prior.as_ref(),
+            &qs,
+            &activecal::select::RefineSettings {
+                sweeps: a.refine_sweeps,
+                ..activecal::select::RefineSettings::default()
+            },
+        )?;
+        let mut rr = activecal::report::RefinementReport::new(&ctx.pool, &sel.poses, &r);
+        if let Some(lb) = pool_bound {
+            rr.set_bound(lb, ctx.x.p());
+        }
+        report.refinement = Some(rr);
+        Some(r)
+    } else {
+        None
+    };
     if let Some(out) = &a.out {
         let mut d = DesignFile::from_pool(&ctx.robot, &ctx.pool, &sel.poses);
+        if let Some(r) = &refined {
+            d.q = Some(r.poses.iter().map(|p| p.q.clone()).collect());
+            d.refined = true;
+        }
+        d.existing = existing
+            .as_ref()
+            .map(|e| activecal::io::design::ExistingPoses {
+                path: e.report.file.clone(),
+                q: e.qs.clone(),
+            });
         let v = serde_json::to_value(&report)?;
         for k in [
             "ln_oid",
@@ -186,8 +251,12 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         d.write(out, a.force)?;
     }
     emit_report(a.json, &report, || {
-        format!(
-            "{:?} ({:?} criterion, seed {}, {} start(s){}): {} poses in {:.3} s\nlog10 OI_D {:.4}  OI {:.6}\nposes: {}\n",
+        let mut s = super::pool_stats_text(&ctx.pool.stats);
+        if let Some(e) = &report.existing {
+            s += &super::existing_text(e);
+        }
+        s += &format!(
+            "{:?} ({:?} criterion, seed {}, {} start(s){}): {} poses in {:.3} s\nlog10 OI_D {:.4}{}  OI {:.6}\nposes: {}\n",
             report.algorithm,
             report.criterion,
             a.seed,
@@ -196,6 +265,11 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
             report.poses.len(),
             seconds,
             report.log10_oid,
+            if report.existing.is_some() {
+                " (existing + new poses)"
+            } else {
+                ""
+            },
             report.oi,
             report
                 .poses
@@ -203,6 +277,52 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
                 .map(|p| p.to_string())
                 .collect::<Vec<_>>()
                 .join(",")
-        )
+        );
+        if let Some(Some(g)) = report.ln_gain {
+            s += &format!(
+                "the new poses add {:.4} to log10 det M0\n",
+                g / std::f64::consts::LN_10
+            );
+        }
+        if let (Some(b), Some(eff)) = (report.log10_bound, report.d_efficiency) {
+            s += &format!(
+                "log10 bound {b:.4}{}  D-efficiency >= {eff:.6}\n",
+                if report.existing.is_some() {
+                    " (with the existing poses' information)"
+                } else {
+                    ""
+                }
+            );
+        }
+        if let Some(r) = &report.refinement {
+            s += &format!(
+                "refined off the pool: log10 OI_D {:.4} -> {:.4} (+{:.4}), {} pass(es)\n",
+                r.ln_oid_before / std::f64::consts::LN_10,
+                r.log10_oid,
+                r.ln_gain / std::f64::consts::LN_10,
+                r.sweeps
+            );
+            s += "pose    log10 gain  largest joint move\n";
+            for p in &r.poses {
+                s += &format!(
+                    "{:>6}  {:>10.4}  {:.4}\n",
+                    p.pose,
+                    p.ln_gain / std::f64::consts::LN_10,
+                    p.max_move
+                );
+            }
+            if let (Some(true), Some(b)) = (r.exceeds_pool_bound, report.log10_bound) {
+                s += &format!(
+                    "the refined design EXCEEDS the pool's certified bound (log10 {:.4} > {b:.4}): no design of the pool can reach it\n",
+                    r.log10_oid
+                );
+            } else if let (Some(false), Some(b)) = (r.exceeds_pool_bound, report.log10_bound) {
+                s += &format!(
+                    "the refined design stays below the pool's certified bound (log10 {:.4} <= {b:.4})\n",
+                    r.log10_oid
+                );
+            }
+        }
+        s
     })
 }

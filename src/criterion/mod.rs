@@ -8,7 +8,9 @@
 //! # Pieces
 //!
 //! * [`InfoState`] — a design (pool indices) with `M`, `M⁻¹`, `ln det M`,
-//!   updated by adding, removing or exchanging one pose (a `t`-row block).
+//!   updated by adding, removing or exchanging one pose (a `t`-row block);
+//!   optionally on top of a [`Prior`] `M0` (poses measured before), so that
+//!   `M = M0 + XᵀX`.
 //! * [`lowrank`] — the update kernels on raw matrices: the block form
 //!   ([`lowrank::woodbury`]) and the paper's row-by-row cascade
 //!   ([`lowrank::cascade`]) kept as a reference implementation.
@@ -83,6 +85,7 @@ mod bench;
 mod criteria;
 mod indices;
 pub mod lowrank;
+mod prior;
 mod state;
 #[cfg(test)]
 mod test_util;
@@ -91,6 +94,7 @@ mod variances;
 pub use bench::{ScanTimings, bench_scan, bench_scan_with_threads};
 pub use criteria::{Criterion, DCriterion, OiCriterion, argmax};
 pub use indices::Indices;
+pub use prior::Prior;
 pub use state::{Drift, InfoState, StateSettings, Status};
 pub use variances::{PoolVariances, exchange_gain};
 

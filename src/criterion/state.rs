@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::CriterionError;
 use super::lowrank::{LowRank, woodbury};
+use super::prior::Prior;
 use crate::blocks::Blocks;
 use crate::linalg::chol::cholesky_inverse;
 use crate::linalg::eigen::EigenScratch;
@@ -184,6 +185,9 @@ pub struct InfoState {
     log: Vec<LowRank>,
     /// Scratch for a gathered Jacobian block.
     block: Vec<f64>,
+    /// Information measured before the design, `M0` (in `M` whenever `M`
+    /// is recomputed from the design).
+    prior: Option<Prior>,
 }
 
 impl Clone for InfoState {
@@ -208,6 +212,7 @@ impl Clone for InfoState {
             log_base: self.log_base,
             log: self.log.clone(),
             block: Vec::new(),
+            prior: self.prior.clone(),
         }
     }
 }
@@ -249,7 +254,31 @@ impl InfoState {
         design: &[usize],
         settings: StateSettings,
     ) -> Result<Self, CriterionError> {
+        Self::with_prior(pool, design, None, settings)
+    }
+
+    /// [`new`](Self::new) for a design added to prior information:
+    /// `M = M0 + XᵀX (+ δI)`, so `ln det M` is `ln det(M0 + XᵀX)`. A prior
+    /// of another size than the pool's `p` is
+    /// [`CriterionError::UnsupportedShape`].
+    pub fn with_prior(
+        pool: &Blocks,
+        design: &[usize],
+        prior: Option<Prior>,
+        settings: StateSettings,
+    ) -> Result<Self, CriterionError> {
         settings.validate()?;
+        if let Some(pr) = &prior
+            && pr.p() != pool.p()
+        {
+            return Err(CriterionError::UnsupportedShape {
+                reason: format!(
+                    "the prior is for {} unknowns, the pool has {}",
+                    pr.p(),
+                    pool.p()
+                ),
+            });
+        }
         let (t, p, n_pool) = (pool.t(), pool.p(), pool.n_poses());
         if t == 0 || p == 0 {
             return Err(CriterionError::UnsupportedShape {
@@ -282,7 +311,14 @@ impl InfoState {
             }
             position[q] = k;
         }
-        let f = Self::factor(pool, design, settings.ridge, settings.max_condition, true)?;
+        let f = Self::factor(
+            pool,
+            design,
+            prior.as_ref(),
+            settings.ridge,
+            settings.max_condition,
+            true,
+        )?;
         Ok(Self {
             id: fresh_id(),
             t,
@@ -301,21 +337,23 @@ impl InfoState {
             log_base: 0,
             log: Vec::new(),
             block: Vec::new(),
+            prior,
         })
     }
 
-    /// `M = δI + Σ_{i∈design} X_iᵀX_i`, factored; with `check_condition`, a
-    /// condition number above `max_condition` (from the eigenvalues) is
-    /// singular too.
+    /// `M = M0 + δI + Σ_{i∈design} X_iᵀX_i`, factored; with
+    /// `check_condition`, a condition number above `max_condition` (from
+    /// the eigenvalues) is singular too.
     fn factor(
         pool: &Blocks,
         design: &[usize],
+        prior: Option<&Prior>,
         ridge: f64,
         max_condition: f64,
         check_condition: bool,
     ) -> Result<Factored, CriterionError> {
         let p = pool.p();
-        let m = Self::information(pool, design, ridge);
+        let m = Self::information(pool, design, prior, ridge);
         let singular = |m: &[f64]| CriterionError::Singular {
             rank_estimate: rank_estimate(view(m, p), max_condition).min(p - 1),
             p,
@@ -342,12 +380,16 @@ impl InfoState {
         })
     }
 
-    /// `δI + Σ_{i∈design} X_iᵀX_i`, column-major, summed in design order.
-    fn information(pool: &Blocks, design: &[usize], ridge: f64) -> Vec<f64> {
+    /// `M0 + δI + Σ_{i∈design} X_iᵀX_i`, column-major, summed in design
+    /// order after the prior.
+    fn information(pool: &Blocks, design: &[usize], prior: Option<&Prior>, ridge: f64) -> Vec<f64> {
         let p = pool.p();
         let mut m = vec![0.0; p * p];
+        if let Some(pr) = prior {
+            pr.add_to(&mut m);
+        }
         for i in 0..p {
-            m[i * p + i] = ridge;
+            m[i * p + i] += ridge;
         }
         let mut xb = Vec::with_capacity(pool.t() * p);
         for &q in design {
@@ -443,6 +485,12 @@ impl InfoState {
     #[must_use]
     pub fn settings(&self) -> &StateSettings {
         &self.settings
+    }
+
+    /// The prior information `M0`, if any.
+    #[must_use]
+    pub fn prior(&self) -> Option<&Prior> {
+        self.prior.as_ref()
     }
 
     /// The ridge `δ`.
@@ -682,6 +730,7 @@ impl InfoState {
         let f = Self::factor(
             pool,
             &self.design,
+            self.prior.as_ref(),
             self.settings.ridge,
             self.settings.max_condition,
             false,
@@ -709,7 +758,14 @@ impl InfoState {
         self.check_pool(pool);
         let settings = self.settings.with_ridge(ridge);
         settings.validate()?;
-        let f = Self::factor(pool, &self.design, ridge, settings.max_condition, true)?;
+        let f = Self::factor(
+            pool,
+            &self.design,
+            self.prior.as_ref(),
+            ridge,
+            settings.max_condition,
+            true,
+        )?;
         self.settings = settings;
         self.install(f);
         Ok(())
@@ -730,7 +786,7 @@ impl InfoState {
     pub fn drift(&self, pool: &Blocks) -> Drift {
         self.check_pool(pool);
         let p = self.p;
-        let fresh = Self::information(pool, &self.design, self.settings.ridge);
+        let fresh = Self::information(pool, &self.design, self.prior.as_ref(), self.settings.ridge);
         let ln_det = match cholesky_inverse(view(&fresh, p)) {
             Ok((_, ld)) => (ld - self.ln_det).abs(),
             Err(()) => f64::INFINITY,

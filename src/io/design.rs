@@ -13,8 +13,9 @@
 //! criterion values) are kept as extra information.
 
 use crate::error::{Error, Result};
+use crate::model::ParamTable;
 use crate::model::Robot;
-use crate::pool::{Lattice, Pool, PoolSpec};
+use crate::pool::{Configurations, Lattice, Pool, PoolSource, PoolSpec};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -41,9 +42,33 @@ pub struct DesignFile {
     /// Joint values of each pose (absent in old files: the lattice's).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub q: Option<Vec<Vec<f64>>>,
+    /// Every configuration of a file-sourced pool, before filtering, in id
+    /// order: with it the design's pool is rebuilt without the original
+    /// file (lattice and sampled pools are regenerated from their spec).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pool_qs: Option<Vec<Vec<f64>>>,
+    /// Poses measured before the design was chosen (`select --existing`):
+    /// their file and joint values, so that `gap` scores the design on top
+    /// of the same prior information without the file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub existing: Option<ExistingPoses>,
+    /// Whether the poses were refined off the pool (`select --refine`):
+    /// their ids name the pool poses they started from, their joint values
+    /// are the refined ones.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub refined: bool,
     /// Anything else (algorithm, seed, ln_oid, ...), kept as written.
     #[serde(flatten)]
     pub extra: serde_json::Map<String, serde_json::Value>,
+}
+
+/// Poses measured before a design was chosen, as a design file stores them.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ExistingPoses {
+    /// The file they were read from (informational).
+    pub path: String,
+    /// Their joint values.
+    pub q: Vec<Vec<f64>>,
 }
 
 impl DesignFile {
@@ -56,6 +81,9 @@ impl DesignFile {
             levels: pool.spec.levels(),
             poses: pool.ids_of(positions),
             q: Some(positions.iter().map(|&k| pool.q(k)).collect()),
+            pool_qs: pool.listed().map(<[Vec<f64>]>::to_vec),
+            existing: None,
+            refined: false,
             extra: serde_json::Map::new(),
         }
     }
@@ -70,6 +98,9 @@ impl DesignFile {
             levels: Some(levels),
             poses,
             q: None,
+            pool_qs: None,
+            existing: None,
+            refined: false,
             extra: serde_json::Map::new(),
         }
     }
@@ -114,6 +145,26 @@ impl DesignFile {
             (None, None) => Err(Error::Invalid(
                 "the design names no pool (neither 'pool' nor 'levels')".into(),
             )),
+        }
+    }
+
+    /// Builds `spec` (the design's pool, [`spec`](Self::spec), possibly with
+    /// other filters) for `robot`: a file-sourced pool from the
+    /// configurations stored in the design when it has them (the original
+    /// file is then not read), any other pool from its spec.
+    pub fn build_pool(&self, spec: &PoolSpec, robot: &Robot, table: &ParamTable) -> Result<Pool> {
+        match (&spec.source, &self.pool_qs) {
+            (PoolSource::File { path }, Some(qs)) => spec.build_listed(
+                robot,
+                table,
+                Configurations {
+                    qs: qs.clone(),
+                    notes: vec![format!(
+                        "the configurations of {path} as stored in the design file"
+                    )],
+                },
+            ),
+            _ => spec.build(robot, table),
         }
     }
 
@@ -289,6 +340,36 @@ mod tests {
         assert!(d.joint_values(&r).is_err());
         d.q.as_mut().unwrap().pop();
         assert!(d.joint_values(&r).is_err());
+    }
+
+    #[test]
+    fn sampled_sources_round_trip_through_a_design_file() {
+        let r = Robot::puma560();
+        for source in [
+            PoolSource::Random {
+                count: 200,
+                seed: 5,
+            },
+            PoolSource::Sobol {
+                count: 128,
+                seed: Some(3),
+            },
+            PoolSource::Sobol {
+                count: 128,
+                seed: None,
+            },
+        ] {
+            let pool = PoolSpec::of(source.clone()).build(&r, &r.nominal).unwrap();
+            let d = DesignFile::from_pool(&r, &pool, &[3, 77, 101]);
+            let text = serde_json::to_string(&d).unwrap();
+            let back: DesignFile = serde_json::from_str(&text).unwrap();
+            assert_eq!(back.spec().unwrap().source, source);
+            assert!(back.pool_qs.is_none());
+            let again = back
+                .build_pool(&back.spec().unwrap(), &r, &r.nominal)
+                .unwrap();
+            assert_eq!(back.positions_in(&r, &again).unwrap(), vec![3, 77, 101]);
+        }
     }
 
     #[test]

@@ -1,19 +1,26 @@
 //! Pose pools: the candidate joint configurations of a selection.
 //!
 //! A pool is made from a [`PoolSpec`]: a [`PoolSource`] (the joint-space
-//! [`Lattice`] today) through [`PoolFilter`]s (sensor visibility). One
-//! function, [`PoolSpec::build`], makes it for every command. The [`Pool`]
-//! holds the configurations (contiguous, `n × dof`), a stable id per pose
-//! (the lattice index for lattice poses) and the spec it was made from, and
-//! computes the identification Jacobian of every pose in one parallel pass.
+//! [`Lattice`], uniform random or Sobol samples inside the joint limits
+//! ([`sampled`]), or a file of configurations ([`file`])) through
+//! [`PoolFilter`]s (sensor visibility). One function, [`PoolSpec::build`],
+//! makes it for every command. The [`Pool`] holds the configurations
+//! (contiguous, `n × dof`), a stable id per pose (its index in the source:
+//! the lattice index, the sample number, the file's data row), the spec it
+//! was made from and what each filter removed ([`PoolStats`]), and computes
+//! the identification Jacobian of every pose in one parallel pass.
 //!
-//! A new source (random samples, a file of configurations) is a variant of
-//! [`PoolSource`] and an arm of [`PoolSource::generate`]; nothing else
+//! A new source is a variant of [`PoolSource`] and an arm of the private
+//! `Candidates` (its size and the configuration of an id); nothing else
 //! changes.
 
+pub mod file;
 pub mod lattice;
+pub mod sampled;
 
+pub use file::{Configurations, read_configurations};
 pub use lattice::Lattice;
+pub use sampled::{Sobol, Uniform};
 
 use crate::blocks::Blocks;
 use crate::error::{Error, Result};
@@ -22,8 +29,11 @@ use crate::measure::Visibility;
 use crate::model::{ParamTable, Robot};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use std::path::Path;
 
-/// Where the candidate configurations come from.
+/// Where the candidate configurations come from. A pose's id is its index
+/// in the source (before filtering), so ids are stable: the same spec gives
+/// the same ids and joint values on every machine and thread count.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PoolSource {
@@ -33,6 +43,53 @@ pub enum PoolSource {
         /// Values per joint.
         levels: usize,
     },
+    /// `count` configurations drawn uniformly inside the joint limits from
+    /// ChaCha8 seeded with `seed` ([`Uniform`]); id `k` is the `k`-th draw.
+    Random {
+        /// Samples.
+        count: usize,
+        /// Seed of the stream.
+        seed: u64,
+    },
+    /// The first `count` points of the Sobol sequence mapped onto the joint
+    /// box ([`Sobol`]); id `k` is point `k`. With a seed, the sequence is
+    /// scrambled (random linear matrix and digital shift).
+    Sobol {
+        /// Points.
+        count: usize,
+        /// Seed of the scramble; none for the plain sequence.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        seed: Option<u64>,
+    },
+    /// Joint configurations listed in a CSV or JSON file
+    /// ([`file`](self::file)); id `k` is the `k`-th data row (0-based).
+    File {
+        /// The file, as given.
+        path: String,
+    },
+}
+
+impl PoolSource {
+    /// A short name: `lattice`, `random`, `sobol` or `file`.
+    #[must_use]
+    pub fn kind(&self) -> &'static str {
+        match self {
+            PoolSource::Lattice { .. } => "lattice",
+            PoolSource::Random { .. } => "random",
+            PoolSource::Sobol { .. } => "sobol",
+            PoolSource::File { .. } => "file",
+        }
+    }
+
+    /// Number of candidates before any file is read, when the spec alone
+    /// says it (every source but a file).
+    fn declared_size(&self, robot: &Robot) -> Result<Option<usize>> {
+        Ok(match *self {
+            PoolSource::Lattice { levels } => Some(Lattice::new(robot, levels)?.size()),
+            PoolSource::Random { count, .. } | PoolSource::Sobol { count, .. } => Some(count),
+            PoolSource::File { .. } => None,
+        })
+    }
 }
 
 /// A rule that removes candidate configurations.
@@ -45,12 +102,47 @@ pub enum PoolFilter {
 }
 
 impl PoolFilter {
-    /// Whether the configuration `q` passes.
-    fn keeps(&self, robot: &Robot, table: &ParamTable, q: &[f64]) -> bool {
+    /// Whether the configuration `q` passes (evaluated at `table`).
+    #[must_use]
+    pub fn keeps(&self, robot: &Robot, table: &ParamTable, q: &[f64]) -> bool {
         match self {
             PoolFilter::Visibility(v) => v.sees(&position(robot, table, q)),
         }
     }
+
+    /// A short name: `visibility`.
+    #[must_use]
+    pub fn kind(&self) -> &'static str {
+        match self {
+            PoolFilter::Visibility(_) => "visibility",
+        }
+    }
+}
+
+/// How many candidates one filter removed.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct FilterStat {
+    /// The filter ([`PoolFilter::kind`]).
+    pub filter: String,
+    /// Candidates that reached it (passed every filter before it).
+    pub seen: usize,
+    /// Of those, the ones it removed.
+    pub removed: usize,
+}
+
+/// What building a pool did: candidates of the source, what each filter
+/// removed, what was kept, and notes (columns of a file that were ignored).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct PoolStats {
+    /// Candidates of the source, before filtering.
+    pub candidates: usize,
+    /// One entry per filter, in the order they were applied.
+    pub filters: Vec<FilterStat>,
+    /// Candidates kept.
+    pub kept: usize,
+    /// Notes (ignored columns of a configuration file).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
 }
 
 /// How a pool is made: a source, then filters in order.
@@ -63,12 +155,46 @@ pub struct PoolSpec {
     pub filters: Vec<PoolFilter>,
 }
 
+/// The generated candidates of a source, each computable from its id.
+enum Candidates<'a> {
+    Lattice(Lattice),
+    Random(Uniform),
+    Sobol(Sobol),
+    Listed(&'a [Vec<f64>]),
+}
+
+impl Candidates<'_> {
+    fn size(&self) -> usize {
+        match self {
+            Candidates::Lattice(l) => l.size(),
+            Candidates::Random(u) => u.size(),
+            Candidates::Sobol(s) => s.size(),
+            Candidates::Listed(rows) => rows.len(),
+        }
+    }
+
+    fn q_into(&self, id: usize, q: &mut [f64]) {
+        match self {
+            Candidates::Lattice(l) => l.q_into(id, q),
+            Candidates::Random(u) => u.q_into(id, q),
+            Candidates::Sobol(s) => s.q_into(id, q),
+            Candidates::Listed(rows) => q.copy_from_slice(&rows[id]),
+        }
+    }
+}
+
 impl PoolSpec {
     /// Every pose of a `levels`-value lattice, unfiltered.
     #[must_use]
     pub fn lattice(levels: usize) -> Self {
+        Self::of(PoolSource::Lattice { levels })
+    }
+
+    /// The unfiltered pool of a source.
+    #[must_use]
+    pub fn of(source: PoolSource) -> Self {
         Self {
-            source: PoolSource::Lattice { levels },
+            source,
             filters: Vec::new(),
         }
     }
@@ -85,39 +211,177 @@ impl PoolSpec {
     pub fn levels(&self) -> Option<usize> {
         match self.source {
             PoolSource::Lattice { levels } => Some(levels),
+            _ => None,
         }
     }
 
     /// Builds the pool for `robot`: generates the source's configurations
-    /// and keeps those that pass every filter (evaluated at `table`, the
-    /// model the sensor region is known in, usually the nominal one). A pool
-    /// that the filters leave empty is an error.
+    /// (reading the file of a [`PoolSource::File`]) and keeps those that
+    /// pass every filter (evaluated at `table`, the model the sensor region
+    /// is known in, usually the nominal one). A pool that the filters leave
+    /// empty is an error naming the filter that removed the last candidates.
     pub fn build(&self, robot: &Robot, table: &ParamTable) -> Result<Pool> {
-        let n = match self.source {
-            PoolSource::Lattice { levels } => Lattice::new(robot, levels)?.size(),
-        };
-        check_memory(robot, n)?;
-        let (ids, lattice) = self.source.generate(robot, |q| {
-            self.filters.iter().all(|f| f.keeps(robot, table, q))
-        })?;
-        if ids.is_empty() {
-            return Err(Error::Invalid(
-                "the visibility filter removed every pose of the pool".into(),
-            ));
+        match &self.source {
+            PoolSource::File { path } => {
+                let rows = read_configurations(Path::new(path), robot)?;
+                self.build_listed(robot, table, rows)
+            }
+            _ => self.build_inner(robot, table, None, Vec::new()),
+        }
+    }
+
+    /// Builds a [`PoolSource::File`] pool from its rows as already read (the
+    /// file's configurations stored in a design file, so that the design
+    /// needs no access to the original file). Errors for another source.
+    pub fn build_listed(
+        &self,
+        robot: &Robot,
+        table: &ParamTable,
+        rows: Configurations,
+    ) -> Result<Pool> {
+        if !matches!(self.source, PoolSource::File { .. }) {
+            return Err(Error::Invalid(format!(
+                "stored configurations given for a {} pool",
+                self.source.kind()
+            )));
         }
         let dof = robot.dof();
+        if let Some(k) = rows
+            .qs
+            .iter()
+            .position(|q| q.len() != dof || q.iter().any(|v| !v.is_finite()))
+        {
+            return Err(Error::Invalid(format!(
+                "configuration {k} of the pool has {} joint values (the robot {dof}), or one is not finite",
+                rows.qs[k].len()
+            )));
+        }
+        self.build_inner(robot, table, Some(rows.qs), rows.notes)
+    }
+
+    fn build_inner(
+        &self,
+        robot: &Robot,
+        table: &ParamTable,
+        rows: Option<Vec<Vec<f64>>>,
+        notes: Vec<String>,
+    ) -> Result<Pool> {
+        let n = match self.source.declared_size(robot)? {
+            Some(n) => n,
+            None => rows.as_ref().map_or(0, Vec::len),
+        };
+        check_memory(robot, n)?;
+        let cands = match (&self.source, rows.as_deref()) {
+            (PoolSource::Lattice { levels }, _) => {
+                Candidates::Lattice(Lattice::new(robot, *levels)?)
+            }
+            (PoolSource::Random { count, seed }, _) => {
+                Candidates::Random(Uniform::new(robot, *count, *seed)?)
+            }
+            (PoolSource::Sobol { count, seed }, _) => {
+                Candidates::Sobol(Sobol::new(robot, *count, *seed)?)
+            }
+            (PoolSource::File { .. }, Some(rows)) => Candidates::Listed(rows),
+            (PoolSource::File { .. }, None) => unreachable!("a file source is built from its rows"),
+        };
+        let dof = robot.dof();
+        let n_filters = self.filters.len();
+        // For each candidate, the first filter that removes it (n_filters:
+        // none). Integer counts: the same whatever the thread split.
+        let first_fail = |id: usize| -> usize {
+            let mut q = vec![0.0; dof];
+            cands.q_into(id, &mut q);
+            self.filters
+                .iter()
+                .position(|f| !f.keeps(robot, table, &q))
+                .unwrap_or(n_filters)
+        };
+        let ids: Vec<usize> = if n_filters == 0 {
+            (0..cands.size()).collect()
+        } else {
+            (0..cands.size())
+                .into_par_iter()
+                .filter(|&id| first_fail(id) == n_filters)
+                .collect()
+        };
+        let removed: Vec<usize> = if n_filters == 0 {
+            Vec::new()
+        } else {
+            (0..cands.size())
+                .into_par_iter()
+                .fold(
+                    || vec![0usize; n_filters],
+                    |mut acc, id| {
+                        let f = first_fail(id);
+                        if f < n_filters {
+                            acc[f] += 1;
+                        }
+                        acc
+                    },
+                )
+                .reduce(
+                    || vec![0usize; n_filters],
+                    |mut a, b| {
+                        a.iter_mut().zip(&b).for_each(|(x, y)| *x += y);
+                        a
+                    },
+                )
+        };
+        let mut seen = cands.size();
+        let filters: Vec<FilterStat> = self
+            .filters
+            .iter()
+            .zip(&removed)
+            .map(|(f, &r)| {
+                let s = FilterStat {
+                    filter: f.kind().to_string(),
+                    seen,
+                    removed: r,
+                };
+                seen -= r;
+                s
+            })
+            .collect();
+        debug_assert_eq!(seen, ids.len());
+        if ids.is_empty() {
+            let last = filters.iter().rposition(|f| f.removed > 0);
+            return Err(Error::Invalid(match last {
+                Some(k) => format!(
+                    "the {} filter removed every pose of the pool that reached it ({} of {}; the source had {})",
+                    filters[k].filter,
+                    filters[k].removed,
+                    filters[k].seen,
+                    cands.size()
+                ),
+                None => "the pool has no candidates".into(),
+            }));
+        }
         let mut q = vec![0.0; ids.len() * dof];
         if dof > 0 {
             q.par_chunks_mut(dof)
                 .zip(ids.par_iter())
-                .for_each(|(row, &id)| self.source.fill(lattice.as_ref(), id, row));
+                .for_each(|(row, &id)| cands.q_into(id, row));
         }
+        let stats = PoolStats {
+            candidates: cands.size(),
+            filters,
+            kept: ids.len(),
+            notes,
+        };
+        let source_size = cands.size();
+        let lattice = match cands {
+            Candidates::Lattice(l) => Some(l),
+            _ => None,
+        };
         Ok(Pool {
             spec: self.clone(),
             dof,
             q,
             ids,
             lattice,
+            source_size,
+            stats,
+            listed: rows,
         })
     }
 }
@@ -125,7 +389,9 @@ impl PoolSpec {
 /// Bytes a pool of `n` candidates takes through selection: its id and joint
 /// values, its identification Jacobian (`t·p` values a pose), and one
 /// workspace of the Jacobian's size (the pool variances' `Y = X L⁻ᵀ`, the
-/// bound's scaled copy).
+/// bound's scaled copy). The same for every source: `n` is the number of
+/// candidates before filtering (lattice size, sample count, or rows of a
+/// file), an upper bound of the pool's size.
 #[must_use]
 pub fn memory_estimate(robot: &Robot, n: usize) -> u64 {
     let per_pose = 8 * (1 + robot.dof() + 2 * robot.rows_per_pose() * robot.n_params());
@@ -145,46 +411,6 @@ fn check_memory(robot: &Robot, n: usize) -> Result<()> {
     )
 }
 
-impl PoolSource {
-    /// The ids of the candidates that `keep` accepts, ascending, and the
-    /// lattice when the source is one.
-    fn generate<K>(&self, robot: &Robot, keep: K) -> Result<(Vec<usize>, Option<Lattice>)>
-    where
-        K: Fn(&[f64]) -> bool + Sync,
-    {
-        match *self {
-            PoolSource::Lattice { levels } => {
-                let lattice = Lattice::new(robot, levels)?;
-                let ids = (0..lattice.size())
-                    .into_par_iter()
-                    .filter(|&i| {
-                        let mut q = vec![0.0; lattice.dof()];
-                        lattice.q_into(i, &mut q);
-                        keep(&q)
-                    })
-                    .collect();
-                Ok((ids, Some(lattice)))
-            }
-        }
-    }
-
-    /// Writes the configuration of candidate `id` into `q`.
-    fn fill(&self, lattice: Option<&Lattice>, id: usize, q: &mut [f64]) {
-        match self {
-            PoolSource::Lattice { .. } => lattice
-                .expect("a lattice source has its lattice")
-                .q_into(id, q),
-        }
-    }
-
-    /// Why an id is not a candidate of the source at all, if it is not.
-    fn check_id(&self, lattice: Option<&Lattice>, id: usize) -> Result<()> {
-        match self {
-            PoolSource::Lattice { .. } => lattice.map_or(Ok(()), |l| l.check_index(id)),
-        }
-    }
-}
-
 /// The candidate poses: joint configurations with stable ids, made from a
 /// [`PoolSpec`].
 #[derive(Clone, Debug)]
@@ -198,6 +424,12 @@ pub struct Pool {
     /// poses).
     pub ids: Vec<usize>,
     lattice: Option<Lattice>,
+    /// Candidates of the source before filtering (ids are below it).
+    source_size: usize,
+    /// What the build did (candidates, removals per filter, notes).
+    pub stats: PoolStats,
+    /// Every configuration of a file source, before filtering, in id order.
+    listed: Option<Vec<Vec<f64>>>,
 }
 
 impl Pool {
@@ -218,6 +450,15 @@ impl Pool {
         PoolSpec::lattice(levels)
             .with_filter(PoolFilter::Visibility(vis.clone()))
             .build(robot, table)
+    }
+
+    /// Every configuration of a [`PoolSource::File`] source, before
+    /// filtering, in id order (what a design file stores so that it needs
+    /// no access to the file); `None` for the other sources, which their
+    /// spec regenerates.
+    #[must_use]
+    pub fn listed(&self) -> Option<&[Vec<f64>]> {
+        self.listed.as_deref()
     }
 
     /// Number of pool poses.
@@ -259,12 +500,32 @@ impl Pool {
     /// Position in the pool of a pose id, or an error saying why it is not
     /// there.
     pub fn position_of(&self, id: usize) -> Result<usize> {
-        self.spec.source.check_id(self.lattice.as_ref(), id)?;
+        if let Some(l) = &self.lattice {
+            l.check_index(id)?;
+        } else if id >= self.source_size {
+            return Err(Error::PoseNotInPool {
+                index: id,
+                reason: format!(
+                    "the {} source has {} candidates, 0..{}",
+                    self.spec.source.kind(),
+                    self.source_size,
+                    self.source_size - 1
+                ),
+            });
+        }
         self.ids
             .binary_search(&id)
             .map_err(|_| Error::PoseNotInPool {
                 index: id,
-                reason: "removed by the visibility filter".into(),
+                reason: format!(
+                    "removed by the pool's {} filter",
+                    self.spec
+                        .filters
+                        .iter()
+                        .map(PoolFilter::kind)
+                        .collect::<Vec<_>>()
+                        .join(" or ")
+                ),
             })
     }
 

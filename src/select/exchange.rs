@@ -3,7 +3,9 @@
 use super::random::{design_rng, oi_from_ln_oid, random_design};
 use super::{Algorithm, Settings, StepKind, TraceRow};
 use crate::blocks::Blocks;
-use crate::criterion::{Criterion, CriterionError, InfoState, StateSettings, Status, argmax};
+use crate::criterion::{
+    Criterion, CriterionError, InfoState, Prior, StateSettings, Status, argmax,
+};
 use crate::error::{Error, Result};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -14,7 +16,8 @@ use serde::Serialize;
 pub struct Selection {
     /// Pool positions of the design, in the order they entered.
     pub poses: Vec<usize>,
-    /// `ln OI_D = ln det(XᵀX)` of the design (no ridge).
+    /// `ln OI_D = ln det(XᵀX)` of the design (no ridge); with a prior,
+    /// `ln det(M0 + XᵀX)`.
     pub ln_oid: f64,
     /// The paper's OI, eq. (1).
     pub oi: f64,
@@ -80,16 +83,21 @@ struct Run<'a, C: Criterion> {
 }
 
 impl<'a, C: Criterion> Run<'a, C> {
-    /// Starts from `design`, with a ridge if it is singular without one.
-    fn new(pool: &'a Blocks, crit: &'a mut C, design: &[usize], fixed: &[usize]) -> Result<Self> {
-        let state = match InfoState::new(pool, design, StateSettings::default()) {
+    /// Starts from `design` (on top of `prior`, if any), with a ridge if it
+    /// is singular without one.
+    fn new(
+        pool: &'a Blocks,
+        crit: &'a mut C,
+        design: &[usize],
+        fixed: &[usize],
+        prior: Option<&Prior>,
+    ) -> Result<Self> {
+        let state = |settings| InfoState::with_prior(pool, design, prior.cloned(), settings);
+        let state = match state(StateSettings::default()) {
             Ok(s) => s,
-            Err(CriterionError::Singular { .. }) => InfoState::new(
-                pool,
-                design,
-                StateSettings::default().with_ridge(ridge_for(pool)),
-            )
-            .map_err(crit_err)?,
+            Err(CriterionError::Singular { .. }) => {
+                state(StateSettings::default().with_ridge(ridge_for(pool))).map_err(crit_err)?
+            }
             Err(e) => return Err(crit_err(e)),
         };
         let mut mask = vec![false; pool.n_poses()];
@@ -331,7 +339,7 @@ fn run_from_random<C: Criterion>(
 ) -> Result<Selection> {
     s.validate(pool)?;
     let init = start_design(pool, s, size, rng);
-    let mut run = Run::new(pool, crit, &init, &s.fixed)?;
+    let mut run = Run::new(pool, crit, &init, &s.fixed, s.prior.as_ref())?;
     phases(&mut run);
     run.finish(algorithm)
 }
@@ -382,7 +390,7 @@ pub fn polish<C: Criterion>(
     sel: Selection,
     s: &Settings,
 ) -> Result<Selection> {
-    let mut run = Run::new(pool, crit, &sel.poses, &s.fixed)?;
+    let mut run = Run::new(pool, crit, &sel.poses, &s.fixed, s.prior.as_ref())?;
     run.trace = sel.trace.clone();
     run.fedorov_phase(s.max_iter);
     let mut out = run.finish(sel.algorithm)?;
@@ -410,8 +418,9 @@ where
 {
     s.validate(pool)?;
     if algorithm == Algorithm::Random {
-        let r = super::random_search(
+        let r = super::random_search_with_prior(
             pool,
+            s.prior.as_ref(),
             &non_fixed(pool, &s.fixed),
             &s.fixed,
             s.n,
@@ -422,7 +431,7 @@ where
             return Err(Error::Invalid("every random design is singular".into()));
         }
         let mut crit = make();
-        let run = Run::new(pool, &mut crit, &r.best, &s.fixed)?;
+        let run = Run::new(pool, &mut crit, &r.best, &s.fixed, s.prior.as_ref())?;
         let mut sel = run.finish(Algorithm::Random)?;
         sel.start_ln_oid = r.ln_oid;
         sel.start = (0..sel.start_ln_oid.len())

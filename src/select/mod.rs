@@ -7,6 +7,13 @@
 //! poses removed by the pool's visibility filter are not in the pool, so they
 //! are never chosen. Fixed poses are in every design and never removed.
 //!
+//! # Prior information
+//!
+//! With [`Settings::prior`] (`M0`, the information of poses measured
+//! before), every state is `M = M0 + XᵀX` and every algorithm maximises
+//! `ln det(M0 + XᵀX)`: the `N` poses that add the most to what is already
+//! known. A design that is singular on its own may then be regular.
+//!
 //! # Starting below full rank
 //!
 //! When the initial design has too few rows for a non-singular `M`
@@ -19,17 +26,20 @@
 //! ridge was on carry `ridge: true`.
 
 use crate::blocks::Blocks;
-use crate::criterion::{DCriterion, OiCriterion};
+use crate::criterion::{DCriterion, OiCriterion, Prior};
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
 mod exchange;
 mod random;
+pub mod refine;
 
 pub use exchange::{Selection, detmax, eae, fedorov, multistart, polish};
 pub use random::{
-    RandomSearch, design_rng, ln_det_direct, oi_from_ln_oid, random_design, random_search,
+    RandomSearch, design_rng, ln_det_direct, ln_det_with_prior, oi_from_ln_oid, random_design,
+    random_search, random_search_with_prior,
 };
+pub use refine::{RefineSettings, Refinement, refine};
 
 /// The selection algorithms.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
@@ -89,6 +99,11 @@ pub struct Settings {
     /// Largest number of exchange (or excursion) iterations per phase
     /// (default 1,000).
     pub max_iter: usize,
+    /// Information already measured, `M0` (default none): the search then
+    /// maximises `ln det(M0 + XᵀX)` and every reported `ln OI_D` includes
+    /// `M0`. Not serialised (a report names its source instead).
+    #[serde(skip)]
+    pub prior: Option<Prior>,
 }
 
 impl Default for Settings {
@@ -102,6 +117,7 @@ impl Default for Settings {
             seed: 1,
             fixed: Vec::new(),
             max_iter: 1000,
+            prior: None,
         }
     }
 }
@@ -120,7 +136,17 @@ impl Settings {
                 self.n
             )));
         }
-        if self.n * t < p {
+        if let Some(pr) = &self.prior
+            && pr.p() != p
+        {
+            return Err(Error::Invalid(format!(
+                "the prior information is for {} unknowns, the pool has {p}",
+                pr.p()
+            )));
+        }
+        // With a prior, fewer new rows than unknowns may do: the state
+        // refuses a design that is singular even with M0.
+        if self.n * t < p && self.prior.is_none() {
             return Err(Error::Invalid(format!(
                 "N = {} poses give {} measurement rows, fewer than the {p} unknowns: every design would be singular (need N >= {})",
                 self.n,

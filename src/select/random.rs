@@ -2,6 +2,7 @@
 //! one by `ln OI_D`, and the whole distribution (the paper's Fig. 2).
 
 use crate::blocks::Blocks;
+use crate::criterion::Prior;
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -55,6 +56,19 @@ pub fn ln_det_direct(pool: &Blocks, poses: &[usize]) -> Option<f64> {
     crate::linalg::chol::ln_det_spd(pool.information(poses).as_ref())
 }
 
+/// `ln det(M0 + XᵀX)` of a design on top of a prior (`ln det XᵀX`
+/// without one), or `None` when it is not positive definite.
+#[must_use]
+pub fn ln_det_with_prior(pool: &Blocks, prior: Option<&Prior>, poses: &[usize]) -> Option<f64> {
+    match prior {
+        None => ln_det_direct(pool, poses),
+        Some(pr) => {
+            let m = pool.information(poses) + pr.matrix();
+            crate::linalg::chol::ln_det_spd(m.as_ref())
+        }
+    }
+}
+
 /// The paper's OI, eq. (1), from `ln OI_D` of a full-rank design with `p`
 /// unknowns: `OI = exp(ln OI_D / (2p)) / p`, since `OI_D = ((OI·L)^L)²`.
 #[must_use]
@@ -78,6 +92,21 @@ pub fn random_search(
     designs: usize,
     seed: u64,
 ) -> RandomSearch {
+    random_search_with_prior(pool, None, allowed, fixed, n, designs, seed)
+}
+
+/// [`random_search`] with the designs ranked by `ln det(M0 + XᵀX)`
+/// ([`ln_det_with_prior`]).
+#[must_use]
+pub fn random_search_with_prior(
+    pool: &Blocks,
+    prior: Option<&Prior>,
+    allowed: &[usize],
+    fixed: &[usize],
+    n: usize,
+    designs: usize,
+    seed: u64,
+) -> RandomSearch {
     let p = pool.p();
     // Only the values are kept (8 bytes a design); the best design is drawn
     // again from its own seed, so no design list is held in memory.
@@ -85,7 +114,7 @@ pub fn random_search(
         .into_par_iter()
         .map(|k| {
             let d = random_design(&mut design_rng(seed, k as u64), allowed, fixed, n);
-            ln_det_direct(pool, &d).unwrap_or(f64::NEG_INFINITY)
+            ln_det_with_prior(pool, prior, &d).unwrap_or(f64::NEG_INFINITY)
         })
         .collect();
     let mut best = 0;

@@ -1,0 +1,341 @@
+//! Joint configurations from a file, such as a motion planner exports or a
+//! measurement campaign recorded: the source of a [`PoolSource::File`] pool
+//! and of `select --existing`.
+//!
+//! Two formats, told apart by the extension (`.json` is JSON, anything else
+//! CSV):
+//!
+//! * **CSV** with a header row naming the joints. A column is a joint when
+//!   its name is one of the chain's joints ([`joint_names`]: the URDF joint
+//!   names, or the frame labels of a built-in arm) or `q1`…`qN`; the order of
+//!   the columns is free, every joint must have one, and other columns
+//!   (measured positions, timestamps) are ignored with a note. Blank lines
+//!   are skipped.
+//! * **JSON** `{"qs": [[...], ...]}` (values in joint order) or
+//!   `{"joints": [names], "qs": [...]}` (values in the order of `joints`,
+//!   matched by name as CSV columns are). Other keys (a measurement file's
+//!   `points`, `orientations`, `robot`) are ignored with a note; a `robot`
+//!   key, when present, must name the robot.
+//!
+//! Every value is checked: a value that does not parse, is not finite, or
+//! lies outside the joint's limits (beyond [`LIMIT_TOL`]) is an error naming
+//! the file, the row (the 1-based line for CSV, `qs[k]` for JSON) and the
+//! column.
+//!
+//! [`PoolSource::File`]: super::PoolSource::File
+
+use crate::error::{Error, Result};
+use crate::model::Robot;
+use std::path::Path;
+
+/// Slack on the joint limits, absolute (radians or metres): values written
+/// with a few digits fewer than the limits themselves still pass.
+pub const LIMIT_TOL: f64 = 1e-9;
+
+/// Joint configurations read from a file, in row order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Configurations {
+    /// Joint values, one vector of `dof` per row, in the robot's joint order.
+    pub qs: Vec<Vec<f64>>,
+    /// What was ignored (extra columns or keys), for reports.
+    pub notes: Vec<String>,
+}
+
+/// The names a configuration file may use for each joint, in joint order:
+/// the label of the frame the joint drives (a URDF's joint name).
+#[must_use]
+pub fn joint_names(robot: &Robot) -> Vec<String> {
+    let mut names = vec![String::new(); robot.dof()];
+    for f in &robot.frames {
+        if let Some(j) = f.joint
+            && j < names.len()
+        {
+            names[j].clone_from(&f.label);
+        }
+    }
+    names
+}
+
+/// The joint index of a column name: a joint name, or `q1`…`qN`.
+fn joint_of(name: &str, names: &[String]) -> Option<usize> {
+    if let Some(j) = names.iter().position(|n| n == name) {
+        return Some(j);
+    }
+    let k: usize = name.strip_prefix('q')?.parse().ok()?;
+    (1..=names.len()).contains(&k).then(|| k - 1)
+}
+
+/// Maps header names to joints: `map[c]` is the joint of column `c`, or
+/// `None` for an ignored column. Errors name a joint without a column or a
+/// joint with two.
+fn map_columns(
+    path: &Path,
+    header: &[String],
+    names: &[String],
+) -> Result<(Vec<Option<usize>>, Vec<String>)> {
+    let mut map = vec![None; header.len()];
+    let mut seen: Vec<Option<usize>> = vec![None; names.len()];
+    let mut ignored = Vec::new();
+    for (c, h) in header.iter().enumerate() {
+        match joint_of(h, names) {
+            Some(j) => {
+                if let Some(c0) = seen[j] {
+                    return Err(parse_err(
+                        path,
+                        format!(
+                            "columns '{}' and '{h}' both give joint {} ({})",
+                            header[c0],
+                            j + 1,
+                            names[j]
+                        ),
+                    ));
+                }
+                seen[j] = Some(c);
+                map[c] = Some(j);
+            }
+            None => ignored.push(h.clone()),
+        }
+    }
+    if let Some(j) = seen.iter().position(Option::is_none) {
+        return Err(parse_err(
+            path,
+            format!(
+                "no column for joint {} '{}' (columns: {}; a joint column is named by its joint, {}, or q1..q{})",
+                j + 1,
+                names[j],
+                header.join(", "),
+                names.join(", "),
+                names.len()
+            ),
+        ));
+    }
+    Ok((map, ignored))
+}
+
+fn parse_err(path: &Path, message: String) -> Error {
+    Error::Parse {
+        path: path.display().to_string(),
+        message,
+    }
+}
+
+/// Checks one value against its joint's limits.
+fn check_value(path: &Path, robot: &Robot, row: &str, col: &str, j: usize, v: f64) -> Result<()> {
+    let [lo, hi] = robot.limits[j];
+    if !v.is_finite() {
+        return Err(parse_err(
+            path,
+            format!(
+                "{row}, column '{col}' (joint {}): {v} is not a finite number",
+                j + 1
+            ),
+        ));
+    }
+    if v < lo - LIMIT_TOL || v > hi + LIMIT_TOL {
+        return Err(parse_err(
+            path,
+            format!(
+                "{row}, column '{col}' (joint {}): {v} is outside the joint limits [{lo}, {hi}]",
+                j + 1
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Reads the joint configurations of `path` for `robot` (see the module
+/// docs for the formats and checks). An empty file or one without rows is
+/// an error.
+pub fn read_configurations(path: &Path, robot: &Robot) -> Result<Configurations> {
+    let len = std::fs::metadata(path)
+        .map_err(|cause| Error::Io {
+            path: path.display().to_string(),
+            cause,
+        })?
+        .len();
+    // The text and its parse live together for a moment: twice the file.
+    crate::resources::check_alloc::<u8>(
+        &format!("reading {}", path.display()),
+        usize::try_from(len.saturating_mul(2)).unwrap_or(usize::MAX),
+    )?;
+    let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
+        path: path.display().to_string(),
+        cause,
+    })?;
+    let json = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    let c = if json {
+        parse_json(path, &text, robot)?
+    } else {
+        parse_csv(path, &text, robot)?
+    };
+    if c.qs.is_empty() {
+        return Err(parse_err(
+            path,
+            "no joint configurations in the file".into(),
+        ));
+    }
+    Ok(c)
+}
+
+/// Parses CSV text (see the module docs).
+pub fn parse_csv(path: &Path, text: &str, robot: &Robot) -> Result<Configurations> {
+    let names = joint_names(robot);
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
+    let Some((_, header)) = lines.next() else {
+        return Err(parse_err(
+            path,
+            "the file is empty (expected a header row of joint names)".into(),
+        ));
+    };
+    let header: Vec<String> = header
+        .split(',')
+        .map(|h| h.trim().trim_matches('"').to_string())
+        .collect();
+    let (map, ignored) = map_columns(path, &header, &names)?;
+    let mut qs = Vec::new();
+    for (i, line) in lines {
+        let row = format!("line {}", i + 1);
+        let cells: Vec<&str> = line.split(',').collect();
+        if cells.len() != header.len() {
+            return Err(parse_err(
+                path,
+                format!(
+                    "{row}: {} columns, the header has {}",
+                    cells.len(),
+                    header.len()
+                ),
+            ));
+        }
+        let mut q = vec![f64::NAN; names.len()];
+        for (c, cell) in cells.iter().enumerate() {
+            let Some(j) = map[c] else { continue };
+            let cell = cell.trim().trim_matches('"');
+            let v: f64 = cell.parse().map_err(|_| {
+                parse_err(
+                    path,
+                    format!(
+                        "{row}, column '{}' (joint {}): cannot read '{cell}' as a number",
+                        header[c],
+                        j + 1
+                    ),
+                )
+            })?;
+            check_value(path, robot, &row, &header[c], j, v)?;
+            q[j] = v;
+        }
+        qs.push(q);
+    }
+    let mut notes = Vec::new();
+    if !ignored.is_empty() {
+        notes.push(format!(
+            "{}: columns ignored (not joints of the chain): {}",
+            path.display(),
+            ignored.join(", ")
+        ));
+    }
+    Ok(Configurations { qs, notes })
+}
+
+/// Parses JSON text (see the module docs).
+pub fn parse_json(path: &Path, text: &str, robot: &Robot) -> Result<Configurations> {
+    let names = joint_names(robot);
+    let v: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| parse_err(path, e.to_string()))?;
+    let Some(obj) = v.as_object() else {
+        return Err(parse_err(
+            path,
+            "expected an object {\"qs\": [[...], ...]} (optionally with \"joints\": [names])"
+                .into(),
+        ));
+    };
+    if let Some(r) = obj.get("robot").and_then(|r| r.as_str())
+        && r != robot.name
+    {
+        return Err(parse_err(
+            path,
+            format!("the file is for robot '{r}', not '{}'", robot.name),
+        ));
+    }
+    let Some(rows) = obj.get("qs").and_then(|q| q.as_array()) else {
+        return Err(parse_err(path, "no \"qs\" array of joint vectors".into()));
+    };
+    let (map, mut ignored, width, header) = match obj.get("joints") {
+        Some(j) => {
+            let header: Vec<String> = j
+                .as_array()
+                .and_then(|a| a.iter().map(|x| x.as_str().map(str::to_string)).collect())
+                .ok_or_else(|| parse_err(path, "\"joints\" must be an array of names".into()))?;
+            let (map, ignored) = map_columns(path, &header, &names)?;
+            let width = header.len();
+            (map, ignored, width, header)
+        }
+        None => (
+            (0..names.len()).map(Some).collect(),
+            Vec::new(),
+            names.len(),
+            names.clone(),
+        ),
+    };
+    let mut keys: Vec<&str> = obj
+        .keys()
+        .map(String::as_str)
+        .filter(|k| !["qs", "joints", "robot"].contains(k))
+        .collect();
+    keys.sort_unstable();
+    let mut qs = Vec::with_capacity(rows.len());
+    for (k, r) in rows.iter().enumerate() {
+        let row = format!("qs[{k}] (row {})", k + 1);
+        let Some(cells) = r.as_array() else {
+            return Err(parse_err(path, format!("{row}: not an array of numbers")));
+        };
+        if cells.len() != width {
+            return Err(parse_err(
+                path,
+                format!("{row}: {} values, expected {width}", cells.len()),
+            ));
+        }
+        let mut q = vec![f64::NAN; names.len()];
+        for (c, cell) in cells.iter().enumerate() {
+            let Some(j) = map[c] else { continue };
+            // JSON has no NaN; `null` is how serializers write one.
+            let v = match cell {
+                serde_json::Value::Null => f64::NAN,
+                x => x.as_f64().ok_or_else(|| {
+                    parse_err(
+                        path,
+                        format!(
+                            "{row}, column '{}' (joint {}): {x} is not a number",
+                            header[c],
+                            j + 1
+                        ),
+                    )
+                })?,
+            };
+            check_value(path, robot, &row, &header[c], j, v)?;
+            q[j] = v;
+        }
+        qs.push(q);
+    }
+    let mut notes = Vec::new();
+    if !ignored.is_empty() {
+        ignored.sort_unstable();
+        notes.push(format!(
+            "{}: joints ignored (not in the chain): {}",
+            path.display(),
+            ignored.join(", ")
+        ));
+    }
+    if !keys.is_empty() {
+        notes.push(format!(
+            "{}: keys ignored (only the joint values are used): {}",
+            path.display(),
+            keys.join(", ")
+        ));
+    }
+    Ok(Configurations { qs, notes })
+}

@@ -28,6 +28,19 @@ where
         .collect()
 }
 
+/// Parses `--seed`: a non-negative integer. With `allow_negative_numbers`
+/// (on every numeric option), `--seed -1` and `--seed=-1` both reach this
+/// parser and get the same message (clap would otherwise take `-1` for an
+/// unknown option).
+pub fn parse_seed(s: &str) -> std::result::Result<u64, String> {
+    s.trim().parse::<u64>().map_err(|_| {
+        format!(
+            "the seed must be a non-negative integer (0 to {}), got '{s}'",
+            u64::MAX
+        )
+    })
+}
+
 /// The chain chosen by `--base`, `--tip` and `--lock` (global options).
 static CHAIN: std::sync::OnceLock<activecal::io::ChainChoice> = std::sync::OnceLock::new();
 
@@ -124,7 +137,7 @@ pub struct PoolOpts {
     #[arg(long, default_value = "puma560")]
     pub robot: String,
     /// Lattice values per joint.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, allow_negative_numbers = true)]
     pub levels: usize,
     /// Parameter set the Jacobian is computed with.
     #[arg(long, value_enum, default_value_t = ParamSet::Nominal)]
@@ -156,6 +169,8 @@ pub fn filters(
         (Some(v), _) => {
             let vis: Visibility =
                 serde_json::from_str(v).map_err(|e| anyhow::anyhow!("--visibility: {e}"))?;
+            vis.validate()
+                .map_err(|e| anyhow::anyhow!("--visibility: {e}"))?;
             vec![PoolFilter::Visibility(vis)]
         }
         (None, Some(vis)) => vec![PoolFilter::Visibility(vis.clone())],

@@ -98,6 +98,13 @@ impl LmSettings {
             value: value.to_string(),
             reason,
         };
+        if self.max_iterations == 0 {
+            return Err(IdentifyError::Setting {
+                name: "max_iterations",
+                value: "0".into(),
+                reason: "at least one iteration is needed (0 would report the start as the estimate)",
+            });
+        }
         for (name, v) in [
             ("xtol", self.xtol),
             ("ftol", self.ftol),

@@ -339,7 +339,7 @@ struct MeasurementsFile {
     #[serde(default)]
     robot: Option<String>,
     qs: Vec<Vec<f64>>,
-    points: Vec<[f64; 3]>,
+    points: Vec<Vec<f64>>,
     #[serde(default)]
     orientations: Vec<[[f64; 3]; 3]>,
     #[serde(default)]
@@ -366,10 +366,20 @@ impl TryFrom<MeasurementsFile> for Measurements {
             ));
             orientations.push(rows(uq.to_rotation_matrix().matrix()));
         }
+        let mut points = Vec::with_capacity(f.points.len());
+        for (i, p) in f.points.iter().enumerate() {
+            let &[x, y, z] = p.as_slice() else {
+                return Err(format!(
+                    "point {i}: expected 3 coordinates [x, y, z], got {}",
+                    p.len()
+                ));
+            };
+            points.push([x, y, z]);
+        }
         Ok(Self {
             robot: f.robot,
             qs: f.qs,
-            points: f.points,
+            points,
             orientations,
         })
     }

@@ -91,8 +91,16 @@ impl PoolSpec {
     /// Builds the pool for `robot`: generates the source's configurations
     /// and keeps those that pass every filter (evaluated at `table`, the
     /// model the sensor region is known in, usually the nominal one). A pool
-    /// that the filters leave empty is an error.
+    /// that the filters leave empty is an error, and so is a filter whose
+    /// region is malformed ([`Visibility::validate`]).
     pub fn build(&self, robot: &Robot, table: &ParamTable) -> Result<Pool> {
+        for f in &self.filters {
+            match f {
+                PoolFilter::Visibility(v) => v
+                    .validate()
+                    .map_err(|e| Error::Invalid(format!("visibility filter: {e}")))?,
+            }
+        }
         let n = match self.source {
             PoolSource::Lattice { levels } => Lattice::new(robot, levels)?.size(),
         };

@@ -23,7 +23,7 @@ pub enum Error {
         got: usize,
     },
     /// A NaN or infinite joint angle.
-    #[error("joint angle q{joint} is not a finite number ({value})")]
+    #[error("joint angle q{joint} is not a finite number ({})", Compact(*.value))]
     NonFiniteAngle {
         /// 1-based joint number.
         joint: usize,
@@ -31,7 +31,11 @@ pub enum Error {
         value: f64,
     },
     /// Joint limits with lower > upper, or not finite.
-    #[error("joint q{joint}: invalid limits [{lo}, {hi}] (need finite lo <= hi)")]
+    #[error(
+        "joint q{joint}: invalid limits [{}, {}] (need finite lo <= hi)",
+        Compact(*.lo),
+        Compact(*.hi)
+    )]
     InvalidLimits {
         /// 1-based joint number.
         joint: usize,
@@ -73,7 +77,7 @@ pub enum Error {
     #[error("unknown parameter '{0}'")]
     UnknownParameter(String),
     /// A parameter table entry that is not finite.
-    #[error("parameter {name} is not finite ({value})")]
+    #[error("parameter {name} is not finite ({})", Compact(*.value))]
     NonFiniteParameter {
         /// Parameter name, `<symbol>_<frame>`.
         name: String,
@@ -130,3 +134,27 @@ pub enum Error {
 
 /// Result with the crate's [`Error`].
 pub type Result<T> = std::result::Result<T, Error>;
+
+/// A number for messages: as Rust prints it when that is short (`0.5`,
+/// `-250`, `1000000`), in scientific notation when it would be long
+/// (`1e300`, not 301 digits; `1.5e-12`).
+///
+/// ```
+/// use activecal::error::Compact;
+/// assert_eq!(Compact(1e300).to_string(), "1e300");
+/// assert_eq!(Compact(-0.25).to_string(), "-0.25");
+/// assert_eq!(Compact(f64::NAN).to_string(), "NaN");
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Compact(pub f64);
+
+impl std::fmt::Display for Compact {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let v = self.0;
+        if v.is_finite() && v != 0.0 && !(1e-6..1e9).contains(&v.abs()) {
+            write!(f, "{v:e}")
+        } else {
+            write!(f, "{v}")
+        }
+    }
+}

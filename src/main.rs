@@ -3,7 +3,8 @@
 
 mod cli;
 
-use clap::{Parser, Subcommand};
+use clap::parser::ValueSource;
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use cli::basic::{FkArgs, PoolArgs, RobotsArgs};
 use cli::bench::BenchArgs;
 use cli::bound::{BoundArgs, GapArgs};
@@ -69,7 +70,26 @@ enum Command {
 }
 
 fn main() {
-    let cli = Cli::parse();
+    let matches = Cli::command().get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    // Pool options typed on the command line (not defaulted): `score`
+    // refuses those that conflict with a `--design`.
+    let given = |sub: &str| -> Vec<&'static str> {
+        let Some(m) = matches.subcommand_matches(sub) else {
+            return Vec::new();
+        };
+        [
+            "robot",
+            "levels",
+            "visibility",
+            "pool",
+            "count",
+            "pool_seed",
+        ]
+        .into_iter()
+        .filter(|id| m.value_source(id) == Some(ValueSource::CommandLine))
+        .collect()
+    };
     if let Err(e) = cli::set_chain_choice(cli.base, cli.tip, cli.lock.as_deref()) {
         eprintln!("error: {e:#}");
         std::process::exit(1);
@@ -78,7 +98,7 @@ fn main() {
         Command::Robots(a) => cli::basic::cmd_robots(a),
         Command::Fk(a) => cli::basic::cmd_fk(a),
         Command::Pool(a) => cli::basic::cmd_pool(a),
-        Command::Score(a) => cli::select::cmd_score(a),
+        Command::Score(a) => cli::select::cmd_score(a, &given("score")),
         Command::Select(a) => cli::select::cmd_select(a),
         Command::Bench(a) => cli::bench::cmd_bench(a),
         Command::Reproduce(a) => cli::reproduce::cmd_reproduce(a),

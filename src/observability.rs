@@ -22,6 +22,9 @@
 use crate::blocks::Blocks;
 use crate::blocks::jacobian_of;
 use crate::error::{Error, Result};
+use crate::linalg::eigen::symmetric_eigen;
+use crate::linalg::gram::gram_of;
+use crate::linalg::rank::{equilibrated, rank_of_eigenvalues};
 use crate::model::{Convention, MeasurementKind, ParamId, ParamTable, Robot, Symbol};
 
 use rand::{RngExt, SeedableRng};
@@ -32,11 +35,19 @@ use serde::Serialize;
 pub const DESIGN_LEVELS: usize = 5;
 
 /// A candidate is kept when the component of its unit-norm column orthogonal
-/// to the kept columns has norm above this. On the built-in robots (point
-/// and pose) dependent columns leave at most 4e-16 (rounding) and the
-/// independent ones at least 0.09 (`tests/robots.rs` checks both), so 1e-8
-/// separates them by seven orders of magnitude on each side.
-pub const INDEPENDENCE_TOL: f64 = 1e-8;
+/// to the kept columns has norm above this: `1/√MAX_CONDITION` (3.2e-7),
+/// since a smaller component makes the smallest singular value of the
+/// unit-column Jacobian smaller than that and the set fails the rank rule
+/// every command shares ([`crate::linalg::rank`]). On the built-in robots
+/// (point and pose) dependent columns leave at most 4e-16 (rounding) and the
+/// independent ones at least 0.09 (`tests/robots.rs` checks both), so the
+/// threshold separates them by several orders of magnitude on each side.
+pub const INDEPENDENCE_TOL: f64 = 3.162_277_660_168_379_5e-7;
+
+/// Largest accepted condition number of the equilibrated information matrix
+/// `D^-½ XᵀX D^-½` (`D = diag XᵀX`): the one rank rule of `select`, `bound`,
+/// `score`, `gap` and `calibrate` (see [`identifiability`]).
+pub const MAX_CONDITION: f64 = crate::linalg::rank::MAX_CONDITION;
 
 /// Seed of the design [`Robot::choose_unknowns`] uses.
 const CHOOSE_SEED: u64 = 0x5eed_0c00_5e00;
@@ -47,7 +58,8 @@ const CHECK_SEED: u64 = 0x5eed_c4ec_0001;
 /// Result of an identifiability check.
 #[derive(Clone, Debug, Serialize)]
 pub struct Identifiability {
-    /// Numerical rank of the column-scaled stacked Jacobian.
+    /// Numerical rank of the column-scaled stacked Jacobian, by the rule of
+    /// [`crate::linalg::rank`].
     pub rank: usize,
     /// Number of unknowns.
     pub p: usize,
@@ -57,42 +69,36 @@ pub struct Identifiability {
     pub singular_values: Vec<f64>,
 }
 
-/// Numerical rank of a stacked Jacobian and the unknowns it cannot determine.
+/// Numerical rank of a stacked Jacobian and the unknowns it cannot determine,
+/// by the rank rule every command shares ([`crate::linalg::rank`]).
 ///
-/// Columns are scaled to unit norm first (rank is scale-invariant, the
-/// tolerance is not); a zero column is unidentifiable outright. Singular
-/// values below `max(rows, p) · ε · σ_max` count as zero, and an unknown is
-/// named when its entry in a null-space vector exceeds 1e-6 in magnitude.
+/// Works on the normal equations of the column-scaled problem: `M = XᵀX`
+/// (`O(rows·p²)` time, `O(p²)` memory — never a copy of `X`, let alone a
+/// `rows × rows` matrix), equilibrated to `M̃ = D^-½ M D^-½ = X̃ᵀX̃` (`X̃`
+/// with unit-norm columns; rank is scale-invariant, a tolerance is not). The
+/// rank counts the eigenvalues `σ̃²` of `M̃` with
+/// `σ̃² · MAX_CONDITION > σ̃_max²`; a zero column is unidentifiable outright.
+/// An unknown is named when its entry in an eigenvector of the rejected
+/// eigenvalues (the numerical null space) exceeds 1e-6 in magnitude.
 #[must_use]
 pub fn identifiability(robot: &Robot, x: &Blocks) -> Identifiability {
     let m = x.mat();
     let (rows, p) = (m.nrows(), m.ncols());
-    let norms: Vec<f64> = (0..p).map(|c| m.col(c).norm_l2()).collect();
-    let scaled = faer::Mat::from_fn(rows, p, |r, c| {
-        if norms[c] > 0.0 {
-            m[(r, c)] / norms[c]
-        } else {
-            0.0
-        }
-    });
     let names = robot.parameter_names();
-    // The thin SVD: U is rows × p, not rows × rows, so memory stays
-    // O(rows · p) (a full U of 30,000 measured points would take 65 GB).
-    // With fewer rows than unknowns the full SVD is small and gives the whole
-    // null space (a thin V would stop at `rows` columns).
-    let svd = if rows >= p {
-        scaled.thin_svd()
-    } else {
-        scaled.svd()
-    }
-    .expect("SVD of a finite matrix converges");
-    let s: Vec<f64> = (0..p.min(rows)).map(|i| svd.S()[i]).collect();
-    let smax = s.iter().cloned().fold(0.0, f64::max);
-    let tol = rows.max(p) as f64 * f64::EPSILON * smax.max(f64::MIN_POSITIVE);
-    let rank = s.iter().filter(|&&v| v > tol).count();
-    let v = svd.V();
+    let (scaled, _) = equilibrated(gram_of(m).as_ref());
+    let Some((ev, v)) = symmetric_eigen(scaled.as_ref()) else {
+        // Only a non-finite Jacobian gets here: nothing is determined.
+        return Identifiability {
+            rank: 0,
+            p,
+            unidentifiable: names,
+            singular_values: vec![0.0; p.min(rows)],
+        };
+    };
+    // Eigenvalues come nondecreasing: the largest rank of them pass.
+    let rank = rank_of_eigenvalues(&ev, MAX_CONDITION);
     let mut flagged = vec![false; p];
-    for k in rank..p {
+    for k in 0..p - rank {
         for (c, f) in flagged.iter_mut().enumerate() {
             if v[(c, k)].abs() > 1e-6 {
                 *f = true;
@@ -109,7 +115,12 @@ pub fn identifiability(robot: &Robot, x: &Blocks) -> Identifiability {
         rank,
         p,
         unidentifiable,
-        singular_values: s,
+        singular_values: ev
+            .iter()
+            .rev()
+            .take(p.min(rows))
+            .map(|&l| l.max(0.0).sqrt())
+            .collect(),
     }
 }
 

@@ -776,5 +776,16 @@ fn cli_calibrate_rejects_bad_designs_and_options() {
     ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(err.contains("sigma = -1"), "{err}");
+    assert!(err.contains("--noise -1"), "{err}");
+    // `--noise -1` (a negative number as the next word) reads the same.
+    let out = run(&[
+        "calibrate",
+        "--design",
+        good.to_str().unwrap(),
+        "--noise",
+        "-1",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("--noise -1"), "{err}");
 }

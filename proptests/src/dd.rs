@@ -226,6 +226,14 @@ impl DdMat {
         }
     }
 
+    /// `self += diag(d)` (`d` empty: unchanged).
+    pub fn add_diagonal_entries(&mut self, d: &[f64]) {
+        for (i, &v) in d.iter().enumerate() {
+            let s = self.get(i, i) + Dd::from_f64(v);
+            self.set(i, i, s);
+        }
+    }
+
     /// `XᵀX` of an `f64` matrix.
     #[must_use]
     pub fn gram(x: &DMatrix<f64>) -> Self {

@@ -71,8 +71,11 @@ pub struct Reference {
     /// 2-norm condition number of the equilibrated `D M D`,
     /// `D = diag(M_jj^-½)`.
     pub kappa_scaled: f64,
-    /// `‖M‖₁‖M⁻¹‖₁`, the quantity the state's singularity rule uses.
+    /// `‖M‖₁‖M⁻¹‖₁` of the raw matrix.
     pub kappa_1: f64,
+    /// `‖DMD‖₁‖(DMD)⁻¹‖₁` of the equilibrated matrix, the quantity the
+    /// state's singularity rule uses (unchanged by column scaling).
+    pub kappa_1_scaled: f64,
     /// `sqrt(M_jj)`: the column scales of the equilibration.
     pub col_scale: Vec<f64>,
 }
@@ -96,6 +99,7 @@ impl Reference {
         let msi = DMatrix::from_fn(m.n, m.n, |i, j| inv[(i, j)] * col_scale[i] * col_scale[j]);
         let kappa_scaled = lmax(&ms) * lmax(&msi);
         let kappa_1 = m.norm1() * crate::norm1(&inv);
+        let kappa_1_scaled = crate::norm1(&ms) * crate::norm1(&msi);
         Some(Self {
             m: m.clone(),
             ldlt,
@@ -104,15 +108,16 @@ impl Reference {
             kappa,
             kappa_scaled,
             kappa_1,
+            kappa_1_scaled,
             col_scale,
         })
     }
 
-    /// The reference of `XᵀX + δI`.
+    /// The reference of `XᵀX + diag(ridge)` (`ridge` empty: no ridge).
     #[must_use]
-    pub fn of_rows(x: &DMatrix<f64>, ridge: f64) -> Option<Self> {
+    pub fn of_rows(x: &DMatrix<f64>, ridge: &[f64]) -> Option<Self> {
         let mut m = DdMat::gram(x);
-        m.add_diagonal(ridge);
+        m.add_diagonal_entries(ridge);
         Self::of(&m)
     }
 

@@ -79,7 +79,7 @@ fn oi_d_from_updates_equals_stacked() {
                 ));
             };
             let mut pv = PoolVariances::new(&pool, &st);
-            let r0 = Reference::of_rows(&stacked(&x, c.t, &design), 0.0).unwrap();
+            let r0 = Reference::of_rows(&stacked(&x, c.t, &design), &[]).unwrap();
             let p = c.p;
             let mut bound =
                 8.0 * (k * c.t + p) as f64 * EPS * r0.kappa_scaled + 64.0 * EPS * r0.ln_det.abs();
@@ -115,9 +115,10 @@ fn oi_d_from_updates_equals_stacked() {
                 } else {
                     // A refused change leaves the design as it was, and the
                     // reference keeps at most a floor-sized fraction (the floor
-                    // from the reference's κ̂, 1% for the state's own rounding).
+                    // from the reference's equilibrated κ̂, 1% for the state's
+                    // own rounding).
                     prop_assert_eq!(st.design(), &d[..]);
-                    let floor = 1.01 * ch.before.kappa_1 / 1e13;
+                    let floor = 1.01 * ch.before.kappa_1_scaled / 1e13;
                     let slack = guard.tol(ch.refusal_slack(rows) * g);
                     prop_assert!(
                         ch.mu <= floor + slack,
@@ -128,7 +129,7 @@ fn oi_d_from_updates_equals_stacked() {
                 pv.sync(&pool, &st);
             }
             let xd = stacked(&x, c.t, st.design());
-            let r = Reference::of_rows(&xd, 0.0).unwrap();
+            let r = Reference::of_rows(&xd, &[]).unwrap();
             let tol = guard.tol(bound);
             let e = (st.ln_det() - r.ln_det).abs();
             guard.observe(e, bound);

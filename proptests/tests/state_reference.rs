@@ -33,9 +33,10 @@ fn factor_bound(rows: usize, r: &Reference) -> f64 {
 }
 
 /// Relative error of the state's construction test `λ_max < 1e13·λ_min` on
-/// the raw (unequilibrated) `M`: `f64` eigenvalues err by `≲ p·ε·λ_max`
-/// absolute (and forming `M` by `(m + p)·ε·|X|ᵀ|X|`), so the computed ratio
-/// near `1e13` is off by a factor `1 ± 8·(m + p)·ε·1e13`.
+/// the equilibrated `M̃ = D^-½ M D^-½` (the rank rule every command shares):
+/// `f64` eigenvalues err by `≲ p·ε·λ_max` absolute (and forming `M` by
+/// `(m + p)·ε·|X|ᵀ|X|`, which the equilibration leaves relative), so the
+/// computed ratio near `1e13` is off by a factor `1 ± 8·(m + p)·ε·1e13`.
 fn construction_band(rows: usize, p: usize) -> f64 {
     8.0 * (rows + p) as f64 * EPS * MAX_CONDITION
 }
@@ -51,9 +52,26 @@ fn graded_pool(c: &GradedCase, k: usize, extra: usize) -> (DMatrix<f64>, Vec<f64
     (scale_columns(&vstack(&[&x0, &x1]), &s), s)
 }
 
-/// The reference of a design (rows of `x`, `t` per pose) plus a ridge.
-fn design_ref(x: &DMatrix<f64>, t: usize, design: &[usize], ridge: f64) -> Option<Reference> {
+/// The reference of a design (rows of `x`, `t` per pose) plus a ridge
+/// diagonal ([`ridge_diagonal`]; empty for none).
+fn design_ref(x: &DMatrix<f64>, t: usize, design: &[usize], ridge: &[f64]) -> Option<Reference> {
     Reference::of_rows(&stacked(x, t, design), ridge)
+}
+
+/// The state's ridge `δ·diag(r_j)` for a pool of rows `x` (`t` per pose),
+/// computed independently: `r_j = ‖x[:, j]‖² / n_pool`, `1` for a zero
+/// column (see `StateSettings::ridge`). Empty when `δ = 0`.
+fn ridge_diagonal(x: &DMatrix<f64>, t: usize, delta: f64) -> Vec<f64> {
+    if delta == 0.0 {
+        return Vec::new();
+    }
+    let n = (x.nrows() / t) as f64;
+    (0..x.ncols())
+        .map(|j| {
+            let r = x.column(j).norm_squared() / n;
+            delta * if r > 0.0 && r.is_finite() { r } else { 1.0 }
+        })
+        .collect()
 }
 
 /// Checks the state's `ln det` and `M⁻¹` against a reference within `bound`.
@@ -81,8 +99,9 @@ fn check_state(
 }
 
 /// Builds the state of `design`, or checks that a refusal is justified by
-/// the reference (`κ(M) ≥ 1e13` up to the band of the `f64` test). An
-/// accepted design must be below that band and match the reference.
+/// the reference (equilibrated `κ_s(M) ≥ 1e13` up to the band of the `f64`
+/// test). An accepted design must be below that band and match the
+/// reference.
 fn build(
     pool: &activecal::blocks::Blocks,
     x: &DMatrix<f64>,
@@ -91,16 +110,16 @@ fn build(
     settings: StateSettings,
     guard: &Guard,
 ) -> Result<Option<(InfoState, Reference)>, TestCaseError> {
-    let r = design_ref(x, t, design, settings.ridge);
+    let r = design_ref(x, t, design, &ridge_diagonal(x, t, settings.ridge));
     let rows = design.len() * t;
     let band = construction_band(rows, x.ncols());
     match InfoState::new(pool, design, settings) {
         Ok(st) => {
             let r = r.ok_or_else(|| TestCaseError::fail("accepted a singular design"))?;
             prop_assert!(
-                r.kappa < MAX_CONDITION * (1.0 + band),
-                "accepted κ = {:e}",
-                r.kappa
+                r.kappa_scaled < MAX_CONDITION * (1.0 + band),
+                "accepted κ_s = {:e}",
+                r.kappa_scaled
             );
             check_state(&st, &r, factor_bound(rows, &r), guard)?;
             Ok(Some((st, r)))
@@ -108,9 +127,9 @@ fn build(
         Err(CriterionError::Singular { .. }) => {
             if let Some(r) = r {
                 prop_assert!(
-                    r.kappa * (1.0 + band) >= MAX_CONDITION,
-                    "refused κ = {:e}",
-                    r.kappa
+                    r.kappa_scaled * (1.0 + band) >= MAX_CONDITION,
+                    "refused κ_s = {:e}",
+                    r.kappa_scaled
                 );
             }
             Ok(None)
@@ -177,9 +196,9 @@ fn check_update(
     }
     if !regular || price == f64::NEG_INFINITY {
         // Refused ⇒ the exact retained fraction is at the floor
-        // κ̂(M)/1e13 (from the reference; the state's own κ̂ agrees to
+        // κ̂(M̃)/1e13 (from the reference; the state's own κ̂ agrees to
         // (m+p)·ε·κ_s relative) within the pivot's rounding.
-        let floor = before_ref.kappa_1 / MAX_CONDITION
+        let floor = before_ref.kappa_1_scaled / MAX_CONDITION
             * (1.0 + construction_band(rows, before.p()) / MAX_CONDITION);
         let slack = guard.tol(ch.refusal_slack(rows));
         prop_assert!(
@@ -255,7 +274,7 @@ fn graded_updates_and_prices() {
     );
 }
 
-/// A ridge start from fewer poses than `p/t`: `ln det(XᵀX + δI)` and the
+/// A ridge start from fewer poses than `p/t`: `ln det(XᵀX + δR)` and the
 /// inverse match the reference, poses added on top too; dropping the ridge
 /// is refused while `XᵀX` is singular (rank `< p`) and, once the design
 /// has enough poses, succeeds or is refused exactly as the reference's
@@ -275,14 +294,14 @@ fn ridge_start_and_removal() {
             // Fewer rows than parameters: XᵀX has rank < p.
             let k0 = (c.p - 1) / c.t;
             let design: Vec<usize> = (0..k0).collect();
-            // A ridge relative to the typical information per column, at most
-            // 100 times smaller: the first additions then grow the information
-            // by G ≲ 100·p over the ridge, which the inverse's error follows
-            // (Change::tol_after); smaller ridges make every later update lose
-            // more than 1e-6 by design.
-            let scale =
-                stacked(&x, c.t, &(0..full).collect::<Vec<_>>()).norm_squared() / c.p as f64;
-            let ridge = scale * 10f64.powf(log_ridge);
+            // A ridge of each column's pool information, at most 100 times
+            // smaller (the state's R holds the information per pool pose,
+            // hence the factor `full`): the first additions then grow the
+            // information by G ≲ 100·p over the ridge, which the inverse's
+            // error follows (Change::tol_after); smaller ridges make every
+            // later update lose more than 1e-6 by design.
+            let ridge = full as f64 * 10f64.powf(log_ridge);
+            let rd = ridge_diagonal(&x, c.t, ridge);
             let Some((mut st, _)) = build(
                 &pool,
                 &x,
@@ -295,6 +314,13 @@ fn ridge_start_and_removal() {
                 return Ok(());
             };
             prop_assert_eq!(st.ridge(), ridge);
+            // The state's R is the one computed here (rounding of the sums).
+            for (got, want) in st.ridge_scales().iter().zip(&rd) {
+                prop_assert!(
+                    (ridge * got - want).abs() <= 1e-13 * want,
+                    "{got} vs {want}"
+                );
+            }
             if k0 > 0 {
                 // Without the ridge M is singular: refused, state unchanged.
                 let before = (st.ln_det(), st.version());
@@ -313,13 +339,13 @@ fn ridge_start_and_removal() {
             // left, whose error relative to the current M grows by G (see
             // Change::tol_after).
             let mut m_start = DdMat::gram(&stacked(&x, c.t, &design));
-            m_start.add_diagonal(ridge);
+            m_start.add_diagonal_entries(&rd);
             let r_start = Reference::of(&m_start).unwrap();
             let mut bound = factor_bound(k0 * c.t + c.p, &r_start);
             for q in k0..full {
                 let d = st.design().to_vec();
                 let mut dd = DdMat::gram(&stacked(&x, c.t, &d));
-                dd.add_diagonal(ridge);
+                dd.add_diagonal_entries(&rd);
                 let ch = Change::of(
                     &dd,
                     &x.rows(q * c.t, c.t).into_owned(),
@@ -332,7 +358,7 @@ fn ridge_start_and_removal() {
             }
             // Drop the ridge: a refactorization of XᵀX.
             let all: Vec<usize> = st.design().to_vec();
-            let r = design_ref(&x, c.t, &all, 0.0);
+            let r = design_ref(&x, c.t, &all, &[]);
             let rows = all.len() * c.t;
             let band = construction_band(rows, c.p);
             match st.set_ridge(&pool, 0.0) {
@@ -340,16 +366,16 @@ fn ridge_start_and_removal() {
                     let r = r.ok_or_else(|| {
                         TestCaseError::fail("ridge dropped from a singular design")
                     })?;
-                    prop_assert!(r.kappa < MAX_CONDITION * (1.0 + band));
+                    prop_assert!(r.kappa_scaled < MAX_CONDITION * (1.0 + band));
                     prop_assert_eq!(st.ridge(), 0.0);
                     check_state(&st, &r, factor_bound(rows, &r), guard)?;
                 }
                 Err(CriterionError::Singular { .. }) => {
                     if let Some(r) = r {
                         prop_assert!(
-                            r.kappa * (1.0 + band) >= MAX_CONDITION,
-                            "refused κ {:e}",
-                            r.kappa
+                            r.kappa_scaled * (1.0 + band) >= MAX_CONDITION,
+                            "refused κ_s {:e}",
+                            r.kappa_scaled
                         );
                     }
                     prop_assert_eq!(st.ridge(), ridge);
@@ -439,7 +465,7 @@ fn multi_chunk_pricing_equals_direct() {
                             }
                             _ => {
                                 prop_assert!(v == f64::NEG_INFINITY, "priced a singular exchange");
-                                let floor = r0.kappa_1 / MAX_CONDITION
+                                let floor = r0.kappa_1_scaled / MAX_CONDITION
                                     * (1.0 + construction_band(rows, p) / MAX_CONDITION);
                                 prop_assert!(
                                     ch.mu <= floor + guard.tol(ch.refusal_slack(rows)),
@@ -494,7 +520,8 @@ fn add_then_remove_round_trip() {
             if !s.is_regular() {
                 prop_assert!(
                     back.mu
-                        <= r0.kappa_1 / MAX_CONDITION + guard.tol(back.refusal_slack(rows + c.t))
+                        <= r0.kappa_1_scaled / MAX_CONDITION
+                            + guard.tol(back.refusal_slack(rows + c.t))
                 );
                 return Ok(());
             }
@@ -530,7 +557,8 @@ fn add_then_remove_round_trip() {
 /// leaves every `X_iᵀX_i` unchanged), and column scaling
 /// `X → X·diag(s)`, which shifts `ln det` by exactly `2 Σ ln s_j` — to the
 /// last bits for powers of two (all arithmetic scales exactly), within the
-/// factorization bound for any `s` (`κ_s` is invariant under it).
+/// factorization bound for any `s` (`κ_s` is invariant under it) — and
+/// never changes the singularity rule's verdict (it is decided on `κ_s`).
 #[test]
 fn invariances() {
     run_property(
@@ -608,10 +636,9 @@ fn invariances() {
             let x2 = scale_columns(&x, &s2);
             let Ok(st_2) = InfoState::new(&to_blocks(&x2, c.t), &design, StateSettings::default())
             else {
-                // The raw κ changes with the scaling, so the rule may refuse now.
-                let r2 = design_ref(&x2, c.t, &design, 0.0).unwrap();
-                prop_assert!(r2.kappa * (1.0 + construction_band(rows, c.p)) >= MAX_CONDITION);
-                return Ok(());
+                return Err(TestCaseError::fail(
+                    "a power-of-two column scaling changed the singularity verdict",
+                ));
             };
             let tiny = 4.0
                 * c.p as f64
@@ -633,7 +660,7 @@ fn invariances() {
             let shift: f64 = s.iter().map(|v| 2.0 * v.ln()).sum();
             let xs = scale_columns(&x, &s);
             let pool_s = to_blocks(&xs, c.t);
-            let rs = design_ref(&xs, c.t, &design, 0.0).unwrap();
+            let rs = design_ref(&xs, c.t, &design, &[]).unwrap();
             prop_assert!(
                 (rs.ln_det - r0.ln_det - shift).abs()
                     <= 1e-12 * (1.0 + rs.ln_det.abs() + shift.abs()),
@@ -653,10 +680,13 @@ fn invariances() {
                         st.ln_det()
                     );
                 }
-                // The raw κ changes with the scaling, so the rule may refuse now.
-                Err(_) => {
-                    prop_assert!(rs.kappa * (1.0 + construction_band(rows, c.p)) >= MAX_CONDITION)
-                }
+                // The rule is decided on κ_s, which the scaling leaves alone: a
+                // refusal now needs the original at the threshold too.
+                Err(_) => prop_assert!(
+                    rs.kappa_scaled * (1.0 + construction_band(rows, c.p)) >= MAX_CONDITION,
+                    "column scaling changed the verdict at κ_s = {:e}",
+                    rs.kappa_scaled
+                ),
             }
             Ok(())
         },

@@ -12,6 +12,7 @@ use super::{Bound, BoundError, BoundStatus};
 use crate::blocks::Blocks;
 use crate::criterion::Prior;
 use crate::linalg::chol::ln_det_spd_equilibrated;
+use crate::linalg::rank::{MAX_CONDITION, ln_det_regular};
 
 use serde::Serialize;
 
@@ -48,10 +49,11 @@ pub struct DesignGap {
 }
 
 /// `ln det` of a design's information matrix `Σ_{i∈design} X_iᵀX_i`,
-/// computed on unit-norm columns and unscaled; `None` if singular.
+/// computed on unit-norm columns and unscaled; `None` if singular by the
+/// rank rule every command shares ([`crate::linalg::rank`]).
 #[must_use]
 pub fn design_ln_det(x: &Blocks, design: &[usize]) -> Option<f64> {
-    ln_det_spd_equilibrated(x.information(design).as_ref())
+    ln_det_regular(x.information(design).as_ref(), MAX_CONDITION)
 }
 
 /// [`design_ln_det`] on top of prior information: `ln det(M0 + Σ X_iᵀX_i)`.

@@ -9,12 +9,15 @@
 use super::BoundError;
 use crate::blocks::Blocks;
 use crate::linalg::chol::ln_det_of_factor;
+use crate::linalg::rank;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::{Mat, MatRef, Par, Side};
 
-/// Eigenvalue ratio λ_min/λ_max of the column-scaled pool Gram matrix below
-/// which the pool counts as rank deficient (a singular-value ratio of 1e-6).
-pub const RANK_TOL: f64 = 1e-12;
+/// Eigenvalue ratio λ_min/λ_max of the column-scaled pool Gram matrix at or
+/// below which the pool counts as rank deficient: `1/MAX_CONDITION`, the
+/// rule every command shares ([`crate::linalg::rank`]; a singular-value
+/// ratio of `3.2e-7`).
+pub const RANK_TOL: f64 = 1.0 / crate::linalg::rank::MAX_CONDITION;
 
 /// A column-scaled copy of a pool Jacobian, `X̃ = X·S⁻¹`, and of a prior
 /// `M̃0 = S⁻¹ M0 S⁻¹` when there is one.
@@ -154,8 +157,8 @@ pub fn scale_columns_with_prior(
     let max = eig.iter().cloned().fold(0.0, f64::max);
     let min = eig.iter().cloned().fold(f64::INFINITY, f64::min);
     let ratio = if max > 0.0 { min / max } else { 0.0 };
-    if ratio <= RANK_TOL {
-        let rank = eig.iter().filter(|&&l| l > RANK_TOL * max).count();
+    if !rank::eigenvalues_regular(&eig, rank::MAX_CONDITION) {
+        let rank = rank::rank_of_eigenvalues(&eig, rank::MAX_CONDITION);
         return Err(BoundError::RankDeficient { rank, p, ratio });
     }
     Ok(Scaled {

@@ -58,7 +58,7 @@ pub struct PoolArgs {
     #[arg(long, default_value = "puma560")]
     pub robot: String,
     /// Lattice values per joint.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, allow_negative_numbers = true)]
     pub levels: usize,
     /// Lattice digits of one pose (joint 1 first), comma separated.
     #[arg(long)]

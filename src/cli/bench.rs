@@ -19,7 +19,7 @@ use std::time::Instant;
 #[derive(Args)]
 pub struct BenchArgs {
     /// Repetitions per measurement (the median is reported).
-    #[arg(long, default_value_t = 7)]
+    #[arg(long, default_value_t = 7, allow_negative_numbers = true)]
     pub reps: usize,
     /// Also run the 10⁶-pose scale test (10 levels per joint, N = 145).
     #[arg(long)]
@@ -65,9 +65,12 @@ fn eae_run(x: &Blocks, s: &Settings, seed: u64) -> activecal::select::Selection 
 
 /// Runs `bench`.
 pub fn cmd_bench(a: BenchArgs) -> Result<()> {
+    if a.reps == 0 {
+        anyhow::bail!("--reps 0: the median needs at least 1 repetition");
+    }
     let robot = Robot::puma560();
     let pool = Pool::full(&robot, 5)?;
-    let reps = a.reps.max(1);
+    let reps = a.reps;
     let (t_jac, x) = time(reps, || pool.jacobian(&robot, &robot.nominal));
     let s = Settings::default();
     let sel = eae_run(&x, &s, 1);

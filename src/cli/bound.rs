@@ -16,7 +16,7 @@ use std::path::PathBuf;
 #[derive(Args, Clone, Debug)]
 pub struct SolveOpts {
     /// Target certified gap in ln det (bound − best feasible relaxation value).
-    #[arg(long, default_value_t = 1e-6)]
+    #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
     pub gap_tol: f64,
     /// Solve with the first-order solver alone (no Clarabel).
     #[arg(long)]
@@ -27,7 +27,7 @@ pub struct SolveOpts {
     pub solver: RelaxationSolver,
     /// Poses outside the first-order support given to Clarabel, by largest
     /// variance.
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = 100, allow_negative_numbers = true)]
     pub screen_extra: usize,
     /// First-order certificate gap (ln det) at which screening stops and the
     /// candidate-set solver takes over.
@@ -35,7 +35,7 @@ pub struct SolveOpts {
     pub screen_gap: f64,
     /// Most candidate-set solves (screening rounds); large pools may need
     /// more than the default to certify.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, allow_negative_numbers = true)]
     pub max_rounds: usize,
 }
 
@@ -58,7 +58,7 @@ pub struct BoundArgs {
     #[command(flatten)]
     pub pool: PoolOpts,
     /// Poses per design.
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = 30, allow_negative_numbers = true)]
     pub n: usize,
     #[command(flatten)]
     pub solve: SolveOpts,

@@ -51,19 +51,24 @@ pub struct CalibrateArgs {
     pub force: bool,
     /// Measurement noise σ per coordinate, metres. A full-pose robot's
     /// orientation noise is σ / orientation_scale radians per axis.
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
     pub noise: f64,
     /// Seed of the noise and of the validation poses.
-    #[arg(long, default_value_t = 0)]
+    #[arg(
+        long,
+        default_value_t = 0,
+        value_parser = super::parse_seed,
+        allow_negative_numbers = true
+    )]
     pub seed: u64,
     /// Noise realisations; more than 1 adds a Monte-Carlo summary.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub trials: usize,
     /// Held-out lattice poses (not in the design) for the validation RMS.
-    #[arg(long, default_value_t = 500)]
+    #[arg(long, default_value_t = 500, allow_negative_numbers = true)]
     pub validation: usize,
     /// Levenberg–Marquardt iteration limit.
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = 200, allow_negative_numbers = true)]
     pub max_iterations: usize,
     /// Plain Levenberg–Marquardt steps, without geodesic acceleration.
     #[arg(long)]
@@ -150,6 +155,17 @@ fn refuse_unconverged(a: &CalibrateArgs, id: &Identification) -> Result<()> {
 
 /// Runs `calibrate`.
 pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
+    if !(a.noise.is_finite() && a.noise >= 0.0) {
+        bail!(
+            "--noise {}: the noise σ must be a finite number >= 0 (metres)",
+            a.noise
+        );
+    }
+    if a.design.is_some() && a.validation == 0 {
+        bail!(
+            "--validation 0: the validation RMS needs at least 1 held-out pose (the RMS error of no poses would read 0)"
+        );
+    }
     let outputs: Vec<(&str, &std::path::Path)> = [
         ("--out", a.out.as_deref()),
         ("--save-measurements", a.save_measurements.as_deref()),

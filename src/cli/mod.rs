@@ -29,6 +29,19 @@ where
         .collect()
 }
 
+/// Parses `--seed`: a non-negative integer. With `allow_negative_numbers`
+/// (on every numeric option), `--seed -1` and `--seed=-1` both reach this
+/// parser and get the same message (clap would otherwise take `-1` for an
+/// unknown option).
+pub fn parse_seed(s: &str) -> std::result::Result<u64, String> {
+    s.trim().parse::<u64>().map_err(|_| {
+        format!(
+            "the seed must be a non-negative integer (0 to {}), got '{s}'",
+            u64::MAX
+        )
+    })
+}
+
 /// The chain chosen by `--base`, `--tip` and `--lock` (global options).
 static CHAIN: std::sync::OnceLock<activecal::io::ChainChoice> = std::sync::OnceLock::new();
 
@@ -176,14 +189,14 @@ pub struct PoolOpts {
     #[arg(long, value_name = "lattice|random|sobol|file:PATH", default_value = "lattice", value_parser = parse_pool_kind)]
     pub pool: PoolKind,
     /// Lattice values per joint (--pool lattice) [default: 5].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub levels: Option<usize>,
     /// Samples of --pool random or sobol [default: 4096].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub count: Option<usize>,
     /// Seed of --pool random [default: 0], or of the scramble of --pool
     /// sobol (without it, the plain Sobol sequence).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub pool_seed: Option<u64>,
     /// Parameter set the Jacobian is computed with.
     #[arg(long, value_enum, default_value_t = ParamSet::Nominal)]
@@ -280,6 +293,8 @@ pub fn filters(
         (Some(v), _) => {
             let vis: Visibility =
                 serde_json::from_str(v).map_err(|e| anyhow::anyhow!("--visibility: {e}"))?;
+            vis.validate()
+                .map_err(|e| anyhow::anyhow!("--visibility: {e}"))?;
             vec![PoolFilter::Visibility(vis)]
         }
         (None, Some(vis)) => vec![PoolFilter::Visibility(vis.clone())],

@@ -24,28 +24,33 @@ pub struct ReproduceArgs {
     #[arg(long)]
     pub force: bool,
     /// Lattice values per joint (the paper: 5).
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, allow_negative_numbers = true)]
     pub levels: usize,
     /// Poses per design (the paper: 30).
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = 30, allow_negative_numbers = true)]
     pub n: usize,
     /// Initial EAE poses (the paper: 12).
-    #[arg(long, default_value_t = 12)]
+    #[arg(long, default_value_t = 12, allow_negative_numbers = true)]
     pub initial: usize,
     /// Random designs of the baseline (the paper: 5,000).
-    #[arg(long, default_value_t = 5000)]
+    #[arg(long, default_value_t = 5000, allow_negative_numbers = true)]
     pub designs: usize,
     /// Starts of the multi-start EAE.
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = 20, allow_negative_numbers = true)]
     pub starts: usize,
     /// Monte-Carlo calibration trials per design.
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = 200, allow_negative_numbers = true)]
     pub trials: usize,
     /// Measurement noise σ per coordinate, metres (the paper: 1 cm).
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
     pub noise: f64,
     /// Seed of every random choice.
-    #[arg(long, default_value_t = 1)]
+    #[arg(
+        long,
+        default_value_t = 1,
+        value_parser = super::parse_seed,
+        allow_negative_numbers = true
+    )]
     pub seed: u64,
     /// Skip the eigenvalue-OI run (slow: an eigen-decomposition per candidate).
     #[arg(long)]

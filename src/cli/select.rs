@@ -26,8 +26,71 @@ pub struct ScoreArgs {
     pub json: bool,
 }
 
-/// Runs `score`.
-pub fn cmd_score(a: ScoreArgs) -> Result<()> {
+/// `--robot`, `--levels` and `--visibility` given beside `--design` (the
+/// option names in `given`) must agree with the design's own robot and pool,
+/// which are what `score` uses: a conflict is refused naming both, never
+/// silently ignored.
+fn check_design_options(
+    a: &ScoreArgs,
+    given: &[&str],
+    d: &DesignFile,
+    path: &std::path::Path,
+) -> Result<()> {
+    let spec = d.spec()?;
+    if given.contains(&"robot") {
+        let robot = super::load_robot(&a.pool.robot)?;
+        if let Err(e) = d.check_robot(&robot) {
+            bail!(
+                "--robot {} conflicts with {}: {e}; a design is scored on the robot it names: drop --robot",
+                a.pool.robot,
+                path.display()
+            );
+        }
+    }
+    let pool = match spec.levels() {
+        Some(l) => format!("the {l}-level lattice"),
+        None => "not a lattice".to_string(),
+    };
+    let levels = a.pool.levels.unwrap_or(super::DEFAULT_LEVELS);
+    if given.contains(&"levels") && spec.levels() != Some(levels) {
+        bail!(
+            "--levels {levels} conflicts with {}: its pool is {pool}; a design is scored on its own pool: drop --levels",
+            path.display()
+        );
+    }
+    for (id, opt) in [
+        ("pool", "--pool"),
+        ("count", "--count"),
+        ("pool_seed", "--pool-seed"),
+    ] {
+        if given.contains(&id) {
+            bail!(
+                "{opt} given with {}: its pool is {pool} ({}); a design is scored on its own pool: drop {opt}",
+                path.display(),
+                serde_json::to_string(&spec.source)?
+            );
+        }
+    }
+    if given.contains(&"visibility") {
+        let mine = super::filters(a.pool.visibility.as_deref(), None)?;
+        if serde_json::to_value(&mine)? != serde_json::to_value(&spec.filters)? {
+            let theirs = if spec.filters.is_empty() {
+                "no filter".to_string()
+            } else {
+                format!("the filters {}", serde_json::to_string(&spec.filters)?)
+            };
+            bail!(
+                "--visibility conflicts with {}: its pool ({pool}) has {theirs}; a design is scored on its own pool: drop --visibility",
+                path.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Runs `score`; `given` names the pool options given on the command line
+/// (not defaulted), which must agree with a `--design`.
+pub fn cmd_score(a: ScoreArgs, given: &[&str]) -> Result<()> {
     let report = match (&a.poses, &a.design) {
         (Some(p), None) => {
             let ids: Vec<usize> = parse_list(p, "--poses")?;
@@ -42,6 +105,7 @@ pub fn cmd_score(a: ScoreArgs) -> Result<()> {
         }
         (None, Some(path)) => {
             let d = DesignFile::read(path)?;
+            check_design_options(&a, given, &d, path)?;
             let desc = load_description(&d.robot)?;
             let robot = desc.robot;
             let qs = d
@@ -90,25 +154,31 @@ pub struct SelectArgs {
     #[command(flatten)]
     pub pool: PoolOpts,
     /// Poses in the design.
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = 30, allow_negative_numbers = true)]
     pub n: usize,
     /// The selection algorithm.
     #[arg(long, value_enum, default_value_t = Algorithm::Eae)]
     pub algorithm: Algorithm,
-    /// Initial random poses of EAE (fixed poses included).
-    #[arg(long, default_value_t = 12)]
-    pub initial: usize,
+    /// Initial random poses of EAE (fixed poses included), 1..=N [default:
+    /// 12, or N when N is smaller].
+    #[arg(long, allow_negative_numbers = true)]
+    pub initial: Option<usize>,
     /// Independent random starts; the best (by the criterion) is kept.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub starts: usize,
     /// Random designs drawn by --algorithm random.
-    #[arg(long, default_value_t = 5000)]
+    #[arg(long, default_value_t = 5000, allow_negative_numbers = true)]
     pub designs: usize,
     /// Polish the best start with Fedorov exchange.
     #[arg(long)]
     pub polish: bool,
     /// Seed of every random choice.
-    #[arg(long, default_value_t = 1)]
+    #[arg(
+        long,
+        default_value_t = 1,
+        value_parser = super::parse_seed,
+        allow_negative_numbers = true
+    )]
     pub seed: u64,
     /// Pose ids (lattice indices) every design must contain.
     #[arg(long)]
@@ -155,6 +225,15 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         // Checked before the search: an existing file, a missing directory.
         super::refuse_overwrite(out, a.force)?;
     }
+    // Refused, never clamped (as `reproduce` does).
+    let initial = match a.initial {
+        Some(i) if i == 0 || i > a.n => bail!(
+            "--initial {i}: the initial EAE design must have 1..=N poses (--n {})",
+            a.n
+        ),
+        Some(i) => i,
+        None => Settings::default().initial.min(a.n),
+    };
     let ctx = a.pool.load()?;
     let existing = a
         .existing
@@ -170,7 +249,7 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     let fixed = ctx.pool.positions_of(&fixed_ids)?;
     let s = Settings {
         n: a.n,
-        initial: a.initial.max(fixed.len()).min(a.n),
+        initial: initial.max(fixed.len()),
         starts: a.starts,
         designs: a.designs,
         polish: a.polish,

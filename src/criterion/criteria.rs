@@ -25,6 +25,7 @@ use super::state::InfoState;
 use super::variances::{PoolVariances, SCAN_CHUNK};
 use crate::linalg::eigen::EigenScratch;
 use crate::linalg::gram::{add_gram, gather_block, view};
+use crate::linalg::rank::{eigenvalues_regular, equilibrate_into};
 use crate::linalg::small::{STACK_T, ln_det_i_minus, ln_det_i_plus};
 
 /// Candidates per parallel work item of the OI criterion (`O(p³)` each).
@@ -191,7 +192,8 @@ impl Criterion for DCriterion {
 /// (`M + X_iᵀX_i`, `M − X_jᵀX_j`, or both): `O(p³)` per candidate, the slow
 /// path the determinant updates replace.
 ///
-/// A changed `M` whose eigenvalues give `λ_max ≥ max_condition·λ_min`
+/// A changed `M` whose equilibrated form `D^-½ M D^-½` (`D = diag M`, the
+/// rule of [`crate::linalg::rank`]) has `λ_max ≥ max_condition·λ_min`
 /// ([`StateSettings::max_condition`](super::StateSettings::max_condition)
 /// of the state) is numerically singular and priced `-∞`. Since `OI` is a
 /// monotone function of `ln det M`, it ranks designs as [`DCriterion`] does.
@@ -204,6 +206,8 @@ struct OiScratch {
     /// The changed `M`, `p×p` column-major.
     m: Vec<f64>,
     block: Vec<f64>,
+    /// The equilibrated changed `M`.
+    scaled: Vec<f64>,
     eig: EigenScratch,
 }
 
@@ -213,6 +217,7 @@ impl OiScratch {
             p,
             m: vec![0.0; p * p],
             block: Vec::with_capacity(STACK_T * p),
+            scaled: Vec::with_capacity(p * p),
             eig: EigenScratch::new(p),
         }
     }
@@ -238,22 +243,36 @@ impl OiScratch {
                 add_gram(&mut self.m, p, &self.block, pool.t(), sign);
             }
         }
-        oi_of(view(&self.m, p), max_condition, &mut self.eig)
+        oi_of(
+            view(&self.m, p),
+            max_condition,
+            &mut self.eig,
+            &mut self.scaled,
+        )
     }
 }
 
-fn oi_of(m: MatRef<'_, f64>, max_condition: f64, eig: &mut EigenScratch) -> f64 {
-    let p = m.nrows() as f64;
-    let Some(ev) = eig.eigenvalues(m) else {
+/// The OI of `M` from the eigenvalues of its equilibrated form `M̃`
+/// (`ln det M = ln det M̃ + 2 Σ ln s_j`), `-∞` when `M̃` fails the rank
+/// rule.
+fn oi_of(
+    m: MatRef<'_, f64>,
+    max_condition: f64,
+    eig: &mut EigenScratch,
+    scaled: &mut Vec<f64>,
+) -> f64 {
+    let p = m.nrows();
+    let s = equilibrate_into(m, scaled);
+    let Some(ev) = eig.eigenvalues(view(scaled, p)) else {
         return f64::NEG_INFINITY;
     };
-    let lo = ev.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = ev.iter().copied().fold(0.0, f64::max);
-    if !(lo * max_condition > hi) {
+    if !eigenvalues_regular(ev, max_condition) {
         return f64::NEG_INFINITY;
     }
-    let ln_det: f64 = ev.iter().map(|l| l.ln()).sum();
-    (ln_det / (2.0 * p)).exp() / p
+    let ln_det: f64 =
+        ev.iter().map(|l| l.ln()).sum::<f64>() + 2.0 * s.iter().map(|v| v.ln()).sum::<f64>();
+    let pf = p as f64;
+    (ln_det / (2.0 * pf)).exp() / pf
 }
 
 impl OiCriterion {
@@ -271,7 +290,12 @@ impl Criterion for OiCriterion {
 
     fn score(&mut self, _pool: &Blocks, state: &InfoState) -> f64 {
         let mut eig = EigenScratch::new(state.p());
-        oi_of(state.m(), state.settings().max_condition, &mut eig)
+        oi_of(
+            state.m(),
+            state.settings().max_condition,
+            &mut eig,
+            &mut Vec::new(),
+        )
     }
 
     fn price_adds(

@@ -11,6 +11,7 @@ use serde::Serialize;
 
 use crate::blocks::Blocks;
 use crate::linalg::eigen::{EigenScratch, singular_values};
+use crate::linalg::rank::{MAX_CONDITION, equilibrated_rank, rank_of_singular_values};
 
 /// The singular-value indices of one design. Smaller-is-better indices are
 /// marked; all others are larger-is-better. Infinite values (a singular
@@ -41,7 +42,12 @@ pub struct Indices {
     /// A-optimality `tr(M⁻¹) = Σ 1/σ_i²`; smaller is better, `+∞` if
     /// singular.
     pub a_trace: f64,
-    /// Numerical rank: the number of `σ_i > max(m, p)·ε·σ_max`.
+    /// Numerical rank by the rule every command shares
+    /// ([`crate::linalg::rank`]): the number of singular values `σ̃` of the
+    /// column-scaled `X` (unit-norm columns) with
+    /// `σ̃² · MAX_CONDITION > σ̃_max²`, so that units cannot change it
+    /// ([`from_singular_values`](Self::from_singular_values), which has no
+    /// columns to scale, applies it to the `σ` given).
     pub rank: usize,
 }
 
@@ -66,7 +72,6 @@ impl Indices {
         } else {
             (ln_oid / (2.0 * l)).exp()
         };
-        let tol = (m.max(p) as f64) * f64::EPSILON * s_max;
         let recip: f64 = sigma.iter().map(|&s| 1.0 / s).sum();
         let recip2: f64 = sigma.iter().map(|&s| 1.0 / (s * s)).sum();
         Self {
@@ -87,7 +92,7 @@ impl Indices {
             },
             o5: 1.0 / recip,
             a_trace: recip2,
-            rank: sigma.iter().filter(|&&s| s > tol).count(),
+            rank: rank_of_singular_values(sigma, MAX_CONDITION),
         }
     }
 
@@ -96,7 +101,18 @@ impl Indices {
     #[must_use]
     pub fn from_design(pool: &Blocks, poses: &[usize]) -> Self {
         let x = pool.select(poses);
-        Self::from_singular_values(&singular_values(x.mat()), x.mat().nrows())
+        let m = x.mat();
+        let mut ix = Self::from_singular_values(&singular_values(m), m.nrows());
+        let norms: Vec<f64> = (0..m.ncols()).map(|c| m.col(c).norm_l2()).collect();
+        let unit = faer::Mat::from_fn(m.nrows(), m.ncols(), |r, c| {
+            if norms[c] > 0.0 {
+                m[(r, c)] / norms[c]
+            } else {
+                0.0
+            }
+        });
+        ix.rank = rank_of_singular_values(&singular_values(unit.as_ref()), MAX_CONDITION);
+        ix
     }
 
     /// Indices from an information matrix `M = XᵀX` (its eigenvalues are
@@ -109,7 +125,9 @@ impl Indices {
             .eigenvalues(m_info)
             .map(|ev| ev.iter().map(|&l| l.max(0.0).sqrt()).collect())
             .unwrap_or_else(|| vec![0.0; m_info.nrows()]);
-        Self::from_singular_values(&sigma, m)
+        let mut ix = Self::from_singular_values(&sigma, m);
+        ix.rank = equilibrated_rank(m_info, MAX_CONDITION);
+        ix
     }
 }
 

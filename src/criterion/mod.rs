@@ -1,5 +1,5 @@
 //! The observability-criterion engine: the information state of a design
-//! (`M = XᵀX (+ δI)`, `M⁻¹`, `ln det M`), its rank-`t` updates by the
+//! (`M = XᵀX (+ δR)`, `M⁻¹`, `ln det M`), its rank-`t` updates by the
 //! matrix determinant lemma and Woodbury (paper §III, eq. (4)–(22)), batched
 //! pricing of every candidate pose of a pool, eigenvalue-based observability
 //! indices, and the [`Criterion`] trait the selection algorithms are written
@@ -37,19 +37,29 @@
 //!
 //! # Singularity rule
 //!
-//! `M` is accepted at construction when its eigenvalues satisfy
+//! Every condition number here is that of the *equilibrated* matrix
+//! `M̃ = D^-½ M D^-½` (`D = diag M`), the rule of [`crate::linalg::rank`]
+//! that every command decides rank by, so that scaling a column of the pool
+//! (a unit change: millimetres for metres) changes no decision. `M` is
+//! accepted at construction when the eigenvalues of `M̃` satisfy
 //! `λ_max < max_condition · λ_min` ([`StateSettings::max_condition`],
-//! default `1e13`; the rank estimate counts eigenvalues above
+//! default `1e13`; the rank estimate counts eigenvalues of `M̃` above
 //! `λ_max / max_condition`). A change that removes rows is refused when a
 //! pivot `d` of the (diagonally pivoted) Cholesky factor of its Schur
 //! complement `B = I − S_oo (+ S_oi(I + S_ii)⁻¹S_io)` satisfies
-//! `d ≤ κ̂(M) / max_condition`, with `κ̂(M) = ‖M‖₁‖M⁻¹‖₁ ≥ κ₂(M)`. The
-//! rounding error of an update is about `p·u·κ(M)·a` with the
-//! amplification `a ≈ 1/d` of a removal (downdating cancels), so the rule
-//! caps it at `p·u·max_condition`; and since `M' ⪰ λ_min(B)·M` with
-//! `λ_min(B) ≤ d`, `κ̂(M)/d` also estimates the condition number of the
-//! result. A refused change thus certifies that the exact retained fraction
-//! `λ_min(B)` is at most `d ≤ κ̂(M)/max_condition` (up to rounding).
+//! `d ≤ κ̂(M̃) / max_condition`, with `κ̂(M̃) = ‖M̃‖₁‖M̃⁻¹‖₁ ≥ κ₂(M̃)`
+//! (`S_ab = X_a M⁻¹ X_bᵀ`, hence `B` and `d`, are invariant under column
+//! scaling too). The rounding of the updates is componentwise, so an update
+//! errs by about `p·u·κ(M̃)·a` with the amplification `a ≈ 1/d` of a
+//! removal (downdating cancels), and the rule caps it at
+//! `p·u·max_condition`; since `M' ⪰ λ_min(B)·M` with `λ_min(B) ≤ d`,
+//! `κ̂(M̃)/d` also estimates the condition number of the result. A refused
+//! change thus certifies that the exact retained fraction `λ_min(B)` is at
+//! most `d ≤ κ̂(M̃)/max_condition` (up to rounding).
+//!
+//! A ridge ([`StateSettings::ridge`]) is relative and per column,
+//! `M = XᵀX + δ·diag(r_j)` with `r_j` the mean information of column `j`
+//! per pool pose, so it scales with the units of its column as well.
 //!
 //! # Drift
 //!

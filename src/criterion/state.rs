@@ -1,4 +1,4 @@
-//! The information state of a design over a pose pool: `M = XᵀX (+ δI)`,
+//! The information state of a design over a pose pool: `M = XᵀX (+ δR)`,
 //! `M⁻¹`, `ln det M`, updated by the paper's formulas (eq. (4)–(22)) in
 //! block form.
 
@@ -13,20 +13,29 @@ use super::prior::Prior;
 use crate::blocks::Blocks;
 use crate::linalg::chol::cholesky_inverse;
 use crate::linalg::eigen::EigenScratch;
-use crate::linalg::gram::{add_gram, gather_block, norm1, view};
+use crate::linalg::gram::{add_gram, gather_block, view};
+use crate::linalg::rank::{
+    MAX_CONDITION, eigenvalues_regular, equilibrated_cond1, equilibrated_eigenvalues,
+    rank_of_eigenvalues,
+};
 
 /// Settings of an [`InfoState`]; validated by [`InfoState::new`].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct StateSettings {
-    /// Ridge `δ ≥ 0`: `M = XᵀX + δI`. Lets a selection start from fewer than
-    /// `p/t` poses. Default `0`.
+    /// Relative ridge `δ ≥ 0`: `M = XᵀX + δR`, `R = diag(r_j)` with `r_j`
+    /// the mean information of column `j` per pool pose
+    /// ([`InfoState::ridge_scales`]), so that scaling a column (a unit
+    /// change) scales its ridge with it. Lets a selection start from fewer
+    /// than `p/t` poses. Default `0`.
     pub ridge: f64,
     /// Refactorize (recompute `M` from the design, Cholesky, `M⁻¹`,
     /// `ln det M`) after this many updates, `≥ 1`. Default `64`.
     pub refactor_every: usize,
-    /// Largest accepted condition number of `M` (see the module docs'
-    /// singularity rule), `> 1`. Default `1e13`.
+    /// Largest accepted condition number of the equilibrated `M` (see the
+    /// module docs' singularity rule), `> 1`. Default
+    /// [`MAX_CONDITION`](crate::linalg::rank::MAX_CONDITION) `= 1e13`, the
+    /// rule every command decides rank by.
     pub max_condition: f64,
 }
 
@@ -35,7 +44,7 @@ impl Default for StateSettings {
         Self {
             ridge: 0.0,
             refactor_every: 64,
-            max_condition: 1e13,
+            max_condition: MAX_CONDITION,
         }
     }
 }
@@ -101,12 +110,12 @@ pub enum Status {
         /// Smallest pivot `d` of the removal Schur complement (`+∞` when
         /// nothing is removed; in `(0, 1]` for a pure removal). The rounding
         /// error of the change is amplified by about `1/d`, and the singularity
-        /// rule keeps `κ̂(M)/d < max_condition`.
+        /// rule keeps `κ̂(M̃)/d < max_condition` (`M̃` the equilibrated `M`).
         min_pivot: f64,
     },
     /// The change would make `M` numerically singular: a pivot of the
     /// removal Schur complement was `≤ pivot_floor`
-    /// (`= κ̂(M)/max_condition`). For an update method, nothing was changed.
+    /// (`= κ̂(M̃)/max_condition`). For an update method, nothing was changed.
     Singular {
         /// The offending pivot (may be `≤ 0`).
         pivot: f64,
@@ -158,8 +167,9 @@ fn fresh_id() -> u64 {
 }
 
 /// The information state of a design over a pool: design pose list (pool
-/// indices, no repeats), `M = XᵀX + δI` (`p×p`), `M⁻¹`, `ln det M`, and the
-/// number of updates since the last refactorization.
+/// indices, no repeats), `M = XᵀX + δR` (`p×p`, see
+/// [`StateSettings::ridge`]), `M⁻¹`, `ln det M`, and the number of updates
+/// since the last refactorization.
 ///
 /// Every method that needs the Jacobian blocks takes the pool the state was
 /// built on; passing another pool of a different shape panics.
@@ -172,6 +182,8 @@ pub struct InfoState {
     design: Vec<usize>,
     position: Vec<usize>,
     settings: StateSettings,
+    /// `r_j` of the ridge `δR` (see [`StateSettings::ridge`]).
+    ridge_scale: Vec<f64>,
     /// `M`, `p×p` column-major (stride `p`), exactly symmetric.
     m: Vec<f64>,
     /// `M⁻¹`, same layout.
@@ -202,6 +214,7 @@ impl Clone for InfoState {
             design: self.design.clone(),
             position: self.position.clone(),
             settings: self.settings,
+            ridge_scale: self.ridge_scale.clone(),
             m: self.m.clone(),
             m_inv: self.m_inv.clone(),
             ln_det: self.ln_det,
@@ -225,22 +238,37 @@ struct Factored {
     cond1: f64,
 }
 
-/// Number of eigenvalues of `m` above `λ_max / max_condition`.
+/// Number of eigenvalues of the equilibrated `m` above
+/// `λ_max / max_condition` (the rank rule of [`crate::linalg::rank`]).
 fn rank_estimate(m: MatRef<'_, f64>, max_condition: f64) -> usize {
     let mut es = EigenScratch::new(m.nrows());
-    match es.eigenvalues(m) {
-        Some(ev) => {
-            let top = ev.iter().copied().fold(0.0, f64::max);
-            ev.iter().filter(|&&l| l * max_condition > top).count()
-        }
-        None => 0,
-    }
+    equilibrated_eigenvalues(m, &mut Vec::new(), &mut es)
+        .map_or(0, |ev| rank_of_eigenvalues(&ev, max_condition))
+}
+
+/// `r_j = ‖X_pool[:, j]‖² / n_pool`, the mean information of column `j` per
+/// pool pose; `1` for a column that is zero (or overflows) on the whole
+/// pool, which no ridge can make identifiable anyway.
+fn ridge_scales(pool: &Blocks) -> Vec<f64> {
+    let x = pool.mat();
+    let n = pool.n_poses().max(1) as f64;
+    (0..x.ncols())
+        .map(|c| {
+            let r = x.col(c).squared_norm_l2() / n;
+            if r > 0.0 && r.is_finite() { r } else { 1.0 }
+        })
+        .collect()
+}
+
+/// The ridge's diagonal `δ·r_j`.
+fn ridge_diagonal(scales: &[f64], ridge: f64) -> Vec<f64> {
+    scales.iter().map(|r| ridge * r).collect()
 }
 
 impl InfoState {
     /// Builds the state of `design` (pool indices, no repeats, any order)
-    /// from scratch: `M` from the blocks, Cholesky (faer `llt`), `M⁻¹`,
-    /// `ln det M = 2 Σ ln L_ii`.
+    /// from scratch: `M` from the blocks (plus the ridge), Cholesky (faer
+    /// `llt`), `M⁻¹`, `ln det M = 2 Σ ln L_ii`.
     ///
     /// Errors: bad input ([`CriterionError::PoseOutOfRange`],
     /// [`DuplicatePose`](CriterionError::DuplicatePose),
@@ -248,7 +276,8 @@ impl InfoState {
     /// [`InvalidSetting`](CriterionError::InvalidSetting),
     /// [`UnsupportedShape`](CriterionError::UnsupportedShape) for `t > 6` or
     /// `p = 0`), or [`CriterionError::Singular`] when `M` is not positive
-    /// definite or its condition number exceeds `max_condition`.
+    /// definite or the condition number of its equilibrated form exceeds
+    /// `max_condition`.
     pub fn new(
         pool: &Blocks,
         design: &[usize],
@@ -311,11 +340,13 @@ impl InfoState {
             }
             position[q] = k;
         }
+        let ridge_scale = ridge_scales(pool);
+        let ridge = ridge_diagonal(&ridge_scale, settings.ridge);
         let f = Self::factor(
             pool,
             design,
             prior.as_ref(),
-            settings.ridge,
+            &ridge,
             settings.max_condition,
             true,
         )?;
@@ -327,6 +358,7 @@ impl InfoState {
             design: design.to_vec(),
             position,
             settings,
+            ridge_scale,
             m: f.m,
             m_inv: f.m_inv,
             ln_det: f.ln_det,
@@ -341,14 +373,14 @@ impl InfoState {
         })
     }
 
-    /// `M = M0 + δI + Σ_{i∈design} X_iᵀX_i`, factored; with
-    /// `check_condition`, a condition number above `max_condition` (from
-    /// the eigenvalues) is singular too.
+    /// `M = M0 + diag(ridge) + Σ_{i∈design} X_iᵀX_i`, factored; with
+    /// `check_condition`, a condition number of the equilibrated `M` above
+    /// `max_condition` (from its eigenvalues) is singular too.
     fn factor(
         pool: &Blocks,
         design: &[usize],
         prior: Option<&Prior>,
-        ridge: f64,
+        ridge: &[f64],
         max_condition: f64,
         check_condition: bool,
     ) -> Result<Factored, CriterionError> {
@@ -363,15 +395,13 @@ impl InfoState {
         };
         if check_condition {
             let mut es = EigenScratch::new(p);
-            if let Some(ev) = es.eigenvalues(view(&m, p)) {
-                let lo = ev.iter().copied().fold(f64::INFINITY, f64::min);
-                let hi = ev.iter().copied().fold(0.0, f64::max);
-                if !(lo * max_condition > hi) {
-                    return Err(singular(&m));
-                }
+            if let Some(ev) = equilibrated_eigenvalues(view(&m, p), &mut Vec::new(), &mut es)
+                && !eigenvalues_regular(&ev, max_condition)
+            {
+                return Err(singular(&m));
             }
         }
-        let cond1 = norm1(&m, p) * norm1(&m_inv, p);
+        let cond1 = equilibrated_cond1(&m, &m_inv, p);
         Ok(Factored {
             m,
             m_inv,
@@ -380,16 +410,21 @@ impl InfoState {
         })
     }
 
-    /// `M0 + δI + Σ_{i∈design} X_iᵀX_i`, column-major, summed in design
-    /// order after the prior.
-    fn information(pool: &Blocks, design: &[usize], prior: Option<&Prior>, ridge: f64) -> Vec<f64> {
+    /// `M0 + diag(ridge) + Σ_{i∈design} X_iᵀX_i`, column-major, summed in
+    /// design order after the prior.
+    fn information(
+        pool: &Blocks,
+        design: &[usize],
+        prior: Option<&Prior>,
+        ridge: &[f64],
+    ) -> Vec<f64> {
         let p = pool.p();
         let mut m = vec![0.0; p * p];
         if let Some(pr) = prior {
             pr.add_to(&mut m);
         }
         for i in 0..p {
-            m[i * p + i] += ridge;
+            m[i * p + i] += ridge[i];
         }
         let mut xb = Vec::with_capacity(pool.t() * p);
         for &q in design {
@@ -493,13 +528,21 @@ impl InfoState {
         self.prior.as_ref()
     }
 
-    /// The ridge `δ`.
+    /// The relative ridge `δ`.
     #[must_use]
     pub fn ridge(&self) -> f64 {
         self.settings.ridge
     }
 
-    /// `M = XᵀX + δI` (exactly symmetric).
+    /// `r_j`, the ridge's column scales: `M = XᵀX + δ·diag(r_j)` with
+    /// `r_j = ‖X_pool[:, j]‖² / n_pool` (`1` for a column that is zero on the
+    /// whole pool).
+    #[must_use]
+    pub fn ridge_scales(&self) -> &[f64] {
+        &self.ridge_scale
+    }
+
+    /// `M = XᵀX + δR` (exactly symmetric).
     #[must_use]
     pub fn m(&self) -> MatRef<'_, f64> {
         view(&self.m, self.p)
@@ -517,13 +560,15 @@ impl InfoState {
         self.ln_det
     }
 
-    /// `κ̂(M) = ‖M‖₁‖M⁻¹‖₁`, an upper bound of the 2-norm condition number.
+    /// `κ̂(M̃) = ‖M̃‖₁‖M̃⁻¹‖₁` of the equilibrated `M̃ = D^-½ M D^-½`
+    /// (`D = diag M`): an upper bound of its 2-norm condition number, and
+    /// unchanged when a column of the pool is scaled.
     #[must_use]
     pub fn condition_estimate(&self) -> f64 {
         self.cond1
     }
 
-    /// Pivot floor of the singularity rule: `κ̂(M) / max_condition`.
+    /// Pivot floor of the singularity rule: `κ̂(M̃) / max_condition`.
     #[must_use]
     pub fn pivot_floor(&self) -> f64 {
         self.cond1 / self.settings.max_condition
@@ -657,7 +702,7 @@ impl InfoState {
         }
         lr.apply_to_col_major(&mut self.m_inv);
         self.ln_det += lr.ln_det_ratio();
-        self.cond1 = norm1(&self.m, p) * norm1(&self.m_inv, p);
+        self.cond1 = equilibrated_cond1(&self.m, &self.m_inv, p);
         self.version += 1;
         self.log.push(lr);
         // Keep the log short when refactorizations are rare: a consumer more
@@ -727,11 +772,12 @@ impl InfoState {
     /// unchanged.
     pub fn refactorize(&mut self, pool: &Blocks) -> Result<(), CriterionError> {
         self.check_pool(pool);
+        let ridge = ridge_diagonal(&self.ridge_scale, self.settings.ridge);
         let f = Self::factor(
             pool,
             &self.design,
             self.prior.as_ref(),
-            self.settings.ridge,
+            &ridge,
             self.settings.max_condition,
             false,
         )?;
@@ -751,18 +797,19 @@ impl InfoState {
         self.log.clear();
     }
 
-    /// Sets the ridge `δ` (`M = XᵀX + δI`) and refactorizes; `set_ridge(0)`
-    /// drops it. On error (invalid `δ`, or [`CriterionError::Singular`]
+    /// Sets the relative ridge `δ` (`M = XᵀX + δR`) and refactorizes;
+    /// `set_ridge(0)` drops it. On error (invalid `δ`, or [`CriterionError::Singular`]
     /// under the construction rule) the state is unchanged.
     pub fn set_ridge(&mut self, pool: &Blocks, ridge: f64) -> Result<(), CriterionError> {
         self.check_pool(pool);
         let settings = self.settings.with_ridge(ridge);
         settings.validate()?;
+        let diag = ridge_diagonal(&self.ridge_scale, ridge);
         let f = Self::factor(
             pool,
             &self.design,
             self.prior.as_ref(),
-            ridge,
+            &diag,
             settings.max_condition,
             true,
         )?;
@@ -786,7 +833,8 @@ impl InfoState {
     pub fn drift(&self, pool: &Blocks) -> Drift {
         self.check_pool(pool);
         let p = self.p;
-        let fresh = Self::information(pool, &self.design, self.prior.as_ref(), self.settings.ridge);
+        let ridge = ridge_diagonal(&self.ridge_scale, self.settings.ridge);
+        let fresh = Self::information(pool, &self.design, self.prior.as_ref(), &ridge);
         let ln_det = match cholesky_inverse(view(&fresh, p)) {
             Ok((_, ld)) => (ld - self.ln_det).abs(),
             Err(()) => f64::INFINITY,

@@ -98,6 +98,13 @@ impl LmSettings {
             value: value.to_string(),
             reason,
         };
+        if self.max_iterations == 0 {
+            return Err(IdentifyError::Setting {
+                name: "max_iterations",
+                value: "0".into(),
+                reason: "at least one iteration is needed (0 would report the start as the estimate)",
+            });
+        }
         for (name, v) in [
             ("xtol", self.xtol),
             ("ftol", self.ftol),
@@ -394,10 +401,14 @@ fn finish(
     let dof = m.saturating_sub(p);
     let sigma_hat = (dof > 0 && out.rss.is_finite()).then(|| (out.rss / dof as f64).sqrt());
     let (rank, unidentifiable, inv) = if out.finite {
-        let x = Blocks::new(out.jac.clone(), robot.rows_per_pose());
+        // Moved, not copied: the Jacobian is the largest thing held.
+        let x = Blocks::new(
+            std::mem::replace(&mut out.jac, Mat::new()),
+            robot.rows_per_pose(),
+        );
         let idf = identifiability(robot, &x);
         let inv = (idf.rank == p)
-            .then(|| inverse_information(out.jac.as_ref()))
+            .then(|| inverse_information(x.mat()))
             .flatten();
         (idf.rank, idf.unidentifiable, inv)
     } else {
@@ -534,9 +545,11 @@ pub fn levenberg_marquardt<R: Residuals + ?Sized>(
     let mut evaluations = 1;
     let finite = prob.eval(&theta, &mut r, Some(&mut jac));
     let rss0 = sumsq(&r);
+    // The Jacobian is held once (3n × p for n measured points): `out.jac`
+    // gets it at the end, and each trial builds only the augmented system.
     let mut out = Solution {
         theta: theta.clone(),
-        jac: jac.clone(),
+        jac: Mat::new(),
         finite: finite && rss0.is_finite(),
         stop: StopReason::NonFinite,
         iterations: 0,
@@ -547,6 +560,7 @@ pub fn levenberg_marquardt<R: Residuals + ?Sized>(
         lambda: 0.0,
     };
     if !out.finite {
+        out.jac = jac;
         return out;
     }
     let mut cost = 0.5 * rss0;
@@ -583,10 +597,11 @@ pub fn levenberg_marquardt<R: Residuals + ?Sized>(
         if iterations >= s.max_iterations {
             break StopReason::MaxIterations;
         }
-        let js = Mat::from_fn(m, p, |i, j| jac[(i, j)] / d[j]);
         if lambda.is_nan() {
+            // The largest diagonal entry of the scaled JᵀJ, ‖J_{:,j}/d_j‖²
+            // (one column at a time).
             let max_diag = (0..p)
-                .map(|c| js.col(c).squared_norm_l2())
+                .map(|c| faer::Col::from_fn(m, |i| jac[(i, c)] / d[c]).squared_norm_l2())
                 .fold(0.0, f64::max);
             lambda = s.initial_damping * max_diag.max(f64::MIN_POSITIVE);
         }
@@ -595,11 +610,11 @@ pub fn levenberg_marquardt<R: Residuals + ?Sized>(
 
         // ---- inner loop: damped trial steps ---------------------------------
         loop {
-            // [Js; √λ I] u = [−r; 0]
+            // [Js; √λ I] u = [−r; 0], Js = J D⁻¹
             let sl = lambda.sqrt();
             let aug = Mat::from_fn(m + p, p, |i, j| {
                 if i < m {
-                    js[(i, j)]
+                    jac[(i, j)] / d[j]
                 } else if i - m == j {
                     sl
                 } else {

@@ -434,7 +434,7 @@ struct MeasurementsFile {
     qs: Vec<Vec<f64>>,
     #[serde(default = "one")]
     markers: usize,
-    points: Vec<[f64; 3]>,
+    points: Vec<Vec<f64>>,
     #[serde(default)]
     orientations: Vec<[[f64; 3]; 3]>,
     #[serde(default)]
@@ -464,11 +464,21 @@ impl TryFrom<MeasurementsFile> for Measurements {
         if f.markers == 0 {
             return Err("`markers` must be at least 1 (points per pose)".into());
         }
+        let mut points = Vec::with_capacity(f.points.len());
+        for (i, p) in f.points.iter().enumerate() {
+            let &[x, y, z] = p.as_slice() else {
+                return Err(format!(
+                    "point {i}: expected 3 coordinates [x, y, z], got {}",
+                    p.len()
+                ));
+            };
+            points.push([x, y, z]);
+        }
         Ok(Self {
             robot: f.robot,
             qs: f.qs,
             markers: f.markers,
-            points: f.points,
+            points,
             orientations,
         })
     }

@@ -116,6 +116,13 @@ impl MonteCarloSettings {
                 reason: "the noise standard deviation must be finite and >= 0",
             });
         }
+        if self.validation_poses == 0 {
+            return Err(IdentifyError::Setting {
+                name: "validation_poses",
+                value: "0".into(),
+                reason: "at least one held-out pose is needed (the RMS error of no poses is no measurement)",
+            });
+        }
         self.lm.validate()
     }
 }

@@ -105,18 +105,25 @@ impl DesignFile {
         }
     }
 
-    /// Reads and parses a design file.
+    /// Reads and parses a design file ([`DesignFile::parse`]).
     pub fn read(path: &Path) -> Result<DesignFile> {
         let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
             path: path.display().to_string(),
             cause,
         })?;
-        let d: DesignFile = serde_json::from_str(&text).map_err(|e| Error::Parse {
-            path: path.display().to_string(),
+        Self::parse(&text, &path.display().to_string())
+    }
+
+    /// Parses the text of a design file, `origin` naming it in errors
+    /// ([`Error::Parse`]: JSON syntax and types with line and column, a
+    /// repeated pose, ids and joint vectors of different counts, no pool).
+    pub fn parse(text: &str, origin: &str) -> Result<DesignFile> {
+        let d: DesignFile = serde_json::from_str(text).map_err(|e| Error::Parse {
+            path: origin.to_string(),
             message: e.to_string(),
         })?;
         d.check_shape().map_err(|e| Error::Parse {
-            path: path.display().to_string(),
+            path: origin.to_string(),
             message: e.to_string(),
         })?;
         Ok(d)
@@ -209,7 +216,12 @@ impl DesignFile {
         let qs = match &self.q {
             Some(q) => q.clone(),
             None => {
-                let levels = self.levels.expect("checked by check_shape");
+                // An old file: its lattice gives the joint values.
+                let Some(levels) = self.spec()?.levels() else {
+                    return Err(Error::Invalid(
+                        "the design stores no joint values ('q') and its pool is not a lattice: there is no way to know its poses".into(),
+                    ));
+                };
                 let lattice = Lattice::new(robot, levels)?;
                 self.poses
                     .iter()

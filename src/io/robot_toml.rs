@@ -53,7 +53,7 @@
 //! identifiable ([`Robot::check_identifiable`]).
 
 use super::Description;
-use crate::error::{Error, Result};
+use crate::error::{Compact, Error, Result};
 use crate::measure::Visibility;
 use crate::model::{
     Convention, Frame, JointKind, MeasurementKind, ParamId, ParamTable, Robot, Symbol,
@@ -213,7 +213,8 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
                 return Err(cx.at(
                     s.span(),
                     format!(
-                        "orientation_scale = {v}: must be a finite number > 0 (metres per radian)"
+                        "orientation_scale = {}: must be a finite number in (0, {MAX_ABS:e}] (metres per radian)",
+                        Compact(v)
                     ),
                 ));
             }
@@ -536,8 +537,9 @@ fn row(
             return Err(cx.at(
                 v.span(),
                 format!(
-                    "frame '{label}': {which} {} = {x} is out of range (|value| <= {MAX_ABS:e})",
-                    Symbol::ALL[k]
+                    "frame '{label}': {which} {} = {} is out of range (|value| <= {MAX_ABS:e})",
+                    Symbol::ALL[k],
+                    Compact(x)
                 ),
             ));
         }
@@ -600,7 +602,9 @@ fn joint_limits(
         return Err(cx.at(
             v.span(),
             format!(
-                "frame '{label}': joint q{joint_no} limits [{lo}, {hi}] are not finite numbers within ±{MAX_ABS:e}"
+                "frame '{label}': joint q{joint_no} limits [{}, {}] are not finite numbers within ±{MAX_ABS:e}",
+                Compact(lo),
+                Compact(hi)
             ),
         ));
     }
@@ -608,7 +612,19 @@ fn joint_limits(
         return Err(cx.at(
             v.span(),
             format!(
-                "frame '{label}': joint q{joint_no} has inverted limits [{lo}, {hi}] (need lo <= hi)"
+                "frame '{label}': joint q{joint_no} has inverted limits [{}, {}] (need lo <= hi)",
+                Compact(lo),
+                Compact(hi)
+            ),
+        ));
+    }
+    if lo == hi {
+        return Err(cx.at(
+            v.span(),
+            format!(
+                "frame '{label}': joint q{joint_no} has an empty range [{}, {}]: a joint that never moves leaves its frame's unknowns unidentifiable; give it a range, or make the frame fixed (`joint = \"fixed\"`) with the value in its table",
+                Compact(lo),
+                Compact(hi)
             ),
         ));
     }

@@ -54,7 +54,7 @@
 //! fixed joint `tool` to the link `tip`. `fixtures/puma560.urdf` is the
 //! paper's nominal PUMA written this way.
 
-use crate::error::{Error, Result};
+use crate::error::{Compact, Error, Result};
 use crate::kinematics::joint_chain;
 use crate::model::catalogue::perturbed;
 use crate::model::{
@@ -506,20 +506,26 @@ fn extract_chain(
             let [lo, hi] = limits;
             if lo.is_nan() || hi.is_nan() || !lo.is_finite() || !hi.is_finite() {
                 return Err(format!(
-                    "joint '{}': limits [{lo}, {hi}] are not finite",
-                    j.name
+                    "joint '{}': limits [{}, {}] are not finite",
+                    j.name,
+                    Compact(lo),
+                    Compact(hi)
                 ));
             }
             if lo > hi {
                 return Err(format!(
-                    "joint '{}': inverted limits [{lo}, {hi}] (need lower <= upper)",
-                    j.name
+                    "joint '{}': inverted limits [{}, {}] (need lower <= upper)",
+                    j.name,
+                    Compact(lo),
+                    Compact(hi)
                 ));
             }
             if lo == hi {
                 return Err(format!(
-                    "joint '{}': empty range [{lo}, {hi}] (is <limit lower=… upper=…> missing?)",
-                    j.name
+                    "joint '{}': empty range [{}, {}] (is <limit lower=… upper=…> missing?)",
+                    j.name,
+                    Compact(lo),
+                    Compact(hi)
                 ));
             }
         }

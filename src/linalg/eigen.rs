@@ -50,6 +50,34 @@ impl EigenScratch {
     }
 }
 
+/// Eigenvalues (nondecreasing) and eigenvectors (the columns of the second
+/// matrix) of the symmetric `m` (lower triangle read), sequential; `None` if
+/// the iteration fails.
+pub(crate) fn symmetric_eigen(m: MatRef<'_, f64>) -> Option<(Vec<f64>, faer::Mat<f64>)> {
+    let p = m.nrows();
+    let req = evd::self_adjoint_evd_scratch::<f64>(
+        p,
+        ComputeEigenvectors::Yes,
+        Par::Seq,
+        Default::default(),
+    );
+    let mut mem = MemBuffer::new(req);
+    let mut s = Diag::<f64>::zeros(p);
+    let mut u = faer::Mat::<f64>::zeros(p, p);
+    let r = evd::self_adjoint_evd(
+        m,
+        s.as_mut(),
+        Some(u.as_mut()),
+        Par::Seq,
+        MemStack::new(&mut mem),
+        Default::default(),
+    );
+    clear_upper_simd_state();
+    r.ok()?;
+    let ev: Vec<f64> = (0..p).map(|i| s[i]).collect();
+    Some((ev, u))
+}
+
 /// Singular values of `x` (nonincreasing), padded with zeros to `x.ncols()`
 /// when `x` has fewer rows than columns.
 pub(crate) fn singular_values(x: MatRef<'_, f64>) -> Vec<f64> {

@@ -32,6 +32,7 @@ pub(crate) fn add_gram(m: &mut [f64], p: usize, xb: &[f64], t: usize, sign: f64)
 
 /// Induced 1-norm (largest absolute column sum) of a `p×p` column-major
 /// matrix.
+#[cfg(test)]
 pub(crate) fn norm1(m: &[f64], p: usize) -> f64 {
     m.chunks(p.max(1))
         .map(|c| c.iter().map(|x| x.abs()).sum::<f64>())

@@ -6,6 +6,8 @@
 //! - [`gram`]: `M ± XᵀX` on `p×p` slices, `AᵀA` and products;
 //! - [`qr`]: Householder QR, least squares and `(XᵀX)⁻¹` for identification;
 //! - [`eigen`]: eigenvalues and singular values;
+//! - [`rank`]: the one rank and conditioning rule, on the column-scaled
+//!   (equilibrated) problem, that every command decides by;
 //! - [`simd`]: register hygiene after faer's kernels;
 //! - [`blas`]: the system BLAS kept on one thread.
 //!
@@ -19,5 +21,6 @@ pub mod chol;
 pub mod eigen;
 pub mod gram;
 pub mod qr;
+pub mod rank;
 pub mod simd;
 pub mod small;

@@ -530,7 +530,7 @@ impl Robot {
         if !(self.orientation_scale.is_finite() && self.orientation_scale > 0.0) {
             return Err(Error::Invalid(format!(
                 "orientation_scale = {}: must be a finite number > 0 (metres per radian)",
-                self.orientation_scale
+                crate::error::Compact(self.orientation_scale)
             )));
         }
         let mut seen = vec![false; self.dof()];
@@ -575,6 +575,19 @@ impl Robot {
                     lo,
                     hi,
                 });
+            }
+            if lo == hi {
+                let frame = self
+                    .frames
+                    .iter()
+                    .find(|f| f.joint == Some(j))
+                    .map_or("?", |f| f.label.as_str());
+                return Err(Error::Invalid(format!(
+                    "joint q{} (frame {frame}) has an empty range [{}, {}]: a joint that never moves leaves its frame's unknowns unidentifiable; give it a range, or make the frame fixed",
+                    j + 1,
+                    crate::error::Compact(lo),
+                    crate::error::Compact(hi)
+                )));
             }
         }
         for table in [&self.real, &self.nominal] {

@@ -219,8 +219,10 @@ impl PoolSpec {
     /// (reading the file of a [`PoolSource::File`]) and keeps those that
     /// pass every filter (evaluated at `table`, the model the sensor region
     /// is known in, usually the nominal one). A pool that the filters leave
-    /// empty is an error naming the filter that removed the last candidates.
+    /// empty is an error naming the filter that removed the last candidates,
+    /// and so is a filter whose region is malformed ([`Visibility::validate`]).
     pub fn build(&self, robot: &Robot, table: &ParamTable) -> Result<Pool> {
+        self.validate_filters()?;
         match &self.source {
             PoolSource::File { path } => {
                 let rows = read_configurations(Path::new(path), robot)?;
@@ -228,6 +230,18 @@ impl PoolSpec {
             }
             _ => self.build_inner(robot, table, None, Vec::new()),
         }
+    }
+
+    /// Checks every filter's own settings (a malformed region).
+    fn validate_filters(&self) -> Result<()> {
+        for f in &self.filters {
+            match f {
+                PoolFilter::Visibility(v) => v
+                    .validate()
+                    .map_err(|e| Error::Invalid(format!("visibility filter: {e}")))?,
+            }
+        }
+        Ok(())
     }
 
     /// Builds a [`PoolSource::File`] pool from its rows as already read (the
@@ -239,6 +253,7 @@ impl PoolSpec {
         table: &ParamTable,
         rows: Configurations,
     ) -> Result<Pool> {
+        self.validate_filters()?;
         if !matches!(self.source, PoolSource::File { .. }) {
             return Err(Error::Invalid(format!(
                 "stored configurations given for a {} pool",

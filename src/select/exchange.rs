@@ -96,7 +96,7 @@ impl<'a, C: Criterion> Run<'a, C> {
         let state = match state(StateSettings::default()) {
             Ok(s) => s,
             Err(CriterionError::Singular { .. }) => {
-                state(StateSettings::default().with_ridge(ridge_for(pool))).map_err(crit_err)?
+                state(StateSettings::default().with_ridge(START_RIDGE)).map_err(crit_err)?
             }
             Err(e) => return Err(crit_err(e)),
         };
@@ -300,16 +300,11 @@ impl<'a, C: Criterion> Run<'a, C> {
     }
 }
 
-/// Ridge `δ` for a rank-deficient start: `1e-8` times the mean diagonal of
-/// the per-pose information (see the module docs).
-fn ridge_for(pool: &Blocks) -> f64 {
-    let m = pool.mat();
-    let mut s = 0.0;
-    for c in 0..m.ncols() {
-        s += m.col(c).squared_norm_l2();
-    }
-    (1e-8 * s / (pool.n_poses() * pool.p()) as f64).max(f64::MIN_POSITIVE)
-}
+/// Relative ridge `δ` of a rank-deficient start: `1e-8` times each
+/// column's mean information per pool pose
+/// ([`StateSettings::ridge`](crate::criterion::StateSettings::ridge); see
+/// the module docs).
+const START_RIDGE: f64 = 1e-8;
 
 fn non_fixed(pool: &Blocks, fixed: &[usize]) -> Vec<usize> {
     let mut mask = vec![false; pool.n_poses()];

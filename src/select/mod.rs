@@ -18,9 +18,11 @@
 //!
 //! When the initial design has too few rows for a non-singular `M`
 //! (`n0·t < p`, or degenerate poses), the state starts with a small ridge
-//! `M = XᵀX + δI`, `δ = 10⁻⁸ · tr(X_poolᵀX_pool)/(n_pool·p)` (a relative
-//! size far below any eigenvalue a full-rank design has, yet enough to
-//! factor). The ridge is dropped as soon as the design is non-singular
+//! `M = XᵀX + δ·diag(r_j)`, `δ = 10⁻⁸`, `r_j = ‖X_pool[:, j]‖²/n_pool` the
+//! mean information of column `j` per pool pose (a relative size far below
+//! any eigenvalue a full-rank design has, yet enough to factor; per column,
+//! so that a unit change of one column scales its ridge with it and changes
+//! no decision). The ridge is dropped as soon as the design is non-singular
 //! without it (tried after every add step), so every reported value of a
 //! finished design is the ridge-free `ln det XᵀX`; trace rows taken while the
 //! ridge was on carry `ridge: true`.

@@ -49,11 +49,15 @@ pub fn random_design(
     d
 }
 
-/// `ln det(XᵀX)` of a design by Cholesky, or `None` when it is not positive
-/// definite (singular design).
+/// `ln det(XᵀX)` of a design by Cholesky of its equilibrated form, or
+/// `None` when it is singular by the rank rule every command shares
+/// ([`crate::linalg::rank`]: condition number of the equilibrated `XᵀX` at
+/// least [`MAX_CONDITION`](crate::linalg::rank::MAX_CONDITION)), so a unit
+/// change of a column changes no verdict.
 #[must_use]
 pub fn ln_det_direct(pool: &Blocks, poses: &[usize]) -> Option<f64> {
-    crate::linalg::chol::ln_det_spd(pool.information(poses).as_ref())
+    use crate::linalg::rank::{MAX_CONDITION, ln_det_regular};
+    ln_det_regular(pool.information(poses).as_ref(), MAX_CONDITION)
 }
 
 /// `ln det(M0 + XᵀX)` of a design on top of a prior (`ln det XᵀX`

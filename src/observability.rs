@@ -166,9 +166,8 @@ impl Robot {
     /// this robot's joints and measurement: `4R + 2P + 3` for point
     /// measurements, `4R + 2P + 6` for full poses (R revolute, P prismatic
     /// joints; Everett, Driels & Mooring 1987, less 3 for a point), and for
-    /// `K` markers `4R + 2P + d − 3 + 3K` with `d` the frame freedoms they see
-    /// (3, 5, 6 for one, two, three or more markers): the offsets replace the
-    /// tool translation. Special
+    /// `K` markers `4R + 2P + 3K`: each marker's offset places it freely in
+    /// the last joint frame, so the offsets absorb the whole tool frame. Special
     /// geometries (a measured point on the last joint axis, coaxial joints)
     /// have fewer.
     #[must_use]
@@ -176,9 +175,12 @@ impl Robot {
         let p = self.frames.iter().filter(|f| f.is_prismatic()).count();
         let r = self.dof().saturating_sub(p);
         let sensor = crate::measure::sensor_for(self);
-        // Marker offsets take the tool translation (3) and add their own.
-        let own = sensor.n_own_params();
-        4 * r + 2 * p + sensor.observed_dof() + own - if own > 0 { 3 } else { 0 }
+        match self.measurement.markers() {
+            // The offsets place each marker freely in the last joint frame:
+            // they absorb the whole tool frame, translation and rotation.
+            0 => 4 * r + 2 * p + sensor.observed_dof(),
+            k => 4 * r + 2 * p + 3 * k,
+        }
     }
 
     /// A maximal identifiable set of unknowns: `preferred` first (in the given
@@ -357,9 +359,9 @@ impl Robot {
     /// use activecal::model::Robot;
     /// let ur5 = Robot::ur5();
     /// let m = ur5.with_markers(&[[0.1, 0.0, 0.05], [0.0, 0.1, 0.05], [0.0, 0.0, 0.15]]).unwrap();
-    /// // The offsets take the tool translation: 3 orientation unknowns more
-    /// // than the point robot's 27 less 3, plus 9 offsets.
-    /// assert_eq!((m.rows_per_pose(), m.n_params()), (9, ur5.n_unknowns() + 3 + 9 - 3));
+    /// // The offsets absorb the tool frame: 4 per revolute joint, 3 per marker.
+    /// assert_eq!((m.rows_per_pose(), m.n_params()), (9, 4 * 6 + 9));
+    /// assert_eq!(m.n_params(), m.minimal_unknowns());
     /// ```
     pub fn with_markers(&self, offsets: &[[f64; 3]]) -> Result<Robot> {
         if offsets.is_empty() {

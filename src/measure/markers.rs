@@ -5,8 +5,9 @@
 //! Marker `k` sits at `m_k = p + R o_k`, with `(R, p)` the end frame and
 //! `o_k` its offset in the end frame, an unknown of the sensor's own (see
 //! [`super::sensor`]): the offsets are never known to the precision of a
-//! calibration, so each marker brings three unknowns and the robot's tool
-//! translation, which they absorb, is not among the robot's unknowns.
+//! calibration, so each marker brings three unknowns, and the tool frame's
+//! translation and rotation, which they absorb, are not among the robot's
+//! unknowns.
 //!
 //! Under an elementary motion of the chain with linear velocity `v` of `p`
 //! and angular velocity `ω` of the end frame, marker `k` moves with

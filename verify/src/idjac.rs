@@ -142,6 +142,7 @@ impl Source {
                 match measurement {
                     MeasurementKind::Point => stem,
                     MeasurementKind::Pose => format!("{stem}_pose"),
+                    MeasurementKind::Markers(k) => format!("{stem}_markers{k}"),
                 }
             }
         }
@@ -186,6 +187,7 @@ pub fn sources() -> Vec<Source> {
                 orientation_scale: match m {
                     MeasurementKind::Point => activecal::model::DEFAULT_ORIENTATION_SCALE,
                     MeasurementKind::Pose => URDF_ORIENTATION_SCALE,
+                    MeasurementKind::Markers(_) => unreachable!("points and poses only"),
                 },
             });
         }

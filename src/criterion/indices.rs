@@ -101,17 +101,8 @@ impl Indices {
     #[must_use]
     pub fn from_design(pool: &Blocks, poses: &[usize]) -> Self {
         let x = pool.select(poses);
-        let m = x.mat();
-        let mut ix = Self::from_singular_values(&singular_values(m), m.nrows());
-        let norms: Vec<f64> = (0..m.ncols()).map(|c| m.col(c).norm_l2()).collect();
-        let unit = faer::Mat::from_fn(m.nrows(), m.ncols(), |r, c| {
-            if norms[c] > 0.0 {
-                m[(r, c)] / norms[c]
-            } else {
-                0.0
-            }
-        });
-        ix.rank = rank_of_singular_values(&singular_values(unit.as_ref()), MAX_CONDITION);
+        let mut ix = Self::from_singular_values(&singular_values(x.mat()), x.mat().nrows());
+        ix.rank = equilibrated_rank(pool.information(poses).as_ref(), MAX_CONDITION);
         ix
     }
 

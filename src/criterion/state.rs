@@ -16,7 +16,7 @@ use crate::linalg::eigen::EigenScratch;
 use crate::linalg::gram::{add_gram, gather_block, view};
 use crate::linalg::rank::{
     MAX_CONDITION, eigenvalues_regular, equilibrated_cond1, equilibrated_eigenvalues,
-    rank_of_eigenvalues,
+    equilibrated_rank,
 };
 
 /// Settings of an [`InfoState`]; validated by [`InfoState::new`].
@@ -238,14 +238,6 @@ struct Factored {
     cond1: f64,
 }
 
-/// Number of eigenvalues of the equilibrated `m` above
-/// `λ_max / max_condition` (the rank rule of [`crate::linalg::rank`]).
-fn rank_estimate(m: MatRef<'_, f64>, max_condition: f64) -> usize {
-    let mut es = EigenScratch::new(m.nrows());
-    equilibrated_eigenvalues(m, &mut Vec::new(), &mut es)
-        .map_or(0, |ev| rank_of_eigenvalues(&ev, max_condition))
-}
-
 /// `r_j = ‖X_pool[:, j]‖² / n_pool`, the mean information of column `j` per
 /// pool pose; `1` for a column that is zero (or overflows) on the whole
 /// pool, which no ridge can make identifiable anyway.
@@ -387,7 +379,7 @@ impl InfoState {
         let p = pool.p();
         let m = Self::information(pool, design, prior, ridge);
         let singular = |m: &[f64]| CriterionError::Singular {
-            rank_estimate: rank_estimate(view(m, p), max_condition).min(p - 1),
+            rank_estimate: equilibrated_rank(view(m, p), max_condition).min(p - 1),
             p,
         };
         let Ok((m_inv, ln_det)) = cholesky_inverse(view(&m, p)) else {

@@ -27,12 +27,10 @@ pub fn ln_det_spd(m: MatRef<'_, f64>) -> Option<f64> {
 /// definite.
 #[must_use]
 pub fn ln_det_spd_equilibrated(m: MatRef<'_, f64>) -> Option<f64> {
-    let p = m.nrows();
-    let s: Vec<f64> = (0..p).map(|j| m[(j, j)].sqrt()).collect();
-    if s.iter().any(|&v| !(v > 0.0 && v.is_finite())) {
+    if (0..m.nrows()).any(|j| !(m[(j, j)] > 0.0 && m[(j, j)].is_finite())) {
         return None;
     }
-    let scaled = Mat::from_fn(p, p, |r, c| m[(r, c)] / (s[r] * s[c]));
+    let (scaled, s) = super::rank::equilibrated(m);
     Some(ln_det_spd(scaled.as_ref())? + 2.0 * s.iter().map(|v| v.ln()).sum::<f64>())
 }
 

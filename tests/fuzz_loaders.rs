@@ -498,12 +498,50 @@ fn measurement_files() {
                         .flatten()
                         .flatten()
                         .all(|v| v.is_finite());
-                if finite && m.points().len() == m.len() {
+                if finite && m.points().len() == m.markers() * m.len() {
                     Ok(true)
                 } else {
                     Err("checked measurements hold non-finite values or the wrong shape".into())
                 }
             }
+            Err(e) => refused(e),
+        }
+    });
+}
+
+#[test]
+fn measurement_csv_files() {
+    use activecal::io::measurements::parse_csv_measurements;
+    let load = |name: &str| activecal::io::load_robot(name).unwrap();
+    let tiago = load("fixtures/figaroh/tiago.urdf#tip=arm_tool_link")
+        .with_markers(&[[0.3, -0.1, 0.0], [0.35, -0.15, -0.2], [0.45, -0.15, -0.17], [0.45, -0.15, -0.17]])
+        .unwrap();
+    let ur10 = load("fixtures/figaroh/ur10_robot.urdf:pose#tip=wrist_3_link");
+    // The first rows of the two real files (a header and 6 postures each).
+    let head = |path: &str| -> String {
+        fixture(path).lines().take(7).collect::<Vec<_>>().join("\n") + "\n"
+    };
+    let seeds = vec![
+        head("figaroh/tiago_mocap_4markers.csv"),
+        head("figaroh/ur10_full_pose.csv"),
+    ];
+    fuzz("measurements CSV", &seeds, 0x5eed_0005, false, |s, text| {
+        let robot = if s == 0 { &tiago } else { &ur10 };
+        let f = match parse_csv_measurements(text, "m.csv", robot) {
+            Ok(f) => f,
+            Err(e) => return refused(e),
+        };
+        let m = f.measurements;
+        let finite = m.qs().iter().all(|q| q.len() == robot.dof() && q.iter().all(|v| v.is_finite()))
+            && m.points().iter().flatten().all(|v| v.is_finite())
+            && m.points().len() == m.markers() * m.len();
+        if !finite {
+            return Err("a read CSV holds non-finite values or the wrong shape".into());
+        }
+        // What the reader accepts, the sensor check either accepts or
+        // refuses with a message (a marker column lost, say).
+        match m.check(robot) {
+            Ok(()) => Ok(true),
             Err(e) => refused(e),
         }
     });

@@ -142,6 +142,7 @@ impl Source {
                 match measurement {
                     MeasurementKind::Point => stem,
                     MeasurementKind::Pose => format!("{stem}_pose"),
+                    MeasurementKind::Markers(k) => format!("{stem}_markers{k}"),
                 }
             }
         }
@@ -183,9 +184,10 @@ pub fn sources() -> Vec<Source> {
                 path: format!("fixtures/example-robot-data/{file}"),
                 tip: tip.into(),
                 measurement: m,
-                orientation_scale: match m {
-                    MeasurementKind::Point => activecal::model::DEFAULT_ORIENTATION_SCALE,
-                    MeasurementKind::Pose => URDF_ORIENTATION_SCALE,
+                orientation_scale: if m == MeasurementKind::Pose {
+                    URDF_ORIENTATION_SCALE
+                } else {
+                    activecal::model::DEFAULT_ORIENTATION_SCALE
                 },
             });
         }

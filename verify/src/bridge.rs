@@ -264,6 +264,9 @@ fn unpack(r: &Bound<'_, PyAny>, dof: usize, n: usize) -> Result<Kinematics> {
     Ok(Kinematics { position, jacobian })
 }
 
+/// A joint as `urdf_chain` in bridge.py returns it: (name, nq, limits).
+type PyJoint = (String, usize, Option<(f64, f64)>);
+
 /// A moving joint of Pinocchio's model of a URDF chain.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PinJoint {
@@ -300,7 +303,7 @@ impl Bridge {
                 .with_context(|| {
                     format!("Pinocchio's chain {base:?} → {tip} of {}", path.display())
                 })?;
-            let joints: Vec<(String, usize, Option<(f64, f64)>)> = r.extract()?;
+            let joints: Vec<PyJoint> = r.extract()?;
             Ok(joints
                 .into_iter()
                 .map(|(name, nq, limits)| PinJoint {

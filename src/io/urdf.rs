@@ -600,7 +600,7 @@ fn to_line(
         // The common normal is along ez × u: its direction is taken from the
         // axes (exact to rounding, |cross| > sin threshold), its length and
         // sign from the feet. Taking the direction from `n` itself would
-        // carry the rounding of the feet' coordinates divided by a short
+        // carry the rounding of the feet's coordinates divided by a short
         // normal's length (1e-16 · 1 m / 1e-7 m = 1e-9 rad for a normal of
         // 0.1 µm) into an x axis not quite perpendicular to u, and the next
         // frame's z axis would miss the joint axis by as much. A normal at

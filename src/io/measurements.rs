@@ -274,9 +274,9 @@ mod tests {
         let ry = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::y_axis(), y);
         let rx = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::x_axis(), x);
         let want = crate::identify::rows((rz * ry * rx).matrix());
-        for i in 0..3 {
-            for j in 0..3 {
-                assert!((m.orientations()[0][i][j] - want[i][j]).abs() < 1e-15);
+        for (got, want) in m.orientations()[0].iter().zip(&want) {
+            for (g, w) in got.iter().zip(want) {
+                assert!((g - w).abs() < 1e-15);
             }
         }
         assert!(f.notes[0].contains("temp"), "{:?}", f.notes);

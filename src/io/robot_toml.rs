@@ -446,6 +446,9 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
     }
 }
 
+/// Nominal and real offsets of the markers (metres, last frame).
+type MarkerOffsets = (Vec<[f64; 3]>, Vec<[f64; 3]>);
+
 /// The nominal and real marker offsets of `[[marker]]` tables, for a
 /// `measurement = "markers"` file (`None` otherwise); tables without that
 /// measurement, or that measurement without tables, are errors.
@@ -453,7 +456,7 @@ fn marker_offsets(
     cx: &Ctx<'_>,
     specs: &[MarkerSpec],
     measurement: MeasurementKind,
-) -> Result<Option<(Vec<[f64; 3]>, Vec<[f64; 3]>)>> {
+) -> Result<Option<MarkerOffsets>> {
     if measurement.markers() == 0 {
         return match specs.first() {
             Some(m) => Err(cx.at(

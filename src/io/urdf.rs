@@ -6,7 +6,9 @@
 //! Revolute and continuous joints become revolute joints (a continuous joint
 //! gets the range [`CONTINUOUS_RANGE`]), prismatic joints prismatic ones,
 //! fixed joints are folded into their neighbours; floating,
-//! planar, spherical and mimic joints are refused. With every joint at 0,
+//! planar, spherical and mimic joints are refused. Only links (their names)
+//! and joints are read: visual, collision, inertial and other elements are
+//! ignored, incomplete ones included. With every joint at 0,
 //! each joint axis is a line in the root frame; the frames map one axis line
 //! to the next:
 //!
@@ -15,7 +17,9 @@
 //!   Hayati frame would be singular if the two coincide — a fixed DH frame
 //!   `m` = `Rx(−π/2)` with no unknowns first turns z into the root's y axis;
 //! * the frame driven by joint k maps its axis to the axis of joint k + 1:
-//!   a DH frame, or a Hayati frame (d = 0) when the two axes are nearly
+//!   a DH frame (its x axis along the cross product of the two axes, so
+//!   that a short common normal loses no precision), or a Hayati frame
+//!   (d = 0) when the two axes are nearly
 //!   parallel, i.e. the angle between them (or their negatives) is below
 //!   [`UrdfOptions::parallel_threshold`], default [`PARALLEL_THRESHOLD`] =
 //!   10°. Below 10°, DH's d and γ are more than 1/sin 10° ≈ 5.8 times as
@@ -137,8 +141,9 @@ pub fn parse(text: &str, origin: &str, opts: &UrdfOptions) -> Result<Robot> {
             opts.parallel_threshold
         )));
     }
-    let urdf =
-        urdf_rs::read_from_string(text).map_err(|e| bad(format!("not a valid URDF: {e}")))?;
+    let urdf = kinematic_part(text)
+        .and_then(|k| urdf_rs::read_from_string(&k).map_err(|e| e.to_string()))
+        .map_err(|e| bad(format!("not a valid URDF: {e}")))?;
     let chain =
         extract_chain(&urdf, opts.base.as_deref(), opts.tip.as_deref(), &opts.lock).map_err(bad)?;
     let name = if urdf.name.is_empty() {
@@ -169,6 +174,33 @@ pub fn parse(text: &str, origin: &str, opts: &UrdfOptions) -> Result<Robot> {
     robot.validate().map_err(|e| bad(e.to_string()))?;
     robot.check_identifiable().map_err(|e| bad(e.to_string()))?;
     Ok(robot)
+}
+
+/// The kinematic part of a URDF document, as text: the `<robot>` element
+/// with its attributes, its `<link>` elements reduced to their names, and its
+/// `<joint>` elements whole. Everything else — a link's visual, collision and
+/// inertial elements, materials, Gazebo, transmission and xacro elements —
+/// the chain never reads, and is dropped before `urdf_rs` checks the document
+/// against its schema, so that an incomplete appearance element (iCub's and
+/// Romeo's URDFs have `<texture/>` without a file name) does not make the
+/// kinematics unreadable.
+fn kinematic_part(text: &str) -> std::result::Result<String, String> {
+    let mut robot: xml::Element = text.parse().map_err(|e| format!("{e}"))?;
+    if robot.name != "robot" {
+        return Err(format!("the root element is <{}>, not <robot>", robot.name));
+    }
+    robot.children = std::mem::take(&mut robot.children)
+        .into_iter()
+        .filter_map(|node| match node {
+            xml::Xml::ElementNode(mut e) if e.name == "link" => {
+                e.children.clear();
+                Some(xml::Xml::ElementNode(e))
+            }
+            xml::Xml::ElementNode(e) if e.name == "joint" => Some(xml::Xml::ElementNode(e)),
+            _ => None,
+        })
+        .collect();
+    Ok(robot.to_string())
 }
 
 /// One URDF joint of the chain, fixed ones included.
@@ -571,8 +603,24 @@ fn to_line(
         let s2 = (e - b * d1) / den;
         let n = (p + u * s2) - (o + ez * s1);
         let n = n - ez * ez.dot(&n);
-        let a = n.norm();
-        let xn = if a > tiny { n / a } else { cross.normalize() };
+        // The common normal is along ez × u: its direction is taken from the
+        // axes (exact to rounding, |cross| > sin threshold), its length and
+        // sign from the feet. Taking the direction from `n` itself would
+        // carry the rounding of the feet's coordinates divided by a short
+        // normal's length (1e-16 · 1 m / 1e-7 m = 1e-9 rad for a normal of
+        // 0.1 µm) into an x axis not quite perpendicular to u, and the next
+        // frame's z axis would miss the joint axis by as much. A normal at
+        // rounding level (axes that intersect, up to `tiny`) keeps x along
+        // ez × u and its signed length, which may be negative: its absolute
+        // value along x would put the foot on the wrong side, off by twice
+        // the normal.
+        let c = cross.normalize();
+        let (xn, a) = if n.norm() > tiny {
+            let xn = if n.dot(&c) >= 0.0 { c } else { -c };
+            (xn, n.dot(&xn))
+        } else {
+            (c, n.dot(&c))
+        };
         let alpha = cross.dot(&xn).atan2(ez.dot(u));
         (Convention::Dh, [angle_of(&xn), alpha, a, s1, 0.0])
     } else {

@@ -164,6 +164,107 @@ def pinocchio_urdf_eval(path, qs):
     return tip, out
 
 
+# --- URDF chains of example-robot-data (verify/src/erd_fk.rs).
+
+
+def erd_location():
+    """The installed example-robot-data's version and robots/ directory (the
+    wheel installs its data under cmeel.prefix/share/, no Python module)."""
+    from importlib import metadata
+
+    dist = metadata.distribution("example-robot-data")
+    robots = dist.locate_file("cmeel.prefix/share/example-robot-data/robots")
+    if not os.path.isdir(str(robots)):
+        raise ValueError("example-robot-data %s has no %s" % (dist.version, robots))
+    return dist.version, str(robots)
+
+
+_URDF_MODELS = {}
+
+
+def _urdf_model(path):
+    """buildModelFromUrdf(path), once per file."""
+    model = _URDF_MODELS.get(path)
+    if model is None:
+        model = pin.buildModelFromUrdf(path)
+        _URDF_MODELS[path] = model
+    return model
+
+
+def _body_frame(model, link):
+    if not model.existFrame(link, pin.FrameType.BODY):
+        raise ValueError("Pinocchio's model has no link %s" % link)
+    return model.getFrameId(link, pin.FrameType.BODY)
+
+
+def _chain_joints(model, base, tip):
+    """The joint ids from the base link (None: the root, Pinocchio's universe)
+    down to the tip link, in order; an error if the tip is not below the base."""
+    stop = model.frames[_body_frame(model, base)].parentJoint if base is not None else 0
+    j = model.frames[_body_frame(model, tip)].parentJoint
+    path = []
+    while j != stop:
+        if j == 0:
+            raise ValueError("the link %s is not below %s" % (tip, base))
+        path.append(j)
+        j = model.parents[j]
+    return path[::-1]
+
+
+def urdf_chain(path, base, tip):
+    """The moving joints of Pinocchio's model of a URDF from the link `base`
+    (None: the root) to the link `tip`, in order: (name, nq, limits), limits
+    (lower, upper) for nq == 1 and None for a continuous joint (nq == 2,
+    stored as cos, sin)."""
+    model = _urdf_model(path)
+    out = []
+    for j in _chain_joints(model, base, tip):
+        joint = model.joints[j]
+        if joint.nq == 1:
+            limits = (float(model.lowerPositionLimit[joint.idx_q]),
+                      float(model.upperPositionLimit[joint.idx_q]))
+        elif joint.nq == 2:
+            limits = None
+        else:
+            raise ValueError("joint %s has nq = %d" % (model.names[j], joint.nq))
+        out.append((model.names[j], joint.nq, limits))
+    return out
+
+
+def urdf_relative_poses(path, base, tip, names, qs):
+    """The tip link's placement in the base link's frame (base None: the
+    root's), oMf(base)^-1 * oMf(tip) after framesForwardKinematics, at each
+    joint vector: qs[k][i] is the value of the joint names[i] (a continuous
+    joint's angle enters as cos, sin), every other joint at neutral.
+    Returns, per vector, (rotation row-major 3x3, position)."""
+    model = _urdf_model(path)
+    data = model.createData()
+    tf = _body_frame(model, tip)
+    bf = _body_frame(model, base) if base is not None else None
+    joints = []
+    for n in names:
+        if not model.existJointName(n):
+            raise ValueError("Pinocchio's model has no joint %s" % n)
+        joints.append(model.joints[model.getJointId(n)])
+    out = []
+    for q in qs:
+        if len(q) != len(joints):
+            raise ValueError("%d values for %d joints" % (len(q), len(joints)))
+        x = pin.neutral(model)
+        for joint, v in zip(joints, q):
+            if joint.nq == 1:
+                x[joint.idx_q] = v
+            elif joint.nq == 2:
+                x[joint.idx_q] = np.cos(v)
+                x[joint.idx_q + 1] = np.sin(v)
+            else:
+                raise ValueError("unsupported joint with nq = %d" % joint.nq)
+        pin.framesForwardKinematics(model, data, x)
+        m = data.oMf[tf] if bf is None else data.oMf[bf].actInv(data.oMf[tf])
+        out.append((m.rotation.tolist(), m.translation.tolist()))
+    return out
+
+
 def pinocchio_end_frames(model, qs):
     """The "ee" frame's placement (rotation 3x3, translation 3) at each q."""
     data = model.createData()

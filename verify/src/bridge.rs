@@ -264,6 +264,98 @@ fn unpack(r: &Bound<'_, PyAny>, dof: usize, n: usize) -> Result<Kinematics> {
     Ok(Kinematics { position, jacobian })
 }
 
+/// A joint as `urdf_chain` in bridge.py returns it: (name, nq, limits).
+type PyJoint = (String, usize, Option<(f64, f64)>);
+
+/// A moving joint of Pinocchio's model of a URDF chain.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PinJoint {
+    /// The URDF joint's name.
+    pub name: String,
+    /// Configuration size: 1, or 2 for a continuous joint (cos, sin).
+    pub nq: usize,
+    /// Position limits (`nq = 1` only).
+    pub limits: Option<[f64; 2]>,
+}
+
+impl Bridge {
+    /// The installed `example-robot-data`'s version and its `robots/`
+    /// directory.
+    pub fn erd_location(&self) -> Result<(String, PathBuf)> {
+        Python::attach(|py| {
+            let r = module(py)?
+                .getattr("erd_location")?
+                .call0()
+                .context("locating example-robot-data in the venv")?;
+            let (version, dir): (String, String) = r.extract()?;
+            Ok((version, PathBuf::from(dir)))
+        })
+    }
+
+    /// The moving joints of Pinocchio's model of the URDF at `path`
+    /// (`buildModelFromUrdf`) from the link `base` (`None`: the root) to the
+    /// link `tip`, in order.
+    pub fn urdf_chain(&self, path: &Path, base: Option<&str>, tip: &str) -> Result<Vec<PinJoint>> {
+        Python::attach(|py| {
+            let r = module(py)?
+                .getattr("urdf_chain")?
+                .call1((path.to_string_lossy().as_ref(), base, tip))
+                .with_context(|| {
+                    format!("Pinocchio's chain {base:?} → {tip} of {}", path.display())
+                })?;
+            let joints: Vec<PyJoint> = r.extract()?;
+            Ok(joints
+                .into_iter()
+                .map(|(name, nq, limits)| PinJoint {
+                    name,
+                    nq,
+                    limits: limits.map(|(lo, hi)| [lo, hi]),
+                })
+                .collect())
+        })
+    }
+
+    /// Pinocchio's placement of the link `tip` in the frame of the link
+    /// `base` (`None`: the root) of the URDF at `path`, at each joint vector
+    /// (`qs[k][i]` the value of the joint `names[i]`; other joints neutral):
+    /// `oMf(base)⁻¹ · oMf(tip)` after `framesForwardKinematics`.
+    pub fn urdf_relative_poses(
+        &self,
+        path: &Path,
+        base: Option<&str>,
+        tip: &str,
+        names: &[String],
+        qs: &[Vec<f64>],
+    ) -> Result<Vec<crate::erd_fk::Placement>> {
+        Python::attach(|py| {
+            let r = module(py)?
+                .getattr("urdf_relative_poses")?
+                .call1((
+                    path.to_string_lossy().as_ref(),
+                    base,
+                    tip,
+                    names.to_vec(),
+                    qs.to_vec(),
+                ))
+                .with_context(|| {
+                    format!("Pinocchio's placements of {tip} in {}", path.display())
+                })?;
+            let poses: Vec<PyPlacement> = r.extract()?;
+            if poses.len() != qs.len() {
+                bail!(
+                    "bridge returned {} placements for {} joint vectors",
+                    poses.len(),
+                    qs.len()
+                );
+            }
+            Ok(poses
+                .into_iter()
+                .map(|(rotation, position)| crate::erd_fk::Placement { rotation, position })
+                .collect())
+        })
+    }
+}
+
 /// cvxpy's solution of the relaxation (R) (see `bridge.py`).
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct CvxSolution {

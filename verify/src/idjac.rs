@@ -184,10 +184,10 @@ pub fn sources() -> Vec<Source> {
                 path: format!("fixtures/example-robot-data/{file}"),
                 tip: tip.into(),
                 measurement: m,
-                orientation_scale: match m {
-                    MeasurementKind::Point => activecal::model::DEFAULT_ORIENTATION_SCALE,
-                    MeasurementKind::Pose => URDF_ORIENTATION_SCALE,
-                    MeasurementKind::Markers(_) => unreachable!("points and poses only"),
+                orientation_scale: if m == MeasurementKind::Pose {
+                    URDF_ORIENTATION_SCALE
+                } else {
+                    activecal::model::DEFAULT_ORIENTATION_SCALE
                 },
             });
         }

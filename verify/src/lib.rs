@@ -8,6 +8,11 @@
 //! runs the checks ([`check`]); `cargo run -p verify --features live --
 //! regen` rewrites `fixtures/`, `… -- check` prints the deviations.
 //!
+//! [`erd`] is the table of the serial arms of `example-robot-data`, and
+//! [`erd_fk`] compares their import with Pinocchio's forward kinematics of
+//! the same URDF files (live) and writes the fixtures of
+//! `fixtures/example-robot-data/fk/`.
+//!
 //! What is compared, at each configuration `q`: the end-point position
 //! `p(q)` in the measurement frame, and the positional joint Jacobian
 //! `∂p/∂q` (3 × dof), whose column `j` is also the identification-Jacobian
@@ -19,6 +24,8 @@
 #![warn(missing_docs)]
 
 pub mod compare;
+pub mod erd;
+pub mod erd_fk;
 pub mod fixture;
 pub mod idjac;
 pub mod model;

@@ -7,8 +7,11 @@
 //!
 //! `regen` writes `fixtures/<robot>_<set>.json` (positions and joint
 //! Jacobians) and `fixtures/idjac/<robot>.json` (Pinocchio's
-//! finite-difference identification Jacobians, [`verify::idjac`]); with
-//! `--out DIR` the latter go to `DIR/idjac/`.
+//! finite-difference identification Jacobians, [`verify::idjac`]) and
+//! `fixtures/example-robot-data/fk/<arm>.json` (Pinocchio's forward
+//! kinematics of the `example-robot-data` arms, [`verify::erd_fk`]) with
+//! copies of their URDFs in `fixtures/example-robot-data/`; with `--out DIR`
+//! they go to `DIR/idjac/` and `DIR/example-robot-data/`.
 //!
 //! Build with `PYO3_PYTHON=$PWD/.venv/bin/python` (scripts/test does).
 
@@ -19,7 +22,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 use verify::bridge::Bridge;
 use verify::check::{check_live, regenerate};
-use verify::{TOLERANCE, builtin_robots, fixture, idjac, synthetic_robot};
+use verify::{TOLERANCE, builtin_robots, erd_fk, fixture, idjac, synthetic_robot};
 
 /// Configurations of the identification-Jacobian check.
 const IDJAC_CONFIGS: usize = 200;
@@ -56,6 +59,10 @@ fn regen(dir: PathBuf) -> Result<bool> {
     let bridge = Bridge::new()?;
     let mut paths = regenerate(&bridge, &dir)?;
     paths.extend(idjac::live::regenerate(&bridge, &dir.join("idjac"))?);
+    paths.extend(erd_fk::live::regenerate(
+        &bridge,
+        &dir.join("example-robot-data"),
+    )?);
     for path in paths {
         let size = std::fs::metadata(&path)?.len();
         println!("wrote {} ({size} bytes)", path.display());

@@ -514,7 +514,12 @@ fn measurement_csv_files() {
     use activecal::io::measurements::parse_csv_measurements;
     let load = |name: &str| activecal::io::load_robot(name).unwrap();
     let tiago = load("fixtures/figaroh/tiago.urdf#tip=arm_tool_link")
-        .with_markers(&[[0.3, -0.1, 0.0], [0.35, -0.15, -0.2], [0.45, -0.15, -0.17], [0.45, -0.15, -0.17]])
+        .with_markers(&[
+            [0.3, -0.1, 0.0],
+            [0.35, -0.15, -0.2],
+            [0.45, -0.15, -0.17],
+            [0.45, -0.15, -0.17],
+        ])
         .unwrap();
     let ur10 = load("fixtures/figaroh/ur10_robot.urdf:pose#tip=wrist_3_link");
     // The first rows of the two real files (a header and 6 postures each).
@@ -532,7 +537,10 @@ fn measurement_csv_files() {
             Err(e) => return refused(e),
         };
         let m = f.measurements;
-        let finite = m.qs().iter().all(|q| q.len() == robot.dof() && q.iter().all(|v| v.is_finite()))
+        let finite = m
+            .qs()
+            .iter()
+            .all(|q| q.len() == robot.dof() && q.iter().all(|v| v.is_finite()))
             && m.points().iter().flatten().all(|v| v.is_finite())
             && m.points().len() == m.markers() * m.len();
         if !finite {

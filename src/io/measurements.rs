@@ -20,6 +20,7 @@
 //! the line and column; a non-finite value one naming the row.
 
 use super::table::parse_csv;
+pub use crate::pool::file::joint_names;
 use crate::error::{Error, Result};
 use crate::identify::{Measurements, ROTATION_TOLERANCE};
 use crate::model::Robot;
@@ -38,19 +39,6 @@ pub struct MeasurementFile {
     pub measurements: Measurements,
     /// What the reader noticed (columns ignored, the sensor the file implies).
     pub notes: Vec<String>,
-}
-
-/// The name of each joint of `robot`, by joint number: the label of the
-/// frame it drives (a URDF import labels frames by joint name).
-#[must_use]
-pub fn joint_names(robot: &Robot) -> Vec<String> {
-    let mut names = vec![String::new(); robot.dof()];
-    for f in &robot.frames {
-        if let Some(j) = f.joint.filter(|&j| j < names.len()) {
-            names[j].clone_from(&f.label);
-        }
-    }
-    names
 }
 
 /// Reads a measurement file for `robot`: CSV when the name ends in `.csv`,

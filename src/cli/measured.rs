@@ -4,7 +4,7 @@
 //! work is in `activecal::identify`.
 
 use super::emit_report;
-use activecal::identify::evaluation::Residuals;
+use activecal::identify::evaluation::ModelErrors;
 use activecal::identify::{
     Fit, HoldoutSettings, Identification, LmSettings, LossChoice, Measurements, ParameterTrust,
     SplitResult, fit, for_measurements, holdout, residuals, trust, with_fixed_and_free,
@@ -93,9 +93,9 @@ pub struct MeasuredReport {
     /// The loss.
     pub loss: LossChoice,
     /// Errors of the fitted model on the data, mm and degrees.
-    pub residuals: Residuals,
+    pub residuals: ModelErrors,
     /// Errors of the nominal model on the data.
-    pub nominal_residuals: Residuals,
+    pub nominal_residuals: ModelErrors,
     /// Each parameter's estimate, change, σ, t and verdict.
     pub parameters: Vec<ParameterTrust>,
     /// Poses the robust loss down-weighted: `[pose, weight]`.
@@ -356,7 +356,7 @@ struct EvaluateReport {
     chain: Vec<String>,
     measurements: String,
     poses: usize,
-    residuals: Residuals,
+    residuals: ModelErrors,
     notes: Vec<String>,
 }
 

@@ -28,7 +28,7 @@ pub struct SampleResidual {
 
 /// A model's errors on a measurement set.
 #[derive(Clone, Debug, Serialize, PartialEq)]
-pub struct Residuals {
+pub struct ModelErrors {
     /// RMS over samples (measured points) of the position error norm, mm.
     pub position_rms_mm: f64,
     /// Largest position error norm, mm.
@@ -47,7 +47,7 @@ pub struct Residuals {
 
 /// The errors of `robot` with parameters `table` on `meas` (checked against
 /// the robot first).
-pub fn residuals(robot: &Robot, table: &ParamTable, meas: &Measurements) -> Result<Residuals> {
+pub fn residuals(robot: &Robot, table: &ParamTable, meas: &Measurements) -> Result<ModelErrors> {
     meas.check(robot)?;
     let sensor = sensor_for(robot);
     let (t, vl) = (sensor.rows(), sensor.value_len());
@@ -94,7 +94,7 @@ pub fn residuals(robot: &Robot, table: &ParamTable, meas: &Measurements) -> Resu
     };
     let ori = || per_sample.iter().filter_map(|s| s.orientation_deg);
     let has_ori = per_sample.iter().any(|s| s.orientation_deg.is_some());
-    Ok(Residuals {
+    Ok(ModelErrors {
         position_rms_mm: rms(&mut pos()),
         position_max_mm: max(&mut pos()),
         position_rms_mm_per_marker: (0..k)
@@ -106,7 +106,7 @@ pub fn residuals(robot: &Robot, table: &ParamTable, meas: &Measurements) -> Resu
     })
 }
 
-impl Residuals {
+impl ModelErrors {
     /// One line: `position RMS 2.41 mm (max 5.10 mm)[, orientation RMS …]`.
     #[must_use]
     pub fn summary(&self) -> String {

@@ -3,7 +3,7 @@
 //! held-out validation over random splits (optionally against a model
 //! pruned to its significant parameters).
 
-use super::evaluation::{Residuals, residuals};
+use super::evaluation::{ModelErrors, residuals};
 use super::start::for_measurements;
 use super::{
     Calibration, Cauchy, Huber, Identification, IdentifyError, LmSettings, Loss, Measurements,
@@ -229,14 +229,14 @@ pub struct SplitResult {
     /// Poses held out.
     pub test: usize,
     /// Errors of the fitted model on the poses it was fitted to.
-    pub fitted: Residuals,
+    pub fitted: ModelErrors,
     /// Errors of the fitted model on the held-out poses.
-    pub held_out: Residuals,
+    pub held_out: ModelErrors,
     /// Errors of the nominal model on the held-out poses.
-    pub nominal: Residuals,
+    pub nominal: ModelErrors,
     /// The pruned model's held-out errors and its unknowns' count.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub pruned: Option<(usize, Residuals)>,
+    pub pruned: Option<(usize, ModelErrors)>,
 }
 
 /// Fits on a random `1 − fraction` of the poses and evaluates on the rest,

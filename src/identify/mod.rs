@@ -46,7 +46,7 @@ pub mod start;
 
 pub mod tables;
 
-pub use evaluation::{SampleResidual, residuals};
+pub use evaluation::{ModelErrors, SampleResidual, residuals};
 pub use fit::{
     Fit, HoldoutSettings, LossChoice, ParameterTrust, SplitResult, fit, holdout, trust,
     with_fixed_and_free,

@@ -20,10 +20,10 @@
 //! the line and column; a non-finite value one naming the row.
 
 use super::table::parse_csv;
-pub use crate::pool::file::joint_names;
 use crate::error::{Error, Result};
 use crate::identify::{Measurements, ROTATION_TOLERANCE};
 use crate::model::Robot;
+pub use crate::pool::file::joint_names;
 use nalgebra::{Quaternion, Rotation3, UnitQuaternion};
 use std::path::Path;
 

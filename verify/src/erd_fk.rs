@@ -31,7 +31,6 @@ use activecal::model::Robot;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
-use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
 /// Version of the fixture layout.
@@ -284,13 +283,7 @@ impl FkFixture {
     /// shortest round-trip decimals, trailing newline.
     #[must_use]
     pub fn to_json(&self) -> String {
-        fn j<T: Serialize + ?Sized>(v: &T) -> String {
-            serde_json::to_string(v).expect("fixture values serialize")
-        }
-        fn lines<T: Serialize>(items: &[T]) -> String {
-            let body: Vec<String> = items.iter().map(|x| format!("    {}", j(x))).collect();
-            format!("[\n{}\n  ]", body.join(",\n"))
-        }
+        use crate::fixture::{json_lines as lines, json_value as j};
         let fields: [(&str, String); 14] = [
             ("format", j(&self.format)),
             ("arm", j(&self.arm)),
@@ -307,29 +300,12 @@ impl FkFixture {
             ("reference", j(&self.reference)),
             ("samples", lines(&self.samples)),
         ];
-        let mut s = String::from("{\n");
-        let n = fields.len();
-        for (i, (k, v)) in fields.iter().enumerate() {
-            let sep = if i + 1 < n { "," } else { "" };
-            writeln!(s, "  {}: {v}{sep}", j(*k)).unwrap();
-        }
-        s.push_str("}\n");
-        s
+        crate::fixture::json_object(&fields)
     }
 
     /// Reads a fixture file.
     pub fn read(path: &Path) -> Result<FkFixture> {
-        let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
-        let f: FkFixture =
-            serde_json::from_str(&text).with_context(|| path.display().to_string())?;
-        if f.format != FORMAT {
-            bail!(
-                "{}: format {} (this build reads {FORMAT})",
-                path.display(),
-                f.format
-            );
-        }
-        Ok(f)
+        crate::fixture::read_versioned(path, FORMAT, |f: &FkFixture| f.format)
     }
 }
 

@@ -84,6 +84,57 @@ pub struct Fixture {
     pub samples: Vec<Sample>,
 }
 
+/// One value as compact JSON (numbers as the shortest decimal that parses
+/// back to the same `f64`): the unit every fixture file is written in.
+#[must_use]
+pub fn json_value<T: Serialize + ?Sized>(v: &T) -> String {
+    serde_json::to_string(v).expect("fixture values serialize")
+}
+
+/// A list as a fixture writes it under a top-level key: one item a line.
+#[must_use]
+pub fn json_lines<T: Serialize>(items: &[T]) -> String {
+    let body: Vec<String> = items
+        .iter()
+        .map(|x| format!("    {}", json_value(x)))
+        .collect();
+    format!("[\n{}\n  ]", body.join(",\n"))
+}
+
+/// A fixture file's text: the rendered values under their keys, in the
+/// given order, one key a line, trailing newline (deterministic output).
+#[must_use]
+pub fn json_object(fields: &[(&str, String)]) -> String {
+    let mut s = String::from("{\n");
+    let n = fields.len();
+    for (i, (k, v)) in fields.iter().enumerate() {
+        let sep = if i + 1 < n { "," } else { "" };
+        writeln!(s, "  {}: {v}{sep}", json_value(*k)).unwrap();
+    }
+    s.push_str("}\n");
+    s
+}
+
+/// Reads a JSON fixture whose layout version (`version` of the parsed
+/// value) must be `format`; errors name the file.
+pub fn read_versioned<T: serde::de::DeserializeOwned>(
+    path: &Path,
+    format: u32,
+    version: impl Fn(&T) -> u32,
+) -> Result<T> {
+    use anyhow::Context;
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    let f: T = serde_json::from_str(&text).with_context(|| path.display().to_string())?;
+    if version(&f) != format {
+        bail!(
+            "{}: format {} (this build reads {format})",
+            path.display(),
+            version(&f)
+        );
+    }
+    Ok(f)
+}
+
 /// `nominal` or `real`.
 #[must_use]
 pub fn set_name(set: ParamSet) -> &'static str {
@@ -175,19 +226,12 @@ impl Fixture {
     /// round-trip decimal), trailing newline.
     #[must_use]
     pub fn to_json(&self) -> String {
-        fn j<T: Serialize + ?Sized>(v: &T) -> String {
-            serde_json::to_string(v).expect("fixture values serialize")
-        }
-        fn lines<T: Serialize>(items: &[T]) -> String {
-            let body: Vec<String> = items.iter().map(|x| format!("    {}", j(x))).collect();
-            format!("[\n{}\n  ]", body.join(",\n"))
-        }
-        let mut s = String::from("{\n");
+        use json_value as j;
         let fields: [(&str, String); 13] = [
             ("format", j(&self.format)),
             ("robot", j(&self.robot)),
             ("param_set", j(&self.param_set)),
-            ("params", lines(&self.params)),
+            ("params", json_lines(&self.params)),
             ("regenerate", j(&self.regenerate)),
             ("seed", j(&self.seed)),
             ("n_random", j(&self.n_random)),
@@ -196,15 +240,9 @@ impl Fixture {
             ("reference", j(&self.reference)),
             ("mujoco_deviation", j(&self.mujoco_deviation)),
             ("jacobian_layout", j(&self.jacobian_layout)),
-            ("samples", lines(&self.samples)),
+            ("samples", json_lines(&self.samples)),
         ];
-        let n = fields.len();
-        for (i, (k, v)) in fields.iter().enumerate() {
-            let sep = if i + 1 < n { "," } else { "" };
-            writeln!(s, "  {}: {v}{sep}", j(*k)).unwrap();
-        }
-        s.push_str("}\n");
-        s
+        json_object(&fields)
     }
 
     /// Parses a fixture file's text.

@@ -406,6 +406,9 @@ struct PairWork {
     g: Mat<f64>,
     r: Mat<f64>,
     wr: Mat<f64>,
+    v: Mat<f64>,
+    wv: Mat<f64>,
+    sq: Vec<f64>,
     mu: Vec<f64>,
 }
 
@@ -417,6 +420,9 @@ impl PairWork {
             g: Mat::zeros(2 * t, 2 * t),
             r: Mat::zeros(2 * t, 2 * t),
             wr: Mat::zeros(p, 2 * t),
+            v: Mat::zeros(2 * t, 2 * t),
+            wv: Mat::zeros(p, 2 * t),
+            sq: Vec::new(),
             mu: Vec::with_capacity(2 * t),
         }
     }
@@ -442,7 +448,6 @@ fn exchange_round(
     let xk = Mat::from_fn(kn * t, p, |r, c| xm[(cand[r / t] * t + r % t, c)]);
     let mut dk: Vec<f64> = cand.iter().map(|&i| d[i]).collect();
     let mut pk = Mat::<f64>::zeros(kn * t, 2 * t);
-    let mut qk = Mat::<f64>::zeros(kn * t, 2 * t);
     const FULL: f64 = 1.0 - 1e-12;
     let mut steps = 0;
     while steps < max_steps {
@@ -526,31 +531,46 @@ fn exchange_round(
             w[j] -= delta;
         }
         // d_k −= tr(P_k R P_kᵀ), P = X_K W;  M⁻¹ −= W R Wᵀ   (X2)
+        // With R = V Λ Vᵀ: tr(P_k R P_kᵀ) = Σ_l λ_l ‖X_k (W V)_l‖², one
+        // product X_K (W V) instead of two.
+        let er = SymmetricEigen::new(DMatrix::from_fn(2 * t, 2 * t, |a, c| pw.r[(a, c)]));
+        for a in 0..2 * t {
+            for c in 0..2 * t {
+                pw.v[(a, c)] = er.eigenvectors[(a, c)];
+            }
+        }
+        matmul(
+            pw.wv.as_mut(),
+            Accum::Replace,
+            pw.wm.as_ref(),
+            pw.v.as_ref(),
+            1.0,
+            Par::Seq,
+        );
         matmul(
             pk.as_mut(),
             Accum::Replace,
             xk.as_ref(),
-            pw.wm.as_ref(),
+            pw.wv.as_ref(),
             1.0,
             Par::Seq,
         );
-        matmul(
-            qk.as_mut(),
-            Accum::Replace,
-            pk.as_ref(),
-            pw.r.as_ref(),
-            1.0,
-            Par::Seq,
-        );
-        for (k, dkv) in dk.iter_mut().enumerate() {
-            let mut s = 0.0;
-            for c in 0..2 * t {
-                let (pc, qc) = (pk.col(c), qk.col(c));
-                for row in k * t..k * t + t {
-                    s += pc[row] * qc[row];
-                }
+        // Row sums Σ_l λ_l (X_K W V)²_rl, vectorised along the rows, then
+        // per pose.
+        pw.sq.clear();
+        pw.sq.resize(kn * t, 0.0);
+        for (l, &lam) in er.eigenvalues.iter().enumerate() {
+            let col = pk
+                .col(l)
+                .try_as_col_major()
+                .expect("a column of an owned matrix is contiguous")
+                .as_slice();
+            for (s, &v) in pw.sq.iter_mut().zip(col) {
+                *s += lam * v * v;
             }
-            *dkv -= s;
+        }
+        for (dkv, rows) in dk.iter_mut().zip(pw.sq.chunks_exact(t)) {
+            *dkv -= rows.iter().sum::<f64>();
         }
         matmul(
             pw.wr.as_mut(),

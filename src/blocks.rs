@@ -106,6 +106,7 @@ where
     // (no row-major copy: a 10⁶-pose pool's Jacobian is 650 MB already).
     let mut mat = faer::Mat::<f64>::zeros(n * t, p);
     const CHUNK: usize = 256;
+    let task = crate::progress::Task::start("jacobian", Some(n as u64));
     mat.as_mut()
         .par_row_chunks_mut(CHUNK * t)
         .enumerate()
@@ -127,6 +128,7 @@ where
                     }
                 }
             }
+            task.inc((chunk.nrows() / t) as u64);
         });
     Blocks::new(mat, t)
 }

@@ -20,6 +20,7 @@ pub mod measure;
 pub mod model;
 pub mod observability;
 pub mod pool;
+pub mod progress;
 pub mod report;
 pub mod resources;
 pub mod select;

@@ -38,6 +38,11 @@ struct Cli {
         allow_hyphen_values = true
     )]
     lock: Option<String>,
+    /// Show progress on stderr even with --json or when stderr is not a
+    /// terminal (then as plain lines). Without it, progress is a bar on a
+    /// terminal's stderr, and nothing with --json. Never on stdout.
+    #[arg(long, global = true)]
+    progress: bool,
 }
 
 #[derive(Subcommand)]
@@ -90,6 +95,11 @@ fn main() {
         .filter(|id| m.value_source(id) == Some(ValueSource::CommandLine))
         .collect()
     };
+    let json = matches
+        .subcommand()
+        .and_then(|(_, m)| m.try_get_one::<bool>("json").ok().flatten().copied())
+        .unwrap_or(false);
+    cli::progress::install_for(cli.progress, json);
     if let Err(e) = cli::set_chain_choice(cli.base, cli.tip, cli.lock.as_deref()) {
         eprintln!("error: {e:#}");
         std::process::exit(1);

@@ -289,6 +289,7 @@ pub(crate) fn solve_scaled(
 
     // --- exchange rounds
     let mut steps = 0;
+    let task = crate::progress::Task::start("bound: first-order rounds", None);
     let mut best_w = w.clone();
     let mut best_ln_det = eval.ln_det;
     let step_tol = s.gap_tol / (4.0 * n as f64);
@@ -299,6 +300,14 @@ pub(crate) fn solve_scaled(
             best_w.clone_from(&w);
         }
         best_bound = best_bound.min(eval.bound);
+        task.inc(1);
+        task.note(|| {
+            format!(
+                "gap {:.2e} -> {:.0e}, {steps} steps",
+                best_bound - best_ln_det,
+                s.gap_tol
+            )
+        });
         if best_bound - best_ln_det <= s.gap_tol
             || rounds >= s.max_rounds
             || clock.elapsed().as_secs_f64() > s.time_limit

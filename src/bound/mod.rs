@@ -530,6 +530,7 @@ pub fn relaxation_bound_with_prior(
     }
 
     if settings.use_conic && best.gap() > settings.gap_tol {
+        let task = crate::progress::Task::start("bound: candidate solves", None);
         // --- Clarabel on the candidates, screening rounds
         let fo_eval = evaluate(&sc, n, &fo.weights, &mut work, &mut scratch)
             .expect("the first-order point is positive definite");
@@ -549,6 +550,15 @@ pub fn relaxation_bound_with_prior(
             } else {
                 last = true;
             }
+            task.inc(1);
+            task.note(|| {
+                format!(
+                    "{:?} on {} candidates, gap {:.2e}",
+                    settings.solver,
+                    cand.len(),
+                    best.gap()
+                )
+            });
             let sub = xs.select(&cand);
             // A rank-deficient candidate set cannot happen for a support of a
             // positive definite M(w); if it does, keep what we have.

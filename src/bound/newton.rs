@@ -210,7 +210,10 @@ pub(crate) fn solve_scaled(
     let mut status = ConicStatus::MaxIterations;
     let mut ld = f64::NAN;
     let ones = Mat::<f64>::from_fn(n, 1, |_, _| 1.0);
+    let task = crate::progress::Task::start("newton steps", None);
     while (steps as usize) < settings.max_steps {
+        task.inc(1);
+        task.note(|| format!("{n} weights, barrier bound {:.1e}", 2.0 * n as f64 * mu));
         let Some(l) = derivatives(sc, &w, &mut q, &mut d) else {
             return fail(w, ConicStatus::NumericalError, steps);
         };

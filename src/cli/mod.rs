@@ -6,6 +6,7 @@ pub mod bound;
 pub mod calibrate;
 pub mod figures;
 pub mod measured;
+pub mod progress;
 pub mod reproduce;
 pub mod select;
 

@@ -7,10 +7,9 @@
 
 use super::figures;
 use activecal::experiment::paper::{self, PaperReport, PaperSettings};
+use activecal::progress::Task;
 use anyhow::{Result, bail};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -57,26 +56,20 @@ pub struct ReproduceArgs {
     pub skip_oi: bool,
 }
 
+/// The experiment's steps as one progress task ([`activecal::progress`]).
 struct Steps {
-    bar: ProgressBar,
+    task: Task,
 }
 
 impl Steps {
     fn new(n: u64) -> Self {
-        let bar = ProgressBar::new(n);
-        if std::io::stdout().is_terminal() {
-            bar.set_style(
-                ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} ({elapsed})")
-                    .expect("template"),
-            );
-        } else {
-            bar.set_draw_target(ProgressDrawTarget::hidden());
+        Self {
+            task: Task::start("reproduce", Some(n)),
         }
-        Self { bar }
     }
     fn step(&self, msg: &'static str) {
-        self.bar.set_message(msg);
-        self.bar.inc(1);
+        self.task.note(|| msg.to_string());
+        self.task.inc(1);
     }
 }
 
@@ -143,7 +136,7 @@ pub fn cmd_reproduce(a: ReproduceArgs) -> Result<()> {
     std::fs::write(out.join("report.md"), report.markdown())?;
     staged.commit()?;
     let out = &a.out;
-    steps.bar.finish_and_clear();
+    drop(steps);
     println!(
         "wrote {}/report.md, report.json and figures in {:.1} s",
         out.display(),

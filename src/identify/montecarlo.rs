@@ -476,9 +476,11 @@ pub fn monte_carlo(
     let truth = robot.unknown_values(&robot.real);
 
     // ---- trials, in parallel, reduced in trial order -------------------------
+    let task = crate::progress::Task::start("monte-carlo trials", Some(settings.trials as u64));
     let trials: Vec<Result<Trial>> = (0..settings.trials)
         .into_par_iter()
         .map(|t| {
+            let _tick = task.tick();
             let meas = simulate(
                 robot,
                 &robot.real,

@@ -444,11 +444,21 @@ where
             Algorithm::Random => unreachable!("handled above"),
         }
     };
+    let task = crate::progress::Task::start(
+        &format!("select ({algorithm:?} starts)").to_lowercase(),
+        Some(s.starts as u64),
+    );
+    let one = |k: usize| {
+        let r = one(k);
+        task.inc(1);
+        r
+    };
     let results: Vec<Result<Selection>> = if s.starts == 1 {
         vec![one(0)]
     } else {
         (0..s.starts).into_par_iter().map(one).collect()
     };
+    drop(task);
     let mut best: Option<Selection> = None;
     let mut lns = Vec::with_capacity(results.len());
     let mut scores = Vec::with_capacity(results.len());

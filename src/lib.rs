@@ -8,6 +8,7 @@
 #![warn(missing_docs)]
 
 pub mod blocks;
+pub mod collision;
 pub mod bound;
 pub mod criterion;
 pub mod error;

@@ -207,6 +207,27 @@ pub struct PoolOpts {
     /// '{"kind":"cone","apex":[0,0,0],"axis":[0,1,0],"half_angle":0.1,"max_range":40}'.
     #[arg(long)]
     pub visibility: Option<String>,
+    /// Remove the candidates where two links of the URDF robot touch (its
+    /// collision geometry: boxes, cylinders, spheres, STL meshes), skipping
+    /// adjacent links and an SRDF's disabled pairs.
+    #[arg(long)]
+    pub self_collision: bool,
+    /// SRDF whose `disable_collisions` pairs are not checked.
+    #[arg(long, value_name = "FILE")]
+    pub srdf: Option<std::path::PathBuf>,
+    /// Directory searched for `package://` meshes (repeatable; the URDF's
+    /// directory and its ancestors are searched too).
+    #[arg(long = "package-dir", value_name = "DIR")]
+    pub package_dirs: Vec<std::path::PathBuf>,
+    /// Remove the candidates where a link touches this box:
+    /// box:cx,cy,cz,sx,sy,sz (centre and full sizes, metres, in the base
+    /// link's frame; repeatable).
+    #[arg(long = "obstacle", value_name = "box:cx,cy,cz,sx,sy,sz", allow_hyphen_values = true)]
+    pub obstacles: Vec<String>,
+    /// Remove the candidates where a link (other than the base's) goes below
+    /// z = Z of the base link's frame.
+    #[arg(long, value_name = "Z", allow_negative_numbers = true)]
+    pub floor: Option<f64>,
 }
 
 /// Poses measured before a selection (`--existing`): their prior
@@ -369,10 +390,81 @@ impl PoolOpts {
 
     /// The pool these options describe, for a robot description.
     pub fn spec(&self, described: Option<&Visibility>) -> Result<PoolSpec> {
+        let mut filters = filters(self.visibility.as_deref(), described)?;
+        filters.extend(self.collision_filters()?);
         Ok(PoolSpec {
             source: self.source()?,
-            filters: filters(self.visibility.as_deref(), described)?,
+            filters,
         })
+    }
+
+    /// The self-collision and obstacle filters of `--self-collision`,
+    /// `--obstacle` and `--floor` (one filter each kind, so that the pool
+    /// statistics say what each removed); `--srdf` and `--package-dir`
+    /// without them are errors.
+    pub fn collision_filters(&self) -> Result<Vec<PoolFilter>> {
+        use activecal::collision::{CollisionFilter, CollisionSpec, Obstacle};
+        let obstacles = self
+            .obstacles
+            .iter()
+            .map(|o| Obstacle::parse(o).map_err(anyhow::Error::msg))
+            .collect::<Result<Vec<_>>>()?;
+        if let Some(z) = self.floor
+            && !z.is_finite()
+        {
+            anyhow::bail!("--floor {z}: not a finite height");
+        }
+        let any_obstacle = !obstacles.is_empty() || self.floor.is_some();
+        if !self.self_collision && !any_obstacle {
+            if self.srdf.is_some() || !self.package_dirs.is_empty() {
+                anyhow::bail!("--srdf and --package-dir apply with --self-collision, --obstacle or --floor");
+            }
+            return Ok(Vec::new());
+        }
+        if self.srdf.is_some() && !self.self_collision {
+            anyhow::bail!("--srdf lists pairs of links for --self-collision, which is not given");
+        }
+        let Some((urdf, joints, base, lock)) = activecal::io::urdf_chain(&with_chain(&self.robot))? else {
+            anyhow::bail!(
+                "--self-collision, --obstacle and --floor need a URDF robot with collision geometry (--robot FILE.urdf); {} has none",
+                self.robot
+            );
+        };
+        for (opt, p) in self
+            .srdf
+            .iter()
+            .map(|p| ("--srdf", p))
+            .chain(self.package_dirs.iter().map(|p| ("--package-dir", p)))
+        {
+            if !p.exists() {
+                anyhow::bail!("{opt} {}: no such file or directory", p.display());
+            }
+        }
+        let base_spec = CollisionSpec {
+            urdf,
+            joints,
+            lock,
+            base: Some(base),
+            srdf: self.srdf.as_ref().map(|p| p.display().to_string()),
+            package_dirs: self.package_dirs.iter().map(|p| p.display().to_string()).collect(),
+            ..CollisionSpec::default()
+        };
+        let mut out = Vec::new();
+        if self.self_collision {
+            out.push(PoolFilter::Collision(CollisionFilter::new(CollisionSpec {
+                self_collision: true,
+                ..base_spec.clone()
+            })));
+        }
+        if any_obstacle {
+            out.push(PoolFilter::Collision(CollisionFilter::new(CollisionSpec {
+                obstacles,
+                floor: self.floor,
+                srdf: None,
+                ..base_spec
+            })));
+        }
+        Ok(out)
     }
 
     /// Loads the robot, builds the pool and its Jacobian.

@@ -129,6 +129,37 @@ impl ChainChoice {
     }
 }
 
+/// The URDF behind a robot name and the chain chosen in it, as a collision
+/// filter needs them: the file, the chain's moving joints in configuration
+/// order, its base link and its locks. `None` for a built-in robot or a
+/// description file.
+pub fn urdf_chain(name_or_path: &str) -> Result<Option<(String, Vec<String>, String, Vec<(String, f64)>)>> {
+    let (head, chain) = match name_or_path.rsplit_once('#') {
+        Some((h, f)) if f.contains('=') => (h, ChainChoice::parse_fragment(f)?),
+        _ => (name_or_path, ChainChoice::default()),
+    };
+    let file = match head.strip_suffix(":pose") {
+        Some(f) if !Path::new(head).exists() => f,
+        _ => head,
+    };
+    let path = Path::new(file);
+    if !path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
+    {
+        return Ok(None);
+    }
+    let opts = urdf::UrdfOptions {
+        base: chain.base.clone(),
+        tip: chain.tip.clone(),
+        lock: chain.lock.clone(),
+        ..urdf::UrdfOptions::default()
+    };
+    let (joints, base) = urdf::chain_joints(path, &opts)?;
+    Ok(Some((file.to_string(), joints, base, chain.lock)))
+}
+
 /// As [`load_robot`], with the description's visibility region. A `#…`
 /// fragment chooses the chain of a URDF tree ([`ChainChoice`]).
 pub fn load_description(name_or_path: &str) -> Result<Description> {

@@ -23,6 +23,7 @@ pub use lattice::Lattice;
 pub use sampled::{Sobol, Uniform};
 
 use crate::blocks::Blocks;
+use crate::collision::CollisionFilter;
 use crate::error::{Error, Result};
 use crate::kinematics::position;
 use crate::measure::Visibility;
@@ -99,6 +100,9 @@ pub enum PoolFilter {
     /// Keep the poses whose end point (at the build's parameter table) the
     /// sensor sees.
     Visibility(Visibility),
+    /// Keep the poses where no two links touch and no link touches an
+    /// obstacle ([`crate::collision`]).
+    Collision(CollisionFilter),
 }
 
 impl PoolFilter {
@@ -107,14 +111,17 @@ impl PoolFilter {
     pub fn keeps(&self, robot: &Robot, table: &ParamTable, q: &[f64]) -> bool {
         match self {
             PoolFilter::Visibility(v) => v.sees(&position(robot, table, q)),
+            PoolFilter::Collision(c) => c.keeps(q),
         }
     }
 
-    /// A short name: `visibility`.
+    /// A short name: `visibility`, `self-collision`, `obstacles` or
+    /// `collision`.
     #[must_use]
     pub fn kind(&self) -> &'static str {
         match self {
             PoolFilter::Visibility(_) => "visibility",
+            PoolFilter::Collision(c) => c.kind(),
         }
     }
 }
@@ -239,6 +246,10 @@ impl PoolSpec {
                 PoolFilter::Visibility(v) => v
                     .validate()
                     .map_err(|e| Error::Invalid(format!("visibility filter: {e}")))?,
+                PoolFilter::Collision(c) => {
+                    c.load()
+                        .map_err(|e| Error::Invalid(format!("{} filter: {e}", c.kind())))?;
+                }
             }
         }
         Ok(())
@@ -311,37 +322,33 @@ impl PoolSpec {
                 .position(|f| !f.keeps(robot, table, &q))
                 .unwrap_or(n_filters)
         };
+        // Each candidate's verdict once (a collision check is the costly
+        // filter), in parallel over fixed chunks, with progress.
+        let task = crate::progress::Task::start("pool filters", Some(cands.size() as u64));
+        let verdict: Vec<usize> = if n_filters == 0 {
+            Vec::new()
+        } else {
+            let mut v = vec![n_filters; cands.size()];
+            v.par_chunks_mut(1024).enumerate().for_each(|(c, chunk)| {
+                for (k, out) in chunk.iter_mut().enumerate() {
+                    *out = first_fail(c * 1024 + k);
+                }
+                task.inc(chunk.len() as u64);
+            });
+            v
+        };
+        drop(task);
         let ids: Vec<usize> = if n_filters == 0 {
             (0..cands.size()).collect()
         } else {
-            (0..cands.size())
-                .into_par_iter()
-                .filter(|&id| first_fail(id) == n_filters)
-                .collect()
+            (0..cands.size()).filter(|&id| verdict[id] == n_filters).collect()
         };
-        let removed: Vec<usize> = if n_filters == 0 {
-            Vec::new()
-        } else {
-            (0..cands.size())
-                .into_par_iter()
-                .fold(
-                    || vec![0usize; n_filters],
-                    |mut acc, id| {
-                        let f = first_fail(id);
-                        if f < n_filters {
-                            acc[f] += 1;
-                        }
-                        acc
-                    },
-                )
-                .reduce(
-                    || vec![0usize; n_filters],
-                    |mut a, b| {
-                        a.iter_mut().zip(&b).for_each(|(x, y)| *x += y);
-                        a
-                    },
-                )
-        };
+        let mut removed = vec![0usize; n_filters];
+        for &f in &verdict {
+            if f < n_filters {
+                removed[f] += 1;
+            }
+        }
         let mut seen = cands.size();
         let filters: Vec<FilterStat> = self
             .filters

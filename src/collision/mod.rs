@@ -1,0 +1,464 @@
+//! Self-collision and obstacles: the pool filter that removes the poses a
+//! real arm cannot take.
+//!
+//! A [`CollisionModel`] is read from a URDF's `<collision>` elements (boxes,
+//! cylinders, spheres, capsules and STL meshes, the meshes found through
+//! `package://` or a path relative to the URDF, [`stl`]) on every link of
+//! the tree — gripper fingers and other links outside the measured chain
+//! included, at joint value 0 (locked joints at their lock value). Placements
+//! come from the URDF's own joint origins and axes ([`tree`]). Meshes are
+//! triangle surfaces, as Coal (hpp-fcl) treats them for Pinocchio, so the two
+//! agree on what touches; the queries are `parry3d`'s (the nalgebra authors'
+//! collision library), after a bounding-sphere test per pair.
+//!
+//! Pairs checked: every two geometries on different rigid bodies (links
+//! joined by fixed joints are one body) that are not adjacent (bodies joined
+//! by one joint touch by design) and not listed in an SRDF's
+//! `disable_collisions` ([`srdf`]). Obstacles — boxes and a floor plane in
+//! the frame of the chain's base link — are checked against every geometry
+//! not on the base's rigid body.
+//!
+//! The filter ([`CollisionFilter`]) stores only its [`CollisionSpec`] (paths
+//! and numbers; a design file keeps it) and loads the model once per
+//! process, on first use or in [`CollisionFilter::load`], which pool
+//! building calls before any candidate is checked.
+
+pub mod srdf;
+pub mod stl;
+mod tree;
+
+use parry3d_f64::na::{Isometry3, Point3, Vector3};
+use parry3d_f64::shape::{Ball, Capsule, Cuboid, Cylinder, HalfSpace, SharedShape, TriMesh};
+use serde::{Deserialize, Serialize};
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
+use tree::Tree;
+
+/// An obstacle in the base link's frame (metres).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum Obstacle {
+    /// An axis-aligned box: centre and full sizes.
+    Box {
+        /// Centre.
+        center: [f64; 3],
+        /// Full sizes along x, y, z (> 0).
+        size: [f64; 3],
+    },
+}
+
+impl Obstacle {
+    /// Parses `box:cx,cy,cz,sx,sy,sz` (centre and full sizes, metres).
+    pub fn parse(text: &str) -> Result<Obstacle, String> {
+        let Some(rest) = text.strip_prefix("box:") else {
+            return Err(format!(
+                "--obstacle '{text}': expected box:cx,cy,cz,sx,sy,sz (centre and full sizes in metres, base frame)"
+            ));
+        };
+        let v: Vec<f64> = rest
+            .split(',')
+            .map(|s| s.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|e| format!("--obstacle '{text}': {e}"))?;
+        if v.len() != 6 {
+            return Err(format!("--obstacle '{text}': {} numbers, expected 6 (cx,cy,cz,sx,sy,sz)", v.len()));
+        }
+        if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+            return Err(format!("--obstacle '{text}': {x} is not finite"));
+        }
+        if let Some(s) = v[3..].iter().find(|s| **s <= 0.0) {
+            return Err(format!("--obstacle '{text}': size {s} must be > 0"));
+        }
+        Ok(Obstacle::Box {
+            center: [v[0], v[1], v[2]],
+            size: [v[3], v[4], v[5]],
+        })
+    }
+}
+
+/// What a collision filter checks, as stored in a pool spec.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CollisionSpec {
+    /// The URDF file.
+    pub urdf: String,
+    /// The chain's moving joints, in the order of a configuration's values.
+    pub joints: Vec<String>,
+    /// Joints held at a value (`--lock`).
+    #[serde(default)]
+    pub lock: Vec<(String, f64)>,
+    /// The frame of obstacles: the chain's base link (default: the root).
+    #[serde(default)]
+    pub base: Option<String>,
+    /// Check the links against each other.
+    #[serde(default)]
+    pub self_collision: bool,
+    /// SRDF whose `disable_collisions` pairs are not checked.
+    #[serde(default)]
+    pub srdf: Option<String>,
+    /// Directories searched for `package://` meshes.
+    #[serde(default)]
+    pub package_dirs: Vec<String>,
+    /// Boxes in the base frame.
+    #[serde(default)]
+    pub obstacles: Vec<Obstacle>,
+    /// A floor: the half-space `z < floor` of the base frame.
+    #[serde(default)]
+    pub floor: Option<f64>,
+}
+
+/// One collision geometry on a link.
+struct Geometry {
+    link: usize,
+    /// Placement in the link frame.
+    origin: Isometry3<f64>,
+    shape: SharedShape,
+    /// Bounding sphere in the geometry frame: centre and radius.
+    center: Point3<f64>,
+    radius: f64,
+}
+
+/// The loaded geometry, pairs and obstacles of a [`CollisionSpec`].
+pub struct CollisionModel {
+    tree: Tree,
+    geoms: Vec<Geometry>,
+    pairs: Vec<(usize, usize)>,
+    /// Obstacle shapes with their placement in the root frame.
+    obstacles: Vec<(String, Isometry3<f64>, SharedShape)>,
+    /// Geometries checked against obstacles.
+    exposed: Vec<usize>,
+    /// For each configuration value `k`, the tree joint it drives.
+    drives: Vec<usize>,
+    /// Joint values at a zero configuration (locks applied).
+    rest: Vec<f64>,
+}
+
+impl std::fmt::Debug for CollisionModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "CollisionModel({} links, {} geometries, {} pairs, {} obstacles)",
+            self.tree.links.len(),
+            self.geoms.len(),
+            self.pairs.len(),
+            self.obstacles.len()
+        )
+    }
+}
+
+/// Where a `package://PKG/rest` or relative mesh file is: the package
+/// directories given, then the URDF's directory and its ancestors (a
+/// directory named PKG, or one holding PKG).
+fn resolve(file: &str, urdf_dir: &Path, package_dirs: &[String]) -> Option<PathBuf> {
+    if let Some(rest) = file.strip_prefix("package://") {
+        let (pkg, sub) = rest.split_once('/').unwrap_or((rest, ""));
+        let mut roots: Vec<PathBuf> = package_dirs.iter().map(PathBuf::from).collect();
+        roots.extend(urdf_dir.ancestors().map(Path::to_path_buf));
+        for r in roots {
+            for cand in [r.join(pkg).join(sub), r.join(sub)] {
+                let named = r.file_name().is_some_and(|n| n == pkg);
+                if (named || cand.starts_with(r.join(pkg))) && cand.is_file() {
+                    return Some(cand);
+                }
+            }
+        }
+        return None;
+    }
+    let p = file.strip_prefix("file://").unwrap_or(file);
+    let p = if Path::new(p).is_absolute() { PathBuf::from(p) } else { urdf_dir.join(p) };
+    p.is_file().then_some(p)
+}
+
+fn shape_of(
+    g: &urdf_rs::Geometry,
+    link: &str,
+    urdf_dir: &Path,
+    spec: &CollisionSpec,
+) -> Result<SharedShape, String> {
+    let positive = |what: &str, v: f64| -> Result<f64, String> {
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err(format!("link '{link}': collision {what} {v} must be finite and > 0"))
+        }
+    };
+    Ok(match g {
+        urdf_rs::Geometry::Box { size } => SharedShape::new(Cuboid::new(Vector3::new(
+            positive("box size", size[0])? / 2.0,
+            positive("box size", size[1])? / 2.0,
+            positive("box size", size[2])? / 2.0,
+        ))),
+        urdf_rs::Geometry::Sphere { radius } => SharedShape::new(Ball::new(positive("sphere radius", *radius)?)),
+        // URDF cylinders and capsules run along z; parry's along y.
+        urdf_rs::Geometry::Cylinder { radius, length } => SharedShape::new(Cylinder::new(
+            positive("cylinder length", *length)? / 2.0,
+            positive("cylinder radius", *radius)?,
+        )),
+        urdf_rs::Geometry::Capsule { radius, length } => SharedShape::new(Capsule::new_z(
+            positive("capsule length", *length)? / 2.0,
+            positive("capsule radius", *radius)?,
+        )),
+        urdf_rs::Geometry::Mesh { filename, scale } => {
+            let path = resolve(filename, urdf_dir, &spec.package_dirs).ok_or_else(|| {
+                format!(
+                    "link '{link}': mesh '{filename}' not found (searched {}the URDF's directory {} and its ancestors; give --package-dir DIR)",
+                    spec.package_dirs.iter().map(|d| format!("{d}, ")).collect::<String>(),
+                    urdf_dir.display()
+                )
+            })?;
+            let lower = path.to_string_lossy().to_ascii_lowercase();
+            if !lower.ends_with(".stl") {
+                return Err(format!(
+                    "link '{link}': mesh {} is not an STL file (collision meshes are read from STL)",
+                    path.display()
+                ));
+            }
+            let bytes = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let tris = stl::parse(&bytes, &path.display().to_string())?;
+            let s = scale.as_ref().map_or([1.0; 3], |v| [v[0], v[1], v[2]]);
+            let mut vertices = Vec::with_capacity(3 * tris.len());
+            for t in &tris {
+                for v in t {
+                    vertices.push(Point3::new(v[0] * s[0], v[1] * s[1], v[2] * s[2]));
+                }
+            }
+            let indices = (0..tris.len() as u32).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]).collect();
+            SharedShape::new(
+                TriMesh::new(vertices, indices)
+                    .map_err(|e| format!("{}: not a usable triangle mesh: {e:?}", path.display()))?,
+            )
+        }
+    })
+}
+
+impl CollisionModel {
+    /// Loads the model of `spec`: errors name the URDF, a missing or broken
+    /// mesh file and its link, an SRDF line naming an unknown link, a chain
+    /// joint or lock the URDF does not have.
+    pub fn load(spec: &CollisionSpec) -> Result<CollisionModel, String> {
+        let urdf_path = Path::new(&spec.urdf);
+        let text = std::fs::read_to_string(urdf_path).map_err(|e| format!("{}: {e}", spec.urdf))?;
+        let urdf = urdf_rs::read_from_string(&text).map_err(|e| format!("{}: not a valid URDF: {e}", spec.urdf))?;
+        let tree = Tree::new(&urdf).map_err(|e| format!("{}: {e}", spec.urdf))?;
+        let urdf_dir = urdf_path.parent().unwrap_or(Path::new("."));
+        let joint_index = |name: &str| tree.joints.iter().position(|j| j.name == name);
+        let drives = spec
+            .joints
+            .iter()
+            .map(|n| joint_index(n).ok_or_else(|| format!("{}: no joint '{n}'", spec.urdf)))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut rest = vec![0.0; tree.joints.len()];
+        for (n, v) in &spec.lock {
+            let k = joint_index(n).ok_or_else(|| format!("{}: no joint '{n}' to lock", spec.urdf))?;
+            rest[k] = *v;
+        }
+        let mut geoms = Vec::new();
+        for l in &urdf.links {
+            let link = tree.index[&l.name];
+            for c in &l.collision {
+                let shape = shape_of(&c.geometry, &l.name, urdf_dir, spec).map_err(|e| format!("{}: {e}", spec.urdf))?;
+                let aabb = shape.compute_local_aabb();
+                let center = aabb.center();
+                let radius = aabb.half_extents().norm();
+                geoms.push(Geometry {
+                    link,
+                    origin: tree::pose(&c.origin),
+                    shape,
+                    center,
+                    radius,
+                });
+            }
+        }
+        let mut disabled: HashSet<(usize, usize)> = HashSet::new();
+        if let Some(s) = &spec.srdf {
+            let t = std::fs::read_to_string(s).map_err(|e| format!("--srdf {s}: {e}"))?;
+            for p in srdf::disabled_pairs(&t, s)? {
+                let find = |name: &str| {
+                    tree.index.get(name).copied().ok_or_else(|| {
+                        format!(
+                            "{s}:{}: disable_collisions names link '{name}', which {} does not have",
+                            p.line, spec.urdf
+                        )
+                    })
+                };
+                let (a, b) = (find(&p.link1)?, find(&p.link2)?);
+                disabled.insert((a.min(b), a.max(b)));
+            }
+        }
+        let mut pairs = Vec::new();
+        if spec.self_collision {
+            for a in 0..geoms.len() {
+                for b in a + 1..geoms.len() {
+                    let (la, lb) = (geoms[a].link, geoms[b].link);
+                    let (ba, bb) = (tree.body[la], tree.body[lb]);
+                    if ba == bb || tree.adjacent_bodies(ba, bb) || disabled.contains(&(la.min(lb), la.max(lb))) {
+                        continue;
+                    }
+                    pairs.push((a, b));
+                }
+            }
+        }
+        // Obstacles live in the base link's frame; placements are in the root's.
+        let base = match &spec.base {
+            Some(b) => *tree.index.get(b).ok_or_else(|| format!("{}: no link '{b}'", spec.urdf))?,
+            None => tree.root,
+        };
+        let mut at_rest = vec![Isometry3::identity(); tree.links.len()];
+        tree.placements(&rest, &mut at_rest);
+        // The base link's placement moves only if a joint above it moves;
+        // obstacles are fixed to it at the rest configuration of the joints
+        // above the chain (locks applied).
+        let base_pose = at_rest[base];
+        let mut obstacles = Vec::new();
+        for (k, o) in spec.obstacles.iter().enumerate() {
+            let Obstacle::Box { center, size } = o;
+            if size.iter().any(|s| !(s.is_finite() && *s > 0.0)) || center.iter().any(|c| !c.is_finite()) {
+                return Err(format!("obstacle {}: needs a finite centre and sizes > 0", k + 1));
+            }
+            obstacles.push((
+                format!("box {}", k + 1),
+                base_pose * Isometry3::translation(center[0], center[1], center[2]),
+                SharedShape::new(Cuboid::new(Vector3::new(size[0] / 2.0, size[1] / 2.0, size[2] / 2.0))),
+            ));
+        }
+        if let Some(z) = spec.floor {
+            if !z.is_finite() {
+                return Err(format!("--floor {z}: not finite"));
+            }
+            obstacles.push((
+                "floor".to_string(),
+                base_pose * Isometry3::translation(0.0, 0.0, z),
+                SharedShape::new(HalfSpace::new(Vector3::z_axis())),
+            ));
+        }
+        // The half-space's normal points out of the solid: z < floor is
+        // inside when the normal is +z.
+        let base_body = tree.body[base];
+        let exposed = (0..geoms.len()).filter(|&g| tree.body[geoms[g].link] != base_body).collect();
+        Ok(CollisionModel {
+            tree,
+            geoms,
+            pairs,
+            obstacles,
+            exposed,
+            drives,
+            rest,
+        })
+    }
+
+    /// Geometry pairs checked for self-collision.
+    #[must_use]
+    pub fn pair_count(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// The first contact at configuration `q` (the chain's joint values), as
+    /// the two links (or link and obstacle) that touch, or `None` when the
+    /// configuration is free.
+    #[must_use]
+    pub fn contact(&self, q: &[f64]) -> Option<(String, String)> {
+        let mut values = self.rest.clone();
+        for (k, &j) in self.drives.iter().enumerate() {
+            if let Some(v) = q.get(k) {
+                values[j] = *v;
+            }
+        }
+        let mut links = vec![Isometry3::identity(); self.tree.links.len()];
+        self.tree.placements(&values, &mut links);
+        let poses: Vec<Isometry3<f64>> = self.geoms.iter().map(|g| links[g.link] * g.origin).collect();
+        let name = |g: usize| self.tree.links[self.geoms[g].link].clone();
+        for &(a, b) in &self.pairs {
+            let (ga, gb) = (&self.geoms[a], &self.geoms[b]);
+            let d = (poses[a] * ga.center - poses[b] * gb.center).norm();
+            if d > ga.radius + gb.radius {
+                continue;
+            }
+            if parry3d_f64::query::intersection_test(&poses[a], ga.shape.as_ref(), &poses[b], gb.shape.as_ref())
+                .unwrap_or(false)
+            {
+                return Some((name(a), name(b)));
+            }
+        }
+        for (oname, opose, oshape) in &self.obstacles {
+            for &g in &self.exposed {
+                let geom = &self.geoms[g];
+                if parry3d_f64::query::intersection_test(&poses[g], geom.shape.as_ref(), opose, oshape.as_ref())
+                    .unwrap_or(false)
+                {
+                    return Some((name(g), oname.clone()));
+                }
+            }
+        }
+        None
+    }
+}
+
+/// The pool filter: a [`CollisionSpec`] and its model, loaded once.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct CollisionFilter {
+    /// What is checked.
+    #[serde(flatten)]
+    pub spec: CollisionSpec,
+    #[serde(skip)]
+    model: Arc<OnceLock<Result<Arc<CollisionModel>, String>>>,
+}
+
+impl CollisionFilter {
+    /// A filter for `spec` (nothing loaded yet).
+    #[must_use]
+    pub fn new(spec: CollisionSpec) -> Self {
+        Self {
+            spec,
+            model: Arc::default(),
+        }
+    }
+
+    /// The loaded model (loading it on first call), or the load error.
+    pub fn load(&self) -> Result<Arc<CollisionModel>, String> {
+        self.model
+            .get_or_init(|| CollisionModel::load(&self.spec).map(Arc::new))
+            .clone()
+    }
+
+    /// Whether `q` is free; `false` when the model cannot be loaded (pool
+    /// building loads it first and reports the error).
+    #[must_use]
+    pub fn keeps(&self, q: &[f64]) -> bool {
+        self.load().is_ok_and(|m| m.contact(q).is_none())
+    }
+
+    /// `self-collision`, `obstacles`, or `collision` (both).
+    #[must_use]
+    pub fn kind(&self) -> &'static str {
+        let obstacles = !self.spec.obstacles.is_empty() || self.spec.floor.is_some();
+        match (self.spec.self_collision, obstacles) {
+            (true, false) => "self-collision",
+            (false, true) => "obstacles",
+            _ => "collision",
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn obstacles_parse_and_refuse_bad_numbers() {
+        assert_eq!(
+            Obstacle::parse("box:0.5,0,0.1,0.2,0.2,0.2").unwrap(),
+            Obstacle::Box { center: [0.5, 0.0, 0.1], size: [0.2, 0.2, 0.2] }
+        );
+        for (bad, why) in [
+            ("sphere:1", "expected box"),
+            ("box:1,2,3", "3 numbers"),
+            ("box:0,0,0,1,1,-1", "must be > 0"),
+            ("box:0,0,0,1,1,0", "must be > 0"),
+            ("box:0,0,x,1,1,1", "invalid float"),
+            ("box:0,0,inf,1,1,1", "not finite"),
+        ] {
+            let e = Obstacle::parse(bad).unwrap_err();
+            assert!(e.contains(why) && e.contains(bad), "{bad}: {e}");
+        }
+    }
+}

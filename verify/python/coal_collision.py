@@ -2,6 +2,8 @@
 activecal's collision filter (issue #15).
 
 Usage: coal_collision.py URDF SRDF PACKAGE_DIR JOINTS(comma) N SEED OUT.json
+       (N = file:CONFIGS.json checks the configurations of that JSON list
+       instead of sampling)
 
 The URDF's collision geometry is loaded by Pinocchio (meshes as Coal BVH
 triangle surfaces, boxes as boxes); every collision pair is added, the SRDF's
@@ -39,10 +41,14 @@ def main():
     lo = np.array([model.lowerPositionLimit[i] for i in idx])
     hi = np.array([model.upperPositionLimit[i] for i in idx])
     rng = np.random.default_rng(int(seed))
+    if n.startswith("file:"):
+        with open(n[5:]) as f:
+            given = [np.array(c, dtype=float) for c in json.load(f)]
+    else:
+        given = [rng.uniform(lo, hi) for _ in range(int(n))]
     data, gdata = model.createData(), gmodel.createData()
     res = {"configs": [], "collides": [], "collides_1mm": [], "distance": [], "depth": []}
-    for _ in range(int(n)):
-        qc = rng.uniform(lo, hi)
+    for qc in given:
         q = pin.neutral(model)
         for k, i in enumerate(idx):
             q[i] = qc[k]

@@ -8,8 +8,8 @@
 #![warn(missing_docs)]
 
 pub mod blocks;
-pub mod collision;
 pub mod bound;
+pub mod collision;
 pub mod criterion;
 pub mod error;
 pub mod experiment;

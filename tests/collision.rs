@@ -28,9 +28,10 @@ struct CoalFixture {
 
 fn panda(self_collision: bool, srdf: bool) -> (CoalFixture, CollisionModel) {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/example-robot-data");
-    let f: CoalFixture =
-        serde_json::from_str(&std::fs::read_to_string(format!("{dir}/panda_collision_coal.json")).unwrap())
-            .unwrap();
+    let f: CoalFixture = serde_json::from_str(
+        &std::fs::read_to_string(format!("{dir}/panda_collision_coal.json")).unwrap(),
+    )
+    .unwrap();
     let spec = CollisionSpec {
         urdf: format!("{dir}/panda.urdf"),
         joints: f.joints.clone(),
@@ -46,15 +47,26 @@ fn panda(self_collision: bool, srdf: bool) -> (CoalFixture, CollisionModel) {
 fn panda_self_collision_agrees_with_coal_within_a_millimetre_of_contact() {
     let (f, model) = panda(true, true);
     assert_eq!(f.configs.len(), 2000);
-    assert_eq!(model.pair_count(), f.pairs, "the same pairs as Pinocchio after the SRDF and adjacency");
+    assert_eq!(
+        model.pair_count(),
+        f.pairs,
+        "the same pairs as Pinocchio after the SRDF and adjacency"
+    );
     let coal_hits = f.collides.iter().filter(|&&c| c).count();
-    assert!(coal_hits >= 20, "the sample must contain collisions to test anything: {coal_hits}");
+    assert!(
+        coal_hits >= 20,
+        "the sample must contain collisions to test anything: {coal_hits}"
+    );
     let (mut ours_hits, mut disagree) = (0, Vec::new());
     for (k, q) in f.configs.iter().enumerate() {
         let ours = model.contact(q).is_some();
         ours_hits += usize::from(ours);
         if ours != f.collides[k] {
-            let near = if ours { f.collides_1mm[k] } else { f.depth[k] <= 1e-3 };
+            let near = if ours {
+                f.collides_1mm[k]
+            } else {
+                f.depth[k] <= 1e-3
+            };
             disagree.push((k, ours, near));
         }
     }
@@ -62,8 +74,14 @@ fn panda_self_collision_agrees_with_coal_within_a_millimetre_of_contact() {
         "Panda, 2,000 configurations: Coal {coal_hits} in collision, activecal {ours_hits}, disagreements {:?}",
         disagree
     );
-    assert!(disagree.iter().all(|d| d.2), "a disagreement beyond 1 mm of contact: {disagree:?}");
-    assert!(disagree.len() <= 5, "more than a few grazing disagreements: {disagree:?}");
+    assert!(
+        disagree.iter().all(|d| d.2),
+        "a disagreement beyond 1 mm of contact: {disagree:?}"
+    );
+    assert!(
+        disagree.len() <= 5,
+        "more than a few grazing disagreements: {disagree:?}"
+    );
 }
 
 #[test]
@@ -95,12 +113,170 @@ fn a_floor_and_a_box_catch_the_links_that_reach_them() {
     // flange).
     let up = [0.0; 7];
     let m = CollisionModel::load(&spec(Some(0.0), vec![])).unwrap();
-    assert!(m.contact(&up).is_none(), "the base stands on the floor: not a contact");
+    assert!(
+        m.contact(&up).is_none(),
+        "the base stands on the floor: not a contact"
+    );
     let m = CollisionModel::load(&spec(Some(0.5), vec![])).unwrap();
     assert!(m.contact(&up).is_some(), "links cross z = 0.5 m");
     // A box around the upright arm's top touches; one beside it does not.
-    let hit = activecal::collision::Obstacle::Box { center: [0.0, 0.0, 0.9], size: [0.1, 0.1, 0.1] };
-    let miss = activecal::collision::Obstacle::Box { center: [0.6, 0.0, 0.9], size: [0.1, 0.1, 0.1] };
-    assert!(CollisionModel::load(&spec(None, vec![hit])).unwrap().contact(&up).is_some());
-    assert!(CollisionModel::load(&spec(None, vec![miss])).unwrap().contact(&up).is_none());
+    let hit = activecal::collision::Obstacle::Box {
+        center: [0.0, 0.0, 0.9],
+        size: [0.1, 0.1, 0.1],
+    };
+    let miss = activecal::collision::Obstacle::Box {
+        center: [0.6, 0.0, 0.9],
+        size: [0.1, 0.1, 0.1],
+    };
+    assert!(
+        CollisionModel::load(&spec(None, vec![hit]))
+            .unwrap()
+            .contact(&up)
+            .is_some()
+    );
+    assert!(
+        CollisionModel::load(&spec(None, vec![miss]))
+            .unwrap()
+            .contact(&up)
+            .is_none()
+    );
+}
+
+mod common;
+
+/// A temporary copy of the Panda's fixture files (URDF, meshes, SRDF) to
+/// break one of them.
+fn panda_copy(tag: &str) -> std::path::PathBuf {
+    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/example-robot-data");
+    let dst =
+        std::env::temp_dir().join(format!("activecal-collision-{tag}-{}", std::process::id()));
+    let mesh = "robots/panda_description/meshes/collision";
+    std::fs::create_dir_all(dst.join("example-robot-data").join(mesh)).unwrap();
+    for f in ["panda.urdf", "panda.srdf"] {
+        std::fs::copy(src.join(f), dst.join("example-robot-data").join(f)).unwrap();
+    }
+    for e in std::fs::read_dir(src.join(mesh)).unwrap() {
+        let p = e.unwrap().path();
+        std::fs::copy(
+            &p,
+            dst.join("example-robot-data")
+                .join(mesh)
+                .join(p.file_name().unwrap()),
+        )
+        .unwrap();
+    }
+    dst.join("example-robot-data")
+}
+
+#[test]
+fn bad_collision_inputs_are_clear_errors() {
+    use common::fails_with;
+    let fx = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/example-robot-data");
+    let urdf = format!("{fx}/panda.urdf");
+    let srdf = format!("{fx}/panda.srdf");
+    let base = [
+        "select",
+        "--robot",
+        &urdf,
+        "--tip",
+        "panda_hand_tcp",
+        "--levels",
+        "3",
+        "--n",
+        "30",
+    ];
+    let with = |extra: &[&str]| -> Vec<String> {
+        base.iter().chain(extra).map(|s| s.to_string()).collect()
+    };
+    let run = |args: Vec<String>, needle: &str| {
+        let a: Vec<&str> = args.iter().map(String::as_str).collect();
+        fails_with(&a, needle);
+    };
+    run(with(&["--obstacle", "box:0,0,1"]), "3 numbers, expected 6");
+    run(with(&["--obstacle", "box:0,0,1,1,1,0"]), "must be > 0");
+    run(with(&["--floor", "nan"]), "--floor");
+    run(with(&["--srdf", &srdf]), "--self-collision");
+    run(
+        vec![
+            "select".into(),
+            "--robot".into(),
+            "puma560".into(),
+            "--self-collision".into(),
+        ],
+        "need a URDF robot",
+    );
+    run(
+        with(&["--self-collision", "--srdf", "/no/such.srdf"]),
+        "/no/such.srdf",
+    );
+    // The floor above the whole arm removes every candidate: the message
+    // names the filter.
+    run(
+        with(&["--floor", "2.0"]),
+        "the obstacles filter removed every pose",
+    );
+
+    // A missing mesh names the file and the link.
+    let d = panda_copy("mesh");
+    std::fs::remove_file(d.join("robots/panda_description/meshes/collision/link3.stl")).unwrap();
+    let u = d.join("panda.urdf").display().to_string();
+    run(
+        vec![
+            "select".into(),
+            "--robot".into(),
+            u.clone(),
+            "--tip".into(),
+            "panda_hand_tcp".into(),
+            "--self-collision".into(),
+        ],
+        "link 'panda_link3': mesh 'package://example-robot-data/robots/panda_description/meshes/collision/link3.stl' not found",
+    );
+    // A truncated mesh is an error naming the file, not a panic.
+    let m = d.join("robots/panda_description/meshes/collision/link3.stl");
+    let full =
+        std::fs::read(d.join("robots/panda_description/meshes/collision/link2.stl")).unwrap();
+    std::fs::write(&m, &full[..full.len() - 7]).unwrap();
+    run(
+        vec![
+            "select".into(),
+            "--robot".into(),
+            u.clone(),
+            "--tip".into(),
+            "panda_hand_tcp".into(),
+            "--self-collision".into(),
+        ],
+        "link3.stl: not an STL mesh",
+    );
+    // An SRDF naming a link the URDF does not have: file, line and link.
+    let s = d.join("panda.srdf");
+    let text = std::fs::read_to_string(&s).unwrap();
+    let line = text
+        .lines()
+        .position(|l| l.contains("<disable_collisions"))
+        .unwrap()
+        + 1;
+    std::fs::write(
+        &s,
+        text.replacen("link1=\"panda_hand\"", "link1=\"panda_wrist\"", 1),
+    )
+    .unwrap();
+    std::fs::copy(
+        d.join("robots/panda_description/meshes/collision/link2.stl"),
+        &m,
+    )
+    .unwrap();
+    run(
+        vec![
+            "select".into(),
+            "--robot".into(),
+            u,
+            "--tip".into(),
+            "panda_hand_tcp".into(),
+            "--self-collision".into(),
+            "--srdf".into(),
+            s.display().to_string(),
+        ],
+        &format!("panda.srdf:{line}: disable_collisions names link 'panda_wrist'"),
+    );
+    std::fs::remove_dir_all(d.parent().unwrap()).ok();
 }

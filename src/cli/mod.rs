@@ -222,7 +222,11 @@ pub struct PoolOpts {
     /// Remove the candidates where a link touches this box:
     /// box:cx,cy,cz,sx,sy,sz (centre and full sizes, metres, in the base
     /// link's frame; repeatable).
-    #[arg(long = "obstacle", value_name = "box:cx,cy,cz,sx,sy,sz", allow_hyphen_values = true)]
+    #[arg(
+        long = "obstacle",
+        value_name = "box:cx,cy,cz,sx,sy,sz",
+        allow_hyphen_values = true
+    )]
     pub obstacles: Vec<String>,
     /// Remove the candidates where a link (other than the base's) goes below
     /// z = Z of the base link's frame.
@@ -417,14 +421,17 @@ impl PoolOpts {
         let any_obstacle = !obstacles.is_empty() || self.floor.is_some();
         if !self.self_collision && !any_obstacle {
             if self.srdf.is_some() || !self.package_dirs.is_empty() {
-                anyhow::bail!("--srdf and --package-dir apply with --self-collision, --obstacle or --floor");
+                anyhow::bail!(
+                    "--srdf and --package-dir apply with --self-collision, --obstacle or --floor"
+                );
             }
             return Ok(Vec::new());
         }
         if self.srdf.is_some() && !self.self_collision {
             anyhow::bail!("--srdf lists pairs of links for --self-collision, which is not given");
         }
-        let Some((urdf, joints, base, lock)) = activecal::io::urdf_chain(&with_chain(&self.robot))? else {
+        let Some((urdf, joints, base, lock)) = activecal::io::urdf_chain(&with_chain(&self.robot))?
+        else {
             anyhow::bail!(
                 "--self-collision, --obstacle and --floor need a URDF robot with collision geometry (--robot FILE.urdf); {} has none",
                 self.robot
@@ -446,7 +453,11 @@ impl PoolOpts {
             lock,
             base: Some(base),
             srdf: self.srdf.as_ref().map(|p| p.display().to_string()),
-            package_dirs: self.package_dirs.iter().map(|p| p.display().to_string()).collect(),
+            package_dirs: self
+                .package_dirs
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect(),
             ..CollisionSpec::default()
         };
         let mut out = Vec::new();

@@ -62,7 +62,10 @@ impl Obstacle {
             .collect::<Result<_, _>>()
             .map_err(|e| format!("--obstacle '{text}': {e}"))?;
         if v.len() != 6 {
-            return Err(format!("--obstacle '{text}': {} numbers, expected 6 (cx,cy,cz,sx,sy,sz)", v.len()));
+            return Err(format!(
+                "--obstacle '{text}': {} numbers, expected 6 (cx,cy,cz,sx,sy,sz)",
+                v.len()
+            ));
         }
         if let Some(x) = v.iter().find(|x| !x.is_finite()) {
             return Err(format!("--obstacle '{text}': {x} is not finite"));
@@ -165,7 +168,11 @@ fn resolve(file: &str, urdf_dir: &Path, package_dirs: &[String]) -> Option<PathB
         return None;
     }
     let p = file.strip_prefix("file://").unwrap_or(file);
-    let p = if Path::new(p).is_absolute() { PathBuf::from(p) } else { urdf_dir.join(p) };
+    let p = if Path::new(p).is_absolute() {
+        PathBuf::from(p)
+    } else {
+        urdf_dir.join(p)
+    };
     p.is_file().then_some(p)
 }
 
@@ -179,7 +186,9 @@ fn shape_of(
         if v.is_finite() && v > 0.0 {
             Ok(v)
         } else {
-            Err(format!("link '{link}': collision {what} {v} must be finite and > 0"))
+            Err(format!(
+                "link '{link}': collision {what} {v} must be finite and > 0"
+            ))
         }
     };
     Ok(match g {
@@ -188,7 +197,9 @@ fn shape_of(
             positive("box size", size[1])? / 2.0,
             positive("box size", size[2])? / 2.0,
         ))),
-        urdf_rs::Geometry::Sphere { radius } => SharedShape::new(Ball::new(positive("sphere radius", *radius)?)),
+        urdf_rs::Geometry::Sphere { radius } => {
+            SharedShape::new(Ball::new(positive("sphere radius", *radius)?))
+        }
         // URDF cylinders and capsules run along z; parry's along y.
         urdf_rs::Geometry::Cylinder { radius, length } => SharedShape::new(Cylinder::new(
             positive("cylinder length", *length)? / 2.0,
@@ -222,10 +233,13 @@ fn shape_of(
                     vertices.push(Point3::new(v[0] * s[0], v[1] * s[1], v[2] * s[2]));
                 }
             }
-            let indices = (0..tris.len() as u32).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]).collect();
+            let indices = (0..tris.len() as u32)
+                .map(|k| [3 * k, 3 * k + 1, 3 * k + 2])
+                .collect();
             SharedShape::new(
-                TriMesh::new(vertices, indices)
-                    .map_err(|e| format!("{}: not a usable triangle mesh: {e:?}", path.display()))?,
+                TriMesh::new(vertices, indices).map_err(|e| {
+                    format!("{}: not a usable triangle mesh: {e:?}", path.display())
+                })?,
             )
         }
     })
@@ -238,7 +252,8 @@ impl CollisionModel {
     pub fn load(spec: &CollisionSpec) -> Result<CollisionModel, String> {
         let urdf_path = Path::new(&spec.urdf);
         let text = std::fs::read_to_string(urdf_path).map_err(|e| format!("{}: {e}", spec.urdf))?;
-        let urdf = urdf_rs::read_from_string(&text).map_err(|e| format!("{}: not a valid URDF: {e}", spec.urdf))?;
+        let urdf = urdf_rs::read_from_string(&text)
+            .map_err(|e| format!("{}: not a valid URDF: {e}", spec.urdf))?;
         let tree = Tree::new(&urdf).map_err(|e| format!("{}: {e}", spec.urdf))?;
         let urdf_dir = urdf_path.parent().unwrap_or(Path::new("."));
         let joint_index = |name: &str| tree.joints.iter().position(|j| j.name == name);
@@ -249,14 +264,16 @@ impl CollisionModel {
             .collect::<Result<Vec<_>, _>>()?;
         let mut rest = vec![0.0; tree.joints.len()];
         for (n, v) in &spec.lock {
-            let k = joint_index(n).ok_or_else(|| format!("{}: no joint '{n}' to lock", spec.urdf))?;
+            let k =
+                joint_index(n).ok_or_else(|| format!("{}: no joint '{n}' to lock", spec.urdf))?;
             rest[k] = *v;
         }
         let mut geoms = Vec::new();
         for l in &urdf.links {
             let link = tree.index[&l.name];
             for c in &l.collision {
-                let shape = shape_of(&c.geometry, &l.name, urdf_dir, spec).map_err(|e| format!("{}: {e}", spec.urdf))?;
+                let shape = shape_of(&c.geometry, &l.name, urdf_dir, spec)
+                    .map_err(|e| format!("{}: {e}", spec.urdf))?;
                 let aabb = shape.compute_local_aabb();
                 let center = aabb.center();
                 let radius = aabb.half_extents().norm();
@@ -291,7 +308,10 @@ impl CollisionModel {
                 for b in a + 1..geoms.len() {
                     let (la, lb) = (geoms[a].link, geoms[b].link);
                     let (ba, bb) = (tree.body[la], tree.body[lb]);
-                    if ba == bb || tree.adjacent_bodies(ba, bb) || disabled.contains(&(la.min(lb), la.max(lb))) {
+                    if ba == bb
+                        || tree.adjacent_bodies(ba, bb)
+                        || disabled.contains(&(la.min(lb), la.max(lb)))
+                    {
                         continue;
                     }
                     pairs.push((a, b));
@@ -300,7 +320,10 @@ impl CollisionModel {
         }
         // Obstacles live in the base link's frame; placements are in the root's.
         let base = match &spec.base {
-            Some(b) => *tree.index.get(b).ok_or_else(|| format!("{}: no link '{b}'", spec.urdf))?,
+            Some(b) => *tree
+                .index
+                .get(b)
+                .ok_or_else(|| format!("{}: no link '{b}'", spec.urdf))?,
             None => tree.root,
         };
         let mut at_rest = vec![Isometry3::identity(); tree.links.len()];
@@ -312,13 +335,22 @@ impl CollisionModel {
         let mut obstacles = Vec::new();
         for (k, o) in spec.obstacles.iter().enumerate() {
             let Obstacle::Box { center, size } = o;
-            if size.iter().any(|s| !(s.is_finite() && *s > 0.0)) || center.iter().any(|c| !c.is_finite()) {
-                return Err(format!("obstacle {}: needs a finite centre and sizes > 0", k + 1));
+            if size.iter().any(|s| !(s.is_finite() && *s > 0.0))
+                || center.iter().any(|c| !c.is_finite())
+            {
+                return Err(format!(
+                    "obstacle {}: needs a finite centre and sizes > 0",
+                    k + 1
+                ));
             }
             obstacles.push((
                 format!("box {}", k + 1),
                 base_pose * Isometry3::translation(center[0], center[1], center[2]),
-                SharedShape::new(Cuboid::new(Vector3::new(size[0] / 2.0, size[1] / 2.0, size[2] / 2.0))),
+                SharedShape::new(Cuboid::new(Vector3::new(
+                    size[0] / 2.0,
+                    size[1] / 2.0,
+                    size[2] / 2.0,
+                ))),
             ));
         }
         if let Some(z) = spec.floor {
@@ -334,7 +366,9 @@ impl CollisionModel {
         // The half-space's normal points out of the solid: z < floor is
         // inside when the normal is +z.
         let base_body = tree.body[base];
-        let exposed = (0..geoms.len()).filter(|&g| tree.body[geoms[g].link] != base_body).collect();
+        let exposed = (0..geoms.len())
+            .filter(|&g| tree.body[geoms[g].link] != base_body)
+            .collect();
         Ok(CollisionModel {
             tree,
             geoms,
@@ -365,7 +399,11 @@ impl CollisionModel {
         }
         let mut links = vec![Isometry3::identity(); self.tree.links.len()];
         self.tree.placements(&values, &mut links);
-        let poses: Vec<Isometry3<f64>> = self.geoms.iter().map(|g| links[g.link] * g.origin).collect();
+        let poses: Vec<Isometry3<f64>> = self
+            .geoms
+            .iter()
+            .map(|g| links[g.link] * g.origin)
+            .collect();
         let name = |g: usize| self.tree.links[self.geoms[g].link].clone();
         for &(a, b) in &self.pairs {
             let (ga, gb) = (&self.geoms[a], &self.geoms[b]);
@@ -373,8 +411,13 @@ impl CollisionModel {
             if d > ga.radius + gb.radius {
                 continue;
             }
-            if parry3d_f64::query::intersection_test(&poses[a], ga.shape.as_ref(), &poses[b], gb.shape.as_ref())
-                .unwrap_or(false)
+            if parry3d_f64::query::intersection_test(
+                &poses[a],
+                ga.shape.as_ref(),
+                &poses[b],
+                gb.shape.as_ref(),
+            )
+            .unwrap_or(false)
             {
                 return Some((name(a), name(b)));
             }
@@ -382,8 +425,13 @@ impl CollisionModel {
         for (oname, opose, oshape) in &self.obstacles {
             for &g in &self.exposed {
                 let geom = &self.geoms[g];
-                if parry3d_f64::query::intersection_test(&poses[g], geom.shape.as_ref(), opose, oshape.as_ref())
-                    .unwrap_or(false)
+                if parry3d_f64::query::intersection_test(
+                    &poses[g],
+                    geom.shape.as_ref(),
+                    opose,
+                    oshape.as_ref(),
+                )
+                .unwrap_or(false)
                 {
                     return Some((name(g), oname.clone()));
                 }
@@ -447,7 +495,10 @@ mod tests {
     fn obstacles_parse_and_refuse_bad_numbers() {
         assert_eq!(
             Obstacle::parse("box:0.5,0,0.1,0.2,0.2,0.2").unwrap(),
-            Obstacle::Box { center: [0.5, 0.0, 0.1], size: [0.2, 0.2, 0.2] }
+            Obstacle::Box {
+                center: [0.5, 0.0, 0.1],
+                size: [0.2, 0.2, 0.2]
+            }
         );
         for (bad, why) in [
             ("sphere:1", "expected box"),

@@ -33,9 +33,13 @@ pub fn disabled_pairs(text: &str, origin: &str) -> Result<Vec<DisabledPair>, Str
                 .find(&key)
                 .ok_or_else(|| format!("{origin}:{line}: <disable_collisions> without {name}"))?;
             let v = &tag[i + key.len()..];
-            let q = v.chars().next().filter(|c| *c == '"' || *c == '\'').ok_or_else(|| {
-                format!("{origin}:{line}: the {name} of <disable_collisions> is not quoted")
-            })?;
+            let q = v
+                .chars()
+                .next()
+                .filter(|c| *c == '"' || *c == '\'')
+                .ok_or_else(|| {
+                    format!("{origin}:{line}: the {name} of <disable_collisions> is not quoted")
+                })?;
             let close = v[1..]
                 .find(q)
                 .ok_or_else(|| format!("{origin}:{line}: unterminated {name} value"))?;
@@ -61,10 +65,24 @@ mod tests {
         let t = "<robot>\n  <disable_collisions link1=\"a\" link2='b' reason=\"Adjacent\"/>\n\n<disable_collisions link2=\"d\" link1=\"c\"/>\n</robot>";
         let p = disabled_pairs(t, "r.srdf").unwrap();
         assert_eq!(p.len(), 2);
-        assert_eq!((p[0].link1.as_str(), p[0].link2.as_str(), p[0].line), ("a", "b", 2));
-        assert_eq!((p[1].link1.as_str(), p[1].link2.as_str(), p[1].line), ("c", "d", 4));
-        assert!(disabled_pairs("<disable_collisions link1=\"a\"/>", "x").unwrap_err().contains("link2"));
-        assert!(disabled_pairs("\n<disable_collisions link1=a link2=\"b\"/>", "x").unwrap_err().contains("x:2"));
+        assert_eq!(
+            (p[0].link1.as_str(), p[0].link2.as_str(), p[0].line),
+            ("a", "b", 2)
+        );
+        assert_eq!(
+            (p[1].link1.as_str(), p[1].link2.as_str(), p[1].line),
+            ("c", "d", 4)
+        );
+        assert!(
+            disabled_pairs("<disable_collisions link1=\"a\"/>", "x")
+                .unwrap_err()
+                .contains("link2")
+        );
+        assert!(
+            disabled_pairs("\n<disable_collisions link1=a link2=\"b\"/>", "x")
+                .unwrap_err()
+                .contains("x:2")
+        );
         assert!(disabled_pairs("<disable_collisions link1=\"a", "x").is_err());
     }
 }

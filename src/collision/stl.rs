@@ -34,7 +34,14 @@ fn binary(bytes: &[u8], count: usize, origin: &str) -> Result<Triangles, String>
     if count == 0 {
         return Err(format!("{origin}: the STL mesh has no triangles"));
     }
-    let f = |o: usize| f64::from(f32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]));
+    let f = |o: usize| {
+        f64::from(f32::from_le_bytes([
+            bytes[o],
+            bytes[o + 1],
+            bytes[o + 2],
+            bytes[o + 3],
+        ]))
+    };
     let mut out = Vec::with_capacity(count);
     for k in 0..count {
         let base = 84 + 50 * k + 12;
@@ -45,7 +52,10 @@ fn binary(bytes: &[u8], count: usize, origin: &str) -> Result<Triangles, String>
             }
         }
         if tri.iter().flatten().any(|x| !x.is_finite()) {
-            return Err(format!("{origin}: triangle {} has a non-finite vertex", k + 1));
+            return Err(format!(
+                "{origin}: triangle {} has a non-finite vertex",
+                k + 1
+            ));
         }
         out.push(tri);
     }
@@ -53,8 +63,12 @@ fn binary(bytes: &[u8], count: usize, origin: &str) -> Result<Triangles, String>
 }
 
 fn ascii(bytes: &[u8], origin: &str) -> Result<Triangles, String> {
-    let text = std::str::from_utf8(bytes)
-        .map_err(|e| format!("{origin}: ASCII STL with invalid UTF-8 at byte {}", e.valid_up_to()))?;
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        format!(
+            "{origin}: ASCII STL with invalid UTF-8 at byte {}",
+            e.valid_up_to()
+        )
+    })?;
     let mut out = Vec::new();
     let mut cur: Vec<[f64; 3]> = Vec::new();
     for (n, line) in text.lines().enumerate() {
@@ -67,7 +81,9 @@ fn ascii(bytes: &[u8], origin: &str) -> Result<Triangles, String> {
                         .next()
                         .and_then(|s| s.parse::<f64>().ok())
                         .filter(|x| x.is_finite())
-                        .ok_or_else(|| format!("{origin}:{}: a vertex needs three finite numbers", n + 1))?;
+                        .ok_or_else(|| {
+                            format!("{origin}:{}: a vertex needs three finite numbers", n + 1)
+                        })?;
                 }
                 cur.push(v);
             }
@@ -142,7 +158,11 @@ mod tests {
                 .collect();
             let _ = parse(&junk, "junk.stl");
         }
-        assert!(parse(b"solid x\nvertex 0 0\nendloop\n", "v.stl").unwrap_err().contains("v.stl:2"));
+        assert!(
+            parse(b"solid x\nvertex 0 0\nendloop\n", "v.stl")
+                .unwrap_err()
+                .contains("v.stl:2")
+        );
         assert!(parse(b"solid x\nvertex 0 0 nan\n", "n.stl").is_err());
     }
 }

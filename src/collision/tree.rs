@@ -85,7 +85,11 @@ impl Tree {
                 _ => Motion::Fixed,
             };
             let a = Vector3::new(j.axis.xyz[0], j.axis.xyz[1], j.axis.xyz[2]);
-            let axis = if a.norm() > 0.0 { a.normalize() } else { Vector3::x() };
+            let axis = if a.norm() > 0.0 {
+                a.normalize()
+            } else {
+                Vector3::x()
+            };
             joints.push(TreeJoint {
                 name: j.name.clone(),
                 parent: p,
@@ -100,7 +104,11 @@ impl Tree {
             return Err(format!(
                 "the URDF's links form {} trees (roots {}), not one",
                 roots.len(),
-                roots.iter().map(|&r| links[r].as_str()).collect::<Vec<_>>().join(", ")
+                roots
+                    .iter()
+                    .map(|&r| links[r].as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
             ));
         }
         // Joints from the root down (breadth first).
@@ -120,7 +128,11 @@ impl Tree {
         let joints: Vec<TreeJoint> = order.iter().map(|&k| joints[k].clone()).collect();
         let mut body = vec![0; n];
         for (k, j) in joints.iter().enumerate() {
-            body[j.child] = if j.motion == Motion::Fixed { body[j.parent] } else { k + 1 };
+            body[j.child] = if j.motion == Motion::Fixed {
+                body[j.parent]
+            } else {
+                k + 1
+            };
         }
         Ok(Tree {
             links,

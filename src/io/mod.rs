@@ -133,7 +133,9 @@ impl ChainChoice {
 /// filter needs them: the file, the chain's moving joints in configuration
 /// order, its base link and its locks. `None` for a built-in robot or a
 /// description file.
-pub fn urdf_chain(name_or_path: &str) -> Result<Option<(String, Vec<String>, String, Vec<(String, f64)>)>> {
+pub fn urdf_chain(
+    name_or_path: &str,
+) -> Result<Option<(String, Vec<String>, String, Vec<(String, f64)>)>> {
     let (head, chain) = match name_or_path.rsplit_once('#') {
         Some((h, f)) if f.contains('=') => (h, ChainChoice::parse_fragment(f)?),
         _ => (name_or_path, ChainChoice::default()),

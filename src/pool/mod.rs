@@ -341,7 +341,9 @@ impl PoolSpec {
         let ids: Vec<usize> = if n_filters == 0 {
             (0..cands.size()).collect()
         } else {
-            (0..cands.size()).filter(|&id| verdict[id] == n_filters).collect()
+            (0..cands.size())
+                .filter(|&id| verdict[id] == n_filters)
+                .collect()
         };
         let mut removed = vec![0usize; n_filters];
         for &f in &verdict {

@@ -43,7 +43,11 @@ pub struct ExchangeSettings {
     pub gap_tol: f64,
     /// Maximum rounds (full-pool variance evaluations). Default 2000.
     pub max_rounds: usize,
-    /// Wall-clock limit in seconds. Default 60.
+    /// Wall-clock limit in seconds: a safety net, not a stopping rule.
+    /// Default one day, so that the rounds and step limits decide and the
+    /// result never depends on the machine's speed or load (a 60 s default
+    /// stopped the 10⁶-pose PUMA screening half-way on a loaded machine and
+    /// left the bound uncertified).
     pub time_limit: f64,
     /// Capped multiplicative steps `w_i ← min(1, c·w_i d_i)` before the
     /// exchange rounds, when no start is given. Default 30.
@@ -63,7 +67,7 @@ impl Default for ExchangeSettings {
         Self {
             gap_tol: 1e-7,
             max_rounds: 2000,
-            time_limit: 60.0,
+            time_limit: 86_400.0,
             warmup_rounds: 30,
             keep: 1000,
             extra: 100,

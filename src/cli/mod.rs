@@ -430,8 +430,7 @@ impl PoolOpts {
         if self.srdf.is_some() && !self.self_collision {
             anyhow::bail!("--srdf lists pairs of links for --self-collision, which is not given");
         }
-        let Some((urdf, joints, base, lock)) = activecal::io::urdf_chain(&with_chain(&self.robot))?
-        else {
+        let Some(chain) = activecal::io::urdf_chain(&with_chain(&self.robot))? else {
             anyhow::bail!(
                 "--self-collision, --obstacle and --floor need a URDF robot with collision geometry (--robot FILE.urdf); {} has none",
                 self.robot
@@ -448,10 +447,10 @@ impl PoolOpts {
             }
         }
         let base_spec = CollisionSpec {
-            urdf,
-            joints,
-            lock,
-            base: Some(base),
+            urdf: chain.file,
+            joints: chain.joints,
+            lock: chain.lock,
+            base: Some(chain.base),
             srdf: self.srdf.as_ref().map(|p| p.display().to_string()),
             package_dirs: self
                 .package_dirs

@@ -130,12 +130,22 @@ impl ChainChoice {
 }
 
 /// The URDF behind a robot name and the chain chosen in it, as a collision
-/// filter needs them: the file, the chain's moving joints in configuration
-/// order, its base link and its locks. `None` for a built-in robot or a
+/// filter needs them.
+#[derive(Clone, Debug)]
+pub struct UrdfChain {
+    /// The URDF file.
+    pub file: String,
+    /// The chain's moving joints, in configuration order.
+    pub joints: Vec<String>,
+    /// The chain's base link.
+    pub base: String,
+    /// Joints held at a value.
+    pub lock: Vec<(String, f64)>,
+}
+
+/// The [`UrdfChain`] of a robot name; `None` for a built-in robot or a
 /// description file.
-pub fn urdf_chain(
-    name_or_path: &str,
-) -> Result<Option<(String, Vec<String>, String, Vec<(String, f64)>)>> {
+pub fn urdf_chain(name_or_path: &str) -> Result<Option<UrdfChain>> {
     let (head, chain) = match name_or_path.rsplit_once('#') {
         Some((h, f)) if f.contains('=') => (h, ChainChoice::parse_fragment(f)?),
         _ => (name_or_path, ChainChoice::default()),
@@ -159,7 +169,12 @@ pub fn urdf_chain(
         ..urdf::UrdfOptions::default()
     };
     let (joints, base) = urdf::chain_joints(path, &opts)?;
-    Ok(Some((file.to_string(), joints, base, chain.lock)))
+    Ok(Some(UrdfChain {
+        file: file.to_string(),
+        joints,
+        base,
+        lock: chain.lock,
+    }))
 }
 
 /// As [`load_robot`], with the description's visibility region. A `#…`

@@ -173,6 +173,29 @@ fn ur10_new_poses_on_top_of_the_first_half() {
     assert!((g["ln_oid"].as_f64().unwrap() - reported).abs() < 1e-8 * ln.abs());
     assert!((g["d_efficiency"].as_f64().unwrap() - eff).abs() < 1e-6);
     assert_eq!(g["existing"]["poses"], 12);
+    // `calibrate --design` simulates the existing poses and the new ones,
+    // in that order, at their stored joint values.
+    let saved = d.join("measured.json");
+    let _ = json_of(&[
+        "calibrate",
+        "--robot",
+        &format!("{UR10}#tip=wrist_3_link"),
+        "--design",
+        design.to_str().unwrap(),
+        "--save-measurements",
+        saved.to_str().unwrap(),
+        "--json",
+    ]);
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&saved).unwrap()).unwrap();
+    let measured = qs(&m["qs"]);
+    assert_eq!(
+        measured.len(),
+        12 + 8,
+        "existing and new poses are measured"
+    );
+    assert_eq!(&measured[..12], &old_q[..]);
+    assert_eq!(&measured[12..], &new_q[..]);
 }
 
 #[test]

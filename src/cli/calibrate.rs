@@ -253,7 +253,8 @@ fn status_text(id: &Identification) -> String {
 
 /// Simulated calibration at a design's poses.
 ///
-/// The measurements are simulated at the design's stored joint values; the
+/// The measurements are simulated at the design's stored joint values (after
+/// the existing poses a design chosen with `select --existing` stores); the
 /// held-out validation poses come from the design's own pool (the same pool,
 /// filters included, that `select` chose it from), outside the design.
 fn from_design(
@@ -275,7 +276,14 @@ fn from_design(
     let pool = design
         .build_pool(&spec, robot, &robot.nominal)
         .map_err(in_file)?;
-    let qs = design.joint_values(robot).map_err(in_file)?;
+    // A design chosen on top of poses already measured (`select
+    // --existing`) is calibrated from all of them: the existing poses, then
+    // the new ones, as they will be measured.
+    let new_qs = design.joint_values(robot).map_err(in_file)?;
+    let qs: Vec<Vec<f64>> = match &design.existing {
+        Some(e) => e.q.iter().chain(&new_qs).cloned().collect(),
+        None => new_qs,
+    };
     let positions = design.positions_found_in(robot, &pool).map_err(in_file)?;
     let lm = LmSettings::default()
         .with_max_iterations(a.max_iterations)

@@ -337,6 +337,22 @@ fn design_gap_reports_d_efficiency() {
     let mut dup = design.clone();
     dup[1] = dup[0];
     assert!(design_gap(&x, &dup, &b).is_err());
+    // A Jacobian of another pool: the same size with fewer unknowns, or the
+    // same unknowns with more poses (each mismatch alone is refused).
+    let fewer_columns = Blocks::new(
+        Mat::from_fn(x.mat().nrows(), x.p() - 1, |i, j| x.mat()[(i, j)]),
+        x.t(),
+    );
+    assert!(matches!(
+        design_gap(&fewer_columns, &design, &b),
+        Err(BoundError::InvalidDesign(m)) if m.contains("unknowns")
+    ));
+    let more_poses = random_data(15, 13);
+    assert_eq!(more_poses.p(), x.p());
+    assert!(matches!(
+        design_gap(&more_poses, &design, &b),
+        Err(BoundError::InvalidDesign(m)) if m.contains("pool of 14 poses")
+    ));
 }
 
 #[test]

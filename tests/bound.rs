@@ -326,6 +326,7 @@ fn design_gap_reports_d_efficiency() {
     assert!((g.d_efficiency - eff).abs() < 1e-12);
     assert!(g.d_efficiency > 0.0 && g.d_efficiency <= 1.0);
     assert!((g.log10_bound - b.ln_bound / std::f64::consts::LN_10).abs() < 1e-12);
+    assert!((g.log10_oid.unwrap() - best / std::f64::consts::LN_10).abs() < 1e-9);
     for (k, &i) in design.iter().enumerate() {
         assert_eq!(g.weights[k], b.weights[i]);
         assert_eq!(g.weighted.contains(&k), b.weights[i] > WEIGHT_TOL);

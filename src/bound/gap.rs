@@ -137,6 +137,8 @@ pub fn design_gap_with_prior(
         d_efficiency,
         bound_status: bound.status,
         certificate_gap: bound.certificate_gap,
+        // `>` or `≥` differ only for a weight exactly equal to WEIGHT_TOL
+        // (an equivalent mutant for cargo-mutants: no solver lands there).
         weighted: (0..design.len())
             .filter(|&k| weights[k] > WEIGHT_TOL)
             .collect(),

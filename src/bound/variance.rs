@@ -13,12 +13,6 @@ use crate::linalg::rank;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::{Mat, MatRef, Par, Side};
 
-/// Eigenvalue ratio λ_min/λ_max of the column-scaled pool Gram matrix at or
-/// below which the pool counts as rank deficient: `1/MAX_CONDITION`, the
-/// rule every command shares ([`crate::linalg::rank`]; a singular-value
-/// ratio of `3.2e-7`).
-pub const RANK_TOL: f64 = 1.0 / crate::linalg::rank::MAX_CONDITION;
-
 /// A column-scaled copy of a pool Jacobian, `X̃ = X·S⁻¹`, and of a prior
 /// `M̃0 = S⁻¹ M0 S⁻¹` when there is one.
 ///
@@ -106,7 +100,8 @@ pub fn check_problem_with_prior(x: &Blocks, n: usize, with_prior: bool) -> Resul
 /// information matrix with unit diagonal: `s_j = ‖X_{:,j}‖·√(N / pool)`.
 ///
 /// Errors with [`BoundError::RankDeficient`] on a zero column or when the
-/// scaled Gram matrix has `λ_min/λ_max ≤` [`RANK_TOL`].
+/// scaled Gram matrix has `λ_min/λ_max ≤ 1/`[`crate::linalg::rank::MAX_CONDITION`]
+/// (the rank rule every command shares; a singular-value ratio of `3.2e-7`).
 pub fn scale_columns(x: &Blocks, n: usize) -> Result<Scaled, BoundError> {
     scale_columns_with_prior(x, None, n)
 }

@@ -35,7 +35,7 @@ pub struct SolveOpts {
     pub screen_gap: f64,
     /// Most candidate-set solves (screening rounds); large pools may need
     /// more than the default to certify.
-    #[arg(long, default_value_t = 10, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 20, allow_negative_numbers = true)]
     pub max_rounds: usize,
 }
 

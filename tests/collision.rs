@@ -220,34 +220,33 @@ fn bad_collision_inputs_are_clear_errors() {
     let d = panda_copy("mesh");
     std::fs::remove_file(d.join("robots/panda_description/meshes/collision/link3.stl")).unwrap();
     let u = d.join("panda.urdf").display().to_string();
+    // `select --self-collision` on the copy, with `extra` options.
+    let on_copy = |extra: &[String]| -> Vec<String> {
+        [
+            "select",
+            "--robot",
+            &u,
+            "--tip",
+            "panda_hand_tcp",
+            "--self-collision",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .chain(extra.iter().cloned())
+        .collect()
+    };
     run(
-        vec![
-            "select".into(),
-            "--robot".into(),
-            u.clone(),
-            "--tip".into(),
-            "panda_hand_tcp".into(),
-            "--self-collision".into(),
-        ],
+        on_copy(&[]),
         "link 'panda_link3': mesh 'package://example-robot-data/robots/panda_description/meshes/collision/link3.stl' not found",
     );
     // A truncated mesh is an error naming the file, not a panic.
     let m = d.join("robots/panda_description/meshes/collision/link3.stl");
-    let full =
-        std::fs::read(d.join("robots/panda_description/meshes/collision/link2.stl")).unwrap();
+    let link2 = d.join("robots/panda_description/meshes/collision/link2.stl");
+    let full = std::fs::read(&link2).unwrap();
     std::fs::write(&m, &full[..full.len() - 7]).unwrap();
-    run(
-        vec![
-            "select".into(),
-            "--robot".into(),
-            u.clone(),
-            "--tip".into(),
-            "panda_hand_tcp".into(),
-            "--self-collision".into(),
-        ],
-        "link3.stl: not an STL mesh",
-    );
+    run(on_copy(&[]), "link3.stl: not an STL mesh");
     // An SRDF naming a link the URDF does not have: file, line and link.
+    std::fs::copy(&link2, &m).unwrap();
     let s = d.join("panda.srdf");
     let text = std::fs::read_to_string(&s).unwrap();
     let line = text
@@ -260,22 +259,8 @@ fn bad_collision_inputs_are_clear_errors() {
         text.replacen("link1=\"panda_hand\"", "link1=\"panda_wrist\"", 1),
     )
     .unwrap();
-    std::fs::copy(
-        d.join("robots/panda_description/meshes/collision/link2.stl"),
-        &m,
-    )
-    .unwrap();
     run(
-        vec![
-            "select".into(),
-            "--robot".into(),
-            u,
-            "--tip".into(),
-            "panda_hand_tcp".into(),
-            "--self-collision".into(),
-            "--srdf".into(),
-            s.display().to_string(),
-        ],
+        on_copy(&["--srdf".to_string(), s.display().to_string()]),
         &format!("panda.srdf:{line}: disable_collisions names link 'panda_wrist'"),
     );
     std::fs::remove_dir_all(d.parent().unwrap()).ok();

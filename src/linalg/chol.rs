@@ -72,6 +72,8 @@ pub(crate) fn cholesky_inverse(m: MatRef<'_, f64>) -> Result<(Vec<f64>, f64), ()
     let mut ln_det = 0.0;
     for i in 0..p {
         let d = l[(i, i)];
+        // faer refuses non-positive pivots, so `>` vs `≥` here is an
+        // equivalent mutant; the finiteness test catches an infinite one.
         if !(d > 0.0) || !d.is_finite() {
             return Err(());
         }
@@ -85,7 +87,8 @@ pub(crate) fn cholesky_inverse(m: MatRef<'_, f64>) -> Result<(Vec<f64>, f64), ()
         stack,
     );
     clear_upper_simd_state();
-    // The kernel writes the lower triangle; mirror it.
+    // The kernel writes the lower triangle; mirror it (from `j + 1`: the
+    // diagonal copied onto itself, as `j * 1` would, changes nothing).
     for j in 0..p {
         for i in j + 1..p {
             inv[i * p + j] = inv[j * p + i];
@@ -119,6 +122,16 @@ mod tests {
             }
         }
     }
+    #[test]
+    fn cholesky_inverse_refuses_an_infinite_pivot() {
+        let m = Mat::from_fn(2, 2, |i, j| match (i, j) {
+            (0, 0) => f64::INFINITY,
+            (1, 1) => 1.0,
+            _ => 0.0,
+        });
+        assert!(cholesky_inverse(m.as_ref()).is_err());
+    }
+
     #[test]
     fn ln_det_handles_scales() {
         let a = Mat::from_fn(3, 3, |i, j| {

@@ -116,12 +116,7 @@ mod tests {
         // 60 random 2 × 3 blocks (m = 3·4/2 + 1 = 7), spread weights.
         let (n, t, p) = (60, 2, 3);
         let mut seed = 3u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
+        let mut rnd = || crate::linalg::test_rng::lcg(&mut seed);
         let x = Blocks::new(Mat::from_fn(n * t, p, |_, _| rnd()), t);
         let mut w: Vec<f64> = (0..n)
             .map(|i| 0.02 + 0.1 * ((i * 7) % 13) as f64 / 13.0)

@@ -24,3 +24,16 @@ pub mod qr;
 pub mod rank;
 pub mod simd;
 pub mod small;
+
+/// Random test data for the unit tests of every layer.
+#[cfg(test)]
+pub(crate) mod test_rng {
+    /// A deterministic uniform draw in [−1, 1) (64-bit LCG), independent of
+    /// the rand crate's streams.
+    pub(crate) fn lcg(seed: &mut u64) -> f64 {
+        *seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((*seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+}

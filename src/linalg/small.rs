@@ -407,12 +407,7 @@ mod tests {
     #[test]
     fn add_gain_equals_the_eigenvalue_sum() {
         let mut seed = 7u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
+        let mut rnd = || crate::linalg::test_rng::lcg(&mut seed);
         for t in 1..=8 {
             for case in 0..200 {
                 let scale = 10f64.powf(-3.0 + 6.0 * (case as f64 / 199.0));

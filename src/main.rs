@@ -75,6 +75,11 @@ enum Command {
 }
 
 fn main() {
+    // faer's own default runs its large factorizations (the bound's Newton
+    // system) on every core, with waiting threads spinning: 8 % of the
+    // PUMA bound's profile, and results that could depend on the core
+    // count. Parallelism is ours to choose (rayon, over starts and pools).
+    faer::set_global_parallelism(faer::Par::Seq);
     let matches = Cli::command().get_matches();
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     // Pool options typed on the command line (not defaulted): `score`

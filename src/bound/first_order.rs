@@ -22,6 +22,7 @@
 //! while they fail.
 
 use super::BoundError;
+use super::pair::PairFactors;
 use super::variance::{
     Scaled, VarianceWork, certificate_with_prior, check_problem, make_feasible, scale_columns,
     top_sum, variances_into,
@@ -417,12 +418,14 @@ struct PairWork {
     ut: Mat<f64>,
     wm: Mat<f64>,
     g: Mat<f64>,
-    r: Mat<f64>,
     wr: Mat<f64>,
     v: Mat<f64>,
     wv: Mat<f64>,
     sq: Vec<f64>,
     mu: Vec<f64>,
+    s: Vec<f64>,
+    gs: Vec<f64>,
+    pf: PairFactors,
 }
 
 impl PairWork {
@@ -431,12 +434,14 @@ impl PairWork {
             ut: Mat::zeros(p, 2 * t),
             wm: Mat::zeros(p, 2 * t),
             g: Mat::zeros(2 * t, 2 * t),
-            r: Mat::zeros(2 * t, 2 * t),
             wr: Mat::zeros(p, 2 * t),
             v: Mat::zeros(2 * t, 2 * t),
             wv: Mat::zeros(p, 2 * t),
             sq: Vec::new(),
             mu: Vec::with_capacity(2 * t),
+            s: Vec::with_capacity(2 * t),
+            gs: vec![0.0; 4 * t * t],
+            pf: PairFactors::new(t),
         }
     }
 }
@@ -503,35 +508,15 @@ fn exchange_round(
             1.0,
             Par::Seq,
         );
-        let g = DMatrix::from_fn(2 * t, 2 * t, |a, b| 0.5 * (pw.g[(a, b)] + pw.g[(b, a)]));
-        // μ: eigenvalues of D G = those of the symmetric G^{1/2} D G^{1/2}.
-        let eg = SymmetricEigen::new(g.clone());
-        let sq = DMatrix::from_diagonal(&eg.eigenvalues.map(|l| l.max(0.0).sqrt()));
-        let half = &eg.eigenvectors * sq * eg.eigenvectors.transpose();
-        let mut dm = DMatrix::<f64>::identity(2 * t, 2 * t);
-        for a in t..2 * t {
-            dm[(a, a)] = -1.0;
-        }
-        let b = &half * &dm * &half;
-        let b = (&b + b.transpose()) * 0.5;
-        pw.mu.clear();
-        pw.mu.extend(SymmetricEigen::new(b).eigenvalues.iter());
-        let hi = (1.0 - w[i]).min(w[j]);
-        let delta = line_search(&pw.mu, hi);
-        if delta <= 0.0 {
-            break;
-        }
-        // R = δ (I + δ D G)⁻¹ D, symmetrised.
-        let bmat = DMatrix::<f64>::identity(2 * t, 2 * t) + &dm * &g * delta;
-        let Some(binv) = bmat.try_inverse() else {
-            break;
-        };
-        let r = binv * &dm * delta;
-        for a in 0..2 * t {
-            for c in 0..2 * t {
-                pw.r[(a, c)] = 0.5 * (r[(a, c)] + r[(c, a)]);
+        let m2 = 2 * t;
+        for a in 0..m2 {
+            for b in 0..m2 {
+                pw.gs[a * m2 + b] = 0.5 * (pw.g[(a, b)] + pw.g[(b, a)]);
             }
         }
+        let Some(delta) = pair_step(pw, t, (1.0 - w[i]).min(w[j])) else {
+            break;
+        };
         // Weights; exact bounds when a pose fills up or empties.
         if delta >= 1.0 - w[i] {
             w[i] = 1.0;
@@ -544,14 +529,8 @@ fn exchange_round(
             w[j] -= delta;
         }
         // d_k −= tr(P_k R P_kᵀ), P = X_K W;  M⁻¹ −= W R Wᵀ   (X2)
-        // With R = V Λ Vᵀ: tr(P_k R P_kᵀ) = Σ_l λ_l ‖X_k (W V)_l‖², one
-        // product X_K (W V) instead of two.
-        let er = SymmetricEigen::new(DMatrix::from_fn(2 * t, 2 * t, |a, c| pw.r[(a, c)]));
-        for a in 0..2 * t {
-            for c in 0..2 * t {
-                pw.v[(a, c)] = er.eigenvectors[(a, c)];
-            }
-        }
+        // With R = E diag(s) Eᵀ: tr(P_k R P_kᵀ) = Σ_l s_l ‖X_k (W E)_l‖², one
+        // product X_K (W E) instead of two.
         matmul(
             pw.wv.as_mut(),
             Accum::Replace,
@@ -568,11 +547,11 @@ fn exchange_round(
             1.0,
             Par::Seq,
         );
-        // Row sums Σ_l λ_l (X_K W V)²_rl, vectorised along the rows, then
+        // Row sums Σ_l s_l (X_K W E)²_rl, vectorised along the rows, then
         // per pose.
         pw.sq.clear();
         pw.sq.resize(kn * t, 0.0);
-        for (l, &lam) in er.eigenvalues.iter().enumerate() {
+        for (l, &lam) in pw.s.iter().enumerate() {
             let col = pk
                 .col(l)
                 .try_as_col_major()
@@ -585,25 +564,97 @@ fn exchange_round(
         for (dkv, rows) in dk.iter_mut().zip(pw.sq.chunks_exact(t)) {
             *dkv -= rows.iter().sum::<f64>();
         }
-        matmul(
-            pw.wr.as_mut(),
-            Accum::Replace,
-            pw.wm.as_ref(),
-            pw.r.as_ref(),
-            1.0,
-            Par::Seq,
-        );
+        // M⁻¹ −= (W E) diag(s) (W E)ᵀ.
+        for l in 0..m2 {
+            for c in 0..p {
+                pw.wr[(c, l)] = pw.wv[(c, l)] * pw.s[l];
+            }
+        }
         matmul(
             minv.as_mut(),
             Accum::Add,
             pw.wr.as_ref(),
-            pw.wm.transpose(),
+            pw.wv.transpose(),
             -1.0,
             Par::Seq,
         );
         steps += 1;
     }
     steps
+}
+
+/// The step of the pair whose symmetric matrix `G` is in `pw.gs`: the exact
+/// line search (eq. X1) over `[0, hi]`, then `R = E diag(s) Eᵀ` (eq. X2) with
+/// `E` in `pw.v` and `s` in `pw.s`. `None` when no step improves.
+fn pair_step(pw: &mut PairWork, t: usize, hi: f64) -> Option<f64> {
+    let m2 = 2 * t;
+    let fast = pw.pf.factor(&pw.gs);
+    pw.mu.clear();
+    if fast {
+        pw.mu.extend_from_slice(pw.pf.mu());
+    } else {
+        pw.mu.extend(general_mu(&pw.gs, t).iter());
+    }
+    let delta = line_search(&pw.mu, hi);
+    if delta <= 0.0 {
+        return None;
+    }
+    pw.s.clear();
+    if fast {
+        let (e, sv) = pw.pf.update(delta);
+        for a in 0..m2 {
+            for c in 0..m2 {
+                pw.v[(a, c)] = e[a * m2 + c];
+            }
+        }
+        pw.s.extend_from_slice(sv);
+    } else {
+        let (e, sv) = general_r(&pw.gs, t, delta)?;
+        for a in 0..m2 {
+            for c in 0..m2 {
+                pw.v[(a, c)] = e[(a, c)];
+            }
+        }
+        pw.s.extend(sv.iter());
+    }
+    Some(delta)
+}
+
+/// `D = diag(I_t, −I_t)`.
+fn sign_matrix(t: usize) -> DMatrix<f64> {
+    DMatrix::from_fn(2 * t, 2 * t, |a, b| match (a == b, a < t) {
+        (false, _) => 0.0,
+        (true, true) => 1.0,
+        (true, false) => -1.0,
+    })
+}
+
+/// The eigenvalues `μ` of `D G` for a pair matrix `G` (row-major, `2t × 2t`)
+/// that is only positive semidefinite: those of `G^{1/2} D G^{1/2}`. The
+/// general path of [`PairFactors`].
+fn general_mu(g: &[f64], t: usize) -> Vec<f64> {
+    let m = 2 * t;
+    let g = DMatrix::from_row_slice(m, m, &g[..m * m]);
+    let eg = SymmetricEigen::new(g);
+    let sq = DMatrix::from_diagonal(&eg.eigenvalues.map(|l| l.max(0.0).sqrt()));
+    let half = &eg.eigenvectors * sq * eg.eigenvectors.transpose();
+    let b = &half * sign_matrix(t) * &half;
+    let b = (&b + b.transpose()) * 0.5;
+    SymmetricEigen::new(b).eigenvalues.iter().copied().collect()
+}
+
+/// `R = δ (I + δ D G)⁻¹ D` (eq. X2) as `V diag(λ) Vᵀ` for a positive
+/// semidefinite `G`: the general path of [`PairFactors::update`]. `None`
+/// if `I + δ D G` is singular.
+fn general_r(g: &[f64], t: usize, delta: f64) -> Option<(DMatrix<f64>, Vec<f64>)> {
+    let m = 2 * t;
+    let g = DMatrix::from_row_slice(m, m, &g[..m * m]);
+    let dm = sign_matrix(t);
+    let bmat = DMatrix::<f64>::identity(m, m) + &dm * &g * delta;
+    let r = bmat.try_inverse()? * &dm * delta;
+    let r = (&r + r.transpose()) * 0.5;
+    let er = SymmetricEigen::new(r);
+    Some((er.eigenvectors, er.eigenvalues.iter().copied().collect()))
 }
 
 /// The step `δ ∈ [0, hi]` maximising `φ(δ) = Σ_k ln(1 + δ μ_k)` (eq. X1):

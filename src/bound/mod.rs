@@ -36,6 +36,7 @@ mod error;
 pub mod first_order;
 pub mod gap;
 pub mod newton;
+mod pair;
 mod support;
 pub mod variance;
 

@@ -28,6 +28,7 @@ use super::variance::{
     top_sum, variances_into,
 };
 use crate::blocks::Blocks;
+use crate::linalg::simd::clear_upper_simd_state;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
 use nalgebra::{DMatrix, SymmetricEigen};
@@ -547,6 +548,9 @@ fn exchange_round(
             1.0,
             Par::Seq,
         );
+        // gemm's AVX-512 kernels can leave dirty upper registers, which
+        // slow every SSE instruction after them (see `clear_upper_simd_state`).
+        clear_upper_simd_state();
         // Row sums Σ_l s_l (X_K W E)²_rl, vectorised along the rows, then
         // per pose.
         pw.sq.clear();
@@ -578,6 +582,7 @@ fn exchange_round(
             -1.0,
             Par::Seq,
         );
+        clear_upper_simd_state();
         steps += 1;
     }
     steps

@@ -103,6 +103,7 @@ fn derivatives(sc: &Scaled, w: &[f64], q: &mut Mat<f64>, d: &mut [f64]) -> Optio
     let ld = crate::linalg::chol::ln_det_of_factor(l)?;
     let mut y = x.mat().to_owned();
     solve_lower_triangular_in_place(l, y.as_mut().transpose_mut(), Par::Seq);
+    crate::linalg::simd::clear_upper_simd_state();
     q_packed(y.as_ref(), t, q, d);
     Some(ld)
 }

@@ -172,11 +172,36 @@ pub fn information(x: &Blocks, w: &[f64]) -> Mat<f64> {
     let t = x.t();
     let support: Vec<usize> = (0..w.len()).filter(|&i| w[i] > 0.0).collect();
     let m = x.mat();
-    let xs = Mat::from_fn(support.len() * t, x.p(), |r, c| {
-        let i = support[r / t];
-        w[i].sqrt() * m[(i * t + r % t, c)]
-    });
-    xs.transpose() * &xs
+    let sw: Vec<f64> = support.iter().map(|&i| w[i].sqrt()).collect();
+    let mut xs = Mat::<f64>::zeros(support.len() * t, x.p());
+    // Column by column over contiguous slices (the blocks are column-major).
+    for c in 0..x.p() {
+        let src = m
+            .col(c)
+            .try_as_col_major()
+            .expect("Blocks are column-major")
+            .as_slice();
+        let dst = xs
+            .col_mut(c)
+            .try_as_col_major_mut()
+            .expect("owned")
+            .as_slice_mut();
+        for (k, (&i, &s)) in support.iter().zip(&sw).enumerate() {
+            for a in 0..t {
+                dst[k * t + a] = s * src[i * t + a];
+            }
+        }
+    }
+    let mut out = Mat::<f64>::zeros(x.p(), x.p());
+    faer::linalg::matmul::matmul(
+        out.as_mut(),
+        faer::Accum::Replace,
+        xs.transpose(),
+        xs.as_ref(),
+        1.0,
+        faer::Par::Seq,
+    );
+    out
 }
 
 /// Reusable memory for [`variances_into`]: the `t·n × p` matrix Y.

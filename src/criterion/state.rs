@@ -868,6 +868,47 @@ mod tests {
         (ld, view(&inv, m.nrows()).to_owned())
     }
 
+    /// The `min_pivot` a price reports (it sets the proptests' tolerance
+    /// and the singularity rule) is `+∞` for an addition, and for a removal
+    /// lies between `λ_min(B)` and `det(B)^{1/t}` of the Schur complement `B
+    /// = I − X_q M⁻¹ X_qᵀ` computed directly: every Cholesky pivot of an SPD
+    /// matrix is at least its smallest eigenvalue, and the smallest of `t`
+    /// pivots is at most their geometric mean, `det(B)^{1/t}` (< 1 here).
+    #[test]
+    fn the_reported_min_pivot_is_that_of_the_removal_schur_complement() {
+        let pool = random_pool(40, 3, 9, 11);
+        let design = [0, 1, 2, 3, 4, 5];
+        let st = InfoState::new(&pool, &design, StateSettings::default()).unwrap();
+        match st.price_add(&pool, 7).unwrap() {
+            Status::Regular { min_pivot, .. } => assert_eq!(min_pivot, f64::INFINITY),
+            s => panic!("adding is never singular: {s:?}"),
+        }
+        let (_, inv) = direct(&pool, &design);
+        for q in [0, 2, 5] {
+            let x = pool.block(q);
+            let b = nalgebra::DMatrix::from_fn(3, 3, |a, c| {
+                let mut v = if a == c { 1.0 } else { 0.0 };
+                for k in 0..9 {
+                    for l in 0..9 {
+                        v -= x[(a, k)] * inv[(k, l)] * x[(c, l)];
+                    }
+                }
+                v
+            });
+            let eig = b.clone().symmetric_eigenvalues();
+            let lmin = eig.iter().copied().fold(f64::INFINITY, f64::min);
+            let geo = b.determinant().powf(1.0 / 3.0);
+            assert!(lmin > 0.0 && geo < 1.0 - 1e-6, "pose {q}: λ_min {lmin}, det^(1/3) {geo}");
+            match st.price_remove(&pool, q).unwrap() {
+                Status::Regular { min_pivot, .. } => assert!(
+                    min_pivot >= lmin * (1.0 - 1e-9) && min_pivot <= geo * (1.0 + 1e-9),
+                    "pose {q}: pivot {min_pivot} outside [{lmin}, {geo}]"
+                ),
+                s => panic!("pose {q} is removable: {s:?}"),
+            }
+        }
+    }
+
     #[test]
     fn updates_match_direct() {
         let pool = random_pool(40, 3, 9, 11);

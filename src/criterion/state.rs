@@ -898,7 +898,10 @@ mod tests {
             let eig = b.clone().symmetric_eigenvalues();
             let lmin = eig.iter().copied().fold(f64::INFINITY, f64::min);
             let geo = b.determinant().powf(1.0 / 3.0);
-            assert!(lmin > 0.0 && geo < 1.0 - 1e-6, "pose {q}: λ_min {lmin}, det^(1/3) {geo}");
+            assert!(
+                lmin > 0.0 && geo < 1.0 - 1e-6,
+                "pose {q}: λ_min {lmin}, det^(1/3) {geo}"
+            );
             match st.price_remove(&pool, q).unwrap() {
                 Status::Regular { min_pivot, .. } => assert!(
                     min_pivot >= lmin * (1.0 - 1e-9) && min_pivot <= geo * (1.0 + 1e-9),

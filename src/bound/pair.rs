@@ -176,10 +176,8 @@ mod tests {
             let g = random_spd(m, seed);
             let mut f = PairFactors::new(t);
             assert!(f.factor(&g));
-            // Σ μ = tr(D G) and Π (1 + δμ) = det(I + δ D G), checked against
-            // a direct LU-free computation: det by the Cholesky of the SPD
-            // case is not available (I + δDG is not symmetric), so compare
-            // tr((DG)²) = Σ μ² instead.
+            // The eigenvalues of D G, by their first two power sums against
+            // traces computed directly: Σ μ = tr(D G), Σ μ² = tr((D G)²).
             let mut dg = g.clone();
             for a in t..m {
                 for c in 0..m {

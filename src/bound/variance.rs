@@ -192,16 +192,7 @@ pub fn information(x: &Blocks, w: &[f64]) -> Mat<f64> {
             }
         }
     }
-    let mut out = Mat::<f64>::zeros(x.p(), x.p());
-    faer::linalg::matmul::matmul(
-        out.as_mut(),
-        faer::Accum::Replace,
-        xs.transpose(),
-        xs.as_ref(),
-        1.0,
-        faer::Par::Seq,
-    );
-    out
+    crate::linalg::gram::gram_of(xs.as_ref())
 }
 
 /// Reusable memory for [`variances_into`]: the `t·n × p` matrix Y.

@@ -65,14 +65,15 @@ pub struct PoolVariances {
 }
 
 /// Computes `P = X · A` in parallel over fixed row chunks of `CHUNK` poses
-/// (sequential faer GEMM inside each), writing into the column-major
-/// workspace `work` (`n·t × k`), then calls `f(first_pose, X_c, P_c, out_c)`
-/// on each chunk with the matching chunk of `out` (`per_pose` entries a pose).
+/// (sequential faer GEMM inside each) and calls `f(first_pose, X_c, P_c,
+/// out_c)` on each chunk with the matching chunk of `out` (`per_pose`
+/// entries a pose). Each worker thread holds one chunk's `P_c` (`CHUNK·t ×
+/// k`), never the whole product: for `k = p` that would be a second copy of
+/// the pool's Jacobian (648 MB at 10⁶ PUMA poses).
 fn chunked_product<F>(
     x: MatRef<'_, f64>,
     t: usize,
     a: MatRef<'_, f64>,
-    work: &mut Vec<f64>,
     out: &mut [f64],
     per_pose: usize,
     f: F,
@@ -81,30 +82,39 @@ fn chunked_product<F>(
 {
     let rows = x.nrows();
     let k = a.ncols();
-    assert!(out.len() == rows / t * per_pose);
+    assert!(per_pose > 0 && out.len() == rows / t * per_pose);
+    let chunk_rows = CHUNK * t;
+    x.par_row_chunks(chunk_rows)
+        .zip(out.par_chunks_mut(CHUNK * per_pose))
+        .enumerate()
+        .for_each_init(Vec::new, |buf: &mut Vec<f64>, (c, (xc, oc))| {
+            let r = xc.nrows();
+            buf.resize(chunk_rows * k, 0.0);
+            let mut pc = MatMut::from_column_major_slice_mut(&mut buf[..r * k], r, k);
+            matmul(pc.rb_mut(), Accum::Replace, xc, a, 1.0, Par::Seq);
+            clear_upper_simd_state();
+            f(c * CHUNK, xc, pc.rb(), oc);
+        });
+}
+
+/// The whole product `W = X · A` (`n·t × k`, column-major) into the first
+/// `n·t·k` entries of `work`, in parallel over the same row chunks as
+/// [`chunked_product`]; for the cross terms, whose `k = |outs|·t` columns
+/// are few.
+fn full_product(x: MatRef<'_, f64>, a: MatRef<'_, f64>, t: usize, work: &mut Vec<f64>) {
+    let rows = x.nrows();
+    let k = a.ncols();
     if work.len() < rows * k {
         work.resize(rows * k, 0.0);
     }
     let w = MatMut::from_column_major_slice_mut(&mut work[..rows * k], rows, k);
     let chunk_rows = CHUNK * t;
-    let xs = x
-        .par_row_chunks(chunk_rows)
-        .zip(w.par_row_chunks_mut(chunk_rows));
-    if per_pose == 0 {
-        xs.enumerate().for_each(|(c, (xc, mut pc))| {
+    x.par_row_chunks(chunk_rows)
+        .zip(w.par_row_chunks_mut(chunk_rows))
+        .for_each(|(xc, mut pc)| {
             matmul(pc.rb_mut(), Accum::Replace, xc, a, 1.0, Par::Seq);
             clear_upper_simd_state();
-            f(c * CHUNK, xc, pc.rb(), &mut []);
         });
-    } else {
-        xs.zip(out.par_chunks_mut(CHUNK * per_pose))
-            .enumerate()
-            .for_each(|(c, ((xc, mut pc), oc))| {
-                matmul(pc.rb_mut(), Accum::Replace, xc, a, 1.0, Par::Seq);
-                clear_upper_simd_state();
-                f(c * CHUNK, xc, pc.rb(), oc);
-            });
-    }
 }
 
 impl PoolVariances {
@@ -149,7 +159,6 @@ impl PoolVariances {
             pool.mat(),
             t,
             state.m_inv(),
-            &mut self.work,
             &mut self.v,
             tp,
             |_, xc, yc, vc| {
@@ -181,29 +190,21 @@ impl PoolVariances {
         let f = lr.factors();
         let a = lr.n_plus();
         let k = f.ncols();
-        chunked_product(
-            pool.mat(),
-            t,
-            f,
-            &mut self.work,
-            &mut self.v,
-            tp,
-            |_, _, pc, vc| {
-                for c in 0..k {
-                    let sign = if c < a { -1.0 } else { 1.0 };
-                    let pcol = col(pc, c);
-                    for (i, vi) in vc.chunks_mut(tp).enumerate() {
-                        let q = &pcol[i * t..i * t + t];
-                        for r in 0..t {
-                            let sr = sign * q[r];
-                            for s in 0..=r {
-                                vi[pk(r, s)] += sr * q[s];
-                            }
+        chunked_product(pool.mat(), t, f, &mut self.v, tp, |_, _, pc, vc| {
+            for c in 0..k {
+                let sign = if c < a { -1.0 } else { 1.0 };
+                let pcol = col(pc, c);
+                for (i, vi) in vc.chunks_mut(tp).enumerate() {
+                    let q = &pcol[i * t..i * t + t];
+                    for r in 0..t {
+                        let sr = sign * q[r];
+                        for s in 0..=r {
+                            vi[pk(r, s)] += sr * q[s];
                         }
                     }
                 }
-            },
-        );
+            }
+        });
         self.incremental_updates += 1;
     }
 
@@ -308,18 +309,9 @@ impl PoolVariances {
     ) -> MatRef<'_, f64> {
         self.check(pool, state);
         let t = self.t;
-        let k = outs.len() * t;
-        let rows = self.n * t;
         let a = out_projection(pool, state, outs);
-        chunked_product(
-            pool.mat(),
-            t,
-            a.as_ref(),
-            &mut self.work,
-            &mut [],
-            0,
-            |_, _, _, _| {},
-        );
+        full_product(pool.mat(), a.as_ref(), t, &mut self.work);
+        let (rows, k) = (self.n * t, outs.len() * t);
         MatRef::from_column_major_slice(&self.work[..rows * k], rows, k)
     }
 
@@ -352,16 +344,8 @@ impl PoolVariances {
             // product W = X·A (n·t × k, column-major), whose few columns a
             // candidate reads in contiguous runs of t rows, beats gathering
             // the candidates' rows per task.
+            full_product(pool.mat(), a.as_ref(), t, &mut self.work);
             let rows = self.n * t;
-            chunked_product(
-                pool.mat(),
-                t,
-                a.as_ref(),
-                &mut self.work,
-                &mut [],
-                0,
-                |_, _, _, _| {},
-            );
             let w = MatRef::from_column_major_slice(&self.work[..rows * k], rows, k);
             let wcols: Vec<&[f64]> = (0..k).map(|c| col(w, c)).collect();
             let this = &*self;

@@ -10,7 +10,9 @@ use super::BoundError;
 use crate::blocks::Blocks;
 use crate::linalg::chol::ln_det_of_factor;
 use crate::linalg::rank;
+use crate::linalg::simd::clear_upper_simd_state;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
+use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Mat, MatRef, Par, Side};
 
 /// A column-scaled copy of a pool Jacobian, `X̃ = X·S⁻¹`, and of a prior
@@ -195,7 +197,9 @@ pub fn information(x: &Blocks, w: &[f64]) -> Mat<f64> {
     crate::linalg::gram::gram_of(xs.as_ref())
 }
 
-/// Reusable memory for [`variances_into`]: the `t·n × p` matrix Y.
+/// Reusable memory for [`variances_into`]: one chunk of the matrix Y
+/// (`VARIANCE_CHUNK` poses' rows × p), never the whole pool's: at 10⁶ PUMA
+/// poses that would be a second copy of the 648 MB Jacobian.
 #[derive(Debug)]
 pub struct VarianceWork {
     y: Mat<f64>,
@@ -213,8 +217,8 @@ impl Default for VarianceWork {
 /// `d` and returns `ln det M` with `M⁻¹`, or `None` if `M` is not
 /// numerically positive definite.
 ///
-/// One Cholesky `M = L Lᵀ`, one triangular solve `Y = X L⁻ᵀ` over the whole
-/// pool, and the row norms of Y.
+/// One Cholesky `M = L Lᵀ`, then the triangular solve `Y = X L⁻ᵀ` and the
+/// row norms of Y, chunk by chunk of `VARIANCE_CHUNK` poses.
 pub fn variances_into(
     x: &Blocks,
     m: MatRef<'_, f64>,
@@ -227,22 +231,31 @@ pub fn variances_into(
     let l = llt.L();
     let ln_det = ln_det_of_factor(l)?;
     let xm = x.mat();
-    if work.y.nrows() != xm.nrows() || work.y.ncols() != xm.ncols() {
-        work.y = Mat::zeros(xm.nrows(), xm.ncols());
-    }
-    work.y.copy_from(xm);
-    // L Yᵀ = Xᵀ, i.e. Y = X L⁻ᵀ.
-    solve_lower_triangular_in_place(l, work.y.as_mut().transpose_mut(), Par::Seq);
     let t = x.t();
-    d.iter_mut().for_each(|v| *v = 0.0);
-    for c in 0..xm.ncols() {
-        let col = work.y.col(c);
-        for (i, di) in d.iter_mut().enumerate() {
-            let mut s = 0.0;
-            for r in i * t..i * t + t {
-                s += col[r] * col[r];
+    let p = xm.ncols();
+    let chunk_rows = VARIANCE_CHUNK * t;
+    let rows = chunk_rows.min(xm.nrows());
+    if work.y.nrows() != rows || work.y.ncols() != p {
+        work.y = Mat::zeros(rows, p);
+    }
+    for (k, dc) in d.chunks_mut(VARIANCE_CHUNK).enumerate() {
+        let r0 = k * chunk_rows;
+        let nr = dc.len() * t;
+        let mut y = work.y.as_mut().subrows_mut(0, nr);
+        y.copy_from(xm.subrows(r0, nr));
+        // L Yᵀ = Xᵀ, i.e. Y = X L⁻ᵀ.
+        solve_lower_triangular_in_place(l, y.rb_mut().transpose_mut(), Par::Seq);
+        clear_upper_simd_state();
+        dc.iter_mut().for_each(|v| *v = 0.0);
+        for c in 0..p {
+            let col = y.rb().col(c);
+            for (i, di) in dc.iter_mut().enumerate() {
+                let mut s = 0.0;
+                for r in i * t..i * t + t {
+                    s += col[r] * col[r];
+                }
+                *di += s;
             }
-            *di += s;
         }
     }
     if d.iter().any(|v| !v.is_finite()) {
@@ -250,6 +263,10 @@ pub fn variances_into(
     }
     Some((ln_det, llt.inverse()))
 }
+
+/// Poses per chunk of [`variances_into`]: 4,096 (a 2.6 MB chunk of Y for
+/// the PUMA), large enough that the triangular solve runs at GEMM speed.
+const VARIANCE_CHUNK: usize = 4096;
 
 /// `S_N`: the sum of the `n` largest entries of `d`. `scratch` is reused.
 #[must_use]
@@ -357,23 +374,42 @@ mod tests {
         Blocks::from_row_major(&rows, t, p)
     }
 
+    /// Against `tr(X_i M⁻¹ X_iᵀ)` computed directly, on a pool within one
+    /// chunk and on one of three chunks (the last one partial), with the
+    /// workspace reused from the first call.
     #[test]
     fn variances_match_direct_formula() {
-        let x = random_blocks(40, 3, 7, 1);
-        let w: Vec<f64> = (0..40).map(|i| 0.1 + 0.02 * i as f64).collect();
-        let m = information(&x, &w);
-        let mut d = vec![0.0; 40];
-        let (ld, minv) = variances_into(&x, m.as_ref(), &mut VarianceWork::default(), &mut d)
-            .expect("positive definite");
-        for i in [0, 17, 39] {
-            let b = x.block(i);
-            let direct = (b * &minv * b.transpose()).diagonal().column_vector().sum();
-            assert!((direct - d[i]).abs() < 1e-10 * direct.abs().max(1.0));
+        let mut work = VarianceWork::default();
+        for n in [40, 2 * VARIANCE_CHUNK + 41] {
+            let x = random_blocks(n, 3, 7, 1);
+            let w: Vec<f64> = (0..n).map(|i| 0.1 + 0.02 * (i % 40) as f64).collect();
+            let m = information(&x, &w);
+            let mut d = vec![0.0; n];
+            let (ld, minv) =
+                variances_into(&x, m.as_ref(), &mut work, &mut d).expect("positive definite");
+            let last = VARIANCE_CHUNK - 1;
+            for i in [0, 17, 39, last, last + 1, 2 * last + 2, n - 1] {
+                if i >= n {
+                    continue;
+                }
+                let b = x.block(i);
+                let direct = (b * &minv * b.transpose()).diagonal().column_vector().sum();
+                assert!(
+                    (direct - d[i]).abs() < 1e-10 * direct.abs().max(1.0),
+                    "pose {i} of {n}"
+                );
+            }
+            // Σ w_i d_i = tr(M⁻¹ M) = p, over every pose of every chunk.
+            let s: f64 = w.iter().zip(&d).map(|(a, b)| a * b).sum();
+            assert!(
+                (s - 7.0).abs() < 1e-10 * (n as f64 / 40.0),
+                "Σ w d = {s} on {n} poses"
+            );
+            assert!(
+                (ld - crate::linalg::chol::ln_det_spd(m.as_ref()).unwrap()).abs()
+                    < 1e-12 * ld.abs().max(1.0)
+            );
         }
-        // Σ w_i d_i = tr(M⁻¹ M) = p.
-        let s: f64 = w.iter().zip(&d).map(|(a, b)| a * b).sum();
-        assert!((s - 7.0).abs() < 1e-10);
-        assert!((ld - crate::linalg::chol::ln_det_spd(m.as_ref()).unwrap()).abs() < 1e-12);
     }
 
     #[test]

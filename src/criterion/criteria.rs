@@ -26,7 +26,7 @@ use super::variances::{PoolVariances, SCAN_CHUNK};
 use crate::linalg::eigen::EigenScratch;
 use crate::linalg::gram::{add_gram, gather_block, view};
 use crate::linalg::rank::{eigenvalues_regular, equilibrate_into};
-use crate::linalg::small::{STACK_T, ln_det_i_minus, ln_det_i_plus};
+use crate::linalg::small::{STACK_T, ln_det_i_minus};
 
 /// Candidates per parallel work item of the OI criterion (`O(p³)` each).
 const OI_CHUNK: usize = 8;
@@ -139,19 +139,8 @@ impl Criterion for DCriterion {
     ) {
         assert_eq!(candidates.len(), out.len());
         let base = state.ln_det();
-        let t = pool.t();
         let vars = &*self.variances(pool, state);
-        out.par_chunks_mut(SCAN_CHUNK)
-            .zip(candidates.par_chunks(SCAN_CHUNK))
-            .for_each(|(oc, cc)| {
-                for (o, &i) in oc.iter_mut().zip(cc) {
-                    *o = if state.contains(i) {
-                        f64::NEG_INFINITY
-                    } else {
-                        base + ln_det_i_plus(vars.packed(i), t)
-                    };
-                }
-            });
+        vars.add_scores(candidates, out, base, |i| state.contains(i));
     }
 
     fn price_removals(&mut self, pool: &Blocks, state: &InfoState, out: &mut [f64]) {

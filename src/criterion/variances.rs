@@ -22,10 +22,11 @@ use rayon::prelude::*;
 use super::lowrank::LowRank;
 use super::state::InfoState;
 use crate::blocks::Blocks;
+use crate::linalg::log::ln_in_place;
 use crate::linalg::simd::clear_upper_simd_state;
 use crate::linalg::small::{
-    BlockScratch, exchange_in_factor, exchange_ln_det, exchange_out_ln_det, ln_det_i_minus,
-    ln_det_i_plus, packed_len, pk,
+    BlockScratch, det_i_plus3, exchange_in_factor, exchange_ln_det, exchange_out_ln_det,
+    ln_det_i_minus, ln_det_i_plus, packed_len, pk,
 };
 
 /// Column `c` of a matrix with unit row stride, as a slice.
@@ -275,13 +276,62 @@ impl PoolVariances {
     /// Add gains `ln det(I + V_i)` (eq. (17)/(20) in block form) of the given
     /// pool poses into `out` (same length). Parallel, allocation-free.
     pub fn add_gains(&self, candidates: &[usize], out: &mut [f64]) {
+        self.add_scores(candidates, out, 0.0, |_| false);
+    }
+
+    /// `out[k] = base + ln det(I + V_i)` for `i = candidates[k]`, or `-∞`
+    /// where `skip(i)` (a pose already in the design): the add scan of
+    /// [`DCriterion`](super::DCriterion). Parallel over chunks of
+    /// [`SCAN_CHUNK`] candidates, allocation-free. For points (`t = 3`) each
+    /// chunk takes the block determinants first ([`det_i_plus3`]), then
+    /// their logarithms in one vectorised pass ([`ln_in_place`]), then
+    /// [`ln_det_i_plus`] for the rare determinant that is not finite and
+    /// positive, so every value is [`ln_det_i_plus`]'s to within 1 ulp of
+    /// the logarithm.
+    pub fn add_scores(
+        &self,
+        candidates: &[usize],
+        out: &mut [f64],
+        base: f64,
+        skip: impl Fn(usize) -> bool + Sync,
+    ) {
         assert_eq!(candidates.len(), out.len());
         let t = self.t;
         out.par_chunks_mut(SCAN_CHUNK)
             .zip(candidates.par_chunks(SCAN_CHUNK))
             .for_each(|(oc, cc)| {
-                for (o, &i) in oc.iter_mut().zip(cc) {
-                    *o = ln_det_i_plus(self.packed(i), t);
+                if t == 3 {
+                    let c0 = cc.first().copied().unwrap_or(0);
+                    if cc.iter().zip(c0..).all(|(&i, k)| i == k) {
+                        // A run of consecutive poses (every scan without
+                        // fixed poses): the blocks are one contiguous slice.
+                        let v = &self.v[c0 * 6..(c0 + cc.len()) * 6];
+                        for (o, b) in oc.iter_mut().zip(v.chunks_exact(6)) {
+                            *o = det_i_plus3(b);
+                        }
+                    } else {
+                        for (o, &i) in oc.iter_mut().zip(cc) {
+                            *o = det_i_plus3(self.packed(i));
+                        }
+                    }
+                    ln_in_place(oc);
+                    for (o, &i) in oc.iter_mut().zip(cc) {
+                        *o = if skip(i) {
+                            f64::NEG_INFINITY
+                        } else if o.is_finite() {
+                            base + *o
+                        } else {
+                            base + ln_det_i_plus(self.packed(i), t)
+                        };
+                    }
+                } else {
+                    for (o, &i) in oc.iter_mut().zip(cc) {
+                        *o = if skip(i) {
+                            f64::NEG_INFINITY
+                        } else {
+                            base + ln_det_i_plus(self.packed(i), t)
+                        };
+                    }
                 }
             });
     }

@@ -4,6 +4,7 @@
 //! - [`chol`]: Cholesky of `p×p` SPD matrices, `ln det`, inverse;
 //! - [`small`]: `t×t` block kernels of the rank-t updates (eqs. (17)–(22));
 //! - [`gram`]: `M ± XᵀX` on `p×p` slices, `AᵀA` and products;
+//! - [`log`]: a vectorised `ln` over slices (the add-gain scan's one `ln`);
 //! - [`qr`]: Householder QR, least squares and `(XᵀX)⁻¹` for identification;
 //! - [`eigen`]: eigenvalues and singular values;
 //! - [`rank`]: the one rank and conditioning rule, on the column-scaled
@@ -20,6 +21,7 @@ pub mod blas;
 pub mod chol;
 pub mod eigen;
 pub mod gram;
+pub mod log;
 pub mod qr;
 pub mod rank;
 pub mod simd;

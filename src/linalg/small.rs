@@ -195,6 +195,23 @@ pub(crate) fn min_pivot(l: &[f64], n: usize) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// `det(I + V)` of a packed symmetric `3×3` block `V` (a point's add
+/// block) by the pivots of its square-root-free `LDLᵀ`: branch-free, so a
+/// loop over candidates vectorises; [`ln_det_i_plus`]'s value is the
+/// logarithm of this one when it is finite and positive.
+#[inline(always)]
+pub(crate) fn det_i_plus3(v: &[f64]) -> f64 {
+    let (a00, a10, a11) = (1.0 + v[0], v[1], 1.0 + v[2]);
+    let (a20, a21, a22) = (v[3], v[4], 1.0 + v[5]);
+    // With m1 = a00·d1, m2 = a00·(a22 − a20²/a00) and n = a00·u21 (the
+    // pivots scaled by the first), d1·d2 = (m1·m2 − n²)/(a00·m1)·… reduces
+    // to one division: det = a00·d1·d2 = (m1·m2 − n²)/a00.
+    let m1 = a00 * a11 - a10 * a10;
+    let m2 = a00 * a22 - a20 * a20;
+    let n = a00 * a21 - a20 * a10;
+    (m1 * m2 - n * n) / a00
+}
+
 /// `ln det(I + V)` for a packed PSD `t×t` block `V`: the add gain of
 /// eq. (17)/(20) in block form. `I + V ⪰ I`, so the only failure is non-finite
 /// input, reported as `-∞`.
@@ -209,14 +226,7 @@ pub(crate) fn min_pivot(l: &[f64], n: usize) -> f64 {
 #[inline]
 pub(crate) fn ln_det_i_plus(v: &[f64], t: usize) -> f64 {
     let det = if t == 3 {
-        let (a00, a10, a11) = (1.0 + v[0], v[1], 1.0 + v[2]);
-        let (a20, a21, a22) = (v[3], v[4], 1.0 + v[5]);
-        let r0 = 1.0 / a00;
-        let (l10, l20) = (a10 * r0, a20 * r0);
-        let d1 = a11 - l10 * a10;
-        let u21 = a21 - l20 * a10;
-        let d2 = a22 - l20 * a20 - u21 * u21 / d1;
-        a00 * d1 * d2
+        det_i_plus3(v)
     } else {
         let mut a_buf = BlockScratch::new(t * t);
         let mut d_buf = BlockScratch::new(t);

@@ -260,6 +260,10 @@ pub struct SelectReport {
     pub starts: usize,
     /// Fedorov polish.
     pub polish: bool,
+    /// Rounds of iterated local search per start (0: the algorithm alone).
+    pub ils: usize,
+    /// Design poses exchanged at random per round of iterated local search.
+    pub kick: usize,
     /// The start that won.
     pub best_start: usize,
     /// Ids of the fixed poses.
@@ -331,6 +335,8 @@ impl SelectReport {
             seed: s.seed,
             starts: s.starts,
             polish: s.polish,
+            ils: s.ils,
+            kick: s.kick,
             best_start: sel.start,
             fixed: pool.ids_of(&s.fixed),
             log10_bound: None,

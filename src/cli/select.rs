@@ -9,6 +9,11 @@ use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
 
+/// Default rounds of iterated local search per start (`--ils`): with the
+/// default two starts, a PUMA selection stays under a second on two cores
+/// (README, "Selection quality").
+const DEFAULT_ILS: usize = 12;
+
 /// Arguments of `score`.
 #[derive(Args)]
 pub struct ScoreArgs {
@@ -163,9 +168,22 @@ pub struct SelectArgs {
     /// 12, or N when N is smaller].
     #[arg(long, allow_negative_numbers = true)]
     pub initial: Option<usize>,
-    /// Independent random starts; the best (by the criterion) is kept.
-    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+    /// Independent random starts, run in parallel; the best (by the
+    /// criterion) is kept.
+    #[arg(long, default_value_t = 2, allow_negative_numbers = true)]
     pub starts: usize,
+    /// Rounds of iterated local search per start after the algorithm: climb
+    /// to a local optimum of single exchanges (modified Fedorov), then ILS
+    /// times exchange --kick random design poses, climb again, keep the
+    /// better design. 0 runs the algorithm alone (the paper's EAE). With
+    /// the defaults the PUMA experiment reaches D-efficiency 0.984–0.987
+    /// (median 0.985 over 10 seeds) in under a second, where one EAE start
+    /// stops at 0.970–0.982.
+    #[arg(long, default_value_t = DEFAULT_ILS, allow_negative_numbers = true)]
+    pub ils: usize,
+    /// Design poses exchanged at random per round of --ils.
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
+    pub kick: usize,
     /// Random designs drawn by --algorithm random.
     #[arg(long, default_value_t = 5000, allow_negative_numbers = true)]
     pub designs: usize,
@@ -253,6 +271,8 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         starts: a.starts,
         designs: a.designs,
         polish: a.polish,
+        ils: a.ils,
+        kick: a.kick,
         seed: a.seed,
         fixed,
         prior: prior.clone(),
@@ -323,6 +343,8 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
             "seed",
             "starts",
             "polish",
+            "ils",
+            "kick",
             "fixed",
         ] {
             d.extra.insert(k.into(), v[k].clone());
@@ -335,11 +357,16 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
             s += &super::existing_text(e);
         }
         s += &format!(
-            "{:?} ({:?} criterion, seed {}, {} start(s){}): {} poses in {:.3} s\nlog10 OI_D {:.4}{}  OI {:.6}\nposes: {}\n",
+            "{:?} ({:?} criterion, seed {}, {} start(s){}{}): {} poses in {:.3} s\nlog10 OI_D {:.4}{}  OI {:.6}\nposes: {}\n",
             report.algorithm,
             report.criterion,
             a.seed,
             a.starts,
+            if a.ils > 0 {
+                format!(", {} ILS rounds of {} kicks", a.ils, a.kick)
+            } else {
+                String::new()
+            },
             if a.polish { ", Fedorov polish" } else { "" },
             report.poses.len(),
             seconds,

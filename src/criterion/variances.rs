@@ -25,8 +25,9 @@ use crate::blocks::Blocks;
 use crate::linalg::log::ln_in_place;
 use crate::linalg::simd::clear_upper_simd_state;
 use crate::linalg::small::{
-    BlockScratch, det_i_plus3, exchange_in_factor, exchange_ln_det, exchange_out_ln_det,
-    ln_det_i_minus, ln_det_i_plus, packed_len, pk,
+    BlockScratch, FAST_EXCHANGE_PIVOT, det_i_plus3, exchange_in_factor, exchange_ln_det,
+    exchange_out_ln_det, ln_det_i_minus, ln_det_i_plus, packed_len, pk, removal_inverse_factor3,
+    variance_after_removal3,
 };
 
 /// Column `c` of a matrix with unit row stride, as a slice.
@@ -365,6 +366,69 @@ impl PoolVariances {
         MatRef::from_column_major_slice(&self.work[..rows * k], rows, k)
     }
 
+    /// [`exchange_gains`](Self::exchange_gains) for one out-pose of a point
+    /// pool whose removal is comfortably regular: each candidate's gain is
+    /// `loss + ln det(I + V_i + Z Zᵀ)`, `Z = W_i U`
+    /// ([`removal_inverse_factor3`]), the determinants of a chunk first and
+    /// their logarithms in one vectorised pass, as the add scan does. A
+    /// candidate whose determinant is not finite and positive falls back to
+    /// the general formula.
+    #[allow(clippy::too_many_arguments)]
+    fn exchange_gains_one_out3(
+        &mut self,
+        pool: &Blocks,
+        state: &InfoState,
+        out_pose: usize,
+        a: &Mat<f64>,
+        loss: f64,
+        u: &[f64; 9],
+        candidates: &[usize],
+        pivot_floor: f64,
+        out: &mut [f64],
+    ) {
+        full_product(pool.mat(), a.as_ref(), 3, &mut self.work);
+        let rows = self.n * 3;
+        let w = MatRef::from_column_major_slice(&self.work[..rows * 3], rows, 3);
+        let wcols: [&[f64]; 3] = [col(w, 0), col(w, 1), col(w, 2)];
+        let this = &*self;
+        let w_of = |i: usize| {
+            let mut wi = [0.0; 9];
+            for r in 0..3 {
+                for c in 0..3 {
+                    wi[r * 3 + c] = wcols[c][i * 3 + r];
+                }
+            }
+            wi
+        };
+        out.par_chunks_mut(SCAN_CHUNK)
+            .zip(candidates.par_chunks(SCAN_CHUNK))
+            .for_each(|(oc, cc)| {
+                for (o, &i) in oc.iter_mut().zip(cc) {
+                    *o = det_i_plus3(&variance_after_removal3(this.packed(i), &w_of(i), u));
+                }
+                ln_in_place(oc);
+                for (o, &i) in oc.iter_mut().zip(cc) {
+                    *o = if state.contains(i) {
+                        f64::NEG_INFINITY
+                    } else if o.is_finite() {
+                        loss + *o
+                    } else {
+                        let mut g = [0.0];
+                        exchange_row(
+                            3,
+                            this.packed(i),
+                            &[out_pose],
+                            |j| this.packed(j),
+                            |_, r, c| wcols[c][i * 3 + r],
+                            pivot_floor,
+                            &mut g,
+                        );
+                        g[0]
+                    };
+                }
+            });
+    }
+
     /// Exchange gains `ln det M' − ln det M` for removing design pose
     /// `outs[o]` and adding pool pose `candidates[c]`, written candidate-major:
     /// `out[c·|outs| + o]`. Computed from `V_in`, `V_out` and the cross terms
@@ -389,6 +453,24 @@ impl PoolVariances {
         let (t, p) = (self.t, self.p);
         let k = no * t;
         let a = out_projection(pool, state, outs);
+        if no == 1 && t == 3 {
+            if let Some((loss, u)) =
+                removal_inverse_factor3(self.packed(outs[0]), FAST_EXCHANGE_PIVOT)
+            {
+                self.exchange_gains_one_out3(
+                    pool,
+                    state,
+                    outs[0],
+                    &a,
+                    loss,
+                    &u,
+                    candidates,
+                    pivot_floor,
+                    out,
+                );
+                return;
+            }
+        }
         if no <= SMALL_OUTS {
             // Few out-poses (the paper's exchange step has one): one dense
             // product W = X·A (n·t × k, column-major), whose few columns a
@@ -601,6 +683,58 @@ mod tests {
                     match s.delta() {
                         Some(d) => assert!((d - e[ci * 2 + oi]).abs() < 1e-10),
                         None => assert_eq!(e[ci * 2 + oi], f64::NEG_INFINITY),
+                    }
+                }
+            }
+        }
+    }
+
+    /// The one-out scan of a point pool. Where the removal is regular it
+    /// goes through `(I − V_out)⁻¹` with no factorization per candidate;
+    /// checked against the state's own pricing of each exchange (a
+    /// factorization of the `2t×2t` exchange system per pair, no shared
+    /// formula) to 1e-10, the multi-out check's tolerance on gains of order
+    /// 1 (the fast route's own error is about `ε/FAST_EXCHANGE_PIVOT` ≈
+    /// 2e-12; a wrong term changes a gain by O(0.1)). On a square design
+    /// (exactly `p` rows) every removal alone is singular, so the scan must
+    /// take the general formula: checked against [`exchange_gain`] on the
+    /// same cross terms, which it must reproduce to rounding (1e-12).
+    #[test]
+    fn one_out_point_scan_matches_the_state_pricing() {
+        // p = 27 with 12 poses (regular removals), p = 9 with 3 (square).
+        for (p, n, fast) in [(27, 12, true), (9, 3, false)] {
+            let pool = random_pool(400, 3, p, 5);
+            let design: Vec<usize> = (0..n).map(|k| 7 * k + 3).collect();
+            let st = InfoState::new(&pool, &design, StateSettings::default()).unwrap();
+            let mut pv = PoolVariances::new(&pool, &st);
+            let cands: Vec<usize> = (0..400).collect();
+            for &o in st.design() {
+                assert_eq!(
+                    removal_inverse_factor3(pv.packed(o), FAST_EXCHANGE_PIVOT).is_some(),
+                    fast,
+                    "p = {p}: the removal of {o} is regular exactly on the 12-pose design"
+                );
+                let mut e = vec![0.0; cands.len()];
+                pv.exchange_gains(&pool, &st, &[o], &cands, st.pivot_floor(), &mut e);
+                let w = pv.cross_terms(&pool, &st, &[o]).to_owned();
+                for (&c, &g) in cands.iter().zip(&e) {
+                    if st.contains(c) {
+                        assert_eq!(g, f64::NEG_INFINITY);
+                        continue;
+                    }
+                    let want = if fast {
+                        st.price_exchange(&pool, o, c).unwrap().delta()
+                    } else {
+                        let wc = w.as_ref().subrows(c * 3, 3);
+                        exchange_gain(3, pv.packed(c), pv.packed(o), wc, st.pivot_floor()).ok()
+                    };
+                    let tol = if fast { 1e-10 } else { 1e-12 };
+                    match want {
+                        Some(d) => assert!(
+                            (d - g).abs() < tol * (1.0 + d.abs()),
+                            "p = {p}, out {o}, in {c}: {d} vs {g}"
+                        ),
+                        None => assert_eq!(g, f64::NEG_INFINITY, "p = {p}, out {o}, in {c}"),
                     }
                 }
             }

@@ -45,6 +45,10 @@ pub struct Selection {
 /// engine's update error is ~p·u·κ ≈ 1e-12 for well-conditioned designs).
 const TOL: f64 = 1e-10;
 
+/// Most sweeps of one modified-Fedorov climb (each sweep tries every design
+/// pose once; a climb from a kicked local optimum takes 2–4 on the PUMA).
+const MAX_SWEEPS: usize = 100;
+
 fn improves(new: f64, cur: f64) -> bool {
     new > cur + TOL * cur.abs().max(1.0)
 }
@@ -226,6 +230,88 @@ impl<'a, C: Criterion> Run<'a, C> {
         }
     }
 
+    /// Modified Fedorov exchange (Cook & Nachtsheim 1980): each removable
+    /// design pose in turn is exchanged for the pool pose that gives the best
+    /// score, at once if that improves it; sweeps until a whole sweep
+    /// improves nothing (or `max_sweeps`).
+    fn modified_fedorov_phase(&mut self, max_sweeps: usize) {
+        for _ in 0..max_sweeps {
+            let mut improved = false;
+            let outs: Vec<usize> = self
+                .state
+                .design()
+                .iter()
+                .copied()
+                .filter(|&j| !self.fixed[j])
+                .collect();
+            for out in outs {
+                let cur = self.score();
+                let Some((_, inn, new)) = self.best_exchange(&[out]) else {
+                    continue;
+                };
+                if improves(new, cur) && self.apply_exchange(out, inn) {
+                    improved = true;
+                }
+            }
+            if !improved {
+                return;
+            }
+        }
+    }
+
+    /// Iterated local search (Lourenço, Martin & Stützle 2003) from the
+    /// current design: [`modified_fedorov_phase`](Self::modified_fedorov_phase)
+    /// to a local optimum, then `rounds` times: exchange `kick` random
+    /// removable design poses for random pool poses outside the design
+    /// (drawn from `rng`), climb back with exchange steps and modified
+    /// Fedorov, and keep the result if it beats the best so far; otherwise
+    /// return to the best (state and trace). The kicks let the search leave
+    /// the local optima of single exchanges, where EAE and Fedorov stop.
+    fn iterated_phase(
+        &mut self,
+        rounds: usize,
+        kick: usize,
+        max_iter: usize,
+        rng: &mut ChaCha8Rng,
+    ) {
+        use rand::RngExt;
+        self.modified_fedorov_phase(MAX_SWEEPS);
+        let mut best = (self.state.clone(), self.trace.clone(), self.score());
+        let n_pool = self.pool.n_poses();
+        for _ in 0..rounds {
+            for _ in 0..kick {
+                let outs: Vec<usize> = self
+                    .state
+                    .design()
+                    .iter()
+                    .copied()
+                    .filter(|&j| !self.fixed[j])
+                    .collect();
+                if outs.is_empty() || self.state.design().len() >= n_pool {
+                    return;
+                }
+                let out = outs[rng.random_range(0..outs.len())];
+                let inn = loop {
+                    let c = rng.random_range(0..n_pool);
+                    if !self.state.contains(c) {
+                        break c;
+                    }
+                };
+                // A kick that would make the design singular is skipped.
+                self.apply_exchange(out, inn);
+            }
+            self.exchange_phase(max_iter);
+            self.modified_fedorov_phase(MAX_SWEEPS);
+            let score = self.score();
+            if improves(score, best.2) {
+                best = (self.state.clone(), self.trace.clone(), score);
+            } else {
+                self.state = best.0.clone();
+                self.trace = best.1.clone();
+            }
+        }
+    }
+
     /// Add steps (§IV, steps 4–5): add the best pose until the design has
     /// `n` poses or no addition increases the criterion.
     fn add_phase(&mut self, n: usize) {
@@ -322,7 +408,8 @@ fn start_design(pool: &Blocks, s: &Settings, size: usize, rng: &mut ChaCha8Rng) 
 }
 
 /// Runs `phases` on a state started from a random design of `size` poses
-/// (fixed ones included) and finishes it.
+/// (fixed ones included), then, with [`Settings::ils`] rounds, the iterated
+/// local search from its result, and finishes it.
 fn run_from_random<C: Criterion>(
     pool: &Blocks,
     crit: &mut C,
@@ -336,6 +423,9 @@ fn run_from_random<C: Criterion>(
     let init = start_design(pool, s, size, rng);
     let mut run = Run::new(pool, crit, &init, &s.fixed, s.prior.as_ref())?;
     phases(&mut run);
+    if s.ils > 0 {
+        run.iterated_phase(s.ils, s.kick, s.max_iter, rng);
+    }
     run.finish(algorithm)
 }
 

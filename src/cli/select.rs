@@ -3,16 +3,11 @@
 use super::{PoolOpts, emit_report, load_description, parse_list};
 use activecal::io::design::DesignFile;
 use activecal::report::{PoolInfo, ScoreReport, SelectReport};
-use activecal::select::{Algorithm, CriterionKind, Settings, select};
+use activecal::select::{Algorithm, CriterionKind, Settings, default_ils_rounds, select};
 use anyhow::{Result, bail};
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
-
-/// Default rounds of iterated local search per start (`--ils`): with the
-/// default two starts, a PUMA selection stays under a second on two cores
-/// (README, "Selection quality").
-const DEFAULT_ILS: usize = 12;
 
 /// Arguments of `score`.
 #[derive(Args)]
@@ -175,12 +170,14 @@ pub struct SelectArgs {
     /// Rounds of iterated local search per start after the algorithm: climb
     /// to a local optimum of single exchanges (modified Fedorov), then ILS
     /// times exchange --kick random design poses, climb again, keep the
-    /// better design. 0 runs the algorithm alone (the paper's EAE). With
-    /// the defaults the PUMA experiment reaches D-efficiency 0.984–0.987
-    /// (median 0.985 over 10 seeds) in under a second, where one EAE start
-    /// stops at 0.970–0.982.
-    #[arg(long, default_value_t = DEFAULT_ILS, allow_negative_numbers = true)]
-    pub ils: usize,
+    /// better design. 0 runs the algorithm alone (the paper's EAE).
+    /// [default: 12 on a 15,625-pose point pool, fewer on larger pools and
+    /// full poses, 0 from about 10⁵ point poses]. With the defaults the
+    /// PUMA experiment reaches D-efficiency 0.984–0.987 (median 0.985 over
+    /// 10 seeds) in under a second, where one EAE start stops at
+    /// 0.970–0.982.
+    #[arg(long, allow_negative_numbers = true)]
+    pub ils: Option<usize>,
     /// Design poses exchanged at random per round of --ils.
     #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
     pub kick: usize,
@@ -271,7 +268,9 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         starts: a.starts,
         designs: a.designs,
         polish: a.polish,
-        ils: a.ils,
+        ils: a
+            .ils
+            .unwrap_or_else(|| default_ils_rounds(ctx.x.n_poses(), ctx.x.t())),
         kick: a.kick,
         seed: a.seed,
         fixed,
@@ -362,8 +361,8 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
             report.criterion,
             a.seed,
             a.starts,
-            if a.ils > 0 {
-                format!(", {} ILS rounds of {} kicks", a.ils, a.kick)
+            if report.ils > 0 {
+                format!(", {} ILS rounds of {} kicks", report.ils, report.kick)
             } else {
                 String::new()
             },

@@ -26,8 +26,8 @@ use crate::linalg::log::ln_in_place;
 use crate::linalg::simd::clear_upper_simd_state;
 use crate::linalg::small::{
     BlockScratch, FAST_EXCHANGE_PIVOT, det_i_plus3, exchange_in_factor, exchange_ln_det,
-    exchange_out_ln_det, ln_det_i_minus, ln_det_i_plus, packed_len, pk, removal_inverse_factor3,
-    variance_after_removal3,
+    exchange_out_ln_det, ln_det_i_minus, ln_det_i_plus, packed_len, pk, removal_inverse_factor,
+    variance_after_removal, variance_after_removal3,
 };
 
 /// Column `c` of a matrix with unit row stride, as a slice.
@@ -374,61 +374,75 @@ impl PoolVariances {
     /// candidate whose determinant is not finite and positive falls back to
     /// the general formula.
     #[allow(clippy::too_many_arguments)]
-    fn exchange_gains_one_out3(
+    fn exchange_gains_one_out(
         &self,
         pool: &Blocks,
         state: &InfoState,
         out_pose: usize,
         a: &Mat<f64>,
         loss: f64,
-        u: &[f64; 9],
+        u: &[f64],
         candidates: &[usize],
         pivot_floor: f64,
         out: &mut [f64],
     ) {
-        let x = pool.mat();
+        let (x, t, tp) = (pool.mat(), self.t, packed_len(self.t));
         let this = &*self;
+        let u3: [f64; 9] = std::array::from_fn(|k| u.get(k).copied().unwrap_or(0.0));
         // The cross terms W = X·A are formed a chunk of candidates at a time
-        // into a per-task buffer (`3·len × 3`, column-major): no pool-sized
+        // into a per-task buffer (`t·len × t`, column-major): no pool-sized
         // workspace (72 MB at 10⁶ poses).
         out.par_chunks_mut(SCAN_CHUNK)
             .zip(candidates.par_chunks(SCAN_CHUNK))
             .for_each_init(
-                || vec![0.0; SCAN_CHUNK * 9],
-                |buf, (oc, cc)| {
+                || {
+                    (
+                        vec![0.0; SCAN_CHUNK * t * t],
+                        vec![0.0; t * t],
+                        vec![0.0; tp],
+                    )
+                },
+                |(buf, wi, vt), (oc, cc)| {
                     let len = cc.len();
                     let c0 = cc.first().copied().unwrap_or(0);
                     let mut wc =
-                        MatMut::from_column_major_slice_mut(&mut buf[..len * 9], len * 3, 3);
+                        MatMut::from_column_major_slice_mut(&mut buf[..len * t * t], len * t, t);
                     if cc.iter().zip(c0..).all(|(&i, k)| i == k) {
-                        let xc = x.subrows(c0 * 3, len * 3);
+                        let xc = x.subrows(c0 * t, len * t);
                         matmul(wc.rb_mut(), Accum::Replace, xc, a.as_ref(), 1.0, Par::Seq);
                         clear_upper_simd_state();
                     } else {
                         for (k, &i) in cc.iter().enumerate() {
-                            for r in 0..3 {
-                                for c in 0..3 {
+                            for r in 0..t {
+                                for c in 0..t {
                                     let mut acc = 0.0;
                                     for q in 0..x.ncols() {
-                                        acc += x[(i * 3 + r, q)] * a[(q, c)];
+                                        acc += x[(i * t + r, q)] * a[(q, c)];
                                     }
-                                    wc[(k * 3 + r, c)] = acc;
+                                    wc[(k * t + r, c)] = acc;
                                 }
                             }
                         }
                     }
                     let wc = wc.rb();
-                    let w_at = |k: usize, r: usize, c: usize| wc[(k * 3 + r, c)];
+                    let w_at = |k: usize, r: usize, c: usize| wc[(k * t + r, c)];
                     for (k, (o, &i)) in oc.iter_mut().zip(cc).enumerate() {
-                        let mut wi = [0.0; 9];
-                        for r in 0..3 {
-                            for c in 0..3 {
-                                wi[r * 3 + c] = w_at(k, r, c);
+                        for r in 0..t {
+                            for c in 0..t {
+                                wi[r * t + c] = w_at(k, r, c);
                             }
                         }
-                        *o = det_i_plus3(&variance_after_removal3(this.packed(i), &wi, u));
+                        *o = if t == 3 {
+                            let w3: [f64; 9] = std::array::from_fn(|q| wi[q]);
+                            det_i_plus3(&variance_after_removal3(this.packed(i), &w3, &u3))
+                        } else {
+                            variance_after_removal(this.packed(i), wi, u, t, vt);
+                            ln_det_i_plus(vt, t)
+                        };
                     }
-                    ln_in_place(oc);
+                    if t == 3 {
+                        ln_in_place(oc);
+                    }
                     for (k, (o, &i)) in oc.iter_mut().zip(cc).enumerate() {
                         *o = if state.contains(i) {
                             f64::NEG_INFINITY
@@ -437,7 +451,7 @@ impl PoolVariances {
                         } else {
                             let mut g = [0.0];
                             exchange_row(
-                                3,
+                                t,
                                 this.packed(i),
                                 &[out_pose],
                                 |j| this.packed(j),
@@ -476,23 +490,22 @@ impl PoolVariances {
         let (t, p) = (self.t, self.p);
         let k = no * t;
         let a = out_projection(pool, state, outs);
-        if no == 1 && t == 3 {
-            if let Some((loss, u)) =
-                removal_inverse_factor3(self.packed(outs[0]), FAST_EXCHANGE_PIVOT)
-            {
-                self.exchange_gains_one_out3(
-                    pool,
-                    state,
-                    outs[0],
-                    &a,
-                    loss,
-                    &u,
-                    candidates,
-                    pivot_floor,
-                    out,
-                );
-                return;
-            }
+        if no == 1
+            && let Some((loss, u)) =
+                removal_inverse_factor(self.packed(outs[0]), t, FAST_EXCHANGE_PIVOT)
+        {
+            self.exchange_gains_one_out(
+                pool,
+                state,
+                outs[0],
+                &a,
+                loss,
+                &u,
+                candidates,
+                pivot_floor,
+                out,
+            );
+            return;
         }
         if no <= SMALL_OUTS {
             // Few out-poses (the paper's exchange step has one): one dense
@@ -724,18 +737,19 @@ mod tests {
     /// same cross terms, which it must reproduce to rounding (1e-12).
     #[test]
     fn one_out_point_scan_matches_the_state_pricing() {
-        // p = 27 with 12 poses (regular removals), p = 9 with 3 (square).
-        for (p, n, fast) in [(27, 12, true), (9, 3, false)] {
-            let pool = random_pool(400, 3, p, 5);
+        // Points: p = 27 with 12 poses (regular removals), p = 9 with 3
+        // (square); full poses (t = 6, the general-t route): p = 30 with 8.
+        for (t, p, n, fast) in [(3, 27, 12, true), (3, 9, 3, false), (6, 30, 8, true)] {
+            let pool = random_pool(400, t, p, 5);
             let design: Vec<usize> = (0..n).map(|k| 7 * k + 3).collect();
             let st = InfoState::new(&pool, &design, StateSettings::default()).unwrap();
             let mut pv = PoolVariances::new(&pool, &st);
             let cands: Vec<usize> = (0..400).collect();
             for &o in st.design() {
                 assert_eq!(
-                    removal_inverse_factor3(pv.packed(o), FAST_EXCHANGE_PIVOT).is_some(),
+                    removal_inverse_factor(pv.packed(o), t, FAST_EXCHANGE_PIVOT).is_some(),
                     fast,
-                    "p = {p}: the removal of {o} is regular exactly on the 12-pose design"
+                    "t = {t}, p = {p}: the removal of {o} is regular exactly off the square design"
                 );
                 let mut e = vec![0.0; cands.len()];
                 pv.exchange_gains(&pool, &st, &[o], &cands, st.pivot_floor(), &mut e);
@@ -760,8 +774,8 @@ mod tests {
                     let want = if fast {
                         st.price_exchange(&pool, o, c).unwrap().delta()
                     } else {
-                        let wc = w.as_ref().subrows(c * 3, 3);
-                        exchange_gain(3, pv.packed(c), pv.packed(o), wc, st.pivot_floor()).ok()
+                        let wc = w.as_ref().subrows(c * t, t);
+                        exchange_gain(t, pv.packed(c), pv.packed(o), wc, st.pivot_floor()).ok()
                     };
                     let tol = if fast { 1e-10 } else { 1e-12 };
                     match want {

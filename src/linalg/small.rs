@@ -358,6 +358,65 @@ pub(crate) fn removal_inverse_factor3(v: &[f64], min_pivot: f64) -> Option<(f64,
     Some(((d0 * d1 * d2).ln(), u))
 }
 
+/// [`removal_inverse_factor3`] for any `t`: `ln det(I − V_out)` and
+/// `U = L⁻ᵀ` (row-major `t×t`, upper triangular), or `None` when a pivot
+/// of `I − V_out` is below `min_pivot`.
+pub(crate) fn removal_inverse_factor(
+    v: &[f64],
+    t: usize,
+    min_pivot: f64,
+) -> Option<(f64, Vec<f64>)> {
+    if t == 3 {
+        return removal_inverse_factor3(v, min_pivot).map(|(l, u)| (l, u.to_vec()));
+    }
+    let mut a = vec![0.0; t * t];
+    for r in 0..t {
+        for c in 0..=r {
+            a[r * t + c] = f64::from(u8::from(r == c)) - v[pk(r, c)];
+        }
+    }
+    let mut prod = 1.0;
+    chol_pivots_in_place(&mut a, t, min_pivot, |d| prod *= d).ok()?;
+    // L⁻¹ column by column (forward substitution), then U = L⁻ᵀ.
+    let mut u = vec![0.0; t * t];
+    for c in 0..t {
+        for r in c..t {
+            let mut s = f64::from(u8::from(r == c));
+            for k in c..r {
+                s -= a[r * t + k] * u[c * t + k];
+            }
+            // u[c][r] holds L⁻¹[r][c]: U = L⁻ᵀ directly.
+            u[c * t + r] = s / a[r * t + r];
+        }
+    }
+    prod.is_finite().then(|| (prod.ln(), u))
+}
+
+/// [`variance_after_removal3`] for any `t`: the packed `V_i + Z Zᵀ`,
+/// `Z = W U`, into `out` (`w`, `u` row-major `t×t`).
+pub(crate) fn variance_after_removal(v: &[f64], w: &[f64], u: &[f64], t: usize, out: &mut [f64]) {
+    let mut z_buf = BlockScratch::new(t * t);
+    let z: &mut [f64] = &mut z_buf;
+    for r in 0..t {
+        for c in 0..t {
+            let mut s = 0.0;
+            for k in 0..=c {
+                s += w[r * t + k] * u[k * t + c];
+            }
+            z[r * t + c] = s;
+        }
+    }
+    for r in 0..t {
+        for q in 0..=r {
+            let mut s = v[pk(r, q)];
+            for c in 0..t {
+                s += z[r * t + c] * z[q * t + c];
+            }
+            out[pk(r, q)] = s;
+        }
+    }
+}
+
 /// The packed `V_i + Z Zᵀ`, `Z = W U` (`w` row-major `3×3`, the cross block
 /// `X_i M⁻¹ X_outᵀ`; `u` from [`removal_inverse_factor3`]): the variance
 /// of candidate `i` once `out` is removed.

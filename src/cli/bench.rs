@@ -9,7 +9,9 @@ use activecal::criterion::{DCriterion, bench_scan};
 use activecal::identify::{LmSettings, identify, simulate, trial_rng};
 use activecal::model::Robot;
 use activecal::pool::Pool;
-use activecal::select::{Settings, design_rng, eae, polish};
+use activecal::select::{
+    Algorithm, CriterionKind, Settings, default_ils_rounds, design_rng, eae, polish, select,
+};
 use anyhow::Result;
 use clap::Args;
 use serde_json::{Value, json};
@@ -24,9 +26,72 @@ pub struct BenchArgs {
     /// Also run the 10⁶-pose scale test (10 levels per joint, N = 145).
     #[arg(long)]
     pub scale: bool,
+    /// Also compare the robots side by side: the certified bound, one EAE
+    /// start and the default selection (multi-start with iterated local
+    /// search) with its D-efficiency, and each robot's peak memory, on each
+    /// robot's 5-level lattice (PUMA, UR5 full pose, and the FIGAROH UR10
+    /// and example-robot-data Panda in full pose when run from the
+    /// repository, where their URDFs are).
+    #[arg(long)]
+    pub robots: bool,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
+}
+
+/// The robots of `bench --robots`: a label and a `--robot` value (with its
+/// chain fragment).
+const ROBOTS: [(&str, &str); 4] = [
+    ("PUMA 560, points", "puma560"),
+    ("UR5, full pose", "ur5:pose"),
+    (
+        "UR10 (FIGAROH), full pose",
+        "fixtures/figaroh/ur10_robot.urdf:pose#tip=wrist_3_link",
+    ),
+    (
+        "Panda, full pose",
+        "fixtures/example-robot-data/panda.urdf:pose#tip=panda_hand_tcp",
+    ),
+];
+
+/// Resets the process's peak resident memory (VmHWM) to its current size
+/// (`/proc/self/clear_refs`, Linux ≥ 4.0), so that [`peak_mib`] measures
+/// the next step alone; false where that is not possible.
+fn reset_peak() -> bool {
+    std::fs::write("/proc/self/clear_refs", "5").is_ok()
+}
+
+/// One row of `bench --robots`, as JSON.
+fn robot_row(label: &str, spec: &str) -> Result<Value> {
+    let robot = activecal::io::load_robot(spec)?;
+    robot.validate()?;
+    let reset = reset_peak();
+    let pool = Pool::full(&robot, 5)?;
+    let x = pool.jacobian(&robot, &robot.nominal);
+    let settings = BoundSettings::builder()
+        .solver(RelaxationSolver::Newton)
+        .build()?;
+    let s = Settings::default();
+    let b = relaxation_bound(&x, s.n, &settings)?;
+    let t0 = Instant::now();
+    let one = eae(&x, &mut DCriterion::new(), &s, &mut design_rng(1, 0))?;
+    let t_one = t0.elapsed().as_secs_f64();
+    let ds = Settings {
+        starts: 2,
+        ils: default_ils_rounds(x.n_poses(), x.t()),
+        ..Settings::default()
+    };
+    let t0 = Instant::now();
+    let best = select(&x, CriterionKind::Det, Algorithm::Eae, &ds)?;
+    let t_def = t0.elapsed().as_secs_f64();
+    let eff = |ln: f64| ((ln - b.ln_bound) / x.p() as f64).exp();
+    Ok(json!({
+        "robot": label, "spec": spec, "p": x.p(), "t": x.t(), "poses": x.n_poses(),
+        "bound_s": b.seconds, "bound_gap": b.certificate_gap, "bound_status": b.status,
+        "eae_s": t_one, "eae_d_efficiency": eff(one.ln_oid),
+        "select_s": t_def, "select_ils": ds.ils, "select_d_efficiency": eff(best.ln_oid),
+        "peak_mib": if reset { json!(peak_mib()) } else { Value::Null },
+    }))
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -231,6 +296,18 @@ pub fn cmd_bench(a: BenchArgs) -> Result<()> {
             "bound_status": bb.status, "peak_mib": peak_mib()});
     }
     v["peak_mib"] = json!(peak_mib());
+    let mut robot_rows = Vec::new();
+    if a.robots {
+        for (label, spec) in ROBOTS {
+            let file = spec.split([':', '#']).next().unwrap_or(spec);
+            if file.contains('/') && !std::path::Path::new(file).exists() {
+                eprintln!("bench: {label} skipped: {file} not found (run from the repository)");
+                continue;
+            }
+            robot_rows.push(robot_row(label, spec)?);
+        }
+        v["robots"] = Value::Array(robot_rows.clone());
+    }
     let table = rows.clone();
     v["table"] = Value::Array(
         rows.into_iter()
@@ -252,6 +329,38 @@ pub fn cmd_bench(a: BenchArgs) -> Result<()> {
             s += &format!("{n:<48} {ms:>12}  {note}\n");
         }
         s += &format!("peak memory: {:.0} MiB\n", peak_mib());
+        if !robot_rows.is_empty() {
+            s += "\nrobots side by side (5-level lattices, N = 30; one run each):\n";
+            s += &format!(
+                "{:<28} {:>3} {:>2} {:>7} {:>8} {:>8} {:>9} {:>10} {:>9} {:>8}\n",
+                "robot",
+                "p",
+                "t",
+                "poses",
+                "bound s",
+                "EAE s",
+                "EAE eff",
+                "select s",
+                "sel eff",
+                "peak MiB"
+            );
+            for r in &robot_rows {
+                s += &format!(
+                    "{:<28} {:>3} {:>2} {:>7} {:>8.2} {:>8.3} {:>9.4} {:>10.3} {:>9.4} {:>8.0}\n",
+                    r["robot"].as_str().unwrap_or(""),
+                    r["p"],
+                    r["t"],
+                    r["poses"],
+                    r["bound_s"].as_f64().unwrap_or(f64::NAN),
+                    r["eae_s"].as_f64().unwrap_or(f64::NAN),
+                    r["eae_d_efficiency"].as_f64().unwrap_or(f64::NAN),
+                    r["select_s"].as_f64().unwrap_or(f64::NAN),
+                    r["select_d_efficiency"].as_f64().unwrap_or(f64::NAN),
+                    r["peak_mib"].as_f64().unwrap_or(f64::NAN),
+                );
+            }
+            s += "(select: 2 starts with the default iterated local search; eff: D-efficiency against the certified bound)\n";
+        }
         s
     });
     Ok(())

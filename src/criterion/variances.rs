@@ -169,6 +169,22 @@ impl PoolVariances {
                 // over k for every pose.
                 for k in 0..p {
                     let (yk, xk) = (col(yc, k), col(xc, k));
+                    if t == 3 {
+                        // Points, unrolled (same sums, same order).
+                        for ((vi, y), x) in vc
+                            .chunks_exact_mut(6)
+                            .zip(yk.chunks_exact(3))
+                            .zip(xk.chunks_exact(3))
+                        {
+                            vi[0] += y[0] * x[0];
+                            vi[1] += y[1] * x[0];
+                            vi[2] += y[1] * x[1];
+                            vi[3] += y[2] * x[0];
+                            vi[4] += y[2] * x[1];
+                            vi[5] += y[2] * x[2];
+                        }
+                        continue;
+                    }
                     for (i, vi) in vc.chunks_mut(tp).enumerate() {
                         let (y, x) = (&yk[i * t..i * t + t], &xk[i * t..i * t + t]);
                         for a in 0..t {
@@ -196,6 +212,20 @@ impl PoolVariances {
             for c in 0..k {
                 let sign = if c < a { -1.0 } else { 1.0 };
                 let pcol = col(pc, c);
+                if t == 3 {
+                    // Points, unrolled: the same products and sums as the
+                    // general loop below, in the same order.
+                    for (vi, q) in vc.chunks_exact_mut(6).zip(pcol.chunks_exact(3)) {
+                        let (s0, s1, s2) = (sign * q[0], sign * q[1], sign * q[2]);
+                        vi[0] += s0 * q[0];
+                        vi[1] += s1 * q[0];
+                        vi[2] += s1 * q[1];
+                        vi[3] += s2 * q[0];
+                        vi[4] += s2 * q[1];
+                        vi[5] += s2 * q[2];
+                    }
+                    continue;
+                }
                 for (i, vi) in vc.chunks_mut(tp).enumerate() {
                     let q = &pcol[i * t..i * t + t];
                     for r in 0..t {
@@ -426,22 +456,36 @@ impl PoolVariances {
                     }
                     let wc = wc.rb();
                     let w_at = |k: usize, r: usize, c: usize| wc[(k * t + r, c)];
-                    for (k, (o, &i)) in oc.iter_mut().zip(cc).enumerate() {
-                        for r in 0..t {
-                            for c in 0..t {
-                                wi[r * t + c] = w_at(k, r, c);
-                            }
-                        }
-                        *o = if t == 3 {
-                            let w3: [f64; 9] = std::array::from_fn(|q| wi[q]);
-                            det_i_plus3(&variance_after_removal3(this.packed(i), &w3, &u3))
-                        } else {
-                            variance_after_removal(this.packed(i), wi, u, t, vt);
-                            ln_det_i_plus(vt, t)
-                        };
-                    }
                     if t == 3 {
+                        // Points: the three columns read as slices, the
+                        // block's determinant unrolled, one vectorised ln.
+                        let (w0, w1, w2) = (col(wc, 0), col(wc, 1), col(wc, 2));
+                        for (k, (o, &i)) in oc.iter_mut().zip(cc).enumerate() {
+                            let b = 3 * k;
+                            let w3 = [
+                                w0[b],
+                                w1[b],
+                                w2[b],
+                                w0[b + 1],
+                                w1[b + 1],
+                                w2[b + 1],
+                                w0[b + 2],
+                                w1[b + 2],
+                                w2[b + 2],
+                            ];
+                            *o = det_i_plus3(&variance_after_removal3(this.packed(i), &w3, &u3));
+                        }
                         ln_in_place(oc);
+                    } else {
+                        for (k, (o, &i)) in oc.iter_mut().zip(cc).enumerate() {
+                            for r in 0..t {
+                                for c in 0..t {
+                                    wi[r * t + c] = w_at(k, r, c);
+                                }
+                            }
+                            variance_after_removal(this.packed(i), wi, u, t, vt);
+                            *o = ln_det_i_plus(vt, t);
+                        }
                     }
                     for (k, (o, &i)) in oc.iter_mut().zip(cc).enumerate() {
                         *o = if state.contains(i) {

@@ -417,7 +417,7 @@ impl PoolVariances {
         out: &mut [f64],
     ) {
         let (x, t, tp) = (pool.mat(), self.t, packed_len(self.t));
-        let this = &*self;
+        let this = self;
         let u3: [f64; 9] = std::array::from_fn(|k| u.get(k).copied().unwrap_or(0.0));
         // The cross terms W = X·A are formed a chunk of candidates at a time
         // into a per-task buffer (`t·len × t`, column-major): no pool-sized

@@ -14,18 +14,19 @@
 
 /// `ln 2` split as fdlibm does: `LN2_HI` has its low 32 bits zero, so
 /// `k·LN2_HI` is exact for every exponent `k`.
-const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-1;
+const LN2_HI: f64 = f64::from_bits(0x3fe6_2e42_fee0_0000);
 /// The rest of `ln 2` below [`LN2_HI`].
-const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10;
-/// fdlibm's minimax coefficients of `R(z) = Lg1·z + … + Lg7·z⁷`.
+const LN2_LO: f64 = f64::from_bits(0x3dea_39ef_3579_3c76);
+/// fdlibm's minimax coefficients of `R(z) = Lg1·z + … + Lg7·z⁷`, as
+/// e_log.c gives them in hexadecimal.
 const LG: [f64; 7] = [
-    6.666_666_666_666_735_130e-1,
-    3.999_999_999_940_941_908e-1,
-    2.857_142_874_366_239_149e-1,
-    2.222_219_843_214_978_396e-1,
-    1.818_357_216_161_805_012e-1,
-    1.531_383_769_920_937_332e-1,
-    1.479_819_860_511_658_591e-1,
+    f64::from_bits(0x3fe5_5555_5555_5593), // 6.666666666666735130e-01
+    f64::from_bits(0x3fd9_9999_9997_fa04), // 3.999999999940941908e-01
+    f64::from_bits(0x3fd2_4924_9422_9359), // 2.857142874366239149e-01
+    f64::from_bits(0x3fcc_71c5_1d8e_78af), // 2.222219843214978396e-01
+    f64::from_bits(0x3fc7_4664_96cb_03de), // 1.818357216161805012e-01
+    f64::from_bits(0x3fc3_9a09_d078_c69f), // 1.531383769920937332e-01
+    f64::from_bits(0x3fc2_f112_df3e_5244), // 1.479819860511658591e-01
 ];
 
 /// `1.mantissa` at the high word 0x6147a: from here e_log.c's first form.
@@ -68,7 +69,7 @@ fn ln_normal(x: f64) -> f64 {
     let hfsq = 0.5 * f * f;
     let a = k * LN2_HI - ((hfsq - (s * (hfsq + r) + k * LN2_LO)) - f);
     let b = k * LN2_HI - ((s * (f - r) - k * LN2_LO) - f);
-    if mant >= FORM_LO && mant < FORM_HI {
+    if (FORM_LO..FORM_HI).contains(&mant) {
         a
     } else {
         b
@@ -78,7 +79,7 @@ fn ln_normal(x: f64) -> f64 {
 /// Whether `x` is in the fast path's domain: positive, normal and finite.
 #[inline(always)]
 fn is_fast_domain(x: f64) -> bool {
-    x >= f64::MIN_POSITIVE && x < f64::INFINITY
+    (f64::MIN_POSITIVE..f64::INFINITY).contains(&x)
 }
 
 /// Lanes handled per block: the domain check and the logarithm run over a

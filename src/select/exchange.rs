@@ -214,13 +214,7 @@ impl<'a, C: Criterion> Run<'a, C> {
     fn fedorov_phase(&mut self, max_iter: usize) {
         for _ in 0..max_iter {
             let cur = self.score();
-            let outs: Vec<usize> = self
-                .state
-                .design()
-                .iter()
-                .copied()
-                .filter(|&j| !self.fixed[j])
-                .collect();
+            let outs = self.removable();
             let Some((out, inn, new)) = self.best_exchange(&outs) else {
                 return;
             };
@@ -230,6 +224,16 @@ impl<'a, C: Criterion> Run<'a, C> {
         }
     }
 
+    /// The design poses a step may remove (all but the fixed ones).
+    fn removable(&self) -> Vec<usize> {
+        self.state
+            .design()
+            .iter()
+            .copied()
+            .filter(|&j| !self.fixed[j])
+            .collect()
+    }
+
     /// Modified Fedorov exchange (Cook & Nachtsheim 1980): each removable
     /// design pose in turn is exchanged for the pool pose that gives the best
     /// score, at once if that improves it; sweeps until a whole sweep
@@ -237,13 +241,7 @@ impl<'a, C: Criterion> Run<'a, C> {
     fn modified_fedorov_phase(&mut self, max_sweeps: usize) {
         for _ in 0..max_sweeps {
             let mut improved = false;
-            let outs: Vec<usize> = self
-                .state
-                .design()
-                .iter()
-                .copied()
-                .filter(|&j| !self.fixed[j])
-                .collect();
+            let outs = self.removable();
             for out in outs {
                 let cur = self.score();
                 let Some((_, inn, new)) = self.best_exchange(&[out]) else {
@@ -278,18 +276,12 @@ impl<'a, C: Criterion> Run<'a, C> {
         self.modified_fedorov_phase(MAX_SWEEPS);
         let mut best = (self.state.clone(), self.trace.clone(), self.score());
         let n_pool = self.pool.n_poses();
+        if self.removable().is_empty() || self.state.design().len() >= n_pool {
+            return; // nothing to kick out, or nothing to kick in
+        }
         for _ in 0..rounds {
             for _ in 0..kick {
-                let outs: Vec<usize> = self
-                    .state
-                    .design()
-                    .iter()
-                    .copied()
-                    .filter(|&j| !self.fixed[j])
-                    .collect();
-                if outs.is_empty() || self.state.design().len() >= n_pool {
-                    return;
-                }
+                let outs = self.removable();
                 let out = outs[rng.random_range(0..outs.len())];
                 let inn = loop {
                     let c = rng.random_range(0..n_pool);

@@ -188,7 +188,7 @@ impl PoolVariances {
                     for (i, vi) in vc.chunks_mut(tp).enumerate() {
                         let (y, x) = (&yk[i * t..i * t + t], &xk[i * t..i * t + t]);
                         for a in 0..t {
-                            for b in 0..=a {
+                            for b in 0..a + 1 {
                                 vi[pk(a, b)] += y[a] * x[b];
                             }
                         }
@@ -230,7 +230,7 @@ impl PoolVariances {
                     let q = &pcol[i * t..i * t + t];
                     for r in 0..t {
                         let sr = sign * q[r];
-                        for s in 0..=r {
+                        for s in 0..r + 1 {
                             vi[pk(r, s)] += sr * q[s];
                         }
                     }

@@ -39,6 +39,14 @@ fn col(m: MatRef<'_, f64>, c: usize) -> &[f64] {
         .as_slice()
 }
 
+/// The first pose of `cc` if `cc` is a run of consecutive poses (every scan
+/// without fixed poses: their blocks, and their rows of `X`, are one
+/// contiguous slice), `None` otherwise.
+fn run_start(cc: &[usize]) -> Option<usize> {
+    let c0 = *cc.first()?;
+    cc.iter().zip(c0..).all(|(&i, k)| i == k).then_some(c0)
+}
+
 /// Poses per parallel work item of the products `X·A` (a 256-pose chunk of
 /// a `p = 27`, `t = 3` pool times `M⁻¹` is ≈ 1 Mflop).
 pub(crate) const CHUNK: usize = 256;
@@ -332,10 +340,7 @@ impl PoolVariances {
             .zip(candidates.par_chunks(SCAN_CHUNK))
             .for_each(|(oc, cc)| {
                 if t == 3 {
-                    let c0 = cc.first().copied().unwrap_or(0);
-                    if cc.iter().zip(c0..).all(|(&i, k)| i == k) {
-                        // A run of consecutive poses (every scan without
-                        // fixed poses): the blocks are one contiguous slice.
+                    if let Some(c0) = run_start(cc) {
                         let v = &self.v[c0 * 6..(c0 + cc.len()) * 6];
                         for (o, b) in oc.iter_mut().zip(v.chunks_exact(6)) {
                             *o = det_i_plus3(b);
@@ -434,10 +439,9 @@ impl PoolVariances {
                 },
                 |(buf, wi, vt), (oc, cc)| {
                     let len = cc.len();
-                    let c0 = cc.first().copied().unwrap_or(0);
                     let mut wc =
                         MatMut::from_column_major_slice_mut(&mut buf[..len * t * t], len * t, t);
-                    if cc.iter().zip(c0..).all(|(&i, k)| i == k) {
+                    if let Some(c0) = run_start(cc) {
                         let xc = x.subrows(c0 * t, len * t);
                         matmul(wc.rb_mut(), Accum::Replace, xc, a.as_ref(), 1.0, Par::Seq);
                         clear_upper_simd_state();

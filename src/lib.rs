@@ -13,6 +13,7 @@ pub mod collision;
 pub mod criterion;
 pub mod error;
 pub mod experiment;
+pub mod frames;
 pub mod identify;
 pub mod io;
 pub mod kinematics;

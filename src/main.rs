@@ -38,6 +38,11 @@ struct Cli {
         allow_hyphen_values = true
     )]
     lock: Option<String>,
+    /// A frames file written by `calibrate --out cal.yaml`: mounts a .urdf
+    /// robot in its measurement frame with its tool or markers (and takes
+    /// its chain's base and tip unless --base/--tip are given).
+    #[arg(long, global = true, value_name = "FILE")]
+    frames: Option<std::path::PathBuf>,
     /// Show progress on stderr even with --json or when stderr is not a
     /// terminal (then as plain lines). Without it, progress is a bar on a
     /// terminal's stderr, and nothing with --json. Never on stdout.
@@ -105,7 +110,7 @@ fn main() {
         .and_then(|(_, m)| m.try_get_one::<bool>("json").ok().flatten().copied())
         .unwrap_or(false);
     cli::progress::install_for(cli.progress, json);
-    if let Err(e) = cli::set_chain_choice(cli.base, cli.tip, cli.lock.as_deref()) {
+    if let Err(e) = cli::set_chain_choice(cli.base, cli.tip, cli.lock.as_deref(), cli.frames) {
         eprintln!("error: {e:#}");
         std::process::exit(1);
     }

@@ -583,8 +583,10 @@ pub struct MeasuredCalibrationReport {
     pub rms_residual: f64,
     /// RMS weighted residual per row of the nominal model.
     pub initial_rms_residual: f64,
-    /// The calibrated description written, if any.
-    pub out: Option<String>,
+    /// The calibrated robot's files written (none when not asked or not
+    /// converged).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub out: Vec<String>,
     /// Wall-clock seconds.
     pub elapsed_seconds: f64,
 }
@@ -615,7 +617,7 @@ impl MeasuredCalibrationReport {
             change: named(&id.names, &change),
             rms_residual: (id.rss / rows).sqrt(),
             initial_rms_residual: (id.initial_rss / rows).sqrt(),
-            out: None,
+            out: Vec::new(),
             elapsed_seconds: 0.0,
         }
     }
@@ -664,6 +666,10 @@ pub struct SimulatedCalibrationReport {
     pub monte_carlo: Option<crate::identify::MonteCarloSummary>,
     /// Seconds of the Monte-Carlo.
     pub monte_carlo_seconds: Option<f64>,
+    /// The calibrated robot's measurement frame, tool and joint origins
+    /// (URDF robots).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub frames: Option<crate::frames::report::FramesReport>,
     /// Wall-clock seconds.
     pub elapsed_seconds: f64,
 }

@@ -10,7 +10,9 @@ use activecal::identify::{
     paper_tables,
 };
 use activecal::io::design::DesignFile;
-use activecal::io::robot_toml as file;
+use activecal::frames::CalibratedFrames;
+use activecal::frames::report::{FitBlock, FramesReport};
+use activecal::io::calibrated::Format;
 use activecal::model::Robot;
 use activecal::report::{IdentificationReport, SimulatedCalibrationReport};
 use anyhow::{Result, bail};
@@ -42,10 +44,14 @@ pub struct CalibrateArgs {
     /// file, in the format `--measurements` reads.
     #[arg(long)]
     pub save_measurements: Option<PathBuf>,
-    /// Write the calibrated robot as a description (TOML) whose nominal and
-    /// real tables are the estimate.
+    /// Write the calibrated robot, by extension (repeatable): .urdf — your
+    /// URDF with only the chain's joint origins changed (a built-in or TOML
+    /// robot: its chain as URDF); .yaml — the frames file (measurement
+    /// frame, tool or markers, joint origins with σ); .toml — activecal's
+    /// description whose tables are the estimate. Written only when the fit
+    /// converged.
     #[arg(long)]
-    pub out: Option<PathBuf>,
+    pub out: Vec<PathBuf>,
     /// Replace existing output files.
     #[arg(long)]
     pub force: bool,
@@ -105,49 +111,68 @@ pub struct CalibrateArgs {
     pub json: bool,
 }
 
-/// The robot calibrated by `id`, as a description: both tables are the
-/// estimate (the best knowledge of the real robot).
-fn calibrated_description(robot: &Robot, id: &Identification, source: &str) -> String {
-    let mut r = robot.clone();
-    r.nominal = id.table.clone();
-    r.real = id.table.clone();
-    let header = format!(
+/// The header of a calibrated TOML description.
+fn toml_header(id: &Identification, source: &str) -> String {
+    format!(
         "# Calibrated by activecal from {source}: nominal = real = the estimate\n# ({:?}, {} iterations, σ̂ = {}).\n",
         id.status,
         id.iterations,
         id.sigma_hat.map_or("-".into(), |v| format!("{v:.6e}"))
-    );
-    header + &file::to_toml(&r)
+    )
 }
 
-/// Writes the calibrated description to `--out` when identification
-/// converged; returns whether it wrote. A non-converged estimate is never
-/// written as a robot model (see [`refuse_unconverged`]).
+/// The calibrated frames of a URDF robot at the estimate (`None` for other
+/// robots), with σ from the fit's covariance.
+fn frames_of(
+    robot: &Robot,
+    id: &Identification,
+    fit: Option<FitBlock>,
+) -> Result<Option<(CalibratedFrames, FramesReport)>> {
+    let cov = id.covariance.as_ref().map(|c| c.matrix.as_slice());
+    Ok(activecal::frames::calibrated(robot, &id.table, cov, fit)?)
+}
+
+/// Writes the calibrated robot to every `--out` when identification
+/// converged (by extension, [`Format`]); returns the files written. A
+/// non-converged estimate is never written as a robot model (see
+/// [`refuse_unconverged`]).
 fn write_calibrated(
     a: &CalibrateArgs,
     robot: &Robot,
     id: &Identification,
     source: &str,
-) -> Result<bool> {
-    match &a.out {
-        Some(out) if id.converged() => {
-            write_new(out, &calibrated_description(robot, id, source), a.force)?;
-            Ok(true)
-        }
-        _ => Ok(false),
+    frames: Option<&(CalibratedFrames, FramesReport)>,
+) -> Result<Vec<String>> {
+    if !id.converged() {
+        return Ok(Vec::new());
     }
+    let mut written = Vec::new();
+    for out in &a.out {
+        let text = activecal::io::calibrated::render(
+            Format::of(out)?,
+            robot,
+            &id.table,
+            frames.map(|(f, r)| (f, r)),
+            &toml_header(id, source),
+        )
+        .map_err(|e| anyhow::anyhow!("--out {}: {e}", out.display()))?;
+        write_new(out, &text, a.force)?;
+        written.push(out.display().to_string());
+    }
+    Ok(written)
 }
 
 /// After the report is printed: an error (exit 1) when `--out` was asked for
 /// but the estimate did not converge, so that no script mistakes it for a
 /// calibrated model.
 fn refuse_unconverged(a: &CalibrateArgs, id: &Identification) -> Result<()> {
-    if let (Some(out), false) = (&a.out, id.converged()) {
+    if !a.out.is_empty() && !id.converged() {
+        let names: Vec<String> = a.out.iter().map(|p| p.display().to_string()).collect();
         bail!(
-            "identification ended {:?} ({:?}): {} was not written",
+            "identification ended {:?} ({:?}): {} not written",
             id.status,
             id.stop,
-            out.display()
+            names.join(", ")
         );
     }
     Ok(())
@@ -166,13 +191,15 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
             "--validation 0: the validation RMS needs at least 1 held-out pose (the RMS error of no poses would read 0)"
         );
     }
-    let outputs: Vec<(&str, &std::path::Path)> = [
-        ("--out", a.out.as_deref()),
-        ("--save-measurements", a.save_measurements.as_deref()),
-    ]
-    .into_iter()
-    .filter_map(|(o, p)| p.map(|p| (o, p)))
-    .collect();
+    for out in &a.out {
+        Format::of(out).map_err(|e| anyhow::anyhow!("--out {e}"))?;
+    }
+    let outputs: Vec<(&str, &std::path::Path)> = a
+        .out
+        .iter()
+        .map(|p| ("--out", p.as_path()))
+        .chain(a.save_measurements.as_deref().map(|p| ("--save-measurements", p)))
+        .collect();
     let robot_path = std::path::Path::new(a.robot.trim_end_matches(":pose"));
     let inputs: Vec<&std::path::Path> = [
         a.design.as_deref(),
@@ -216,16 +243,18 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     let (fitted, f, mut report) =
         super::measured::calibrate_measured(robot, path, &o, &|| t0.elapsed().as_secs_f64())?;
     let id = &f.id;
-    let written = write_calibrated(a, &fitted, id, &path.display().to_string())?;
-    report.base.out = a
-        .out
-        .as_ref()
-        .filter(|_| written)
-        .map(|p| p.display().to_string());
+    let fit = FitBlock {
+        poses: report.base.poses,
+        position_rms_mm: report.residuals.position_rms_mm,
+        orientation_rms_deg: report.residuals.orientation_rms_deg,
+    };
+    let frames = frames_of(&fitted, id, Some(fit))?;
+    report.frames = frames.as_ref().map(|(_, r)| r.clone());
+    report.base.out = write_calibrated(a, &fitted, id, &path.display().to_string(), frames.as_ref())?;
     super::emit_report(a.json, &report, || {
         let mut s = super::measured::measured_text(&report, id, &status_text(id));
-        if let Some(out) = a.out.as_ref().filter(|_| written) {
-            s += &format!("\ncalibrated robot written to {}\n", out.display());
+        for out in &report.base.out {
+            s += &format!("\ncalibrated robot written to {out}\n");
         }
         s
     })?;
@@ -305,7 +334,8 @@ fn from_design(
         write_new(path, &text, a.force)?;
     }
     let source = format!("simulated measurements at {}", design_path.display());
-    write_calibrated(a, robot, id, &source)?;
+    let frames = frames_of(robot, id, None)?;
+    write_calibrated(a, robot, id, &source, frames.as_ref())?;
     let truth = robot.unknown_values(&robot.real);
     let residual: Vec<f64> = truth.iter().zip(&id.estimate).map(|(t, e)| t - e).collect();
     let before = validation.rms(robot, &robot.nominal);
@@ -351,6 +381,7 @@ fn from_design(
         validation_orientation_rms_after: rot_after,
         monte_carlo_seconds: mc.as_ref().map(|_| mc_seconds),
         monte_carlo: mc.clone(),
+        frames: frames.map(|(_, r)| r),
         elapsed_seconds: t0.elapsed().as_secs_f64(),
     };
     let v = serde_json::to_value(&report)?;
@@ -390,6 +421,9 @@ fn from_design(
         }
         if let Some(mc) = &mc {
             s += &mc_text(mc, mc_seconds);
+        }
+        if let Some(f) = &report.frames {
+            s += &super::frames_text::frames_text(f);
         }
         s
     });

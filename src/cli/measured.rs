@@ -60,12 +60,22 @@ pub fn read_measurements(
     quiet: bool,
 ) -> Result<(Measurements, Vec<String>)> {
     let f = activecal::io::measurements::read(path, robot)?;
+    let mut notes = f.notes;
+    let (meas, repeats) = f.measurements.without_repeated_markers();
+    for (copy, of) in repeats {
+        notes.push(format!(
+            "marker {} repeats marker {} in every row: counted once ({} markers per pose)",
+            copy + 1,
+            of + 1,
+            meas.markers()
+        ));
+    }
     if !quiet {
-        for n in &f.notes {
+        for n in &notes {
             eprintln!("note: {n}");
         }
     }
-    Ok((f.measurements, f.notes))
+    Ok((meas, notes))
 }
 
 /// What `calibrate --measurements` does beyond the plain fit.
@@ -105,6 +115,10 @@ pub struct MeasuredReport {
     pub holdout: Option<HoldoutReport>,
     /// What was adapted to the data (sensor, markers, ignored columns).
     pub notes: Vec<String>,
+    /// The calibrated robot's measurement frame, tool or markers and joint
+    /// origins (URDF robots).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub frames: Option<activecal::frames::report::FramesReport>,
 }
 
 /// Held-out figures over splits.
@@ -195,6 +209,38 @@ fn holdout_report(settings: HoldoutSettings, splits: Vec<SplitResult>) -> Holdou
     }
 }
 
+/// How much better the rigid fit of the nominal points must fit the data
+/// than the nominal model does before identification starts from it: a
+/// tracker metres away or turned tens of degrees (a start LM does not
+/// converge from) gains orders of magnitude; a measurement frame already
+/// near the base, or markers far from the tip, gain less than this.
+const MOUNT_GAIN: f64 = 10.0;
+
+/// A URDF robot mounted in the data's frame when the nominal model is far
+/// from it ([`activecal::frames::align`]), with a note saying so.
+fn mounted_start(robot: &Robot, meas: &Measurements) -> Result<Option<(Robot, String)>> {
+    let Some(src) = robot.source.as_ref() else {
+        return Ok(None);
+    };
+    let Some(a) = activecal::frames::align::measurement_frame(robot, meas) else {
+        return Ok(None);
+    };
+    if !(a.rms_after * MOUNT_GAIN < a.rms_before) {
+        return Ok(None);
+    }
+    let mount = a.motion * src.mount;
+    let r = activecal::io::urdf::remount(robot, mount, src.tool * a.tool)?;
+    let t = mount.translation.vector;
+    let note = format!(
+        "the data are far from the nominal model (RMS {:.1} mm): identification starts from the measurement frame that fits them best (RMS {:.1} mm), {:.3} m away and turned {:.1}°",
+        a.rms_before * 1e3,
+        a.rms_after * 1e3,
+        t.norm(),
+        mount.rotation.angle().to_degrees()
+    );
+    Ok(Some((r, note)))
+}
+
 /// Identification from a measurement file; returns the fit (for `--out`)
 /// and the robot it was fitted as.
 pub fn calibrate_measured(
@@ -204,6 +250,17 @@ pub fn calibrate_measured(
     elapsed: &dyn Fn() -> f64,
 ) -> Result<(Robot, Fit, MeasuredReport)> {
     let (meas, mut notes) = read_measurements(path, robot, o.json)?;
+    let mounted = mounted_start(robot, &meas)?;
+    let robot = match &mounted {
+        Some((r, note)) => {
+            if !o.json {
+                eprintln!("note: {note}");
+            }
+            notes.push(note.clone());
+            r
+        }
+        None => robot,
+    };
     let start = for_measurements(robot, &meas, &o.lm)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     notes.extend(start.notes.iter().cloned());
@@ -245,6 +302,7 @@ pub fn calibrate_measured(
         downweighted: f.downweighted(),
         holdout: ho,
         notes,
+        frames: None,
     };
     Ok((r, f, report))
 }
@@ -283,6 +341,9 @@ pub fn measured_text(r: &MeasuredReport, id: &Identification, status: &str) -> S
             p.t.map_or("-".into(), |v| format!("{v:.2}")),
             p.verdict
         );
+    }
+    if let Some(f) = &r.frames {
+        s += &super::frames_text::frames_text(f);
     }
     if let Some(h) = &r.holdout {
         s += &format!(

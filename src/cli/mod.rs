@@ -5,6 +5,7 @@ pub mod bench;
 pub mod bound;
 pub mod calibrate;
 pub mod figures;
+pub mod frames_text;
 pub mod measured;
 pub mod progress;
 pub mod reproduce;
@@ -51,12 +52,23 @@ pub fn set_chain_choice(
     base: Option<String>,
     tip: Option<String>,
     lock: Option<&str>,
+    frames: Option<std::path::PathBuf>,
 ) -> Result<()> {
     let lock = match lock {
         Some(l) => activecal::io::ChainChoice::parse_lock(l)?,
         None => Vec::new(),
     };
-    let _ = CHAIN.set(activecal::io::ChainChoice { base, tip, lock });
+    if let Some(f) = &frames
+        && !f.is_file()
+    {
+        anyhow::bail!("--frames {}: no such file", f.display());
+    }
+    let _ = CHAIN.set(activecal::io::ChainChoice {
+        base,
+        tip,
+        lock,
+        frames: frames.map(|f| f.display().to_string()),
+    });
     Ok(())
 }
 

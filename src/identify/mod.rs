@@ -279,6 +279,47 @@ impl Measurements {
         }
     }
 
+    /// The markers that repeat an earlier marker in every pose (the same
+    /// coordinates to 1e-12 relative: an exporter's copy, not a second
+    /// marker), as `(duplicate, original)` pairs of 0-based marker numbers,
+    /// and the measurements with each counted once. Two copies of one
+    /// marker are one measurement: fitted as two, they would halve its
+    /// noise and give the copy an offset of its own.
+    #[must_use]
+    pub fn without_repeated_markers(&self) -> (Self, Vec<(usize, usize)>) {
+        let k = self.markers;
+        let same = |a: &[f64; 3], b: &[f64; 3]| {
+            a.iter()
+                .zip(b)
+                .all(|(x, y)| (x - y).abs() <= 1e-12 * (1.0 + x.abs().max(y.abs())))
+        };
+        let mut repeats = Vec::new();
+        for b in 1..k {
+            if let Some(a) = (0..b).find(|&a| {
+                !repeats.iter().any(|&(d, _)| d == a)
+                    && self
+                        .points
+                        .chunks_exact(k)
+                        .all(|pose| same(&pose[a], &pose[b]))
+            }) {
+                repeats.push((b, a));
+            }
+        }
+        if repeats.is_empty() || self.points.is_empty() {
+            return (self.clone(), Vec::new());
+        }
+        let keep: Vec<usize> = (0..k).filter(|m| !repeats.iter().any(|&(d, _)| d == *m)).collect();
+        let points = self
+            .points
+            .chunks_exact(k)
+            .flat_map(|pose| keep.iter().map(|&m| pose[m]).collect::<Vec<_>>())
+            .collect();
+        let mut out = self.clone();
+        out.markers = keep.len();
+        out.points = points;
+        (out, repeats)
+    }
+
     /// Markers (points) per pose.
     #[must_use]
     pub fn markers(&self) -> usize {

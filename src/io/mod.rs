@@ -3,11 +3,14 @@
 //! model never imports them.
 
 pub mod atomic;
+pub mod calibrated;
 pub mod design;
+pub mod frames_file;
 pub mod measurements;
 pub mod robot_toml;
 pub mod table;
 pub mod urdf;
+pub mod urdf_edit;
 
 use crate::error::{Error, Result};
 use crate::measure::Visibility;
@@ -54,13 +57,16 @@ pub struct ChainChoice {
     pub tip: Option<String>,
     /// Joints made fixed at a value.
     pub lock: Vec<(String, f64)>,
+    /// A frames file ([`frames_file`]): the measurement frame and tool (or
+    /// markers) to mount the chain with.
+    pub frames: Option<String>,
 }
 
 impl ChainChoice {
     /// Whether nothing is chosen.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.base.is_none() && self.tip.is_none() && self.lock.is_empty()
+        self.base.is_none() && self.tip.is_none() && self.lock.is_empty() && self.frames.is_none()
     }
 
     /// The `#…` fragment of a robot name (empty when nothing is chosen).
@@ -76,6 +82,9 @@ impl ChainChoice {
         if !self.lock.is_empty() {
             let l: Vec<String> = self.lock.iter().map(|(n, v)| format!("{n}:{v}")).collect();
             parts.push(format!("lock={}", l.join(",")));
+        }
+        if let Some(f) = &self.frames {
+            parts.push(format!("frames={f}"));
         }
         if parts.is_empty() {
             String::new()
@@ -118,9 +127,10 @@ impl ChainChoice {
                 Some(("base", v)) => c.base = Some(v.to_string()),
                 Some(("tip", v)) => c.tip = Some(v.to_string()),
                 Some(("lock", v)) => c.lock = ChainChoice::parse_lock(v)?,
+                Some(("frames", v)) => c.frames = Some(v.to_string()),
                 _ => {
                     return Err(Error::Invalid(format!(
-                        "robot name: unknown chain choice '{part}' after '#' (expected base=LINK, tip=LINK or lock=JOINT:VALUE,…)"
+                        "robot name: unknown chain choice '{part}' after '#' (expected base=LINK, tip=LINK, lock=JOINT:VALUE,… or frames=FILE)"
                     )));
                 }
             }
@@ -189,6 +199,45 @@ pub fn load_description(name_or_path: &str) -> Result<Description> {
     Ok(d)
 }
 
+/// A URDF robot with the chain options, mounted with the frames file's
+/// measurement frame and tool (whose chain, if it names one, is the default
+/// base and tip); two or more markers in the frames file make a marker
+/// robot.
+fn load_urdf(path: &Path, chain: &ChainChoice, pose: bool) -> Result<Robot> {
+    let frames = chain
+        .frames
+        .as_ref()
+        .map(|f| frames_file::read(Path::new(f)))
+        .transpose()?;
+    let mut opts = urdf::UrdfOptions {
+        measurement: if pose {
+            MeasurementKind::Pose
+        } else {
+            MeasurementKind::Point
+        },
+        base: chain.base.clone(),
+        tip: chain.tip.clone(),
+        lock: chain.lock.clone(),
+        ..urdf::UrdfOptions::default()
+    };
+    if let Some(f) = &frames {
+        opts.base = opts.base.or_else(|| f.base.clone());
+        opts.tip = opts.tip.or_else(|| f.tip.clone());
+        opts.mount = f.mount;
+        opts.tool = f.tool;
+    }
+    let robot = urdf::load(path, &opts)?;
+    match frames {
+        Some(f) if !f.markers.is_empty() => {
+            let source = robot.source.clone();
+            let mut r = robot.with_markers(&f.markers)?;
+            r.source = source;
+            Ok(r)
+        }
+        _ => Ok(robot),
+    }
+}
+
 fn load_head(name_or_path: &str, chain: &ChainChoice) -> Result<Description> {
     if let Ok(robot) = Robot::builtin(name_or_path) {
         if !chain.is_empty() {
@@ -212,7 +261,7 @@ fn load_head(name_or_path: &str, chain: &ChainChoice) -> Result<Description> {
         .map(str::to_ascii_lowercase);
     if !chain.is_empty() && ext.as_deref() != Some("urdf") {
         return Err(Error::Invalid(format!(
-            "{name_or_path}: --base, --tip and --lock choose the chain of a .urdf file (in a description, use its `base`, `tip` and [lock] keys)"
+            "{name_or_path}: --base, --tip, --lock and --frames apply to a .urdf file (in a description, use its `base`, `tip` and [lock] keys)"
         )));
     }
     let d = match ext.as_deref() {
@@ -224,20 +273,7 @@ fn load_head(name_or_path: &str, chain: &ChainChoice) -> Result<Description> {
             d
         }
         Some("urdf") => Description {
-            robot: urdf::load(
-                path,
-                &urdf::UrdfOptions {
-                    measurement: if pose {
-                        MeasurementKind::Pose
-                    } else {
-                        MeasurementKind::Point
-                    },
-                    base: chain.base.clone(),
-                    tip: chain.tip.clone(),
-                    lock: chain.lock.clone(),
-                    ..urdf::UrdfOptions::default()
-                },
-            )?,
+            robot: load_urdf(path, chain, pose)?,
             visibility: None,
         },
         _ if path.exists() => {

@@ -412,6 +412,7 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
         limits,
         measurement,
         orientation_scale,
+        source: None,
     };
     if let Some((nominal, real)) = markers {
         robot.nominal.markers = nominal;

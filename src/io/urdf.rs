@@ -61,6 +61,7 @@
 use crate::error::{Compact, Error, Result};
 use crate::kinematics::joint_chain;
 use crate::model::catalogue::perturbed;
+use crate::model::source::{SourceJoint, UrdfSource};
 use crate::model::{
     Convention, Frame, JointKind, MeasurementKind, ParamId, ParamTable, Robot, frame_transform,
 };
@@ -100,6 +101,13 @@ pub struct UrdfOptions {
     /// Angle in radians below which consecutive axes are nearly parallel
     /// (Hayati frame). Default [`PARALLEL_THRESHOLD`].
     pub parallel_threshold: f64,
+    /// The measurement frame to mount the chain in: measurement frame → base
+    /// link (identity: the base link is the measurement frame). A frames
+    /// file's `measurement_frame`.
+    pub mount: Isometry3<f64>,
+    /// The tool: tip link → measured frame (identity: the tip link's origin
+    /// and axes are measured). A frames file's `tool`.
+    pub tool: Isometry3<f64>,
     /// Make the real table the nominal one plus the built-in arms'
     /// deterministic perturbation of every unknown (default true); if false
     /// the real robot is the URDF.
@@ -114,6 +122,8 @@ impl Default for UrdfOptions {
             lock: Vec::new(),
             measurement: MeasurementKind::Point,
             parallel_threshold: PARALLEL_THRESHOLD,
+            mount: Isometry3::identity(),
+            tool: Isometry3::identity(),
             perturb_real: true,
         }
     }
@@ -205,7 +215,40 @@ pub fn parse(text: &str, origin: &str, opts: &UrdfOptions) -> Result<Robot> {
     }
     robot.validate().map_err(|e| bad(e.to_string()))?;
     robot.check_identifiable().map_err(|e| bad(e.to_string()))?;
+    robot.source = Some(std::sync::Arc::new(source_of(&urdf, &chain, text, origin, opts)));
     Ok(robot)
+}
+
+/// The chain as the file gives it, kept beside the model.
+fn source_of(
+    urdf: &urdf_rs::Robot,
+    chain: &[ChainJoint],
+    text: &str,
+    origin: &str,
+    opts: &UrdfOptions,
+) -> UrdfSource {
+    let link = |name: &str, parent: bool| {
+        urdf.joints
+            .iter()
+            .find(|u| u.name == name)
+            .map(|u| {
+                if parent {
+                    u.parent.link.clone()
+                } else {
+                    u.child.link.clone()
+                }
+            })
+            .unwrap_or_default()
+    };
+    UrdfSource {
+        path: origin.to_string(),
+        text: text.to_string(),
+        base: chain.first().map_or_else(String::new, |j| link(&j.name, true)),
+        tip: chain.last().map_or_else(String::new, |j| link(&j.name, false)),
+        joints: chain.iter().map(|j| j.source.clone()).collect(),
+        mount: opts.mount,
+        tool: opts.tool,
+    }
 }
 
 /// The kinematic part of a URDF document, as text: the `<robot>` element
@@ -245,6 +288,8 @@ struct ChainJoint {
     /// Unit axis in the joint frame.
     axis: Vector3<f64>,
     limits: [f64; 2],
+    /// The joint as the file gives it (origin and axis unfolded).
+    source: SourceJoint,
 }
 
 fn iso_from_pose(p: &urdf_rs::Pose) -> Option<Isometry3<f64>> {
@@ -528,6 +573,16 @@ fn extract_chain(
                 origin,
                 axis: Vector3::z(),
                 limits: [0.0; 2],
+                source: SourceJoint {
+                    name: j.name.clone(),
+                    kind: Some(match j.joint_type {
+                        T::Prismatic => JointKind::Prismatic,
+                        _ => JointKind::Revolute,
+                    }),
+                    origin: iso_from_pose(&j.origin).unwrap_or(origin),
+                    axis: u.into_inner(),
+                    locked: Some(v),
+                },
             });
             continue;
         }
@@ -599,6 +654,13 @@ fn extract_chain(
             origin,
             axis,
             limits,
+            source: SourceJoint {
+                name: j.name.clone(),
+                kind,
+                origin,
+                axis,
+                locked: None,
+            },
         });
     }
     if out.iter().all(|j| j.kind.is_none()) {
@@ -707,8 +769,8 @@ fn label_for(name: &str, k: usize, used: &[String]) -> String {
 /// empty: the caller fills them).
 fn convert(chain: &[ChainJoint], name: &str, opts: &UrdfOptions) -> Robot {
     let thr = opts.parallel_threshold;
-    // Axis lines and the tip at q = 0, in the root frame.
-    let mut t = Isometry3::identity();
+    // Axis lines and the tip at q = 0, in the measurement frame.
+    let mut t = opts.mount;
     let mut lines = Vec::new();
     for j in chain {
         t *= j.origin;
@@ -716,7 +778,7 @@ fn convert(chain: &[ChainJoint], name: &str, opts: &UrdfOptions) -> Robot {
             lines.push((t.translation.vector, t.rotation * j.axis, kind, j));
         }
     }
-    let tip = t;
+    let tip = t * opts.tool;
     let mut frames: Vec<Frame> = Vec::new();
     let mut rows: Vec<[f64; 5]> = Vec::new();
     let mut limits = Vec::new();
@@ -772,24 +834,11 @@ fn convert(chain: &[ChainJoint], name: &str, opts: &UrdfOptions) -> Robot {
         limits,
         measurement: opts.measurement,
         orientation_scale: crate::model::DEFAULT_ORIENTATION_SCALE,
+        source: None,
     }
 }
 
-/// URDF `rpy` (fixed-axis roll, pitch, yaw: `R = Rz(yaw) Ry(pitch) Rx(roll)`)
-/// of a rotation. Yaw comes first from `atan2(R10, R00)` (any value will do
-/// at gimbal lock, where it is ill-determined), then pitch and roll from
-/// `Rz(−yaw) R = Ry(pitch) Rx(roll)`, whose entries are all of order 1, so
-/// the angles rebuild the rotation to rounding everywhere, gimbal lock
-/// included.
-#[must_use]
-pub fn rpy(r: &Rotation3<f64>) -> [f64; 3] {
-    let m = r.matrix();
-    let yaw = m[(1, 0)].atan2(m[(0, 0)]);
-    let (sy, cy) = yaw.sin_cos();
-    let pitch = (-m[(2, 0)]).atan2(cy * m[(0, 0)] + sy * m[(1, 0)]);
-    let roll = (sy * m[(0, 2)] - cy * m[(1, 2)]).atan2(cy * m[(1, 1)] - sy * m[(0, 1)]);
-    [roll, pitch, yaw]
-}
+pub use crate::model::source::rpy;
 
 /// Writes the robot with parameter table `table` as URDF: root link
 /// `measurement`, links `link1…linkN`, joints `q1…qN` (revolute or prismatic
@@ -869,4 +918,44 @@ fn xml_escape(s: &str) -> String {
         .replace('<', "&lt;")
         .replace('>', "&gt;")
         .replace('"', "&quot;")
+}
+
+/// `robot` (imported from a URDF) imported again from the same text and
+/// chain, mounted with measurement frame `mount` and tool `tool`: its
+/// frames, tables and unknowns follow the new mount; its name, sensor and
+/// marker offsets are kept. Errors for a robot without a URDF source.
+pub fn remount(robot: &Robot, mount: Isometry3<f64>, tool: Isometry3<f64>) -> Result<Robot> {
+    let src = robot.source.as_ref().ok_or_else(|| {
+        Error::Invalid(format!(
+            "robot '{}' was not imported from a URDF: it cannot be mounted in another frame",
+            robot.name
+        ))
+    })?;
+    let lock = src
+        .joints
+        .iter()
+        .filter_map(|j| j.locked.map(|v| (j.name.clone(), v)))
+        .collect();
+    let kind = match robot.measurement {
+        MeasurementKind::Markers(_) => MeasurementKind::Point,
+        k => k,
+    };
+    let opts = UrdfOptions {
+        base: Some(src.base.clone()),
+        tip: Some(src.tip.clone()),
+        lock,
+        measurement: kind,
+        mount,
+        tool,
+        ..UrdfOptions::default()
+    };
+    let mut r = parse(&src.text, &src.path, &opts)?;
+    r.name = robot.name.clone();
+    r.orientation_scale = robot.orientation_scale;
+    if let MeasurementKind::Markers(_) = robot.measurement {
+        let source = r.source.clone();
+        r = r.with_markers(&robot.nominal.markers)?;
+        r.source = source;
+    }
+    Ok(r)
 }

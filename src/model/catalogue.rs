@@ -91,6 +91,7 @@ fn assemble(
         limits,
         measurement: m,
         orientation_scale: super::DEFAULT_ORIENTATION_SCALE,
+        source: None,
     };
     debug_assert!(r.validate().is_ok());
     r

@@ -17,6 +17,7 @@
 
 pub mod catalogue;
 pub mod frame;
+pub mod source;
 
 pub use frame::{FrameMotion, frame_transform};
 
@@ -287,6 +288,10 @@ pub struct Robot {
     /// the same noise σ_position and `XᵀX` is the Fisher information up to
     /// `σ²`. Default [`DEFAULT_ORIENTATION_SCALE`]; unused for points.
     pub orientation_scale: f64,
+    /// The URDF the chain was imported from, when it was (see
+    /// [`source::UrdfSource`]): what writing a calibrated URDF back needs.
+    #[serde(skip)]
+    pub source: Option<std::sync::Arc<source::UrdfSource>>,
 }
 
 /// Default [`Robot::orientation_scale`]: 1 m/rad, i.e. an orientation noise
@@ -410,6 +415,7 @@ impl Robot {
             limits,
             measurement: MeasurementKind::Point,
             orientation_scale: DEFAULT_ORIENTATION_SCALE,
+        source: None,
         }
     }
 

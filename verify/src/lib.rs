@@ -143,6 +143,7 @@ pub fn synthetic_robot() -> Robot {
         ],
         measurement: MeasurementKind::Point,
         orientation_scale: activecal::model::DEFAULT_ORIENTATION_SCALE,
+        source: None,
     };
     robot.validate().expect("synthetic robot is valid");
     robot

@@ -1,0 +1,286 @@
+//! The calibrated frames as a report: what `calibrate` prints and what the
+//! frames file (`cal.yaml`) holds. Units: metres and radians for values,
+//! millimetres and degrees for changes and standard deviations, as their
+//! names say; rpy as in URDF (`R = Rz(yaw) Ry(pitch) Rx(roll)`), quaternions
+//! `[w, x, y, z]`.
+
+use super::structure::{AxisRelation, relations};
+use super::uncertainty::{FrameSigma, FramesSigma};
+use super::{CalibratedFrames, chain::UrdfFrames};
+use crate::model::MeasurementKind;
+use crate::model::source::{UrdfSource, rpy};
+use nalgebra::{Isometry3, Vector3};
+use serde::ser::SerializeMap;
+use serde::{Serialize, Serializer};
+use std::collections::BTreeMap;
+
+/// The chain the frames belong to.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct ChainBlock {
+    /// Base link.
+    pub base: String,
+    /// Tip link.
+    pub tip: String,
+    /// Driven joints, in configuration order.
+    pub joints: Vec<String>,
+    /// Locked joints and their values (radians or metres).
+    pub locked: BTreeMap<String, f64>,
+}
+
+/// A frame: the child's pose in the parent's frame.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct FrameBlock {
+    /// The frame it is expressed in.
+    pub parent: String,
+    /// The frame it places (absent for a tool).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub child: Option<String>,
+    /// Translation (m).
+    pub xyz: [f64; 3],
+    /// Roll, pitch, yaw (rad).
+    pub rpy: [f64; 3],
+    /// Roll, pitch, yaw (degrees).
+    pub rpy_deg: [f64; 3],
+    /// Rotation as a unit quaternion `[w, x, y, z]`.
+    pub quaternion: [f64; 4],
+    /// σ of xyz (mm), when the fit has a covariance.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma_xyz_mm: Option<[f64; 3]>,
+    /// σ of rpy (degrees).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma_rpy_deg: Option<[f64; 3]>,
+}
+
+/// A marker (or the measured point) on the tip link.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct MarkerBlock {
+    /// `point` for a point sensor, `marker1`… for markers.
+    pub name: String,
+    /// The tip link.
+    pub parent: String,
+    /// Position in the tip link's frame (m).
+    pub xyz: [f64; 3],
+    /// σ of xyz (mm).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma_xyz_mm: Option<[f64; 3]>,
+}
+
+/// A driven joint's calibrated origin.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct JointBlock {
+    /// The joint's name (the key in the file).
+    #[serde(skip)]
+    pub name: String,
+    /// The calibrated origin's translation (m).
+    pub xyz: [f64; 3],
+    /// The calibrated origin's rpy (rad).
+    pub rpy: [f64; 3],
+    /// Change of xyz from the file's (mm).
+    pub delta_xyz_mm: [f64; 3],
+    /// Change of rpy from the file's (degrees).
+    pub delta_rpy_deg: [f64; 3],
+    /// Zero offset: the origin's turn about the joint's own axis (degrees).
+    pub offset_deg: f64,
+    /// σ of xyz (mm).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma_xyz_mm: Option<[f64; 3]>,
+    /// σ of rpy (degrees).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma_rpy_deg: Option<[f64; 3]>,
+    /// σ of the offset (degrees).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma_offset_deg: Option<f64>,
+    /// Largest |change / σ| over xyz and rpy.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_t: Option<f64>,
+}
+
+/// The joints, in chain order, written as a map from name to origin.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Joints(pub Vec<JointBlock>);
+
+impl Serialize for Joints {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut m = s.serialize_map(Some(self.0.len()))?;
+        for j in &self.0 {
+            m.serialize_entry(&j.name, j)?;
+        }
+        m.end()
+    }
+}
+
+/// How well the calibrated model fits its data.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct FitBlock {
+    /// Poses fitted.
+    pub poses: usize,
+    /// Position RMS (mm).
+    pub position_rms_mm: f64,
+    /// Orientation RMS (degrees), full poses only.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orientation_rms_deg: Option<f64>,
+}
+
+/// The calibrated frames report (and frames file).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct FramesReport {
+    /// The input description's file name.
+    pub robot: String,
+    /// The chain.
+    pub chain: ChainBlock,
+    /// The sensor's frame → the base link.
+    pub measurement_frame: FrameBlock,
+    /// Tip link → measured frame (full poses).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tool: Option<FrameBlock>,
+    /// The measured point or markers on the tip link.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub markers: Vec<MarkerBlock>,
+    /// Each driven joint's calibrated origin.
+    pub joints: Joints,
+    /// Relations of consecutive joint axes, nominal against calibrated.
+    pub structure: Vec<AxisRelation>,
+    /// The fit.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fit: Option<FitBlock>,
+}
+
+fn quaternion(t: &Isometry3<f64>) -> [f64; 4] {
+    let q = t.rotation.quaternion();
+    [q.w, q.i, q.j, q.k]
+}
+
+fn mm(v: [f64; 3]) -> [f64; 3] {
+    v.map(|x| x * 1e3)
+}
+
+fn deg(v: [f64; 3]) -> [f64; 3] {
+    v.map(f64::to_degrees)
+}
+
+fn frame_block(parent: &str, child: Option<&str>, t: &Isometry3<f64>, s: Option<&FrameSigma>) -> FrameBlock {
+    let r = rpy(&t.rotation.to_rotation_matrix());
+    FrameBlock {
+        parent: parent.to_string(),
+        child: child.map(str::to_string),
+        xyz: t.translation.vector.into(),
+        rpy: r,
+        rpy_deg: deg(r),
+        quaternion: quaternion(t),
+        sigma_xyz_mm: s.map(|s| mm(s.xyz)),
+        sigma_rpy_deg: s.map(|s| deg(s.rpy)),
+    }
+}
+
+/// `a − b` of rpy angles, each wrapped into (−π, π].
+fn rpy_change(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    use std::f64::consts::{PI, TAU};
+    std::array::from_fn(|i| {
+        let w = (a[i] - b[i]) - TAU * ((a[i] - b[i]) / TAU).round();
+        if w <= -PI { w + TAU } else { w }
+    })
+}
+
+fn joint_block(j: &super::JointOrigin, s: Option<(&FrameSigma, f64)>) -> JointBlock {
+    let (r, rn) = (
+        rpy(&j.calibrated.rotation.to_rotation_matrix()),
+        rpy(&j.nominal.rotation.to_rotation_matrix()),
+    );
+    let dx: Vector3<f64> = j.calibrated.translation.vector - j.nominal.translation.vector;
+    let dr = rpy_change(r, rn);
+    let max_t = s.map(|(s, _)| {
+        (0..3)
+            .flat_map(|i| [dx[i] / s.xyz[i], dr[i] / s.rpy[i]])
+            .filter(|t| t.is_finite())
+            .fold(0.0_f64, |m, t| m.max(t.abs()))
+    });
+    JointBlock {
+        name: j.name.clone(),
+        xyz: j.calibrated.translation.vector.into(),
+        rpy: r,
+        delta_xyz_mm: mm(dx.into()),
+        delta_rpy_deg: deg(dr),
+        offset_deg: j.offset().to_degrees(),
+        sigma_xyz_mm: s.map(|(s, _)| mm(s.xyz)),
+        sigma_rpy_deg: s.map(|(s, _)| deg(s.rpy)),
+        sigma_offset_deg: s.map(|(_, o)| o.to_degrees()),
+        max_t,
+    }
+}
+
+impl FramesReport {
+    /// The report of calibrated frames `f` (with standard deviations
+    /// `sigma` when the fit has them) of a robot from `src` measured as
+    /// `measurement`.
+    #[must_use]
+    pub fn new(
+        src: &UrdfSource,
+        measurement: MeasurementKind,
+        f: &CalibratedFrames,
+        sigma: Option<&FramesSigma>,
+        fit: Option<FitBlock>,
+    ) -> FramesReport {
+        let file = std::path::Path::new(&src.path)
+            .file_name()
+            .map_or_else(|| src.path.clone(), |n| n.to_string_lossy().into_owned());
+        let chain = ChainBlock {
+            base: src.base.clone(),
+            tip: src.tip.clone(),
+            joints: src.driven_names(),
+            locked: src
+                .joints
+                .iter()
+                .filter_map(|j| j.locked.map(|v| (j.name.clone(), v)))
+                .collect(),
+        };
+        let (tool, markers) = match measurement {
+            MeasurementKind::Pose => (
+                Some(frame_block(&src.tip, None, &f.tool, sigma.map(|s| &s.tool))),
+                Vec::new(),
+            ),
+            MeasurementKind::Point => (
+                None,
+                vec![MarkerBlock {
+                    name: "point".into(),
+                    parent: src.tip.clone(),
+                    xyz: f.tool.translation.vector.into(),
+                    sigma_xyz_mm: sigma.map(|s| mm(s.tool.xyz)),
+                }],
+            ),
+            MeasurementKind::Markers(_) => (
+                None,
+                f.markers
+                    .iter()
+                    .enumerate()
+                    .map(|(k, m)| MarkerBlock {
+                        name: format!("marker{}", k + 1),
+                        parent: src.tip.clone(),
+                        xyz: (*m).into(),
+                        sigma_xyz_mm: sigma.map(|s| mm(s.markers[k])),
+                    })
+                    .collect(),
+            ),
+        };
+        let joints = f
+            .joints
+            .iter()
+            .enumerate()
+            .map(|(k, j)| joint_block(j, sigma.map(|s| (&s.joints[k], s.offsets[k]))))
+            .collect();
+        FramesReport {
+            robot: file,
+            chain,
+            measurement_frame: frame_block(
+                "measurement",
+                Some(&src.base),
+                &f.measurement,
+                sigma.map(|s| &s.measurement),
+            ),
+            tool,
+            markers,
+            joints: Joints(joints),
+            structure: relations(f, &UrdfFrames::of(src).before),
+            fit,
+        }
+    }
+}

@@ -22,7 +22,14 @@ fn read(path: &str) -> String {
     std::fs::read_to_string(format!("{}/{path}", env!("CARGO_MANIFEST_DIR"))).unwrap()
 }
 
-fn import(text: &str, path: &str, tip: &str, m: MeasurementKind, mount: Isometry3<f64>, tool: Isometry3<f64>) -> Robot {
+fn import(
+    text: &str,
+    path: &str,
+    tip: &str,
+    m: MeasurementKind,
+    mount: Isometry3<f64>,
+    tool: Isometry3<f64>,
+) -> Robot {
     let opts = UrdfOptions {
         tip: Some(tip.into()),
         measurement: m,
@@ -37,8 +44,11 @@ fn import(text: &str, path: &str, tip: &str, m: MeasurementKind, mount: Isometry
 /// Direct URDF kinematics from the chain's base to its tip, by urdf_rs and
 /// nalgebra alone (independent of the importer and of the split).
 fn urdf_fk(u: &urdf_rs::Robot, base: &str, tip: &str, q: &HashMap<String, f64>) -> Isometry3<f64> {
-    let by_child: HashMap<&str, &urdf_rs::Joint> =
-        u.joints.iter().map(|j| (j.child.link.as_str(), j)).collect();
+    let by_child: HashMap<&str, &urdf_rs::Joint> = u
+        .joints
+        .iter()
+        .map(|j| (j.child.link.as_str(), j))
+        .collect();
     let mut chain = Vec::new();
     let mut at = tip;
     while at != base {
@@ -85,12 +95,22 @@ fn src(robot: &Robot) -> &UrdfSource {
 /// read by urdf_rs and composed with the split's measurement frame and tool,
 /// predicts what the fitted model predicts, at 100 random configurations.
 fn check_export(path: &str, tip: &str, m: MeasurementKind) {
-    let robot = import(&read(path), path, tip, m, Isometry3::identity(), Isometry3::identity());
+    let robot = import(
+        &read(path),
+        path,
+        tip,
+        m,
+        Isometry3::identity(),
+        Isometry3::identity(),
+    );
     // The "real" table: every unknown perturbed, as a calibration finds.
     let table = robot.real.clone();
     let f = decompose(&robot, &table).unwrap();
-    let origins: Vec<(String, Isometry3<f64>)> =
-        f.joints.iter().map(|j| (j.name.clone(), j.calibrated)).collect();
+    let origins: Vec<(String, Isometry3<f64>)> = f
+        .joints
+        .iter()
+        .map(|j| (j.name.clone(), j.calibrated))
+        .collect();
     let s = src(&robot);
     let text = with_origins(&s.text, path, &origins).unwrap();
     let u = urdf_rs::read_from_string(&text).unwrap();
@@ -110,7 +130,9 @@ fn check_export(path: &str, tip: &str, m: MeasurementKind) {
         let (r, p) = pose(&robot, &table, &q);
         worst = worst.max((direct.translation.vector - p).norm());
         if m == MeasurementKind::Pose {
-            let dr = (direct.rotation.to_rotation_matrix().matrix() - r).abs().max();
+            let dr = (direct.rotation.to_rotation_matrix().matrix() - r)
+                .abs()
+                .max();
             worst = worst.max(dr);
         }
     }
@@ -122,8 +144,16 @@ fn check_export(path: &str, tip: &str, m: MeasurementKind) {
 
 #[test]
 fn the_exported_urdf_and_frames_reproduce_the_fitted_model() {
-    check_export("fixtures/figaroh/ur10_robot.urdf", "wrist_3_link", MeasurementKind::Pose);
-    check_export("fixtures/example-robot-data/panda.urdf", "panda_hand_tcp", MeasurementKind::Pose);
+    check_export(
+        "fixtures/figaroh/ur10_robot.urdf",
+        "wrist_3_link",
+        MeasurementKind::Pose,
+    );
+    check_export(
+        "fixtures/example-robot-data/panda.urdf",
+        "panda_hand_tcp",
+        MeasurementKind::Pose,
+    );
     check_export("fixtures/ur5.urdf", "target", MeasurementKind::Point);
     check_export("fixtures/puma560.urdf", "tip", MeasurementKind::Point);
 }
@@ -139,8 +169,11 @@ fn only_the_chains_origins_change_in_the_exported_urdf() {
     };
     let robot = parse(&text, path, &opts).unwrap();
     let f = decompose(&robot, &robot.real).unwrap();
-    let origins: Vec<(String, Isometry3<f64>)> =
-        f.joints.iter().map(|j| (j.name.clone(), j.calibrated)).collect();
+    let origins: Vec<(String, Isometry3<f64>)> = f
+        .joints
+        .iter()
+        .map(|j| (j.name.clone(), j.calibrated))
+        .collect();
     let out = with_origins(&text, path, &origins).unwrap();
     // Remove every origin of the chain's joints from both texts: what is
     // left must be byte for byte the same.
@@ -149,7 +182,11 @@ fn only_the_chains_origins_change_in_the_exported_urdf() {
         let mut ranges: Vec<std::ops::Range<usize>> = doc
             .descendants()
             .filter(|n| n.tag_name().name() == "joint")
-            .filter(|n| origins.iter().any(|(name, _)| n.attribute("name") == Some(name)))
+            .filter(|n| {
+                origins
+                    .iter()
+                    .any(|(name, _)| n.attribute("name") == Some(name))
+            })
             .filter_map(|n| n.children().find(|c| c.tag_name().name() == "origin"))
             .map(|o| o.range())
             .collect();
@@ -178,8 +215,10 @@ fn perturbed(s: &UrdfSource, path: &str, rng: &mut ChaCha8Rng) -> String {
         .filter(|j| j.is_driven())
         .map(|j| {
             let dt = Vector3::new(draw(5e-4, 3e-3), draw(5e-4, 3e-3), draw(5e-4, 3e-3));
-            let dr = Vector3::new(draw(0.05, 0.3), draw(0.05, 0.3), draw(0.05, 0.3)).map(f64::to_radians);
-            let d = Isometry3::from_parts(Translation3::from(dt), UnitQuaternion::from_scaled_axis(dr));
+            let dr = Vector3::new(draw(0.05, 0.3), draw(0.05, 0.3), draw(0.05, 0.3))
+                .map(f64::to_radians);
+            let d =
+                Isometry3::from_parts(Translation3::from(dt), UnitQuaternion::from_scaled_axis(dr));
             (j.name.clone(), j.origin * d)
         })
         .collect();
@@ -198,9 +237,14 @@ fn measure(robot: &Robot, qs: &[Vec<f64>], sigma: f64, rng: &mut ChaCha8Rng) -> 
     let mut rots = Vec::new();
     for q in qs {
         let (r, p) = pose(robot, &robot.nominal, q);
-        points.push([p.x + sigma * gauss(), p.y + sigma * gauss(), p.z + sigma * gauss()]);
+        points.push([
+            p.x + sigma * gauss(),
+            p.y + sigma * gauss(),
+            p.z + sigma * gauss(),
+        ]);
         if robot.measurement == MeasurementKind::Pose {
-            let e = UnitQuaternion::from_scaled_axis(Vector3::new(gauss(), gauss(), gauss()) * sigma);
+            let e =
+                UnitQuaternion::from_scaled_axis(Vector3::new(gauss(), gauss(), gauss()) * sigma);
             let rm = e.to_rotation_matrix().matrix() * r;
             rots.push(std::array::from_fn(|i| std::array::from_fn(|j| rm[(i, j)])));
         }
@@ -230,7 +274,10 @@ fn figures(f: &CalibratedFrames) -> Vec<(String, f64)> {
 
 fn sigma_list(s: &activecal::frames::uncertainty::FramesSigma) -> Vec<f64> {
     let mut v = Vec::new();
-    for f in std::iter::once(&s.measurement).chain(std::iter::once(&s.tool)).chain(&s.joints) {
+    for f in std::iter::once(&s.measurement)
+        .chain(std::iter::once(&s.tool))
+        .chain(&s.joints)
+    {
         v.extend(f.xyz);
         v.extend(f.rpy);
     }
@@ -239,16 +286,29 @@ fn sigma_list(s: &activecal::frames::uncertainty::FramesSigma) -> Vec<f64> {
 
 fn synthetic_truth(path: &str, tip: &str, m: MeasurementKind) {
     let mut rng = ChaCha8Rng::seed_from_u64(11);
-    let nominal = import(&read(path), path, tip, m, Isometry3::identity(), Isometry3::identity());
+    let nominal = import(
+        &read(path),
+        path,
+        tip,
+        m,
+        Isometry3::identity(),
+        Isometry3::identity(),
+    );
     let truth_text = perturbed(src(&nominal), path, &mut rng);
     // The tracker 3 m away, turned 100°; the tool 5–20 cm off and turned 20°.
     let mount = Isometry3::from_parts(
         Translation3::from(Vector3::new(2.0, -2.0, 1.0).normalize() * 3.0),
-        UnitQuaternion::from_axis_angle(&Unit::new_normalize(Vector3::new(0.3, 0.5, 0.8)), 100f64.to_radians()),
+        UnitQuaternion::from_axis_angle(
+            &Unit::new_normalize(Vector3::new(0.3, 0.5, 0.8)),
+            100f64.to_radians(),
+        ),
     );
     let tool = Isometry3::from_parts(
         Translation3::new(0.05, -0.12, 0.15),
-        UnitQuaternion::from_axis_angle(&Unit::new_normalize(Vector3::new(1.0, -0.4, 0.2)), 20f64.to_radians()),
+        UnitQuaternion::from_axis_angle(
+            &Unit::new_normalize(Vector3::new(1.0, -0.4, 0.2)),
+            20f64.to_radians(),
+        ),
     );
     let truth = import(&truth_text, path, tip, m, mount, tool);
     let qs: Vec<Vec<f64>> = (0..80).map(|_| random_q(&nominal, &mut rng)).collect();
@@ -260,7 +320,10 @@ fn synthetic_truth(path: &str, tip: &str, m: MeasurementKind) {
     let lm = LmSettings::default().with_max_iterations(500);
     let id = identify(&start, &start.nominal, &meas, &lm).unwrap();
     assert!(id.converged(), "{path}: {:?} {:?}", id.status, id.stop);
-    eprintln!("{path}: align {:.4} -> {:.4} m; rss {:e}, start rss {:e}, iterations {}", a.rms_before, a.rms_after, id.rss, id.initial_rss, id.iterations);
+    eprintln!(
+        "{path}: align {:.4} -> {:.4} m; rss {:e}, start rss {:e}, iterations {}",
+        a.rms_before, a.rms_after, id.rss, id.initial_rss, id.iterations
+    );
     let cal = decompose(&start, &id.table).unwrap();
     let sig = sigmas(&start, &id.table, &id.covariance.as_ref().unwrap().matrix).unwrap();
     // The truth in the same terms: the same model fitted to noise-free data
@@ -269,7 +332,11 @@ fn synthetic_truth(path: &str, tip: &str, m: MeasurementKind) {
     let more: Vec<Vec<f64>> = (0..200).map(|_| random_q(&nominal, &mut rng)).collect();
     let exact = measure(&truth, &more, 0.0, &mut rng);
     let id_true = identify(&start, &id.table, &exact, &lm).unwrap();
-    assert!(id_true.rss < 1e-18, "{path}: the truth is not in the model: rss {:e}", id_true.rss);
+    assert!(
+        id_true.rss < 1e-18,
+        "{path}: the truth is not in the model: rss {:e}",
+        id_true.rss
+    );
     let truth_split = decompose(&start, &id_true.table).unwrap();
     let (got, want, s) = (figures(&cal), figures(&truth_split), sigma_list(&sig));
     let mut worst = (0.0, String::new());
@@ -290,9 +357,15 @@ fn synthetic_truth(path: &str, tip: &str, m: MeasurementKind) {
     // the gauge moves slides along axes), never the decimetres of the
     // measurement frame or tool.
     for j in &cal.joints {
-        let dt = (j.calibrated.translation.vector - j.nominal.translation.vector).abs().max();
+        let dt = (j.calibrated.translation.vector - j.nominal.translation.vector)
+            .abs()
+            .max();
         let dr = (j.nominal.rotation.inverse() * j.calibrated.rotation).angle();
-        assert!(dt < 0.01 && dr < 1f64.to_radians(), "{path}: {} moved {dt} m, {dr} rad", j.name);
+        assert!(
+            dt < 0.01 && dr < 1f64.to_radians(),
+            "{path}: {} moved {dt} m, {dr} rad",
+            j.name
+        );
     }
     // And the frames themselves are found.
     assert!((cal.measurement.translation.vector - mount.translation.vector).norm() < 0.02);
@@ -300,10 +373,18 @@ fn synthetic_truth(path: &str, tip: &str, m: MeasurementKind) {
 
 #[test]
 fn synthetic_truth_is_recovered_within_three_sigma_ur10_full_pose() {
-    synthetic_truth("fixtures/figaroh/ur10_robot.urdf", "wrist_3_link", MeasurementKind::Pose);
+    synthetic_truth(
+        "fixtures/figaroh/ur10_robot.urdf",
+        "wrist_3_link",
+        MeasurementKind::Pose,
+    );
 }
 
 #[test]
 fn synthetic_truth_is_recovered_within_three_sigma_panda_points() {
-    synthetic_truth("fixtures/example-robot-data/panda.urdf", "panda_hand_tcp", MeasurementKind::Point);
+    synthetic_truth(
+        "fixtures/example-robot-data/panda.urdf",
+        "panda_hand_tcp",
+        MeasurementKind::Point,
+    );
 }

@@ -5,14 +5,14 @@
 //! written as a description file.
 
 use super::{emit, write_new};
+use activecal::frames::CalibratedFrames;
+use activecal::frames::report::{FitBlock, FramesReport};
 use activecal::identify::{
     Identification, LmSettings, MonteCarloSettings, MonteCarloSummary, ValidationSet, monte_carlo,
     paper_tables,
 };
-use activecal::io::design::DesignFile;
-use activecal::frames::CalibratedFrames;
-use activecal::frames::report::{FitBlock, FramesReport};
 use activecal::io::calibrated::Format;
+use activecal::io::design::DesignFile;
 use activecal::model::Robot;
 use activecal::report::{IdentificationReport, SimulatedCalibrationReport};
 use anyhow::{Result, bail};
@@ -169,10 +169,11 @@ fn refuse_unconverged(a: &CalibrateArgs, id: &Identification) -> Result<()> {
     if !a.out.is_empty() && !id.converged() {
         let names: Vec<String> = a.out.iter().map(|p| p.display().to_string()).collect();
         bail!(
-            "identification ended {:?} ({:?}): {} not written",
+            "identification ended {:?} ({:?}): {} {} not written",
             id.status,
             id.stop,
-            names.join(", ")
+            names.join(", "),
+            if names.len() == 1 { "was" } else { "were" }
         );
     }
     Ok(())
@@ -191,14 +192,15 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
             "--validation 0: the validation RMS needs at least 1 held-out pose (the RMS error of no poses would read 0)"
         );
     }
-    for out in &a.out {
-        Format::of(out).map_err(|e| anyhow::anyhow!("--out {e}"))?;
-    }
     let outputs: Vec<(&str, &std::path::Path)> = a
         .out
         .iter()
         .map(|p| ("--out", p.as_path()))
-        .chain(a.save_measurements.as_deref().map(|p| ("--save-measurements", p)))
+        .chain(
+            a.save_measurements
+                .as_deref()
+                .map(|p| ("--save-measurements", p)),
+        )
         .collect();
     let robot_path = std::path::Path::new(a.robot.trim_end_matches(":pose"));
     let inputs: Vec<&std::path::Path> = [
@@ -210,6 +212,9 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     .flatten()
     .collect();
     super::check_outputs(&outputs, &inputs, a.force)?;
+    for out in &a.out {
+        Format::of(out).map_err(|e| anyhow::anyhow!("--out {e}"))?;
+    }
     let desc = super::load_description(&a.robot)?;
     let robot = &desc.robot;
     match (&a.design, &a.measurements) {
@@ -250,7 +255,8 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     };
     let frames = frames_of(&fitted, id, Some(fit))?;
     report.frames = frames.as_ref().map(|(_, r)| r.clone());
-    report.base.out = write_calibrated(a, &fitted, id, &path.display().to_string(), frames.as_ref())?;
+    report.base.out =
+        write_calibrated(a, &fitted, id, &path.display().to_string(), frames.as_ref())?;
     super::emit_report(a.json, &report, || {
         let mut s = super::measured::measured_text(&report, id, &status_text(id));
         for out in &report.base.out {

@@ -250,6 +250,7 @@ pub fn calibrate_measured(
     elapsed: &dyn Fn() -> f64,
 ) -> Result<(Robot, Fit, MeasuredReport)> {
     let (meas, mut notes) = read_measurements(path, robot, o.json)?;
+    let given = robot;
     let mounted = mounted_start(robot, &meas)?;
     let robot = match &mounted {
         Some((r, note)) => {
@@ -273,7 +274,15 @@ pub fn calibrate_measured(
     let f = fit(&r, &start.table, &meas, &o.lm, o.loss)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let res = residuals(&r, &f.id.table, &meas)?;
-    let nominal = residuals(&r, &r.nominal, &meas)?;
+    let nominal = match &mounted {
+        // The user's nominal model in the data's frame as given (with the
+        // best marker offsets for it), not the start mounted for the fit.
+        Some(_) => match for_measurements(given, &meas, &o.lm) {
+            Ok(s) => residuals(&s.robot, &s.robot.nominal, &meas)?,
+            Err(_) => residuals(&r, &r.nominal, &meas)?,
+        },
+        None => residuals(&r, &r.nominal, &meas)?,
+    };
     let params = trust(&r, &r.nominal, &f.id);
     let ho = match &o.holdout {
         Some(h) => {
@@ -281,7 +290,7 @@ pub fn calibrate_measured(
             let prep = move |x: &Robot| with_fixed_and_free(x, &fix, &free);
             Some(holdout_report(
                 *h,
-                holdout(robot, &meas, &o.lm, o.loss, h, &prep)?,
+                holdout(robot, given, &meas, &o.lm, o.loss, h, &prep)?,
             ))
         }
         None => None,

@@ -78,7 +78,8 @@ pub fn measurement_frame(robot: &Robot, meas: &Measurements) -> Option<Alignment
         .chunks_exact(k)
         .map(|c| c.iter().map(|v| Vector3::from(*v)).sum::<Vector3<f64>>() / k as f64)
         .collect();
-    let points = |t: &Vector3<f64>| -> Vec<Vector3<f64>> { ends.iter().map(|(r, p)| r * t + p).collect() };
+    let points =
+        |t: &Vector3<f64>| -> Vec<Vector3<f64>> { ends.iter().map(|(r, p)| r * t + p).collect() };
     let rms = |m: &Isometry3<f64>, t: &Vector3<f64>| {
         let s: f64 = points(t)
             .iter()

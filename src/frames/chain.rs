@@ -133,7 +133,12 @@ pub fn model_to_urdf(
             urdf.len()
         )));
     }
-    let scale = 1.0 + urdf.joint.iter().map(|j| j.translation.vector.norm()).fold(0.0, f64::max);
+    let scale = 1.0
+        + urdf
+            .joint
+            .iter()
+            .map(|j| j.translation.vector.norm())
+            .fold(0.0, f64::max);
     let mut out = Vec::with_capacity(urdf.len());
     for k in 0..urdf.len() {
         let c = model.joint[k].inverse() * urdf.joint[k];

@@ -107,7 +107,12 @@ pub fn decompose(robot: &Robot, table: &ParamTable) -> Result<CalibratedFrames, 
     let urdf = UrdfFrames::of(src);
     let to_urdf = model_to_urdf(robot, &urdf)?;
     let model = ModelFrames::of(robot, table);
-    let cal: Vec<Isometry3<f64>> = model.joint.iter().zip(&to_urdf).map(|(z, c)| z * c).collect();
+    let cal: Vec<Isometry3<f64>> = model
+        .joint
+        .iter()
+        .zip(&to_urdf)
+        .map(|(z, c)| z * c)
+        .collect();
     let split = gauge::split(&urdf, &cal, length_scale(&urdf));
     let base_to_first = src.mount.inverse() * urdf.joint[0];
     let measurement = split.joint[0] * base_to_first.inverse();
@@ -150,7 +155,9 @@ pub fn calibrated(
         return Ok(None);
     };
     let f = decompose(robot, table)?;
-    let sigma = cov.map(|c| uncertainty::sigmas(robot, table, c)).transpose()?;
+    let sigma = cov
+        .map(|c| uncertainty::sigmas(robot, table, c))
+        .transpose()?;
     let r = report::FramesReport::new(src, robot.measurement, &f, sigma.as_ref(), fit);
     Ok(Some((f, r)))
 }

@@ -158,7 +158,12 @@ fn deg(v: [f64; 3]) -> [f64; 3] {
     v.map(f64::to_degrees)
 }
 
-fn frame_block(parent: &str, child: Option<&str>, t: &Isometry3<f64>, s: Option<&FrameSigma>) -> FrameBlock {
+fn frame_block(
+    parent: &str,
+    child: Option<&str>,
+    t: &Isometry3<f64>,
+    s: Option<&FrameSigma>,
+) -> FrameBlock {
     let r = rpy(&t.rotation.to_rotation_matrix());
     FrameBlock {
         parent: parent.to_string(),

@@ -84,7 +84,11 @@ pub fn relations(f: &CalibratedFrames, before: &[Isometry3<f64>]) -> Vec<AxisRel
     };
     let axes: Vec<Vector3<f64>> = f.joints.iter().map(|j| j.axis).collect();
     let (nom, cal) = (lines(&chain(false), &axes), lines(&chain(true), &axes));
-    let length: f64 = chain(false).iter().map(|o| o.translation.vector.norm()).sum::<f64>().max(1e-3);
+    let length: f64 = chain(false)
+        .iter()
+        .map(|o| o.translation.vector.norm())
+        .sum::<f64>()
+        .max(1e-3);
     (1..f.joints.len())
         .map(|k| {
             let (an, dn) = relation(&nom[k - 1], &nom[k]);

@@ -242,9 +242,13 @@ pub struct SplitResult {
 /// Fits on a random `1 − fraction` of the poses and evaluates on the rest,
 /// `splits` times. `prepare` turns the robot adapted to the data
 /// ([`for_measurements`]) into the one fitted (e.g.
-/// [`with_fixed_and_free`]).
+/// [`with_fixed_and_free`]). The nominal figures are those of `baseline`
+/// (the user's model, adapted to the data's sensor on the training poses)
+/// when it differs from `robot` (a start mounted in the data's frame).
+#[allow(clippy::too_many_arguments)]
 pub fn holdout(
     robot: &Robot,
+    baseline: &Robot,
     meas: &Measurements,
     lm: &LmSettings,
     loss: LossChoice,
@@ -282,7 +286,14 @@ pub fn holdout(
         let f = fit(&r, &start.table, &mtr, lm, loss)?;
         let fitted = residuals(&r, &f.id.table, &mtr)?;
         let held_out = residuals(&r, &f.id.table, &mte)?;
-        let nominal = residuals(&r, &r.nominal, &mte)?;
+        let nominal = if std::ptr::eq(baseline, robot) {
+            residuals(&r, &r.nominal, &mte)?
+        } else {
+            match for_measurements(baseline, &mtr, lm) {
+                Ok(b) => residuals(&b.robot, &b.robot.nominal, &mte)?,
+                Err(_) => residuals(&r, &r.nominal, &mte)?,
+            }
+        };
         let pruned = if settings.prune {
             let keep: Vec<String> = trust(&r, &r.nominal, &f.id)
                 .into_iter()

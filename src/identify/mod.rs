@@ -308,7 +308,9 @@ impl Measurements {
         if repeats.is_empty() || self.points.is_empty() {
             return (self.clone(), Vec::new());
         }
-        let keep: Vec<usize> = (0..k).filter(|m| !repeats.iter().any(|&(d, _)| d == *m)).collect();
+        let keep: Vec<usize> = (0..k)
+            .filter(|m| !repeats.iter().any(|&(d, _)| d == *m))
+            .collect();
         let points = self
             .points
             .chunks_exact(k)

@@ -89,7 +89,8 @@ pub fn parse(text: &str, origin: &str) -> Result<Frames> {
         path: origin.to_string(),
         message,
     };
-    let f: FileEntry = yaml_serde::from_str(text).map_err(|e| bad(format!("not a frames file: {e}")))?;
+    let f: FileEntry =
+        yaml_serde::from_str(text).map_err(|e| bad(format!("not a frames file: {e}")))?;
     let finite = |what: &str, v: &[f64]| {
         if v.iter().all(|x| x.is_finite()) {
             Ok(())
@@ -97,7 +98,10 @@ pub fn parse(text: &str, origin: &str) -> Result<Frames> {
             Err(bad(format!("{what}: {v:?} is not finite")))
         }
     };
-    for (what, e) in [("measurement_frame", &f.measurement_frame), ("tool", &f.tool)] {
+    for (what, e) in [
+        ("measurement_frame", &f.measurement_frame),
+        ("tool", &f.tool),
+    ] {
         if let Some(e) = e {
             finite(&format!("{what}.xyz"), &e.xyz)?;
             finite(&format!("{what}.rpy"), &e.rpy)?;
@@ -107,7 +111,9 @@ pub fn parse(text: &str, origin: &str) -> Result<Frames> {
         finite(&format!("markers[{k}].xyz"), &m.xyz)?;
     }
     if f.tool.is_some() && !f.markers.is_empty() {
-        return Err(bad("both a tool and markers: a frames file has one or the other".into()));
+        return Err(bad(
+            "both a tool and markers: a frames file has one or the other".into(),
+        ));
     }
     let mut tool = f.tool.as_ref().map_or_else(Isometry3::identity, iso);
     let mut markers: Vec<[f64; 3]> = f.markers.iter().map(|m| m.xyz).collect();
@@ -120,7 +126,10 @@ pub fn parse(text: &str, origin: &str) -> Result<Frames> {
         markers.clear();
     }
     Ok(Frames {
-        mount: f.measurement_frame.as_ref().map_or_else(Isometry3::identity, iso),
+        mount: f
+            .measurement_frame
+            .as_ref()
+            .map_or_else(Isometry3::identity, iso),
         tool,
         markers,
         base: f.chain.as_ref().and_then(|c| c.base.clone()),

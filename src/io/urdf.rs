@@ -215,7 +215,9 @@ pub fn parse(text: &str, origin: &str, opts: &UrdfOptions) -> Result<Robot> {
     }
     robot.validate().map_err(|e| bad(e.to_string()))?;
     robot.check_identifiable().map_err(|e| bad(e.to_string()))?;
-    robot.source = Some(std::sync::Arc::new(source_of(&urdf, &chain, text, origin, opts)));
+    robot.source = Some(std::sync::Arc::new(source_of(
+        &urdf, &chain, text, origin, opts,
+    )));
     Ok(robot)
 }
 
@@ -243,8 +245,12 @@ fn source_of(
     UrdfSource {
         path: origin.to_string(),
         text: text.to_string(),
-        base: chain.first().map_or_else(String::new, |j| link(&j.name, true)),
-        tip: chain.last().map_or_else(String::new, |j| link(&j.name, false)),
+        base: chain
+            .first()
+            .map_or_else(String::new, |j| link(&j.name, true)),
+        tip: chain
+            .last()
+            .map_or_else(String::new, |j| link(&j.name, false)),
         joints: chain.iter().map(|j| j.source.clone()).collect(),
         mount: opts.mount,
         tool: opts.tool,

@@ -99,7 +99,11 @@ fn line_indent(text: &str, at: usize) -> String {
 /// The URDF `text` (from `path`, for messages) with the `<origin>` of each
 /// named joint set to its transform (xyz in metres, rpy in radians as URDF
 /// reads them). Errors when the text is not XML or a joint is not in it.
-pub fn with_origins(text: &str, path: &str, origins: &[(String, Isometry3<f64>)]) -> Result<String> {
+pub fn with_origins(
+    text: &str,
+    path: &str,
+    origins: &[(String, Isometry3<f64>)],
+) -> Result<String> {
     let opts = roxmltree::ParsingOptions {
         allow_dtd: true,
         ..roxmltree::ParsingOptions::default()
@@ -110,10 +114,9 @@ pub fn with_origins(text: &str, path: &str, origins: &[(String, Isometry3<f64>)]
     })?;
     let mut edits = Vec::new();
     for (name, t) in origins {
-        let joint = doc
-            .root_element()
-            .children()
-            .find(|c| c.is_element() && c.tag_name().name() == "joint" && c.attribute("name") == Some(name));
+        let joint = doc.root_element().children().find(|c| {
+            c.is_element() && c.tag_name().name() == "joint" && c.attribute("name") == Some(name)
+        });
         let Some(joint) = joint else {
             return Err(Error::Parse {
                 path: path.to_string(),
@@ -160,14 +163,25 @@ mod tests {
         assert!(out.starts_with("<?xml version=\"1.0\"?>\n<!-- keep me -->\n<robot name=\"r\">"));
         assert!(out.contains("<parent link=\"a\"/>\n  </joint>\n  <joint name=\"j3\""));
         let doc = roxmltree::Document::parse(&out).unwrap();
-        for (name, t) in [("j1", iso(0.1, 0.2)), ("j2", iso(-0.3, 0.1)), ("j3", iso(0.7, -0.4))] {
+        for (name, t) in [
+            ("j1", iso(0.1, 0.2)),
+            ("j2", iso(-0.3, 0.1)),
+            ("j3", iso(0.7, -0.4)),
+        ] {
             let j = doc
                 .descendants()
                 .find(|n| n.attribute("name") == Some(name))
                 .unwrap();
-            let o = j.children().find(|c| c.tag_name().name() == "origin").unwrap();
+            let o = j
+                .children()
+                .find(|c| c.tag_name().name() == "origin")
+                .unwrap();
             let parse = |a: &str| -> Vec<f64> {
-                o.attribute(a).unwrap().split_whitespace().map(|v| v.parse().unwrap()).collect()
+                o.attribute(a)
+                    .unwrap()
+                    .split_whitespace()
+                    .map(|v| v.parse().unwrap())
+                    .collect()
             };
             let (x, r) = (parse("xyz"), parse("rpy"));
             let back = Isometry3::from_parts(
@@ -176,7 +190,10 @@ mod tests {
             );
             // Shortest round-trip decimals: the transform rebuilds to
             // rounding of the rpy conversion (a few ulps).
-            assert!((back.to_homogeneous() - t.to_homogeneous()).abs().max() < 1e-15, "{name}");
+            assert!(
+                (back.to_homogeneous() - t.to_homogeneous()).abs().max() < 1e-15,
+                "{name}"
+            );
         }
     }
 

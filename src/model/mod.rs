@@ -415,7 +415,7 @@ impl Robot {
             limits,
             measurement: MeasurementKind::Point,
             orientation_scale: DEFAULT_ORIENTATION_SCALE,
-        source: None,
+            source: None,
         }
     }
 

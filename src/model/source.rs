@@ -107,4 +107,3 @@ pub fn rpy(r: &Rotation3<f64>) -> [f64; 3] {
     let roll = (sy * m[(0, 2)] - cy * m[(1, 2)]).atan2(cy * m[(1, 1)] - sy * m[(0, 1)]);
     [roll, pitch, yaw]
 }
-

@@ -252,22 +252,30 @@ fn measure(robot: &Robot, qs: &[Vec<f64>], sigma: f64, rng: &mut ChaCha8Rng) -> 
     Measurements::with_orientations(robot, qs.to_vec(), points, rots).unwrap()
 }
 
-/// Every figure of the split, for comparisons: (name, value).
-fn figures(f: &CalibratedFrames) -> Vec<(String, f64)> {
+/// Every figure of the split `f` against `truth`: (name, difference) of the
+/// translations and of the rotation (a rotation vector in the frame's own
+/// axes, as the σ are).
+fn differences(f: &CalibratedFrames, truth: &CalibratedFrames) -> Vec<(String, f64)> {
     let mut v = Vec::new();
-    let mut frame = |name: &str, t: &Isometry3<f64>| {
-        for (i, x) in t.translation.vector.iter().enumerate() {
+    let mut frame = |name: &str, t: &Isometry3<f64>, w: &Isometry3<f64>| {
+        for (i, x) in (t.translation.vector - w.translation.vector)
+            .iter()
+            .enumerate()
+        {
             v.push((format!("{name}.xyz[{i}]"), *x));
         }
-        let r = activecal::model::source::rpy(&t.rotation.to_rotation_matrix());
-        for (i, x) in r.iter().enumerate() {
-            v.push((format!("{name}.rpy[{i}]"), *x));
+        for (i, x) in (w.rotation.inverse() * t.rotation)
+            .scaled_axis()
+            .iter()
+            .enumerate()
+        {
+            v.push((format!("{name}.rot[{i}]"), *x));
         }
     };
-    frame("measurement", &f.measurement);
-    frame("tool", &f.tool);
-    for j in &f.joints {
-        frame(&j.name, &j.calibrated);
+    frame("measurement", &f.measurement, &truth.measurement);
+    frame("tool", &f.tool, &truth.tool);
+    for (j, w) in f.joints.iter().zip(&truth.joints) {
+        frame(&j.name, &j.calibrated, &w.calibrated);
     }
     v
 }
@@ -279,7 +287,7 @@ fn sigma_list(s: &activecal::frames::uncertainty::FramesSigma) -> Vec<f64> {
         .chain(&s.joints)
     {
         v.extend(f.xyz);
-        v.extend(f.rpy);
+        v.extend(f.rot);
     }
     v
 }
@@ -338,14 +346,14 @@ fn synthetic_truth(path: &str, tip: &str, m: MeasurementKind) {
         id_true.rss
     );
     let truth_split = decompose(&start, &id_true.table).unwrap();
-    let (got, want, s) = (figures(&cal), figures(&truth_split), sigma_list(&sig));
+    let (diff, s) = (differences(&cal, &truth_split), sigma_list(&sig));
     let mut worst = (0.0, String::new());
-    for ((name, g), ((_, w), s)) in got.iter().zip(want.iter().zip(&s)) {
-        let skip_tool_rotation = m == MeasurementKind::Point && name.starts_with("tool.rpy");
+    for ((name, d), s) in diff.iter().zip(&s) {
+        let skip_tool_rotation = m == MeasurementKind::Point && name.starts_with("tool.rot");
         if skip_tool_rotation {
             continue;
         }
-        let z = (g - w).abs() / s.max(1e-15);
+        let z = d.abs() / s.max(1e-15);
         if z > worst.0 {
             worst = (z, name.clone());
         }

@@ -20,8 +20,12 @@ fn frame_lines(name: &str, f: &FrameBlock) -> String {
             f.quaternion[0], f.quaternion[1], f.quaternion[2], f.quaternion[3]
         )
     );
-    if let (Some(x), Some(r)) = (f.sigma_xyz_mm, f.sigma_rpy_deg) {
-        s += &format!("  σ xyz {} mm, σ rpy {} deg\n", v3(x, 3), v3(r, 4));
+    if let (Some(x), Some(r)) = (f.sigma_xyz_mm, f.sigma_rotation_deg) {
+        s += &format!(
+            "  σ xyz {} mm, σ of a rotation about its x, y, z {} deg\n",
+            v3(x, 3),
+            v3(r, 4)
+        );
     }
     s
 }
@@ -43,17 +47,17 @@ pub fn frames_text(r: &FramesReport) -> String {
         }
         s += "\n";
     }
-    s += "joint origins (URDF xyz m, rpy rad; change from the file in mm and deg; offset = turn about the joint's own axis):\n";
+    s += "joint origins: change from the file's <origin> (Δxyz in mm; Δrot, the turn about the joint frame's x, y, z, in degrees; offset, the turn about the joint's own axis, in degrees):\n";
     s += &format!(
         "{:<28} {:>30} {:>30} {:>10} {:>7}\n",
-        "joint", "Δxyz (mm)", "Δrpy (deg)", "offset°", "max|t|"
+        "joint", "Δxyz (mm)", "Δrot (deg)", "offset°", "max|t|"
     );
     for j in &r.joints.0 {
         s += &format!(
             "{:<28} {:>30} {:>30} {:>10.4} {:>7}\n",
             j.name,
             v3(j.delta_xyz_mm, 3),
-            v3(j.delta_rpy_deg, 4),
+            v3(j.delta_rotation_deg, 4),
             j.offset_deg,
             j.max_t.map_or("-".into(), |t| format!("{t:.1}"))
         );
@@ -63,8 +67,14 @@ pub fn frames_text(r: &FramesReport) -> String {
         s += "axis relations the calibrated model no longer keeps (closed-form IK solvers assume them):\n";
         for a in broken {
             s += &format!(
-                "  {} → {}: nominally {}, now {:.4}° apart and {:.3} mm apart\n",
-                a.from, a.to, a.nominal, a.angle_deg[1], a.distance_mm[1]
+                "  {} → {}: nominally {} ({:.4}°, {:.3} mm apart), now {:.4}° and {:.3} mm\n",
+                a.from,
+                a.to,
+                a.nominal,
+                a.angle_deg[0],
+                a.distance_mm[0],
+                a.angle_deg[1],
+                a.distance_mm[1]
             );
         }
     }

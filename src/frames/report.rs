@@ -46,9 +46,9 @@ pub struct FrameBlock {
     /// σ of xyz (mm), when the fit has a covariance.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sigma_xyz_mm: Option<[f64; 3]>,
-    /// σ of rpy (degrees).
+    /// σ of a small rotation about the frame's own x, y, z axes (degrees).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub sigma_rpy_deg: Option<[f64; 3]>,
+    pub sigma_rotation_deg: Option<[f64; 3]>,
 }
 
 /// A marker (or the measured point) on the tip link.
@@ -77,20 +77,25 @@ pub struct JointBlock {
     pub rpy: [f64; 3],
     /// Change of xyz from the file's (mm).
     pub delta_xyz_mm: [f64; 3],
-    /// Change of rpy from the file's (degrees).
+    /// Change of rpy from the file's (degrees), with the calibrated rpy
+    /// taken as the equivalent triple nearest the file's.
     pub delta_rpy_deg: [f64; 3],
+    /// The change as a rotation about the joint frame's own x, y, z axes
+    /// (degrees: the rotation vector of `R_fileᵀ R_calibrated`); unlike rpy
+    /// it is small whenever the change is, gimbal lock or not.
+    pub delta_rotation_deg: [f64; 3],
     /// Zero offset: the origin's turn about the joint's own axis (degrees).
     pub offset_deg: f64,
     /// σ of xyz (mm).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sigma_xyz_mm: Option<[f64; 3]>,
-    /// σ of rpy (degrees).
+    /// σ of the rotation change (degrees).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub sigma_rpy_deg: Option<[f64; 3]>,
+    pub sigma_rotation_deg: Option<[f64; 3]>,
     /// σ of the offset (degrees).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sigma_offset_deg: Option<f64>,
-    /// Largest |change / σ| over xyz and rpy.
+    /// Largest |change / σ| over xyz and the rotation change.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_t: Option<f64>,
 }
@@ -173,17 +178,22 @@ fn frame_block(
         rpy_deg: deg(r),
         quaternion: quaternion(t),
         sigma_xyz_mm: s.map(|s| mm(s.xyz)),
-        sigma_rpy_deg: s.map(|s| deg(s.rpy)),
+        sigma_rotation_deg: s.map(|s| deg(s.rot)),
     }
 }
 
-/// `a − b` of rpy angles, each wrapped into (−π, π].
+/// `a − b` of rpy angles, each wrapped into (−π, π], with `a` replaced by
+/// its other triple `(r + π, π − p, y + π)` when that is nearer `b`.
 fn rpy_change(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     use std::f64::consts::{PI, TAU};
-    std::array::from_fn(|i| {
-        let w = (a[i] - b[i]) - TAU * ((a[i] - b[i]) / TAU).round();
+    let wrap = |x: f64| {
+        let w = x - TAU * (x / TAU).round();
         if w <= -PI { w + TAU } else { w }
-    })
+    };
+    let diff = |a: [f64; 3]| -> [f64; 3] { std::array::from_fn(|i| wrap(a[i] - b[i])) };
+    let (d1, d2) = (diff(a), diff([a[0] + PI, PI - a[1], a[2] + PI]));
+    let size = |d: &[f64; 3]| d.iter().map(|x| x * x).sum::<f64>();
+    if size(&d2) < size(&d1) { d2 } else { d1 }
 }
 
 fn joint_block(j: &super::JointOrigin, s: Option<(&FrameSigma, f64)>) -> JointBlock {
@@ -193,9 +203,10 @@ fn joint_block(j: &super::JointOrigin, s: Option<(&FrameSigma, f64)>) -> JointBl
     );
     let dx: Vector3<f64> = j.calibrated.translation.vector - j.nominal.translation.vector;
     let dr = rpy_change(r, rn);
+    let rot = (j.nominal.rotation.inverse() * j.calibrated.rotation).scaled_axis();
     let max_t = s.map(|(s, _)| {
         (0..3)
-            .flat_map(|i| [dx[i] / s.xyz[i], dr[i] / s.rpy[i]])
+            .flat_map(|i| [dx[i] / s.xyz[i], rot[i] / s.rot[i]])
             .filter(|t| t.is_finite())
             .fold(0.0_f64, |m, t| m.max(t.abs()))
     });
@@ -205,9 +216,10 @@ fn joint_block(j: &super::JointOrigin, s: Option<(&FrameSigma, f64)>) -> JointBl
         rpy: r,
         delta_xyz_mm: mm(dx.into()),
         delta_rpy_deg: deg(dr),
+        delta_rotation_deg: deg(rot.into()),
         offset_deg: j.offset().to_degrees(),
         sigma_xyz_mm: s.map(|(s, _)| mm(s.xyz)),
-        sigma_rpy_deg: s.map(|(s, _)| deg(s.rpy)),
+        sigma_rotation_deg: s.map(|(s, _)| deg(s.rot)),
         sigma_offset_deg: s.map(|(_, o)| o.to_degrees()),
         max_t,
     }

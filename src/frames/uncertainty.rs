@@ -4,17 +4,18 @@
 //! `Cov f = D C Dᵀ`, with `D` by central differences.
 
 use super::{CalibratedFrames, FramesError, decompose};
-use crate::model::source::rpy;
 use crate::model::{ParamTable, Robot};
 use nalgebra::Isometry3;
 
-/// Standard deviations of a frame: xyz (metres) and rpy (radians).
+/// Standard deviations of a frame: of its translation (metres) and of a
+/// small rotation about its own x, y and z axes (radians: the rotation
+/// vector of `R̂ᵀ R`, which unlike rpy has no gimbal lock).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FrameSigma {
     /// σ of x, y, z.
     pub xyz: [f64; 3],
-    /// σ of roll, pitch, yaw.
-    pub rpy: [f64; 3],
+    /// σ of the rotation about x, y, z.
+    pub rot: [f64; 3],
 }
 
 /// Standard deviations of every figure of [`CalibratedFrames`].
@@ -32,22 +33,15 @@ pub struct FramesSigma {
     pub offsets: Vec<f64>,
 }
 
-/// `x` shifted by a multiple of 2π into (−π, π].
-fn wrap(x: f64) -> f64 {
-    use std::f64::consts::{PI, TAU};
-    let w = x - TAU * (x / TAU).round();
-    if w <= -PI { w + TAU } else { w }
-}
-
 fn push_frame(out: &mut Vec<f64>, t: &Isometry3<f64>, reference: &Isometry3<f64>) {
     out.extend(t.translation.vector.iter());
-    let (a, b) = (
-        rpy(&t.rotation.to_rotation_matrix()),
-        rpy(&reference.rotation.to_rotation_matrix()),
+    // The rotation relative to the estimate's, as a rotation vector in the
+    // frame's own axes: smooth everywhere (rpy is not at pitch ±90°).
+    out.extend(
+        (reference.rotation.inverse() * t.rotation)
+            .scaled_axis()
+            .iter(),
     );
-    // Angles relative to the estimate's, wrapped: no jump of 2π between
-    // the two sides of a central difference.
-    out.extend((0..3).map(|i| b[i] + wrap(a[i] - b[i])));
 }
 
 /// The split as one vector of figures, angles taken near `reference`'s.
@@ -124,7 +118,7 @@ pub fn sigmas(
 fn frame_sigma(v: &[f64]) -> FrameSigma {
     FrameSigma {
         xyz: [v[0], v[1], v[2]],
-        rpy: [v[3], v[4], v[5]],
+        rot: [v[3], v[4], v[5]],
     }
 }
 

@@ -405,6 +405,35 @@ const CASES: &[Case] = &[
         1,
         &["--out d.json", "is an input of this command"],
     ),
+    // A calibrated robot is written as .urdf, .yaml or .toml: anything
+    // else is refused before any work, naming the three.
+    case(
+        &["calibrate", "--design", "d.json", "--out", "cal.json"],
+        1,
+        &["cal.json", ".urdf", ".yaml", ".toml"],
+    ),
+    case(
+        &["robots", "--export", "puma560", "--out", "puma.csv"],
+        1,
+        &["puma.csv", ".urdf", ".yaml", ".toml"],
+    ),
+    // The frames file is a .urdf robot's: a built-in has none.
+    case(
+        &["calibrate", "--design", "d.json", "--out", "cal.yaml"],
+        1,
+        &["cal.yaml", "not imported from a URDF"],
+    ),
+    case(
+        &[
+            "fk",
+            "--frames",
+            "no-such-frames.yaml",
+            "--q",
+            "0,0,0,0,0,0",
+        ],
+        1,
+        &["--frames no-such-frames.yaml", "no such file"],
+    ),
     case(
         &[
             "calibrate",

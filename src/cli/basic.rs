@@ -15,7 +15,10 @@ pub struct RobotsArgs {
     /// unknowns, limits or `orientation_scale`, then pass it as `--robot`.
     #[arg(long, value_name = "ROBOT")]
     pub export: Option<String>,
-    /// File for `--export` (default: standard output).
+    /// File for `--export` (default: standard output, as TOML), by
+    /// extension: .toml (a description), .urdf (the URDF, or a built-in's
+    /// chain as URDF), .yaml (a URDF robot's frames file); any other is
+    /// refused.
     #[arg(long, requires = "export")]
     pub out: Option<std::path::PathBuf>,
     /// Replace an existing `--out` file.
@@ -82,9 +85,32 @@ fn joint_kinds(r: &Robot) -> Vec<activecal::model::JointKind> {
 /// Runs `robots`.
 pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
     if let Some(name) = &a.export {
+        use activecal::io::calibrated::{Format, render};
+        let format = match &a.out {
+            Some(p) => {
+                super::refuse_overwrite(p, a.force)?;
+                Format::of(p).map_err(|e| anyhow::anyhow!("--out {e}"))?
+            }
+            None => Format::Toml,
+        };
         let d = super::load_description(name)?;
         d.robot.validate()?;
-        let text = activecal::io::robot_toml::description_to_toml(&d.robot, d.visibility.as_ref());
+        let r = &d.robot;
+        let text = match format {
+            Format::Toml => {
+                activecal::io::robot_toml::description_to_toml(r, d.visibility.as_ref())
+            }
+            _ => {
+                let frames = activecal::frames::calibrated(r, &r.nominal, None, None)?;
+                render(
+                    format,
+                    r,
+                    &r.nominal,
+                    frames.as_ref().map(|(f, rep)| (f, rep)),
+                    "",
+                )?
+            }
+        };
         match &a.out {
             Some(path) => super::write_new(path, &text, a.force)?,
             None => print!("{text}"),

@@ -98,7 +98,11 @@ fn nearest_notice(file: &Path, top: &Path) -> Option<PathBuf> {
 
 /// What is wrong with `file`'s licence entry, if anything.
 fn uncovered(file: &Path, top: &Path) -> Option<String> {
-    let shown = file.strip_prefix(ROOT).unwrap_or(file).display().to_string();
+    let shown = file
+        .strip_prefix(ROOT)
+        .unwrap_or(file)
+        .display()
+        .to_string();
     let Some(notice) = nearest_notice(file, top) else {
         return Some(format!("{shown}: no NOTICE.md above it"));
     };

@@ -753,7 +753,7 @@ fn scratch() -> PathBuf {
     // A description whose only frame is fixed: no joints.
     w(
         "nojoint.toml",
-        "name = \"nojoint\"\nmeasurement = \"point\"\n\n[[frame]]\nlabel = \"a\"\n\
+        "name = \"nojoint\"\nmeasurement = \"point\"\nunknowns = \"auto\"\n\n[[frame]]\nlabel = \"a\"\n\
          convention = \"hayati\"\njoint = \"fixed\"\nreal = [0.0, 0.0, 1.0, 0.0, 0.0]\n\
          nominal = [0.0, 0.0, 1.0, 0.0, 0.0]\n",
     );

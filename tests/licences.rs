@@ -32,7 +32,7 @@ fn files_under(dir: &Path, out: &mut Vec<PathBuf>) {
 fn entries(text: &str) -> Vec<String> {
     let mut out: Vec<String> = Vec::new();
     let mut para = String::new();
-    let mut flush = |para: &mut String, out: &mut Vec<String>| {
+    let flush = |para: &mut String, out: &mut Vec<String>| {
         if !para.trim().is_empty() {
             out.push(std::mem::take(para));
         }

@@ -284,6 +284,18 @@ const CASES: &[Case] = &[
             "above the limit of 10.5 MB (ACTIVECAL_MAX_MEMORY=10M)",
         ],
     ),
+    // The bound's Newton system grows with N²: refused with its figure
+    // (at N = 50,000 it was a 20 GB allocation and a panic).
+    case_limited(
+        &["bound", "--levels", "3", "--n", "700"],
+        0,
+        &[("ACTIVECAL_MAX_MEMORY", "2M")],
+        &[
+            "the Newton solver's 700×700 system",
+            "would need 3.9 MB",
+            "(ACTIVECAL_MAX_MEMORY=2M)",
+        ],
+    ),
     case_lacking(
         &["select", "--robot", "big.toml"],
         1,

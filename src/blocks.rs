@@ -96,15 +96,46 @@ pub fn jacobian_of<F>(robot: &Robot, table: &ParamTable, n: usize, fill_q: F) ->
 where
     F: Fn(usize, &mut [f64]) + Sync,
 {
+    let t = sensor_for(robot).rows();
+    let mut mat = Mat::<f64>::zeros(n * t, robot.n_params());
+    fill_jacobian(robot, table, &mut mat, fill_q);
+    Blocks::new(mat, t)
+}
+
+/// [`jacobian_of`] with the matrix reserved fallibly: when the system
+/// refuses its memory, an error naming `what` and the figure
+/// ([`crate::resources::try_zeros_mat`]) instead of an abort. For the
+/// large matrices (a pool's).
+pub fn try_jacobian_of<F>(
+    what: &str,
+    robot: &Robot,
+    table: &ParamTable,
+    n: usize,
+    fill_q: F,
+) -> crate::Result<Blocks>
+where
+    F: Fn(usize, &mut [f64]) + Sync,
+{
+    let t = sensor_for(robot).rows();
+    let mut mat = crate::resources::try_zeros_mat(what, n.saturating_mul(t), robot.n_params())?;
+    fill_jacobian(robot, table, &mut mat, fill_q);
+    Ok(Blocks::new(mat, t))
+}
+
+/// Writes the rows of every pose into `mat` (`n·t × p`), straight into the
+/// column-major matrix, chunk by chunk of rows (no row-major copy: a
+/// 10⁶-pose pool's Jacobian is 650 MB already).
+fn fill_jacobian<F>(robot: &Robot, table: &ParamTable, mat: &mut Mat<f64>, fill_q: F)
+where
+    F: Fn(usize, &mut [f64]) + Sync,
+{
     let n_kin = robot.n_unknowns();
     let p = robot.n_params();
     let own = table.marker_values();
     let sensor = sensor_for(robot);
     let t = sensor.rows();
     let dof = robot.dof();
-    // Written straight into the column-major matrix, chunk by chunk of rows
-    // (no row-major copy: a 10⁶-pose pool's Jacobian is 650 MB already).
-    let mut mat = faer::Mat::<f64>::zeros(n * t, p);
+    let n = mat.nrows() / t;
     const CHUNK: usize = 256;
     let task = crate::progress::Task::start("jacobian", Some(n as u64));
     mat.as_mut()
@@ -130,5 +161,4 @@ where
             }
             task.inc((chunk.nrows() / t) as u64);
         });
-    Blocks::new(mat, t)
 }

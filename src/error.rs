@@ -109,6 +109,17 @@ pub enum Error {
         /// Where the budget comes from.
         source_of_limit: String,
     },
+    /// An allocation the system refused although the budget allowed it (a
+    /// limit the budget cannot see, or memory taken by other processes).
+    #[error(
+        "{what}: allocating {needed} failed (the system refused the memory); use a smaller pool or free memory"
+    )]
+    OutOfMemory {
+        /// What was to be allocated.
+        what: String,
+        /// Its size.
+        needed: String,
+    },
     /// Any other invalid argument, with a message saying what and why.
     #[error("{0}")]
     Invalid(String),

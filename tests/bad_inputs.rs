@@ -22,6 +22,10 @@ struct Case {
     needs: &'static [&'static str],
     /// Words the message must not contain.
     lacks: &'static [&'static str],
+    /// An address-space limit in KiB (`ulimit -v`), 0 for none.
+    ulimit_v: u64,
+    /// Environment variables set for the run.
+    env: &'static [(&'static str, &'static str)],
 }
 
 const fn case(args: &'static [&'static str], status: i32, needs: &'static [&'static str]) -> Case {
@@ -30,6 +34,8 @@ const fn case(args: &'static [&'static str], status: i32, needs: &'static [&'sta
         status,
         needs,
         lacks: &[],
+        ulimit_v: 0,
+        env: &[],
     }
 }
 
@@ -44,6 +50,26 @@ const fn case_lacking(
         status,
         needs,
         lacks,
+        ulimit_v: 0,
+        env: &[],
+    }
+}
+
+/// A case run under an address-space limit (`ulimit -v`, KiB) and with
+/// environment variables.
+const fn case_limited(
+    args: &'static [&'static str],
+    ulimit_v: u64,
+    env: &'static [(&'static str, &'static str)],
+    needs: &'static [&'static str],
+) -> Case {
+    Case {
+        args,
+        status: 1,
+        needs,
+        lacks: &[],
+        ulimit_v,
+        env,
     }
 }
 
@@ -57,6 +83,12 @@ const BOX_OK: &str = r#"{"kind":"box","min":[-30,-30,-30],"max":[30,30,30]}"#;
 
 const TIAGO: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/figaroh/tiago.urdf");
 const UR5: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/ur5.urdf");
+const TIAGO_ARM: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/fixtures/figaroh/tiago.urdf#tip=arm_tool_link"
+);
+/// The issue's address-space limit: 2,000,000 KiB (2.05 GB).
+const ULIMIT_2G: u64 = 2_000_000;
 
 /// The table. Files named here are made by [`scratch`]: `d.json` a valid
 /// 3-level PUMA design, `m.json` its measurements, and broken variants.
@@ -223,6 +255,47 @@ const CASES: &[Case] = &[
         1,
         &["would need", "of memory", "ACTIVECAL_MAX_MEMORY"],
     ),
+    // Memory limits from every source: the address-space limit names
+    // itself; a random search's memory no longer grows with --designs.
+    case_limited(
+        &[
+            "select",
+            "--levels",
+            "12",
+            "--algorithm",
+            "random",
+            "--designs",
+            "100000000",
+        ],
+        ULIMIT_2G,
+        &[],
+        &[
+            "a pool of 2985984 poses",
+            "would need 4.0 GB",
+            "RLIMIT_AS (ulimit -v) of 2.0 GB less the",
+        ],
+    ),
+    case_limited(
+        &["select", "--levels", "6", "--algorithm", "random"],
+        ULIMIT_2G,
+        &[("ACTIVECAL_MAX_MEMORY", "10M")],
+        &[
+            "would need 63.1 MB",
+            "above the limit of 10.5 MB (ACTIVECAL_MAX_MEMORY=10M)",
+        ],
+    ),
+    // The bound's Newton system grows with N²: refused with its figure
+    // (at N = 50,000 it was a 20 GB allocation and a panic).
+    case_limited(
+        &["bound", "--levels", "3", "--n", "700"],
+        0,
+        &[("ACTIVECAL_MAX_MEMORY", "2M")],
+        &[
+            "the Newton solver's 700×700 system",
+            "would need 3.9 MB",
+            "(ACTIVECAL_MAX_MEMORY=2M)",
+        ],
+    ),
     case_lacking(
         &["select", "--robot", "big.toml"],
         1,
@@ -284,6 +357,42 @@ const CASES: &[Case] = &[
         &["fk", "--robot", "loop.urdf", "--q", "0"],
         1,
         &["loop.urdf", "loop (j1 → j2 → j3 → j1)"],
+    ),
+    case(
+        &[
+            "fk",
+            "--robot",
+            TIAGO_ARM,
+            "--tip",
+            "arm_7_link",
+            "--q",
+            "0",
+        ],
+        1,
+        &[
+            "--tip arm_7_link conflicts with the robot",
+            "#tip=arm_tool_link",
+            "give the chain once",
+        ],
+    ),
+    case(
+        &[
+            "select",
+            "--robot",
+            TIAGO_ARM,
+            "--lock",
+            "torso_lift_joint=0.1",
+        ],
+        1,
+        &[
+            "--lock torso_lift_joint=0.1 conflicts",
+            "#tip=arm_tool_link",
+        ],
+    ),
+    case(
+        &["fk", "--robot", "nojoint.toml", "--q", "0"],
+        1,
+        &["nojoint.toml", "this robot has no joints"],
     ),
     case(
         &["pool", "--levels", "3", "--digits", "0,0,0"],
@@ -464,6 +573,27 @@ const CASES: &[Case] = &[
         &["visibility filter", "inverted on x"],
     ),
     case(
+        &["calibrate", "--measurements", "m.json", "--noise", "0.5"],
+        2,
+        &["'--measurements <MEASUREMENTS>' cannot be used with '--noise <NOISE>'"],
+    ),
+    case(
+        &[
+            "calibrate",
+            "--measurements",
+            "m.json",
+            "--validation",
+            "10",
+        ],
+        2,
+        &["cannot be used with '--validation <VALIDATION>'"],
+    ),
+    case(
+        &["calibrate", "--measurements", "m.json", "--seed", "3"],
+        1,
+        &["--seed 3", "only draws the --holdout splits"],
+    ),
+    case(
         &["calibrate", "--measurements", "m4.json"],
         1,
         &[
@@ -551,9 +681,24 @@ const CASES: &[Case] = &[
 ];
 
 fn activecal(dir: &Path, args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_activecal"))
-        .current_dir(dir)
+    limited(dir, args, 0, &[])
+}
+
+/// Runs the binary under `ulimit -v ulimit_v` (KiB; 0: no limit) with `env`.
+fn limited(dir: &Path, args: &[&str], ulimit_v: u64, env: &[(&str, &str)]) -> std::process::Output {
+    let bin = env!("CARGO_BIN_EXE_activecal");
+    let mut cmd = if ulimit_v > 0 {
+        let mut c = Command::new("sh");
+        c.arg("-c")
+            .arg(format!("ulimit -v {ulimit_v} && exec \"$0\" \"$@\""))
+            .arg(bin);
+        c
+    } else {
+        Command::new(bin)
+    };
+    cmd.current_dir(dir)
         .args(args)
+        .envs(env.iter().copied())
         .output()
         .expect("runs")
 }
@@ -646,6 +791,13 @@ fn scratch() -> PathBuf {
             "limits = [0.5, 0.5]",
         ),
     );
+    // A description whose only frame is fixed: no joints.
+    w(
+        "nojoint.toml",
+        "name = \"nojoint\"\nmeasurement = \"point\"\nunknowns = \"auto\"\n\n[[frame]]\nlabel = \"a\"\n\
+         convention = \"hayati\"\njoint = \"fixed\"\nreal = [0.0, 0.0, 1.0, 0.0, 0.0]\n\
+         nominal = [0.0, 0.0, 1.0, 0.0, 0.0]\n",
+    );
     let j = r#"<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/>"#;
     w(
         "loop.urdf",
@@ -668,7 +820,7 @@ fn every_bad_input_gets_its_status_and_a_clear_message() {
     for c in CASES {
         let args: Vec<String> = c.args.iter().map(|a| a.replace('@', d)).collect();
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
-        let out = activecal(&dir, &args);
+        let out = limited(&dir, &args, c.ulimit_v, c.env);
         let err = String::from_utf8_lossy(&out.stderr);
         let mut wrong = Vec::new();
         if out.status.code() != Some(c.status) {

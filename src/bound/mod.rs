@@ -492,6 +492,10 @@ pub fn relaxation_bound_with_prior(
         )));
     }
     check_problem_with_prior(x, n, prior.is_some())?;
+    if settings.use_conic && settings.solver == RelaxationSolver::Newton {
+        // Every candidate set holds the support, at least N poses.
+        check_newton_memory(n.min(x.n_poses()))?;
+    }
     let clock = Instant::now();
     let sc = scale_columns_with_prior(x, prior.map(Prior::matrix), n)?;
     let xs = &sc.x;
@@ -569,6 +573,9 @@ pub fn relaxation_bound_with_prior(
             let Ok(sub_sc) = scale_columns_with_prior(&sub, sub_prior, n.min(cand.len())) else {
                 break;
             };
+            if settings.solver == RelaxationSolver::Newton {
+                check_newton_memory(cand.len())?;
+            }
             let out = match settings.solver {
                 RelaxationSolver::Clarabel => conic::solve_scaled(&sub_sc, n, &conic_settings),
                 RelaxationSolver::Newton => {
@@ -698,6 +705,16 @@ pub fn relaxation_bound_with_prior(
 
 /// First-order polish from a feasible point, limited to
 /// `settings.polish_rounds` rounds.
+/// Refuses a Newton solve on `k` candidates whose dense `k × k` system
+/// exceeds the memory budget (it grows with the square of the design size).
+fn check_newton_memory(k: usize) -> Result<(), BoundError> {
+    crate::resources::MemoryBudget::from_env()?.check(
+        &format!("the Newton solver's {k}×{k} system on {k} candidate poses"),
+        crate::resources::bytes_of(k.saturating_mul(k), 8),
+    )?;
+    Ok(())
+}
+
 fn polish(sc: &variance::Scaled, n: usize, w: &[f64], settings: &BoundSettings) -> ExchangeOutcome {
     let mut s = settings.first_order.clone();
     s.gap_tol = settings.gap_tol;

@@ -38,7 +38,12 @@ pub struct CalibrateArgs {
     /// and radians) or JSON (`qs`, `points`, optional `orientations` or
     /// `quaternions`, `markers`). Several markers per pose calibrate a
     /// marker sensor with one offset per marker; orientations a full pose.
-    #[arg(long, conflicts_with_all = ["design", "trials", "save_measurements"])]
+    /// The simulation's options (`--noise`, `--validation`, `--trials`,
+    /// `--save-measurements`) do not apply to measured data: refused.
+    #[arg(
+        long,
+        conflicts_with_all = ["design", "trials", "save_measurements", "noise", "validation"]
+    )]
     pub measurements: Option<PathBuf>,
     /// Write the simulated measurements (trial 0 of the seed) to this JSON
     /// file, in the format `--measurements` reads.
@@ -59,14 +64,10 @@ pub struct CalibrateArgs {
     /// orientation noise is σ / orientation_scale radians per axis.
     #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
     pub noise: f64,
-    /// Seed of the noise and of the validation poses.
-    #[arg(
-        long,
-        default_value_t = 0,
-        value_parser = super::parse_seed,
-        allow_negative_numbers = true
-    )]
-    pub seed: u64,
+    /// Seed of the noise and of the validation poses (default 0); with
+    /// --measurements, of the --holdout splits only.
+    #[arg(long, value_parser = super::parse_seed, allow_negative_numbers = true)]
+    pub seed: Option<u64>,
     /// Noise realisations; more than 1 adds a Monte-Carlo summary.
     #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub trials: usize,
@@ -179,8 +180,20 @@ fn refuse_unconverged(a: &CalibrateArgs, id: &Identification) -> Result<()> {
     Ok(())
 }
 
+impl CalibrateArgs {
+    /// `--seed`, 0 when not given.
+    fn seed(&self) -> u64 {
+        self.seed.unwrap_or(0)
+    }
+}
+
 /// Runs `calibrate`.
 pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
+    if let (Some(seed), Some(_), None) = (a.seed, &a.measurements, a.holdout) {
+        bail!(
+            "--seed {seed}: with --measurements the seed only draws the --holdout splits, and --holdout is not given (the fit of measured data has no randomness)"
+        );
+    }
     if !(a.noise.is_finite() && a.noise >= 0.0) {
         bail!(
             "--noise {}: the noise σ must be a finite number >= 0 (metres)",
@@ -240,7 +253,7 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
             .map(|fraction| activecal::identify::HoldoutSettings {
                 fraction,
                 splits: a.splits,
-                seed: a.seed,
+                seed: a.seed(),
                 prune: a.compare_pruned,
             }),
         json: a.json,
@@ -326,14 +339,14 @@ fn from_design(
     let settings = MonteCarloSettings::default()
         .with_trials(a.trials)
         .with_sigma(a.noise)
-        .with_seed(a.seed)
+        .with_seed(a.seed())
         .with_validation_poses(a.validation);
     let settings = MonteCarloSettings { lm, ..settings };
     settings.validate()?;
-    let validation = ValidationSet::sample(robot, &pool, &positions, a.validation, a.seed)?;
+    let validation = ValidationSet::sample(robot, &pool, &positions, a.validation, a.seed())?;
 
     // ---- one calibration: trial 0 of the seed --------------------------------
-    let tables = paper_tables(robot, &qs, a.noise, a.seed, &settings.lm)?;
+    let tables = paper_tables(robot, &qs, a.noise, a.seed(), &settings.lm)?;
     let id = &tables.identification;
     if let Some(path) = &a.save_measurements {
         let text = serde_json::to_string_pretty(&tables.measurements)? + "\n";
@@ -373,7 +386,7 @@ fn from_design(
         measurement: robot.measurement,
         noise: a.noise,
         orientation_noise: full.then(|| a.noise / robot.orientation_scale),
-        seed: a.seed,
+        seed: a.seed(),
         residual: id
             .names
             .iter()
@@ -405,7 +418,7 @@ fn from_design(
             "{}: {} poses, {noise}, seed {}\n{}",
             design_path.display(),
             qs.len(),
-            a.seed,
+            a.seed(),
             status_text(id)
         );
         s += "\nestimate (Table III)\n";

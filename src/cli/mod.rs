@@ -72,22 +72,61 @@ pub fn set_chain_choice(
     Ok(())
 }
 
-/// A `--robot` name with the chain options appended as its `#…` fragment
-/// (unless it names a chain already, as a design file's robot does), so
-/// that reports and design files record the chain.
-pub fn with_chain(name: &str) -> String {
-    match CHAIN.get() {
-        Some(c) if !c.is_empty() && !name.contains('#') => format!("{name}{}", c.fragment()),
-        _ => name.to_string(),
+/// A `--robot` name with the chain options appended as its `#…` fragment,
+/// so that reports and design files record the chain. A name that names a
+/// chain already (`tiago.urdf#tip=…`, as a design file's robot does) is
+/// kept; chain options that differ from its chain are refused, naming both.
+pub fn with_chain(name: &str) -> Result<String> {
+    let Some(c) = CHAIN.get().filter(|c| !c.is_empty()) else {
+        return Ok(name.to_string());
+    };
+    let Some(k) = name.find('#') else {
+        return Ok(format!("{name}{}", c.fragment()));
+    };
+    if name[k..] != c.fragment() {
+        anyhow::bail!(
+            "{} conflicts with the robot '{name}', which names its chain already ({}); give the chain once",
+            chain_options(c),
+            &name[k..]
+        );
     }
+    Ok(name.to_string())
+}
+
+/// The chain options as typed: `--base B --tip T --lock J=V`.
+fn chain_options(c: &activecal::io::ChainChoice) -> String {
+    let mut parts = Vec::new();
+    if let Some(b) = &c.base {
+        parts.push(format!("--base {b}"));
+    }
+    if let Some(t) = &c.tip {
+        parts.push(format!("--tip {t}"));
+    }
+    if !c.lock.is_empty() {
+        let l: Vec<String> = c.lock.iter().map(|(n, v)| format!("{n}={v}")).collect();
+        parts.push(format!("--lock {}", l.join(",")));
+    }
+    parts.join(" ")
 }
 
 /// Loads and validates a robot: a built-in name, or a `.toml` description or
 /// `.urdf` file ([`activecal::io::load_robot`]), with the chain options.
 pub fn load_robot(name: &str) -> Result<Robot> {
-    let r = activecal::io::load_robot(&with_chain(name))?;
+    let r = activecal::io::load_robot(&with_chain(name)?)?;
     r.validate()?;
+    has_joints(name, &r)?;
     Ok(r)
+}
+
+/// Refuses a robot without a driven joint (a description whose frames are
+/// all fixed, a chain whose joints are all locked): nothing to move.
+fn has_joints(name: &str, r: &Robot) -> Result<()> {
+    if r.dof() == 0 {
+        anyhow::bail!(
+            "{name}: this robot has no joints (every frame of its chain is fixed); a robot needs at least one revolute or prismatic joint"
+        );
+    }
+    Ok(())
 }
 
 /// Errors if `path` exists and `force` is not set: nothing the user has is
@@ -342,8 +381,9 @@ pub fn filters(
 
 /// Loads a robot with its description's visibility region (validated).
 pub fn load_description(name: &str) -> Result<activecal::io::Description> {
-    let d = activecal::io::load_description(&with_chain(name))?;
+    let d = activecal::io::load_description(&with_chain(name)?)?;
     d.robot.validate()?;
+    has_joints(name, &d.robot)?;
     Ok(d)
 }
 
@@ -351,13 +391,14 @@ pub fn load_description(name: &str) -> Result<activecal::io::Description> {
 /// nominal model) and its Jacobian at `params`.
 pub fn build_pool(robot: Robot, spec: &PoolSpec, params: ParamSet) -> Result<PoolCtx> {
     let pool = spec.build(&robot, &robot.nominal)?;
-    Ok(with_jacobian(robot, pool, params))
+    with_jacobian(robot, pool, params)
 }
 
-/// A built pool with its Jacobian at `params`.
-pub fn with_jacobian(robot: Robot, pool: Pool, params: ParamSet) -> PoolCtx {
-    let x = pool.jacobian(&robot, robot.params(params));
-    PoolCtx { robot, pool, x }
+/// A built pool with its Jacobian at `params` (reserved fallibly: memory
+/// the system refuses is an error, not an abort).
+pub fn with_jacobian(robot: Robot, pool: Pool, params: ParamSet) -> Result<PoolCtx> {
+    let x = pool.try_jacobian(&robot, robot.params(params))?;
+    Ok(PoolCtx { robot, pool, x })
 }
 
 /// One line per filter (what it removed) and per note of a pool's build.
@@ -442,7 +483,7 @@ impl PoolOpts {
         if self.srdf.is_some() && !self.self_collision {
             anyhow::bail!("--srdf lists pairs of links for --self-collision, which is not given");
         }
-        let Some(chain) = activecal::io::urdf_chain(&with_chain(&self.robot))? else {
+        let Some(chain) = activecal::io::urdf_chain(&with_chain(&self.robot)?)? else {
             anyhow::bail!(
                 "--self-collision, --obstacle and --floor need a URDF robot with collision geometry (--robot FILE.urdf); {} has none",
                 self.robot

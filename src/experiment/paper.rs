@@ -356,7 +356,7 @@ pub fn run(
     let clock = Instant::now();
     let robot = Robot::puma560();
     let pool = PoolSpec::lattice(a.levels).build(&robot, &robot.nominal)?;
-    let x = pool.jacobian(&robot, &robot.nominal);
+    let x = pool.try_jacobian(&robot, &robot.nominal)?;
     let p = x.p();
     let ids = |d: &[usize]| pool.ids_of(d);
     let s = Settings {
@@ -373,9 +373,11 @@ pub fn run(
     progress("random designs");
     let all: Vec<usize> = (0..x.n_poses()).collect();
     let rs = random_search(&x, &all, &[], a.n, a.designs, a.seed);
+    // The median of the kept designs (all of them up to SAMPLE_CAP).
     let mut order: Vec<usize> = (0..rs.ln_oid.len()).collect();
     order.sort_by(|&i, &j| rs.ln_oid[i].total_cmp(&rs.ln_oid[j]));
-    let median_k = order[order.len() / 2];
+    let median_j = order[order.len() / 2];
+    let median_k = median_j * rs.stride;
     let median_design = random_design(&mut design_rng(a.seed, median_k as u64), &all, &[], a.n);
 
     // 2. EAE with the paper's settings, determinant criterion (§V-D).
@@ -498,7 +500,7 @@ pub fn run(
         random: RandomSummary {
             best_log10_oid: l10(rs.best_ln_oid),
             best_oi: oi_from_ln_oid(rs.best_ln_oid, p),
-            median_log10_oid: l10(rs.ln_oid[median_k]),
+            median_log10_oid: l10(rs.ln_oid[median_j]),
             best_poses: ids(&rs.best),
         },
         eae: EaeSummary {

@@ -584,6 +584,21 @@ impl Pool {
             q.copy_from_slice(self.config(k));
         })
     }
+
+    /// [`jacobian`](Self::jacobian) with the matrix reserved fallibly: an
+    /// allocation the system refuses is an error naming the pool and the
+    /// figure, not an abort.
+    pub fn try_jacobian(&self, robot: &Robot, table: &ParamTable) -> Result<Blocks> {
+        let what = format!(
+            "the {}×{} Jacobian of a pool of {} poses",
+            self.len() * robot.rows_per_pose(),
+            robot.n_params(),
+            self.len()
+        );
+        crate::blocks::try_jacobian_of(&what, robot, table, self.len(), |k, q| {
+            q.copy_from_slice(self.config(k));
+        })
+    }
 }
 
 #[cfg(test)]

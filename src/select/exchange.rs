@@ -30,9 +30,12 @@ pub struct Selection {
     /// The driving criterion's own score of the design
     /// ([`Criterion::score`]; `ln OI_D` for the D criterion).
     pub score: f64,
-    /// Index of the start that won (multi-start), 0 otherwise.
+    /// Index of the start that won (multi-start; a random search: the
+    /// number of the best design), 0 otherwise.
     pub start: usize,
-    /// `ln OI_D` of every start, in start order.
+    /// `ln OI_D` of every start, in start order (a random search: of its
+    /// kept designs, every [`RandomSearch::stride`](super::RandomSearch)-th
+    /// one, at most [`SAMPLE_CAP`](super::SAMPLE_CAP)).
     pub start_ln_oid: Vec<f64>,
     /// The criterion's score of every start, in start order: the starts are
     /// ranked by it (`-∞` for a start that failed). A random search ranks
@@ -510,10 +513,10 @@ where
         let mut crit = make();
         let run = Run::new(pool, &mut crit, &r.best, &s.fixed, s.prior.as_ref())?;
         let mut sel = run.finish(Algorithm::Random)?;
+        // The kept sample of the designs (every `r.stride`-th); `start` is
+        // the number of the best design.
         sel.start_ln_oid = r.ln_oid;
-        sel.start = (0..sel.start_ln_oid.len())
-            .find(|&k| sel.start_ln_oid[k] == r.best_ln_oid)
-            .unwrap_or(0);
+        sel.start = r.best_design;
         return finish_polish(pool, make, sel, s);
     }
     let one = |k: usize| -> Result<Selection> {

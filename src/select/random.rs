@@ -1,5 +1,6 @@
 //! Random design search (paper §V-C): `R` random `N`-pose designs, the best
-//! one by `ln OI_D`, and the whole distribution (the paper's Fig. 2).
+//! one by `ln OI_D`, and their distribution (the paper's Fig. 2) from a
+//! sample of fixed size: memory does not grow with `R`.
 
 use crate::blocks::Blocks;
 use crate::criterion::Prior;
@@ -9,6 +10,15 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::Serialize;
 
+/// Most designs whose values a random search keeps for the distribution
+/// (16 bytes each: 2 MiB). Up to this many designs every one is kept; above
+/// it every `stride`-th ([`RandomSearch::stride`]).
+pub const SAMPLE_CAP: usize = 1 << 17;
+
+/// Designs evaluated in parallel between two sequential passes that update
+/// the best design and the sample (one 128 KiB buffer of values).
+const BATCH: usize = 1 << 14;
+
 /// Outcome of a random search.
 #[derive(Clone, Debug, Serialize)]
 pub struct RandomSearch {
@@ -16,9 +26,19 @@ pub struct RandomSearch {
     pub best: Vec<usize>,
     /// `ln OI_D` of the best design.
     pub best_ln_oid: f64,
-    /// `ln OI_D` of every design, in design order (`-inf` for a singular one).
+    /// Number of the best design (the lowest on ties).
+    pub best_design: usize,
+    /// Designs drawn.
+    pub designs: usize,
+    /// The kept designs are numbers `0, stride, 2·stride, …`: every design
+    /// up to [`SAMPLE_CAP`] of them, else a systematic sample of at most
+    /// that many. The designs are independent draws, so the sample has the
+    /// distribution of all of them.
+    pub stride: usize,
+    /// `ln OI_D` of every kept design, in design order (`-inf` for a
+    /// singular one).
     pub ln_oid: Vec<f64>,
-    /// The paper's OI, eq. (1), of every design (0 for a singular one).
+    /// The paper's OI, eq. (1), of every kept design (0 for a singular one).
     pub oi: Vec<f64>,
 }
 
@@ -111,26 +131,99 @@ pub fn random_search_with_prior(
     designs: usize,
     seed: u64,
 ) -> RandomSearch {
-    let p = pool.p();
-    // Only the values are kept (8 bytes a design); the best design is drawn
-    // again from its own seed, so no design list is held in memory.
-    let ln_oid: Vec<f64> = (0..designs)
-        .into_par_iter()
-        .map(|k| {
-            let d = random_design(&mut design_rng(seed, k as u64), allowed, fixed, n);
-            ln_det_with_prior(pool, prior, &d).unwrap_or(f64::NEG_INFINITY)
-        })
-        .collect();
-    let mut best = 0;
-    for (k, &v) in ln_oid.iter().enumerate() {
-        if v > ln_oid[best] {
-            best = k;
+    sampled_search(pool, prior, allowed, fixed, n, designs, seed, SAMPLE_CAP)
+}
+
+/// The search, keeping at most `cap` designs' values. Designs are evaluated
+/// in parallel batches; the best one is then drawn again from its own seed,
+/// so no design list is held in memory.
+#[allow(clippy::too_many_arguments)]
+fn sampled_search(
+    pool: &Blocks,
+    prior: Option<&Prior>,
+    allowed: &[usize],
+    fixed: &[usize],
+    n: usize,
+    designs: usize,
+    seed: u64,
+    cap: usize,
+) -> RandomSearch {
+    let stride = designs.div_ceil(cap.max(1)).max(1);
+    let mut ln_oid = Vec::with_capacity(designs.div_ceil(stride));
+    let (mut best, mut best_ln_oid) = (0, f64::NEG_INFINITY);
+    let mut batch = vec![0.0; BATCH.min(designs)];
+    for start in (0..designs).step_by(BATCH) {
+        let values = &mut batch[..BATCH.min(designs - start)];
+        values.par_iter_mut().enumerate().for_each(|(i, v)| {
+            let k = (start + i) as u64;
+            let d = random_design(&mut design_rng(seed, k), allowed, fixed, n);
+            *v = ln_det_with_prior(pool, prior, &d).unwrap_or(f64::NEG_INFINITY);
+        });
+        for (i, &v) in values.iter().enumerate() {
+            let k = start + i;
+            if v > best_ln_oid || k == 0 {
+                (best, best_ln_oid) = (k, v);
+            }
+            if k % stride == 0 {
+                ln_oid.push(v);
+            }
         }
     }
+    let p = pool.p();
     RandomSearch {
         best: random_design(&mut design_rng(seed, best as u64), allowed, fixed, n),
-        best_ln_oid: ln_oid[best],
+        best_ln_oid,
+        best_design: best,
+        designs,
+        stride,
         oi: ln_oid.iter().map(|&v| oi_from_ln_oid(v, p)).collect(),
         ln_oid,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 3-level PUMA pool (729 poses).
+    fn pool() -> Blocks {
+        let robot = crate::model::Robot::puma560();
+        let pool = crate::pool::PoolSpec::lattice(3)
+            .build(&robot, &robot.nominal)
+            .unwrap();
+        pool.jacobian(&robot, &robot.nominal)
+    }
+
+    #[test]
+    fn the_sample_is_bounded_and_the_best_is_that_of_every_design() {
+        let x = pool();
+        let all: Vec<usize> = (0..x.n_poses()).collect();
+        let full = sampled_search(&x, None, &all, &[], 30, 1000, 5, usize::MAX);
+        assert_eq!((full.stride, full.ln_oid.len()), (1, 1000));
+        // A cap of 64 keeps every 16th design (1000 / 64 rounded up) ...
+        let s = sampled_search(&x, None, &all, &[], 30, 1000, 5, 64);
+        assert_eq!((s.stride, s.ln_oid.len()), (16, 63));
+        for (j, &v) in s.ln_oid.iter().enumerate() {
+            assert_eq!(
+                v.to_bits(),
+                full.ln_oid[j * 16].to_bits(),
+                "design {}",
+                j * 16
+            );
+        }
+        // ... and finds the same best design among all of them.
+        let max = full
+            .ln_oid
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max);
+        assert_eq!(s.best_ln_oid, max);
+        assert_eq!(full.ln_oid[s.best_design], max);
+        assert_eq!(
+            (s.best.clone(), s.best_design),
+            (full.best, full.best_design)
+        );
+        assert_eq!(ln_det_direct(&x, &s.best), Some(max));
+        assert_eq!(s.oi.len(), s.ln_oid.len());
     }
 }

@@ -474,3 +474,70 @@ fn synthetic_truth_is_recovered_within_three_sigma_panda_points() {
         None,
     );
 }
+
+mod common;
+
+/// `calibrate --out cal.urdf --out cal.yaml`, then `evaluate` of the
+/// calibrated URDF mounted by `--frames cal.yaml` on the same data: the
+/// fitted errors again, with no fitting (the written origins and frames are
+/// the fitted model).
+#[test]
+fn the_written_urdf_and_frames_evaluate_to_the_fitted_errors() {
+    let dir = std::env::temp_dir().join(format!("activecal-frames-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (urdf, yaml) = (dir.join("ur10_cal.urdf"), dir.join("ur10_frames.yaml"));
+    let data = "fixtures/figaroh/ur10_full_pose.csv";
+    let v = common::json_of(&[
+        "calibrate",
+        "--robot",
+        "fixtures/figaroh/ur10_robot.urdf:pose",
+        "--tip",
+        "wrist_3_link",
+        "--measurements",
+        data,
+        "--out",
+        urdf.to_str().unwrap(),
+        "--out",
+        yaml.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(v["out"].as_array().unwrap().len(), 2);
+    // The report's blocks: the frames apart, the joints in URDF terms.
+    let f = &v["frames"];
+    assert_eq!(f["measurement_frame"]["child"], "world");
+    assert_eq!(f["tool"]["parent"], "wrist_3_link");
+    assert_eq!(f["joints"].as_object().unwrap().len(), 6);
+    let e = common::json_of(&[
+        "evaluate",
+        "--robot",
+        &format!("{}:pose", urdf.display()),
+        "--frames",
+        yaml.to_str().unwrap(),
+        "--measurements",
+        data,
+        "--json",
+    ]);
+    let (a, b) = (
+        e["residuals"]["position_rms_mm"].as_f64().unwrap(),
+        v["residuals"]["position_rms_mm"].as_f64().unwrap(),
+    );
+    // Shortest round-trip decimals in both files: the same model, to the
+    // rounding of re-importing it (1e-9 of a few mm).
+    assert!((a - b).abs() < 1e-6, "evaluate {a} mm vs calibrate {b} mm");
+    let (a, b) = (
+        e["residuals"]["orientation_rms_deg"].as_f64().unwrap(),
+        v["residuals"]["orientation_rms_deg"].as_f64().unwrap(),
+    );
+    assert!((a - b).abs() < 1e-6, "evaluate {a}° vs calibrate {b}°");
+    // Read back through the same YAML crate: the numbers are the report's.
+    let back: serde_json::Value = serde_json::to_value(
+        yaml_serde::from_str::<serde_json::Value>(&std::fs::read_to_string(&yaml).unwrap())
+            .unwrap(),
+    )
+    .unwrap();
+    assert_eq!(
+        back["measurement_frame"]["xyz"],
+        f["measurement_frame"]["xyz"]
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

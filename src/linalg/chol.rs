@@ -34,7 +34,12 @@ pub fn ln_det_spd_equilibrated(m: MatRef<'_, f64>) -> Option<f64> {
     if (0..m.nrows()).any(|j| !(m[(j, j)] > 0.0 && m[(j, j)].is_finite())) {
         return None;
     }
-    let (scaled, s) = super::rank::equilibrated(m);
+    // The equilibration scales √M_jj (all positive and finite here): the
+    // same as `rank::equilibration_scales`, computed here so that this
+    // file and `rank.rs` do not import each other.
+    let p = m.nrows();
+    let s: Vec<f64> = (0..p).map(|j| m[(j, j)].sqrt()).collect();
+    let scaled = Mat::from_fn(p, p, |i, j| m[(i, j)] / (s[i] * s[j]));
     Some(ln_det_spd(scaled.as_ref())? + 2.0 * s.iter().map(|v| v.ln()).sum::<f64>())
 }
 

@@ -12,7 +12,7 @@ pub mod sensor;
 pub mod so3;
 pub mod visibility;
 
-pub use sensor::{Observation, ObservationBuf, RowKind, Sensor, sensor_for, sensor_of};
+pub use sensor::{Observation, ObservationBuf, RowKind, Sensor};
 pub use visibility::Visibility;
 
 use crate::kinematics::{Evaluator, Motion};
@@ -89,4 +89,24 @@ impl<'r> JacobianEvaluator<'r> {
             .motion_rows(&end, &self.own, &self.joints, jac, dof);
         end.position
     }
+}
+
+// The dispatcher lives beside the implementations' module declarations,
+// not beside the trait: each sensor file imports the trait, and the trait's
+// file imports none of them.
+/// The sensor of a measurement kind, with the robot's weights.
+#[must_use]
+pub fn sensor_of(kind: crate::model::MeasurementKind, orientation_scale: f64) -> Box<dyn Sensor> {
+    match kind {
+        crate::model::MeasurementKind::Point => Box::new(point::PointSensor::new()),
+        crate::model::MeasurementKind::Pose => Box::new(pose::PoseSensor::new(orientation_scale)),
+        crate::model::MeasurementKind::Markers(k) => Box::new(markers::MarkerSensor::new(k)),
+    }
+}
+
+/// The sensor a robot is measured with ([`Robot::measurement`], weighted by
+/// [`Robot::orientation_scale`]).
+#[must_use]
+pub fn sensor_for(robot: &Robot) -> Box<dyn Sensor> {
+    sensor_of(robot.measurement, robot.orientation_scale)
 }

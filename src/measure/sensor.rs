@@ -28,12 +28,8 @@
 //! Point and pose sensors have no unknowns of their own (`own` is empty).
 
 use crate::kinematics::{EndFrame, Motion};
-use crate::model::{MeasurementKind, Robot};
+use crate::model::MeasurementKind;
 use std::fmt;
-
-use super::markers::MarkerSensor;
-use super::point::PointSensor;
-use super::pose::PoseSensor;
 
 /// What a row of a residual measures, for reports that split errors into
 /// distances and angles.
@@ -69,10 +65,10 @@ pub struct ObservationBuf {
 
 /// A sensor: rows per pose, prediction, residual, Jacobian rows and weights.
 ///
-/// Implementations: [`PointSensor`] (3 rows, the end point),
-/// [`PoseSensor`] (6 rows, the end point and the end frame's orientation)
-/// and [`MarkerSensor`] (`3K` rows, `K` markers with their own offsets).
-/// [`sensor_for`] picks one from [`Robot::measurement`].
+/// Implementations: [`super::point::PointSensor`] (3 rows, the end point),
+/// [`super::pose::PoseSensor`] (6 rows, the end point and the end frame's orientation)
+/// and [`super::markers::MarkerSensor`] (`3K` rows, `K` markers with their own offsets).
+/// [`super::sensor_for`] picks one from [`crate::model::Robot::measurement`].
 ///
 /// The hot path, the pool Jacobian of up to 10⁶ poses, calls
 /// [`Sensor::motion_rows`] once per pose; every other method is per pose or
@@ -93,7 +89,7 @@ pub trait Sensor: fmt::Debug + Send + Sync {
 
     /// Weight of each row: residual and Jacobian rows are multiplied by it so
     /// that every row carries the same noise σ (1 for positions,
-    /// [`Robot::orientation_scale`] for orientations).
+    /// [`crate::model::Robot::orientation_scale`] for orientations).
     fn weights(&self) -> &[f64];
 
     /// Degrees of freedom of the end frame the sensor observes (3 for a
@@ -188,21 +184,4 @@ pub trait Sensor: fmt::Debug + Send + Sync {
     fn own_rows(&self, end: &EndFrame, own: &[f64], out: &mut [f64], ld: usize) {
         let _ = (end, own, out, ld);
     }
-}
-
-/// The sensor of a measurement kind, with the robot's weights.
-#[must_use]
-pub fn sensor_of(kind: MeasurementKind, orientation_scale: f64) -> Box<dyn Sensor> {
-    match kind {
-        MeasurementKind::Point => Box::new(PointSensor::new()),
-        MeasurementKind::Pose => Box::new(PoseSensor::new(orientation_scale)),
-        MeasurementKind::Markers(k) => Box::new(MarkerSensor::new(k)),
-    }
-}
-
-/// The sensor a robot is measured with ([`Robot::measurement`], weighted by
-/// [`Robot::orientation_scale`]).
-#[must_use]
-pub fn sensor_for(robot: &Robot) -> Box<dyn Sensor> {
-    sensor_of(robot.measurement, robot.orientation_scale)
 }

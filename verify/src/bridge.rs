@@ -14,6 +14,7 @@ use anyhow::{Context, Result, bail};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyModule};
+use serde::{Deserialize, Serialize};
 use std::ffi::CString;
 use std::path::{Path, PathBuf};
 
@@ -211,6 +212,16 @@ impl Bridge {
 }
 
 /// A placement as the bridge passes it: (rotation row-major, translation).
+/// A placement: rotation (row-major; its columns are the frame's axes) and
+/// position.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Placement {
+    /// Rotation, row-major.
+    pub rotation: [[f64; 3]; 3],
+    /// Position (metres).
+    pub position: [f64; 3],
+}
+
 type PyPlacement = ([[f64; 3]; 3], [f64; 3]);
 
 /// activecal's joint kinds as bridge.py's names.
@@ -326,7 +337,7 @@ impl Bridge {
         tip: &str,
         names: &[String],
         qs: &[Vec<f64>],
-    ) -> Result<Vec<crate::erd_fk::Placement>> {
+    ) -> Result<Vec<Placement>> {
         Python::attach(|py| {
             let r = module(py)?
                 .getattr("urdf_relative_poses")?
@@ -350,7 +361,7 @@ impl Bridge {
             }
             Ok(poses
                 .into_iter()
-                .map(|(rotation, position)| crate::erd_fk::Placement { rotation, position })
+                .map(|(rotation, position)| Placement { rotation, position })
                 .collect())
         })
     }

@@ -45,15 +45,7 @@ pub const REFERENCE: &str = "Pinocchio buildModelFromUrdf + framesForwardKinemat
      (base: the URDF's root when null); rotation row-major (columns: the tip's axes), \
      position in metres";
 
-/// A placement: rotation (row-major; its columns are the frame's axes) and
-/// position.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Placement {
-    /// Rotation, row-major.
-    pub rotation: [[f64; 3]; 3],
-    /// Position (metres).
-    pub position: [f64; 3],
-}
+pub use crate::bridge::Placement;
 
 /// Largest deviation between two lists of placements.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
@@ -131,6 +123,7 @@ pub fn robot_name(arm: &Arm, path: &Path) -> String {
         base: arm.base.map(str::to_string),
         tip: Some(arm.tip.to_string()),
         lock: arm.lock.iter().map(|&(n, v)| (n.to_string(), v)).collect(),
+        frames: None,
     };
     format!("{}{}", path.display(), choice.fragment())
 }

@@ -6,8 +6,9 @@
 use super::emit_report;
 use activecal::identify::evaluation::ModelErrors;
 use activecal::identify::{
-    Fit, HoldoutSettings, Identification, LmSettings, LossChoice, Measurements, ParameterTrust,
-    SplitResult, fit, for_measurements, holdout, residuals, trust, with_fixed_and_free,
+    Fit, FixedParameter, HoldoutSettings, Identification, LmSettings, LossChoice, Measurements,
+    ParameterTrust, SplitResult, fit, for_measurements, holdout, prepare_for_data, residuals,
+    trust,
 };
 use activecal::model::Robot;
 use anyhow::{Result, bail};
@@ -52,14 +53,22 @@ pub fn loss_choice(kind: LossKind, scale: Option<f64>) -> Result<LossChoice> {
     })
 }
 
-/// Reads a measurement file (CSV or JSON) for `robot`, printing its notes to
-/// stderr unless `quiet`.
+/// Reads a measurement file (CSV or JSON) for `robot` in `units`, printing
+/// its notes to stderr unless `quiet`; positions beyond the robot's reach
+/// are refused ([`activecal::identify::evaluation::check_in_reach`]).
 pub fn read_measurements(
     path: &Path,
     robot: &Robot,
+    units: activecal::units::Units,
     quiet: bool,
 ) -> Result<(Measurements, Vec<String>)> {
-    let f = activecal::io::measurements::read(path, robot)?;
+    let f = activecal::io::measurements::read_in(path, robot, units)?;
+    activecal::identify::evaluation::check_in_reach(
+        robot,
+        &f.measurements,
+        &path.display().to_string(),
+        units.length,
+    )?;
     if !quiet {
         for n in &f.notes {
             eprintln!("note: {n}");
@@ -82,6 +91,8 @@ pub struct MeasuredOptions<'a> {
     pub holdout: Option<HoldoutSettings>,
     /// JSON output (notes to stderr are silenced).
     pub json: bool,
+    /// Units of the measurement file.
+    pub units: activecal::units::Units,
 }
 
 /// `calibrate --measurements`' JSON report.
@@ -98,6 +109,8 @@ pub struct MeasuredReport {
     pub nominal_residuals: ModelErrors,
     /// Each parameter's estimate, change, σ, t and verdict.
     pub parameters: Vec<ParameterTrust>,
+    /// Unknowns the data do not determine, fixed at nominal, with why.
+    pub fixed: Vec<FixedParameter>,
     /// Poses the robust loss down-weighted: `[pose, weight]`.
     pub downweighted: Vec<(usize, f64)>,
     /// Held-out validation, if asked.
@@ -203,7 +216,7 @@ pub fn calibrate_measured(
     o: &MeasuredOptions<'_>,
     elapsed: &dyn Fn() -> f64,
 ) -> Result<(Robot, Fit, MeasuredReport)> {
-    let (meas, mut notes) = read_measurements(path, robot, o.json)?;
+    let (meas, mut notes) = read_measurements(path, robot, o.units, o.json)?;
     let start = for_measurements(robot, &meas, &o.lm)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     notes.extend(start.notes.iter().cloned());
@@ -212,7 +225,8 @@ pub fn calibrate_measured(
             eprintln!("note: {n}");
         }
     }
-    let r = with_fixed_and_free(&start.robot, o.fix, o.free)?;
+    let det = prepare_for_data(&start.robot, &start.table, &meas, o.fix, o.free)?;
+    let r = det.robot;
     let f = fit(&r, &start.table, &meas, &o.lm, o.loss)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let res = residuals(&r, &f.id.table, &meas)?;
@@ -221,7 +235,9 @@ pub fn calibrate_measured(
     let ho = match &o.holdout {
         Some(h) => {
             let (fix, free) = (o.fix.to_vec(), o.free.to_vec());
-            let prep = move |x: &Robot| with_fixed_and_free(x, &fix, &free);
+            let prep = move |x: &Robot, t: &activecal::model::ParamTable, m: &Measurements| {
+                prepare_for_data(x, t, m, &fix, &free).map(|d| d.robot)
+            };
             Some(holdout_report(
                 *h,
                 holdout(robot, &meas, &o.lm, o.loss, h, &prep)?,
@@ -242,6 +258,7 @@ pub fn calibrate_measured(
         residuals: res,
         nominal_residuals: nominal,
         parameters: params,
+        fixed: det.fixed,
         downweighted: f.downweighted(),
         holdout: ho,
         notes,
@@ -258,6 +275,15 @@ pub fn measured_text(r: &MeasuredReport, id: &Identification, status: &str) -> S
         r.base.measurement.name(),
         id.names.len()
     );
+    if !r.fixed.is_empty() {
+        s += &format!(
+            "fixed at nominal, not determined by these data ({}):\n",
+            r.fixed.len()
+        );
+        for f in &r.fixed {
+            s += &format!("  {} = {:.6} ({})\n", f.name, f.value, f.reason);
+        }
+    }
     s += &format!("fitted:  {}\n", r.residuals.summary());
     s += &format!("nominal: {}\n", r.nominal_residuals.summary());
     if !r.downweighted.is_empty() {
@@ -344,6 +370,9 @@ pub struct EvaluateArgs {
     /// qw1…qz1, one column per joint by name) or JSON.
     #[arg(long)]
     pub measurements: std::path::PathBuf,
+    /// Units of the measurement file.
+    #[command(flatten)]
+    pub units: super::units::UnitOpts,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -363,7 +392,7 @@ struct EvaluateReport {
 /// Runs `evaluate`: the model's errors on the data, no fitting.
 pub fn cmd_evaluate(a: EvaluateArgs) -> Result<()> {
     let robot = super::load_robot(&a.robot)?;
-    let (meas, notes) = read_measurements(&a.measurements, &robot, a.json)?;
+    let (meas, notes) = read_measurements(&a.measurements, &robot, a.units.units(), a.json)?;
     let res = residuals(&robot, &robot.nominal, &meas).map_err(|e| {
         anyhow::anyhow!(
             "{}: {e}{}",

@@ -199,6 +199,21 @@ pub fn with_fixed_and_free(robot: &Robot, fix: &[String], free: &[String]) -> Re
     Ok(r)
 }
 
+/// The robot a data set is fitted as: `fix` and `free` applied
+/// ([`with_fixed_and_free`]), then the unknowns `meas` do not determine at
+/// `start` fixed with a reason ([`super::fix_undetermined`]; never one
+/// named in `free`).
+pub fn prepare_for_data(
+    robot: &Robot,
+    start: &ParamTable,
+    meas: &Measurements,
+    fix: &[String],
+    free: &[String],
+) -> Result<super::Determined> {
+    let r = with_fixed_and_free(robot, fix, free)?;
+    super::fix_undetermined(&r, start, meas, free)
+}
+
 fn setting(option: &'static str, name: &str, reason: &'static str) -> IdentifyError {
     IdentifyError::Setting {
         name: option,
@@ -241,15 +256,15 @@ pub struct SplitResult {
 
 /// Fits on a random `1 − fraction` of the poses and evaluates on the rest,
 /// `splits` times. `prepare` turns the robot adapted to the data
-/// ([`for_measurements`]) into the one fitted (e.g.
-/// [`with_fixed_and_free`]).
+/// ([`for_measurements`]), its start table and the training poses into the
+/// one fitted (e.g. [`prepare_for_data`]).
 pub fn holdout(
     robot: &Robot,
     meas: &Measurements,
     lm: &LmSettings,
     loss: LossChoice,
     settings: &HoldoutSettings,
-    prepare: &dyn Fn(&Robot) -> Result<Robot>,
+    prepare: &dyn Fn(&Robot, &ParamTable, &Measurements) -> Result<Robot>,
 ) -> Result<Vec<SplitResult>> {
     let n = meas.len();
     let test = (settings.fraction * n as f64).round() as usize;
@@ -278,7 +293,7 @@ pub fn holdout(
         te.sort_unstable();
         let (mtr, mte) = (meas.subset(&tr), meas.subset(&te));
         let start = for_measurements(robot, &mtr, lm)?;
-        let r = prepare(&start.robot)?;
+        let r = prepare(&start.robot, &start.table, &mtr)?;
         let f = fit(&r, &start.table, &mtr, lm, loss)?;
         let fitted = residuals(&r, &f.id.table, &mtr)?;
         let held_out = residuals(&r, &f.id.table, &mte)?;

@@ -93,22 +93,29 @@ pub struct Units {
 /// Absolute slack on a joint limit, radians or metres: a value printed with
 /// six decimals (`%.6f`, a common export) is within 5e-7 of what was meant,
 /// and a limit of 2π written as `6.283185` in a URDF is 3.1e-7 below the
-/// 2π a controller reports; 1e-6 lets both pass. A unit mix-up misses the
-/// limits by orders of magnitude more (a degree value of 7 against a limit
-/// of 6.283185).
+/// 2π a controller reports; 1e-6 lets both pass (it matters for joints of
+/// zero or tiny range).
 pub const LIMIT_ABS_TOL: f64 = 1e-6;
 
-/// Relative slack on a joint limit (of the limit's magnitude): a value
-/// stored in single precision (as many controllers log joint readings) is
-/// off by up to 6e-8 of itself (half of f32's 1.19e-7 epsilon); 1e-7
-/// covers it.
-pub const LIMIT_REL_TOL: f64 = 1e-7;
+/// Slack on a joint limit relative to the joint's range `hi − lo`. Joint
+/// values that are right can lie past a model's limits: real readings
+/// overshoot a URDF's limits (FIGAROH's TIAGo torso reads 0.35018 m against
+/// an upper limit of 0.35 m, 0.05 % of its range), and the built-in arms'
+/// limits are working ranges chosen for pose pools, narrower than the
+/// hardware's (the UR5's q2 ∈ [−180°, 0] against the datasheet's ±360°;
+/// `tests/real_data.rs` round-trips measurements with q2 = 0.5 rad, 16 %
+/// of the range past its limit). A unit error misses by a factor instead:
+/// degrees read as radians are 57.3 times too large, millimetres read as
+/// metres 1000 times, which puts a column past its limits by far more than
+/// a fifth of the range unless every angle in it is within a few degrees of
+/// zero (FIGAROH's UR10 in degrees: 143 against ±6.28, 11 ranges past).
+pub const LIMIT_REL_TOL: f64 = 0.2;
 
 /// How far past a joint's limits `[lo, hi]` a value may lie and still be
-/// accepted: [`LIMIT_ABS_TOL`] + [`LIMIT_REL_TOL`] · max(|lo|, |hi|).
+/// accepted: [`LIMIT_ABS_TOL`] + [`LIMIT_REL_TOL`] · (hi − lo).
 #[must_use]
 pub fn limit_tolerance(lo: f64, hi: f64) -> f64 {
-    LIMIT_ABS_TOL + LIMIT_REL_TOL * lo.abs().max(hi.abs())
+    LIMIT_ABS_TOL + LIMIT_REL_TOL * (hi - lo).abs()
 }
 
 /// Where joint values come from, for messages.
@@ -378,7 +385,10 @@ mod tests {
             rows: &rows,
             columns: &cols,
         };
-        let mut q = vec![vec![1.0; 6], vec![1.0, 1.0, 143.0, 1.0, 1.0, 1.0]];
+        let mut q = vec![
+            vec![1.0, -1.0, 1.0, 1.0, 1.0, 1.0],
+            vec![1.0, -1.0, 143.0, 1.0, 1.0, 1.0],
+        ];
         let e = joint_values_to_model_units(&r, Units::default(), &src, &mut q).unwrap_err();
         assert!(matches!(
             e,
@@ -394,17 +404,21 @@ mod tests {
         );
         assert!(s.contains("degrees"), "{s}");
         // 1000 fits no unit: no hint.
-        let mut q = vec![vec![1.0, 1.0, 1000.0, 1.0, 1.0, 1.0]];
+        let mut q = vec![vec![1.0, -1.0, 1000.0, 1.0, 1.0, 1.0]];
         let e = joint_values_to_model_units(&r, Units::default(), &src, &mut q).unwrap_err();
         assert!(matches!(e, Error::JointOutOfLimits { hint: None, .. }));
     }
 
     #[test]
-    fn the_tolerance_admits_six_decimals_and_not_more() {
+    fn the_tolerance_is_a_fifth_of_the_range_and_not_more() {
         let r = Robot::builtin("ur5").unwrap();
-        let [_, hi] = r.limits[0];
-        let tol = limit_tolerance(-hi, hi);
-        assert!(tol > 5e-7 && tol < 2e-6, "{tol}");
+        // Joint 2: [−π, 0], a working range.
+        let [lo, hi] = r.limits[1];
+        let tol = limit_tolerance(lo, hi);
+        assert!(
+            (tol - 1e-6 - 0.2 * std::f64::consts::PI).abs() < 1e-12,
+            "{tol}"
+        );
         let cols: Vec<String> = (1..=6).map(|j| format!("q{j}")).collect();
         let rows = rows(1);
         let src = JointSource {
@@ -412,9 +426,11 @@ mod tests {
             rows: &rows,
             columns: &cols,
         };
-        let mut ok = vec![vec![hi + 0.9 * tol, 0.0, 0.0, 0.0, 0.0, 0.0]];
+        let mut ok = vec![vec![0.0, hi + 0.99 * tol, 0.0, 0.0, 0.0, 0.0]];
         joint_values_to_model_units(&r, Units::default(), &src, &mut ok).unwrap();
-        let mut bad = vec![vec![hi + 1.1 * tol, 0.0, 0.0, 0.0, 0.0, 0.0]];
+        let mut bad = vec![vec![0.0, hi + 1.01 * tol, 0.0, 0.0, 0.0, 0.0]];
+        assert!(joint_values_to_model_units(&r, Units::default(), &src, &mut bad).is_err());
+        let mut bad = vec![vec![0.0, lo - 1.01 * tol, 0.0, 0.0, 0.0, 0.0]];
         assert!(joint_values_to_model_units(&r, Units::default(), &src, &mut bad).is_err());
     }
 }

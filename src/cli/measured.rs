@@ -225,7 +225,8 @@ pub fn calibrate_measured(
             eprintln!("note: {n}");
         }
     }
-    let det = prepare_for_data(&start.robot, &start.table, &meas, o.fix, o.free)?;
+    let det = prepare_for_data(&start.robot, &start.table, &meas, o.fix, o.free)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let r = det.robot;
     let f = fit(&r, &start.table, &meas, &o.lm, o.loss)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;

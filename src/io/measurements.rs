@@ -76,6 +76,15 @@ pub fn read_in(path: &Path, robot: &Robot, units: Units) -> Result<MeasurementFi
                 path: origin.clone(),
                 message: e.to_string(),
             })?;
+        if let Some(name) = measurements.robot().filter(|n| *n != robot.name) {
+            return Err(Error::Parse {
+                path: origin,
+                message: format!(
+                    "the measurements are of robot '{name}', not '{}'",
+                    robot.name
+                ),
+            });
+        }
         let rows: Vec<String> = (0..measurements.len())
             .map(|k| format!("qs[{k}] (row {})", k + 1))
             .collect();
@@ -304,10 +313,10 @@ mod tests {
 
     #[test]
     fn rpy_is_rz_ry_rx_and_joints_match_by_name_in_any_order() {
-        let text = "q6,q5,q4,q3,q2,q1,x1,y1,z1,phix1,phiy1,phiz1,temp\n6,5,4,3,2,1,0.1,0.2,0.3,0.3,-0.2,1.1,20\n";
+        let text = "q6,q5,q4,q3,q2,q1,x1,y1,z1,phix1,phiy1,phiz1,temp\n0.6,0.5,0.4,0.3,-0.2,0.1,0.1,0.2,0.3,0.3,-0.2,1.1,20\n";
         let f = parse_csv_measurements(text, "m.csv", &ur5()).unwrap();
         let m = &f.measurements;
-        assert_eq!(m.qs()[0], [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+        assert_eq!(m.qs()[0], [0.1, -0.2, 0.3, 0.4, 0.5, 0.6]);
         assert_eq!(m.points()[0], [0.1, 0.2, 0.3]);
         let (x, y, z) = (0.3f64, -0.2f64, 1.1f64);
         let rz = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::z_axis(), z);

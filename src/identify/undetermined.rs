@@ -11,10 +11,11 @@
 //! 1. always kept: the sensor's own marker offsets and the parameters the
 //!    caller forces free (`--free`);
 //! 2. the other unknowns;
-//! 3. the unknowns of frames driven by a joint that never moves in these
-//!    data (its column constant over the rows) — pivoted last, so that a
-//!    frozen joint's own parameters are the ones fixed and the reason can
-//!    name the joint.
+//! 3. the unknowns of the frames that move or place the axis of a joint
+//!    that never moves in these data (its column constant over the rows):
+//!    the frame it drives and the frames before it up to the previous
+//!    driven one — pivoted last, so that those are the parameters fixed
+//!    and the reason can name the joint.
 //!
 //! A column whose remaining norm is at or below [`PIVOT_TOL`] is not
 //! determined. The kept set is then checked with the rank rule itself, and
@@ -140,11 +141,20 @@ pub fn frozen_joints(robot: &Robot, meas: &Measurements) -> Vec<bool> {
         .collect()
 }
 
-/// The frozen joint that drives the frame of unknown `k`, if any.
+/// The frozen joint whose axis the frame of unknown `k` moves or places, if
+/// any: the frame driven by a joint `j` that never moves, or a frame whose
+/// next driven frame is `j`'s (it places axis `j`: with `j` frozen, where
+/// that axis lies is not seen, only the fixed transform through it).
 fn frozen_frame_joint(robot: &Robot, k: usize, frozen: &[bool]) -> Option<usize> {
     let u = robot.unknowns.get(k)?;
-    let j = robot.frames[u.frame].joint?;
-    frozen.get(j).copied().unwrap_or(false).then_some(j)
+    let is_frozen = |j: usize| frozen.get(j).copied().unwrap_or(false);
+    if let Some(j) = robot.frames[u.frame].joint
+        && is_frozen(j)
+    {
+        return Some(j);
+    }
+    let next = robot.frames[u.frame + 1..].iter().find_map(|f| f.joint)?;
+    is_frozen(next).then_some(next)
 }
 
 /// The identification Jacobian of `meas` at `start` (all parameters).
@@ -206,7 +216,12 @@ fn pivoted_selection(x: &Mat<f64>, group: &[usize]) -> Vec<usize> {
         }
     }
     // The rank rule itself on the kept columns: drop the last pivots that
-    // are not forced until it passes.
+    // are not forced until it passes — unless the forced columns alone fail
+    // it (what the caller forces free is the caller's: the fit says).
+    let forced: Vec<usize> = kept.iter().copied().filter(|&c| group[c] == 0).collect();
+    if !forced.is_empty() && !passes_rank_rule(x, &forced) {
+        return kept;
+    }
     while kept.len() > 1 && !passes_rank_rule(x, &kept) {
         match kept.iter().rposition(|&c| group[c] > 0) {
             Some(i) => {

@@ -57,6 +57,14 @@ const BOX_OK: &str = r#"{"kind":"box","min":[-30,-30,-30],"max":[30,30,30]}"#;
 
 const TIAGO: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/figaroh/tiago.urdf");
 const UR5: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/ur5.urdf");
+const UR10_POSE: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/fixtures/figaroh/ur10_robot.urdf:pose"
+);
+const UR10_CSV: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/fixtures/figaroh/ur10_full_pose.csv"
+);
 
 /// The table. Files named here are made by [`scratch`]: `d.json` a valid
 /// 3-level PUMA design, `m.json` its measurements, and broken variants.
@@ -245,6 +253,35 @@ const CASES: &[Case] = &[
         &["fk", "--q", "0,0,0"],
         1,
         &["expected 6 joint angles, got 3"],
+    ),
+    // The wrong joint count names the joints expected, in order.
+    case(
+        &["fk", "--robot", UR5, "--q", "0,0,0"],
+        1,
+        &[
+            "expected 6 joint angles, got 3",
+            "shoulder_pan_joint, shoulder_lift_joint, elbow_joint, wrist_1_joint",
+        ],
+    ),
+    // An unknown --fix name: the closest valid name, then all of them.
+    case(
+        &[
+            "--tip",
+            "wrist_3_link",
+            "calibrate",
+            "--robot",
+            UR10_POSE,
+            "--measurements",
+            UR10_CSV,
+            "--fix",
+            "gamma_elbow_jiont",
+        ],
+        1,
+        &[
+            "--fix gamma_elbow_jiont",
+            "did you mean gamma_elbow_joint?",
+            "the valid names are gamma_base, ",
+        ],
     ),
     case(&["fk", "--q", "0,0,0,0,0,x"], 1, &["--q: cannot parse 'x'"]),
     case(

@@ -175,7 +175,14 @@ pub fn with_fixed_and_free(robot: &Robot, fix: &[String], free: &[String]) -> Re
                 "marker offsets are always estimated",
             ));
         }
-        let id = robot.param_id(name)?;
+        let unknowns: Vec<String> = robot
+            .unknowns
+            .iter()
+            .map(|&u| robot.param_name(u))
+            .collect();
+        let id = robot
+            .param_id(name)
+            .map_err(|_| unknown_name("--fix", name, &unknowns))?;
         let Some(pos) = ids.iter().position(|&u| u == id) else {
             return Err(setting(
                 "--fix",
@@ -186,7 +193,14 @@ pub fn with_fixed_and_free(robot: &Robot, fix: &[String], free: &[String]) -> Re
         ids.remove(pos);
     }
     for name in free {
-        let id = robot.param_id(name)?;
+        let id = robot.param_id(name).map_err(|_| {
+            let all: Vec<String> = robot
+                .candidate_unknowns()
+                .into_iter()
+                .map(|u| robot.param_name(u))
+                .collect();
+            unknown_name("--free", name, &all)
+        })?;
         if !ids.contains(&id) {
             ids.push(id);
         }
@@ -212,6 +226,44 @@ pub fn prepare_for_data(
 ) -> Result<super::Determined> {
     let r = with_fixed_and_free(robot, fix, free)?;
     super::fix_undetermined(&r, start, meas, free)
+}
+
+/// An unknown parameter name given to `option`: the closest valid names
+/// (by edit distance) and the whole list.
+fn unknown_name(option: &str, name: &str, valid: &[String]) -> IdentifyError {
+    let mut by: Vec<(usize, &String)> = valid.iter().map(|v| (edit_distance(name, v), v)).collect();
+    by.sort();
+    let best = by.first().map_or(usize::MAX, |b| b.0);
+    let close: Vec<&str> = by
+        .iter()
+        .filter(|(d, _)| *d == best && *d <= name.len().max(3) / 2 + 1)
+        .map(|(_, v)| v.as_str())
+        .collect();
+    let mean = if close.is_empty() {
+        String::new()
+    } else {
+        format!(" (did you mean {}?)", close.join(" or "))
+    };
+    IdentifyError::Model(crate::Error::Invalid(format!(
+        "{option} {name}: not a parameter of this robot{mean}; the valid names are {}",
+        valid.join(", ")
+    )))
+}
+
+/// Levenshtein distance between two names (characters).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, &cb) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(ca != cb))
+                .min(prev[j + 1] + 1)
+                .min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
 }
 
 fn setting(option: &'static str, name: &str, reason: &'static str) -> IdentifyError {

@@ -120,6 +120,61 @@ pub enum Error {
         /// Its size.
         needed: String,
     },
+    /// A joint value outside its joint's limits by more than
+    /// [`crate::units::limit_tolerance`] (see [`crate::units`]).
+    #[error(
+        "{file}: {row}, column '{column}'{}: {} {unit} is outside the joint's limits [{}, {}] {unit} (by more than the tolerance {:.1e} {unit}){}",
+        if column == joint { String::new() } else { format!(" (joint '{joint}')") },
+        Compact(*.value),
+        Compact(*.lo),
+        Compact(*.hi),
+        tolerance,
+        hint.map_or(String::new(), |h| format!("; {}", h.column_text()))
+    )]
+    JointOutOfLimits {
+        /// The file (or option) that gave the value.
+        file: String,
+        /// The row, in the file's terms (`line 5`, `qs[3]`).
+        row: String,
+        /// The column's name.
+        column: String,
+        /// The joint's name.
+        joint: String,
+        /// The value, in the unit the file was read in.
+        value: f64,
+        /// That unit's symbol.
+        unit: &'static str,
+        /// Lower limit, in that unit.
+        lo: f64,
+        /// Upper limit, in that unit.
+        hi: f64,
+        /// The accepted slack, in that unit.
+        tolerance: f64,
+        /// The unit the whole column would fit in, if another.
+        hint: Option<UnitHint>,
+    },
+    /// Measured positions whose nominal residuals are far beyond the robot's
+    /// reach ([`crate::units::check_positions_in_reach`]).
+    #[error(
+        "{file}: the measured positions are {} m (RMS) from where the nominal model puts them, more than {factor} times the robot's reach of {} m (positions read in {unit}){}",
+        Compact(*.rms),
+        Compact(*.reach),
+        hint.map_or(String::new(), |h| format!("; {}", h.position_text(unit)))
+    )]
+    PositionsBeyondReach {
+        /// The measurement file.
+        file: String,
+        /// The nominal RMS residual, metres (after reading in `unit`).
+        rms: f64,
+        /// The robot's reach, metres ([`crate::units::reach`]).
+        reach: f64,
+        /// The factor of the reach allowed.
+        factor: f64,
+        /// The length unit the positions were read in.
+        unit: &'static str,
+        /// The unit they would pass in, if another.
+        hint: Option<UnitHint>,
+    },
     /// Any other invalid argument, with a message saying what and why.
     #[error("{0}")]
     Invalid(String),
@@ -141,6 +196,54 @@ pub enum Error {
         /// What is wrong, with its place.
         message: String,
     },
+}
+
+/// The unit a file's values look like when they fail in the unit they were
+/// read in (see [`crate::units`]); the command line names the option.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UnitHint {
+    /// Angles in degrees, read as radians.
+    Degrees,
+    /// Angles in radians, read as degrees.
+    Radians,
+    /// Lengths in millimetres, read as metres.
+    Millimetres,
+    /// Lengths in metres, read as millimetres.
+    Metres,
+}
+
+impl UnitHint {
+    /// What a joint column that fits in this unit looks like.
+    #[must_use]
+    pub fn column_text(self) -> &'static str {
+        match self {
+            UnitHint::Degrees => {
+                "every value of this column fits the limits after a degree→radian conversion: it looks like degrees"
+            }
+            UnitHint::Radians => {
+                "every value of this column fits the limits as radians: it looks like radians, not degrees"
+            }
+            UnitHint::Millimetres => {
+                "every value of this column fits the limits after a millimetre→metre conversion: it looks like millimetres"
+            }
+            UnitHint::Metres => {
+                "every value of this column fits the limits as metres: it looks like metres, not millimetres"
+            }
+        }
+    }
+
+    /// What positions that pass in this unit look like.
+    #[must_use]
+    pub fn position_text(self, read_as: &str) -> String {
+        match self {
+            UnitHint::Millimetres | UnitHint::Degrees => format!(
+                "read as millimetres they are within reach: the positions look like millimetres (read as {read_as})"
+            ),
+            UnitHint::Metres | UnitHint::Radians => format!(
+                "read as metres they are within reach: the positions look like metres (read as {read_as})"
+            ),
+        }
+    }
 }
 
 /// Result with the crate's [`Error`].

@@ -26,5 +26,6 @@ pub mod progress;
 pub mod report;
 pub mod resources;
 pub mod select;
+pub mod units;
 
 pub use error::{Error, Result};

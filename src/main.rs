@@ -129,6 +129,14 @@ fn main() {
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");
-        std::process::exit(1);
+        if let Some(h) = cli::units::flag_hint(&e) {
+            eprintln!("hint: {h}");
+        }
+        let not_converged = e.downcast_ref::<cli::calibrate::NotConverged>().is_some();
+        std::process::exit(if not_converged {
+            cli::calibrate::EXIT_NOT_CONVERGED
+        } else {
+            1
+        });
     }
 }

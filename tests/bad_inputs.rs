@@ -89,6 +89,14 @@ const TIAGO_ARM: &str = concat!(
 );
 /// The address-space limit: 2,000,000 KiB (2.05 GB).
 const ULIMIT_2G: u64 = 2_000_000;
+const UR10_POSE: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/fixtures/figaroh/ur10_robot.urdf:pose"
+);
+const UR10_CSV: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/fixtures/figaroh/ur10_full_pose.csv"
+);
 
 /// The table. Files named here are made by [`scratch`]: `d.json` a valid
 /// 3-level PUMA design, `m.json` its measurements, and broken variants.
@@ -318,6 +326,35 @@ const CASES: &[Case] = &[
         &["fk", "--q", "0,0,0"],
         1,
         &["expected 6 joint angles, got 3"],
+    ),
+    // The wrong joint count names the joints expected, in order.
+    case(
+        &["fk", "--robot", UR5, "--q", "0,0,0"],
+        1,
+        &[
+            "expected 6 joint angles, got 3",
+            "shoulder_pan_joint, shoulder_lift_joint, elbow_joint, wrist_1_joint",
+        ],
+    ),
+    // An unknown --fix name: the closest valid name, then all of them.
+    case(
+        &[
+            "--tip",
+            "wrist_3_link",
+            "calibrate",
+            "--robot",
+            UR10_POSE,
+            "--measurements",
+            UR10_CSV,
+            "--fix",
+            "gamma_elbow_jiont",
+        ],
+        1,
+        &[
+            "--fix gamma_elbow_jiont",
+            "did you mean gamma_elbow_joint?",
+            "the valid names are gamma_base, ",
+        ],
     ),
     case(&["fk", "--q", "0,0,0,0,0,x"], 1, &["--q: cannot parse 'x'"]),
     case(

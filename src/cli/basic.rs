@@ -39,12 +39,17 @@ pub struct FkArgs {
     /// Parameter set.
     #[arg(long, value_enum, default_value_t = ParamSet::Nominal)]
     pub params: ParamSet,
-    /// Joint angles, comma separated (radians, or degrees with --deg).
+    /// Joint values, comma separated, in joint order (radians and metres,
+    /// or as --angle-unit and --length-unit say); checked against the
+    /// joint limits.
     #[arg(long, allow_hyphen_values = true)]
     pub q: String,
-    /// Angles are in degrees.
+    /// Angles are in degrees (the same as --angle-unit deg).
     #[arg(long)]
     pub deg: bool,
+    /// Units of --q.
+    #[command(flatten)]
+    pub units: super::units::UnitOpts,
     /// Also print the identification Jacobian (t × p: 3 rows for a point, 6 for a pose).
     #[arg(long)]
     pub jacobian: bool,
@@ -177,10 +182,35 @@ pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
 /// Runs `fk`.
 pub fn cmd_fk(a: FkArgs) -> Result<()> {
     let robot = load_robot(&a.robot)?;
-    let mut q: Vec<f64> = parse_list(&a.q, "--q")?;
-    if a.deg {
-        q.iter_mut().for_each(|v| *v = v.to_radians());
+    let q: Vec<f64> = parse_list(&a.q, "--q")?;
+    let names = activecal::units::joint_names(&robot);
+    if q.len() != robot.dof() {
+        anyhow::bail!(
+            "--q: expected {} joint angles, got {}: the joints of {} are, in order, {}",
+            robot.dof(),
+            q.len(),
+            robot.name,
+            names.join(", ")
+        );
     }
+    robot.check_q(&q)?;
+    let mut units = a.units.units();
+    if a.deg {
+        units.angle = activecal::units::AngleUnit::Deg;
+    }
+    let mut qs = vec![q];
+    let rows = ["the joint vector".to_string()];
+    activecal::units::joint_values_to_model_units(
+        &robot,
+        units,
+        &activecal::units::JointSource {
+            file: "--q",
+            rows: &rows,
+            columns: &names,
+        },
+        &mut qs,
+    )?;
+    let q = qs.pop().expect("one joint vector");
     let r = FkReport::new(&robot, a.params, q, a.jacobian)?;
     emit_report(a.json, &r, || {
         let [x, y, z] = r.position;

@@ -144,7 +144,7 @@ pub fn cmd_bound(a: BoundArgs) -> Result<()> {
     let existing = a
         .existing
         .as_deref()
-        .map(|p| super::load_existing(p, &ctx.robot, a.pool.params))
+        .map(|p| super::load_existing(p, &ctx.robot, a.pool.params, a.pool.units.units()))
         .transpose()?;
     let prior = existing.as_ref().map(|e| &e.prior);
     let b = relaxation_bound_with_prior(&ctx.x, prior, a.n, &settings)?;

@@ -107,6 +107,9 @@ pub struct CalibrateArgs {
     /// |t| >= 2 and compare held-out errors.
     #[arg(long, requires = "holdout")]
     pub compare_pruned: bool,
+    /// Units of the --measurements file.
+    #[command(flatten)]
+    pub units: super::units::UnitOpts,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -163,21 +166,59 @@ fn write_calibrated(
     Ok(written)
 }
 
-/// After the report is printed: an error (exit 1) when `--out` was asked for
-/// but the estimate did not converge, so that no script mistakes it for a
-/// calibrated model.
+/// The exit status of a calibration whose fit did not converge or is rank
+/// deficient (0: converged, 1: an error, 2: a usage error).
+pub const EXIT_NOT_CONVERGED: i32 = 3;
+
+/// A calibration that ran but whose fit did not converge: the report is
+/// printed, and the process exits with [`EXIT_NOT_CONVERGED`].
+#[derive(Debug)]
+pub struct NotConverged(pub String);
+
+impl std::fmt::Display for NotConverged {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for NotConverged {}
+
+/// The exit status a calibration ends with: 0 or [`EXIT_NOT_CONVERGED`].
+fn exit_status(id: &Identification) -> i32 {
+    if id.converged() {
+        0
+    } else {
+        EXIT_NOT_CONVERGED
+    }
+}
+
+/// After the report is printed: a [`NotConverged`] error (exit status
+/// [`EXIT_NOT_CONVERGED`]) with the reason when the estimate did not
+/// converge, so that no script mistakes it for a calibrated model; with
+/// `--out`, the message says that nothing was written.
 fn refuse_unconverged(a: &CalibrateArgs, id: &Identification) -> Result<()> {
-    if !a.out.is_empty() && !id.converged() {
+    if id.converged() {
+        return Ok(());
+    }
+    let mut why = format!(
+        "identification ended {:?} ({:?}) after {} iterations",
+        id.status, id.stop, id.iterations
+    );
+    if !id.unidentifiable.is_empty() {
+        why += &format!(
+            "; not determined by the data: {}",
+            id.unidentifiable.join(", ")
+        );
+    }
+    if !a.out.is_empty() {
         let names: Vec<String> = a.out.iter().map(|p| p.display().to_string()).collect();
-        bail!(
-            "identification ended {:?} ({:?}): {} {} not written",
-            id.status,
-            id.stop,
+        why += &format!(
+            "; {} {} not written",
             names.join(", "),
             if names.len() == 1 { "was" } else { "were" }
         );
     }
-    Ok(())
+    Err(NotConverged(why).into())
 }
 
 impl CalibrateArgs {
@@ -257,6 +298,7 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
                 prune: a.compare_pruned,
             }),
         json: a.json,
+        units: a.units.units(),
     };
     let (fitted, f, mut report) =
         super::measured::calibrate_measured(robot, path, &o, &|| t0.elapsed().as_secs_f64())?;
@@ -270,13 +312,15 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     report.frames = frames.as_ref().map(|(_, r)| r.clone());
     report.base.out =
         write_calibrated(a, &fitted, id, &path.display().to_string(), frames.as_ref())?;
-    super::emit_report(a.json, &report, || {
+    let mut v = serde_json::to_value(&report)?;
+    v["exit_status"] = exit_status(id).into();
+    super::emit(a.json, &v, || {
         let mut s = super::measured::measured_text(&report, id, &status_text(id));
         for out in &report.base.out {
             s += &format!("\ncalibrated robot written to {out}\n");
         }
         s
-    })?;
+    });
     refuse_unconverged(a, id)
 }
 
@@ -403,7 +447,8 @@ fn from_design(
         frames: frames.map(|(_, r)| r),
         elapsed_seconds: t0.elapsed().as_secs_f64(),
     };
-    let v = serde_json::to_value(&report)?;
+    let mut v = serde_json::to_value(&report)?;
+    v["exit_status"] = exit_status(id).into();
     emit(a.json, &v, || {
         let noise = if full {
             format!(

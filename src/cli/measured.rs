@@ -6,8 +6,9 @@
 use super::emit_report;
 use activecal::identify::evaluation::ModelErrors;
 use activecal::identify::{
-    Fit, HoldoutSettings, Identification, LmSettings, LossChoice, Measurements, ParameterTrust,
-    SplitResult, fit, for_measurements, holdout, residuals, trust, with_fixed_and_free,
+    Fit, FixedParameter, HoldoutSettings, Identification, LmSettings, LossChoice, Measurements,
+    ParameterTrust, SplitResult, fit, for_measurements, holdout, prepare_for_data, residuals,
+    trust,
 };
 use activecal::model::Robot;
 use anyhow::{Result, bail};
@@ -52,14 +53,22 @@ pub fn loss_choice(kind: LossKind, scale: Option<f64>) -> Result<LossChoice> {
     })
 }
 
-/// Reads a measurement file (CSV or JSON) for `robot`, printing its notes to
-/// stderr unless `quiet`.
+/// Reads a measurement file (CSV or JSON) for `robot` in `units`, printing
+/// its notes to stderr unless `quiet`; positions beyond the robot's reach
+/// are refused ([`activecal::identify::evaluation::check_in_reach`]).
 pub fn read_measurements(
     path: &Path,
     robot: &Robot,
+    units: activecal::units::Units,
     quiet: bool,
 ) -> Result<(Measurements, Vec<String>)> {
-    let f = activecal::io::measurements::read(path, robot)?;
+    let f = activecal::io::measurements::read_in(path, robot, units)?;
+    activecal::identify::evaluation::check_in_reach(
+        robot,
+        &f.measurements,
+        &path.display().to_string(),
+        units.length,
+    )?;
     let mut notes = f.notes;
     let (meas, repeats) = f.measurements.without_repeated_markers();
     for (copy, of) in repeats {
@@ -92,6 +101,8 @@ pub struct MeasuredOptions<'a> {
     pub holdout: Option<HoldoutSettings>,
     /// JSON output (notes to stderr are silenced).
     pub json: bool,
+    /// Units of the measurement file.
+    pub units: activecal::units::Units,
 }
 
 /// `calibrate --measurements`' JSON report.
@@ -108,6 +119,8 @@ pub struct MeasuredReport {
     pub nominal_residuals: ModelErrors,
     /// Each parameter's estimate, change, σ, t and verdict.
     pub parameters: Vec<ParameterTrust>,
+    /// Unknowns the data do not determine, fixed at nominal, with why.
+    pub fixed: Vec<FixedParameter>,
     /// Poses the robust loss down-weighted: `[pose, weight]`.
     pub downweighted: Vec<(usize, f64)>,
     /// Held-out validation, if asked.
@@ -211,10 +224,11 @@ fn holdout_report(settings: HoldoutSettings, splits: Vec<SplitResult>) -> Holdou
 
 /// How much better the rigid fit of the nominal points must fit the data
 /// than the nominal model does before identification starts from it: a
-/// tracker metres away or turned tens of degrees (a start LM does not
-/// converge from) gains orders of magnitude; a measurement frame already
-/// near the base, or markers far from the tip, gain less than this.
-const MOUNT_GAIN: f64 = 10.0;
+/// tracker metres away and turned by tens of degrees gains 450–4,000×
+/// (`tests/frames.rs`), where Levenberg–Marquardt from the nominal model
+/// ends in a false minimum; FIGAROH's real TIAGo and UR10 data gain 125×
+/// and 38× and converge from the nominal model, as before.
+const MOUNT_GAIN: f64 = 200.0;
 
 /// A URDF robot mounted in the data's frame when the nominal model is far
 /// from it ([`activecal::frames::align`]), with a note saying so.
@@ -249,7 +263,7 @@ pub fn calibrate_measured(
     o: &MeasuredOptions<'_>,
     elapsed: &dyn Fn() -> f64,
 ) -> Result<(Robot, Fit, MeasuredReport)> {
-    let (meas, mut notes) = read_measurements(path, robot, o.json)?;
+    let (meas, mut notes) = read_measurements(path, robot, o.units, o.json)?;
     let given = robot;
     let mounted = mounted_start(robot, &meas)?;
     let robot = match &mounted {
@@ -270,7 +284,9 @@ pub fn calibrate_measured(
             eprintln!("note: {n}");
         }
     }
-    let r = with_fixed_and_free(&start.robot, o.fix, o.free)?;
+    let det = prepare_for_data(&start.robot, &start.table, &meas, o.fix, o.free)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let r = det.robot;
     let f = fit(&r, &start.table, &meas, &o.lm, o.loss)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let res = residuals(&r, &f.id.table, &meas)?;
@@ -287,7 +303,9 @@ pub fn calibrate_measured(
     let ho = match &o.holdout {
         Some(h) => {
             let (fix, free) = (o.fix.to_vec(), o.free.to_vec());
-            let prep = move |x: &Robot| with_fixed_and_free(x, &fix, &free);
+            let prep = move |x: &Robot, t: &activecal::model::ParamTable, m: &Measurements| {
+                prepare_for_data(x, t, m, &fix, &free).map(|d| d.robot)
+            };
             Some(holdout_report(
                 *h,
                 holdout(robot, given, &meas, &o.lm, o.loss, h, &prep)?,
@@ -308,6 +326,7 @@ pub fn calibrate_measured(
         residuals: res,
         nominal_residuals: nominal,
         parameters: params,
+        fixed: det.fixed,
         downweighted: f.downweighted(),
         holdout: ho,
         notes,
@@ -325,6 +344,15 @@ pub fn measured_text(r: &MeasuredReport, id: &Identification, status: &str) -> S
         r.base.measurement.name(),
         id.names.len()
     );
+    if !r.fixed.is_empty() {
+        s += &format!(
+            "fixed at nominal, not determined by these data ({}):\n",
+            r.fixed.len()
+        );
+        for f in &r.fixed {
+            s += &format!("  {} = {:.6} ({})\n", f.name, f.value, f.reason);
+        }
+    }
     s += &format!("fitted:  {}\n", r.residuals.summary());
     s += &format!("nominal: {}\n", r.nominal_residuals.summary());
     if !r.downweighted.is_empty() {
@@ -414,6 +442,9 @@ pub struct EvaluateArgs {
     /// qw1…qz1, one column per joint by name) or JSON.
     #[arg(long)]
     pub measurements: std::path::PathBuf,
+    /// Units of the measurement file.
+    #[command(flatten)]
+    pub units: super::units::UnitOpts,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -433,7 +464,7 @@ struct EvaluateReport {
 /// Runs `evaluate`: the model's errors on the data, no fitting.
 pub fn cmd_evaluate(a: EvaluateArgs) -> Result<()> {
     let robot = super::load_robot(&a.robot)?;
-    let (meas, notes) = read_measurements(&a.measurements, &robot, a.json)?;
+    let (meas, notes) = read_measurements(&a.measurements, &robot, a.units.units(), a.json)?;
     let res = residuals(&robot, &robot.nominal, &meas).map_err(|e| {
         anyhow::anyhow!(
             "{}: {e}{}",

@@ -10,6 +10,7 @@ pub mod measured;
 pub mod progress;
 pub mod reproduce;
 pub mod select;
+pub mod units;
 
 use activecal::measure::Visibility;
 use activecal::model::{ParamSet, Robot};
@@ -283,6 +284,9 @@ pub struct PoolOpts {
     /// z = Z of the base link's frame.
     #[arg(long, value_name = "Z", allow_negative_numbers = true)]
     pub floor: Option<f64>,
+    /// Units of --pool file: and --existing values.
+    #[command(flatten)]
+    pub units: units::UnitOpts,
 }
 
 /// Poses measured before a selection (`--existing`): their prior
@@ -299,9 +303,14 @@ pub struct Existing {
 /// Reads the poses of `--existing FILE` (a CSV or JSON of joint
 /// configurations, or a JSON measurement file: the same reader as
 /// `--pool file:…`) and makes their prior information at `params`.
-pub fn load_existing(path: &std::path::Path, robot: &Robot, params: ParamSet) -> Result<Existing> {
-    let c = activecal::pool::read_configurations(path, robot)
-        .map_err(|e| anyhow::anyhow!("--existing: {e}"))?;
+pub fn load_existing(
+    path: &std::path::Path,
+    robot: &Robot,
+    params: ParamSet,
+    units: activecal::units::Units,
+) -> Result<Existing> {
+    use anyhow::Context;
+    let c = activecal::pool::read_configurations_in(path, robot, units).context("--existing")?;
     existing_from(path.display().to_string(), c.qs, c.notes, robot, params)
 }
 
@@ -530,10 +539,20 @@ impl PoolOpts {
         Ok(out)
     }
 
-    /// Loads the robot, builds the pool and its Jacobian.
+    /// Loads the robot, builds the pool and its Jacobian. A pool file is
+    /// read in the options' units.
     pub fn load(&self) -> Result<PoolCtx> {
         let d = load_description(&self.robot)?;
         let spec = self.spec(d.visibility.as_ref())?;
+        if let PoolSource::File { path } = &spec.source {
+            let rows = activecal::pool::read_configurations_in(
+                std::path::Path::new(path),
+                &d.robot,
+                self.units.units(),
+            )?;
+            let pool = spec.build_listed(&d.robot, &d.robot.nominal, rows)?;
+            return with_jacobian(d.robot, pool, self.params);
+        }
         build_pool(d.robot, &spec, self.params)
     }
 }

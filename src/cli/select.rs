@@ -253,7 +253,7 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     let existing = a
         .existing
         .as_deref()
-        .map(|p| super::load_existing(p, &ctx.robot, a.pool.params))
+        .map(|p| super::load_existing(p, &ctx.robot, a.pool.params, a.pool.units.units()))
         .transpose()?;
     let prior = existing.as_ref().map(|e| e.prior.clone());
     let fixed_ids: Vec<usize> = match &a.fixed {

@@ -166,3 +166,31 @@ mod tests {
         assert!((r.orientation_max_deg.unwrap() - 0.5).abs() < 1e-9);
     }
 }
+
+/// Checks that the measured points are within reach of `robot`'s nominal
+/// model ([`crate::units::check_positions_in_reach`]): each point against
+/// the nominal end frame's position at its pose. `length` is the unit the
+/// file was read in (for the hint); `file` names it.
+pub fn check_in_reach(
+    robot: &Robot,
+    meas: &Measurements,
+    file: &str,
+    length: crate::units::LengthUnit,
+) -> Result<()> {
+    let k = meas.markers().max(1);
+    if meas.qs().iter().any(|q| q.len() != robot.dof()) || meas.points().len() != k * meas.len() {
+        // The shape is the residuals' check to report, naming the pose.
+        return Ok(());
+    }
+    let mut ev = Evaluator::new(robot, &robot.nominal);
+    let predicted: Vec<[f64; 3]> = meas
+        .qs()
+        .iter()
+        .flat_map(|q| {
+            let p: [f64; 3] = ev.end_frame(q).position.into();
+            std::iter::repeat_n(p, k)
+        })
+        .collect();
+    crate::units::check_positions_in_reach(robot, file, length, meas.points(), &predicted)?;
+    Ok(())
+}

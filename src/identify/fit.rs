@@ -175,7 +175,14 @@ pub fn with_fixed_and_free(robot: &Robot, fix: &[String], free: &[String]) -> Re
                 "marker offsets are always estimated",
             ));
         }
-        let id = robot.param_id(name)?;
+        let unknowns: Vec<String> = robot
+            .unknowns
+            .iter()
+            .map(|&u| robot.param_name(u))
+            .collect();
+        let id = robot
+            .param_id(name)
+            .map_err(|_| unknown_name("--fix", name, &unknowns))?;
         let Some(pos) = ids.iter().position(|&u| u == id) else {
             return Err(setting(
                 "--fix",
@@ -186,7 +193,14 @@ pub fn with_fixed_and_free(robot: &Robot, fix: &[String], free: &[String]) -> Re
         ids.remove(pos);
     }
     for name in free {
-        let id = robot.param_id(name)?;
+        let id = robot.param_id(name).map_err(|_| {
+            let all: Vec<String> = robot
+                .candidate_unknowns()
+                .into_iter()
+                .map(|u| robot.param_name(u))
+                .collect();
+            unknown_name("--free", name, &all)
+        })?;
         if !ids.contains(&id) {
             ids.push(id);
         }
@@ -197,6 +211,59 @@ pub fn with_fixed_and_free(robot: &Robot, fix: &[String], free: &[String]) -> Re
     r.validate()?;
     r.check_identifiable()?;
     Ok(r)
+}
+
+/// The robot a data set is fitted as: `fix` and `free` applied
+/// ([`with_fixed_and_free`]), then the unknowns `meas` do not determine at
+/// `start` fixed with a reason ([`super::fix_undetermined`]; never one
+/// named in `free`).
+pub fn prepare_for_data(
+    robot: &Robot,
+    start: &ParamTable,
+    meas: &Measurements,
+    fix: &[String],
+    free: &[String],
+) -> Result<super::Determined> {
+    let r = with_fixed_and_free(robot, fix, free)?;
+    super::fix_undetermined(&r, start, meas, free)
+}
+
+/// An unknown parameter name given to `option`: the closest valid names
+/// (by edit distance) and the whole list.
+fn unknown_name(option: &str, name: &str, valid: &[String]) -> IdentifyError {
+    let mut by: Vec<(usize, &String)> = valid.iter().map(|v| (edit_distance(name, v), v)).collect();
+    by.sort();
+    let best = by.first().map_or(usize::MAX, |b| b.0);
+    let close: Vec<&str> = by
+        .iter()
+        .filter(|(d, _)| *d == best && *d <= name.len().max(3) / 2 + 1)
+        .map(|(_, v)| v.as_str())
+        .collect();
+    let mean = if close.is_empty() {
+        String::new()
+    } else {
+        format!(" (did you mean {}?)", close.join(" or "))
+    };
+    IdentifyError::Model(crate::Error::Invalid(format!(
+        "{option} {name}: not a parameter of this robot{mean}; the valid names are {}",
+        valid.join(", ")
+    )))
+}
+
+/// Levenshtein distance between two names (characters).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, &cb) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(ca != cb))
+                .min(prev[j + 1] + 1)
+                .min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
 }
 
 fn setting(option: &'static str, name: &str, reason: &'static str) -> IdentifyError {
@@ -241,10 +308,11 @@ pub struct SplitResult {
 
 /// Fits on a random `1 − fraction` of the poses and evaluates on the rest,
 /// `splits` times. `prepare` turns the robot adapted to the data
-/// ([`for_measurements`]) into the one fitted (e.g.
-/// [`with_fixed_and_free`]). The nominal figures are those of `baseline`
-/// (the user's model, adapted to the data's sensor on the training poses)
-/// when it differs from `robot` (a start mounted in the data's frame).
+/// ([`for_measurements`]), its start table and the training poses into the
+/// one fitted (e.g. [`prepare_for_data`]). The nominal figures are those of
+/// `baseline` (the user's model, adapted to the data's sensor on the
+/// training poses) when it differs from `robot` (a start mounted in the
+/// data's frame).
 #[allow(clippy::too_many_arguments)]
 pub fn holdout(
     robot: &Robot,
@@ -253,7 +321,7 @@ pub fn holdout(
     lm: &LmSettings,
     loss: LossChoice,
     settings: &HoldoutSettings,
-    prepare: &dyn Fn(&Robot) -> Result<Robot>,
+    prepare: &dyn Fn(&Robot, &ParamTable, &Measurements) -> Result<Robot>,
 ) -> Result<Vec<SplitResult>> {
     let n = meas.len();
     let test = (settings.fraction * n as f64).round() as usize;
@@ -282,7 +350,7 @@ pub fn holdout(
         te.sort_unstable();
         let (mtr, mte) = (meas.subset(&tr), meas.subset(&te));
         let start = for_measurements(robot, &mtr, lm)?;
-        let r = prepare(&start.robot)?;
+        let r = prepare(&start.robot, &start.table, &mtr)?;
         let f = fit(&r, &start.table, &mtr, lm, loss)?;
         let fitted = residuals(&r, &f.id.table, &mtr)?;
         let held_out = residuals(&r, &f.id.table, &mte)?;

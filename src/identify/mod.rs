@@ -45,11 +45,12 @@ pub mod simulate;
 pub mod start;
 
 pub mod tables;
+pub mod undetermined;
 
 pub use evaluation::{ModelErrors, SampleResidual, residuals};
 pub use fit::{
-    Fit, HoldoutSettings, LossChoice, ParameterTrust, SplitResult, fit, holdout, trust,
-    with_fixed_and_free,
+    Fit, HoldoutSettings, LossChoice, ParameterTrust, SplitResult, fit, holdout, prepare_for_data,
+    trust, with_fixed_and_free,
 };
 pub use lm::{
     Correlation, Covariance, Identification, LmSettings, Solution, Status, StopReason, identify,
@@ -64,6 +65,7 @@ pub use residual::{Calibration, Residuals};
 pub use simulate::{simulate, trial_rng};
 pub use start::{Start, for_measurements};
 pub use tables::{PaperTables, ParamGrid, paper_tables};
+pub use undetermined::{Determined, FixedParameter, fix_undetermined};
 
 use crate::error::Error;
 use crate::measure::Observation;
@@ -320,6 +322,19 @@ impl Measurements {
         out.markers = keep.len();
         out.points = points;
         (out, repeats)
+    }
+
+    /// Replaces the joint vectors (as converted by a reader, one per pose)
+    /// and scales every measured point by `length_to_m`: a file read in
+    /// other units, brought to radians and metres.
+    pub fn set_units(&mut self, qs: Vec<Vec<f64>>, length_to_m: f64) {
+        debug_assert_eq!(qs.len(), self.qs.len());
+        self.qs = qs;
+        if length_to_m != 1.0 {
+            for p in &mut self.points {
+                p.iter_mut().for_each(|c| *c *= length_to_m);
+            }
+        }
     }
 
     /// Markers (points) per pose.

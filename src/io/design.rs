@@ -243,6 +243,27 @@ impl DesignFile {
                 });
             }
         }
+        // Design files hold radians and metres (`select` writes them); the
+        // limits are checked by the rule of every joint-value reader.
+        let mut qs = qs;
+        let rows: Vec<String> = self
+            .poses
+            .iter()
+            .enumerate()
+            .map(|(k, id)| format!("q[{k}] (pose {id})"))
+            .collect();
+        let columns = crate::units::joint_names(robot);
+        let source = crate::units::JointSource {
+            file: "the design file",
+            rows: &rows,
+            columns: &columns,
+        };
+        crate::units::joint_values_to_model_units(
+            robot,
+            crate::units::Units::default(),
+            &source,
+            &mut qs,
+        )?;
         Ok(qs)
     }
 

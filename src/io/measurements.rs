@@ -18,12 +18,21 @@
 //! A missing joint column is an error naming it; other columns are listed
 //! in a note, never silently dropped. A non-numeric cell is an error naming
 //! the line and column; a non-finite value one naming the row.
+//!
+//! # Units
+//! Both formats are read in the [`Units`] the caller names (radians and
+//! metres by default): revolute joint values in its angle unit, measured
+//! positions and prismatic joint values in its length unit (roll, pitch
+//! and yaw stay radians). Joint values are converted and checked against
+//! the joint limits by the one rule of every joint-value reader
+//! ([`crate::units::joint_values_to_model_units`]).
 
 use super::table::parse_csv;
 use crate::error::{Error, Result};
 use crate::identify::{Measurements, ROTATION_TOLERANCE};
 use crate::model::Robot;
-pub use crate::pool::file::joint_names;
+pub use crate::units::joint_names;
+use crate::units::{JointSource, Units, joint_values_to_model_units};
 use nalgebra::{Quaternion, Rotation3, UnitQuaternion};
 use std::path::Path;
 
@@ -43,8 +52,14 @@ pub struct MeasurementFile {
 
 /// Reads a measurement file for `robot`: CSV when the name ends in `.csv`,
 /// otherwise JSON ([`Measurements`]). The joint columns of a CSV are matched
-/// to the robot's joints by name.
+/// to the robot's joints by name. Radians and metres.
 pub fn read(path: &Path, robot: &Robot) -> Result<MeasurementFile> {
+    read_in(path, robot, Units::default())
+}
+
+/// As [`read`], for a file in `units` (see the module documentation): the
+/// result is in radians and metres.
+pub fn read_in(path: &Path, robot: &Robot, units: Units) -> Result<MeasurementFile> {
     let origin = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
         path: origin.clone(),
@@ -54,12 +69,38 @@ pub fn read(path: &Path, robot: &Robot) -> Result<MeasurementFile> {
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
     if is_csv {
-        parse_csv_measurements(&text, &origin, robot)
+        parse_csv_measurements_in(&text, &origin, robot, units)
     } else {
-        let measurements: Measurements = serde_json::from_str(&text).map_err(|e| Error::Parse {
-            path: origin,
-            message: e.to_string(),
-        })?;
+        let mut measurements: Measurements =
+            serde_json::from_str(&text).map_err(|e| Error::Parse {
+                path: origin.clone(),
+                message: e.to_string(),
+            })?;
+        if let Some(name) = measurements.robot().filter(|n| *n != robot.name) {
+            return Err(Error::Parse {
+                path: origin,
+                message: format!(
+                    "the measurements are of robot '{name}', not '{}'",
+                    robot.name
+                ),
+            });
+        }
+        let rows: Vec<String> = (0..measurements.len())
+            .map(|k| format!("qs[{k}] (row {})", k + 1))
+            .collect();
+        let columns = joint_names(robot);
+        let source = JointSource {
+            file: &origin,
+            rows: &rows,
+            columns: &columns,
+        };
+        let mut qs = measurements.qs().to_vec();
+        // A joint vector of another length is the check's to report, with
+        // its pose (`Measurements::check`); only whole rows are converted.
+        if qs.iter().all(|q| q.len() == robot.dof()) {
+            joint_values_to_model_units(robot, units, &source, &mut qs)?;
+        }
+        measurements.set_units(qs, units.length.to_m());
         Ok(MeasurementFile {
             measurements,
             notes: Vec::new(),
@@ -67,8 +108,19 @@ pub fn read(path: &Path, robot: &Robot) -> Result<MeasurementFile> {
     }
 }
 
-/// Parses measurement CSV `text` (see the module documentation).
+/// Parses measurement CSV `text` (see the module documentation), radians
+/// and metres.
 pub fn parse_csv_measurements(text: &str, origin: &str, robot: &Robot) -> Result<MeasurementFile> {
+    parse_csv_measurements_in(text, origin, robot, Units::default())
+}
+
+/// Parses measurement CSV `text` in `units` (see the module documentation).
+pub fn parse_csv_measurements_in(
+    text: &str,
+    origin: &str,
+    robot: &Robot,
+    units: Units,
+) -> Result<MeasurementFile> {
     let t = parse_csv(text, origin)?;
     let err = |message: String| Error::Parse {
         path: origin.to_string(),
@@ -207,8 +259,9 @@ pub fn parse_csv_measurements(text: &str, origin: &str, robot: &Robot) -> Result
                 .map(|&c| at(c))
                 .collect::<Result<Vec<f64>>>()?,
         );
+        let m = units.length.to_m();
         for cols in &marker_cols {
-            points.push([at(cols[0])?, at(cols[1])?, at(cols[2])?]);
+            points.push([m * at(cols[0])?, m * at(cols[1])?, m * at(cols[2])?]);
         }
         if has_rpy {
             let a: Vec<f64> = rpy.iter().map(|c| at(c.unwrap())).collect::<Result<_>>()?;
@@ -236,6 +289,14 @@ pub fn parse_csv_measurements(text: &str, origin: &str, robot: &Robot) -> Result
             orientations.push(crate::identify::rows(uq.to_rotation_matrix().matrix()));
         }
     }
+    let rows: Vec<String> = t.lines.iter().map(|l| format!("line {l}")).collect();
+    let columns: Vec<String> = joint_cols.iter().map(|&c| t.columns[c].clone()).collect();
+    let source = JointSource {
+        file: origin,
+        rows: &rows,
+        columns: &columns,
+    };
+    joint_values_to_model_units(robot, units, &source, &mut qs)?;
     Ok(MeasurementFile {
         measurements: Measurements::unchecked(qs, marker_cols.len(), points, orientations),
         notes,
@@ -252,10 +313,10 @@ mod tests {
 
     #[test]
     fn rpy_is_rz_ry_rx_and_joints_match_by_name_in_any_order() {
-        let text = "q6,q5,q4,q3,q2,q1,x1,y1,z1,phix1,phiy1,phiz1,temp\n6,5,4,3,2,1,0.1,0.2,0.3,0.3,-0.2,1.1,20\n";
+        let text = "q6,q5,q4,q3,q2,q1,x1,y1,z1,phix1,phiy1,phiz1,temp\n0.6,0.5,0.4,0.3,-0.2,0.1,0.1,0.2,0.3,0.3,-0.2,1.1,20\n";
         let f = parse_csv_measurements(text, "m.csv", &ur5()).unwrap();
         let m = &f.measurements;
-        assert_eq!(m.qs()[0], [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+        assert_eq!(m.qs()[0], [0.1, -0.2, 0.3, 0.4, 0.5, 0.6]);
         assert_eq!(m.points()[0], [0.1, 0.2, 0.3]);
         let (x, y, z) = (0.3f64, -0.2f64, 1.1f64);
         let rz = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::z_axis(), z);

@@ -17,20 +17,19 @@
 //!   `points`, `orientations`, `robot`) are ignored with a note; a `robot`
 //!   key, when present, must name the robot.
 //!
-//! Every value is checked: a value that does not parse, is not finite, or
-//! lies outside the joint's limits (beyond [`LIMIT_TOL`]) is an error naming
+//! Every value is checked: a value that does not parse is an error naming
 //! the file, the row (the 1-based line for CSV, `qs[k]` for JSON) and the
-//! column.
+//! column; the values are then converted from the file's [`Units`] and
+//! checked against the joint limits by the one rule of every joint-value
+//! reader ([`crate::units::joint_values_to_model_units`]).
 //!
 //! [`PoolSource::File`]: super::PoolSource::File
 
 use crate::error::{Error, Result};
 use crate::model::Robot;
+pub use crate::units::joint_names;
+use crate::units::{JointSource, Units, joint_values_to_model_units};
 use std::path::Path;
-
-/// Slack on the joint limits, absolute (radians or metres): values written
-/// with a few digits fewer than the limits themselves still pass.
-pub const LIMIT_TOL: f64 = 1e-9;
 
 /// Joint configurations read from a file, in row order.
 #[derive(Clone, Debug, PartialEq)]
@@ -39,21 +38,6 @@ pub struct Configurations {
     pub qs: Vec<Vec<f64>>,
     /// What was ignored (extra columns or keys), for reports.
     pub notes: Vec<String>,
-}
-
-/// The names a configuration file may use for each joint, in joint order:
-/// the label of the frame the joint drives (a URDF's joint name).
-#[must_use]
-pub fn joint_names(robot: &Robot) -> Vec<String> {
-    let mut names = vec![String::new(); robot.dof()];
-    for f in &robot.frames {
-        if let Some(j) = f.joint
-            && j < names.len()
-        {
-            names[j].clone_from(&f.label);
-        }
-    }
-    names
 }
 
 /// The joint index of a column name: a joint name, or `q1`…`qN`.
@@ -119,34 +103,16 @@ fn parse_err(path: &Path, message: String) -> Error {
     }
 }
 
-/// Checks one value against its joint's limits.
-fn check_value(path: &Path, robot: &Robot, row: &str, col: &str, j: usize, v: f64) -> Result<()> {
-    let [lo, hi] = robot.limits[j];
-    if !v.is_finite() {
-        return Err(parse_err(
-            path,
-            format!(
-                "{row}, column '{col}' (joint {}): {v} is not a finite number",
-                j + 1
-            ),
-        ));
-    }
-    if v < lo - LIMIT_TOL || v > hi + LIMIT_TOL {
-        return Err(parse_err(
-            path,
-            format!(
-                "{row}, column '{col}' (joint {}): {v} is outside the joint limits [{lo}, {hi}]",
-                j + 1
-            ),
-        ));
-    }
-    Ok(())
+/// Reads the joint configurations of `path` for `robot`, in radians and
+/// metres (see the module docs for the formats and checks). An empty file
+/// or one without rows is an error.
+pub fn read_configurations(path: &Path, robot: &Robot) -> Result<Configurations> {
+    read_configurations_in(path, robot, Units::default())
 }
 
-/// Reads the joint configurations of `path` for `robot` (see the module
-/// docs for the formats and checks). An empty file or one without rows is
-/// an error.
-pub fn read_configurations(path: &Path, robot: &Robot) -> Result<Configurations> {
+/// As [`read_configurations`], for a file whose joint values are in `units`
+/// (converted to radians and metres).
+pub fn read_configurations_in(path: &Path, robot: &Robot, units: Units) -> Result<Configurations> {
     let len = std::fs::metadata(path)
         .map_err(|cause| Error::Io {
             path: path.display().to_string(),
@@ -166,9 +132,9 @@ pub fn read_configurations(path: &Path, robot: &Robot) -> Result<Configurations>
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
     let c = if json {
-        parse_json(path, &text, robot)?
+        parse_json_in(path, &text, robot, units)?
     } else {
-        parse_csv(path, &text, robot)?
+        parse_csv_in(path, &text, robot, units)?
     };
     if c.qs.is_empty() {
         return Err(parse_err(
@@ -179,8 +145,44 @@ pub fn read_configurations(path: &Path, robot: &Robot) -> Result<Configurations>
     Ok(c)
 }
 
-/// Parses CSV text (see the module docs).
+/// Converts and checks the values read ([`joint_values_to_model_units`]),
+/// naming each joint's column as the file does.
+fn check_units(
+    path: &Path,
+    robot: &Robot,
+    units: Units,
+    header: &[String],
+    map: &[Option<usize>],
+    rows: &[String],
+    qs: &mut [Vec<f64>],
+) -> Result<()> {
+    let mut columns = joint_names(robot);
+    for (c, j) in map.iter().enumerate() {
+        if let Some(j) = *j {
+            columns[j].clone_from(&header[c]);
+        }
+    }
+    let file = path.display().to_string();
+    let source = JointSource {
+        file: &file,
+        rows,
+        columns: &columns,
+    };
+    joint_values_to_model_units(robot, units, &source, qs)
+}
+
+/// Parses CSV text (see the module docs), radians and metres.
 pub fn parse_csv(path: &Path, text: &str, robot: &Robot) -> Result<Configurations> {
+    parse_csv_in(path, text, robot, Units::default())
+}
+
+/// Parses CSV text whose joint values are in `units`.
+pub fn parse_csv_in(
+    path: &Path,
+    text: &str,
+    robot: &Robot,
+    units: Units,
+) -> Result<Configurations> {
     let names = joint_names(robot);
     let mut lines = text
         .lines()
@@ -198,6 +200,7 @@ pub fn parse_csv(path: &Path, text: &str, robot: &Robot) -> Result<Configuration
         .collect();
     let (map, ignored) = map_columns(path, &header, &names)?;
     let mut qs = Vec::new();
+    let mut rows = Vec::new();
     for (i, line) in lines {
         let row = format!("line {}", i + 1);
         let cells: Vec<&str> = line.split(',').collect();
@@ -225,11 +228,12 @@ pub fn parse_csv(path: &Path, text: &str, robot: &Robot) -> Result<Configuration
                     ),
                 )
             })?;
-            check_value(path, robot, &row, &header[c], j, v)?;
             q[j] = v;
         }
         qs.push(q);
+        rows.push(row);
     }
+    check_units(path, robot, units, &header, &map, &rows, &mut qs)?;
     let mut notes = Vec::new();
     if !ignored.is_empty() {
         notes.push(format!(
@@ -241,8 +245,18 @@ pub fn parse_csv(path: &Path, text: &str, robot: &Robot) -> Result<Configuration
     Ok(Configurations { qs, notes })
 }
 
-/// Parses JSON text (see the module docs).
+/// Parses JSON text (see the module docs), radians and metres.
 pub fn parse_json(path: &Path, text: &str, robot: &Robot) -> Result<Configurations> {
+    parse_json_in(path, text, robot, Units::default())
+}
+
+/// Parses JSON text whose joint values are in `units`.
+pub fn parse_json_in(
+    path: &Path,
+    text: &str,
+    robot: &Robot,
+    units: Units,
+) -> Result<Configurations> {
     let names = joint_names(robot);
     let v: serde_json::Value =
         serde_json::from_str(text).map_err(|e| parse_err(path, e.to_string()))?;
@@ -288,6 +302,7 @@ pub fn parse_json(path: &Path, text: &str, robot: &Robot) -> Result<Configuratio
         .collect();
     keys.sort_unstable();
     let mut qs = Vec::with_capacity(rows.len());
+    let mut labels = Vec::with_capacity(rows.len());
     for (k, r) in rows.iter().enumerate() {
         let row = format!("qs[{k}] (row {})", k + 1);
         let Some(cells) = r.as_array() else {
@@ -316,11 +331,12 @@ pub fn parse_json(path: &Path, text: &str, robot: &Robot) -> Result<Configuratio
                     )
                 })?,
             };
-            check_value(path, robot, &row, &header[c], j, v)?;
             q[j] = v;
         }
         qs.push(q);
+        labels.push(row);
     }
+    check_units(path, robot, units, &header, &map, &labels, &mut qs)?;
     let mut notes = Vec::new();
     if !ignored.is_empty() {
         ignored.sort_unstable();

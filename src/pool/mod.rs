@@ -18,7 +18,7 @@ pub mod file;
 pub mod lattice;
 pub mod sampled;
 
-pub use file::{Configurations, read_configurations};
+pub use file::{Configurations, read_configurations, read_configurations_in};
 pub use lattice::Lattice;
 pub use sampled::{Sobol, Uniform};
 

@@ -1,0 +1,81 @@
+//! `--angle-unit` and `--length-unit`: the units of the joint values and
+//! positions a command reads (measurement files, pool and `--existing`
+//! files, `fk --q`), parsed once into the library's typed
+//! [`activecal::units::Units`]; and the option a unit error calls for.
+
+use activecal::error::UnitHint;
+use activecal::units::{AngleUnit, LengthUnit, Units};
+
+/// The unit of revolute joint values, as typed.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AngleArg {
+    /// Radians.
+    Rad,
+    /// Degrees.
+    Deg,
+}
+
+/// The unit of lengths, as typed.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LengthArg {
+    /// Metres.
+    M,
+    /// Millimetres.
+    Mm,
+}
+
+/// The unit options of every command that reads joint values or positions.
+#[derive(clap::Args, Clone, Copy, Debug)]
+pub struct UnitOpts {
+    /// Unit of the revolute joint values read (files, --q): rad or deg.
+    /// Roll, pitch and yaw columns stay radians.
+    #[arg(long, value_enum, default_value = "rad")]
+    pub angle_unit: AngleArg,
+    /// Unit of the lengths read: measured positions (x1, y1, z1, …) and
+    /// prismatic joint values: m or mm.
+    #[arg(long, value_enum, default_value = "m")]
+    pub length_unit: LengthArg,
+}
+
+impl UnitOpts {
+    /// The typed units.
+    #[must_use]
+    pub fn units(&self) -> Units {
+        Units {
+            angle: match self.angle_unit {
+                AngleArg::Rad => AngleUnit::Rad,
+                AngleArg::Deg => AngleUnit::Deg,
+            },
+            length: match self.length_unit {
+                LengthArg::M => LengthUnit::M,
+                LengthArg::Mm => LengthUnit::Mm,
+            },
+        }
+    }
+}
+
+/// The option a unit error calls for, if the error (anywhere in its chain)
+/// is one: a joint column out of its limits that fits in the other unit, or
+/// positions beyond the robot's reach that fit in the other length unit.
+#[must_use]
+pub fn flag_hint(e: &anyhow::Error) -> Option<&'static str> {
+    let hint = e.chain().find_map(|c| {
+        let lib = c.downcast_ref::<activecal::Error>().or_else(|| {
+            match c.downcast_ref::<activecal::identify::IdentifyError>() {
+                Some(activecal::identify::IdentifyError::Model(m)) => Some(m),
+                _ => None,
+            }
+        })?;
+        match lib {
+            activecal::Error::JointOutOfLimits { hint, .. }
+            | activecal::Error::PositionsBeyondReach { hint, .. } => *hint,
+            _ => None,
+        }
+    })?;
+    Some(match hint {
+        UnitHint::Degrees => "the joint values look like degrees: give --angle-unit deg",
+        UnitHint::Radians => "the joint values look like radians: drop --angle-unit deg",
+        UnitHint::Millimetres => "the lengths look like millimetres: give --length-unit mm",
+        UnitHint::Metres => "the lengths look like metres: drop --length-unit mm",
+    })
+}

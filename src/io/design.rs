@@ -37,6 +37,10 @@ pub struct DesignFile {
     /// readers).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub levels: Option<usize>,
+    /// The chain's joint names, in the order of the joint values (absent
+    /// in files written before they were stored).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint_names: Option<Vec<String>>,
     /// Id of each pose in its pool (the lattice index for lattice poses).
     pub poses: Vec<usize>,
     /// Joint values of each pose (absent in old files: the lattice's).
@@ -79,6 +83,7 @@ impl DesignFile {
             robot: robot.name.clone(),
             pool: Some(pool.spec.clone()),
             levels: pool.spec.levels(),
+            joint_names: Some(crate::pool::file::joint_names(robot)),
             poses: pool.ids_of(positions),
             q: Some(positions.iter().map(|&k| pool.q(k)).collect()),
             pool_qs: pool.listed().map(<[Vec<f64>]>::to_vec),
@@ -96,6 +101,7 @@ impl DesignFile {
             robot: robot.to_string(),
             pool: None,
             levels: Some(levels),
+            joint_names: None,
             poses,
             q: None,
             pool_qs: None,
@@ -105,13 +111,22 @@ impl DesignFile {
         }
     }
 
-    /// Reads and parses a design file ([`DesignFile::parse`]).
+    /// Reads and parses a design file: JSON ([`DesignFile::parse`]), or
+    /// the YAML form `select --out d.yaml` writes
+    /// ([`super::design_formats::parse_yaml`]) when the name ends in
+    /// `.yaml` or `.yml`.
     pub fn read(path: &Path) -> Result<DesignFile> {
         let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
             path: path.display().to_string(),
             cause,
         })?;
-        Self::parse(&text, &path.display().to_string())
+        let origin = path.display().to_string();
+        if super::design_formats::DesignFormat::of(path).ok()
+            == Some(super::design_formats::DesignFormat::Yaml)
+        {
+            return super::design_formats::parse_yaml(&text, &origin);
+        }
+        Self::parse(&text, &origin)
     }
 
     /// Parses the text of a design file, `origin` naming it in errors
@@ -213,6 +228,22 @@ impl DesignFile {
     pub fn joint_values(&self, robot: &Robot) -> Result<Vec<Vec<f64>>> {
         self.check_robot(robot)?;
         self.check_shape()?;
+        if let Some(names) = &self.joint_names {
+            let chain = crate::pool::file::joint_names(robot);
+            if let Some(n) = names.iter().find(|n| !chain.contains(n)) {
+                return Err(Error::Invalid(format!(
+                    "the design's joint '{n}' is not a joint of the robot's chain ({})",
+                    chain.join(", ")
+                )));
+            }
+            if names != &chain {
+                return Err(Error::Invalid(format!(
+                    "the design's joints ({}) are not the chain's, in its order ({})",
+                    names.join(", "),
+                    chain.join(", ")
+                )));
+            }
+        }
         let qs = match &self.q {
             Some(q) => q.clone(),
             None => {

@@ -4,6 +4,8 @@
 
 pub mod atomic;
 pub mod design;
+pub mod design_formats;
+pub mod joint_speeds;
 pub mod measurements;
 pub mod robot_toml;
 pub mod table;

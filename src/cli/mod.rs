@@ -243,7 +243,12 @@ pub struct PoolOpts {
     /// With --self-collision, --obstacle or --floor: also remove the
     /// candidates where two checked links, or a link and an obstacle, come
     /// closer than this, metres (parry's distance query).
-    #[arg(long, value_name = "METRES", default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "METRES",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
     pub clearance: f64,
 }
 
@@ -497,10 +502,7 @@ impl PoolOpts {
         }
         let any_obstacle = !obstacles.is_empty() || self.floor.is_some();
         if !(self.clearance.is_finite() && self.clearance >= 0.0) {
-            anyhow::bail!(
-                "--clearance {}: a distance >= 0 metres",
-                self.clearance
-            );
+            anyhow::bail!("--clearance {}: a distance >= 0 metres", self.clearance);
         }
         if !self.self_collision && !any_obstacle {
             if self.clearance > 0.0 {

@@ -472,7 +472,13 @@ impl CollisionModel {
             if d > ga.radius + gb.radius + c {
                 continue;
             }
-            if too_close(&poses[a], ga.shape.as_ref(), &poses[b], gb.shape.as_ref(), c) {
+            if too_close(
+                &poses[a],
+                ga.shape.as_ref(),
+                &poses[b],
+                gb.shape.as_ref(),
+                c,
+            ) {
                 return Some(k);
             }
         }

@@ -281,7 +281,9 @@ pub fn parse_json(path: &Path, text: &str, robot: &Robot) -> Result<Configuratio
             let header: Vec<String> = j
                 .as_array()
                 .and_then(|a| a.iter().map(|x| x.as_str().map(str::to_string)).collect())
-                .ok_or_else(|| parse_err(path, format!("\"{joints_key}\" must be an array of names")))?;
+                .ok_or_else(|| {
+                    parse_err(path, format!("\"{joints_key}\" must be an array of names"))
+                })?;
             let (map, ignored) = map_columns(path, &header, &names)?;
             let width = header.len();
             (map, ignored, width, header)

@@ -222,9 +222,21 @@ mod tests {
     #[test]
     fn whole_turns_are_laid_on_the_circle() {
         let mut r = Robot::builtin("ur5").unwrap();
-        r.limits = vec![[-TAU, TAU], [-PI, PI], [-1.0, 1.0], [-TAU, TAU], [-TAU, TAU], [-PI, PI]];
+        r.limits = vec![
+            [-TAU, TAU],
+            [-PI, PI],
+            [-1.0, 1.0],
+            [-TAU, TAU],
+            [-TAU, TAU],
+            [-PI, PI],
+        ];
         let l = Lattice::new(&r, 5).unwrap();
-        assert_eq!(l.levels_of(0), (0..5).map(|d| -TAU + TAU * d as f64 / 5.0).collect::<Vec<_>>());
+        assert_eq!(
+            l.levels_of(0),
+            (0..5)
+                .map(|d| -TAU + TAU * d as f64 / 5.0)
+                .collect::<Vec<_>>()
+        );
         assert!(l.turns(1) && !l.turns(2));
         assert_eq!(l.distinct_poses(), 15_625);
         // With a margin the turn starts inside the lower limit.

@@ -423,7 +423,10 @@ impl PoolSpec {
             PoolFilter::Visibility(_) => None,
         }));
         let filters = stats::filter_stats(&names, &models, &verdict, cands.size());
-        debug_assert_eq!(filters.last().map_or(cands.size(), |f| f.seen - f.removed), ids.len());
+        debug_assert_eq!(
+            filters.last().map_or(cands.size(), |f| f.seen - f.removed),
+            ids.len()
+        );
         if ids.is_empty() {
             return Err(Error::Invalid(stats::emptied(&filters, cands.size())));
         }

@@ -142,8 +142,7 @@ mod tests {
         let pool = PoolSpec::lattice(3).build(&r, &r.nominal).unwrap();
         let qs: Vec<Vec<f64>> = [5, 100, 700].iter().map(|&k| pool.q(k)).collect();
         let text = poses_csv(&joint_names(&r), &qs, &[5, 100, 700]);
-        let back =
-            crate::pool::file::parse_csv(std::path::Path::new("p.csv"), &text, &r).unwrap();
+        let back = crate::pool::file::parse_csv(std::path::Path::new("p.csv"), &text, &r).unwrap();
         assert_eq!(back.qs, qs);
         let text = poses_json(&r.name, &joint_names(&r), &qs, &[5, 100, 700]);
         let back =

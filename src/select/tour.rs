@@ -57,7 +57,10 @@ impl MoveCost {
 /// The largest joint travel of a move, radians or metres.
 #[must_use]
 pub fn largest_travel(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (y - x).abs()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (y - x).abs())
+        .fold(0.0, f64::max)
 }
 
 /// Totals of a path through poses in a given order.
@@ -72,7 +75,12 @@ pub struct PathTotals {
 
 /// The totals of visiting `qs` in `order`, from `home` when given.
 #[must_use]
-pub fn totals(cost: &MoveCost, home: Option<&[f64]>, qs: &[Vec<f64>], order: &[usize]) -> PathTotals {
+pub fn totals(
+    cost: &MoveCost,
+    home: Option<&[f64]>,
+    qs: &[Vec<f64>],
+    order: &[usize],
+) -> PathTotals {
     let mut t = PathTotals {
         time_s: 0.0,
         travel: 0.0,

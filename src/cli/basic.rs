@@ -207,8 +207,8 @@ fn pool_out_format(path: &std::path::Path) -> Result<&'static str> {
 /// with `--out`.
 pub fn cmd_pool(a: PoolArgs) -> Result<()> {
     if let Some(out) = &a.out {
-        pool_out_format(out)?;
         super::refuse_overwrite(out, a.force)?;
+        pool_out_format(out)?;
     }
     if let Some(d) = a.digits.as_deref() {
         let robot = load_robot(&a.pool.robot)?;

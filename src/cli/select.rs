@@ -273,9 +273,9 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     if let Some(out) = &a.out {
         // Checked before the search: the format, an existing file, a missing
         // directory.
+        super::refuse_overwrite(out, a.force)?;
         activecal::io::design_formats::DesignFormat::of(out)
             .map_err(|e| anyhow::anyhow!("--out {e}"))?;
-        super::refuse_overwrite(out, a.force)?;
     }
     // Cheap checks of the ordering's inputs before the pool is built.
     let speeds = activecal::io::joint_speeds::joint_speeds(&super::with_chain(&a.pool.robot))?;

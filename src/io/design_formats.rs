@@ -8,7 +8,8 @@
 //!   values as a list of named joint configurations,
 //!   `configurations: [{name: pose_01, id: 17, joints: {joint_a: 0.1, ...}}]`,
 //!   the shape robot scripts and ROS tools read (a name and a map of joint
-//!   name to position). [`DesignFile::read`] loads it as it loads JSON.
+//!   name to position). [`DesignFile::read`] loads it as it loads JSON
+//!   ([`DesignFile::parse_yaml`]).
 //!
 //! YAML is written and read with `serde-saphyr` (pure Rust, maintained;
 //! `serde_yaml` is archived and its fork `serde_yml` unsound). Values are
@@ -16,7 +17,7 @@
 
 use super::design::DesignFile;
 use crate::error::{Error, Result};
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 use std::path::Path;
 
 /// The formats of a design output.
@@ -76,15 +77,6 @@ struct Named<'a> {
     joints: Joints<'a>,
 }
 
-/// One named joint configuration as read back.
-#[derive(Deserialize)]
-struct NamedIn {
-    #[allow(dead_code)]
-    name: Option<String>,
-    id: usize,
-    joints: std::collections::BTreeMap<String, f64>,
-}
-
 /// The design's joint names: stored, else an error (a design written
 /// before joint names were stored cannot name its joints).
 fn names_of(d: &DesignFile) -> Result<&[String]> {
@@ -131,56 +123,6 @@ pub fn to_yaml(d: &DesignFile) -> Result<String> {
     .map_err(|e| Error::Invalid(format!("writing YAML: {e}")))
 }
 
-/// Parses the YAML form back into a design file (`origin` names it in
-/// errors): the configurations' joint values become `q`, in the order of
-/// `joint_names`; a configuration missing a joint, or naming one the design
-/// does not list, is an error naming it.
-pub fn parse_yaml(text: &str, origin: &str) -> Result<DesignFile> {
-    let perr = |message: String| Error::Parse {
-        path: origin.to_string(),
-        message,
-    };
-    let mut v: serde_json::Value = serde_saphyr::from_str(text).map_err(|e| perr(e.to_string()))?;
-    let confs = v
-        .as_object_mut()
-        .and_then(|o| o.remove("configurations"))
-        .ok_or_else(|| perr("no 'configurations' list of named joint configurations".into()))?;
-    let confs: Vec<NamedIn> =
-        serde_json::from_value(confs).map_err(|e| perr(format!("configurations: {e}")))?;
-    let names: Vec<String> = v
-        .get("joint_names")
-        .cloned()
-        .map(serde_json::from_value)
-        .transpose()
-        .map_err(|e| perr(format!("joint_names: {e}")))?
-        .ok_or_else(|| perr("no 'joint_names' list".into()))?;
-    let mut ids = Vec::with_capacity(confs.len());
-    let mut qs = Vec::with_capacity(confs.len());
-    for (k, c) in confs.iter().enumerate() {
-        if let Some(extra) = c.joints.keys().find(|n| !names.contains(n)) {
-            return Err(perr(format!(
-                "configurations[{k}]: joint '{extra}' is not one of the design's joints ({})",
-                names.join(", ")
-            )));
-        }
-        let q = names
-            .iter()
-            .map(|n| {
-                c.joints
-                    .get(n)
-                    .copied()
-                    .ok_or_else(|| perr(format!("configurations[{k}]: no value for joint '{n}'")))
-            })
-            .collect::<Result<Vec<f64>>>()?;
-        ids.push(c.id);
-        qs.push(q);
-    }
-    let o = v.as_object_mut().expect("an object: it had configurations");
-    o.insert("poses".into(), serde_json::json!(ids));
-    o.insert("q".into(), serde_json::json!(qs));
-    DesignFile::parse(&v.to_string(), origin)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -225,7 +167,7 @@ mod tests {
             text.contains("configurations:") && text.contains("pose_01"),
             "{text}"
         );
-        let back = parse_yaml(&text, "d.yaml").unwrap();
+        let back = DesignFile::parse_yaml(&text, "d.yaml").unwrap();
         assert_eq!(back.q, d.q);
         assert_eq!(back.poses, d.poses);
         assert_eq!(back.joint_names, d.joint_names);
@@ -243,7 +185,9 @@ mod tests {
             })
             .map(|l| format!("{l}\n"))
             .collect();
-        let e = parse_yaml(&cut, "d.yaml").unwrap_err().to_string();
+        let e = DesignFile::parse_yaml(&cut, "d.yaml")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains(name.as_str()) && e.contains("d.yaml"), "{e}");
     }
 

@@ -235,9 +235,9 @@ pub struct PoolOpts {
     pub floor: Option<f64>,
     /// Keep candidates this far inside every revolute joint's limits,
     /// degrees: lattice and sampled pools are made over the shrunk ranges, a
-    /// file's rows closer to a limit are removed [default: 2 for a robot
-    /// from a .urdf or .toml file; 0 for the built-in arms (the paper's
-    /// lattice) and for --pool file:].
+    /// file's rows closer to a limit are removed [default: 2 for a .urdf
+    /// robot; 0 for the built-in arms (the paper's lattice), .toml
+    /// descriptions (their limits as stated) and --pool file:].
     #[arg(long, value_name = "DEGREES", allow_negative_numbers = true)]
     pub margin: Option<f64>,
     /// With --self-collision, --obstacle or --floor: also remove the
@@ -252,8 +252,8 @@ pub struct PoolOpts {
     pub clearance: f64,
 }
 
-/// The joint-limit margin of a robot loaded from a file when `--margin` is
-/// not given, degrees: clear of the hard stops, where a badly calibrated
+/// The joint-limit margin of a URDF robot when `--margin` is not given,
+/// degrees: clear of the hard stops, where a badly calibrated
 /// arm's controller faults, by more than a calibration's usual joint
 /// offsets (tenths of a degree).
 pub const DEFAULT_MARGIN_DEG: f64 = 2.0;
@@ -465,21 +465,23 @@ impl PoolOpts {
     }
 
     /// The joint-limit margin in radians: `--margin`, else
-    /// [`DEFAULT_MARGIN_DEG`] for a robot from a file and a generated pool,
-    /// else 0 (a built-in arm keeps the paper's lattice; a file of poses is
-    /// taken as given).
+    /// [`DEFAULT_MARGIN_DEG`] for a URDF robot and a generated pool, else 0
+    /// (a built-in arm keeps the paper's lattice, a `.toml` description
+    /// states its limits as its pools should use them — an export of a
+    /// built-in arm gives the same pool —, a file of poses is taken as
+    /// given).
     pub fn margin_radians(&self) -> Result<f64> {
         let deg = match self.margin {
             Some(m) if !(m.is_finite() && m >= 0.0) => {
                 anyhow::bail!("--margin {m}: the margin is an angle >= 0 degrees")
             }
             Some(m) => m,
-            None if Robot::builtin(&self.robot).is_ok()
-                || matches!(self.pool, PoolKind::File(_)) =>
+            None if activecal::io::urdf_chain(&with_chain(&self.robot))?.is_some()
+                && !matches!(self.pool, PoolKind::File(_)) =>
             {
-                0.0
+                DEFAULT_MARGIN_DEG
             }
-            None => DEFAULT_MARGIN_DEG,
+            None => 0.0,
         };
         Ok(deg.to_radians())
     }

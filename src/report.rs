@@ -292,6 +292,24 @@ pub struct SelectReport {
     /// With `--refine`: the design moved continuously off the pool.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub refinement: Option<RefinementReport>,
+    /// The chain's joint names, in configuration order.
+    pub joint_names: Vec<String>,
+    /// The design's poses with their joint values (refined ones with
+    /// `--refine`), in visiting order ([`SelectReport::set_visit`]; the
+    /// selection's order until then).
+    pub configurations: Vec<PoseConfig>,
+    /// The visiting order's figures, when one was planned.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tour: Option<crate::select::tour::TourReport>,
+}
+
+/// One pose of a design with its joint values.
+#[derive(Clone, Debug, Serialize)]
+pub struct PoseConfig {
+    /// Its id in the pool.
+    pub id: usize,
+    /// Joint values, radians or metres, in the order of `joint_names`.
+    pub q: Vec<f64>,
 }
 
 impl SelectReport {
@@ -311,6 +329,16 @@ impl SelectReport {
             pool: PoolInfo::new(robot, pool),
             pool_size: pool.len(),
             poses: pool.ids_of(&sel.poses),
+            joint_names: crate::pool::file::joint_names(robot),
+            configurations: sel
+                .poses
+                .iter()
+                .map(|&k| PoseConfig {
+                    id: pool.id(k),
+                    q: pool.q(k),
+                })
+                .collect(),
+            tour: None,
             ln_oid: sel.ln_oid,
             log10_oid: l10(sel.ln_oid),
             oi: sel.oi,

@@ -531,7 +531,7 @@ fn the_written_urdf_and_frames_evaluate_to_the_fitted_errors() {
     assert!((a - b).abs() < 1e-6, "evaluate {a}° vs calibrate {b}°");
     // Read back through the same YAML crate: the numbers are the report's.
     let back: serde_json::Value = serde_json::to_value(
-        yaml_serde::from_str::<serde_json::Value>(&std::fs::read_to_string(&yaml).unwrap())
+        serde_saphyr::from_str::<serde_json::Value>(&std::fs::read_to_string(&yaml).unwrap())
             .unwrap(),
     )
     .unwrap();

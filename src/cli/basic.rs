@@ -61,16 +61,19 @@ pub struct FkArgs {
 /// Arguments of the command.
 #[derive(Args)]
 pub struct PoolArgs {
-    /// Robot: a built-in name, or a .toml description or .urdf file; append
-    /// `:pose` for full-pose measurements.
-    #[arg(long, default_value = "puma560")]
-    pub robot: String,
-    /// Lattice values per joint.
-    #[arg(long, default_value_t = 5, allow_negative_numbers = true)]
-    pub levels: usize,
+    #[command(flatten)]
+    pub pool: super::PoolOpts,
     /// Lattice digits of one pose (joint 1 first), comma separated.
     #[arg(long)]
     pub digits: Option<String>,
+    /// Write the kept poses here: .csv (a header of the joint names and
+    /// `id`, one pose a row) or .json ({"joints", "ids", "qs"}), both
+    /// readable by --pool file:.
+    #[arg(long)]
+    pub out: Option<std::path::PathBuf>,
+    /// Replace an existing --out file.
+    #[arg(long, requires = "out")]
+    pub force: bool,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -238,19 +241,91 @@ pub fn cmd_fk(a: FkArgs) -> Result<()> {
     })
 }
 
-/// Runs `pool`.
-pub fn cmd_pool(a: PoolArgs) -> Result<()> {
-    let robot = load_robot(&a.robot)?;
-    let digits: Option<Vec<usize>> = a
-        .digits
+/// The format of `pool --out`, by its extension.
+fn pool_out_format(path: &std::path::Path) -> Result<&'static str> {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
         .as_deref()
-        .map(|d| parse_list(d, "--digits"))
-        .transpose()?;
-    let r = LatticeReport::new(&robot, a.levels, digits)?;
+    {
+        Some("csv") => Ok("csv"),
+        Some("json") => Ok("json"),
+        _ => anyhow::bail!(
+            "--out {}: the poses are written as .csv or .json; name the file with one of these extensions",
+            path.display()
+        ),
+    }
+}
+
+/// Runs `pool`: one lattice pose (`--digits`), or the pool every source and
+/// filter makes, with its counts, checked for repeated poses and written
+/// with `--out`.
+pub fn cmd_pool(a: PoolArgs) -> Result<()> {
+    if let Some(out) = &a.out {
+        super::refuse_overwrite(out, a.force)?;
+        pool_out_format(out)?;
+    }
+    if let Some(d) = a.digits.as_deref() {
+        let robot = load_robot(&a.pool.robot)?;
+        if !matches!(a.pool.pool, super::PoolKind::Lattice) || a.out.is_some() {
+            anyhow::bail!("--digits names one pose of --pool lattice, without --out");
+        }
+        let digits: Vec<usize> = parse_list(d, "--digits")?;
+        let levels = a.pool.levels.unwrap_or(super::DEFAULT_LEVELS);
+        let r = LatticeReport::new(&robot, levels, Some(digits))?;
+        return emit_report(a.json, &r, || {
+            let mut s = format!("lattice: {} levels per joint, {} poses\n", r.levels, r.size);
+            if let (Some(i), Some(q)) = (r.index, &r.q) {
+                s += &format!("index: {i}\nq (rad): {q:?}\n");
+            }
+            s
+        });
+    }
+    let d = super::load_description(&a.pool.robot)?;
+    let spec = a.pool.spec(d.visibility.as_ref())?;
+    let pool = spec.build(&d.robot, &d.robot.nominal)?;
+    let r = activecal::pool::summary::PoolSummary::new(&d.robot, &pool)?;
+    if let Some(out) = &a.out {
+        let qs: Vec<Vec<f64>> = (0..pool.len()).map(|k| pool.q(k)).collect();
+        let text = match pool_out_format(out)? {
+            "csv" => activecal::pool::summary::poses_csv(&r.joints, &qs, &pool.ids),
+            _ => activecal::pool::summary::poses_json(&r.robot, &r.joints, &qs, &pool.ids),
+        };
+        super::write_new(out, &text, a.force)?;
+    }
     emit_report(a.json, &r, || {
-        let mut s = format!("lattice: {} levels per joint, {} poses\n", r.levels, r.size);
-        if let (Some(i), Some(q)) = (r.index, &r.q) {
-            s += &format!("index: {i}\nq (rad): {q:?}\n");
+        let mut s = super::pool_stats_text(&r.pool_stats);
+        if let Some(l) = pool.lattice() {
+            s += &format!(
+                "lattice: {} levels per joint, {} poses, {} distinct\n",
+                l.levels,
+                l.size(),
+                l.distinct_poses()
+            );
+        }
+        if r.pool.margin > 0.0 {
+            s += &format!(
+                "margin: {:.4}° inside every revolute joint's limits\n",
+                r.pool.margin.to_degrees()
+            );
+        }
+        for j in r.lattice.iter().flatten() {
+            s += &format!(
+                "  {}: {} levels{}, {} distinct\n",
+                j.name,
+                j.levels.len(),
+                if j.full_turn {
+                    " on the circle (the joint turns all the way round)"
+                } else {
+                    ""
+                },
+                j.distinct
+            );
+        }
+        s += &format!("{} poses kept, {} distinct\n", r.size, r.distinct);
+        if let Some(out) = &a.out {
+            s += &format!("wrote {}\n", out.display());
         }
         s
     })

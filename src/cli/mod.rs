@@ -10,6 +10,7 @@ pub mod measured;
 pub mod progress;
 pub mod reproduce;
 pub mod select;
+pub mod tour;
 pub mod units;
 
 use activecal::measure::Visibility;
@@ -287,7 +288,30 @@ pub struct PoolOpts {
     /// Units of --pool file: and --existing values.
     #[command(flatten)]
     pub units: units::UnitOpts,
+    /// Keep candidates this far inside every revolute joint's limits,
+    /// degrees: lattice and sampled pools are made over the shrunk ranges, a
+    /// file's rows closer to a limit are removed [default: 2 for a .urdf
+    /// robot; 0 for the built-in arms (the paper's lattice), .toml
+    /// descriptions (their limits as stated) and --pool file:].
+    #[arg(long, value_name = "DEGREES", allow_negative_numbers = true)]
+    pub margin: Option<f64>,
+    /// With --self-collision, --obstacle or --floor: also remove the
+    /// candidates where two checked links, or a link and an obstacle, come
+    /// closer than this, metres (parry's distance query).
+    #[arg(
+        long,
+        value_name = "METRES",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub clearance: f64,
 }
+
+/// The joint-limit margin of a URDF robot when `--margin` is not given,
+/// degrees: clear of the hard stops, where a badly calibrated
+/// arm's controller faults, by more than a calibration's usual joint
+/// offsets (tenths of a degree).
+pub const DEFAULT_MARGIN_DEG: f64 = 2.0;
 
 /// Poses measured before a selection (`--existing`): their prior
 /// information `M0` and its report.
@@ -301,15 +325,24 @@ pub struct Existing {
 }
 
 /// Reads the poses of `--existing FILE` (a CSV or JSON of joint
-/// configurations, or a JSON measurement file: the same reader as
-/// `--pool file:…`) and makes their prior information at `params`.
+/// configurations, a JSON measurement file or a design file: the same
+/// reader as `--pool file:…`; or a design written as YAML) and makes their
+/// prior information at `params`.
 pub fn load_existing(
     path: &std::path::Path,
     robot: &Robot,
     params: ParamSet,
     units: activecal::units::Units,
 ) -> Result<Existing> {
+    use activecal::io::design_formats::DesignFormat;
     use anyhow::Context;
+    if DesignFormat::of(path).ok() == Some(DesignFormat::Yaml) {
+        // A design written as YAML: its joint values.
+        let d = activecal::io::design::DesignFile::read(path)
+            .and_then(|d| d.joint_values(robot))
+            .map_err(|e| anyhow::anyhow!("--existing {}: {e}", path.display()))?;
+        return existing_from(path.display().to_string(), d, Vec::new(), robot, params);
+    }
     let c = activecal::pool::read_configurations_in(path, robot, units).context("--existing")?;
     existing_from(path.display().to_string(), c.qs, c.notes, robot, params)
 }
@@ -417,6 +450,35 @@ pub fn pool_stats_text(st: &activecal::pool::PoolStats) -> String {
         s += &format!(", {} filter removed {} of {}", f.filter, f.removed, f.seen);
     }
     s += &format!(", {} kept\n", st.kept);
+    for f in &st.filters {
+        if let Some(c) = &f.contacts {
+            s += &format!(
+                "  {} filter: {} removed by two links touching, {} by a link touching an obstacle; {} pairs, the largest:\n",
+                f.filter, c.self_collision, c.obstacle, c.distinct_pairs
+            );
+            for p in &c.top {
+                s += &format!(
+                    "    {:>7}  {} – {}{}\n",
+                    p.removed,
+                    p.link,
+                    p.other,
+                    if p.obstacle { " (obstacle)" } else { "" }
+                );
+            }
+        }
+        if let Some(w) = &f.warning {
+            s += &format!("warning: {w}");
+            let own = f
+                .contacts
+                .as_ref()
+                .and_then(|c| c.top.first())
+                .is_some_and(|p| !p.obstacle);
+            if own {
+                s += " (give the SRDF with --srdf FILE)";
+            }
+            s += "\n";
+        }
+    }
     for n in &st.notes {
         s += &format!("note: {n}\n");
     }
@@ -461,7 +523,30 @@ impl PoolOpts {
         Ok(PoolSpec {
             source: self.source()?,
             filters,
+            margin: self.margin_radians()?,
         })
+    }
+
+    /// The joint-limit margin in radians: `--margin`, else
+    /// [`DEFAULT_MARGIN_DEG`] for a URDF robot and a generated pool, else 0
+    /// (a built-in arm keeps the paper's lattice, a `.toml` description
+    /// states its limits as its pools should use them — an export of a
+    /// built-in arm gives the same pool —, a file of poses is taken as
+    /// given).
+    pub fn margin_radians(&self) -> Result<f64> {
+        let deg = match self.margin {
+            Some(m) if !(m.is_finite() && m >= 0.0) => {
+                anyhow::bail!("--margin {m}: the margin is an angle >= 0 degrees")
+            }
+            Some(m) => m,
+            None if activecal::io::urdf_chain(&with_chain(&self.robot)?)?.is_some()
+                && !matches!(self.pool, PoolKind::File(_)) =>
+            {
+                DEFAULT_MARGIN_DEG
+            }
+            None => 0.0,
+        };
+        Ok(deg.to_radians())
     }
 
     /// The self-collision and obstacle filters of `--self-collision`,
@@ -481,7 +566,13 @@ impl PoolOpts {
             anyhow::bail!("--floor {z}: not a finite height");
         }
         let any_obstacle = !obstacles.is_empty() || self.floor.is_some();
+        if !(self.clearance.is_finite() && self.clearance >= 0.0) {
+            anyhow::bail!("--clearance {}: a distance >= 0 metres", self.clearance);
+        }
         if !self.self_collision && !any_obstacle {
+            if self.clearance > 0.0 {
+                anyhow::bail!("--clearance applies with --self-collision, --obstacle or --floor");
+            }
             if self.srdf.is_some() || !self.package_dirs.is_empty() {
                 anyhow::bail!(
                     "--srdf and --package-dir apply with --self-collision, --obstacle or --floor"
@@ -519,6 +610,7 @@ impl PoolOpts {
                 .iter()
                 .map(|p| p.display().to_string())
                 .collect(),
+            clearance: self.clearance,
             ..CollisionSpec::default()
         };
         let mut out = Vec::new();

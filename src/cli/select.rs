@@ -14,7 +14,9 @@ use std::time::Instant;
 pub struct ScoreArgs {
     #[command(flatten)]
     pub pool: PoolOpts,
-    /// Pose ids (lattice indices) of the design, comma separated.
+    /// Pose ids (lattice indices) of the design, comma separated. Without
+    /// it (and --design), a --pool file: is scored whole: a design written
+    /// by `select --out d.csv` scores as `score --pool file:d.csv`.
     #[arg(long)]
     pub poses: Option<String>,
     /// A design file (as `select --out` writes) instead of --poses: its
@@ -126,7 +128,19 @@ pub fn cmd_score(a: ScoreArgs, given: &[&str]) -> Result<()> {
             };
             ScoreReport::new(info, d.poses.clone(), &x)
         }
-        _ => bail!("give the design with --poses I1,I2,... or --design FILE"),
+        (None, None) if matches!(a.pool.pool, super::PoolKind::File(_)) => {
+            // Every pose of the file: a design written as .csv or .json.
+            let ctx = a.pool.load()?;
+            let all: Vec<usize> = (0..ctx.pool.len()).collect();
+            ScoreReport::new(
+                PoolInfo::new(&ctx.robot, &ctx.pool),
+                ctx.pool.ids.clone(),
+                &ctx.x.select(&all),
+            )
+        }
+        _ => bail!(
+            "give the design with --poses I1,I2,..., --design FILE, or --pool file:FILE alone (every pose of the file)"
+        ),
     };
     emit_report(a.json, &report, || {
         let ind = &report.indices;
@@ -229,17 +243,43 @@ pub struct SelectArgs {
     /// Passes over the poses of --refine (fewer when a pass gains nothing).
     #[arg(long, default_value_t = 3, requires = "refine")]
     pub refine_sweeps: usize,
+    /// Visiting order of the design: `time` orders the poses to take the
+    /// least total move time (a move takes max_j |Δq_j|/v_j with the URDF's
+    /// joint speed limits, 1 rad/s where none is given: nearest neighbour,
+    /// then 2-opt and Or-opt), `none` keeps selection order [default: time
+    /// when the robot's speed limits are known (a URDF robot), else none].
+    #[arg(long, value_enum)]
+    pub order: Option<Order>,
+    /// Start of the visiting path (the arm's position before the first
+    /// pose), joint values comma separated (radians or metres).
+    #[arg(long, value_name = "Q1,...", allow_hyphen_values = true)]
+    pub home: Option<String>,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
 }
 
+/// How `select` orders the design's poses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Order {
+    /// Least total move time.
+    Time,
+    /// Selection order.
+    None,
+}
+
 /// Runs `select`.
 pub fn cmd_select(a: SelectArgs) -> Result<()> {
     if let Some(out) = &a.out {
-        // Checked before the search: an existing file, a missing directory.
+        // Checked before the search: the format, an existing file, a missing
+        // directory.
         super::refuse_overwrite(out, a.force)?;
+        activecal::io::design_formats::DesignFormat::of(out)
+            .map_err(|e| anyhow::anyhow!("--out {e}"))?;
     }
+    // Cheap checks of the ordering's inputs before the pool is built.
+    let speeds = activecal::io::joint_speeds::joint_speeds(&super::with_chain(&a.pool.robot)?)?;
+    let home = super::tour::parse_home(a.home.as_deref(), &super::load_robot(&a.pool.robot)?)?;
     // Refused, never clamped (as `reproduce` does).
     let initial = match a.initial {
         Some(i) if i == 0 || i > a.n => bail!(
@@ -320,12 +360,20 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     } else {
         None
     };
+    if let Some(r) = &refined {
+        for (c, p) in report.configurations.iter_mut().zip(&r.poses) {
+            c.q.clone_from(&p.q);
+        }
+    }
+    let reorder = a.order.map_or(speeds.is_some(), |o| o == Order::Time);
+    let order = super::tour::order_design(&mut report, speeds.as_ref(), home.as_deref(), reorder)?;
     if let Some(out) = &a.out {
         let mut d = DesignFile::from_pool(&ctx.robot, &ctx.pool, &sel.poses);
         if let Some(r) = &refined {
             d.q = Some(r.poses.iter().map(|p| p.q.clone()).collect());
             d.refined = true;
         }
+        super::tour::reorder_design(&mut d, &order);
         d.existing = existing
             .as_ref()
             .map(|e| activecal::io::design::ExistingPoses {
@@ -348,7 +396,7 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         ] {
             d.extra.insert(k.into(), v[k].clone());
         }
-        d.write(out, a.force)?;
+        super::tour::write_design(&d, out, a.force)?;
     }
     emit_report(a.json, &report, || {
         let mut s = super::pool_stats_text(&ctx.pool.stats);
@@ -428,6 +476,7 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
                 );
             }
         }
+        s += &super::tour::configurations_text(&report);
         s
     })
 }

@@ -108,6 +108,44 @@ pub struct CollisionSpec {
     /// A floor: the half-space `z < floor` of the base frame.
     #[serde(default)]
     pub floor: Option<f64>,
+    /// Least distance kept between checked geometries (and to obstacles),
+    /// metres: a configuration closer than this counts as a contact. 0:
+    /// touching only.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub clearance: f64,
+}
+
+#[allow(clippy::trivially_copy_pass_by_ref)]
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+/// What two geometries at `pa`, `pb` are to each other: closer than
+/// `clearance` (touching when it is 0).
+fn too_close(
+    pa: &Isometry3<f64>,
+    a: &dyn parry3d_f64::shape::Shape,
+    pb: &Isometry3<f64>,
+    b: &dyn parry3d_f64::shape::Shape,
+    clearance: f64,
+) -> bool {
+    if clearance > 0.0 {
+        parry3d_f64::query::distance(pa, a, pb, b).is_ok_and(|d| d < clearance)
+    } else {
+        parry3d_f64::query::intersection_test(pa, a, pb, b).unwrap_or(false)
+    }
+}
+
+/// Which pair a contact is: a self-collision pair, or a link and an
+/// obstacle.
+#[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct ContactPair {
+    /// The first link.
+    pub link: String,
+    /// The other link, or the obstacle (`box 1`, `floor`).
+    pub other: String,
+    /// Whether `other` is an obstacle.
+    pub obstacle: bool,
 }
 
 /// One collision geometry on a link.
@@ -132,6 +170,8 @@ pub struct CollisionModel {
     exposed: Vec<usize>,
     /// For each configuration value `k`, the tree joint it drives.
     drives: Vec<usize>,
+    /// Least distance kept, metres ([`CollisionSpec::clearance`]).
+    clearance: f64,
     /// Joint values at a zero configuration (locks applied).
     rest: Vec<f64>,
 }
@@ -214,7 +254,11 @@ fn shape_of(
                 format!(
                     "link '{link}': mesh '{filename}' not found (searched {}the URDF's directory {} and its ancestors; give --package-dir DIR)",
                     spec.package_dirs.iter().map(|d| format!("{d}, ")).collect::<String>(),
-                    urdf_dir.display()
+                    if urdf_dir.as_os_str().is_empty() {
+                        Path::new(".").display()
+                    } else {
+                        urdf_dir.display()
+                    }
                 )
             })?;
             let lower = path.to_string_lossy().to_ascii_lowercase();
@@ -369,6 +413,12 @@ impl CollisionModel {
         let exposed = (0..geoms.len())
             .filter(|&g| tree.body[geoms[g].link] != base_body)
             .collect();
+        if !(spec.clearance.is_finite() && spec.clearance >= 0.0) {
+            return Err(format!(
+                "a clearance of {} m: it must be a finite distance >= 0",
+                spec.clearance
+            ));
+        }
         Ok(CollisionModel {
             tree,
             geoms,
@@ -376,6 +426,7 @@ impl CollisionModel {
             obstacles,
             exposed,
             drives,
+            clearance: spec.clearance,
             rest,
         })
     }
@@ -387,10 +438,20 @@ impl CollisionModel {
     }
 
     /// The first contact at configuration `q` (the chain's joint values), as
-    /// the two links (or link and obstacle) that touch, or `None` when the
-    /// configuration is free.
+    /// the two links (or link and obstacle) that touch (closer than the
+    /// spec's clearance), or `None` when the configuration is free.
     #[must_use]
     pub fn contact(&self, q: &[f64]) -> Option<(String, String)> {
+        self.contact_key(q).map(|k| {
+            let p = self.pair_of(k);
+            (p.link, p.other)
+        })
+    }
+
+    /// The first contact at `q` as a number ([`pair_of`](Self::pair_of)
+    /// names it): cheap to count per candidate.
+    #[must_use]
+    pub fn contact_key(&self, q: &[f64]) -> Option<usize> {
         let mut values = self.rest.clone();
         for (k, &j) in self.drives.iter().enumerate() {
             if let Some(v) = q.get(k) {
@@ -404,40 +465,55 @@ impl CollisionModel {
             .iter()
             .map(|g| links[g.link] * g.origin)
             .collect();
-        let name = |g: usize| self.tree.links[self.geoms[g].link].clone();
-        for &(a, b) in &self.pairs {
+        let c = self.clearance;
+        for (k, &(a, b)) in self.pairs.iter().enumerate() {
             let (ga, gb) = (&self.geoms[a], &self.geoms[b]);
             let d = (poses[a] * ga.center - poses[b] * gb.center).norm();
-            if d > ga.radius + gb.radius {
+            if d > ga.radius + gb.radius + c {
                 continue;
             }
-            if parry3d_f64::query::intersection_test(
+            if too_close(
                 &poses[a],
                 ga.shape.as_ref(),
                 &poses[b],
                 gb.shape.as_ref(),
-            )
-            .unwrap_or(false)
-            {
-                return Some((name(a), name(b)));
+                c,
+            ) {
+                return Some(k);
             }
         }
-        for (oname, opose, oshape) in &self.obstacles {
+        for (o, (_, opose, oshape)) in self.obstacles.iter().enumerate() {
             for &g in &self.exposed {
                 let geom = &self.geoms[g];
-                if parry3d_f64::query::intersection_test(
-                    &poses[g],
-                    geom.shape.as_ref(),
-                    opose,
-                    oshape.as_ref(),
-                )
-                .unwrap_or(false)
-                {
-                    return Some((name(g), oname.clone()));
+                if too_close(&poses[g], geom.shape.as_ref(), opose, oshape.as_ref(), c) {
+                    return Some(self.pairs.len() + o * self.geoms.len() + g);
                 }
             }
         }
         None
+    }
+
+    /// The links (or link and obstacle) of a [`contact_key`](Self::contact_key).
+    #[must_use]
+    pub fn pair_of(&self, key: usize) -> ContactPair {
+        let name = |g: usize| self.tree.links[self.geoms[g].link].clone();
+        if key < self.pairs.len() {
+            let (a, b) = self.pairs[key];
+            let (x, y) = (name(a), name(b));
+            let (link, other) = if x <= y { (x, y) } else { (y, x) };
+            return ContactPair {
+                link,
+                other,
+                obstacle: false,
+            };
+        }
+        let k = key - self.pairs.len();
+        let (o, g) = (k / self.geoms.len(), k % self.geoms.len());
+        ContactPair {
+            link: name(g),
+            other: self.obstacles[o].0.clone(),
+            obstacle: true,
+        }
     }
 }
 
@@ -472,7 +548,14 @@ impl CollisionFilter {
     /// building loads it first and reports the error).
     #[must_use]
     pub fn keeps(&self, q: &[f64]) -> bool {
-        self.load().is_ok_and(|m| m.contact(q).is_none())
+        self.load().is_ok_and(|m| m.contact_key(q).is_none())
+    }
+
+    /// The contact that removes `q` ([`CollisionModel::contact_key`]), or
+    /// `None` when it is free or the model cannot be loaded.
+    #[must_use]
+    pub fn contact_key(&self, q: &[f64]) -> Option<usize> {
+        self.load().ok().and_then(|m| m.contact_key(q))
     }
 
     /// `self-collision`, `obstacles`, or `collision` (both).

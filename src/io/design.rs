@@ -37,6 +37,10 @@ pub struct DesignFile {
     /// readers).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub levels: Option<usize>,
+    /// The chain's joint names, in the order of the joint values (absent
+    /// in files written before they were stored).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint_names: Option<Vec<String>>,
     /// Id of each pose in its pool (the lattice index for lattice poses).
     pub poses: Vec<usize>,
     /// Joint values of each pose (absent in old files: the lattice's).
@@ -62,6 +66,15 @@ pub struct DesignFile {
     pub extra: serde_json::Map<String, serde_json::Value>,
 }
 
+/// One named joint configuration as read back.
+#[derive(Deserialize)]
+struct NamedIn {
+    #[allow(dead_code)]
+    name: Option<String>,
+    id: usize,
+    joints: std::collections::BTreeMap<String, f64>,
+}
+
 /// Poses measured before a design was chosen, as a design file stores them.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct ExistingPoses {
@@ -79,6 +92,7 @@ impl DesignFile {
             robot: robot.name.clone(),
             pool: Some(pool.spec.clone()),
             levels: pool.spec.levels(),
+            joint_names: Some(crate::pool::file::joint_names(robot)),
             poses: pool.ids_of(positions),
             q: Some(positions.iter().map(|&k| pool.q(k)).collect()),
             pool_qs: pool.listed().map(<[Vec<f64>]>::to_vec),
@@ -96,6 +110,7 @@ impl DesignFile {
             robot: robot.to_string(),
             pool: None,
             levels: Some(levels),
+            joint_names: None,
             poses,
             q: None,
             pool_qs: None,
@@ -105,13 +120,74 @@ impl DesignFile {
         }
     }
 
-    /// Reads and parses a design file ([`DesignFile::parse`]).
+    /// Reads and parses a design file: JSON ([`DesignFile::parse`]), or
+    /// the YAML form `select --out d.yaml` writes
+    /// ([`DesignFile::parse_yaml`]) when the name ends in
+    /// `.yaml` or `.yml`.
     pub fn read(path: &Path) -> Result<DesignFile> {
         let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
             path: path.display().to_string(),
             cause,
         })?;
-        Self::parse(&text, &path.display().to_string())
+        let origin = path.display().to_string();
+        let yaml = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
+        if yaml {
+            return Self::parse_yaml(&text, &origin);
+        }
+        Self::parse(&text, &origin)
+    }
+
+    /// Parses the YAML form back into a design file (`origin` names it in
+    /// errors): the configurations' joint values become `q`, in the order of
+    /// `joint_names`; a configuration missing a joint, or naming one the design
+    /// does not list, is an error naming it.
+    pub fn parse_yaml(text: &str, origin: &str) -> Result<DesignFile> {
+        let perr = |message: String| Error::Parse {
+            path: origin.to_string(),
+            message,
+        };
+        let mut v: serde_json::Value =
+            serde_saphyr::from_str(text).map_err(|e| perr(e.to_string()))?;
+        let confs = v
+            .as_object_mut()
+            .and_then(|o| o.remove("configurations"))
+            .ok_or_else(|| perr("no 'configurations' list of named joint configurations".into()))?;
+        let confs: Vec<NamedIn> =
+            serde_json::from_value(confs).map_err(|e| perr(format!("configurations: {e}")))?;
+        let names: Vec<String> = v
+            .get("joint_names")
+            .cloned()
+            .map(serde_json::from_value)
+            .transpose()
+            .map_err(|e| perr(format!("joint_names: {e}")))?
+            .ok_or_else(|| perr("no 'joint_names' list".into()))?;
+        let mut ids = Vec::with_capacity(confs.len());
+        let mut qs = Vec::with_capacity(confs.len());
+        for (k, c) in confs.iter().enumerate() {
+            if let Some(extra) = c.joints.keys().find(|n| !names.contains(n)) {
+                return Err(perr(format!(
+                    "configurations[{k}]: joint '{extra}' is not one of the design's joints ({})",
+                    names.join(", ")
+                )));
+            }
+            let q = names
+                .iter()
+                .map(|n| {
+                    c.joints.get(n).copied().ok_or_else(|| {
+                        perr(format!("configurations[{k}]: no value for joint '{n}'"))
+                    })
+                })
+                .collect::<Result<Vec<f64>>>()?;
+            ids.push(c.id);
+            qs.push(q);
+        }
+        let o = v.as_object_mut().expect("an object: it had configurations");
+        o.insert("poses".into(), serde_json::json!(ids));
+        o.insert("q".into(), serde_json::json!(qs));
+        DesignFile::parse(&v.to_string(), origin)
     }
 
     /// Parses the text of a design file, `origin` naming it in errors
@@ -213,6 +289,22 @@ impl DesignFile {
     pub fn joint_values(&self, robot: &Robot) -> Result<Vec<Vec<f64>>> {
         self.check_robot(robot)?;
         self.check_shape()?;
+        if let Some(names) = &self.joint_names {
+            let chain = crate::pool::file::joint_names(robot);
+            if let Some(n) = names.iter().find(|n| !chain.contains(n)) {
+                return Err(Error::Invalid(format!(
+                    "the design's joint '{n}' is not a joint of the robot's chain ({})",
+                    chain.join(", ")
+                )));
+            }
+            if names != &chain {
+                return Err(Error::Invalid(format!(
+                    "the design's joints ({}) are not the chain's, in its order ({})",
+                    names.join(", "),
+                    chain.join(", ")
+                )));
+            }
+        }
         let qs = match &self.q {
             Some(q) => q.clone(),
             None => {

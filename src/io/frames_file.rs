@@ -3,10 +3,8 @@
 //! written as YAML, and read back to mount a (calibrated) URDF in the
 //! sensor's frame with its tool.
 //!
-//! Written and read with `yaml_serde`, the YAML organisation's maintained
-//! fork of `serde_yaml` (archived in 2024; `serde_yml` began as one
-//! unreviewed commit, `serde_yaml_ng` and `serde_norway` have had no release
-//! since 2024, and `serde-saphyr` has another API).
+//! Written and read with `serde_saphyr` (pure Rust, maintained, panic-free),
+//! the crate design files use too.
 
 use crate::error::{Error, Result};
 use crate::frames::report::FramesReport;
@@ -19,7 +17,7 @@ const HEADER: &str = "# Calibrated frames written by activecal. Units: metres an
 
 /// The frames file's text.
 pub fn to_yaml(report: &FramesReport) -> Result<String> {
-    let body = yaml_serde::to_string(report)
+    let body = serde_saphyr::to_string(report)
         .map_err(|e| Error::Invalid(format!("cannot write the frames as YAML: {e}")))?;
     Ok(format!("{HEADER}{body}"))
 }
@@ -90,7 +88,7 @@ pub fn parse(text: &str, origin: &str) -> Result<Frames> {
         message,
     };
     let f: FileEntry =
-        yaml_serde::from_str(text).map_err(|e| bad(format!("not a frames file: {e}")))?;
+        serde_saphyr::from_str(text).map_err(|e| bad(format!("not a frames file: {e}")))?;
     let finite = |what: &str, v: &[f64]| {
         if v.iter().all(|x| x.is_finite()) {
             Ok(())

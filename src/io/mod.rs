@@ -5,7 +5,9 @@
 pub mod atomic;
 pub mod calibrated;
 pub mod design;
+pub mod design_formats;
 pub mod frames_file;
+pub mod joint_speeds;
 pub mod measurements;
 pub mod robot_toml;
 pub mod table;

@@ -13,7 +13,8 @@
 //!   are skipped.
 //! * **JSON** `{"qs": [[...], ...]}` (values in joint order) or
 //!   `{"joints": [names], "qs": [...]}` (values in the order of `joints`,
-//!   matched by name as CSV columns are). Other keys (a measurement file's
+//!   matched by name as CSV columns are), or a design file (`"poses"`,
+//!   `"q"`, `"joint_names"`). Other keys (a measurement file's
 //!   `points`, `orientations`, `robot`) are ignored with a note; a `robot`
 //!   key, when present, must name the robot.
 //!
@@ -275,15 +276,28 @@ pub fn parse_json_in(
             format!("the file is for robot '{r}', not '{}'", robot.name),
         ));
     }
-    let Some(rows) = obj.get("qs").and_then(|q| q.as_array()) else {
-        return Err(parse_err(path, "no \"qs\" array of joint vectors".into()));
+    // A design file (`select --out`) names its joint vectors `q` and its
+    // joints `joint_names`.
+    let design = !obj.contains_key("qs") && obj.contains_key("q") && obj.contains_key("poses");
+    let (rows_key, joints_key) = if design {
+        ("q", "joint_names")
+    } else {
+        ("qs", "joints")
     };
-    let (map, mut ignored, width, header) = match obj.get("joints") {
+    let Some(rows) = obj.get(rows_key).and_then(|q| q.as_array()) else {
+        return Err(parse_err(
+            path,
+            "no \"qs\" array of joint vectors (nor a design file's \"q\")".into(),
+        ));
+    };
+    let (map, mut ignored, width, header) = match obj.get(joints_key) {
         Some(j) => {
             let header: Vec<String> = j
                 .as_array()
                 .and_then(|a| a.iter().map(|x| x.as_str().map(str::to_string)).collect())
-                .ok_or_else(|| parse_err(path, "\"joints\" must be an array of names".into()))?;
+                .ok_or_else(|| {
+                    parse_err(path, format!("\"{joints_key}\" must be an array of names"))
+                })?;
             let (map, ignored) = map_columns(path, &header, &names)?;
             let width = header.len();
             (map, ignored, width, header)
@@ -298,13 +312,13 @@ pub fn parse_json_in(
     let mut keys: Vec<&str> = obj
         .keys()
         .map(String::as_str)
-        .filter(|k| !["qs", "joints", "robot"].contains(k))
+        .filter(|k| ![rows_key, joints_key, "robot"].contains(k))
         .collect();
     keys.sort_unstable();
     let mut qs = Vec::with_capacity(rows.len());
     let mut labels = Vec::with_capacity(rows.len());
     for (k, r) in rows.iter().enumerate() {
-        let row = format!("qs[{k}] (row {})", k + 1);
+        let row = format!("{rows_key}[{k}] (row {})", k + 1);
         let Some(cells) = r.as_array() else {
             return Err(parse_err(path, format!("{row}: not an array of numbers")));
         };

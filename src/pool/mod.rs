@@ -17,6 +17,9 @@
 pub mod file;
 pub mod lattice;
 pub mod sampled;
+pub mod stats;
+pub mod summary;
+pub mod turn;
 
 pub use file::{Configurations, read_configurations, read_configurations_in};
 pub use lattice::Lattice;
@@ -135,6 +138,14 @@ pub struct FilterStat {
     pub seen: usize,
     /// Of those, the ones it removed.
     pub removed: usize,
+    /// For a collision filter: which pairs of links (or link and obstacle)
+    /// removed them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contacts: Option<stats::ContactCounts>,
+    /// A warning: the filter removed more than [`stats::MOST`] of what
+    /// reached it (naming the pair that removed most).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub warning: Option<String>,
 }
 
 /// What building a pool did: candidates of the source, what each filter
@@ -160,6 +171,17 @@ pub struct PoolSpec {
     /// Filters applied to every candidate (none: keep them all).
     #[serde(default)]
     pub filters: Vec<PoolFilter>,
+    /// Margin kept inside every revolute joint's limits, radians
+    /// ([`turn::shrunk_limits`]): a lattice or sampled source is made over
+    /// the shrunk ranges; a file's rows closer to a limit are removed (the
+    /// `margin` entry of the pool statistics). 0 (the default): the limits.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub margin: f64,
+}
+
+#[allow(clippy::trivially_copy_pass_by_ref)]
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// The generated candidates of a source, each computable from its id.
@@ -203,7 +225,28 @@ impl PoolSpec {
         Self {
             source,
             filters: Vec::new(),
+            margin: 0.0,
         }
+    }
+
+    /// The spec with a joint-limit margin of `margin` radians.
+    #[must_use]
+    pub fn with_margin(mut self, margin: f64) -> Self {
+        self.margin = margin;
+        self
+    }
+
+    /// The robot with the margin taken off its joint limits (itself without
+    /// a margin); an error names a joint whose range the margin empties.
+    fn margined(&self, robot: &Robot) -> Result<Option<Robot>> {
+        if self.margin == 0.0 {
+            return Ok(None);
+        }
+        let names = file::joint_names(robot);
+        let limits = turn::shrunk_limits(robot, &names, self.margin)?;
+        let mut r = robot.clone();
+        r.limits = limits;
+        Ok(Some(r))
     }
 
     /// The spec with one more filter.
@@ -292,43 +335,72 @@ impl PoolSpec {
         rows: Option<Vec<Vec<f64>>>,
         notes: Vec<String>,
     ) -> Result<Pool> {
-        let n = match self.source.declared_size(robot)? {
+        let margined = self.margined(robot)?;
+        let inside = margined.as_ref().unwrap_or(robot);
+        let n = match self.source.declared_size(inside)? {
             Some(n) => n,
             None => rows.as_ref().map_or(0, Vec::len),
         };
         check_memory(robot, n)?;
         let cands = match (&self.source, rows.as_deref()) {
             (PoolSource::Lattice { levels }, _) => {
-                Candidates::Lattice(Lattice::new(robot, *levels)?)
+                Candidates::Lattice(Lattice::within(robot, *levels, &inside.limits)?)
             }
             (PoolSource::Random { count, seed }, _) => {
-                Candidates::Random(Uniform::new(robot, *count, *seed)?)
+                Candidates::Random(Uniform::new(inside, *count, *seed)?)
             }
             (PoolSource::Sobol { count, seed }, _) => {
-                Candidates::Sobol(Sobol::new(robot, *count, *seed)?)
+                Candidates::Sobol(Sobol::new(inside, *count, *seed)?)
             }
             (PoolSource::File { .. }, Some(rows)) => Candidates::Listed(rows),
             (PoolSource::File { .. }, None) => unreachable!("a file source is built from its rows"),
         };
         let dof = robot.dof();
-        let n_filters = self.filters.len();
+        // A file's rows are checked against the margin first (generated
+        // sources are made inside it).
+        let margin_limits = match (&cands, &margined) {
+            (Candidates::Listed(_), Some(m)) => Some(m.limits.clone()),
+            _ => None,
+        };
+        let mut names: Vec<String> = Vec::new();
+        if margin_limits.is_some() {
+            names.push("margin".into());
+        }
+        names.extend(self.filters.iter().map(|f| f.kind().to_string()));
+        let n_filters = names.len();
+        let skip = usize::from(margin_limits.is_some());
         // For each candidate, the first filter that removes it (n_filters:
-        // none). Integer counts: the same whatever the thread split.
-        let first_fail = |id: usize| -> usize {
+        // none) and, for a collision filter, the contact that did
+        // (`NO_CONTACT` otherwise). Integer counts: the same whatever the
+        // thread split.
+        let first_fail = |id: usize| -> (usize, usize) {
             let mut q = vec![0.0; dof];
             cands.q_into(id, &mut q);
-            self.filters
-                .iter()
-                .position(|f| !f.keeps(robot, table, &q))
-                .unwrap_or(n_filters)
+            if let Some(m) = &margin_limits
+                && q.iter().zip(m).any(|(v, l)| *v < l[0] || *v > l[1])
+            {
+                return (0, stats::NO_CONTACT);
+            }
+            for (k, f) in self.filters.iter().enumerate() {
+                match f {
+                    PoolFilter::Collision(c) => {
+                        if let Some(key) = c.contact_key(&q) {
+                            return (k + skip, key);
+                        }
+                    }
+                    _ if !f.keeps(robot, table, &q) => return (k + skip, stats::NO_CONTACT),
+                    _ => {}
+                }
+            }
+            (n_filters, stats::NO_CONTACT)
         };
         // Each candidate's verdict once (a collision check is the costly
         // filter), in parallel over fixed chunks, with progress.
         let task = crate::progress::Task::start("pool filters", Some(cands.size() as u64));
-        let verdict: Vec<usize> = if n_filters == 0 {
+        let verdict: Vec<(usize, usize)> = if n_filters == 0 {
             Vec::new()
         } else {
-            let mut v = vec![n_filters; cands.size()];
+            let mut v = vec![(n_filters, stats::NO_CONTACT); cands.size()];
             v.par_chunks_mut(1024).enumerate().for_each(|(c, chunk)| {
                 for (k, out) in chunk.iter_mut().enumerate() {
                     *out = first_fail(c * 1024 + k);
@@ -342,43 +414,21 @@ impl PoolSpec {
             (0..cands.size()).collect()
         } else {
             (0..cands.size())
-                .filter(|&id| verdict[id] == n_filters)
+                .filter(|&id| verdict[id].0 == n_filters)
                 .collect()
         };
-        let mut removed = vec![0usize; n_filters];
-        for &f in &verdict {
-            if f < n_filters {
-                removed[f] += 1;
-            }
-        }
-        let mut seen = cands.size();
-        let filters: Vec<FilterStat> = self
-            .filters
-            .iter()
-            .zip(&removed)
-            .map(|(f, &r)| {
-                let s = FilterStat {
-                    filter: f.kind().to_string(),
-                    seen,
-                    removed: r,
-                };
-                seen -= r;
-                s
-            })
-            .collect();
-        debug_assert_eq!(seen, ids.len());
+        let mut models = vec![None; skip];
+        models.extend(self.filters.iter().map(|f| match f {
+            PoolFilter::Collision(c) => c.load().ok(),
+            PoolFilter::Visibility(_) => None,
+        }));
+        let filters = stats::filter_stats(&names, &models, &verdict, cands.size());
+        debug_assert_eq!(
+            filters.last().map_or(cands.size(), |f| f.seen - f.removed),
+            ids.len()
+        );
         if ids.is_empty() {
-            let last = filters.iter().rposition(|f| f.removed > 0);
-            return Err(Error::Invalid(match last {
-                Some(k) => format!(
-                    "the {} filter removed every pose of the pool that reached it ({} of {}; the source had {})",
-                    filters[k].filter,
-                    filters[k].removed,
-                    filters[k].seen,
-                    cands.size()
-                ),
-                None => "the pool has no candidates".into(),
-            }));
+            return Err(Error::Invalid(stats::emptied(&filters, cands.size())));
         }
         let mut q = vec![0.0; ids.len() * dof];
         if dof > 0 {

@@ -1,6 +1,8 @@
 //! Sampled pools: uniform random and low-discrepancy (Sobol) configurations
 //! inside the joint limits, each pose computable from its id alone so that a
-//! pool is the same whatever the number of threads that builds it.
+//! pool is the same whatever the number of threads that builds it. A
+//! revolute joint that turns all the way round is drawn on one turn from its
+//! lower limit (`[lo, lo + 2π)`, [`super::turn`]): each angle once.
 //!
 //! * [`Uniform`]: sample `k` is the values `k·dof .. (k+1)·dof` of one
 //!   ChaCha8 stream seeded with the pool's seed (each value a uniform `f64`
@@ -24,8 +26,11 @@ use rand_chacha::ChaCha8Rng;
 /// Most samples a sampled pool may have (ids are 32-bit Sobol indices).
 pub const MAX_SAMPLES: usize = 1 << 32;
 
-/// Checked joint limits of a robot: finite, `lo ≤ hi`.
+/// The intervals a robot's joints are sampled from: its joint limits,
+/// checked (finite, `lo ≤ hi`), one turn of a joint that turns all the way
+/// round ([`super::turn::sampling_range`]).
 pub(crate) fn checked_limits(robot: &Robot) -> Result<Vec<[f64; 2]>> {
+    let revolute = super::turn::revolute_joints(robot);
     for (j, &[lo, hi]) in robot.limits.iter().enumerate() {
         if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
             return Err(Error::InvalidLimits {
@@ -35,10 +40,16 @@ pub(crate) fn checked_limits(robot: &Robot) -> Result<Vec<[f64; 2]>> {
             });
         }
     }
-    Ok(robot.limits.clone())
+    Ok(robot
+        .limits
+        .iter()
+        .zip(&revolute)
+        .map(|(&l, &r)| super::turn::sampling_range(r, l))
+        .collect())
 }
 
-/// `lo·(1−u) + hi·u`: exact at both ends.
+/// `lo·(1−u) + hi·u`: exact at both ends (with `u < 1`, a full turn's top,
+/// which is its bottom again, is reached only by rounding).
 fn lerp([lo, hi]: [f64; 2], u: f64) -> f64 {
     lo * (1.0 - u) + hi * u
 }

@@ -35,6 +35,7 @@ use serde::{Deserialize, Serialize};
 mod exchange;
 mod random;
 pub mod refine;
+pub mod tour;
 
 pub use exchange::{Selection, detmax, eae, fedorov, multistart, polish};
 pub use random::{

@@ -1,0 +1,119 @@
+//! `select`'s visiting order and design outputs: the poses in the order to
+//! measure them, written in the robot's terms (.json, .csv, .yaml).
+
+use activecal::io::design::DesignFile;
+use activecal::io::design_formats::{self, DesignFormat};
+use activecal::io::joint_speeds::JointSpeeds;
+use activecal::model::Robot;
+use activecal::report::SelectReport;
+use anyhow::{Result, bail};
+
+/// Speed assumed for a joint whose limit the robot does not state, rad/s
+/// (or m/s).
+pub const FALLBACK_SPEED: f64 = 1.0;
+
+/// Parses `--home`: one finite value per joint of `robot`.
+pub fn parse_home(text: Option<&str>, robot: &Robot) -> Result<Option<Vec<f64>>> {
+    let Some(t) = text else { return Ok(None) };
+    let q: Vec<f64> = super::parse_list(t, "--home")?;
+    if q.len() != robot.dof() {
+        bail!(
+            "--home {t}: {} joint values, the robot has {} joints ({})",
+            q.len(),
+            robot.dof(),
+            activecal::pool::file::joint_names(robot).join(", ")
+        );
+    }
+    if let Some(j) = q.iter().position(|v| !v.is_finite()) {
+        bail!("--home {t}: joint {} value {} is not finite", j + 1, q[j]);
+    }
+    Ok(Some(q))
+}
+
+/// Orders the report's configurations (the design's joint values) for
+/// visiting when `reorder` (else keeps selection order) and records the
+/// figures; returns the order as positions in selection order.
+pub fn order_design(
+    report: &mut SelectReport,
+    speeds: Option<&JointSpeeds>,
+    home: Option<&[f64]>,
+    reorder: bool,
+) -> Result<Vec<usize>> {
+    let names = &report.joint_names;
+    let (v, assumed) = match speeds {
+        Some(s) => (
+            s.or(FALLBACK_SPEED),
+            s.speeds
+                .iter()
+                .zip(&s.joints)
+                .filter(|(v, _)| v.is_none())
+                .map(|(_, n)| n.clone())
+                .collect(),
+        ),
+        None => (vec![FALLBACK_SPEED; names.len()], names.clone()),
+    };
+    let qs: Vec<Vec<f64>> = report.configurations.iter().map(|c| c.q.clone()).collect();
+    let (order, tour) = activecal::select::tour::visit(&v, assumed, home, &qs, reorder)?;
+    let old = std::mem::take(&mut report.configurations);
+    report.configurations = order.iter().map(|&k| old[k].clone()).collect();
+    report.tour = Some(tour);
+    Ok(order)
+}
+
+/// Puts a design file's poses in `order` (positions in selection order).
+pub fn reorder_design(d: &mut DesignFile, order: &[usize]) {
+    d.poses = order.iter().map(|&k| d.poses[k]).collect();
+    if let Some(q) = &d.q {
+        d.q = Some(order.iter().map(|&k| q[k].clone()).collect());
+    }
+}
+
+/// Writes the design in the format its extension names (checked before the
+/// search too).
+pub fn write_design(d: &DesignFile, out: &std::path::Path, force: bool) -> Result<()> {
+    match DesignFormat::of(out)? {
+        DesignFormat::Json => d.write(out, force)?,
+        DesignFormat::Csv => super::write_new(out, &design_formats::to_csv(d)?, force)?,
+        DesignFormat::Yaml => super::write_new(out, &design_formats::to_yaml(d)?, force)?,
+    }
+    Ok(())
+}
+
+/// Text lines: the ordering's figures and the poses with their named joint
+/// values, in visiting order.
+pub fn configurations_text(r: &SelectReport) -> String {
+    let mut s = String::new();
+    if let Some(t) = &r.tour {
+        let (b, a) = (&t.selection_order, &t.visiting_order);
+        if t.reordered {
+            s += &format!(
+                "visiting order: move time {:.2} s -> {:.2} s ({:.3} of selection order's), largest-joint travel {:.2} -> {:.2} rad\n",
+                b.time_s, a.time_s, t.time_ratio, b.travel, a.travel
+            );
+        } else {
+            s += &format!(
+                "selection order kept: move time {:.2} s, largest-joint travel {:.2} rad\n",
+                b.time_s, b.travel
+            );
+        }
+        if !t.assumed_speeds.is_empty() {
+            s += &format!(
+                "  (speed limit {FALLBACK_SPEED} rad/s assumed for {})\n",
+                t.assumed_speeds.join(", ")
+            );
+        }
+    }
+    s += &format!("{:>4} {:>8}", "#", "id");
+    for n in &r.joint_names {
+        s += &format!(" {n:>12}");
+    }
+    s += "   (rad; m for prismatic joints)\n";
+    for (k, c) in r.configurations.iter().enumerate() {
+        s += &format!("{:>4} {:>8}", k + 1, c.id);
+        for v in &c.q {
+            s += &format!(" {v:>12.6}");
+        }
+        s += "\n";
+    }
+    s
+}

@@ -83,6 +83,7 @@ fn import(f: &Fixture) -> Robot {
         base: f.base.clone(),
         tip: Some(f.tip.clone()),
         lock: f.lock.clone(),
+        frames: None,
     };
     let name = format!("{}{}", root().join(&f.urdf).display(), choice.fragment());
     load_robot(&name).unwrap_or_else(|e| panic!("{name}: {e}"))

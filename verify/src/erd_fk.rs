@@ -131,6 +131,7 @@ pub fn robot_name(arm: &Arm, path: &Path) -> String {
         base: arm.base.map(str::to_string),
         tip: Some(arm.tip.to_string()),
         lock: arm.lock.iter().map(|&(n, v)| (n.to_string(), v)).collect(),
+        frames: None,
     };
     format!("{}{}", path.display(), choice.fragment())
 }

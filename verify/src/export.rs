@@ -191,7 +191,7 @@ pub fn cases(erd_dir: Option<&Path>) -> Vec<Case> {
         for sensor in [Sensor::Point, Sensor::Pose] {
             v.push(Case {
                 name: format!("builtin_{name}_{}", sensor.name()),
-                description: Description::Builtin(*name),
+                description: Description::Builtin(name),
                 base: None,
                 tip: None,
                 lock: Vec::new(),

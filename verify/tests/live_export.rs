@@ -122,7 +122,7 @@ fn a_joint_origin_off_by_a_microradian_is_seen() {
                 let bad = case
                     .export_with(&|j, t| {
                         if j == k {
-                            t.rotation = t.rotation * turn;
+                            t.rotation *= turn;
                         }
                     })
                     .unwrap();

@@ -11,7 +11,9 @@
 //! [`erd`] is the table of the serial arms of `example-robot-data`, and
 //! [`erd_fk`] compares their import with Pinocchio's forward kinematics of
 //! the same URDF files (live) and writes the fixtures of
-//! `fixtures/example-robot-data/fk/`.
+//! `fixtures/example-robot-data/fk/`; [`export`] checks the calibrated URDF
+//! activecal writes back (issue #26) with Pinocchio and writes
+//! `fixtures/export/`.
 //!
 //! What is compared, at each configuration `q`: the end-point position
 //! `p(q)` in the measurement frame, and the positional joint Jacobian
@@ -26,6 +28,7 @@
 pub mod compare;
 pub mod erd;
 pub mod erd_fk;
+pub mod export;
 pub mod fixture;
 pub mod idjac;
 pub mod model;

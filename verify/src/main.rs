@@ -10,8 +10,10 @@
 //! finite-difference identification Jacobians, [`verify::idjac`]) and
 //! `fixtures/example-robot-data/fk/<arm>.json` (Pinocchio's forward
 //! kinematics of the `example-robot-data` arms, [`verify::erd_fk`]) with
-//! copies of their URDFs in `fixtures/example-robot-data/`; with `--out DIR`
-//! they go to `DIR/idjac/` and `DIR/example-robot-data/`.
+//! copies of their URDFs in `fixtures/example-robot-data/`, and
+//! `fixtures/export/<case>.json` (Pinocchio's forward kinematics of the
+//! calibrated URDFs activecal writes, [`verify::export`]); with `--out DIR`
+//! they go to `DIR/idjac/`, `DIR/example-robot-data/` and `DIR/export/`.
 //!
 //! Build with `PYO3_PYTHON=$PWD/.venv/bin/python` (scripts/test does).
 
@@ -22,7 +24,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 use verify::bridge::Bridge;
 use verify::check::{check_live, regenerate};
-use verify::{TOLERANCE, builtin_robots, erd_fk, fixture, idjac, synthetic_robot};
+use verify::{TOLERANCE, builtin_robots, erd_fk, export, fixture, idjac, synthetic_robot};
 
 /// Configurations of the identification-Jacobian check.
 const IDJAC_CONFIGS: usize = 200;
@@ -63,6 +65,7 @@ fn regen(dir: PathBuf) -> Result<bool> {
         &bridge,
         &dir.join("example-robot-data"),
     )?);
+    paths.extend(export::live::regenerate(&bridge, &dir.join("export"))?);
     for path in paths {
         let size = std::fs::metadata(&path)?.len();
         println!("wrote {} ({size} bytes)", path.display());

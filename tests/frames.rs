@@ -41,44 +41,6 @@ fn import(
     parse(text, path, &opts).unwrap()
 }
 
-/// Direct URDF kinematics from the chain's base to its tip, by urdf_rs and
-/// nalgebra alone (independent of the importer and of the split).
-fn urdf_fk(u: &urdf_rs::Robot, base: &str, tip: &str, q: &HashMap<String, f64>) -> Isometry3<f64> {
-    let by_child: HashMap<&str, &urdf_rs::Joint> = u
-        .joints
-        .iter()
-        .map(|j| (j.child.link.as_str(), j))
-        .collect();
-    let mut chain = Vec::new();
-    let mut at = tip;
-    while at != base {
-        let j = by_child[at];
-        chain.push(j);
-        at = &j.parent.link;
-    }
-    chain.reverse();
-    let mut t = Isometry3::identity();
-    for j in chain {
-        let [x, y, z] = j.origin.xyz.0;
-        let [r, p, yw] = j.origin.rpy.0;
-        t *= Isometry3::from_parts(
-            Translation3::new(x, y, z),
-            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yw)
-                * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), p)
-                * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), r),
-        );
-        let axis = Unit::new_normalize(Vector3::from(j.axis.xyz.0));
-        use urdf_rs::JointType as T;
-        let v = q.get(&j.name).copied().unwrap_or(0.0);
-        match j.joint_type {
-            T::Revolute | T::Continuous => t *= UnitQuaternion::from_axis_angle(&axis, v),
-            T::Prismatic => t *= Translation3::from(axis.into_inner() * v),
-            _ => {}
-        }
-    }
-    t
-}
-
 fn random_q(robot: &Robot, rng: &mut ChaCha8Rng) -> Vec<f64> {
     robot
         .limits
@@ -126,7 +88,7 @@ fn check_export(path: &str, tip: &str, m: MeasurementKind) {
         let q = random_q(&robot, &mut rng);
         let mut qm = locked.clone();
         qm.extend(names.iter().cloned().zip(q.iter().copied()));
-        let direct = f.measurement * urdf_fk(&u, &s.base, &s.tip, &qm) * f.tool;
+        let direct = f.measurement * common::urdf_fk(&u, &s.base, &s.tip, &qm) * f.tool;
         let (r, p) = pose(&robot, &table, &q);
         worst = worst.max((direct.translation.vector - p).norm());
         if m == MeasurementKind::Pose {

@@ -7,9 +7,11 @@
 use activecal::io::urdf::{self, MAX_CHAIN_JOINTS, UrdfOptions};
 use activecal::kinematics::pose;
 use activecal::model::Robot;
-use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
+use nalgebra::Isometry3;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+
+mod common;
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -26,12 +28,6 @@ fn opts(base: Option<&str>, tip: Option<&str>, lock: &[(&str, f64)]) -> UrdfOpti
     }
 }
 
-fn rpy(r: f64, p: f64, y: f64) -> UnitQuaternion<f64> {
-    UnitQuaternion::from_axis_angle(&Vector3::z_axis(), y)
-        * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), p)
-        * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), r)
-}
-
 /// Direct URDF kinematics from `base` to `tip`, independent of the importer:
 /// `Π origin_k · motion_k(q_k)`, with each moving joint's value taken from
 /// `q` by name.
@@ -46,35 +42,7 @@ fn urdf_fk_of(
     tip: &str,
     q: &HashMap<String, f64>,
 ) -> Isometry3<f64> {
-    let by_child: HashMap<&str, &urdf_rs::Joint> = u
-        .joints
-        .iter()
-        .map(|j| (j.child.link.as_str(), j))
-        .collect();
-    let mut chain = Vec::new();
-    let mut at = tip;
-    while at != base {
-        let j = by_child[at];
-        chain.push(j);
-        at = &j.parent.link;
-    }
-    chain.reverse();
-    let mut t = Isometry3::identity();
-    for j in chain {
-        let [x, y, z] = j.origin.xyz.0;
-        let [r, p, yw] = j.origin.rpy.0;
-        t *= Isometry3::from_parts(Translation3::new(x, y, z), rpy(r, p, yw));
-        let axis = Unit::new_normalize(Vector3::from(j.axis.xyz.0));
-        use urdf_rs::JointType as T;
-        match j.joint_type {
-            T::Revolute | T::Continuous => {
-                t *= UnitQuaternion::from_axis_angle(&axis, q[&j.name]);
-            }
-            T::Prismatic => t *= Translation3::from(axis.into_inner() * q[&j.name]),
-            _ => {}
-        }
-    }
-    t
+    common::urdf_fk(u, base, tip, q)
 }
 
 /// The imported robot's driven frames carry the URDF joint names (sanitised;

@@ -248,6 +248,7 @@ fn any_robot() -> impl Strategy<Value = Robot> {
                     MeasurementKind::Point
                 },
                 orientation_scale: activecal::model::DEFAULT_ORIENTATION_SCALE,
+                source: None,
             }
         })
 }

@@ -54,3 +54,49 @@ pub fn eae_design(x: &activecal::blocks::Blocks) -> activecal::select::Selection
     )
     .unwrap_or_else(|e| panic!("EAE: {e}"))
 }
+
+/// Direct URDF kinematics from `base` to `tip` of a parsed URDF,
+/// independent of activecal's importer: `Π origin_k · motion_k(q_k)`, each
+/// moving joint's value taken from `q` by name.
+pub fn urdf_fk(
+    u: &urdf_rs::Robot,
+    base: &str,
+    tip: &str,
+    q: &std::collections::HashMap<String, f64>,
+) -> nalgebra::Isometry3<f64> {
+    use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
+    let by_child: std::collections::HashMap<&str, &urdf_rs::Joint> = u
+        .joints
+        .iter()
+        .map(|j| (j.child.link.as_str(), j))
+        .collect();
+    let mut chain = Vec::new();
+    let mut at = tip;
+    while at != base {
+        let j = by_child[at];
+        chain.push(j);
+        at = &j.parent.link;
+    }
+    chain.reverse();
+    let mut t = Isometry3::identity();
+    for j in chain {
+        let [x, y, z] = j.origin.xyz.0;
+        let [r, p, yw] = j.origin.rpy.0;
+        t *= Isometry3::from_parts(
+            Translation3::new(x, y, z),
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yw)
+                * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), p)
+                * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), r),
+        );
+        let axis = Unit::new_normalize(Vector3::from(j.axis.xyz.0));
+        use urdf_rs::JointType as T;
+        match j.joint_type {
+            T::Revolute | T::Continuous => {
+                t *= UnitQuaternion::from_axis_angle(&axis, q[&j.name]);
+            }
+            T::Prismatic => t *= Translation3::from(axis.into_inner() * q[&j.name]),
+            _ => {}
+        }
+    }
+    t
+}

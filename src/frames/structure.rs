@@ -92,8 +92,17 @@ pub fn relations(f: &CalibratedFrames, before: &[Isometry3<f64>]) -> Vec<AxisRel
     (1..f.joints.len())
         .map(|k| {
             let (an, dn) = relation(&nom[k - 1], &nom[k]);
-            let (ac, dc) = relation(&cal[k - 1], &cal[k]);
+            let (ac, mut dc) = relation(&cal[k - 1], &cal[k]);
             let nominal = name(an, dn, length);
+            if matches!(nominal, "parallel" | "coaxial") {
+                // Nominally parallel axes that are no longer are skew, and
+                // their common normal may lie far away: the distance that
+                // compares with the nominal one is the next axis's distance
+                // from the first joint's origin.
+                let (p, (q, u)) = (cal[k - 1].0, cal[k]);
+                let w = p - q;
+                dc = (w - u * w.dot(&u)).norm();
+            }
             let kept = match nominal {
                 "coaxial" => ac < EXACT && dc < EXACT * length,
                 "parallel" => ac < EXACT,
@@ -114,4 +123,50 @@ pub fn relations(f: &CalibratedFrames, before: &[Isometry3<f64>]) -> Vec<AxisRel
             }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frames::JointOrigin;
+    use crate::model::JointKind;
+    use nalgebra::{Translation3, UnitQuaternion};
+
+    fn joint(name: &str, nominal: Isometry3<f64>, calibrated: Isometry3<f64>) -> JointOrigin {
+        JointOrigin {
+            name: name.into(),
+            kind: JointKind::Revolute,
+            axis: Vector3::z(),
+            nominal,
+            calibrated,
+        }
+    }
+
+    #[test]
+    fn a_tilted_parallel_pair_is_reported_with_its_angle_and_distance() {
+        let shifted =
+            Isometry3::from_parts(Translation3::new(1.0, 0.0, 0.0), UnitQuaternion::identity());
+        let tilted = shifted * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), 0.01);
+        let f = CalibratedFrames {
+            measurement: Isometry3::identity(),
+            tool: Isometry3::identity(),
+            markers: Vec::new(),
+            joints: vec![
+                joint("a", Isometry3::identity(), Isometry3::identity()),
+                joint("b", shifted, tilted),
+                joint("c", shifted, shifted),
+            ],
+        };
+        let r = relations(&f, &[Isometry3::identity(); 3]);
+        // a → b: parallel 1 m apart; calibrated 0.01 rad apart, and b's
+        // axis still 1 m from a's origin (the tilt is about b's origin).
+        assert_eq!(r[0].nominal, "parallel");
+        assert!(!r[0].kept);
+        assert!((r[0].angle_deg[1] - 0.01f64.to_degrees()).abs() < 1e-12);
+        assert!((r[0].distance_mm[1] - 1000.0).abs() < 1e-9);
+        // b → c: c is placed from b's calibrated (tilted) frame with the
+        // same origin as nominal: the pair keeps its relation.
+        assert_eq!(r[1].nominal, "parallel");
+        assert!(r[1].kept, "{:?}", r[1]);
+    }
 }

@@ -230,12 +230,8 @@ fn load_urdf(path: &Path, chain: &ChainChoice, pose: bool) -> Result<Robot> {
     }
     let robot = urdf::load(path, &opts)?;
     match frames {
-        Some(f) if !f.markers.is_empty() => {
-            let source = robot.source.clone();
-            let mut r = robot.with_markers(&f.markers)?;
-            r.source = source;
-            Ok(r)
-        }
+        // A copy of the robot with markers: its source comes along.
+        Some(f) if !f.markers.is_empty() => robot.with_markers(&f.markers),
         _ => Ok(robot),
     }
 }

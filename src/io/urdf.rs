@@ -959,9 +959,7 @@ pub fn remount(robot: &Robot, mount: Isometry3<f64>, tool: Isometry3<f64>) -> Re
     r.name = robot.name.clone();
     r.orientation_scale = robot.orientation_scale;
     if let MeasurementKind::Markers(_) = robot.measurement {
-        let source = r.source.clone();
         r = r.with_markers(&robot.nominal.markers)?;
-        r.source = source;
     }
     Ok(r)
 }

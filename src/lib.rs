@@ -20,6 +20,7 @@ pub mod kinematics;
 pub(crate) mod linalg;
 pub mod measure;
 pub mod model;
+pub mod names;
 pub mod observability;
 pub mod pool;
 pub mod progress;

@@ -563,6 +563,12 @@ const CASES: &[Case] = &[
         1,
         &["puma.csv", ".urdf", ".yaml", ".toml"],
     ),
+    // A mistyped link: the nearest names.
+    case(
+        &["fk", "--robot", TIAGO, "--tip", "arm_tool_lnk", "--q", "0"],
+        1,
+        &["arm_tool_lnk", "did you mean arm_tool_link?"],
+    ),
     // The frames file is a .urdf robot's: a built-in has none.
     case(
         &["calibrate", "--design", "d.json", "--out", "cal.yaml"],

@@ -231,39 +231,11 @@ pub fn prepare_for_data(
 /// An unknown parameter name given to `option`: the closest valid names
 /// (by edit distance) and the whole list.
 fn unknown_name(option: &str, name: &str, valid: &[String]) -> IdentifyError {
-    let mut by: Vec<(usize, &String)> = valid.iter().map(|v| (edit_distance(name, v), v)).collect();
-    by.sort();
-    let best = by.first().map_or(usize::MAX, |b| b.0);
-    let close: Vec<&str> = by
-        .iter()
-        .filter(|(d, _)| *d == best && *d <= name.len().max(3) / 2 + 1)
-        .map(|(_, v)| v.as_str())
-        .collect();
-    let mean = if close.is_empty() {
-        String::new()
-    } else {
-        format!(" (did you mean {}?)", close.join(" or "))
-    };
     IdentifyError::Model(crate::Error::Invalid(format!(
-        "{option} {name}: not a parameter of this robot{mean}; the valid names are {}",
+        "{option} {name}: not a parameter of this robot{}; the valid names are {}",
+        crate::names::did_you_mean(name, valid),
         valid.join(", ")
     )))
-}
-
-/// Levenshtein distance between two names (characters).
-fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut cur = vec![i + 1; b.len() + 1];
-        for (j, &cb) in b.iter().enumerate() {
-            cur[j + 1] = (prev[j] + usize::from(ca != cb))
-                .min(prev[j + 1] + 1)
-                .min(cur[j] + 1);
-        }
-        prev = cur;
-    }
-    prev[b.len()]
 }
 
 fn setting(option: &'static str, name: &str, reason: &'static str) -> IdentifyError {

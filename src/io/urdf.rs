@@ -423,7 +423,8 @@ fn extract_chain(
     };
     let unknown_link = |what: &str, l: &str| {
         format!(
-            "the {what} link '{l}' is not in the URDF (its links: {})",
+            "the {what} link '{l}' is not in the URDF{} (its links: {})",
+            crate::names::did_you_mean(l, &links),
             list_names(&links)
         )
     };

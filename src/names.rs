@@ -1,0 +1,59 @@
+//! Names a user may mistype (parameters, links, joints): the closest valid
+//! ones, for a "did you mean" in the message.
+
+/// Levenshtein distance between two names (characters).
+#[must_use]
+pub fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, &cb) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(ca != cb))
+                .min(prev[j + 1] + 1)
+                .min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+/// The valid names nearest `name` by edit distance, when near enough to be
+/// a typo (at most half the name's length plus one edits): all those at
+/// the smallest distance, in the given order.
+#[must_use]
+pub fn closest<'a, S: AsRef<str>>(name: &str, valid: &'a [S]) -> Vec<&'a str> {
+    let by: Vec<(usize, &str)> = valid
+        .iter()
+        .map(|v| (edit_distance(name, v.as_ref()), v.as_ref()))
+        .collect();
+    let best = by.iter().map(|b| b.0).min().unwrap_or(usize::MAX);
+    by.into_iter()
+        .filter(|(d, _)| *d == best && *d <= name.len().max(3) / 2 + 1)
+        .map(|(_, v)| v)
+        .collect()
+}
+
+/// `" (did you mean A or B?)"`, or nothing when no valid name is near.
+#[must_use]
+pub fn did_you_mean<S: AsRef<str>>(name: &str, valid: &[S]) -> String {
+    let close = closest(name, valid);
+    if close.is_empty() {
+        String::new()
+    } else {
+        format!(" (did you mean {}?)", close.join(" or "))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_typo_finds_its_name_and_nonsense_finds_none() {
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        let links = ["arm_tool_link", "arm_7_link", "base_link"];
+        assert_eq!(closest("arm_tool_lnk", &links), vec!["arm_tool_link"]);
+        assert!(did_you_mean("zzzzzzzzzzzzzzzzzz", &links).is_empty());
+    }
+}

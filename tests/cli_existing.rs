@@ -12,13 +12,7 @@ const UR10: &str = "fixtures/figaroh/ur10_robot.urdf:pose";
 const UR10_CSV: &str = "fixtures/figaroh/ur10_full_pose.csv";
 
 fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!(
-        "activecal-cli-existing-{name}-{}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::scratch_dir("cli-existing", name)
 }
 
 /// The header and the first 12 of the 23 data rows.

@@ -13,10 +13,7 @@ const PANDA: &str = "fixtures/example-robot-data/panda.urdf";
 const PANDA_SRDF: &str = "fixtures/example-robot-data/panda.srdf";
 
 fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("activecal-cli-op-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::scratch_dir("cli-op", name)
 }
 
 #[test]

@@ -24,14 +24,7 @@ fn f(v: &Value, key: &str) -> f64 {
 
 /// A fresh scratch directory for one robot's files.
 fn scratch(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!(
-        "activecal-cli-robots-{}-{}",
-        std::process::id(),
-        tag
-    ));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::scratch_dir("cli-robots", tag)
 }
 
 /// select → bound → gap → calibrate (exact and noisy) for one robot with

@@ -100,3 +100,12 @@ pub fn urdf_fk(
     }
     t
 }
+
+/// A fresh, empty directory for one test of one suite (unique per process,
+/// so concurrent test runs do not share files).
+pub fn scratch_dir(suite: &str, name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("activecal-{suite}-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}

@@ -57,3 +57,39 @@ mod tests {
         assert!(did_you_mean("zzzzzzzzzzzzzzzzzz", &links).is_empty());
     }
 }
+
+/// A closed set of named values a user chooses from by name (a parameter
+/// table, an algorithm, a solver): the names the command line offers and
+/// parses, kept beside the type so that the library needs no command-line
+/// crate.
+pub trait Choice: Copy + Sized + 'static {
+    /// Every value, in the order a listing shows them.
+    const ALL: &'static [Self];
+
+    /// The value's name (as serialised).
+    fn name(self) -> &'static str;
+
+    /// The value named `name`, if any.
+    fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.iter().copied().find(|v| v.name() == name)
+    }
+}
+
+/// Implements [`Choice`] and [`std::fmt::Display`] for a field-less enum:
+/// `choice!(Type { Variant => "name", … })`.
+#[macro_export]
+macro_rules! choice {
+    ($t:ty { $($v:ident => $n:literal),+ $(,)? }) => {
+        impl $crate::names::Choice for $t {
+            const ALL: &'static [Self] = &[$(<$t>::$v),+];
+            fn name(self) -> &'static str {
+                match self { $(<$t>::$v => $n),+ }
+            }
+        }
+        impl ::std::fmt::Display for $t {
+            fn fmt(&self, f: &mut ::std::fmt::Formatter<'_>) -> ::std::fmt::Result {
+                f.write_str($crate::names::Choice::name(*self))
+            }
+        }
+    };
+}

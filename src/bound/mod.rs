@@ -61,7 +61,7 @@ use variance::{
 pub const SUPPORT_TOL: f64 = 1e-6;
 
 /// The solver of the candidate subproblems of (R).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum RelaxationSolver {
     /// Clarabel on the PSD + exponential-cone form ([`conic`]).
@@ -72,6 +72,8 @@ pub enum RelaxationSolver {
     #[default]
     Newton,
 }
+
+crate::choice!(RelaxationSolver { Clarabel => "clarabel", Newton => "newton" });
 
 /// Settings of [`relaxation_bound`]. Build with [`BoundSettings::builder`]
 /// (validated) or take [`BoundSettings::default`].

@@ -37,7 +37,7 @@ pub struct FkArgs {
     #[arg(long, default_value = "puma560")]
     pub robot: String,
     /// Parameter set.
-    #[arg(long, value_enum, default_value_t = ParamSet::Nominal)]
+    #[arg(long, value_parser = super::choice::<ParamSet>(), default_value_t = ParamSet::Nominal)]
     pub params: ParamSet,
     /// Joint values, comma separated, in joint order (radians and metres,
     /// or as --angle-unit and --length-unit say); checked against the

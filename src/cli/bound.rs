@@ -23,7 +23,7 @@ pub struct SolveOpts {
     pub first_order: bool,
     /// Solver of the candidate subproblems: clarabel (conic form) or newton
     /// (log-barrier Newton on ln det itself). Both are certified by eq. (C).
-    #[arg(long, value_enum, default_value_t = RelaxationSolver::Newton)]
+    #[arg(long, value_parser = super::choice::<RelaxationSolver>(), default_value_t = RelaxationSolver::Newton)]
     pub solver: RelaxationSolver,
     /// Poses outside the first-order support given to Clarabel, by largest
     /// variance.
@@ -81,7 +81,7 @@ pub struct GapArgs {
     #[arg(long)]
     pub design: PathBuf,
     /// Parameter set the Jacobian is computed with.
-    #[arg(long, value_enum, default_value_t = ParamSet::Nominal)]
+    #[arg(long, value_parser = super::choice::<ParamSet>(), default_value_t = ParamSet::Nominal)]
     pub params: ParamSet,
     /// Sensor visibility region as JSON (see `bound --help`).
     #[arg(long)]

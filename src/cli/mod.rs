@@ -33,6 +33,17 @@ where
         .collect()
 }
 
+/// The value parser of an option that takes one of a library type's named
+/// values ([`activecal::names::Choice`]): `--help` lists the names, and a
+/// wrong one is refused with them.
+pub fn choice<T: activecal::names::Choice + Send + Sync>()
+-> impl clap::builder::TypedValueParser<Value = T> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(T::ALL.iter().map(|v| v.name())).try_map(|s| {
+        T::from_name(&s).ok_or_else(|| format!("'{s}' is not one of the offered names"))
+    })
+}
+
 /// Parses `--seed`: a non-negative integer. With `allow_negative_numbers`
 /// (on every numeric option), `--seed -1` and `--seed=-1` both reach this
 /// parser and get the same message (clap would otherwise take `-1` for an
@@ -253,7 +264,7 @@ pub struct PoolOpts {
     #[arg(long, allow_negative_numbers = true)]
     pub pool_seed: Option<u64>,
     /// Parameter set the Jacobian is computed with.
-    #[arg(long, value_enum, default_value_t = ParamSet::Nominal)]
+    #[arg(long, value_parser = choice::<ParamSet>(), default_value_t = ParamSet::Nominal)]
     pub params: ParamSet,
     /// Sensor visibility region as JSON, e.g.
     /// '{"kind":"box","min":[-30,-30,-30],"max":[30,30,30]}' or

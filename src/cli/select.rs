@@ -171,7 +171,7 @@ pub struct SelectArgs {
     #[arg(long, default_value_t = 30, allow_negative_numbers = true)]
     pub n: usize,
     /// The selection algorithm.
-    #[arg(long, value_enum, default_value_t = Algorithm::Eae)]
+    #[arg(long, value_parser = super::choice::<Algorithm>(), default_value_t = Algorithm::Eae)]
     pub algorithm: Algorithm,
     /// Initial random poses of EAE (fixed poses included), 1..=N [default:
     /// 12, or N when N is smaller].
@@ -213,7 +213,7 @@ pub struct SelectArgs {
     #[arg(long)]
     pub fixed: Option<String>,
     /// det (ln OI_D, with O(p²) updates) or oi (the paper's eigenvalue OI, recomputed).
-    #[arg(long, value_enum, default_value_t = CriterionKind::Det)]
+    #[arg(long, value_parser = super::choice::<CriterionKind>(), default_value_t = CriterionKind::Det)]
     pub criterion: CriterionKind,
     /// Write the design file here.
     #[arg(long)]
@@ -225,7 +225,7 @@ pub struct SelectArgs {
     #[arg(long)]
     pub gap: bool,
     /// Solver of the bound for `--gap` (see `bound`).
-    #[arg(long, value_enum, default_value_t = activecal::bound::RelaxationSolver::Newton, requires = "gap")]
+    #[arg(long, value_parser = super::choice::<activecal::bound::RelaxationSolver>(), default_value_t = activecal::bound::RelaxationSolver::Newton, requires = "gap")]
     pub gap_solver: activecal::bound::RelaxationSolver,
     /// Poses already measured: a CSV or JSON of joint configurations (as
     /// --pool file: reads them) or a JSON measurement file. The new poses

@@ -202,7 +202,7 @@ pub struct ParamId {
 }
 
 /// Which of a robot's two parameter tables to use.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ParamSet {
     /// The nominal (design) model, used to compute Jacobians for pose selection.
@@ -210,6 +210,8 @@ pub enum ParamSet {
     /// The real robot, used to simulate measurements.
     Real,
 }
+
+crate::choice!(ParamSet { Nominal => "nominal", Real => "real" });
 
 /// What is measured at each pose.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

@@ -45,7 +45,7 @@ pub use random::{
 pub use refine::{RefineSettings, Refinement, refine};
 
 /// The selection algorithms.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Algorithm {
     /// The paper's exchange-add-exchange (§IV).
@@ -58,8 +58,10 @@ pub enum Algorithm {
     Random,
 }
 
+crate::choice!(Algorithm { Eae => "eae", Fedorov => "fedorov", Detmax => "detmax", Random => "random" });
+
 /// The criterion a selection maximises.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum CriterionKind {
     /// `ln OI_D = ln det M`, priced by O(p²) updates ([`DCriterion`]).
@@ -68,6 +70,8 @@ pub enum CriterionKind {
     /// The paper's eigenvalue OI, eq. (1), recomputed ([`OiCriterion`]).
     Oi,
 }
+
+crate::choice!(CriterionKind { Det => "det", Oi => "oi" });
 
 /// [`multistart`] with the criterion `kind`.
 pub fn select(

@@ -79,6 +79,32 @@ enum Command {
     Gap(GapArgs),
 }
 
+impl Command {
+    /// Gives the chain options to the command's robot, resolved once; a
+    /// command without a `--robot` refuses them.
+    fn take_chain(&mut self, c: &activecal::io::ChainChoice) -> anyhow::Result<()> {
+        let robot = match self {
+            Command::Robots(a) => a.export.as_mut(),
+            Command::Fk(a) => Some(&mut a.robot),
+            Command::Pool(a) => Some(&mut a.pool.robot),
+            Command::Score(a) => Some(&mut a.pool.robot),
+            Command::Select(a) => Some(&mut a.pool.robot),
+            Command::Bound(a) => Some(&mut a.pool.robot),
+            Command::Calibrate(a) => Some(&mut a.robot),
+            Command::Evaluate(a) => Some(&mut a.robot),
+            Command::Bench(_) | Command::Reproduce(_) | Command::Gap(_) => None,
+        };
+        match robot {
+            Some(r) => cli::apply_chain(r, c),
+            None if c.is_empty() => Ok(()),
+            None => anyhow::bail!(
+                "{} applies to a command that takes --robot (or `robots --export`); this one does not (a design file names its robot and chain)",
+                cli::chain_options(c)
+            ),
+        }
+    }
+}
+
 fn main() {
     // faer's own default runs its large factorizations (the bound's Newton
     // system) on every core, with waiting threads spinning: 8 % of the
@@ -110,11 +136,14 @@ fn main() {
         .and_then(|(_, m)| m.try_get_one::<bool>("json").ok().flatten().copied())
         .unwrap_or(false);
     cli::progress::install_for(cli.progress, json);
-    if let Err(e) = cli::set_chain_choice(cli.base, cli.tip, cli.lock.as_deref(), cli.frames) {
+    let mut command = cli.command;
+    let chain = cli::chain_choice(cli.base, cli.tip, cli.lock.as_deref(), cli.frames)
+        .and_then(|c| command.take_chain(&c));
+    if let Err(e) = chain {
         eprintln!("error: {e:#}");
         std::process::exit(1);
     }
-    let r = match cli.command {
+    let r = match command {
         Command::Robots(a) => cli::basic::cmd_robots(a),
         Command::Fk(a) => cli::basic::cmd_fk(a),
         Command::Pool(a) => cli::basic::cmd_pool(a),
@@ -127,6 +156,12 @@ fn main() {
         Command::Bound(a) => cli::bound::cmd_bound(a),
         Command::Gap(a) => cli::bound::cmd_gap(a),
     };
+    if std::env::var_os("ACTIVECAL_DEBUG_READS").is_some() {
+        // Each input file and how often it was read (once is the rule).
+        for (path, n) in activecal::io::read::reads() {
+            eprintln!("read {n}× {}", path.display());
+        }
+    }
     if let Err(e) = r {
         eprintln!("error: {e:#}");
         if let Some(h) = cli::units::flag_hint(&e) {

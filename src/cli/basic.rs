@@ -13,8 +13,8 @@ pub struct RobotsArgs {
     /// Write this robot (a built-in name, a .toml description or a .urdf
     /// file) as a description file to start your own from: edit its tables,
     /// unknowns, limits or `orientation_scale`, then pass it as `--robot`.
-    #[arg(long, value_name = "ROBOT")]
-    pub export: Option<String>,
+    #[arg(long, value_name = "ROBOT", value_parser = super::parse_robot)]
+    pub export: Option<activecal::io::RobotRef>,
     /// File for `--export` (default: standard output, as TOML), by
     /// extension: .toml (a description), .urdf (the URDF, or a built-in's
     /// chain as URDF), .yaml (a URDF robot's frames file); any other is
@@ -34,8 +34,8 @@ pub struct RobotsArgs {
 pub struct FkArgs {
     /// Robot: a built-in name, or a .toml description or .urdf file; append
     /// `:pose` for full-pose measurements.
-    #[arg(long, default_value = "puma560")]
-    pub robot: String,
+    #[arg(long, default_value = "puma560", value_parser = super::parse_robot)]
+    pub robot: activecal::io::RobotRef,
     /// Parameter set.
     #[arg(long, value_parser = super::choice::<ParamSet>(), default_value_t = ParamSet::Nominal)]
     pub params: ParamSet,
@@ -283,7 +283,7 @@ pub fn cmd_pool(a: PoolArgs) -> Result<()> {
         });
     }
     let d = super::load_description(&a.pool.robot)?;
-    let spec = a.pool.spec(d.visibility.as_ref())?;
+    let spec = a.pool.spec(&d)?;
     let pool = spec.build(&d.robot, &d.robot.nominal)?;
     let r = activecal::pool::summary::PoolSummary::new(&d.robot, &pool)?;
     if let Some(out) = &a.out {

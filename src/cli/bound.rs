@@ -178,7 +178,7 @@ pub fn cmd_bound(a: BoundArgs) -> Result<()> {
 pub fn cmd_gap(a: GapArgs) -> Result<()> {
     let settings = a.solve.settings()?;
     let d = DesignFile::read(&a.design)?;
-    let desc = load_description(&d.robot)?;
+    let desc = load_description(&d.robot_ref()?)?;
     let mut spec = d.spec()?;
     if d.pool.is_none() || a.visibility.is_some() {
         spec.filters = filters(a.visibility.as_deref(), desc.visibility.as_ref())?;

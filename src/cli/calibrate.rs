@@ -25,8 +25,8 @@ use std::time::Instant;
 pub struct CalibrateArgs {
     /// Robot: a built-in name, or a .toml description or .urdf file; append
     /// `:pose` for full-pose measurements.
-    #[arg(long, default_value = "puma560")]
-    pub robot: String,
+    #[arg(long, default_value = "puma560", value_parser = super::parse_robot)]
+    pub robot: activecal::io::RobotRef,
     /// Design file (JSON with robot, levels, poses), as written by `select`:
     /// measurements are simulated there.
     #[arg(long, required_unless_present = "measurements")]
@@ -256,7 +256,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
                 .map(|p| ("--save-measurements", p)),
         )
         .collect();
-    let robot_path = std::path::Path::new(a.robot.trim_end_matches(":pose"));
+    let robot_path = std::path::Path::new(&a.robot.name);
     let inputs: Vec<&std::path::Path> = [
         a.design.as_deref(),
         a.measurements.as_deref(),

@@ -436,8 +436,8 @@ pub struct EvaluateArgs {
     /// The model: a built-in name, a .toml description (e.g. what
     /// `calibrate --out` wrote) or a .urdf file; append `:pose` for full
     /// poses. Its nominal table is evaluated.
-    #[arg(long)]
-    pub robot: String,
+    #[arg(long, value_parser = super::parse_robot)]
+    pub robot: activecal::io::RobotRef,
     /// Measurement file: CSV (x1,y1,z1…, optional phix1,phiy1,phiz1 or
     /// qw1…qz1, one column per joint by name) or JSON.
     #[arg(long)]

@@ -13,6 +13,7 @@ pub mod select;
 pub mod tour;
 pub mod units;
 
+use activecal::io::{ChainChoice, RobotRef, UrdfChain};
 use activecal::measure::Visibility;
 use activecal::model::{ParamSet, Robot};
 use activecal::pool::{Pool, PoolFilter, PoolSource, PoolSpec};
@@ -57,18 +58,24 @@ pub fn parse_seed(s: &str) -> std::result::Result<u64, String> {
     })
 }
 
-/// The chain chosen by `--base`, `--tip` and `--lock` (global options).
-static CHAIN: std::sync::OnceLock<activecal::io::ChainChoice> = std::sync::OnceLock::new();
+/// Parses `--robot` (and `robots --export`): a built-in name or a path,
+/// with an optional `:pose` suffix and, as design files of old wrote it,
+/// a `#…` chain ([`RobotRef::parse`]).
+pub fn parse_robot(s: &str) -> std::result::Result<RobotRef, String> {
+    RobotRef::parse(s).map_err(|e| e.to_string())
+}
 
-/// Records the global chain options (once, before the command runs).
-pub fn set_chain_choice(
+/// The chain options typed on the command line (`--base`, `--tip`,
+/// `--lock`, `--frames`), checked: one value, resolved once and given to
+/// the command's robot ([`apply_chain`]).
+pub fn chain_choice(
     base: Option<String>,
     tip: Option<String>,
     lock: Option<&str>,
     frames: Option<std::path::PathBuf>,
-) -> Result<()> {
+) -> Result<ChainChoice> {
     let lock = match lock {
-        Some(l) => activecal::io::ChainChoice::parse_lock(l)?,
+        Some(l) => ChainChoice::parse_lock(l).map_err(|e| anyhow::anyhow!("--{e}"))?,
         None => Vec::new(),
     };
     if let Some(f) = &frames
@@ -76,38 +83,34 @@ pub fn set_chain_choice(
     {
         anyhow::bail!("--frames {}: no such file", f.display());
     }
-    let _ = CHAIN.set(activecal::io::ChainChoice {
+    Ok(ChainChoice {
         base,
         tip,
         lock,
         frames: frames.map(|f| f.display().to_string()),
-    });
+    })
+}
+
+/// Gives the chain options to a command's robot. A robot that names a chain
+/// already (`tiago.urdf#tip=…`, as design files of old did) keeps it; chain
+/// options that differ from it are refused, naming both.
+pub fn apply_chain(robot: &mut RobotRef, c: &ChainChoice) -> Result<()> {
+    if c.is_empty() {
+        return Ok(());
+    }
+    if !robot.chain.is_empty() && robot.chain != *c {
+        anyhow::bail!(
+            "{} conflicts with the robot '{robot}', which names its chain already ({}); give the chain once",
+            chain_options(c),
+            robot.chain.fragment()
+        );
+    }
+    robot.chain = c.clone();
     Ok(())
 }
 
-/// A `--robot` name with the chain options appended as its `#…` fragment,
-/// so that reports and design files record the chain. A name that names a
-/// chain already (`tiago.urdf#tip=…`, as a design file's robot does) is
-/// kept; chain options that differ from its chain are refused, naming both.
-pub fn with_chain(name: &str) -> Result<String> {
-    let Some(c) = CHAIN.get().filter(|c| !c.is_empty()) else {
-        return Ok(name.to_string());
-    };
-    let Some(k) = name.find('#') else {
-        return Ok(format!("{name}{}", c.fragment()));
-    };
-    if name[k..] != c.fragment() {
-        anyhow::bail!(
-            "{} conflicts with the robot '{name}', which names its chain already ({}); give the chain once",
-            chain_options(c),
-            &name[k..]
-        );
-    }
-    Ok(name.to_string())
-}
-
-/// The chain options as typed: `--base B --tip T --lock J=V`.
-fn chain_options(c: &activecal::io::ChainChoice) -> String {
+/// The chain options as typed: `--base B --tip T --lock J=V --frames F`.
+pub fn chain_options(c: &ChainChoice) -> String {
     let mut parts = Vec::new();
     if let Some(b) = &c.base {
         parts.push(format!("--base {b}"));
@@ -119,16 +122,16 @@ fn chain_options(c: &activecal::io::ChainChoice) -> String {
         let l: Vec<String> = c.lock.iter().map(|(n, v)| format!("{n}={v}")).collect();
         parts.push(format!("--lock {}", l.join(",")));
     }
+    if let Some(f) = &c.frames {
+        parts.push(format!("--frames {f}"));
+    }
     parts.join(" ")
 }
 
 /// Loads and validates a robot: a built-in name, or a `.toml` description or
-/// `.urdf` file ([`activecal::io::load_robot`]), with the chain options.
-pub fn load_robot(name: &str) -> Result<Robot> {
-    let r = activecal::io::load_robot(&with_chain(name)?)?;
-    r.validate()?;
-    has_joints(name, &r)?;
-    Ok(r)
+/// `.urdf` file ([`RobotRef::load`]), with its chain.
+pub fn load_robot(r: &RobotRef) -> Result<Robot> {
+    load_description(r).map(|d| d.robot)
 }
 
 /// Refuses a robot without a driven joint (a description whose frames are
@@ -245,8 +248,8 @@ pub const DEFAULT_LEVELS: usize = 5;
 pub struct PoolOpts {
     /// Robot: a built-in name (puma560, ur5, stanford), or a .toml
     /// description or .urdf file; append `:pose` for full-pose measurements.
-    #[arg(long, default_value = "puma560")]
-    pub robot: String,
+    #[arg(long, default_value = "puma560", value_parser = parse_robot)]
+    pub robot: RobotRef,
     /// Candidate poses: lattice (--levels), random or sobol (--count,
     /// --pool-seed) inside the joint limits, or file:PATH, a CSV with a
     /// header of joint names (or q1..qN) or JSON {"qs": [[...]]} of joint
@@ -433,10 +436,10 @@ pub fn filters(
 }
 
 /// Loads a robot with its description's visibility region (validated).
-pub fn load_description(name: &str) -> Result<activecal::io::Description> {
-    let d = activecal::io::load_description(&with_chain(name)?)?;
+pub fn load_description(r: &RobotRef) -> Result<activecal::io::Description> {
+    let d = r.load()?;
     d.robot.validate()?;
-    has_joints(name, &d.robot)?;
+    has_joints(&r.to_string(), &d.robot)?;
     Ok(d)
 }
 
@@ -528,9 +531,9 @@ impl PoolOpts {
     }
 
     /// The pool these options describe, for a robot description.
-    pub fn spec(&self, described: Option<&Visibility>) -> Result<PoolSpec> {
-        let mut filters = filters(self.visibility.as_deref(), described)?;
-        filters.extend(self.collision_filters()?);
+    pub fn spec(&self, d: &activecal::io::Description) -> Result<PoolSpec> {
+        let mut filters = filters(self.visibility.as_deref(), d.visibility.as_ref())?;
+        filters.extend(self.collision_filters(&d.robot)?);
         Ok(PoolSpec {
             source: self.source()?,
             filters,
@@ -550,9 +553,7 @@ impl PoolOpts {
                 anyhow::bail!("--margin {m}: the margin is an angle >= 0 degrees")
             }
             Some(m) => m,
-            None if activecal::io::urdf_chain(&with_chain(&self.robot)?)?.is_some()
-                && !matches!(self.pool, PoolKind::File(_)) =>
-            {
+            None if self.robot.is_urdf() && !matches!(self.pool, PoolKind::File(_)) => {
                 DEFAULT_MARGIN_DEG
             }
             None => 0.0,
@@ -564,7 +565,7 @@ impl PoolOpts {
     /// `--obstacle` and `--floor` (one filter each kind, so that the pool
     /// statistics say what each removed); `--srdf` and `--package-dir`
     /// without them are errors.
-    pub fn collision_filters(&self) -> Result<Vec<PoolFilter>> {
+    pub fn collision_filters(&self, robot: &Robot) -> Result<Vec<PoolFilter>> {
         use activecal::collision::{CollisionFilter, CollisionSpec, Obstacle};
         let obstacles = self
             .obstacles
@@ -594,7 +595,7 @@ impl PoolOpts {
         if self.srdf.is_some() && !self.self_collision {
             anyhow::bail!("--srdf lists pairs of links for --self-collision, which is not given");
         }
-        let Some(chain) = activecal::io::urdf_chain(&with_chain(&self.robot)?)? else {
+        let Some(chain) = UrdfChain::of(robot) else {
             anyhow::bail!(
                 "--self-collision, --obstacle and --floor need a URDF robot with collision geometry (--robot FILE.urdf); {} has none",
                 self.robot
@@ -612,6 +613,7 @@ impl PoolOpts {
         }
         let base_spec = CollisionSpec {
             urdf: chain.file,
+            text: Some(chain.text),
             joints: chain.joints,
             lock: chain.lock,
             base: Some(chain.base),
@@ -645,8 +647,13 @@ impl PoolOpts {
     /// Loads the robot, builds the pool and its Jacobian. A pool file is
     /// read in the options' units.
     pub fn load(&self) -> Result<PoolCtx> {
-        let d = load_description(&self.robot)?;
-        let spec = self.spec(d.visibility.as_ref())?;
+        self.load_for(load_description(&self.robot)?)
+    }
+
+    /// Builds the pool of these options and its Jacobian for a robot
+    /// already loaded (from [`PoolOpts::robot`]).
+    pub fn load_for(&self, d: activecal::io::Description) -> Result<PoolCtx> {
+        let spec = self.spec(&d)?;
         if let PoolSource::File { path } = &spec.source {
             let rows = activecal::pool::read_configurations_in(
                 std::path::Path::new(path),

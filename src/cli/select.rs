@@ -108,7 +108,7 @@ pub fn cmd_score(a: ScoreArgs, given: &[&str]) -> Result<()> {
         (None, Some(path)) => {
             let d = DesignFile::read(path)?;
             check_design_options(&a, given, &d, path)?;
-            let desc = load_description(&d.robot)?;
+            let desc = load_description(&d.robot_ref()?)?;
             let robot = desc.robot;
             let qs = d
                 .joint_values(&robot)
@@ -278,8 +278,9 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
             .map_err(|e| anyhow::anyhow!("--out {e}"))?;
     }
     // Cheap checks of the ordering's inputs before the pool is built.
-    let speeds = activecal::io::joint_speeds::joint_speeds(&super::with_chain(&a.pool.robot)?)?;
-    let home = super::tour::parse_home(a.home.as_deref(), &super::load_robot(&a.pool.robot)?)?;
+    let described = super::load_description(&a.pool.robot)?;
+    let speeds = activecal::io::joint_speeds::joint_speeds(&described.robot)?;
+    let home = super::tour::parse_home(a.home.as_deref(), &described.robot)?;
     // Refused, never clamped (as `reproduce` does).
     let initial = match a.initial {
         Some(i) if i == 0 || i > a.n => bail!(
@@ -289,7 +290,7 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         Some(i) => i,
         None => Settings::default().initial.min(a.n),
     };
-    let ctx = a.pool.load()?;
+    let ctx = a.pool.load_for(described)?;
     let existing = a
         .existing
         .as_deref()

@@ -85,6 +85,11 @@ impl Obstacle {
 pub struct CollisionSpec {
     /// The URDF file.
     pub urdf: String,
+    /// The URDF's text as the robot was imported from it, so that the file
+    /// is read once per process; read from `urdf` when absent (a pool spec
+    /// loaded from a design file).
+    #[serde(skip)]
+    pub text: Option<std::sync::Arc<str>>,
     /// The chain's moving joints, in the order of a configuration's values.
     pub joints: Vec<String>,
     /// Joints held at a value (`--lock`).
@@ -295,7 +300,12 @@ impl CollisionModel {
     /// joint or lock the URDF does not have.
     pub fn load(spec: &CollisionSpec) -> Result<CollisionModel, String> {
         let urdf_path = Path::new(&spec.urdf);
-        let text = std::fs::read_to_string(urdf_path).map_err(|e| format!("{}: {e}", spec.urdf))?;
+        let text = match &spec.text {
+            Some(t) => t.to_string(),
+            None => {
+                std::fs::read_to_string(urdf_path).map_err(|e| format!("{}: {e}", spec.urdf))?
+            }
+        };
         let urdf = urdf_rs::read_from_string(&text)
             .map_err(|e| format!("{}: not a valid URDF: {e}", spec.urdf))?;
         let tree = Tree::new(&urdf).map_err(|e| format!("{}: {e}", spec.urdf))?;
@@ -541,6 +551,28 @@ impl CollisionFilter {
     pub fn load(&self) -> Result<Arc<CollisionModel>, String> {
         self.model
             .get_or_init(|| CollisionModel::load(&self.spec).map(Arc::new))
+            .clone()
+    }
+
+    /// As [`CollisionFilter::load`], taking the URDF's text from `source`
+    /// (a file's path and the text a robot was imported from) when the spec
+    /// holds none and names the same file: the file is not read again.
+    pub fn load_sharing(
+        &self,
+        source: Option<(&str, &str)>,
+    ) -> Result<Arc<CollisionModel>, String> {
+        self.model
+            .get_or_init(|| {
+                let shared = source.filter(|(path, _)| *path == self.spec.urdf);
+                match (&self.spec.text, shared) {
+                    (None, Some((_, text))) => CollisionModel::load(&CollisionSpec {
+                        text: Some(text.into()),
+                        ..self.spec.clone()
+                    }),
+                    _ => CollisionModel::load(&self.spec),
+                }
+                .map(Arc::new)
+            })
             .clone()
     }
 

@@ -13,6 +13,7 @@
 //! criterion values) are kept as extra information.
 
 use crate::error::{Error, Result};
+use crate::io::{ChainChoice, RobotRef};
 use crate::model::ParamTable;
 use crate::model::Robot;
 use crate::pool::{Configurations, Lattice, Pool, PoolSource, PoolSpec};
@@ -27,8 +28,14 @@ const Q_TOL: f64 = 1e-9;
 /// A design as stored on disk.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DesignFile {
-    /// Robot name (built-in) or path of its description.
+    /// Robot name (built-in) or path of its description, with `:pose`
+    /// for full poses (files of old also carry the chain here, as a `#…`
+    /// fragment: see [`DesignFile::robot_ref`]).
     pub robot: String,
+    /// The chain of a URDF tree the design is for (base, tip, locks,
+    /// frames file); absent for a built-in robot or a description file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub chain: Option<ChainChoice>,
     /// The pool the poses were chosen from (absent in old files: the
     /// unfiltered lattice of `levels`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -88,8 +95,13 @@ impl DesignFile {
     /// The design made of pool positions `positions` of `pool`, for `robot`.
     #[must_use]
     pub fn from_pool(robot: &Robot, pool: &Pool, positions: &[usize]) -> Self {
+        let (name, chain) = match RobotRef::parse(&robot.name) {
+            Ok(r) if !r.chain.is_empty() => (r.head(), Some(r.chain)),
+            _ => (robot.name.clone(), None),
+        };
         Self {
-            robot: robot.name.clone(),
+            robot: name,
+            chain,
             pool: Some(pool.spec.clone()),
             levels: pool.spec.levels(),
             joint_names: Some(crate::pool::file::joint_names(robot)),
@@ -108,6 +120,7 @@ impl DesignFile {
     pub fn new(robot: &str, levels: usize, poses: Vec<usize>) -> Self {
         Self {
             robot: robot.to_string(),
+            chain: None,
             pool: None,
             levels: Some(levels),
             joint_names: None,
@@ -125,10 +138,7 @@ impl DesignFile {
     /// ([`DesignFile::parse_yaml`]) when the name ends in
     /// `.yaml` or `.yml`.
     pub fn read(path: &Path) -> Result<DesignFile> {
-        let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
-            path: path.display().to_string(),
-            cause,
-        })?;
+        let text = crate::io::read::read_text(path)?;
         let origin = path.display().to_string();
         let yaml = path
             .extension()
@@ -272,12 +282,32 @@ impl DesignFile {
         Ok(())
     }
 
+    /// The robot the design is for: its name, with the chain stored apart
+    /// or, in files of old, as the name's `#…` fragment (a file giving both
+    /// must give the same chain).
+    pub fn robot_ref(&self) -> Result<RobotRef> {
+        let mut r = RobotRef::parse(&self.robot)?;
+        if let Some(c) = &self.chain {
+            if !r.chain.is_empty() && r.chain != *c {
+                return Err(Error::Invalid(format!(
+                    "the design's robot '{}' names a chain ({}) other than its `chain` ({})",
+                    self.robot,
+                    r.chain.fragment(),
+                    c.fragment()
+                )));
+            }
+            r.chain = c.clone();
+        }
+        Ok(r)
+    }
+
     /// Errors unless the design is for `robot`.
     pub fn check_robot(&self, robot: &Robot) -> Result<()> {
-        if self.robot != robot.name {
+        let mine = self.robot_ref()?;
+        if RobotRef::parse(&robot.name).ok().as_ref() != Some(&mine) {
             return Err(Error::Invalid(format!(
-                "the design is for robot '{}', not '{}'",
-                self.robot, robot.name
+                "the design is for robot '{mine}', not '{}'",
+                robot.name
             )));
         }
         Ok(())

@@ -74,10 +74,7 @@ fn iso(e: &FrameEntry) -> Isometry3<f64> {
 /// Reads a frames file.
 pub fn read(path: &Path) -> Result<Frames> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
-        path: name.clone(),
-        cause,
-    })?;
+    let text = crate::io::read::read_text(path)?;
     parse(&text, &name)
 }
 

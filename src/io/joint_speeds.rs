@@ -3,7 +3,6 @@
 //! the URDF importer: the kinematic model needs no speeds.
 
 use crate::error::{Error, Result};
-use std::path::Path;
 
 /// Speed limits of a chain's joints.
 #[derive(Clone, Debug, PartialEq)]
@@ -23,19 +22,14 @@ impl JointSpeeds {
     }
 }
 
-/// The speed limits of the chain a robot name chooses ([`super::urdf_chain`]:
-/// a `.urdf` path with its `#…` chain options); `None` for a built-in robot
-/// or a description file, which state no speeds.
-pub fn joint_speeds(name_or_path: &str) -> Result<Option<JointSpeeds>> {
-    let Some(chain) = super::urdf_chain(name_or_path)? else {
+/// The speed limits of a URDF robot's chain, from the text it was imported
+/// from ([`super::UrdfChain`]); `None` for a built-in robot or a
+/// description file, which state no speeds.
+pub fn joint_speeds(robot: &crate::model::Robot) -> Result<Option<JointSpeeds>> {
+    let Some(chain) = super::UrdfChain::of(robot) else {
         return Ok(None);
     };
-    let path = Path::new(&chain.file);
-    let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
-        path: chain.file.clone(),
-        cause,
-    })?;
-    Ok(Some(speeds_in(&text, &chain.file, chain.joints)?))
+    Ok(Some(speeds_in(&chain.text, &chain.file, chain.joints)?))
 }
 
 /// The speeds of `joints` in URDF text (`origin` names it in errors).

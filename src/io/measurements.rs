@@ -61,10 +61,7 @@ pub fn read(path: &Path, robot: &Robot) -> Result<MeasurementFile> {
 /// result is in radians and metres.
 pub fn read_in(path: &Path, robot: &Robot, units: Units) -> Result<MeasurementFile> {
     let origin = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
-        path: origin.clone(),
-        cause: e,
-    })?;
+    let text = crate::io::read::read_text(path)?;
     let is_csv = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("csv"));

@@ -9,6 +9,8 @@ pub mod design_formats;
 pub mod frames_file;
 pub mod joint_speeds;
 pub mod measurements;
+pub mod read;
+pub mod robot_ref;
 pub mod robot_toml;
 pub mod table;
 pub mod urdf;
@@ -18,6 +20,8 @@ use crate::error::{Error, Result};
 use crate::measure::Visibility;
 use crate::model::{BUILTIN, MeasurementKind, Robot};
 use std::path::Path;
+
+pub use robot_ref::{ChainChoice, RobotRef};
 
 /// A robot as a description gives it: the model and the sensor's visibility
 /// region, if the description names one (used to filter pose pools when no
@@ -30,123 +34,45 @@ pub struct Description {
     pub visibility: Option<Visibility>,
 }
 
-/// A robot by built-in name (see [`Robot::builtin`]) or from a file: a
-/// `.toml` description ([`robot_toml`]) or a `.urdf` file ([`urdf`], unknowns
-/// chosen automatically). The result is validated, and a file's unknowns are
-/// checked to be identifiable.
-///
-/// A robot from a file is named by the path as given (not by the name inside
-/// the file), so that design files, which record the robot's name, load it
-/// again.
-///
-/// As for built-in names, the suffix `:pose` asks for full-pose
-/// measurements: `arm.urdf:pose` imports with [`MeasurementKind::Pose`];
-/// `arm.toml:pose` turns a point description into its full-pose variant
-/// ([`Robot::with_measurement`]).
+/// A robot by built-in name (see [`Robot::builtin`]) or from a file, in
+/// the text form of a [`RobotRef`] (`arm.urdf:pose#tip=tool`): see
+/// [`RobotRef::load`].
 pub fn load_robot(name_or_path: &str) -> Result<Robot> {
     load_description(name_or_path).map(|d| d.robot)
 }
 
-/// Which chain of a URDF tree to take: the `#…` part of a robot name
-/// (`arm.urdf#base=torso;tip=tool;lock=lift:0.1,head:0`), which the
-/// command line's `--base`, `--tip` and `--lock` write, so that a design
-/// file's robot name loads the same chain again.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct ChainChoice {
-    /// The base link (default: the URDF's root).
-    pub base: Option<String>,
-    /// The tip link (required on a tree).
-    pub tip: Option<String>,
-    /// Joints made fixed at a value.
-    pub lock: Vec<(String, f64)>,
-    /// A frames file ([`frames_file`]): the measurement frame and tool (or
-    /// markers) to mount the chain with.
-    pub frames: Option<String>,
+/// As [`load_robot`], with the description's visibility region.
+pub fn load_description(name_or_path: &str) -> Result<Description> {
+    RobotRef::parse(name_or_path)?.load()
 }
 
-impl ChainChoice {
-    /// Whether nothing is chosen.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.base.is_none() && self.tip.is_none() && self.lock.is_empty() && self.frames.is_none()
-    }
-
-    /// The `#…` fragment of a robot name (empty when nothing is chosen).
-    #[must_use]
-    pub fn fragment(&self) -> String {
-        let mut parts = Vec::new();
-        if let Some(b) = &self.base {
-            parts.push(format!("base={b}"));
-        }
-        if let Some(t) = &self.tip {
-            parts.push(format!("tip={t}"));
-        }
-        if !self.lock.is_empty() {
-            let l: Vec<String> = self.lock.iter().map(|(n, v)| format!("{n}:{v}")).collect();
-            parts.push(format!("lock={}", l.join(",")));
-        }
-        if let Some(f) = &self.frames {
-            parts.push(format!("frames={f}"));
-        }
-        if parts.is_empty() {
-            String::new()
-        } else {
-            format!("#{}", parts.join(";"))
-        }
-    }
-
-    /// Parses `JOINT=VALUE,…` (the `--lock` option) or `JOINT:VALUE,…` (in a
-    /// name's fragment).
-    pub fn parse_lock(text: &str) -> Result<Vec<(String, f64)>> {
-        text.split(',')
-            .filter(|s| !s.trim().is_empty())
-            .map(|item| {
-                let (n, v) = item
-                    .split_once('=')
-                    .or_else(|| item.split_once(':'))
-                    .ok_or_else(|| {
-                        Error::Invalid(format!(
-                            "--lock {item}: expected JOINT=VALUE (radians or metres)"
-                        ))
-                    })?;
-                let v: f64 = v.trim().parse().map_err(|_| {
-                    Error::Invalid(format!("--lock {item}: '{}' is not a number", v.trim()))
-                })?;
-                if !v.is_finite() {
-                    return Err(Error::Invalid(format!(
-                        "--lock {item}: not a finite number"
-                    )));
-                }
-                Ok((n.trim().to_string(), v))
-            })
-            .collect()
-    }
-
-    fn parse_fragment(frag: &str) -> Result<ChainChoice> {
-        let mut c = ChainChoice::default();
-        for part in frag.split(';').filter(|p| !p.is_empty()) {
-            match part.split_once('=') {
-                Some(("base", v)) => c.base = Some(v.to_string()),
-                Some(("tip", v)) => c.tip = Some(v.to_string()),
-                Some(("lock", v)) => c.lock = ChainChoice::parse_lock(v)?,
-                Some(("frames", v)) => c.frames = Some(v.to_string()),
-                _ => {
-                    return Err(Error::Invalid(format!(
-                        "robot name: unknown chain choice '{part}' after '#' (expected base=LINK, tip=LINK, lock=JOINT:VALUE,… or frames=FILE)"
-                    )));
-                }
-            }
-        }
-        Ok(c)
+impl RobotRef {
+    /// The robot and its visibility region: a built-in name (see
+    /// [`Robot::builtin`]), a `.toml` description ([`robot_toml`]) or a
+    /// `.urdf` file ([`urdf`], unknowns chosen automatically; the chain
+    /// and frames of [`RobotRef::chain`]). The result is validated, and a
+    /// file's unknowns are checked to be identifiable.
+    ///
+    /// The robot is named by this reference's text form (not by the name
+    /// inside the file), so that design files, which record it, load it
+    /// again. [`RobotRef::pose`] asks for full-pose measurements: a URDF
+    /// imports with [`MeasurementKind::Pose`], a point description turns
+    /// into its full-pose variant ([`Robot::with_measurement`]).
+    pub fn load(&self) -> Result<Description> {
+        let mut d = load_head(self)?;
+        d.robot.name = self.to_string();
+        Ok(d)
     }
 }
 
-/// The URDF behind a robot name and the chain chosen in it, as a collision
+/// The URDF behind a robot and the chain chosen in it, as a collision
 /// filter needs them.
 #[derive(Clone, Debug)]
 pub struct UrdfChain {
     /// The URDF file.
     pub file: String,
+    /// The file's text, as the robot was imported from it (not read again).
+    pub text: std::sync::Arc<str>,
     /// The chain's moving joints, in configuration order.
     pub joints: Vec<String>,
     /// The chain's base link.
@@ -155,50 +81,29 @@ pub struct UrdfChain {
     pub lock: Vec<(String, f64)>,
 }
 
-/// The [`UrdfChain`] of a robot name; `None` for a built-in robot or a
-/// description file.
-pub fn urdf_chain(name_or_path: &str) -> Result<Option<UrdfChain>> {
-    let (head, chain) = match name_or_path.rsplit_once('#') {
-        Some((h, f)) if f.contains('=') => (h, ChainChoice::parse_fragment(f)?),
-        _ => (name_or_path, ChainChoice::default()),
-    };
-    let file = match head.strip_suffix(":pose") {
-        Some(f) if !Path::new(head).exists() => f,
-        _ => head,
-    };
-    let path = Path::new(file);
-    if !path
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
-    {
-        return Ok(None);
+impl UrdfChain {
+    /// The URDF chain of a loaded robot; `None` for a built-in robot or a
+    /// description file.
+    #[must_use]
+    pub fn of(robot: &Robot) -> Option<UrdfChain> {
+        let s = robot.source.as_ref()?;
+        Some(UrdfChain {
+            file: s.path.clone(),
+            text: s.text.as_str().into(),
+            joints: s
+                .joints
+                .iter()
+                .filter(|j| j.is_driven())
+                .map(|j| j.name.clone())
+                .collect(),
+            base: s.base.clone(),
+            lock: s
+                .joints
+                .iter()
+                .filter_map(|j| j.locked.map(|v| (j.name.clone(), v)))
+                .collect(),
+        })
     }
-    let opts = urdf::UrdfOptions {
-        base: chain.base.clone(),
-        tip: chain.tip.clone(),
-        lock: chain.lock.clone(),
-        ..urdf::UrdfOptions::default()
-    };
-    let (joints, base) = urdf::chain_joints(path, &opts)?;
-    Ok(Some(UrdfChain {
-        file: file.to_string(),
-        joints,
-        base,
-        lock: chain.lock,
-    }))
-}
-
-/// As [`load_robot`], with the description's visibility region. A `#…`
-/// fragment chooses the chain of a URDF tree ([`ChainChoice`]).
-pub fn load_description(name_or_path: &str) -> Result<Description> {
-    let (head, chain) = match name_or_path.rsplit_once('#') {
-        Some((h, f)) if f.contains('=') => (h, ChainChoice::parse_fragment(f)?),
-        _ => (name_or_path, ChainChoice::default()),
-    };
-    let mut d = load_head(head, &chain)?;
-    d.robot.name = name_or_path.to_string();
-    Ok(d)
 }
 
 /// A URDF robot with the chain options, mounted with the frames file's
@@ -236,11 +141,13 @@ fn load_urdf(path: &Path, chain: &ChainChoice, pose: bool) -> Result<Robot> {
     }
 }
 
-fn load_head(name_or_path: &str, chain: &ChainChoice) -> Result<Description> {
-    if let Ok(robot) = Robot::builtin(name_or_path) {
-        if !chain.is_empty() {
+fn load_head(r: &RobotRef) -> Result<Description> {
+    let head = r.head();
+    if let Ok(robot) = Robot::builtin(&head) {
+        if !r.chain.is_empty() {
             return Err(Error::Invalid(format!(
-                "{name_or_path}: --base, --tip and --lock choose the chain of a URDF file, not of a built-in robot"
+                "{head}: a chain choice (base, tip, lock or frames: {}) applies to a URDF file, not to a built-in robot",
+                r.chain.fragment()
             )));
         }
         return Ok(Description {
@@ -248,40 +155,34 @@ fn load_head(name_or_path: &str, chain: &ChainChoice) -> Result<Description> {
             visibility: None,
         });
     }
-    let (file_name, pose) = match name_or_path.strip_suffix(":pose") {
-        Some(f) if !Path::new(name_or_path).exists() => (f, true),
-        _ => (name_or_path, false),
-    };
-    let path = Path::new(file_name);
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    if !chain.is_empty() && ext.as_deref() != Some("urdf") {
+    let ext = r.extension();
+    if !r.chain.is_empty() && !r.is_urdf() {
         return Err(Error::Invalid(format!(
-            "{name_or_path}: --base, --tip, --lock and --frames apply to a .urdf file (in a description, use its `base`, `tip` and [lock] keys)"
+            "{head}: a chain choice (base, tip, lock or frames: {}) applies to a .urdf file; in a description use its `base`, `tip` and [lock] keys",
+            r.chain.fragment()
         )));
     }
+    let path = r.path();
     let d = match ext.as_deref() {
         Some("toml") => {
             let mut d = robot_toml::load_description(path)?;
-            if pose && d.robot.measurement == MeasurementKind::Point {
+            if r.pose && d.robot.measurement == MeasurementKind::Point {
                 d.robot = d.robot.with_measurement(MeasurementKind::Pose)?;
             }
             d
         }
         Some("urdf") => Description {
-            robot: load_urdf(path, chain, pose)?,
+            robot: load_urdf(path, &r.chain, r.pose)?,
             visibility: None,
         },
         _ if path.exists() => {
             return Err(Error::Invalid(format!(
-                "{name_or_path}: unknown robot file type (expected a .toml description or a .urdf file)"
+                "{head}: unknown robot file type (expected a .toml description or a .urdf file)"
             )));
         }
         _ => {
             return Err(Error::UnknownRobot {
-                name: name_or_path.to_string(),
+                name: head,
                 known: format!("{}; or a path to a .toml or .urdf file", BUILTIN.join(", ")),
             });
         }

@@ -163,10 +163,7 @@ pub fn load(path: &Path) -> Result<Robot> {
 
 /// Reads and checks a robot description file, with its visibility region.
 pub fn load_description(path: &Path) -> Result<Description> {
-    let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
-        path: path.display().to_string(),
-        cause,
-    })?;
+    let text = crate::io::read::read_text(path)?;
     parse_description(&text, &path.display().to_string(), path.parent())
 }
 

@@ -131,43 +131,8 @@ impl Default for UrdfOptions {
 
 /// Reads a URDF file and converts its chain (see the module docs).
 pub fn load(path: &Path, opts: &UrdfOptions) -> Result<Robot> {
-    let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
-        path: path.display().to_string(),
-        cause,
-    })?;
+    let text = crate::io::read::read_text(path)?;
     parse(&text, &path.display().to_string(), opts)
-}
-
-/// The moving joints of the chain `opts` chooses in a URDF file, in the
-/// order of a configuration's values (locked joints left out), and the
-/// chain's base link.
-pub fn chain_joints(path: &Path, opts: &UrdfOptions) -> Result<(Vec<String>, String)> {
-    let origin = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|cause| Error::Io {
-        path: origin.clone(),
-        cause,
-    })?;
-    let bad = |message: String| Error::Parse {
-        path: origin.clone(),
-        message,
-    };
-    let urdf = kinematic_part(&text)
-        .and_then(|k| urdf_rs::read_from_string(&k).map_err(|e| e.to_string()))
-        .map_err(|e| bad(format!("not a valid URDF: {e}")))?;
-    let chain =
-        extract_chain(&urdf, opts.base.as_deref(), opts.tip.as_deref(), &opts.lock).map_err(bad)?;
-    let names = chain
-        .iter()
-        .filter(|j| j.kind.is_some())
-        .map(|j| j.name.clone())
-        .collect();
-    // The base link: the parent of the chain's first joint.
-    let base = chain
-        .first()
-        .and_then(|j| urdf.joints.iter().find(|u| u.name == j.name))
-        .map(|u| u.parent.link.clone())
-        .unwrap_or_default();
-    Ok((names, base))
 }
 
 /// Parses URDF text and converts its chain; `origin` names it in errors and

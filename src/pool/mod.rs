@@ -272,7 +272,7 @@ impl PoolSpec {
     /// empty is an error naming the filter that removed the last candidates,
     /// and so is a filter whose region is malformed ([`Visibility::validate`]).
     pub fn build(&self, robot: &Robot, table: &ParamTable) -> Result<Pool> {
-        self.validate_filters()?;
+        self.validate_filters(robot)?;
         match &self.source {
             PoolSource::File { path } => {
                 let rows = read_configurations(Path::new(path), robot)?;
@@ -282,15 +282,21 @@ impl PoolSpec {
         }
     }
 
-    /// Checks every filter's own settings (a malformed region).
-    fn validate_filters(&self) -> Result<()> {
+    /// Checks every filter's own settings (a malformed region) and loads
+    /// the collision models, from the URDF text `robot` was imported from
+    /// when they name its file (so that the file is read once).
+    fn validate_filters(&self, robot: &Robot) -> Result<()> {
+        let source = robot
+            .source
+            .as_ref()
+            .map(|s| (s.path.as_str(), s.text.as_str()));
         for f in &self.filters {
             match f {
                 PoolFilter::Visibility(v) => v
                     .validate()
                     .map_err(|e| Error::Invalid(format!("visibility filter: {e}")))?,
                 PoolFilter::Collision(c) => {
-                    c.load()
+                    c.load_sharing(source)
                         .map_err(|e| Error::Invalid(format!("{} filter: {e}", c.kind())))?;
                 }
             }
@@ -307,7 +313,7 @@ impl PoolSpec {
         table: &ParamTable,
         rows: Configurations,
     ) -> Result<Pool> {
-        self.validate_filters()?;
+        self.validate_filters(robot)?;
         if !matches!(self.source, PoolSource::File { .. }) {
             return Err(Error::Invalid(format!(
                 "stored configurations given for a {} pool",

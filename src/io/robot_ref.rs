@@ -1,0 +1,206 @@
+//! Which robot to load, as one typed value: a built-in name or a
+//! description file, whether full poses are measured, and the chain of a
+//! URDF tree ([`ChainChoice`]). The command line builds one from `--robot`
+//! and the chain options once; design files record one (as a name and a
+//! structured chain) and give it back.
+//!
+//! The text form `NAME[:pose][#base=B;tip=T;lock=J:V,…;frames=F]` is this
+//! value's serialisation, read by [`RobotRef::parse`] and written by its
+//! [`std::fmt::Display`]: a loaded robot's [`crate::model::Robot::name`], and
+//! the `robot` of design files written before the chain was stored apart.
+
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::path::Path;
+
+/// Which chain of a URDF tree to take, and the frames to mount it with.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ChainChoice {
+    /// The base link (default: the URDF's root).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub base: Option<String>,
+    /// The tip link (required on a tree).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tip: Option<String>,
+    /// Joints made fixed at a value (radians or metres).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub lock: Vec<(String, f64)>,
+    /// A frames file ([`super::frames_file`]): the measurement frame and
+    /// tool (or markers) to mount the chain with.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub frames: Option<String>,
+}
+
+impl ChainChoice {
+    /// Whether nothing is chosen.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.base.is_none() && self.tip.is_none() && self.lock.is_empty() && self.frames.is_none()
+    }
+
+    /// The `#…` fragment of the text form (empty when nothing is chosen).
+    #[must_use]
+    pub fn fragment(&self) -> String {
+        let mut parts = Vec::new();
+        if let Some(b) = &self.base {
+            parts.push(format!("base={b}"));
+        }
+        if let Some(t) = &self.tip {
+            parts.push(format!("tip={t}"));
+        }
+        if !self.lock.is_empty() {
+            let l: Vec<String> = self.lock.iter().map(|(n, v)| format!("{n}:{v}")).collect();
+            parts.push(format!("lock={}", l.join(",")));
+        }
+        if let Some(f) = &self.frames {
+            parts.push(format!("frames={f}"));
+        }
+        if parts.is_empty() {
+            String::new()
+        } else {
+            format!("#{}", parts.join(";"))
+        }
+    }
+
+    /// Parses a list of held joints, `JOINT=VALUE,…` or `JOINT:VALUE,…`;
+    /// errors name the item.
+    pub fn parse_lock(text: &str) -> Result<Vec<(String, f64)>> {
+        text.split(',')
+            .filter(|s| !s.trim().is_empty())
+            .map(|item| {
+                let bad = |what: &str| Error::Invalid(format!("lock '{item}': {what}"));
+                let (n, v) = item
+                    .split_once('=')
+                    .or_else(|| item.split_once(':'))
+                    .ok_or_else(|| bad("expected JOINT=VALUE (radians or metres)"))?;
+                let v: f64 = v
+                    .trim()
+                    .parse()
+                    .map_err(|_| bad(&format!("'{}' is not a number", v.trim())))?;
+                if !v.is_finite() {
+                    return Err(bad("not a finite number"));
+                }
+                Ok((n.trim().to_string(), v))
+            })
+            .collect()
+    }
+
+    /// Parses the `#…` fragment's text (without the `#`).
+    fn parse_fragment(frag: &str) -> Result<ChainChoice> {
+        let mut c = ChainChoice::default();
+        for part in frag.split(';').filter(|p| !p.is_empty()) {
+            match part.split_once('=') {
+                Some(("base", v)) => c.base = Some(v.to_string()),
+                Some(("tip", v)) => c.tip = Some(v.to_string()),
+                Some(("lock", v)) => c.lock = ChainChoice::parse_lock(v)?,
+                Some(("frames", v)) => c.frames = Some(v.to_string()),
+                _ => {
+                    return Err(Error::Invalid(format!(
+                        "robot name: unknown chain choice '{part}' after '#' (expected base=LINK, tip=LINK, lock=JOINT:VALUE,… or frames=FILE)"
+                    )));
+                }
+            }
+        }
+        Ok(c)
+    }
+}
+
+/// A robot to load: a built-in name or a `.toml`/`.urdf` path, the
+/// measurement kind asked for, and the chain of a URDF tree.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RobotRef {
+    /// A built-in robot's name or a description file's path, as given.
+    pub name: String,
+    /// Full poses asked for (the `:pose` suffix).
+    pub pose: bool,
+    /// The chain of a URDF tree.
+    pub chain: ChainChoice,
+}
+
+impl RobotRef {
+    /// Reads the text form (see the module documentation). A `:pose`
+    /// suffix is taken from the name unless a file of that exact name
+    /// exists.
+    pub fn parse(text: &str) -> Result<Self> {
+        let (head, chain) = match text.rsplit_once('#') {
+            Some((h, f)) if f.contains('=') => (h, ChainChoice::parse_fragment(f)?),
+            _ => (text, ChainChoice::default()),
+        };
+        let (name, pose) = match head.strip_suffix(":pose") {
+            Some(f) if !Path::new(head).exists() => (f, true),
+            _ => (head, false),
+        };
+        Ok(Self {
+            name: name.to_string(),
+            pose,
+            chain,
+        })
+    }
+
+    /// The description file, if the name is a path with an extension.
+    #[must_use]
+    pub fn path(&self) -> &Path {
+        Path::new(&self.name)
+    }
+
+    /// The file's lower-case extension (`urdf`, `toml`), if any.
+    #[must_use]
+    pub fn extension(&self) -> Option<String> {
+        self.path()
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+    }
+
+    /// Whether the robot is a `.urdf` file.
+    #[must_use]
+    pub fn is_urdf(&self) -> bool {
+        self.extension().as_deref() == Some("urdf")
+    }
+
+    /// The name with its `:pose` suffix, without the chain: what a built-in
+    /// robot is looked up by.
+    #[must_use]
+    pub fn head(&self) -> String {
+        if self.pose {
+            format!("{}:pose", self.name)
+        } else {
+            self.name.clone()
+        }
+    }
+}
+
+impl fmt::Display for RobotRef {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}{}", self.head(), self.chain.fragment())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The text form round-trips through parse and display, and a `:pose`
+    /// suffix and a fragment are both read.
+    #[test]
+    fn text_form_round_trips() {
+        let t = "arm.urdf:pose#base=torso;tip=tool;lock=lift:0.1,head:-0.5;frames=cal.yaml";
+        let r = RobotRef::parse(t).unwrap();
+        assert_eq!(r.name, "arm.urdf");
+        assert!(r.pose);
+        assert_eq!(r.chain.base.as_deref(), Some("torso"));
+        assert_eq!(r.chain.tip.as_deref(), Some("tool"));
+        assert_eq!(
+            r.chain.lock,
+            vec![("lift".to_string(), 0.1), ("head".to_string(), -0.5)]
+        );
+        assert_eq!(r.chain.frames.as_deref(), Some("cal.yaml"));
+        assert_eq!(r.to_string(), t);
+        assert_eq!(RobotRef::parse("puma560").unwrap().to_string(), "puma560");
+        assert!(RobotRef::parse("a.urdf#colour=red").is_err());
+        assert!(ChainChoice::parse_lock("j=abc").is_err());
+        assert!(ChainChoice::parse_lock("j=inf").is_err());
+    }
+}

@@ -1,0 +1,180 @@
+//! The house's rules, checked from outside: a robot is one value, resolved
+//! once from the command line, and every input file is read from disk once
+//! per process (counted through the loaders' one reading function,
+//! `io::read::read_text`, which the binary lists on stderr when
+//! `ACTIVECAL_DEBUG_READS` is set).
+
+mod common;
+
+use std::process::Command;
+
+/// Runs `activecal` with read counting on; returns (success, stderr).
+fn counted(args: &[&str]) -> (bool, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_activecal"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("ACTIVECAL_DEBUG_READS", "1")
+        .args(args)
+        .output()
+        .expect("runs");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// The `read N× PATH` lines of a run's stderr.
+fn reads(stderr: &str) -> Vec<(usize, String)> {
+    stderr
+        .lines()
+        .filter_map(|l| l.strip_prefix("read "))
+        .filter_map(|l| l.split_once("× "))
+        .map(|(n, p)| (n.parse().expect("a count"), p.to_string()))
+        .collect()
+}
+
+/// Asserts the run succeeded, read every file in `expected` (by file name)
+/// and read no file more than once.
+fn reads_once(args: &[&str], expected: &[&str]) {
+    let (ok, err) = counted(args);
+    assert!(ok, "{args:?}: {err}");
+    let r = reads(&err);
+    for (n, p) in &r {
+        assert_eq!(*n, 1, "{args:?}: {p} read {n} times");
+    }
+    for e in expected {
+        assert!(
+            r.iter().any(|(_, p)| p.ends_with(e)),
+            "{args:?}: {e} not among the reads {r:?}"
+        );
+    }
+}
+
+/// Select with self-collision (the URDF feeds the chain, the collision
+/// model and the joint speeds), then score, gap and calibrate the design it
+/// wrote: the URDF is read once in each process.
+#[test]
+fn a_urdf_is_read_once_per_process() {
+    let dir = common::scratch_dir("house", "reads");
+    let design = dir.join("d.json");
+    let d = design.to_str().unwrap();
+    let urdf = "fixtures/example-robot-data/panda.urdf";
+    reads_once(
+        &[
+            "select",
+            "--robot",
+            urdf,
+            "--tip",
+            "panda_hand_tcp",
+            "--pool",
+            "random",
+            "--count",
+            "200",
+            "--self-collision",
+            "--srdf",
+            "fixtures/example-robot-data/panda.srdf",
+            "--package-dir",
+            "fixtures/example-robot-data",
+            "--n",
+            "12",
+            "--ils",
+            "0",
+            "--out",
+            d,
+        ],
+        &["panda.urdf"],
+    );
+    reads_once(
+        &["score", "--design", d, "--json"],
+        &["panda.urdf", "d.json"],
+    );
+    reads_once(&["gap", "--design", d, "--json"], &["panda.urdf", "d.json"]);
+    reads_once(
+        &[
+            "calibrate",
+            "--robot",
+            urdf,
+            "--tip",
+            "panda_hand_tcp",
+            "--design",
+            d,
+            "--validation",
+            "50",
+            "--json",
+        ],
+        &["panda.urdf", "d.json"],
+    );
+    // The measured-data path: URDF, measurements, once each.
+    reads_once(
+        &[
+            "calibrate",
+            "--robot",
+            "fixtures/figaroh/ur10_robot.urdf:pose",
+            "--tip",
+            "wrist_3_link",
+            "--measurements",
+            "fixtures/figaroh/ur10_full_pose.csv",
+            "--json",
+        ],
+        &["ur10_robot.urdf", "ur10_full_pose.csv"],
+    );
+}
+
+/// The design file records the chain as its own structured field (not in
+/// the robot's name), and a design of old, whose robot name carries the
+/// chain as a `#…` fragment, still loads.
+#[test]
+fn designs_record_the_chain_as_fields_and_old_names_still_load() {
+    let dir = common::scratch_dir("house", "chain");
+    let design = dir.join("d.json");
+    let d = design.to_str().unwrap();
+    let urdf = "fixtures/example-robot-data/panda.urdf";
+    let (ok, err) = counted(&[
+        "select",
+        "--robot",
+        urdf,
+        "--tip",
+        "panda_hand_tcp",
+        "--pool",
+        "random",
+        "--count",
+        "200",
+        "--n",
+        "12",
+        "--ils",
+        "0",
+        "--out",
+        d,
+    ]);
+    assert!(ok, "{err}");
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&design).unwrap()).unwrap();
+    assert_eq!(v["robot"], urdf);
+    assert_eq!(v["chain"]["tip"], "panda_hand_tcp");
+    let new_score = common::json_of(&["score", "--design", d, "--json"]);
+    // The same design as a file of old: the chain in the robot's name.
+    v["robot"] = format!("{urdf}#tip=panda_hand_tcp").into();
+    v.as_object_mut().unwrap().remove("chain");
+    let old = dir.join("old.json");
+    std::fs::write(&old, v.to_string()).unwrap();
+    let old_score = common::json_of(&["score", "--design", old.to_str().unwrap(), "--json"]);
+    assert_eq!(new_score["ln_oid"], old_score["ln_oid"]);
+    assert!(new_score["ln_oid"].is_number(), "{new_score}");
+    // A chain option on a command without --robot is refused, not dropped.
+    common::fails_with(
+        &["gap", "--design", d, "--tip", "panda_link8"],
+        "--tip panda_link8",
+    );
+    // A chain option that contradicts the chain a --robot names is refused.
+    common::fails_with(
+        &[
+            "fk",
+            "--robot",
+            &format!("{urdf}#tip=panda_hand_tcp"),
+            "--tip",
+            "panda_link8",
+            "--q",
+            "0,0,0,-1,0,1,0",
+        ],
+        "names its chain already",
+    );
+}

@@ -82,7 +82,9 @@ fn ur10_new_poses_on_top_of_the_first_half() {
     let new_q = qs(&stored["q"]);
     let old_q = qs(&stored["existing"]["q"]);
     assert_eq!(old_q.len(), 12);
-    let robot = activecal::io::load_robot(stored["robot"].as_str().unwrap()).unwrap();
+    // The design's robot with its chain (stored as its own field).
+    let file: activecal::io::design::DesignFile = serde_json::from_value(stored.clone()).unwrap();
+    let robot = file.robot_ref().unwrap().load().unwrap().robot;
     let all: Vec<Vec<f64>> = old_q.iter().chain(&new_q).cloned().collect();
     let x = activecal::blocks::jacobian_of(
         &robot,

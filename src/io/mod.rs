@@ -10,7 +10,6 @@ pub mod frames_file;
 pub mod joint_speeds;
 pub mod measurements;
 pub mod read;
-pub mod robot_ref;
 pub mod robot_toml;
 pub mod table;
 pub mod urdf;
@@ -21,7 +20,7 @@ use crate::measure::Visibility;
 use crate::model::{BUILTIN, MeasurementKind, Robot};
 use std::path::Path;
 
-pub use robot_ref::{ChainChoice, RobotRef};
+pub use crate::model::robot_ref::{ChainChoice, RobotRef};
 
 /// A robot as a description gives it: the model and the sensor's visibility
 /// region, if the description names one (used to filter pose pools when no

@@ -17,6 +17,7 @@
 
 pub mod catalogue;
 pub mod frame;
+pub mod robot_ref;
 pub mod source;
 
 pub use frame::{FrameMotion, frame_transform};

@@ -28,6 +28,7 @@
 
 use crate::error::{Error, Result};
 use crate::model::Robot;
+use crate::model::robot_ref::{ChainChoice, RobotRef};
 pub use crate::units::joint_names;
 use crate::units::{JointSource, Units, joint_values_to_model_units};
 use std::path::Path;
@@ -268,13 +269,22 @@ pub fn parse_json_in(
                 .into(),
         ));
     };
-    if let Some(r) = obj.get("robot").and_then(|r| r.as_str())
-        && r != robot.name
-    {
-        return Err(parse_err(
-            path,
-            format!("the file is for robot '{r}', not '{}'", robot.name),
-        ));
+    if let Some(r) = obj.get("robot").and_then(|r| r.as_str()) {
+        let chain = obj
+            .get("chain")
+            .map(|c| serde_json::from_value::<ChainChoice>(c.clone()))
+            .transpose()
+            .map_err(|e| parse_err(path, format!("\"chain\": {e}")))?;
+        let mut named = RobotRef::parse(r).map_err(|e| parse_err(path, e.to_string()))?;
+        if let Some(c) = chain {
+            named.chain = c;
+        }
+        if RobotRef::parse(&robot.name).ok().as_ref() != Some(&named) {
+            return Err(parse_err(
+                path,
+                format!("the file is for robot '{named}', not '{}'", robot.name),
+            ));
+        }
     }
     // A design file (`select --out`) names its joint vectors `q` and its
     // joints `joint_names`.

@@ -1,7 +1,7 @@
 //! Which robot to load, as one typed value: a built-in name or a
 //! description file, whether full poses are measured, and the chain of a
 //! URDF tree ([`ChainChoice`]). The command line builds one from `--robot`
-//! and the chain options once; design files record one (as a name and a
+//! and the chain options once, [`crate::io`] loads it; design files record one (as a name and a
 //! structured chain) and give it back.
 //!
 //! The text form `NAME[:pose][#base=B;tip=T;lock=J:V,…;frames=F]` is this
@@ -27,7 +27,7 @@ pub struct ChainChoice {
     /// Joints made fixed at a value (radians or metres).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub lock: Vec<(String, f64)>,
-    /// A frames file ([`super::frames_file`]): the measurement frame and
+    /// A frames file ([`crate::io::frames_file`]): the measurement frame and
     /// tool (or markers) to mount the chain with.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub frames: Option<String>,
@@ -70,7 +70,7 @@ impl ChainChoice {
         text.split(',')
             .filter(|s| !s.trim().is_empty())
             .map(|item| {
-                let bad = |what: &str| Error::Invalid(format!("lock '{item}': {what}"));
+                let bad = |what: &str| Error::Invalid(format!("lock {item}: {what}"));
                 let (n, v) = item
                     .split_once('=')
                     .or_else(|| item.split_once(':'))

@@ -13,6 +13,7 @@ pub mod read;
 pub mod robot_toml;
 pub mod table;
 pub mod urdf;
+mod urdf_chain;
 pub mod urdf_edit;
 
 use crate::error::{Error, Result};
@@ -145,7 +146,7 @@ fn load_head(r: &RobotRef) -> Result<Description> {
     if let Ok(robot) = Robot::builtin(&head) {
         if !r.chain.is_empty() {
             return Err(Error::Invalid(format!(
-                "{head}: a chain choice (base, tip, lock or frames: {}) applies to a URDF file, not to a built-in robot",
+                "{head}: a chain choice (base, tip, lock or frames: {}) chooses the chain of a URDF file, not of a built-in robot",
                 r.chain.fragment()
             )));
         }

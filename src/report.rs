@@ -168,7 +168,11 @@ impl RefinementReport {
     /// Compares the refined design with the pool's bound `ln_bound` for `p`
     /// unknowns.
     pub fn set_bound(&mut self, ln_bound: f64, p: usize) {
-        self.d_efficiency_vs_pool_bound = Some(((self.ln_oid - ln_bound) / p as f64).exp());
+        self.d_efficiency_vs_pool_bound = Some(crate::bound::gap::d_efficiency(
+            Some(self.ln_oid),
+            ln_bound,
+            p,
+        ));
         self.exceeds_pool_bound = Some(self.ln_oid > ln_bound);
     }
 }

@@ -178,3 +178,24 @@ fn designs_record_the_chain_as_fields_and_old_names_still_load() {
         "names its chain already",
     );
 }
+
+/// Every named choice a command line offers (`names::Choice`) is named as
+/// it is serialised in reports and design files, so that a value read
+/// back from JSON and one typed on the command line agree.
+#[test]
+fn choices_are_named_as_they_are_serialised() {
+    use activecal::names::Choice;
+    fn check<T: Choice + serde::Serialize + std::fmt::Display>() {
+        for v in T::ALL {
+            let json = serde_json::to_string(v).unwrap();
+            assert_eq!(json, format!("\"{}\"", v.name()));
+            assert_eq!(v.to_string(), v.name());
+            assert!(T::from_name(v.name()).is_some_and(|w| w.name() == v.name()));
+        }
+        assert!(T::from_name("no-such-choice").is_none());
+    }
+    check::<activecal::model::ParamSet>();
+    check::<activecal::select::Algorithm>();
+    check::<activecal::select::CriterionKind>();
+    check::<activecal::bound::RelaxationSolver>();
+}

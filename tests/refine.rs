@@ -12,7 +12,7 @@ fn ln_det_of(robot: &Robot, qs: &[Vec<f64>]) -> f64 {
     let x = activecal::blocks::jacobian_of(robot, &robot.nominal, qs.len(), |k, q| {
         q.copy_from_slice(&qs[k]);
     });
-    activecal::bound::gap::design_ln_det(&x, &(0..qs.len()).collect::<Vec<_>>()).unwrap()
+    activecal::criterion::design_ln_det(&x, None, &(0..qs.len()).collect::<Vec<_>>()).unwrap()
 }
 
 #[test]

@@ -15,6 +15,7 @@ mod common;
 use activecal::blocks::Blocks;
 use activecal::bound::{BoundSettings, relaxation_bound};
 use activecal::criterion::Indices;
+use activecal::criterion::design_ln_det;
 use activecal::identify::{LmSettings, identify, simulate, trial_rng};
 use activecal::io::robot_toml as file;
 use activecal::io::urdf::{self, UrdfOptions};
@@ -24,7 +25,6 @@ use activecal::model::{Convention, JointKind, MeasurementKind, ParamSet, ParamTa
 use activecal::observability::INDEPENDENCE_TOL;
 use activecal::observability::require_identifiable;
 use activecal::pool::Pool;
-use activecal::select::ln_det_direct;
 use common::eae_design;
 use nalgebra::{Isometry3, Matrix3, Translation3, Unit, UnitQuaternion, Vector3};
 use std::collections::HashMap;
@@ -398,8 +398,8 @@ fn orientation_scale_weighs_the_orientation_rows_only() {
     }
     let design: Vec<usize> = (0..40).collect();
     let (l, lw) = (
-        ln_det_direct(&x, &design).unwrap(),
-        ln_det_direct(&xw, &design).unwrap(),
+        design_ln_det(&x, None, &design).unwrap(),
+        design_ln_det(&xw, None, &design).unwrap(),
     );
     assert!(lw < l - 1.0, "{lw} vs {l}");
     let mut p = Robot::stanford();
@@ -1109,7 +1109,7 @@ fn select_and_score_run_on_every_robot() {
         // Scoring (the `score` command's library call) agrees with the run.
         let ind = Indices::from_design(&x, &sel.poses);
         assert_eq!(ind.rank, r.n_unknowns(), "{}", r.name);
-        let direct = ln_det_direct(&x, &sel.poses).unwrap();
+        let direct = design_ln_det(&x, None, &sel.poses).unwrap();
         assert!((direct - sel.ln_oid).abs() < 1e-6, "{}", r.name);
         assert!((ind.ln_oid - sel.ln_oid).abs() < 1e-6, "{}", r.name);
         require_identifiable(&r, &x.select(&sel.poses)).unwrap();
@@ -1124,7 +1124,7 @@ fn select_and_score_run_on_every_robot() {
                         d.push(k);
                     }
                 }
-                ln_det_direct(&x, &d).unwrap_or(f64::NEG_INFINITY)
+                design_ln_det(&x, None, &d).unwrap_or(f64::NEG_INFINITY)
             })
             .fold(f64::NEG_INFINITY, f64::max);
         println!(

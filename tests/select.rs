@@ -2,11 +2,12 @@
 //! thread counts, fixed poses, rank-deficient starts, and local optimality.
 
 use activecal::blocks::Blocks;
+use activecal::criterion::design_ln_det;
 use activecal::criterion::{DCriterion, OiCriterion};
 use activecal::model::Robot;
 use activecal::pool::Pool;
 use activecal::select::{
-    Algorithm, Settings, StepKind, design_rng, detmax, eae, fedorov, ln_det_direct, multistart,
+    Algorithm, Settings, StepKind, design_rng, detmax, eae, fedorov, multistart,
 };
 use std::f64::consts::LN_10;
 
@@ -30,7 +31,7 @@ fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
 /// ≈ 20 on these pools) and the recomputation adds ~1e-12: 1e-7 is ample
 /// and far below any real improvement.
 fn assert_no_improving_swap(x: &Blocks, poses: &[usize], fixed: &[usize]) {
-    let base = ln_det_direct(x, poses).unwrap();
+    let base = design_ln_det(x, None, poses).unwrap();
     for k in 0..poses.len() {
         if fixed.contains(&poses[k]) {
             continue;
@@ -41,7 +42,7 @@ fn assert_no_improving_swap(x: &Blocks, poses: &[usize], fixed: &[usize]) {
             }
             let mut d = poses.to_vec();
             d[k] = i;
-            if let Some(v) = ln_det_direct(x, &d) {
+            if let Some(v) = design_ln_det(x, None, &d) {
                 assert!(v <= base + 1e-7, "swap {k}->{i} improves {base} to {v}");
             }
         }
@@ -63,7 +64,7 @@ fn one_eae_start_reaches_paper_level() {
     // The reported value is ln det of the design, recomputed from scratch.
     // Tolerance: updates drift by ~p·u·κ(M) per step with κ ≈ 1e8 here,
     // refactorized every 64 updates: 1e-6 absolute in ln det is ample.
-    let direct = ln_det_direct(&x, &sel.poses).unwrap();
+    let direct = design_ln_det(&x, None, &sel.poses).unwrap();
     assert!(
         (direct - sel.ln_oid).abs() < 1e-6,
         "{direct} vs {}",
@@ -186,7 +187,7 @@ fn fixed_poses_stay_and_rank_deficient_start_works() {
             .iter()
             .all(|r| r.removed.is_none_or(|p| !fixed.contains(&p)))
     );
-    let direct = ln_det_direct(&x, &sel.poses).unwrap();
+    let direct = design_ln_det(&x, None, &sel.poses).unwrap();
     assert!((direct - sel.ln_oid).abs() < 1e-6);
     // Same quality class as a full-rank start (within 1 decade of OI_D).
     let plain = eae(
@@ -295,7 +296,7 @@ fn score_indices_agree_with_an_independent_cholesky_to_1e_10() {
             30,
         );
         let ind = Indices::from_design(&x, &d);
-        let chol = ln_det_direct(&x, &d).unwrap();
+        let chol = design_ln_det(&x, None, &d).unwrap();
         assert_eq!(ind.rank, 27);
         assert!(
             (ind.ln_oid - chol).abs() <= 1e-10 * chol.abs(),
@@ -382,7 +383,7 @@ fn iterated_local_search_ends_at_a_local_optimum_above_its_start() {
     assert!(a.ln_oid >= p.ln_oid - 1e-9, "{} < {}", a.ln_oid, p.ln_oid);
     assert!(a.poses.contains(&0) && a.poses.contains(&400));
     assert_eq!(a.trace.last().unwrap().ln_oid, a.ln_oid);
-    let base = ln_det_direct(&x, &a.poses).unwrap();
+    let base = design_ln_det(&x, None, &a.poses).unwrap();
     assert!((base - a.ln_oid).abs() < 1e-6);
     assert_no_improving_swap(&x, &a.poses, &[0, 400]);
 }

@@ -11,8 +11,8 @@ use super::variance::information;
 use super::{Bound, BoundError, BoundStatus};
 use crate::blocks::Blocks;
 use crate::criterion::Prior;
+pub use crate::criterion::design_ln_det;
 use crate::linalg::chol::ln_det_spd_equilibrated;
-use crate::linalg::rank::{MAX_CONDITION, ln_det_regular};
 
 use serde::Serialize;
 
@@ -48,25 +48,13 @@ pub struct DesignGap {
     pub weights: Vec<f64>,
 }
 
-/// `ln det` of a design's information matrix `Σ_{i∈design} X_iᵀX_i`,
-/// computed on unit-norm columns and unscaled; `None` if singular by the
-/// rank rule every command shares ([`crate::linalg::rank`]).
+/// A design's D-efficiency against a bound on `p` unknowns:
+/// `(OI_D / bound)^(1/p) = exp((ln OI_D − ln bound) / p)`, the fraction of
+/// the best possible per-parameter information (1 at the bound); 0 for a
+/// singular design (`ln_oid = None`). The one place this formula lives.
 #[must_use]
-pub fn design_ln_det(x: &Blocks, design: &[usize]) -> Option<f64> {
-    ln_det_regular(x.information(design).as_ref(), MAX_CONDITION)
-}
-
-/// [`design_ln_det`] on top of prior information: `ln det(M0 + Σ X_iᵀX_i)`.
-#[must_use]
-pub fn design_ln_det_with_prior(
-    x: &Blocks,
-    prior: Option<&Prior>,
-    design: &[usize],
-) -> Option<f64> {
-    match prior {
-        None => design_ln_det(x, design),
-        Some(pr) => ln_det_spd_equilibrated((x.information(design) + pr.matrix()).as_ref()),
-    }
+pub fn d_efficiency(ln_oid: Option<f64>, ln_bound: f64, p: usize) -> f64 {
+    ln_oid.map_or(0.0, |l| ((l - ln_bound) / p as f64).exp())
 }
 
 /// The gap report of a design (pool positions) against the bound for its
@@ -123,9 +111,8 @@ pub fn design_gap_with_prior(
             )));
         }
     }
-    let ln_oid = design_ln_det_with_prior(x, prior, design);
-    let p = bound.p as f64;
-    let d_efficiency = ln_oid.map_or(0.0, |l| ((l - bound.ln_bound) / p).exp());
+    let ln_oid = design_ln_det(x, prior, design);
+    let d_efficiency = d_efficiency(ln_oid, bound.ln_bound, bound.p);
     let weights: Vec<f64> = design.iter().map(|&i| bound.weights[i]).collect();
     Ok(DesignGap {
         n: design.len(),

@@ -84,7 +84,7 @@ fn robot_row(label: &str, spec: &str) -> Result<Value> {
     let t0 = Instant::now();
     let best = select(&x, CriterionKind::Det, Algorithm::Eae, &ds)?;
     let t_def = t0.elapsed().as_secs_f64();
-    let eff = |ln: f64| ((ln - b.ln_bound) / x.p() as f64).exp();
+    let eff = |ln: f64| activecal::bound::gap::d_efficiency(Some(ln), b.ln_bound, x.p());
     Ok(json!({
         "robot": label, "spec": spec, "p": x.p(), "t": x.t(), "poses": x.n_poses(),
         "bound_s": b.seconds, "bound_gap": b.certificate_gap, "bound_status": b.status,

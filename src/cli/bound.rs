@@ -225,7 +225,7 @@ pub fn cmd_gap(a: GapArgs) -> Result<()> {
         let all: Vec<usize> = (0..qs.len()).collect();
         // The pool's bound is for the pool's Jacobian; the design's own
         // Jacobian is scored against its value.
-        let ln = activecal::bound::gap::design_ln_det_with_prior(&xd, prior, &all);
+        let ln = activecal::criterion::design_ln_det(&xd, prior, &all);
         activecal::bound::DesignGap {
             n: qs.len(),
             p: b.p,
@@ -233,7 +233,7 @@ pub fn cmd_gap(a: GapArgs) -> Result<()> {
             log10_oid: ln.map(|l| l / std::f64::consts::LN_10),
             ln_bound: b.ln_bound,
             log10_bound: b.log10_bound(),
-            d_efficiency: ln.map_or(0.0, |l| ((l - b.ln_bound) / b.p as f64).exp()),
+            d_efficiency: activecal::bound::gap::d_efficiency(ln, b.ln_bound, b.p),
             bound_status: b.status,
             certificate_gap: b.certificate_gap,
             weighted: Vec::new(),

@@ -323,7 +323,7 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     let seconds = t0.elapsed().as_secs_f64();
     let mut report = SelectReport::new(&ctx.robot, &ctx.pool, &sel, a.criterion, &s, seconds);
     if let Some(e) = &existing {
-        let alone = activecal::select::ln_det_direct(&ctx.x, &sel.poses);
+        let alone = activecal::criterion::design_ln_det(&ctx.x, None, &sel.poses);
         report.set_existing(e.report.clone(), alone);
     }
     let mut pool_bound = None;

@@ -110,6 +110,29 @@ pub use variances::{PoolVariances, exchange_gain};
 
 use thiserror::Error;
 
+/// `ln OI_D` of a design, recomputed from scratch: `ln det(M0 + Σ_{i∈design}
+/// X_iᵀX_i)` with the prior information `M0` when there is one. Without a
+/// prior, `None` when the design is singular by the rank rule every command
+/// shares ([`crate::linalg::rank`], on unit-norm columns); with one, `None`
+/// when the sum is not positive definite (on an equilibrated copy, so that
+/// the units of the parameters cannot change the decision). The one
+/// direct evaluation that selection, bounds and reports check their
+/// updated values against.
+#[must_use]
+pub fn design_ln_det(
+    x: &crate::blocks::Blocks,
+    prior: Option<&Prior>,
+    design: &[usize],
+) -> Option<f64> {
+    use crate::linalg::rank::{MAX_CONDITION, ln_det_regular};
+    match prior {
+        None => ln_det_regular(x.information(design).as_ref(), MAX_CONDITION),
+        Some(pr) => crate::linalg::chol::ln_det_spd_equilibrated(
+            (x.information(design) + pr.matrix()).as_ref(),
+        ),
+    }
+}
+
 /// Bad input to the criterion engine, and the one numerical failure that
 /// leaves nothing to work with: an information matrix that cannot be factored.
 #[derive(Debug, Error, Clone, PartialEq)]

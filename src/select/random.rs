@@ -69,30 +69,6 @@ pub fn random_design(
     d
 }
 
-/// `ln det(XᵀX)` of a design by Cholesky of its equilibrated form, or
-/// `None` when it is singular by the rank rule every command shares
-/// ([`crate::linalg::rank`]: condition number of the equilibrated `XᵀX` at
-/// least [`MAX_CONDITION`](crate::linalg::rank::MAX_CONDITION)), so a unit
-/// change of a column changes no verdict.
-#[must_use]
-pub fn ln_det_direct(pool: &Blocks, poses: &[usize]) -> Option<f64> {
-    use crate::linalg::rank::{MAX_CONDITION, ln_det_regular};
-    ln_det_regular(pool.information(poses).as_ref(), MAX_CONDITION)
-}
-
-/// `ln det(M0 + XᵀX)` of a design on top of a prior (`ln det XᵀX`
-/// without one), or `None` when it is not positive definite.
-#[must_use]
-pub fn ln_det_with_prior(pool: &Blocks, prior: Option<&Prior>, poses: &[usize]) -> Option<f64> {
-    match prior {
-        None => ln_det_direct(pool, poses),
-        Some(pr) => {
-            let m = pool.information(poses) + pr.matrix();
-            crate::linalg::chol::ln_det_spd(m.as_ref())
-        }
-    }
-}
-
 /// The paper's OI, eq. (1), from `ln OI_D` of a full-rank design with `p`
 /// unknowns: `OI = exp(ln OI_D / (2p)) / p`, since `OI_D = ((OI·L)^L)²`.
 #[must_use]
@@ -157,7 +133,7 @@ fn sampled_search(
         values.par_iter_mut().enumerate().for_each(|(i, v)| {
             let k = (start + i) as u64;
             let d = random_design(&mut design_rng(seed, k), allowed, fixed, n);
-            *v = ln_det_with_prior(pool, prior, &d).unwrap_or(f64::NEG_INFINITY);
+            *v = crate::criterion::design_ln_det(pool, prior, &d).unwrap_or(f64::NEG_INFINITY);
         });
         for (i, &v) in values.iter().enumerate() {
             let k = start + i;
@@ -223,7 +199,10 @@ mod tests {
             (s.best.clone(), s.best_design),
             (full.best, full.best_design)
         );
-        assert_eq!(ln_det_direct(&x, &s.best), Some(max));
+        assert_eq!(
+            crate::criterion::design_ln_det(&x, None, &s.best),
+            Some(max)
+        );
         assert_eq!(s.oi.len(), s.ln_oid.len());
     }
 }

@@ -128,14 +128,55 @@ fn eae_run(x: &Blocks, s: &Settings, seed: u64) -> activecal::select::Selection 
     eae(x, &mut DCriterion::new(), s, &mut design_rng(seed, 0)).expect("EAE on the PUMA pool")
 }
 
-/// Runs `bench`.
+/// A row of the timing table: what, median milliseconds (NaN: none), note.
+type Row = (String, f64, String);
+
+/// The kernels on the PUMA pool: FK and Jacobian, the scans, one EAE
+/// start, a polish.
+struct Kernels {
+    robot: Robot,
+    pool: Pool,
+    x: Blocks,
+    sel: activecal::select::Selection,
+    json: Value,
+}
+
+/// Runs `bench`: each section's timings as rows of one table, in JSON or
+/// as text.
 pub fn cmd_bench(a: BenchArgs) -> Result<()> {
     if a.reps == 0 {
         anyhow::bail!("--reps 0: the median needs at least 1 repetition");
     }
+    let mut rows = Vec::new();
+    let k = kernels(a.reps, &mut rows)?;
+    let lm = lm_rows(&k, a.reps, &mut rows)?;
+    let bounds = bound_rows(&k.x, &mut rows)?;
+    let mut v = k.json;
+    if let (Some(v), Value::Object(lm)) = (v.as_object_mut(), lm) {
+        v.extend(lm);
+    }
+    v["bounds"] = bounds;
+    if a.scale {
+        v["scale"] = scale_rows(&k.robot, &mut rows)?;
+    }
+    v["peak_mib"] = json!(peak_mib());
+    let robot_rows = if a.robots { robot_rows()? } else { Vec::new() };
+    if a.robots {
+        v["robots"] = Value::Array(robot_rows.clone());
+    }
+    v["table"] = Value::Array(
+        rows.iter()
+            .map(|(n, ms, note)| json!({"what": n, "median_ms": ms, "note": note}))
+            .collect(),
+    );
+    emit(a.json, &v, || bench_text(a.reps, &rows, &robot_rows));
+    Ok(())
+}
+
+/// The kernel rows (PUMA, 15,625 poses).
+fn kernels(reps: usize, rows: &mut Vec<Row>) -> Result<Kernels> {
     let robot = Robot::puma560();
     let pool = Pool::full(&robot, 5)?;
-    let reps = a.reps;
     let (t_jac, x) = time(reps, || pool.jacobian(&robot, &robot.nominal));
     let s = Settings::default();
     let sel = eae_run(&x, &s, 1);
@@ -149,7 +190,7 @@ pub fn cmd_bench(a: BenchArgs) -> Result<()> {
         polish(&x, &mut DCriterion::new(), sel.clone(), &s).expect("polish")
     });
     let polish_iters = pol.trace.len() - sel.trace.len();
-    let mut rows: Vec<(String, f64, String)> = vec![
+    rows.extend([
         (
             "FK + Jacobian, whole 15,625 pool".into(),
             t_jac * 1e3,
@@ -198,9 +239,25 @@ pub fn cmd_bench(a: BenchArgs) -> Result<()> {
                 t_pol * 1e3 / (polish_iters + 1) as f64
             ),
         ),
-    ];
-    // Identification: one Levenberg–Marquardt calibration of the EAE design
-    // from the nominal start, points (PUMA, σ = 1 cm) and full poses (UR5).
+    ]);
+    let json = json!({
+        "threads": rayon::current_num_threads(),
+        "jacobian_ms": t_jac * 1e3, "jacobian_ns_per_pose": t_jac * 1e9 / pool.len() as f64,
+        "scan": scan, "eae_ms": t_eae * 1e3, "polish_ms": t_pol * 1e3, "polish_iterations": polish_iters,
+    });
+    Ok(Kernels {
+        robot,
+        pool,
+        x,
+        sel,
+        json,
+    })
+}
+
+/// Identification rows: one Levenberg–Marquardt calibration of the EAE
+/// design from the nominal start, points (PUMA, σ = 1 cm) and full poses
+/// (UR5, σ = 1 mm).
+fn lm_rows(k: &Kernels, reps: usize, rows: &mut Vec<Row>) -> Result<Value> {
     let lm_time = |r: &Robot, pool: &Pool, poses: &[usize], sigma: f64| -> Result<(f64, usize)> {
         let qs: Vec<Vec<f64>> = poses.iter().map(|&k| pool.q(k)).collect();
         let meas = simulate(r, &r.real, &qs, sigma, &mut trial_rng(1, 0))?;
@@ -208,11 +265,16 @@ pub fn cmd_bench(a: BenchArgs) -> Result<()> {
         let (t, id) = time(reps, || identify(r, &r.nominal, &meas, &lm));
         Ok((t, id?.iterations))
     };
-    let (t_lm, it) = lm_time(&robot, &pool, &sel.poses, 0.01)?;
+    let (t_lm, it) = lm_time(&k.robot, &k.pool, &k.sel.poses, 0.01)?;
     let ur5 = Robot::builtin("ur5:pose")?;
     let pool6 = Pool::full(&ur5, 3)?;
     let x6 = pool6.jacobian(&ur5, &ur5.nominal);
-    let sel6 = eae(&x6, &mut DCriterion::new(), &s, &mut design_rng(1, 0))?;
+    let sel6 = eae(
+        &x6,
+        &mut DCriterion::new(),
+        &Settings::default(),
+        &mut design_rng(1, 0),
+    )?;
     let (t_lm6, it6) = lm_time(&ur5, &pool6, &sel6.poses, 0.001)?;
     rows.push((
         "LM calibration, PUMA, 30 points (p = 27)".into(),
@@ -224,12 +286,20 @@ pub fn cmd_bench(a: BenchArgs) -> Result<()> {
         t_lm6 * 1e3,
         format!("{it6} iterations"),
     ));
-    // The relaxation bound on the same pool, by each candidate-set solver
-    // (one run each: seconds, not microseconds).
+    Ok(json!({
+        "lm_point_ms": t_lm * 1e3, "lm_point_iterations": it,
+        "lm_pose_ms": t_lm6 * 1e3, "lm_pose_iterations": it6,
+    }))
+}
+
+/// The relaxation bound on the kernels' pool by each candidate-set solver
+/// (one run each: seconds, not microseconds).
+fn bound_rows(x: &Blocks, rows: &mut Vec<Row>) -> Result<Value> {
+    let n = Settings::default().n;
     let mut bounds = Vec::new();
     for solver in [RelaxationSolver::Clarabel, RelaxationSolver::Newton] {
         let settings = BoundSettings::builder().solver(solver).build()?;
-        let b = relaxation_bound(&x, s.n, &settings)?;
+        let b = relaxation_bound(x, n, &settings)?;
         rows.push((
             format!("relaxation bound, {solver:?}"),
             b.seconds * 1e3,
@@ -243,16 +313,14 @@ pub fn cmd_bench(a: BenchArgs) -> Result<()> {
             "ln_bound": b.ln_bound, "certificate_gap": b.certificate_gap}),
         );
     }
-    let mut v = json!({
-        "threads": rayon::current_num_threads(),
-        "jacobian_ms": t_jac * 1e3, "jacobian_ns_per_pose": t_jac * 1e9 / pool.len() as f64,
-        "scan": scan, "eae_ms": t_eae * 1e3, "polish_ms": t_pol * 1e3, "polish_iterations": polish_iters,
-        "lm_point_ms": t_lm * 1e3, "lm_point_iterations": it,
-        "lm_pose_ms": t_lm6 * 1e3, "lm_pose_iterations": it6,
-        "bounds": bounds,
-    });
-    if a.scale {
-        let big = Pool::full(&robot, 10)?;
+    Ok(Value::Array(bounds))
+}
+
+/// The 10⁶-pose pool (`--scale`): Jacobian, one EAE start for N = 145,
+/// the bound for N = 30.
+fn scale_rows(robot: &Robot, rows: &mut Vec<Row>) -> Result<Value> {
+    {
+        let big = Pool::full(robot, 10)?;
         let t0 = Instant::now();
         let xb = big.jacobian(&robot, &robot.nominal);
         let t_bj = t0.elapsed().as_secs_f64();
@@ -279,7 +347,7 @@ pub fn cmd_bench(a: BenchArgs) -> Result<()> {
         let settings = BoundSettings::builder()
             .solver(RelaxationSolver::Newton)
             .build()?;
-        let bb = relaxation_bound(&xb, s.n, &settings)?;
+        let bb = relaxation_bound(&xb, Settings::default().n, &settings)?;
         rows.push((
             "10^6 pool: relaxation bound, N = 30 (Newton)".into(),
             bb.seconds * 1e3,
@@ -290,78 +358,77 @@ pub fn cmd_bench(a: BenchArgs) -> Result<()> {
                 bb.conic.rounds
             ),
         ));
-        v["scale"] = json!({"poses": big.len(), "jacobian_s": t_bj, "eae_s": t_be, "n": 145,
+        Ok(
+            json!({"poses": big.len(), "jacobian_s": t_bj, "eae_s": t_be, "n": 145,
             "log10_oid": selb.ln_oid / std::f64::consts::LN_10, "steps": selb.trace.len(), "peak_mib_eae": peak_eae,
             "bound_s": bb.seconds, "bound_log10": bb.log10_bound(), "bound_gap": bb.certificate_gap,
-            "bound_status": bb.status, "peak_mib": peak_mib()});
+            "bound_status": bb.status, "peak_mib": peak_mib()}),
+        )
     }
-    v["peak_mib"] = json!(peak_mib());
-    let mut robot_rows = Vec::new();
-    if a.robots {
-        for (label, spec) in ROBOTS {
-            let file = spec.split([':', '#']).next().unwrap_or(spec);
-            if file.contains('/') && !std::path::Path::new(file).exists() {
-                eprintln!("bench: {label} skipped: {file} not found (run from the repository)");
-                continue;
-            }
-            robot_rows.push(robot_row(label, spec)?);
+}
+
+/// `--robots`: one row per robot found (file robots are skipped, with a
+/// note, outside the repository).
+fn robot_rows() -> Result<Vec<Value>> {
+    let mut out = Vec::new();
+    for (label, spec) in ROBOTS {
+        let file = spec.split([':', '#']).next().unwrap_or(spec);
+        if file.contains('/') && !std::path::Path::new(file).exists() {
+            eprintln!("bench: {label} skipped: {file} not found (run from the repository)");
+            continue;
         }
-        v["robots"] = Value::Array(robot_rows.clone());
+        out.push(robot_row(label, spec)?);
     }
-    let table = rows.clone();
-    v["table"] = Value::Array(
-        rows.into_iter()
-            .map(|(n, ms, note)| json!({"what": n, "median_ms": ms, "note": note}))
-            .collect(),
+    Ok(out)
+}
+
+/// The text report: the timing table, peak memory, the robots' table.
+fn bench_text(reps: usize, table: &[Row], robot_rows: &[Value]) -> String {
+    let mut s = format!(
+        "activecal bench ({} threads, median of {reps})\n",
+        rayon::current_num_threads()
     );
-    emit(a.json, &v, || {
-        let mut s = format!(
-            "activecal bench ({} threads, median of {reps})\n",
-            rayon::current_num_threads()
+    s += &format!("{:<48} {:>12}  {}\n", "", "median ms", "");
+    for (n, ms, note) in table {
+        let ms = if ms.is_nan() {
+            String::new()
+        } else {
+            format!("{ms:.3}")
+        };
+        s += &format!("{n:<48} {ms:>12}  {note}\n");
+    }
+    s += &format!("peak memory: {:.0} MiB\n", peak_mib());
+    if !robot_rows.is_empty() {
+        s += "\nrobots side by side (5-level lattices, N = 30; one run each):\n";
+        s += &format!(
+            "{:<28} {:>3} {:>2} {:>7} {:>8} {:>8} {:>9} {:>10} {:>9} {:>8}\n",
+            "robot",
+            "p",
+            "t",
+            "poses",
+            "bound s",
+            "EAE s",
+            "EAE eff",
+            "select s",
+            "sel eff",
+            "peak MiB"
         );
-        s += &format!("{:<48} {:>12}  {}\n", "", "median ms", "");
-        for (n, ms, note) in &table {
-            let ms = if ms.is_nan() {
-                String::new()
-            } else {
-                format!("{ms:.3}")
-            };
-            s += &format!("{n:<48} {ms:>12}  {note}\n");
-        }
-        s += &format!("peak memory: {:.0} MiB\n", peak_mib());
-        if !robot_rows.is_empty() {
-            s += "\nrobots side by side (5-level lattices, N = 30; one run each):\n";
+        for r in robot_rows {
             s += &format!(
-                "{:<28} {:>3} {:>2} {:>7} {:>8} {:>8} {:>9} {:>10} {:>9} {:>8}\n",
-                "robot",
-                "p",
-                "t",
-                "poses",
-                "bound s",
-                "EAE s",
-                "EAE eff",
-                "select s",
-                "sel eff",
-                "peak MiB"
+                "{:<28} {:>3} {:>2} {:>7} {:>8.2} {:>8.3} {:>9.4} {:>10.3} {:>9.4} {:>8.0}\n",
+                r["robot"].as_str().unwrap_or(""),
+                r["p"],
+                r["t"],
+                r["poses"],
+                r["bound_s"].as_f64().unwrap_or(f64::NAN),
+                r["eae_s"].as_f64().unwrap_or(f64::NAN),
+                r["eae_d_efficiency"].as_f64().unwrap_or(f64::NAN),
+                r["select_s"].as_f64().unwrap_or(f64::NAN),
+                r["select_d_efficiency"].as_f64().unwrap_or(f64::NAN),
+                r["peak_mib"].as_f64().unwrap_or(f64::NAN),
             );
-            for r in &robot_rows {
-                s += &format!(
-                    "{:<28} {:>3} {:>2} {:>7} {:>8.2} {:>8.3} {:>9.4} {:>10.3} {:>9.4} {:>8.0}\n",
-                    r["robot"].as_str().unwrap_or(""),
-                    r["p"],
-                    r["t"],
-                    r["poses"],
-                    r["bound_s"].as_f64().unwrap_or(f64::NAN),
-                    r["eae_s"].as_f64().unwrap_or(f64::NAN),
-                    r["eae_d_efficiency"].as_f64().unwrap_or(f64::NAN),
-                    r["select_s"].as_f64().unwrap_or(f64::NAN),
-                    r["select_d_efficiency"].as_f64().unwrap_or(f64::NAN),
-                    r["peak_mib"].as_f64().unwrap_or(f64::NAN),
-                );
-            }
-            s += "(select: 2 starts with the default iterated local search; eff: D-efficiency against the certified bound)\n";
         }
-        s
-    });
-    Ok(())
+        s += "(select: 2 starts with the default iterated local search; eff: D-efficiency against the certified bound)\n";
+    }
+    s
 }

@@ -79,9 +79,24 @@ pub fn fix_undetermined(
 ) -> Result<Determined> {
     // The Jacobian checks the data against the robot first.
     let x = jacobian_at(robot, start, meas)?;
-    let names = robot.parameter_names();
+    fix_undetermined_of(robot, start, meas.qs(), &x, keep)
+}
+
+/// As [`fix_undetermined`], on a given Jacobian `x` of the poses `qs` (its
+/// columns: `robot`'s unknowns, then a sensor's own unknowns, which are
+/// always kept): for sensors that are not the robot's own
+/// ([`crate::measure::contact`]).
+pub fn fix_undetermined_of(
+    robot: &Robot,
+    start: &ParamTable,
+    qs: &[Vec<f64>],
+    x: &Mat<f64>,
+    keep: &[String],
+) -> Result<Determined> {
+    let mut names = robot.parameter_names();
     let n_kin = robot.n_unknowns();
-    let frozen = frozen_joints(robot, meas);
+    names.truncate(n_kin);
+    let frozen = frozen_joints_of(robot, qs);
     let group = |k: usize| -> usize {
         if k >= n_kin || keep.contains(&names[k]) {
             0
@@ -91,7 +106,7 @@ pub fn fix_undetermined(
             1
         }
     };
-    let kept = pivoted_selection(&x, &(0..names.len()).map(group).collect::<Vec<_>>());
+    let kept = pivoted_selection(x, &(0..x.ncols()).map(group).collect::<Vec<_>>());
     let fixed_idx: Vec<usize> = (0..n_kin).filter(|k| !kept.contains(k)).collect();
     if fixed_idx.is_empty() {
         return Ok(Determined {
@@ -127,16 +142,21 @@ pub fn fix_undetermined(
 /// over the rows (of `meas` checked against `robot`: one value a joint).
 #[must_use]
 pub fn frozen_joints(robot: &Robot, meas: &Measurements) -> Vec<bool> {
+    frozen_joints_of(robot, meas.qs())
+}
+
+/// As [`frozen_joints`], of joint vectors `qs`.
+#[must_use]
+pub fn frozen_joints_of(robot: &Robot, qs: &[Vec<f64>]) -> Vec<bool> {
     (0..robot.dof())
         .map(|j| {
-            let (lo, hi) = meas
-                .qs()
+            let (lo, hi) = qs
                 .iter()
                 .filter_map(|q| q.get(j).copied())
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
                     (a.min(v), b.max(v))
                 });
-            meas.len() > 1 && hi - lo <= FROZEN_JOINT_SPAN
+            qs.len() > 1 && hi - lo <= FROZEN_JOINT_SPAN
         })
         .collect()
 }

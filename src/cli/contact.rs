@@ -4,12 +4,12 @@
 //! placement` / `--train-on`. The work is in `activecal::identify::contact`.
 
 use super::calibrate::CalibrateArgs;
+use activecal::identify::LmSettings;
 use activecal::identify::contact::{
     ContactFit, ContactSettings, HoldoutMode, HoldoutReport, NamedDistance, fit_contacts,
     holdout::{Figures, downweighted_rows, judge},
     holdout_by_placement, resolve_distances,
 };
-use activecal::identify::LmSettings;
 use activecal::io::contacts::{ContactFile, read_contacts};
 use activecal::model::Robot;
 use anyhow::{Context, Result, bail};
@@ -26,7 +26,8 @@ pub enum HoldoutBy {
 
 /// Whether `path` is a CSV whose header has a `point` column.
 pub fn is_contact_file(path: &Path) -> bool {
-    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv"))
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv"))
         && std::fs::read_to_string(path)
             .is_ok_and(|t| activecal::io::contacts::has_point_column(&t))
 }
@@ -51,7 +52,9 @@ fn parse_distance(s: &str) -> Result<NamedDistance> {
 /// Calibrates from a contact file.
 pub fn calibrate_contacts(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()> {
     if a.holdout.is_some() {
-        bail!("--holdout: contacts are held out by placement (--holdout-by placement or --train-on NAME), not by random rows");
+        bail!(
+            "--holdout: contacts are held out by placement (--holdout-by placement or --train-on NAME), not by random rows"
+        );
     }
     if !a.out.is_empty() {
         bail!("--out: writing a robot calibrated from contacts is not supported yet");
@@ -105,7 +108,11 @@ pub fn calibrate_contacts(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Resu
             "the contact fit ended {:?} after {} iterations{}",
             fit.stop,
             fit.iterations,
-            if fit.std.is_none() { " without a full-rank Jacobian" } else { "" }
+            if fit.std.is_none() {
+                " without a full-rank Jacobian"
+            } else {
+                ""
+            }
         ))
         .into());
     }
@@ -113,7 +120,12 @@ pub fn calibrate_contacts(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Resu
 }
 
 /// The report as text.
-fn text(file: &ContactFile, fit: &ContactFit, fig: &Figures, held: Option<&HoldoutReport>) -> String {
+fn text(
+    file: &ContactFile,
+    fit: &ContactFit,
+    fig: &Figures,
+    held: Option<&HoldoutReport>,
+) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -125,7 +137,8 @@ fn text(file: &ContactFile, fit: &ContactFit, fig: &Figures, held: Option<&Holdo
         fit.fixed.len(),
         fit.stop,
         fit.iterations,
-        fit.sigma_hat.map_or("-".into(), |v| format!("{:.4} mm", 1e3 * v))
+        fit.sigma_hat
+            .map_or("-".into(), |v| format!("{:.4} mm", 1e3 * v))
     );
     for f in &fit.fixed {
         let _ = writeln!(s, "  fixed {} = {:.6}: {}", f.name, f.value, f.reason);
@@ -138,7 +151,10 @@ fn text(file: &ContactFile, fit: &ContactFit, fig: &Figures, held: Option<&Holdo
         1e3 * t[1],
         1e3 * t[2]
     );
-    let _ = writeln!(s, "in-sample consistency (RMS distance to the point's mean):");
+    let _ = writeln!(
+        s,
+        "in-sample consistency (RMS distance to the point's mean):"
+    );
     s += &figures_text(fig);
     let down = downweighted_rows(fit, file);
     if !down.is_empty() {
@@ -205,7 +221,10 @@ fn holdout_text(h: &HoldoutReport) -> String {
         h.pooled_nominal_mm, h.pooled_calibrated_mm, h.mean_calibrated_mm
     );
     if let (Some(m), Some(x)) = (h.mean_distance_error_mm, h.max_distance_error_mm) {
-        let _ = writeln!(s, "distance error, calibrated: mean {m:.3} mm, largest {x:.3} mm");
+        let _ = writeln!(
+            s,
+            "distance error, calibrated: mean {m:.3} mm, largest {x:.3} mm"
+        );
     }
     s
 }

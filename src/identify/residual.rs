@@ -122,7 +122,14 @@ impl Residuals for Calibration<'_> {
         let p = self.robot.n_unknowns();
         let t = self.sensor.rows();
         let vl = self.sensor.value_len();
-        let table = self.robot.with_unknowns(self.base, theta);
+        // The robot's own sensor (markers) keeps its offsets in the table
+        // too; another sensor's unknowns are its own only.
+        let robot_part = if n == self.robot.n_params() {
+            theta
+        } else {
+            &theta[..p]
+        };
+        let table = self.robot.with_unknowns(self.base, robot_part);
         let own = &theta[p..];
         let mut ev = Evaluator::new(self.robot, &table);
         let mut finite = true;
@@ -157,7 +164,13 @@ impl Residuals for Calibration<'_> {
 
 impl Calibration<'_> {
     /// The sensor's constraint rows after the poses' (own columns only).
-    fn constraints(&mut self, own: &[f64], p: usize, r: &mut [f64], jac: Option<&mut Mat<f64>>) -> bool {
+    fn constraints(
+        &mut self,
+        own: &[f64],
+        p: usize,
+        r: &mut [f64],
+        jac: Option<&mut Mat<f64>>,
+    ) -> bool {
         let c = self.sensor.constraint_rows();
         if c == 0 {
             return true;

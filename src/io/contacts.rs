@@ -107,7 +107,12 @@ fn split(line: &str) -> Vec<String> {
 }
 
 /// Parses contact CSV `text` (from `origin`, for messages).
-pub fn parse_contacts(text: &str, origin: &str, robot: &Robot, units: Units) -> Result<ContactFile> {
+pub fn parse_contacts(
+    text: &str,
+    origin: &str,
+    robot: &Robot,
+    units: Units,
+) -> Result<ContactFile> {
     let err = |message: String| Error::Parse {
         path: origin.to_string(),
         message,

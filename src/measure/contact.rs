@@ -259,10 +259,7 @@ impl Sensor for ContactSensor {
             if let Some(j) = jac.as_deref_mut() {
                 let u = diff / len;
                 let row = &mut j[i * ld..];
-                let (ka, kb) = (
-                    TOOL_OFFSET_PARAMS + 3 * d.a,
-                    TOOL_OFFSET_PARAMS + 3 * d.b,
-                );
+                let (ka, kb) = (TOOL_OFFSET_PARAMS + 3 * d.a, TOOL_OFFSET_PARAMS + 3 * d.b);
                 for c in 0..3 {
                     row[ka + c] = w * u[c];
                     row[kb + c] = -w * u[c];

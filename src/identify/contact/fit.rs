@@ -18,7 +18,7 @@ use crate::identify::undetermined::{FixedParameter, fix_undetermined_of};
 use crate::identify::{Calibration, LmSettings, LossChoice, Residuals, Result};
 use crate::io::contacts::ContactFile;
 use crate::linalg::qr::inverse_information;
-use crate::measure::contact::{ContactSensor, KnownDistance, TOOL_OFFSET_PARAMS};
+use crate::measure::contact::{ContactSensor, KnownDistance};
 use crate::model::{ParamTable, Robot};
 use faer::Mat;
 use serde::Serialize;
@@ -27,9 +27,9 @@ use serde::Serialize;
 pub const IRLS_ROUNDS: usize = 50;
 /// A robust fit stops when no `√w` of a row changes by more than this.
 pub const IRLS_TOLERANCE: f64 = 1e-9;
-/// A column of a robot unknown whose part outside the points' columns has
-/// at most this norm (of a unit column) is a gauge freedom: rounding of a
-/// few hundred rows is ~1e-14, a real but weak dependence ≥ 1e-4.
+/// An unknown whose twist (rad/s and m/s per unit of it, O(1)) differs by
+/// no more than this between rows is a rigid motion of the whole setup:
+/// rounding of the chain walk is ~1e-15, a joint's motion varies by O(0.1).
 pub const GAUGE_TOL: f64 = 1e-8;
 
 /// The reason given for an unknown that moves every point together.
@@ -173,7 +173,16 @@ pub fn fit_contacts(
     let loss = loss_of(settings.loss)?;
     let sol = solve(&mut prob, &theta0, &settings.lm, loss.as_deref());
     let weights: Vec<f64> = prob.sqrt_w.iter().map(|w| w * w).collect();
-    Ok(finish(r, start, file, &prob, theta0, sol, reduced.fixed, weights))
+    Ok(finish(
+        r,
+        start,
+        file,
+        &prob,
+        theta0,
+        sol,
+        reduced.fixed,
+        weights,
+    ))
 }
 
 /// The loss of a choice (`None` for least squares).
@@ -219,8 +228,10 @@ fn solve(
     unreachable!("the loop returns")
 }
 
-/// The robot reduced to the unknowns the contacts determine, with the
-/// gauge named among the reasons.
+/// The robot reduced to the unknowns the contacts determine: first the
+/// gauge (unknowns whose motion is one rigid motion of the whole setup at
+/// every row, see [`gauge_unknowns`]), then what the shared rule finds on
+/// the Jacobian of the rest.
 fn determined(
     robot: &Robot,
     start: &ParamTable,
@@ -229,58 +240,63 @@ fn determined(
     own0: &[f64],
     keep: &[String],
 ) -> Result<crate::identify::Determined> {
-    let mut prob = problem(robot, start, file, distances);
-    let mut theta = robot.unknown_values(start);
+    let names = robot.parameter_names();
+    let gauge: Vec<usize> = gauge_unknowns(robot, start, &file.qs)
+        .into_iter()
+        .filter(|&k| !keep.contains(&names[k]))
+        .collect();
+    let mut inner = robot.clone();
+    inner.unknowns = (0..robot.n_unknowns())
+        .filter(|k| !gauge.contains(k))
+        .map(|k| robot.unknowns[k])
+        .collect();
+    let mut prob = problem(&inner, start, file, distances);
+    let mut theta = inner.unknown_values(start);
     theta.extend_from_slice(own0);
     let x = jacobian(&mut prob, &theta);
-    let mut d = fix_undetermined_of(robot, start, &file.qs, &x, keep)?;
-    let names = robot.parameter_names();
-    let n_kin = robot.n_unknowns();
-    // The points' columns only (not the tool offset's).
-    let points: Vec<usize> = (n_kin + TOOL_OFFSET_PARAMS..x.ncols()).collect();
-    for f in &mut d.fixed {
-        if let Some(k) = names.iter().position(|n| *n == f.name)
-            && outside_span(&x, k, &points) <= GAUGE_TOL
-        {
-            f.reason = GAUGE_REASON.to_string();
-        }
-    }
+    let mut d = fix_undetermined_of(&inner, start, &file.qs, &x, keep)?;
+    let mut fixed: Vec<FixedParameter> = gauge
+        .iter()
+        .map(|&k| FixedParameter {
+            name: names[k].clone(),
+            value: start.get(robot.unknowns[k]),
+            reason: GAUGE_REASON.to_string(),
+        })
+        .collect();
+    fixed.append(&mut d.fixed);
+    d.fixed = fixed;
     Ok(d)
 }
 
-/// The norm of unit column `k` of `x` after removing its projection on the
-/// span of columns `basis` (modified Gram–Schmidt, twice).
-fn outside_span(x: &Mat<f64>, k: usize, basis: &[usize]) -> f64 {
-    let m = x.nrows();
-    let col = |c: usize| -> Vec<f64> { (0..m).map(|i| x[(i, c)]).collect() };
-    let unit = |mut v: Vec<f64>| -> Option<Vec<f64>> {
-        let n = v.iter().map(|a| a * a).sum::<f64>().sqrt();
-        (n > 0.0).then(|| {
-            v.iter_mut().for_each(|a| *a /= n);
-            v
-        })
-    };
-    let mut q: Vec<Vec<f64>> = Vec::new();
-    let project = |v: &mut Vec<f64>, q: &[Vec<f64>]| {
-        for _ in 0..2 {
-            for b in q {
-                let d: f64 = b.iter().zip(v.iter()).map(|(a, c)| a * c).sum();
-                v.iter_mut().zip(b).for_each(|(y, a)| *y -= d * a);
-            }
-        }
-    };
-    for &c in basis {
-        let mut v = col(c);
-        project(&mut v, &q);
-        if let Some(u) = unit(v).filter(|u| u.iter().all(|a| a.is_finite())) {
-            q.push(u);
+/// The unknowns whose elementary motion is the same rigid motion of the
+/// base frame at every row (a constant twist: angular velocity `ω` and the
+/// velocity `v − ω × p` of the base origin): moving the whole setup, they
+/// change no residual once the points follow.
+#[must_use]
+pub fn gauge_unknowns(robot: &Robot, table: &ParamTable, qs: &[Vec<f64>]) -> Vec<usize> {
+    let n = robot.n_unknowns();
+    let mut ev = crate::kinematics::Evaluator::new(robot, table);
+    let mut motions = vec![crate::kinematics::Motion::default(); n];
+    let mut twists: Vec<Vec<[f64; 6]>> = vec![Vec::with_capacity(qs.len()); n];
+    for q in qs {
+        let end = ev.motions(q, &mut motions);
+        for (k, m) in motions.iter().enumerate() {
+            let v0 = m.lin - m.ang.cross(&end.position);
+            twists[k].push([m.ang.x, m.ang.y, m.ang.z, v0.x, v0.y, v0.z]);
         }
     }
-    let Some(mut v) = unit(col(k)) else {
-        return 0.0;
-    };
-    project(&mut v, &q);
-    v.iter().map(|a| a * a).sum::<f64>().sqrt()
+    (0..n)
+        .filter(|&k| {
+            let t = &twists[k];
+            let Some(first) = t.first() else { return false };
+            let scale = first.iter().map(|a| a.abs()).fold(0.0, f64::max).max(1.0);
+            t.iter().all(|w| {
+                w.iter()
+                    .zip(first)
+                    .all(|(a, b)| (a - b).abs() <= GAUGE_TOL * scale)
+            })
+        })
+        .collect()
 }
 
 /// The fit's report from the solver's state.

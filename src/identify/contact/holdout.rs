@@ -11,7 +11,9 @@
 //! start table, no tool offset) against calibrated.
 
 use super::fit::{ContactFit, ContactSettings, fit_contacts};
-use super::{NamedDistance, group_means, placement_of, resolve_distances, rms, spreads, tool_points};
+use super::{
+    NamedDistance, group_means, placement_of, resolve_distances, rms, spreads, tool_points,
+};
 use crate::error::Error;
 use crate::identify::Result;
 use crate::io::contacts::ContactFile;
@@ -245,7 +247,9 @@ pub fn holdout_by_placement(
     };
     let mut folds = Vec::with_capacity(pairs.len());
     for (train_on, held) in pairs {
-        folds.push(fold(robot, start, file, distances, settings, train_on, held)?);
+        folds.push(fold(
+            robot, start, file, distances, settings, train_on, held,
+        )?);
     }
     Ok(summarise(mode, folds))
 }

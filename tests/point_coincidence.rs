@@ -1,0 +1,220 @@
+//! The contact sensor (points the tool touches again and again, known
+//! distances between them): Jacobian rows against central differences, bad
+//! inputs, and the figures of issue 29 on MUKCa's real Panda data
+//! (`fixtures/mukca`).
+
+use activecal::identify::contact::{
+    ContactSettings, HoldoutMode, NamedDistance, fit_contacts, holdout_by_placement,
+    resolve_distances,
+};
+use activecal::identify::{Calibration, LmSettings, LossChoice, Residuals};
+use activecal::io::contacts::{ContactFile, parse_contacts, read_contacts};
+use activecal::io::load_robot;
+use activecal::measure::contact::{ContactSensor, KnownDistance};
+use activecal::model::Robot;
+use activecal::units::Units;
+use faer::Mat;
+use std::path::Path;
+
+const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/mukca");
+
+fn panda() -> Robot {
+    load_robot(&format!("{DIR}/panda.urdf#tip=ball_link"))
+        .expect("MUKCa's Panda with its ball link")
+}
+
+fn contacts(robot: &Robot) -> ContactFile {
+    read_contacts(
+        Path::new(&format!("{DIR}/panda_2.csv")),
+        robot,
+        Units::default(),
+    )
+    .expect("panda_2")
+}
+
+/// The two sockets of every placement, 50.0 mm apart.
+fn sockets(file: &ContactFile) -> Vec<NamedDistance> {
+    activecal::identify::contact::placements(file)
+        .into_iter()
+        .map(|p| NamedDistance {
+            a: format!("{p}/0"),
+            b: format!("{p}/1"),
+            metres: 0.05,
+        })
+        .collect()
+}
+
+/// Every column of the residual Jacobian (robot unknowns, tool offset,
+/// points; pose rows and the distance row) is the central difference of the
+/// residual. Step 1e-6 on parameters of O(0.1–1) (metres, radians):
+/// truncation O(h²·|r'''|) ≈ 1e-12, rounding ε·|r|/h ≈ 1e-10; 1e-7
+/// separates a right column from any wrong one (entries O(0.1–1)).
+#[test]
+fn jacobian_rows_are_central_differences() {
+    let robot = panda();
+    let file = contacts(&robot).subset(&(0..12).chain(31..43).collect::<Vec<_>>());
+    let distances = vec![KnownDistance {
+        a: 0,
+        b: 1,
+        metres: 0.05,
+    }];
+    let sensor = ContactSensor::new(file.points.clone(), distances);
+    let measured: Vec<f64> = file
+        .groups
+        .iter()
+        .flat_map(|&g| ContactSensor::value_of(g))
+        .collect();
+    let mut prob =
+        Calibration::with_sensor(&robot, &robot.nominal, &file.qs, Box::new(sensor), measured);
+    let mut theta = robot.unknown_values(&robot.nominal);
+    // A tool offset and points off the data, so that no row is zero.
+    theta.extend_from_slice(&[0.01, -0.02, 0.03]);
+    let own0 = activecal::identify::contact::start_own(&robot, &robot.nominal, &file);
+    theta.extend(own0[3..].iter().map(|v| v + 0.004));
+    let (m, n) = (prob.n_residuals(), prob.n_params());
+    assert_eq!(m, 3 * file.qs.len() + 1);
+    let mut r = vec![0.0; m];
+    let mut jac = Mat::<f64>::zeros(m, n);
+    assert!(prob.eval(&theta, &mut r, Some(&mut jac)));
+    let h = 1e-6;
+    for c in 0..n {
+        let (mut tp, mut tm) = (theta.clone(), theta.clone());
+        tp[c] += h;
+        tm[c] -= h;
+        let (mut rp, mut rm) = (vec![0.0; m], vec![0.0; m]);
+        prob.eval(&tp, &mut rp, None);
+        prob.eval(&tm, &mut rm, None);
+        for i in 0..m {
+            let fd = (rp[i] - rm[i]) / (2.0 * h);
+            assert!(
+                (jac[(i, c)] - fd).abs() < 1e-7,
+                "row {i} column {c}: {} vs {fd}",
+                jac[(i, c)]
+            );
+        }
+    }
+}
+
+/// Bad inputs name the file, the point and the lines.
+#[test]
+fn bad_inputs_are_explained() {
+    let robot = panda();
+    let head = "panda_joint1,panda_joint2,panda_joint3,panda_joint4,panda_joint5,panda_joint6,panda_joint7,point\n";
+    let row = |p: &str| format!("0,0,0,-1.5,0,1.5,0.7,{p}\n");
+    let e = |t: &str| {
+        parse_contacts(t, "c.csv", &robot, Units::default())
+            .unwrap_err()
+            .to_string()
+    };
+    let short = format!(
+        "{head}{}{}{}{}{}",
+        row("a"),
+        row("a"),
+        row("a"),
+        row("b"),
+        row("b")
+    );
+    assert!(
+        e(&short).contains("c.csv: point 'b' has 2 row(s) (line 5, 6)"),
+        "{}",
+        e(&short)
+    );
+    let full_pose = head.replace(",point", ",x1,y1,z1,qw1,qx1,qy1,qz1,point");
+    assert!(
+        e(&full_pose).contains("no measured position or orientation"),
+        "{}",
+        e(&full_pose)
+    );
+    let ok = format!("{head}{}{}{}", row("a"), row("a"), row("a"));
+    let file = parse_contacts(&ok, "c.csv", &robot, Units::default()).unwrap();
+    let unknown = [NamedDistance {
+        a: "a".into(),
+        b: "z".into(),
+        metres: 0.05,
+    }];
+    let msg = resolve_distances(&file, &unknown, true)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("c.csv has no point 'z'") && msg.contains("its points: a"),
+        "{msg}"
+    );
+}
+
+fn settings(loss: LossChoice) -> ContactSettings {
+    ContactSettings {
+        lm: LmSettings::default(),
+        loss,
+        keep: Vec::new(),
+    }
+}
+
+/// Issue 29's acceptance on MUKCa's `panda_2`: leave one placement out.
+/// Figures are means over the held-out placements of each placement's RMS
+/// distance to its sockets' means (the issue's table; measured 0.421 mm,
+/// 0.326 mm without `high`, distance error 0.171 mm mean): the bars are
+/// the issue's, at its two decimals.
+#[test]
+fn panda_2_leave_one_placement_out_meets_the_issue() {
+    let robot = panda();
+    let file = contacts(&robot);
+    let given = sockets(&file);
+    let h = holdout_by_placement(
+        &robot,
+        &robot.nominal,
+        &file,
+        &given,
+        &settings(LossChoice::L2),
+        &HoldoutMode::LeaveOneOut,
+    )
+    .unwrap();
+    assert_eq!(h.folds.len(), 9);
+    assert!(h.folds.iter().all(|f| f.converged));
+    assert!(h.pooled_nominal_mm > 8.0, "{}", h.pooled_nominal_mm);
+    assert!(h.mean_calibrated_mm < 0.425, "{}", h.mean_calibrated_mm);
+    let others: Vec<f64> = h
+        .folds
+        .iter()
+        .filter(|f| f.held_out != "high")
+        .map(|f| f.figures.calibrated_mm)
+        .collect();
+    let without_high = others.iter().sum::<f64>() / others.len() as f64;
+    assert!(without_high <= 0.33, "{without_high}");
+    assert!(h.mean_distance_error_mm.unwrap() <= 0.2, "{:?}", h);
+}
+
+/// A robust loss names the `high` placement's shifted blocks among the rows
+/// it down-weights (hole_0 rows 9–17 are file lines 320–328).
+#[test]
+fn huber_names_the_shifted_high_rows() {
+    let robot = panda();
+    let file = contacts(&robot);
+    let known = resolve_distances(&file, &sockets(&file), true).unwrap();
+    let fit = fit_contacts(
+        &robot,
+        &robot.nominal,
+        &file,
+        &known,
+        &settings(LossChoice::Huber { scale: 6e-4 }),
+    )
+    .unwrap();
+    assert!(fit.converged);
+    let down = activecal::identify::contact::holdout::downweighted_rows(&fit, &file);
+    let high0: Vec<usize> = down
+        .iter()
+        .filter(|d| d.point == "high/0")
+        .map(|d| d.line)
+        .collect();
+    for line in 320..=328 {
+        assert!(
+            high0.contains(&line),
+            "line {line} not down-weighted: {high0:?}"
+        );
+    }
+    // The gauge is named: the whole setup turns about the base's vertical.
+    assert!(
+        fit.fixed
+            .iter()
+            .any(|f| f.name == "gamma_panda_joint1" && f.reason.contains("rigid motion"))
+    );
+}

@@ -284,7 +284,24 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     let robot = &desc.robot;
     match (&a.design, &a.measurements) {
         (_, Some(m)) if super::contact::is_contact_file(m) => {
-            super::contact::calibrate_contacts(&a, robot, m)
+            let c = super::contact::ContactArgs {
+                holdout: a.holdout.is_some(),
+                out: !a.out.is_empty(),
+                point_distance: &a.point_distance,
+                holdout_by: a.holdout_by,
+                train_on: a.train_on.as_deref(),
+                loss: a.loss,
+                loss_scale: a.loss_scale,
+                free: &a.free,
+                max_iterations: a.max_iterations,
+                no_geodesic: a.no_geodesic,
+                units: a.units.units(),
+                json: a.json,
+            };
+            match super::contact::calibrate_contacts(&c, robot, m)? {
+                Some(why) => Err(NotConverged(why).into()),
+                None => Ok(()),
+            }
         }
         (_, Some(m)) => {
             if !a.point_distance.is_empty() || a.holdout_by.is_some() || a.train_on.is_some() {

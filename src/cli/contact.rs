@@ -3,7 +3,6 @@
 //! `--point-distance`, rendering of the fit and of `--holdout-by
 //! placement` / `--train-on`. The work is in `activecal::identify::contact`.
 
-use super::calibrate::CalibrateArgs;
 use activecal::identify::LmSettings;
 use activecal::identify::contact::{
     ContactFit, ContactSettings, HoldoutMode, HoldoutReport, NamedDistance, fit_contacts,
@@ -49,14 +48,47 @@ fn parse_distance(s: &str) -> Result<NamedDistance> {
     })
 }
 
-/// Calibrates from a contact file.
-pub fn calibrate_contacts(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()> {
-    if a.holdout.is_some() {
+/// The options of `calibrate` a contact fit reads.
+pub struct ContactArgs<'a> {
+    /// `--holdout` was given (refused).
+    pub holdout: bool,
+    /// `--out` was given (refused).
+    pub out: bool,
+    /// `--point-distance`.
+    pub point_distance: &'a [String],
+    /// `--holdout-by`.
+    pub holdout_by: Option<HoldoutBy>,
+    /// `--train-on`.
+    pub train_on: Option<&'a str>,
+    /// `--loss`, `--loss-scale`.
+    pub loss: super::measured::LossKind,
+    /// `--loss-scale`.
+    pub loss_scale: Option<f64>,
+    /// `--free`.
+    pub free: &'a [String],
+    /// `--max-iterations`.
+    pub max_iterations: usize,
+    /// `--no-geodesic`.
+    pub no_geodesic: bool,
+    /// The file's units.
+    pub units: activecal::units::Units,
+    /// `--json`.
+    pub json: bool,
+}
+
+/// Calibrates from a contact file; `Ok(Some(why))` when the fit did not
+/// converge (the report is printed).
+pub fn calibrate_contacts(
+    a: &ContactArgs<'_>,
+    robot: &Robot,
+    path: &Path,
+) -> Result<Option<String>> {
+    if a.holdout {
         bail!(
             "--holdout: contacts are held out by placement (--holdout-by placement or --train-on NAME), not by random rows"
         );
     }
-    if !a.out.is_empty() {
+    if a.out {
         bail!("--out: writing a robot calibrated from contacts is not supported yet");
     }
     let given: Vec<NamedDistance> = a
@@ -64,19 +96,19 @@ pub fn calibrate_contacts(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Resu
         .iter()
         .map(|s| parse_distance(s))
         .collect::<Result<_>>()?;
-    let file = read_contacts(path, robot, a.units.units())?;
+    let file = read_contacts(path, robot, a.units)?;
     let known = resolve_distances(&file, &given, true).context("--point-distance")?;
     let settings = ContactSettings {
         lm: LmSettings::default()
             .with_max_iterations(a.max_iterations)
             .with_geodesic(!a.no_geodesic),
         loss: super::measured::loss_choice(a.loss, a.loss_scale)?,
-        keep: a.free.clone(),
+        keep: a.free.to_vec(),
     };
     let fit = fit_contacts(robot, &robot.nominal, &file, &known, &settings)?;
     let figures = judge(robot, &robot.nominal, &fit, &file, &given);
     let mode = match (&a.holdout_by, &a.train_on) {
-        (_, Some(t)) => Some(HoldoutMode::TrainOn(t.clone())),
+        (_, Some(t)) => Some(HoldoutMode::TrainOn((*t).to_string())),
         (Some(HoldoutBy::Placement), None) => Some(HoldoutMode::LeaveOneOut),
         (None, None) => None,
     };
@@ -104,7 +136,7 @@ pub fn calibrate_contacts(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Resu
     });
     super::emit(a.json, &v, || text(&file, &fit, &figures, held.as_ref()));
     if !fit.converged {
-        return Err(super::calibrate::NotConverged(format!(
+        return Ok(Some(format!(
             "the contact fit ended {:?} after {} iterations{}",
             fit.stop,
             fit.iterations,
@@ -113,10 +145,9 @@ pub fn calibrate_contacts(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Resu
             } else {
                 ""
             }
-        ))
-        .into());
+        )));
     }
-    Ok(())
+    Ok(None)
 }
 
 /// The report as text.

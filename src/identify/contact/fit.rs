@@ -11,12 +11,12 @@
 //! ([`crate::identify::undetermined`]: column-pivoted QR on the
 //! column-scaled Jacobian, the sensor's own unknowns pivoted first).
 
+use super::data::ContactFile;
 use super::start_own;
 use crate::identify::lm::{Solution, StopReason, levenberg_marquardt};
 use crate::identify::loss::{Cauchy, Huber, Loss};
 use crate::identify::undetermined::{FixedParameter, fix_undetermined_of};
 use crate::identify::{Calibration, LmSettings, LossChoice, Residuals, Result};
-use crate::io::contacts::ContactFile;
 use crate::linalg::qr::inverse_information;
 use crate::measure::contact::{ContactSensor, KnownDistance};
 use crate::model::{ParamTable, Robot};

@@ -10,13 +10,13 @@
 //! between two points' means against the known distance. Nominal (the
 //! start table, no tool offset) against calibrated.
 
+use super::data::ContactFile;
 use super::fit::{ContactFit, ContactSettings, fit_contacts};
 use super::{
     NamedDistance, group_means, placement_of, resolve_distances, rms, spreads, tool_points,
 };
 use crate::error::Error;
 use crate::identify::Result;
-use crate::io::contacts::ContactFile;
 use crate::model::{ParamTable, Robot};
 use serde::Serialize;
 

@@ -10,9 +10,11 @@
 //! * [`holdout`]: held out by placement (the part of a point's name before
 //!   `/`): leave one placement out, and train on one.
 
+pub mod data;
 pub mod fit;
 pub mod holdout;
 
+pub use data::ContactFile;
 pub use fit::{ContactFit, ContactSettings, fit_contacts};
 pub use holdout::{
     DistanceFigure, DownweightedRow, Figures, HoldoutFold, HoldoutMode, HoldoutReport, PointFigure,
@@ -20,7 +22,6 @@ pub use holdout::{
 };
 
 use crate::error::Error;
-use crate::io::contacts::ContactFile;
 use crate::kinematics::Evaluator;
 use crate::measure::contact::{ContactSensor, KnownDistance, TOOL_OFFSET_PARAMS};
 use crate::model::{ParamTable, Robot};

@@ -151,9 +151,9 @@ fn settings(loss: LossChoice) -> ContactSettings {
 
 /// Issue 29's acceptance on MUKCa's `panda_2`: leave one placement out.
 /// Figures are means over the held-out placements of each placement's RMS
-/// distance to its sockets' means (the issue's table; measured 0.421 mm,
-/// 0.326 mm without `high`, distance error 0.171 mm mean): the bars are
-/// the issue's, at its two decimals.
+/// distance to its sockets' means (the issue's table; measured 0.420 mm,
+/// 0.325 mm without `high`, distance error 0.169 mm mean): the bars are
+/// the issue's.
 #[test]
 fn panda_2_leave_one_placement_out_meets_the_issue() {
     let robot = panda();
@@ -171,7 +171,7 @@ fn panda_2_leave_one_placement_out_meets_the_issue() {
     assert_eq!(h.folds.len(), 9);
     assert!(h.folds.iter().all(|f| f.converged));
     assert!(h.pooled_nominal_mm > 8.0, "{}", h.pooled_nominal_mm);
-    assert!(h.mean_calibrated_mm < 0.425, "{}", h.mean_calibrated_mm);
+    assert!(h.mean_calibrated_mm <= 0.42, "{}", h.mean_calibrated_mm);
     let others: Vec<f64> = h
         .folds
         .iter()
@@ -180,6 +180,37 @@ fn panda_2_leave_one_placement_out_meets_the_issue() {
         .collect();
     let without_high = others.iter().sum::<f64>() / others.len() as f64;
     assert!(without_high <= 0.33, "{without_high}");
+    assert!(h.mean_distance_error_mm.unwrap() <= 0.2, "{:?}", h);
+}
+
+/// Trained on `front_left` alone, judged on the eight other placements
+/// (measured: mean 0.554 mm, 0.455 mm without `high`; the issue's table
+/// gives 0.55 and 0.46 mm at two decimals, so the bars are 0.555 and 0.465).
+#[test]
+fn panda_2_trained_on_front_left() {
+    let robot = panda();
+    let file = contacts(&robot);
+    let given = sockets(&file);
+    let h = holdout_by_placement(
+        &robot,
+        &robot.nominal,
+        &file,
+        &given,
+        &settings(LossChoice::L2),
+        &HoldoutMode::TrainOn("front_left".into()),
+    )
+    .unwrap();
+    assert_eq!(h.folds.len(), 8);
+    assert!(h.folds.iter().all(|f| f.converged));
+    assert!(h.mean_calibrated_mm < 0.555, "{}", h.mean_calibrated_mm);
+    let others: Vec<f64> = h
+        .folds
+        .iter()
+        .filter(|f| f.held_out != "high")
+        .map(|f| f.figures.calibrated_mm)
+        .collect();
+    let without_high = others.iter().sum::<f64>() / others.len() as f64;
+    assert!(without_high < 0.465, "{without_high}");
     assert!(h.mean_distance_error_mm.unwrap() <= 0.2, "{:?}", h);
 }
 

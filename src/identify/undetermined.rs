@@ -93,6 +93,20 @@ pub fn fix_undetermined_of(
     x: &Mat<f64>,
     keep: &[String],
 ) -> Result<Determined> {
+    fix_undetermined_below(robot, start, qs, x, keep, PIVOT_TOL)
+}
+
+/// As [`fix_undetermined_of`], fixing the columns whose pivot is at or
+/// below `pivot_tol` (not [`PIVOT_TOL`]): a stricter bar for data whose
+/// near-dependences are weaker than their noise can carry.
+pub fn fix_undetermined_below(
+    robot: &Robot,
+    start: &ParamTable,
+    qs: &[Vec<f64>],
+    x: &Mat<f64>,
+    keep: &[String],
+    pivot_tol: f64,
+) -> Result<Determined> {
     let mut names = robot.parameter_names();
     let n_kin = robot.n_unknowns();
     names.truncate(n_kin);
@@ -106,7 +120,7 @@ pub fn fix_undetermined_of(
             1
         }
     };
-    let kept = pivoted_selection(x, &(0..x.ncols()).map(group).collect::<Vec<_>>());
+    let kept = pivoted_selection(x, &(0..x.ncols()).map(group).collect::<Vec<_>>(), pivot_tol);
     let fixed_idx: Vec<usize> = (0..n_kin).filter(|k| !kept.contains(k)).collect();
     if fixed_idx.is_empty() {
         return Ok(Determined {
@@ -189,7 +203,7 @@ fn jacobian_at(robot: &Robot, start: &ParamTable, meas: &Measurements) -> Result
 
 /// The columns kept by the grouped column-pivoted QR (see the module
 /// documentation), in pivot order.
-fn pivoted_selection(x: &Mat<f64>, group: &[usize]) -> Vec<usize> {
+fn pivoted_selection(x: &Mat<f64>, group: &[usize], pivot_tol: f64) -> Vec<usize> {
     let (m, p) = x.shape();
     let unit: Vec<Option<Vec<f64>>> = (0..p)
         .map(|c| {
@@ -224,7 +238,7 @@ fn pivoted_selection(x: &Mat<f64>, group: &[usize]) -> Vec<usize> {
                 .enumerate()
                 .max_by(|a, b| a.1.total_cmp(b.1))
                 .expect("rest is not empty");
-            if g > 0 && nb <= PIVOT_TOL {
+            if g > 0 && nb <= pivot_tol {
                 break;
             }
             let (c, mut v) = rest.swap_remove(best);

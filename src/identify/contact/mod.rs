@@ -14,6 +14,7 @@ pub mod data;
 pub mod fit;
 pub mod holdout;
 pub mod project;
+pub mod select;
 
 pub use data::ContactFile;
 pub use fit::{ContactFit, ContactSettings, fit_contacts};

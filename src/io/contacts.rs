@@ -70,6 +70,11 @@ pub fn parse_contacts(
         .position(|c| c == POINT_COLUMN)
         .ok_or_else(|| err(format!("no '{POINT_COLUMN}' column")))?;
     refuse_measured_columns(&columns, &err)?;
+    if columns.iter().any(|c| c == "plane") {
+        return Err(err(
+            "a 'plane' column: plane contacts are not supported yet (only point contacts: rows with the same 'point' touch one fixed point)".into(),
+        ));
+    }
     // The point names, then the numeric rest of the table (same lines).
     let (numeric, names) = split_point_column(text, hidx, pc, &err)?;
     let t = parse_csv(&numeric, origin)?;

@@ -242,6 +242,15 @@ fn huber_names_the_shifted_high_rows() {
             "line {line} not down-weighted: {high0:?}"
         );
     }
+    // The last joint's origin is seen only through the tool offset: the
+    // reason names the offset its motion resembles.
+    assert!(
+        fit.fixed
+            .iter()
+            .any(|f| f.name == "a_panda_joint7" && f.reason.contains("tool_y")),
+        "{:?}",
+        fit.fixed
+    );
     // The gauge is named: the whole setup turns about the base's vertical.
     assert!(
         fit.fixed

@@ -268,6 +268,19 @@ fn determined(
     theta.extend_from_slice(own0);
     let x = jacobian(&mut prob, &theta);
     let mut d = fix_undetermined_below(&inner, start, &file.qs, &x, keep, CONTACT_PIVOT_TOL)?;
+    let mut col_names = inner.parameter_names();
+    col_names.truncate(inner.n_unknowns());
+    col_names.extend(prob.sensor().own_param_names());
+    let kept: Vec<usize> = (0..x.ncols())
+        .filter(|&c| !d.fixed.iter().any(|f| f.name == col_names[c]))
+        .collect();
+    for f in &mut d.fixed {
+        if let Some(k) = col_names.iter().position(|n| *n == f.name)
+            && let Some(like) = nearest_combination(&x, k, &kept, &col_names)
+        {
+            f.reason = format!("{}; its motion is nearly a combination of {like}", f.reason);
+        }
+    }
     let mut fixed: Vec<FixedParameter> = gauge
         .iter()
         .map(|&k| FixedParameter {
@@ -279,6 +292,32 @@ fn determined(
     fixed.append(&mut d.fixed);
     d.fixed = fixed;
     Ok(d)
+}
+
+/// The (up to three) kept columns that carry most of unit column `k` of
+/// `x` in its least-squares fit by the kept columns (each column scaled to
+/// unit norm first): what an undetermined unknown's motion resembles.
+fn nearest_combination(x: &Mat<f64>, k: usize, kept: &[usize], names: &[String]) -> Option<String> {
+    use nalgebra::{DMatrix, DVector};
+    let m = x.nrows();
+    let unit = |c: usize| -> DVector<f64> {
+        let v = DVector::from_fn(m, |i, _| x[(i, c)]);
+        let n = v.norm();
+        if n > 0.0 { v / n } else { v }
+    };
+    let a = DMatrix::from_columns(&kept.iter().map(|&c| unit(c)).collect::<Vec<_>>());
+    let coef = (a.transpose() * &a)
+        .cholesky()?
+        .solve(&(a.transpose() * unit(k)));
+    let mut order: Vec<usize> = (0..kept.len()).collect();
+    order.sort_by(|&i, &j| coef[j].abs().total_cmp(&coef[i].abs()));
+    let top: Vec<String> = order
+        .iter()
+        .take(3)
+        .filter(|&&i| coef[i].abs() > 0.05)
+        .map(|&i| format!("{} ({:+.2})", names[kept[i]], coef[i]))
+        .collect();
+    (!top.is_empty()).then(|| top.join(", "))
 }
 
 /// The unknowns whose elementary motion is the same rigid motion of the

@@ -407,3 +407,88 @@ fn selected_contacts_beat_random_draws() {
     );
     assert!(chosen <= d_opt, "{chosen} vs {d_opt}");
 }
+
+/// Plane contacts: every column of the residual Jacobian with an unknown
+/// plane (chart `a, b` and offset `d`) and a known one, beside points, is
+/// the central difference of the residual (same step and bar as above);
+/// a plane with a zero normal is refused, naming it.
+#[test]
+fn plane_rows_are_central_differences() {
+    use activecal::measure::contact::{Plane, PlaneKind};
+    let robot = panda();
+    let file = contacts(&robot).subset(&(0..12).chain(31..43).collect::<Vec<_>>());
+    let planes = vec![
+        Plane {
+            name: "table".into(),
+            kind: PlaneKind::Unknown {
+                n0: [0.1, -0.2, 1.0],
+            },
+        },
+        Plane {
+            name: "wall".into(),
+            kind: PlaneKind::Known {
+                normal: [1.0, 0.5, 0.0],
+                offset: 0.3,
+            },
+        },
+    ];
+    let zero = ContactSensor::new(file.points.clone(), Vec::new()).with_planes(vec![Plane {
+        name: "floor".into(),
+        kind: PlaneKind::Known {
+            normal: [0.0; 3],
+            offset: 0.0,
+        },
+    }]);
+    assert!(
+        zero.unwrap_err()
+            .contains("plane 'floor': normal (0, 0, 0) is zero")
+    );
+    let sensor = ContactSensor::new(file.points.clone(), Vec::new())
+        .with_planes(planes)
+        .unwrap();
+    // Rows 0–3 touch the unknown plane, 4–7 the known one, the rest points.
+    let tags: Vec<usize> = (0..file.qs.len())
+        .map(|i| match i {
+            0..4 => 2,
+            4..8 => 3,
+            _ => file.groups[i],
+        })
+        .collect();
+    let measured: Vec<f64> = tags
+        .iter()
+        .flat_map(|&g| ContactSensor::value_of(g))
+        .collect();
+    let mut prob =
+        Calibration::with_sensor(&robot, &robot.nominal, &file.qs, Box::new(sensor), measured);
+    let mut theta = robot.unknown_values(&robot.nominal);
+    theta.extend_from_slice(&[0.01, -0.02, 0.03]);
+    let own0 = activecal::identify::contact::start_own(&robot, &robot.nominal, &file);
+    theta.extend(own0[3..].iter().map(|v| v + 0.004));
+    theta.extend_from_slice(&[0.05, -0.03, 0.4]);
+    let (m, n) = (prob.n_residuals(), prob.n_params());
+    assert_eq!(n, theta.len());
+    let mut r = vec![0.0; m];
+    let mut jac = Mat::<f64>::zeros(m, n);
+    assert!(prob.eval(&theta, &mut r, Some(&mut jac)));
+    assert!(
+        r[0].abs() > 1e-3 && r[1] == 0.0,
+        "a plane row and its two zeros"
+    );
+    let h = 1e-6;
+    for c in 0..n {
+        let (mut tp, mut tm) = (theta.clone(), theta.clone());
+        tp[c] += h;
+        tm[c] -= h;
+        let (mut rp, mut rm) = (vec![0.0; m], vec![0.0; m]);
+        prob.eval(&tp, &mut rp, None);
+        prob.eval(&tm, &mut rm, None);
+        for i in 0..m {
+            let fd = (rp[i] - rm[i]) / (2.0 * h);
+            assert!(
+                (jac[(i, c)] - fd).abs() < 1e-7,
+                "row {i} column {c}: {} vs {fd}",
+                jac[(i, c)]
+            );
+        }
+    }
+}

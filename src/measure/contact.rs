@@ -8,7 +8,16 @@
 //! touch one fixed but unknown point `P_g` of the base frame (3 own
 //! unknowns a point). The residual of a pose touching `g` is `t − P_g`.
 //!
-//! Own unknowns, in order: `o` (3), then `P_0, P_1, …` (3 each).
+//! Own unknowns, in order: `o` (3), then `P_0, P_1, …` (3 each), then
+//! `a, b, d` of each unknown plane.
+//!
+//! # Planes
+//! A pose may touch a plane instead ([`ContactSensor::with_planes`]; its
+//! tag is `G + l` for plane `l` after the `G` points): its residual is
+//! `n · t − d` in the first of its 3 rows, the other two are zero (so that
+//! every pose keeps 3 rows; they add nothing to `XᵀX`). A known plane
+//! (`PlaneKind::Known`) has no unknowns; an unknown one has a minimal
+//! chart: `n = (n₀ + a e₁ + b e₂)/‖…‖` about a start normal `n₀`, and `d`.
 //!
 //! Under an elementary motion of the chain (linear velocity `v` of `p`,
 //! angular velocity `ω`), `t` moves with `v + ω × (R o)`; `∂t/∂o = R`,
@@ -47,11 +56,51 @@ pub struct KnownDistance {
     pub metres: f64,
 }
 
+/// A plane the tool touches.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plane {
+    /// Its name.
+    pub name: String,
+    /// Known or unknown.
+    pub kind: PlaneKind,
+}
+
+/// A contact plane `n · x = d` (base frame, metres).
+#[derive(Clone, Debug, PartialEq)]
+pub enum PlaneKind {
+    /// Given: its normal (any non-zero length) and offset `d`.
+    Known {
+        /// The normal.
+        normal: [f64; 3],
+        /// The offset, metres.
+        offset: f64,
+    },
+    /// Unknown: 3 own unknowns `a, b, d`, the normal `n = (n₀ + a e₁ +
+    /// b e₂)/‖…‖` in a chart about `n₀` (`e₁, e₂` orthonormal to it: a
+    /// minimal parametrisation, regular near `n₀`), and the offset `d`.
+    Unknown {
+        /// The chart's centre (a start normal, non-zero).
+        n0: [f64; 3],
+    },
+}
+
+/// Two unit vectors orthonormal to unit `n` (and to each other).
+fn chart(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let helper = if n.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let e1 = n.cross(&helper).normalize();
+    (e1, n.cross(&e1))
+}
+
 /// Contact with named fixed points, `3` rows per pose, own unknowns the
 /// tool offset and the points.
 #[derive(Clone, Debug)]
 pub struct ContactSensor {
     points: Vec<String>,
+    planes: Vec<Plane>,
     distances: Vec<KnownDistance>,
     distance_weight: f64,
 }
@@ -68,6 +117,68 @@ impl ContactSensor {
             points,
             distances,
             distance_weight: DISTANCE_WEIGHT,
+            planes: Vec::new(),
+        }
+    }
+
+    /// The sensor with contact planes too: a pose tagged `G + l` (`G`
+    /// points) touches plane `l`. Errors on a known plane whose normal is
+    /// zero or not finite, or an unknown plane's chart normal likewise.
+    pub fn with_planes(mut self, planes: Vec<Plane>) -> Result<Self, String> {
+        for p in &planes {
+            let n = match &p.kind {
+                PlaneKind::Known { normal, offset } if offset.is_finite() => *normal,
+                PlaneKind::Known { .. } => [f64::NAN; 3],
+                PlaneKind::Unknown { n0 } => *n0,
+            };
+            let v = Vector3::from(n);
+            if !(v.iter().all(|c| c.is_finite()) && v.norm() > 0.0) {
+                return Err(format!(
+                    "plane '{}': normal ({}, {}, {}) is zero or not finite (a plane needs a direction)",
+                    p.name, n[0], n[1], n[2]
+                ));
+            }
+        }
+        self.planes = planes;
+        Ok(self)
+    }
+
+    /// The start of own unknown index of plane `l` (its `a, b, d`), when
+    /// it is unknown.
+    fn plane_own(&self, l: usize) -> Option<usize> {
+        if !matches!(self.planes[l].kind, PlaneKind::Unknown { .. }) {
+            return None;
+        }
+        let before = self.planes[..l]
+            .iter()
+            .filter(|p| matches!(p.kind, PlaneKind::Unknown { .. }))
+            .count();
+        Some(TOOL_OFFSET_PARAMS + 3 * self.points.len() + 3 * before)
+    }
+
+    /// The plane a tag names, if it names a plane.
+    fn plane_of(&self, measured: &[f64]) -> Option<usize> {
+        Self::group(measured).checked_sub(self.points.len())
+    }
+
+    /// Plane `l`'s unit normal, offset and, for an unknown plane, the
+    /// derivatives of the normal along its chart (`∂n/∂a`, `∂n/∂b`).
+    fn plane(&self, own: &[f64], l: usize) -> (Vector3<f64>, f64, Option<[Vector3<f64>; 2]>) {
+        match (&self.planes[l].kind, self.plane_own(l)) {
+            (PlaneKind::Known { normal, offset }, _) => {
+                let n = Vector3::from(*normal);
+                (n / n.norm(), *offset, None)
+            }
+            (PlaneKind::Unknown { n0 }, Some(k)) => {
+                let n0 = Vector3::from(*n0).normalize();
+                let (e1, e2) = chart(&n0);
+                let v = n0 + own[k] * e1 + own[k + 1] * e2;
+                let len = v.norm();
+                let n = v / len;
+                let d = |e: Vector3<f64>| (e - n * n.dot(&e)) / len;
+                (n, own[k + 2], Some([d(e1), d(e2)]))
+            }
+            (PlaneKind::Unknown { .. }, None) => unreachable!("an unknown plane has own unknowns"),
         }
     }
 
@@ -153,7 +264,12 @@ impl Sensor for ContactSensor {
     }
 
     fn n_own_params(&self) -> usize {
-        TOOL_OFFSET_PARAMS + 3 * self.points.len()
+        let unknown = self
+            .planes
+            .iter()
+            .filter(|p| matches!(p.kind, PlaneKind::Unknown { .. }))
+            .count();
+        TOOL_OFFSET_PARAMS + 3 * self.points.len() + 3 * unknown
     }
 
     fn own_param_names(&self) -> Vec<String> {
@@ -162,7 +278,12 @@ impl Sensor for ContactSensor {
             .points
             .iter()
             .flat_map(|n| ["x", "y", "z"].map(|c| format!("point[{n}]_{c}")));
-        tool.into_iter().chain(pts).collect()
+        let planes = self
+            .planes
+            .iter()
+            .filter(|p| matches!(p.kind, PlaneKind::Unknown { .. }))
+            .flat_map(|p| ["a", "b", "d"].map(|c| format!("plane[{}]_{c}", p.name)));
+        tool.into_iter().chain(pts).chain(planes).collect()
     }
 
     fn encode(&self, obs: &Observation<'_>, out: &mut [f64]) {
@@ -194,6 +315,12 @@ impl Sensor for ContactSensor {
     }
 
     fn residual_own(&self, predicted: &[f64], measured: &[f64], own: &[f64], out: &mut [f64]) {
+        if let Some(l) = self.plane_of(measured) {
+            let (n, d, _) = self.plane(own, l);
+            let t = Vector3::new(predicted[0], predicted[1], predicted[2]);
+            out[..3].copy_from_slice(&[n.dot(&t) - d, 0.0, 0.0]);
+            return;
+        }
         let pg = Self::point(own, Self::group(measured));
         for c in 0..3 {
             out[c] = predicted[c] - pg[c];
@@ -230,6 +357,30 @@ impl Sensor for ContactSensor {
         }
     }
 
+    /// A point contact's rows are [`Sensor::motion_rows`]; a plane
+    /// contact's first row is the normal's component of them, the other
+    /// two are zero.
+    fn residual_rows(
+        &self,
+        end: &EndFrame,
+        own: &[f64],
+        motions: &[Motion],
+        measured: &[f64],
+        out: &mut [f64],
+        ld: usize,
+    ) {
+        self.motion_rows(end, own, motions, out, ld);
+        if let Some(l) = self.plane_of(measured) {
+            let (n, _, _) = self.plane(own, l);
+            for c in 0..motions.len() {
+                let v = Vector3::new(out[c], out[ld + c], out[2 * ld + c]);
+                out[c] = n.dot(&v);
+                out[ld + c] = 0.0;
+                out[2 * ld + c] = 0.0;
+            }
+        }
+    }
+
     fn own_rows_of(
         &self,
         end: &EndFrame,
@@ -239,6 +390,22 @@ impl Sensor for ContactSensor {
         ld: usize,
     ) {
         self.own_rows(end, own, out, ld);
+        if let Some(l) = self.plane_of(measured) {
+            let (n, _, dn) = self.plane(own, l);
+            let nr = end.rotation.transpose() * n;
+            let t = Self::tool_point(end, own);
+            let width = self.n_own_params();
+            for i in 1..3 {
+                out[i * ld..i * ld + width].fill(0.0);
+            }
+            out[..3].copy_from_slice(nr.as_slice());
+            if let (Some(k), Some([da, db])) = (self.plane_own(l), dn) {
+                out[k] = da.dot(&t);
+                out[k + 1] = db.dot(&t);
+                out[k + 2] = -1.0;
+            }
+            return;
+        }
         let k = TOOL_OFFSET_PARAMS + 3 * Self::group(measured);
         for i in 0..3 {
             out[i * ld + k + i] = -1.0;

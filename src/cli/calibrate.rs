@@ -107,6 +107,17 @@ pub struct CalibrateArgs {
     /// |t| >= 2 and compare held-out errors.
     #[arg(long, requires = "holdout")]
     pub compare_pruned: bool,
+    /// A distance known between two contact points (a file with a `point`
+    /// column): `A,B=METRES`, repeatable.
+    #[arg(long, value_name = "A,B=METRES", requires = "measurements")]
+    pub point_distance: Vec<String>,
+    /// Contacts held out by placement (the part of a point's name before
+    /// '/'): fit on all placements but one, judge on that one, for each.
+    #[arg(long, value_enum, requires = "measurements")]
+    pub holdout_by: Option<super::contact::HoldoutBy>,
+    /// Contacts: fit on this placement alone, judge on each other one.
+    #[arg(long, value_name = "PLACEMENT", requires = "measurements")]
+    pub train_on: Option<String>,
     /// Units of the --measurements file.
     #[command(flatten)]
     pub units: super::units::UnitOpts,
@@ -272,7 +283,35 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     let desc = super::load_description(&a.robot)?;
     let robot = &desc.robot;
     match (&a.design, &a.measurements) {
-        (_, Some(m)) => from_measurements(&a, robot, m),
+        (_, Some(m)) if super::contact::is_contact_file(m) => {
+            let c = super::contact::ContactArgs {
+                holdout: a.holdout.is_some(),
+                out: !a.out.is_empty(),
+                point_distance: &a.point_distance,
+                holdout_by: a.holdout_by,
+                train_on: a.train_on.as_deref(),
+                loss: a.loss,
+                loss_scale: a.loss_scale,
+                free: &a.free,
+                max_iterations: a.max_iterations,
+                no_geodesic: a.no_geodesic,
+                units: a.units.units(),
+                json: a.json,
+            };
+            match super::contact::calibrate_contacts(&c, robot, m)? {
+                Some(why) => Err(NotConverged(why).into()),
+                None => Ok(()),
+            }
+        }
+        (_, Some(m)) => {
+            if !a.point_distance.is_empty() || a.holdout_by.is_some() || a.train_on.is_some() {
+                bail!(
+                    "--point-distance, --holdout-by and --train-on are for contact files (a CSV with a 'point' column); {} has none",
+                    m.display()
+                );
+            }
+            from_measurements(&a, robot, m)
+        }
         (Some(d), None) => from_design(&a, robot, desc.visibility.as_ref(), d),
         (None, None) => bail!("give --design (simulate) or --measurements (real data)"),
     }

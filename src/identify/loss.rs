@@ -122,7 +122,9 @@ impl<R: Residuals, L: Loss> Robust<R, L> {
     /// Wraps `inner` with `loss`, all weights 1.
     pub fn new(inner: R, loss: L) -> Self {
         let m = inner.n_residuals();
-        let nb = m / inner.block_rows().max(1);
+        // Rows past the last whole block (a sensor's constraint rows) are
+        // one block of their own.
+        let nb = m.div_ceil(inner.block_rows().max(1));
         Self {
             inner,
             loss,

@@ -35,6 +35,7 @@
 //! [`IdentifyError`]; a numerical outcome (no convergence, divergence, a rank
 //! deficient design) is the [`Status`] of the result.
 
+pub mod contact;
 pub mod evaluation;
 pub mod fit;
 pub mod lm;
@@ -471,6 +472,7 @@ impl Measurements {
         Observation {
             points: &self.points[k * i..k * (i + 1)],
             orientation: self.orientations.get(i),
+            tag: None,
         }
     }
 

@@ -53,6 +53,8 @@ pub struct Calibration<'a> {
     pred: Vec<f64>,
     /// Row-major `t × n` Jacobian block of one pose.
     block: Vec<f64>,
+    /// Parameters: the robot's unknowns, then the sensor's own.
+    n_params: usize,
 }
 
 impl<'a> Calibration<'a> {
@@ -66,17 +68,33 @@ impl<'a> Calibration<'a> {
         for (i, out) in measured.chunks_mut(vl).enumerate() {
             sensor.encode(&meas.observation(i), out);
         }
-        let n = robot.n_params();
-        Ok(Self {
+        Ok(Self::with_sensor(robot, base, meas.qs(), sensor, measured))
+    }
+
+    /// The problem of identifying `robot`'s unknowns and `sensor`'s own from
+    /// poses `qs` whose measured values (in the sensor's layout,
+    /// `value_len` each, already checked) are `measured`: for sensors that
+    /// are not the robot's own ([`crate::measure::contact`]).
+    #[must_use]
+    pub fn with_sensor(
+        robot: &'a Robot,
+        base: &'a ParamTable,
+        qs: &'a [Vec<f64>],
+        sensor: Box<dyn Sensor>,
+        measured: Vec<f64>,
+    ) -> Self {
+        let n = robot.n_unknowns() + sensor.n_own_params();
+        Self {
             robot,
             base,
-            qs: meas.qs(),
+            qs,
             motions: vec![Motion::default(); robot.n_unknowns()],
-            pred: vec![0.0; vl],
-            block: vec![0.0; sensor.rows() * n],
+            pred: vec![0.0; sensor.value_len()],
+            block: vec![0.0; sensor.rows().max(sensor.constraint_rows()) * n],
             measured,
             sensor,
-        })
+            n_params: n,
+        }
     }
 
     /// The sensor.
@@ -88,11 +106,11 @@ impl<'a> Calibration<'a> {
 
 impl Residuals for Calibration<'_> {
     fn n_residuals(&self) -> usize {
-        self.sensor.rows() * self.qs.len()
+        self.sensor.rows() * self.qs.len() + self.sensor.constraint_rows()
     }
 
     fn n_params(&self) -> usize {
-        self.robot.n_params()
+        self.n_params
     }
 
     fn block_rows(&self) -> usize {
@@ -104,7 +122,14 @@ impl Residuals for Calibration<'_> {
         let p = self.robot.n_unknowns();
         let t = self.sensor.rows();
         let vl = self.sensor.value_len();
-        let table = self.robot.with_unknowns(self.base, theta);
+        // The robot's own sensor (markers) keeps its offsets in the table
+        // too; another sensor's unknowns are its own only.
+        let robot_part = if n == self.robot.n_params() {
+            theta
+        } else {
+            &theta[..p]
+        };
+        let table = self.robot.with_unknowns(self.base, robot_part);
         let own = &theta[p..];
         let mut ev = Evaluator::new(self.robot, &table);
         let mut finite = true;
@@ -117,12 +142,13 @@ impl Residuals for Calibration<'_> {
                 ev.end_frame(q)
             };
             self.sensor.predict(&end, own, &mut self.pred);
-            self.sensor.residual(&self.pred, y, ri);
+            self.sensor.residual_own(&self.pred, y, own, ri);
             finite &= ri.iter().all(|v| v.is_finite());
             if let Some(j) = jac.as_deref_mut() {
                 self.sensor
                     .residual_rows(&end, own, &self.motions, y, &mut self.block, n);
-                self.sensor.own_rows(&end, own, &mut self.block[p..], n);
+                self.sensor
+                    .own_rows_of(&end, own, y, &mut self.block[p..], n);
                 for c in 0..t {
                     for k in 0..n {
                         let x = self.block[c * n + k];
@@ -130,6 +156,41 @@ impl Residuals for Calibration<'_> {
                         j[(t * i + c, k)] = x;
                     }
                 }
+            }
+        }
+        finite & self.constraints(own, p, r, jac)
+    }
+}
+
+impl Calibration<'_> {
+    /// The sensor's constraint rows after the poses' (own columns only).
+    fn constraints(
+        &mut self,
+        own: &[f64],
+        p: usize,
+        r: &mut [f64],
+        jac: Option<&mut Mat<f64>>,
+    ) -> bool {
+        let c = self.sensor.constraint_rows();
+        if c == 0 {
+            return true;
+        }
+        let n = self.n_params;
+        let first = self.sensor.rows() * self.qs.len();
+        let rc = &mut r[first..first + c];
+        let Some(j) = jac else {
+            self.sensor.constraints(own, rc, None, n);
+            return rc.iter().all(|v| v.is_finite());
+        };
+        self.block[..c * n].fill(0.0);
+        self.sensor
+            .constraints(own, rc, Some(&mut self.block[p..c * n]), n);
+        let mut finite = rc.iter().all(|v| v.is_finite());
+        for i in 0..c {
+            for k in 0..n {
+                let x = self.block[i * n + k];
+                finite &= x.is_finite();
+                j[(first + i, k)] = x;
             }
         }
         finite

@@ -79,9 +79,38 @@ pub fn fix_undetermined(
 ) -> Result<Determined> {
     // The Jacobian checks the data against the robot first.
     let x = jacobian_at(robot, start, meas)?;
-    let names = robot.parameter_names();
+    fix_undetermined_of(robot, start, meas.qs(), &x, keep)
+}
+
+/// As [`fix_undetermined`], on a given Jacobian `x` of the poses `qs` (its
+/// columns: `robot`'s unknowns, then a sensor's own unknowns, which are
+/// always kept): for sensors that are not the robot's own
+/// ([`crate::measure::contact`]).
+pub fn fix_undetermined_of(
+    robot: &Robot,
+    start: &ParamTable,
+    qs: &[Vec<f64>],
+    x: &Mat<f64>,
+    keep: &[String],
+) -> Result<Determined> {
+    fix_undetermined_below(robot, start, qs, x, keep, PIVOT_TOL)
+}
+
+/// As [`fix_undetermined_of`], fixing the columns whose pivot is at or
+/// below `pivot_tol` (not [`PIVOT_TOL`]): a stricter bar for data whose
+/// near-dependences are weaker than their noise can carry.
+pub fn fix_undetermined_below(
+    robot: &Robot,
+    start: &ParamTable,
+    qs: &[Vec<f64>],
+    x: &Mat<f64>,
+    keep: &[String],
+    pivot_tol: f64,
+) -> Result<Determined> {
+    let mut names = robot.parameter_names();
     let n_kin = robot.n_unknowns();
-    let frozen = frozen_joints(robot, meas);
+    names.truncate(n_kin);
+    let frozen = frozen_joints_of(robot, qs);
     let group = |k: usize| -> usize {
         if k >= n_kin || keep.contains(&names[k]) {
             0
@@ -91,7 +120,7 @@ pub fn fix_undetermined(
             1
         }
     };
-    let kept = pivoted_selection(&x, &(0..names.len()).map(group).collect::<Vec<_>>());
+    let kept = pivoted_selection(x, &(0..x.ncols()).map(group).collect::<Vec<_>>(), pivot_tol);
     let fixed_idx: Vec<usize> = (0..n_kin).filter(|k| !kept.contains(k)).collect();
     if fixed_idx.is_empty() {
         return Ok(Determined {
@@ -127,16 +156,21 @@ pub fn fix_undetermined(
 /// over the rows (of `meas` checked against `robot`: one value a joint).
 #[must_use]
 pub fn frozen_joints(robot: &Robot, meas: &Measurements) -> Vec<bool> {
+    frozen_joints_of(robot, meas.qs())
+}
+
+/// As [`frozen_joints`], of joint vectors `qs`.
+#[must_use]
+pub fn frozen_joints_of(robot: &Robot, qs: &[Vec<f64>]) -> Vec<bool> {
     (0..robot.dof())
         .map(|j| {
-            let (lo, hi) = meas
-                .qs()
+            let (lo, hi) = qs
                 .iter()
                 .filter_map(|q| q.get(j).copied())
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
                     (a.min(v), b.max(v))
                 });
-            meas.len() > 1 && hi - lo <= FROZEN_JOINT_SPAN
+            qs.len() > 1 && hi - lo <= FROZEN_JOINT_SPAN
         })
         .collect()
 }
@@ -169,7 +203,7 @@ fn jacobian_at(robot: &Robot, start: &ParamTable, meas: &Measurements) -> Result
 
 /// The columns kept by the grouped column-pivoted QR (see the module
 /// documentation), in pivot order.
-fn pivoted_selection(x: &Mat<f64>, group: &[usize]) -> Vec<usize> {
+fn pivoted_selection(x: &Mat<f64>, group: &[usize], pivot_tol: f64) -> Vec<usize> {
     let (m, p) = x.shape();
     let unit: Vec<Option<Vec<f64>>> = (0..p)
         .map(|c| {
@@ -204,7 +238,7 @@ fn pivoted_selection(x: &Mat<f64>, group: &[usize]) -> Vec<usize> {
                 .enumerate()
                 .max_by(|a, b| a.1.total_cmp(b.1))
                 .expect("rest is not empty");
-            if g > 0 && nb <= PIVOT_TOL {
+            if g > 0 && nb <= pivot_tol {
                 break;
             }
             let (c, mut v) = rest.swap_remove(best);

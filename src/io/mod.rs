@@ -4,6 +4,7 @@
 
 pub mod atomic;
 pub mod calibrated;
+pub mod contacts;
 pub mod design;
 pub mod design_formats;
 pub mod frames_file;

@@ -117,6 +117,7 @@ impl Sensor for MarkerSensor {
         ObservationBuf {
             points: value.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
             orientation: None,
+            tag: None,
         }
     }
 
@@ -256,6 +257,7 @@ mod tests {
             &Observation {
                 points: &pts,
                 orientation: None,
+                tag: None,
             },
             &mut v,
         );

@@ -5,6 +5,7 @@
 //! [`JacobianEvaluator`] joins the kinematics' per-unknown motions and a
 //! sensor's rows into the identification Jacobian of one pose.
 
+pub mod contact;
 pub mod markers;
 pub mod point;
 pub mod pose;

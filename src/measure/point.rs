@@ -66,6 +66,7 @@ impl Sensor for PointSensor {
         ObservationBuf {
             points: vec![[value[0], value[1], value[2]]],
             orientation: None,
+            tag: None,
         }
     }
 

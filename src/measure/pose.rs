@@ -104,6 +104,7 @@ impl Sensor for PoseSensor {
         ObservationBuf {
             points: vec![[value[0], value[1], value[2]]],
             orientation: Some(std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)]))),
+            tag: None,
         }
     }
 

@@ -26,6 +26,16 @@
 //! columns (for a marker `p_k = p + R o_k`: `∂p_k/∂o_k = R`). The robot's
 //! columns of a marker are `lin + ang × (R o_k)`, from the same [`Motion`]s.
 //! Point and pose sensors have no unknowns of their own (`own` is empty).
+//!
+//! # Poses that share unknowns, and constraints between them
+//! A contact sensor ([`super::contact`]) has no measured value at all: a
+//! pose's value is the group it touches (its [`Observation::tag`]), and its
+//! residual is the tool point minus that group's point, an own unknown. Such
+//! a sensor overrides [`Sensor::residual_own`] and [`Sensor::own_rows_of`],
+//! which see the own unknowns and the measured value (the defaults fall back
+//! to [`Sensor::residual`] and [`Sensor::own_rows`]), and may add rows tied
+//! to no pose ([`Sensor::constraint_rows`], [`Sensor::constraints`]: a known
+//! distance between two contact points), appended after the poses' rows.
 
 use crate::kinematics::{EndFrame, Motion};
 use crate::model::MeasurementKind;
@@ -52,6 +62,10 @@ pub struct Observation<'a> {
     /// Measured orientation, present exactly when
     /// [`Sensor::observes_orientation`].
     pub orientation: Option<&'a [[f64; 3]; 3]>,
+    /// The pose's group among the sensor's own unknowns, for sensors whose
+    /// poses share unknowns by group (a contact sensor's point or plane,
+    /// [`super::contact`]); `None` for the others.
+    pub tag: Option<usize>,
 }
 
 /// An owned [`Observation`], as a simulation produces it.
@@ -61,6 +75,8 @@ pub struct ObservationBuf {
     pub points: Vec<[f64; 3]>,
     /// Measured orientation, row-major.
     pub orientation: Option<[[f64; 3]; 3]>,
+    /// The pose's group (see [`Observation::tag`]).
+    pub tag: Option<usize>,
 }
 
 /// A sensor: rows per pose, prediction, residual, Jacobian rows and weights.
@@ -183,5 +199,40 @@ pub trait Sensor: fmt::Debug + Send + Sync {
     /// unknowns).
     fn own_rows(&self, end: &EndFrame, own: &[f64], out: &mut [f64], ld: usize) {
         let _ = (end, own, out, ld);
+    }
+
+    /// The weighted residual of a pose knowing the sensor's own unknowns
+    /// (see the module documentation). Default: [`Sensor::residual`].
+    fn residual_own(&self, predicted: &[f64], measured: &[f64], own: &[f64], out: &mut [f64]) {
+        let _ = own;
+        self.residual(predicted, measured, out);
+    }
+
+    /// The own columns of a pose's residual knowing its measured value.
+    /// Default: [`Sensor::own_rows`].
+    fn own_rows_of(
+        &self,
+        end: &EndFrame,
+        own: &[f64],
+        measured: &[f64],
+        out: &mut [f64],
+        ld: usize,
+    ) {
+        let _ = measured;
+        self.own_rows(end, own, out, ld);
+    }
+
+    /// Rows of constraints between the sensor's own unknowns, tied to no
+    /// pose (appended after every pose's rows). Default 0.
+    fn constraint_rows(&self) -> usize {
+        0
+    }
+
+    /// Writes the weighted constraint residuals ([`Sensor::constraint_rows`]
+    /// entries) into `r` and, when `jac` is given, their own columns
+    /// (`constraint_rows × n_own_params`, row-major, row stride `ld`).
+    /// Default: nothing.
+    fn constraints(&self, own: &[f64], r: &mut [f64], jac: Option<&mut [f64]>, ld: usize) {
+        let _ = (own, r, jac, ld);
     }
 }

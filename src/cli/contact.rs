@@ -1,0 +1,261 @@
+//! `calibrate --measurements contacts.csv` for a file with a `point` column
+//! (calibration from contacts with fixed points, no instrument): parsing of
+//! `--point-distance`, rendering of the fit and of `--holdout-by
+//! placement` / `--train-on`. The work is in `activecal::identify::contact`.
+
+use activecal::identify::LmSettings;
+use activecal::identify::contact::{
+    ContactFit, ContactSettings, HoldoutMode, HoldoutReport, NamedDistance, fit_contacts,
+    holdout::{Figures, downweighted_rows, judge},
+    holdout_by_placement, resolve_distances,
+};
+use activecal::io::contacts::{ContactFile, read_contacts};
+use activecal::model::Robot;
+use anyhow::{Context, Result, bail};
+use serde_json::json;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// How to hold contacts out.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HoldoutBy {
+    /// By placement: the part of a point's name before '/'.
+    Placement,
+}
+
+/// Whether `path` is a CSV whose header has a `point` column.
+pub fn is_contact_file(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv"))
+        && std::fs::read_to_string(path)
+            .is_ok_and(|t| activecal::io::contacts::has_point_column(&t))
+}
+
+/// Parses one `--point-distance A,B=METRES`.
+fn parse_distance(s: &str) -> Result<NamedDistance> {
+    let bad = || {
+        anyhow::anyhow!(
+            "--point-distance {s}: expected A,B=METRES (two point names and a distance in metres, e.g. front_left/0,front_left/1=0.05)"
+        )
+    };
+    let (names, d) = s.split_once('=').ok_or_else(bad)?;
+    let (a, b) = names.split_once(',').ok_or_else(bad)?;
+    let metres: f64 = d.trim().parse().map_err(|_| bad())?;
+    Ok(NamedDistance {
+        a: a.trim().to_string(),
+        b: b.trim().to_string(),
+        metres,
+    })
+}
+
+/// The options of `calibrate` a contact fit reads.
+pub struct ContactArgs<'a> {
+    /// `--holdout` was given (refused).
+    pub holdout: bool,
+    /// `--out` was given (refused).
+    pub out: bool,
+    /// `--point-distance`.
+    pub point_distance: &'a [String],
+    /// `--holdout-by`.
+    pub holdout_by: Option<HoldoutBy>,
+    /// `--train-on`.
+    pub train_on: Option<&'a str>,
+    /// `--loss`, `--loss-scale`.
+    pub loss: super::measured::LossKind,
+    /// `--loss-scale`.
+    pub loss_scale: Option<f64>,
+    /// `--free`.
+    pub free: &'a [String],
+    /// `--max-iterations`.
+    pub max_iterations: usize,
+    /// `--no-geodesic`.
+    pub no_geodesic: bool,
+    /// The file's units.
+    pub units: activecal::units::Units,
+    /// `--json`.
+    pub json: bool,
+}
+
+/// Calibrates from a contact file; `Ok(Some(why))` when the fit did not
+/// converge (the report is printed).
+pub fn calibrate_contacts(
+    a: &ContactArgs<'_>,
+    robot: &Robot,
+    path: &Path,
+) -> Result<Option<String>> {
+    if a.holdout {
+        bail!(
+            "--holdout: contacts are held out by placement (--holdout-by placement or --train-on NAME), not by random rows"
+        );
+    }
+    if a.out {
+        bail!("--out: writing a robot calibrated from contacts is not supported yet");
+    }
+    let given: Vec<NamedDistance> = a
+        .point_distance
+        .iter()
+        .map(|s| parse_distance(s))
+        .collect::<Result<_>>()?;
+    let file = read_contacts(path, robot, a.units)?;
+    let known = resolve_distances(&file, &given, true).context("--point-distance")?;
+    let settings = ContactSettings {
+        lm: LmSettings::default()
+            .with_max_iterations(a.max_iterations)
+            .with_geodesic(!a.no_geodesic),
+        loss: super::measured::loss_choice(a.loss, a.loss_scale)?,
+        keep: a.free.to_vec(),
+    };
+    let fit = fit_contacts(robot, &robot.nominal, &file, &known, &settings)?;
+    let figures = judge(robot, &robot.nominal, &fit, &file, &given);
+    let mode = match (&a.holdout_by, &a.train_on) {
+        (_, Some(t)) => Some(HoldoutMode::TrainOn((*t).to_string())),
+        (Some(HoldoutBy::Placement), None) => Some(HoldoutMode::LeaveOneOut),
+        (None, None) => None,
+    };
+    let held = match &mode {
+        Some(m) => Some(holdout_by_placement(
+            robot,
+            &robot.nominal,
+            &file,
+            &given,
+            &settings,
+            m,
+        )?),
+        None => None,
+    };
+    let down = downweighted_rows(&fit, &file);
+    let v = json!({
+        "robot": robot.name,
+        "measurements": path.display().to_string(),
+        "rows": file.qs.len(),
+        "fit": fit,
+        "downweighted": down,
+        "in_sample": figures,
+        "holdout": held,
+        "exit_status": if fit.converged { 0 } else { 3 },
+    });
+    super::emit(a.json, &v, || text(&file, &fit, &figures, held.as_ref()));
+    if !fit.converged {
+        return Ok(Some(format!(
+            "the contact fit ended {:?} after {} iterations{}",
+            fit.stop,
+            fit.iterations,
+            if fit.std.is_none() {
+                " without a full-rank Jacobian"
+            } else {
+                ""
+            }
+        )));
+    }
+    Ok(None)
+}
+
+/// The report as text.
+fn text(
+    file: &ContactFile,
+    fit: &ContactFit,
+    fig: &Figures,
+    held: Option<&HoldoutReport>,
+) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{}: {} contacts with {} points; {} unknowns estimated ({} robot unknowns fixed), {:?} after {} iterations, σ̂ = {}",
+        file.origin,
+        file.qs.len(),
+        file.points.len(),
+        fit.estimate.len(),
+        fit.fixed.len(),
+        fit.stop,
+        fit.iterations,
+        fit.sigma_hat
+            .map_or("-".into(), |v| format!("{:.4} mm", 1e3 * v))
+    );
+    for f in &fit.fixed {
+        let _ = writeln!(s, "  fixed {} = {:.6}: {}", f.name, f.value, f.reason);
+    }
+    let t = fit.tool_offset;
+    let _ = writeln!(
+        s,
+        "tool offset (end frame): {:.3} {:.3} {:.3} mm",
+        1e3 * t[0],
+        1e3 * t[1],
+        1e3 * t[2]
+    );
+    let _ = writeln!(
+        s,
+        "in-sample consistency (RMS distance to the point's mean):"
+    );
+    s += &figures_text(fig);
+    let down = downweighted_rows(fit, file);
+    if !down.is_empty() {
+        let _ = writeln!(s, "down-weighted rows ({}):", down.len());
+        for d in &down {
+            let _ = writeln!(s, "  line {} ({}): weight {:.3}", d.line, d.point, d.weight);
+        }
+    }
+    if let Some(h) = held {
+        s += &holdout_text(h);
+    }
+    s
+}
+
+fn figures_text(f: &Figures) -> String {
+    let mut s = String::new();
+    for p in &f.points {
+        let _ = writeln!(
+            s,
+            "  {:<20} {:>3} rows  nominal {:7.3} mm  calibrated {:7.3} mm",
+            p.point, p.rows, p.nominal_mm, p.calibrated_mm
+        );
+    }
+    let _ = writeln!(
+        s,
+        "  pooled                        nominal {:7.3} mm  calibrated {:7.3} mm",
+        f.nominal_mm, f.calibrated_mm
+    );
+    for d in &f.distances {
+        let _ = writeln!(
+            s,
+            "  distance {} – {} ({:.3} mm): error nominal {:.3} mm, calibrated {:.3} mm",
+            d.a, d.b, d.known_mm, d.nominal_error_mm, d.calibrated_error_mm
+        );
+    }
+    s
+}
+
+fn holdout_text(h: &HoldoutReport) -> String {
+    let mut s = format!("\nheld out ({}):\n", h.mode);
+    for f in &h.folds {
+        let _ = writeln!(
+            s,
+            "held out {} (trained on {}; {} unknowns, {} fixed{}):",
+            f.held_out,
+            f.trained_on.join(", "),
+            f.estimated,
+            f.fixed,
+            if f.converged { "" } else { "; NOT converged" }
+        );
+        s += &figures_text(&f.figures);
+        if !f.downweighted.is_empty() {
+            let rows: Vec<String> = f
+                .downweighted
+                .iter()
+                .map(|d| format!("line {} ({}, w {:.2})", d.line, d.point, d.weight))
+                .collect();
+            let _ = writeln!(s, "  down-weighted training rows: {}", rows.join("; "));
+        }
+    }
+    let _ = writeln!(
+        s,
+        "pooled over every held-out row: nominal {:.3} mm, calibrated {:.3} mm; mean over folds {:.3} mm",
+        h.pooled_nominal_mm, h.pooled_calibrated_mm, h.mean_calibrated_mm
+    );
+    if let (Some(m), Some(x)) = (h.mean_distance_error_mm, h.max_distance_error_mm) {
+        let _ = writeln!(
+            s,
+            "distance error, calibrated: mean {m:.3} mm, largest {x:.3} mm"
+        );
+    }
+    s
+}

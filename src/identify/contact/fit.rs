@@ -1,0 +1,408 @@
+//! The fit of a contact calibration: the robot's identifiable unknowns,
+//! the tool offset and the points, by Levenberg–Marquardt (a robust loss by
+//! iteratively reweighted least squares on the poses' rows only: a known
+//! distance is never down-weighted).
+//!
+//! **The gauge.** Moving the whole setup rigidly (in particular turning it
+//! about the base's vertical and translating it) changes no residual: the
+//! unknown points follow. Unknowns whose column lies in the span of the
+//! points' columns are fixed and reported as such; the rest of what the
+//! contacts cannot see is fixed by the shared rule
+//! ([`crate::identify::undetermined`]: column-pivoted QR on the
+//! column-scaled Jacobian, the sensor's own unknowns pivoted first).
+
+use super::data::ContactFile;
+use super::start_own;
+use crate::identify::lm::{Solution, StopReason, levenberg_marquardt};
+use crate::identify::loss::{Cauchy, Huber, Loss};
+use crate::identify::undetermined::{FixedParameter, fix_undetermined_below};
+use crate::identify::{Calibration, LmSettings, LossChoice, Residuals, Result};
+use crate::linalg::qr::inverse_information;
+use crate::measure::contact::{ContactSensor, KnownDistance};
+use crate::model::{ParamTable, Robot};
+use faer::Mat;
+use serde::Serialize;
+
+/// Most reweighting rounds of a robust fit.
+pub const IRLS_ROUNDS: usize = 50;
+/// A robust fit stops when no `√w` of a row changes by more than this.
+pub const IRLS_TOLERANCE: f64 = 1e-9;
+/// An unknown whose twist (rad/s and m/s per unit of it, O(1)) differs by
+/// no more than this between rows is a rigid motion of the whole setup:
+/// rounding of the chain walk is ~1e-15, a joint's motion varies by O(0.1).
+pub const GAUGE_TOL: f64 = 1e-8;
+
+/// The pivot (of a unit column, after the columns kept before it) at or
+/// below which a contact fit fixes an unknown: stricter than the shared
+/// [`crate::identify::undetermined::PIVOT_TOL`] (3.2e-5, which separates
+/// exact dependences from rounding). Contacts carry σ ≈ 0.2 mm on points
+/// ~0.5 m from the base (4e-4 relative), so an unknown with less than 1e-3
+/// of its column outside the others is moved by noise far beyond its real
+/// size: on one MUKCa placement joint 6's γ went to 0.56 ± 0.22 rad and
+/// predicted the other placements worse; with 1e-3 joint 6's γ and d are
+/// fixed (their motion at the ball is nearly the tool offset's), on one
+/// placement as on nine (held out: 0.569 → 0.554 mm trained on one
+/// placement, 0.421 → 0.420 mm leaving one out).
+pub const CONTACT_PIVOT_TOL: f64 = 1e-3;
+
+/// The reason given for an unknown that moves every point together.
+pub const GAUGE_REASON: &str = "moves every contact point together (a rigid motion of the whole setup, e.g. about the base's vertical): the unknown points absorb it";
+
+/// How to fit.
+#[derive(Clone, Debug)]
+pub struct ContactSettings {
+    /// The solver's settings.
+    pub lm: LmSettings,
+    /// The loss.
+    pub loss: LossChoice,
+    /// Parameters never fixed (nor counted as the gauge).
+    pub keep: Vec<String>,
+}
+
+/// A contact calibration.
+#[derive(Clone, Debug, Serialize)]
+pub struct ContactFit {
+    /// The robot with the unknowns that were estimated.
+    #[serde(skip)]
+    pub robot: Robot,
+    /// The calibrated parameter table.
+    #[serde(skip)]
+    pub table: ParamTable,
+    /// The estimated tool offset (end frame, metres).
+    pub tool_offset: [f64; 3],
+    /// The points' names.
+    pub points: Vec<String>,
+    /// The estimated points (base frame, metres).
+    pub point_positions: Vec<[f64; 3]>,
+    /// Names of the estimated unknowns (robot's, then own).
+    pub names: Vec<String>,
+    /// Their start values.
+    pub start: Vec<f64>,
+    /// Their estimates.
+    pub estimate: Vec<f64>,
+    /// Their standard deviations `√(σ̂² (XᵀX)⁻¹)_jj`, when determined.
+    pub std: Option<Vec<f64>>,
+    /// Unknowns fixed at their start values, with why.
+    pub fixed: Vec<FixedParameter>,
+    /// Whether a tolerance was met with a finite, full-rank Jacobian.
+    pub converged: bool,
+    /// Why the iteration stopped.
+    pub stop: StopReason,
+    /// Outer iterations, summed over reweighting rounds.
+    pub iterations: usize,
+    /// `σ̂` of a row (metres), weighted.
+    pub sigma_hat: Option<f64>,
+    /// Each row's final loss weight (1 for least squares).
+    pub weights: Vec<f64>,
+}
+
+impl ContactFit {
+    /// Rows (0-based) whose weight is below
+    /// [`crate::identify::fit::DOWNWEIGHTED`], with it.
+    #[must_use]
+    pub fn downweighted(&self) -> Vec<(usize, f64)> {
+        self.weights
+            .iter()
+            .enumerate()
+            .filter(|(_, w)| **w < crate::identify::fit::DOWNWEIGHTED)
+            .map(|(i, &w)| (i, w))
+            .collect()
+    }
+}
+
+/// A calibration's rows scaled by a weight per pose (constraints unscaled).
+struct Weighted<'a> {
+    inner: Calibration<'a>,
+    sqrt_w: Vec<f64>,
+}
+
+impl Residuals for Weighted<'_> {
+    fn n_residuals(&self) -> usize {
+        self.inner.n_residuals()
+    }
+    fn n_params(&self) -> usize {
+        self.inner.n_params()
+    }
+    fn eval(&mut self, theta: &[f64], r: &mut [f64], mut jac: Option<&mut Mat<f64>>) -> bool {
+        let ok = self.inner.eval(theta, r, jac.as_deref_mut());
+        for (i, w) in self.sqrt_w.iter().enumerate() {
+            for k in 3 * i..3 * i + 3 {
+                r[k] *= w;
+                if let Some(j) = jac.as_deref_mut() {
+                    for c in 0..j.ncols() {
+                        j[(k, c)] *= w;
+                    }
+                }
+            }
+        }
+        ok
+    }
+}
+
+/// The calibration problem of `robot` on `file`'s contacts.
+fn problem<'a>(
+    robot: &'a Robot,
+    start: &'a ParamTable,
+    file: &'a ContactFile,
+    distances: &[KnownDistance],
+) -> Calibration<'a> {
+    let sensor = ContactSensor::new(file.points.clone(), distances.to_vec());
+    let measured: Vec<f64> = file
+        .groups
+        .iter()
+        .flat_map(|&g| ContactSensor::value_of(g))
+        .collect();
+    Calibration::with_sensor(robot, start, &file.qs, Box::new(sensor), measured)
+}
+
+/// The Jacobian of `prob` at `theta`.
+fn jacobian(prob: &mut dyn Residuals, theta: &[f64]) -> Mat<f64> {
+    let mut r = vec![0.0; prob.n_residuals()];
+    let mut x = Mat::<f64>::zeros(prob.n_residuals(), prob.n_params());
+    prob.eval(theta, &mut r, Some(&mut x));
+    x
+}
+
+/// Fits `robot`'s determined unknowns, the tool offset and the points to
+/// `file`'s contacts with the known `distances` (indices into
+/// `file.points`), from `start`.
+pub fn fit_contacts(
+    robot: &Robot,
+    start: &ParamTable,
+    file: &ContactFile,
+    distances: &[KnownDistance],
+    settings: &ContactSettings,
+) -> Result<ContactFit> {
+    settings.lm.validate()?;
+    let own0 = start_own(robot, start, file);
+    let reduced = determined(robot, start, file, distances, &own0, &settings.keep)?;
+    let r = &reduced.robot;
+    let mut theta0 = r.unknown_values(start);
+    theta0.extend_from_slice(&own0);
+    let mut prob = Weighted {
+        inner: problem(r, start, file, distances),
+        sqrt_w: vec![1.0; file.qs.len()],
+    };
+    let loss = loss_of(settings.loss)?;
+    let sol = solve(&mut prob, &theta0, &settings.lm, loss.as_deref());
+    let weights: Vec<f64> = prob.sqrt_w.iter().map(|w| w * w).collect();
+    Ok(finish(
+        r,
+        start,
+        file,
+        &prob,
+        theta0,
+        sol,
+        reduced.fixed,
+        weights,
+    ))
+}
+
+/// The loss of a choice (`None` for least squares).
+fn loss_of(choice: LossChoice) -> Result<Option<Box<dyn Loss>>> {
+    Ok(match choice {
+        LossChoice::L2 => None,
+        LossChoice::Huber { scale } => Some(Box::new(Huber::new(scale)?)),
+        LossChoice::Cauchy { scale } => Some(Box::new(Cauchy::new(scale)?)),
+    })
+}
+
+/// Levenberg–Marquardt, reweighted until the weights settle for a loss.
+fn solve(
+    prob: &mut Weighted<'_>,
+    theta0: &[f64],
+    lm: &LmSettings,
+    loss: Option<&dyn Loss>,
+) -> Solution {
+    let mut theta = theta0.to_vec();
+    let mut iterations = 0;
+    for round in 1.. {
+        let mut sol = levenberg_marquardt(prob, &theta, lm);
+        iterations += sol.iterations;
+        sol.iterations = iterations;
+        let Some(loss) = loss else { return sol };
+        let mut r = vec![0.0; prob.n_residuals()];
+        if !sol.finite || !prob.inner.eval(&sol.theta, &mut r, None) {
+            return sol;
+        }
+        let mut change: f64 = 0.0;
+        for (i, w) in prob.sqrt_w.iter_mut().enumerate() {
+            let s: f64 = r[3 * i..3 * i + 3].iter().map(|v| v * v).sum();
+            let new = loss.weight(s).sqrt();
+            change = change.max((new - *w).abs());
+            *w = new;
+        }
+        if change <= IRLS_TOLERANCE || round >= IRLS_ROUNDS {
+            // The Jacobian and rss at the final weights.
+            return levenberg_marquardt(prob, &sol.theta, lm);
+        }
+        theta.clone_from(&sol.theta);
+    }
+    unreachable!("the loop returns")
+}
+
+/// The robot reduced to the unknowns the contacts determine: first the
+/// gauge (unknowns whose motion is one rigid motion of the whole setup at
+/// every row, see [`gauge_unknowns`]), then what the shared rule finds on
+/// the Jacobian of the rest.
+fn determined(
+    robot: &Robot,
+    start: &ParamTable,
+    file: &ContactFile,
+    distances: &[KnownDistance],
+    own0: &[f64],
+    keep: &[String],
+) -> Result<crate::identify::Determined> {
+    let names = robot.parameter_names();
+    let gauge: Vec<usize> = gauge_unknowns(robot, start, &file.qs)
+        .into_iter()
+        .filter(|&k| !keep.contains(&names[k]))
+        .collect();
+    let mut inner = robot.clone();
+    inner.unknowns = (0..robot.n_unknowns())
+        .filter(|k| !gauge.contains(k))
+        .map(|k| robot.unknowns[k])
+        .collect();
+    let mut prob = problem(&inner, start, file, distances);
+    let mut theta = inner.unknown_values(start);
+    theta.extend_from_slice(own0);
+    let x = jacobian(&mut prob, &theta);
+    let mut d = fix_undetermined_below(&inner, start, &file.qs, &x, keep, CONTACT_PIVOT_TOL)?;
+    let mut col_names = inner.parameter_names();
+    col_names.truncate(inner.n_unknowns());
+    col_names.extend(prob.sensor().own_param_names());
+    let kept: Vec<usize> = (0..x.ncols())
+        .filter(|&c| !d.fixed.iter().any(|f| f.name == col_names[c]))
+        .collect();
+    for f in &mut d.fixed {
+        if let Some(k) = col_names.iter().position(|n| *n == f.name)
+            && let Some(like) = nearest_combination(&x, k, &kept, &col_names)
+        {
+            f.reason = format!("{}; its motion is nearly a combination of {like}", f.reason);
+        }
+    }
+    let mut fixed: Vec<FixedParameter> = gauge
+        .iter()
+        .map(|&k| FixedParameter {
+            name: names[k].clone(),
+            value: start.get(robot.unknowns[k]),
+            reason: GAUGE_REASON.to_string(),
+        })
+        .collect();
+    fixed.append(&mut d.fixed);
+    d.fixed = fixed;
+    Ok(d)
+}
+
+/// The (up to three) kept columns that carry most of unit column `k` of
+/// `x` in its least-squares fit by the kept columns (each column scaled to
+/// unit norm first): what an undetermined unknown's motion resembles.
+fn nearest_combination(x: &Mat<f64>, k: usize, kept: &[usize], names: &[String]) -> Option<String> {
+    use nalgebra::{DMatrix, DVector};
+    let m = x.nrows();
+    let unit = |c: usize| -> DVector<f64> {
+        let v = DVector::from_fn(m, |i, _| x[(i, c)]);
+        let n = v.norm();
+        if n > 0.0 { v / n } else { v }
+    };
+    let a = DMatrix::from_columns(&kept.iter().map(|&c| unit(c)).collect::<Vec<_>>());
+    let coef = (a.transpose() * &a)
+        .cholesky()?
+        .solve(&(a.transpose() * unit(k)));
+    let mut order: Vec<usize> = (0..kept.len()).collect();
+    order.sort_by(|&i, &j| coef[j].abs().total_cmp(&coef[i].abs()));
+    let top: Vec<String> = order
+        .iter()
+        .take(3)
+        .filter(|&&i| coef[i].abs() > 0.05)
+        .map(|&i| format!("{} ({:+.2})", names[kept[i]], coef[i]))
+        .collect();
+    (!top.is_empty()).then(|| top.join(", "))
+}
+
+/// The unknowns whose elementary motion is the same rigid motion of the
+/// base frame at every row (a constant twist: angular velocity `ω` and the
+/// velocity `v − ω × p` of the base origin): moving the whole setup, they
+/// change no residual once the points follow.
+#[must_use]
+pub fn gauge_unknowns(robot: &Robot, table: &ParamTable, qs: &[Vec<f64>]) -> Vec<usize> {
+    let n = robot.n_unknowns();
+    let mut ev = crate::kinematics::Evaluator::new(robot, table);
+    let mut motions = vec![crate::kinematics::Motion::default(); n];
+    let mut twists: Vec<Vec<[f64; 6]>> = vec![Vec::with_capacity(qs.len()); n];
+    for q in qs {
+        let end = ev.motions(q, &mut motions);
+        for (k, m) in motions.iter().enumerate() {
+            let v0 = m.lin - m.ang.cross(&end.position);
+            twists[k].push([m.ang.x, m.ang.y, m.ang.z, v0.x, v0.y, v0.z]);
+        }
+    }
+    (0..n)
+        .filter(|&k| {
+            let t = &twists[k];
+            let Some(first) = t.first() else { return false };
+            let scale = first.iter().map(|a| a.abs()).fold(0.0, f64::max).max(1.0);
+            t.iter().all(|w| {
+                w.iter()
+                    .zip(first)
+                    .all(|(a, b)| (a - b).abs() <= GAUGE_TOL * scale)
+            })
+        })
+        .collect()
+}
+
+/// The fit's report from the solver's state.
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    robot: &Robot,
+    start: &ParamTable,
+    file: &ContactFile,
+    prob: &Weighted<'_>,
+    theta0: Vec<f64>,
+    sol: Solution,
+    fixed: Vec<FixedParameter>,
+    weights: Vec<f64>,
+) -> ContactFit {
+    let n_kin = robot.n_unknowns();
+    let p = theta0.len();
+    let m = prob.n_residuals();
+    let dof = m.saturating_sub(p);
+    let sigma_hat = (dof > 0 && sol.rss.is_finite()).then(|| (sol.rss / dof as f64).sqrt());
+    let inv = sol
+        .finite
+        .then(|| inverse_information(sol.jac.as_ref()))
+        .flatten();
+    let std = match (&inv, sigma_hat) {
+        (Some(inv), Some(s)) => Some((0..p).map(|j| s * inv[(j, j)].max(0.0).sqrt()).collect()),
+        _ => None,
+    };
+    let own = &sol.theta[n_kin..];
+    let mut names = robot.parameter_names();
+    names.truncate(n_kin);
+    names.extend(prob.inner.sensor().own_param_names());
+    let converged = sol.finite
+        && std.is_some()
+        && !matches!(
+            sol.stop,
+            StopReason::MaxIterations | StopReason::NonFinite | StopReason::DampingLimit
+        );
+    ContactFit {
+        robot: robot.clone(),
+        table: robot.with_unknowns(start, &sol.theta[..n_kin]),
+        tool_offset: [own[0], own[1], own[2]],
+        points: file.points.clone(),
+        point_positions: (0..file.points.len())
+            .map(|g| ContactSensor::point(own, g).into())
+            .collect(),
+        names,
+        start: theta0,
+        estimate: sol.theta,
+        std,
+        fixed,
+        converged,
+        stop: sol.stop,
+        iterations: sol.iterations,
+        sigma_hat,
+        weights,
+    }
+}

@@ -1,0 +1,149 @@
+//! Calibration without an instrument: contacts with fixed points
+//! ([`crate::measure::contact`]) and the distances known between them.
+//!
+//! * this file: known distances by name, the start of the points, the tool
+//!   points a model predicts, and the figures of a model on contacts
+//!   (consistency: the RMS distance of each row's predicted tool point to
+//!   its point's mean; distance errors);
+//! * [`fit`](mod@fit): the fit (identifiable unknowns, the gauge, a robust
+//!   loss that names the rows it down-weights);
+//! * [`holdout`]: held out by placement (the part of a point's name before
+//!   `/`): leave one placement out, and train on one.
+
+pub mod data;
+pub mod fit;
+pub mod holdout;
+pub mod project;
+pub mod select;
+
+pub use data::ContactFile;
+pub use fit::{ContactFit, ContactSettings, fit_contacts};
+pub use holdout::{
+    DistanceFigure, DownweightedRow, Figures, HoldoutFold, HoldoutMode, HoldoutReport, PointFigure,
+    holdout_by_placement, judge, placements,
+};
+
+use crate::error::Error;
+use crate::kinematics::Evaluator;
+use crate::measure::contact::{ContactSensor, KnownDistance, TOOL_OFFSET_PARAMS};
+use crate::model::{ParamTable, Robot};
+use nalgebra::Vector3;
+use serde::Serialize;
+
+/// A distance known between two named points.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NamedDistance {
+    /// The first point's name.
+    pub a: String,
+    /// The second point's name.
+    pub b: String,
+    /// The distance, metres.
+    pub metres: f64,
+}
+
+/// The distances of `given` between points of `file`, as indices. With
+/// `strict`, a distance naming a point the file does not have is an error
+/// naming it; otherwise it is left out (a training subset without that
+/// point). A distance that is not finite and positive, or between a point
+/// and itself, is an error.
+pub fn resolve_distances(
+    file: &ContactFile,
+    given: &[NamedDistance],
+    strict: bool,
+) -> crate::error::Result<Vec<KnownDistance>> {
+    let mut out = Vec::new();
+    for d in given {
+        let label = format!("distance {},{}={}", d.a, d.b, d.metres);
+        if !(d.metres.is_finite() && d.metres > 0.0) || d.a == d.b {
+            return Err(Error::Invalid(format!(
+                "{label}: a distance needs two different points and a finite length > 0 (metres)"
+            )));
+        }
+        match (file.point_index(&d.a), file.point_index(&d.b)) {
+            (Some(a), Some(b)) => out.push(KnownDistance {
+                a,
+                b,
+                metres: d.metres,
+            }),
+            (ia, _) if strict => {
+                let missing = if ia.is_none() { &d.a } else { &d.b };
+                return Err(Error::Invalid(format!(
+                    "{label}: {} has no point '{missing}' (its points: {})",
+                    file.origin,
+                    file.points.join(", ")
+                )));
+            }
+            _ => {}
+        }
+    }
+    Ok(out)
+}
+
+/// The placement of a point: its name before the first `/` (the whole name
+/// without one).
+#[must_use]
+pub fn placement_of(point: &str) -> &str {
+    point.split('/').next().unwrap_or(point)
+}
+
+/// The tool point `p + R o` of every row of `qs` for `robot` with `table`
+/// and tool offset `offset` (end frame).
+#[must_use]
+pub fn tool_points(
+    robot: &Robot,
+    table: &ParamTable,
+    offset: &[f64; 3],
+    qs: &[Vec<f64>],
+) -> Vec<Vector3<f64>> {
+    let mut ev = Evaluator::new(robot, table);
+    qs.iter()
+        .map(|q| ContactSensor::tool_point(&ev.end_frame(q), offset))
+        .collect()
+}
+
+/// The mean of `pts` over the rows of each of `n` groups.
+#[must_use]
+pub fn group_means(pts: &[Vector3<f64>], groups: &[usize], n: usize) -> Vec<Vector3<f64>> {
+    let mut sum = vec![Vector3::zeros(); n];
+    let mut count = vec![0usize; n];
+    for (p, &g) in pts.iter().zip(groups) {
+        sum[g] += p;
+        count[g] += 1;
+    }
+    sum.iter()
+        .zip(&count)
+        .map(|(s, &c)| s / c.max(1) as f64)
+        .collect()
+}
+
+/// Each row's distance (metres) from its group's mean.
+#[must_use]
+pub fn spreads(pts: &[Vector3<f64>], groups: &[usize], n: usize) -> Vec<f64> {
+    let means = group_means(pts, groups, n);
+    pts.iter()
+        .zip(groups)
+        .map(|(p, &g)| (p - means[g]).norm())
+        .collect()
+}
+
+/// The root mean square of `v` (0 for none).
+#[must_use]
+pub fn rms(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
+}
+
+/// The own unknowns at the start: a zero tool offset and each point at the
+/// mean of its rows' tool points predicted by `table`.
+#[must_use]
+pub fn start_own(robot: &Robot, table: &ParamTable, file: &ContactFile) -> Vec<f64> {
+    let pts = tool_points(robot, table, &[0.0; 3], &file.qs);
+    let means = group_means(&pts, &file.groups, file.points.len());
+    let mut own = vec![0.0; TOOL_OFFSET_PARAMS];
+    for m in means {
+        own.extend_from_slice(m.as_slice());
+    }
+    own
+}

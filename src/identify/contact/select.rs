@@ -1,0 +1,263 @@
+//! Which configurations to record for a socket: a pool of configurations
+//! that put the tool point at the socket (joint-space samples projected by
+//! [`super::project::project_to_point`]), and a D-optimal choice among them
+//! with the contact sensor's own Jacobian (the robot's determined unknowns,
+//! the tool offset and the socket's point as columns).
+//!
+//! A design is judged by its **predicted consistency error**: with unit
+//! noise, the RMS over the pool of the predicted standard deviation of a
+//! contact's residual `t − P` (`√(tr(X_q M⁻¹ X_qᵀ) / 3)` per coordinate, `X_q`
+//! the pool configuration's 3 rows, `M = XᵀX` of the design): how far a
+//! calibrated model's contacts would scatter about the socket, in units of
+//! σ. A design whose `M` is singular has an infinite error.
+
+use super::data::ContactFile;
+use super::fit::{CONTACT_PIVOT_TOL, gauge_unknowns};
+use super::project::project_to_point;
+use crate::identify::Calibration;
+use crate::identify::Residuals;
+use crate::identify::undetermined::fix_undetermined_below;
+use crate::measure::contact::ContactSensor;
+use crate::model::{ParamTable, Robot};
+use faer::Mat;
+use nalgebra::{DMatrix, Vector3};
+use rand::{Rng, RngExt};
+
+/// A pool of configurations at one socket, with their design Jacobian.
+#[derive(Clone, Debug)]
+pub struct SocketPool {
+    /// The robot with the unknowns the pool determines.
+    pub robot: Robot,
+    /// The configurations (all reach the socket).
+    pub qs: Vec<Vec<f64>>,
+    /// Each configuration's 3 × p rows (unknowns: the robot's, the tool
+    /// offset, the point).
+    pub blocks: Vec<DMatrix<f64>>,
+}
+
+/// Samples `count` configurations uniformly inside the limits less
+/// `margin` and keeps those that project onto `socket` (to `tol` metres),
+/// then builds their Jacobian blocks for the unknowns the pool determines.
+#[allow(clippy::too_many_arguments)]
+pub fn socket_pool<R: Rng + ?Sized>(
+    robot: &Robot,
+    table: &ParamTable,
+    socket: &Vector3<f64>,
+    count: usize,
+    margin: f64,
+    tol: f64,
+    rng: &mut R,
+) -> crate::identify::Result<SocketPool> {
+    let mut qs = Vec::new();
+    for _ in 0..count {
+        let q0: Vec<f64> = robot
+            .limits
+            .iter()
+            .map(|&[lo, hi]| lo + margin + rng.random::<f64>() * (hi - lo - 2.0 * margin).max(0.0))
+            .collect();
+        if let Some(q) = project_to_point(robot, table, &[0.0; 3], socket, &q0, margin, tol) {
+            qs.push(q);
+        }
+    }
+    let file = ContactFile {
+        origin: "pool".into(),
+        groups: vec![0; qs.len()],
+        points: vec!["socket".into()],
+        lines: (1..=qs.len()).collect(),
+        qs,
+    };
+    let reduced = determined(robot, table, &file)?;
+    let x = jacobian(&reduced, table, &file);
+    let p = x.ncols();
+    let blocks = (0..file.qs.len())
+        .map(|i| DMatrix::from_fn(3, p, |r, c| x[(3 * i + r, c)]))
+        .collect();
+    Ok(SocketPool {
+        robot: reduced,
+        qs: file.qs,
+        blocks,
+    })
+}
+
+/// The robot without the gauge and the unknowns the pool does not determine.
+fn determined(
+    robot: &Robot,
+    table: &ParamTable,
+    file: &ContactFile,
+) -> crate::identify::Result<Robot> {
+    let gauge = gauge_unknowns(robot, table, &file.qs);
+    let mut inner = robot.clone();
+    inner.unknowns = (0..robot.n_unknowns())
+        .filter(|k| !gauge.contains(k))
+        .map(|k| robot.unknowns[k])
+        .collect();
+    let x = jacobian(&inner, table, file);
+    Ok(fix_undetermined_below(&inner, table, &file.qs, &x, &[], CONTACT_PIVOT_TOL)?.robot)
+}
+
+/// The contact Jacobian of `file` at `table` (tool offset 0, the point at
+/// the mean tool point).
+fn jacobian(robot: &Robot, table: &ParamTable, file: &ContactFile) -> Mat<f64> {
+    let sensor = ContactSensor::new(file.points.clone(), Vec::new());
+    let measured: Vec<f64> = file
+        .groups
+        .iter()
+        .flat_map(|&g| ContactSensor::value_of(g))
+        .collect();
+    let mut prob = Calibration::with_sensor(robot, table, &file.qs, Box::new(sensor), measured);
+    let mut theta = robot.unknown_values(table);
+    theta.extend(super::start_own(robot, table, file));
+    let mut r = vec![0.0; prob.n_residuals()];
+    let mut x = Mat::zeros(prob.n_residuals(), prob.n_params());
+    prob.eval(&theta, &mut r, Some(&mut x));
+    x
+}
+
+/// `M = Σ X_iᵀ X_i` over `design`.
+fn information(pool: &SocketPool, design: &[usize]) -> DMatrix<f64> {
+    let p = pool.blocks[0].ncols();
+    let mut m = DMatrix::zeros(p, p);
+    for &i in design {
+        m += pool.blocks[i].transpose() * &pool.blocks[i];
+    }
+    m
+}
+
+/// The pool's centred second moment `W = Σ_q (X_q − X̄)ᵀ (X_q − X̄) / (3N)`:
+/// `tr(M⁻¹ W)` is the mean squared deviation, per coordinate, of a pool
+/// configuration's predicted tool point from the pool's mean prediction
+/// (the point's own columns are the same for every row and drop out).
+#[must_use]
+pub fn consistency_moment(pool: &SocketPool) -> DMatrix<f64> {
+    let n = pool.blocks.len() as f64;
+    let mean = pool
+        .blocks
+        .iter()
+        .fold(DMatrix::zeros(3, pool.blocks[0].ncols()), |a, b| a + b)
+        / n;
+    let mut w = DMatrix::zeros(mean.ncols(), mean.ncols());
+    for b in &pool.blocks {
+        let c = b - &mean;
+        w += c.transpose() * c;
+    }
+    w / (3.0 * n)
+}
+
+/// The predicted consistency error of `design` in units of σ: the RMS
+/// over the pool, per coordinate, of a calibrated prediction's deviation
+/// from the socket's mean prediction, `√tr(M⁻¹ W)` ([`consistency_moment`]);
+/// infinite when `M` is singular by the shared rank rule (condition of the
+/// equilibrated information above 1e13).
+#[must_use]
+pub fn predicted_consistency(pool: &SocketPool, design: &[usize]) -> f64 {
+    let m = information(pool, design);
+    let d: Vec<f64> = (0..m.nrows()).map(|i| m[(i, i)].max(0.0).sqrt()).collect();
+    if d.iter().any(|&v| v <= 0.0) {
+        return f64::INFINITY;
+    }
+    let scaled = DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)] / (d[i] * d[j]));
+    let eig = scaled.clone().symmetric_eigenvalues();
+    if eig.min() <= eig.max() / crate::linalg::rank::MAX_CONDITION {
+        return f64::INFINITY;
+    }
+    let w = consistency_moment(pool);
+    let ws = DMatrix::from_fn(w.nrows(), w.ncols(), |i, j| w[(i, j)] / (d[i] * d[j]));
+    match scaled.cholesky() {
+        Some(ch) => (ch.inverse() * ws).trace().max(0.0).sqrt(),
+        None => f64::INFINITY,
+    }
+}
+
+/// Improves `design` by exchanges that lower its predicted consistency
+/// error `tr(M⁻¹ W)` (the I-optimal criterion of [`predicted_consistency`]),
+/// each swap priced by the Sherman–Morrison–Woodbury update, until no swap
+/// lowers it (at most 10 sweeps).
+#[must_use]
+pub fn refine_for_consistency(pool: &SocketPool, mut design: Vec<usize>) -> Vec<usize> {
+    let w = consistency_moment(pool);
+    let p = w.nrows();
+    let ridge = DMatrix::identity(p, p) * 1e-12 * information(pool, &design).trace() / p as f64;
+    // tr((A + BᵀB)⁻¹ W) = tr(A⁻¹W) − tr((I + B A⁻¹ Bᵀ)⁻¹ B A⁻¹ W A⁻¹ Bᵀ).
+    let drop = |a_inv: &DMatrix<f64>, g: &DMatrix<f64>, i: usize| -> f64 {
+        let b = &pool.blocks[i];
+        let s = DMatrix::identity(3, 3) + b * a_inv * b.transpose();
+        let v = b * g * b.transpose();
+        s.try_inverse().map_or(0.0, |si| (si * v).trace())
+    };
+    for _ in 0..10 {
+        let mut improved = false;
+        for k in 0..design.len() {
+            let mut rest = design.clone();
+            let out = rest.swap_remove(k);
+            let Some(a_inv) = (information(pool, &rest) + &ridge).try_inverse() else {
+                continue;
+            };
+            let g = &a_inv * &w * &a_inv;
+            let keep = drop(&a_inv, &g, out);
+            let best = (0..pool.qs.len())
+                .filter(|i| !design.contains(i))
+                .map(|i| (i, drop(&a_inv, &g, i)))
+                .max_by(|x, y| x.1.total_cmp(&y.1));
+            if let Some((j, v)) = best
+                && v > keep * (1.0 + 1e-9)
+            {
+                design[k] = j;
+                improved = true;
+            }
+        }
+        if !improved {
+            break;
+        }
+    }
+    design
+}
+
+/// `n` configurations of the pool chosen greedily for the largest
+/// `ln det M` (a ridge of 1e-9 of the information's mean diagonal starts
+/// it), then improved by exchanges (Fedorov) until no swap raises it; each
+/// candidate priced by the matrix determinant lemma,
+/// `ln det(A + BᵀB) = ln det A + ln det(I₃ + B A⁻¹ Bᵀ)`.
+#[must_use]
+pub fn select_d_optimal(pool: &SocketPool, n: usize) -> Vec<usize> {
+    let p = pool.blocks[0].ncols();
+    let all = information(pool, &(0..pool.qs.len()).collect::<Vec<_>>());
+    let ridge = DMatrix::identity(p, p) * (1e-9 * all.trace() / p as f64);
+    let gain = |a_inv: &DMatrix<f64>, i: usize| -> f64 {
+        let b = &pool.blocks[i];
+        let s = DMatrix::identity(3, 3) + b * a_inv * b.transpose();
+        s.determinant().max(f64::MIN_POSITIVE).ln()
+    };
+    let inverse = |m: DMatrix<f64>| m.try_inverse().expect("a ridged information is invertible");
+    let mut design: Vec<usize> = Vec::with_capacity(n);
+    while design.len() < n.min(pool.qs.len()) {
+        let a_inv = inverse(information(pool, &design) + &ridge);
+        let best = (0..pool.qs.len())
+            .filter(|i| !design.contains(i))
+            .max_by(|&x, &y| gain(&a_inv, x).total_cmp(&gain(&a_inv, y)))
+            .expect("candidates remain");
+        design.push(best);
+    }
+    for _ in 0..10 {
+        let mut improved = false;
+        for k in 0..design.len() {
+            let mut rest = design.clone();
+            let out = rest.swap_remove(k);
+            let a_inv = inverse(information(pool, &rest) + &ridge);
+            let keep = gain(&a_inv, out);
+            let best = (0..pool.qs.len())
+                .filter(|i| !design.contains(i))
+                .map(|i| (i, gain(&a_inv, i)))
+                .max_by(|x, y| x.1.total_cmp(&y.1));
+            if let Some((j, g)) = best
+                && g > keep + 1e-9
+            {
+                design[k] = j;
+                improved = true;
+            }
+        }
+        if !improved {
+            break;
+        }
+    }
+    design
+}

@@ -7,6 +7,7 @@ pub mod calibrated;
 pub mod design;
 pub mod design_formats;
 pub mod frames_file;
+pub mod inertia;
 pub mod joint_speeds;
 pub mod measurements;
 pub mod robot_toml;

@@ -413,6 +413,7 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
         measurement,
         orientation_scale,
         source: None,
+        gravity: None,
     };
     if let Some((nominal, real)) = markers {
         robot.nominal.markers = nominal;

@@ -147,6 +147,7 @@ pub fn synthetic_robot() -> Robot {
         measurement: MeasurementKind::Point,
         orientation_scale: activecal::model::DEFAULT_ORIENTATION_SCALE,
         source: None,
+        gravity: None,
     };
     robot.validate().expect("synthetic robot is valid");
     robot

@@ -4,6 +4,7 @@ pub mod basic;
 pub mod bench;
 pub mod bound;
 pub mod calibrate;
+pub mod compliance;
 pub mod figures;
 pub mod frames_text;
 pub mod measured;

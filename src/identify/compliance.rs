@@ -12,11 +12,13 @@ use crate::model::{JointKind, ParamId, ParamTable, Robot, Symbol};
 use serde::Serialize;
 use std::sync::Arc;
 
-/// A torque range over the data below this fraction of the largest gravity
-/// torque of any joint counts as constant (the deflection it causes is then
-/// a zero offset, not a compliance): 1e-6, far below any torque that moves a
-/// joint measurably and far above rounding (1e-16 relative).
-pub const CONSTANT_TORQUE: f64 = 1e-6;
+/// A joint whose gravity torque varies over the data by less than this
+/// fraction of the largest variation of any joint gets no compliance: its
+/// deflection would be a zero offset (a constant torque), or need a
+/// compliance a hundred times the others' to be seen at all — a column the
+/// fit cannot tell from noise, along which Levenberg–Marquardt wanders
+/// (a Panda's hand joint, 1e-3 N·m, sent its compliance to 1e13).
+pub const CONSTANT_TORQUE: f64 = 1e-2;
 
 /// A revolute joint that gets no compliance, and why.
 #[derive(Clone, Debug, Serialize, PartialEq)]
@@ -39,7 +41,7 @@ pub fn with_compliance(
     let mut r = robot.clone();
     r.gravity = Some(Arc::clone(gravity));
     let (lo, hi) = torque_ranges(gravity, meas.qs());
-    let scale = lo.iter().chain(&hi).fold(0.0f64, |m, &v| m.max(v.abs()));
+    let scale = lo.iter().zip(&hi).fold(0.0f64, |m, (a, b)| m.max(b - a));
     let names = joint_names(robot);
     let mut skipped = Vec::new();
     for (f, frame) in robot.frames.iter().enumerate() {
@@ -55,12 +57,12 @@ pub fn with_compliance(
             });
             continue;
         }
-        let reason = if a.abs().max(b.abs()) <= CONSTANT_TORQUE * scale {
+        let reason = if a.abs().max(b.abs()) <= 1e-9 * scale.max(1.0) {
             "no gravity torque in these data (a vertical axis, or nothing carried)".to_string()
         } else {
             format!(
-                "gravity torque constant in these data ({:.3} N·m): its deflection is a zero offset",
-                0.5 * (a + b)
+                "gravity torque nearly constant in these data ({a:.4} … {b:.4} N·m, a variation under {:.0} % of the largest joint's): a compliance would be a zero offset the data cannot tell apart",
+                CONSTANT_TORQUE * 100.0
             )
         };
         skipped.push(NoCompliance {

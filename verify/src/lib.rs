@@ -30,6 +30,7 @@ pub mod erd;
 pub mod erd_fk;
 pub mod export;
 pub mod fixture;
+pub mod gravity;
 pub mod idjac;
 pub mod model;
 pub mod sample;

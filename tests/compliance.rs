@@ -202,3 +202,150 @@ fn a_panda_with_known_stiffnesses_is_recovered_and_reaches_the_noise_floor() {
         "geometric {without} mm, floor {floor} mm"
     );
 }
+
+mod common;
+
+const UR10: &str = "fixtures/figaroh/ur10_robot.urdf:pose";
+const UR10_CSV: &str = "fixtures/figaroh/ur10_full_pose.csv";
+
+#[test]
+fn calibrate_reports_compliances_and_the_joints_without_one() {
+    let v = common::json_of(&[
+        "calibrate",
+        "--robot",
+        UR10,
+        "--tip",
+        "wrist_3_link",
+        "--measurements",
+        UR10_CSV,
+        "--compliance",
+        "--json",
+    ]);
+    let c = &v["compliance"];
+    let names: Vec<&str> = c["estimates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["joint"].as_str().unwrap())
+        .collect();
+    // The shoulder and elbow carry the arm; the base joint is vertical.
+    assert!(
+        names.contains(&"shoulder_lift_joint") && names.contains(&"elbow_joint"),
+        "{names:?}"
+    );
+    let without = c["without"].as_array().unwrap();
+    assert!(without.iter().any(|w| w["joint"] == "shoulder_pan_joint"
+        && w["reason"].as_str().unwrap().contains("no gravity torque")));
+    for e in c["estimates"].as_array().unwrap() {
+        let (cc, k) = (
+            e["c"].as_f64().unwrap(),
+            e["stiffness_nm_per_rad"].as_f64().unwrap(),
+        );
+        assert!((k * cc + 1.0).abs() < 1e-12, "k = −1/c: {e}");
+        assert!(e["std"].as_f64().unwrap() > 0.0);
+    }
+    // Each compliance is a parameter of the fit, with its verdict.
+    assert!(
+        v["parameters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|p| p["name"] == "c_shoulder_lift_joint")
+    );
+}
+
+#[test]
+fn compare_compliance_fits_both_models_on_the_same_splits() {
+    let args = [
+        "calibrate",
+        "--robot",
+        UR10,
+        "--tip",
+        "wrist_3_link",
+        "--measurements",
+        UR10_CSV,
+        "--holdout",
+        "0.25",
+        "--splits",
+        "3",
+        "--json",
+    ];
+    let plain = common::json_of(&args);
+    let mut with = args.to_vec();
+    with.push("--compare-compliance");
+    let v = common::json_of(&with);
+    let c = &v["compliance_comparison"];
+    // The geometric side is the plain held-out run: same splits, same fits.
+    assert_eq!(
+        c["geometric_position_rms_mm"],
+        plain["holdout"]["position_rms_mm"]["per_split"]
+    );
+    assert_eq!(c["compliant_position_rms_mm"].as_array().unwrap().len(), 3);
+    assert!(c["verdict"].as_str().unwrap().contains("compliance"));
+}
+
+#[test]
+fn compliance_inputs_are_checked() {
+    common::fails_with(
+        &[
+            "calibrate",
+            "--robot",
+            "ur5",
+            "--measurements",
+            UR10_CSV,
+            "--compliance",
+        ],
+        "needs a URDF robot",
+    );
+    common::fails_with(
+        &[
+            "calibrate",
+            "--robot",
+            UR10,
+            "--tip",
+            "wrist_3_link",
+            "--measurements",
+            UR10_CSV,
+            "--payload",
+            "2@0,0",
+        ],
+        "three finite numbers",
+    );
+    common::fails_with(
+        &[
+            "calibrate",
+            "--robot",
+            UR10,
+            "--tip",
+            "wrist_3_link",
+            "--measurements",
+            UR10_CSV,
+            "--payload",
+            "2",
+        ],
+        "--inertia and --payload are for --compliance",
+    );
+}
+
+#[test]
+fn a_payload_and_other_inertials_change_the_torques() {
+    let base = [
+        "calibrate",
+        "--robot",
+        UR10,
+        "--tip",
+        "wrist_3_link",
+        "--measurements",
+        UR10_CSV,
+        "--compliance",
+        "--json",
+    ];
+    let range = |v: &serde_json::Value| v["compliance"]["estimates"][0]["torque_range_nm"].clone();
+    let plain = common::json_of(&base);
+    let mut same = base.to_vec();
+    same.extend(["--inertia", "fixtures/figaroh/ur10_robot.urdf"]);
+    assert_eq!(range(&common::json_of(&same)), range(&plain));
+    let mut heavy = base.to_vec();
+    heavy.extend(["--payload", "5@0,0,0.1"]);
+    assert_ne!(range(&common::json_of(&heavy)), range(&plain));
+}

@@ -323,7 +323,14 @@ pub fn calibrate_measured(
     let compliance = without.map(|w| activecal::identify::compliance::report(&r, &f.id, &meas, w));
     let gravity = |on: bool| o.gravity.clone().filter(|_| on);
     let prep_with = |g: Option<std::sync::Arc<activecal::model::gravity::GravityModel>>| {
-        let (fix, free) = (o.fix.to_vec(), o.free.to_vec());
+        // The geometric model has no compliance to fix or free.
+        let geometric = |v: &[String]| -> Vec<String> {
+            v.iter()
+                .filter(|n| g.is_some() || !n.starts_with("c_"))
+                .cloned()
+                .collect()
+        };
+        let (fix, free) = (geometric(o.fix), geometric(o.free));
         move |x: &Robot, t: &activecal::model::ParamTable, m: &Measurements| {
             let x = match &g {
                 Some(g) => with_compliance(x, g, m).0,

@@ -349,3 +349,30 @@ fn a_payload_and_other_inertials_change_the_torques() {
     heavy.extend(["--payload", "5@0,0,0.1"]);
     assert_ne!(range(&common::json_of(&heavy)), range(&plain));
 }
+
+#[test]
+fn bound_and_select_take_the_compliance_columns() {
+    let args = [
+        "bound",
+        "--robot",
+        "fixtures/example-robot-data/panda.urdf:pose",
+        "--tip",
+        "panda_hand_tcp",
+        "--pool",
+        "sobol",
+        "--count",
+        "256",
+        "--n",
+        "40",
+        "--json",
+    ];
+    let plain = common::json_of(&args);
+    let mut with = args.to_vec();
+    with.push("--compliance");
+    let v = common::json_of(&with);
+    // Five compliances (joints 2–6; joint 1 is vertical, joint 7's torque
+    // too small) on top of the 34 geometric unknowns.
+    assert_eq!(plain["p"], 34);
+    assert_eq!(v["p"], 39);
+    assert_eq!(v["status"], "certified");
+}

@@ -289,6 +289,11 @@ pub struct PoolOpts {
     /// Units of --pool file: and --existing values.
     #[command(flatten)]
     pub units: units::UnitOpts,
+    /// Add a compliance unknown per revolute joint whose gravity torque
+    /// (from the URDF's inertials) varies over the pool, so that designs
+    /// separate sag from geometry (as `calibrate --compliance` fits).
+    #[arg(long)]
+    pub compliance: bool,
     /// Keep candidates this far inside every revolute joint's limits,
     /// degrees: lattice and sampled pools are made over the shrunk ranges, a
     /// file's rows closer to a limit are removed [default: 2 for a .urdf
@@ -428,13 +433,6 @@ pub fn load_description(name: &str) -> Result<activecal::io::Description> {
     d.robot.validate()?;
     has_joints(name, &d.robot)?;
     Ok(d)
-}
-
-/// Builds the pool of `spec` for `robot` ([`PoolSpec::build`], filters at the
-/// nominal model) and its Jacobian at `params`.
-pub fn build_pool(robot: Robot, spec: &PoolSpec, params: ParamSet) -> Result<PoolCtx> {
-    let pool = spec.build(&robot, &robot.nominal)?;
-    with_jacobian(robot, pool, params)
 }
 
 /// A built pool with its Jacobian at `params` (reserved fallibly: memory
@@ -644,8 +642,22 @@ impl PoolOpts {
                 self.units.units(),
             )?;
             let pool = spec.build_listed(&d.robot, &d.robot.nominal, rows)?;
-            return with_jacobian(d.robot, pool, self.params);
+            let robot = self.compliant(d.robot, &pool)?;
+            return with_jacobian(robot, pool, self.params);
         }
-        build_pool(d.robot, &spec, self.params)
+        let pool = spec.build(&d.robot, &d.robot.nominal)?;
+        let robot = self.compliant(d.robot, &pool)?;
+        with_jacobian(robot, pool, self.params)
+    }
+
+    /// With `--compliance`, the robot with a compliance unknown per joint
+    /// whose gravity torque varies over the pool.
+    fn compliant(&self, robot: Robot, pool: &Pool) -> Result<Robot> {
+        if !self.compliance {
+            return Ok(robot);
+        }
+        let g = compliance::gravity_for(&robot, None, None)?;
+        let qs: Vec<Vec<f64>> = (0..pool.len()).map(|k| pool.q(k)).collect();
+        Ok(activecal::identify::compliance::with_compliance_at(&robot, &g, &qs).0)
     }
 }

@@ -38,9 +38,20 @@ pub fn with_compliance(
     gravity: &Arc<GravityModel>,
     meas: &Measurements,
 ) -> (Robot, Vec<NoCompliance>) {
+    with_compliance_at(robot, gravity, meas.qs())
+}
+
+/// [`with_compliance`] over joint configurations `qs` (a pool's: the
+/// design Jacobian then has the compliance columns).
+#[must_use]
+pub fn with_compliance_at(
+    robot: &Robot,
+    gravity: &Arc<GravityModel>,
+    qs: &[Vec<f64>],
+) -> (Robot, Vec<NoCompliance>) {
     let mut r = robot.clone();
     r.gravity = Some(Arc::clone(gravity));
-    let (lo, hi) = torque_ranges(gravity, meas.qs());
+    let (lo, hi) = torque_ranges(gravity, qs);
     let scale = lo.iter().zip(&hi).fold(0.0f64, |m, (a, b)| m.max(b - a));
     let names = joint_names(robot);
     let mut skipped = Vec::new();

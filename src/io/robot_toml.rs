@@ -694,7 +694,8 @@ pub fn description_to_toml(robot: &Robot, visibility: Option<&Visibility>) -> St
         let syms: Vec<String> = robot
             .unknowns
             .iter()
-            .filter(|u| u.frame == i)
+            // A compliance belongs to the gravity model, not the description.
+            .filter(|u| u.frame == i && u.symbol != Symbol::C)
             .map(|u| format!("\"{}\"", u.symbol))
             .collect();
         if !syms.is_empty() {

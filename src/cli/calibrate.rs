@@ -121,7 +121,7 @@ pub struct CalibrateArgs {
     #[arg(long, value_name = "FILE")]
     pub inertia: Option<PathBuf>,
     /// A payload on the tip link: KG, or KG@X,Y,Z (metres, tip link frame).
-    #[arg(long, value_name = "KG[@X,Y,Z]", value_parser = super::compliance::parse_payload)]
+    #[arg(long, value_name = "KG[@X,Y,Z]", value_parser = super::compliance::parse_payload, allow_hyphen_values = true)]
     pub payload: Option<activecal::io::inertia::Payload>,
     /// Units of the --measurements file.
     #[command(flatten)]

@@ -375,6 +375,46 @@ fn bound_and_select_take_the_compliance_columns() {
     assert_eq!(plain["p"], 34);
     assert_eq!(v["p"], 39);
     assert_eq!(v["status"], "certified");
+    // A design chosen for them names its compliant joints; gap and score
+    // give them their columns again.
+    let d = common::scratch_dir("compliance", "design");
+    let design = d.join("d.json");
+    common::json_of(&[
+        "select",
+        "--robot",
+        "fixtures/example-robot-data/panda.urdf:pose",
+        "--tip",
+        "panda_hand_tcp",
+        "--pool",
+        "sobol",
+        "--count",
+        "256",
+        "--n",
+        "40",
+        "--starts",
+        "1",
+        "--ils",
+        "0",
+        "--compliance",
+        "--out",
+        design.to_str().unwrap(),
+        "--json",
+    ]);
+    let file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&design).unwrap()).unwrap();
+    assert_eq!(
+        file["compliance"].as_array().unwrap().len(),
+        5,
+        "{}",
+        file["compliance"]
+    );
+    let gap = common::json_of(&["gap", "--design", design.to_str().unwrap(), "--json"]);
+    let score = common::json_of(&["score", "--design", design.to_str().unwrap(), "--json"]);
+    assert_eq!(
+        (gap["p"].as_u64(), score["p"].as_u64()),
+        (Some(39), Some(39))
+    );
+    assert!(gap["d_efficiency"].as_f64().unwrap() <= 1.0 + 1e-9);
 }
 
 #[test]

@@ -442,6 +442,20 @@ pub fn with_jacobian(robot: Robot, pool: Pool, params: ParamSet) -> Result<PoolC
     Ok(PoolCtx { robot, pool, x })
 }
 
+/// The robot with the compliance unknowns a design was chosen for
+/// (`select --compliance`), or as it is.
+pub fn design_compliance(robot: Robot, d: &activecal::io::design::DesignFile) -> Result<Robot> {
+    if d.compliance.is_empty() {
+        return Ok(robot);
+    }
+    let g = compliance::gravity_for(&robot, None, None)?;
+    Ok(activecal::identify::compliance::with_compliant_joints(
+        &robot,
+        &g,
+        &d.compliance,
+    )?)
+}
+
 /// One line per filter (what it removed) and per note of a pool's build.
 pub fn pool_stats_text(st: &activecal::pool::PoolStats) -> String {
     let mut s = format!("pool: {} candidates", st.candidates);

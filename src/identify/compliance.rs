@@ -85,6 +85,41 @@ pub fn with_compliance_at(
     (r, skipped)
 }
 
+/// The robot with a gravity model and a compliance unknown for each joint
+/// of `joints` (by name, as a design file stores them); a name that is not
+/// a revolute joint of the chain is an error.
+pub fn with_compliant_joints(
+    robot: &Robot,
+    gravity: &Arc<GravityModel>,
+    joints: &[String],
+) -> crate::Result<Robot> {
+    let mut r = robot.clone();
+    r.gravity = Some(Arc::clone(gravity));
+    let names = joint_names(robot);
+    for name in joints {
+        let frame = names.iter().position(|n| n == name).and_then(|j| {
+            r.frames
+                .iter()
+                .position(|f| f.joint == Some(j))
+                .filter(|&f| r.is_compliant_frame(f))
+        });
+        let Some(frame) = frame else {
+            return Err(crate::Error::Invalid(format!(
+                "compliance of '{name}': not a revolute joint of the chain ({})",
+                names.join(", ")
+            )));
+        };
+        r.unknowns.push(ParamId {
+            frame,
+            symbol: Symbol::C,
+        });
+    }
+    r.unknowns.sort();
+    r.unknowns.dedup();
+    r.validate()?;
+    Ok(r)
+}
+
 /// Smallest and largest gravity torque of each joint over `qs`.
 fn torque_ranges(g: &GravityModel, qs: &[Vec<f64>]) -> (Vec<f64>, Vec<f64>) {
     let n = g.dof();

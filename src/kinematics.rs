@@ -99,8 +99,7 @@ fn walk(
 /// [`Robot::check_q`]).
 #[must_use]
 pub fn position(robot: &Robot, table: &ParamTable, q: &[f64]) -> Vector3<f64> {
-    let mut axes = vec![FrameAxes::default(); robot.frames.len()];
-    walk(robot, table, q, &mut axes).1
+    Evaluator::new(robot, table).end_frame(q).position
 }
 
 /// Position of the end point, with the joint vector validated.
@@ -114,8 +113,8 @@ pub fn position_checked(robot: &Robot, table: &ParamTable, q: &[f64]) -> Result<
 /// [`Robot::check_q`]).
 #[must_use]
 pub fn pose(robot: &Robot, table: &ParamTable, q: &[f64]) -> (Matrix3<f64>, Vector3<f64>) {
-    let mut axes = vec![FrameAxes::default(); robot.frames.len()];
-    walk(robot, table, q, &mut axes)
+    let e = Evaluator::new(robot, table).end_frame(q);
+    (e.rotation, e.position)
 }
 
 /// The end frame of the chain: orientation `R` (columns: the end frame's
@@ -143,28 +142,67 @@ pub struct Motion {
 
 /// Reusable scratch for walking one robot's chain many times: avoids an
 /// allocation per pose.
+///
+/// A robot with a gravity model ([`Robot::gravity`]) whose table has joint
+/// compliances, or whose unknowns include one ([`Symbol::C`]), is walked at
+/// the deflected configuration `q + c∘τ(q)`, `τ` the gravity torques at
+/// the commanded `q` (which no kinematic parameter changes): every sensor
+/// sees the sag. A compliance's motion is its joint's motion at the
+/// deflected configuration times `τ_j(q)`, exactly.
 #[derive(Clone, Debug)]
 pub struct Evaluator<'r> {
     robot: &'r Robot,
     table: &'r ParamTable,
     axes: Vec<FrameAxes>,
+    /// Whether the chain deflects (or a compliance is unknown).
+    deflects: bool,
+    /// Gravity torques at the last commanded configuration.
+    tau: Vec<f64>,
+    /// The last deflected configuration.
+    q_eff: Vec<f64>,
 }
 
 impl<'r> Evaluator<'r> {
     /// An evaluator for one robot and parameter table.
     #[must_use]
     pub fn new(robot: &'r Robot, table: &'r ParamTable) -> Self {
+        let deflects = robot.gravity.is_some()
+            && (table.has_compliance() || robot.unknowns.iter().any(|u| u.symbol == Symbol::C));
         Self {
             robot,
             table,
             axes: vec![FrameAxes::default(); robot.frames.len()],
+            deflects,
+            tau: vec![0.0; robot.dof()],
+            q_eff: vec![0.0; robot.dof()],
         }
     }
 
-    /// The end frame at `q` (see [`pose`]).
+    /// The end frame at `q` (see [`pose`]), deflected under gravity when the
+    /// robot's joints are compliant.
     pub fn end_frame(&mut self, q: &[f64]) -> EndFrame {
-        let (rotation, position) = walk(self.robot, self.table, q, &mut self.axes);
+        let (rotation, position) = match (self.deflects, self.robot.gravity.as_deref()) {
+            (true, Some(g)) => {
+                g.torques(q, &mut self.tau);
+                self.q_eff.copy_from_slice(q);
+                for (f, frame) in self.robot.frames.iter().enumerate() {
+                    if let Some(j) = frame.joint {
+                        let c = self.table.compliance.get(f).copied().unwrap_or(0.0);
+                        self.q_eff[j] += c * self.tau[j];
+                    }
+                }
+                walk(self.robot, self.table, &self.q_eff, &mut self.axes)
+            }
+            _ => walk(self.robot, self.table, q, &mut self.axes),
+        };
         EndFrame { rotation, position }
+    }
+
+    /// The gravity torques of the last configuration walked (N·m, N; zeros
+    /// for a robot that does not deflect).
+    #[must_use]
+    pub fn torques(&self) -> &[f64] {
+        &self.tau
     }
 
     /// The end frame at `q`, and in `out` (one entry per unknown, in
@@ -197,6 +235,17 @@ impl<'r> Evaluator<'r> {
                     lin: ax.y.cross(&(p - ax.o_twist)),
                     ang: ax.y,
                 },
+                // q_j + c·τ_j: the joint's own motion (revolute, about the
+                // base z) scaled by the torque.
+                Symbol::C => {
+                    let t = self.robot.frames[u.frame]
+                        .joint
+                        .map_or(0.0, |j| self.tau[j]);
+                    Motion {
+                        lin: ax.z.cross(&(p - ax.o_base)) * t,
+                        ang: ax.z * t,
+                    }
+                }
             };
         }
         end

@@ -721,6 +721,66 @@ const CASES: &[Case] = &[
         1,
         &["--out d.json", "exists; pass --force"],
     ),
+    // Compliance (issue #31): a URDF with inertials, a payload of three
+    // coordinates, options that need --compliance.
+    case(
+        &[
+            "calibrate",
+            "--robot",
+            "ur5",
+            "--measurements",
+            UR10_CSV,
+            "--compliance",
+        ],
+        1,
+        &["--compliance needs a URDF robot", "'ur5'"],
+    ),
+    case(
+        &[
+            "calibrate",
+            "--robot",
+            UR10_POSE,
+            "--tip",
+            "wrist_3_link",
+            "--measurements",
+            UR10_CSV,
+            "--compliance",
+            "--payload",
+            "-1",
+        ],
+        2,
+        &["--payload", "must be finite and >= 0"],
+    ),
+    case(
+        &[
+            "calibrate",
+            "--robot",
+            UR10_POSE,
+            "--tip",
+            "wrist_3_link",
+            "--measurements",
+            UR10_CSV,
+            "--compliance",
+            "--inertia",
+            "nowhere.urdf",
+        ],
+        1,
+        &["--inertia nowhere.urdf"],
+    ),
+    case(
+        &[
+            "calibrate",
+            "--robot",
+            UR10_POSE,
+            "--tip",
+            "wrist_3_link",
+            "--measurements",
+            UR10_CSV,
+            "--compare-compliance",
+        ],
+        2,
+        &["--holdout"],
+    ),
 ];
 
 fn activecal(dir: &Path, args: &[&str]) -> std::process::Output {

@@ -249,6 +249,7 @@ fn any_robot() -> impl Strategy<Value = Robot> {
                 },
                 orientation_scale: activecal::model::DEFAULT_ORIENTATION_SCALE,
                 source: None,
+                gravity: None,
             }
         })
 }

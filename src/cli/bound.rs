@@ -186,7 +186,8 @@ pub fn cmd_gap(a: GapArgs) -> Result<()> {
     let pool = d
         .build_pool(&spec, &desc.robot, &desc.robot.nominal)
         .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?;
-    let ctx = super::with_jacobian(desc.robot, pool, a.params)?;
+    let robot = super::design_compliance(desc.robot, &d)?;
+    let ctx = super::with_jacobian(robot, pool, a.params)?;
     // A refined design's poses are off the pool: it is scored from its
     // joint values against the bound of the pool it started from.
     let positions = if d.refined {

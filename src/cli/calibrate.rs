@@ -118,6 +118,22 @@ pub struct CalibrateArgs {
     /// Contacts: fit on this placement alone, judge on each other one.
     #[arg(long, value_name = "PLACEMENT", requires = "measurements")]
     pub train_on: Option<String>,
+    /// Also fit a compliance per revolute joint whose gravity torque (from
+    /// the URDF's inertials) varies over the data: the joint deflects by
+    /// c·τ(q); reports c, σ, t, k = −1/c and the largest deflection.
+    #[arg(long, requires = "measurements")]
+    pub compliance: bool,
+    /// With --holdout: fit with and without compliances on the same splits
+    /// and compare held-out errors.
+    #[arg(long, requires = "holdout")]
+    pub compare_compliance: bool,
+    /// Take the links' masses and centres of mass from this URDF (same link
+    /// names) instead of the robot's own.
+    #[arg(long, value_name = "FILE")]
+    pub inertia: Option<PathBuf>,
+    /// A payload on the tip link: KG, or KG@X,Y,Z (metres, tip link frame).
+    #[arg(long, value_name = "KG[@X,Y,Z]", value_parser = super::compliance::parse_payload, allow_hyphen_values = true)]
+    pub payload: Option<activecal::io::inertia::Payload>,
     /// Units of the --measurements file.
     #[command(flatten)]
     pub units: super::units::UnitOpts,
@@ -338,6 +354,20 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
             }),
         json: a.json,
         units: a.units.units(),
+        gravity: if a.compliance || a.compare_compliance {
+            Some(super::compliance::gravity_for(
+                robot,
+                a.inertia.as_deref(),
+                a.payload,
+            )?)
+        } else {
+            if a.inertia.is_some() || a.payload.is_some() {
+                bail!("--inertia and --payload are for --compliance or --compare-compliance");
+            }
+            None
+        },
+        fit_compliance: a.compliance,
+        compare_compliance: a.compare_compliance,
     };
     let (fitted, f, mut report) =
         super::measured::calibrate_measured(robot, path, &o, &|| t0.elapsed().as_secs_f64())?;

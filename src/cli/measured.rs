@@ -4,6 +4,7 @@
 //! work is in `activecal::identify`.
 
 use super::emit_report;
+use activecal::identify::compliance::with_compliance;
 use activecal::identify::evaluation::ModelErrors;
 use activecal::identify::{
     Fit, FixedParameter, HoldoutSettings, Identification, LmSettings, LossChoice, Measurements,
@@ -103,6 +104,12 @@ pub struct MeasuredOptions<'a> {
     pub json: bool,
     /// Units of the measurement file.
     pub units: activecal::units::Units,
+    /// The gravity model, when compliances are fitted or compared.
+    pub gravity: Option<std::sync::Arc<activecal::model::gravity::GravityModel>>,
+    /// Fit a compliance per joint whose gravity torque varies.
+    pub fit_compliance: bool,
+    /// With held-out splits: fit with and without compliances, side by side.
+    pub compare_compliance: bool,
 }
 
 /// `calibrate --measurements`' JSON report.
@@ -132,6 +139,12 @@ pub struct MeasuredReport {
     /// origins (URDF robots).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub frames: Option<activecal::frames::report::FramesReport>,
+    /// The fitted joint compliances.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compliance: Option<activecal::identify::compliance::ComplianceReport>,
+    /// Held-out errors with and without compliances on the same splits.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compliance_comparison: Option<super::compliance::ComplianceComparison>,
 }
 
 /// Held-out figures over splits.
@@ -284,7 +297,14 @@ pub fn calibrate_measured(
             eprintln!("note: {n}");
         }
     }
-    let det = prepare_for_data(&start.robot, &start.table, &meas, o.fix, o.free)
+    let (fitted_robot, without) = match (&o.gravity, o.fit_compliance) {
+        (Some(g), true) => {
+            let (r, w) = with_compliance(&start.robot, g, &meas);
+            (r, Some(w))
+        }
+        _ => (start.robot.clone(), None),
+    };
+    let det = prepare_for_data(&fitted_robot, &start.table, &meas, o.fix, o.free)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let r = det.robot;
     let f = fit(&r, &start.table, &meas, &o.lm, o.loss)
@@ -300,18 +320,51 @@ pub fn calibrate_measured(
         None => residuals(&r, &r.nominal, &meas)?,
     };
     let params = trust(&r, &r.nominal, &f.id);
+    let compliance = without.map(|w| activecal::identify::compliance::report(&r, &f.id, &meas, w));
+    let gravity = |on: bool| o.gravity.clone().filter(|_| on);
+    let prep_with = |g: Option<std::sync::Arc<activecal::model::gravity::GravityModel>>| {
+        // The geometric model has no compliance to fix or free.
+        let geometric = |v: &[String]| -> Vec<String> {
+            v.iter()
+                .filter(|n| g.is_some() || !n.starts_with("c_"))
+                .cloned()
+                .collect()
+        };
+        let (fix, free) = (geometric(o.fix), geometric(o.free));
+        move |x: &Robot, t: &activecal::model::ParamTable, m: &Measurements| {
+            let x = match &g {
+                Some(g) => with_compliance(x, g, m).0,
+                None => x.clone(),
+            };
+            prepare_for_data(&x, t, m, &fix, &free).map(|d| d.robot)
+        }
+    };
     let ho = match &o.holdout {
         Some(h) => {
-            let (fix, free) = (o.fix.to_vec(), o.free.to_vec());
-            let prep = move |x: &Robot, t: &activecal::model::ParamTable, m: &Measurements| {
-                prepare_for_data(x, t, m, &fix, &free).map(|d| d.robot)
-            };
+            let prep = prep_with(gravity(o.fit_compliance));
             Some(holdout_report(
                 *h,
                 holdout(robot, given, &meas, &o.lm, o.loss, h, &prep)?,
             ))
         }
         None => None,
+    };
+    let comparison = match (&o.holdout, o.compare_compliance) {
+        (Some(h), true) => {
+            let plain = HoldoutSettings { prune: false, ..*h };
+            let geo = holdout(robot, given, &meas, &o.lm, o.loss, &plain, &prep_with(None))?;
+            let com = holdout(
+                robot,
+                given,
+                &meas,
+                &o.lm,
+                o.loss,
+                &plain,
+                &prep_with(gravity(true)),
+            )?;
+            Some(super::compliance::compare(&geo, &com))
+        }
+        _ => None,
     };
     let mut base = activecal::report::MeasuredCalibrationReport::new(
         &r,
@@ -331,6 +384,8 @@ pub fn calibrate_measured(
         holdout: ho,
         notes,
         frames: None,
+        compliance,
+        compliance_comparison: comparison,
     };
     Ok((r, f, report))
 }
@@ -379,6 +434,9 @@ pub fn measured_text(r: &MeasuredReport, id: &Identification, status: &str) -> S
             p.verdict
         );
     }
+    if let Some(c) = &r.compliance {
+        s += &super::compliance::compliance_text(c);
+    }
     if let Some(f) = &r.frames {
         s += &super::frames_text::frames_text(f);
     }
@@ -419,6 +477,12 @@ pub fn measured_text(r: &MeasuredReport, id: &Identification, status: &str) -> S
                 }
             );
         }
+    }
+    if let Some(c) = &r.compliance_comparison {
+        s += &format!(
+            "\ncompliance on the same splits:\n{}",
+            super::compliance::comparison_text(c)
+        );
     }
     s
 }

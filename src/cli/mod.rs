@@ -4,6 +4,7 @@ pub mod basic;
 pub mod bench;
 pub mod bound;
 pub mod calibrate;
+pub mod compliance;
 pub mod contact;
 pub mod figures;
 pub mod frames_text;
@@ -303,6 +304,11 @@ pub struct PoolOpts {
     /// Units of --pool file: and --existing values.
     #[command(flatten)]
     pub units: units::UnitOpts,
+    /// Add a compliance unknown per revolute joint whose gravity torque
+    /// (from the URDF's inertials) varies over the pool, so that designs
+    /// separate sag from geometry (as `calibrate --compliance` fits).
+    #[arg(long)]
+    pub compliance: bool,
     /// Keep candidates this far inside every revolute joint's limits,
     /// degrees: lattice and sampled pools are made over the shrunk ranges, a
     /// file's rows closer to a limit are removed [default: 2 for a .urdf
@@ -444,18 +450,25 @@ pub fn load_description(r: &RobotRef) -> Result<activecal::io::Description> {
     Ok(d)
 }
 
-/// Builds the pool of `spec` for `robot` ([`PoolSpec::build`], filters at the
-/// nominal model) and its Jacobian at `params`.
-pub fn build_pool(robot: Robot, spec: &PoolSpec, params: ParamSet) -> Result<PoolCtx> {
-    let pool = spec.build(&robot, &robot.nominal)?;
-    with_jacobian(robot, pool, params)
-}
-
 /// A built pool with its Jacobian at `params` (reserved fallibly: memory
 /// the system refuses is an error, not an abort).
 pub fn with_jacobian(robot: Robot, pool: Pool, params: ParamSet) -> Result<PoolCtx> {
     let x = pool.try_jacobian(&robot, robot.params(params))?;
     Ok(PoolCtx { robot, pool, x })
+}
+
+/// The robot with the compliance unknowns a design was chosen for
+/// (`select --compliance`), or as it is.
+pub fn design_compliance(robot: Robot, d: &activecal::io::design::DesignFile) -> Result<Robot> {
+    if d.compliance.is_empty() {
+        return Ok(robot);
+    }
+    let g = compliance::gravity_for(&robot, None, None)?;
+    Ok(activecal::identify::compliance::with_compliant_joints(
+        &robot,
+        &g,
+        &d.compliance,
+    )?)
 }
 
 /// One line per filter (what it removed) and per note of a pool's build.
@@ -662,8 +675,22 @@ impl PoolOpts {
                 self.units.units(),
             )?;
             let pool = spec.build_listed(&d.robot, &d.robot.nominal, rows)?;
-            return with_jacobian(d.robot, pool, self.params);
+            let robot = self.compliant(d.robot, &pool)?;
+            return with_jacobian(robot, pool, self.params);
         }
-        build_pool(d.robot, &spec, self.params)
+        let pool = spec.build(&d.robot, &d.robot.nominal)?;
+        let robot = self.compliant(d.robot, &pool)?;
+        with_jacobian(robot, pool, self.params)
+    }
+
+    /// With `--compliance`, the robot with a compliance unknown per joint
+    /// whose gravity torque varies over the pool.
+    fn compliant(&self, robot: Robot, pool: &Pool) -> Result<Robot> {
+        if !self.compliance {
+            return Ok(robot);
+        }
+        let g = compliance::gravity_for(&robot, None, None)?;
+        let qs: Vec<Vec<f64>> = (0..pool.len()).map(|k| pool.q(k)).collect();
+        Ok(activecal::identify::compliance::with_compliance_at(&robot, &g, &qs).0)
     }
 }

@@ -109,7 +109,7 @@ pub fn cmd_score(a: ScoreArgs, given: &[&str]) -> Result<()> {
             let d = DesignFile::read(path)?;
             check_design_options(&a, given, &d, path)?;
             let desc = load_description(&d.robot_ref()?)?;
-            let robot = desc.robot;
+            let robot = super::design_compliance(desc.robot, &d)?;
             let qs = d
                 .joint_values(&robot)
                 .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;

@@ -26,7 +26,7 @@ pub mod report;
 pub mod structure;
 pub mod uncertainty;
 
-use crate::model::{JointKind, ParamTable, Robot};
+use crate::model::{JointKind, ParamTable, Robot, Symbol};
 use chain::{ModelFrames, UrdfFrames, model_to_urdf};
 use nalgebra::{Isometry3, Vector3};
 
@@ -158,6 +158,28 @@ pub fn calibrated(
     let sigma = cov
         .map(|c| uncertainty::sigmas(robot, table, c))
         .transpose()?;
-    let r = report::FramesReport::new(src, robot.measurement, &f, sigma.as_ref(), fit);
+    let mut r = report::FramesReport::new(src, robot.measurement, &f, sigma.as_ref(), fit);
+    let names = src.driven_names();
+    for (k, u) in robot.unknowns.iter().enumerate() {
+        let Some(j) = robot.frames[u.frame]
+            .joint
+            .filter(|_| u.symbol == Symbol::C)
+        else {
+            continue;
+        };
+        let c = table.get(*u);
+        let sigma_c = cov
+            .and_then(|m| m.get(k))
+            .and_then(|row| row.get(k))
+            .map(|v| v.sqrt());
+        r.compliance.insert(
+            names[j].clone(),
+            report::ComplianceBlock {
+                c,
+                k: (c != 0.0).then(|| -1.0 / c),
+                sigma_c,
+            },
+        );
+    }
     Ok(Some((f, r)))
 }

@@ -148,6 +148,24 @@ pub struct FramesReport {
     /// The fit.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fit: Option<FitBlock>,
+    /// Each compliant joint's compliance, by joint name (a fit with
+    /// compliances): the joint deflects by `c·τ(q)` under its gravity
+    /// torque from the URDF's inertials.
+    #[serde(skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub compliance: std::collections::BTreeMap<String, ComplianceBlock>,
+}
+
+/// One joint's compliance in the frames file.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct ComplianceBlock {
+    /// Compliance, rad per N·m.
+    pub c: f64,
+    /// Stiffness `−1/c`, N·m per rad (absent for c = 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub k: Option<f64>,
+    /// σ of `c`, when the fit has a covariance.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma_c: Option<f64>,
 }
 
 fn quaternion(t: &Isometry3<f64>) -> [f64; 4] {
@@ -298,6 +316,7 @@ impl FramesReport {
             joints: Joints(joints),
             structure: relations(f, &UrdfFrames::of(src).before),
             fit,
+            compliance: std::collections::BTreeMap::new(),
         }
     }
 }

@@ -35,6 +35,7 @@
 //! [`IdentifyError`]; a numerical outcome (no convergence, divergence, a rank
 //! deficient design) is the [`Status`] of the result.
 
+pub mod compliance;
 pub mod contact;
 pub mod evaluation;
 pub mod fit;

@@ -68,6 +68,10 @@ pub struct Determined {
 pub const GENERIC_REASON: &str =
     "not determined by these data (column-pivoted QR on the column-scaled Jacobian)";
 
+/// The reason given for a joint compliance the data do not tell from the
+/// geometry.
+pub const COMPLIANCE_REASON: &str = "compliance not determined by these data: the sag it would explain is indistinguishable from the geometry's (held at 0)";
+
 /// Finds the unknowns of `robot` that `meas` do not determine at `start`
 /// and fixes them (see the module documentation); `keep` names the
 /// parameters never to fix (the user's `--free`).
@@ -114,7 +118,11 @@ pub fn fix_undetermined_below(
     let group = |k: usize| -> usize {
         if k >= n_kin || keep.contains(&names[k]) {
             0
-        } else if frozen_frame_joint(robot, k, &frozen).is_some() {
+        } else if frozen_frame_joint(robot, k, &frozen).is_some()
+            || robot.unknowns[k].symbol == crate::model::Symbol::C
+        {
+            // A compliance is pivoted last: where sag and geometry cannot
+            // be told apart, the compliance is the one held (at 0).
             2
         } else {
             1
@@ -136,6 +144,9 @@ pub fn fix_undetermined_below(
             value: start.get(robot.unknowns[k]),
             reason: match frozen_frame_joint(robot, k, &frozen) {
                 Some(j) => format!("joint {} never moves in these data", jnames[j]),
+                None if robot.unknowns[k].symbol == crate::model::Symbol::C => {
+                    COMPLIANCE_REASON.to_string()
+                }
                 None => GENERIC_REASON.to_string(),
             },
         })

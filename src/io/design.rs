@@ -68,6 +68,10 @@ pub struct DesignFile {
     /// are the refined ones.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub refined: bool,
+    /// The joints whose compliance the design was chosen to identify
+    /// (`select --compliance`): `gap` and `score` give them their columns.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub compliance: Vec<String>,
     /// Anything else (algorithm, seed, ln_oid, ...), kept as written.
     #[serde(flatten)]
     pub extra: serde_json::Map<String, serde_json::Value>,
@@ -91,6 +95,17 @@ pub struct ExistingPoses {
     pub q: Vec<Vec<f64>>,
 }
 
+/// The names of the joints with a compliance unknown.
+fn compliant_joints(robot: &Robot) -> Vec<String> {
+    let names = crate::pool::file::joint_names(robot);
+    robot
+        .unknowns
+        .iter()
+        .filter(|u| u.symbol == crate::model::Symbol::C)
+        .filter_map(|u| robot.frames[u.frame].joint.map(|j| names[j].clone()))
+        .collect()
+}
+
 impl DesignFile {
     /// The design made of pool positions `positions` of `pool`, for `robot`.
     #[must_use]
@@ -110,6 +125,7 @@ impl DesignFile {
             pool_qs: pool.listed().map(<[Vec<f64>]>::to_vec),
             existing: None,
             refined: false,
+            compliance: compliant_joints(robot),
             extra: serde_json::Map::new(),
         }
     }
@@ -129,6 +145,7 @@ impl DesignFile {
             pool_qs: None,
             existing: None,
             refined: false,
+            compliance: Vec::new(),
             extra: serde_json::Map::new(),
         }
     }

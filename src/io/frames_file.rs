@@ -40,12 +40,19 @@ struct ChainEntry {
 }
 
 #[derive(Deserialize)]
+struct ComplianceEntry {
+    c: f64,
+}
+
+#[derive(Deserialize)]
 struct FileEntry {
     chain: Option<ChainEntry>,
     measurement_frame: Option<FrameEntry>,
     tool: Option<FrameEntry>,
     #[serde(default)]
     markers: Vec<MarkerEntry>,
+    #[serde(default)]
+    compliance: std::collections::BTreeMap<String, ComplianceEntry>,
 }
 
 /// What a frames file gives to mount a robot.
@@ -62,6 +69,9 @@ pub struct Frames {
     pub base: Option<String>,
     /// The tip link.
     pub tip: Option<String>,
+    /// Joint compliances (rad per N·m) by joint name: the chain deflects
+    /// under its gravity torques (from the URDF's inertials).
+    pub compliance: Vec<(String, f64)>,
 }
 
 fn iso(e: &FrameEntry) -> Isometry3<f64> {
@@ -105,6 +115,9 @@ pub fn parse(text: &str, origin: &str) -> Result<Frames> {
     for (k, m) in f.markers.iter().enumerate() {
         finite(&format!("markers[{k}].xyz"), &m.xyz)?;
     }
+    for (joint, c) in &f.compliance {
+        finite(&format!("compliance.{joint}.c"), &[c.c])?;
+    }
     if f.tool.is_some() && !f.markers.is_empty() {
         return Err(bad(
             "both a tool and markers: a frames file has one or the other".into(),
@@ -129,5 +142,6 @@ pub fn parse(text: &str, origin: &str) -> Result<Frames> {
         markers,
         base: f.chain.as_ref().and_then(|c| c.base.clone()),
         tip: f.chain.as_ref().and_then(|c| c.tip.clone()),
+        compliance: f.compliance.iter().map(|(j, c)| (j.clone(), c.c)).collect(),
     })
 }

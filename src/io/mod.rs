@@ -8,6 +8,7 @@ pub mod contacts;
 pub mod design;
 pub mod design_formats;
 pub mod frames_file;
+pub mod inertia;
 pub mod joint_speeds;
 pub mod measurements;
 pub mod read;
@@ -135,11 +136,58 @@ fn load_urdf(path: &Path, chain: &ChainChoice, pose: bool) -> Result<Robot> {
         opts.tool = f.tool;
     }
     let robot = urdf::load(path, &opts)?;
+    let robot = match &frames {
+        Some(f) if !f.compliance.is_empty() => with_compliance(robot, &f.compliance, chain)?,
+        _ => robot,
+    };
     match frames {
         // A copy of the robot with markers: its source comes along.
         Some(f) if !f.markers.is_empty() => robot.with_markers(&f.markers),
         _ => Ok(robot),
     }
+}
+
+/// The robot deflecting under gravity with the frames file's compliances
+/// (rad per N·m by joint name) in both tables; an unknown joint, or one
+/// that is not a revolute joint of the chain, is an error naming the file.
+fn with_compliance(
+    mut robot: Robot,
+    compliance: &[(String, f64)],
+    chain: &ChainChoice,
+) -> Result<Robot> {
+    let file = chain.frames.clone().unwrap_or_default();
+    let g = inertia::gravity_model(&robot, &inertia::InertiaOptions::default())?;
+    robot.gravity = Some(std::sync::Arc::new(g));
+    let names = robot
+        .source
+        .as_ref()
+        .map(|s| s.driven_names())
+        .unwrap_or_default();
+    for (joint, c) in compliance {
+        let frame = names.iter().position(|n| n == joint).and_then(|j| {
+            robot
+                .frames
+                .iter()
+                .position(|f| f.joint == Some(j))
+                .filter(|&f| robot.is_compliant_frame(f))
+        });
+        let Some(frame) = frame else {
+            return Err(Error::Parse {
+                path: file,
+                message: format!(
+                    "compliance.{joint}: not a revolute joint of the chain ({})",
+                    names.join(", ")
+                ),
+            });
+        };
+        let id = crate::model::ParamId {
+            frame,
+            symbol: crate::model::Symbol::C,
+        };
+        robot.nominal.set(id, *c);
+        robot.real.set(id, *c);
+    }
+    Ok(robot)
 }
 
 fn load_head(r: &RobotRef) -> Result<Description> {

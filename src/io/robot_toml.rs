@@ -410,6 +410,7 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
         measurement,
         orientation_scale,
         source: None,
+        gravity: None,
     };
     if let Some((nominal, real)) = markers {
         robot.nominal.markers = nominal;
@@ -690,7 +691,8 @@ pub fn description_to_toml(robot: &Robot, visibility: Option<&Visibility>) -> St
         let syms: Vec<String> = robot
             .unknowns
             .iter()
-            .filter(|u| u.frame == i)
+            // A compliance belongs to the gravity model, not the description.
+            .filter(|u| u.frame == i && u.symbol != Symbol::C)
             .map(|u| format!("\"{}\"", u.symbol))
             .collect();
         if !syms.is_empty() {

@@ -414,6 +414,7 @@ fn convert(chain: &[ChainJoint], name: &str, opts: &UrdfOptions) -> Robot {
         measurement: opts.measurement,
         orientation_scale: crate::model::DEFAULT_ORIENTATION_SCALE,
         source: None,
+        gravity: None,
     }
 }
 

@@ -92,6 +92,7 @@ fn assemble(
         measurement: m,
         orientation_scale: super::DEFAULT_ORIENTATION_SCALE,
         source: None,
+        gravity: None,
     };
     debug_assert!(r.validate().is_ok());
     r

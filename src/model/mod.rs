@@ -17,6 +17,7 @@
 
 pub mod catalogue;
 pub mod frame;
+pub mod gravity;
 pub mod robot_ref;
 pub mod source;
 
@@ -51,6 +52,12 @@ pub enum Symbol {
     D,
     /// Hayati twist β about y (radians).
     Beta,
+    /// Joint compliance `c` of the joint driving the frame (rad per N·m):
+    /// the joint deflects by `c·τ(q)` under its gravity torque `τ`
+    /// ([`gravity`]). Not a column of the frame tables: it lives in
+    /// [`ParamTable::compliance`], and is an unknown only of a robot with a
+    /// [`Robot::gravity`] model.
+    C,
 }
 
 impl Symbol {
@@ -63,7 +70,8 @@ impl Symbol {
         Symbol::Beta,
     ];
 
-    /// Column of this symbol in a parameter table.
+    /// Column of this symbol in a parameter table ([`Symbol::C`], which has
+    /// none, gives 5, past the table's columns).
     #[must_use]
     pub fn column(self) -> usize {
         self as usize
@@ -78,6 +86,7 @@ impl Symbol {
             Symbol::A => "a",
             Symbol::D => "d",
             Symbol::Beta => "beta",
+            Symbol::C => "c",
         }
     }
 
@@ -162,6 +171,10 @@ pub struct ParamTable {
     /// after the robot's in the parameter vector).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub markers: Vec<[f64; 3]>,
+    /// Joint compliances `c` (rad per N·m, [`Symbol::C`]), one per frame
+    /// (meaningful on frames driven by a revolute joint), or empty: all 0.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub compliance: Vec<f64>,
 }
 
 impl ParamTable {
@@ -171,6 +184,7 @@ impl ParamTable {
         Self {
             rows,
             markers: Vec::new(),
+            compliance: Vec::new(),
         }
     }
 
@@ -184,12 +198,29 @@ impl ParamTable {
     /// Value of a parameter.
     #[must_use]
     pub fn get(&self, id: ParamId) -> f64 {
-        self.rows[id.frame][id.symbol.column()]
+        match id.symbol {
+            Symbol::C => self.compliance.get(id.frame).copied().unwrap_or(0.0),
+            s => self.rows[id.frame][s.column()],
+        }
     }
 
     /// Sets a parameter.
     pub fn set(&mut self, id: ParamId, v: f64) {
-        self.rows[id.frame][id.symbol.column()] = v;
+        match id.symbol {
+            Symbol::C => {
+                if self.compliance.len() != self.rows.len() {
+                    self.compliance.resize(self.rows.len(), 0.0);
+                }
+                self.compliance[id.frame] = v;
+            }
+            s => self.rows[id.frame][s.column()] = v,
+        }
+    }
+
+    /// Whether any joint compliance is non-zero.
+    #[must_use]
+    pub fn has_compliance(&self) -> bool {
+        self.compliance.iter().any(|&c| c != 0.0)
     }
 }
 
@@ -295,6 +326,11 @@ pub struct Robot {
     /// [`source::UrdfSource`]): what writing a calibrated URDF back needs.
     #[serde(skip)]
     pub source: Option<std::sync::Arc<source::UrdfSource>>,
+    /// Gravity torques of the joints, when the robot's joints deflect under
+    /// them: the kinematics then evaluate `q + c∘τ(q)` with the table's
+    /// [`ParamTable::compliance`] (see [`gravity`]).
+    #[serde(skip)]
+    pub gravity: Option<std::sync::Arc<gravity::GravityModel>>,
 }
 
 /// Default [`Robot::orientation_scale`]: 1 m/rad, i.e. an orientation noise
@@ -419,6 +455,7 @@ impl Robot {
             measurement: MeasurementKind::Point,
             orientation_scale: DEFAULT_ORIENTATION_SCALE,
             source: None,
+            gravity: None,
         }
     }
 
@@ -479,7 +516,10 @@ impl Robot {
     pub fn param_id(&self, name: &str) -> Result<ParamId> {
         let bad = || Error::UnknownParameter(name.to_string());
         let (sym, frame) = name.split_once('_').ok_or_else(bad)?;
-        let symbol = Symbol::parse(sym).ok_or_else(bad)?;
+        let symbol = match sym {
+            "c" => Symbol::C,
+            _ => Symbol::parse(sym).ok_or_else(bad)?,
+        };
         let frame = self
             .frames
             .iter()
@@ -488,7 +528,19 @@ impl Robot {
         if symbol == Symbol::Beta && self.frames[frame].convention == Convention::Dh {
             return Err(bad());
         }
+        if symbol == Symbol::C && !self.is_compliant_frame(frame) {
+            return Err(bad());
+        }
         Ok(ParamId { frame, symbol })
+    }
+
+    /// Whether frame `frame` can carry a compliance unknown: the robot has a
+    /// gravity model and a revolute joint drives the frame.
+    #[must_use]
+    pub fn is_compliant_frame(&self, frame: usize) -> bool {
+        self.gravity.is_some()
+            && self.frames[frame].joint.is_some()
+            && self.frames[frame].joint_kind == JointKind::Revolute
     }
 
     /// The identified parameters' values in a table, in parameter-vector
@@ -659,6 +711,12 @@ impl Robot {
                     u.symbol,
                     u.frame,
                     self.frames.len()
+                )));
+            }
+            if u.symbol == Symbol::C && !self.is_compliant_frame(u.frame) {
+                return Err(Error::Invalid(format!(
+                    "{} is not a parameter: a compliance needs a revolute joint and the robot's gravity model",
+                    self.param_name(u)
                 )));
             }
             if u.symbol == Symbol::Beta && self.frames[u.frame].convention == Convention::Dh {

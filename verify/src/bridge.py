@@ -265,6 +265,37 @@ def urdf_relative_poses(path, base, tip, names, qs):
     return out
 
 
+def urdf_gravity(path, names, qs):
+    """Pinocchio's generalized gravity of the URDF at `path` (fixed base,
+    buildModelFromUrdf): computeGeneralizedGravity at each joint vector,
+    qs[k][i] the value of the joint names[i] (a continuous joint's angle
+    enters as cos, sin), every other joint at neutral. Returns, per vector,
+    the torques of the joints `names` (their idx_v entries)."""
+    model = _urdf_model(path)
+    data = model.createData()
+    joints = []
+    for n in names:
+        if not model.existJointName(n):
+            raise ValueError("Pinocchio's model has no joint %s" % n)
+        joints.append(model.joints[model.getJointId(n)])
+    out = []
+    for q in qs:
+        if len(q) != len(joints):
+            raise ValueError("%d values for %d joints" % (len(q), len(joints)))
+        x = pin.neutral(model)
+        for joint, v in zip(joints, q):
+            if joint.nq == 1:
+                x[joint.idx_q] = v
+            elif joint.nq == 2:
+                x[joint.idx_q] = np.cos(v)
+                x[joint.idx_q + 1] = np.sin(v)
+            else:
+                raise ValueError("unsupported joint with nq = %d" % joint.nq)
+        g = pin.computeGeneralizedGravity(model, data, x)
+        out.append([float(g[joint.idx_v]) for joint in joints])
+    return out
+
+
 def pinocchio_end_frames(model, qs):
     """The "ee" frame's placement (rotation 3x3, translation 3) at each q."""
     data = model.createData()

@@ -365,6 +365,33 @@ impl Bridge {
                 .collect())
         })
     }
+
+    /// Pinocchio's generalized gravity (`computeGeneralizedGravity`, fixed
+    /// base) of the URDF at `path` at each joint vector (`qs[k][i]` the value
+    /// of the joint `names[i]`; other joints neutral): the torques of the
+    /// joints `names`, N·m or N.
+    pub fn urdf_gravity(
+        &self,
+        path: &Path,
+        names: &[String],
+        qs: &[Vec<f64>],
+    ) -> Result<Vec<Vec<f64>>> {
+        Python::attach(|py| {
+            let r = module(py)?
+                .getattr("urdf_gravity")?
+                .call1((path.to_string_lossy().as_ref(), names.to_vec(), qs.to_vec()))
+                .with_context(|| format!("Pinocchio's gravity of {}", path.display()))?;
+            let tau: Vec<Vec<f64>> = r.extract()?;
+            if tau.len() != qs.len() {
+                bail!(
+                    "bridge returned {} torque vectors for {} joint vectors",
+                    tau.len(),
+                    qs.len()
+                );
+            }
+            Ok(tau)
+        })
+    }
 }
 
 /// cvxpy's solution of the relaxation (R) (see `bridge.py`).

@@ -30,6 +30,7 @@ pub mod erd;
 pub mod erd_fk;
 pub mod export;
 pub mod fixture;
+pub mod gravity;
 pub mod idjac;
 pub mod model;
 pub mod sample;
@@ -147,6 +148,7 @@ pub fn synthetic_robot() -> Robot {
         measurement: MeasurementKind::Point,
         orientation_scale: activecal::model::DEFAULT_ORIENTATION_SCALE,
         source: None,
+        gravity: None,
     };
     robot.validate().expect("synthetic robot is valid");
     robot

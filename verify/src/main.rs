@@ -12,7 +12,9 @@
 //! kinematics of the `example-robot-data` arms, [`verify::erd_fk`]) with
 //! copies of their URDFs in `fixtures/example-robot-data/`, and
 //! `fixtures/export/<case>.json` (Pinocchio's forward kinematics of the
-//! calibrated URDFs activecal writes, [`verify::export`]); with `--out DIR`
+//! calibrated URDFs activecal writes, [`verify::export`]) and
+//! `fixtures/gravity/<case>.json` (Pinocchio's gravity torques,
+//! [`verify::gravity`]); with `--out DIR`
 //! they go to `DIR/idjac/`, `DIR/example-robot-data/` and `DIR/export/`.
 //!
 //! Build with `PYO3_PYTHON=$PWD/.venv/bin/python` (scripts/test does).
@@ -24,7 +26,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 use verify::bridge::Bridge;
 use verify::check::{check_live, regenerate};
-use verify::{TOLERANCE, builtin_robots, erd_fk, export, fixture, idjac, synthetic_robot};
+use verify::{TOLERANCE, builtin_robots, erd_fk, export, fixture, gravity, idjac, synthetic_robot};
 
 /// Configurations of the identification-Jacobian check.
 const IDJAC_CONFIGS: usize = 200;
@@ -66,6 +68,7 @@ fn regen(dir: PathBuf) -> Result<bool> {
         &dir.join("example-robot-data"),
     )?);
     paths.extend(export::live::regenerate(&bridge, &dir.join("export"))?);
+    paths.extend(gravity::live::regenerate(&bridge, &dir.join("gravity"))?);
     for path in paths {
         let size = std::fs::metadata(&path)?.len();
         println!("wrote {} ({size} bytes)", path.display());

@@ -60,6 +60,11 @@ enum Command {
     /// Size of a pose lattice, or the index and angles of one lattice pose.
     Pool(PoolArgs),
     /// Observability indices of a design (ln OI_D, OI, O1-O5, A-trace, rank).
+    ///
+    /// OI_D = det XᵀX (X the identification Jacobian of the design's poses):
+    /// the parameter confidence ellipsoid's volume is ∝ 1/√OI_D. OI: the
+    /// paper's eq. (1), (σ_1⋯σ_p)^(1/p)/√N; O1–O5: the classical indices
+    /// (smallest singular value, condition, …); A-trace: tr (XᵀX)⁻¹.
     Score(ScoreArgs),
     /// Select the poses to measure (EAE, Fedorov, DETMAX or random search).
     Select(SelectArgs),
@@ -74,8 +79,17 @@ enum Command {
     /// fitting: the nominal model, or a calibrated description.
     Evaluate(EvaluateArgs),
     /// Certified upper bound on OI_D of every N-pose design (convex relaxation).
+    ///
+    /// OI_D = det XᵀX of a design. The bound: ln det M(w*) of the relaxation
+    /// (weights 0 ≤ w ≤ 1 summing to N), certified by a solver-free formula
+    /// so no N-pose pool design can exceed it; support: the poses carrying
+    /// relaxation weight.
     Bound(BoundArgs),
     /// A design's D-efficiency against the relaxation bound.
+    ///
+    /// D-efficiency = (OI_D / bound)^(1/p), OI_D = det XᵀX of the design: 1
+    /// means no N-pose design of the pool is better; a design refined off
+    /// the pool may exceed the pool's bound (it is said when it does).
     Gap(GapArgs),
 }
 

@@ -60,9 +60,10 @@ pub struct CalibrateArgs {
     /// Replace existing output files.
     #[arg(long)]
     pub force: bool,
-    /// Measurement noise σ per coordinate, metres. A full-pose robot's
-    /// orientation noise is σ / orientation_scale radians per axis.
-    #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
+    /// Measurement noise σ per coordinate, metres (the default, 0.01, is
+    /// 1 cm). A full-pose robot's orientation noise is σ / orientation_scale
+    /// radians per axis.
+    #[arg(long, default_value_t = DEFAULT_NOISE, allow_negative_numbers = true)]
     pub noise: f64,
     /// Seed of the noise and of the validation poses (default 0); with
     /// --measurements, of the --holdout splits only.
@@ -120,6 +121,9 @@ pub struct CalibrateArgs {
     #[arg(long)]
     pub json: bool,
 }
+
+/// The simulated measurement noise σ when `--noise` is not given, metres.
+pub const DEFAULT_NOISE: f64 = 0.01;
 
 /// The header of a calibrated TOML description.
 fn toml_header(id: &Identification, source: &str) -> String {
@@ -589,6 +593,11 @@ fn from_design(
             )
         } else {
             format!("σ = {} m", a.noise)
+        };
+        let noise = if a.noise == DEFAULT_NOISE {
+            format!("{noise}, the default of --noise")
+        } else {
+            noise
         };
         let mut s = format!(
             "{}: {} poses, {noise}, seed {}\n{}",

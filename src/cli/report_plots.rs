@@ -155,8 +155,9 @@ fn rms(v: &[f64]) -> f64 {
     (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt()
 }
 
-/// Histograms of the errors before and after calibration, on one axis of
-/// shared bins.
+/// Histograms of the errors before (left) and after calibration (right),
+/// each on its own bins: the calibrated errors are often a hundredth of the
+/// nominal ones, and shared bins would put them all in one.
 pub fn histograms(
     base: &Path,
     title: &str,
@@ -164,6 +165,50 @@ pub fn histograms(
     before: &[f64],
     after: &[f64],
 ) -> Result<()> {
+    fn panel<DB: DrawingBackend>(
+        area: &Area<DB>,
+        title: &str,
+        unit: &str,
+        v: &[f64],
+        col: RGBColor,
+    ) -> Result<()> {
+        let (_, hi) = range(v, true);
+        let bins = 20usize;
+        let w = hi / bins as f64;
+        let mut counts = vec![0u32; bins];
+        for &x in v.iter().filter(|x| x.is_finite()) {
+            counts[((x / w) as usize).min(bins - 1)] += 1;
+        }
+        let top = counts.iter().copied().max().unwrap_or(1).max(1) as f64 * 1.15;
+        let mut c = ChartBuilder::on(area)
+            .caption(title, (FONT, 19))
+            .margin(15)
+            .x_label_area_size(55)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0f64..hi, 0f64..top)
+            .map_err(err)?;
+        c.configure_mesh()
+            .x_desc(format!("error ({unit})"))
+            .y_desc("poses")
+            .axis_desc_style((FONT, 16))
+            .label_style((FONT, 13))
+            .x_labels(6)
+            .y_label_formatter(&|y| format!("{y:.0}"))
+            .draw()
+            .map_err(err)?;
+        c.draw_series(
+            counts
+                .iter()
+                .enumerate()
+                .filter(|(_, n)| **n > 0)
+                .map(|(i, &n)| {
+                    let x0 = i as f64 * w;
+                    Rectangle::new([(x0, 0.0), (x0 + w, f64::from(n))], col.mix(0.7).filled())
+                }),
+        )
+        .map_err(err)?;
+        Ok(())
+    }
     fn draw<DB: DrawingBackend>(
         root: &Area<DB>,
         title: &str,
@@ -171,57 +216,24 @@ pub fn histograms(
         before: &[f64],
         after: &[f64],
     ) -> Result<()> {
-        let all = [before, after].concat();
-        let (_, hi) = range(&all, true);
-        let bins = 30usize;
-        let w = hi / bins as f64;
-        let count = |v: &[f64]| {
-            let mut c = vec![0u32; bins];
-            for &x in v.iter().filter(|x| x.is_finite()) {
-                c[((x / w) as usize).min(bins - 1)] += 1;
-            }
-            c
-        };
-        let (cb, ca) = (count(before), count(after));
-        let top = cb.iter().chain(&ca).copied().max().unwrap_or(1).max(1) as f64 * 1.15;
-        let mut c = ChartBuilder::on(root)
-            .caption(title, (FONT, 22))
-            .margin(15)
-            .x_label_area_size(55)
-            .y_label_area_size(70)
-            .build_cartesian_2d(0f64..hi, 0f64..top)
-            .map_err(err)?;
-        c.configure_mesh()
-            .x_desc(format!("error ({unit})"))
-            .y_desc("poses")
-            .axis_desc_style((FONT, 17))
-            .label_style((FONT, 14))
-            .y_label_formatter(&|y| format!("{y:.0}"))
-            .draw()
-            .map_err(err)?;
-        for (counts, col, label) in [
-            (&cb, BEFORE, "nominal model"),
-            (&ca, AFTER, "calibrated model"),
-        ] {
-            c.draw_series(
-                counts
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, n)| **n > 0)
-                    .map(|(i, &n)| {
-                        let x0 = i as f64 * w;
-                        Rectangle::new([(x0, 0.0), (x0 + w, f64::from(n))], col.mix(0.55).filled())
-                    }),
-            )
-            .map_err(err)?
-            .label(label)
-            .legend(move |(x, y)| {
-                Rectangle::new([(x, y - 6), (x + 16, y + 6)], col.mix(0.55).filled())
-            });
-        }
-        legend(&mut c, SeriesLabelPosition::UpperRight)
+        let root = root.titled(title, (FONT, 22)).map_err(err)?;
+        let (l, r) = root.split_horizontally(DOUBLE.0 / 2);
+        panel(
+            &l,
+            &format!("nominal model (RMS {:.3} {unit})", rms(before)),
+            unit,
+            before,
+            BEFORE,
+        )?;
+        panel(
+            &r,
+            &format!("calibrated model (RMS {:.3} {unit})", rms(after)),
+            unit,
+            after,
+            AFTER,
+        )
     }
-    both!(base, WIDE, |r| draw(r, title, unit, before, after))
+    both!(base, DOUBLE, |r| draw(r, title, unit, before, after))
 }
 
 /// Held-out position RMS of each split: the nominal model against the
@@ -312,14 +324,15 @@ pub fn parameter_changes(base: &Path, lengths: &[ParamBar], angles: &[ParamBar])
             .margin(12)
             .x_label_area_size(55)
             .y_label_area_size(200)
-            .build_cartesian_2d(lo..hi, -0.5f64..n as f64 - 0.5)
+            // Two empty rows at the bottom hold the legend, clear of the bars.
+            .build_cartesian_2d(lo..hi, -2.5f64..n as f64 - 0.5)
             .map_err(err)?;
         c.configure_mesh()
             .x_desc(format!("estimate − nominal ({unit}), bars ±σ"))
             .axis_desc_style((FONT, 16))
             .label_style((FONT, 13))
             .x_labels(6)
-            .y_labels(n)
+            .y_labels(n + 3)
             .y_label_formatter(&|y| {
                 let k = y.round();
                 if (y - k).abs() < 1e-6 && k >= 0.0 {
@@ -681,7 +694,6 @@ pub fn tour(base: &Path, names: &[String], times: &[f64], values: &[Vec<f64>]) -
             .margin(15)
             .x_label_area_size(55)
             .y_label_area_size(80)
-            .right_y_label_area_size(10)
             .build_cartesian_2d(0f64..t1 * 1.25, lo..hi)
             .map_err(err)?;
         c.configure_mesh()

@@ -221,7 +221,11 @@ pub struct SelectArgs {
     /// Overwrite --out if it exists.
     #[arg(long)]
     pub force: bool,
-    /// Also compute the relaxation bound and report the design's D-efficiency.
+    /// Also compute the relaxation bound and report the design's
+    /// D-efficiency. The bound: a certified upper bound on ln OI_D (OI_D =
+    /// det XᵀX) of every N-pose design of the pool (the convex relaxation);
+    /// D-efficiency: (OI_D / bound)^(1/p), 1 = no pool design is better;
+    /// support: the poses carrying relaxation weight.
     #[arg(long)]
     pub gap: bool,
     /// Solver of the bound for `--gap` (see `bound`).
@@ -274,7 +278,7 @@ pub struct SelectArgs {
 
 /// The noise σ of `select --report` when `--noise` is not given, metres
 /// (`calibrate`'s default).
-pub const DEFAULT_REPORT_NOISE: f64 = 0.01;
+pub const DEFAULT_REPORT_NOISE: f64 = super::calibrate::DEFAULT_NOISE;
 
 /// How `select` orders the design's poses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

@@ -62,9 +62,10 @@ enum Command {
     /// Observability indices of a design (ln OI_D, OI, O1-O5, A-trace, rank).
     ///
     /// OI_D = det XᵀX (X the identification Jacobian of the design's poses):
-    /// the parameter confidence ellipsoid's volume is ∝ 1/√OI_D. OI: the
-    /// paper's eq. (1), (σ_1⋯σ_p)^(1/p)/√N; O1–O5: the classical indices
-    /// (smallest singular value, condition, …); A-trace: tr (XᵀX)⁻¹.
+    /// the parameter confidence ellipsoid's volume is ∝ 1/√OI_D. With σ_i
+    /// the singular values of X: OI (eq. 1) = (σ_1⋯σ_L)^(1/L) / L; O1 =
+    /// (σ_1⋯σ_L)^(1/L) / √m; O2 = σ_max/σ_min; O3 = σ_min; O4 =
+    /// σ_min²/σ_max; O5 = 1/Σ(1/σ_i); A-trace: tr (XᵀX)⁻¹.
     Score(ScoreArgs),
     /// Select the poses to measure (EAE, Fedorov, DETMAX or random search).
     Select(SelectArgs),
@@ -114,6 +115,11 @@ fn main() {
             "pool",
             "count",
             "pool_seed",
+            "margin",
+            "clearance",
+            "self_collision",
+            "obstacles",
+            "floor",
         ]
         .into_iter()
         .filter(|id| m.value_source(id) == Some(ValueSource::CommandLine))

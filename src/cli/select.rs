@@ -64,6 +64,13 @@ fn check_design_options(
         ("pool", "--pool"),
         ("count", "--count"),
         ("pool_seed", "--pool-seed"),
+        // The filters a design's pool was built with are its own; a margin
+        // or a collision filter given beside it would otherwise be ignored.
+        ("margin", "--margin"),
+        ("clearance", "--clearance"),
+        ("self_collision", "--self-collision"),
+        ("obstacles", "--obstacle"),
+        ("floor", "--floor"),
     ] {
         if given.contains(&id) {
             bail!(

@@ -400,7 +400,9 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         }
     }
     let reorder = a.order.map_or(speeds.is_some(), |o| o == Order::Time);
-    let order = super::tour::order_design(&mut report, speeds.as_ref(), home.as_deref(), reorder)?;
+    let mut order =
+        super::tour::order_design(&mut report, speeds.as_ref(), home.as_deref(), reorder)?;
+    super::tour::check_moves(&mut report, &mut order, &ctx.pool, home.as_deref())?;
     if let Some(out) = &a.out {
         let mut d = DesignFile::from_pool(&ctx.robot, &ctx.pool, &sel.poses);
         if let Some(r) = &refined {

@@ -23,6 +23,7 @@
 //! process, on first use or in [`CollisionFilter::load`], which pool
 //! building calls before any candidate is checked.
 
+pub mod mesh;
 pub mod srdf;
 pub mod stl;
 mod tree;
@@ -279,15 +280,7 @@ fn shape_of(
                     }
                 )
             })?;
-            let lower = path.to_string_lossy().to_ascii_lowercase();
-            if !lower.ends_with(".stl") {
-                return Err(format!(
-                    "link '{link}': mesh {} is not an STL file (collision meshes are read from STL)",
-                    path.display()
-                ));
-            }
-            let bytes = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-            let tris = stl::parse(&bytes, &path.display().to_string())?;
+            let tris = mesh::load(&path).map_err(|e| format!("link '{link}': {e}"))?;
             let s = scale.as_ref().map_or([1.0; 3], |v| [v[0], v[1], v[2]]);
             let mut vertices = Vec::with_capacity(3 * tris.len());
             for t in &tris {

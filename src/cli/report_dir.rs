@@ -398,6 +398,22 @@ pub fn selection(
             p.n, p.d_efficiency, p.predicted.position_rms_mm, p.predicted.position_p95_mm
         );
     }
+    if let Some(m) = &report.moves {
+        let _ = writeln!(
+            md,
+            "\nMoves of the tour checked for collision ({} moves, at most {} mm of link motion between checks): {}.",
+            m.moves_checked,
+            m.resolution_m * 1e3,
+            if m.colliding.is_empty() {
+                "every move is free".to_string()
+            } else {
+                format!(
+                    "{} move(s) collide, see report.json's selection.moves",
+                    m.colliding.len()
+                )
+            }
+        );
+    }
     for (n, why) in &curve.skipped {
         let _ = writeln!(md, "\nN = {n}: no identifying design ({why}).");
     }

@@ -110,34 +110,56 @@ pub fn sorted_errors(
             s.sort_unstable_by(f64::total_cmp);
             s
         };
-        let (b, a) = (sort(before), sort(after));
+        // A log scale: the calibrated errors are often a hundredth of the
+        // nominal ones, and would lie flat on a linear axis. Zero errors sit
+        // on the axis's floor.
+        let all: Vec<f64> = before
+            .iter()
+            .chain(after)
+            .copied()
+            .filter(|v| v.is_finite())
+            .collect();
+        let top = all.iter().copied().fold(0.0f64, f64::max).max(1e-12) * 1.5;
+        let floor = all
+            .iter()
+            .copied()
+            .filter(|v| *v > 0.0)
+            .fold(f64::INFINITY, f64::min)
+            .min(top / 10.0)
+            / 1.5;
+        let clamp = |v: &[f64]| -> Vec<f64> { sort(v).into_iter().map(|x| x.max(floor)).collect() };
+        let (b, a) = (clamp(before), clamp(after));
         let n = b.len().max(a.len()).max(2);
-        let (_, hi) = range(&[b.as_slice(), a.as_slice()].concat(), true);
         let mut c = ChartBuilder::on(root)
             .caption(title, (FONT, 22))
             .margin(15)
             .x_label_area_size(55)
             .y_label_area_size(80)
-            .build_cartesian_2d(0.5f64..n as f64 + 0.5, 0f64..hi)
+            .build_cartesian_2d(0.5f64..n as f64 + 0.5, (floor..top).log_scale())
             .map_err(err)?;
         c.configure_mesh()
             .x_desc("pose, by increasing error (rank)")
-            .y_desc(format!("error ({unit})"))
+            .y_desc(format!("error ({unit}, log scale)"))
+            .y_label_formatter(&|y| match *y {
+                v if v >= 10.0 => format!("{v:.0}"),
+                v if v >= 1.0 => format!("{v:.1}"),
+                v => format!("{v:.3}"),
+            })
             .axis_desc_style((FONT, 17))
             .label_style((FONT, 14))
             .x_label_formatter(&|x| format!("{x:.0}"))
             .draw()
             .map_err(err)?;
-        for (v, col, label) in [
-            (&b, BEFORE, "nominal model"),
-            (&a, AFTER, "calibrated model"),
+        for (v, col, label, r) in [
+            (&b, BEFORE, "nominal model", rms(before)),
+            (&a, AFTER, "calibrated model", rms(after)),
         ] {
             c.draw_series(LineSeries::new(
                 v.iter().enumerate().map(|(i, &y)| ((i + 1) as f64, y)),
                 col.stroke_width(2),
             ))
             .map_err(err)?
-            .label(format!("{label} (RMS {:.3} {unit})", rms(v)))
+            .label(format!("{label} (RMS {r:.3} {unit})"))
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], col.stroke_width(2)));
             c.draw_series(
                 v.iter()
@@ -146,7 +168,8 @@ pub fn sorted_errors(
             )
             .map_err(err)?;
         }
-        legend(&mut c, SeriesLabelPosition::UpperLeft)
+        // Sorted curves rise to the right: the lower right is free.
+        legend(&mut c, SeriesLabelPosition::LowerRight)
     }
     both!(base, WIDE, |r| draw(r, title, unit, before, after))
 }

@@ -14,6 +14,7 @@ pub mod criterion;
 pub mod error;
 pub mod experiment;
 pub mod frames;
+pub mod how_many;
 pub mod identify;
 pub mod io;
 pub mod kinematics;

@@ -60,6 +60,12 @@ enum Command {
     /// Size of a pose lattice, or the index and angles of one lattice pose.
     Pool(PoolArgs),
     /// Observability indices of a design (ln OI_D, OI, O1-O5, A-trace, rank).
+    ///
+    /// OI_D = det XᵀX (X the identification Jacobian of the design's poses):
+    /// the parameter confidence ellipsoid's volume is ∝ 1/√OI_D. With σ_i
+    /// the singular values of X: OI (eq. 1) = (σ_1⋯σ_L)^(1/L) / L; O1 =
+    /// (σ_1⋯σ_L)^(1/L) / √m; O2 = σ_max/σ_min; O3 = σ_min; O4 =
+    /// σ_min²/σ_max; O5 = 1/Σ(1/σ_i); A-trace: tr (XᵀX)⁻¹.
     Score(ScoreArgs),
     /// Select the poses to measure (EAE, Fedorov, DETMAX or random search).
     Select(SelectArgs),
@@ -74,8 +80,17 @@ enum Command {
     /// fitting: the nominal model, or a calibrated description.
     Evaluate(EvaluateArgs),
     /// Certified upper bound on OI_D of every N-pose design (convex relaxation).
+    ///
+    /// OI_D = det XᵀX of a design. The bound: ln det M(w*) of the relaxation
+    /// (weights 0 ≤ w ≤ 1 summing to N), certified by a solver-free formula
+    /// so no N-pose pool design can exceed it; support: the poses carrying
+    /// relaxation weight.
     Bound(BoundArgs),
     /// A design's D-efficiency against the relaxation bound.
+    ///
+    /// D-efficiency = (OI_D / bound)^(1/p), OI_D = det XᵀX of the design: 1
+    /// means no N-pose design of the pool is better; a design refined off
+    /// the pool may exceed the pool's bound (it is said when it does).
     Gap(GapArgs),
 }
 
@@ -84,7 +99,7 @@ impl Command {
     /// command without a `--robot` refuses them.
     fn take_chain(&mut self, c: &activecal::io::ChainChoice) -> anyhow::Result<()> {
         let robot = match self {
-            Command::Robots(a) => a.export.as_mut(),
+            Command::Robots(a) => a.export.as_mut().or(a.robot.as_mut()),
             Command::Fk(a) => Some(&mut a.robot),
             Command::Pool(a) => Some(&mut a.pool.robot),
             Command::Score(a) => Some(&mut a.pool.robot),
@@ -126,6 +141,11 @@ fn main() {
             "pool",
             "count",
             "pool_seed",
+            "margin",
+            "clearance",
+            "self_collision",
+            "obstacles",
+            "floor",
         ]
         .into_iter()
         .filter(|id| m.value_source(id) == Some(ValueSource::CommandLine))

@@ -305,6 +305,10 @@ pub struct SelectReport {
     /// The visiting order's figures, when one was planned.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tour: Option<crate::select::tour::TourReport>,
+    /// The tour's moves checked for collision (pools with a collision
+    /// filter).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub moves: Option<crate::select::moves::MovesReport>,
 }
 
 /// One pose of a design with its joint values.
@@ -343,6 +347,7 @@ impl SelectReport {
                 })
                 .collect(),
             tour: None,
+            moves: None,
             ln_oid: sel.ln_oid,
             log10_oid: l10(sel.ln_oid),
             oi: sel.oi,

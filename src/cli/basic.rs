@@ -24,6 +24,12 @@ pub struct RobotsArgs {
     /// Replace an existing `--out` file.
     #[arg(long, requires = "out")]
     pub force: bool,
+    /// Describe this robot (a built-in name, a .toml description or a
+    /// .urdf file, with --base/--tip/--lock for a tree) instead of listing
+    /// the built-in ones: its chain, joints with limits, parameter tables
+    /// and unknowns.
+    #[arg(long, value_name = "ROBOT", conflicts_with = "export", value_parser = super::parse_robot)]
+    pub robot: Option<activecal::io::RobotRef>,
     /// Print one JSON object.
     #[arg(long, conflicts_with = "export")]
     pub json: bool,
@@ -125,61 +131,98 @@ pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
         }
         return Ok(());
     }
-    let robots: Vec<Value> = activecal::model::BUILTIN
-        .iter()
-        .map(|n| {
-            let r = Robot::builtin(n).expect("built-in");
-            json!({
-                "name": r.name,
-                "dof": r.dof(),
-                "frames": r.frames,
-                "real": r.real.rows,
-                "nominal": r.nominal.rows,
-                "unknowns": r.parameter_names(),
-                // Revolute joints in degrees; prismatic ones have none (null): see `limits`.
-                "limits_deg": joint_kinds(&r).iter().zip(&r.limits).map(|(k, l)| match k {
-                    activecal::model::JointKind::Revolute => Some([l[0].to_degrees(), l[1].to_degrees()]),
-                    activecal::model::JointKind::Prismatic => None,
-                }).collect::<Vec<_>>(),
-                "limits": r.limits,
-                "joint_kinds": joint_kinds(&r),
-                "measurement": r.measurement,
-            })
-        })
-        .collect();
-    let v = json!({ "robots": robots });
-    emit(a.json, &v, || {
-        let mut s = String::new();
-        for n in activecal::model::BUILTIN {
-            let r = Robot::builtin(n).expect("built-in");
-            s += &format!(
-                "{} ({} joints, {} unknowns)\n",
-                r.name,
-                r.dof(),
-                r.n_unknowns()
-            );
-            s += "frame  conv    joint       gamma       alpha           a           d        beta   (real | nominal)\n";
-            for (i, f) in r.frames.iter().enumerate() {
-                for (tag, t) in [("real", &r.real), ("nom ", &r.nominal)] {
-                    let row = t.rows[i];
-                    s += &format!(
-                        "{:>5}  {:<6}  {:>5} {tag} {:>10.4}  {:>10.4}  {:>10.4}  {:>10.4}  {:>10.4}\n",
-                        f.label,
-                        format!("{:?}", f.convention),
-                        f.joint.map_or("-".into(), |j| format!("q{}", j + 1)),
-                        row[0],
-                        row[1],
-                        row[2],
-                        row[3],
-                        row[4]
-                    );
-                }
-            }
-            s += &format!("unknowns: {}\n", r.parameter_names().join(" "));
+    let robots: Vec<Robot> = match &a.robot {
+        Some(name) => {
+            let d = super::load_description(name)?;
+            d.robot.validate()?;
+            vec![d.robot]
         }
-        s
-    });
+        None => activecal::model::BUILTIN
+            .iter()
+            .map(|n| Robot::builtin(n).expect("built-in"))
+            .collect(),
+    };
+    let described: Vec<Value> = robots.iter().map(robot_json).collect();
+    let v = json!({ "robots": described });
+    emit(a.json, &v, || robots.iter().map(robot_text).collect());
     Ok(())
+}
+
+/// One robot of `robots --json`.
+fn robot_json(r: &Robot) -> Value {
+    json!({
+        "name": r.name,
+        "chain": activecal::report::chain(r),
+        "joint_names": activecal::units::joint_names(r),
+        "dof": r.dof(),
+        "frames": r.frames,
+        "real": r.real.rows,
+        "nominal": r.nominal.rows,
+        "unknowns": r.parameter_names(),
+        // Revolute joints in degrees; prismatic ones have none (null): see `limits`.
+        "limits_deg": joint_kinds(r).iter().zip(&r.limits).map(|(k, l)| match k {
+            activecal::model::JointKind::Revolute => Some([l[0].to_degrees(), l[1].to_degrees()]),
+            activecal::model::JointKind::Prismatic => None,
+        }).collect::<Vec<_>>(),
+        "limits": r.limits,
+        "joint_kinds": joint_kinds(r),
+        "measurement": r.measurement,
+    })
+}
+
+/// One robot of `robots`' text: chain, joints with limits, parameter
+/// tables (lengths in metres, angles in radians), unknowns.
+fn robot_text(r: &Robot) -> String {
+    let mut s = format!(
+        "{} ({} joints, {} unknowns)\nchain: {}\n",
+        r.name,
+        r.dof(),
+        r.n_unknowns(),
+        activecal::report::chain(r).join(" -> ")
+    );
+    s += "joint                            kind        lower       upper\n";
+    for ((name, k), l) in activecal::units::joint_names(r)
+        .iter()
+        .zip(joint_kinds(r))
+        .zip(&r.limits)
+    {
+        let (lo, hi, unit) = match k {
+            activecal::model::JointKind::Revolute => (l[0].to_degrees(), l[1].to_degrees(), "deg"),
+            activecal::model::JointKind::Prismatic => (l[0], l[1], "m"),
+        };
+        s += &format!(
+            "{name:<32} {:<10} {lo:>9.3} {hi:>9.3} {unit}\n",
+            format!("{k:?}").to_lowercase()
+        );
+    }
+    let w = r
+        .frames
+        .iter()
+        .map(|f| f.label.chars().count())
+        .max()
+        .unwrap_or(5)
+        .max(5);
+    s += &format!(
+        "{:>w$}  conv    joint   gamma(rad)  alpha(rad)        a(m)        d(m)   beta(rad)   (real | nominal)\n",
+        "frame"
+    );
+    for (i, f) in r.frames.iter().enumerate() {
+        for (tag, t) in [("real", &r.real), ("nom ", &r.nominal)] {
+            let row = t.rows[i];
+            s += &format!(
+                "{:>w$}  {:<6}  {:>5} {tag} {:>10.4}  {:>10.4}  {:>10.4}  {:>10.4}  {:>10.4}\n",
+                f.label,
+                format!("{:?}", f.convention),
+                f.joint.map_or("-".into(), |j| format!("q{}", j + 1)),
+                row[0],
+                row[1],
+                row[2],
+                row[3],
+                row[4]
+            );
+        }
+    }
+    s + &format!("unknowns: {}\n", r.parameter_names().join(" "))
 }
 
 /// Runs `fk`.

@@ -60,9 +60,10 @@ pub struct CalibrateArgs {
     /// Replace existing output files.
     #[arg(long)]
     pub force: bool,
-    /// Measurement noise σ per coordinate, metres. A full-pose robot's
-    /// orientation noise is σ / orientation_scale radians per axis.
-    #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
+    /// Measurement noise σ per coordinate, metres (the default, 0.01, is
+    /// 1 cm). A full-pose robot's orientation noise is σ / orientation_scale
+    /// radians per axis.
+    #[arg(long, default_value_t = DEFAULT_NOISE, allow_negative_numbers = true)]
     pub noise: f64,
     /// Seed of the noise and of the validation poses (default 0); with
     /// --measurements, of the --holdout splits only.
@@ -134,6 +135,12 @@ pub struct CalibrateArgs {
     /// A payload on the tip link: KG, or KG@X,Y,Z (metres, tip link frame).
     #[arg(long, value_name = "KG[@X,Y,Z]", value_parser = super::compliance::parse_payload, allow_hyphen_values = true)]
     pub payload: Option<activecal::io::inertia::Payload>,
+    /// Write a report directory: report.md, report.json and figures (PNG
+    /// and SVG) of the errors before and after, the held-out splits, the
+    /// parameter changes with ±σ and their correlations. An existing
+    /// non-empty directory needs --force.
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
     /// Units of the --measurements file.
     #[command(flatten)]
     pub units: super::units::UnitOpts,
@@ -141,6 +148,9 @@ pub struct CalibrateArgs {
     #[arg(long)]
     pub json: bool,
 }
+
+/// The simulated measurement noise σ when `--noise` is not given, metres.
+pub const DEFAULT_NOISE: f64 = 0.01;
 
 /// The header of a calibrated TOML description.
 fn toml_header(id: &Identification, source: &str) -> String {
@@ -293,6 +303,9 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     .flatten()
     .collect();
     super::check_outputs(&outputs, &inputs, a.force)?;
+    if let Some(dir) = &a.report {
+        super::report_dir::check(dir, a.force)?;
+    }
     for out in &a.out {
         Format::of(out).map_err(|e| anyhow::anyhow!("--out {e}"))?;
     }
@@ -383,6 +396,9 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         write_calibrated(a, &fitted, id, &path.display().to_string(), frames.as_ref())?;
     let mut v = serde_json::to_value(&report)?;
     v["exit_status"] = exit_status(id).into();
+    if let Some(dir) = &a.report {
+        super::report_dir::calibration(dir, &measured_summary(&fitted, id, path, &report, &v))?;
+    }
     super::emit(a.json, &v, || {
         let mut s = super::measured::measured_text(&report, id, &status_text(id));
         for out in &report.base.out {
@@ -391,6 +407,67 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         s
     });
     refuse_unconverged(a, id)
+}
+
+/// What `--report` shows of a calibration from measurements.
+fn measured_summary<'a>(
+    robot: &'a Robot,
+    id: &'a Identification,
+    path: &Path,
+    r: &super::measured::MeasuredReport,
+    json: &serde_json::Value,
+) -> super::report_dir::CalibrationSummary<'a> {
+    let pos = |e: &activecal::identify::ModelErrors| -> Vec<f64> {
+        e.per_sample
+            .iter()
+            .flat_map(|s| s.position_mm.iter().copied())
+            .collect()
+    };
+    let ori = |e: &activecal::identify::ModelErrors| -> Option<Vec<f64>> {
+        e.per_sample.iter().map(|s| s.orientation_deg).collect()
+    };
+    let mut notes: Vec<String> = r
+        .fixed
+        .iter()
+        .map(|f| {
+            format!(
+                "Fixed at nominal: {}",
+                serde_json::to_string(f).unwrap_or_default()
+            )
+        })
+        .collect();
+    if let Some(h) = &r.holdout {
+        notes.push(format!(
+            "Held-out position RMS over {} splits: {:.3} mm calibrated, {:.3} mm nominal (mean).",
+            h.splits.len(),
+            h.position_rms_mm.mean,
+            h.nominal_position_rms_mm
+        ));
+    }
+    super::report_dir::CalibrationSummary {
+        robot,
+        id,
+        source: format!("measurements `{}`, {} poses", path.display(), r.base.poses),
+        what: "pose",
+        position_mm: (pos(&r.nominal_residuals), pos(&r.residuals)),
+        orientation_deg: ori(&r.nominal_residuals).zip(ori(&r.residuals)),
+        params: r
+            .parameters
+            .iter()
+            .map(|p| (p.name.clone(), p.change, p.std))
+            .collect(),
+        splits: r.holdout.as_ref().map(|h| {
+            (
+                h.splits.iter().map(|s| s.nominal.position_rms_mm).collect(),
+                h.splits
+                    .iter()
+                    .map(|s| s.held_out.position_rms_mm)
+                    .collect(),
+            )
+        }),
+        notes,
+        json: json.clone(),
+    }
 }
 
 fn status_text(id: &Identification) -> String {
@@ -518,6 +595,64 @@ fn from_design(
     };
     let mut v = serde_json::to_value(&report)?;
     v["exit_status"] = exit_status(id).into();
+    if let Some(dir) = &a.report {
+        let to_mm = |v: Vec<f64>| v.into_iter().map(|x| x * 1e3).collect::<Vec<_>>();
+        let to_deg = |v: Vec<f64>| v.into_iter().map(f64::to_degrees).collect::<Vec<_>>();
+        let nominal = robot.unknown_values(&robot.nominal);
+        let std = id.covariance.as_ref().map(|c| c.std.clone());
+        let mut notes = vec![format!(
+            "Simulated measurements at the design's {} poses with noise σ = {} mm per coordinate{} (seed {}); errors at {} held-out poses of the design's pool.",
+            qs.len(),
+            a.noise * 1e3,
+            if a.noise == 0.01 {
+                " (the default of --noise)"
+            } else {
+                ""
+            },
+            a.seed(),
+            validation.len()
+        )];
+        if let Some(mc) = &mc {
+            notes.push(format!(
+                "Monte-Carlo over {} trials: validation RMS after calibration median {} mm, predicted {} mm.",
+                mc.trials,
+                mc.validation_rms_after.as_ref().map_or("-".into(), |v| format!("{:.4}", v.median * 1e3)),
+                mc.validation_rms_predicted.map_or("-".into(), |p| format!("{:.4}", p * 1e3))
+            ));
+        }
+        let s = super::report_dir::CalibrationSummary {
+            robot,
+            id,
+            source: format!("simulated, design `{}`", design_path.display()),
+            what: "held-out pose",
+            position_mm: (
+                to_mm(validation.position_errors(robot, &robot.nominal)),
+                to_mm(validation.position_errors(robot, &id.table)),
+            ),
+            orientation_deg: full.then(|| {
+                (
+                    to_deg(validation.orientation_errors(robot, &robot.nominal)),
+                    to_deg(validation.orientation_errors(robot, &id.table)),
+                )
+            }),
+            params: id
+                .names
+                .iter()
+                .enumerate()
+                .map(|(k, n)| {
+                    (
+                        n.clone(),
+                        id.estimate[k] - nominal[k],
+                        std.as_ref().map(|s| s[k]),
+                    )
+                })
+                .collect(),
+            splits: None,
+            notes,
+            json: v.clone(),
+        };
+        super::report_dir::calibration(dir, &s)?;
+    }
     emit(a.json, &v, || {
         let noise = if full {
             format!(
@@ -527,6 +662,11 @@ fn from_design(
             )
         } else {
             format!("σ = {} m", a.noise)
+        };
+        let noise = if a.noise == DEFAULT_NOISE {
+            format!("{noise}, the default of --noise")
+        } else {
+            noise
         };
         let mut s = format!(
             "{}: {} poses, {noise}, seed {}\n{}",

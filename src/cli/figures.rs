@@ -201,15 +201,29 @@ pub fn poses(base: &Path, title: &str, digits: &[Vec<usize>], levels: usize) -> 
         let mut c = ChartBuilder::on(root)
             .caption(title, ("sans-serif", 20))
             .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(50)
+            .x_label_area_size(55)
+            .y_label_area_size(70)
             .build_cartesian_2d(0.8f64..dof as f64 + 0.2, -0.3f64..levels as f64 - 0.7)
             .map_err(err)?;
+        // Whole numbers only (joints 1..6, digits 0..levels-1), and the
+        // axis names in monospace: plotters' bitmap text clips the left of a
+        // proportional "j" (the label read ",oint").
+        let whole = |v: &f64| {
+            if (v - v.round()).abs() < 1e-9 {
+                format!("{v:.0}")
+            } else {
+                String::new()
+            }
+        };
         c.configure_mesh()
-            .x_desc("joint")
-            .y_desc("lattice digit")
+            .x_desc("joint number")
+            .y_desc("lattice digit (level index)")
+            .axis_desc_style(("monospace", 16))
+            .label_style(("monospace", 14))
             .x_labels(dof)
             .y_labels(levels)
+            .x_label_formatter(&whole)
+            .y_label_formatter(&whole)
             .draw()
             .map_err(err)?;
         for (k, d) in digits.iter().enumerate() {

@@ -10,6 +10,8 @@ pub mod figures;
 pub mod frames_text;
 pub mod measured;
 pub mod progress;
+pub mod report_dir;
+pub mod report_plots;
 pub mod reproduce;
 pub mod select;
 pub mod tour;

@@ -64,6 +64,13 @@ fn check_design_options(
         ("pool", "--pool"),
         ("count", "--count"),
         ("pool_seed", "--pool-seed"),
+        // The filters a design's pool was built with are its own; a margin
+        // or a collision filter given beside it would otherwise be ignored.
+        ("margin", "--margin"),
+        ("clearance", "--clearance"),
+        ("self_collision", "--self-collision"),
+        ("obstacles", "--obstacle"),
+        ("floor", "--floor"),
     ] {
         if given.contains(&id) {
             bail!(
@@ -221,7 +228,11 @@ pub struct SelectArgs {
     /// Overwrite --out if it exists.
     #[arg(long)]
     pub force: bool,
-    /// Also compute the relaxation bound and report the design's D-efficiency.
+    /// Also compute the relaxation bound and report the design's
+    /// D-efficiency. The bound: a certified upper bound on ln OI_D (OI_D =
+    /// det XᵀX) of every N-pose design of the pool (the convex relaxation);
+    /// D-efficiency: (OI_D / bound)^(1/p), 1 = no pool design is better;
+    /// support: the poses carrying relaxation weight.
     #[arg(long)]
     pub gap: bool,
     /// Solver of the bound for `--gap` (see `bound`).
@@ -254,10 +265,27 @@ pub struct SelectArgs {
     /// pose), joint values comma separated (radians or metres).
     #[arg(long, value_name = "Q1,...", allow_hyphen_values = true)]
     pub home: Option<String>,
+    /// Write a report directory: report.md, report.json and figures (PNG
+    /// and SVG) of the "how many poses" curve (for N from the fewest that
+    /// can identify the robot to three times that: the best design's
+    /// D-efficiency against the certified bound, and the position error
+    /// predicted at 1,000 random configurations from the design's
+    /// covariance σ²(XᵀX)⁻¹), the poses against the joint limits and the
+    /// tour. An existing non-empty directory needs --force.
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
+    /// Sensor noise σ per measured coordinate of --report's predicted
+    /// errors, metres [default: 0.01, as `calibrate --noise`].
+    #[arg(long, requires = "report", allow_negative_numbers = true)]
+    pub noise: Option<f64>,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
 }
+
+/// The noise σ of `select --report` when `--noise` is not given, metres
+/// (`calibrate`'s default).
+pub const DEFAULT_REPORT_NOISE: f64 = super::calibrate::DEFAULT_NOISE;
 
 /// How `select` orders the design's poses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -276,6 +304,12 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         super::refuse_overwrite(out, a.force)?;
         activecal::io::design_formats::DesignFormat::of(out)
             .map_err(|e| anyhow::anyhow!("--out {e}"))?;
+    }
+    if let Some(dir) = &a.report {
+        super::report_dir::check(dir, a.force)?;
+    }
+    if let Some(n) = a.noise.filter(|v| !(v.is_finite() && *v > 0.0)) {
+        bail!("--noise {n}: the sensor noise σ must be a finite number > 0 (metres)");
     }
     // Cheap checks of the ordering's inputs before the pool is built.
     let described = super::load_description(&a.pool.robot)?;
@@ -367,7 +401,9 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         }
     }
     let reorder = a.order.map_or(speeds.is_some(), |o| o == Order::Time);
-    let order = super::tour::order_design(&mut report, speeds.as_ref(), home.as_deref(), reorder)?;
+    let mut order =
+        super::tour::order_design(&mut report, speeds.as_ref(), home.as_deref(), reorder)?;
+    super::tour::check_moves(&mut report, &mut order, &ctx.pool, home.as_deref())?;
     if let Some(out) = &a.out {
         let mut d = DesignFile::from_pool(&ctx.robot, &ctx.pool, &sel.poses);
         if let Some(r) = &refined {
@@ -398,6 +434,23 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
             d.extra.insert(k.into(), v[k].clone());
         }
         super::tour::write_design(&d, out, a.force)?;
+    }
+    if let Some(dir) = &a.report {
+        let mut cs = activecal::how_many::CurveSettings::new(
+            s.clone(),
+            a.noise.unwrap_or(DEFAULT_REPORT_NOISE),
+        );
+        cs.criterion = a.criterion;
+        cs.algorithm = a.algorithm;
+        cs.also = vec![a.n];
+        let curve = activecal::how_many::pose_count_curve(
+            &ctx.robot,
+            ctx.robot.params(a.pool.params),
+            &ctx.x,
+            &ctx.pool.ids,
+            &cs,
+        )?;
+        super::report_dir::selection(dir, &ctx.robot, &report, &curve, a.noise.is_none())?;
     }
     emit_report(a.json, &report, || {
         let mut s = super::pool_stats_text(&ctx.pool.stats);

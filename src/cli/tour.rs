@@ -60,6 +60,93 @@ pub fn order_design(
     Ok(order)
 }
 
+/// With collision filters on the pool, checks every move of the visiting
+/// order (from `home` when given) at a step where no link point moves more
+/// than the clearance (1 mm without one), reorders around colliding moves
+/// where it can, and records what it found in the report; `order` (as
+/// [`order_design`] returned it) is updated.
+pub fn check_moves(
+    report: &mut SelectReport,
+    order: &mut Vec<usize>,
+    pool: &activecal::pool::Pool,
+    home: Option<&[f64]>,
+) -> Result<()> {
+    let mut models = Vec::new();
+    let mut clearance: f64 = 0.0;
+    for f in &pool.spec.filters {
+        if let activecal::pool::PoolFilter::Collision(c) = f {
+            models.push(c.load().map_err(|e| anyhow::anyhow!(e))?);
+            clearance = clearance.max(c.spec.clearance);
+        }
+    }
+    if models.is_empty() {
+        return Ok(());
+    }
+    let resolution = if clearance > 0.0 { clearance } else { 1e-3 };
+    // The poses in selection order, as `order` indexes them.
+    let mut qs = vec![Vec::new(); order.len()];
+    for (c, &k) in report.configurations.iter().zip(order.iter()) {
+        qs[k].clone_from(&c.q);
+    }
+    let refs: Vec<&activecal::collision::CollisionModel> =
+        models.iter().map(|m| m.as_ref()).collect();
+    let before = order.clone();
+    let moves = activecal::select::moves::check_tour(&refs, resolution, home, &qs, order);
+    if *order != before {
+        let by_pos: Vec<usize> = before.clone();
+        let old = std::mem::take(&mut report.configurations);
+        let at: std::collections::HashMap<usize, usize> =
+            by_pos.iter().enumerate().map(|(i, &k)| (k, i)).collect();
+        report.configurations = order.iter().map(|k| old[at[k]].clone()).collect();
+        if let Some(t) = report.tour.as_mut() {
+            let cost = activecal::select::tour::MoveCost::new(&t.speeds)?;
+            t.visiting_order = activecal::select::tour::totals(&cost, home, &qs, order);
+            if t.selection_order.time_s > 0.0 {
+                t.time_ratio = t.visiting_order.time_s / t.selection_order.time_s;
+            }
+        }
+    }
+    report.moves = Some(moves);
+    Ok(())
+}
+
+/// Text lines of the moves' collision check.
+fn moves_text(m: &activecal::select::moves::MovesReport) -> String {
+    let mut s = format!(
+        "moves checked for collision: {} moves, {} configurations, at most {} mm of link motion between checks",
+        m.moves_checked,
+        m.configurations_checked,
+        m.resolution_m * 1e3
+    );
+    if m.colliding.is_empty() {
+        if m.reordered {
+            s += &format!(
+                "; the {} colliding move(s) of the planned order avoided by reordering: every move is free\n",
+                m.colliding_before
+            );
+        } else {
+            s += "; every move is free\n";
+        }
+        return s;
+    }
+    s += &format!(
+        "; {} move(s) COLLIDE and no reorder avoids them:\n",
+        m.colliding.len()
+    );
+    for c in &m.colliding {
+        s += &format!(
+            "  {} -> pose {}: {} touches {} at {:.0} % of the move\n",
+            c.from
+                .map_or("home".to_string(), |f| format!("pose {}", f + 1)),
+            c.to + 1,
+            c.pair.link,
+            c.pair.other,
+            c.at * 100.0
+        );
+    }
+    s
+}
+
 /// Puts a design file's poses in `order` (positions in selection order).
 pub fn reorder_design(d: &mut DesignFile, order: &[usize]) {
     d.poses = order.iter().map(|&k| d.poses[k]).collect();
@@ -102,6 +189,9 @@ pub fn configurations_text(r: &SelectReport) -> String {
                 t.assumed_speeds.join(", ")
             );
         }
+    }
+    if let Some(m) = &r.moves {
+        s += &moves_text(m);
     }
     s += &format!("{:>4} {:>8}", "#", "id");
     for n in &r.joint_names {

@@ -235,6 +235,30 @@ impl ValidationSet {
         (s / self.qs.len() as f64).sqrt()
     }
 
+    /// The position error `‖p(table, q) − p(real, q)‖` at every pose, metres.
+    #[must_use]
+    pub fn position_errors(&self, robot: &Robot, table: &ParamTable) -> Vec<f64> {
+        self.qs
+            .iter()
+            .zip(&self.truth)
+            .map(|(q, t)| (position(robot, table, q) - t).norm())
+            .collect()
+    }
+
+    /// The orientation error angle `∠(R(table, q) R(real, q)ᵀ)` at every
+    /// pose, radians; empty for a point robot.
+    #[must_use]
+    pub fn orientation_errors(&self, robot: &Robot, table: &ParamTable) -> Vec<f64> {
+        self.qs
+            .iter()
+            .zip(&self.truth_rot)
+            .map(|(q, t)| {
+                let (r, _) = pose(robot, table, q);
+                so3::difference(&so3::to_quaternion(&r), t).norm()
+            })
+            .collect()
+    }
+
     /// RMS orientation error `√(mean ∠(R(table, q) R(real, q)ᵀ)²)`, radians,
     /// over the poses; `None` for a point robot (or an empty set).
     #[must_use]

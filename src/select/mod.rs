@@ -33,6 +33,7 @@ use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
 mod exchange;
+pub mod moves;
 mod random;
 pub mod refine;
 pub mod tour;

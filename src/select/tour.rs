@@ -296,6 +296,25 @@ pub fn visit(
     ))
 }
 
+/// The time (s) at which each pose of `qs` is reached, visiting them in
+/// order from `home` (or from the first pose, reached at 0), each move
+/// taking [`MoveCost::time`] at `speeds`.
+pub fn arrival_times(speeds: &[f64], home: Option<&[f64]>, qs: &[Vec<f64>]) -> Result<Vec<f64>> {
+    let cost = MoveCost::new(speeds)?;
+    let mut t = 0.0;
+    let mut prev: Option<&[f64]> = home;
+    Ok(qs
+        .iter()
+        .map(|q| {
+            if let Some(p) = prev {
+                t += cost.time(p, q);
+            }
+            prev = Some(q);
+            t
+        })
+        .collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

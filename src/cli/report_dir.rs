@@ -1,0 +1,441 @@
+//! `--report DIR` of `calibrate` and `select`: a directory with report.md,
+//! report.json and the figures (PNG and SVG, [`super::report_plots`]). The
+//! directory is checked before any work (an existing non-empty one needs
+//! `--force`), built aside and swapped in whole.
+
+use super::report_plots::{self as plots, CurveRow, JointRow, ParamBar};
+use activecal::how_many::PoseCountCurve;
+use activecal::identify::Identification;
+use activecal::io::atomic::{StagedDir, write_atomic};
+use activecal::model::{JointKind, Robot, Symbol};
+use activecal::report::SelectReport;
+use anyhow::{Result, bail};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Refuses `--report DIR` when DIR is a file, is a non-empty directory
+/// (without `force`), or its parent does not exist.
+pub fn check(dir: &Path, force: bool) -> Result<()> {
+    if dir.exists() {
+        if !dir.is_dir() {
+            bail!("--report {}: exists and is not a directory", dir.display());
+        }
+        let non_empty = std::fs::read_dir(dir)
+            .map(|mut d| d.next().is_some())
+            .unwrap_or(true);
+        if non_empty && !force {
+            bail!(
+                "--report {}: exists and is not empty; pass --force to replace it",
+                dir.display()
+            );
+        }
+    }
+    if let Some(parent) = dir
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty() && !p.is_dir())
+    {
+        bail!(
+            "--report {}: the directory {} does not exist",
+            dir.display(),
+            parent.display()
+        );
+    }
+    Ok(())
+}
+
+/// Writes `text` into the staged directory as `name`.
+fn put(staged: &StagedDir, name: &str, text: &str) -> Result<()> {
+    write_atomic(&staged.path().join(name), text.as_bytes())?;
+    Ok(())
+}
+
+/// Whether a parameter name is an angle (γ, α, β: radians) rather than a
+/// length (metres).
+fn is_angle(name: &str) -> bool {
+    name.split('_')
+        .next()
+        .and_then(Symbol::parse)
+        .is_some_and(|s| matches!(s, Symbol::Gamma | Symbol::Alpha | Symbol::Beta))
+}
+
+/// Parameter changes and σ (SI units) as bars: lengths in mm, angles in
+/// degrees.
+fn bars(rows: &[(String, f64, Option<f64>)]) -> (Vec<ParamBar>, Vec<ParamBar>) {
+    let (mut lengths, mut angles) = (Vec::new(), Vec::new());
+    for (name, change, sigma) in rows {
+        let (to, into) = if is_angle(name) {
+            (180.0 / std::f64::consts::PI, &mut angles)
+        } else {
+            (1e3, &mut lengths)
+        };
+        into.push(ParamBar {
+            name: name.clone(),
+            change: change * to,
+            sigma: sigma.map(|s| s * to),
+        });
+    }
+    (lengths, angles)
+}
+
+/// The figures every calibration report has: errors sorted and their
+/// histograms, parameter changes, correlations. Returns the figure list of
+/// report.md (file stem, caption).
+fn calibration_figures(
+    out: &Path,
+    what: &str,
+    pos: (&[f64], &[f64]),
+    ori: Option<(&[f64], &[f64])>,
+    params: &[(String, f64, Option<f64>)],
+    id: &Identification,
+) -> Result<Vec<(String, String)>> {
+    let mut figs = Vec::new();
+    plots::sorted_errors(
+        &out.join("position_errors_sorted"),
+        &format!("Position error per {what}, sorted"),
+        "mm",
+        pos.0,
+        pos.1,
+    )?;
+    figs.push((
+        "position_errors_sorted".into(),
+        format!(
+            "position error at each {what} (mm), nominal and calibrated, each sorted increasing"
+        ),
+    ));
+    plots::histograms(
+        &out.join("position_errors_histogram"),
+        &format!("Position error per {what}: histogram"),
+        "mm",
+        pos.0,
+        pos.1,
+    )?;
+    figs.push((
+        "position_errors_histogram".into(),
+        "histogram of the position errors (mm)".into(),
+    ));
+    if let Some((b, a)) = ori {
+        plots::sorted_errors(
+            &out.join("orientation_errors_sorted"),
+            &format!("Orientation error per {what}, sorted"),
+            "degrees",
+            b,
+            a,
+        )?;
+        figs.push((
+            "orientation_errors_sorted".into(),
+            format!("orientation error angle at each {what} (degrees), sorted"),
+        ));
+        plots::histograms(
+            &out.join("orientation_errors_histogram"),
+            &format!("Orientation error per {what}: histogram"),
+            "degrees",
+            b,
+            a,
+        )?;
+        figs.push((
+            "orientation_errors_histogram".into(),
+            "histogram of the orientation errors (degrees)".into(),
+        ));
+    }
+    let (lengths, angles) = bars(params);
+    plots::parameter_changes(&out.join("parameter_changes"), &lengths, &angles)?;
+    figs.push((
+        "parameter_changes".into(),
+        "each parameter's change from nominal with ±σ (lengths in mm, angles in degrees)".into(),
+    ));
+    if let Some(c) = &id.covariance {
+        plots::correlation(
+            &out.join("correlation"),
+            &c.correlation.names,
+            &c.correlation.matrix,
+        )?;
+        figs.push((
+            "correlation".into(),
+            "correlation of the parameter estimates (−1 blue, +1 red)".into(),
+        ));
+    }
+    Ok(figs)
+}
+
+/// The report.md figure section.
+fn figure_section(figs: &[(String, String)]) -> String {
+    let mut s = String::from("\n## Figures\n\nEach figure is in PNG and SVG.\n\n");
+    for (stem, caption) in figs {
+        let _ = writeln!(
+            s,
+            "- {caption}: `{stem}.png`, `{stem}.svg`\n\n  ![{caption}]({stem}.png)\n"
+        );
+    }
+    s
+}
+
+/// The parameter table of report.md.
+fn parameter_table(params: &[(String, f64, Option<f64>)]) -> String {
+    let mut s =
+        String::from("\n## Parameters\n\n| parameter | change | σ | t |\n|---|---|---|---|\n");
+    for (name, change, sigma) in params {
+        let (to, unit) = if is_angle(name) {
+            (180.0 / std::f64::consts::PI, "°")
+        } else {
+            (1e3, " mm")
+        };
+        let _ = writeln!(
+            s,
+            "| {name} | {:.4}{unit} | {} | {} |",
+            change * to,
+            sigma.map_or("-".into(), |v| format!("{:.4}{unit}", v * to)),
+            sigma
+                .filter(|v| *v > 0.0)
+                .map_or("-".into(), |v| format!("{:.2}", change / v))
+        );
+    }
+    s
+}
+
+/// What a calibration report shows beside its figures.
+pub struct CalibrationSummary<'a> {
+    /// The robot.
+    pub robot: &'a Robot,
+    /// The fit.
+    pub id: &'a Identification,
+    /// Where the data came from (a file, or a simulated design).
+    pub source: String,
+    /// What one error is taken at ("pose", "held-out pose").
+    pub what: &'static str,
+    /// Position errors, mm: nominal and calibrated.
+    pub position_mm: (Vec<f64>, Vec<f64>),
+    /// Orientation errors, degrees, for full poses.
+    pub orientation_deg: Option<(Vec<f64>, Vec<f64>)>,
+    /// Each parameter: name, change from nominal and σ (metres or radians).
+    pub params: Vec<(String, f64, Option<f64>)>,
+    /// Held-out position RMS per split (mm): nominal and calibrated.
+    pub splits: Option<(Vec<f64>, Vec<f64>)>,
+    /// Further lines of the summary (markdown).
+    pub notes: Vec<String>,
+    /// The command's JSON report.
+    pub json: serde_json::Value,
+}
+
+/// Writes `calibrate --report DIR`.
+pub fn calibration(dir: &Path, s: &CalibrationSummary<'_>) -> Result<()> {
+    let staged = StagedDir::new(dir)?;
+    let out = staged.path();
+    let ori = s
+        .orientation_deg
+        .as_ref()
+        .map(|(b, a)| (b.as_slice(), a.as_slice()));
+    let mut figs = calibration_figures(
+        out,
+        s.what,
+        (&s.position_mm.0, &s.position_mm.1),
+        ori,
+        &s.params,
+        s.id,
+    )?;
+    if let Some((nom, cal)) = &s.splits {
+        plots::splits(&out.join("holdout_splits"), nom, cal)?;
+        figs.push((
+            "holdout_splits".into(),
+            "held-out position RMS of each split (mm): nominal against calibrated".into(),
+        ));
+    }
+    let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt();
+    let mut md = format!(
+        "# Calibration report\n\nRobot: `{}` (chain {}). Data: {}.\n\nFit: {:?} ({:?}) after {} iterations, rank {} of {}.\n\n",
+        s.robot.name,
+        activecal::report::chain(s.robot).join(" → "),
+        s.source,
+        s.id.status,
+        s.id.stop,
+        s.id.iterations,
+        s.id.rank,
+        s.id.names.len()
+    );
+    let _ = writeln!(
+        md,
+        "Position error over {} {}s: RMS {:.3} mm nominal, {:.3} mm calibrated.",
+        s.position_mm.0.len(),
+        s.what,
+        rms(&s.position_mm.0),
+        rms(&s.position_mm.1)
+    );
+    if let Some((b, a)) = &s.orientation_deg {
+        let _ = writeln!(
+            md,
+            "\nOrientation error: RMS {:.4}° nominal, {:.4}° calibrated.",
+            rms(b),
+            rms(a)
+        );
+    }
+    for n in &s.notes {
+        let _ = writeln!(md, "\n{n}");
+    }
+    md += &figure_section(&figs);
+    md += &parameter_table(&s.params);
+    put(&staged, "report.md", &md)?;
+    put(
+        &staged,
+        "report.json",
+        &(serde_json::to_string_pretty(&s.json)? + "\n"),
+    )?;
+    staged.commit()?;
+    Ok(())
+}
+
+/// The joint rows of the limits figure: each joint's values as fractions of
+/// its range, labelled with its limits (degrees, or mm for prismatic).
+fn joint_rows(robot: &Robot, names: &[String], qs: &[Vec<f64>]) -> Vec<JointRow> {
+    let scale = joint_scale(robot);
+    robot
+        .limits
+        .iter()
+        .enumerate()
+        .map(|(j, &[lo, hi])| {
+            let unit = if scale[j] == 1e3 { " mm" } else { "°" };
+            let span = (hi - lo).max(f64::MIN_POSITIVE);
+            JointRow {
+                label: format!(
+                    "{} [{:.0}{unit}, {:.0}{unit}]",
+                    names
+                        .get(j)
+                        .filter(|n| n.parse::<f64>().is_err())
+                        .map_or_else(|| format!("q{}", j + 1), Clone::clone),
+                    lo * scale[j],
+                    hi * scale[j]
+                ),
+                fractions: qs.iter().map(|q| (q[j] - lo) / span).collect(),
+            }
+        })
+        .collect()
+}
+
+/// Writes `select --report DIR`: the "how many poses" curve, the selected
+/// poses against the joint limits, the tour when ordered.
+pub fn selection(
+    dir: &Path,
+    robot: &Robot,
+    report: &SelectReport,
+    curve: &PoseCountCurve,
+    noise_is_default: bool,
+) -> Result<()> {
+    let staged = StagedDir::new(dir)?;
+    let out = staged.path();
+    let rows: Vec<CurveRow> = curve
+        .points
+        .iter()
+        .map(|p| CurveRow {
+            n: p.n,
+            d_efficiency: p.d_efficiency,
+            rms_mm: p.predicted.position_rms_mm,
+            p95_mm: p.predicted.position_p95_mm,
+        })
+        .collect();
+    let noise_mm = curve.noise_m * 1e3;
+    plots::how_many(
+        &out.join("how_many_poses"),
+        &rows,
+        report.poses.len(),
+        noise_mm,
+    )?;
+    let mut figs = vec![(
+        "how_many_poses".to_string(),
+        format!(
+            "the best design found at each N: D-efficiency against the certified bound, and the position error predicted at {} random configurations (mm) for σ = {noise_mm} mm",
+            curve.configurations
+        ),
+    )];
+    let qs: Vec<Vec<f64>> = report.configurations.iter().map(|c| c.q.clone()).collect();
+    plots::joints_vs_limits(
+        &out.join("joints_vs_limits"),
+        &joint_rows(robot, &report.joint_names, &qs),
+    )?;
+    figs.push((
+        "joints_vs_limits".into(),
+        "the selected poses' joint values within each joint's limits".into(),
+    ));
+    if let Some(t) = report.tour.as_ref().filter(|t| t.reordered) {
+        let times = activecal::select::tour::arrival_times(&t.speeds, t.home.as_deref(), &qs)?;
+        let deg: Vec<Vec<f64>> = qs
+            .iter()
+            .map(|q| {
+                q.iter()
+                    .zip(&joint_scale(robot))
+                    .map(|(v, s)| v * s)
+                    .collect()
+            })
+            .collect();
+        plots::tour(&out.join("tour"), &report.joint_names, &times, &deg)?;
+        figs.push(("tour".into(), format!("the poses in visiting order: each joint's value against the time the tour reaches the pose (s); {:.2} s in all against {:.2} s in selection order", t.visiting_order.time_s, t.selection_order.time_s)));
+    }
+    let mut md = format!(
+        "# Pose selection report\n\nRobot: `{}` (chain {}), {} unknowns, {} rows per pose; pool of {} poses.\n\nSelected: {} poses, log10 OI_D {:.4} (OI_D = det XᵀX, the information of the design).\n",
+        robot.name,
+        activecal::report::chain(robot).join(" → "),
+        curve.p,
+        curve.rows_per_pose,
+        report.pool_size,
+        report.poses.len(),
+        report.log10_oid
+    );
+    let _ = writeln!(
+        md,
+        "\n## How many poses\n\nFor each N from the fewest whose rows can determine the {} unknowns ({}) to three times that, the best design the selection finds, its D-efficiency ((det M / det M*)^(1/p), M* the certified bound of every N-pose design of the pool), and the position error predicted after calibrating with it, from its covariance σ² (XᵀX)⁻¹ (no fitting), at {} random configurations within the joint limits (seed {}). Sensor noise σ = {noise_mm} mm per coordinate{}.\n",
+        curve.p,
+        curve.n_min,
+        curve.configurations,
+        curve.seed,
+        if noise_is_default {
+            " (the default of --noise)"
+        } else {
+            ""
+        }
+    );
+    md += "| N | D-efficiency | predicted RMS (mm) | predicted 95th percentile (mm) |\n|---|---|---|---|\n";
+    for p in &curve.points {
+        let _ = writeln!(
+            md,
+            "| {} | {:.4} | {:.4} | {:.4} |",
+            p.n, p.d_efficiency, p.predicted.position_rms_mm, p.predicted.position_p95_mm
+        );
+    }
+    if let Some(m) = &report.moves {
+        let _ = writeln!(
+            md,
+            "\nMoves of the tour checked for collision ({} moves, at most {} mm of link motion between checks): {}.",
+            m.moves_checked,
+            m.resolution_m * 1e3,
+            if m.colliding.is_empty() {
+                "every move is free".to_string()
+            } else {
+                format!(
+                    "{} move(s) collide, see report.json's selection.moves",
+                    m.colliding.len()
+                )
+            }
+        );
+    }
+    for (n, why) in &curve.skipped {
+        let _ = writeln!(md, "\nN = {n}: no identifying design ({why}).");
+    }
+    md += &figure_section(&figs);
+    put(&staged, "report.md", &md)?;
+    let json = serde_json::json!({ "selection": report, "how_many_poses": curve });
+    put(
+        &staged,
+        "report.json",
+        &(serde_json::to_string_pretty(&json)? + "\n"),
+    )?;
+    staged.commit()?;
+    Ok(())
+}
+
+/// Per joint, the factor from radians (metres) to the figures' degrees (mm).
+fn joint_scale(robot: &Robot) -> Vec<f64> {
+    let mut k = vec![180.0 / std::f64::consts::PI; robot.dof()];
+    for f in &robot.frames {
+        if let (Some(j), JointKind::Prismatic) = (f.joint, f.joint_kind) {
+            k[j] = 1e3;
+        }
+    }
+    k
+}

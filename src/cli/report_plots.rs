@@ -1,0 +1,749 @@
+//! The figures of `calibrate --report` and `select --report`, each written
+//! as PNG and SVG (plotters): labelled axes with their units, a legend
+//! wherever there are several series, label areas wide enough for the
+//! labels.
+
+use anyhow::{Result, anyhow};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::Path;
+
+type Area<DB> = DrawingArea<DB, Shift>;
+
+/// The size of a one-panel figure, pixels.
+pub const WIDE: (u32, u32) = (900, 560);
+/// The size of a two-panel figure, pixels.
+pub const DOUBLE: (u32, u32) = (1200, 560);
+/// The size of the parameter and correlation figures, pixels.
+pub const TALL: (u32, u32) = (1100, 950);
+
+/// Monospace: plotters' bitmap text clips a glyph left of its origin, which
+/// in the proportional fonts loses most of a small "j" ("joint" read
+/// ",oint"); the monospace glyphs all start right of it.
+const FONT: &str = "monospace";
+const BEFORE: RGBColor = RGBColor(200, 60, 40);
+const AFTER: RGBColor = RGBColor(30, 90, 200);
+
+fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
+    anyhow!("drawing a figure: {e:?}")
+}
+
+/// Draws `$body` once on a PNG and once on an SVG backend: `<base>.png` and
+/// `<base>.svg`.
+macro_rules! both {
+    ($base:expr, $size:expr, |$r:ident| $body:expr) => {{
+        let png = $base.with_extension("png");
+        let svg = $base.with_extension("svg");
+        {
+            let root = BitMapBackend::new(&png, $size).into_drawing_area();
+            root.fill(&WHITE).map_err(err)?;
+            let $r = &root;
+            $body?;
+            root.present().map_err(err)?;
+        }
+        {
+            let root = SVGBackend::new(&svg, $size).into_drawing_area();
+            root.fill(&WHITE).map_err(err)?;
+            let $r = &root;
+            $body?;
+            root.present().map_err(err)?;
+        }
+        Ok(())
+    }};
+}
+
+/// `[lo, hi]` of the finite values, padded by 5 % (and never empty);
+/// `zero` includes 0.
+fn range(v: &[f64], zero: bool) -> (f64, f64) {
+    let mut lo = v
+        .iter()
+        .copied()
+        .filter(|x| x.is_finite())
+        .fold(f64::INFINITY, f64::min);
+    let mut hi = v
+        .iter()
+        .copied()
+        .filter(|x| x.is_finite())
+        .fold(f64::NEG_INFINITY, f64::max);
+    if !lo.is_finite() {
+        (lo, hi) = (0.0, 1.0);
+    }
+    if zero {
+        (lo, hi) = (lo.min(0.0), hi.max(0.0));
+    }
+    let pad = ((hi - lo) * 0.05).max(1e-9);
+    (if zero && lo == 0.0 { 0.0 } else { lo - pad }, hi + pad)
+}
+
+fn legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
+    c: &mut ChartContext<'a, DB, CT>,
+    pos: SeriesLabelPosition,
+) -> Result<()> {
+    c.configure_series_labels()
+        .position(pos)
+        .border_style(BLACK)
+        .background_style(WHITE.mix(0.9))
+        .label_font((FONT, 15))
+        .draw()
+        .map_err(err)
+}
+
+/// Each pose's error before and after calibration, each series sorted
+/// increasing (rank on x): the nominal and the calibrated model's errors
+/// side by side.
+pub fn sorted_errors(
+    base: &Path,
+    title: &str,
+    unit: &str,
+    before: &[f64],
+    after: &[f64],
+) -> Result<()> {
+    fn draw<DB: DrawingBackend>(
+        root: &Area<DB>,
+        title: &str,
+        unit: &str,
+        before: &[f64],
+        after: &[f64],
+    ) -> Result<()> {
+        let sort = |v: &[f64]| {
+            let mut s = v.to_vec();
+            s.sort_unstable_by(f64::total_cmp);
+            s
+        };
+        // A log scale: the calibrated errors are often a hundredth of the
+        // nominal ones, and would lie flat on a linear axis. Zero errors sit
+        // on the axis's floor.
+        let all: Vec<f64> = before
+            .iter()
+            .chain(after)
+            .copied()
+            .filter(|v| v.is_finite())
+            .collect();
+        let top = all.iter().copied().fold(0.0f64, f64::max).max(1e-12) * 1.5;
+        let floor = all
+            .iter()
+            .copied()
+            .filter(|v| *v > 0.0)
+            .fold(f64::INFINITY, f64::min)
+            .min(top / 10.0)
+            / 1.5;
+        let clamp = |v: &[f64]| -> Vec<f64> { sort(v).into_iter().map(|x| x.max(floor)).collect() };
+        let (b, a) = (clamp(before), clamp(after));
+        let n = b.len().max(a.len()).max(2);
+        let mut c = ChartBuilder::on(root)
+            .caption(title, (FONT, 22))
+            .margin(15)
+            .x_label_area_size(55)
+            .y_label_area_size(80)
+            .build_cartesian_2d(0.5f64..n as f64 + 0.5, (floor..top).log_scale())
+            .map_err(err)?;
+        c.configure_mesh()
+            .x_desc("pose, by increasing error (rank)")
+            .y_desc(format!("error ({unit}, log scale)"))
+            .y_label_formatter(&|y| match *y {
+                v if v >= 10.0 => format!("{v:.0}"),
+                v if v >= 1.0 => format!("{v:.1}"),
+                v => format!("{v:.3}"),
+            })
+            .axis_desc_style((FONT, 17))
+            .label_style((FONT, 14))
+            .x_label_formatter(&|x| format!("{x:.0}"))
+            .draw()
+            .map_err(err)?;
+        for (v, col, label, r) in [
+            (&b, BEFORE, "nominal model", rms(before)),
+            (&a, AFTER, "calibrated model", rms(after)),
+        ] {
+            c.draw_series(LineSeries::new(
+                v.iter().enumerate().map(|(i, &y)| ((i + 1) as f64, y)),
+                col.stroke_width(2),
+            ))
+            .map_err(err)?
+            .label(format!("{label} (RMS {r:.3} {unit})"))
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], col.stroke_width(2)));
+            c.draw_series(
+                v.iter()
+                    .enumerate()
+                    .map(|(i, &y)| Circle::new(((i + 1) as f64, y), 3, col.filled())),
+            )
+            .map_err(err)?;
+        }
+        // Sorted curves rise to the right: the lower right is free.
+        legend(&mut c, SeriesLabelPosition::LowerRight)
+    }
+    both!(base, WIDE, |r| draw(r, title, unit, before, after))
+}
+
+fn rms(v: &[f64]) -> f64 {
+    (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt()
+}
+
+/// Histograms of the errors before (left) and after calibration (right),
+/// each on its own bins: the calibrated errors are often a hundredth of the
+/// nominal ones, and shared bins would put them all in one.
+pub fn histograms(
+    base: &Path,
+    title: &str,
+    unit: &str,
+    before: &[f64],
+    after: &[f64],
+) -> Result<()> {
+    fn panel<DB: DrawingBackend>(
+        area: &Area<DB>,
+        title: &str,
+        unit: &str,
+        v: &[f64],
+        col: RGBColor,
+    ) -> Result<()> {
+        let (_, hi) = range(v, true);
+        let bins = 20usize;
+        let w = hi / bins as f64;
+        let mut counts = vec![0u32; bins];
+        for &x in v.iter().filter(|x| x.is_finite()) {
+            counts[((x / w) as usize).min(bins - 1)] += 1;
+        }
+        let top = counts.iter().copied().max().unwrap_or(1).max(1) as f64 * 1.15;
+        let mut c = ChartBuilder::on(area)
+            .caption(title, (FONT, 19))
+            .margin(15)
+            .x_label_area_size(55)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0f64..hi, 0f64..top)
+            .map_err(err)?;
+        c.configure_mesh()
+            .x_desc(format!("error ({unit})"))
+            .y_desc("poses")
+            .axis_desc_style((FONT, 16))
+            .label_style((FONT, 13))
+            .x_labels(6)
+            .y_label_formatter(&|y| format!("{y:.0}"))
+            .draw()
+            .map_err(err)?;
+        c.draw_series(
+            counts
+                .iter()
+                .enumerate()
+                .filter(|(_, n)| **n > 0)
+                .map(|(i, &n)| {
+                    let x0 = i as f64 * w;
+                    Rectangle::new([(x0, 0.0), (x0 + w, f64::from(n))], col.mix(0.7).filled())
+                }),
+        )
+        .map_err(err)?;
+        Ok(())
+    }
+    fn draw<DB: DrawingBackend>(
+        root: &Area<DB>,
+        title: &str,
+        unit: &str,
+        before: &[f64],
+        after: &[f64],
+    ) -> Result<()> {
+        let root = root.titled(title, (FONT, 22)).map_err(err)?;
+        let (l, r) = root.split_horizontally(DOUBLE.0 / 2);
+        panel(
+            &l,
+            &format!("nominal model (RMS {:.3} {unit})", rms(before)),
+            unit,
+            before,
+            BEFORE,
+        )?;
+        panel(
+            &r,
+            &format!("calibrated model (RMS {:.3} {unit})", rms(after)),
+            unit,
+            after,
+            AFTER,
+        )
+    }
+    both!(base, DOUBLE, |r| draw(r, title, unit, before, after))
+}
+
+/// Held-out position RMS of each split: the nominal model against the
+/// calibrated one (grouped bars), mm.
+pub fn splits(base: &Path, nominal: &[f64], calibrated: &[f64]) -> Result<()> {
+    fn draw<DB: DrawingBackend>(
+        root: &Area<DB>,
+        nominal: &[f64],
+        calibrated: &[f64],
+    ) -> Result<()> {
+        let n = nominal.len().max(1);
+        let (_, hi) = range(&[nominal, calibrated].concat(), true);
+        let mut c = ChartBuilder::on(root)
+            .caption("Held-out position error per split", (FONT, 22))
+            .margin(15)
+            .x_label_area_size(55)
+            .y_label_area_size(80)
+            .build_cartesian_2d(0.4f64..n as f64 + 0.6, 0f64..hi * 1.1)
+            .map_err(err)?;
+        c.configure_mesh()
+            .x_desc("split")
+            .y_desc("held-out position RMS (mm)")
+            .axis_desc_style((FONT, 17))
+            .label_style((FONT, 14))
+            .x_labels(n)
+            .x_label_formatter(&|x| {
+                if (x - x.round()).abs() < 1e-6 && *x >= 1.0 {
+                    format!("{x:.0}")
+                } else {
+                    String::new()
+                }
+            })
+            .disable_x_mesh()
+            .draw()
+            .map_err(err)?;
+        for (k, (v, col, label)) in [
+            (nominal, BEFORE, "nominal model"),
+            (calibrated, AFTER, "calibrated model"),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let off = if k == 0 { -0.35 } else { 0.0 };
+            c.draw_series(v.iter().enumerate().map(|(i, &y)| {
+                let x0 = (i + 1) as f64 + off;
+                Rectangle::new([(x0, 0.0), (x0 + 0.35, y)], col.filled())
+            }))
+            .map_err(err)?
+            .label(label)
+            .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 16, y + 6)], col.filled()));
+        }
+        legend(&mut c, SeriesLabelPosition::UpperRight)
+    }
+    both!(base, WIDE, |r| draw(r, nominal, calibrated))
+}
+
+/// One parameter of [`parameter_changes`].
+pub struct ParamBar {
+    /// Name.
+    pub name: String,
+    /// Change from nominal, in the panel's unit.
+    pub change: f64,
+    /// σ in the same unit, when known.
+    pub sigma: Option<f64>,
+}
+
+/// Each parameter's change from nominal with ±σ bars: lengths (mm) in the
+/// left panel, angles (degrees) in the right one, names on the y axis.
+pub fn parameter_changes(base: &Path, lengths: &[ParamBar], angles: &[ParamBar]) -> Result<()> {
+    fn panel<DB: DrawingBackend>(
+        area: &Area<DB>,
+        title: &str,
+        unit: &str,
+        bars: &[ParamBar],
+    ) -> Result<()> {
+        let ends: Vec<f64> = bars
+            .iter()
+            .flat_map(|b| {
+                let s = b.sigma.unwrap_or(0.0);
+                [b.change - s, b.change + s]
+            })
+            .collect();
+        let (lo, hi) = range(&ends, true);
+        let n = bars.len().max(1);
+        let names: Vec<String> = bars.iter().map(|b| b.name.clone()).collect();
+        let mut c = ChartBuilder::on(area)
+            .caption(title, (FONT, 20))
+            .margin(12)
+            .x_label_area_size(55)
+            .y_label_area_size(200)
+            // Two empty rows at the bottom hold the legend, clear of the bars.
+            .build_cartesian_2d(lo..hi, -2.5f64..n as f64 - 0.5)
+            .map_err(err)?;
+        c.configure_mesh()
+            .x_desc(format!("estimate − nominal ({unit}), bars ±σ"))
+            .axis_desc_style((FONT, 16))
+            .label_style((FONT, 13))
+            .x_labels(6)
+            .y_labels(n + 3)
+            .y_label_formatter(&|y| {
+                let k = y.round();
+                if (y - k).abs() < 1e-6 && k >= 0.0 {
+                    names.get(n - 1 - k as usize).cloned().unwrap_or_default()
+                } else {
+                    String::new()
+                }
+            })
+            .disable_y_mesh()
+            .draw()
+            .map_err(err)?;
+        c.draw_series(std::iter::once(PathElement::new(
+            [(0.0, -0.5), (0.0, n as f64 - 0.5)],
+            BLACK,
+        )))
+        .map_err(err)?;
+        let y = |k: usize| (n - 1 - k) as f64;
+        c.draw_series(bars.iter().enumerate().map(|(k, b)| {
+            Rectangle::new(
+                [(0.0, y(k) - 0.3), (b.change, y(k) + 0.3)],
+                AFTER.mix(0.6).filled(),
+            )
+        }))
+        .map_err(err)?
+        .label("change")
+        .legend(|(x, y)| Rectangle::new([(x, y - 6), (x + 16, y + 6)], AFTER.mix(0.6).filled()));
+        c.draw_series(bars.iter().enumerate().filter_map(|(k, b)| {
+            b.sigma.map(|s| {
+                ErrorBar::new_horizontal(
+                    y(k),
+                    b.change - s,
+                    b.change,
+                    b.change + s,
+                    BLACK.stroke_width(2),
+                    8,
+                )
+            })
+        }))
+        .map_err(err)?
+        .label("±σ")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK.stroke_width(2)));
+        legend(&mut c, SeriesLabelPosition::LowerRight)
+    }
+    fn draw<DB: DrawingBackend>(
+        root: &Area<DB>,
+        lengths: &[ParamBar],
+        angles: &[ParamBar],
+    ) -> Result<()> {
+        let (l, r) = root.split_horizontally(TALL.0 / 2);
+        panel(&l, "Length parameters", "mm", lengths)?;
+        panel(&r, "Angle parameters", "degrees", angles)
+    }
+    both!(base, TALL, |r| draw(r, lengths, angles))
+}
+
+/// The blue–white–red colour of a correlation in [-1, 1].
+fn diverging(v: f64) -> RGBColor {
+    let v = v.clamp(-1.0, 1.0);
+    let mix = |a: u8, t: f64| (255.0 + (f64::from(a) - 255.0) * t).round() as u8;
+    if v >= 0.0 {
+        RGBColor(mix(200, v), mix(30, v), mix(30, v))
+    } else {
+        RGBColor(mix(30, -v), mix(60, -v), mix(200, -v))
+    }
+}
+
+/// The correlation matrix of the parameters as a heat map (−1 blue, 0
+/// white, +1 red), with its colour scale.
+pub fn correlation(base: &Path, names: &[String], m: &[Vec<f64>]) -> Result<()> {
+    fn draw<DB: DrawingBackend>(root: &Area<DB>, names: &[String], m: &[Vec<f64>]) -> Result<()> {
+        let (main, bar) = root.split_horizontally(TALL.0 - 130);
+        let n = names.len().max(1);
+        // Row k from the top is parameter k (numbered from 1 as on the x axis).
+        let whole = |v: f64| {
+            let k = v.round();
+            ((v - k).abs() < 1e-6 && k >= 0.0 && (k as usize) < n).then_some(k as usize)
+        };
+        let ylabel = |v: &f64| {
+            whole(*v).map_or(String::new(), |k| format!("{} {}", n - k, names[n - 1 - k]))
+        };
+        let xlabel = |v: &f64| whole(*v).map_or(String::new(), |k| format!("{}", k + 1));
+        let font = if n > 30 { 11 } else { 13 };
+        let longest = names.iter().map(|s| s.chars().count()).max().unwrap_or(4) + 3;
+        let mut c = ChartBuilder::on(&main)
+            .caption("Correlation of the parameter estimates", (FONT, 22))
+            .margin(12)
+            .x_label_area_size(60)
+            // Monospace: about 0.62 em a character.
+            .y_label_area_size(20 + (longest as f64 * f64::from(font) * 0.62) as u32)
+            .build_cartesian_2d(-0.5f64..n as f64 - 0.5, -0.5f64..n as f64 - 0.5)
+            .map_err(err)?;
+        c.configure_mesh()
+            .disable_mesh()
+            .x_labels(n)
+            .y_labels(n)
+            .x_label_formatter(&xlabel)
+            .y_label_formatter(&ylabel)
+            .x_desc("parameter (number, as on the left)")
+            .axis_desc_style((FONT, 15))
+            .x_label_style((FONT, font))
+            .y_label_style((FONT, font))
+            .draw()
+            .map_err(err)?;
+        c.draw_series((0..n).flat_map(|i| {
+            (0..n).map(move |j| {
+                let v = m.get(i).and_then(|r| r.get(j)).copied().unwrap_or(f64::NAN);
+                let col = if v.is_finite() {
+                    diverging(v)
+                } else {
+                    RGBColor(160, 160, 160)
+                };
+                let y = (n - 1 - i) as f64;
+                Rectangle::new(
+                    [(j as f64 - 0.5, y - 0.5), (j as f64 + 0.5, y + 0.5)],
+                    col.filled(),
+                )
+            })
+        }))
+        .map_err(err)?;
+        let mut s = ChartBuilder::on(&bar)
+            .margin_top(60)
+            .margin_bottom(80)
+            .margin_right(10)
+            .y_label_area_size(50)
+            .build_cartesian_2d(0f64..1.0, -1f64..1.0)
+            .map_err(err)?;
+        s.configure_mesh()
+            .disable_mesh()
+            .disable_x_axis()
+            .y_desc("correlation")
+            .axis_desc_style((FONT, 15))
+            .label_style((FONT, 13))
+            .y_labels(5)
+            .draw()
+            .map_err(err)?;
+        s.draw_series((0..100).map(|k| {
+            let v0 = -1.0 + f64::from(k) * 0.02;
+            Rectangle::new([(0.0, v0), (1.0, v0 + 0.02)], diverging(v0 + 0.01).filled())
+        }))
+        .map_err(err)?;
+        Ok(())
+    }
+    both!(base, TALL, |r| draw(r, names, m))
+}
+
+/// One design size of [`how_many`].
+pub struct CurveRow {
+    /// Poses.
+    pub n: usize,
+    /// D-efficiency against the certified bound.
+    pub d_efficiency: f64,
+    /// Predicted RMS position error, mm.
+    pub rms_mm: f64,
+    /// Predicted 95th percentile, mm.
+    pub p95_mm: f64,
+}
+
+/// The "how many poses" curve: D-efficiency (left) and the predicted
+/// position error, RMS and 95th percentile (right), against N; the chosen N
+/// marked.
+pub fn how_many(base: &Path, rows: &[CurveRow], chosen: usize, noise_mm: f64) -> Result<()> {
+    fn draw<DB: DrawingBackend>(
+        root: &Area<DB>,
+        rows: &[CurveRow],
+        chosen: usize,
+        noise_mm: f64,
+    ) -> Result<()> {
+        let (l, r) = root.split_horizontally(DOUBLE.0 / 2);
+        let n0 = rows.first().map_or(1, |r| r.n) as f64 - 0.5;
+        let n1 = rows.last().map_or(2, |r| r.n) as f64 + 0.5;
+        let eff: Vec<f64> = rows.iter().map(|r| r.d_efficiency).collect();
+        let (elo, _) = range(&eff, false);
+        let mut c = ChartBuilder::on(&l)
+            .caption("Best design found vs the certified bound", (FONT, 19))
+            .margin(15)
+            .x_label_area_size(55)
+            .y_label_area_size(75)
+            .build_cartesian_2d(n0..n1, elo.min(0.95)..1.0)
+            .map_err(err)?;
+        c.configure_mesh()
+            .x_desc("poses in the design, N")
+            .y_desc("D-efficiency (1 = the bound)")
+            .axis_desc_style((FONT, 16))
+            .label_style((FONT, 14))
+            .x_label_formatter(&|x| format!("{x:.0}"))
+            .draw()
+            .map_err(err)?;
+        c.draw_series(LineSeries::new(
+            rows.iter().map(|r| (r.n as f64, r.d_efficiency)),
+            AFTER.stroke_width(2),
+        ))
+        .map_err(err)?
+        .label("D-efficiency")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], AFTER.stroke_width(2)));
+        c.draw_series(
+            rows.iter()
+                .map(|r| Circle::new((r.n as f64, r.d_efficiency), 3, AFTER.filled())),
+        )
+        .map_err(err)?;
+        legend(&mut c, SeriesLabelPosition::LowerRight)?;
+
+        let all: Vec<f64> = rows.iter().flat_map(|r| [r.rms_mm, r.p95_mm]).collect();
+        let (_, hi) = range(&all, true);
+        let mut e = ChartBuilder::on(&r)
+            .caption(
+                format!("Predicted error after calibration (σ = {noise_mm} mm)"),
+                (FONT, 19),
+            )
+            .margin(15)
+            .x_label_area_size(55)
+            .y_label_area_size(75)
+            .build_cartesian_2d(n0..n1, 0f64..hi)
+            .map_err(err)?;
+        e.configure_mesh()
+            .x_desc("poses in the design, N")
+            .y_desc("position error at random poses (mm)")
+            .axis_desc_style((FONT, 16))
+            .label_style((FONT, 14))
+            .x_label_formatter(&|x| format!("{x:.0}"))
+            .draw()
+            .map_err(err)?;
+        for (f, col, label) in [
+            (
+                &(|r: &CurveRow| r.rms_mm) as &dyn Fn(&CurveRow) -> f64,
+                AFTER,
+                "RMS",
+            ),
+            (&|r: &CurveRow| r.p95_mm, BEFORE, "95th percentile"),
+        ] {
+            e.draw_series(LineSeries::new(
+                rows.iter().map(|r| (r.n as f64, f(r))),
+                col.stroke_width(2),
+            ))
+            .map_err(err)?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], col.stroke_width(2)));
+            e.draw_series(
+                rows.iter()
+                    .map(|r| Circle::new((r.n as f64, f(r)), 3, col.filled())),
+            )
+            .map_err(err)?;
+        }
+        if rows.iter().any(|r| r.n == chosen) {
+            e.draw_series(std::iter::once(PathElement::new(
+                [(chosen as f64, 0.0), (chosen as f64, hi)],
+                BLACK.stroke_width(1),
+            )))
+            .map_err(err)?
+            .label(format!("N = {chosen} (--n)"))
+            .legend(|(x, y)| PathElement::new([(x + 10, y - 7), (x + 10, y + 7)], BLACK));
+        }
+        legend(&mut e, SeriesLabelPosition::UpperRight)
+    }
+    both!(base, DOUBLE, |r| draw(r, rows, chosen, noise_mm))
+}
+
+/// One joint of [`joints_vs_limits`].
+pub struct JointRow {
+    /// Name, with its limits and unit (the y-axis label).
+    pub label: String,
+    /// The design's values as a fraction of the range (0 = lower limit,
+    /// 1 = upper).
+    pub fractions: Vec<f64>,
+}
+
+/// The selected poses' joint values within their limits: one row per
+/// joint, the range from its lower (0 %) to its upper limit (100 %).
+pub fn joints_vs_limits(base: &Path, joints: &[JointRow]) -> Result<()> {
+    fn draw<DB: DrawingBackend>(root: &Area<DB>, joints: &[JointRow]) -> Result<()> {
+        let n = joints.len().max(1);
+        let mut c = ChartBuilder::on(root)
+            .caption("Selected poses' joint values within the limits", (FONT, 22))
+            .margin(15)
+            .x_label_area_size(55)
+            // Monospace labels at 13 px: about 8 px a character.
+            .y_label_area_size(
+                20 + 8 * joints
+                    .iter()
+                    .map(|j| j.label.chars().count())
+                    .max()
+                    .unwrap_or(4) as u32,
+            )
+            // Room right of 100 % for the legend, clear of the poses.
+            .build_cartesian_2d(-5f64..140.0, -0.6f64..n as f64 - 0.4)
+            .map_err(err)?;
+        c.configure_mesh()
+            .x_desc("position in the joint's range (%: 0 = lower limit, 100 = upper)")
+            .x_label_formatter(&|x| {
+                if *x <= 100.0 + 1e-9 {
+                    format!("{x:.0}")
+                } else {
+                    String::new()
+                }
+            })
+            .axis_desc_style((FONT, 16))
+            .label_style((FONT, 13))
+            .y_labels(n)
+            .y_label_formatter(&|y| {
+                let k = y.round();
+                if (y - k).abs() < 1e-6 && k >= 0.0 {
+                    joints
+                        .get(n - 1 - k as usize)
+                        .map(|j| j.label.clone())
+                        .unwrap_or_default()
+                } else {
+                    String::new()
+                }
+            })
+            .disable_y_mesh()
+            .draw()
+            .map_err(err)?;
+        let y = |k: usize| (n - 1 - k) as f64;
+        c.draw_series((0..joints.len()).map(|k| {
+            Rectangle::new(
+                [(0.0, y(k) - 0.25), (100.0, y(k) + 0.25)],
+                RGBColor(225, 225, 225).filled(),
+            )
+        }))
+        .map_err(err)?
+        .label("joint range")
+        .legend(|(x, y)| {
+            Rectangle::new(
+                [(x, y - 6), (x + 16, y + 6)],
+                RGBColor(225, 225, 225).filled(),
+            )
+        });
+        c.draw_series(joints.iter().enumerate().flat_map(|(k, j)| {
+            let m = j.fractions.len().max(1) as f64;
+            j.fractions.iter().enumerate().map(move |(i, &f)| {
+                // A small vertical spread keeps poses on one value apart.
+                let dy = (i as f64 / m - 0.5) * 0.4;
+                Circle::new((f * 100.0, y(k) + dy), 3, AFTER.filled())
+            })
+        }))
+        .map_err(err)?
+        .label("a selected pose")
+        .legend(|(x, y)| Circle::new((x + 8, y), 3, AFTER.filled()));
+        legend(&mut c, SeriesLabelPosition::UpperRight)
+    }
+    both!(base, (1000, 120 + 70 * joints.len().max(1) as u32), |r| {
+        draw(r, joints)
+    })
+}
+
+/// The tour: each joint's value (degrees; mm for a prismatic joint) at
+/// every pose in visiting order, against the cumulative move time.
+pub fn tour(base: &Path, names: &[String], times: &[f64], values: &[Vec<f64>]) -> Result<()> {
+    fn draw<DB: DrawingBackend>(
+        root: &Area<DB>,
+        names: &[String],
+        times: &[f64],
+        values: &[Vec<f64>],
+    ) -> Result<()> {
+        let all: Vec<f64> = values.iter().flatten().copied().collect();
+        let (lo, hi) = range(&all, false);
+        let t1 = times.last().copied().unwrap_or(1.0).max(1e-9);
+        let mut c = ChartBuilder::on(root)
+            .caption("Visiting order: joint values along the tour", (FONT, 22))
+            .margin(15)
+            .x_label_area_size(55)
+            .y_label_area_size(80)
+            .build_cartesian_2d(0f64..t1 * 1.25, lo..hi)
+            .map_err(err)?;
+        c.configure_mesh()
+            .x_desc("cumulative move time at each pose (s)")
+            .y_desc("joint value (degrees; mm for prismatic)")
+            .axis_desc_style((FONT, 16))
+            .label_style((FONT, 14))
+            .draw()
+            .map_err(err)?;
+        for (j, name) in names.iter().enumerate() {
+            let col = Palette99::pick(j).to_rgba();
+            c.draw_series(LineSeries::new(
+                times.iter().zip(values).map(|(&t, q)| (t, q[j])),
+                col.stroke_width(2),
+            ))
+            .map_err(err)?
+            .label(name.clone())
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], col.stroke_width(2)));
+            c.draw_series(
+                times
+                    .iter()
+                    .zip(values)
+                    .map(|(&t, q)| Circle::new((t, q[j]), 3, col.filled())),
+            )
+            .map_err(err)?;
+        }
+        legend(&mut c, SeriesLabelPosition::UpperRight)
+    }
+    both!(base, WIDE, |r| draw(r, names, times, values))
+}

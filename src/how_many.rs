@@ -1,0 +1,407 @@
+//! "How many poses do I need?": for each design size `N`, the best design
+//! the selection finds, its D-efficiency against the certified bound, and
+//! the position (and orientation) error the calibrated robot is predicted to
+//! keep at random configurations, from the design's covariance alone (no
+//! fitting).
+//!
+//! With noise σ per measured coordinate (metres; a full pose's orientation
+//! rows carry σ after their weight, see [`crate::measure::Sensor::weights`]),
+//! the estimate's covariance is `C = σ² M⁻¹`, `M = XᵀX` of the design (plus
+//! `M0` of poses already measured). At a configuration `q` with Jacobian
+//! rows `J_q` the expected squared position error of a measured point is
+//! `tr(J_pos C J_posᵀ)` (divided by the points per pose), and of the
+//! orientation `tr(J_ori C J_oriᵀ) / w²` radians² ([`predicted_errors`]).
+//! The curve reports the RMS over the configurations of that error and the
+//! 95th percentile of its per-configuration root.
+
+use crate::blocks::{Blocks, jacobian_of};
+use crate::bound::{BoundError, BoundSettings, design_gap_with_prior, relaxation_bound_with_prior};
+use crate::criterion::Prior;
+use crate::measure::{RowKind, sensor_for};
+use crate::model::{ParamTable, Robot};
+use crate::select::{Algorithm, CriterionKind, Settings, select};
+use faer::linalg::solvers::DenseSolveCore;
+use faer::{Mat, MatRef, Side};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+use thiserror::Error;
+
+/// What can go wrong computing the curve.
+#[derive(Debug, Error)]
+pub enum HowManyError {
+    /// Bad settings or a selection error.
+    #[error(transparent)]
+    Input(#[from] crate::Error),
+    /// The bound refused its problem.
+    #[error(transparent)]
+    Bound(#[from] BoundError),
+}
+
+/// Settings of [`pose_count_curve`].
+#[derive(Clone, Debug)]
+pub struct CurveSettings {
+    /// The selection run at every `N` (its `n` and `initial` are set per
+    /// point; its prior, if any, is the poses already measured).
+    pub select: Settings,
+    /// The criterion of the selection.
+    pub criterion: CriterionKind,
+    /// The selection algorithm.
+    pub algorithm: Algorithm,
+    /// The bound's settings.
+    pub bound: BoundSettings,
+    /// Sensor noise σ per measured coordinate, metres.
+    pub noise: f64,
+    /// Random configurations the errors are predicted at (uniform within
+    /// the joint limits).
+    pub configurations: usize,
+    /// Seed of those configurations.
+    pub seed: u64,
+    /// Design sizes besides the curve's own range (e.g. the `N` asked for).
+    pub also: Vec<usize>,
+    /// Most sizes on the curve (evenly spaced beyond this, ends kept).
+    pub max_points: usize,
+}
+
+impl CurveSettings {
+    /// Settings with the selection `select`, noise `noise` (metres), 1,000
+    /// configurations of seed 0, at most 20 sizes.
+    #[must_use]
+    pub fn new(select: Settings, noise: f64) -> Self {
+        CurveSettings {
+            select,
+            criterion: CriterionKind::Det,
+            algorithm: Algorithm::Eae,
+            bound: BoundSettings::default(),
+            noise,
+            configurations: 1000,
+            seed: 0,
+            also: Vec::new(),
+            max_points: 20,
+        }
+    }
+}
+
+/// The errors predicted at a set of configurations.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PredictedErrors {
+    /// RMS over configurations of the position error of a measured point,
+    /// mm.
+    pub position_rms_mm: f64,
+    /// 95th percentile over configurations of the predicted RMS position
+    /// error at one configuration, mm.
+    pub position_p95_mm: f64,
+    /// RMS orientation error angle, degrees (full-pose sensors).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orientation_rms_deg: Option<f64>,
+    /// 95th percentile of the orientation error angle, degrees.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orientation_p95_deg: Option<f64>,
+}
+
+/// One design size on the curve.
+#[derive(Clone, Debug, Serialize)]
+pub struct CurvePoint {
+    /// Poses in the design.
+    pub n: usize,
+    /// `ln OI_D` of the best design found.
+    pub ln_oid: f64,
+    /// Certified upper bound on `ln OI_D` of every `N`-pose pool design.
+    pub ln_bound: f64,
+    /// D-efficiency `(det M / det M*)^(1/p)`, in `[0, 1]`.
+    pub d_efficiency: f64,
+    /// The errors predicted after calibrating with this design.
+    pub predicted: PredictedErrors,
+    /// Pose ids of the design, in selection order.
+    pub poses: Vec<usize>,
+}
+
+/// The "how many poses" curve.
+#[derive(Clone, Debug, Serialize)]
+pub struct PoseCountCurve {
+    /// Unknowns.
+    pub p: usize,
+    /// Rows per pose.
+    pub rows_per_pose: usize,
+    /// The fewest poses whose rows can determine the unknowns
+    /// (`⌈p / rows⌉`, 1 on top of poses already measured).
+    pub n_min: usize,
+    /// Sensor noise σ, metres.
+    pub noise_m: f64,
+    /// Random configurations the errors are predicted at.
+    pub configurations: usize,
+    /// Their seed.
+    pub seed: u64,
+    /// One point per design size, increasing `N`.
+    pub points: Vec<CurvePoint>,
+    /// Sizes where no identifying design was found, with why.
+    pub skipped: Vec<(usize, String)>,
+}
+
+/// The sizes of the curve: `n_min..=3·n_min` (evenly thinned to at most
+/// `max_points`, ends kept) and `also`, increasing, below `pool` poses.
+#[must_use]
+pub fn curve_sizes(n_min: usize, also: &[usize], max_points: usize, pool: usize) -> Vec<usize> {
+    let hi = 3 * n_min;
+    let span = hi - n_min;
+    let k = max_points.max(2).min(span + 1);
+    let mut v: Vec<usize> = (0..k)
+        .map(|i| n_min + (i * span + (k - 1) / 2) / (k - 1).max(1))
+        .collect();
+    v.extend_from_slice(also);
+    v.retain(|&n| n >= 1 && n <= pool);
+    v.sort_unstable();
+    v.dedup();
+    v
+}
+
+/// `configurations` joint vectors drawn uniformly within the robot's joint
+/// limits (seeded).
+#[must_use]
+pub fn random_configurations(robot: &Robot, count: usize, seed: u64) -> Vec<Vec<f64>> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..count)
+        .map(|_| {
+            robot
+                .limits
+                .iter()
+                .map(|&[lo, hi]| lo + (hi - lo) * rng.random::<f64>())
+                .collect()
+        })
+        .collect()
+}
+
+/// `M⁻¹` of a symmetric positive definite `M`, through the Cholesky factor
+/// of its unit-diagonal equilibration; `None` when it is not positive
+/// definite.
+fn spd_inverse(m: MatRef<'_, f64>) -> Option<Mat<f64>> {
+    let p = m.nrows();
+    let d: Vec<f64> = (0..p).map(|i| m[(i, i)].max(0.0).sqrt()).collect();
+    if d.iter().any(|&v| !(v > 0.0 && v.is_finite())) {
+        return None;
+    }
+    let e = Mat::from_fn(p, p, |i, j| m[(i, j)] / (d[i] * d[j]));
+    let inv = e.llt(Side::Lower).ok()?.inverse();
+    Some(Mat::from_fn(p, p, |i, j| inv[(i, j)] / (d[i] * d[j])))
+}
+
+/// The value at quantile `q` (0..=1) of `v` (sorted in place; nearest rank).
+fn quantile(v: &mut [f64], q: f64) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_unstable_by(f64::total_cmp);
+    let k = ((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1;
+    v[k]
+}
+
+/// The errors predicted at the configurations of `eval` (their Jacobian
+/// rows, as the robot's sensor stacks them) after a calibration whose
+/// information matrix is `info` and noise σ is `noise` metres; `None` when
+/// `info` is singular.
+#[must_use]
+pub fn predicted_errors(
+    robot: &Robot,
+    eval: &Blocks,
+    info: MatRef<'_, f64>,
+    noise: f64,
+) -> Option<PredictedErrors> {
+    let inv = spd_inverse(info)?;
+    let sensor = sensor_for(robot);
+    let kinds = sensor.row_kinds();
+    let w = sensor
+        .weights()
+        .iter()
+        .zip(kinds)
+        .find(|&(_, &k)| k == RowKind::Orientation)
+        .map_or(1.0, |(w, _)| *w);
+    let points = kinds.iter().filter(|&&k| k == RowKind::Position).count() as f64 / 3.0;
+    let full = kinds.contains(&RowKind::Orientation);
+    let s2 = noise * noise;
+    let (mut pos, mut ori) = (Vec::new(), Vec::new());
+    for i in 0..eval.n_poses() {
+        let b = eval.block(i);
+        let xc = b * inv.as_ref();
+        let mut tr = [0.0f64; 2];
+        for r in 0..b.nrows() {
+            let v: f64 = (0..b.ncols()).map(|c| xc[(r, c)] * b[(r, c)]).sum();
+            tr[usize::from(kinds[r] == RowKind::Orientation)] += v.max(0.0);
+        }
+        pos.push((s2 * tr[0] / points.max(1.0)).sqrt() * 1e3);
+        ori.push((s2 * tr[1]).sqrt() / w * 180.0 / std::f64::consts::PI);
+    }
+    let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt();
+    Some(PredictedErrors {
+        position_rms_mm: rms(&pos),
+        position_p95_mm: quantile(&mut pos.clone(), 0.95),
+        orientation_rms_deg: full.then(|| rms(&ori)),
+        orientation_p95_deg: full.then(|| quantile(&mut ori, 0.95)),
+    })
+}
+
+/// The curve on the pool `x` (Jacobian blocks at `table`; `ids` its pose
+/// ids): for every size of [`curve_sizes`], the best design of
+/// `settings.select`, its certified D-efficiency and its predicted errors at
+/// [`random_configurations`].
+pub fn pose_count_curve(
+    robot: &Robot,
+    table: &ParamTable,
+    x: &Blocks,
+    ids: &[usize],
+    settings: &CurveSettings,
+) -> Result<PoseCountCurve, HowManyError> {
+    if !(settings.noise.is_finite() && settings.noise > 0.0) {
+        return Err(crate::Error::Invalid(format!(
+            "noise {}: the sensor noise σ must be a finite number > 0 (metres)",
+            settings.noise
+        ))
+        .into());
+    }
+    let (p, t) = (x.p(), x.t());
+    let prior: Option<&Prior> = settings.select.prior.as_ref();
+    let n_min = if prior.is_some() { 1 } else { p.div_ceil(t) };
+    let qs = random_configurations(robot, settings.configurations, settings.seed);
+    let eval = jacobian_of(robot, table, qs.len(), |k, q| q.copy_from_slice(&qs[k]));
+    let sizes = curve_sizes(n_min, &settings.also, settings.max_points, x.n_poses());
+    let (mut points, mut skipped) = (Vec::new(), Vec::new());
+    for n in sizes {
+        if n < settings.select.fixed.len() {
+            skipped.push((n, "fewer poses than the fixed ones".into()));
+            continue;
+        }
+        let s = Settings {
+            n,
+            initial: settings
+                .select
+                .initial
+                .clamp(settings.select.fixed.len().max(1), n),
+            ..settings.select.clone()
+        };
+        let sel = match select(x, settings.criterion, settings.algorithm, &s) {
+            Ok(sel) if sel.ln_oid.is_finite() => sel,
+            Ok(_) => {
+                skipped.push((n, "every design found is singular".into()));
+                continue;
+            }
+            Err(e) => {
+                skipped.push((n, e.to_string()));
+                continue;
+            }
+        };
+        let bound = match relaxation_bound_with_prior(x, prior, n, &settings.bound) {
+            Ok(b) => b,
+            Err(e @ BoundError::TooFewRows { .. }) => {
+                skipped.push((n, e.to_string()));
+                continue;
+            }
+            Err(e) => return Err(e.into()),
+        };
+        let gap = design_gap_with_prior(x, prior, &sel.poses, &bound)?;
+        let mut info = x.information(&sel.poses);
+        if let Some(pr) = prior {
+            info += pr.matrix();
+        }
+        let Some(predicted) = predicted_errors(robot, &eval, info.as_ref(), settings.noise) else {
+            skipped.push((n, "the design's information matrix is singular".into()));
+            continue;
+        };
+        points.push(CurvePoint {
+            n,
+            ln_oid: sel.ln_oid,
+            ln_bound: bound.ln_bound,
+            d_efficiency: gap.d_efficiency,
+            predicted,
+            poses: sel.poses.iter().map(|&k| ids[k]).collect(),
+        });
+    }
+    Ok(PoseCountCurve {
+        p,
+        rows_per_pose: t,
+        n_min,
+        noise_m: settings.noise,
+        configurations: qs.len(),
+        seed: settings.seed,
+        points,
+        skipped,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_run_from_the_fewest_to_three_times_and_include_the_asked() {
+        assert_eq!(
+            curve_sizes(9, &[30], 20, 15_625),
+            (9..=27).chain([30]).collect::<Vec<_>>()
+        );
+        let v = curve_sizes(20, &[], 5, 15_625);
+        assert_eq!(v.first(), Some(&20));
+        assert_eq!(v.last(), Some(&60));
+        assert_eq!(v.len(), 5);
+        // Never above the pool.
+        assert_eq!(curve_sizes(4, &[100], 20, 10), vec![4, 5, 6, 7, 8, 9, 10]);
+    }
+
+    #[test]
+    fn predicted_errors_scale_with_the_noise_and_shrink_with_more_poses() {
+        let robot = Robot::puma560();
+        let qs = random_configurations(&robot, 60, 3);
+        let x = jacobian_of(&robot, &robot.nominal, qs.len(), |k, q| {
+            q.copy_from_slice(&qs[k])
+        });
+        let eval = x.select(&(0..20).collect::<Vec<_>>());
+        let few = x.information(&(20..40).collect::<Vec<_>>());
+        let many = x.information(&(20..60).collect::<Vec<_>>());
+        let a = predicted_errors(&robot, &eval, few.as_ref(), 1e-3).unwrap();
+        let b = predicted_errors(&robot, &eval, few.as_ref(), 2e-3).unwrap();
+        let c = predicted_errors(&robot, &eval, many.as_ref(), 1e-3).unwrap();
+        // Linear in σ (up to rounding).
+        assert!((b.position_rms_mm / a.position_rms_mm - 2.0).abs() < 1e-12);
+        // Adding poses adds information: the error cannot grow.
+        assert!(c.position_rms_mm < a.position_rms_mm);
+        assert!(a.position_p95_mm >= a.position_rms_mm * 0.5);
+        assert!(a.orientation_rms_deg.is_none());
+    }
+
+    #[test]
+    fn a_singular_design_predicts_nothing() {
+        let robot = Robot::puma560();
+        let qs = random_configurations(&robot, 5, 1);
+        let x = jacobian_of(&robot, &robot.nominal, 5, |k, q| q.copy_from_slice(&qs[k]));
+        // 5 poses × 3 rows < 27 unknowns.
+        assert!(
+            predicted_errors(&robot, &x, x.information(&[0, 1, 2, 3, 4]).as_ref(), 1e-3).is_none()
+        );
+    }
+
+    #[test]
+    fn the_predicted_rms_matches_the_trace_of_the_covariance() {
+        // One configuration, one design: E‖e‖² = σ² tr(J M⁻¹ Jᵀ).
+        let robot = Robot::puma560();
+        let qs = random_configurations(&robot, 41, 9);
+        let x = jacobian_of(&robot, &robot.nominal, 41, |k, q| q.copy_from_slice(&qs[k]));
+        let m = x.information(&(1..41).collect::<Vec<_>>());
+        let e = predicted_errors(&robot, &x.select(&[0]), m.as_ref(), 1e-3).unwrap();
+        let inv =
+            crate::linalg::qr::inverse_information(x.select(&(1..41).collect::<Vec<_>>()).mat())
+                .unwrap();
+        let j = x.block(0);
+        let tr: f64 = (0..3)
+            .map(|r| {
+                (0..j.ncols())
+                    .flat_map(|a| (0..j.ncols()).map(move |b| (a, b)))
+                    .map(|(a, b)| j[(r, a)] * inv[(a, b)] * j[(r, b)])
+                    .sum::<f64>()
+            })
+            .sum();
+        let want = (1e-6 * tr).sqrt() * 1e3;
+        // Two inverses (Cholesky, QR) of a matrix of condition ~1e8: 1e-6.
+        assert!(
+            (e.position_rms_mm / want - 1.0).abs() < 1e-6,
+            "{} {want}",
+            e.position_rms_mm
+        );
+    }
+}

@@ -1,0 +1,171 @@
+//! The moves of a visiting order checked for collision: every straight
+//! joint-space move (home → first → … → last) is checked against the
+//! pool's collision models ([`CollisionModel::check_move`]); a move that
+//! collides is replaced, when possible, by reversing a stretch of the tour
+//! (a 2-opt move) whose two new moves are free; what cannot be replaced is
+//! reported with its pair of links.
+
+use crate::collision::{CollisionModel, ContactPair};
+use serde::Serialize;
+use std::collections::HashMap;
+
+/// A move of the tour that collides.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct CollidingMove {
+    /// Position in the visiting order of the pose the move starts from
+    /// (`None`: from home).
+    pub from: Option<usize>,
+    /// Position in the visiting order of the pose the move goes to.
+    pub to: usize,
+    /// The links (or link and obstacle) that touch.
+    pub pair: ContactPair,
+    /// Where on the move (0 = start, 1 = end).
+    pub at: f64,
+}
+
+/// What checking a tour's moves found.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct MovesReport {
+    /// Largest motion of a link point between two checks, metres.
+    pub resolution_m: f64,
+    /// Moves checked (distinct moves, the repair's trials included).
+    pub moves_checked: usize,
+    /// Configurations checked along them.
+    pub configurations_checked: usize,
+    /// Moves of the planned order that collided.
+    pub colliding_before: usize,
+    /// Whether the order was changed to avoid them.
+    pub reordered: bool,
+    /// Moves of the final order that still collide (none when every move
+    /// is free).
+    pub colliding: Vec<CollidingMove>,
+}
+
+/// Memoised move checks against every model.
+struct Checker<'a> {
+    models: &'a [&'a CollisionModel],
+    resolution: f64,
+    home: Option<&'a [f64]>,
+    qs: &'a [Vec<f64>],
+    memo: HashMap<(usize, usize), Option<(ContactPair, f64)>>,
+    configurations: usize,
+}
+
+impl Checker<'_> {
+    /// Node 0 is home, node `k + 1` pose `k`.
+    fn node(&self, n: usize) -> &[f64] {
+        if n == 0 {
+            self.home.unwrap_or(&[])
+        } else {
+            &self.qs[n - 1]
+        }
+    }
+
+    /// The first contact on the move between nodes `a` and `b`.
+    fn contact(&mut self, a: usize, b: usize) -> Option<(ContactPair, f64)> {
+        let key = (a.min(b), a.max(b));
+        if let Some(c) = self.memo.get(&key) {
+            return c.clone();
+        }
+        let (qa, qb) = (self.node(key.0).to_vec(), self.node(key.1).to_vec());
+        let mut found = None;
+        for m in self.models {
+            let r = m.check_move(&qa, &qb, self.resolution);
+            self.configurations += r.checks;
+            if r.contact.is_some() {
+                found = r.contact;
+                break;
+            }
+        }
+        self.memo.insert(key, found.clone());
+        found
+    }
+
+    /// The nodes of a visiting order (home first when given).
+    fn path(&self, order: &[usize]) -> Vec<usize> {
+        let start = usize::from(self.home.is_none());
+        let mut p: Vec<usize> = Vec::with_capacity(order.len() + 1);
+        if start == 0 {
+            p.push(0);
+        }
+        p.extend(order.iter().map(|&k| k + 1));
+        p
+    }
+
+    /// Positions `i` in `path` whose move `path[i] → path[i+1]` collides.
+    fn colliding(&mut self, path: &[usize]) -> Vec<usize> {
+        (0..path.len().saturating_sub(1))
+            .filter(|&i| self.contact(path[i], path[i + 1]).is_some())
+            .collect()
+    }
+}
+
+/// Checks the moves of visiting `qs` in `order` from `home` against
+/// `models` at `resolution` metres, and reorders `order` (2-opt
+/// reversals whose new moves are free, the home kept first) to remove
+/// colliding moves where it can.
+pub fn check_tour(
+    models: &[&CollisionModel],
+    resolution: f64,
+    home: Option<&[f64]>,
+    qs: &[Vec<f64>],
+    order: &mut Vec<usize>,
+) -> MovesReport {
+    let mut c = Checker {
+        models,
+        resolution,
+        home,
+        qs,
+        memo: HashMap::new(),
+        configurations: 0,
+    };
+    let mut path = c.path(order);
+    let before = c.colliding(&path).len();
+    let first = usize::from(home.is_some()); // the home node never moves
+    let mut reordered = false;
+    // Each accepted reversal removes one colliding move and adds none.
+    'repair: for _ in 0..before {
+        let bad = c.colliding(&path);
+        for &i in &bad {
+            for j in (i + 1)..path.len() {
+                // Reverse path[i+1..=j]: moves (i, j) and (i+1, j+1) replace
+                // (i, i+1) and (j, j+1).
+                let ok_a = c.contact(path[i], path[j]).is_none();
+                let ok_b = j + 1 >= path.len() || c.contact(path[i + 1], path[j + 1]).is_none();
+                if ok_a && ok_b && j > i + 1 {
+                    path[i + 1..=j].reverse();
+                    reordered = true;
+                    continue 'repair;
+                }
+            }
+        }
+        break;
+    }
+    let colliding: Vec<CollidingMove> = c
+        .colliding(&path)
+        .into_iter()
+        .map(|i| {
+            let (pair, at) = c.contact(path[i], path[i + 1]).expect("colliding");
+            let pos = |n: usize| path[first..].iter().position(|&x| x == n);
+            CollidingMove {
+                from: if path[i] == 0 && home.is_some() {
+                    None
+                } else {
+                    pos(path[i])
+                },
+                to: pos(path[i + 1]).unwrap_or(0),
+                pair,
+                at,
+            }
+        })
+        .collect();
+    *order = path[first..].iter().map(|&n| n - 1).collect();
+    MovesReport {
+        resolution_m: resolution,
+        moves_checked: c.memo.len(),
+        configurations_checked: c.configurations,
+        colliding_before: before,
+        reordered,
+        colliding,
+    }
+}

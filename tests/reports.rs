@@ -1,0 +1,157 @@
+//! `calibrate --report` and `select --report`: every figure is written as a
+//! PNG that decodes, at its documented size, beside its SVG; report.md and
+//! report.json are there; an existing directory is refused without --force.
+
+mod common;
+
+use common::{fails_with, run, scratch_dir};
+use std::path::Path;
+
+const UR10: &str = "fixtures/figaroh/ur10_robot.urdf:pose";
+const UR10_CSV: &str = "fixtures/figaroh/ur10_full_pose.csv";
+
+/// Decodes `dir/stem.png` and returns its size; asserts the SVG beside it.
+fn png_size(dir: &Path, stem: &str) -> (u32, u32) {
+    let path = dir.join(format!("{stem}.png"));
+    let file = std::fs::File::open(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .unwrap_or_else(|e| panic!("{} does not decode: {e}", path.display()));
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).expect("one frame");
+    // Not blank: a figure has more than the white background.
+    assert!(
+        buf[..info.buffer_size()].iter().any(|&b| b < 200),
+        "{} is blank",
+        path.display()
+    );
+    let svg = std::fs::read_to_string(dir.join(format!("{stem}.svg"))).expect("svg");
+    assert!(svg.contains("<svg"), "{stem}.svg is not SVG");
+    (info.width, info.height)
+}
+
+fn ok(args: &[&str]) {
+    let out = run(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn calibrate_report_on_the_ur10_writes_every_figure() {
+    let d = scratch_dir("reports", "ur10").join("rep");
+    let dir = d.to_str().unwrap();
+    let args = [
+        "--tip",
+        "wrist_3_link",
+        "calibrate",
+        "--robot",
+        UR10,
+        "--measurements",
+        UR10_CSV,
+        "--holdout",
+        "0.25",
+        "--report",
+        dir,
+    ];
+    ok(&args);
+    for (stem, size) in [
+        ("position_errors_sorted", (900, 560)),
+        ("position_errors_histogram", (1200, 560)),
+        ("orientation_errors_sorted", (900, 560)),
+        ("orientation_errors_histogram", (1200, 560)),
+        ("holdout_splits", (900, 560)),
+        ("parameter_changes", (1100, 950)),
+        ("correlation", (1100, 950)),
+    ] {
+        assert_eq!(png_size(&d, stem), size, "{stem}");
+    }
+    let md = std::fs::read_to_string(d.join("report.md")).unwrap();
+    assert!(md.contains("mm") && md.contains("position_errors_sorted.png"));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("report.json")).unwrap()).unwrap();
+    assert_eq!(v["status"], "converged");
+    // The directory now holds a report: refused without --force, replaced with it.
+    fails_with(&args, "--force");
+    let mut forced = args.to_vec();
+    forced.push("--force");
+    ok(&forced);
+}
+
+#[test]
+fn select_report_draws_the_curve_the_limits_and_the_tour() {
+    let d = scratch_dir("reports", "select").join("rep");
+    let dir = d.to_str().unwrap();
+    ok(&[
+        "--tip",
+        "panda_hand_tcp",
+        "select",
+        "--robot",
+        "fixtures/example-robot-data/panda.urdf:pose",
+        "--pool",
+        "sobol",
+        "--count",
+        "256",
+        "--n",
+        "12",
+        "--starts",
+        "1",
+        "--report",
+        dir,
+        "--noise",
+        "0.001",
+    ]);
+    assert_eq!(png_size(&d, "how_many_poses"), (1200, 560));
+    // 120 px of frame and 70 a joint.
+    assert_eq!(png_size(&d, "joints_vs_limits"), (1000, 120 + 70 * 7));
+    // A URDF robot's poses are ordered by default: the tour is drawn.
+    assert_eq!(png_size(&d, "tour"), (900, 560));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("report.json")).unwrap()).unwrap();
+    let curve = &v["how_many_poses"];
+    // p = 34 unknowns, 6 rows a pose: from 6 poses to 18, and the N asked.
+    assert_eq!(curve["n_min"], 6);
+    let pts = curve["points"].as_array().unwrap();
+    let ns: Vec<u64> = pts.iter().map(|p| p["n"].as_u64().unwrap()).collect();
+    assert_eq!(ns.first(), Some(&6));
+    assert_eq!(ns.last(), Some(&18));
+    assert!(ns.contains(&12));
+    for p in pts {
+        let e = p["d_efficiency"].as_f64().unwrap();
+        assert!(e > 0.0 && e <= 1.0 + 1e-9, "{p}");
+        let (rms, p95) = (
+            p["predicted"]["position_rms_mm"].as_f64().unwrap(),
+            p["predicted"]["position_p95_mm"].as_f64().unwrap(),
+        );
+        assert!(rms > 0.0 && p95 > 0.0, "{p}");
+    }
+    // Designs of different sizes are chosen independently (a larger one need
+    // not contain a smaller one), so only the ends are compared: 18 poses
+    // carry three times the rows of 6.
+    let first = pts[0]["predicted"]["position_rms_mm"].as_f64().unwrap();
+    let last = pts[pts.len() - 1]["predicted"]["position_rms_mm"]
+        .as_f64()
+        .unwrap();
+    assert!(last < first, "{first} -> {last}");
+}
+
+#[test]
+fn a_report_path_that_is_a_file_is_refused_before_any_work() {
+    let d = scratch_dir("reports", "file");
+    let f = d.join("taken");
+    std::fs::write(&f, "x").unwrap();
+    fails_with(
+        &[
+            "select",
+            "--levels",
+            "3",
+            "--n",
+            "10",
+            "--report",
+            f.to_str().unwrap(),
+        ],
+        "not a directory",
+    );
+}

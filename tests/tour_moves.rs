@@ -1,0 +1,87 @@
+//! The tour's moves checked for collision: a straight joint-space move
+//! that sweeps a link through an obstacle is found, with its pair and
+//! where on the move; a free move passes; and the repair reorders a tour
+//! around a colliding move when another order is free.
+
+use activecal::collision::{CollisionModel, CollisionSpec, Obstacle};
+use activecal::select::moves::check_tour;
+
+/// A planar arm: one revolute joint about z carrying a 1 m bar along x.
+const ARM: &str = r#"<robot name="bar">
+  <link name="base"/>
+  <link name="bar">
+    <collision><origin xyz="0.5 0 0"/><geometry><box size="1.0 0.1 0.1"/></geometry></collision>
+  </link>
+  <joint name="j1" type="revolute">
+    <parent link="base"/><child link="bar"/><axis xyz="0 0 1"/>
+    <limit lower="-3.1" upper="3.1" effort="1" velocity="1"/>
+  </joint>
+</robot>"#;
+
+fn model() -> CollisionModel {
+    let dir = std::env::temp_dir().join(format!("activecal-tour-moves-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let urdf = dir.join("bar.urdf");
+    std::fs::write(&urdf, ARM).unwrap();
+    CollisionModel::load(&CollisionSpec {
+        urdf: urdf.display().to_string(),
+        joints: vec!["j1".into()],
+        // A 0.2 m cube on the +y axis, 0.8 m out: the bar passes through it
+        // at q = π/2.
+        obstacles: vec![Obstacle::parse("box:0,0.8,0,0.2,0.2,0.2").unwrap()],
+        ..CollisionSpec::default()
+    })
+    .unwrap()
+}
+
+#[test]
+fn a_move_through_the_obstacle_is_found_where_it_hits() {
+    let m = model();
+    assert!(m.contact(&[0.0]).is_none() && m.contact(&[2.5]).is_none());
+    let r = m.check_move(&[0.0], &[2.5], 1e-3);
+    let (pair, at) = r.contact.expect("the bar sweeps through the cube");
+    assert_eq!(pair.link, "bar");
+    assert!(pair.obstacle);
+    // The bar (half-width 0.05) first touches the cube's face x = −0.1…0.1
+    // edge at 0.7 m when its angle is about π/2 − atan(0.15/0.7) ≈ 1.36 rad:
+    // at s ≈ 0.54 of the move 0 → 2.5. A 1 mm resolution at ≤ 1 m
+    // reach is ≤ 1e-3 rad, 4e-4 of the move; 0.03 allows for the geometry
+    // estimate above.
+    assert!((at - 1.36 / 2.5).abs() < 0.03, "{at}");
+    // The way round (0 → −2.5) is free, checked at more than one step.
+    let free = m.check_move(&[0.0], &[-2.5], 1e-3);
+    assert!(free.contact.is_none());
+    assert!(free.checks > 2);
+}
+
+#[test]
+fn a_free_move_agrees_with_dense_sampling() {
+    // Every configuration on the move, at 1e-4 rad (0.1 mm at the bar's
+    // tip), is free when the check says the move is.
+    let m = model();
+    let (a, b) = (-3.0, 1.2);
+    assert!(m.check_move(&[a], &[b], 1e-3).contact.is_none());
+    for k in 0..=42_000 {
+        let q = a + (b - a) * f64::from(k) / 42_000.0;
+        assert!(m.contact(&[q]).is_none(), "q = {q}");
+    }
+}
+
+#[test]
+fn the_tour_is_reordered_around_a_colliding_move_or_reports_it() {
+    let m = model();
+    // Poses at −2, 0 and 1: visiting 1 → −2 → 0 crosses nothing. From a
+    // home at 2.0 (beyond the cube) every first move crosses it: no order
+    // avoids that (one joint), so it is reported, from home.
+    let qs = vec![vec![-2.0], vec![0.0], vec![1.0]];
+    let mut order = vec![2, 0, 1]; // 1 → −2 → 0
+    let r = check_tour(&[&m], 1e-3, None, &qs, &mut order);
+    assert!(r.colliding.is_empty(), "{r:?}");
+    assert_eq!(r.colliding_before, 0);
+    let mut order = vec![0, 1, 2];
+    let r = check_tour(&[&m], 1e-3, Some(&[2.0]), &qs, &mut order);
+    assert_eq!(r.colliding.len(), 1, "{r:?}");
+    let c = &r.colliding[0];
+    assert_eq!(c.from, None); // from home
+    assert_eq!(c.pair.link, "bar");
+}

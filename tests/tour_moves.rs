@@ -18,13 +18,12 @@ const ARM: &str = r#"<robot name="bar">
   </joint>
 </robot>"#;
 
+/// The arm's collision model, from its text (no file: the tests run in
+/// parallel).
 fn model() -> CollisionModel {
-    let dir = std::env::temp_dir().join(format!("activecal-tour-moves-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let urdf = dir.join("bar.urdf");
-    std::fs::write(&urdf, ARM).unwrap();
     CollisionModel::load(&CollisionSpec {
-        urdf: urdf.display().to_string(),
+        urdf: "bar.urdf".into(),
+        text: Some(ARM.into()),
         joints: vec!["j1".into()],
         // A 0.2 m cube on the +y axis, 0.8 m out: the bar passes through it
         // at q = π/2.

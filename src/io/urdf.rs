@@ -58,7 +58,7 @@
 //! fixed joint `tool` to the link `tip`. `fixtures/puma560.urdf` is the
 //! paper's nominal PUMA written this way.
 
-pub use super::urdf_chain::MAX_CHAIN_JOINTS;
+pub use super::urdf_chain::{CONTINUOUS_RANGE, MAX_CHAIN_JOINTS};
 use super::urdf_chain::{ChainJoint, extract_chain};
 use crate::error::{Error, Result};
 use crate::kinematics::joint_chain;
@@ -75,11 +75,6 @@ use std::path::Path;
 /// nearly parallel and get a Hayati frame: 10°.
 pub const PARALLEL_THRESHOLD: f64 = 10.0 * PI / 180.0;
 
-/// Range given to a continuous joint (and to a revolute joint whose URDF
-/// limits are infinite): ±170°. A lattice over ±180° would repeat its end
-/// poses (−180° and 180° are one pose), and with 3 levels see only two
-/// angles of the joint.
-pub const CONTINUOUS_RANGE: [f64; 2] = [-170.0 * PI / 180.0, 170.0 * PI / 180.0];
 
 /// How to import a URDF.
 #[derive(Clone, Debug, PartialEq)]

@@ -3,12 +3,18 @@
 //! tip link, held joints folded into fixed ones, and each joint's axis and
 //! limits checked. [`super::urdf`] turns the chain into DH/Hayati frames.
 
-use super::urdf::CONTINUOUS_RANGE;
 use crate::error::Compact;
 use crate::model::JointKind;
 use crate::model::source::SourceJoint;
 use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion, Vector3};
 use std::collections::HashMap;
+use std::f64::consts::PI;
+
+/// Range given to a continuous joint (and to a revolute joint whose URDF
+/// limits are infinite): ±170°. A lattice over ±180° would repeat its end
+/// poses (−180° and 180° are one pose), and with 3 levels see only two
+/// angles of the joint.
+pub const CONTINUOUS_RANGE: [f64; 2] = [-170.0 * PI / 180.0, 170.0 * PI / 180.0];
 
 /// One URDF joint of the chain, fixed ones included.
 #[derive(Clone, Debug)]

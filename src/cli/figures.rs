@@ -9,7 +9,8 @@ use std::path::Path;
 
 type Area<'a, DB> = DrawingArea<DB, Shift>;
 
-fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
+/// A drawing error as the commands report it.
+pub(super) fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
     anyhow!("drawing a figure: {e:?}")
 }
 
@@ -36,6 +37,7 @@ macro_rules! both {
         Ok(())
     }};
 }
+pub(super) use both;
 
 fn range(v: &[f64]) -> (f64, f64) {
     let lo = v

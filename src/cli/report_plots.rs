@@ -3,7 +3,7 @@
 //! wherever there are several series, label areas wide enough for the
 //! labels.
 
-use anyhow::{Result, anyhow};
+use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -24,33 +24,7 @@ const FONT: &str = "monospace";
 const BEFORE: RGBColor = RGBColor(200, 60, 40);
 const AFTER: RGBColor = RGBColor(30, 90, 200);
 
-fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
-    anyhow!("drawing a figure: {e:?}")
-}
-
-/// Draws `$body` once on a PNG and once on an SVG backend: `<base>.png` and
-/// `<base>.svg`.
-macro_rules! both {
-    ($base:expr, $size:expr, |$r:ident| $body:expr) => {{
-        let png = $base.with_extension("png");
-        let svg = $base.with_extension("svg");
-        {
-            let root = BitMapBackend::new(&png, $size).into_drawing_area();
-            root.fill(&WHITE).map_err(err)?;
-            let $r = &root;
-            $body?;
-            root.present().map_err(err)?;
-        }
-        {
-            let root = SVGBackend::new(&svg, $size).into_drawing_area();
-            root.fill(&WHITE).map_err(err)?;
-            let $r = &root;
-            $body?;
-            root.present().map_err(err)?;
-        }
-        Ok(())
-    }};
-}
+use super::figures::{both, err};
 
 /// `[lo, hi]` of the finite values, padded by 5 % (and never empty);
 /// `zero` includes 0.

@@ -75,7 +75,6 @@ use std::path::Path;
 /// nearly parallel and get a Hayati frame: 10°.
 pub const PARALLEL_THRESHOLD: f64 = 10.0 * PI / 180.0;
 
-
 /// How to import a URDF.
 #[derive(Clone, Debug, PartialEq)]
 pub struct UrdfOptions {

@@ -126,6 +126,7 @@ struct FrameSpec {
 }
 
 /// The text being parsed, for turning byte spans into places.
+#[derive(Clone, Copy)]
 struct Ctx<'a> {
     text: &'a str,
     origin: &'a str,
@@ -190,11 +191,68 @@ pub fn parse(text: &str, origin: &str, dir: Option<&Path>) -> Result<Robot> {
 pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result<Description> {
     let cx = Ctx { text, origin };
     let spec: FileSpec = toml::from_str(text).map_err(|e| cx.plain(e.to_string().trim_end()))?;
+    let top = top_level(&cx, &spec)?;
+    if let Some(urdf) = &spec.urdf {
+        let robot = imported(&cx, &spec, urdf, dir, &top)?;
+        return Ok(Description {
+            robot,
+            visibility: top.visibility,
+        });
+    }
+    check_chain_keys(&cx, &spec)?;
+    let chain = frames_of(&cx, &spec)?;
+    chain.check_unknowns_given(&cx, top.auto)?;
+    let default_name = Path::new(origin)
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("robot")
+        .to_string();
+    let mut robot = Robot {
+        name: spec.name.clone().unwrap_or(default_name),
+        frames: chain.frames,
+        real: ParamTable::from_rows(chain.real),
+        nominal: ParamTable::from_rows(chain.nominal),
+        unknowns: chain.unknowns,
+        limits: chain.limits,
+        measurement: top.measurement,
+        orientation_scale: top.orientation_scale,
+        source: None,
+        gravity: None,
+    };
+    if let Some((nominal, real)) = top.markers {
+        robot.nominal.markers = nominal;
+        robot.real.markers = real;
+    }
+    if top.auto {
+        robot.unknowns = robot.choose_unknowns(&[]).map_err(|e| cx.plain(e))?;
+        if robot.unknowns.is_empty() {
+            return Err(cx.plain("no parameter of this chain is identifiable"));
+        }
+    }
+    identifiable(&cx, robot, &chain.unknown_spans).map(|robot| Description {
+        robot,
+        visibility: top.visibility,
+    })
+}
+
+/// The top-level keys of a description, checked: what is measured (with
+/// the markers' offsets), the orientation weight, automatic unknowns, the
+/// sensor's visibility region.
+struct TopLevel {
+    measurement: MeasurementKind,
+    markers: Option<MarkerOffsets>,
+    orientation_scale: f64,
+    auto: bool,
+    visibility: Option<Visibility>,
+}
+
+fn top_level(cx: &Ctx<'_>, spec: &FileSpec) -> Result<TopLevel> {
     let measurement = match spec.measurement {
         None | Some(MeasurementSpec::Point) => MeasurementKind::Point,
         Some(MeasurementSpec::Pose) => MeasurementKind::Pose,
         Some(MeasurementSpec::Markers) => MeasurementKind::Markers(spec.marker.len()),
     };
+    let cx = *cx;
     let markers = marker_offsets(&cx, &spec.marker, measurement)?;
     let orientation_scale = match &spec.orientation_scale {
         None => crate::model::DEFAULT_ORIENTATION_SCALE,
@@ -231,61 +289,75 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
             ));
         }
     };
-    let visibility = match spec.visibility {
+    let visibility = match &spec.visibility {
         None => None,
         Some(v) => {
             v.get_ref()
                 .validate()
                 .map_err(|m| cx.at(v.span(), format!("visibility: {m}")))?;
-            Some(v.into_inner())
+            Some(v.get_ref().clone())
         }
     };
-    let default_name = Path::new(origin)
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .unwrap_or("robot")
-        .to_string();
+    Ok(TopLevel {
+        measurement,
+        markers,
+        orientation_scale,
+        auto,
+        visibility,
+    })
+}
 
-    if let Some(urdf) = &spec.urdf {
-        if !spec.frame.is_empty() {
-            return Err(cx.at(
-                urdf.span(),
-                "give either `urdf = …` or [[frame]] tables, not both",
-            ));
-        }
-        let path = match dir {
-            Some(d) => d.join(urdf.get_ref()),
-            None => Path::new(urdf.get_ref()).to_path_buf(),
-        };
-        let opts = super::urdf::UrdfOptions {
-            base: spec.base.as_ref().map(|t| t.get_ref().clone()),
-            tip: spec.tip.as_ref().map(|t| t.get_ref().clone()),
-            lock: spec
-                .lock
-                .as_ref()
-                .map(|l| l.get_ref().iter().map(|(k, v)| (k.clone(), *v)).collect())
-                .unwrap_or_default(),
-            measurement: if markers.is_some() {
-                MeasurementKind::Point
-            } else {
-                measurement
-            },
-            ..super::urdf::UrdfOptions::default()
-        };
-        let mut r = super::urdf::load(&path, &opts).map_err(|e| cx.at(urdf.span(), e))?;
-        if let Some((nominal, real)) = &markers {
-            r = r.with_markers(nominal).map_err(|e| cx.plain(e))?;
-            r.real.markers.clone_from(real);
-        }
-        if let Some(n) = spec.name {
-            r.name = n;
-        }
-        r.orientation_scale = orientation_scale;
-        return Ok(Description {
-            robot: r,
-            visibility,
-        });
+/// A chain imported from a URDF (`urdf = …`, with `base`, `tip`, `lock`),
+/// with the description's markers, name and orientation weight.
+fn imported(
+    cx: &Ctx<'_>,
+    spec: &FileSpec,
+    urdf: &Spanned<String>,
+    dir: Option<&Path>,
+    top: &TopLevel,
+) -> Result<Robot> {
+    let (measurement, markers, orientation_scale) =
+        (top.measurement, &top.markers, top.orientation_scale);
+    if !spec.frame.is_empty() {
+        return Err(cx.at(
+            urdf.span(),
+            "give either `urdf = …` or [[frame]] tables, not both",
+        ));
     }
+    let path = match dir {
+        Some(d) => d.join(urdf.get_ref()),
+        None => Path::new(urdf.get_ref()).to_path_buf(),
+    };
+    let opts = super::urdf::UrdfOptions {
+        base: spec.base.as_ref().map(|t| t.get_ref().clone()),
+        tip: spec.tip.as_ref().map(|t| t.get_ref().clone()),
+        lock: spec
+            .lock
+            .as_ref()
+            .map(|l| l.get_ref().iter().map(|(k, v)| (k.clone(), *v)).collect())
+            .unwrap_or_default(),
+        measurement: if markers.is_some() {
+            MeasurementKind::Point
+        } else {
+            measurement
+        },
+        ..super::urdf::UrdfOptions::default()
+    };
+    let mut r = super::urdf::load(&path, &opts).map_err(|e| cx.at(urdf.span(), e))?;
+    if let Some((nominal, real)) = &markers {
+        r = r.with_markers(nominal).map_err(|e| cx.plain(e))?;
+        r.real.markers.clone_from(real);
+    }
+    if let Some(n) = spec.name.clone() {
+        r.name = n;
+    }
+    r.orientation_scale = orientation_scale;
+    Ok(r)
+}
+
+/// A description without `urdf = …`: no import keys, and 1 to
+/// [`MAX_FRAMES`] frames.
+fn check_chain_keys(cx: &Ctx<'_>, spec: &FileSpec) -> Result<()> {
     if let Some(t) = &spec.tip {
         return Err(cx.at(t.span(), "`tip` is only for `urdf = …` imports"));
     }
@@ -307,14 +379,44 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
         )));
     }
 
-    let mut frames = Vec::with_capacity(spec.frame.len());
-    let mut real = Vec::with_capacity(spec.frame.len());
-    let mut nominal = Vec::with_capacity(spec.frame.len());
-    let mut limits = Vec::new();
-    let mut unknowns = Vec::new();
-    // Where each frame's unknowns were listed, to point at unidentifiable ones.
-    let mut unknown_spans: Vec<Option<Range<usize>>> = Vec::new();
+    Ok(())
+}
+
+/// The chain of `[[frame]]` tables: frames, both tables' rows, joint
+/// limits, the unknowns listed and where each frame listed them.
+struct FrameTables {
+    frames: Vec<Frame>,
+    real: Vec<[f64; 5]>,
+    nominal: Vec<[f64; 5]>,
+    limits: Vec<[f64; 2]>,
+    unknowns: Vec<ParamId>,
+    /// Where each frame's unknowns were listed, to point at unidentifiable ones.
+    unknown_spans: Vec<Option<Range<usize>>>,
+}
+
+fn frames_of(cx: &Ctx<'_>, spec: &FileSpec) -> Result<FrameTables> {
+    let n = spec.frame.len();
+    let mut t = FrameTables {
+        frames: Vec::with_capacity(n),
+        real: Vec::with_capacity(n),
+        nominal: Vec::with_capacity(n),
+        limits: Vec::new(),
+        unknowns: Vec::new(),
+        unknown_spans: Vec::new(),
+    };
     for (i, f) in spec.frame.iter().enumerate() {
+        t.push(cx, spec, i, f)?;
+    }
+    t.unknowns.sort();
+    Ok(t)
+}
+
+impl FrameTables {
+    /// Adds frame `i` of the file, checking its label, rows, joint and
+    /// unknowns.
+    fn push(&mut self, cx: &Ctx<'_>, spec: &FileSpec, i: usize, f: &FrameSpec) -> Result<()> {
+        let cx = *cx;
+        let (limits, unknowns) = (&mut self.limits, &mut self.unknowns);
         let label = f.label.get_ref();
         if label.is_empty() || label.chars().any(|c| c.is_whitespace() || c == ',') {
             return Err(cx.at(
@@ -352,25 +454,26 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
                 (Some(joint_no - 1), kind)
             }
         };
-        frames.push(Frame {
+        self.frames.push(Frame {
             label: label.clone(),
             convention: f.convention,
             joint,
             joint_kind: kind,
         });
-        real.push(real_row);
-        nominal.push(nominal_row);
-        unknown_spans.push(f.unknowns.as_ref().map(|u| u.span()));
+        self.real.push(real_row);
+        self.nominal.push(nominal_row);
+        self.unknown_spans
+            .push(f.unknowns.as_ref().map(|u| u.span()));
         for s in f.unknowns.iter().flat_map(|u| u.get_ref()) {
             let symbol = Symbol::parse(s.get_ref()).ok_or_else(|| {
-                cx.at(
-                    s.span(),
-                    format!(
-                        "frame '{label}': unknown parameter symbol '{}' (expected gamma, alpha, a, d or beta)",
-                        s.get_ref()
-                    ),
-                )
-            })?;
+                    cx.at(
+                        s.span(),
+                        format!(
+                            "frame '{label}': unknown parameter symbol '{}' (expected gamma, alpha, a, d or beta)",
+                            s.get_ref()
+                        ),
+                    )
+                })?;
             if symbol == Symbol::Beta && f.convention == Convention::Dh {
                 return Err(cx.at(
                     s.span(),
@@ -386,45 +489,39 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
             }
             unknowns.push(id);
         }
+        Ok(())
     }
-    if auto {
-        if let Some(span) = unknown_spans.iter().flatten().next() {
-            return Err(cx.at(
-                span.clone(),
-                "`unknowns = \"auto\"` at the top level and a frame's own `unknowns` list: give one or the other",
+
+    /// Unknowns come either from every frame's list or from
+    /// `unknowns = "auto"`, never both, never neither.
+    fn check_unknowns_given(&self, cx: &Ctx<'_>, auto: bool) -> Result<()> {
+        let (unknowns, unknown_spans) = (&self.unknowns, &self.unknown_spans);
+        if auto {
+            if let Some(span) = unknown_spans.iter().flatten().next() {
+                return Err(cx.at(
+                    span.clone(),
+                    "`unknowns = \"auto\"` at the top level and a frame's own `unknowns` list: give one or the other",
+                ));
+            }
+        } else if unknowns.is_empty() {
+            return Err(cx.plain(
+                "no unknowns: list each frame's unknown parameters (`unknowns = [\"gamma\", …]`) or set `unknowns = \"auto\"` at the top",
             ));
         }
-    } else if unknowns.is_empty() {
-        return Err(cx.plain(
-            "no unknowns: list each frame's unknown parameters (`unknowns = [\"gamma\", …]`) or set `unknowns = \"auto\"` at the top",
-        ));
+        Ok(())
     }
-    unknowns.sort();
-    let mut robot = Robot {
-        name: spec.name.unwrap_or(default_name),
-        frames,
-        real: ParamTable::from_rows(real),
-        nominal: ParamTable::from_rows(nominal),
-        unknowns,
-        limits,
-        measurement,
-        orientation_scale,
-        source: None,
-        gravity: None,
-    };
-    if let Some((nominal, real)) = markers {
-        robot.nominal.markers = nominal;
-        robot.real.markers = real;
-    }
-    if auto {
-        robot.unknowns = robot.choose_unknowns(&[]).map_err(|e| cx.plain(e))?;
-        if robot.unknowns.is_empty() {
-            return Err(cx.plain("no parameter of this chain is identifiable"));
-        }
-    }
+}
+
+/// The robot, validated, if its unknowns are identifiable; otherwise an
+/// error pointing at the first unidentifiable unknown's list.
+fn identifiable(
+    cx: &Ctx<'_>,
+    robot: Robot,
+    unknown_spans: &[Option<Range<usize>>],
+) -> Result<Robot> {
     robot.validate().map_err(|e| cx.plain(e))?;
     match robot.check_identifiable() {
-        Ok(_) => Ok(Description { robot, visibility }),
+        Ok(_) => Ok(robot),
         Err(Error::Unidentifiable { names, rank, p }) => {
             let first = names
                 .first()

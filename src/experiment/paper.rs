@@ -346,31 +346,15 @@ fn l10(ln: f64) -> f64 {
     ln / std::f64::consts::LN_10
 }
 
-/// Runs the experiment; `progress` is called with the name of each of the
-/// [`STEPS`] stages as it starts.
-pub fn run(
-    a: &PaperSettings,
-    mut progress: impl FnMut(&'static str),
-) -> Result<PaperReport, ExperimentError> {
-    a.validate()?;
-    let clock = Instant::now();
-    let robot = Robot::puma560();
-    let pool = PoolSpec::lattice(a.levels).build(&robot, &robot.nominal)?;
-    let x = pool.try_jacobian(&robot, &robot.nominal)?;
-    let p = x.p();
-    let ids = |d: &[usize]| pool.ids_of(d);
-    let s = Settings {
-        n: a.n,
-        initial: a.initial,
-        starts: a.starts,
-        designs: a.designs,
-        seed: a.seed,
-        ..Settings::default()
-    };
-    s.validate(&x)?;
+/// The random baseline (§V-C): the best of `designs` random designs and
+/// the median one (its design drawn again from its seed).
+struct RandomBaseline {
+    search: crate::select::RandomSearch,
+    median_j: usize,
+    median_design: Vec<usize>,
+}
 
-    // 1. Random baseline (§V-C).
-    progress("random designs");
+fn random_baseline(x: &crate::blocks::Blocks, a: &PaperSettings) -> RandomBaseline {
     let all: Vec<usize> = (0..x.n_poses()).collect();
     let rs = random_search(&x, &all, &[], a.n, a.designs, a.seed);
     // The median of the kept designs (all of them up to SAMPLE_CAP).
@@ -380,7 +364,34 @@ pub fn run(
     let median_k = median_j * rs.stride;
     let median_design = random_design(&mut design_rng(a.seed, median_k as u64), &all, &[], a.n);
 
-    // 2. EAE with the paper's settings, determinant criterion (§V-D).
+    RandomBaseline {
+        search: rs,
+        median_j,
+        median_design,
+    }
+}
+
+/// The selections of §V-D: EAE with the paper's settings (determinant, and
+/// the eigenvalue OI unless skipped), multi-start EAE with a Fedorov polish,
+/// Fedorov and DETMAX alone.
+struct Selections {
+    e_det: Selection,
+    eae_seconds: f64,
+    e_oi: Option<Selection>,
+    best: Selection,
+    best_seconds: f64,
+    fed: Selection,
+    det: Selection,
+}
+
+fn selections(
+    x: &crate::blocks::Blocks,
+    a: &PaperSettings,
+    s: &Settings,
+    progress: &mut impl FnMut(&'static str),
+) -> Result<Selections, ExperimentError> {
+    let x = x;
+    let s = s.clone();
     progress("EAE (det)");
     let t0 = Instant::now();
     let e_det = eae(&x, &mut DCriterion::new(), &s, &mut design_rng(a.seed, 0))?;
@@ -417,6 +428,42 @@ pub fn run(
     let fed = multistart(&x, DCriterion::new, Algorithm::Fedorov, &one_start)?;
     let det = multistart(&x, DCriterion::new, Algorithm::Detmax, &one_start)?;
 
+    Ok(Selections {
+        e_det,
+        eae_seconds,
+        e_oi,
+        best,
+        best_seconds,
+        fed,
+        det,
+    })
+}
+
+/// Runs the experiment; `progress` is called with the name of each of the
+/// [`STEPS`] stages as it starts.
+pub fn run(
+    a: &PaperSettings,
+    mut progress: impl FnMut(&'static str),
+) -> Result<PaperReport, ExperimentError> {
+    a.validate()?;
+    let clock = Instant::now();
+    let robot = Robot::puma560();
+    let pool = PoolSpec::lattice(a.levels).build(&robot, &robot.nominal)?;
+    let x = pool.try_jacobian(&robot, &robot.nominal)?;
+    let s = Settings {
+        n: a.n,
+        initial: a.initial,
+        starts: a.starts,
+        designs: a.designs,
+        seed: a.seed,
+        ..Settings::default()
+    };
+    s.validate(&x)?;
+    // 1. Random baseline (§V-C).
+    progress("random designs");
+    let random = random_baseline(&x, a);
+    // 2.–4. EAE, its eigenvalue-OI twin, multi-start, Fedorov, DETMAX.
+    let sel = selections(&x, a, &s, &mut progress)?;
     // 5. The relaxation bound, cross-checked by the Newton barrier solver.
     progress("relaxation bound");
     let bound = relaxation_bound(&x, a.n, &BoundSettings::default())?;
@@ -428,20 +475,20 @@ pub fn run(
             .build()?,
     )?;
     let named: Vec<(&str, Vec<usize>)> = vec![
-        ("EAE (paper settings)", e_det.poses.clone()),
-        ("multi-start EAE + polish", best.poses.clone()),
-        ("Fedorov", fed.poses.clone()),
-        ("DETMAX", det.poses.clone()),
-        ("best random", rs.best.clone()),
-        ("median random", median_design),
+        ("EAE (paper settings)", sel.e_det.poses.clone()),
+        ("multi-start EAE + polish", sel.best.poses.clone()),
+        ("Fedorov", sel.fed.poses.clone()),
+        ("DETMAX", sel.det.poses.clone()),
+        ("best random", random.search.best.clone()),
+        ("median random", random.median_design.clone()),
     ];
     let gaps: Vec<DesignGap> = named
         .iter()
         .map(|(_, d)| design_gap(&x, d, &bound))
         .collect::<Result<_, _>>()?;
-
     // 6. Calibration: Tables III/IV on the EAE design, Monte-Carlo on several.
     progress("calibration (Tables III, IV)");
+    let e_det = &sel.e_det;
     let qs: Vec<Vec<f64>> = e_det.poses.iter().map(|&k| pool.q(k)).collect();
     let tables: PaperTables = paper_tables(&robot, &qs, a.noise, a.seed, &LmSettings::default())?;
     progress("Monte-Carlo calibration");
@@ -466,69 +513,139 @@ pub fn run(
         d.iter().map(|&k| lattice.digits(pool.id(k))).collect()
     };
     let figures = FigureData {
-        random_oi: rs.oi.clone(),
+        random_oi: random.search.oi.clone(),
         eae_oi: e_det.oi,
         eae_trace_oi: e_det.trace.iter().map(|r| r.oi).collect(),
-        eae_oi_trace_oi: e_oi
+        eae_oi_trace_oi: sel
+            .e_oi
             .as_ref()
             .map(|o| o.trace.iter().map(|r| r.oi).collect()),
         initial_digits: digits(&e_det.trace_initial())?,
         selected_digits: digits(&e_det.poses)?,
     };
-    let same_design = |o: &Selection| {
-        let mut a1 = o.poses.clone();
-        let mut b1 = e_det.poses.clone();
-        a1.sort_unstable();
-        b1.sort_unstable();
-        a1 == b1
+    let parts = Parts {
+        pool: &pool,
+        robot: &robot,
+        p: x.p(),
+        random: &random,
+        sel: &sel,
+        bound: &bound,
+        newton: &newton,
+        named: &named,
+        gaps: &gaps,
+        tables: &tables,
     };
-    Ok(PaperReport {
-        settings: SettingsSummary {
-            levels: a.levels,
-            n: a.n,
-            initial: a.initial,
-            designs: a.designs,
-            starts: a.starts,
-            trials: a.trials,
-            noise: a.noise,
-            seed: a.seed,
-            pool: pool.len(),
-            p,
-        },
-        pool: pool.spec.clone(),
-        chain: crate::report::chain(&robot),
-        random: RandomSummary {
-            best_log10_oid: l10(rs.best_ln_oid),
-            best_oi: oi_from_ln_oid(rs.best_ln_oid, p),
-            median_log10_oid: l10(rs.ln_oid[median_j]),
-            best_poses: ids(&rs.best),
-        },
-        eae: EaeSummary {
-            log10_oid: l10(e_det.ln_oid),
-            oi: e_det.oi,
-            seconds: eae_seconds,
-            poses: ids(&e_det.poses),
-            trace_log10_oid: e_det.trace.iter().map(|r| l10(r.ln_oid)).collect(),
-        },
-        eae_oi: e_oi.as_ref().map(|o| EaeOiSummary {
-            log10_oid: l10(o.ln_oid),
-            oi: o.oi,
-            same_design: same_design(o),
-            poses: ids(&o.poses),
-        }),
-        multistart: MultistartSummary {
-            log10_oid: l10(best.ln_oid),
-            oi: best.oi,
-            seconds: best_seconds,
-            best_start: best.start,
-        },
-        fedorov: Log10Oid {
-            log10_oid: l10(fed.ln_oid),
-        },
-        detmax: Log10Oid {
-            log10_oid: l10(det.ln_oid),
-        },
-        bound: BoundSummary {
+    Ok(parts.report(a, mc, figures, clock.elapsed().as_secs_f64()))
+}
+
+/// Everything the experiment computed, for the report.
+struct Parts<'a> {
+    pool: &'a crate::pool::Pool,
+    robot: &'a Robot,
+    p: usize,
+    random: &'a RandomBaseline,
+    sel: &'a Selections,
+    bound: &'a crate::bound::Bound,
+    newton: &'a crate::bound::Bound,
+    named: &'a [(&'a str, Vec<usize>)],
+    gaps: &'a [DesignGap],
+    tables: &'a PaperTables,
+}
+
+impl Parts<'_> {
+    /// The design of `d` as pool ids.
+    fn ids(&self, d: &[usize]) -> Vec<usize> {
+        self.pool.ids_of(d)
+    }
+
+    /// The typed report of the run.
+    fn report(
+        &self,
+        a: &PaperSettings,
+        mc: crate::identify::montecarlo::Comparison,
+        figures: FigureData,
+        seconds: f64,
+    ) -> PaperReport {
+        let (pool, robot, p) = (self.pool, self.robot, self.p);
+        let rs = &self.random.search;
+        let sel = self.sel;
+        let (e_det, best, fed, det) = (&sel.e_det, &sel.best, &sel.fed, &sel.det);
+        PaperReport {
+            settings: SettingsSummary {
+                levels: a.levels,
+                n: a.n,
+                initial: a.initial,
+                designs: a.designs,
+                starts: a.starts,
+                trials: a.trials,
+                noise: a.noise,
+                seed: a.seed,
+                pool: pool.len(),
+                p,
+            },
+            pool: pool.spec.clone(),
+            chain: crate::report::chain(robot),
+            random: RandomSummary {
+                best_log10_oid: l10(rs.best_ln_oid),
+                best_oi: oi_from_ln_oid(rs.best_ln_oid, p),
+                median_log10_oid: l10(rs.ln_oid[self.random.median_j]),
+                best_poses: self.ids(&rs.best),
+            },
+            eae: EaeSummary {
+                log10_oid: l10(e_det.ln_oid),
+                oi: e_det.oi,
+                seconds: sel.eae_seconds,
+                poses: self.ids(&e_det.poses),
+                trace_log10_oid: e_det.trace.iter().map(|r| l10(r.ln_oid)).collect(),
+            },
+            eae_oi: sel.e_oi.as_ref().map(|o| EaeOiSummary {
+                log10_oid: l10(o.ln_oid),
+                oi: o.oi,
+                same_design: same_poses(&o.poses, &e_det.poses),
+                poses: self.ids(&o.poses),
+            }),
+            multistart: MultistartSummary {
+                log10_oid: l10(best.ln_oid),
+                oi: best.oi,
+                seconds: sel.best_seconds,
+                best_start: best.start,
+            },
+            fedorov: Log10Oid {
+                log10_oid: l10(fed.ln_oid),
+            },
+            detmax: Log10Oid {
+                log10_oid: l10(det.ln_oid),
+            },
+            bound: self.bound_summary(),
+            designs: self
+                .named
+                .iter()
+                .zip(self.gaps)
+                .map(|((name, d), g)| DesignRow {
+                    name: (*name).to_string(),
+                    poses: self.ids(d),
+                    log10_oid: g.log10_oid,
+                    d_efficiency: g.d_efficiency,
+                })
+                .collect(),
+            tables: TablesSummary {
+                estimate: self.tables.estimate.clone(),
+                residual: self.tables.residual.clone(),
+                std: self.tables.std.clone(),
+                iterations: self.tables.identification.iterations,
+                status: self.tables.identification.status,
+            },
+            monte_carlo: mc.designs.iter().map(monte_carlo_row).collect(),
+            seconds,
+            monte_carlo_full: mc.designs,
+            figures,
+        }
+    }
+
+    /// The bound and its Newton cross-check.
+    fn bound_summary(&self) -> BoundSummary {
+        let (bound, newton) = (self.bound, self.newton);
+        BoundSummary {
             log10_bound: bound.log10_bound(),
             ln_bound: bound.ln_bound,
             ln_primal: bound.ln_primal,
@@ -544,46 +661,35 @@ pub fn run(
                 seconds: newton.seconds,
                 status: newton.status,
             },
-        },
-        designs: named
+        }
+    }
+}
+
+/// Whether two designs hold the same poses, in any order.
+fn same_poses(a: &[usize], b: &[usize]) -> bool {
+    let mut a1 = a.to_vec();
+    let mut b1 = b.to_vec();
+    a1.sort_unstable();
+    b1.sort_unstable();
+    a1 == b1
+}
+
+/// One design's Monte-Carlo row of the report.
+fn monte_carlo_row(d: &crate::identify::montecarlo::MonteCarloSummary) -> MonteCarloRow {
+    MonteCarloRow {
+        design: d.design.clone(),
+        trials: d.trials,
+        converged: d.converged,
+        rmse_median_over_predicted: d.rmse_over_predicted.as_ref().map(|s| s.median),
+        param_rmse: d
+            .parameters
             .iter()
-            .zip(&gaps)
-            .map(|((name, d), g)| DesignRow {
-                name: (*name).to_string(),
-                poses: ids(d),
-                log10_oid: g.log10_oid,
-                d_efficiency: g.d_efficiency,
-            })
+            .map(|q| (q.name.clone(), q.rmse))
             .collect(),
-        tables: TablesSummary {
-            estimate: tables.estimate.clone(),
-            residual: tables.residual.clone(),
-            std: tables.std.clone(),
-            iterations: tables.identification.iterations,
-            status: tables.identification.status,
-        },
-        monte_carlo: mc
-            .designs
-            .iter()
-            .map(|d| MonteCarloRow {
-                design: d.design.clone(),
-                trials: d.trials,
-                converged: d.converged,
-                rmse_median_over_predicted: d.rmse_over_predicted.as_ref().map(|s| s.median),
-                param_rmse: d
-                    .parameters
-                    .iter()
-                    .map(|q| (q.name.clone(), q.rmse))
-                    .collect(),
-                ln_generalized_variance_ratio: d.generalized_variance.as_ref().map(|g| g.ln_ratio),
-                validation_rms_before: d.validation_rms_before,
-                validation_rms_after_median: d.validation_rms_after.as_ref().map(|s| s.median),
-            })
-            .collect(),
-        seconds: clock.elapsed().as_secs_f64(),
-        monte_carlo_full: mc.designs,
-        figures,
-    })
+        ln_generalized_variance_ratio: d.generalized_variance.as_ref().map(|g| g.ln_ratio),
+        validation_rms_before: d.validation_rms_before,
+        validation_rms_after_median: d.validation_rms_after.as_ref().map(|s| s.median),
+    }
 }
 
 fn fmt_opt(v: Option<f64>, digits: usize) -> String {

@@ -7,10 +7,7 @@
 use super::{emit, write_new};
 use activecal::frames::CalibratedFrames;
 use activecal::frames::report::{FitBlock, FramesReport};
-use activecal::identify::{
-    Identification, LmSettings, MonteCarloSettings, MonteCarloSummary, ValidationSet, monte_carlo,
-    paper_tables,
-};
+use activecal::identify::{Identification, LmSettings, MonteCarloSettings, MonteCarloSummary};
 use activecal::io::calibrated::Format;
 use activecal::io::design::DesignFile;
 use activecal::model::Robot;
@@ -511,18 +508,6 @@ fn from_design(
         // robot description's visibility region.
         spec.filters = super::filters(None, described)?;
     }
-    let pool = design
-        .build_pool(&spec, robot, &robot.nominal)
-        .map_err(in_file)?;
-    // A design chosen on top of poses already measured (`select
-    // --existing`) is calibrated from all of them: the existing poses, then
-    // the new ones, as they will be measured.
-    let new_qs = design.joint_values(robot).map_err(in_file)?;
-    let qs: Vec<Vec<f64>> = match &design.existing {
-        Some(e) => e.q.iter().chain(&new_qs).cloned().collect(),
-        None => new_qs,
-    };
-    let positions = design.positions_found_in(robot, &pool).map_err(in_file)?;
     let lm = LmSettings::default()
         .with_max_iterations(a.max_iterations)
         .with_geodesic(!a.no_geodesic);
@@ -532,11 +517,16 @@ fn from_design(
         .with_seed(a.seed())
         .with_validation_poses(a.validation);
     let settings = MonteCarloSettings { lm, ..settings };
-    settings.validate()?;
-    let validation = ValidationSet::sample(robot, &pool, &positions, a.validation, a.seed())?;
-
-    // ---- one calibration: trial 0 of the seed --------------------------------
-    let tables = paper_tables(robot, &qs, a.noise, a.seed(), &settings.lm)?;
+    let name = design_path
+        .file_stem()
+        .map_or("design".into(), |s| s.to_string_lossy().into_owned());
+    let sim =
+        activecal::experiment::simulated::calibrate_design(robot, &design, &spec, &name, &settings)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", design_path.display()))?;
+    let (pool, qs, tables, validation) = (&sim.pool, &sim.qs, &sim.tables, &sim.validation);
+    let (before, after) = (sim.rms_before, sim.rms_after);
+    let (rot_before, rot_after) = (sim.orientation_rms_before, sim.orientation_rms_after);
+    let (mc, mc_seconds) = (sim.monte_carlo.clone(), sim.monte_carlo_seconds);
     let id = &tables.identification;
     if let Some(path) = &a.save_measurements {
         let text = serde_json::to_string_pretty(&tables.measurements)? + "\n";
@@ -547,23 +537,7 @@ fn from_design(
     write_calibrated(a, robot, id, &source, frames.as_ref())?;
     let truth = robot.unknown_values(&robot.real);
     let residual: Vec<f64> = truth.iter().zip(&id.estimate).map(|(t, e)| t - e).collect();
-    let before = validation.rms(robot, &robot.nominal);
-    let after = validation.rms(robot, &id.table);
-    let rot_before = validation.orientation_rms(robot, &robot.nominal);
-    let rot_after = validation.orientation_rms(robot, &id.table);
     let full = activecal::measure::sensor_for(robot).observes_orientation();
-
-    // ---- Monte-Carlo ------------------------------------------------------------
-    let t_mc = Instant::now();
-    let mc: Option<MonteCarloSummary> = if a.trials > 1 {
-        let name = design_path
-            .file_stem()
-            .map_or("design".into(), |s| s.to_string_lossy().into_owned());
-        Some(monte_carlo(robot, &name, &qs, &validation, &settings)?)
-    } else {
-        None
-    };
-    let mc_seconds = t_mc.elapsed().as_secs_f64();
 
     let report = SimulatedCalibrationReport {
         identification: IdentificationReport::from(id),

@@ -298,19 +298,7 @@ pub enum Order {
 
 /// Runs `select`.
 pub fn cmd_select(a: SelectArgs) -> Result<()> {
-    if let Some(out) = &a.out {
-        // Checked before the search: the format, an existing file, a missing
-        // directory.
-        super::refuse_overwrite(out, a.force)?;
-        activecal::io::design_formats::DesignFormat::of(out)
-            .map_err(|e| anyhow::anyhow!("--out {e}"))?;
-    }
-    if let Some(dir) = &a.report {
-        super::report_dir::check(dir, a.force)?;
-    }
-    if let Some(n) = a.noise.filter(|v| !(v.is_finite() && *v > 0.0)) {
-        bail!("--noise {n}: the sensor noise σ must be a finite number > 0 (metres)");
-    }
+    check_select_outputs(&a)?;
     // Cheap checks of the ordering's inputs before the pool is built.
     let described = super::load_description(&a.pool.robot)?;
     let speeds = activecal::io::joint_speeds::joint_speeds(&described.robot)?;
@@ -331,13 +319,72 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         .map(|p| super::load_existing(p, &ctx.robot, a.pool.params, a.pool.units.units()))
         .transpose()?;
     let prior = existing.as_ref().map(|e| e.prior.clone());
+    let s = selection_settings(&a, &ctx, initial, prior.clone())?;
+    let t0 = Instant::now();
+    let sel = select(&ctx.x, a.criterion, a.algorithm, &s)?;
+    let seconds = t0.elapsed().as_secs_f64();
+    let mut report = SelectReport::new(&ctx.robot, &ctx.pool, &sel, a.criterion, &s, seconds);
+    if let Some(e) = &existing {
+        let alone = activecal::criterion::design_ln_det(&ctx.x, None, &sel.poses);
+        report.set_existing(e.report.clone(), alone);
+    }
+    let pool_bound = with_gap(&a, &ctx, prior.as_ref(), &sel, &mut report)?;
+    let refined = refined(&a, &ctx, prior.as_ref(), &sel, pool_bound, &mut report)?;
+    let reorder = a.order.map_or(speeds.is_some(), |o| o == Order::Time);
+    let mut order =
+        super::tour::order_design(&mut report, speeds.as_ref(), home.as_deref(), reorder)?;
+    super::tour::check_moves(&mut report, &mut order, &ctx.pool, home.as_deref())?;
+    if let Some(out) = &a.out {
+        let design = design_file(
+            &ctx,
+            &sel,
+            refined.as_ref(),
+            existing.as_ref(),
+            &order,
+            &report,
+        )?;
+        super::tour::write_design(&design, out, a.force)?;
+    }
+    if let Some(dir) = &a.report {
+        report_dir(&a, &ctx, &s, dir, &report)?;
+    }
+    emit_report(a.json, &report, || select_text(&a, &ctx, &report, seconds))
+}
+
+/// The outputs and report options of `select`, checked before any work:
+/// the format, an existing file, a missing directory, the noise.
+fn check_select_outputs(a: &SelectArgs) -> Result<()> {
+    if let Some(out) = &a.out {
+        // Checked before the search: the format, an existing file, a missing
+        // directory.
+        super::refuse_overwrite(out, a.force)?;
+        activecal::io::design_formats::DesignFormat::of(out)
+            .map_err(|e| anyhow::anyhow!("--out {e}"))?;
+    }
+    if let Some(dir) = &a.report {
+        super::report_dir::check(dir, a.force)?;
+    }
+    if let Some(n) = a.noise.filter(|v| !(v.is_finite() && *v > 0.0)) {
+        bail!("--noise {n}: the sensor noise σ must be a finite number > 0 (metres)");
+    }
+    Ok(())
+}
+
+/// The selection's settings from the options, the pool and the poses
+/// already measured (`--fixed` ids checked against the pool).
+fn selection_settings(
+    a: &SelectArgs,
+    ctx: &super::PoolCtx,
+    initial: usize,
+    prior: Option<activecal::criterion::Prior>,
+) -> Result<Settings> {
     let fixed_ids: Vec<usize> = match &a.fixed {
         Some(f) => parse_list(f, "--fixed")?,
         None => vec![],
     };
     activecal::io::design::check_unique(&fixed_ids)?;
     let fixed = ctx.pool.positions_of(&fixed_ids)?;
-    let s = Settings {
+    Ok(Settings {
         n: a.n,
         initial: initial.max(fixed.len()),
         starts: a.starts,
@@ -349,188 +396,215 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         kick: a.kick,
         seed: a.seed,
         fixed,
-        prior: prior.clone(),
+        prior,
         ..Settings::default()
-    };
-    let t0 = Instant::now();
-    let sel = select(&ctx.x, a.criterion, a.algorithm, &s)?;
-    let seconds = t0.elapsed().as_secs_f64();
-    let mut report = SelectReport::new(&ctx.robot, &ctx.pool, &sel, a.criterion, &s, seconds);
-    if let Some(e) = &existing {
-        let alone = activecal::criterion::design_ln_det(&ctx.x, None, &sel.poses);
-        report.set_existing(e.report.clone(), alone);
-    }
+    })
+}
+
+/// `--gap`: the design against the pool's bound; returns the bound.
+fn with_gap(
+    a: &SelectArgs,
+    ctx: &super::PoolCtx,
+    prior: Option<&activecal::criterion::Prior>,
+    sel: &activecal::select::Selection,
+    report: &mut SelectReport,
+) -> Result<Option<f64>> {
     let mut pool_bound = None;
     if a.gap {
         let settings = activecal::bound::BoundSettings::builder()
             .solver(a.gap_solver)
             .build()?;
-        let bound =
-            activecal::bound::relaxation_bound_with_prior(&ctx.x, prior.as_ref(), a.n, &settings)?;
-        let g =
-            activecal::bound::design_gap_with_prior(&ctx.x, prior.as_ref(), &sel.poses, &bound)?;
+        let bound = activecal::bound::relaxation_bound_with_prior(&ctx.x, prior, a.n, &settings)?;
+        let g = activecal::bound::design_gap_with_prior(&ctx.x, prior, &sel.poses, &bound)?;
         report.set_gap(&g);
         pool_bound = Some(bound.ln_bound);
     }
-    let refined = if a.refine {
-        let qs: Vec<Vec<f64>> = sel.poses.iter().map(|&k| ctx.pool.q(k)).collect();
-        let r = activecal::select::refine(
-            &ctx.robot,
-            ctx.robot.params(a.pool.params),
-            &ctx.robot.nominal,
-            &ctx.pool.spec.filters,
-            prior.as_ref(),
-            &qs,
-            &activecal::select::RefineSettings {
-                sweeps: a.refine_sweeps,
-                ..activecal::select::RefineSettings::default()
-            },
-        )?;
-        let mut rr = activecal::report::RefinementReport::new(&ctx.pool, &sel.poses, &r);
-        if let Some(lb) = pool_bound {
-            rr.set_bound(lb, ctx.x.p());
-        }
-        report.refinement = Some(rr);
-        Some(r)
-    } else {
-        None
-    };
-    if let Some(r) = &refined {
-        for (c, p) in report.configurations.iter_mut().zip(&r.poses) {
-            c.q.clone_from(&p.q);
-        }
+    Ok(pool_bound)
+}
+
+/// `--refine`: the design refined off the pool (its joint values replace
+/// the pool's in the report).
+fn refined(
+    a: &SelectArgs,
+    ctx: &super::PoolCtx,
+    prior: Option<&activecal::criterion::Prior>,
+    sel: &activecal::select::Selection,
+    pool_bound: Option<f64>,
+    report: &mut SelectReport,
+) -> Result<Option<activecal::select::Refinement>> {
+    if !a.refine {
+        return Ok(None);
     }
-    let reorder = a.order.map_or(speeds.is_some(), |o| o == Order::Time);
-    let mut order =
-        super::tour::order_design(&mut report, speeds.as_ref(), home.as_deref(), reorder)?;
-    super::tour::check_moves(&mut report, &mut order, &ctx.pool, home.as_deref())?;
-    if let Some(out) = &a.out {
-        let mut d = DesignFile::from_pool(&ctx.robot, &ctx.pool, &sel.poses);
-        if let Some(r) = &refined {
-            d.q = Some(r.poses.iter().map(|p| p.q.clone()).collect());
-            d.refined = true;
-        }
-        super::tour::reorder_design(&mut d, &order);
-        d.existing = existing
-            .as_ref()
-            .map(|e| activecal::io::design::ExistingPoses {
-                path: e.report.file.clone(),
-                q: e.qs.clone(),
-            });
-        let v = serde_json::to_value(&report)?;
-        for k in [
-            "ln_oid",
-            "log10_oid",
-            "oi",
-            "algorithm",
-            "criterion",
-            "seed",
-            "starts",
-            "polish",
-            "ils",
-            "kick",
-            "fixed",
-        ] {
-            d.extra.insert(k.into(), v[k].clone());
-        }
-        super::tour::write_design(&d, out, a.force)?;
+    let qs: Vec<Vec<f64>> = sel.poses.iter().map(|&k| ctx.pool.q(k)).collect();
+    let r = activecal::select::refine(
+        &ctx.robot,
+        ctx.robot.params(a.pool.params),
+        &ctx.robot.nominal,
+        &ctx.pool.spec.filters,
+        prior,
+        &qs,
+        &activecal::select::RefineSettings {
+            sweeps: a.refine_sweeps,
+            ..activecal::select::RefineSettings::default()
+        },
+    )?;
+    let mut rr = activecal::report::RefinementReport::new(&ctx.pool, &sel.poses, &r);
+    if let Some(lb) = pool_bound {
+        rr.set_bound(lb, ctx.x.p());
     }
-    if let Some(dir) = &a.report {
-        let mut cs = activecal::how_many::CurveSettings::new(
-            s.clone(),
-            a.noise.unwrap_or(DEFAULT_REPORT_NOISE),
-        );
-        cs.criterion = a.criterion;
-        cs.algorithm = a.algorithm;
-        cs.also = vec![a.n];
-        let curve = activecal::how_many::pose_count_curve(
-            &ctx.robot,
-            ctx.robot.params(a.pool.params),
-            &ctx.x,
-            &ctx.pool.ids,
-            &cs,
-        )?;
-        super::report_dir::selection(dir, &ctx.robot, &report, &curve, a.noise.is_none())?;
+    report.refinement = Some(rr);
+    for (c, p) in report.configurations.iter_mut().zip(&r.poses) {
+        c.q.clone_from(&p.q);
     }
-    emit_report(a.json, &report, || {
-        let mut s = super::pool_stats_text(&ctx.pool.stats);
-        if let Some(e) = &report.existing {
-            s += &super::existing_text(e);
-        }
+    Ok(Some(r))
+}
+
+/// The design file of the selection, in visiting order, with the report's
+/// figures as extra keys.
+fn design_file(
+    ctx: &super::PoolCtx,
+    sel: &activecal::select::Selection,
+    refined: Option<&activecal::select::Refinement>,
+    existing: Option<&super::Existing>,
+    order: &[usize],
+    report: &SelectReport,
+) -> Result<DesignFile> {
+    let mut d = DesignFile::from_pool(&ctx.robot, &ctx.pool, &sel.poses);
+    if let Some(r) = refined {
+        d.q = Some(r.poses.iter().map(|p| p.q.clone()).collect());
+        d.refined = true;
+    }
+    super::tour::reorder_design(&mut d, order);
+    d.existing = existing.map(|e| activecal::io::design::ExistingPoses {
+        path: e.report.file.clone(),
+        q: e.qs.clone(),
+    });
+    let v = serde_json::to_value(report)?;
+    for k in [
+        "ln_oid",
+        "log10_oid",
+        "oi",
+        "algorithm",
+        "criterion",
+        "seed",
+        "starts",
+        "polish",
+        "ils",
+        "kick",
+        "fixed",
+    ] {
+        d.extra.insert(k.into(), v[k].clone());
+    }
+    Ok(d)
+}
+
+/// `--report DIR`: the "how many poses" curve and the selection's figures.
+fn report_dir(
+    a: &SelectArgs,
+    ctx: &super::PoolCtx,
+    s: &Settings,
+    dir: &std::path::Path,
+    report: &SelectReport,
+) -> Result<()> {
+    let mut cs =
+        activecal::how_many::CurveSettings::new(s.clone(), a.noise.unwrap_or(DEFAULT_REPORT_NOISE));
+    cs.criterion = a.criterion;
+    cs.algorithm = a.algorithm;
+    cs.also = vec![a.n];
+    let curve = activecal::how_many::pose_count_curve(
+        &ctx.robot,
+        ctx.robot.params(a.pool.params),
+        &ctx.x,
+        &ctx.pool.ids,
+        &cs,
+    )?;
+    super::report_dir::selection(dir, &ctx.robot, report, &curve, a.noise.is_none())
+}
+
+/// The text report of `select`.
+fn select_text(
+    a: &SelectArgs,
+    ctx: &super::PoolCtx,
+    report: &SelectReport,
+    seconds: f64,
+) -> String {
+    let mut s = super::pool_stats_text(&ctx.pool.stats);
+    if let Some(e) = &report.existing {
+        s += &super::existing_text(e);
+    }
+    s += &format!(
+        "{:?} ({:?} criterion, seed {}, {} start(s){}{}): {} poses in {:.3} s\nlog10 OI_D {:.4}{}  OI {:.6}\nposes: {}\n",
+        report.algorithm,
+        report.criterion,
+        a.seed,
+        a.starts,
+        if report.ils > 0 {
+            format!(", {} ILS rounds of {} kicks", report.ils, report.kick)
+        } else {
+            String::new()
+        },
+        if a.polish { ", Fedorov polish" } else { "" },
+        report.poses.len(),
+        seconds,
+        report.log10_oid,
+        if report.existing.is_some() {
+            " (existing + new poses)"
+        } else {
+            ""
+        },
+        report.oi,
+        report
+            .poses
+            .iter()
+            .map(|p| p.to_string())
+            .collect::<Vec<_>>()
+            .join(",")
+    );
+    if let Some(Some(g)) = report.ln_gain {
         s += &format!(
-            "{:?} ({:?} criterion, seed {}, {} start(s){}{}): {} poses in {:.3} s\nlog10 OI_D {:.4}{}  OI {:.6}\nposes: {}\n",
-            report.algorithm,
-            report.criterion,
-            a.seed,
-            a.starts,
-            if report.ils > 0 {
-                format!(", {} ILS rounds of {} kicks", report.ils, report.kick)
-            } else {
-                String::new()
-            },
-            if a.polish { ", Fedorov polish" } else { "" },
-            report.poses.len(),
-            seconds,
-            report.log10_oid,
+            "the new poses add {:.4} to log10 det M0\n",
+            g / std::f64::consts::LN_10
+        );
+    }
+    if let (Some(b), Some(eff)) = (report.log10_bound, report.d_efficiency) {
+        s += &format!(
+            "log10 bound {b:.4}{}  D-efficiency >= {eff:.6}\n",
             if report.existing.is_some() {
-                " (existing + new poses)"
+                " (with the existing poses' information)"
             } else {
                 ""
-            },
-            report.oi,
-            report
-                .poses
-                .iter()
-                .map(|p| p.to_string())
-                .collect::<Vec<_>>()
-                .join(",")
+            }
         );
-        if let Some(Some(g)) = report.ln_gain {
+    }
+    if let Some(r) = &report.refinement {
+        s += &format!(
+            "refined off the pool: log10 OI_D {:.4} -> {:.4} (+{:.4}), {} pass(es)\n",
+            r.ln_oid_before / std::f64::consts::LN_10,
+            r.log10_oid,
+            r.ln_gain / std::f64::consts::LN_10,
+            r.sweeps
+        );
+        s += "pose    log10 gain  largest joint move\n";
+        for p in &r.poses {
             s += &format!(
-                "the new poses add {:.4} to log10 det M0\n",
-                g / std::f64::consts::LN_10
+                "{:>6}  {:>10.4}  {:.4}\n",
+                p.pose,
+                p.ln_gain / std::f64::consts::LN_10,
+                p.max_move
             );
         }
-        if let (Some(b), Some(eff)) = (report.log10_bound, report.d_efficiency) {
+        if let (Some(true), Some(b)) = (r.exceeds_pool_bound, report.log10_bound) {
             s += &format!(
-                "log10 bound {b:.4}{}  D-efficiency >= {eff:.6}\n",
-                if report.existing.is_some() {
-                    " (with the existing poses' information)"
-                } else {
-                    ""
-                }
+                "the refined design EXCEEDS the pool's certified bound (log10 {:.4} > {b:.4}): no design of the pool can reach it\n",
+                r.log10_oid
+            );
+        } else if let (Some(false), Some(b)) = (r.exceeds_pool_bound, report.log10_bound) {
+            s += &format!(
+                "the refined design stays below the pool's certified bound (log10 {:.4} <= {b:.4})\n",
+                r.log10_oid
             );
         }
-        if let Some(r) = &report.refinement {
-            s += &format!(
-                "refined off the pool: log10 OI_D {:.4} -> {:.4} (+{:.4}), {} pass(es)\n",
-                r.ln_oid_before / std::f64::consts::LN_10,
-                r.log10_oid,
-                r.ln_gain / std::f64::consts::LN_10,
-                r.sweeps
-            );
-            s += "pose    log10 gain  largest joint move\n";
-            for p in &r.poses {
-                s += &format!(
-                    "{:>6}  {:>10.4}  {:.4}\n",
-                    p.pose,
-                    p.ln_gain / std::f64::consts::LN_10,
-                    p.max_move
-                );
-            }
-            if let (Some(true), Some(b)) = (r.exceeds_pool_bound, report.log10_bound) {
-                s += &format!(
-                    "the refined design EXCEEDS the pool's certified bound (log10 {:.4} > {b:.4}): no design of the pool can reach it\n",
-                    r.log10_oid
-                );
-            } else if let (Some(false), Some(b)) = (r.exceeds_pool_bound, report.log10_bound) {
-                s += &format!(
-                    "the refined design stays below the pool's certified bound (log10 {:.4} <= {b:.4})\n",
-                    r.log10_oid
-                );
-            }
-        }
-        s += &super::tour::configurations_text(&report);
-        s
-    })
+    }
+    s += &super::tour::configurations_text(report);
+    s
 }

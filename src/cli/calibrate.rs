@@ -570,111 +570,144 @@ fn from_design(
     let mut v = serde_json::to_value(&report)?;
     v["exit_status"] = exit_status(id).into();
     if let Some(dir) = &a.report {
-        let to_mm = |v: Vec<f64>| v.into_iter().map(|x| x * 1e3).collect::<Vec<_>>();
-        let to_deg = |v: Vec<f64>| v.into_iter().map(f64::to_degrees).collect::<Vec<_>>();
-        let nominal = robot.unknown_values(&robot.nominal);
-        let std = id.covariance.as_ref().map(|c| c.std.clone());
-        let mut notes = vec![format!(
-            "Simulated measurements at the design's {} poses with noise σ = {} mm per coordinate{} (seed {}); errors at {} held-out poses of the design's pool.",
-            qs.len(),
-            a.noise * 1e3,
-            if a.noise == 0.01 {
-                " (the default of --noise)"
-            } else {
-                ""
-            },
-            a.seed(),
-            validation.len()
-        )];
-        if let Some(mc) = &mc {
-            notes.push(format!(
-                "Monte-Carlo over {} trials: validation RMS after calibration median {} mm, predicted {} mm.",
-                mc.trials,
-                mc.validation_rms_after.as_ref().map_or("-".into(), |v| format!("{:.4}", v.median * 1e3)),
-                mc.validation_rms_predicted.map_or("-".into(), |p| format!("{:.4}", p * 1e3))
-            ));
-        }
-        let s = super::report_dir::CalibrationSummary {
-            robot,
-            id,
-            source: format!("simulated, design `{}`", design_path.display()),
-            what: "held-out pose",
-            position_mm: (
-                to_mm(validation.position_errors(robot, &robot.nominal)),
-                to_mm(validation.position_errors(robot, &id.table)),
-            ),
-            orientation_deg: full.then(|| {
-                (
-                    to_deg(validation.orientation_errors(robot, &robot.nominal)),
-                    to_deg(validation.orientation_errors(robot, &id.table)),
-                )
-            }),
-            params: id
-                .names
-                .iter()
-                .enumerate()
-                .map(|(k, n)| {
-                    (
-                        n.clone(),
-                        id.estimate[k] - nominal[k],
-                        std.as_ref().map(|s| s[k]),
-                    )
-                })
-                .collect(),
-            splits: None,
-            notes,
-            json: v.clone(),
-        };
-        super::report_dir::calibration(dir, &s)?;
+        simulated_report_dir(a, robot, design_path, &sim, dir, &v)?;
     }
     emit(a.json, &v, || {
-        let noise = if full {
-            format!(
-                "σ = {} m and {:.3e} rad (full poses)",
-                a.noise,
-                a.noise / robot.orientation_scale
-            )
-        } else {
-            format!("σ = {} m", a.noise)
-        };
-        let noise = if a.noise == DEFAULT_NOISE {
-            format!("{noise}, the default of --noise")
-        } else {
-            noise
-        };
-        let mut s = format!(
-            "{}: {} poses, {noise}, seed {}\n{}",
-            design_path.display(),
-            qs.len(),
-            a.seed(),
-            status_text(id)
-        );
-        s += "\nestimate (Table III)\n";
-        s += &tables.estimate.to_text(6);
-        s += "\nresidual = real − estimate (Table IV)\n";
-        s += &tables.residual.to_text(6);
-        if let Some(std) = &tables.std {
-            s += "\nstandard deviation\n";
-            s += &std.to_text(6);
-        }
-        s += &format!(
-            "\nvalidation ({} held-out poses): RMS position error {before:.6} m before, {after:.6} m after\n",
-            validation.len()
-        );
-        if let (Some(b), Some(f)) = (rot_before, rot_after) {
-            s += &format!(
-                "validation: RMS orientation error {b:.6e} rad before, {f:.6e} rad after\n"
-            );
-        }
-        if let Some(mc) = &mc {
-            s += &mc_text(mc, mc_seconds);
-        }
-        if let Some(f) = &report.frames {
-            s += &super::frames_text::frames_text(f);
-        }
-        s
+        simulated_text(a, robot, design_path, &sim, &report)
     });
     refuse_unconverged(a, id)
+}
+
+/// `--report DIR` of a simulated calibration: the errors at the held-out
+/// poses before and after, the parameter changes, notes on the simulation.
+fn simulated_report_dir(
+    a: &CalibrateArgs,
+    robot: &Robot,
+    design_path: &Path,
+    sim: &activecal::experiment::simulated::SimulatedCalibration,
+    dir: &Path,
+    v: &serde_json::Value,
+) -> Result<()> {
+    let (qs, tables, validation) = (&sim.qs, &sim.tables, &sim.validation);
+    let id = &tables.identification;
+    let full = activecal::measure::sensor_for(robot).observes_orientation();
+    let mc = &sim.monte_carlo;
+    let to_mm = |v: Vec<f64>| v.into_iter().map(|x| x * 1e3).collect::<Vec<_>>();
+    let to_deg = |v: Vec<f64>| v.into_iter().map(f64::to_degrees).collect::<Vec<_>>();
+    let nominal = robot.unknown_values(&robot.nominal);
+    let std = id.covariance.as_ref().map(|c| c.std.clone());
+    let mut notes = vec![format!(
+        "Simulated measurements at the design's {} poses with noise σ = {} mm per coordinate{} (seed {}); errors at {} held-out poses of the design's pool.",
+        qs.len(),
+        a.noise * 1e3,
+        if a.noise == 0.01 {
+            " (the default of --noise)"
+        } else {
+            ""
+        },
+        a.seed(),
+        validation.len()
+    )];
+    if let Some(mc) = &mc {
+        notes.push(format!(
+            "Monte-Carlo over {} trials: validation RMS after calibration median {} mm, predicted {} mm.",
+            mc.trials,
+            mc.validation_rms_after.as_ref().map_or("-".into(), |v| format!("{:.4}", v.median * 1e3)),
+            mc.validation_rms_predicted.map_or("-".into(), |p| format!("{:.4}", p * 1e3))
+        ));
+    }
+    let s = super::report_dir::CalibrationSummary {
+        robot,
+        id,
+        source: format!("simulated, design `{}`", design_path.display()),
+        what: "held-out pose",
+        position_mm: (
+            to_mm(validation.position_errors(robot, &robot.nominal)),
+            to_mm(validation.position_errors(robot, &id.table)),
+        ),
+        orientation_deg: full.then(|| {
+            (
+                to_deg(validation.orientation_errors(robot, &robot.nominal)),
+                to_deg(validation.orientation_errors(robot, &id.table)),
+            )
+        }),
+        params: id
+            .names
+            .iter()
+            .enumerate()
+            .map(|(k, n)| {
+                (
+                    n.clone(),
+                    id.estimate[k] - nominal[k],
+                    std.as_ref().map(|s| s[k]),
+                )
+            })
+            .collect(),
+        splits: None,
+        notes,
+        json: v.clone(),
+    };
+    super::report_dir::calibration(dir, &s)?;
+    Ok(())
+}
+
+/// The text report of a simulated calibration.
+fn simulated_text(
+    a: &CalibrateArgs,
+    robot: &Robot,
+    design_path: &Path,
+    sim: &activecal::experiment::simulated::SimulatedCalibration,
+    report: &SimulatedCalibrationReport,
+) -> String {
+    let (qs, tables, validation) = (&sim.qs, &sim.tables, &sim.validation);
+    let id = &tables.identification;
+    let full = activecal::measure::sensor_for(robot).observes_orientation();
+    let (before, after) = (sim.rms_before, sim.rms_after);
+    let (rot_before, rot_after) = (sim.orientation_rms_before, sim.orientation_rms_after);
+    let (mc, mc_seconds) = (&sim.monte_carlo, sim.monte_carlo_seconds);
+    let noise = if full {
+        format!(
+            "σ = {} m and {:.3e} rad (full poses)",
+            a.noise,
+            a.noise / robot.orientation_scale
+        )
+    } else {
+        format!("σ = {} m", a.noise)
+    };
+    let noise = if a.noise == DEFAULT_NOISE {
+        format!("{noise}, the default of --noise")
+    } else {
+        noise
+    };
+    let mut s = format!(
+        "{}: {} poses, {noise}, seed {}\n{}",
+        design_path.display(),
+        qs.len(),
+        a.seed(),
+        status_text(id)
+    );
+    s += "\nestimate (Table III)\n";
+    s += &tables.estimate.to_text(6);
+    s += "\nresidual = real − estimate (Table IV)\n";
+    s += &tables.residual.to_text(6);
+    if let Some(std) = &tables.std {
+        s += "\nstandard deviation\n";
+        s += &std.to_text(6);
+    }
+    s += &format!(
+        "\nvalidation ({} held-out poses): RMS position error {before:.6} m before, {after:.6} m after\n",
+        validation.len()
+    );
+    if let (Some(b), Some(f)) = (rot_before, rot_after) {
+        s += &format!("validation: RMS orientation error {b:.6e} rad before, {f:.6e} rad after\n");
+    }
+    if let Some(mc) = &mc {
+        s += &mc_text(mc, mc_seconds);
+    }
+    if let Some(f) = &report.frames {
+        s += &super::frames_text::frames_text(f);
+    }
+    s
 }
 
 /// Human-readable Monte-Carlo summary.

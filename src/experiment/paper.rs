@@ -713,46 +713,56 @@ impl PaperReport {
             "Pool: {}-level lattice, {} poses; designs of N = {}; EAE from {} random poses; seed {}; {} random designs; {} multi-start runs; σ = {} m.\n",
             s.levels, s.pool, s.n, s.initial, s.seed, s.designs, s.starts, s.noise
         );
-        let _ = writeln!(m, "## Summary: paper against ours\n");
-        let _ = writeln!(m, "| quantity | paper | ours |");
-        let _ = writeln!(m, "|---|---|---|");
+        self.summary_md(&mut m);
+        self.designs_md(&mut m);
+        self.tables_md(&mut m);
+        self.monte_carlo_md(&mut m);
+        self.figures_md(&mut m);
+        m
+    }
+
+    /// The paper's numbers against ours, with why the random baseline differs.
+    fn summary_md(&self, m: &mut String) {
+        let _ = writeln!(*m, "## Summary: paper against ours\n");
+        let _ = writeln!(*m, "| quantity | paper | ours |");
+        let _ = writeln!(*m, "|---|---|---|");
         let rnd = self.random.best_log10_oid;
         let e = self.eae.log10_oid;
         let best = self.multistart.log10_oid;
         let _ = writeln!(
-            m,
+            *m,
             "| best random design, log10 OI_D | {:.4} | {:.4} |",
             PAPER_RANDOM_OID.log10(),
             rnd
         );
         let _ = writeln!(
-            m,
+            *m,
             "| best random design, OI | {PAPER_RANDOM_OI} | {} |",
             fmt_opt(Some(self.random.best_oi), 6)
         );
         let _ = writeln!(
-            m,
+            *m,
             "| EAE design, log10 OI_D | {:.4} | {:.4} |",
             PAPER_EAE_OID.log10(),
             e
         );
         let _ = writeln!(
-            m,
+            *m,
             "| EAE design, OI | {PAPER_EAE_OI} | {} |",
             fmt_opt(Some(self.eae.oi), 6)
         );
         let _ = writeln!(
-            m,
+            *m,
             "| EAE / best random, OI_D ratio | {:.4e} | {:.4e} |",
             PAPER_EAE_OID / PAPER_RANDOM_OID,
             10f64.powf(e - rnd)
         );
         let _ = writeln!(
-            m,
+            *m,
             "| multi-start EAE + Fedorov polish, log10 OI_D | – | {best:.4} |"
         );
         let _ = writeln!(
-            m,
+            *m,
             "| relaxation upper bound, log10 OI_D | – | {} |",
             fmt_opt(Some(self.bound.log10_bound), 4)
         );
@@ -764,7 +774,7 @@ impl PaperReport {
             );
         }
         let _ = writeln!(
-            m,
+            *m,
             "\nThe paper's best random design (OI_D {PAPER_RANDOM_OID:.4e}) lies at the bottom of our distribution of random lattice designs \
 (median log10 OI_D {}), while our EAE matches the paper's EAE: the model and the criterion agree, the random baseline does not. \
 The paper does not say how its random designs were drawn; ours are uniform 30-subsets of the lattice. The EAE-to-random ratio \
@@ -772,9 +782,16 @@ is therefore about {:.0}x here, not 50,000x.",
             fmt_opt(Some(self.random.median_log10_oid), 3),
             10f64.powf(e - rnd)
         );
-        let _ = writeln!(m, "\n## Designs and their D-efficiency against the bound\n");
-        let _ = writeln!(m, "| design | log10 OI_D | D-efficiency |");
-        let _ = writeln!(m, "|---|---|---|");
+    }
+
+    /// Every design against the bound, and the bound with its Newton cross-check.
+    fn designs_md(&self, m: &mut String) {
+        let _ = writeln!(
+            *m,
+            "\n## Designs and their D-efficiency against the bound\n"
+        );
+        let _ = writeln!(*m, "| design | log10 OI_D | D-efficiency |");
+        let _ = writeln!(*m, "|---|---|---|");
         for d in &self.designs {
             let _ = writeln!(
                 m,
@@ -792,7 +809,7 @@ is therefore about {:.0}x here, not 50,000x.",
                 .unwrap_or_default()
         };
         let _ = writeln!(
-            m,
+            *m,
             "\nBound: status {}, certificate gap {:.2e} (ln det), {} poses carry weight, {:.2} s.\n",
             status(b.status),
             b.certificate_gap,
@@ -801,7 +818,7 @@ is therefore about {:.0}x here, not 50,000x.",
         );
         let nb = &b.newton;
         let _ = writeln!(
-            m,
+            *m,
             "Cross-check by the Newton barrier solver (`bound --solver newton`): ln bound {:.9} against Clarabel's {:.9}, ln primal {:.9} against {:.9}, status {}, certificate gap {:.2e}, {:.2} s.\n",
             nb.ln_bound,
             b.ln_bound,
@@ -811,6 +828,10 @@ is therefore about {:.0}x here, not 50,000x.",
             nb.certificate_gap,
             nb.seconds
         );
+    }
+
+    /// Tables III and IV.
+    fn tables_md(&self, m: &mut String) {
         for (title, grid) in [
             (
                 "Table III: estimated parameters (EAE design)",
@@ -821,28 +842,33 @@ is therefore about {:.0}x here, not 50,000x.",
                 &self.tables.residual,
             ),
         ] {
-            let _ = writeln!(m, "## {title}\n");
-            let _ = writeln!(m, "| frame | gamma | alpha | a | d | beta |");
-            let _ = writeln!(m, "|---|---|---|---|---|---|");
+            let _ = writeln!(*m, "## {title}\n");
+            let _ = writeln!(*m, "| frame | gamma | alpha | a | d | beta |");
+            let _ = writeln!(*m, "|---|---|---|---|---|---|");
             for (f, row) in grid.frames.iter().zip(&grid.rows) {
                 let cells: Vec<String> = row
                     .iter()
                     .map(|c| c.map_or("–".into(), |v| format!("{v:.6}")))
                     .collect();
-                let _ = writeln!(m, "| {f} | {} |", cells.join(" | "));
+                let _ = writeln!(*m, "| {f} | {} |", cells.join(" | "));
             }
-            let _ = writeln!(m);
+            let _ = writeln!(*m);
         }
+    }
+
+    /// The Monte-Carlo comparison of the designs.
+    fn monte_carlo_md(&self, m: &mut String) {
+        let s = &self.settings;
         let _ = writeln!(
-            m,
+            *m,
             "## Monte-Carlo calibration ({} trials per design, σ = {} m)\n",
             s.trials, s.noise
         );
         let _ = writeln!(
-            m,
+            *m,
             "| design | converged | √Σ RMSE² angles (rad) | √Σ RMSE² lengths (m) | median RMSE / predicted σ | ln det(C_emp)/det(C_pred) | validation RMS before (m) | validation RMS after, median (m) |"
         );
-        let _ = writeln!(m, "|---|---|---|---|---|---|---|---|");
+        let _ = writeln!(*m, "|---|---|---|---|---|---|---|---|");
         for d in &self.monte_carlo_full {
             // Angles are the γ, α, β unknowns; lengths the a, d ones.
             let (mut ang, mut len) = (0.0f64, 0.0f64);
@@ -872,7 +898,11 @@ is therefore about {:.0}x here, not 50,000x.",
                     .map_or("–".into(), |s| format!("{:.6}", s.median)),
             );
         }
-        let _ = writeln!(m, "\n## Figures\n");
+    }
+
+    /// Links to the figures.
+    fn figures_md(&self, m: &mut String) {
+        let _ = writeln!(*m, "\n## Figures\n");
         for (f, what) in [
             (
                 "fig2_random_designs",
@@ -893,8 +923,7 @@ is therefore about {:.0}x here, not 50,000x.",
                 "1/OI_D per iteration, log scale (Fig. 6)",
             ),
         ] {
-            let _ = writeln!(m, "- [{f}.png]({f}.png) ([svg]({f}.svg)): {what}");
+            let _ = writeln!(*m, "- [{f}.png]({f}.png) ([svg]({f}.svg)): {what}");
         }
-        m
     }
 }

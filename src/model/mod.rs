@@ -594,6 +594,15 @@ impl Robot {
                 crate::error::Compact(self.orientation_scale)
             )));
         }
+        self.validate_frames()?;
+        self.validate_limits()?;
+        self.validate_tables()?;
+        self.validate_unknowns()
+    }
+
+    /// Labels unique and well formed, prismatic only on driven frames,
+    /// joints numbered 0..dof once each.
+    fn validate_frames(&self) -> Result<()> {
         let mut seen = vec![false; self.dof()];
         for (i, f) in self.frames.iter().enumerate() {
             if f.label.is_empty() || f.label.chars().any(|c| c.is_whitespace() || c == ',') {
@@ -629,6 +638,11 @@ impl Robot {
         if let Some(j) = seen.iter().position(|s| !s) {
             return Err(Error::Invalid(format!("joint q{} drives no frame", j + 1)));
         }
+        Ok(())
+    }
+
+    /// Every joint's limits finite, ordered and not empty.
+    fn validate_limits(&self) -> Result<()> {
         for (j, &[lo, hi]) in self.limits.iter().enumerate() {
             if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
                 return Err(Error::InvalidLimits {
@@ -651,6 +665,12 @@ impl Robot {
                 )));
             }
         }
+        Ok(())
+    }
+
+    /// Both tables: a row per frame, finite parameters, the sensor's
+    /// number of finite marker offsets.
+    fn validate_tables(&self) -> Result<()> {
         for table in [&self.real, &self.nominal] {
             if table.rows.len() != self.frames.len() {
                 return Err(Error::Invalid(format!(
@@ -694,6 +714,12 @@ impl Robot {
                 )));
             }
         }
+        Ok(())
+    }
+
+    /// Unknowns present, sorted, unique, naming existing frames and
+    /// parameters their frames have.
+    fn validate_unknowns(&self) -> Result<()> {
         if self.unknowns.is_empty() {
             return Err(Error::Invalid("the robot has no unknown parameters".into()));
         }

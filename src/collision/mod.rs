@@ -305,6 +305,123 @@ fn shape_of(
     })
 }
 
+/// Every collision element of every link, with its shape loaded (meshes
+/// found beside the URDF or in the package directories) and its bounding
+/// sphere.
+fn geometries(
+    urdf: &urdf_rs::Robot,
+    tree: &Tree,
+    spec: &CollisionSpec,
+) -> Result<Vec<Geometry>, String> {
+    let urdf_dir = Path::new(&spec.urdf).parent().unwrap_or(Path::new("."));
+    let mut geoms = Vec::new();
+    for l in &urdf.links {
+        let link = tree.index[&l.name];
+        for c in &l.collision {
+            let shape = shape_of(&c.geometry, &l.name, urdf_dir, spec)
+                .map_err(|e| format!("{}: {e}", spec.urdf))?;
+            let aabb = shape.compute_local_aabb();
+            let center = aabb.center();
+            let radius = aabb.half_extents().norm();
+            geoms.push(Geometry {
+                link,
+                origin: tree::pose(&c.origin),
+                shape,
+                center,
+                radius,
+            });
+        }
+    }
+    Ok(geoms)
+}
+
+/// The SRDF's `disable_collisions` pairs, as link indices (smaller first).
+fn disabled_pairs(tree: &Tree, spec: &CollisionSpec) -> Result<HashSet<(usize, usize)>, String> {
+    let mut disabled: HashSet<(usize, usize)> = HashSet::new();
+    if let Some(s) = &spec.srdf {
+        let t = std::fs::read_to_string(s).map_err(|e| format!("--srdf {s}: {e}"))?;
+        for p in srdf::disabled_pairs(&t, s)? {
+            let find = |name: &str| {
+                tree.index.get(name).copied().ok_or_else(|| {
+                    format!(
+                        "{s}:{}: disable_collisions names link '{name}', which {} does not have",
+                        p.line, spec.urdf
+                    )
+                })
+            };
+            let (a, b) = (find(&p.link1)?, find(&p.link2)?);
+            disabled.insert((a.min(b), a.max(b)));
+        }
+    }
+    Ok(disabled)
+}
+
+/// The geometry pairs checked for self-collision: on different, not
+/// adjacent bodies, and not disabled.
+fn checked_pairs(
+    tree: &Tree,
+    geoms: &[Geometry],
+    disabled: &HashSet<(usize, usize)>,
+) -> Vec<(usize, usize)> {
+    let mut pairs = Vec::new();
+    {
+        for a in 0..geoms.len() {
+            for b in a + 1..geoms.len() {
+                let (la, lb) = (geoms[a].link, geoms[b].link);
+                let (ba, bb) = (tree.body[la], tree.body[lb]);
+                if ba == bb
+                    || tree.adjacent_bodies(ba, bb)
+                    || disabled.contains(&(la.min(lb), la.max(lb)))
+                {
+                    continue;
+                }
+                pairs.push((a, b));
+            }
+        }
+    }
+    pairs
+}
+
+/// The boxes and the floor, placed in the base link's frame `base_pose`.
+fn obstacles(
+    spec: &CollisionSpec,
+    base_pose: &Isometry3<f64>,
+) -> Result<Vec<(String, Isometry3<f64>, SharedShape)>, String> {
+    let base_pose = *base_pose;
+    let mut obstacles = Vec::new();
+    for (k, o) in spec.obstacles.iter().enumerate() {
+        let Obstacle::Box { center, size } = o;
+        if size.iter().any(|s| !(s.is_finite() && *s > 0.0))
+            || center.iter().any(|c| !c.is_finite())
+        {
+            return Err(format!(
+                "obstacle {}: needs a finite centre and sizes > 0",
+                k + 1
+            ));
+        }
+        obstacles.push((
+            format!("box {}", k + 1),
+            base_pose * Isometry3::translation(center[0], center[1], center[2]),
+            SharedShape::new(Cuboid::new(Vector3::new(
+                size[0] / 2.0,
+                size[1] / 2.0,
+                size[2] / 2.0,
+            ))),
+        ));
+    }
+    if let Some(z) = spec.floor {
+        if !z.is_finite() {
+            return Err(format!("--floor {z}: not finite"));
+        }
+        obstacles.push((
+            "floor".to_string(),
+            base_pose * Isometry3::translation(0.0, 0.0, z),
+            SharedShape::new(HalfSpace::new(Vector3::z_axis())),
+        ));
+    }
+    Ok(obstacles)
+}
+
 impl CollisionModel {
     /// Loads the model of `spec`: errors name the URDF, a missing or broken
     /// mesh file and its link, an SRDF line naming an unknown link, a chain
@@ -320,7 +437,6 @@ impl CollisionModel {
         let urdf = urdf_rs::read_from_string(&text)
             .map_err(|e| format!("{}: not a valid URDF: {e}", spec.urdf))?;
         let tree = Tree::new(&urdf).map_err(|e| format!("{}: {e}", spec.urdf))?;
-        let urdf_dir = urdf_path.parent().unwrap_or(Path::new("."));
         let joint_index = |name: &str| tree.joints.iter().position(|j| j.name == name);
         let drives = spec
             .joints
@@ -333,56 +449,13 @@ impl CollisionModel {
                 joint_index(n).ok_or_else(|| format!("{}: no joint '{n}' to lock", spec.urdf))?;
             rest[k] = *v;
         }
-        let mut geoms = Vec::new();
-        for l in &urdf.links {
-            let link = tree.index[&l.name];
-            for c in &l.collision {
-                let shape = shape_of(&c.geometry, &l.name, urdf_dir, spec)
-                    .map_err(|e| format!("{}: {e}", spec.urdf))?;
-                let aabb = shape.compute_local_aabb();
-                let center = aabb.center();
-                let radius = aabb.half_extents().norm();
-                geoms.push(Geometry {
-                    link,
-                    origin: tree::pose(&c.origin),
-                    shape,
-                    center,
-                    radius,
-                });
-            }
-        }
-        let mut disabled: HashSet<(usize, usize)> = HashSet::new();
-        if let Some(s) = &spec.srdf {
-            let t = std::fs::read_to_string(s).map_err(|e| format!("--srdf {s}: {e}"))?;
-            for p in srdf::disabled_pairs(&t, s)? {
-                let find = |name: &str| {
-                    tree.index.get(name).copied().ok_or_else(|| {
-                        format!(
-                            "{s}:{}: disable_collisions names link '{name}', which {} does not have",
-                            p.line, spec.urdf
-                        )
-                    })
-                };
-                let (a, b) = (find(&p.link1)?, find(&p.link2)?);
-                disabled.insert((a.min(b), a.max(b)));
-            }
-        }
-        let mut pairs = Vec::new();
-        if spec.self_collision {
-            for a in 0..geoms.len() {
-                for b in a + 1..geoms.len() {
-                    let (la, lb) = (geoms[a].link, geoms[b].link);
-                    let (ba, bb) = (tree.body[la], tree.body[lb]);
-                    if ba == bb
-                        || tree.adjacent_bodies(ba, bb)
-                        || disabled.contains(&(la.min(lb), la.max(lb)))
-                    {
-                        continue;
-                    }
-                    pairs.push((a, b));
-                }
-            }
-        }
+        let geoms = geometries(&urdf, &tree, spec)?;
+        let pairs = if spec.self_collision {
+            let disabled = disabled_pairs(&tree, spec)?;
+            checked_pairs(&tree, &geoms, &disabled)
+        } else {
+            Vec::new()
+        };
         // Obstacles live in the base link's frame; placements are in the root's.
         let base = match &spec.base {
             Some(b) => *tree
@@ -396,38 +469,7 @@ impl CollisionModel {
         // The base link's placement moves only if a joint above it moves;
         // obstacles are fixed to it at the rest configuration of the joints
         // above the chain (locks applied).
-        let base_pose = at_rest[base];
-        let mut obstacles = Vec::new();
-        for (k, o) in spec.obstacles.iter().enumerate() {
-            let Obstacle::Box { center, size } = o;
-            if size.iter().any(|s| !(s.is_finite() && *s > 0.0))
-                || center.iter().any(|c| !c.is_finite())
-            {
-                return Err(format!(
-                    "obstacle {}: needs a finite centre and sizes > 0",
-                    k + 1
-                ));
-            }
-            obstacles.push((
-                format!("box {}", k + 1),
-                base_pose * Isometry3::translation(center[0], center[1], center[2]),
-                SharedShape::new(Cuboid::new(Vector3::new(
-                    size[0] / 2.0,
-                    size[1] / 2.0,
-                    size[2] / 2.0,
-                ))),
-            ));
-        }
-        if let Some(z) = spec.floor {
-            if !z.is_finite() {
-                return Err(format!("--floor {z}: not finite"));
-            }
-            obstacles.push((
-                "floor".to_string(),
-                base_pose * Isometry3::translation(0.0, 0.0, z),
-                SharedShape::new(HalfSpace::new(Vector3::z_axis())),
-            ));
-        }
+        let obstacles = obstacles(spec, &at_rest[base])?;
         // The half-space's normal points out of the solid: z < floor is
         // inside when the normal is +z.
         let base_body = tree.body[base];

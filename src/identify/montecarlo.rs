@@ -499,41 +499,9 @@ pub fn monte_carlo(
     let p = names.len();
     let truth = robot.unknown_values(&robot.real);
 
-    // ---- trials, in parallel, reduced in trial order -------------------------
-    let task = crate::progress::Task::start("monte-carlo trials", Some(settings.trials as u64));
-    let trials: Vec<Result<Trial>> = (0..settings.trials)
-        .into_par_iter()
-        .map(|t| {
-            let _tick = task.tick();
-            let meas = simulate(
-                robot,
-                &robot.real,
-                qs,
-                settings.sigma,
-                &mut trial_rng(settings.seed, t as u64),
-            )?;
-            let id = identify(robot, &robot.nominal, &meas, &settings.lm)?;
-            let rms_after = validation.rms(robot, &id.table);
-            let orientation_rms_after = validation.orientation_rms(robot, &id.table);
-            Ok(Trial {
-                status: id.status,
-                iterations: id.iterations,
-                estimate: id.estimate,
-                rms_after,
-                orientation_rms_after,
-            })
-        })
-        .collect();
-    let trials = trials.into_iter().collect::<Result<Vec<_>>>()?;
-
-    let mut statuses = BTreeMap::new();
-    for t in &trials {
-        let key = serde_json::to_value(t.status)
-            .ok()
-            .and_then(|v| v.as_str().map(str::to_string))
-            .unwrap_or_default();
-        *statuses.entry(key).or_insert(0) += 1;
-    }
+    // Trials in parallel, reduced in trial order.
+    let trials = run_trials(robot, qs, validation, settings)?;
+    let statuses = status_counts(&trials);
     let used: Vec<&Trial> = trials
         .iter()
         .filter(|t| t.status == Status::Converged)
@@ -547,37 +515,7 @@ pub fn monte_carlo(
         ln_det_spd(gram(x.mat()).as_ref())
     };
 
-    // ---- per-parameter statistics ---------------------------------------------
-    let mean: Vec<f64> = (0..p)
-        .map(|j| used.iter().map(|t| t.estimate[j]).sum::<f64>() / r.max(1) as f64)
-        .collect();
-    let parameters: Vec<ParameterStats> = if r == 0 {
-        Vec::new()
-    } else {
-        (0..p)
-            .map(|j| {
-                let var = used
-                    .iter()
-                    .map(|t| (t.estimate[j] - mean[j]).powi(2))
-                    .sum::<f64>()
-                    / (r.max(2) - 1) as f64;
-                let mse = used
-                    .iter()
-                    .map(|t| (t.estimate[j] - truth[j]).powi(2))
-                    .sum::<f64>()
-                    / r as f64;
-                ParameterStats {
-                    name: names[j].clone(),
-                    truth: truth[j],
-                    mean: mean[j],
-                    bias: mean[j] - truth[j],
-                    std: var.sqrt(),
-                    rmse: mse.sqrt(),
-                    predicted_std: c_pred.as_ref().map_or(f64::NAN, |c| c[(j, j)].sqrt()),
-                }
-            })
-            .collect()
-    };
+    let parameters = parameter_stats(&names, &truth, &used, c_pred.as_ref());
     let ratios: Vec<f64> = parameters
         .iter()
         .map(|s| s.rmse / s.predicted_std)
@@ -627,6 +565,95 @@ pub fn monte_carlo(
         validation_orientation_rms_after: Spread::of(&after_rot),
         validation_orientation_rms_predicted: predicted.and_then(|p| p.1),
     })
+}
+
+/// The trials, in parallel, reduced in trial order (each on its own seeded
+/// noise, so the result does not depend on the thread count).
+fn run_trials(
+    robot: &Robot,
+    qs: &[Vec<f64>],
+    validation: &ValidationSet,
+    settings: &MonteCarloSettings,
+) -> Result<Vec<Trial>> {
+    let task = crate::progress::Task::start("monte-carlo trials", Some(settings.trials as u64));
+    let trials: Vec<Result<Trial>> = (0..settings.trials)
+        .into_par_iter()
+        .map(|t| {
+            let _tick = task.tick();
+            let meas = simulate(
+                robot,
+                &robot.real,
+                qs,
+                settings.sigma,
+                &mut trial_rng(settings.seed, t as u64),
+            )?;
+            let id = identify(robot, &robot.nominal, &meas, &settings.lm)?;
+            let rms_after = validation.rms(robot, &id.table);
+            let orientation_rms_after = validation.orientation_rms(robot, &id.table);
+            Ok(Trial {
+                status: id.status,
+                iterations: id.iterations,
+                estimate: id.estimate,
+                rms_after,
+                orientation_rms_after,
+            })
+        })
+        .collect();
+    trials.into_iter().collect()
+}
+
+/// How many trials ended in each status (by its serialised name).
+fn status_counts(trials: &[Trial]) -> BTreeMap<String, usize> {
+    let mut statuses = BTreeMap::new();
+    for t in trials {
+        let key = serde_json::to_value(t.status)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_string))
+            .unwrap_or_default();
+        *statuses.entry(key).or_insert(0) += 1;
+    }
+    statuses
+}
+
+/// Per-parameter statistics of the converged trials `used` against the
+/// truth and the predicted covariance.
+fn parameter_stats(
+    names: &[String],
+    truth: &[f64],
+    used: &[&Trial],
+    c_pred: Option<&Mat<f64>>,
+) -> Vec<ParameterStats> {
+    let (p, r) = (names.len(), used.len());
+    let mean: Vec<f64> = (0..p)
+        .map(|j| used.iter().map(|t| t.estimate[j]).sum::<f64>() / r.max(1) as f64)
+        .collect();
+    if r == 0 {
+        Vec::new()
+    } else {
+        (0..p)
+            .map(|j| {
+                let var = used
+                    .iter()
+                    .map(|t| (t.estimate[j] - mean[j]).powi(2))
+                    .sum::<f64>()
+                    / (r.max(2) - 1) as f64;
+                let mse = used
+                    .iter()
+                    .map(|t| (t.estimate[j] - truth[j]).powi(2))
+                    .sum::<f64>()
+                    / r as f64;
+                ParameterStats {
+                    name: names[j].clone(),
+                    truth: truth[j],
+                    mean: mean[j],
+                    bias: mean[j] - truth[j],
+                    std: var.sqrt(),
+                    rmse: mse.sqrt(),
+                    predicted_std: c_pred.map_or(f64::NAN, |c| c[(j, j)].sqrt()),
+                }
+            })
+            .collect()
+    }
 }
 
 /// Evaluates several designs (pool positions) on the same noise seeds and the

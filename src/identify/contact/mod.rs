@@ -17,7 +17,7 @@ pub mod project;
 pub mod select;
 
 pub use data::{ContactFile, NamedPlane};
-pub use fit::{ContactFit, ContactSettings, fit_contacts};
+pub use fit::{ContactFit, ContactSettings, PlaneEstimate, fit_contacts};
 pub use holdout::{
     DistanceFigure, DownweightedRow, Figures, HoldoutFold, HoldoutMode, HoldoutReport, PointFigure,
     holdout_by_placement, judge, placements,

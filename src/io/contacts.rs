@@ -41,8 +41,11 @@ pub const POINT_COLUMN: &str = "point";
 /// [`PLANE_COLUMN`] (a contact file).
 #[must_use]
 pub fn has_point_column(text: &str) -> bool {
-    header_line(text)
-        .is_some_and(|(_, h)| split(h).iter().any(|c| c == POINT_COLUMN || c == PLANE_COLUMN))
+    header_line(text).is_some_and(|(_, h)| {
+        split(h)
+            .iter()
+            .any(|c| c == POINT_COLUMN || c == PLANE_COLUMN)
+    })
 }
 
 /// Reads a contact CSV for `robot` in `units`.
@@ -206,7 +209,11 @@ fn touched(
     err: &dyn Fn(String) -> Error,
 ) -> Result<Vec<(usize, Touch)>> {
     let label = |k: usize| {
-        let name = if has_point && k == 0 { POINT_COLUMN } else { PLANE_COLUMN };
+        let name = if has_point && k == 0 {
+            POINT_COLUMN
+        } else {
+            PLANE_COLUMN
+        };
         format!("column {} ('{name}')", cols[k] + 1)
     };
     cells
@@ -291,9 +298,21 @@ fn group_rows(
             Err(l) => points.len() + l,
         })
         .collect();
-    let all = points.iter().map(|p| ("point", p, MIN_ROWS_PER_POINT, "its 3 coordinates are unknowns"));
+    let all = points.iter().map(|p| {
+        (
+            "point",
+            p,
+            MIN_ROWS_PER_POINT,
+            "its 3 coordinates are unknowns",
+        )
+    });
     let all = all.chain(planes.iter().map(|p| {
-        ("plane", p, MIN_ROWS_PER_PLANE, "3 points span a plane; an unknown one has 3 unknowns")
+        (
+            "plane",
+            p,
+            MIN_ROWS_PER_PLANE,
+            "3 points span a plane; an unknown one has 3 unknowns",
+        )
     }));
     for (g, (what, p, min, why)) in all.enumerate() {
         let at: Vec<String> = names
@@ -316,7 +335,9 @@ fn group_rows(
             name,
             // The chart's centre is set at the start of a fit
             // (`start_planes`); any non-zero normal here.
-            kind: PlaneKind::Unknown { n0: [0.0, 0.0, 1.0] },
+            kind: PlaneKind::Unknown {
+                n0: [0.0, 0.0, 1.0],
+            },
         })
         .collect();
     Ok((points, planes, groups))

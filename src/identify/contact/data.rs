@@ -76,7 +76,11 @@ impl ContactFile {
                     "plane '{}': {} has no such plane (its planes: {})",
                     k.name,
                     self.origin,
-                    if names.is_empty() { "none".to_string() } else { names.join(", ") }
+                    if names.is_empty() {
+                        "none".to_string()
+                    } else {
+                        names.join(", ")
+                    }
                 )));
             };
             p.kind = PlaneKind::Known {
@@ -99,10 +103,13 @@ impl ContactFile {
             match g.checked_sub(self.points.len()) {
                 Some(l) => {
                     let p = &self.planes[l];
-                    let k = planes.iter().position(|q| q.name == p.name).unwrap_or_else(|| {
-                        planes.push(p.clone());
-                        planes.len() - 1
-                    });
+                    let k = planes
+                        .iter()
+                        .position(|q| q.name == p.name)
+                        .unwrap_or_else(|| {
+                            planes.push(p.clone());
+                            planes.len() - 1
+                        });
                     which.push(Err(k));
                 }
                 None => {

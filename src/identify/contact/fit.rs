@@ -196,7 +196,15 @@ pub fn fit_contacts(
     settings.lm.validate()?;
     let own0 = start_own(robot, start, file);
     let planes = start_planes(robot, start, file);
-    let reduced = determined(robot, start, file, distances, &planes, &own0, &settings.keep)?;
+    let reduced = determined(
+        robot,
+        start,
+        file,
+        distances,
+        &planes,
+        &own0,
+        &settings.keep,
+    )?;
     let r = &reduced.robot;
     let mut theta0 = r.unknown_values(start);
     theta0.extend_from_slice(&own0);

@@ -19,8 +19,8 @@ pub mod select;
 pub use data::{ContactFile, NamedPlane};
 pub use fit::{ContactFit, ContactSettings, PlaneEstimate, fit_contacts};
 pub use holdout::{
-    DistanceFigure, DownweightedRow, Figures, HoldoutFold, HoldoutMode, HoldoutReport, PointFigure,
-    holdout_by_placement, judge, placements,
+    DistanceFigure, DownweightedRow, Figures, HoldoutFold, HoldoutMode, HoldoutReport, PlaneFigure,
+    PointFigure, holdout_by_placement, judge, placements,
 };
 
 use crate::error::Error;

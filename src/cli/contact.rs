@@ -1,6 +1,7 @@
 //! `calibrate --measurements contacts.csv` for a file with a `point` column
-//! (calibration from contacts with fixed points, no instrument): parsing of
-//! `--point-distance`, rendering of the fit and of `--holdout-by
+//! or a `plane` column (calibration from contacts with fixed points and
+//! planes, no instrument): parsing of `--point-distance` and `--plane`,
+//! rendering of the fit and of `--holdout-by
 //! placement` / `--train-on`. The work is in `activecal::identify::contact`.
 
 use activecal::identify::LmSettings;

@@ -6,7 +6,9 @@
 //! **The gauge.** Moving the whole setup rigidly (in particular turning it
 //! about the base's vertical and translating it) changes no residual: the
 //! unknown points follow. Unknowns whose column lies in the span of the
-//! points' columns are fixed and reported as such; the rest of what the
+//! points' columns are fixed and reported as such (unknown planes follow
+//! such a motion too; a known plane pins the setup, and then no unknown is
+//! fixed as the gauge); the rest of what the
 //! contacts cannot see is fixed by the shared rule
 //! ([`crate::identify::undetermined`]: column-pivoted QR on the
 //! column-scaled Jacobian, the sensor's own unknowns pivoted first).

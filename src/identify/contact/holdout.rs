@@ -147,8 +147,9 @@ pub struct HoldoutReport {
 #[must_use]
 pub fn placements(file: &ContactFile) -> Vec<String> {
     let mut out: Vec<String> = Vec::new();
-    let names = file.points.iter().map(String::as_str);
-    for p in names.chain(file.planes.iter().map(|p| p.name.as_str())) {
+    // Points only: a plane whose name has no point's placement is in every
+    // fold's training rows (its figures are in-sample only).
+    for p in &file.points {
         let pl = placement_of(p);
         if !out.iter().any(|o| o == pl) {
             out.push(pl.to_string());

@@ -1,7 +1,8 @@
-//! Calibration without an instrument: contacts with fixed points
-//! ([`crate::measure::contact`]) and the distances known between them.
+//! Calibration without an instrument: contacts with fixed points and planes
+//! ([`crate::measure::contact`]) and the distances known between points.
 //!
-//! * this file: known distances by name, the start of the points, the tool
+//! * this file: known distances by name, the start of the points and
+//!   planes (an unknown plane's chart about its rows' best-fit plane), the tool
 //!   points a model predicts, and the figures of a model on contacts
 //!   (consistency: the RMS distance of each row's predicted tool point to
 //!   its point's mean; distance errors);

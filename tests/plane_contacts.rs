@@ -237,6 +237,36 @@ fn unknown_planes_are_fitted_to_the_noise_floor() {
     }
 }
 
+/// Held out by placement, the plane rows (named without a placement) are
+/// in every fold's training rows: each held-out placement's consistency is
+/// at the noise floor (≤ 0.05 mm, the bar of `tests/point_coincidence.rs`:
+/// √3·σ = 0.035 mm a row plus the estimate's spread), and no fold judges a
+/// plane.
+#[test]
+fn planes_train_every_placement_fold() {
+    use activecal::identify::contact::{HoldoutMode, holdout_by_placement};
+    let robot = panda();
+    let (sim, given, _) = simulated(&robot);
+    let h = holdout_by_placement(
+        &robot,
+        &robot.nominal,
+        &sim,
+        &given,
+        &settings(),
+        &HoldoutMode::LeaveOneOut,
+    )
+    .unwrap();
+    assert_eq!(h.folds.len(), 3);
+    for f in &h.folds {
+        assert!(f.converged && f.figures.planes.is_empty(), "{f:?}");
+    }
+    assert!(h.mean_calibrated_mm <= 0.05, "{}", h.mean_calibrated_mm);
+    eprintln!(
+        "held out: nominal {:.3} mm, calibrated {:.4} mm (mean over folds)",
+        h.pooled_nominal_mm, h.mean_calibrated_mm
+    );
+}
+
 /// A plane given with its true normal and offset (scaled by 2: the flag
 /// normalises) is not estimated, and the rows touch it to the noise floor
 /// (same bar as above). The gauge is then pinned: no rigid motion is free.

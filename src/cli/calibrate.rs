@@ -109,6 +109,11 @@ pub struct CalibrateArgs {
     /// column): `A,B=METRES`, repeatable.
     #[arg(long, value_name = "A,B=METRES", requires = "measurements")]
     pub point_distance: Vec<String>,
+    /// A known contact plane (a file with a `plane` column): `NAME=nx,ny,nz,d`
+    /// (base frame, `n · x = d` in metres; the normal is normalised),
+    /// repeatable. Planes not given are unknown and estimated.
+    #[arg(long, value_name = "NAME=nx,ny,nz,d", requires = "measurements")]
+    pub plane: Vec<String>,
     /// Contacts held out by placement (the part of a point's name before
     /// '/'): fit on all placements but one, judge on that one, for each.
     #[arg(long, value_enum, requires = "measurements")]
@@ -314,6 +319,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
                 holdout: a.holdout.is_some(),
                 out: !a.out.is_empty(),
                 point_distance: &a.point_distance,
+                plane: &a.plane,
                 holdout_by: a.holdout_by,
                 train_on: a.train_on.as_deref(),
                 loss: a.loss,
@@ -330,9 +336,13 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
             }
         }
         (_, Some(m)) => {
-            if !a.point_distance.is_empty() || a.holdout_by.is_some() || a.train_on.is_some() {
+            if !a.point_distance.is_empty()
+                || !a.plane.is_empty()
+                || a.holdout_by.is_some()
+                || a.train_on.is_some()
+            {
                 bail!(
-                    "--point-distance, --holdout-by and --train-on are for contact files (a CSV with a 'point' column); {} has none",
+                    "--point-distance, --plane, --holdout-by and --train-on are for contact files (a CSV with a 'point' or 'plane' column); {} has none",
                     m.display()
                 );
             }

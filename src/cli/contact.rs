@@ -1,11 +1,13 @@
 //! `calibrate --measurements contacts.csv` for a file with a `point` column
-//! (calibration from contacts with fixed points, no instrument): parsing of
-//! `--point-distance`, rendering of the fit and of `--holdout-by
+//! or a `plane` column (calibration from contacts with fixed points and
+//! planes, no instrument): parsing of `--point-distance` and `--plane`,
+//! rendering of the fit and of `--holdout-by
 //! placement` / `--train-on`. The work is in `activecal::identify::contact`.
 
 use activecal::identify::LmSettings;
 use activecal::identify::contact::{
-    ContactFit, ContactSettings, HoldoutMode, HoldoutReport, NamedDistance, fit_contacts,
+    ContactFit, ContactSettings, HoldoutMode, HoldoutReport, NamedDistance, NamedPlane,
+    fit_contacts,
     holdout::{Figures, downweighted_rows, judge},
     holdout_by_placement, resolve_distances,
 };
@@ -48,6 +50,33 @@ fn parse_distance(s: &str) -> Result<NamedDistance> {
     })
 }
 
+/// Parses one `--plane NAME=nx,ny,nz,d` (the normal's length is checked
+/// with the file's planes).
+fn parse_plane(s: &str) -> Result<NamedPlane> {
+    let bad = || {
+        anyhow::anyhow!(
+            "--plane {s}: expected NAME=nx,ny,nz,d (a plane name, its normal and offset in metres, n · x = d in the base frame, e.g. table=0,0,1,0.02)"
+        )
+    };
+    let (name, rest) = s.split_once('=').ok_or_else(bad)?;
+    let v: Vec<f64> = rest
+        .split(',')
+        .map(|c| c.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| bad())?;
+    let [nx, ny, nz, d] = v.as_slice() else {
+        return Err(bad());
+    };
+    if name.trim().is_empty() {
+        return Err(bad());
+    }
+    Ok(NamedPlane {
+        name: name.trim().to_string(),
+        normal: [*nx, *ny, *nz],
+        offset: *d,
+    })
+}
+
 /// The options of `calibrate` a contact fit reads.
 pub struct ContactArgs<'a> {
     /// `--holdout` was given (refused).
@@ -56,6 +85,8 @@ pub struct ContactArgs<'a> {
     pub out: bool,
     /// `--point-distance`.
     pub point_distance: &'a [String],
+    /// `--plane`.
+    pub plane: &'a [String],
     /// `--holdout-by`.
     pub holdout_by: Option<HoldoutBy>,
     /// `--train-on`.
@@ -96,7 +127,13 @@ pub fn calibrate_contacts(
         .iter()
         .map(|s| parse_distance(s))
         .collect::<Result<_>>()?;
-    let file = read_contacts(path, robot, a.units)?;
+    let planes: Vec<NamedPlane> = a
+        .plane
+        .iter()
+        .map(|s| parse_plane(s))
+        .collect::<Result<_>>()?;
+    let mut file = read_contacts(path, robot, a.units)?;
+    file.set_known_planes(&planes).context("--plane")?;
     let known = resolve_distances(&file, &given, true).context("--point-distance")?;
     let settings = ContactSettings {
         lm: LmSettings::default()
@@ -160,10 +197,11 @@ fn text(
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{}: {} contacts with {} points; {} unknowns estimated ({} robot unknowns fixed), {:?} after {} iterations, σ̂ = {}",
+        "{}: {} contacts with {} points and {} planes; {} unknowns estimated ({} robot unknowns fixed), {:?} after {} iterations, σ̂ = {}",
         file.origin,
         file.qs.len(),
         file.points.len(),
+        file.planes.len(),
         fit.estimate.len(),
         fit.fixed.len(),
         fit.stop,
@@ -182,9 +220,22 @@ fn text(
         1e3 * t[1],
         1e3 * t[2]
     );
+    for p in &fit.planes {
+        let n = p.normal;
+        let _ = writeln!(
+            s,
+            "plane {} ({}): normal {:.5} {:.5} {:.5}, offset {:.3} mm",
+            p.name,
+            if p.known { "given" } else { "estimated" },
+            n[0],
+            n[1],
+            n[2],
+            1e3 * p.offset_m
+        );
+    }
     let _ = writeln!(
         s,
-        "in-sample consistency (RMS distance to the point's mean):"
+        "in-sample consistency (RMS distance to the point's mean; a plane's: RMS signed distance to it):"
     );
     s += &figures_text(fig);
     let down = downweighted_rows(fit, file);
@@ -214,6 +265,17 @@ fn figures_text(f: &Figures) -> String {
         "  pooled                        nominal {:7.3} mm  calibrated {:7.3} mm",
         f.nominal_mm, f.calibrated_mm
     );
+    for p in &f.planes {
+        let _ = writeln!(
+            s,
+            "  plane {:<14} {:>3} rows  nominal {:7.3} mm  calibrated {:7.3} mm{}",
+            p.plane,
+            p.rows,
+            p.nominal_mm,
+            p.calibrated_mm,
+            if p.known { " (given plane)" } else { "" }
+        );
+    }
     for d in &f.distances {
         let _ = writeln!(
             s,

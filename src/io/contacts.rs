@@ -4,12 +4,19 @@
 //! A CSV whose header has a `point` column: one column per joint (named as
 //! the robot's joints or `q1`…`qN`, as in [`super::measurements`]) and the
 //! name of the point the row touches (`front_left/0`). Every point needs at
-//! least [`MIN_ROWS_PER_POINT`] rows. A file with measured positions
+//! least [`MIN_ROWS_PER_POINT`] rows.
+//!
+//! A `plane` column (instead of `point`, or beside it) names the plane a row
+//! touches: rows with the same plane name touch one plane (unknown unless
+//! made known with [`ContactFile::set_known_planes`]); a plane needs at
+//! least [`MIN_ROWS_PER_PLANE`] rows. With both columns, each row names
+//! exactly one of a point and a plane (the other cell empty). A file with measured positions
 //! (`x1`, `x`, …) or orientations and a `point` column is refused: a
 //! contact has no measured position.
 
 use super::table::parse_csv;
 use crate::error::{Error, Result};
+use crate::measure::contact::{Plane, PlaneKind};
 use crate::model::Robot;
 use crate::units::{JointSource, Units, joint_names, joint_values_to_model_units};
 use std::path::Path;
@@ -18,15 +25,27 @@ use std::path::Path;
 /// fewer rows than 3 leave nothing of the point's rows to calibrate with.
 pub const MIN_ROWS_PER_POINT: usize = 3;
 
+/// Fewest rows a plane needs: an unknown plane has 3 unknowns (its normal's
+/// 2 and its offset), and 3 points are the fewest that span a plane.
+pub const MIN_ROWS_PER_PLANE: usize = 3;
+
 pub use crate::identify::contact::ContactFile;
+
+/// The name of the column that names the plane a row touches.
+pub const PLANE_COLUMN: &str = "plane";
 
 /// The name of the column that makes a CSV a contact file.
 pub const POINT_COLUMN: &str = "point";
 
-/// Whether CSV `text`'s header has a [`POINT_COLUMN`].
+/// Whether CSV `text`'s header has a [`POINT_COLUMN`] or a
+/// [`PLANE_COLUMN`] (a contact file).
 #[must_use]
 pub fn has_point_column(text: &str) -> bool {
-    header_line(text).is_some_and(|(_, h)| split(h).iter().any(|c| c == POINT_COLUMN))
+    header_line(text).is_some_and(|(_, h)| {
+        split(h)
+            .iter()
+            .any(|c| c == POINT_COLUMN || c == PLANE_COLUMN)
+    })
 }
 
 /// Reads a contact CSV for `robot` in `units`.
@@ -65,18 +84,18 @@ pub fn parse_contacts(
     };
     let (hidx, header) = header_line(text).ok_or_else(|| err("empty file".into()))?;
     let columns = split(header);
-    let pc = columns
-        .iter()
-        .position(|c| c == POINT_COLUMN)
-        .ok_or_else(|| err(format!("no '{POINT_COLUMN}' column")))?;
-    refuse_measured_columns(&columns, &err)?;
-    if columns.iter().any(|c| c == "plane") {
-        return Err(err(
-            "a 'plane' column: plane contacts are not supported yet (only point contacts: rows with the same 'point' touch one fixed point)".into(),
-        ));
+    let find = |name: &str| columns.iter().position(|c| c == name);
+    let (pc, lc) = (find(POINT_COLUMN), find(PLANE_COLUMN));
+    if pc.is_none() && lc.is_none() {
+        return Err(err(format!(
+            "no '{POINT_COLUMN}' or '{PLANE_COLUMN}' column"
+        )));
     }
-    // The point names, then the numeric rest of the table (same lines).
-    let (numeric, names) = split_point_column(text, hidx, pc, &err)?;
+    refuse_measured_columns(&columns, &err)?;
+    // The names, then the numeric rest of the table (same lines).
+    let name_cols: Vec<usize> = [pc, lc].into_iter().flatten().collect();
+    let (numeric, cells) = split_name_columns(text, hidx, &name_cols, &err)?;
+    let names = touched(&cells, pc.is_some(), &name_cols, &err)?;
     let t = parse_csv(&numeric, origin)?;
     let joint_cols = joint_columns(robot, &t.columns, &err)?;
     let mut qs: Vec<Vec<f64>> = Vec::with_capacity(t.rows.len());
@@ -105,12 +124,13 @@ pub fn parse_contacts(
         columns: &jcols,
     };
     joint_values_to_model_units(robot, units, &source, &mut qs)?;
-    let (points, groups) = group_rows(&names, &t.lines, &err)?;
+    let (points, planes, groups) = group_rows(&names, &t.lines, &err)?;
     Ok(ContactFile {
         origin: origin.to_string(),
         qs,
         groups,
         points,
+        planes,
         lines: t.lines,
     })
 }
@@ -132,14 +152,15 @@ fn refuse_measured_columns(columns: &[String], err: &dyn Fn(String) -> Error) ->
     Ok(())
 }
 
-/// Removes column `pc` from every data line of `text`, returning the rest
-/// (same line numbers) and each data row's point name with its line.
-fn split_point_column(
+/// Removes columns `cols` (increasing) from every data line of `text`,
+/// returning the rest (same line numbers) and each data row's cells of
+/// them (trimmed) with its line.
+fn split_name_columns(
     text: &str,
     hidx: usize,
-    pc: usize,
+    cols: &[usize],
     err: &dyn Fn(String) -> Error,
-) -> Result<(String, Vec<(usize, String)>)> {
+) -> Result<(String, Vec<(usize, Vec<String>)>)> {
     let mut out = String::with_capacity(text.len());
     let mut names = Vec::new();
     for (i, raw) in text.lines().enumerate() {
@@ -149,30 +170,74 @@ fn split_point_column(
             out.push_str(l);
         } else {
             let mut cells: Vec<&str> = l.split(',').collect();
-            if pc >= cells.len() {
+            let last = cols.iter().copied().max().unwrap_or(0);
+            if last >= cells.len() {
                 return Err(err(format!(
-                    "line {}: {} cells, no '{POINT_COLUMN}' cell (column {})",
+                    "line {}: {} cells, no cell for column {}",
                     i + 1,
                     cells.len(),
-                    pc + 1
+                    last + 1
                 )));
             }
-            let name = cells.remove(pc).trim().trim_matches('"').trim().to_string();
+            let mut row: Vec<String> = Vec::with_capacity(cols.len());
+            for &c in cols.iter().rev() {
+                row.push(cells.remove(c).trim().trim_matches('"').trim().to_string());
+            }
+            row.reverse();
             if i > hidx {
-                if name.is_empty() {
-                    return Err(err(format!(
-                        "line {}, column {} ('{POINT_COLUMN}'): empty point name",
-                        i + 1,
-                        pc + 1
-                    )));
-                }
-                names.push((i + 1, name));
+                names.push((i + 1, row));
             }
             out.push_str(&cells.join(","));
         }
         out.push('\n');
     }
     Ok((out, names))
+}
+
+/// What a row touches, with its line.
+enum Touch {
+    Point(String),
+    Plane(String),
+}
+
+/// Each row's point or plane: exactly one of its name cells (`cells` of
+/// the columns `cols`, the point column first when `has_point`) is given.
+fn touched(
+    cells: &[(usize, Vec<String>)],
+    has_point: bool,
+    cols: &[usize],
+    err: &dyn Fn(String) -> Error,
+) -> Result<Vec<(usize, Touch)>> {
+    let label = |k: usize| {
+        let name = if has_point && k == 0 {
+            POINT_COLUMN
+        } else {
+            PLANE_COLUMN
+        };
+        format!("column {} ('{name}')", cols[k] + 1)
+    };
+    cells
+        .iter()
+        .map(|(line, row)| {
+            let given: Vec<usize> = (0..row.len()).filter(|&k| !row[k].is_empty()).collect();
+            match given.as_slice() {
+                [k] if has_point && *k == 0 => Ok((*line, Touch::Point(row[0].clone()))),
+                [k] => Ok((*line, Touch::Plane(row[*k].clone()))),
+                [] => Err(err(format!(
+                    "line {line}, {}: empty name (a row names the {} it touches)",
+                    label(0),
+                    if cols.len() == 2 { "point or the plane" } else if has_point { "point" } else { "plane" }
+                ))),
+                _ => Err(err(format!(
+                    "line {line}: both a point ('{}', {}) and a plane ('{}', {}): a row touches one (leave the other cell empty)",
+                    row[0],
+                    label(0),
+                    row[1],
+                    label(1)
+                ))),
+            }
+        })
+        .collect()
 }
 
 /// The columns of the robot's joints, by name or `qJ`.
@@ -201,39 +266,81 @@ fn joint_columns(
         .collect()
 }
 
-/// Point names in order of appearance and each row's index; a point with
-/// fewer than [`MIN_ROWS_PER_POINT`] rows is an error naming its lines.
+/// Point and plane names in order of appearance and each row's group
+/// (points first, then planes); a point with fewer than
+/// [`MIN_ROWS_PER_POINT`] rows or a plane with fewer than
+/// [`MIN_ROWS_PER_PLANE`] is an error naming its lines.
 fn group_rows(
-    names: &[(usize, String)],
+    names: &[(usize, Touch)],
     lines: &[usize],
     err: &dyn Fn(String) -> Error,
-) -> Result<(Vec<String>, Vec<usize>)> {
+) -> Result<(Vec<String>, Vec<Plane>, Vec<usize>)> {
     debug_assert_eq!(names.len(), lines.len());
     let mut points: Vec<String> = Vec::new();
-    let mut groups = Vec::with_capacity(names.len());
-    for (_, n) in names {
-        let g = points.iter().position(|p| p == n).unwrap_or_else(|| {
-            points.push(n.clone());
-            points.len() - 1
-        });
-        groups.push(g);
-    }
-    for (g, p) in points.iter().enumerate() {
+    let mut planes: Vec<String> = Vec::new();
+    let index = |list: &mut Vec<String>, n: &String| {
+        list.iter().position(|p| p == n).unwrap_or_else(|| {
+            list.push(n.clone());
+            list.len() - 1
+        })
+    };
+    let which: Vec<std::result::Result<usize, usize>> = names
+        .iter()
+        .map(|(_, t)| match t {
+            Touch::Point(n) => Ok(index(&mut points, n)),
+            Touch::Plane(n) => Err(index(&mut planes, n)),
+        })
+        .collect();
+    let groups: Vec<usize> = which
+        .iter()
+        .map(|w| match *w {
+            Ok(g) => g,
+            Err(l) => points.len() + l,
+        })
+        .collect();
+    let all = points.iter().map(|p| {
+        (
+            "point",
+            p,
+            MIN_ROWS_PER_POINT,
+            "its 3 coordinates are unknowns",
+        )
+    });
+    let all = all.chain(planes.iter().map(|p| {
+        (
+            "plane",
+            p,
+            MIN_ROWS_PER_PLANE,
+            "3 points span a plane; an unknown one has 3 unknowns",
+        )
+    }));
+    for (g, (what, p, min, why)) in all.enumerate() {
         let at: Vec<String> = names
             .iter()
             .zip(&groups)
             .filter(|(_, k)| **k == g)
             .map(|((l, _), _)| l.to_string())
             .collect();
-        if at.len() < MIN_ROWS_PER_POINT {
+        if at.len() < min {
             return Err(err(format!(
-                "point '{p}' has {} row(s) (line {}): a point needs at least {MIN_ROWS_PER_POINT} (its 3 coordinates are unknowns)",
+                "{what} '{p}' has {} row(s) (line {}): a {what} needs at least {min} ({why})",
                 at.len(),
                 at.join(", ")
             )));
         }
     }
-    Ok((points, groups))
+    let planes = planes
+        .into_iter()
+        .map(|name| Plane {
+            name,
+            // The chart's centre is set at the start of a fit
+            // (`start_planes`); any non-zero normal here.
+            kind: PlaneKind::Unknown {
+                n0: [0.0, 0.0, 1.0],
+            },
+        })
+        .collect();
+    Ok((points, planes, groups))
 }
 
 #[cfg(test)]

@@ -182,6 +182,14 @@ impl ContactSensor {
         }
     }
 
+    /// Plane `l`'s unit normal and offset `d` (metres) at own unknowns
+    /// `own`.
+    #[must_use]
+    pub fn plane_at(&self, own: &[f64], l: usize) -> ([f64; 3], f64) {
+        let (n, d, _) = self.plane(own, l);
+        (n.into(), d)
+    }
+
     /// The points' names.
     #[must_use]
     pub fn points(&self) -> &[String] {

@@ -1,5 +1,7 @@
-//! Contacts as read from a file: each row's joint values, the point it
-//! touches and its file line ([`crate::io::contacts`] reads them).
+//! Contacts as read from a file: each row's joint values, the point or
+//! plane it touches and its file line ([`crate::io::contacts`] reads them).
+
+use crate::measure::contact::{Plane, PlaneKind};
 
 /// Contacts read from a file.
 #[derive(Clone, Debug, PartialEq)]
@@ -8,12 +10,28 @@ pub struct ContactFile {
     pub origin: String,
     /// Joint values of each row (radians, metres).
     pub qs: Vec<Vec<f64>>,
-    /// The point each row touches (an index into `points`).
+    /// What each row touches: point `g` for `g < points.len()`, else plane
+    /// `g − points.len()` (the contact sensor's tags).
     pub groups: Vec<usize>,
     /// Point names, in order of first appearance.
     pub points: Vec<String>,
+    /// Planes, in order of first appearance (unknown unless made known by
+    /// [`ContactFile::set_known_planes`]).
+    pub planes: Vec<Plane>,
     /// The 1-based file line of each row.
     pub lines: Vec<usize>,
+}
+
+/// A plane `n · x = d` known by name (base frame, metres; `n` any non-zero
+/// length, normalised when set).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NamedPlane {
+    /// The plane's name (as in the file's `plane` column).
+    pub name: String,
+    /// Its normal.
+    pub normal: [f64; 3],
+    /// Its offset `d`, metres.
+    pub offset: f64,
 }
 
 impl ContactFile {
@@ -23,7 +41,16 @@ impl ContactFile {
         self.points.iter().position(|p| p == name)
     }
 
-    /// Rows touching point `g`.
+    /// The name of what group `g` touches (a point or a plane).
+    #[must_use]
+    pub fn name_of(&self, g: usize) -> &str {
+        match g.checked_sub(self.points.len()) {
+            Some(l) => &self.planes[l].name,
+            None => &self.points[g],
+        }
+    }
+
+    /// Rows touching point (or plane) `g`.
     #[must_use]
     pub fn rows_of(&self, g: usize) -> Vec<usize> {
         (0..self.groups.len())
@@ -31,27 +58,83 @@ impl ContactFile {
             .collect()
     }
 
-    /// The rows `rows` only (points renumbered in order of appearance).
+    /// Makes the planes of `known` known (normal normalised). Errors on a
+    /// name the file has no plane of, and on a zero or non-finite normal or
+    /// offset, naming the plane.
+    pub fn set_known_planes(&mut self, known: &[NamedPlane]) -> crate::error::Result<()> {
+        for k in known {
+            let len = k.normal.iter().map(|c| c * c).sum::<f64>().sqrt();
+            if !(len.is_finite() && len > 0.0 && k.offset.is_finite()) {
+                return Err(crate::error::Error::Invalid(format!(
+                    "plane '{}': normal ({}, {}, {}) with offset {} m: the normal must be non-zero and finite (a plane needs a direction)",
+                    k.name, k.normal[0], k.normal[1], k.normal[2], k.offset
+                )));
+            }
+            let Some(p) = self.planes.iter_mut().find(|p| p.name == k.name) else {
+                let names: Vec<&str> = self.planes.iter().map(|p| p.name.as_str()).collect();
+                return Err(crate::error::Error::Invalid(format!(
+                    "plane '{}': {} has no such plane (its planes: {})",
+                    k.name,
+                    self.origin,
+                    if names.is_empty() {
+                        "none".to_string()
+                    } else {
+                        names.join(", ")
+                    }
+                )));
+            };
+            p.kind = PlaneKind::Known {
+                normal: k.normal.map(|c| c / len),
+                offset: k.offset / len,
+            };
+        }
+        Ok(())
+    }
+
+    /// The rows `rows` only (points and planes renumbered in order of
+    /// appearance, points first).
     #[must_use]
     pub fn subset(&self, rows: &[usize]) -> Self {
         let mut points: Vec<String> = Vec::new();
-        let mut groups = Vec::with_capacity(rows.len());
+        let mut planes: Vec<Plane> = Vec::new();
+        let mut which = Vec::with_capacity(rows.len());
         for &i in rows {
-            let name = &self.points[self.groups[i]];
-            let g = match points.iter().position(|p| p == name) {
-                Some(g) => g,
-                None => {
-                    points.push(name.clone());
-                    points.len() - 1
+            let g = self.groups[i];
+            match g.checked_sub(self.points.len()) {
+                Some(l) => {
+                    let p = &self.planes[l];
+                    let k = planes
+                        .iter()
+                        .position(|q| q.name == p.name)
+                        .unwrap_or_else(|| {
+                            planes.push(p.clone());
+                            planes.len() - 1
+                        });
+                    which.push(Err(k));
                 }
-            };
-            groups.push(g);
+                None => {
+                    let name = &self.points[g];
+                    let k = points.iter().position(|q| q == name).unwrap_or_else(|| {
+                        points.push(name.clone());
+                        points.len() - 1
+                    });
+                    which.push(Ok(k));
+                }
+            }
         }
+        let groups = which
+            .iter()
+            .map(|w| match *w {
+                Ok(k) => k,
+                Err(l) => points.len() + l,
+            })
+            .collect();
         Self {
             origin: self.origin.clone(),
             qs: rows.iter().map(|&i| self.qs[i].clone()).collect(),
             groups,
             points,
+            planes,
             lines: rows.iter().map(|&i| self.lines[i]).collect(),
         }
     }

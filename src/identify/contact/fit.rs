@@ -6,19 +6,21 @@
 //! **The gauge.** Moving the whole setup rigidly (in particular turning it
 //! about the base's vertical and translating it) changes no residual: the
 //! unknown points follow. Unknowns whose column lies in the span of the
-//! points' columns are fixed and reported as such; the rest of what the
+//! points' columns are fixed and reported as such (unknown planes follow
+//! such a motion too; a known plane pins the setup, and then no unknown is
+//! fixed as the gauge); the rest of what the
 //! contacts cannot see is fixed by the shared rule
 //! ([`crate::identify::undetermined`]: column-pivoted QR on the
 //! column-scaled Jacobian, the sensor's own unknowns pivoted first).
 
 use super::data::ContactFile;
-use super::start_own;
+use super::{start_own, start_planes};
 use crate::identify::lm::{Solution, StopReason, levenberg_marquardt};
 use crate::identify::loss::{Cauchy, Huber, Loss};
 use crate::identify::undetermined::{FixedParameter, fix_undetermined_below};
 use crate::identify::{Calibration, LmSettings, LossChoice, Residuals, Result};
 use crate::linalg::qr::inverse_information;
-use crate::measure::contact::{ContactSensor, KnownDistance};
+use crate::measure::contact::{ContactSensor, KnownDistance, Plane, PlaneKind};
 use crate::model::{ParamTable, Robot};
 use faer::Mat;
 use serde::Serialize;
@@ -74,6 +76,8 @@ pub struct ContactFit {
     pub points: Vec<String>,
     /// The estimated points (base frame, metres).
     pub point_positions: Vec<[f64; 3]>,
+    /// The planes: estimated (unknown) or as given (known).
+    pub planes: Vec<PlaneEstimate>,
     /// Names of the estimated unknowns (robot's, then own).
     pub names: Vec<String>,
     /// Their start values.
@@ -108,6 +112,19 @@ impl ContactFit {
             .map(|(i, &w)| (i, w))
             .collect()
     }
+}
+
+/// A contact plane after the fit: `normal · x = offset_m` (base frame).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PlaneEstimate {
+    /// Its name.
+    pub name: String,
+    /// Whether it was given (not estimated).
+    pub known: bool,
+    /// Its unit normal.
+    pub normal: [f64; 3],
+    /// Its offset, metres.
+    pub offset_m: f64,
 }
 
 /// A calibration's rows scaled by a weight per pose (constraints unscaled).
@@ -145,8 +162,13 @@ fn problem<'a>(
     start: &'a ParamTable,
     file: &'a ContactFile,
     distances: &[KnownDistance],
+    planes: &[Plane],
 ) -> Calibration<'a> {
-    let sensor = ContactSensor::new(file.points.clone(), distances.to_vec());
+    // The planes were checked when read or made known: a failure here is a
+    // programming error, not an input's.
+    let sensor = ContactSensor::new(file.points.clone(), distances.to_vec())
+        .with_planes(planes.to_vec())
+        .expect("checked planes");
     let measured: Vec<f64> = file
         .groups
         .iter()
@@ -175,12 +197,21 @@ pub fn fit_contacts(
 ) -> Result<ContactFit> {
     settings.lm.validate()?;
     let own0 = start_own(robot, start, file);
-    let reduced = determined(robot, start, file, distances, &own0, &settings.keep)?;
+    let planes = start_planes(robot, start, file);
+    let reduced = determined(
+        robot,
+        start,
+        file,
+        distances,
+        &planes,
+        &own0,
+        &settings.keep,
+    )?;
     let r = &reduced.robot;
     let mut theta0 = r.unknown_values(start);
     theta0.extend_from_slice(&own0);
     let mut prob = Weighted {
-        inner: problem(r, start, file, distances),
+        inner: problem(r, start, file, distances, &planes),
         sqrt_w: vec![1.0; file.qs.len()],
     };
     let loss = loss_of(settings.loss)?;
@@ -190,6 +221,7 @@ pub fn fit_contacts(
         r,
         start,
         file,
+        &planes,
         &prob,
         theta0,
         sol,
@@ -250,11 +282,21 @@ fn determined(
     start: &ParamTable,
     file: &ContactFile,
     distances: &[KnownDistance],
+    planes: &[Plane],
     own0: &[f64],
     keep: &[String],
 ) -> Result<crate::identify::Determined> {
     let names = robot.parameter_names();
-    let gauge: Vec<usize> = gauge_unknowns(robot, start, &file.qs)
+    // A known plane pins the setup: no rigid motion is free then.
+    let pinned = planes
+        .iter()
+        .any(|p| matches!(p.kind, PlaneKind::Known { .. }));
+    let free = if pinned {
+        Vec::new()
+    } else {
+        gauge_unknowns(robot, start, &file.qs)
+    };
+    let gauge: Vec<usize> = free
         .into_iter()
         .filter(|&k| !keep.contains(&names[k]))
         .collect();
@@ -263,7 +305,7 @@ fn determined(
         .filter(|k| !gauge.contains(k))
         .map(|k| robot.unknowns[k])
         .collect();
-    let mut prob = problem(&inner, start, file, distances);
+    let mut prob = problem(&inner, start, file, distances, planes);
     let mut theta = inner.unknown_values(start);
     theta.extend_from_slice(own0);
     let x = jacobian(&mut prob, &theta);
@@ -357,6 +399,7 @@ fn finish(
     robot: &Robot,
     start: &ParamTable,
     file: &ContactFile,
+    planes: &[Plane],
     prob: &Weighted<'_>,
     theta0: Vec<f64>,
     sol: Solution,
@@ -377,6 +420,22 @@ fn finish(
         _ => None,
     };
     let own = &sol.theta[n_kin..];
+    let sensor = ContactSensor::new(file.points.clone(), Vec::new())
+        .with_planes(planes.to_vec())
+        .expect("checked planes");
+    let planes = planes
+        .iter()
+        .enumerate()
+        .map(|(l, p)| {
+            let (normal, offset_m) = sensor.plane_at(own, l);
+            PlaneEstimate {
+                name: p.name.clone(),
+                known: matches!(p.kind, PlaneKind::Known { .. }),
+                normal,
+                offset_m,
+            }
+        })
+        .collect();
     let mut names = robot.parameter_names();
     names.truncate(n_kin);
     names.extend(prob.inner.sensor().own_param_names());
@@ -394,6 +453,7 @@ fn finish(
         point_positions: (0..file.points.len())
             .map(|g| ContactSensor::point(own, g).into())
             .collect(),
+        planes,
         names,
         start: theta0,
         estimate: sol.theta,

@@ -13,11 +13,14 @@
 use super::data::ContactFile;
 use super::fit::{ContactFit, ContactSettings, fit_contacts};
 use super::{
-    NamedDistance, group_means, placement_of, resolve_distances, rms, spreads, tool_points,
+    NamedDistance, best_plane, group_means, placement_of, resolve_distances, rms, spreads,
+    tool_points,
 };
 use crate::error::Error;
 use crate::identify::Result;
+use crate::measure::contact::PlaneKind;
 use crate::model::{ParamTable, Robot};
+use nalgebra::Vector3;
 use serde::Serialize;
 
 /// One point's consistency on held-out rows, millimetres.
@@ -59,6 +62,25 @@ pub struct DownweightedRow {
     pub weight: f64,
 }
 
+/// One plane's flatness on some rows, millimetres: the RMS signed distance
+/// `n · t − d` of the rows' tool points to the plane, a known plane's own,
+/// an unknown plane's the one that fits the rows best (for the calibrated
+/// model on its training rows, the fitted plane: at the optimum the plane's
+/// unknowns minimise the same sum).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PlaneFigure {
+    /// The plane.
+    pub plane: String,
+    /// Its rows.
+    pub rows: usize,
+    /// Whether the plane was given (not estimated).
+    pub known: bool,
+    /// RMS signed distance of the nominal model, mm.
+    pub nominal_mm: f64,
+    /// RMS signed distance of the calibrated model, mm.
+    pub calibrated_mm: f64,
+}
+
 /// How a model does on rows it was not fitted to.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct Figures {
@@ -70,6 +92,8 @@ pub struct Figures {
     pub calibrated_mm: f64,
     /// Known distances between these rows' points.
     pub distances: Vec<DistanceFigure>,
+    /// The planes these rows touch.
+    pub planes: Vec<PlaneFigure>,
 }
 
 /// One fold: a fit on some placements, judged on others.
@@ -123,6 +147,8 @@ pub struct HoldoutReport {
 #[must_use]
 pub fn placements(file: &ContactFile) -> Vec<String> {
     let mut out: Vec<String> = Vec::new();
+    // Points only: a plane whose name has no point's placement is in every
+    // fold's training rows (its figures are in-sample only).
     for p in &file.points {
         let pl = placement_of(p);
         if !out.iter().any(|o| o == pl) {
@@ -135,7 +161,7 @@ pub fn placements(file: &ContactFile) -> Vec<String> {
 /// The rows of `file` whose placement is (or, with `not`, is not) `pl`.
 fn rows_of(file: &ContactFile, pl: &str, not: bool) -> Vec<usize> {
     (0..file.qs.len())
-        .filter(|&i| (placement_of(&file.points[file.groups[i]]) == pl) != not)
+        .filter(|&i| (placement_of(file.name_of(file.groups[i])) == pl) != not)
         .collect()
 }
 
@@ -149,12 +175,15 @@ pub fn judge(
     distances: &[NamedDistance],
 ) -> Figures {
     let n = test.points.len();
+    let all = n + test.planes.len();
     let nom = tool_points(robot, nominal, &[0.0; 3], &test.qs);
     let cal = tool_points(&fit.robot, &fit.table, &fit.tool_offset, &test.qs);
     let (sn, sc) = (
-        spreads(&nom, &test.groups, n),
-        spreads(&cal, &test.groups, n),
+        spreads(&nom, &test.groups, all),
+        spreads(&cal, &test.groups, all),
     );
+    let point_rows: Vec<usize> = (0..test.qs.len()).filter(|&i| test.groups[i] < n).collect();
+    let pooled = |s: &[f64]| 1e3 * rms(&point_rows.iter().map(|&i| s[i]).collect::<Vec<_>>());
     let points = (0..n)
         .map(|g| {
             let rows = test.rows_of(g);
@@ -168,8 +197,8 @@ pub fn judge(
         })
         .collect();
     let (mn, mc) = (
-        group_means(&nom, &test.groups, n),
-        group_means(&cal, &test.groups, n),
+        group_means(&nom, &test.groups, all),
+        group_means(&cal, &test.groups, all),
     );
     // Every distance given is checked when the test file was read: here a
     // distance whose points are not both in `test` is left out.
@@ -186,10 +215,45 @@ pub fn judge(
         .collect();
     Figures {
         points,
-        nominal_mm: 1e3 * rms(&sn),
-        calibrated_mm: 1e3 * rms(&sc),
+        nominal_mm: pooled(&sn),
+        calibrated_mm: pooled(&sc),
         distances,
+        planes: plane_figures(test, &nom, &cal),
     }
+}
+
+/// Each plane's RMS signed distance of its rows' tool points (nominal and
+/// calibrated, see [`PlaneFigure`]).
+fn plane_figures(
+    test: &ContactFile,
+    nom: &[Vector3<f64>],
+    cal: &[Vector3<f64>],
+) -> Vec<PlaneFigure> {
+    let g0 = test.points.len();
+    test.planes
+        .iter()
+        .enumerate()
+        .map(|(l, p)| {
+            let rows = test.rows_of(g0 + l);
+            let known = match p.kind {
+                PlaneKind::Known { normal, offset } => Some((Vector3::from(normal), offset)),
+                PlaneKind::Unknown { .. } => None,
+            };
+            let figure = |pts: &[Vector3<f64>]| {
+                let at: Vec<Vector3<f64>> = rows.iter().map(|&i| pts[i]).collect();
+                let (nrm, d) = known.unwrap_or_else(|| best_plane(&at));
+                let dist: Vec<f64> = at.iter().map(|t| nrm.dot(t) - d).collect();
+                1e3 * rms(&dist)
+            };
+            PlaneFigure {
+                plane: p.name.clone(),
+                rows: rows.len(),
+                known: known.is_some(),
+                nominal_mm: figure(nom),
+                calibrated_mm: figure(cal),
+            }
+        })
+        .collect()
 }
 
 /// The rows of a fit a robust loss down-weighted, by file line and point.
@@ -199,7 +263,7 @@ pub fn downweighted_rows(fit: &ContactFit, train: &ContactFile) -> Vec<Downweigh
         .into_iter()
         .map(|(i, weight)| DownweightedRow {
             line: train.lines[i],
-            point: train.points[train.groups[i]].clone(),
+            point: train.name_of(train.groups[i]).to_string(),
             weight,
         })
         .collect()

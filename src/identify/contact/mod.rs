@@ -1,7 +1,8 @@
-//! Calibration without an instrument: contacts with fixed points
-//! ([`crate::measure::contact`]) and the distances known between them.
+//! Calibration without an instrument: contacts with fixed points and planes
+//! ([`crate::measure::contact`]) and the distances known between points.
 //!
-//! * this file: known distances by name, the start of the points, the tool
+//! * this file: known distances by name, the start of the points and
+//!   planes (an unknown plane's chart about its rows' best-fit plane), the tool
 //!   points a model predicts, and the figures of a model on contacts
 //!   (consistency: the RMS distance of each row's predicted tool point to
 //!   its point's mean; distance errors);
@@ -16,16 +17,16 @@ pub mod holdout;
 pub mod project;
 pub mod select;
 
-pub use data::ContactFile;
-pub use fit::{ContactFit, ContactSettings, fit_contacts};
+pub use data::{ContactFile, NamedPlane};
+pub use fit::{ContactFit, ContactSettings, PlaneEstimate, fit_contacts};
 pub use holdout::{
-    DistanceFigure, DownweightedRow, Figures, HoldoutFold, HoldoutMode, HoldoutReport, PointFigure,
-    holdout_by_placement, judge, placements,
+    DistanceFigure, DownweightedRow, Figures, HoldoutFold, HoldoutMode, HoldoutReport, PlaneFigure,
+    PointFigure, holdout_by_placement, judge, placements,
 };
 
 use crate::error::Error;
 use crate::kinematics::Evaluator;
-use crate::measure::contact::{ContactSensor, KnownDistance, TOOL_OFFSET_PARAMS};
+use crate::measure::contact::{ContactSensor, KnownDistance, Plane, PlaneKind, TOOL_OFFSET_PARAMS};
 use crate::model::{ParamTable, Robot};
 use nalgebra::Vector3;
 use serde::Serialize;
@@ -135,15 +136,68 @@ pub fn rms(v: &[f64]) -> f64 {
     (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
 }
 
-/// The own unknowns at the start: a zero tool offset and each point at the
-/// mean of its rows' tool points predicted by `table`.
+/// The own unknowns at the start: a zero tool offset, each point at the
+/// mean of its rows' tool points predicted by `table`, and each unknown
+/// plane at the chart centre of [`start_planes`] (`a = b = 0`) with the
+/// offset of the plane through its rows' mean.
 #[must_use]
 pub fn start_own(robot: &Robot, table: &ParamTable, file: &ContactFile) -> Vec<f64> {
     let pts = tool_points(robot, table, &[0.0; 3], &file.qs);
-    let means = group_means(&pts, &file.groups, file.points.len());
+    let n = file.points.len() + file.planes.len();
+    let means = group_means(&pts, &file.groups, n);
     let mut own = vec![0.0; TOOL_OFFSET_PARAMS];
-    for m in means {
+    for m in &means[..file.points.len()] {
         own.extend_from_slice(m.as_slice());
     }
+    for (l, p) in start_planes(robot, table, file).iter().enumerate() {
+        if let PlaneKind::Unknown { n0 } = p.kind {
+            let d = Vector3::from(n0).dot(&means[file.points.len() + l]);
+            own.extend_from_slice(&[0.0, 0.0, d]);
+        }
+    }
     own
+}
+
+/// The file's planes, each unknown one with its chart centred on the
+/// normal of the plane that fits its rows' tool points (predicted by
+/// `table`, no tool offset) best: the start of the fit.
+#[must_use]
+pub fn start_planes(robot: &Robot, table: &ParamTable, file: &ContactFile) -> Vec<Plane> {
+    if file.planes.is_empty() {
+        return Vec::new();
+    }
+    let pts = tool_points(robot, table, &[0.0; 3], &file.qs);
+    let g0 = file.points.len();
+    file.planes
+        .iter()
+        .enumerate()
+        .map(|(l, p)| match p.kind {
+            PlaneKind::Known { .. } => p.clone(),
+            PlaneKind::Unknown { .. } => {
+                let rows: Vec<Vector3<f64>> =
+                    file.rows_of(g0 + l).iter().map(|&i| pts[i]).collect();
+                let (n, _) = best_plane(&rows);
+                Plane {
+                    name: p.name.clone(),
+                    kind: PlaneKind::Unknown { n0: n.into() },
+                }
+            }
+        })
+        .collect()
+}
+
+/// The plane `n · x = d` (unit `n`) nearest `pts` in the least-squares
+/// sense: through their mean, `n` the direction of least spread.
+#[must_use]
+pub fn best_plane(pts: &[Vector3<f64>]) -> (Vector3<f64>, f64) {
+    let mean = pts.iter().sum::<Vector3<f64>>() / pts.len().max(1) as f64;
+    let mut cov = nalgebra::Matrix3::zeros();
+    for p in pts {
+        let d = p - mean;
+        cov += d * d.transpose();
+    }
+    let eig = cov.symmetric_eigen();
+    let k = eig.eigenvalues.imin();
+    let n: Vector3<f64> = eig.eigenvectors.column(k).into();
+    (n, n.dot(&mean))
 }

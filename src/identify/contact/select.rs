@@ -63,6 +63,7 @@ pub fn socket_pool<R: Rng + ?Sized>(
         origin: "pool".into(),
         groups: vec![0; qs.len()],
         points: vec!["socket".into()],
+        planes: Vec::new(),
         lines: (1..=qs.len()).collect(),
         qs,
     };

@@ -390,8 +390,6 @@ fn selections(
     s: &Settings,
     progress: &mut impl FnMut(&'static str),
 ) -> Result<Selections, ExperimentError> {
-    let x = x;
-    let s = s.clone();
     progress("EAE (det)");
     let t0 = Instant::now();
     let e_det = eae(&x, &mut DCriterion::new(), &s, &mut design_rng(a.seed, 0))?;

@@ -252,7 +252,6 @@ fn top_level(cx: &Ctx<'_>, spec: &FileSpec) -> Result<TopLevel> {
         Some(MeasurementSpec::Pose) => MeasurementKind::Pose,
         Some(MeasurementSpec::Markers) => MeasurementKind::Markers(spec.marker.len()),
     };
-    let cx = *cx;
     let markers = marker_offsets(&cx, &spec.marker, measurement)?;
     let orientation_scale = match &spec.orientation_scale {
         None => crate::model::DEFAULT_ORIENTATION_SCALE,
@@ -415,7 +414,6 @@ impl FrameTables {
     /// Adds frame `i` of the file, checking its label, rows, joint and
     /// unknowns.
     fn push(&mut self, cx: &Ctx<'_>, spec: &FileSpec, i: usize, f: &FrameSpec) -> Result<()> {
-        let cx = *cx;
         let (limits, unknowns) = (&mut self.limits, &mut self.unknowns);
         let label = f.label.get_ref();
         if label.is_empty() || label.chars().any(|c| c.is_whitespace() || c == ',') {

@@ -1,19 +1,6 @@
-//! Levenberg–Marquardt identification with column scaling, Nielsen damping
-//! updates and optional geodesic acceleration; covariance `σ̂² (XᵀX)⁻¹`.
-//!
-//! Each step minimises the damped, scaled linear model
-//! `‖J δ + r‖² + λ ‖D δ‖²` by solving the augmented least-squares system
-//! `[J D⁻¹; √λ I] u = [−r; 0]`, `δ = D⁻¹ u`, with faer's Householder QR.
-//!
-//! Why not a crate: `levenberg-marquardt` (the MINPACK port) is written
-//! against its own nalgebra version and would put a second nalgebra in the
-//! build; our Jacobians live in faer matrices anyway. Why the augmented
-//! system and not the normal equations `(JᵀJ + λD²) δ = −Jᵀr`: forming `JᵀJ`
-//! squares the condition number, and a 20 m lever arm (frame `a`) beside
-//! millimetre offsets makes that matter for the 1e-9 recovery we require.
-//!
-//! `D` is MINPACK's scaling, `d_j = max over iterations of ‖J_{:,j}‖`, so the
-//! damping is invariant to the units of the unknowns (radians vs. metres).
+//! Identification by Levenberg–Marquardt ([`super::levmar`]): the
+//! calibration problem posed, solved, and its rank and covariance
+//! `σ̂² (XᵀX)⁻¹` read off the solution.
 //!
 //! The loop ([`levenberg_marquardt`]) sees only a [`Residuals`]: no
 //! kinematics, no sensor. [`identify`] poses the calibration problem
@@ -21,109 +8,16 @@
 //! [`identify_robust`] wraps the problem in a robust loss ([`super::loss`])
 //! and solves it by IRLS ([`irls`]).
 
+pub use super::levmar::{LmSettings, Solution, StopReason, levenberg_marquardt};
 use super::loss::{Loss, Robust};
 use super::residual::{Calibration, Residuals};
 use super::{IdentifyError, Measurements, Result};
 use crate::blocks::Blocks;
-use crate::linalg::qr::{SeqQr, inverse_information};
+use crate::linalg::qr::inverse_information;
 use crate::model::{ParamTable, Robot, Symbol};
 use crate::observability::identifiability;
 use faer::Mat;
 use serde::{Deserialize, Serialize};
-
-/// Settings of the solver, with documented defaults; [`LmSettings::validate`]
-/// is called by [`identify`].
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct LmSettings {
-    /// Most outer iterations (Jacobian evaluations after the first). Default 200.
-    pub max_iterations: usize,
-    /// Step tolerance: stop when `‖D δ‖ ≤ xtol (‖D θ‖ + xtol)`. Default 1e-10.
-    pub xtol: f64,
-    /// Cost tolerance: stop when the actual and the predicted relative
-    /// reductions of the cost are both at most `ftol`. Default 1e-12.
-    pub ftol: f64,
-    /// Gradient tolerance: stop when every column of `J` is within `gtol` of
-    /// orthogonal to the residual (cosine). Default 1e-10.
-    pub gtol: f64,
-    /// Initial damping `λ₀` relative to the largest diagonal entry of the
-    /// scaled `JᵀJ`. Default 1e-3.
-    pub initial_damping: f64,
-    /// Add Transtrum's geodesic acceleration (one extra residual evaluation
-    /// per trial step) to follow curved valleys from a far start. Default true.
-    pub geodesic: bool,
-}
-
-impl Default for LmSettings {
-    fn default() -> Self {
-        Self {
-            max_iterations: 200,
-            xtol: 1e-10,
-            ftol: 1e-12,
-            gtol: 1e-10,
-            initial_damping: 1e-3,
-            geodesic: true,
-        }
-    }
-}
-
-impl LmSettings {
-    /// Sets [`LmSettings::max_iterations`].
-    #[must_use]
-    pub fn with_max_iterations(mut self, n: usize) -> Self {
-        self.max_iterations = n;
-        self
-    }
-
-    /// Sets [`LmSettings::xtol`], [`LmSettings::ftol`] and [`LmSettings::gtol`].
-    #[must_use]
-    pub fn with_tolerances(mut self, xtol: f64, ftol: f64, gtol: f64) -> Self {
-        self.xtol = xtol;
-        self.ftol = ftol;
-        self.gtol = gtol;
-        self
-    }
-
-    /// Sets [`LmSettings::geodesic`].
-    #[must_use]
-    pub fn with_geodesic(mut self, on: bool) -> Self {
-        self.geodesic = on;
-        self
-    }
-
-    /// Checks every setting is in range.
-    pub fn validate(&self) -> Result<()> {
-        let bad = |name, value: f64, reason| IdentifyError::Setting {
-            name,
-            value: value.to_string(),
-            reason,
-        };
-        if self.max_iterations == 0 {
-            return Err(IdentifyError::Setting {
-                name: "max_iterations",
-                value: "0".into(),
-                reason: "at least one iteration is needed (0 would report the start as the estimate)",
-            });
-        }
-        for (name, v) in [
-            ("xtol", self.xtol),
-            ("ftol", self.ftol),
-            ("gtol", self.gtol),
-        ] {
-            if !(v.is_finite() && (0.0..1.0).contains(&v)) {
-                return Err(bad(name, v, "a tolerance must be in [0, 1)"));
-            }
-        }
-        if !(self.initial_damping.is_finite() && self.initial_damping > 0.0) {
-            return Err(bad(
-                "initial_damping",
-                self.initial_damping,
-                "must be finite and > 0",
-            ));
-        }
-        Ok(())
-    }
-}
 
 /// Outcome of an identification.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -141,26 +35,6 @@ pub enum Status {
     /// [`Identification::unidentifiable`]) are not determined by the design,
     /// and there is no covariance.
     RankDeficient,
-}
-
-/// Why the iteration stopped.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum StopReason {
-    /// The residual is exactly zero.
-    ZeroResidual,
-    /// The step tolerance `xtol` was met.
-    StepTolerance,
-    /// The cost tolerance `ftol` was met.
-    CostTolerance,
-    /// The gradient tolerance `gtol` was met.
-    GradientTolerance,
-    /// `max_iterations` outer iterations were done.
-    MaxIterations,
-    /// The cost or the Jacobian was not finite at an accepted point.
-    NonFinite,
-    /// The damping reached its ceiling (1e32) without an acceptable step.
-    DampingLimit,
 }
 
 /// Correlation matrix with its row and column labels.
@@ -237,13 +111,6 @@ fn wrap_angle(x: f64) -> f64 {
     if w <= -PI { w + TAU } else { w }
 }
 
-fn sumsq(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum()
-}
-
-fn norm(v: &[f64]) -> f64 {
-    sumsq(v).sqrt()
-}
 
 /// Identifies the robot's unknowns from `meas` by Levenberg–Marquardt from
 /// the unknowns' values in `start` (normally `robot.nominal`); the parameters
@@ -491,250 +358,6 @@ fn covariance_from(inv: &Mat<f64>, s2: f64, names: &[String]) -> Covariance {
             matrix: corr,
         },
     }
-}
-
-/// What [`levenberg_marquardt`] returns: the solver's state at the end.
-#[derive(Clone, Debug)]
-pub struct Solution {
-    /// Parameters at the end.
-    pub theta: Vec<f64>,
-    /// Jacobian at `theta` (`m × n`).
-    pub jac: Mat<f64>,
-    /// Whether the residual and the Jacobian at `theta` are finite.
-    pub finite: bool,
-    /// Which rule stopped the iteration.
-    pub stop: StopReason,
-    /// Outer iterations (Jacobian evaluations after the first).
-    pub iterations: usize,
-    /// Residual evaluations, including rejected and geodesic trial points.
-    pub evaluations: usize,
-    /// `‖r‖²` at the start.
-    pub initial_rss: f64,
-    /// `‖r‖²` at `theta`.
-    pub rss: f64,
-    /// `‖r‖²` after each accepted step (first entry: start).
-    pub history: Vec<f64>,
-    /// Final damping `λ` (scaled units).
-    pub lambda: f64,
-}
-
-/// Ceiling on the scaled damping: past it a step is ~1e-32 of a gradient step.
-const MAX_DAMPING: f64 = 1e32;
-/// Smallest gain ratio for accepting a step.
-const ACCEPT: f64 = 1e-4;
-/// Geodesic acceleration: finite-difference step along the velocity, and the
-/// largest allowed ratio `2‖a‖/‖v‖` (Transtrum & Sethna 2012).
-const GEO_H: f64 = 0.1;
-const GEO_ALPHA: f64 = 0.75;
-
-/// Levenberg–Marquardt on any [`Residuals`] from `theta0`: one outer
-/// iteration per Jacobian, inner trials raising the damping until a step is
-/// accepted or a tolerance is met (settings are not validated here; see
-/// [`LmSettings::validate`]).
-pub fn levenberg_marquardt<R: Residuals + ?Sized>(
-    prob: &mut R,
-    theta0: &[f64],
-    s: &LmSettings,
-) -> Solution {
-    let p = theta0.len();
-    debug_assert_eq!(p, prob.n_params());
-    let m = prob.n_residuals();
-    let mut theta = theta0.to_vec();
-    let mut r = vec![0.0; m];
-    let mut jac = Mat::<f64>::zeros(m, p);
-    let mut evaluations = 1;
-    let finite = prob.eval(&theta, &mut r, Some(&mut jac));
-    let rss0 = sumsq(&r);
-    // The Jacobian is held once (3n × p for n measured points): `out.jac`
-    // gets it at the end, and each trial builds only the augmented system.
-    let mut out = Solution {
-        theta: theta.clone(),
-        jac: Mat::new(),
-        finite: finite && rss0.is_finite(),
-        stop: StopReason::NonFinite,
-        iterations: 0,
-        evaluations,
-        initial_rss: rss0,
-        rss: rss0,
-        history: vec![rss0],
-        lambda: 0.0,
-    };
-    if !out.finite {
-        out.jac = jac;
-        return out;
-    }
-    let mut cost = 0.5 * rss0;
-    let mut d = vec![0.0f64; p];
-    let mut lambda = f64::NAN;
-    let mut nu = 2.0;
-    let mut r_try = vec![0.0; m];
-    let mut r_geo = vec![0.0; m];
-    let mut theta_try = vec![0.0; p];
-    let mut iterations = 0;
-    let stop = 'outer: loop {
-        // ---- scaling, gradient test -----------------------------------------
-        let col_norms: Vec<f64> = (0..p).map(|c| jac.col(c).norm_l2()).collect();
-        for (dj, &cn) in d.iter_mut().zip(&col_norms) {
-            *dj = (*dj).max(cn);
-            if *dj == 0.0 {
-                *dj = 1.0;
-            }
-        }
-        if cost == 0.0 {
-            break StopReason::ZeroResidual;
-        }
-        let rnorm = norm(&r);
-        let g: Vec<f64> = (0..p)
-            .map(|c| (0..m).map(|i| jac[(i, c)] * r[i]).sum::<f64>())
-            .collect();
-        let gcos = (0..p)
-            .filter(|&c| col_norms[c] > 0.0)
-            .map(|c| g[c].abs() / (col_norms[c] * rnorm))
-            .fold(0.0, f64::max);
-        if gcos <= s.gtol {
-            break StopReason::GradientTolerance;
-        }
-        if iterations >= s.max_iterations {
-            break StopReason::MaxIterations;
-        }
-        if lambda.is_nan() {
-            // The largest diagonal entry of the scaled JᵀJ, ‖J_{:,j}/d_j‖²
-            // (one column at a time).
-            let max_diag = (0..p)
-                .map(|c| faer::Col::from_fn(m, |i| jac[(i, c)] / d[c]).squared_norm_l2())
-                .fold(0.0, f64::max);
-            lambda = s.initial_damping * max_diag.max(f64::MIN_POSITIVE);
-        }
-        let dtheta_norm = norm(&theta.iter().zip(&d).map(|(t, d)| t * d).collect::<Vec<_>>());
-        iterations += 1;
-
-        // ---- inner loop: damped trial steps ---------------------------------
-        loop {
-            // [Js; √λ I] u = [−r; 0], Js = J D⁻¹
-            let sl = lambda.sqrt();
-            let aug = Mat::from_fn(m + p, p, |i, j| {
-                if i < m {
-                    jac[(i, j)] / d[j]
-                } else if i - m == j {
-                    sl
-                } else {
-                    0.0
-                }
-            });
-            let mut qr = SeqQr::new(aug);
-            let mut u = Mat::from_fn(m + p, 1, |i, _| if i < m { -r[i] } else { 0.0 });
-            qr.solve_lstsq_in_place(u.as_mut());
-            let u: Vec<f64> = (0..p).map(|j| u[(j, 0)]).collect();
-            let mut step: Vec<f64> = (0..p).map(|j| u[j] / d[j]).collect();
-            let mut ok = u.iter().all(|v| v.is_finite());
-
-            // ---- geodesic acceleration: a = −(JᵀJ + λD²)⁻¹ Jᵀ r_vv ----------
-            if ok && s.geodesic {
-                for j in 0..p {
-                    theta_try[j] = theta[j] + GEO_H * step[j];
-                }
-                evaluations += 1;
-                if prob.eval(&theta_try, &mut r_geo, None) {
-                    // r_vv ≈ (2/h) [(r(θ + h v) − r(θ))/h − J v]
-                    let jv: Vec<f64> = (0..m)
-                        .map(|i| (0..p).map(|j| jac[(i, j)] * step[j]).sum::<f64>())
-                        .collect();
-                    let mut a = Mat::from_fn(m + p, 1, |i, _| {
-                        if i < m {
-                            -(2.0 / GEO_H) * ((r_geo[i] - r[i]) / GEO_H - jv[i])
-                        } else {
-                            0.0
-                        }
-                    });
-                    qr.solve_lstsq_in_place(a.as_mut());
-                    let a_s: Vec<f64> = (0..p).map(|j| a[(j, 0)]).collect();
-                    let un = norm(&u);
-                    if a_s.iter().all(|v| v.is_finite()) && 2.0 * norm(&a_s) <= GEO_ALPHA * un {
-                        for j in 0..p {
-                            step[j] += 0.5 * a_s[j] / d[j];
-                        }
-                    } else {
-                        // Too curved for this damping: reject, damp more.
-                        ok = false;
-                    }
-                } else {
-                    ok = false;
-                }
-            }
-
-            let du: Vec<f64> = step.iter().zip(&d).map(|(x, d)| x * d).collect();
-            let du_norm = norm(&du);
-            // Predicted reduction of ½‖r‖² by the linear model: −gᵀδ − ½‖Jδ‖².
-            let jd: Vec<f64> = (0..m)
-                .map(|i| (0..p).map(|j| jac[(i, j)] * step[j]).sum::<f64>())
-                .collect();
-            let pred = -(0..p).map(|j| g[j] * step[j]).sum::<f64>() - 0.5 * sumsq(&jd);
-            let mut actual = f64::NEG_INFINITY;
-            let mut new_cost = f64::INFINITY;
-            if ok {
-                for j in 0..p {
-                    theta_try[j] = theta[j] + step[j];
-                }
-                evaluations += 1;
-                if prob.eval(&theta_try, &mut r_try, None) {
-                    new_cost = 0.5 * sumsq(&r_try);
-                    if new_cost.is_finite() {
-                        actual = cost - new_cost;
-                    }
-                }
-            }
-            let rho = if pred > 0.0 {
-                actual / pred
-            } else {
-                f64::NEG_INFINITY
-            };
-            let accepted = rho > ACCEPT;
-
-            // ---- tolerances (MINPACK's tests, on this trial) ----------------
-            let ftol_met = ok
-                && actual.is_finite()
-                && actual.abs() <= s.ftol * cost
-                && pred <= s.ftol * cost
-                && rho <= 2.0;
-            let xtol_met = du_norm <= s.xtol * (dtheta_norm + s.xtol);
-
-            if accepted {
-                theta.copy_from_slice(&theta_try);
-                cost = new_cost;
-                std::mem::swap(&mut r, &mut r_try);
-                out.history.push(2.0 * cost);
-                lambda *= (1.0 / 3.0f64).max(1.0 - (2.0 * rho - 1.0).powi(3));
-                nu = 2.0;
-                if !prob.eval(&theta, &mut r, Some(&mut jac)) {
-                    break 'outer StopReason::NonFinite;
-                }
-            } else {
-                lambda *= nu;
-                nu *= 2.0;
-            }
-            if ftol_met {
-                break 'outer StopReason::CostTolerance;
-            }
-            if xtol_met {
-                break 'outer StopReason::StepTolerance;
-            }
-            if lambda > MAX_DAMPING {
-                break 'outer StopReason::DampingLimit;
-            }
-            if accepted {
-                break;
-            }
-        }
-    };
-    out.finite = stop != StopReason::NonFinite;
-    out.theta = theta;
-    out.jac = jac;
-    out.stop = stop;
-    out.iterations = iterations;
-    out.evaluations = evaluations;
-    out.rss = 2.0 * cost;
-    out.lambda = lambda;
-    out
 }
 
 #[cfg(test)]

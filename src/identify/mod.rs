@@ -39,6 +39,7 @@ pub mod compliance;
 pub mod contact;
 pub mod evaluation;
 pub mod fit;
+pub mod levmar;
 pub mod lm;
 pub mod loss;
 pub mod montecarlo;

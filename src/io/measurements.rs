@@ -27,7 +27,7 @@
 //! the joint limits by the one rule of every joint-value reader
 //! ([`crate::units::joint_values_to_model_units`]).
 
-use super::table::parse_csv;
+use super::table::{Table, parse_csv};
 use crate::error::{Error, Result};
 use crate::identify::{Measurements, ROTATION_TOLERANCE};
 use crate::model::Robot;
@@ -123,13 +123,150 @@ pub fn parse_csv_measurements_in(
         path: origin.to_string(),
         message,
     };
-    let mut used = vec![false; t.columns.len()];
-    let take = |name: &str, used: &mut Vec<bool>| -> Option<usize> {
-        let c = t.column(name)?;
-        used[c] = true;
-        Some(c)
+    let layout = Layout::of(&t, robot).map_err(err)?;
+    let notes = layout.notes(&t, origin, robot);
+    let m = units.length.to_m();
+    let n = t.rows.len();
+    let mut qs = Vec::with_capacity(n);
+    let mut points = Vec::with_capacity(n * layout.markers.len());
+    let mut orientations = Vec::new();
+    for (row, &line) in t.rows.iter().zip(&t.lines) {
+        let cell = Cells {
+            table: &t,
+            row,
+            line,
+        };
+        qs.push(
+            layout
+                .joints
+                .iter()
+                .map(|&c| cell.at(c))
+                .collect::<std::result::Result<Vec<f64>, String>>()
+                .map_err(err)?,
+        );
+        for cols in &layout.markers {
+            let [x, y, z] = cols.map(|c| cell.at(c).map(|v| m * v));
+            points.push([x.map_err(err)?, y.map_err(err)?, z.map_err(err)?]);
+        }
+        if let Some(r) = layout.orientation.read(&cell).map_err(err)? {
+            orientations.push(r);
+        }
+    }
+    let rows: Vec<String> = t.lines.iter().map(|l| format!("line {l}")).collect();
+    let columns: Vec<String> = layout.joints.iter().map(|&c| t.columns[c].clone()).collect();
+    let source = JointSource {
+        file: origin,
+        rows: &rows,
+        columns: &columns,
     };
-    // Markers: x1,y1,z1, x2,…; plain x,y,z count as marker 1.
+    joint_values_to_model_units(robot, units, &source, &mut qs)?;
+    Ok(MeasurementFile {
+        measurements: Measurements::unchecked(qs, layout.markers.len(), points, orientations),
+        notes,
+    })
+}
+
+/// Which columns of a measurement CSV hold what.
+struct Layout {
+    /// `x_k, y_k, z_k` of each marker.
+    markers: Vec<[usize; 3]>,
+    /// The orientation columns of a full pose, if any.
+    orientation: OrientationColumns,
+    /// One column per joint of the robot, in joint order.
+    joints: Vec<usize>,
+    /// Which columns are read (the others go into a note).
+    used: Vec<bool>,
+}
+
+/// How a full pose's orientation is given.
+enum OrientationColumns {
+    /// No orientation: points only.
+    None,
+    /// `phix1, phiy1, phiz1` (roll, pitch, yaw).
+    Rpy([usize; 3]),
+    /// `qw1, qx1, qy1, qz1`.
+    Quaternion([usize; 4]),
+}
+
+/// One row's cells, with what an error about them names.
+struct Cells<'a> {
+    table: &'a Table,
+    row: &'a [f64],
+    line: usize,
+}
+
+impl Cells<'_> {
+    /// The finite value of column `c`.
+    fn at(&self, c: usize) -> std::result::Result<f64, String> {
+        let v = self.row[c];
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(format!(
+                "line {}, column {} ('{}'): {v} is not a finite number",
+                self.line,
+                c + 1,
+                self.table.columns[c]
+            ))
+        }
+    }
+}
+
+impl Layout {
+    /// Finds the marker, orientation and joint columns of `t`'s header.
+    fn of(t: &Table, robot: &Robot) -> std::result::Result<Self, String> {
+        let mut used = vec![false; t.columns.len()];
+        let markers = marker_columns(t, &mut used)?;
+        let orientation = orientation_columns(t, &mut used, markers.len())?;
+        let joints = joint_columns(t, &mut used, robot)?;
+        Ok(Self {
+            markers,
+            orientation,
+            joints,
+            used,
+        })
+    }
+
+    /// Notes on columns left unread and on a several-marker sensor.
+    fn notes(&self, t: &Table, origin: &str, robot: &Robot) -> Vec<String> {
+        let mut notes = Vec::new();
+        let extra: Vec<&str> = t
+            .columns
+            .iter()
+            .zip(&self.used)
+            .filter(|(_, u)| !**u)
+            .map(|(c, _)| c.as_str())
+            .collect();
+        if !extra.is_empty() {
+            notes.push(format!(
+                "{origin}: column(s) not used (not a marker, orientation or joint of robot '{}'): {}",
+                robot.name,
+                extra.join(", ")
+            ));
+        }
+        if self.markers.len() > 1 {
+            notes.push(format!(
+                "{origin}: {} markers per pose: a {}-marker sensor with an offset of its own per marker",
+                self.markers.len(),
+                self.markers.len()
+            ));
+        }
+        notes
+    }
+}
+
+/// Marks column `name` as read and returns its index.
+fn take(t: &Table, name: &str, used: &mut [bool]) -> Option<usize> {
+    let c = t.column(name)?;
+    used[c] = true;
+    Some(c)
+}
+
+/// Markers: `x1,y1,z1`, `x2,…`; plain `x,y,z` count as marker 1.
+fn marker_columns(
+    t: &Table,
+    used: &mut [bool],
+) -> std::result::Result<Vec<[usize; 3]>, String> {
     let mut marker_cols: Vec<[usize; 3]> = Vec::new();
     for k in 1.. {
         let names = [format!("x{k}"), format!("y{k}"), format!("z{k}")];
@@ -139,10 +276,10 @@ pub fn parse_csv_measurements_in(
         } else {
             found
         };
-        match found.iter().filter(|c| c.is_some()).count() {
-            0 => break,
-            3 => {
-                let cols = [found[0].unwrap(), found[1].unwrap(), found[2].unwrap()];
+        match found[..] {
+            [None, None, None] => break,
+            [Some(x), Some(y), Some(z)] => {
+                let cols = [x, y, z];
                 cols.iter().for_each(|&c| used[c] = true);
                 marker_cols.push(cols);
             }
@@ -153,151 +290,124 @@ pub fn parse_csv_measurements_in(
                     .filter(|(_, f)| f.is_none())
                     .map(|(n, _)| n.as_str())
                     .collect();
-                return Err(err(format!(
+                return Err(format!(
                     "marker {k}: column(s) {} missing (a marker needs x{k}, y{k} and z{k})",
                     missing.join(", ")
-                )));
+                ));
             }
         }
     }
     if marker_cols.is_empty() {
-        return Err(err(format!(
+        return Err(format!(
             "no measured point: expected columns x1, y1, z1 (metres); the header has {}",
             t.columns.join(", ")
-        )));
+        ));
     }
+    Ok(marker_cols)
+}
+
+/// The orientation columns: all three angles, all four quaternion entries,
+/// or none; only with one marker.
+fn orientation_columns(
+    t: &Table,
+    used: &mut [bool],
+    markers: usize,
+) -> std::result::Result<OrientationColumns, String> {
     let rpy: Vec<Option<usize>> = ["phix1", "phiy1", "phiz1"]
         .iter()
-        .map(|n| take(n, &mut used))
+        .map(|n| take(t, n, used))
         .collect();
     let quat: Vec<Option<usize>> = ["qw1", "qx1", "qy1", "qz1"]
         .iter()
-        .map(|n| take(n, &mut used))
+        .map(|n| take(t, n, used))
         .collect();
     let has_rpy = rpy.iter().any(Option::is_some);
     let has_quat = quat.iter().any(Option::is_some);
     if has_rpy && has_quat {
-        return Err(err(
+        return Err(
             "both phix1/phiy1/phiz1 and qw1/qx1/qy1/qz1: give the orientation one way".into(),
-        ));
+        );
     }
     if (has_rpy && rpy.iter().any(Option::is_none))
         || (has_quat && quat.iter().any(Option::is_none))
     {
-        return Err(err(
+        return Err(
             "an incomplete orientation: give all of phix1, phiy1, phiz1 (roll, pitch, yaw) or all of qw1, qx1, qy1, qz1".into(),
+        );
+    }
+    if (has_rpy || has_quat) && markers > 1 {
+        return Err(format!(
+            "an orientation with {markers} markers: a full pose has one measured point (orientations with several markers are not supported)"
         ));
     }
-    if (has_rpy || has_quat) && marker_cols.len() > 1 {
-        return Err(err(format!(
-            "an orientation with {} markers: a full pose has one measured point (orientations with several markers are not supported)",
-            marker_cols.len()
-        )));
-    }
-    // Joints by name (or q1…qN).
+    Ok(match (&rpy[..], &quat[..]) {
+        ([Some(a), Some(b), Some(c)], _) => OrientationColumns::Rpy([*a, *b, *c]),
+        (_, [Some(w), Some(x), Some(y), Some(z)]) => {
+            OrientationColumns::Quaternion([*w, *x, *y, *z])
+        }
+        _ => OrientationColumns::None,
+    })
+}
+
+/// One column per joint, by name (or `q1…qN`).
+fn joint_columns(
+    t: &Table,
+    used: &mut [bool],
+    robot: &Robot,
+) -> std::result::Result<Vec<usize>, String> {
     let names = joint_names(robot);
     let mut joint_cols = Vec::with_capacity(names.len());
     for (j, n) in names.iter().enumerate() {
         let alias = format!("q{}", j + 1);
-        match take(n, &mut used).or_else(|| take(&alias, &mut used)) {
+        match take(t, n, used).or_else(|| take(t, &alias, used)) {
             Some(c) => joint_cols.push(c),
             None => {
-                return Err(err(format!(
+                return Err(format!(
                     "no column for joint '{n}' (joint {} of robot '{}'; name the column '{n}' or '{alias}'); the header has {}",
                     j + 1,
                     robot.name,
                     t.columns.join(", ")
-                )));
+                ));
             }
         }
     }
-    let mut notes = Vec::new();
-    let extra: Vec<&str> = t
-        .columns
-        .iter()
-        .zip(&used)
-        .filter(|(_, u)| !**u)
-        .map(|(c, _)| c.as_str())
-        .collect();
-    if !extra.is_empty() {
-        notes.push(format!(
-            "{origin}: column(s) not used (not a marker, orientation or joint of robot '{}'): {}",
-            robot.name,
-            extra.join(", ")
-        ));
-    }
-    if marker_cols.len() > 1 {
-        notes.push(format!(
-            "{origin}: {} markers per pose: a {}-marker sensor with an offset of its own per marker",
-            marker_cols.len(),
-            marker_cols.len()
-        ));
-    }
-    let n = t.rows.len();
-    let mut qs = Vec::with_capacity(n);
-    let mut points = Vec::with_capacity(n * marker_cols.len());
-    let mut orientations = Vec::new();
-    for (row, &line) in t.rows.iter().zip(&t.lines) {
-        let at = |c: usize| -> Result<f64> {
-            let v = row[c];
-            if v.is_finite() {
-                Ok(v)
-            } else {
-                Err(err(format!(
-                    "line {line}, column {} ('{}'): {v} is not a finite number",
-                    c + 1,
-                    t.columns[c]
-                )))
+    Ok(joint_cols)
+}
+
+impl OrientationColumns {
+    /// The row's orientation as a row-major rotation, if the file has one.
+    fn read(&self, cell: &Cells<'_>) -> std::result::Result<Option<[[f64; 3]; 3]>, String> {
+        match self {
+            Self::None => Ok(None),
+            Self::Rpy(cols) => {
+                let a = [cell.at(cols[0])?, cell.at(cols[1])?, cell.at(cols[2])?];
+                if let Some((i, v)) = a.iter().enumerate().find(|(_, v)| v.abs() > MAX_ANGLE) {
+                    let c = cols[i];
+                    return Err(format!(
+                        "line {}, column {} ('{}'): angle {v} is out of range (radians, |angle| <= 2π; degrees?)",
+                        cell.line,
+                        c + 1,
+                        cell.table.columns[c]
+                    ));
+                }
+                // R = Rz(phiz) Ry(phiy) Rx(phix): nalgebra's roll-pitch-yaw.
+                let r = Rotation3::from_euler_angles(a[0], a[1], a[2]);
+                Ok(Some(crate::identify::rows(r.matrix())))
             }
-        };
-        qs.push(
-            joint_cols
-                .iter()
-                .map(|&c| at(c))
-                .collect::<Result<Vec<f64>>>()?,
-        );
-        let m = units.length.to_m();
-        for cols in &marker_cols {
-            points.push([m * at(cols[0])?, m * at(cols[1])?, m * at(cols[2])?]);
-        }
-        if has_rpy {
-            let a: Vec<f64> = rpy.iter().map(|c| at(c.unwrap())).collect::<Result<_>>()?;
-            if let Some((i, v)) = a.iter().enumerate().find(|(_, v)| v.abs() > MAX_ANGLE) {
-                let c = rpy[i].unwrap();
-                return Err(err(format!(
-                    "line {line}, column {} ('{}'): angle {v} is out of range (radians, |angle| <= 2π; degrees?)",
-                    c + 1,
-                    t.columns[c]
-                )));
+            Self::Quaternion(cols) => {
+                let v = [cell.at(cols[0])?, cell.at(cols[1])?, cell.at(cols[2])?, cell.at(cols[3])?];
+                let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+                if (norm - 1.0).abs() > ROTATION_TOLERANCE {
+                    return Err(format!(
+                        "line {}: quaternion (qw1, qx1, qy1, qz1) has norm {norm}, not 1 (to {ROTATION_TOLERANCE:e})",
+                        cell.line
+                    ));
+                }
+                let uq = UnitQuaternion::from_quaternion(Quaternion::new(v[0], v[1], v[2], v[3]));
+                Ok(Some(crate::identify::rows(uq.to_rotation_matrix().matrix())))
             }
-            // R = Rz(phiz) Ry(phiy) Rx(phix): nalgebra's roll-pitch-yaw.
-            let r = Rotation3::from_euler_angles(a[0], a[1], a[2]);
-            orientations.push(crate::identify::rows(r.matrix()));
-        }
-        if has_quat {
-            let v: Vec<f64> = quat.iter().map(|c| at(c.unwrap())).collect::<Result<_>>()?;
-            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            if (norm - 1.0).abs() > ROTATION_TOLERANCE {
-                return Err(err(format!(
-                    "line {line}: quaternion (qw1, qx1, qy1, qz1) has norm {norm}, not 1 (to {ROTATION_TOLERANCE:e})"
-                )));
-            }
-            let uq = UnitQuaternion::from_quaternion(Quaternion::new(v[0], v[1], v[2], v[3]));
-            orientations.push(crate::identify::rows(uq.to_rotation_matrix().matrix()));
         }
     }
-    let rows: Vec<String> = t.lines.iter().map(|l| format!("line {l}")).collect();
-    let columns: Vec<String> = joint_cols.iter().map(|&c| t.columns[c].clone()).collect();
-    let source = JointSource {
-        file: origin,
-        rows: &rows,
-        columns: &columns,
-    };
-    joint_values_to_model_units(robot, units, &source, &mut qs)?;
-    Ok(MeasurementFile {
-        measurements: Measurements::unchecked(qs, marker_cols.len(), points, orientations),
-        notes,
-    })
 }
 
 #[cfg(test)]

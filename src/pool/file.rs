@@ -269,23 +269,7 @@ pub fn parse_json_in(
                 .into(),
         ));
     };
-    if let Some(r) = obj.get("robot").and_then(|r| r.as_str()) {
-        let chain = obj
-            .get("chain")
-            .map(|c| serde_json::from_value::<ChainChoice>(c.clone()))
-            .transpose()
-            .map_err(|e| parse_err(path, format!("\"chain\": {e}")))?;
-        let mut named = RobotRef::parse(r).map_err(|e| parse_err(path, e.to_string()))?;
-        if let Some(c) = chain {
-            named.chain = c;
-        }
-        if RobotRef::parse(&robot.name).ok().as_ref() != Some(&named) {
-            return Err(parse_err(
-                path,
-                format!("the file is for robot '{named}', not '{}'", robot.name),
-            ));
-        }
-    }
+    check_robot_key(path, obj, robot)?;
     // A design file (`select --out`) names its joint vectors `q` and its
     // joints `joint_names`.
     let design = !obj.contains_key("qs") && obj.contains_key("q") && obj.contains_key("poses");
@@ -300,7 +284,7 @@ pub fn parse_json_in(
             "no \"qs\" array of joint vectors (nor a design file's \"q\")".into(),
         ));
     };
-    let (map, mut ignored, width, header) = match obj.get(joints_key) {
+    let (map, mut ignored, header) = match obj.get(joints_key) {
         Some(j) => {
             let header: Vec<String> = j
                 .as_array()
@@ -309,15 +293,9 @@ pub fn parse_json_in(
                     parse_err(path, format!("\"{joints_key}\" must be an array of names"))
                 })?;
             let (map, ignored) = map_columns(path, &header, &names)?;
-            let width = header.len();
-            (map, ignored, width, header)
+            (map, ignored, header)
         }
-        None => (
-            (0..names.len()).map(Some).collect(),
-            Vec::new(),
-            names.len(),
-            names.clone(),
-        ),
+        None => ((0..names.len()).map(Some).collect(), Vec::new(), names.clone()),
     };
     let mut keys: Vec<&str> = obj
         .keys()
@@ -325,41 +303,14 @@ pub fn parse_json_in(
         .filter(|k| ![rows_key, joints_key, "robot"].contains(k))
         .collect();
     keys.sort_unstable();
-    let mut qs = Vec::with_capacity(rows.len());
-    let mut labels = Vec::with_capacity(rows.len());
-    for (k, r) in rows.iter().enumerate() {
-        let row = format!("{rows_key}[{k}] (row {})", k + 1);
-        let Some(cells) = r.as_array() else {
-            return Err(parse_err(path, format!("{row}: not an array of numbers")));
-        };
-        if cells.len() != width {
-            return Err(parse_err(
-                path,
-                format!("{row}: {} values, expected {width}", cells.len()),
-            ));
-        }
-        let mut q = vec![f64::NAN; names.len()];
-        for (c, cell) in cells.iter().enumerate() {
-            let Some(j) = map[c] else { continue };
-            // JSON has no NaN; `null` is how serializers write one.
-            let v = match cell {
-                serde_json::Value::Null => f64::NAN,
-                x => x.as_f64().ok_or_else(|| {
-                    parse_err(
-                        path,
-                        format!(
-                            "{row}, column '{}' (joint {}): {x} is not a number",
-                            header[c],
-                            j + 1
-                        ),
-                    )
-                })?,
-            };
-            q[j] = v;
-        }
-        qs.push(q);
-        labels.push(row);
-    }
+    let columns = JsonColumns {
+        path,
+        rows_key,
+        header: &header,
+        map: &map,
+        dof: names.len(),
+    };
+    let (mut qs, labels) = columns.read_rows(rows)?;
     check_units(path, robot, units, &header, &map, &labels, &mut qs)?;
     let mut notes = Vec::new();
     if !ignored.is_empty() {
@@ -378,4 +329,86 @@ pub fn parse_json_in(
         ));
     }
     Ok(Configurations { qs, notes })
+}
+
+/// Errors when the file's `robot` (and `chain`) name another robot.
+fn check_robot_key(
+    path: &Path,
+    obj: &serde_json::Map<String, serde_json::Value>,
+    robot: &Robot,
+) -> Result<()> {
+    let Some(r) = obj.get("robot").and_then(|r| r.as_str()) else {
+        return Ok(());
+    };
+    let chain = obj
+        .get("chain")
+        .map(|c| serde_json::from_value::<ChainChoice>(c.clone()))
+        .transpose()
+        .map_err(|e| parse_err(path, format!("\"chain\": {e}")))?;
+    let mut named = RobotRef::parse(r).map_err(|e| parse_err(path, e.to_string()))?;
+    if let Some(c) = chain {
+        named.chain = c;
+    }
+    if RobotRef::parse(&robot.name).ok().as_ref() != Some(&named) {
+        return Err(parse_err(
+            path,
+            format!("the file is for robot '{named}', not '{}'", robot.name),
+        ));
+    }
+    Ok(())
+}
+
+/// How a JSON file's rows map onto the robot's joints.
+struct JsonColumns<'a> {
+    path: &'a Path,
+    /// `qs`, or a design file's `q`.
+    rows_key: &'a str,
+    /// The names of a row's values.
+    header: &'a [String],
+    /// For each value of a row, the robot joint it is (`None`: ignored).
+    map: &'a [Option<usize>],
+    /// Joints of the robot.
+    dof: usize,
+}
+
+impl JsonColumns<'_> {
+    /// Each row's joint values (NaN for a `null`) and its label.
+    fn read_rows(&self, rows: &[serde_json::Value]) -> Result<(Vec<Vec<f64>>, Vec<String>)> {
+        let (path, width) = (self.path, self.header.len());
+        let mut qs = Vec::with_capacity(rows.len());
+        let mut labels = Vec::with_capacity(rows.len());
+        for (k, r) in rows.iter().enumerate() {
+            let row = format!("{}[{k}] (row {})", self.rows_key, k + 1);
+            let Some(cells) = r.as_array() else {
+                return Err(parse_err(path, format!("{row}: not an array of numbers")));
+            };
+            if cells.len() != width {
+                return Err(parse_err(
+                    path,
+                    format!("{row}: {} values, expected {width}", cells.len()),
+                ));
+            }
+            let mut q = vec![f64::NAN; self.dof];
+            for (c, cell) in cells.iter().enumerate() {
+                let Some(j) = self.map[c] else { continue };
+                // JSON has no NaN; `null` is how serializers write one.
+                q[j] = match cell {
+                    serde_json::Value::Null => f64::NAN,
+                    x => x.as_f64().ok_or_else(|| {
+                        parse_err(
+                            path,
+                            format!(
+                                "{row}, column '{}' (joint {}): {x} is not a number",
+                                self.header[c],
+                                j + 1
+                            ),
+                        )
+                    })?,
+                };
+            }
+            qs.push(q);
+            labels.push(row);
+        }
+        Ok((qs, labels))
+    }
 }

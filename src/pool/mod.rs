@@ -348,19 +348,7 @@ impl PoolSpec {
             None => rows.as_ref().map_or(0, Vec::len),
         };
         check_memory(robot, n)?;
-        let cands = match (&self.source, rows.as_deref()) {
-            (PoolSource::Lattice { levels }, _) => {
-                Candidates::Lattice(Lattice::within(robot, *levels, &inside.limits)?)
-            }
-            (PoolSource::Random { count, seed }, _) => {
-                Candidates::Random(Uniform::new(inside, *count, *seed)?)
-            }
-            (PoolSource::Sobol { count, seed }, _) => {
-                Candidates::Sobol(Sobol::new(inside, *count, *seed)?)
-            }
-            (PoolSource::File { .. }, Some(rows)) => Candidates::Listed(rows),
-            (PoolSource::File { .. }, None) => unreachable!("a file source is built from its rows"),
-        };
+        let cands = self.candidates(robot, inside, rows.as_deref())?;
         let dof = robot.dof();
         // A file's rows are checked against the margin first (generated
         // sources are made inside it).
@@ -373,57 +361,11 @@ impl PoolSpec {
             names.push("margin".into());
         }
         names.extend(self.filters.iter().map(|f| f.kind().to_string()));
-        let n_filters = names.len();
-        let skip = usize::from(margin_limits.is_some());
-        // For each candidate, the first filter that removes it (n_filters:
-        // none) and, for a collision filter, the contact that did
-        // (`NO_CONTACT` otherwise). Integer counts: the same whatever the
-        // thread split.
-        let first_fail = |id: usize| -> (usize, usize) {
-            let mut q = vec![0.0; dof];
-            cands.q_into(id, &mut q);
-            if let Some(m) = &margin_limits
-                && q.iter().zip(m).any(|(v, l)| *v < l[0] || *v > l[1])
-            {
-                return (0, stats::NO_CONTACT);
-            }
-            for (k, f) in self.filters.iter().enumerate() {
-                match f {
-                    PoolFilter::Collision(c) => {
-                        if let Some(key) = c.contact_key(&q) {
-                            return (k + skip, key);
-                        }
-                    }
-                    _ if !f.keeps(robot, table, &q) => return (k + skip, stats::NO_CONTACT),
-                    _ => {}
-                }
-            }
-            (n_filters, stats::NO_CONTACT)
-        };
-        // Each candidate's verdict once (a collision check is the costly
-        // filter), in parallel over fixed chunks, with progress.
-        let task = crate::progress::Task::start("pool filters", Some(cands.size() as u64));
-        let verdict: Vec<(usize, usize)> = if n_filters == 0 {
-            Vec::new()
-        } else {
-            let mut v = vec![(n_filters, stats::NO_CONTACT); cands.size()];
-            v.par_chunks_mut(1024).enumerate().for_each(|(c, chunk)| {
-                for (k, out) in chunk.iter_mut().enumerate() {
-                    *out = first_fail(c * 1024 + k);
-                }
-                task.inc(chunk.len() as u64);
-            });
-            v
-        };
-        drop(task);
-        let ids: Vec<usize> = if n_filters == 0 {
-            (0..cands.size()).collect()
-        } else {
-            (0..cands.size())
-                .filter(|&id| verdict[id].0 == n_filters)
-                .collect()
-        };
-        let mut models = vec![None; skip];
+        let verdict = self.verdicts(robot, table, &cands, margin_limits.as_deref(), names.len());
+        let ids: Vec<usize> = (0..cands.size())
+            .filter(|&id| verdict.get(id).is_none_or(|v| v.0 == names.len()))
+            .collect();
+        let mut models = vec![None; usize::from(margin_limits.is_some())];
         models.extend(self.filters.iter().map(|f| match f {
             PoolFilter::Collision(c) => c.load().ok(),
             PoolFilter::Visibility(_) => None,
@@ -463,6 +405,80 @@ impl PoolSpec {
             stats,
             listed: rows,
         })
+    }
+
+    /// The source's candidates, generated inside `inside`'s limits (the
+    /// robot with the margin applied), or a file's rows as given.
+    fn candidates<'r>(
+        &self,
+        robot: &Robot,
+        inside: &Robot,
+        rows: Option<&'r [Vec<f64>]>,
+    ) -> Result<Candidates<'r>> {
+        Ok(match (&self.source, rows) {
+            (PoolSource::Lattice { levels }, _) => {
+                Candidates::Lattice(Lattice::within(robot, *levels, &inside.limits)?)
+            }
+            (PoolSource::Random { count, seed }, _) => {
+                Candidates::Random(Uniform::new(inside, *count, *seed)?)
+            }
+            (PoolSource::Sobol { count, seed }, _) => {
+                Candidates::Sobol(Sobol::new(inside, *count, *seed)?)
+            }
+            (PoolSource::File { .. }, Some(rows)) => Candidates::Listed(rows),
+            (PoolSource::File { .. }, None) => unreachable!("a file source is built from its rows"),
+        })
+    }
+
+    /// For each candidate, the first filter that removes it (`n_filters`:
+    /// none; filter 0 is the margin when `margin_limits` is given) and, for
+    /// a collision filter, the contact that did (`NO_CONTACT` otherwise);
+    /// empty when there is no filter. Each candidate's verdict once (a
+    /// collision check is the costly filter), in parallel over fixed chunks,
+    /// with progress. Integer counts: the same whatever the thread split.
+    fn verdicts(
+        &self,
+        robot: &Robot,
+        table: &ParamTable,
+        cands: &Candidates<'_>,
+        margin_limits: Option<&[[f64; 2]]>,
+        n_filters: usize,
+    ) -> Vec<(usize, usize)> {
+        if n_filters == 0 {
+            return Vec::new();
+        }
+        let dof = robot.dof();
+        let skip = usize::from(margin_limits.is_some());
+        let first_fail = |id: usize| -> (usize, usize) {
+            let mut q = vec![0.0; dof];
+            cands.q_into(id, &mut q);
+            if let Some(m) = margin_limits
+                && q.iter().zip(m).any(|(v, l)| *v < l[0] || *v > l[1])
+            {
+                return (0, stats::NO_CONTACT);
+            }
+            for (k, f) in self.filters.iter().enumerate() {
+                match f {
+                    PoolFilter::Collision(c) => {
+                        if let Some(key) = c.contact_key(&q) {
+                            return (k + skip, key);
+                        }
+                    }
+                    _ if !f.keeps(robot, table, &q) => return (k + skip, stats::NO_CONTACT),
+                    _ => {}
+                }
+            }
+            (n_filters, stats::NO_CONTACT)
+        };
+        let task = crate::progress::Task::start("pool filters", Some(cands.size() as u64));
+        let mut v = vec![(n_filters, stats::NO_CONTACT); cands.size()];
+        v.par_chunks_mut(1024).enumerate().for_each(|(c, chunk)| {
+            for (k, out) in chunk.iter_mut().enumerate() {
+                *out = first_fail(c * 1024 + k);
+            }
+            task.inc(chunk.len() as u64);
+        });
+        v
     }
 }
 

@@ -126,6 +126,84 @@ impl Problem<'_> {
     }
 }
 
+impl Problem<'_> {
+    /// Errors on a pose of the wrong length, outside the limits or a filter.
+    fn check_design(&self, qs: &[Vec<f64>]) -> Result<()> {
+        let dof = self.robot.dof();
+        for (k, q) in qs.iter().enumerate() {
+            if q.len() != dof {
+                return Err(Error::JointCount {
+                    expected: dof,
+                    got: q.len(),
+                });
+            }
+            let inside = q
+                .iter()
+                .zip(&self.robot.limits)
+                .all(|(v, [lo, hi])| *lo <= *v && *v <= *hi);
+            if !inside || !self.admissible(q) {
+                return Err(Error::Invalid(format!(
+                    "design pose {} is outside the joint limits or a pool filter",
+                    k + 1
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// `∇f(q)` by central differences of step `h`, one-sided at a limit.
+    fn gradient(&mut self, rest: &Mat<f64>, q: &[f64], h: f64, grad: &mut [f64]) {
+        for (j, gj) in grad.iter_mut().enumerate() {
+            let [lo, hi] = self.robot.limits[j];
+            let mut a = q.to_vec();
+            let mut b = q.to_vec();
+            a[j] = (a[j] + h).min(hi);
+            b[j] = (b[j] - h).max(lo);
+            let width = a[j] - b[j];
+            *gj = if width > 0.0 {
+                (self.value(rest, &a) - self.value(rest, &b)) / width
+            } else {
+                0.0
+            };
+        }
+    }
+
+    /// Up to `s.steps` projected gradient steps on pose `q` with the other
+    /// poses' information `rest` held, each halved until it gains more than
+    /// `s.tol` within the filters; returns the gain in ln det.
+    fn ascend_pose(&mut self, rest: &Mat<f64>, q: &mut Vec<f64>, s: &RefineSettings) -> f64 {
+        let mut f = self.value(rest, q);
+        let mut gain = 0.0;
+        let mut grad = vec![0.0; q.len()];
+        for _ in 0..s.steps {
+            self.gradient(rest, q, s.fd_step, &mut grad);
+            let gmax = grad.iter().fold(0.0f64, |m, g| m.max(g.abs()));
+            if !(gmax > 0.0 && gmax.is_finite()) {
+                break;
+            }
+            let mut alpha = s.max_move / gmax;
+            let mut accepted = false;
+            for _ in 0..30 {
+                let mut trial: Vec<f64> = q.iter().zip(&grad).map(|(v, g)| v + alpha * g).collect();
+                clip(&mut trial, &self.robot.limits);
+                let ft = self.value(rest, &trial);
+                if ft > f + s.tol && self.admissible(&trial) {
+                    gain += ft - f;
+                    f = ft;
+                    *q = trial;
+                    accepted = true;
+                    break;
+                }
+                alpha *= 0.5;
+            }
+            if !accepted {
+                break;
+            }
+        }
+        gain
+    }
+}
+
 fn clip(q: &mut [f64], limits: &[[f64; 2]]) {
     for (v, &[lo, hi]) in q.iter_mut().zip(limits) {
         *v = v.clamp(lo, hi);
@@ -146,7 +224,7 @@ pub fn refine(
     qs: &[Vec<f64>],
     s: &RefineSettings,
 ) -> Result<Refinement> {
-    let (t, p, dof) = (robot.rows_per_pose(), robot.n_unknowns(), robot.dof());
+    let (t, p) = (robot.rows_per_pose(), robot.n_unknowns());
     if !(s.max_move > 0.0 && s.fd_step > 0.0 && s.tol >= 0.0) {
         return Err(Error::Invalid(
             "refinement needs max_move > 0, fd_step > 0 and tol >= 0".into(),
@@ -162,24 +240,7 @@ pub fn refine(
         p,
         evaluations: 0,
     };
-    for (k, q) in qs.iter().enumerate() {
-        if q.len() != dof {
-            return Err(Error::JointCount {
-                expected: dof,
-                got: q.len(),
-            });
-        }
-        let inside = q
-            .iter()
-            .zip(&robot.limits)
-            .all(|(v, [lo, hi])| *lo <= *v && *v <= *hi);
-        if !inside || !pb.admissible(q) {
-            return Err(Error::Invalid(format!(
-                "design pose {} is outside the joint limits or a pool filter",
-                k + 1
-            )));
-        }
-    }
+    pb.check_design(qs)?;
     let mut q: Vec<Vec<f64>> = qs.to_vec();
     let mut grams: Vec<Mat<f64>> = q.iter().map(|x| pb.gram(x)).collect();
     let base = || match prior {
@@ -191,7 +252,6 @@ pub fn refine(
         .ok_or_else(|| Error::Invalid("the design to refine is singular".into()))?;
     let mut gains = vec![0.0; q.len()];
     let mut sweeps = 0;
-    let mut grad = vec![0.0; dof];
     for _ in 0..s.sweeps {
         sweeps += 1;
         let mut sweep_gain = 0.0;
@@ -201,47 +261,9 @@ pub fn refine(
                 .enumerate()
                 .filter(|&(j, _)| j != k)
                 .fold(base(), |acc, (_, g)| acc + g);
-            let mut f = pb.value(&rest, &q[k]);
-            for _ in 0..s.steps {
-                // Central differences, one-sided at a limit.
-                for j in 0..dof {
-                    let [lo, hi] = robot.limits[j];
-                    let mut a = q[k].clone();
-                    let mut b = q[k].clone();
-                    a[j] = (a[j] + s.fd_step).min(hi);
-                    b[j] = (b[j] - s.fd_step).max(lo);
-                    let h = a[j] - b[j];
-                    grad[j] = if h > 0.0 {
-                        (pb.value(&rest, &a) - pb.value(&rest, &b)) / h
-                    } else {
-                        0.0
-                    };
-                }
-                let gmax = grad.iter().fold(0.0f64, |m, g| m.max(g.abs()));
-                if !(gmax > 0.0 && gmax.is_finite()) {
-                    break;
-                }
-                let mut alpha = s.max_move / gmax;
-                let mut accepted = false;
-                for _ in 0..30 {
-                    let mut trial: Vec<f64> =
-                        q[k].iter().zip(&grad).map(|(v, g)| v + alpha * g).collect();
-                    clip(&mut trial, &robot.limits);
-                    let ft = pb.value(&rest, &trial);
-                    if ft > f + s.tol && pb.admissible(&trial) {
-                        gains[k] += ft - f;
-                        sweep_gain += ft - f;
-                        f = ft;
-                        q[k] = trial;
-                        accepted = true;
-                        break;
-                    }
-                    alpha *= 0.5;
-                }
-                if !accepted {
-                    break;
-                }
-            }
+            let gain = pb.ascend_pose(&rest, &mut q[k], s);
+            gains[k] += gain;
+            sweep_gain += gain;
             grams[k] = pb.gram(&q[k]);
         }
         if sweep_gain <= s.tol {
@@ -255,22 +277,27 @@ pub fn refine(
         ln_oid_before: ln_before,
         ln_oid: ln_after,
         gain: ln_after - ln_before,
-        poses: q
-            .iter()
-            .zip(qs)
-            .enumerate()
-            .map(|(k, (after, before))| RefinedPose {
-                index: k,
-                q_before: before.clone(),
-                q: after.clone(),
-                gain: gains[k],
-                max_move: after
-                    .iter()
-                    .zip(before)
-                    .fold(0.0f64, |m, (a, b)| m.max((a - b).abs())),
-            })
-            .collect(),
+        poses: refined_poses(qs, &q, &gains),
         sweeps,
         evaluations: pb.evaluations,
     })
+}
+
+/// Each pose before and after, with its gain and its largest joint move.
+fn refined_poses(before: &[Vec<f64>], after: &[Vec<f64>], gains: &[f64]) -> Vec<RefinedPose> {
+    after
+        .iter()
+        .zip(before)
+        .enumerate()
+        .map(|(k, (after, before))| RefinedPose {
+            index: k,
+            q_before: before.clone(),
+            q: after.clone(),
+            gain: gains[k],
+            max_move: after
+                .iter()
+                .zip(before)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs())),
+        })
+        .collect()
 }

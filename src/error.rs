@@ -97,7 +97,7 @@ pub enum Error {
     /// A structure whose estimated memory exceeds the budget
     /// ([`crate::resources::MemoryBudget`]), refused before allocating it.
     #[error(
-        "{what} would need {needed} of memory, above the limit of {limit} ({source_of_limit}); use a smaller pool (fewer --levels or poses) or raise the limit"
+        "{what} would need {needed} of memory, above the limit of {limit} ({source_of_limit}); use a smaller pool (fewer lattice levels or poses) or raise the limit"
     )]
     TooLarge {
         /// What was to be allocated.

@@ -160,7 +160,7 @@ fn main() {
     let chain = cli::chain_choice(cli.base, cli.tip, cli.lock.as_deref(), cli.frames)
         .and_then(|c| command.take_chain(&c));
     if let Err(e) = chain {
-        eprintln!("error: {e:#}");
+        report_error(&e);
         std::process::exit(1);
     }
     let r = match command {
@@ -183,15 +183,23 @@ fn main() {
         }
     }
     if let Err(e) = r {
-        eprintln!("error: {e:#}");
-        if let Some(h) = cli::units::flag_hint(&e) {
-            eprintln!("hint: {h}");
-        }
+        report_error(&e);
         let not_converged = e.downcast_ref::<cli::calibrate::NotConverged>().is_some();
         std::process::exit(if not_converged {
             cli::calibrate::EXIT_NOT_CONVERGED
         } else {
             1
         });
+    }
+}
+
+/// Prints an error with the options it calls for: a unit to change
+/// ([`cli::units::flag_hint`]) or the option that gives the input it names
+/// ([`cli::hints::option_hints`]).
+fn report_error(e: &anyhow::Error) {
+    eprintln!("error: {e:#}");
+    let unit = cli::units::flag_hint(e);
+    for h in unit.into_iter().chain(cli::hints::option_hints(e)) {
+        eprintln!("hint: {h}");
     }
 }

@@ -199,3 +199,29 @@ fn choices_are_named_as_they_are_serialised() {
     check::<activecal::select::CriterionKind>();
     check::<activecal::bound::RelaxationSolver>();
 }
+
+/// The library names an input by what it is; the command line adds the
+/// option that gives it. Without a tip, the TIAGo's tree is refused by the
+/// library in its own words and the binary adds `--tip`; a missing locked
+/// joint gets `--lock`.
+#[test]
+fn library_errors_name_the_input_and_the_binary_names_the_option() {
+    let (ok, err) = counted(&["fk", "--robot", "fixtures/figaroh/tiago.urdf", "--q", "0"]);
+    assert!(!ok);
+    assert!(err.contains("the chain's tip") && !err.starts_with("error: --tip"), "{err}");
+    assert!(err.contains("hint: --tip LINK names the chain's tip"), "{err}");
+    let (ok, err) = counted(&[
+        "fk",
+        "--robot",
+        "fixtures/figaroh/tiago.urdf",
+        "--tip",
+        "arm_tool_link",
+        "--lock",
+        "no_such_joint=0",
+        "--q",
+        "0",
+    ]);
+    assert!(!ok);
+    assert!(err.contains("locked joint 'no_such_joint'"), "{err}");
+    assert!(err.contains("hint: --lock NAME=VALUE"), "{err}");
+}

@@ -99,7 +99,10 @@ fn tiago_arm_chains_by_base_tip_and_lock() {
     let path = fixture("figaroh/tiago.urdf");
     // A tree: without a tip, the error lists the candidates and says how.
     let e = err(&path, &UrdfOptions::default());
-    assert!(e.contains("--tip") && e.contains("candidate tips"), "{e}");
+    assert!(
+        e.contains("the chain's tip") && e.contains("candidate tips"),
+        "{e}"
+    );
     // Root to the arm tool: the torso's prismatic lift and seven arm joints.
     let r = urdf::load(&path, &opts(None, Some("arm_tool_link"), &[])).unwrap();
     let mut want: Vec<String> = vec!["torso_lift_joint".into()];
@@ -262,7 +265,7 @@ fn bad_chains_are_refused_with_what_to_do() {
         ),
         (
             opts(None, Some("arm_tool_link"), &[("head_1_joint", 0.0)]),
-            "--lock head_1_joint: the joint is not on the chain",
+            "locked joint 'head_1_joint': the joint is not on the chain",
         ),
         (
             opts(None, Some("arm_tool_link"), &[("no_such_joint", 0.0)]),
@@ -302,7 +305,7 @@ fn grippers_loops_and_long_chains_are_never_taken_silently() {
     let text = format!("<robot name=\"t\">{arm}{jaw}</robot>");
     let e = parse_err(&text, &UrdfOptions::default());
     assert!(
-        e.contains("'finger_joint' looks like a gripper's") && e.contains("--tip d"),
+        e.contains("'finger_joint' looks like a gripper's") && e.contains("the chain's tip 'd'"),
         "{e}"
     );
     // Named explicitly, or the jaw locked, the chain is taken.

@@ -8,6 +8,7 @@ pub mod compliance;
 pub mod contact;
 pub mod figures;
 pub mod frames_text;
+pub mod hints;
 pub mod measured;
 pub mod progress;
 pub mod report_dir;
@@ -165,7 +166,7 @@ pub fn check_outputs(
 ) -> Result<()> {
     let outs: Vec<activecal::io::atomic::Output<'_>> = outputs
         .iter()
-        .map(|&(option, path)| activecal::io::atomic::Output { option, path })
+        .map(|&(label, path)| activecal::io::atomic::Output { label, path })
         .collect();
     activecal::io::atomic::check_outputs(&outs, inputs, force)?;
     Ok(())

@@ -54,25 +54,25 @@ impl Obstacle {
     pub fn parse(text: &str) -> Result<Obstacle, String> {
         let Some(rest) = text.strip_prefix("box:") else {
             return Err(format!(
-                "--obstacle '{text}': expected box:cx,cy,cz,sx,sy,sz (centre and full sizes in metres, base frame)"
+                "obstacle '{text}': expected box:cx,cy,cz,sx,sy,sz (centre and full sizes in metres, base frame)"
             ));
         };
         let v: Vec<f64> = rest
             .split(',')
             .map(|s| s.trim().parse::<f64>())
             .collect::<Result<_, _>>()
-            .map_err(|e| format!("--obstacle '{text}': {e}"))?;
+            .map_err(|e| format!("obstacle '{text}': {e}"))?;
         if v.len() != 6 {
             return Err(format!(
-                "--obstacle '{text}': {} numbers, expected 6 (cx,cy,cz,sx,sy,sz)",
+                "obstacle '{text}': {} numbers, expected 6 (cx,cy,cz,sx,sy,sz)",
                 v.len()
             ));
         }
         if let Some(x) = v.iter().find(|x| !x.is_finite()) {
-            return Err(format!("--obstacle '{text}': {x} is not finite"));
+            return Err(format!("obstacle '{text}': {x} is not finite"));
         }
         if let Some(s) = v[3..].iter().find(|s| **s <= 0.0) {
-            return Err(format!("--obstacle '{text}': size {s} must be > 0"));
+            return Err(format!("obstacle '{text}': size {s} must be > 0"));
         }
         Ok(Obstacle::Box {
             center: [v[0], v[1], v[2]],
@@ -276,7 +276,7 @@ fn shape_of(
         urdf_rs::Geometry::Mesh { filename, scale } => {
             let path = resolve(filename, urdf_dir, &spec.package_dirs).ok_or_else(|| {
                 format!(
-                    "link '{link}': mesh '{filename}' not found (searched {}the URDF's directory {} and its ancestors; give --package-dir DIR)",
+                    "link '{link}': mesh '{filename}' not found (searched {}the URDF's directory {} and its ancestors; name the package directory that holds it)",
                     spec.package_dirs.iter().map(|d| format!("{d}, ")).collect::<String>(),
                     if urdf_dir.as_os_str().is_empty() {
                         Path::new(".").display()
@@ -339,7 +339,7 @@ fn geometries(
 fn disabled_pairs(tree: &Tree, spec: &CollisionSpec) -> Result<HashSet<(usize, usize)>, String> {
     let mut disabled: HashSet<(usize, usize)> = HashSet::new();
     if let Some(s) = &spec.srdf {
-        let t = std::fs::read_to_string(s).map_err(|e| format!("--srdf {s}: {e}"))?;
+        let t = std::fs::read_to_string(s).map_err(|e| format!("SRDF file {s}: {e}"))?;
         for p in srdf::disabled_pairs(&t, s)? {
             let find = |name: &str| {
                 tree.index.get(name).copied().ok_or_else(|| {
@@ -411,7 +411,7 @@ fn obstacles(
     }
     if let Some(z) = spec.floor {
         if !z.is_finite() {
-            return Err(format!("--floor {z}: not finite"));
+            return Err(format!("floor height {z}: not finite"));
         }
         obstacles.push((
             "floor".to_string(),

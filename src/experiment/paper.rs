@@ -817,7 +817,7 @@ is therefore about {:.0}x here, not 50,000x.",
         let nb = &b.newton;
         let _ = writeln!(
             *m,
-            "Cross-check by the Newton barrier solver (`bound --solver newton`): ln bound {:.9} against Clarabel's {:.9}, ln primal {:.9} against {:.9}, status {}, certificate gap {:.2e}, {:.2} s.\n",
+            "Cross-check by the Newton barrier solver: ln bound {:.9} against Clarabel's {:.9}, ln primal {:.9} against {:.9}, status {}, certificate gap {:.2e}, {:.2} s.\n",
             nb.ln_bound,
             b.ln_bound,
             nb.ln_primal,

@@ -170,7 +170,7 @@ pub fn with_fixed_and_free(robot: &Robot, fix: &[String], free: &[String]) -> Re
     for name in fix {
         if name.starts_with("marker") {
             return Err(setting(
-                "--fix",
+                "fixed parameter",
                 name,
                 "marker offsets are always estimated",
             ));
@@ -182,10 +182,10 @@ pub fn with_fixed_and_free(robot: &Robot, fix: &[String], free: &[String]) -> Re
             .collect();
         let id = robot
             .param_id(name)
-            .map_err(|_| unknown_name("--fix", name, &unknowns))?;
+            .map_err(|_| unknown_name("fixed parameter", name, &unknowns))?;
         let Some(pos) = ids.iter().position(|&u| u == id) else {
             return Err(setting(
-                "--fix",
+                "fixed parameter",
                 name,
                 "not an unknown of this robot (see the estimate's names)",
             ));
@@ -199,7 +199,7 @@ pub fn with_fixed_and_free(robot: &Robot, fix: &[String], free: &[String]) -> Re
                 .into_iter()
                 .map(|u| robot.param_name(u))
                 .collect();
-            unknown_name("--free", name, &all)
+            unknown_name("freed parameter", name, &all)
         })?;
         if !ids.contains(&id) {
             ids.push(id);
@@ -228,19 +228,19 @@ pub fn prepare_for_data(
     super::fix_undetermined(&r, start, meas, free)
 }
 
-/// An unknown parameter name given to `option`: the closest valid names
+/// An unknown parameter name given as `what` (a fixed or a freed parameter): the closest valid names
 /// (by edit distance) and the whole list.
-fn unknown_name(option: &str, name: &str, valid: &[String]) -> IdentifyError {
+fn unknown_name(what: &str, name: &str, valid: &[String]) -> IdentifyError {
     IdentifyError::Model(crate::Error::Invalid(format!(
-        "{option} {name}: not a parameter of this robot{}; the valid names are {}",
+        "{what} '{name}': not a parameter of this robot{}; the valid names are {}",
         crate::names::did_you_mean(name, valid),
         valid.join(", ")
     )))
 }
 
-fn setting(option: &'static str, name: &str, reason: &'static str) -> IdentifyError {
+fn setting(what: &'static str, name: &str, reason: &'static str) -> IdentifyError {
     IdentifyError::Setting {
-        name: option,
+        name: what,
         value: name.to_string(),
         reason,
     }
@@ -299,14 +299,14 @@ pub fn holdout(
     let test = (settings.fraction * n as f64).round() as usize;
     if !(settings.fraction > 0.0 && settings.fraction < 1.0) || test == 0 || test >= n {
         return Err(IdentifyError::Setting {
-            name: "--holdout",
+            name: "held-out fraction",
             value: format!("{} of {n} poses", settings.fraction),
             reason: "the held-out fraction must be in (0, 1) and leave at least one pose on each side",
         });
     }
     if settings.splits == 0 {
         return Err(IdentifyError::Setting {
-            name: "--splits",
+            name: "held-out splits",
             value: "0".into(),
             reason: "at least one split",
         });

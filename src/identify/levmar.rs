@@ -320,9 +320,7 @@ impl<'a, R: Residuals + ?Sized> Iteration<'a, R> {
             // The largest diagonal entry of the scaled JᵀJ, ‖J_{:,j}/d_j‖²
             // (one column at a time).
             let max_diag = (0..p)
-                .map(|c| {
-                    faer::Col::from_fn(m, |i| self.jac[(i, c)] / self.d[c]).squared_norm_l2()
-                })
+                .map(|c| faer::Col::from_fn(m, |i| self.jac[(i, c)] / self.d[c]).squared_norm_l2())
                 .fold(0.0, f64::max);
             self.lambda = self.s.initial_damping * max_diag.max(f64::MIN_POSITIVE);
         }
@@ -351,8 +349,7 @@ impl<'a, R: Residuals + ?Sized> Iteration<'a, R> {
                 && trial.actual.abs() <= self.s.ftol * self.cost
                 && trial.pred <= self.s.ftol * self.cost
                 && rho <= 2.0;
-            let xtol_met =
-                trial.du_norm <= self.s.xtol * (gradient.dtheta_norm + self.s.xtol);
+            let xtol_met = trial.du_norm <= self.s.xtol * (gradient.dtheta_norm + self.s.xtol);
             if accepted {
                 if !self.accept(trial.new_cost, rho) {
                     return Some(StopReason::NonFinite);
@@ -468,7 +465,8 @@ impl<'a, R: Residuals + ?Sized> Iteration<'a, R> {
         self.history.push(2.0 * self.cost);
         self.lambda *= (1.0 / 3.0f64).max(1.0 - (2.0 * rho - 1.0).powi(3));
         self.nu = 2.0;
-        self.prob.eval(&self.theta, &mut self.r, Some(&mut self.jac))
+        self.prob
+            .eval(&self.theta, &mut self.r, Some(&mut self.jac))
     }
 
     /// `J v`.

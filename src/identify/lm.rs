@@ -111,7 +111,6 @@ fn wrap_angle(x: f64) -> f64 {
     if w <= -PI { w + TAU } else { w }
 }
 
-
 /// Identifies the robot's unknowns from `meas` by Levenberg–Marquardt from
 /// the unknowns' values in `start` (normally `robot.nominal`); the parameters
 /// that are not unknown keep their values in `start`.

@@ -17,9 +17,10 @@ use std::path::{Path, PathBuf};
 /// One output of a command, for [`check_outputs`].
 #[derive(Clone, Copy, Debug)]
 pub struct Output<'a> {
-    /// The option that names it (`--out`, `--save-measurements`), for
+    /// What the output is, as the caller names it (`design file`, or the
+    /// option that named it on a command line), for
     /// messages.
-    pub option: &'a str,
+    pub label: &'a str,
     /// The path given.
     pub path: &'a Path,
 }
@@ -47,18 +48,18 @@ fn identity(path: &Path) -> PathBuf {
 /// Checks a command's output files before it does any work: each must name
 /// a file (not a directory) in an existing directory, must not exist unless
 /// `force`, must not be one of `inputs`, and no two outputs may be the same
-/// file. The error names the option and the path.
+/// file. The error names the output (its label) and the path.
 pub fn check_outputs(outputs: &[Output<'_>], inputs: &[&Path], force: bool) -> Result<()> {
     for (k, o) in outputs.iter().enumerate() {
         let shown = o.path.display();
         if o.path.is_dir() {
             return Err(invalid(format!(
                 "{} {shown}: is a directory; give a file name",
-                o.option
+                o.label
             )));
         }
         if o.path.file_name().is_none() {
-            return Err(invalid(format!("{} {shown}: not a file name", o.option)));
+            return Err(invalid(format!("{} {shown}: not a file name", o.label)));
         }
         let parent = match o.path.parent() {
             Some(p) if !p.as_os_str().is_empty() => p,
@@ -67,7 +68,7 @@ pub fn check_outputs(outputs: &[Output<'_>], inputs: &[&Path], force: bool) -> R
         if !parent.is_dir() {
             return Err(invalid(format!(
                 "{} {shown}: the directory {} does not exist",
-                o.option,
+                o.label,
                 parent.display()
             )));
         }
@@ -75,20 +76,20 @@ pub fn check_outputs(outputs: &[Output<'_>], inputs: &[&Path], force: bool) -> R
         if let Some(i) = inputs.iter().find(|i| identity(i) == id) {
             return Err(invalid(format!(
                 "{} {shown}: is an input of this command ({}); choose another file",
-                o.option,
+                o.label,
                 i.display()
             )));
         }
         if let Some(other) = outputs[..k].iter().find(|p| identity(p.path) == id) {
             return Err(invalid(format!(
                 "{} and {} name the same file {shown}",
-                other.option, o.option
+                other.label, o.label
             )));
         }
         if o.path.exists() && !force {
             return Err(invalid(format!(
-                "{} {shown}: exists; pass --force to overwrite it",
-                o.option
+                "{} {shown}: exists; it is overwritten only when overwriting is asked for",
+                o.label
             )));
         }
     }
@@ -235,7 +236,7 @@ mod tests {
         std::fs::write(&input, "{}").unwrap();
         fn out(p: &Path) -> Output<'_> {
             Output {
-                option: "--out",
+                label: "--out",
                 path: p,
             }
         }
@@ -250,12 +251,12 @@ mod tests {
         assert!(e(&[out(&input)], false).contains("is an input"));
         let new = d.join("new.json");
         let second = Output {
-            option: "--save-measurements",
+            label: "--save-measurements",
             path: &new,
         };
         assert!(e(&[out(&new), second], true).contains("name the same file"));
         std::fs::write(&new, "old").unwrap();
-        assert!(e(&[out(&new)], false).contains("--force"));
+        assert!(e(&[out(&new)], false).contains("overwriting is asked for"));
         check_outputs(&[out(&new)], &[&input], true).unwrap();
         check_outputs(&[out(&d.join("fresh.json"))], &[&input], false).unwrap();
         std::fs::remove_dir_all(&d).unwrap();

@@ -237,7 +237,7 @@ impl DesignFile {
     pub fn write(&self, path: &Path, overwrite: bool) -> Result<()> {
         super::atomic::check_outputs(
             &[super::atomic::Output {
-                option: "--out",
+                label: "design file",
                 path,
             }],
             &[],

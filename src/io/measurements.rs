@@ -153,7 +153,11 @@ pub fn parse_csv_measurements_in(
         }
     }
     let rows: Vec<String> = t.lines.iter().map(|l| format!("line {l}")).collect();
-    let columns: Vec<String> = layout.joints.iter().map(|&c| t.columns[c].clone()).collect();
+    let columns: Vec<String> = layout
+        .joints
+        .iter()
+        .map(|&c| t.columns[c].clone())
+        .collect();
     let source = JointSource {
         file: origin,
         rows: &rows,
@@ -263,10 +267,7 @@ fn take(t: &Table, name: &str, used: &mut [bool]) -> Option<usize> {
 }
 
 /// Markers: `x1,y1,z1`, `x2,…`; plain `x,y,z` count as marker 1.
-fn marker_columns(
-    t: &Table,
-    used: &mut [bool],
-) -> std::result::Result<Vec<[usize; 3]>, String> {
+fn marker_columns(t: &Table, used: &mut [bool]) -> std::result::Result<Vec<[usize; 3]>, String> {
     let mut marker_cols: Vec<[usize; 3]> = Vec::new();
     for k in 1.. {
         let names = [format!("x{k}"), format!("y{k}"), format!("z{k}")];
@@ -395,7 +396,12 @@ impl OrientationColumns {
                 Ok(Some(crate::identify::rows(r.matrix())))
             }
             Self::Quaternion(cols) => {
-                let v = [cell.at(cols[0])?, cell.at(cols[1])?, cell.at(cols[2])?, cell.at(cols[3])?];
+                let v = [
+                    cell.at(cols[0])?,
+                    cell.at(cols[1])?,
+                    cell.at(cols[2])?,
+                    cell.at(cols[3])?,
+                ];
                 let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
                 if (norm - 1.0).abs() > ROTATION_TOLERANCE {
                     return Err(format!(
@@ -404,7 +410,9 @@ impl OrientationColumns {
                     ));
                 }
                 let uq = UnitQuaternion::from_quaternion(Quaternion::new(v[0], v[1], v[2], v[3]));
-                Ok(Some(crate::identify::rows(uq.to_rotation_matrix().matrix())))
+                Ok(Some(crate::identify::rows(
+                    uq.to_rotation_matrix().matrix(),
+                )))
             }
         }
     }

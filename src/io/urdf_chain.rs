@@ -240,7 +240,7 @@ impl<'u> Tree<'u> {
                     .map(|(l, n)| format!("{l} ({n} joint{})", if *n == 1 { "" } else { "s" }))
                     .collect();
                 Err(format!(
-                    "the URDF is a tree with {} branches below '{base}': choose the measured link with --tip (or `tip = \"…\"` in a description); candidate tips: {}",
+                    "the URDF is a tree with {} branches below '{base}': choose the measured link as the chain's tip (`tip = \"…\"` in a description); candidate tips: {}",
                     many.len(),
                     list_names(&c)
                 ))
@@ -260,7 +260,7 @@ impl<'u> Tree<'u> {
         for (name, value) in lock {
             let Some(j) = joints.iter().find(|j| &j.name == name) else {
                 return Err(format!(
-                    "--lock {name}: there is no joint '{name}' in the URDF"
+                    "locked joint '{name}': there is no joint '{name}' in the URDF"
                 ));
             };
             if !path.iter().any(|&i| joints[i].name == *name) {
@@ -270,15 +270,17 @@ impl<'u> Tree<'u> {
                     .map(|&i| joints[i].name.as_str())
                     .collect();
                 return Err(format!(
-                    "--lock {name}: the joint is not on the chain from '{base}' to '{tip}' (its joints: {})",
+                    "locked joint '{name}': the joint is not on the chain from '{base}' to '{tip}' (its joints: {})",
                     list_names(&on)
                 ));
             }
             if !is_moving(j) {
-                return Err(format!("--lock {name}: the joint is fixed already"));
+                return Err(format!("locked joint '{name}': the joint is fixed already"));
             }
             if !value.is_finite() {
-                return Err(format!("--lock {name}={value}: not a finite number"));
+                return Err(format!(
+                    "locked joint '{name}' = {value}: not a finite number"
+                ));
             }
         }
         Ok(())
@@ -295,7 +297,7 @@ impl<'u> Tree<'u> {
         let joints = self.joints;
         if moving.len() > MAX_CHAIN_JOINTS {
             return Err(format!(
-                "the chain from '{base}' to '{tip}' has {} moving joints ('{}' … '{}'), more than {MAX_CHAIN_JOINTS}: choose a shorter chain with --base/--tip or lock joints",
+                "the chain from '{base}' to '{tip}' has {} moving joints ('{}' … '{}'), more than {MAX_CHAIN_JOINTS}: choose a shorter chain (the chain's base and tip) or locked joints",
                 moving.len(),
                 joints[moving[0]].name,
                 joints[moving[moving.len() - 1]].name
@@ -308,13 +310,13 @@ impl<'u> Tree<'u> {
         let parent = &j.parent.link;
         if j.mimic.is_some() {
             return Err(format!(
-                "joint '{}' mimics another joint (a gripper's, usually): end the chain before it with --tip {parent}, or lock it with --lock {}=0",
+                "joint '{}' mimics another joint (a gripper's, usually): end the chain before it (the chain's tip '{parent}'), or hold it still (locked joint '{}' = 0)",
                 j.name, j.name
             ));
         }
         if let Some(why) = gripper_reason(j).filter(|_| !explicit_tip) {
             return Err(format!(
-                "the chain's last moving joint '{}' looks like a gripper's ({why}): measure the arm's flange with --tip {parent}, or keep the joint still with --lock {}=VALUE, or name this tip explicitly with --tip {tip}",
+                "the chain's last moving joint '{}' looks like a gripper's ({why}): measure the arm's flange (the chain's tip '{parent}'), or keep the joint still (locked joint '{}' = a value), or name this tip explicitly (the chain's tip '{tip}')",
                 j.name, j.name
             ));
         }
@@ -435,7 +437,7 @@ fn chain_joint(j: &urdf_rs::Joint) -> std::result::Result<ChainJoint, String> {
     if let Some(kind) = kind {
         if j.mimic.is_some() {
             return Err(format!(
-                "joint '{}' mimics another joint: it is not an independent joint (lock it with --lock {}=VALUE, or end the chain before it with --tip)",
+                "joint '{}' mimics another joint: it is not an independent joint (hold it still as a locked joint '{}' = a value, or end the chain before it: the chain's tip)",
                 j.name, j.name
             ));
         }

@@ -295,7 +295,11 @@ pub fn parse_json_in(
             let (map, ignored) = map_columns(path, &header, &names)?;
             (map, ignored, header)
         }
-        None => ((0..names.len()).map(Some).collect(), Vec::new(), names.clone()),
+        None => (
+            (0..names.len()).map(Some).collect(),
+            Vec::new(),
+            names.clone(),
+        ),
     };
     let mut keys: Vec<&str> = obj
         .keys()

@@ -171,7 +171,7 @@ fn without_a_tip_each_urdf_behaves_as_the_table_says() {
             Tipless::Tree => {
                 let e = got.unwrap_err().to_string();
                 assert!(
-                    e.contains("candidate tips") && e.contains("--tip"),
+                    e.contains("candidate tips") && e.contains("the chain's tip"),
                     "{}: {e}",
                     arm.name
                 );

@@ -94,6 +94,15 @@ pub enum Error {
         /// Number of unknowns.
         p: usize,
     },
+    /// An output file that exists, with overwriting not asked for: nothing
+    /// the user has is lost without asking.
+    #[error("{label} {path}: exists, and overwriting it was not asked for")]
+    OutputExists {
+        /// What the output is (its label, see [`crate::io::atomic::Output`]).
+        label: String,
+        /// The path given.
+        path: String,
+    },
     /// A structure whose estimated memory exceeds the budget
     /// ([`crate::resources::MemoryBudget`]), refused before allocating it.
     #[error(

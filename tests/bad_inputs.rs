@@ -351,7 +351,8 @@ const CASES: &[Case] = &[
         ],
         1,
         &[
-            "--fix gamma_elbow_jiont",
+            "fixed parameter 'gamma_elbow_jiont'",
+            "hint: --fix NAME",
             "did you mean gamma_elbow_joint?",
             "the valid names are gamma_base, ",
         ],
@@ -375,7 +376,11 @@ const CASES: &[Case] = &[
     case(
         &["fk", "--robot", UR5, "--lock", "nojoint=1", "--q", "0"],
         1,
-        &["--lock nojoint", "no joint 'nojoint'"],
+        &[
+            "locked joint 'nojoint'",
+            "no joint 'nojoint'",
+            "hint: --lock NAME=VALUE",
+        ],
     ),
     case(
         &[

@@ -208,8 +208,14 @@ fn choices_are_named_as_they_are_serialised() {
 fn library_errors_name_the_input_and_the_binary_names_the_option() {
     let (ok, err) = counted(&["fk", "--robot", "fixtures/figaroh/tiago.urdf", "--q", "0"]);
     assert!(!ok);
-    assert!(err.contains("the chain's tip") && !err.starts_with("error: --tip"), "{err}");
-    assert!(err.contains("hint: --tip LINK names the chain's tip"), "{err}");
+    assert!(
+        err.contains("the chain's tip") && !err.starts_with("error: --tip"),
+        "{err}"
+    );
+    assert!(
+        err.contains("hint: --tip LINK names the chain's tip"),
+        "{err}"
+    );
     let (ok, err) = counted(&[
         "fk",
         "--robot",

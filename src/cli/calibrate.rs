@@ -359,11 +359,11 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     let lm = LmSettings::default()
         .with_max_iterations(a.max_iterations)
         .with_geodesic(!a.no_geodesic);
-    let o = super::measured::MeasuredOptions {
+    let o = activecal::experiment::measured::MeasuredSettings {
         lm,
         loss: super::measured::loss_choice(a.loss, a.loss_scale)?,
-        fix: &a.fix,
-        free: &a.free,
+        fix: a.fix.clone(),
+        free: a.free.clone(),
         holdout: a
             .holdout
             .map(|fraction| activecal::identify::HoldoutSettings {
@@ -372,7 +372,6 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
                 seed: a.seed(),
                 prune: a.compare_pruned,
             }),
-        json: a.json,
         units: a.units.units(),
         gravity: if a.compliance || a.compare_compliance {
             Some(super::compliance::gravity_for(
@@ -389,8 +388,17 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         fit_compliance: a.compliance,
         compare_compliance: a.compare_compliance,
     };
-    let (fitted, f, mut report) =
-        super::measured::calibrate_measured(robot, path, &o, &|| t0.elapsed().as_secs_f64())?;
+    let mut print_note = |n: &str| {
+        if !a.json {
+            eprintln!("note: {n}");
+        }
+    };
+    let activecal::experiment::measured::MeasuredCalibration {
+        robot: fitted,
+        fit: f,
+        mut report,
+    } = activecal::experiment::measured::calibrate_measured(robot, path, &o, &mut print_note)?;
+    report.base.elapsed_seconds = t0.elapsed().as_secs_f64();
     let id = &f.id;
     let fit = FitBlock {
         poses: report.base.poses,
@@ -421,7 +429,7 @@ fn measured_summary<'a>(
     robot: &'a Robot,
     id: &'a Identification,
     path: &Path,
-    r: &super::measured::MeasuredReport,
+    r: &activecal::experiment::measured::MeasuredReport,
     json: &serde_json::Value,
 ) -> super::report_dir::CalibrationSummary<'a> {
     let pos = |e: &activecal::identify::ModelErrors| -> Vec<f64> {

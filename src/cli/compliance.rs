@@ -3,13 +3,12 @@
 //! rendering of compliances and of the side-by-side held-out comparison.
 //! The work is in `activecal::identify::compliance`.
 
-use activecal::identify::SplitResult;
+use activecal::identify::compliance::ComplianceComparison;
 use activecal::identify::compliance::ComplianceReport;
 use activecal::io::inertia::{InertiaOptions, Payload, gravity_model};
 use activecal::model::Robot;
 use activecal::model::gravity::GravityModel;
 use anyhow::{Context, Result, bail};
-use serde::Serialize;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -67,69 +66,8 @@ pub fn gravity_for(
     Ok(Arc::new(gravity_model(robot, &opts)?))
 }
 
-/// Held-out errors of the geometric model and of the model with
-/// compliances, fitted on the same splits.
-#[derive(Serialize)]
-pub struct ComplianceComparison {
-    /// Held-out position RMS (mm) per split, geometric model.
-    pub geometric_position_rms_mm: Vec<f64>,
-    /// Held-out position RMS (mm) per split, with compliances.
-    pub compliant_position_rms_mm: Vec<f64>,
-    /// Fitted (training) position RMS (mm) per split, geometric.
-    pub geometric_fitted_rms_mm: Vec<f64>,
-    /// Fitted (training) position RMS (mm) per split, with compliances.
-    pub compliant_fitted_rms_mm: Vec<f64>,
-    /// Held-out orientation RMS (degrees) per split, geometric (full poses).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub geometric_orientation_rms_deg: Option<Vec<f64>>,
-    /// The same with compliances.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub compliant_orientation_rms_deg: Option<Vec<f64>>,
-    /// Splits where the model with compliances predicts better.
-    pub splits_better: usize,
-    /// The verdict.
-    pub verdict: String,
-}
-
 fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len().max(1) as f64
-}
-
-/// The comparison of two held-out runs on the same splits.
-#[must_use]
-pub fn compare(geometric: &[SplitResult], compliant: &[SplitResult]) -> ComplianceComparison {
-    let pos = |s: &[SplitResult]| s.iter().map(|x| x.held_out.position_rms_mm).collect();
-    let fit = |s: &[SplitResult]| s.iter().map(|x| x.fitted.position_rms_mm).collect();
-    let ori = |s: &[SplitResult]| -> Option<Vec<f64>> {
-        s.iter().map(|x| x.held_out.orientation_rms_deg).collect()
-    };
-    let (g, c): (Vec<f64>, Vec<f64>) = (pos(geometric), pos(compliant));
-    let better = g.iter().zip(&c).filter(|(a, b)| b < a).count();
-    let verdict = if mean(&c) < mean(&g) && 2 * better > g.len() {
-        format!(
-            "compliance helps: held-out {:.3} → {:.3} mm, better on {better} of {} splits",
-            mean(&g),
-            mean(&c),
-            g.len()
-        )
-    } else {
-        format!(
-            "compliance does not help: held-out {:.3} mm geometric, {:.3} mm with compliance, better on {better} of {} splits",
-            mean(&g),
-            mean(&c),
-            g.len()
-        )
-    };
-    ComplianceComparison {
-        geometric_fitted_rms_mm: fit(geometric),
-        compliant_fitted_rms_mm: fit(compliant),
-        geometric_orientation_rms_deg: ori(geometric),
-        compliant_orientation_rms_deg: ori(compliant),
-        geometric_position_rms_mm: g,
-        compliant_position_rms_mm: c,
-        splits_better: better,
-        verdict,
-    }
 }
 
 fn join(v: &[f64], d: usize) -> String {

@@ -43,7 +43,10 @@ const OPTIONS: &[(&str, &str)] = &[
         "fewer lattice levels",
         "--levels N sets the lattice's levels per joint",
     ),
-    ("overwriting is asked for", "pass --force to overwrite it"),
+    (
+        "overwriting it was not asked for",
+        "pass --force to overwrite it",
+    ),
 ];
 
 /// The options an error's message (its whole chain) calls for, in the

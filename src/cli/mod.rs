@@ -168,8 +168,12 @@ pub fn check_outputs(
         .iter()
         .map(|&(label, path)| activecal::io::atomic::Output { label, path })
         .collect();
-    activecal::io::atomic::check_outputs(&outs, inputs, force)?;
-    Ok(())
+    activecal::io::atomic::check_outputs(&outs, inputs, force).map_err(|e| match e {
+        activecal::Error::OutputExists { label, path } => {
+            anyhow::anyhow!("{label} {path}: exists; pass --force to overwrite it")
+        }
+        e => e.into(),
+    })
 }
 
 /// Writes `text` to `path` (see [`refuse_overwrite`]), naming the file in

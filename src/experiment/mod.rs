@@ -1,4 +1,5 @@
 //! Experiments: whole pipelines that return typed reports.
 
+pub mod measured;
 pub mod paper;
 pub mod simulated;

@@ -51,6 +51,14 @@ pub enum ExperimentError {
     /// Identification or Monte-Carlo.
     #[error(transparent)]
     Identify(#[from] IdentifyError),
+    /// Identification from a data file that the file's data make fail.
+    #[error("{path}: {error}")]
+    InFile {
+        /// The data file.
+        path: String,
+        /// What is wrong.
+        error: IdentifyError,
+    },
 }
 
 /// Settings of the experiment; the defaults are the paper's (with 20 starts

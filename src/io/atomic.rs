@@ -87,10 +87,10 @@ pub fn check_outputs(outputs: &[Output<'_>], inputs: &[&Path], force: bool) -> R
             )));
         }
         if o.path.exists() && !force {
-            return Err(invalid(format!(
-                "{} {shown}: exists; it is overwritten only when overwriting is asked for",
-                o.label
-            )));
+            return Err(Error::OutputExists {
+                label: o.label.to_string(),
+                path: shown.to_string(),
+            });
         }
     }
     Ok(())
@@ -256,7 +256,7 @@ mod tests {
         };
         assert!(e(&[out(&new), second], true).contains("name the same file"));
         std::fs::write(&new, "old").unwrap();
-        assert!(e(&[out(&new)], false).contains("overwriting is asked for"));
+        assert!(e(&[out(&new)], false).contains("overwriting it was not asked for"));
         check_outputs(&[out(&new)], &[&input], true).unwrap();
         check_outputs(&[out(&d.join("fresh.json"))], &[&input], false).unwrap();
         std::fs::remove_dir_all(&d).unwrap();

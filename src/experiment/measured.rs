@@ -1,0 +1,416 @@
+//! Calibration from measured data, as one pipeline: the measurement file
+//! read and checked, the start mounted in the data's frame when the nominal
+//! model is far from it, the unknowns the data cannot see fixed, the fit
+//! (with a loss, compliances if asked), residuals, parameter significance
+//! and held-out splits, in one typed report ([`MeasuredReport`]). The
+//! command line parses its options into [`MeasuredSettings`] and renders
+//! the report.
+
+use super::paper::ExperimentError;
+use crate::identify::compliance::{ComplianceComparison, compare, with_compliance};
+use crate::identify::evaluation::ModelErrors;
+use crate::identify::{
+    Fit, FixedParameter, HoldoutSettings, LmSettings, LossChoice, Measurements, ParameterTrust,
+    SplitResult, fit, for_measurements, holdout, prepare_for_data, residuals, trust,
+};
+use crate::model::gravity::GravityModel;
+use crate::model::{ParamTable, Robot};
+use serde::Serialize;
+use std::path::Path;
+use std::sync::Arc;
+
+/// What a calibration from measurements does beyond the plain fit.
+#[derive(Clone, Debug)]
+pub struct MeasuredSettings {
+    /// Levenberg–Marquardt settings.
+    pub lm: LmSettings,
+    /// The loss.
+    pub loss: LossChoice,
+    /// Unknowns to fix at their nominal values.
+    pub fix: Vec<String>,
+    /// Parameters to add to the unknowns.
+    pub free: Vec<String>,
+    /// Held-out validation, if asked.
+    pub holdout: Option<HoldoutSettings>,
+    /// Units of the measurement file.
+    pub units: crate::units::Units,
+    /// The gravity model, when compliances are fitted or compared.
+    pub gravity: Option<Arc<GravityModel>>,
+    /// Fit a compliance per joint whose gravity torque varies.
+    pub fit_compliance: bool,
+    /// With held-out splits: fit with and without compliances, side by side.
+    pub compare_compliance: bool,
+}
+
+/// A calibration from measurements: the robot as fitted, the fit, and its
+/// report.
+pub struct MeasuredCalibration {
+    /// The robot the data were fitted as (mounted, with fixed and freed
+    /// unknowns).
+    pub robot: Robot,
+    /// The fit.
+    pub fit: Fit,
+    /// The report.
+    pub report: MeasuredReport,
+}
+
+/// Reads a measurement file (CSV or JSON) for `robot` in `units`; positions
+/// beyond the robot's reach are refused
+/// ([`crate::identify::evaluation::check_in_reach`]), a marker that repeats
+/// another in every row is counted once. Returns the measurements and
+/// notes on what was read.
+pub fn read_measurement_file(
+    path: &Path,
+    robot: &Robot,
+    units: crate::units::Units,
+) -> Result<(Measurements, Vec<String>), crate::identify::IdentifyError> {
+    let f = crate::io::measurements::read_in(path, robot, units)?;
+    crate::identify::evaluation::check_in_reach(
+        robot,
+        &f.measurements,
+        &path.display().to_string(),
+        units.length,
+    )?;
+    let mut notes = f.notes;
+    let (meas, repeats) = f.measurements.without_repeated_markers();
+    for (copy, of) in repeats {
+        notes.push(format!(
+            "marker {} repeats marker {} in every row: counted once ({} markers per pose)",
+            copy + 1,
+            of + 1,
+            meas.markers()
+        ));
+    }
+    Ok((meas, notes))
+}
+
+/// The report of a calibration from measurements.
+#[derive(Serialize)]
+pub struct MeasuredReport {
+    /// The plain identification report (status, estimate, covariance, …).
+    #[serde(flatten)]
+    pub base: crate::report::MeasuredCalibrationReport,
+    /// The loss.
+    pub loss: LossChoice,
+    /// Errors of the fitted model on the data, mm and degrees.
+    pub residuals: ModelErrors,
+    /// Errors of the nominal model on the data.
+    pub nominal_residuals: ModelErrors,
+    /// Each parameter's estimate, change, σ, t and verdict.
+    pub parameters: Vec<ParameterTrust>,
+    /// Unknowns the data do not determine, fixed at nominal, with why.
+    pub fixed: Vec<FixedParameter>,
+    /// Poses the robust loss down-weighted: `[pose, weight]`.
+    pub downweighted: Vec<(usize, f64)>,
+    /// Held-out validation, if asked.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub holdout: Option<HoldoutReport>,
+    /// What was adapted to the data (sensor, markers, ignored columns).
+    pub notes: Vec<String>,
+    /// The calibrated robot's measurement frame, tool or markers and joint
+    /// origins (URDF robots).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub frames: Option<crate::frames::report::FramesReport>,
+    /// The fitted joint compliances.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compliance: Option<crate::identify::compliance::ComplianceReport>,
+    /// Held-out errors with and without compliances on the same splits.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compliance_comparison: Option<ComplianceComparison>,
+}
+
+/// Held-out figures over splits.
+#[derive(Serialize)]
+pub struct HoldoutReport {
+    /// The settings.
+    pub settings: HoldoutSettings,
+    /// Held-out position RMS (mm): mean and per split.
+    pub position_rms_mm: Stat,
+    /// Held-out orientation RMS (degrees), full poses only.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orientation_rms_deg: Option<Stat>,
+    /// The nominal model's held-out position RMS (mm), mean over splits.
+    pub nominal_position_rms_mm: f64,
+    /// The fitted model's position RMS on its training poses, mean.
+    pub fitted_position_rms_mm: f64,
+    /// The pruned model (|t| ≥ 2 kept): unknowns per split and held-out
+    /// position RMS.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pruned: Option<PrunedReport>,
+    /// Every split.
+    pub splits: Vec<SplitResult>,
+}
+
+/// A figure over splits.
+#[derive(Serialize)]
+pub struct Stat {
+    /// Mean over splits.
+    pub mean: f64,
+    /// Each split's value.
+    pub per_split: Vec<f64>,
+}
+
+impl Stat {
+    fn of(v: Vec<f64>) -> Stat {
+        Stat {
+            mean: v.iter().sum::<f64>() / v.len().max(1) as f64,
+            per_split: v,
+        }
+    }
+}
+
+/// The pruned model's held-out figures.
+#[derive(Serialize)]
+pub struct PrunedReport {
+    /// Parameters identified per split.
+    pub n_params: Vec<usize>,
+    /// Held-out position RMS (mm).
+    pub position_rms_mm: Stat,
+    /// Held-out orientation RMS (degrees).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orientation_rms_deg: Option<Stat>,
+}
+
+/// The held-out figures over `splits`.
+fn holdout_report(settings: HoldoutSettings, splits: Vec<SplitResult>) -> HoldoutReport {
+    let mean = |v: &mut dyn Iterator<Item = f64>| {
+        let x: Vec<f64> = v.collect();
+        x.iter().sum::<f64>() / x.len().max(1) as f64
+    };
+    let ori = |f: &dyn Fn(&SplitResult) -> Option<f64>| -> Option<Stat> {
+        splits
+            .iter()
+            .map(f)
+            .collect::<Option<Vec<f64>>>()
+            .map(Stat::of)
+    };
+    let pruned = settings.prune.then(|| PrunedReport {
+        n_params: splits
+            .iter()
+            .filter_map(|s| s.pruned.as_ref().map(|p| p.0))
+            .collect(),
+        position_rms_mm: Stat::of(
+            splits
+                .iter()
+                .filter_map(|s| s.pruned.as_ref().map(|p| p.1.position_rms_mm))
+                .collect(),
+        ),
+        orientation_rms_deg: ori(&|s| s.pruned.as_ref().and_then(|p| p.1.orientation_rms_deg)),
+    });
+    HoldoutReport {
+        settings,
+        position_rms_mm: Stat::of(splits.iter().map(|s| s.held_out.position_rms_mm).collect()),
+        orientation_rms_deg: ori(&|s| s.held_out.orientation_rms_deg),
+        nominal_position_rms_mm: mean(&mut splits.iter().map(|s| s.nominal.position_rms_mm)),
+        fitted_position_rms_mm: mean(&mut splits.iter().map(|s| s.fitted.position_rms_mm)),
+        pruned,
+        splits,
+    }
+}
+
+/// How much better the rigid fit of the nominal points must fit the data
+/// than the nominal model does before identification starts from it: a
+/// tracker metres away and turned by tens of degrees gains 450–4,000×
+/// (`tests/frames.rs`), where Levenberg–Marquardt from the nominal model
+/// ends in a false minimum; FIGAROH's real TIAGo and UR10 data gain 125×
+/// and 38× and converge from the nominal model, as before.
+const MOUNT_GAIN: f64 = 200.0;
+
+/// A URDF robot mounted in the data's frame when the nominal model is far
+/// from it ([`crate::frames::align`]), with a note saying so.
+fn mounted_start(
+    robot: &Robot,
+    meas: &Measurements,
+) -> Result<Option<(Robot, String)>, crate::Error> {
+    let Some(src) = robot.source.as_ref() else {
+        return Ok(None);
+    };
+    let Some(a) = crate::frames::align::measurement_frame(robot, meas) else {
+        return Ok(None);
+    };
+    if !(a.rms_after * MOUNT_GAIN < a.rms_before) {
+        return Ok(None);
+    }
+    let mount = a.motion * src.mount;
+    let r = crate::io::urdf::remount(robot, mount, src.tool * a.tool)?;
+    let t = mount.translation.vector;
+    let note = format!(
+        "the data are far from the nominal model (RMS {:.1} mm): identification starts from the measurement frame that fits them best (RMS {:.1} mm), {:.3} m away and turned {:.1}°",
+        a.rms_before * 1e3,
+        a.rms_after * 1e3,
+        t.norm(),
+        mount.rotation.angle().to_degrees()
+    );
+    Ok(Some((r, note)))
+}
+
+/// Identification from the measurement file `path`: each note is passed
+/// to `on_note` as it is found (what was read, the mount, the start) and
+/// kept in the report.
+pub fn calibrate_measured(
+    robot: &Robot,
+    path: &Path,
+    s: &MeasuredSettings,
+    on_note: &mut dyn FnMut(&str),
+) -> Result<MeasuredCalibration, ExperimentError> {
+    let in_file = |e: crate::identify::IdentifyError| ExperimentError::InFile {
+        path: path.display().to_string(),
+        error: e,
+    };
+    let (meas, read_notes) = read_measurement_file(path, robot, s.units)?;
+    let mut notes = Vec::new();
+    let mut note = |n: &str| {
+        on_note(n);
+        notes.push(n.to_string());
+    };
+    read_notes.iter().for_each(|n| note(n));
+    let given = robot;
+    let mounted = mounted_start(robot, &meas)?;
+    let robot = match &mounted {
+        Some((r, n)) => {
+            note(n);
+            r
+        }
+        None => robot,
+    };
+    let start = for_measurements(robot, &meas, &s.lm).map_err(in_file)?;
+    start.notes.iter().for_each(|n| note(n));
+    let (fitted_robot, without) = match (&s.gravity, s.fit_compliance) {
+        (Some(g), true) => {
+            let (r, w) = with_compliance(&start.robot, g, &meas);
+            (r, Some(w))
+        }
+        _ => (start.robot.clone(), None),
+    };
+    let det =
+        prepare_for_data(&fitted_robot, &start.table, &meas, &s.fix, &s.free).map_err(in_file)?;
+    let r = det.robot;
+    let f = fit(&r, &start.table, &meas, &s.lm, s.loss).map_err(in_file)?;
+    let res = residuals(&r, &f.id.table, &meas)?;
+    let nominal = nominal_residuals(given, mounted.is_some(), &r, &meas, &s.lm)?;
+    let params = trust(&r, &r.nominal, &f.id);
+    let compliance = without.map(|w| crate::identify::compliance::report(&r, &f.id, &meas, w));
+    let splits = Splits {
+        robot,
+        given,
+        meas: &meas,
+        s,
+    };
+    let ho = s.holdout.map(|h| splits.holdout_report(h)).transpose()?;
+    let comparison = match (&s.holdout, s.compare_compliance) {
+        (Some(h), true) => Some(splits.compliance_comparison(h)?),
+        _ => None,
+    };
+    let base = crate::report::MeasuredCalibrationReport::new(
+        &r,
+        &f.id,
+        path.display().to_string(),
+        meas.len(),
+    );
+    let report = MeasuredReport {
+        base,
+        loss: s.loss,
+        residuals: res,
+        nominal_residuals: nominal,
+        parameters: params,
+        fixed: det.fixed,
+        downweighted: f.downweighted(),
+        holdout: ho,
+        notes,
+        frames: None,
+        compliance,
+        compliance_comparison: comparison,
+    };
+    Ok(MeasuredCalibration {
+        robot: r,
+        fit: f,
+        report,
+    })
+}
+
+/// The nominal model's errors on the data: with a mounted start, the
+/// user's nominal model in the data's frame as given (with the best marker
+/// offsets for it), not the start mounted for the fit.
+fn nominal_residuals(
+    given: &Robot,
+    mounted: bool,
+    fitted: &Robot,
+    meas: &Measurements,
+    lm: &LmSettings,
+) -> Result<ModelErrors, crate::identify::IdentifyError> {
+    if mounted && let Ok(s) = for_measurements(given, meas, lm) {
+        return residuals(&s.robot, &s.robot.nominal, meas);
+    }
+    residuals(fitted, &fitted.nominal, meas)
+}
+
+/// Held-out splits of one data set, with the settings' fixed and freed
+/// unknowns (and compliances) applied to every split's fit.
+struct Splits<'a> {
+    /// The robot the data are fitted as (mounted when far).
+    robot: &'a Robot,
+    /// The user's robot, for the nominal figures.
+    given: &'a Robot,
+    meas: &'a Measurements,
+    s: &'a MeasuredSettings,
+}
+
+impl Splits<'_> {
+    /// What a split's training fit is prepared as: compliances from `g` if
+    /// any, the settings' fixed and freed unknowns (compliance names
+    /// dropped when there is no gravity model), the undetermined fixed.
+    fn prepare(
+        &self,
+        g: Option<Arc<GravityModel>>,
+    ) -> impl Fn(&Robot, &ParamTable, &Measurements) -> crate::identify::Result<Robot> + use<> {
+        // The geometric model has no compliance to fix or free.
+        let geometric = |v: &[String]| -> Vec<String> {
+            v.iter()
+                .filter(|n| g.is_some() || !n.starts_with("c_"))
+                .cloned()
+                .collect()
+        };
+        let (fix, free) = (geometric(&self.s.fix), geometric(&self.s.free));
+        move |x: &Robot, t: &ParamTable, m: &Measurements| {
+            let x = match &g {
+                Some(g) => with_compliance(x, g, m).0,
+                None => x.clone(),
+            };
+            prepare_for_data(&x, t, m, &fix, &free).map(|d| d.robot)
+        }
+    }
+
+    fn run(
+        &self,
+        h: &HoldoutSettings,
+        g: Option<Arc<GravityModel>>,
+    ) -> crate::identify::Result<Vec<SplitResult>> {
+        let prep = self.prepare(g);
+        holdout(
+            self.robot,
+            self.given,
+            self.meas,
+            &self.s.lm,
+            self.s.loss,
+            h,
+            &prep,
+        )
+    }
+
+    /// The held-out figures with the model as fitted.
+    fn holdout_report(&self, h: HoldoutSettings) -> crate::identify::Result<HoldoutReport> {
+        let g = self.s.gravity.clone().filter(|_| self.s.fit_compliance);
+        Ok(holdout_report(h, self.run(&h, g)?))
+    }
+
+    /// Held-out errors with and without compliances on the same splits.
+    fn compliance_comparison(
+        &self,
+        h: &HoldoutSettings,
+    ) -> crate::identify::Result<ComplianceComparison> {
+        let plain = HoldoutSettings { prune: false, ..*h };
+        let geo = self.run(&plain, None)?;
+        let com = self.run(&plain, self.s.gravity.clone())?;
+        Ok(compare(&geo, &com))
+    }
+}

@@ -51,12 +51,19 @@ fn kill_during_writes_never_leaves_a_partial_file() {
     std::fs::write(&target, generation(0)).unwrap();
     let exe = std::env::current_exe().unwrap();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    // The writer test's name in this binary: its module path without the
+    // crate's name.
+    let writer = module_path!()
+        .split_once("::")
+        .map_or("writer_process".to_string(), |(_, m)| {
+            format!("{m}::writer_process")
+        });
     let mut advanced = 0;
     for round in 0..12 {
         let mut child = Command::new(&exe)
             .args([
                 "--exact",
-                "writer_process",
+                writer.as_str(),
                 "--nocapture",
                 "--test-threads=1",
             ])

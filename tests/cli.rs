@@ -1,7 +1,7 @@
 //! The command line: documented outputs and clear errors (non-zero exit, no
 //! panic) on bad input.
 
-mod common;
+use crate::common;
 
 use common::{fails_with, json_of, run};
 

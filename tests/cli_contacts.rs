@@ -1,7 +1,7 @@
 //! `calibrate --measurements` on a contact file (a `point` column): the
 //! JSON report, held out by placement, and bad inputs with their messages.
 
-mod common;
+use crate::common;
 use common::{fails_with, json_of};
 
 const URDF: &str = "fixtures/mukca/panda.urdf";

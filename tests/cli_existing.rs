@@ -2,7 +2,7 @@
 //! (the first half of FIGAROH's UR10 data), with the D-efficiency reported
 //! against the prior-aware bound, recomputed here independently.
 
-mod common;
+use crate::common;
 
 use activecal::model::ParamSet;
 use common::{fails_with, json_of};

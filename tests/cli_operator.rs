@@ -3,7 +3,7 @@
 //! .yaml that read back the same, the visiting order, margins, and the
 //! collision filter's per-pair counts.
 
-mod common;
+use crate::common;
 
 use common::{fails_with, json_of, run};
 use std::path::PathBuf;

@@ -2,7 +2,7 @@
 //! command that builds a pool, filter statistics in the reports, design files
 //! that need no pool file, the memory budget, and clear errors.
 
-mod common;
+use crate::common;
 
 use common::{fails_with, json_of, run};
 use std::path::PathBuf;

@@ -4,7 +4,7 @@
 //! while stdout stays one JSON object equal to the run without progress;
 //! without `--progress`, `--json` runs print no progress at all.
 
-mod common;
+use crate::common;
 use common::run;
 use serde_json::Value;
 

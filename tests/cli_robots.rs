@@ -10,7 +10,7 @@
 //! any gap; the exact solve is tested in `tests/bound.rs`), which keeps each
 //! robot's pipeline to a few seconds.
 
-mod common;
+use crate::common;
 
 use common::{fails_with, json_of, run};
 use serde_json::Value;

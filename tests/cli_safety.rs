@@ -2,7 +2,7 @@
 //! refused before the expensive step, with exit status 1, a message naming
 //! the input and what would be accepted, and no file left behind.
 
-mod common;
+use crate::common;
 
 use common::{fails_with, run};
 use std::path::PathBuf;

@@ -142,7 +142,7 @@ fn a_floor_and_a_box_catch_the_links_that_reach_them() {
     );
 }
 
-mod common;
+use crate::common;
 
 /// A temporary copy of the Panda's fixture files (URDF, meshes, SRDF) to
 /// break one of them.

@@ -203,7 +203,7 @@ fn a_panda_with_known_stiffnesses_is_recovered_and_reaches_the_noise_floor() {
     );
 }
 
-mod common;
+use crate::common;
 
 const UR10: &str = "fixtures/figaroh/ur10_robot.urdf:pose";
 const UR10_CSV: &str = "fixtures/figaroh/ur10_full_pose.csv";

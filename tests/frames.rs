@@ -437,7 +437,7 @@ fn synthetic_truth_is_recovered_within_three_sigma_panda_points() {
     );
 }
 
-mod common;
+use crate::common;
 
 /// `calibrate --out cal.urdf --out cal.yaml`, then `evaluate` of the
 /// calibrated URDF mounted by `--frames cal.yaml` on the same data: the

@@ -4,7 +4,7 @@
 //! `io::read::read_text`, which the binary lists on stderr when
 //! `ACTIVECAL_DEBUG_READS` is set).
 
-mod common;
+use crate::common;
 
 use std::process::Command;
 

@@ -2,6 +2,7 @@
 //! agreement with the linearised covariance, statuses for numerical outcomes,
 //! errors for bad input, determinism of the Monte-Carlo, and the command line.
 
+use crate::common;
 use activecal::identify::{
     IdentifyError, LmSettings, Measurements, MonteCarloSettings, Status, StopReason, ValidationSet,
     compare_designs, identify, monte_carlo, paper_tables, simulate, trial_rng,
@@ -14,7 +15,6 @@ use nalgebra::DMatrix;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::Value;
-mod common;
 
 use common::{eae_design, run};
 

@@ -5,7 +5,7 @@
 //! touching MUKCa's sockets and three non-parallel planes, fitted back to
 //! the noise floor; bad inputs refused naming the file and row or the flag.
 
-mod common;
+use crate::common;
 use common::{fails_with, json_of, scratch_dir};
 
 use activecal::identify::contact::project::{project_to_point, simulate_contacts};

@@ -8,7 +8,7 @@
 //! with the acceptance margins (3 mm; 3.5 mm and 0.4°): they are
 //! properties of the data and of a correct calibration, not of this code.
 
-mod common;
+use crate::common;
 
 use activecal::identify::{LmSettings, Measurements, identify, simulate};
 use activecal::model::Robot;

@@ -2,7 +2,7 @@
 //! PNG that decodes, at its documented size, beside its SVG; report.md and
 //! report.json are there; an existing directory is refused without --force.
 
-mod common;
+use crate::common;
 
 use common::{fails_with, run, scratch_dir};
 use std::path::Path;

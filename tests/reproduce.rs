@@ -3,7 +3,7 @@
 //! run separately, and they equal the golden report committed before the
 //! restructuring of the module tree (`tests/golden/reproduce_levels3.json`).
 
-mod common;
+use crate::common;
 
 use serde_json::Value;
 use std::process::Command;

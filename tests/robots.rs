@@ -10,7 +10,7 @@
 //! ε·|y|/h ≈ 5e-9 (rounding at 20 m), so analytic Jacobians are checked to
 //! 1e-7 absolute.
 
-mod common;
+use crate::common;
 
 use activecal::blocks::Blocks;
 use activecal::bound::{BoundSettings, relaxation_bound};

@@ -1,7 +1,7 @@
 //! `robots --robot X` describes one robot (a URDF chain with --tip
 //! included): its chain, joints with limits and parameters.
 
-mod common;
+use crate::common;
 
 use common::{fails_with, json_of, run};
 

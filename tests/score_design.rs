@@ -1,7 +1,7 @@
 //! `score --design` scores a design on its own pool: a pool filter given
 //! beside it (margin, clearance, collision) is refused, never ignored.
 
-mod common;
+use crate::common;
 
 use common::{fails_with, run, scratch_dir};
 

@@ -6,7 +6,7 @@
 //!
 //! The modified files are written into a scratch directory by the test.
 
-mod common;
+use crate::common;
 
 use common::{json_of, run};
 use serde_json::Value;

@@ -12,7 +12,7 @@
 //!   two DH axes 1e-5 rad apart (equilibrated `κ ≈ 1e15`: `d` of both frames
 //!   along the common normal cannot be told apart) refused by all of them.
 
-mod common;
+use crate::common;
 
 use activecal::blocks::Blocks;
 use activecal::bound::{BoundError, BoundSettings, RelaxationSolver, relaxation_bound};
@@ -236,7 +236,8 @@ fn select_bound_score_and_calibrate_agree_on_identifiability() {
 
 #[test]
 fn the_commands_agree_on_a_sensor_900_km_away() {
-    let dir = std::env::temp_dir().join(format!("activecal-units-{}", std::process::id()));
+    let dir =
+        std::env::temp_dir().join(format!("activecal-unit-invariance-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let robot = dir.join("far.toml");

@@ -4,6 +4,7 @@
 //! [`activecal::units::Units`]; and the option a unit error calls for.
 
 use activecal::error::UnitHint;
+use activecal::identify::IdentifyError;
 use activecal::units::{AngleUnit, LengthUnit, Units};
 
 /// The unit of revolute joint values, as typed.
@@ -54,18 +55,31 @@ impl UnitOpts {
     }
 }
 
+/// The input error inside an identification error, if it is one.
+fn model_error(e: &IdentifyError) -> Option<&activecal::Error> {
+    match e {
+        IdentifyError::Model(m) => Some(m),
+        _ => None,
+    }
+}
+
 /// The option a unit error calls for, if the error (anywhere in its chain)
 /// is one: a joint column out of its limits that fits in the other unit, or
 /// positions beyond the robot's reach that fit in the other length unit.
 #[must_use]
 pub fn flag_hint(e: &anyhow::Error) -> Option<&'static str> {
     let hint = e.chain().find_map(|c| {
-        let lib = c.downcast_ref::<activecal::Error>().or_else(|| {
-            match c.downcast_ref::<activecal::identify::IdentifyError>() {
-                Some(activecal::identify::IdentifyError::Model(m)) => Some(m),
-                _ => None,
-            }
-        })?;
+        let lib = c
+            .downcast_ref::<activecal::Error>()
+            .or_else(|| c.downcast_ref::<IdentifyError>().and_then(model_error))
+            .or_else(|| {
+                use activecal::experiment::paper::ExperimentError as E;
+                match c.downcast_ref::<E>()? {
+                    E::Input(m) => Some(m),
+                    E::Identify(i) | E::InFile { error: i, .. } => model_error(i),
+                    _ => None,
+                }
+            })?;
         match lib {
             activecal::Error::JointOutOfLimits { hint, .. }
             | activecal::Error::PositionsBeyondReach { hint, .. } => *hint,

@@ -1,0 +1,76 @@
+//! Every integration test, in one test binary: one build and one link of
+//! the library for all of them (each file under `tests/` used to be a binary
+//! of its own, linked 40-odd times), and one process whose test threads
+//! share the machine's cores across files. Each file is a module; a new
+//! test file is added to the list below (`every_test_file_is_a_module`
+//! fails until it is). Run one file's tests with
+//! `cargo test --test all FILE::`.
+
+mod common;
+
+mod atomic_writes;
+mod bad_inputs;
+mod bound;
+mod cli;
+mod cli_contacts;
+mod cli_existing;
+mod cli_operator;
+mod cli_pools;
+mod cli_progress;
+mod cli_robots;
+mod cli_safety;
+mod collision;
+mod compliance;
+mod erd_fixtures;
+mod export_fixtures;
+mod fixtures;
+mod frames;
+mod fuzz_loaders;
+mod gravity_fixtures;
+mod house;
+mod identification_jacobian_fixtures;
+mod identify;
+mod jacobian;
+mod licences;
+mod mesh_formats;
+mod paper_golden;
+mod plane_contacts;
+mod point_coincidence;
+mod pool_sources;
+mod prior;
+mod real_data;
+mod refine;
+mod reports;
+mod reproduce;
+mod robots;
+mod robots_describe;
+mod score_design;
+mod select;
+mod tour_moves;
+mod undetermined;
+mod unit_invariance;
+mod units;
+mod urdf_chains;
+
+/// Every `tests/*.rs` file is one of the modules above: a file left out
+/// would silently never run.
+#[test]
+fn every_test_file_is_a_module() {
+    let listed: Vec<&str> = include_str!("all.rs")
+        .lines()
+        .filter_map(|l| l.strip_prefix("mod ")?.strip_suffix(';'))
+        .collect();
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests");
+    let mut missing = Vec::new();
+    for e in std::fs::read_dir(&dir).expect("tests/ is readable") {
+        let name = e.expect("a directory entry").file_name();
+        let name = name.to_string_lossy();
+        if let Some(stem) = name.strip_suffix(".rs")
+            && stem != "all"
+            && !listed.contains(&stem)
+        {
+            missing.push(stem.to_string());
+        }
+    }
+    assert!(missing.is_empty(), "tests/all.rs does not list {missing:?}");
+}

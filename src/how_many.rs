@@ -15,7 +15,7 @@
 //! 95th percentile of its per-configuration root.
 
 use crate::blocks::{Blocks, jacobian_of};
-use crate::bound::{BoundError, BoundSettings, design_gap_with_prior, relaxation_bound_with_prior};
+use crate::bound::{BoundError, BoundSettings, design_gap, relaxation_bound};
 use crate::criterion::Prior;
 use crate::measure::{RowKind, sensor_for};
 use crate::model::{ParamTable, Robot};
@@ -288,7 +288,7 @@ pub fn pose_count_curve(
                 continue;
             }
         };
-        let bound = match relaxation_bound_with_prior(x, prior, n, &settings.bound) {
+        let bound = match relaxation_bound(x, prior, n, &settings.bound) {
             Ok(b) => b,
             Err(e @ BoundError::TooFewRows { .. }) => {
                 skipped.push((n, e.to_string()));
@@ -296,7 +296,7 @@ pub fn pose_count_curve(
             }
             Err(e) => return Err(e.into()),
         };
-        let gap = design_gap_with_prior(x, prior, &sel.poses, &bound)?;
+        let gap = design_gap(x, prior, &sel.poses, &bound)?;
         let mut info = x.information(&sel.poses);
         if let Some(pr) = prior {
             info += pr.matrix();

@@ -85,7 +85,7 @@ fn small_pools_bound_the_enumerated_optimum_and_solvers_agree() {
             let (best, _) = enumerate(&x, n);
             assert!(best.is_finite(), "{name} N={n}: some subset is nonsingular");
 
-            let b = relaxation_bound(&x, n, &BoundSettings::default()).unwrap();
+            let b = relaxation_bound(&x, None, n, &BoundSettings::default()).unwrap();
             assert_eq!(b.status, BoundStatus::Certified, "{name} N={n}");
             assert!(
                 b.ln_bound >= best,
@@ -153,7 +153,7 @@ fn certificate_bounds_the_optimum_from_any_point() {
 #[test]
 fn n_equal_to_pool_size_is_exact() {
     let x = random_data(14, 5);
-    let b = relaxation_bound(&x, 14, &BoundSettings::default()).unwrap();
+    let b = relaxation_bound(&x, None, 14, &BoundSettings::default()).unwrap();
     assert_eq!(b.status, BoundStatus::Exact);
     let all: Vec<usize> = (0..14).collect();
     let exact = design_ln_det(&x, None, &all).unwrap();
@@ -167,11 +167,11 @@ fn bad_input_is_an_error() {
     let x = random_data(14, 5);
     let s = BoundSettings::default();
     assert!(matches!(
-        relaxation_bound(&x, 15, &s),
+        relaxation_bound(&x, None, 15, &s),
         Err(BoundError::TooManyPoses { n: 15, pool: 14 })
     ));
     // 3 poses · 3 rows < 10 unknowns: every design singular.
-    let e = relaxation_bound(&x, 3, &s).unwrap_err();
+    let e = relaxation_bound(&x, None, 3, &s).unwrap_err();
     assert!(matches!(e, BoundError::TooFewRows { need: 4, .. }), "{e}");
     assert!(e.to_string().contains("singular"));
     // A repeated column: rank deficient.
@@ -181,7 +181,7 @@ fn bad_input_is_an_error() {
         3,
     );
     assert!(matches!(
-        relaxation_bound(&dup, 8, &s),
+        relaxation_bound(&dup, None, 8, &s),
         Err(BoundError::RankDeficient { rank: 9, p: 10, .. })
     ));
     let zero = Blocks::new(
@@ -189,7 +189,7 @@ fn bad_input_is_an_error() {
         3,
     );
     assert!(matches!(
-        relaxation_bound(&zero, 8, &s),
+        relaxation_bound(&zero, None, 8, &s),
         Err(BoundError::RankDeficient { .. })
     ));
     let nan = Blocks::new(
@@ -203,7 +203,7 @@ fn bad_input_is_an_error() {
         3,
     );
     assert!(matches!(
-        relaxation_bound(&nan, 8, &s),
+        relaxation_bound(&nan, None, 8, &s),
         Err(BoundError::NonFinite { row: 7, col: 2, .. })
     ));
     assert!(matches!(
@@ -239,7 +239,7 @@ fn a_stalled_solver_still_gives_a_valid_bound() {
         })
         .build()
         .unwrap();
-    let b = relaxation_bound(&x, n, &s).unwrap();
+    let b = relaxation_bound(&x, None, n, &s).unwrap();
     assert_eq!(b.status, BoundStatus::GapAboveTolerance);
     assert_eq!(b.conic.status, Some(ConicStatus::MaxIterations));
     assert!(b.certificate_gap > s.gap_tol);
@@ -256,7 +256,7 @@ fn active_box_constraints_are_respected() {
     // N close to the pool size: several weights sit at their upper bound 1.
     let x = random_data(40, 21);
     let n = 30;
-    let b = relaxation_bound(&x, n, &BoundSettings::default()).unwrap();
+    let b = relaxation_bound(&x, None, n, &BoundSettings::default()).unwrap();
     assert_eq!(b.status, BoundStatus::Certified);
     let full = b.weights.iter().filter(|&&w| w > 1.0 - 1e-6).count();
     assert!(full >= 10, "{full} weights at 1");
@@ -286,7 +286,7 @@ fn screening_reaches_the_same_optimum_as_the_whole_pool() {
         .screen_extra(20)
         .build()
         .unwrap();
-    let b = relaxation_bound(&x, n, &s).unwrap();
+    let b = relaxation_bound(&x, None, n, &s).unwrap();
     assert_eq!(b.status, BoundStatus::Certified, "{:?}", b.conic);
     assert!(
         b.conic.candidates < 400,
@@ -319,8 +319,8 @@ fn design_gap_reports_d_efficiency() {
     let x = random_data(14, 13);
     let n = 6;
     let (best, design) = enumerate(&x, n);
-    let b = relaxation_bound(&x, n, &BoundSettings::default()).unwrap();
-    let g = design_gap(&x, &design, &b).unwrap();
+    let b = relaxation_bound(&x, None, n, &BoundSettings::default()).unwrap();
+    let g = design_gap(&x, None, &design, &b).unwrap();
     assert!((g.ln_oid.unwrap() - best).abs() < 1e-9);
     let eff = ((best - b.ln_bound) / x.p() as f64).exp();
     assert!((g.d_efficiency - eff).abs() < 1e-12);
@@ -332,12 +332,12 @@ fn design_gap_reports_d_efficiency() {
         assert_eq!(g.weighted.contains(&k), b.weights[i] > WEIGHT_TOL);
     }
     assert!(matches!(
-        design_gap(&x, &design[..n - 1], &b),
+        design_gap(&x, None, &design[..n - 1], &b),
         Err(BoundError::InvalidDesign(_))
     ));
     let mut dup = design.clone();
     dup[1] = dup[0];
-    assert!(design_gap(&x, &dup, &b).is_err());
+    assert!(design_gap(&x, None, &dup, &b).is_err());
     // A Jacobian of another pool: the same size with fewer unknowns, or the
     // same unknowns with more poses (each mismatch alone is refused).
     let fewer_columns = Blocks::new(
@@ -345,13 +345,13 @@ fn design_gap_reports_d_efficiency() {
         x.t(),
     );
     assert!(matches!(
-        design_gap(&fewer_columns, &design, &b),
+        design_gap(&fewer_columns, None, &design, &b),
         Err(BoundError::InvalidDesign(m)) if m.contains("unknowns")
     ));
     let more_poses = random_data(15, 13);
     assert_eq!(more_poses.p(), x.p());
     assert!(matches!(
-        design_gap(&more_poses, &design, &b),
+        design_gap(&more_poses, None, &design, &b),
         Err(BoundError::InvalidDesign(m)) if m.contains("pool of 14 poses")
     ));
 }
@@ -407,10 +407,10 @@ fn newton_solver_agrees_with_clarabel() {
         .unwrap();
     cases.push(("screened N=12".into(), random_data(400, 17), 12, screened));
     for (name, x, n, s) in cases {
-        let nb = relaxation_bound(&x, n, &s).unwrap();
+        let nb = relaxation_bound(&x, None, n, &s).unwrap();
         let mut cs = s.clone();
         cs.solver = RelaxationSolver::Clarabel;
-        let cb = relaxation_bound(&x, n, &cs).unwrap();
+        let cb = relaxation_bound(&x, None, n, &cs).unwrap();
         println!(
             "{name}: newton {:.10} (gap {:.1e}, {} steps) clarabel {:.10} (gap {:.1e})",
             nb.ln_primal,
@@ -458,7 +458,7 @@ fn a_stalled_newton_solve_still_gives_a_valid_bound() {
         })
         .build()
         .unwrap();
-    let b = relaxation_bound(&x, n, &s).unwrap();
+    let b = relaxation_bound(&x, None, n, &s).unwrap();
     assert_eq!(b.status, BoundStatus::GapAboveTolerance);
     assert_eq!(b.conic.status, Some(ConicStatus::MaxIterations));
     assert!(

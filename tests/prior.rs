@@ -9,10 +9,7 @@ use activecal::bound::variance::{
     VarianceWork, certificate, certificate_with_prior, information, make_feasible, top_sum,
     variances_into,
 };
-use activecal::bound::{
-    BoundSettings, RelaxationSolver, design_gap, design_gap_with_prior, relaxation_bound,
-    relaxation_bound_with_prior,
-};
+use activecal::bound::{BoundSettings, RelaxationSolver, design_gap, relaxation_bound};
 use activecal::criterion::{InfoState, Prior, StateSettings};
 use activecal::select::{Algorithm, CriterionKind, Settings, select};
 use faer::{Mat, MatRef, Side};
@@ -93,7 +90,7 @@ fn the_prior_aware_bound_is_at_least_the_enumerated_optimum() {
                     .use_conic(conic)
                     .build()
                     .unwrap();
-                let b = relaxation_bound_with_prior(&x, Some(&prior), n, &s).unwrap();
+                let b = relaxation_bound(&x, Some(&prior), n, &s).unwrap();
                 assert!(b.with_prior);
                 // The bound and the optimum are sums of p logs of pivots of
                 // O(1) matrices: 1e-9 relative is far above their rounding.
@@ -158,8 +155,8 @@ fn a_zero_prior_gives_the_bound_without_one() {
         let x = random_blocks(40, t, p, seed);
         for solver in [RelaxationSolver::Clarabel, RelaxationSolver::Newton] {
             let s = BoundSettings::builder().solver(solver).build().unwrap();
-            let a = relaxation_bound(&x, n, &s).unwrap();
-            let b = relaxation_bound_with_prior(&x, Some(&zero), n, &s).unwrap();
+            let a = relaxation_bound(&x, None, n, &s).unwrap();
+            let b = relaxation_bound(&x, Some(&zero), n, &s).unwrap();
             // Both are certified to gap_tol above the same relaxation optimum.
             let tol = 2.0 * s.gap_tol;
             assert!(
@@ -170,8 +167,8 @@ fn a_zero_prior_gives_the_bound_without_one() {
             );
             assert!(!a.with_prior && b.with_prior);
             // A design scored against the other kind of bound is refused.
-            assert!(design_gap(&x, &[0, 1, 2, 3], &b).is_err());
-            assert!(design_gap_with_prior(&x, Some(&zero), &[0, 1, 2, 3], &a).is_err());
+            assert!(design_gap(&x, None, &[0, 1, 2, 3], &b).is_err());
+            assert!(design_gap(&x, Some(&zero), &[0, 1, 2, 3], &a).is_err());
         }
     }
 }
@@ -202,9 +199,8 @@ fn the_state_and_selection_work_on_top_of_the_prior() {
     assert!((sel.ln_oid - recomputed).abs() < 1e-9 * recomputed.abs().max(1.0));
     let opt = enumerate(&x, &prior, 2);
     assert!(sel.ln_oid <= opt + 1e-9 * opt.abs().max(1.0));
-    let bound =
-        relaxation_bound_with_prior(&x, Some(&prior), 2, &BoundSettings::default()).unwrap();
-    let g = design_gap_with_prior(&x, Some(&prior), &sel.poses, &bound).unwrap();
+    let bound = relaxation_bound(&x, Some(&prior), 2, &BoundSettings::default()).unwrap();
+    let g = design_gap(&x, Some(&prior), &sel.poses, &bound).unwrap();
     assert!(
         g.d_efficiency > 0.0 && g.d_efficiency <= 1.0 + 1e-12,
         "{}",
@@ -246,5 +242,5 @@ fn the_state_and_selection_work_on_top_of_the_prior() {
         )
         .is_err()
     );
-    assert!(relaxation_bound_with_prior(&x, Some(&wrong), 3, &BoundSettings::default()).is_err());
+    assert!(relaxation_bound(&x, Some(&wrong), 3, &BoundSettings::default()).is_err());
 }

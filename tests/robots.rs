@@ -1150,7 +1150,8 @@ fn bound_runs_on_every_robot_and_lies_above_the_selected_design() {
             .gap_tol(1e-2)
             .build()
             .unwrap();
-        let b = relaxation_bound(&x, 30, &settings).unwrap_or_else(|e| panic!("{}: {e}", r.name));
+        let b =
+            relaxation_bound(&x, None, 30, &settings).unwrap_or_else(|e| panic!("{}: {e}", r.name));
         println!(
             "{}: bound {:.3} ≥ EAE {:.3} (gap {:.2e}, {:?}, {:.2} s)",
             r.name, b.ln_bound, sel.ln_oid, b.certificate_gap, b.status, b.seconds

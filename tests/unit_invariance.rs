@@ -188,7 +188,7 @@ fn verdicts(robot: &Robot) -> [bool; 4] {
         .solver(RelaxationSolver::Newton)
         .build()
         .unwrap();
-    let bound = relaxation_bound(&x, 30, &settings);
+    let bound = relaxation_bound(&x, None, 30, &settings);
     if let Err(e) = &bound {
         assert!(matches!(e, BoundError::RankDeficient { .. }), "{e}");
     }

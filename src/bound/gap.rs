@@ -60,15 +60,12 @@ pub fn d_efficiency(ln_oid: Option<f64>, ln_bound: f64, p: usize) -> f64 {
 /// The gap report of a design (pool positions) against the bound for its
 /// size. Errors when the design's size differs from the bound's `n`, a
 /// position is outside the pool, or a pose repeats.
-pub fn design_gap(x: &Blocks, design: &[usize], bound: &Bound) -> Result<DesignGap, BoundError> {
-    design_gap_with_prior(x, None, design, bound)
-}
-
-/// [`design_gap`] on top of prior information: the design's
-/// `ln det(M0 + Σ X_iᵀX_i)` against a bound computed with the same prior
-/// ([`super::relaxation_bound_with_prior`]). A bound made with a prior used
-/// without one, or the reverse, is an error.
-pub fn design_gap_with_prior(
+///
+/// With prior information (`prior`), the design's `ln det(M0 + Σ X_iᵀX_i)`
+/// against a bound computed with the same prior
+/// ([`super::relaxation_bound`]); a bound made with a prior used without
+/// one, or the reverse, is an error.
+pub fn design_gap(
     x: &Blocks,
     prior: Option<&Prior>,
     design: &[usize],

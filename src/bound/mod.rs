@@ -24,7 +24,7 @@
 //!    it never depends on a solver having converged. Solver objective values
 //!    are reported beside it but never used as the bound.
 //!
-//! **Prior information** ([`relaxation_bound_with_prior`]): with poses
+//! **Prior information** ([`relaxation_bound`]): with poses
 //! already measured, `M(w) = M0 + Σ_i w_i X_iᵀX_i` in (R); every stage
 //! carries `M0` (the scaled `M̃0` of [`variance::Scaled`], the constant of
 //! Clarabel's PSD block, Newton's `ln det`), and the certificate becomes
@@ -41,7 +41,7 @@ mod support;
 pub mod variance;
 
 pub use error::BoundError;
-pub use gap::{DesignGap, design_gap, design_gap_with_prior};
+pub use gap::{DesignGap, design_gap};
 
 use crate::blocks::Blocks;
 use crate::bound::conic::ConicOutcome;
@@ -475,20 +475,12 @@ impl Best {
 /// singular), a non-finite entry, a rank-deficient pool Jacobian, invalid
 /// settings. A solver that stalls gives a valid bound with status
 /// [`BoundStatus::GapAboveTolerance`].
+///
+/// With prior information `M0` (`prior`: poses already measured) it bounds
+/// `ln det(M0 + Σ_{design} X_iᵀX_i)` of every `n`-pose design, certified by
+/// eq. (C0); errors also on a prior of another size than the pool's `p`,
+/// and when `M0` plus the whole pool is rank deficient.
 pub fn relaxation_bound(
-    x: &Blocks,
-    n: usize,
-    settings: &BoundSettings,
-) -> Result<Bound, BoundError> {
-    relaxation_bound_with_prior(x, None, n, settings)
-}
-
-/// [`relaxation_bound`] on top of prior information `M0` (poses already
-/// measured): bounds `ln det(M0 + Σ_{design} X_iᵀX_i)` of every `n`-pose
-/// design, certified by eq. (C0). With `prior = None` it is
-/// [`relaxation_bound`]. Errors also on a prior of another size than the
-/// pool's `p`, and when `M0` plus the whole pool is rank deficient.
-pub fn relaxation_bound_with_prior(
     x: &Blocks,
     prior: Option<&Prior>,
     n: usize,
@@ -546,7 +538,7 @@ pub fn relaxation_bound_with_prior(
 }
 
 /// Checks the settings, the prior's size and the problem (see
-/// [`relaxation_bound_with_prior`]'s errors), and the Newton system's
+/// [`relaxation_bound`]'s errors), and the Newton system's
 /// memory, before any work.
 fn check_inputs(
     x: &Blocks,
@@ -863,7 +855,7 @@ pub fn pool_bound(
 ) -> Result<(Pool, Blocks, Bound), BoundError> {
     let pool = Pool::full(robot, levels)?;
     let x = pool.jacobian(robot, robot.params(params));
-    let b = relaxation_bound(&x, n, settings)?;
+    let b = relaxation_bound(&x, None, n, settings)?;
     Ok((pool, x, b))
 }
 

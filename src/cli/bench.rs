@@ -72,7 +72,7 @@ fn robot_row(label: &str, spec: &str) -> Result<Value> {
         .solver(RelaxationSolver::Newton)
         .build()?;
     let s = Settings::default();
-    let b = relaxation_bound(&x, s.n, &settings)?;
+    let b = relaxation_bound(&x, None, s.n, &settings)?;
     let t0 = Instant::now();
     let one = eae(&x, &mut DCriterion::new(), &s, &mut design_rng(1, 0))?;
     let t_one = t0.elapsed().as_secs_f64();
@@ -299,7 +299,7 @@ fn bound_rows(x: &Blocks, rows: &mut Vec<Row>) -> Result<Value> {
     let mut bounds = Vec::new();
     for solver in [RelaxationSolver::Clarabel, RelaxationSolver::Newton] {
         let settings = BoundSettings::builder().solver(solver).build()?;
-        let b = relaxation_bound(x, n, &settings)?;
+        let b = relaxation_bound(x, None, n, &settings)?;
         rows.push((
             format!("relaxation bound, {solver:?}"),
             b.seconds * 1e3,
@@ -347,7 +347,7 @@ fn scale_rows(robot: &Robot, rows: &mut Vec<Row>) -> Result<Value> {
         let settings = BoundSettings::builder()
             .solver(RelaxationSolver::Newton)
             .build()?;
-        let bb = relaxation_bound(&xb, Settings::default().n, &settings)?;
+        let bb = relaxation_bound(&xb, None, Settings::default().n, &settings)?;
         rows.push((
             "10^6 pool: relaxation bound, N = 30 (Newton)".into(),
             bb.seconds * 1e3,

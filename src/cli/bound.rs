@@ -2,9 +2,7 @@
 //! design's D-efficiency against it.
 
 use super::{PoolOpts, emit_report, filters, load_description};
-use activecal::bound::{
-    Bound, BoundSettings, RelaxationSolver, design_gap_with_prior, relaxation_bound_with_prior,
-};
+use activecal::bound::{Bound, BoundSettings, RelaxationSolver, design_gap, relaxation_bound};
 use activecal::io::design::DesignFile;
 use activecal::model::ParamSet;
 use activecal::report::{BoundCommandReport, GapReport, PoolInfo};
@@ -147,7 +145,7 @@ pub fn cmd_bound(a: BoundArgs) -> Result<()> {
         .map(|p| super::load_existing(p, &ctx.robot, a.pool.params, a.pool.units.units()))
         .transpose()?;
     let prior = existing.as_ref().map(|e| &e.prior);
-    let b = relaxation_bound_with_prior(&ctx.x, prior, a.n, &settings)?;
+    let b = relaxation_bound(&ctx.x, prior, a.n, &settings)?;
     let mut report = BoundCommandReport::new(
         &ctx.robot,
         &ctx.pool,
@@ -212,7 +210,7 @@ pub fn cmd_gap(a: GapArgs) -> Result<()> {
         })
         .transpose()?;
     let prior = existing.as_ref().map(|e| &e.prior);
-    let b = relaxation_bound_with_prior(&ctx.x, prior, d.poses.len(), &settings)?;
+    let b = relaxation_bound(&ctx.x, prior, d.poses.len(), &settings)?;
     let g = if d.refined {
         let qs = d
             .joint_values(&ctx.robot)
@@ -241,7 +239,7 @@ pub fn cmd_gap(a: GapArgs) -> Result<()> {
             weights: Vec::new(),
         }
     } else {
-        design_gap_with_prior(&ctx.x, prior, &positions, &b)?
+        design_gap(&ctx.x, prior, &positions, &b)?
     };
     let mut report = GapReport::new(
         PoolInfo::new(&ctx.robot, &ctx.pool),

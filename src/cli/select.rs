@@ -414,8 +414,8 @@ fn with_gap(
         let settings = activecal::bound::BoundSettings::builder()
             .solver(a.gap_solver)
             .build()?;
-        let bound = activecal::bound::relaxation_bound_with_prior(&ctx.x, prior, a.n, &settings)?;
-        let g = activecal::bound::design_gap_with_prior(&ctx.x, prior, &sel.poses, &bound)?;
+        let bound = activecal::bound::relaxation_bound(&ctx.x, prior, a.n, &settings)?;
+        let g = activecal::bound::design_gap(&ctx.x, prior, &sel.poses, &bound)?;
         report.set_gap(&g);
         pool_bound = Some(bound.ln_bound);
     }

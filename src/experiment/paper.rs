@@ -364,7 +364,7 @@ struct RandomBaseline {
 
 fn random_baseline(x: &crate::blocks::Blocks, a: &PaperSettings) -> RandomBaseline {
     let all: Vec<usize> = (0..x.n_poses()).collect();
-    let rs = random_search(&x, &all, &[], a.n, a.designs, a.seed);
+    let rs = random_search(&x, None, &all, &[], a.n, a.designs, a.seed);
     // The median of the kept designs (all of them up to SAMPLE_CAP).
     let mut order: Vec<usize> = (0..rs.ln_oid.len()).collect();
     order.sort_by(|&i, &j| rs.ln_oid[i].total_cmp(&rs.ln_oid[j]));
@@ -472,9 +472,10 @@ pub fn run(
     let sel = selections(&x, a, &s, &mut progress)?;
     // 5. The relaxation bound, cross-checked by the Newton barrier solver.
     progress("relaxation bound");
-    let bound = relaxation_bound(&x, a.n, &BoundSettings::default())?;
+    let bound = relaxation_bound(&x, None, a.n, &BoundSettings::default())?;
     let newton = relaxation_bound(
         &x,
+        None,
         a.n,
         &BoundSettings::builder()
             .solver(RelaxationSolver::Newton)
@@ -490,7 +491,7 @@ pub fn run(
     ];
     let gaps: Vec<DesignGap> = named
         .iter()
-        .map(|(_, d)| design_gap(&x, d, &bound))
+        .map(|(_, d)| design_gap(&x, None, d, &bound))
         .collect::<Result<_, _>>()?;
     // 6. Calibration: Tables III/IV on the EAE design, Monte-Carlo on several.
     progress("calibration (Tables III, IV)");

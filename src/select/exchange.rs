@@ -498,7 +498,7 @@ where
 {
     s.validate(pool)?;
     if algorithm == Algorithm::Random {
-        let r = super::random_search_with_prior(
+        let r = super::random_search(
             pool,
             s.prior.as_ref(),
             &non_fixed(pool, &s.fixed),

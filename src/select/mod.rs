@@ -41,7 +41,6 @@ pub mod tour;
 pub use exchange::{Selection, detmax, eae, fedorov, multistart, polish};
 pub use random::{
     RandomSearch, SAMPLE_CAP, design_rng, oi_from_ln_oid, random_design, random_search,
-    random_search_with_prior,
 };
 pub use refine::{RefineSettings, Refinement, refine};
 

@@ -83,22 +83,10 @@ pub fn oi_from_ln_oid(ln_oid: f64, p: usize) -> f64 {
 /// Draws `designs` random `n`-pose designs (each containing `fixed`, the
 /// rest from `allowed`) in parallel and keeps the best. Deterministic for a
 /// seed whatever the thread count; ties go to the lowest design number.
+/// With a prior `M0`, the designs are ranked by `ln det(M0 + XᵀX)`
+/// ([`crate::criterion::design_ln_det`]).
 #[must_use]
 pub fn random_search(
-    pool: &Blocks,
-    allowed: &[usize],
-    fixed: &[usize],
-    n: usize,
-    designs: usize,
-    seed: u64,
-) -> RandomSearch {
-    random_search_with_prior(pool, None, allowed, fixed, n, designs, seed)
-}
-
-/// [`random_search`] with the designs ranked by `ln det(M0 + XᵀX)`
-/// ([`ln_det_with_prior`]).
-#[must_use]
-pub fn random_search_with_prior(
     pool: &Blocks,
     prior: Option<&Prior>,
     allowed: &[usize],

@@ -75,7 +75,7 @@ fn feasible(w: &[f64], n: usize) -> Vec<f64> {
 
 fn run(bridge: &Bridge, name: &str, x: &Blocks, n: usize) {
     let start = Instant::now();
-    let b = relaxation_bound(x, n, &BoundSettings::default()).unwrap();
+    let b = relaxation_bound(x, None, n, &BoundSettings::default()).unwrap();
     let ac_seconds = start.elapsed().as_secs_f64();
     assert_eq!(b.status, BoundStatus::Certified, "{name}");
     assert!(b.certificate_gap <= 1e-6, "{name}: {}", b.certificate_gap);

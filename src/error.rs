@@ -255,7 +255,7 @@ impl UnitHint {
     }
 }
 
-/// Result with the crate's [`Error`].
+/// Result with the crate's [`Error`](enum@Error).
 pub type Result<T> = std::result::Result<T, Error>;
 
 /// A number for messages: as Rust prints it when that is short (`0.5`,

@@ -38,7 +38,7 @@ pub const DESIGN_LEVELS: usize = 5;
 /// to the kept columns has norm above this: `1/√MAX_CONDITION` (3.2e-7),
 /// since a smaller component makes the smallest singular value of the
 /// unit-column Jacobian smaller than that and the set fails the rank rule
-/// every command shares ([`crate::linalg::rank`]). On the built-in robots
+/// every command shares (`linalg::rank`). On the built-in robots
 /// (point and pose) dependent columns leave at most 4e-16 (rounding) and the
 /// independent ones at least 0.09 (`tests/robots.rs` checks both), so the
 /// threshold separates them by several orders of magnitude on each side.
@@ -59,7 +59,7 @@ const CHECK_SEED: u64 = 0x5eed_c4ec_0001;
 #[derive(Clone, Debug, Serialize)]
 pub struct Identifiability {
     /// Numerical rank of the column-scaled stacked Jacobian, by the rule of
-    /// [`crate::linalg::rank`].
+    /// `linalg::rank`.
     pub rank: usize,
     /// Number of unknowns.
     pub p: usize,
@@ -70,7 +70,7 @@ pub struct Identifiability {
 }
 
 /// Numerical rank of a stacked Jacobian and the unknowns it cannot determine,
-/// by the rank rule every command shares ([`crate::linalg::rank`]).
+/// by the rank rule every command shares (`linalg::rank`).
 ///
 /// Works on the normal equations of the column-scaled problem: `M = XᵀX`
 /// (`O(rows·p²)` time, `O(p²)` memory — never a copy of `X`, let alone a
@@ -275,7 +275,7 @@ impl Robot {
     /// Checks numerically that every unknown is identifiable: the stacked
     /// Jacobian (nominal parameters) of a random design of the 5-level
     /// lattice, `max(40, 2p)` poses with a fixed seed, has full column rank
-    /// ([`crate::pool::require_identifiable`]).
+    /// ([`require_identifiable`]).
     pub fn check_identifiable(&self) -> Result<Identifiability> {
         self.check_shape()?;
         if self.unknowns.is_empty() {

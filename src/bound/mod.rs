@@ -13,7 +13,7 @@
 //! The pipeline ([`relaxation_bound`]):
 //! 1. scale the Jacobian columns to a common size ([`variance::scale_columns`];
 //!    `ln det` shifts by the known `2·Σ ln s_j`);
-//! 2. a first-order solver ([`exchange`]) gives a warm point and its variances
+//! 2. a first-order solver ([`first_order`]) gives a warm point and its variances
 //!    `d_i = tr(X_i M(w)⁻¹ X_iᵀ)`;
 //! 3. Clarabel ([`conic`]) solves (R) on the candidates that can carry weight
 //!    (support ∪ the largest `d_i`); the optimality conditions

@@ -11,9 +11,9 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum RelaxationSolver {
-    /// Clarabel on the PSD + exponential-cone form ([`conic`]).
+    /// Clarabel on the PSD + exponential-cone form ([`super::conic`]).
     Clarabel,
-    /// The log-barrier Newton method on `ln det M(w)` itself ([`newton`]):
+    /// The log-barrier Newton method on `ln det M(w)` itself ([`super::newton`]):
     /// the default, 5–15 times faster than Clarabel on every pool measured
     /// (PUMA, UR5 full pose, a four-marker TIAGo) with a tighter certificate.
     #[default]
@@ -22,7 +22,7 @@ pub enum RelaxationSolver {
 
 crate::choice!(RelaxationSolver { Clarabel => "clarabel", Newton => "newton" });
 
-/// Settings of [`relaxation_bound`]. Build with [`BoundSettings::builder`]
+/// Settings of [`super::relaxation_bound`]. Build with [`BoundSettings::builder`]
 /// (validated) or take [`BoundSettings::default`].
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(default)]

@@ -102,7 +102,7 @@ pub fn check_problem_with_prior(x: &Blocks, n: usize, with_prior: bool) -> Resul
 /// information matrix with unit diagonal: `s_j = ‖X_{:,j}‖·√(N / pool)`.
 ///
 /// Errors with [`BoundError::RankDeficient`] on a zero column or when the
-/// scaled Gram matrix has `λ_min/λ_max ≤ 1/`[`crate::linalg::rank::MAX_CONDITION`]
+/// scaled Gram matrix has `λ_min/λ_max ≤ 1/``linalg::rank::MAX_CONDITION`
 /// (the rank rule every command shares; a singular-value ratio of `3.2e-7`).
 pub fn scale_columns(x: &Blocks, n: usize) -> Result<Scaled, BoundError> {
     scale_columns_with_prior(x, None, n)

@@ -182,7 +182,7 @@ impl Criterion for DCriterion {
 /// path the determinant updates replace.
 ///
 /// A changed `M` whose equilibrated form `D^-½ M D^-½` (`D = diag M`, the
-/// rule of [`crate::linalg::rank`]) has `λ_max ≥ max_condition·λ_min`
+/// rule of `linalg::rank`) has `λ_max ≥ max_condition·λ_min`
 /// ([`StateSettings::max_condition`](super::StateSettings::max_condition)
 /// of the state) is numerically singular and priced `-∞`. Since `OI` is a
 /// monotone function of `ln det M`, it ranks designs as [`DCriterion`] does.

@@ -43,7 +43,7 @@ pub struct Indices {
     /// singular.
     pub a_trace: f64,
     /// Numerical rank by the rule every command shares
-    /// ([`crate::linalg::rank`]): the number of singular values `σ̃` of the
+    /// (`linalg::rank`): the number of singular values `σ̃` of the
     /// column-scaled `X` (unit-norm columns) with
     /// `σ̃² · MAX_CONDITION > σ̃_max²`, so that units cannot change it
     /// ([`from_singular_values`](Self::from_singular_values), which has no

@@ -38,7 +38,7 @@
 //! # Singularity rule
 //!
 //! Every condition number here is that of the *equilibrated* matrix
-//! `M̃ = D^-½ M D^-½` (`D = diag M`), the rule of [`crate::linalg::rank`]
+//! `M̃ = D^-½ M D^-½` (`D = diag M`), the rule of `linalg::rank`
 //! that every command decides rank by, so that scaling a column of the pool
 //! (a unit change: millimetres for metres) changes no decision. `M` is
 //! accepted at construction when the eigenvalues of `M̃` satisfy
@@ -113,7 +113,7 @@ use thiserror::Error;
 /// `ln OI_D` of a design, recomputed from scratch: `ln det(M0 + Σ_{i∈design}
 /// X_iᵀX_i)` with the prior information `M0` when there is one. Without a
 /// prior, `None` when the design is singular by the rank rule every command
-/// shares ([`crate::linalg::rank`], on unit-norm columns); with one, `None`
+/// shares (`linalg::rank`, on unit-norm columns); with one, `None`
 /// when the sum is not positive definite (on an equilibrated copy, so that
 /// the units of the parameters cannot change the decision). The one
 /// direct evaluation that selection, bounds and reports check their

@@ -25,7 +25,7 @@ use faer::Mat;
 use serde::{Deserialize, Serialize};
 
 /// Settings of the solver, with documented defaults; [`LmSettings::validate`]
-/// is called by [`identify`].
+/// is called by [`super::identify`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct LmSettings {

@@ -428,7 +428,7 @@ impl Measurements {
     }
 
     /// Records the robot's name, so that [`Measurements::check`] refuses the
-    /// measurements for another robot (as [`simulate`] does).
+    /// measurements for another robot (as [`simulate()`] does).
     #[must_use]
     pub fn of_robot(mut self, name: &str) -> Self {
         self.robot = Some(name.to_string());

@@ -3,7 +3,7 @@
 //! fixed at their start (nominal) values, each with a reason, so that the
 //! fit goes on with the rest instead of ending rank deficient.
 //!
-//! The rule is the one every command shares ([`crate::linalg::rank`]): rank
+//! The rule is the one every command shares (`linalg::rank`): rank
 //! on the column-scaled Jacobian, which no change of units moves. The
 //! columns are scaled to unit norm and factored by a column-pivoted QR
 //! (modified Gram–Schmidt, twice, the largest remaining column first) in

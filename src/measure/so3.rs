@@ -4,7 +4,7 @@
 //! Orientation residuals are `φ = log(R(θ) R_measᵀ)` (a rotation vector in
 //! the base frame). A change `dθ` of the unknowns turns the model's
 //! orientation by the angular velocity `ω dθ` (the orientation rows of
-//! [`crate::kinematics::Evaluator::eval`]), `R(θ + dθ) ≈ exp([ω dθ]×) R(θ)`,
+//! `crate::kinematics::Evaluator::eval`), `R(θ + dθ) ≈ exp([ω dθ]×) R(θ)`,
 //! so `φ(θ + dθ) ≈ φ + J_l⁻¹(φ) ω dθ`: the residual's exact Jacobian is the
 //! evaluator's block premultiplied by [`left_jacobian_inverse`].
 

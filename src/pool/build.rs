@@ -59,7 +59,7 @@ impl PoolSpec {
     /// pass every filter (evaluated at `table`, the model the sensor region
     /// is known in, usually the nominal one). A pool that the filters leave
     /// empty is an error naming the filter that removed the last candidates,
-    /// and so is a filter whose region is malformed ([`Visibility::validate`]).
+    /// and so is a filter whose region is malformed ([`crate::measure::Visibility::validate`]).
     pub fn build(&self, robot: &Robot, table: &ParamTable) -> Result<Pool> {
         self.validate_filters(robot)?;
         match &self.source {

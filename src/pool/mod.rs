@@ -2,7 +2,7 @@
 //!
 //! A pool is made from a [`PoolSpec`]: a [`PoolSource`] (the joint-space
 //! [`Lattice`], uniform random or Sobol samples inside the joint limits
-//! ([`sampled`]), or a file of configurations ([`file`])) through
+//! ([`sampled`]), or a file of configurations ([`file`](mod@file))) through
 //! [`PoolFilter`]s (sensor visibility). One function, [`PoolSpec::build`],
 //! makes it for every command. The [`Pool`] holds the configurations
 //! (contiguous, `n × dof`), a stable id per pose (its index in the source:
@@ -66,7 +66,7 @@ pub enum PoolSource {
         seed: Option<u64>,
     },
     /// Joint configurations listed in a CSV or JSON file
-    /// ([`file`](self::file)); id `k` is the `k`-th data row (0-based).
+    /// ([`file`](mod@self::file)); id `k` is the `k`-th data row (0-based).
     File {
         /// The file, as given.
         path: String,

@@ -15,6 +15,7 @@ pub mod report_dir;
 pub mod report_plots;
 pub mod reproduce;
 pub mod select;
+pub mod simulated;
 pub mod tour;
 pub mod units;
 

@@ -4,9 +4,9 @@
 //! (Monte-Carlo); the work is in `activecal::experiment::simulated`, this
 //! file renders it (text, JSON, report directory).
 
-use super::calibrate::{
-    CalibrateArgs, DEFAULT_NOISE, exit_status, frames_of, refuse_unconverged, status_text,
-    write_calibrated,
+use super::calibrate_args::{CalibrateArgs, DEFAULT_NOISE};
+use super::calibrated::{
+    exit_status, frames_of, refuse_unconverged, status_text, write_calibrated,
 };
 use super::{emit, write_new};
 use activecal::identify::{LmSettings, MonteCarloSettings, MonteCarloSummary};

@@ -1,0 +1,148 @@
+//! The arguments of `calibrate`, parsed once.
+
+use clap::Args;
+use std::path::PathBuf;
+
+/// Arguments of the command.
+#[derive(Args)]
+pub struct CalibrateArgs {
+    /// Robot: a built-in name, or a .toml description or .urdf file; append
+    /// `:pose` for full-pose measurements.
+    #[arg(long, default_value = "puma560", value_parser = super::parse_robot)]
+    pub robot: activecal::io::RobotRef,
+    /// Design file (JSON with robot, levels, poses), as written by `select`:
+    /// measurements are simulated there.
+    #[arg(long, required_unless_present = "measurements")]
+    pub design: Option<PathBuf>,
+    /// Measurement file: identify from these real measurements instead of
+    /// simulating a design. CSV (`x1,y1,z1`, `x2,y2,z2`… for several
+    /// markers, optional `phix1,phiy1,phiz1` roll-pitch-yaw or
+    /// `qw1,qx1,qy1,qz1`, one column per joint named as in the URDF; metres
+    /// and radians) or JSON (`qs`, `points`, optional `orientations` or
+    /// `quaternions`, `markers`). Several markers per pose calibrate a
+    /// marker sensor with one offset per marker; orientations a full pose.
+    /// The simulation's options (`--noise`, `--validation`, `--trials`,
+    /// `--save-measurements`) do not apply to measured data: refused.
+    #[arg(
+        long,
+        conflicts_with_all = ["design", "trials", "save_measurements", "noise", "validation"]
+    )]
+    pub measurements: Option<PathBuf>,
+    /// Write the simulated measurements (trial 0 of the seed) to this JSON
+    /// file, in the format `--measurements` reads.
+    #[arg(long)]
+    pub save_measurements: Option<PathBuf>,
+    /// Write the calibrated robot, by extension (repeatable): .urdf — your
+    /// URDF with only the chain's joint origins changed (a built-in or TOML
+    /// robot: its chain as URDF); .yaml — the frames file (measurement
+    /// frame, tool or markers, joint origins with σ); .toml — activecal's
+    /// description whose tables are the estimate. Written only when the fit
+    /// converged.
+    #[arg(long)]
+    pub out: Vec<PathBuf>,
+    /// Replace existing output files.
+    #[arg(long)]
+    pub force: bool,
+    /// Measurement noise σ per coordinate, metres (the default, 0.01, is
+    /// 1 cm). A full-pose robot's orientation noise is σ / orientation_scale
+    /// radians per axis.
+    #[arg(long, default_value_t = DEFAULT_NOISE, allow_negative_numbers = true)]
+    pub noise: f64,
+    /// Seed of the noise and of the validation poses (default 0); with
+    /// --measurements, of the --holdout splits only.
+    #[arg(long, value_parser = super::parse_seed, allow_negative_numbers = true)]
+    pub seed: Option<u64>,
+    /// Noise realisations; more than 1 adds a Monte-Carlo summary.
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+    pub trials: usize,
+    /// Held-out lattice poses (not in the design) for the validation RMS.
+    #[arg(long, default_value_t = 500, allow_negative_numbers = true)]
+    pub validation: usize,
+    /// Levenberg–Marquardt iteration limit.
+    #[arg(long, default_value_t = 200, allow_negative_numbers = true)]
+    pub max_iterations: usize,
+    /// Plain Levenberg–Marquardt steps, without geodesic acceleration.
+    #[arg(long)]
+    pub no_geodesic: bool,
+    /// Loss of the fit (with --measurements): l2, or huber / cauchy with
+    /// --loss-scale; poses the robust loss down-weights are named.
+    #[arg(long, value_enum, default_value = "l2", requires = "measurements")]
+    pub loss: super::measured::LossKind,
+    /// Scale of a robust loss: a pose's residual norm (metres) where it
+    /// turns robust.
+    #[arg(long, requires = "measurements")]
+    pub loss_scale: Option<f64>,
+    /// Unknowns to fix at their nominal values (comma-separated names, as
+    /// in the estimate), with --measurements.
+    #[arg(long, value_delimiter = ',', requires = "measurements")]
+    pub fix: Vec<String>,
+    /// Parameters to estimate besides the chosen unknowns (names such as
+    /// `d_arm_3_joint`), with --measurements.
+    #[arg(long, value_delimiter = ',', requires = "measurements")]
+    pub free: Vec<String>,
+    /// Held-out validation: fit on a random 1 − F of the poses, evaluate on
+    /// the rest (with --measurements; --splits times, seeded by --seed).
+    #[arg(long, value_name = "F", requires = "measurements")]
+    pub holdout: Option<f64>,
+    /// Random splits of --holdout.
+    #[arg(long, default_value_t = 4, requires = "holdout")]
+    pub splits: usize,
+    /// With --holdout: also fit a model pruned to the parameters with
+    /// |t| >= 2 and compare held-out errors.
+    #[arg(long, requires = "holdout")]
+    pub compare_pruned: bool,
+    /// A distance known between two contact points (a file with a `point`
+    /// column): `A,B=METRES`, repeatable.
+    #[arg(long, value_name = "A,B=METRES", requires = "measurements")]
+    pub point_distance: Vec<String>,
+    /// A known contact plane (a file with a `plane` column): `NAME=nx,ny,nz,d`
+    /// (base frame, `n · x = d` in metres; the normal is normalised),
+    /// repeatable. Planes not given are unknown and estimated.
+    #[arg(long, value_name = "NAME=nx,ny,nz,d", requires = "measurements")]
+    pub plane: Vec<String>,
+    /// Contacts held out by placement (the part of a point's name before
+    /// '/'): fit on all placements but one, judge on that one, for each.
+    #[arg(long, value_enum, requires = "measurements")]
+    pub holdout_by: Option<super::contact::HoldoutBy>,
+    /// Contacts: fit on this placement alone, judge on each other one.
+    #[arg(long, value_name = "PLACEMENT", requires = "measurements")]
+    pub train_on: Option<String>,
+    /// Also fit a compliance per revolute joint whose gravity torque (from
+    /// the URDF's inertials) varies over the data: the joint deflects by
+    /// c·τ(q); reports c, σ, t, k = −1/c and the largest deflection.
+    #[arg(long, requires = "measurements")]
+    pub compliance: bool,
+    /// With --holdout: fit with and without compliances on the same splits
+    /// and compare held-out errors.
+    #[arg(long, requires = "holdout")]
+    pub compare_compliance: bool,
+    /// Take the links' masses and centres of mass from this URDF (same link
+    /// names) instead of the robot's own.
+    #[arg(long, value_name = "FILE")]
+    pub inertia: Option<PathBuf>,
+    /// A payload on the tip link: KG, or KG@X,Y,Z (metres, tip link frame).
+    #[arg(long, value_name = "KG[@X,Y,Z]", value_parser = super::compliance::parse_payload, allow_hyphen_values = true)]
+    pub payload: Option<activecal::io::inertia::Payload>,
+    /// Write a report directory: report.md, report.json and figures (PNG
+    /// and SVG) of the errors before and after, the held-out splits, the
+    /// parameter changes with ±σ and their correlations. An existing
+    /// non-empty directory needs --force.
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
+    /// Units of the --measurements file.
+    #[command(flatten)]
+    pub units: super::units::UnitOpts,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The simulated measurement noise σ when `--noise` is not given, metres.
+pub const DEFAULT_NOISE: f64 = 0.01;
+
+impl CalibrateArgs {
+    /// `--seed`, 0 when not given.
+    pub(super) fn seed(&self) -> u64 {
+        self.seed.unwrap_or(0)
+    }
+}

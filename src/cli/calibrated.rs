@@ -1,0 +1,137 @@
+//! What every kind of calibration shares on the way out: the calibrated
+//! robot written by `--out` (by extension, with its frames), the exit status
+//! of an unconverged fit, and the status line.
+
+use super::calibrate_args::CalibrateArgs;
+use super::write_new;
+use activecal::frames::CalibratedFrames;
+use activecal::frames::report::{FitBlock, FramesReport};
+use activecal::identify::Identification;
+use activecal::io::calibrated::Format;
+use activecal::model::Robot;
+use anyhow::Result;
+
+/// The header of a calibrated TOML description.
+fn toml_header(id: &Identification, source: &str) -> String {
+    format!(
+        "# Calibrated by activecal from {source}: nominal = real = the estimate\n# ({:?}, {} iterations, σ̂ = {}).\n",
+        id.status,
+        id.iterations,
+        id.sigma_hat.map_or("-".into(), |v| format!("{v:.6e}"))
+    )
+}
+
+/// The calibrated frames of a URDF robot at the estimate (`None` for other
+/// robots), with σ from the fit's covariance.
+pub fn frames_of(
+    robot: &Robot,
+    id: &Identification,
+    fit: Option<FitBlock>,
+) -> Result<Option<(CalibratedFrames, FramesReport)>> {
+    let cov = id.covariance.as_ref().map(|c| c.matrix.as_slice());
+    Ok(activecal::frames::calibrated(robot, &id.table, cov, fit)?)
+}
+
+/// Writes the calibrated robot to every `--out` when identification
+/// converged (by extension, [`Format`]); returns the files written. A
+/// non-converged estimate is never written as a robot model (see
+/// [`refuse_unconverged`]).
+pub fn write_calibrated(
+    a: &CalibrateArgs,
+    robot: &Robot,
+    id: &Identification,
+    source: &str,
+    frames: Option<&(CalibratedFrames, FramesReport)>,
+) -> Result<Vec<String>> {
+    if !id.converged() {
+        return Ok(Vec::new());
+    }
+    let mut written = Vec::new();
+    for out in &a.out {
+        let text = activecal::io::calibrated::render(
+            Format::of(out)?,
+            robot,
+            &id.table,
+            frames.map(|(f, r)| (f, r)),
+            &toml_header(id, source),
+        )
+        .map_err(|e| anyhow::anyhow!("--out {}: {e}", out.display()))?;
+        write_new(out, &text, a.force)?;
+        written.push(out.display().to_string());
+    }
+    Ok(written)
+}
+
+/// The exit status of a calibration whose fit did not converge or is rank
+/// deficient (0: converged, 1: an error, 2: a usage error).
+pub const EXIT_NOT_CONVERGED: i32 = 3;
+
+/// A calibration that ran but whose fit did not converge: the report is
+/// printed, and the process exits with [`EXIT_NOT_CONVERGED`].
+#[derive(Debug)]
+pub struct NotConverged(pub String);
+
+impl std::fmt::Display for NotConverged {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for NotConverged {}
+
+/// The exit status a calibration ends with: 0 or [`EXIT_NOT_CONVERGED`].
+pub fn exit_status(id: &Identification) -> i32 {
+    if id.converged() {
+        0
+    } else {
+        EXIT_NOT_CONVERGED
+    }
+}
+
+/// After the report is printed: a [`NotConverged`] error (exit status
+/// [`EXIT_NOT_CONVERGED`]) with the reason when the estimate did not
+/// converge, so that no script mistakes it for a calibrated model; with
+/// `--out`, the message says that nothing was written.
+pub fn refuse_unconverged(a: &CalibrateArgs, id: &Identification) -> Result<()> {
+    if id.converged() {
+        return Ok(());
+    }
+    let mut why = format!(
+        "identification ended {:?} ({:?}) after {} iterations",
+        id.status, id.stop, id.iterations
+    );
+    if !id.unidentifiable.is_empty() {
+        why += &format!(
+            "; not determined by the data: {}",
+            id.unidentifiable.join(", ")
+        );
+    }
+    if !a.out.is_empty() {
+        let names: Vec<String> = a.out.iter().map(|p| p.display().to_string()).collect();
+        why += &format!(
+            "; {} {} not written",
+            names.join(", "),
+            if names.len() == 1 { "was" } else { "were" }
+        );
+    }
+    Err(NotConverged(why).into())
+}
+
+pub fn status_text(id: &Identification) -> String {
+    let mut s = format!(
+        "status: {:?} ({:?}) after {} iterations, {} evaluations\n",
+        id.status, id.stop, id.iterations, id.evaluations
+    );
+    s += &format!(
+        "rss {:.6e} (start {:.6e}), σ̂ = {}, rank {}/{}\n",
+        id.rss,
+        id.initial_rss,
+        id.sigma_hat.map_or("-".into(), |v| format!("{v:.6}")),
+        id.rank,
+        id.names.len()
+    );
+    if !id.unidentifiable.is_empty() {
+        s += &format!("unidentifiable: {}\n", id.unidentifiable.join(" "));
+    }
+    s
+}

@@ -1,0 +1,404 @@
+//! The pool options every pool-using command shares (`--pool`, `--levels`,
+//! `--count`, margins, filters), resolved once into a `PoolSpec`, and the
+//! pool with its Jacobian.
+
+use super::{choice, compliance, load_description, parse_robot, units};
+use activecal::io::{RobotRef, UrdfChain};
+use activecal::measure::Visibility;
+use activecal::model::{ParamSet, Robot};
+use activecal::pool::{Pool, PoolFilter, PoolSource, PoolSpec};
+use anyhow::Result;
+
+/// Where the candidate poses come from (`--pool`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum PoolKind {
+    /// The joint-space lattice (`--levels`).
+    Lattice,
+    /// Uniform random samples inside the joint limits (`--count`, `--pool-seed`).
+    Random,
+    /// Sobol points inside the joint limits (`--count`, `--pool-seed` to scramble).
+    Sobol,
+    /// Joint configurations from a CSV or JSON file.
+    File(std::path::PathBuf),
+}
+
+/// Parses `--pool`: `lattice`, `random`, `sobol`, `file:PATH`, or a path
+/// ending in `.csv` or `.json`.
+pub fn parse_pool_kind(s: &str) -> std::result::Result<PoolKind, String> {
+    match s {
+        "lattice" => Ok(PoolKind::Lattice),
+        "random" => Ok(PoolKind::Random),
+        "sobol" => Ok(PoolKind::Sobol),
+        _ => {
+            if let Some(p) = s.strip_prefix("file:") {
+                if p.is_empty() {
+                    return Err("file: needs a path, e.g. file:poses.csv".into());
+                }
+                return Ok(PoolKind::File(p.into()));
+            }
+            let lower = s.to_ascii_lowercase();
+            if lower.ends_with(".csv") || lower.ends_with(".json") {
+                return Ok(PoolKind::File(s.into()));
+            }
+            Err(format!(
+                "unknown pool '{s}': use lattice, random, sobol, or file:PATH (a CSV or JSON of joint configurations)"
+            ))
+        }
+    }
+}
+
+/// Samples of a random or Sobol pool when `--count` is not given (2¹²: a
+/// whole number of Sobol strata).
+pub const DEFAULT_COUNT: usize = 4096;
+
+/// Lattice values per joint when `--levels` is not given.
+pub const DEFAULT_LEVELS: usize = 5;
+
+/// Options that define a pose pool, shared by the commands that need one.
+#[derive(clap::Args, Clone, Debug)]
+pub struct PoolOpts {
+    /// Robot: a built-in name (puma560, ur5, stanford), or a .toml
+    /// description or .urdf file; append `:pose` for full-pose measurements.
+    #[arg(long, default_value = "puma560", value_parser = parse_robot)]
+    pub robot: RobotRef,
+    /// Candidate poses: lattice (--levels), random or sobol (--count,
+    /// --pool-seed) inside the joint limits, or file:PATH, a CSV with a
+    /// header of joint names (or q1..qN) or JSON {"qs": [[...]]} of joint
+    /// configurations (a PATH ending in .csv or .json also works).
+    #[arg(long, value_name = "lattice|random|sobol|file:PATH", default_value = "lattice", value_parser = parse_pool_kind)]
+    pub pool: PoolKind,
+    /// Lattice values per joint (--pool lattice) [default: 5].
+    #[arg(long, allow_negative_numbers = true)]
+    pub levels: Option<usize>,
+    /// Samples of --pool random or sobol [default: 4096].
+    #[arg(long, allow_negative_numbers = true)]
+    pub count: Option<usize>,
+    /// Seed of --pool random [default: 0], or of the scramble of --pool
+    /// sobol (without it, the plain Sobol sequence).
+    #[arg(long, allow_negative_numbers = true)]
+    pub pool_seed: Option<u64>,
+    /// Parameter set the Jacobian is computed with.
+    #[arg(long, value_parser = choice::<ParamSet>(), default_value_t = ParamSet::Nominal)]
+    pub params: ParamSet,
+    /// Sensor visibility region as JSON, e.g.
+    /// '{"kind":"box","min":[-30,-30,-30],"max":[30,30,30]}' or
+    /// '{"kind":"cone","apex":[0,0,0],"axis":[0,1,0],"half_angle":0.1,"max_range":40}'.
+    #[arg(long)]
+    pub visibility: Option<String>,
+    /// Remove the candidates where two links of the URDF robot touch (its
+    /// collision geometry: boxes, cylinders, spheres, STL meshes), skipping
+    /// adjacent links and an SRDF's disabled pairs.
+    #[arg(long)]
+    pub self_collision: bool,
+    /// SRDF whose `disable_collisions` pairs are not checked.
+    #[arg(long, value_name = "FILE")]
+    pub srdf: Option<std::path::PathBuf>,
+    /// Directory searched for `package://` meshes (repeatable; the URDF's
+    /// directory and its ancestors are searched too).
+    #[arg(long = "package-dir", value_name = "DIR")]
+    pub package_dirs: Vec<std::path::PathBuf>,
+    /// Remove the candidates where a link touches this box:
+    /// box:cx,cy,cz,sx,sy,sz (centre and full sizes, metres, in the base
+    /// link's frame; repeatable).
+    #[arg(
+        long = "obstacle",
+        value_name = "box:cx,cy,cz,sx,sy,sz",
+        allow_hyphen_values = true
+    )]
+    pub obstacles: Vec<String>,
+    /// Remove the candidates where a link (other than the base's) goes below
+    /// z = Z of the base link's frame.
+    #[arg(long, value_name = "Z", allow_negative_numbers = true)]
+    pub floor: Option<f64>,
+    /// Units of --pool file: and --existing values.
+    #[command(flatten)]
+    pub units: units::UnitOpts,
+    /// Add a compliance unknown per revolute joint whose gravity torque
+    /// (from the URDF's inertials) varies over the pool, so that designs
+    /// separate sag from geometry (as `calibrate --compliance` fits).
+    #[arg(long)]
+    pub compliance: bool,
+    /// Keep candidates this far inside every revolute joint's limits,
+    /// degrees: lattice and sampled pools are made over the shrunk ranges, a
+    /// file's rows closer to a limit are removed [default: 2 for a .urdf
+    /// robot; 0 for the built-in arms (the paper's lattice), .toml
+    /// descriptions (their limits as stated) and --pool file:].
+    #[arg(long, value_name = "DEGREES", allow_negative_numbers = true)]
+    pub margin: Option<f64>,
+    /// With --self-collision, --obstacle or --floor: also remove the
+    /// candidates where two checked links, or a link and an obstacle, come
+    /// closer than this, metres (parry's distance query).
+    #[arg(
+        long,
+        value_name = "METRES",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub clearance: f64,
+}
+
+/// The joint-limit margin of a URDF robot when `--margin` is not given,
+/// degrees: clear of the hard stops, where a badly calibrated
+/// arm's controller faults, by more than a calibration's usual joint
+/// offsets (tenths of a degree).
+pub const DEFAULT_MARGIN_DEG: f64 = 2.0;
+
+/// A robot, its pose pool and the pool's identification Jacobian.
+pub struct PoolCtx {
+    /// The robot.
+    pub robot: Robot,
+    /// The pool.
+    pub pool: Pool,
+    /// Identification Jacobian of every pool pose.
+    pub x: activecal::blocks::Blocks,
+}
+
+/// The filters of a pool: `--visibility`, else the robot description's
+/// region, else none.
+pub fn filters(
+    visibility: Option<&str>,
+    described: Option<&Visibility>,
+) -> Result<Vec<PoolFilter>> {
+    Ok(match (visibility, described) {
+        (Some(v), _) => {
+            let vis: Visibility =
+                serde_json::from_str(v).map_err(|e| anyhow::anyhow!("--visibility: {e}"))?;
+            vis.validate()
+                .map_err(|e| anyhow::anyhow!("--visibility: {e}"))?;
+            vec![PoolFilter::Visibility(vis)]
+        }
+        (None, Some(vis)) => vec![PoolFilter::Visibility(vis.clone())],
+        (None, None) => vec![],
+    })
+}
+
+/// A built pool with its Jacobian at `params` (reserved fallibly: memory
+/// the system refuses is an error, not an abort).
+pub fn with_jacobian(robot: Robot, pool: Pool, params: ParamSet) -> Result<PoolCtx> {
+    let x = pool.try_jacobian(&robot, robot.params(params))?;
+    Ok(PoolCtx { robot, pool, x })
+}
+
+/// One line per filter (what it removed) and per note of a pool's build.
+pub fn pool_stats_text(st: &activecal::pool::PoolStats) -> String {
+    let mut s = format!("pool: {} candidates", st.candidates);
+    for f in &st.filters {
+        s += &format!(", {} filter removed {} of {}", f.filter, f.removed, f.seen);
+    }
+    s += &format!(", {} kept\n", st.kept);
+    for f in &st.filters {
+        if let Some(c) = &f.contacts {
+            s += &format!(
+                "  {} filter: {} removed by two links touching, {} by a link touching an obstacle; {} pairs, the largest:\n",
+                f.filter, c.self_collision, c.obstacle, c.distinct_pairs
+            );
+            for p in &c.top {
+                s += &format!(
+                    "    {:>7}  {} – {}{}\n",
+                    p.removed,
+                    p.link,
+                    p.other,
+                    if p.obstacle { " (obstacle)" } else { "" }
+                );
+            }
+        }
+        if let Some(w) = &f.warning {
+            s += &format!("warning: {w}");
+            let own = f
+                .contacts
+                .as_ref()
+                .and_then(|c| c.top.first())
+                .is_some_and(|p| !p.obstacle);
+            if own {
+                s += " (give the SRDF with --srdf FILE)";
+            }
+            s += "\n";
+        }
+    }
+    for n in &st.notes {
+        s += &format!("note: {n}\n");
+    }
+    s
+}
+
+impl PoolOpts {
+    /// The pool source these options describe; an option that does not
+    /// apply to the chosen pool is an error.
+    pub fn source(&self) -> Result<PoolSource> {
+        let lattice = matches!(self.pool, PoolKind::Lattice);
+        let sampled = matches!(self.pool, PoolKind::Random | PoolKind::Sobol);
+        if self.levels.is_some() && !lattice {
+            anyhow::bail!("--levels applies to --pool lattice only");
+        }
+        if !sampled && (self.count.is_some() || self.pool_seed.is_some()) {
+            anyhow::bail!("--count and --pool-seed apply to --pool random or sobol only");
+        }
+        let count = self.count.unwrap_or(DEFAULT_COUNT);
+        Ok(match &self.pool {
+            PoolKind::Lattice => PoolSource::Lattice {
+                levels: self.levels.unwrap_or(DEFAULT_LEVELS),
+            },
+            PoolKind::Random => PoolSource::Random {
+                count,
+                seed: self.pool_seed.unwrap_or(0),
+            },
+            PoolKind::Sobol => PoolSource::Sobol {
+                count,
+                seed: self.pool_seed,
+            },
+            PoolKind::File(p) => PoolSource::File {
+                path: p.display().to_string(),
+            },
+        })
+    }
+
+    /// The pool these options describe, for a robot description.
+    pub fn spec(&self, d: &activecal::io::Description) -> Result<PoolSpec> {
+        let mut filters = filters(self.visibility.as_deref(), d.visibility.as_ref())?;
+        filters.extend(self.collision_filters(&d.robot)?);
+        Ok(PoolSpec {
+            source: self.source()?,
+            filters,
+            margin: self.margin_radians()?,
+        })
+    }
+
+    /// The joint-limit margin in radians: `--margin`, else
+    /// [`DEFAULT_MARGIN_DEG`] for a URDF robot and a generated pool, else 0
+    /// (a built-in arm keeps the paper's lattice, a `.toml` description
+    /// states its limits as its pools should use them — an export of a
+    /// built-in arm gives the same pool —, a file of poses is taken as
+    /// given).
+    pub fn margin_radians(&self) -> Result<f64> {
+        let deg = match self.margin {
+            Some(m) if !(m.is_finite() && m >= 0.0) => {
+                anyhow::bail!("--margin {m}: the margin is an angle >= 0 degrees")
+            }
+            Some(m) => m,
+            None if self.robot.is_urdf() && !matches!(self.pool, PoolKind::File(_)) => {
+                DEFAULT_MARGIN_DEG
+            }
+            None => 0.0,
+        };
+        Ok(deg.to_radians())
+    }
+
+    /// The self-collision and obstacle filters of `--self-collision`,
+    /// `--obstacle` and `--floor` (one filter each kind, so that the pool
+    /// statistics say what each removed); `--srdf` and `--package-dir`
+    /// without them are errors.
+    pub fn collision_filters(&self, robot: &Robot) -> Result<Vec<PoolFilter>> {
+        use activecal::collision::{CollisionFilter, CollisionSpec, Obstacle};
+        let obstacles = self
+            .obstacles
+            .iter()
+            .map(|o| Obstacle::parse(o).map_err(anyhow::Error::msg))
+            .collect::<Result<Vec<_>>>()?;
+        if let Some(z) = self.floor
+            && !z.is_finite()
+        {
+            anyhow::bail!("--floor {z}: not a finite height");
+        }
+        let any_obstacle = !obstacles.is_empty() || self.floor.is_some();
+        if !(self.clearance.is_finite() && self.clearance >= 0.0) {
+            anyhow::bail!("--clearance {}: a distance >= 0 metres", self.clearance);
+        }
+        if !self.self_collision && !any_obstacle {
+            if self.clearance > 0.0 {
+                anyhow::bail!("--clearance applies with --self-collision, --obstacle or --floor");
+            }
+            if self.srdf.is_some() || !self.package_dirs.is_empty() {
+                anyhow::bail!(
+                    "--srdf and --package-dir apply with --self-collision, --obstacle or --floor"
+                );
+            }
+            return Ok(Vec::new());
+        }
+        if self.srdf.is_some() && !self.self_collision {
+            anyhow::bail!("--srdf lists pairs of links for --self-collision, which is not given");
+        }
+        let Some(chain) = UrdfChain::of(robot) else {
+            anyhow::bail!(
+                "--self-collision, --obstacle and --floor need a URDF robot with collision geometry (--robot FILE.urdf); {} has none",
+                self.robot
+            );
+        };
+        for (opt, p) in self
+            .srdf
+            .iter()
+            .map(|p| ("--srdf", p))
+            .chain(self.package_dirs.iter().map(|p| ("--package-dir", p)))
+        {
+            if !p.exists() {
+                anyhow::bail!("{opt} {}: no such file or directory", p.display());
+            }
+        }
+        let base_spec = CollisionSpec {
+            urdf: chain.file,
+            text: Some(chain.text),
+            joints: chain.joints,
+            lock: chain.lock,
+            base: Some(chain.base),
+            srdf: self.srdf.as_ref().map(|p| p.display().to_string()),
+            package_dirs: self
+                .package_dirs
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect(),
+            clearance: self.clearance,
+            ..CollisionSpec::default()
+        };
+        let mut out = Vec::new();
+        if self.self_collision {
+            out.push(PoolFilter::Collision(CollisionFilter::new(CollisionSpec {
+                self_collision: true,
+                ..base_spec.clone()
+            })));
+        }
+        if any_obstacle {
+            out.push(PoolFilter::Collision(CollisionFilter::new(CollisionSpec {
+                obstacles,
+                floor: self.floor,
+                srdf: None,
+                ..base_spec
+            })));
+        }
+        Ok(out)
+    }
+
+    /// Loads the robot, builds the pool and its Jacobian. A pool file is
+    /// read in the options' units.
+    pub fn load(&self) -> Result<PoolCtx> {
+        self.load_for(load_description(&self.robot)?)
+    }
+
+    /// Builds the pool of these options and its Jacobian for a robot
+    /// already loaded (from [`PoolOpts::robot`]).
+    pub fn load_for(&self, d: activecal::io::Description) -> Result<PoolCtx> {
+        let spec = self.spec(&d)?;
+        if let PoolSource::File { path } = &spec.source {
+            let rows = activecal::pool::read_configurations_in(
+                std::path::Path::new(path),
+                &d.robot,
+                self.units.units(),
+            )?;
+            let pool = spec.build_listed(&d.robot, &d.robot.nominal, rows)?;
+            let robot = self.compliant(d.robot, &pool)?;
+            return with_jacobian(robot, pool, self.params);
+        }
+        let pool = spec.build(&d.robot, &d.robot.nominal)?;
+        let robot = self.compliant(d.robot, &pool)?;
+        with_jacobian(robot, pool, self.params)
+    }
+
+    /// With `--compliance`, the robot with a compliance unknown per joint
+    /// whose gravity torque varies over the pool.
+    fn compliant(&self, robot: Robot, pool: &Pool) -> Result<Robot> {
+        if !self.compliance {
+            return Ok(robot);
+        }
+        let g = compliance::gravity_for(&robot, None, None)?;
+        let qs: Vec<Vec<f64>> = (0..pool.len()).map(|k| pool.q(k)).collect();
+        Ok(activecal::identify::compliance::with_compliance_at(&robot, &g, &qs).0)
+    }
+}

@@ -1,0 +1,173 @@
+//! The model built from its spec: the URDF's tree, the geometries, the pairs
+//! checked for self-collision (SRDF exclusions applied) and the obstacles
+//! placed in the base link's frame.
+
+use super::model::CollisionModel;
+use super::shapes::{Geometry, geometries};
+use super::spec::{CollisionSpec, Obstacle};
+use super::srdf;
+use super::tree::Tree;
+use parry3d_f64::na::{Isometry3, Vector3};
+use parry3d_f64::shape::{Cuboid, HalfSpace, SharedShape};
+use std::collections::HashSet;
+use std::path::Path;
+
+/// The SRDF's `disable_collisions` pairs, as link indices (smaller first).
+fn disabled_pairs(tree: &Tree, spec: &CollisionSpec) -> Result<HashSet<(usize, usize)>, String> {
+    let mut disabled: HashSet<(usize, usize)> = HashSet::new();
+    if let Some(s) = &spec.srdf {
+        let t = std::fs::read_to_string(s).map_err(|e| format!("SRDF file {s}: {e}"))?;
+        for p in srdf::disabled_pairs(&t, s)? {
+            let find = |name: &str| {
+                tree.index.get(name).copied().ok_or_else(|| {
+                    format!(
+                        "{s}:{}: disable_collisions names link '{name}', which {} does not have",
+                        p.line, spec.urdf
+                    )
+                })
+            };
+            let (a, b) = (find(&p.link1)?, find(&p.link2)?);
+            disabled.insert((a.min(b), a.max(b)));
+        }
+    }
+    Ok(disabled)
+}
+
+/// The geometry pairs checked for self-collision: on different, not
+/// adjacent bodies, and not disabled.
+fn checked_pairs(
+    tree: &Tree,
+    geoms: &[Geometry],
+    disabled: &HashSet<(usize, usize)>,
+) -> Vec<(usize, usize)> {
+    let mut pairs = Vec::new();
+    {
+        for a in 0..geoms.len() {
+            for b in a + 1..geoms.len() {
+                let (la, lb) = (geoms[a].link, geoms[b].link);
+                let (ba, bb) = (tree.body[la], tree.body[lb]);
+                if ba == bb
+                    || tree.adjacent_bodies(ba, bb)
+                    || disabled.contains(&(la.min(lb), la.max(lb)))
+                {
+                    continue;
+                }
+                pairs.push((a, b));
+            }
+        }
+    }
+    pairs
+}
+
+/// The boxes and the floor, placed in the base link's frame `base_pose`.
+fn obstacles(
+    spec: &CollisionSpec,
+    base_pose: &Isometry3<f64>,
+) -> Result<Vec<(String, Isometry3<f64>, SharedShape)>, String> {
+    let base_pose = *base_pose;
+    let mut obstacles = Vec::new();
+    for (k, o) in spec.obstacles.iter().enumerate() {
+        let Obstacle::Box { center, size } = o;
+        if size.iter().any(|s| !(s.is_finite() && *s > 0.0))
+            || center.iter().any(|c| !c.is_finite())
+        {
+            return Err(format!(
+                "obstacle {}: needs a finite centre and sizes > 0",
+                k + 1
+            ));
+        }
+        obstacles.push((
+            format!("box {}", k + 1),
+            base_pose * Isometry3::translation(center[0], center[1], center[2]),
+            SharedShape::new(Cuboid::new(Vector3::new(
+                size[0] / 2.0,
+                size[1] / 2.0,
+                size[2] / 2.0,
+            ))),
+        ));
+    }
+    if let Some(z) = spec.floor {
+        if !z.is_finite() {
+            return Err(format!("floor height {z}: not finite"));
+        }
+        obstacles.push((
+            "floor".to_string(),
+            base_pose * Isometry3::translation(0.0, 0.0, z),
+            SharedShape::new(HalfSpace::new(Vector3::z_axis())),
+        ));
+    }
+    Ok(obstacles)
+}
+
+impl CollisionModel {
+    /// Loads the model of `spec`: errors name the URDF, a missing or broken
+    /// mesh file and its link, an SRDF line naming an unknown link, a chain
+    /// joint or lock the URDF does not have.
+    pub fn load(spec: &CollisionSpec) -> Result<CollisionModel, String> {
+        let urdf_path = Path::new(&spec.urdf);
+        let text = match &spec.text {
+            Some(t) => t.to_string(),
+            None => {
+                std::fs::read_to_string(urdf_path).map_err(|e| format!("{}: {e}", spec.urdf))?
+            }
+        };
+        let urdf = urdf_rs::read_from_string(&text)
+            .map_err(|e| format!("{}: not a valid URDF: {e}", spec.urdf))?;
+        let tree = Tree::new(&urdf).map_err(|e| format!("{}: {e}", spec.urdf))?;
+        let joint_index = |name: &str| tree.joints.iter().position(|j| j.name == name);
+        let drives = spec
+            .joints
+            .iter()
+            .map(|n| joint_index(n).ok_or_else(|| format!("{}: no joint '{n}'", spec.urdf)))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut rest = vec![0.0; tree.joints.len()];
+        for (n, v) in &spec.lock {
+            let k =
+                joint_index(n).ok_or_else(|| format!("{}: no joint '{n}' to lock", spec.urdf))?;
+            rest[k] = *v;
+        }
+        let geoms = geometries(&urdf, &tree, spec)?;
+        let pairs = if spec.self_collision {
+            let disabled = disabled_pairs(&tree, spec)?;
+            checked_pairs(&tree, &geoms, &disabled)
+        } else {
+            Vec::new()
+        };
+        // Obstacles live in the base link's frame; placements are in the root's.
+        let base = match &spec.base {
+            Some(b) => *tree
+                .index
+                .get(b)
+                .ok_or_else(|| format!("{}: no link '{b}'", spec.urdf))?,
+            None => tree.root,
+        };
+        let mut at_rest = vec![Isometry3::identity(); tree.links.len()];
+        tree.placements(&rest, &mut at_rest);
+        // The base link's placement moves only if a joint above it moves;
+        // obstacles are fixed to it at the rest configuration of the joints
+        // above the chain (locks applied).
+        let obstacles = obstacles(spec, &at_rest[base])?;
+        // The half-space's normal points out of the solid: z < floor is
+        // inside when the normal is +z.
+        let base_body = tree.body[base];
+        let exposed = (0..geoms.len())
+            .filter(|&g| tree.body[geoms[g].link] != base_body)
+            .collect();
+        if !(spec.clearance.is_finite() && spec.clearance >= 0.0) {
+            return Err(format!(
+                "a clearance of {} m: it must be a finite distance >= 0",
+                spec.clearance
+            ));
+        }
+        Ok(CollisionModel {
+            tree,
+            geoms,
+            pairs,
+            obstacles,
+            exposed,
+            drives,
+            clearance: spec.clearance,
+            rest,
+        })
+    }
+}

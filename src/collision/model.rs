@@ -1,0 +1,265 @@
+//! The loaded model and its queries at a configuration: the first contact
+//! (closer than the clearance), which pair it is, and how fast each joint
+//! sweeps the geometry.
+
+use super::shapes::Geometry;
+use super::tree::{Motion, Tree};
+use parry3d_f64::na::Isometry3;
+use parry3d_f64::shape::SharedShape;
+use serde::Serialize;
+
+/// What two geometries at `pa`, `pb` are to each other: closer than
+/// `clearance` (touching when it is 0).
+fn too_close(
+    pa: &Isometry3<f64>,
+    a: &dyn parry3d_f64::shape::Shape,
+    pb: &Isometry3<f64>,
+    b: &dyn parry3d_f64::shape::Shape,
+    clearance: f64,
+) -> bool {
+    if clearance > 0.0 {
+        parry3d_f64::query::distance(pa, a, pb, b).is_ok_and(|d| d < clearance)
+    } else {
+        parry3d_f64::query::intersection_test(pa, a, pb, b).unwrap_or(false)
+    }
+}
+
+/// Which pair a contact is: a self-collision pair, or a link and an
+/// obstacle.
+#[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+pub struct ContactPair {
+    /// The first link.
+    pub link: String,
+    /// The other link, or the obstacle (`box 1`, `floor`).
+    pub other: String,
+    /// Whether `other` is an obstacle.
+    pub obstacle: bool,
+}
+
+/// Two placed shapes and the gap of their bounding spheres.
+pub(super) type Item<'s> = (
+    Isometry3<f64>,
+    &'s dyn parry3d_f64::shape::Shape,
+    Isometry3<f64>,
+    &'s dyn parry3d_f64::shape::Shape,
+    f64,
+);
+
+/// The loaded geometry, pairs and obstacles of a [`CollisionSpec`](super::CollisionSpec).
+pub struct CollisionModel {
+    pub(super) tree: Tree,
+    pub(super) geoms: Vec<Geometry>,
+    pub(super) pairs: Vec<(usize, usize)>,
+    /// Obstacle shapes with their placement in the root frame.
+    pub(super) obstacles: Vec<(String, Isometry3<f64>, SharedShape)>,
+    /// Geometries checked against obstacles.
+    pub(super) exposed: Vec<usize>,
+    /// For each configuration value `k`, the tree joint it drives.
+    pub(super) drives: Vec<usize>,
+    /// Least distance kept, metres ([`CollisionSpec::clearance`](super::CollisionSpec::clearance)).
+    pub(super) clearance: f64,
+    /// Joint values at a zero configuration (locks applied).
+    pub(super) rest: Vec<f64>,
+}
+
+impl std::fmt::Debug for CollisionModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "CollisionModel({} links, {} geometries, {} pairs, {} obstacles)",
+            self.tree.links.len(),
+            self.geoms.len(),
+            self.pairs.len(),
+            self.obstacles.len()
+        )
+    }
+}
+
+impl CollisionModel {
+    /// Geometry pairs checked for self-collision.
+    #[must_use]
+    pub fn pair_count(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// The first contact at configuration `q` (the chain's joint values), as
+    /// the two links (or link and obstacle) that touch (closer than the
+    /// spec's clearance), or `None` when the configuration is free.
+    #[must_use]
+    pub fn contact(&self, q: &[f64]) -> Option<(String, String)> {
+        self.contact_key(q).map(|k| {
+            let p = self.pair_of(k);
+            (p.link, p.other)
+        })
+    }
+
+    /// The first contact at `q` as a number ([`pair_of`](Self::pair_of)
+    /// names it): cheap to count per candidate.
+    #[must_use]
+    pub fn contact_key(&self, q: &[f64]) -> Option<usize> {
+        let mut values = self.rest.clone();
+        for (k, &j) in self.drives.iter().enumerate() {
+            if let Some(v) = q.get(k) {
+                values[j] = *v;
+            }
+        }
+        let mut links = vec![Isometry3::identity(); self.tree.links.len()];
+        self.tree.placements(&values, &mut links);
+        let poses: Vec<Isometry3<f64>> = self
+            .geoms
+            .iter()
+            .map(|g| links[g.link] * g.origin)
+            .collect();
+        let c = self.clearance;
+        for (k, &(a, b)) in self.pairs.iter().enumerate() {
+            let (ga, gb) = (&self.geoms[a], &self.geoms[b]);
+            let d = (poses[a] * ga.center - poses[b] * gb.center).norm();
+            if d > ga.radius + gb.radius + c {
+                continue;
+            }
+            if too_close(
+                &poses[a],
+                ga.shape.as_ref(),
+                &poses[b],
+                gb.shape.as_ref(),
+                c,
+            ) {
+                return Some(k);
+            }
+        }
+        for (o, (_, opose, oshape)) in self.obstacles.iter().enumerate() {
+            for &g in &self.exposed {
+                let geom = &self.geoms[g];
+                if too_close(&poses[g], geom.shape.as_ref(), opose, oshape.as_ref(), c) {
+                    return Some(self.pairs.len() + o * self.geoms.len() + g);
+                }
+            }
+        }
+        None
+    }
+
+    /// How far any point of a checked geometry can move per unit change of
+    /// each configuration value at `q`, metres per radian (or per metre):
+    /// for a revolute joint the largest distance from its axis point of a
+    /// geometry it carries (`|centre − axis point| + radius`, which bounds
+    /// the distance to the axis), for a prismatic joint 1, for a value
+    /// that moves no geometry 0.
+    #[must_use]
+    pub fn sweep_rates(&self, q: &[f64]) -> Vec<f64> {
+        let mut values = self.rest.clone();
+        for (k, &j) in self.drives.iter().enumerate() {
+            if let Some(v) = q.get(k) {
+                values[j] = *v;
+            }
+        }
+        let mut links = vec![Isometry3::identity(); self.tree.links.len()];
+        self.tree.placements(&values, &mut links);
+        // The tree joint above each link (None at the root).
+        let mut above = vec![None; self.tree.links.len()];
+        for (k, j) in self.tree.joints.iter().enumerate() {
+            above[j.child] = Some(k);
+        }
+        let mut rates = vec![0.0f64; self.drives.len()];
+        for g in &self.geoms {
+            let centre = links[g.link] * g.origin * g.center;
+            let mut link = g.link;
+            while let Some(j) = above[link] {
+                let joint = &self.tree.joints[j];
+                if let Some(k) = self.drives.iter().position(|&d| d == j) {
+                    let r = match joint.motion {
+                        Motion::Prismatic => 1.0,
+                        Motion::Fixed => 0.0,
+                        Motion::Revolute => {
+                            let axis_point =
+                                (links[joint.parent] * joint.origin).translation.vector;
+                            (centre.coords - axis_point).norm() + g.radius
+                        }
+                    };
+                    rates[k] = rates[k].max(r);
+                }
+                link = joint.parent;
+            }
+        }
+        rates
+    }
+
+    /// Every geometry's placement in the root frame at `q`.
+    pub(super) fn geometry_poses(&self, q: &[f64]) -> Vec<Isometry3<f64>> {
+        let mut values = self.rest.clone();
+        for (k, &j) in self.drives.iter().enumerate() {
+            if let Some(v) = q.get(k) {
+                values[j] = *v;
+            }
+        }
+        let mut links = vec![Isometry3::identity(); self.tree.links.len()];
+        self.tree.placements(&values, &mut links);
+        self.geoms
+            .iter()
+            .map(|g| links[g.link] * g.origin)
+            .collect()
+    }
+
+    /// The checked items (geometry pairs, then geometry–obstacle pairs) as
+    /// their [`contact_key`](Self::contact_key)s.
+    pub(super) fn item_keys(&self) -> Vec<usize> {
+        let mut keys: Vec<usize> = (0..self.pairs.len()).collect();
+        for o in 0..self.obstacles.len() {
+            keys.extend(
+                self.exposed
+                    .iter()
+                    .map(|&g| self.pairs.len() + o * self.geoms.len() + g),
+            );
+        }
+        keys
+    }
+
+    /// The placements and shapes of an item key, and the gap of its
+    /// bounding spheres (−∞ against an obstacle, which has none).
+    pub(super) fn item<'s>(&'s self, key: usize, poses: &[Isometry3<f64>]) -> Item<'s> {
+        if key < self.pairs.len() {
+            let (a, b) = self.pairs[key];
+            let (ga, gb) = (&self.geoms[a], &self.geoms[b]);
+            let gap = (poses[a] * ga.center - poses[b] * gb.center).norm() - ga.radius - gb.radius;
+            return (
+                poses[a],
+                ga.shape.as_ref(),
+                poses[b],
+                gb.shape.as_ref(),
+                gap,
+            );
+        }
+        let k = key - self.pairs.len();
+        let (o, g) = (k / self.geoms.len(), k % self.geoms.len());
+        let (_, opose, oshape) = &self.obstacles[o];
+        (
+            poses[g],
+            self.geoms[g].shape.as_ref(),
+            *opose,
+            oshape.as_ref(),
+            f64::NEG_INFINITY,
+        )
+    }
+
+    /// The links (or link and obstacle) of a [`contact_key`](Self::contact_key).
+    #[must_use]
+    pub fn pair_of(&self, key: usize) -> ContactPair {
+        let name = |g: usize| self.tree.links[self.geoms[g].link].clone();
+        if key < self.pairs.len() {
+            let (a, b) = self.pairs[key];
+            let (x, y) = (name(a), name(b));
+            let (link, other) = if x <= y { (x, y) } else { (y, x) };
+            return ContactPair {
+                link,
+                other,
+                obstacle: false,
+            };
+        }
+        let k = key - self.pairs.len();
+        let (o, g) = (k / self.geoms.len(), k % self.geoms.len());
+        ContactPair {
+            link: name(g),
+            other: self.obstacles[o].0.clone(),
+            obstacle: true,
+        }
+    }
+}

@@ -1,0 +1,100 @@
+//! The settings of a Monte-Carlo run, with their defaults and check.
+
+use crate::identify::lm::LmSettings;
+use crate::identify::{IdentifyError, Result};
+use serde::{Deserialize, Serialize};
+
+/// Settings of a Monte-Carlo run, with documented defaults.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct MonteCarloSettings {
+    /// Noise realisations `R`. Default 200.
+    pub trials: usize,
+    /// Measurement noise σ per coordinate, metres. Default 0.01 (paper §V).
+    pub sigma: f64,
+    /// Seed of the noise, the validation poses and the bootstrap. Default 0.
+    pub seed: u64,
+    /// Held-out validation poses. Default 500.
+    pub validation_poses: usize,
+    /// Bootstrap resamples for the spread of the generalised-variance ratio
+    /// (0 to skip). Default 200.
+    pub bootstrap: usize,
+    /// The solver's settings.
+    pub lm: LmSettings,
+}
+
+impl Default for MonteCarloSettings {
+    fn default() -> Self {
+        Self {
+            trials: 200,
+            sigma: 0.01,
+            seed: 0,
+            validation_poses: 500,
+            bootstrap: 200,
+            lm: LmSettings::default(),
+        }
+    }
+}
+
+impl MonteCarloSettings {
+    /// Sets [`MonteCarloSettings::trials`].
+    #[must_use]
+    pub fn with_trials(mut self, trials: usize) -> Self {
+        self.trials = trials;
+        self
+    }
+
+    /// Sets [`MonteCarloSettings::sigma`].
+    #[must_use]
+    pub fn with_sigma(mut self, sigma: f64) -> Self {
+        self.sigma = sigma;
+        self
+    }
+
+    /// Sets [`MonteCarloSettings::seed`].
+    #[must_use]
+    pub fn with_seed(mut self, seed: u64) -> Self {
+        self.seed = seed;
+        self
+    }
+
+    /// Sets [`MonteCarloSettings::validation_poses`].
+    #[must_use]
+    pub fn with_validation_poses(mut self, n: usize) -> Self {
+        self.validation_poses = n;
+        self
+    }
+
+    /// Sets [`MonteCarloSettings::bootstrap`].
+    #[must_use]
+    pub fn with_bootstrap(mut self, b: usize) -> Self {
+        self.bootstrap = b;
+        self
+    }
+
+    /// Checks every setting is in range.
+    pub fn validate(&self) -> Result<()> {
+        if self.trials == 0 {
+            return Err(IdentifyError::Setting {
+                name: "trials",
+                value: "0".into(),
+                reason: "at least one trial is needed",
+            });
+        }
+        if !(self.sigma.is_finite() && self.sigma >= 0.0) {
+            return Err(IdentifyError::Setting {
+                name: "sigma",
+                value: self.sigma.to_string(),
+                reason: "the noise standard deviation must be finite and >= 0",
+            });
+        }
+        if self.validation_poses == 0 {
+            return Err(IdentifyError::Setting {
+                name: "validation_poses",
+                value: "0".into(),
+                reason: "at least one held-out pose is needed (the RMS error of no poses is no measurement)",
+            });
+        }
+        self.lm.validate()
+    }
+}

@@ -354,7 +354,7 @@ fn synthetic_truth_is_fitted_to_the_noise_floor() {
 #[test]
 fn selected_contacts_beat_random_draws() {
     use activecal::identify::contact::select::{
-        predicted_consistency, refine_for_consistency, select_d_optimal, socket_pool,
+        Socket, predicted_consistency, refine_for_consistency, select_d_optimal, socket_pool,
     };
     use activecal::identify::contact::{group_means, tool_points};
     use rand::seq::SliceRandom;
@@ -364,10 +364,14 @@ fn selected_contacts_beat_random_draws() {
     let pts = tool_points(&robot, &robot.nominal, &[0.0; 3], &real.qs);
     let socket = group_means(&pts, &real.groups, real.points.len())[g];
     let mut rng = activecal::identify::trial_rng(29, 1);
+    let at = Socket {
+        name: "front_left/0".into(),
+        position: socket.into(),
+    };
     let pool = socket_pool(
         &robot,
         &robot.nominal,
-        &socket,
+        &[at],
         600,
         2f64.to_radians(),
         1e-7,

@@ -4,6 +4,7 @@
 
 pub mod atomic;
 pub mod calibrated;
+pub mod contact_design;
 pub mod contacts;
 pub mod design;
 pub mod design_formats;

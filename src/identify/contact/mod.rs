@@ -9,13 +9,16 @@
 //! * [`fit`](mod@fit): the fit (identifiable unknowns, the gauge, a robust
 //!   loss that names the rows it down-weights);
 //! * [`holdout`]: held out by placement (the part of a point's name before
-//!   `/`): leave one placement out, and train on one.
+//!   `/`): leave one placement out, and train on one;
+//! * [`select`], [`socket_design`]: the configurations to record for
+//!   sockets at given positions.
 
 pub mod data;
 pub mod fit;
 pub mod holdout;
 pub mod project;
 pub mod select;
+pub mod socket_design;
 
 pub use data::{ContactFile, NamedPlane};
 pub use fit::{ContactFit, ContactSettings, PlaneEstimate, fit_contacts};

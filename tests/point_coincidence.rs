@@ -346,16 +346,23 @@ fn synthetic_truth_is_fitted_to_the_noise_floor() {
 /// then exchanged for the predicted consistency error, against the median
 /// of 100 random 30-configuration draws from the same pool (the
 /// hand-recorded baseline); every pool configuration reaches the socket to
-/// 0.1 mm. Measured: D-optimal 0.481 σ, refined 0.476 σ, random median
-/// 0.588 σ (1.235×). The issue asks for 1.5×, which this pool does not
-/// give: its random draws are already spread over the whole reachable set
-/// (the exchange barely improves on D-optimal, a sign the design is near
-/// the pool's best). The bar is 1.2×: selection must beat random clearly.
+/// 0.1 mm. Measured (600 samples, 498 reach): D-optimal 0.481 σ, refined
+/// 0.476 σ, random median 0.588 σ (1.235×), and the convex relaxation
+/// certifies that no 30-configuration design of this pool is below
+/// 0.469 σ: the issue's 1.5× is out of reach of any design of the pool
+/// (median / bound = 1.25). Random draws are already nearly I-optimal on
+/// average (their mean information gives 0.494 σ); what they lose is the
+/// scatter of a 90-row, 25-unknown information matrix (about
+/// 3n/(3n − p − 1) = 1.41 in variance, 1.19 in σ). So the test asserts
+/// that the choice beats random clearly (1.2×), is within 2% of the bound
+/// (1.5% measured), and that 1.5× is beyond the bound (so the shortfall is
+/// the pool's, not the search's).
 #[test]
 fn selected_contacts_beat_random_draws() {
     use activecal::identify::contact::select::{
         Socket, predicted_consistency, refine_for_consistency, select_d_optimal, socket_pool,
     };
+    use activecal::identify::contact::socket_design::consistency_bound;
     use activecal::identify::contact::{group_means, tool_points};
     use rand::seq::SliceRandom;
     let robot = panda();
@@ -410,6 +417,18 @@ fn selected_contacts_beat_random_draws() {
         "{chosen} vs {median}"
     );
     assert!(chosen <= d_opt, "{chosen} vs {d_opt}");
+    let bound = consistency_bound(&pool, 30);
+    eprintln!("bound {:?}", bound);
+    // Certified: no design is below it (1e-9: rounding of traces of O(1)).
+    assert!(bound.certified_sigma <= chosen + 1e-9);
+    assert!(
+        chosen <= 1.02 * bound.certified_sigma,
+        "{chosen} vs {bound:?}"
+    );
+    assert!(
+        median < 1.5 * bound.certified_sigma,
+        "{median} vs {bound:?}"
+    );
 }
 
 /// Plane contacts: every column of the residual Jacobian with an unknown

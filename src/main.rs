@@ -168,6 +168,7 @@ fn main() {
         Command::Fk(a) => cli::basic::cmd_fk(a),
         Command::Pool(a) => cli::basic::cmd_pool(a),
         Command::Score(a) => cli::select::cmd_score(a, &given("score")),
+        Command::Select(a) if !a.points.is_empty() => cli::contact_select::cmd_select_points(&a),
         Command::Select(a) => cli::select::cmd_select(a),
         Command::Bench(a) => cli::bench::cmd_bench(a),
         Command::Reproduce(a) => cli::reproduce::cmd_reproduce(a),

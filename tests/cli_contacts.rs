@@ -59,7 +59,7 @@ fn contacts_calibrate_and_hold_out_by_placement() {
 }
 
 /// Bad inputs: a distance naming no point of the file, a holding out on a
-/// file of measured points, a malformed distance.
+/// file of measured points, a malformed distance, no distance at all.
 #[test]
 fn contact_bad_inputs() {
     let base = [
@@ -77,6 +77,9 @@ fn contact_bad_inputs() {
     let mut a = base.to_vec();
     a.extend(["--point-distance", "front_left/0=0.05"]);
     fails_with(&a, "expected A,B=METRES");
+    // Without a known distance the scale is free (the fit would shrink the
+    // arm to a point: σ̂ = 0 on panda_2).
+    fails_with(&base, "nothing fixes the scale");
     fails_with(
         &[
             "calibrate",

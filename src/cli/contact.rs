@@ -135,6 +135,7 @@ pub fn calibrate_contacts(
     let mut file = read_contacts(path, robot, a.units)?;
     file.set_known_planes(&planes).context("--plane")?;
     let known = resolve_distances(&file, &given, true).context("--point-distance")?;
+    activecal::identify::contact::check_scale(&file, &known).context("--point-distance")?;
     let settings = ContactSettings {
         lm: LmSettings::default()
             .with_max_iterations(a.max_iterations)

@@ -306,9 +306,6 @@ pub enum Order {
 
 /// Runs `select`.
 pub fn cmd_select(a: SelectArgs) -> Result<()> {
-    if !a.points.is_empty() {
-        return super::contact_select::cmd_select_points(&a);
-    }
     check_select_outputs(&a)?;
     // Cheap checks of the ordering's inputs before the pool is built.
     let described = super::load_description(&a.pool.robot)?;

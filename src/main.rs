@@ -173,6 +173,9 @@ fn main() {
         Command::Bench(a) => cli::bench::cmd_bench(a),
         Command::Reproduce(a) => cli::reproduce::cmd_reproduce(a),
         Command::Calibrate(a) => cli::calibrate::cmd_calibrate(a),
+        Command::Evaluate(a) if cli::contact::is_contact_file(&a.measurements) => {
+            cli::contact_evaluate::cmd_evaluate_contacts(&a)
+        }
         Command::Evaluate(a) => cli::measured::cmd_evaluate(a),
         Command::Bound(a) => cli::bound::cmd_bound(a),
         Command::Gap(a) => cli::bound::cmd_gap(a),

@@ -217,3 +217,76 @@ fn select_for_a_socket_bad_inputs() {
         "--gap: not available with --point",
     );
 }
+
+/// `evaluate` on a contact file: the nominal model's consistency per point
+/// and pooled, and a distance's error, equal the nominal figures of
+/// `calibrate`'s in-sample report (the same definition, no fit); a
+/// distance naming no point of the file is refused, and
+/// `--point-distance` on a file of measured points too.
+#[test]
+fn evaluate_a_contact_file() {
+    let d = ["--point-distance", "front_left/0,front_left/1=0.05"];
+    let mut args = vec![
+        "evaluate",
+        "--robot",
+        URDF,
+        "--tip",
+        "ball_link",
+        "--measurements",
+        DATA,
+        "--json",
+    ];
+    args.extend(d);
+    let e = json_of(&args);
+    assert_eq!(e["rows"], 559);
+    let c = &e["contacts"];
+    assert_eq!(c["points"].as_array().unwrap().len(), 18);
+    let mut cal = vec![
+        "calibrate",
+        "--robot",
+        URDF,
+        "--tip",
+        "ball_link",
+        "--measurements",
+        DATA,
+        "--json",
+    ];
+    cal.extend(d);
+    let f = json_of(&cal);
+    let s = &f["in_sample"];
+    // Both are the same sums over the same rows: equal to rounding.
+    let close = |a: &serde_json::Value, b: &serde_json::Value| {
+        (a.as_f64().unwrap() - b.as_f64().unwrap()).abs() < 1e-9
+    };
+    assert!(close(&c["pooled_mm"], &s["nominal_mm"]), "{c} vs {s}");
+    assert!(c["pooled_mm"].as_f64().unwrap() > 1.0);
+    for (p, q) in c["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(s["points"].as_array().unwrap())
+    {
+        assert_eq!(p["point"], q["point"]);
+        assert!(close(&p["consistency_mm"], &q["nominal_mm"]), "{p} vs {q}");
+    }
+    let (de, dc) = (&c["distances"][0], &s["distances"][0]);
+    assert!(
+        close(&de["error_mm"], &dc["nominal_error_mm"]),
+        "{de} vs {dc}"
+    );
+    let mut bad = args[..8].to_vec();
+    bad.extend(["--point-distance", "front_left/0,nowhere/1=0.05"]);
+    fails_with(&bad, "has no point 'nowhere/1'");
+    fails_with(
+        &[
+            "evaluate",
+            "--robot",
+            "fixtures/ur5.urdf",
+            "--measurements",
+            "fixtures/figaroh/ur10_full_pose.csv",
+            "--point-distance",
+            "a,b=0.05",
+        ],
+        "are for contact files",
+    );
+}

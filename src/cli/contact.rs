@@ -34,7 +34,7 @@ pub fn is_contact_file(path: &Path) -> bool {
 }
 
 /// Parses one `--point-distance A,B=METRES`.
-fn parse_distance(s: &str) -> Result<NamedDistance> {
+pub fn parse_distance(s: &str) -> Result<NamedDistance> {
     let bad = || {
         anyhow::anyhow!(
             "--point-distance {s}: expected A,B=METRES (two point names and a distance in metres, e.g. front_left/0,front_left/1=0.05)"
@@ -52,7 +52,7 @@ fn parse_distance(s: &str) -> Result<NamedDistance> {
 
 /// Parses one `--plane NAME=nx,ny,nz,d` (the normal's length is checked
 /// with the file's planes).
-fn parse_plane(s: &str) -> Result<NamedPlane> {
+pub fn parse_plane(s: &str) -> Result<NamedPlane> {
     let bad = || {
         anyhow::anyhow!(
             "--plane {s}: expected NAME=nx,ny,nz,d (a plane name, its normal and offset in metres, n · x = d in the base frame, e.g. table=0,0,1,0.02)"

@@ -6,6 +6,7 @@ pub mod bound;
 pub mod calibrate;
 pub mod compliance;
 pub mod contact;
+pub mod contact_evaluate;
 pub mod contact_select;
 pub mod figures;
 pub mod frames_text;

@@ -14,6 +14,7 @@
 //!   sockets at given positions.
 
 pub mod data;
+pub mod evaluate;
 pub mod fit;
 pub mod holdout;
 pub mod project;

@@ -216,6 +216,10 @@ fn select_for_a_socket_bad_inputs() {
         &with(&base, &["--point", FRONT_LEFT_0, "--gap"]),
         "--gap: not available with --point",
     );
+    fails_with(
+        &with(&base, &["--point", FRONT_LEFT_0, "--algorithm", "fedorov"]),
+        "--algorithm: not available with --point",
+    );
 }
 
 /// `evaluate` on a contact file: the nominal model's consistency per point

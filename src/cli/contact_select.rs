@@ -11,6 +11,7 @@ use activecal::identify::contact::socket_design::{
 use activecal::io::contact_design;
 use activecal::io::design_formats::DesignFormat;
 use activecal::model::MeasurementKind;
+use activecal::select::{Algorithm, CriterionKind};
 use anyhow::{Result, bail};
 use std::fmt::Write as _;
 
@@ -48,6 +49,13 @@ fn parse_socket(s: &str) -> Result<Socket> {
 fn refuse_pool_options(a: &SelectArgs) -> Result<()> {
     let p = &a.pool;
     let given = [
+        (a.algorithm != Algorithm::Eae, "--algorithm"),
+        (a.criterion != CriterionKind::Det, "--criterion"),
+        (a.initial.is_some(), "--initial"),
+        (a.ils.is_some(), "--ils"),
+        (a.polish, "--polish"),
+        (a.order.is_some(), "--order"),
+        (a.home.is_some(), "--home"),
         (a.existing.is_some(), "--existing"),
         (a.refine, "--refine"),
         (a.report.is_some(), "--report"),
@@ -63,7 +71,7 @@ fn refuse_pool_options(a: &SelectArgs) -> Result<()> {
     ];
     if let Some((_, name)) = given.iter().find(|(g, _)| *g) {
         bail!(
-            "{name}: not available with --point (the pool is configurations projected onto each socket from --count joint-space samples)"
+            "{name}: not available with --point (the pool is configurations projected onto each socket from --count joint-space samples, chosen D-optimally then exchanged for the predicted consistency error, in selection order)"
         );
     }
     Ok(())

@@ -515,3 +515,74 @@ fn plane_rows_are_central_differences() {
         }
     }
 }
+
+/// The same selection judged where it matters for a calibration: the
+/// predicted consistency error (variance of the unknowns the socket
+/// determines, robot and tool offset) at the configurations MUKCa recorded
+/// at the eight other placements of `panda_2`, not at the pool it was
+/// chosen from. Measured: D-optimal 0.408 σ, exchanged 0.397 σ, median of
+/// 100 random draws 0.494 σ (1.245×): the ratio is that of the pool (1.235×),
+/// so judging elsewhere does not bring the 1.5× either. Asserted:
+/// the choice beats the random median by 1.15× there too.
+#[test]
+fn selected_contacts_judged_at_other_placements() {
+    use activecal::identify::contact::select::{
+        Socket, SocketPool, consistency_moment, refine_for_consistency, select_d_optimal,
+        socket_pool, with_unknowns_of,
+    };
+    use activecal::identify::contact::{group_means, placement_of, tool_points};
+    use nalgebra::DMatrix;
+    use rand::seq::SliceRandom;
+    let robot = panda();
+    let real = contacts(&robot);
+    let g = real.point_index("front_left/0").unwrap();
+    let pts = tool_points(&robot, &robot.nominal, &[0.0; 3], &real.qs);
+    let at = Socket {
+        name: "front_left/0".into(),
+        position: group_means(&pts, &real.groups, real.points.len())[g].into(),
+    };
+    let mut rng = activecal::identify::trial_rng(29, 1);
+    let margin = 2f64.to_radians();
+    let pool = socket_pool(&robot, &robot.nominal, &[at], 600, margin, 1e-7, &mut rng).unwrap();
+    let rows: Vec<usize> = (0..real.qs.len())
+        .filter(|&i| placement_of(&real.points[real.groups[i]]) != "front_left")
+        .collect();
+    let eval = with_unknowns_of(
+        &pool,
+        &robot.nominal,
+        &real.points,
+        rows.iter().map(|&i| real.qs[i].clone()).collect(),
+        rows.iter().map(|&i| real.groups[i]).collect(),
+    );
+    // Robot unknowns and tool offset lead both column sets; the points'
+    // columns drop out of a moment centred per point.
+    let k = pool.robot.n_unknowns() + 3;
+    let w = consistency_moment(&eval).view((0, 0), (k, k)).into_owned();
+    let score = |pool: &SocketPool, d: &[usize]| -> f64 {
+        let p = pool.blocks[0].ncols();
+        let mut m = DMatrix::zeros(p, p);
+        for &i in d {
+            m += pool.blocks[i].transpose() * &pool.blocks[i];
+        }
+        m.try_inverse().map_or(f64::INFINITY, |mi| {
+            (mi.view((0, 0), (k, k)) * &w).trace().sqrt()
+        })
+    };
+    let d_opt = select_d_optimal(&pool, 30);
+    let chosen = refine_for_consistency(&pool, d_opt.clone());
+    let ids: Vec<usize> = (0..pool.qs.len()).collect();
+    let mut random: Vec<f64> = (0..100)
+        .map(|_| {
+            let mut d = ids.clone();
+            d.shuffle(&mut rng);
+            score(&pool, &d[..30])
+        })
+        .collect();
+    random.sort_by(f64::total_cmp);
+    let median = 0.5 * (random[49] + random[50]);
+    let (a, b) = (score(&pool, &d_opt), score(&pool, &chosen));
+    eprintln!(
+        "other placements: D-optimal {a:.4} σ, exchanged {b:.4} σ, random median {median:.4} σ"
+    );
+    assert!(b.is_finite() && median >= 1.15 * b, "{b} vs {median}");
+}

@@ -105,17 +105,47 @@ pub fn socket_pool<R: Rng + ?Sized>(
         qs,
     };
     let reduced = determined(robot, table, &file)?;
-    let x = jacobian(&reduced, table, &file);
+    Ok(pool_of(&reduced, table, file))
+}
+
+/// The pool of `file`'s configurations with `robot`'s unknowns as they are
+/// (no gauge or rank reduction): each row's 3 × p block.
+fn pool_of(robot: &Robot, table: &ParamTable, file: ContactFile) -> SocketPool {
+    let x = jacobian(robot, table, &file);
     let p = x.ncols();
     let blocks = (0..file.qs.len())
         .map(|i| DMatrix::from_fn(3, p, |r, c| x[(3 * i + r, c)]))
         .collect();
-    Ok(SocketPool {
-        robot: reduced,
+    SocketPool {
+        robot: robot.clone(),
         qs: file.qs,
         sockets: file.groups,
         blocks,
-    })
+    }
+}
+
+/// The configurations `qs` (touching sockets `sockets[k]` of `names`) as
+/// a pool with the unknowns of `pool` (its robot's, the tool offset, one
+/// point a name): to judge a design of `pool` on configurations it was not
+/// chosen from (other sockets), by the
+/// [`consistency_moment`] of the result, whose point columns drop out.
+#[must_use]
+pub fn with_unknowns_of(
+    pool: &SocketPool,
+    table: &ParamTable,
+    names: &[String],
+    qs: Vec<Vec<f64>>,
+    sockets: Vec<usize>,
+) -> SocketPool {
+    let file = ContactFile {
+        origin: "evaluation".into(),
+        lines: (1..=qs.len()).collect(),
+        groups: sockets,
+        points: names.to_vec(),
+        planes: Vec::new(),
+        qs,
+    };
+    pool_of(&pool.robot, table, file)
 }
 
 /// The robot without the gauge and the unknowns the pool does not determine.

@@ -294,3 +294,90 @@ fn evaluate_a_contact_file() {
         "are for contact files",
     );
 }
+
+/// A description file's `[[distance]]` and `[[plane]]` tables act as
+/// `--point-distance` and `--plane`: `evaluate` gives the same distance
+/// errors either way, `calibrate` fits with them (the scale fixed) and
+/// reports all nine; a table with a zero normal or a distance between a
+/// point and itself is refused at its line.
+#[test]
+fn description_tables_give_distances_and_planes() {
+    let dir = common::scratch_dir("cli_contacts", "description_tables");
+    let urdf = std::fs::canonicalize(URDF).unwrap();
+    let mut toml = format!("urdf = \"{}\"\ntip = \"ball_link\"\n", urdf.display());
+    let placements = distances();
+    for pair in placements.chunks(2) {
+        let (names, m) = pair[1].split_once('=').unwrap();
+        let (a, b) = names.split_once(',').unwrap();
+        toml += &format!("\n[[distance]]\na = \"{a}\"\nb = \"{b}\"\nmetres = {m}\n");
+    }
+    let setup = dir.join("setup.toml");
+    std::fs::write(&setup, &toml).unwrap();
+    let setup_s = setup.to_str().unwrap();
+    let from_file = json_of(&[
+        "evaluate",
+        "--robot",
+        setup_s,
+        "--measurements",
+        DATA,
+        "--json",
+    ]);
+    let mut flags = vec![
+        "evaluate",
+        "--robot",
+        URDF,
+        "--tip",
+        "ball_link",
+        "--measurements",
+        DATA,
+        "--json",
+    ];
+    flags.extend(placements.iter().map(String::as_str));
+    let from_flags = json_of(&flags);
+    let d = from_file["contacts"]["distances"].as_array().unwrap();
+    assert_eq!(d.len(), 9);
+    assert_eq!(d, from_flags["contacts"]["distances"].as_array().unwrap());
+    let fit = json_of(&[
+        "calibrate",
+        "--robot",
+        setup_s,
+        "--measurements",
+        DATA,
+        "--json",
+    ]);
+    assert_eq!(fit["exit_status"], 0);
+    assert_eq!(fit["in_sample"]["distances"].as_array().unwrap().len(), 9);
+    assert!(fit["in_sample"]["calibrated_mm"].as_f64().unwrap() > 0.1);
+    let bad = dir.join("bad.toml");
+    std::fs::write(
+        &bad,
+        format!("{toml}\n[[plane]]\nname = \"table\"\nnormal = [0, 0, 0]\noffset = 0.0\n"),
+    )
+    .unwrap();
+    fails_with(
+        &[
+            "evaluate",
+            "--robot",
+            bad.to_str().unwrap(),
+            "--measurements",
+            DATA,
+        ],
+        "[[plane]] 'table': a plane needs a finite, non-zero normal",
+    );
+    std::fs::write(
+        &bad,
+        format!("{toml}\n[[distance]]\na = \"x\"\nb = \"x\"\nmetres = 0.05\n"),
+    )
+    .unwrap();
+    fails_with(
+        &[
+            "evaluate",
+            "--robot",
+            bad.to_str().unwrap(),
+            "--measurements",
+            DATA,
+        ],
+        "a distance needs two different points",
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}

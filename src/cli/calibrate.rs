@@ -320,6 +320,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
                 out: !a.out.is_empty(),
                 point_distance: &a.point_distance,
                 plane: &a.plane,
+                setup: &desc.contacts,
                 holdout_by: a.holdout_by,
                 train_on: a.train_on.as_deref(),
                 loss: a.loss,

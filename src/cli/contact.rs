@@ -77,6 +77,24 @@ pub fn parse_plane(s: &str) -> Result<NamedPlane> {
     })
 }
 
+/// The description's distances and planes followed by those of
+/// `--point-distance` and `--plane`.
+pub fn contact_setup(
+    setup: &activecal::io::ContactSetup,
+    point_distance: &[String],
+    plane: &[String],
+) -> Result<(Vec<NamedDistance>, Vec<NamedPlane>)> {
+    let mut given = setup.distances.clone();
+    for s in point_distance {
+        given.push(parse_distance(s)?);
+    }
+    let mut planes = setup.planes.clone();
+    for s in plane {
+        planes.push(parse_plane(s)?);
+    }
+    Ok((given, planes))
+}
+
 /// The options of `calibrate` a contact fit reads.
 pub struct ContactArgs<'a> {
     /// `--holdout` was given (refused).
@@ -87,6 +105,8 @@ pub struct ContactArgs<'a> {
     pub point_distance: &'a [String],
     /// `--plane`.
     pub plane: &'a [String],
+    /// The description's `[[distance]]` and `[[plane]]` tables.
+    pub setup: &'a activecal::io::ContactSetup,
     /// `--holdout-by`.
     pub holdout_by: Option<HoldoutBy>,
     /// `--train-on`.
@@ -122,16 +142,7 @@ pub fn calibrate_contacts(
     if a.out {
         bail!("--out: writing a robot calibrated from contacts is not supported yet");
     }
-    let given: Vec<NamedDistance> = a
-        .point_distance
-        .iter()
-        .map(|s| parse_distance(s))
-        .collect::<Result<_>>()?;
-    let planes: Vec<NamedPlane> = a
-        .plane
-        .iter()
-        .map(|s| parse_plane(s))
-        .collect::<Result<_>>()?;
+    let (given, planes) = contact_setup(a.setup, a.point_distance, a.plane)?;
     let mut file = read_contacts(path, robot, a.units)?;
     file.set_known_planes(&planes).context("--plane")?;
     let known = resolve_distances(&file, &given, true).context("--point-distance")?;

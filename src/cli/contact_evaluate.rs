@@ -3,10 +3,10 @@
 //! and each plane's flatness, mm. The work is in
 //! `activecal::identify::contact::evaluate`.
 
-use super::contact::{parse_distance, parse_plane};
+use super::contact::contact_setup;
 use super::measured::EvaluateArgs;
 use activecal::identify::contact::evaluate::{ContactEvaluation, evaluate_contacts};
-use activecal::identify::contact::{NamedDistance, NamedPlane, resolve_distances};
+use activecal::identify::contact::resolve_distances;
 use activecal::io::contacts::read_contacts;
 use anyhow::{Context, Result};
 use serde_json::json;
@@ -14,17 +14,9 @@ use std::fmt::Write as _;
 
 /// Runs `evaluate` on a contact file.
 pub fn cmd_evaluate_contacts(a: &EvaluateArgs) -> Result<()> {
-    let given: Vec<NamedDistance> = a
-        .point_distance
-        .iter()
-        .map(|s| parse_distance(s))
-        .collect::<Result<_>>()?;
-    let planes: Vec<NamedPlane> = a
-        .plane
-        .iter()
-        .map(|s| parse_plane(s))
-        .collect::<Result<_>>()?;
-    let robot = super::load_robot(&a.robot)?;
+    let desc = super::load_description(&a.robot)?;
+    let (given, planes) = contact_setup(&desc.contacts, &a.point_distance, &a.plane)?;
+    let robot = desc.robot;
     let mut file = read_contacts(&a.measurements, &robot, a.units.units())?;
     file.set_known_planes(&planes).context("--plane")?;
     resolve_distances(&file, &given, true).context("--point-distance")?;

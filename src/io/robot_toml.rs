@@ -45,6 +45,13 @@
 //! metres), `measurement`, `name` and `visibility`; its unknowns are chosen
 //! automatically (see [`super::urdf`]).
 //!
+//! For calibration from contacts (a measurement file with a `point` or
+//! `plane` column), `[[distance]]` tables give known distances between
+//! points (`a = "front_left/0"`, `b = "front_left/1"`, `metres = 0.05`)
+//! and `[[plane]]` tables known planes (`name = "table"`, `normal = [0, 0,
+//! 1]`, `offset = 0.02`: `normal · x = offset` in the base frame, metres),
+//! as `--point-distance` and `--plane` do ([`super::ContactSetup`]).
+//!
 //! Every problem is an [`Error::Parse`] naming the file and the place:
 //! TOML syntax, unknown keys, missing or mistyped fields (with the TOML
 //! parser's line and column), and — with line, column and frame label — a
@@ -87,6 +94,73 @@ struct FileSpec {
     lock: Option<Spanned<std::collections::BTreeMap<String, f64>>>,
     #[serde(default)]
     frame: Vec<FrameSpec>,
+    #[serde(default)]
+    distance: Vec<Spanned<DistanceSpec>>,
+    #[serde(default)]
+    plane: Vec<Spanned<PlaneSpec>>,
+}
+
+/// `[[distance]]`: a known distance between two contact points, metres.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DistanceSpec {
+    a: String,
+    b: String,
+    metres: f64,
+}
+
+/// `[[plane]]`: a known plane `normal · x = offset` (base frame, metres).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PlaneSpec {
+    name: String,
+    normal: [f64; 3],
+    offset: f64,
+}
+
+/// The `[[distance]]` and `[[plane]]` tables, checked: a distance between
+/// two different points, finite and > 0; a plane with a finite, non-zero
+/// normal and a finite offset (each error at its table's line).
+fn contact_setup(cx: &Ctx<'_>, spec: &FileSpec) -> Result<crate::io::ContactSetup> {
+    let mut setup = crate::io::ContactSetup::default();
+    for d in &spec.distance {
+        let v = d.get_ref();
+        if v.a == v.b || !(v.metres.is_finite() && v.metres > 0.0) {
+            return Err(cx.at(
+                d.span(),
+                format!(
+                    "[[distance]] {},{}={}: a distance needs two different points and a finite length > 0 (metres)",
+                    v.a, v.b, v.metres
+                ),
+            ));
+        }
+        setup
+            .distances
+            .push(crate::identify::contact::NamedDistance {
+                a: v.a.clone(),
+                b: v.b.clone(),
+                metres: v.metres,
+            });
+    }
+    for p in &spec.plane {
+        let v = p.get_ref();
+        let n2: f64 = v.normal.iter().map(|c| c * c).sum();
+        if !(n2.is_finite() && n2 > 0.0 && v.offset.is_finite()) {
+            return Err(cx.at(
+                p.span(),
+                format!(
+                    "[[plane]] '{}': a plane needs a finite, non-zero normal and a finite offset (metres)",
+                    v.name
+                ),
+            ));
+        }
+        setup.planes.push(crate::identify::contact::NamedPlane {
+            name: v.name.clone(),
+            normal: v.normal,
+            offset: v.offset,
+        });
+    }
+    Ok(setup)
 }
 
 #[derive(Deserialize, Clone, Copy, PartialEq, Eq)]
@@ -192,11 +266,13 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
     let cx = Ctx { text, origin };
     let spec: FileSpec = toml::from_str(text).map_err(|e| cx.plain(e.to_string().trim_end()))?;
     let top = top_level(&cx, &spec)?;
+    let contacts = contact_setup(&cx, &spec)?;
     if let Some(urdf) = &spec.urdf {
         let robot = imported(&cx, &spec, urdf, dir, &top)?;
         return Ok(Description {
             robot,
             visibility: top.visibility,
+            contacts,
         });
     }
     check_chain_keys(&cx, &spec)?;
@@ -232,6 +308,7 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
     identifiable(&cx, robot, &chain.unknown_spans).map(|robot| Description {
         robot,
         visibility: top.visibility,
+        contacts,
     })
 }
 

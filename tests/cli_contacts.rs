@@ -298,7 +298,7 @@ fn evaluate_a_contact_file() {
 /// A description file's `[[distance]]` and `[[plane]]` tables act as
 /// `--point-distance` and `--plane`: `evaluate` gives the same distance
 /// errors either way, `calibrate` fits with them (the scale fixed) and
-/// reports all nine; a table with a zero normal or a distance between a
+/// reports all nine (and `--report` writes report.md and report.json); a table with a zero normal or a distance between a
 /// point and itself is refused at its line.
 #[test]
 fn description_tables_give_distances_and_planes() {
@@ -337,6 +337,7 @@ fn description_tables_give_distances_and_planes() {
     let d = from_file["contacts"]["distances"].as_array().unwrap();
     assert_eq!(d.len(), 9);
     assert_eq!(d, from_flags["contacts"]["distances"].as_array().unwrap());
+    let report = dir.join("report");
     let fit = json_of(&[
         "calibrate",
         "--robot",
@@ -344,8 +345,20 @@ fn description_tables_give_distances_and_planes() {
         "--measurements",
         DATA,
         "--json",
+        "--report",
+        report.to_str().unwrap(),
     ]);
     assert_eq!(fit["exit_status"], 0);
+    // --report writes the text report and the same JSON.
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+    assert!(
+        md.contains("in-sample consistency") && md.contains("front_left/0"),
+        "{md}"
+    );
+    let saved: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report.join("report.json")).unwrap())
+            .unwrap();
+    assert_eq!(saved, fit);
     assert_eq!(fit["in_sample"]["distances"].as_array().unwrap().len(), 9);
     assert!(fit["in_sample"]["calibrated_mm"].as_f64().unwrap() > 0.1);
     let bad = dir.join("bad.toml");

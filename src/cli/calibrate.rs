@@ -330,6 +330,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
                 no_geodesic: a.no_geodesic,
                 units: a.units.units(),
                 json: a.json,
+                report: a.report.as_deref(),
             };
             match super::contact::calibrate_contacts(&c, robot, m)? {
                 Some(why) => Err(NotConverged(why).into()),

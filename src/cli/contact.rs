@@ -125,6 +125,8 @@ pub struct ContactArgs<'a> {
     pub units: activecal::units::Units,
     /// `--json`.
     pub json: bool,
+    /// `--report DIR` (checked before the fit).
+    pub report: Option<&'a Path>,
 }
 
 /// Calibrates from a contact file; `Ok(Some(why))` when the fit did not
@@ -183,7 +185,11 @@ pub fn calibrate_contacts(
         "holdout": held,
         "exit_status": if fit.converged { 0 } else { 3 },
     });
-    super::emit(a.json, &v, || text(&file, &fit, &figures, held.as_ref()));
+    let report = text(&file, &fit, &figures, held.as_ref());
+    if let Some(dir) = a.report {
+        super::report_dir::contacts(dir, robot, &report, &v)?;
+    }
+    super::emit(a.json, &v, || report);
     if !fit.converged {
         return Ok(Some(format!(
             "the contact fit ended {:?} after {} iterations{}",

@@ -168,10 +168,14 @@ fn main() {
         Command::Fk(a) => cli::basic::cmd_fk(a),
         Command::Pool(a) => cli::basic::cmd_pool(a),
         Command::Score(a) => cli::select::cmd_score(a, &given("score")),
+        Command::Select(a) if !a.points.is_empty() => cli::contact_select::cmd_select_points(&a),
         Command::Select(a) => cli::select::cmd_select(a),
         Command::Bench(a) => cli::bench::cmd_bench(a),
         Command::Reproduce(a) => cli::reproduce::cmd_reproduce(a),
         Command::Calibrate(a) => cli::calibrate::cmd_calibrate(a),
+        Command::Evaluate(a) if cli::contact::is_contact_file(&a.measurements) => {
+            cli::contact_evaluate::cmd_evaluate_contacts(&a)
+        }
         Command::Evaluate(a) => cli::measured::cmd_evaluate(a),
         Command::Bound(a) => cli::bound::cmd_bound(a),
         Command::Gap(a) => cli::bound::cmd_gap(a),

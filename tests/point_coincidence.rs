@@ -346,16 +346,23 @@ fn synthetic_truth_is_fitted_to_the_noise_floor() {
 /// then exchanged for the predicted consistency error, against the median
 /// of 100 random 30-configuration draws from the same pool (the
 /// hand-recorded baseline); every pool configuration reaches the socket to
-/// 0.1 mm. Measured: D-optimal 0.481 σ, refined 0.476 σ, random median
-/// 0.588 σ (1.235×). The issue asks for 1.5×, which this pool does not
-/// give: its random draws are already spread over the whole reachable set
-/// (the exchange barely improves on D-optimal, a sign the design is near
-/// the pool's best). The bar is 1.2×: selection must beat random clearly.
+/// 0.1 mm. Measured (600 samples, 498 reach): D-optimal 0.481 σ, refined
+/// 0.476 σ, random median 0.588 σ (1.235×), and the convex relaxation
+/// certifies that no 30-configuration design of this pool is below
+/// 0.469 σ: the issue's 1.5× is out of reach of any design of the pool
+/// (median / bound = 1.25). Random draws are already nearly I-optimal on
+/// average (their mean information gives 0.494 σ); what they lose is the
+/// scatter of a 90-row, 25-unknown information matrix (about
+/// 3n/(3n − p − 1) = 1.41 in variance, 1.19 in σ). So the test asserts
+/// that the choice beats random clearly (1.2×), is within 2% of the bound
+/// (1.5% measured), and that 1.5× is beyond the bound (so the shortfall is
+/// the pool's, not the search's).
 #[test]
 fn selected_contacts_beat_random_draws() {
     use activecal::identify::contact::select::{
-        predicted_consistency, refine_for_consistency, select_d_optimal, socket_pool,
+        Socket, predicted_consistency, refine_for_consistency, select_d_optimal, socket_pool,
     };
+    use activecal::identify::contact::socket_design::consistency_bound;
     use activecal::identify::contact::{group_means, tool_points};
     use rand::seq::SliceRandom;
     let robot = panda();
@@ -364,10 +371,14 @@ fn selected_contacts_beat_random_draws() {
     let pts = tool_points(&robot, &robot.nominal, &[0.0; 3], &real.qs);
     let socket = group_means(&pts, &real.groups, real.points.len())[g];
     let mut rng = activecal::identify::trial_rng(29, 1);
+    let at = Socket {
+        name: "front_left/0".into(),
+        position: socket.into(),
+    };
     let pool = socket_pool(
         &robot,
         &robot.nominal,
-        &socket,
+        &[at],
         600,
         2f64.to_radians(),
         1e-7,
@@ -406,6 +417,18 @@ fn selected_contacts_beat_random_draws() {
         "{chosen} vs {median}"
     );
     assert!(chosen <= d_opt, "{chosen} vs {d_opt}");
+    let bound = consistency_bound(&pool, 30);
+    eprintln!("bound {:?}", bound);
+    // Certified: no design is below it (1e-9: rounding of traces of O(1)).
+    assert!(bound.certified_sigma <= chosen + 1e-9);
+    assert!(
+        chosen <= 1.02 * bound.certified_sigma,
+        "{chosen} vs {bound:?}"
+    );
+    assert!(
+        median < 1.5 * bound.certified_sigma,
+        "{median} vs {bound:?}"
+    );
 }
 
 /// Plane contacts: every column of the residual Jacobian with an unknown
@@ -491,4 +514,75 @@ fn plane_rows_are_central_differences() {
             );
         }
     }
+}
+
+/// The same selection judged where it matters for a calibration: the
+/// predicted consistency error (variance of the unknowns the socket
+/// determines, robot and tool offset) at the configurations MUKCa recorded
+/// at the eight other placements of `panda_2`, not at the pool it was
+/// chosen from. Measured: D-optimal 0.408 σ, exchanged 0.397 σ, median of
+/// 100 random draws 0.494 σ (1.245×): the ratio is that of the pool (1.235×),
+/// so judging elsewhere does not bring the issue's 1.5× either. Asserted:
+/// the choice beats the random median by 1.15× there too.
+#[test]
+fn selected_contacts_judged_at_other_placements() {
+    use activecal::identify::contact::select::{
+        Socket, SocketPool, consistency_moment, refine_for_consistency, select_d_optimal,
+        socket_pool, with_unknowns_of,
+    };
+    use activecal::identify::contact::{group_means, placement_of, tool_points};
+    use nalgebra::DMatrix;
+    use rand::seq::SliceRandom;
+    let robot = panda();
+    let real = contacts(&robot);
+    let g = real.point_index("front_left/0").unwrap();
+    let pts = tool_points(&robot, &robot.nominal, &[0.0; 3], &real.qs);
+    let at = Socket {
+        name: "front_left/0".into(),
+        position: group_means(&pts, &real.groups, real.points.len())[g].into(),
+    };
+    let mut rng = activecal::identify::trial_rng(29, 1);
+    let margin = 2f64.to_radians();
+    let pool = socket_pool(&robot, &robot.nominal, &[at], 600, margin, 1e-7, &mut rng).unwrap();
+    let rows: Vec<usize> = (0..real.qs.len())
+        .filter(|&i| placement_of(&real.points[real.groups[i]]) != "front_left")
+        .collect();
+    let eval = with_unknowns_of(
+        &pool,
+        &robot.nominal,
+        &real.points,
+        rows.iter().map(|&i| real.qs[i].clone()).collect(),
+        rows.iter().map(|&i| real.groups[i]).collect(),
+    );
+    // Robot unknowns and tool offset lead both column sets; the points'
+    // columns drop out of a moment centred per point.
+    let k = pool.robot.n_unknowns() + 3;
+    let w = consistency_moment(&eval).view((0, 0), (k, k)).into_owned();
+    let score = |pool: &SocketPool, d: &[usize]| -> f64 {
+        let p = pool.blocks[0].ncols();
+        let mut m = DMatrix::zeros(p, p);
+        for &i in d {
+            m += pool.blocks[i].transpose() * &pool.blocks[i];
+        }
+        m.try_inverse().map_or(f64::INFINITY, |mi| {
+            (mi.view((0, 0), (k, k)) * &w).trace().sqrt()
+        })
+    };
+    let d_opt = select_d_optimal(&pool, 30);
+    let chosen = refine_for_consistency(&pool, d_opt.clone());
+    let ids: Vec<usize> = (0..pool.qs.len()).collect();
+    let mut random: Vec<f64> = (0..100)
+        .map(|_| {
+            let mut d = ids.clone();
+            d.shuffle(&mut rng);
+            score(&pool, &d[..30])
+        })
+        .collect();
+    random.sort_by(f64::total_cmp);
+    let median = 0.5 * (random[49] + random[50]);
+    let (a, b) = (score(&pool, &d_opt), score(&pool, &chosen));
+    eprintln!(
+        "other placements: D-optimal {a:.4} σ, exchanged {b:.4} σ, random median {median:.4} σ"
+    );
+    assert!(b.is_finite() && median >= 1.15 * b, "{b} vs {median}");
 }

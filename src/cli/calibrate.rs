@@ -70,6 +70,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
                 out: !a.out.is_empty(),
                 point_distance: &a.point_distance,
                 plane: &a.plane,
+                setup: &desc.contacts,
                 holdout_by: a.holdout_by,
                 train_on: a.train_on.as_deref(),
                 loss: a.loss,
@@ -79,6 +80,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
                 no_geodesic: a.no_geodesic,
                 units: a.units.units(),
                 json: a.json,
+                report: a.report.as_deref(),
             };
             match super::contact::calibrate_contacts(&c, robot, m)? {
                 Some(why) => Err(NotConverged(why).into()),

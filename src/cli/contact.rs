@@ -34,7 +34,7 @@ pub fn is_contact_file(path: &Path) -> bool {
 }
 
 /// Parses one `--point-distance A,B=METRES`.
-fn parse_distance(s: &str) -> Result<NamedDistance> {
+pub fn parse_distance(s: &str) -> Result<NamedDistance> {
     let bad = || {
         anyhow::anyhow!(
             "--point-distance {s}: expected A,B=METRES (two point names and a distance in metres, e.g. front_left/0,front_left/1=0.05)"
@@ -52,7 +52,7 @@ fn parse_distance(s: &str) -> Result<NamedDistance> {
 
 /// Parses one `--plane NAME=nx,ny,nz,d` (the normal's length is checked
 /// with the file's planes).
-fn parse_plane(s: &str) -> Result<NamedPlane> {
+pub fn parse_plane(s: &str) -> Result<NamedPlane> {
     let bad = || {
         anyhow::anyhow!(
             "--plane {s}: expected NAME=nx,ny,nz,d (a plane name, its normal and offset in metres, n · x = d in the base frame, e.g. table=0,0,1,0.02)"
@@ -77,6 +77,24 @@ fn parse_plane(s: &str) -> Result<NamedPlane> {
     })
 }
 
+/// The description's distances and planes followed by those of
+/// `--point-distance` and `--plane`.
+pub fn contact_setup(
+    setup: &activecal::io::ContactSetup,
+    point_distance: &[String],
+    plane: &[String],
+) -> Result<(Vec<NamedDistance>, Vec<NamedPlane>)> {
+    let mut given = setup.distances.clone();
+    for s in point_distance {
+        given.push(parse_distance(s)?);
+    }
+    let mut planes = setup.planes.clone();
+    for s in plane {
+        planes.push(parse_plane(s)?);
+    }
+    Ok((given, planes))
+}
+
 /// The options of `calibrate` a contact fit reads.
 pub struct ContactArgs<'a> {
     /// `--holdout` was given (refused).
@@ -87,6 +105,8 @@ pub struct ContactArgs<'a> {
     pub point_distance: &'a [String],
     /// `--plane`.
     pub plane: &'a [String],
+    /// The description's `[[distance]]` and `[[plane]]` tables.
+    pub setup: &'a activecal::io::ContactSetup,
     /// `--holdout-by`.
     pub holdout_by: Option<HoldoutBy>,
     /// `--train-on`.
@@ -105,6 +125,8 @@ pub struct ContactArgs<'a> {
     pub units: activecal::units::Units,
     /// `--json`.
     pub json: bool,
+    /// `--report DIR` (checked before the fit).
+    pub report: Option<&'a Path>,
 }
 
 /// Calibrates from a contact file; `Ok(Some(why))` when the fit did not
@@ -122,19 +144,11 @@ pub fn calibrate_contacts(
     if a.out {
         bail!("--out: writing a robot calibrated from contacts is not supported yet");
     }
-    let given: Vec<NamedDistance> = a
-        .point_distance
-        .iter()
-        .map(|s| parse_distance(s))
-        .collect::<Result<_>>()?;
-    let planes: Vec<NamedPlane> = a
-        .plane
-        .iter()
-        .map(|s| parse_plane(s))
-        .collect::<Result<_>>()?;
+    let (given, planes) = contact_setup(a.setup, a.point_distance, a.plane)?;
     let mut file = read_contacts(path, robot, a.units)?;
     file.set_known_planes(&planes).context("--plane")?;
     let known = resolve_distances(&file, &given, true).context("--point-distance")?;
+    activecal::identify::contact::check_scale(&file, &known).context("--point-distance")?;
     let settings = ContactSettings {
         lm: LmSettings::default()
             .with_max_iterations(a.max_iterations)
@@ -171,7 +185,11 @@ pub fn calibrate_contacts(
         "holdout": held,
         "exit_status": if fit.converged { 0 } else { 3 },
     });
-    super::emit(a.json, &v, || text(&file, &fit, &figures, held.as_ref()));
+    let report = text(&file, &fit, &figures, held.as_ref());
+    if let Some(dir) = a.report {
+        super::report_dir::contacts(dir, robot, &report, &v)?;
+    }
+    super::emit(a.json, &v, || report);
     if !fit.converged {
         return Ok(Some(format!(
             "the contact fit ended {:?} after {} iterations{}",

@@ -187,6 +187,13 @@ pub struct EvaluateArgs {
     /// Units of the measurement file.
     #[command(flatten)]
     pub units: super::units::UnitOpts,
+    /// A contact file's known distance between two points, A,B=METRES
+    /// (repeatable): its error is reported.
+    #[arg(long = "point-distance", value_name = "A,B=METRES")]
+    pub point_distance: Vec<String>,
+    /// A contact file's known plane, NAME=nx,ny,nz,d (repeatable).
+    #[arg(long, value_name = "NAME=nx,ny,nz,d", allow_hyphen_values = true)]
+    pub plane: Vec<String>,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -205,6 +212,12 @@ struct EvaluateReport {
 
 /// Runs `evaluate`: the model's errors on the data, no fitting.
 pub fn cmd_evaluate(a: EvaluateArgs) -> Result<()> {
+    if !(a.point_distance.is_empty() && a.plane.is_empty()) {
+        anyhow::bail!(
+            "--point-distance and --plane are for contact files (a CSV with a point or plane column); {} is not one",
+            a.measurements.display()
+        );
+    }
     let robot = super::load_robot(&a.robot)?;
     let (meas, notes) = read_measurements(&a.measurements, &robot, a.units.units(), a.json)?;
     let res = residuals(&robot, &robot.nominal, &meas).map_err(|e| {

@@ -8,6 +8,8 @@ pub mod calibrate_args;
 pub mod calibrated;
 pub mod compliance;
 pub mod contact;
+pub mod contact_evaluate;
+pub mod contact_select;
 pub mod existing;
 pub mod figures;
 pub mod frames_text;

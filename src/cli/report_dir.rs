@@ -439,3 +439,24 @@ fn joint_scale(robot: &Robot) -> Vec<f64> {
     }
     k
 }
+
+/// Writes `calibrate --report DIR` for a contact file: report.md (the text
+/// report: the fit, in-sample and held-out consistency, in mm) and
+/// report.json (the `--json` object). No figures yet.
+pub fn contacts(dir: &Path, robot: &Robot, text: &str, json: &serde_json::Value) -> Result<()> {
+    let staged = StagedDir::new(dir)?;
+    let md = format!(
+        "# Calibration report (contacts)\n\nRobot: `{}` (chain {}).\n\n```text\n{}```\n",
+        robot.name,
+        activecal::report::chain(robot).join(" → "),
+        text
+    );
+    put(&staged, "report.md", &md)?;
+    put(
+        &staged,
+        "report.json",
+        &(serde_json::to_string_pretty(json)? + "\n"),
+    )?;
+    staged.commit()?;
+    Ok(())
+}

@@ -278,6 +278,14 @@ pub struct SelectArgs {
     /// errors, metres [default: 0.01, as `calibrate --noise`].
     #[arg(long, requires = "report", allow_negative_numbers = true)]
     pub noise: Option<f64>,
+    /// Choose configurations that touch a socket at this position instead
+    /// of poses of a pool: NAME=X,Y,Z (base frame, metres; repeatable).
+    /// Joint-space samples (--count, default 1000 a socket; --pool-seed)
+    /// are projected onto each socket within the limits less --margin,
+    /// and --n are chosen with the contact Jacobian; the predicted
+    /// consistency error is compared with random draws (--seed).
+    #[arg(long = "point", value_name = "NAME=X,Y,Z", allow_hyphen_values = true)]
+    pub points: Vec<String>,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,

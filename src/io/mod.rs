@@ -4,6 +4,7 @@
 
 pub mod atomic;
 pub mod calibrated;
+pub mod contact_design;
 pub mod contacts;
 pub mod design;
 pub mod design_formats;
@@ -34,6 +35,20 @@ pub struct Description {
     pub robot: Robot,
     /// The region the sensor sees, if given.
     pub visibility: Option<Visibility>,
+    /// Known distances between contact points and known planes
+    /// (`[[distance]]`, `[[plane]]` of a description file).
+    pub contacts: ContactSetup,
+}
+
+/// What a description knows of a contact setup: distances between named
+/// points and planes given by name (used with a contact file's `point` and
+/// `plane` columns).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ContactSetup {
+    /// Known distances.
+    pub distances: Vec<crate::identify::contact::NamedDistance>,
+    /// Known planes.
+    pub planes: Vec<crate::identify::contact::NamedPlane>,
 }
 
 /// A robot by built-in name (see [`Robot::builtin`]) or from a file, in
@@ -202,6 +217,7 @@ fn load_head(r: &RobotRef) -> Result<Description> {
         return Ok(Description {
             robot,
             visibility: None,
+            contacts: ContactSetup::default(),
         });
     }
     let ext = r.extension();
@@ -223,6 +239,7 @@ fn load_head(r: &RobotRef) -> Result<Description> {
         Some("urdf") => Description {
             robot: load_urdf(path, &r.chain, r.pose)?,
             visibility: None,
+            contacts: ContactSetup::default(),
         },
         _ if path.exists() => {
             return Err(Error::Invalid(format!(

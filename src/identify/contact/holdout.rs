@@ -174,13 +174,25 @@ pub fn judge(
     test: &ContactFile,
     distances: &[NamedDistance],
 ) -> Figures {
-    let n = test.points.len();
-    let all = n + test.planes.len();
     let nom = tool_points(robot, nominal, &[0.0; 3], &test.qs);
     let cal = tool_points(&fit.robot, &fit.table, &fit.tool_offset, &test.qs);
+    figures_of(&nom, &cal, test, distances)
+}
+
+/// The figures of two models' tool points `nom` and `cal` (one a row of
+/// `test`).
+#[must_use]
+pub fn figures_of(
+    nom: &[Vector3<f64>],
+    cal: &[Vector3<f64>],
+    test: &ContactFile,
+    distances: &[NamedDistance],
+) -> Figures {
+    let n = test.points.len();
+    let all = n + test.planes.len();
     let (sn, sc) = (
-        spreads(&nom, &test.groups, all),
-        spreads(&cal, &test.groups, all),
+        spreads(nom, &test.groups, all),
+        spreads(cal, &test.groups, all),
     );
     let point_rows: Vec<usize> = (0..test.qs.len()).filter(|&i| test.groups[i] < n).collect();
     let pooled = |s: &[f64]| 1e3 * rms(&point_rows.iter().map(|&i| s[i]).collect::<Vec<_>>());
@@ -197,8 +209,8 @@ pub fn judge(
         })
         .collect();
     let (mn, mc) = (
-        group_means(&nom, &test.groups, all),
-        group_means(&cal, &test.groups, all),
+        group_means(nom, &test.groups, all),
+        group_means(cal, &test.groups, all),
     );
     // Every distance given is checked when the test file was read: here a
     // distance whose points are not both in `test` is left out.
@@ -218,7 +230,7 @@ pub fn judge(
         nominal_mm: pooled(&sn),
         calibrated_mm: pooled(&sc),
         distances,
-        planes: plane_figures(test, &nom, &cal),
+        planes: plane_figures(test, nom, cal),
     }
 }
 

@@ -9,13 +9,17 @@
 //! * [`fit`](mod@fit): the fit (identifiable unknowns, the gauge, a robust
 //!   loss that names the rows it down-weights);
 //! * [`holdout`]: held out by placement (the part of a point's name before
-//!   `/`): leave one placement out, and train on one.
+//!   `/`): leave one placement out, and train on one;
+//! * [`select`], [`socket_design`]: the configurations to record for
+//!   sockets at given positions.
 
 pub mod data;
+pub mod evaluate;
 pub mod fit;
 pub mod holdout;
 pub mod project;
 pub mod select;
+pub mod socket_design;
 
 pub use data::{ContactFile, NamedPlane};
 pub use fit::{ContactFit, ContactSettings, PlaneEstimate, fit_contacts};
@@ -78,6 +82,22 @@ pub fn resolve_distances(
         }
     }
     Ok(out)
+}
+
+/// Refuses contacts with no known distance between two of their points:
+/// nothing then fixes the scale, and a fit shrinks the arm (every joint
+/// origin's offset to zero, the tool on a joint axis) until every contact
+/// coincides — a "perfect" fit of any data (MUKCa's `panda_2` without its
+/// distances: σ̂ = 0, every point at joint 2's origin). Planes do not fix it
+/// either (the collapsed tool point lies on them).
+pub fn check_scale(file: &ContactFile, known: &[KnownDistance]) -> crate::error::Result<()> {
+    if known.is_empty() {
+        return Err(Error::Invalid(format!(
+            "{}: no known distance between two of its points, so nothing fixes the scale: a fit would shrink the arm until every contact coincides; give the distance between two points it touches (e.g. the two sockets of a block)",
+            file.origin
+        )));
+    }
+    Ok(())
 }
 
 /// The placement of a point: its name before the first `/` (the whole name

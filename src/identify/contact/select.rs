@@ -22,62 +22,130 @@ use crate::model::{ParamTable, Robot};
 use faer::Mat;
 use nalgebra::{DMatrix, Vector3};
 use rand::{Rng, RngExt};
+use serde::Serialize;
 
-/// A pool of configurations at one socket, with their design Jacobian.
+/// A socket the tool is to touch: its name and approximate position in
+/// the base frame (metres).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Socket {
+    /// The point's name (as a contact file's `point` column names it).
+    pub name: String,
+    /// Its position in the base frame, metres.
+    pub position: [f64; 3],
+}
+
+/// A pool of configurations at one or more sockets, with their design
+/// Jacobian.
 #[derive(Clone, Debug)]
 pub struct SocketPool {
     /// The robot with the unknowns the pool determines.
     pub robot: Robot,
-    /// The configurations (all reach the socket).
+    /// The configurations (each reaches its socket).
     pub qs: Vec<Vec<f64>>,
+    /// The socket each configuration reaches (an index into the sockets).
+    pub sockets: Vec<usize>,
     /// Each configuration's 3 × p rows (unknowns: the robot's, the tool
-    /// offset, the point).
+    /// offset, every socket's point).
     pub blocks: Vec<DMatrix<f64>>,
 }
 
-/// Samples `count` configurations uniformly inside the limits less
-/// `margin` and keeps those that project onto `socket` (to `tol` metres),
-/// then builds their Jacobian blocks for the unknowns the pool determines.
+/// Fewest configurations a socket of a pool needs (as a contact file's
+/// point needs rows).
+pub const MIN_SOCKET_CONFIGURATIONS: usize = 3;
+
+/// For each socket, samples `count` configurations uniformly inside the
+/// limits less `margin` and keeps those that project onto it (to `tol`
+/// metres), then builds their Jacobian blocks for the unknowns the pool
+/// determines. A socket that fewer than [`MIN_SOCKET_CONFIGURATIONS`]
+/// samples reach is an error naming it.
 #[allow(clippy::too_many_arguments)]
 pub fn socket_pool<R: Rng + ?Sized>(
     robot: &Robot,
     table: &ParamTable,
-    socket: &Vector3<f64>,
+    sockets: &[Socket],
     count: usize,
     margin: f64,
     tol: f64,
     rng: &mut R,
 ) -> crate::identify::Result<SocketPool> {
     let mut qs = Vec::new();
-    for _ in 0..count {
-        let q0: Vec<f64> = robot
-            .limits
-            .iter()
-            .map(|&[lo, hi]| lo + margin + rng.random::<f64>() * (hi - lo - 2.0 * margin).max(0.0))
-            .collect();
-        if let Some(q) = project_to_point(robot, table, &[0.0; 3], socket, &q0, margin, tol) {
-            qs.push(q);
+    let mut groups = Vec::new();
+    for (g, s) in sockets.iter().enumerate() {
+        let target = Vector3::from(s.position);
+        let before = qs.len();
+        for _ in 0..count {
+            let q0: Vec<f64> = robot
+                .limits
+                .iter()
+                .map(|&[lo, hi]| {
+                    lo + margin + rng.random::<f64>() * (hi - lo - 2.0 * margin).max(0.0)
+                })
+                .collect();
+            if let Some(q) = project_to_point(robot, table, &[0.0; 3], &target, &q0, margin, tol) {
+                qs.push(q);
+                groups.push(g);
+            }
+        }
+        let reached = qs.len() - before;
+        if reached < MIN_SOCKET_CONFIGURATIONS {
+            let p = s.position;
+            return Err(crate::error::Error::Invalid(format!(
+                "point '{}' at ({}, {}, {}) m: {reached} of {count} sampled configurations reach it within the joint limits (less the margin), {MIN_SOCKET_CONFIGURATIONS} needed; is it within the arm's reach?",
+                s.name, p[0], p[1], p[2]
+            ))
+            .into());
         }
     }
     let file = ContactFile {
         origin: "pool".into(),
-        groups: vec![0; qs.len()],
-        points: vec!["socket".into()],
+        groups,
+        points: sockets.iter().map(|s| s.name.clone()).collect(),
         planes: Vec::new(),
         lines: (1..=qs.len()).collect(),
         qs,
     };
     let reduced = determined(robot, table, &file)?;
-    let x = jacobian(&reduced, table, &file);
+    Ok(pool_of(&reduced, table, file))
+}
+
+/// The pool of `file`'s configurations with `robot`'s unknowns as they are
+/// (no gauge or rank reduction): each row's 3 × p block.
+fn pool_of(robot: &Robot, table: &ParamTable, file: ContactFile) -> SocketPool {
+    let x = jacobian(robot, table, &file);
     let p = x.ncols();
     let blocks = (0..file.qs.len())
         .map(|i| DMatrix::from_fn(3, p, |r, c| x[(3 * i + r, c)]))
         .collect();
-    Ok(SocketPool {
-        robot: reduced,
+    SocketPool {
+        robot: robot.clone(),
         qs: file.qs,
+        sockets: file.groups,
         blocks,
-    })
+    }
+}
+
+/// The configurations `qs` (touching sockets `sockets[k]` of `names`) as
+/// a pool with the unknowns of `pool` (its robot's, the tool offset, one
+/// point a name): to judge a design of `pool` on configurations it was not
+/// chosen from (other sockets), by the
+/// [`consistency_moment`] of the result, whose point columns drop out.
+#[must_use]
+pub fn with_unknowns_of(
+    pool: &SocketPool,
+    table: &ParamTable,
+    names: &[String],
+    qs: Vec<Vec<f64>>,
+    sockets: Vec<usize>,
+) -> SocketPool {
+    let file = ContactFile {
+        origin: "evaluation".into(),
+        lines: (1..=qs.len()).collect(),
+        groups: sockets,
+        points: names.to_vec(),
+        planes: Vec::new(),
+        qs,
+    };
+    pool_of(&pool.robot, table, file)
 }
 
 /// The robot without the gauge and the unknowns the pool does not determine.
@@ -124,24 +192,32 @@ fn information(pool: &SocketPool, design: &[usize]) -> DMatrix<f64> {
     m
 }
 
-/// The pool's centred second moment `W = Σ_q (X_q − X̄)ᵀ (X_q − X̄) / (3N)`:
-/// `tr(M⁻¹ W)` is the mean squared deviation, per coordinate, of a pool
-/// configuration's predicted tool point from the pool's mean prediction
-/// (the point's own columns are the same for every row and drop out).
+/// The pool's second moment about each socket's mean,
+/// `W = Σ_q (X_q − X̄_s(q))ᵀ (X_q − X̄_s(q)) / (3N)`: `tr(M⁻¹ W)` is the mean
+/// squared deviation, per coordinate, of a pool configuration's predicted
+/// tool point from its socket's mean prediction (a point's own columns are
+/// the same for every row of its socket and drop out).
 #[must_use]
 pub fn consistency_moment(pool: &SocketPool) -> DMatrix<f64> {
-    let n = pool.blocks.len() as f64;
-    let mean = pool
-        .blocks
-        .iter()
-        .fold(DMatrix::zeros(3, pool.blocks[0].ncols()), |a, b| a + b)
-        / n;
-    let mut w = DMatrix::zeros(mean.ncols(), mean.ncols());
-    for b in &pool.blocks {
-        let c = b - &mean;
+    let p = pool.blocks[0].ncols();
+    let k = pool.sockets.iter().max().map_or(0, |m| m + 1);
+    let mut sums = vec![DMatrix::zeros(3, p); k];
+    let mut counts = vec![0usize; k];
+    for (b, &g) in pool.blocks.iter().zip(&pool.sockets) {
+        sums[g] += b;
+        counts[g] += 1;
+    }
+    let means: Vec<DMatrix<f64>> = sums
+        .into_iter()
+        .zip(&counts)
+        .map(|(s, &c)| s / c.max(1) as f64)
+        .collect();
+    let mut w = DMatrix::zeros(p, p);
+    for (b, &g) in pool.blocks.iter().zip(&pool.sockets) {
+        let c = b - &means[g];
         w += c.transpose() * c;
     }
-    w / (3.0 * n)
+    w / (3.0 * pool.blocks.len() as f64)
 }
 
 /// The predicted consistency error of `design` in units of σ: the RMS

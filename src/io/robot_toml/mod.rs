@@ -45,6 +45,13 @@
 //! metres), `measurement`, `name` and `visibility`; its unknowns are chosen
 //! automatically (see [`super::urdf`]).
 //!
+//! For calibration from contacts (a measurement file with a `point` or
+//! `plane` column), `[[distance]]` tables give known distances between
+//! points (`a = "front_left/0"`, `b = "front_left/1"`, `metres = 0.05`)
+//! and `[[plane]]` tables known planes (`name = "table"`, `normal = [0, 0,
+//! 1]`, `offset = 0.02`: `normal · x = offset` in the base frame, metres),
+//! as `--point-distance` and `--plane` do ([`super::ContactSetup`]).
+//!
 //! Every problem is an [`Error::Parse`] naming the file and the place:
 //! TOML syntax, unknown keys, missing or mistyped fields (with the TOML
 //! parser's line and column), and — with line, column and frame label — a
@@ -52,6 +59,7 @@
 //! inverted limits, an unknown symbol, no unknowns, and unknowns that are not
 //! identifiable ([`Robot::check_identifiable`]).
 
+mod contacts;
 mod frames;
 mod spec;
 mod write;
@@ -104,11 +112,13 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
     let cx = Ctx { text, origin };
     let spec: FileSpec = toml::from_str(text).map_err(|e| cx.plain(e.to_string().trim_end()))?;
     let top = top_level(&cx, &spec)?;
+    let contacts = contacts::contact_setup(&cx, &spec)?;
     if let Some(urdf) = &spec.urdf {
         let robot = imported(&cx, &spec, urdf, dir, &top)?;
         return Ok(Description {
             robot,
             visibility: top.visibility,
+            contacts,
         });
     }
     check_chain_keys(&cx, &spec)?;
@@ -144,6 +154,7 @@ pub fn parse_description(text: &str, origin: &str, dir: Option<&Path>) -> Result
     identifiable(&cx, robot, &chain.unknown_spans).map(|robot| Description {
         robot,
         visibility: top.visibility,
+        contacts,
     })
 }
 

@@ -32,6 +32,28 @@ pub(super) struct FileSpec {
     pub(super) lock: Option<Spanned<std::collections::BTreeMap<String, f64>>>,
     #[serde(default)]
     pub(super) frame: Vec<FrameSpec>,
+    #[serde(default)]
+    pub(super) distance: Vec<Spanned<DistanceSpec>>,
+    #[serde(default)]
+    pub(super) plane: Vec<Spanned<PlaneSpec>>,
+}
+
+/// `[[distance]]`: a known distance between two contact points, metres.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct DistanceSpec {
+    pub(super) a: String,
+    pub(super) b: String,
+    pub(super) metres: f64,
+}
+
+/// `[[plane]]`: a known plane `normal · x = offset` (base frame, metres).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct PlaneSpec {
+    pub(super) name: String,
+    pub(super) normal: [f64; 3],
+    pub(super) offset: f64,
 }
 
 #[derive(Deserialize, Clone, Copy, PartialEq, Eq)]

@@ -1,0 +1,174 @@
+//! `select --point NAME=x,y,z`: the configurations to record for sockets
+//! (calibration from contacts, no instrument). Parses the sockets and the
+//! options that apply, renders the design; the work is in
+//! `activecal::identify::contact::socket_design`.
+
+use super::select::SelectArgs;
+use activecal::identify::contact::select::Socket;
+use activecal::identify::contact::socket_design::{
+    SocketDesign, SocketDesignSettings, design_for_sockets,
+};
+use activecal::io::contact_design;
+use activecal::io::design_formats::DesignFormat;
+use activecal::model::MeasurementKind;
+use activecal::select::{Algorithm, CriterionKind};
+use anyhow::{Result, bail};
+use std::fmt::Write as _;
+
+/// Joint-space samples projected onto each socket when `--count` is not
+/// given.
+pub const DEFAULT_SAMPLES: usize = 1000;
+
+/// Parses one `--point NAME=x,y,z` (base frame, metres).
+fn parse_socket(s: &str) -> Result<Socket> {
+    let bad = || {
+        anyhow::anyhow!(
+            "--point {s}: expected NAME=X,Y,Z (a point name and its position in the base frame, metres, e.g. front_left/0=0.48,0.23,0.02)"
+        )
+    };
+    let (name, rest) = s.split_once('=').ok_or_else(bad)?;
+    let v: Vec<f64> = rest
+        .split(',')
+        .map(|c| c.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| bad())?;
+    let [x, y, z] = v.as_slice() else {
+        return Err(bad());
+    };
+    if name.trim().is_empty() || v.iter().any(|c| !c.is_finite()) {
+        return Err(bad());
+    }
+    Ok(Socket {
+        name: name.trim().to_string(),
+        position: [*x, *y, *z],
+    })
+}
+
+/// The options of `select` that have no meaning for sockets, refused
+/// rather than ignored.
+fn refuse_pool_options(a: &SelectArgs) -> Result<()> {
+    let p = &a.pool;
+    let given = [
+        (a.algorithm != Algorithm::Eae, "--algorithm"),
+        (a.criterion != CriterionKind::Det, "--criterion"),
+        (a.initial.is_some(), "--initial"),
+        (a.ils.is_some(), "--ils"),
+        (a.polish, "--polish"),
+        (a.order.is_some(), "--order"),
+        (a.home.is_some(), "--home"),
+        (a.existing.is_some(), "--existing"),
+        (a.refine, "--refine"),
+        (a.report.is_some(), "--report"),
+        (a.gap, "--gap"),
+        (a.fixed.is_some(), "--fixed"),
+        (p.pool != super::PoolKind::Lattice, "--pool"),
+        (p.levels.is_some(), "--levels"),
+        (p.visibility.is_some(), "--visibility"),
+        (p.self_collision, "--self-collision"),
+        (!p.obstacles.is_empty(), "--obstacle"),
+        (p.floor.is_some(), "--floor"),
+        (p.compliance, "--compliance"),
+    ];
+    if let Some((_, name)) = given.iter().find(|(g, _)| *g) {
+        bail!(
+            "{name}: not available with --point (the pool is configurations projected onto each socket from --count joint-space samples, chosen D-optimally then exchanged for the predicted consistency error, in selection order)"
+        );
+    }
+    Ok(())
+}
+
+/// Runs `select --point ...`.
+pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
+    let sockets: Vec<Socket> = a
+        .points
+        .iter()
+        .map(|s| parse_socket(s))
+        .collect::<Result<_>>()?;
+    refuse_pool_options(a)?;
+    if let Some(out) = &a.out {
+        super::refuse_overwrite(out, a.force)?;
+        DesignFormat::of(out).map_err(|e| anyhow::anyhow!("--out {e}"))?;
+    }
+    let margin_deg = a.pool.margin.unwrap_or(super::pool_opts::DEFAULT_MARGIN_DEG);
+    if !(margin_deg.is_finite() && margin_deg >= 0.0) {
+        bail!("--margin {margin_deg}: a margin is a finite number of degrees ≥ 0");
+    }
+    let described = super::load_description(&a.pool.robot)?;
+    let robot = described.robot;
+    if !matches!(robot.measurement, MeasurementKind::Point) {
+        bail!(
+            "--point: the tool point of {} is a measured point; use the robot without :pose",
+            robot.name
+        );
+    }
+    let settings = SocketDesignSettings {
+        n: a.n,
+        samples: a.pool.count.unwrap_or(DEFAULT_SAMPLES),
+        margin: margin_deg.to_radians(),
+        sample_seed: a.pool.pool_seed.unwrap_or(0),
+        draw_seed: a.seed,
+        ..SocketDesignSettings::default()
+    };
+    let d = design_for_sockets(&robot, robot.params(a.pool.params), &sockets, &settings)?;
+    if let Some(out) = &a.out {
+        let text = match DesignFormat::of(out)? {
+            DesignFormat::Json => contact_design::to_json(&d),
+            DesignFormat::Csv => contact_design::to_csv(&d),
+            DesignFormat::Yaml => contact_design::to_yaml(&d)?,
+        };
+        super::write_new(out, &text, a.force)?;
+    }
+    super::emit_report(a.json, &d, || text(&d))
+}
+
+/// The design as text: the figures, then the configurations with their
+/// named joint values.
+fn text(d: &SocketDesign) -> String {
+    let mut s = String::new();
+    for p in &d.points {
+        let x = p.socket.position;
+        let _ = writeln!(
+            s,
+            "point {} at ({:.4}, {:.4}, {:.4}) m: {} of {} samples reach it",
+            p.socket.name, x[0], x[1], x[2], p.configurations, d.samples_per_point
+        );
+    }
+    let _ = writeln!(
+        s,
+        "{} configurations chosen from {}; {} unknowns ({} of the robot, tool offset, points)",
+        d.configurations.len(),
+        d.pool,
+        d.unknowns,
+        d.robot_unknowns
+    );
+    let r = &d.random;
+    let _ = writeln!(
+        s,
+        "predicted consistency error (σ = contact noise per coordinate): chosen {:.4} σ (D-optimal {:.4} σ), median of {} random draws {:.4} σ (quartiles {:.4}–{:.4} σ): {:.3}× lower",
+        d.predicted_sigma,
+        d.d_optimal_sigma,
+        r.draws,
+        r.median_sigma,
+        r.q1_sigma,
+        r.q3_sigma,
+        d.ratio_to_random
+    );
+    let _ = writeln!(
+        s,
+        "no design of this pool can be below {:.4} σ (convex relaxation, certified; {} configurations carry weight)",
+        d.bound.certified_sigma, d.bound.support
+    );
+    let _ = write!(s, "{:>4} {:>6} {:<16}", "#", "id", "point");
+    for n in &d.joint_names {
+        let _ = write!(s, " {n:>12}");
+    }
+    s += "  reach (mm)   (rad; m for prismatic joints)\n";
+    for (k, c) in d.configurations.iter().enumerate() {
+        let _ = write!(s, "{:>4} {:>6} {:<16}", k + 1, c.id, c.point);
+        for v in &c.q {
+            let _ = write!(s, " {v:>12.6}");
+        }
+        let _ = writeln!(s, "  {:.2e}", 1e3 * c.reach_m);
+    }
+    s
+}

@@ -22,16 +22,14 @@
 //! while they fail.
 
 use super::BoundError;
-use super::pair::PairFactors;
+pub use super::exchange_step::line_search;
+use super::exchange_step::{PairWork, exchange_round};
 use super::variance::{
     Scaled, VarianceWork, certificate_with_prior, check_problem, make_feasible, scale_columns,
     top_sum, variances_into,
 };
 use crate::blocks::Blocks;
-use crate::linalg::simd::clear_upper_simd_state;
-use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, Par};
-use nalgebra::{DMatrix, SymmetricEigen};
+use faer::Mat;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -220,15 +218,18 @@ pub(crate) fn solve_scaled(
     start: Option<Vec<f64>>,
     s: &ExchangeSettings,
 ) -> ExchangeOutcome {
-    let x = &sc.x;
     let clock = Instant::now();
-    let pool = x.n_poses();
-    let (t, p) = (x.t(), x.p());
-    let mut work = VarianceWork::default();
-    let mut scratch = Vec::new();
+    let pool = sc.x.n_poses();
+    let (t, p) = (sc.x.t(), sc.x.p());
+    let mut ev = Evaluator {
+        sc,
+        n,
+        work: VarianceWork::default(),
+        scratch: Vec::new(),
+    };
     if n == pool {
         let w = vec![1.0; pool];
-        let e = evaluate(sc, n, &w, &mut work, &mut scratch).expect("full-rank pool");
+        let e = ev.eval(&w).expect("full-rank pool");
         return ExchangeOutcome {
             weights: w,
             ln_det: e.ln_det,
@@ -240,9 +241,45 @@ pub(crate) fn solve_scaled(
             seconds: clock.elapsed().as_secs_f64(),
         };
     }
-
     // --- start: given weights, or uniform + capped multiplicative steps + pruning
     let started = start.is_some();
+    let mut it = start_point(&mut ev, start);
+    let support = it.w.iter().filter(|&&v| v > 0.0).count();
+    let keep = s.keep.max(n).max(p.div_ceil(t));
+    if !started && support > keep {
+        warm_up_and_prune(&mut ev, &mut it, s.warmup_rounds, keep);
+    }
+    exchange_rounds(&mut ev, it, s, clock)
+}
+
+/// Evaluations at one problem, with their reusable workspace.
+struct Evaluator<'a> {
+    sc: &'a Scaled,
+    n: usize,
+    work: VarianceWork,
+    scratch: Vec<f64>,
+}
+
+impl Evaluator<'_> {
+    /// [`evaluate`] at `w`.
+    fn eval(&mut self, w: &[f64]) -> Option<Evaluation> {
+        evaluate(self.sc, self.n, w, &mut self.work, &mut self.scratch)
+    }
+}
+
+/// The solver's point between phases, its evaluation, the smallest
+/// certificate seen and the rounds (evaluations) so far.
+struct Iterate {
+    w: Vec<f64>,
+    eval: Evaluation,
+    best_bound: f64,
+    rounds: usize,
+}
+
+/// The start: the given weights made feasible, or uniform; uniform too when
+/// the given weights' `M` is singular.
+fn start_point(ev: &mut Evaluator<'_>, start: Option<Vec<f64>>) -> Iterate {
+    let (n, pool) = (ev.n, ev.sc.x.n_poses());
     let mut w = match start {
         Some(mut w) => {
             make_feasible(&mut w, n);
@@ -250,107 +287,122 @@ pub(crate) fn solve_scaled(
         }
         None => vec![n as f64 / pool as f64; pool],
     };
-    let mut eval = match evaluate(sc, n, &w, &mut work, &mut scratch) {
+    let eval = match ev.eval(&w) {
         Some(e) => e,
         None => {
             // A start with a singular M: fall back to the uniform design.
             w = vec![n as f64 / pool as f64; pool];
-            evaluate(sc, n, &w, &mut work, &mut scratch).expect("full-rank pool")
+            ev.eval(&w).expect("full-rank pool")
         }
     };
-    let mut best_bound = eval.bound;
-    let mut rounds = 1;
-    let support = w.iter().filter(|&&v| v > 0.0).count();
-    let keep = s.keep.max(n).max(p.div_ceil(t));
-    if !started && support > keep {
-        for _ in 0..s.warmup_rounds {
-            if !multiplicative_step(&mut w, &eval.d, n) {
-                break;
-            }
-            match evaluate(sc, n, &w, &mut work, &mut scratch) {
-                Some(e) => eval = e,
-                None => break,
-            }
-            rounds += 1;
-            best_bound = best_bound.min(eval.bound);
-        }
-        // Prune to the `keep` largest weights; widen if M becomes singular.
-        let mut k = keep;
-        loop {
-            let mut pruned = prune(&w, k);
-            make_feasible(&mut pruned, n);
-            if let Some(e) = evaluate(sc, n, &pruned, &mut work, &mut scratch) {
-                w = pruned;
-                eval = e;
-                rounds += 1;
-                best_bound = best_bound.min(eval.bound);
-                break;
-            }
-            if k >= pool {
-                break;
-            }
-            k = (2 * k).min(pool);
-        }
+    Iterate {
+        w,
+        best_bound: eval.bound,
+        eval,
+        rounds: 1,
     }
+}
 
-    // --- exchange rounds
+/// From a uniform start: capped multiplicative steps (at most `rounds`),
+/// then the weights pruned to the `keep` largest (widened while `M` is
+/// singular).
+fn warm_up_and_prune(ev: &mut Evaluator<'_>, it: &mut Iterate, rounds: usize, keep: usize) {
+    let (n, pool) = (ev.n, ev.sc.x.n_poses());
+    for _ in 0..rounds {
+        if !multiplicative_step(&mut it.w, &it.eval.d, n) {
+            break;
+        }
+        match ev.eval(&it.w) {
+            Some(e) => it.eval = e,
+            None => break,
+        }
+        it.rounds += 1;
+        it.best_bound = it.best_bound.min(it.eval.bound);
+    }
+    // Prune to the `keep` largest weights; widen if M becomes singular.
+    let mut k = keep;
+    loop {
+        let mut pruned = prune(&it.w, k);
+        make_feasible(&mut pruned, n);
+        if let Some(e) = ev.eval(&pruned) {
+            it.w = pruned;
+            it.eval = e;
+            it.rounds += 1;
+            it.best_bound = it.best_bound.min(it.eval.bound);
+            break;
+        }
+        if k >= pool {
+            break;
+        }
+        k = (2 * k).min(pool);
+    }
+}
+
+/// Exchange rounds on the candidates ([`candidates`], [`exchange_round`])
+/// until the certified gap of the best point is at most `s.gap_tol`, or a
+/// round or time limit.
+fn exchange_rounds(
+    ev: &mut Evaluator<'_>,
+    mut it: Iterate,
+    s: &ExchangeSettings,
+    clock: Instant,
+) -> ExchangeOutcome {
+    let (x, n) = (&ev.sc.x, ev.n);
     let mut steps = 0;
     let task = crate::progress::Task::start("bound: first-order rounds", None);
-    let mut best_w = w.clone();
-    let mut best_ln_det = eval.ln_det;
+    let mut best_w = it.w.clone();
+    let mut best_ln_det = it.eval.ln_det;
     let step_tol = s.gap_tol / (4.0 * n as f64);
-    let mut pair = PairWork::new(t, p);
+    let mut pair = PairWork::new(x.t(), x.p());
     loop {
-        if eval.ln_det > best_ln_det {
-            best_ln_det = eval.ln_det;
-            best_w.clone_from(&w);
+        if it.eval.ln_det > best_ln_det {
+            best_ln_det = it.eval.ln_det;
+            best_w.clone_from(&it.w);
         }
-        best_bound = best_bound.min(eval.bound);
+        it.best_bound = it.best_bound.min(it.eval.bound);
         task.inc(1);
         task.note(|| {
             format!(
                 "gap {:.2e} -> {:.0e}, {steps} steps",
-                best_bound - best_ln_det,
+                it.best_bound - best_ln_det,
                 s.gap_tol
             )
         });
-        if best_bound - best_ln_det <= s.gap_tol
-            || rounds >= s.max_rounds
+        if it.best_bound - best_ln_det <= s.gap_tol
+            || it.rounds >= s.max_rounds
             || clock.elapsed().as_secs_f64() > s.time_limit
         {
             break;
         }
-        let cand = candidates(&w, &eval.d, s.extra);
+        let cand = candidates(&it.w, &it.eval.d, s.extra);
+        let minv = std::mem::replace(&mut it.eval.minv, Mat::new());
         steps += exchange_round(
             x,
             &cand,
-            &mut w,
-            eval.minv,
-            &eval.d,
+            &mut it.w,
+            minv,
+            &it.eval.d,
             step_tol,
             s.max_steps,
             &mut pair,
         );
         // Rounding in the Woodbury updates can leave tiny negative weights.
-        make_feasible(&mut w, n);
-        match evaluate(sc, n, &w, &mut work, &mut scratch) {
-            Some(e) => eval = e,
-            None => {
-                // Should not happen (the line search keeps M positive
-                // definite); stop with the best point.
-                rounds += 1;
-                break;
-            }
+        make_feasible(&mut it.w, n);
+        it.rounds += 1;
+        match ev.eval(&it.w) {
+            Some(e) => it.eval = e,
+            // Should not happen (the line search keeps M positive definite);
+            // stop with the best point.
+            None => break,
         }
-        rounds += 1;
     }
     ExchangeOutcome {
-        gap: best_bound - best_ln_det,
-        converged: best_bound - best_ln_det <= s.gap_tol,
+        gap: it.best_bound - best_ln_det,
+        converged: it.best_bound - best_ln_det <= s.gap_tol,
         weights: best_w,
         ln_det: best_ln_det,
-        ln_bound: best_bound,
-        rounds,
+        ln_bound: it.best_bound,
+        rounds: it.rounds,
         steps,
         seconds: clock.elapsed().as_secs_f64(),
     }
@@ -412,302 +464,6 @@ pub(crate) fn candidates(w: &[f64], d: &[f64], extra: usize) -> Vec<usize> {
     }
     cand.sort_unstable();
     cand
-}
-
-/// Reused memory of the pairwise steps.
-struct PairWork {
-    ut: Mat<f64>,
-    wm: Mat<f64>,
-    g: Mat<f64>,
-    wr: Mat<f64>,
-    v: Mat<f64>,
-    wv: Mat<f64>,
-    sq: Vec<f64>,
-    mu: Vec<f64>,
-    s: Vec<f64>,
-    gs: Vec<f64>,
-    pf: PairFactors,
-}
-
-impl PairWork {
-    fn new(t: usize, p: usize) -> Self {
-        Self {
-            ut: Mat::zeros(p, 2 * t),
-            wm: Mat::zeros(p, 2 * t),
-            g: Mat::zeros(2 * t, 2 * t),
-            wr: Mat::zeros(p, 2 * t),
-            v: Mat::zeros(2 * t, 2 * t),
-            wv: Mat::zeros(p, 2 * t),
-            sq: Vec::new(),
-            mu: Vec::with_capacity(2 * t),
-            s: Vec::with_capacity(2 * t),
-            gs: vec![0.0; 4 * t * t],
-            pf: PairFactors::new(t),
-        }
-    }
-}
-
-/// Pairwise steps on the candidate set `cand`, starting from `M⁻¹ = minv`
-/// and the full-pool variances `d`. Returns the number of steps taken.
-#[allow(clippy::too_many_arguments)]
-fn exchange_round(
-    x: &Blocks,
-    cand: &[usize],
-    w: &mut [f64],
-    mut minv: Mat<f64>,
-    d: &[f64],
-    step_tol: f64,
-    max_steps: usize,
-    pw: &mut PairWork,
-) -> usize {
-    let (t, p) = (x.t(), x.p());
-    let xm = x.mat();
-    let kn = cand.len();
-    // Candidate blocks, contiguous.
-    let xk = Mat::from_fn(kn * t, p, |r, c| xm[(cand[r / t] * t + r % t, c)]);
-    let mut dk: Vec<f64> = cand.iter().map(|&i| d[i]).collect();
-    let mut pk = Mat::<f64>::zeros(kn * t, 2 * t);
-    const FULL: f64 = 1.0 - 1e-12;
-    let mut steps = 0;
-    while steps < max_steps {
-        // i: largest d among w < 1; j: smallest d among w > 0.
-        let mut bi = usize::MAX;
-        let mut bj = usize::MAX;
-        for k in 0..kn {
-            let wk = w[cand[k]];
-            if wk < FULL && (bi == usize::MAX || dk[k] > dk[bi]) {
-                bi = k;
-            }
-            if wk > 0.0 && (bj == usize::MAX || dk[k] < dk[bj]) {
-                bj = k;
-            }
-        }
-        if bi == usize::MAX || bj == usize::MAX || bi == bj || dk[bi] - dk[bj] <= step_tol {
-            break;
-        }
-        let (i, j) = (cand[bi], cand[bj]);
-        // Uᵀ = [X_iᵀ X_jᵀ] (p × 2t), W = M⁻¹Uᵀ, G = U W.
-        for r in 0..t {
-            for c in 0..p {
-                pw.ut[(c, r)] = xk[(bi * t + r, c)];
-                pw.ut[(c, t + r)] = xk[(bj * t + r, c)];
-            }
-        }
-        matmul(
-            pw.wm.as_mut(),
-            Accum::Replace,
-            minv.as_ref(),
-            pw.ut.as_ref(),
-            1.0,
-            Par::Seq,
-        );
-        matmul(
-            pw.g.as_mut(),
-            Accum::Replace,
-            pw.ut.transpose(),
-            pw.wm.as_ref(),
-            1.0,
-            Par::Seq,
-        );
-        let m2 = 2 * t;
-        for a in 0..m2 {
-            for b in 0..m2 {
-                pw.gs[a * m2 + b] = 0.5 * (pw.g[(a, b)] + pw.g[(b, a)]);
-            }
-        }
-        let Some(delta) = pair_step(pw, t, (1.0 - w[i]).min(w[j])) else {
-            break;
-        };
-        // Weights; exact bounds when a pose fills up or empties.
-        if delta >= 1.0 - w[i] {
-            w[i] = 1.0;
-        } else {
-            w[i] += delta;
-        }
-        if delta >= w[j] {
-            w[j] = 0.0;
-        } else {
-            w[j] -= delta;
-        }
-        // d_k −= tr(P_k R P_kᵀ), P = X_K W;  M⁻¹ −= W R Wᵀ   (X2)
-        // With R = E diag(s) Eᵀ: tr(P_k R P_kᵀ) = Σ_l s_l ‖X_k (W E)_l‖², one
-        // product X_K (W E) instead of two.
-        matmul(
-            pw.wv.as_mut(),
-            Accum::Replace,
-            pw.wm.as_ref(),
-            pw.v.as_ref(),
-            1.0,
-            Par::Seq,
-        );
-        matmul(
-            pk.as_mut(),
-            Accum::Replace,
-            xk.as_ref(),
-            pw.wv.as_ref(),
-            1.0,
-            Par::Seq,
-        );
-        // gemm's AVX-512 kernels can leave dirty upper registers, which
-        // slow every SSE instruction after them (see `clear_upper_simd_state`).
-        clear_upper_simd_state();
-        // Row sums Σ_l s_l (X_K W E)²_rl, vectorised along the rows, then
-        // per pose.
-        pw.sq.clear();
-        pw.sq.resize(kn * t, 0.0);
-        for (l, &lam) in pw.s.iter().enumerate() {
-            let col = pk
-                .col(l)
-                .try_as_col_major()
-                .expect("a column of an owned matrix is contiguous")
-                .as_slice();
-            for (s, &v) in pw.sq.iter_mut().zip(col) {
-                *s += lam * v * v;
-            }
-        }
-        for (dkv, rows) in dk.iter_mut().zip(pw.sq.chunks_exact(t)) {
-            *dkv -= rows.iter().sum::<f64>();
-        }
-        // M⁻¹ −= (W E) diag(s) (W E)ᵀ.
-        for l in 0..m2 {
-            for c in 0..p {
-                pw.wr[(c, l)] = pw.wv[(c, l)] * pw.s[l];
-            }
-        }
-        matmul(
-            minv.as_mut(),
-            Accum::Add,
-            pw.wr.as_ref(),
-            pw.wv.transpose(),
-            -1.0,
-            Par::Seq,
-        );
-        clear_upper_simd_state();
-        steps += 1;
-    }
-    steps
-}
-
-/// The step of the pair whose symmetric matrix `G` is in `pw.gs`: the exact
-/// line search (eq. X1) over `[0, hi]`, then `R = E diag(s) Eᵀ` (eq. X2) with
-/// `E` in `pw.v` and `s` in `pw.s`. `None` when no step improves.
-fn pair_step(pw: &mut PairWork, t: usize, hi: f64) -> Option<f64> {
-    let m2 = 2 * t;
-    let fast = pw.pf.factor(&pw.gs);
-    pw.mu.clear();
-    if fast {
-        pw.mu.extend_from_slice(pw.pf.mu());
-    } else {
-        pw.mu.extend(general_mu(&pw.gs, t).iter());
-    }
-    let delta = line_search(&pw.mu, hi);
-    if delta <= 0.0 {
-        return None;
-    }
-    pw.s.clear();
-    if fast {
-        let (e, sv) = pw.pf.update(delta);
-        for a in 0..m2 {
-            for c in 0..m2 {
-                pw.v[(a, c)] = e[a * m2 + c];
-            }
-        }
-        pw.s.extend_from_slice(sv);
-    } else {
-        let (e, sv) = general_r(&pw.gs, t, delta)?;
-        for a in 0..m2 {
-            for c in 0..m2 {
-                pw.v[(a, c)] = e[(a, c)];
-            }
-        }
-        pw.s.extend(sv.iter());
-    }
-    Some(delta)
-}
-
-/// `D = diag(I_t, −I_t)`.
-fn sign_matrix(t: usize) -> DMatrix<f64> {
-    DMatrix::from_fn(2 * t, 2 * t, |a, b| match (a == b, a < t) {
-        (false, _) => 0.0,
-        (true, true) => 1.0,
-        (true, false) => -1.0,
-    })
-}
-
-/// The eigenvalues `μ` of `D G` for a pair matrix `G` (row-major, `2t × 2t`)
-/// that is only positive semidefinite: those of `G^{1/2} D G^{1/2}`. The
-/// general path of [`PairFactors`].
-fn general_mu(g: &[f64], t: usize) -> Vec<f64> {
-    let m = 2 * t;
-    let g = DMatrix::from_row_slice(m, m, &g[..m * m]);
-    let eg = SymmetricEigen::new(g);
-    let sq = DMatrix::from_diagonal(&eg.eigenvalues.map(|l| l.max(0.0).sqrt()));
-    let half = &eg.eigenvectors * sq * eg.eigenvectors.transpose();
-    let b = &half * sign_matrix(t) * &half;
-    let b = (&b + b.transpose()) * 0.5;
-    SymmetricEigen::new(b).eigenvalues.iter().copied().collect()
-}
-
-/// `R = δ (I + δ D G)⁻¹ D` (eq. X2) as `V diag(λ) Vᵀ` for a positive
-/// semidefinite `G`: the general path of [`PairFactors::update`]. `None`
-/// if `I + δ D G` is singular.
-fn general_r(g: &[f64], t: usize, delta: f64) -> Option<(DMatrix<f64>, Vec<f64>)> {
-    let m = 2 * t;
-    let g = DMatrix::from_row_slice(m, m, &g[..m * m]);
-    let dm = sign_matrix(t);
-    let bmat = DMatrix::<f64>::identity(m, m) + &dm * &g * delta;
-    let r = bmat.try_inverse()? * &dm * delta;
-    let r = (&r + r.transpose()) * 0.5;
-    let er = SymmetricEigen::new(r);
-    Some((er.eigenvectors, er.eigenvalues.iter().copied().collect()))
-}
-
-/// The step `δ ∈ [0, hi]` maximising `φ(δ) = Σ_k ln(1 + δ μ_k)` (eq. X1):
-/// `hi` if `φ'(hi) ≥ 0`, else the root of the decreasing `φ'` by safeguarded
-/// Newton. `φ'(0) = Σ μ_k = d_i − d_j > 0` for an improving pair.
-#[must_use]
-pub fn line_search(mu: &[f64], hi: f64) -> f64 {
-    let dphi = |x: f64| -> f64 {
-        let mut s = 0.0;
-        for &m in mu {
-            let den = 1.0 + x * m;
-            if den <= 0.0 {
-                return f64::NEG_INFINITY;
-            }
-            s += m / den;
-        }
-        s
-    };
-    let d2phi = |x: f64| -> f64 { -mu.iter().map(|&m| (m / (1.0 + x * m)).powi(2)).sum::<f64>() };
-    if hi <= 0.0 || dphi(0.0) <= 0.0 {
-        return 0.0;
-    }
-    let fhi = dphi(hi);
-    if fhi >= 0.0 {
-        return hi;
-    }
-    let (mut lo, mut up) = (0.0, hi);
-    let mut x = 0.0;
-    for _ in 0..100 {
-        let f = dphi(x);
-        if f > 0.0 {
-            lo = x;
-        } else {
-            up = x;
-        }
-        let mut nx = x - f / d2phi(x);
-        if !(nx > lo && nx < up && f.is_finite()) {
-            nx = 0.5 * (lo + up);
-        }
-        if (nx - x).abs() <= 1e-15 * up.max(1e-300) || up - lo <= 1e-15 * up {
-            x = nx;
-            break;
-        }
-        x = nx;
-    }
-    // Stay on the side where φ' ≥ 0 is not required; any point of [0, hi]
-    // with 1 + δμ > 0 is feasible and improves on δ = 0 by concavity.
-    x.clamp(0.0, hi)
 }
 
 #[cfg(test)]

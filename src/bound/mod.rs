@@ -33,6 +33,7 @@
 
 pub mod conic;
 mod error;
+mod exchange_step;
 pub mod first_order;
 pub mod gap;
 pub mod newton;

@@ -167,6 +167,99 @@ fn barrier_value(sc: &Scaled, w: &[f64], mu: f64) -> Option<f64> {
     Some(ld + mu * w.iter().map(|&v| v.ln() + (1.0 - v).ln()).sum::<f64>())
 }
 
+/// A strictly interior start: the warm point (candidate weights, feasible
+/// or not) blended with uniform `N/n`, rescaled to `Σ w = N`; uniform when
+/// there is no warm point or the blend is not interior.
+fn interior_start(warm: Option<&[f64]>, n: usize, nf: f64) -> Vec<f64> {
+    let uniform = nf / n as f64;
+    let mut w: Vec<f64> = match warm {
+        Some(v) if v.len() == n => {
+            let s: f64 = v.iter().map(|x| x.clamp(0.0, 1.0)).sum();
+            let scale = if s > 0.0 { nf / s } else { 0.0 };
+            v.iter()
+                .map(|&x| 0.9 * (x.clamp(0.0, 1.0) * scale).min(1.0) + 0.1 * uniform)
+                .collect()
+        }
+        _ => vec![uniform; n],
+    };
+    // Rescaling may have capped entries at 1: restore Σ w = N on the rest by
+    // moving towards uniform, which is interior.
+    let s: f64 = w.iter().sum();
+    if (s - nf).abs() > 1e-12 * nf {
+        let a = (nf - s) / (n as f64 * uniform - s);
+        w.iter_mut().for_each(|v| *v = (1.0 - a) * *v + a * uniform);
+    }
+    if w.iter().any(|&v| !(v > 0.0 && v < 1.0)) {
+        w = vec![uniform; n];
+    }
+    w
+}
+
+/// The Newton direction of `F_μ` on `Σ w = N`: `K = Q + μ D`,
+/// `g = d + μ (1/w − 1/(1 − w))`, `Δ = K⁻¹g − ν K⁻¹1` with `ν` making
+/// `1ᵀΔ = 0`, and the decrement `λ² = gᵀΔ` (`= ΔᵀKΔ`); `None` when `K` is
+/// not positive definite or `λ²` is not finite.
+fn newton_direction(
+    q: &Mat<f64>,
+    d: &[f64],
+    w: &[f64],
+    mu: f64,
+    ones: &Mat<f64>,
+) -> Option<(Vec<f64>, f64)> {
+    use faer::linalg::solvers::Solve;
+    let n = w.len();
+    let mut k = q.clone();
+    let mut g = Mat::<f64>::zeros(n, 1);
+    for i in 0..n {
+        let (a, b) = (w[i], 1.0 - w[i]);
+        k[(i, i)] += mu * (1.0 / (a * a) + 1.0 / (b * b));
+        g[(i, 0)] = d[i] + mu * (1.0 / a - 1.0 / b);
+    }
+    let kc = k.llt(Side::Lower).ok()?;
+    let u = kc.solve(&g);
+    let v = kc.solve(ones);
+    let nu = u.col(0).sum() / v.col(0).sum();
+    let delta: Vec<f64> = (0..n).map(|i| u[(i, 0)] - nu * v[(i, 0)]).collect();
+    let lambda2: f64 = (0..n).map(|i| g[(i, 0)] * delta[i]).sum();
+    lambda2.is_finite().then_some((delta, lambda2))
+}
+
+/// The largest step along `delta` inside `(0, 1)` (at 0.99 of the way to
+/// the boundary), then backtracking (halving, at most 60 times) until
+/// `F_μ` rises by a quarter of the decrement's prediction (Armijo); the
+/// accepted point, or `None` when no step ascends (rounding).
+fn line_search(
+    sc: &Scaled,
+    w: &[f64],
+    delta: &[f64],
+    lambda2: f64,
+    mu: f64,
+    ld: f64,
+) -> Option<Vec<f64>> {
+    let n = w.len();
+    let mut s_max = 1.0f64;
+    for i in 0..n {
+        if delta[i] < 0.0 {
+            s_max = s_max.min(0.99 * w[i] / -delta[i]);
+        } else if delta[i] > 0.0 {
+            s_max = s_max.min(0.99 * (1.0 - w[i]) / delta[i]);
+        }
+    }
+    let f0 = ld + mu * w.iter().map(|&v| v.ln() + (1.0 - v).ln()).sum::<f64>();
+    let mut s = s_max;
+    let mut trial = vec![0.0; n];
+    for _ in 0..60 {
+        for i in 0..n {
+            trial[i] = w[i] + s * delta[i];
+        }
+        if barrier_value(sc, &trial, mu).is_some_and(|f1| f1 >= f0 + 0.25 * s * lambda2) {
+            return Some(trial);
+        }
+        s *= 0.5;
+    }
+    None
+}
+
 /// Solves (R) on the scaled candidate blocks `sc.x` from `warm` (candidate
 /// weights, feasible or not; `None` for uniform), returning the result in
 /// Clarabel's outcome type: weights, status (`Solved` when the barrier
@@ -205,28 +298,7 @@ pub(crate) fn solve_scaled(
             None => fail(w, ConicStatus::NumericalError, 0),
         };
     }
-    // A strictly interior start: the warm point blended with uniform N/n.
-    let uniform = nf / n as f64;
-    let mut w: Vec<f64> = match warm {
-        Some(v) if v.len() == n => {
-            let s: f64 = v.iter().map(|x| x.clamp(0.0, 1.0)).sum();
-            let scale = if s > 0.0 { nf / s } else { 0.0 };
-            v.iter()
-                .map(|&x| 0.9 * (x.clamp(0.0, 1.0) * scale).min(1.0) + 0.1 * uniform)
-                .collect()
-        }
-        _ => vec![uniform; n],
-    };
-    // Rescaling may have capped entries at 1: restore Σ w = N on the rest by
-    // moving towards uniform, which is interior.
-    let s: f64 = w.iter().sum();
-    if (s - nf).abs() > 1e-12 * nf {
-        let a = (nf - s) / (n as f64 * uniform - s);
-        w.iter_mut().for_each(|v| *v = (1.0 - a) * *v + a * uniform);
-    }
-    if w.iter().any(|&v| !(v > 0.0 && v < 1.0)) {
-        w = vec![uniform; n];
-    }
+    let mut w = interior_start(warm, n, nf);
 
     let mut q = Mat::<f64>::zeros(n, n);
     let mut d = vec![0.0; n];
@@ -245,27 +317,9 @@ pub(crate) fn solve_scaled(
         };
         ld = l;
         steps += 1;
-        // K = Q + μ D, g = d + μ (1/w − 1/(1 − w)).
-        let mut k = q.clone();
-        let mut g = Mat::<f64>::zeros(n, 1);
-        for i in 0..n {
-            let (a, b) = (w[i], 1.0 - w[i]);
-            k[(i, i)] += mu * (1.0 / (a * a) + 1.0 / (b * b));
-            g[(i, 0)] = d[i] + mu * (1.0 / a - 1.0 / b);
-        }
-        let Ok(kc) = k.llt(Side::Lower) else {
+        let Some((delta, lambda2)) = newton_direction(&q, &d, &w, mu, &ones) else {
             return fail(w, ConicStatus::NumericalError, steps);
         };
-        use faer::linalg::solvers::Solve;
-        let u = kc.solve(&g);
-        let v = kc.solve(&ones);
-        let nu = u.col(0).sum() / v.col(0).sum();
-        let delta: Vec<f64> = (0..n).map(|i| u[(i, 0)] - nu * v[(i, 0)]).collect();
-        // Newton decrement λ² = gᵀΔ (= Δᵀ K Δ since 1ᵀΔ = 0).
-        let lambda2: f64 = (0..n).map(|i| g[(i, 0)] * delta[i]).sum();
-        if !lambda2.is_finite() {
-            return fail(w, ConicStatus::NumericalError, steps);
-        }
         // Centred enough: at the last barrier weight, λ² ≤ tol (the
         // distance to the central point, about λ²/2 in F_μ, is then below
         // the barrier's own bound 2nμ ≤ tol); before it, λ² ≤ CENTERING·μ
@@ -277,47 +331,23 @@ pub(crate) fn solve_scaled(
         } else {
             (CENTERING * mu).max(settings.tol)
         };
-        if lambda2 <= centred {
+        // Centred, or no ascent left at this μ (rounding): the next μ, or
+        // done at the last.
+        let next_mu = lambda2 <= centred
+            || match line_search(sc, &w, &delta, lambda2, mu, ld) {
+                Some(t) => {
+                    w = t;
+                    false
+                }
+                None => true,
+            };
+        if next_mu {
             if 2.0 * n as f64 * mu <= settings.tol {
                 status = ConicStatus::Solved;
                 break;
             }
             mu /= settings.mu_factor;
-            continue;
         }
-        // Largest step inside (0, 1), then backtracking on F_μ.
-        let mut s_max = 1.0f64;
-        for i in 0..n {
-            if delta[i] < 0.0 {
-                s_max = s_max.min(0.99 * w[i] / -delta[i]);
-            } else if delta[i] > 0.0 {
-                s_max = s_max.min(0.99 * (1.0 - w[i]) / delta[i]);
-            }
-        }
-        let f0 = ld + mu * w.iter().map(|&v| v.ln() + (1.0 - v).ln()).sum::<f64>();
-        let mut s = s_max;
-        let mut trial = vec![0.0; n];
-        let mut accepted = false;
-        for _ in 0..60 {
-            for i in 0..n {
-                trial[i] = w[i] + s * delta[i];
-            }
-            if barrier_value(sc, &trial, mu).is_some_and(|f1| f1 >= f0 + 0.25 * s * lambda2) {
-                accepted = true;
-                break;
-            }
-            s *= 0.5;
-        }
-        if !accepted {
-            // No ascent left at this μ (rounding): move on to the next.
-            if 2.0 * n as f64 * mu <= settings.tol {
-                status = ConicStatus::Solved;
-                break;
-            }
-            mu /= settings.mu_factor;
-            continue;
-        }
-        std::mem::swap(&mut w, &mut trial);
     }
     let ld = ln_det_spd(sc.information(&w).as_ref()).unwrap_or(ld);
     ConicOutcome {

@@ -89,7 +89,10 @@ pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
         super::refuse_overwrite(out, a.force)?;
         DesignFormat::of(out).map_err(|e| anyhow::anyhow!("--out {e}"))?;
     }
-    let margin_deg = a.pool.margin.unwrap_or(super::pool_opts::DEFAULT_MARGIN_DEG);
+    let margin_deg = a
+        .pool
+        .margin
+        .unwrap_or(super::pool_opts::DEFAULT_MARGIN_DEG);
     if !(margin_deg.is_finite() && margin_deg >= 0.0) {
         bail!("--margin {margin_deg}: a margin is a finite number of degrees ≥ 0");
     }

@@ -137,12 +137,61 @@ pub fn woodbury(
 ) -> Result<LowRank, Singular> {
     let p = m_inv.nrows();
     assert!(m_inv.ncols() == p && plus.ncols() == p && minus.ncols() == p);
-    let a = plus.nrows();
-    let b = minus.nrows();
+    let (a, b) = (plus.nrows(), minus.nrows());
+    let (u, s) = products(m_inv, plus, minus);
+    let (la, ln_a) = addition_factor(&s, a)?;
+    let mut f = vec![0.0; p * (a + b)];
+    added_columns(&mut f, &u, &la, a, p);
+    if b == 0 {
+        return Ok(LowRank {
+            ln_det_ratio: ln_a,
+            min_pivot: f64::INFINITY,
+            f,
+            p,
+            n_plus: a,
+        });
+    }
+    let (y, mut lb) = removal_schur(&s, &la, a, b);
+    let mut perm = vec![0usize; b];
+    let ln_b = chol_pivoted_in_place(&mut lb, b, pivot_floor, &mut perm)
+        .map_err(|pivot| Singular { pivot, pivot_floor })?;
+    removed_columns(&mut f, &u, &y, &lb, &perm, (a, b, p));
+    Ok(LowRank {
+        ln_det_ratio: ln_a + ln_b,
+        min_pivot: min_pivot(&lb, b),
+        f,
+        p,
+        n_plus: a,
+    })
+}
+
+/// `S = Z M⁻¹ Zᵀ` (`k×k`, column-major, `k = a + b`) read as the symmetric
+/// matrix it is in exact arithmetic: only `S[i][j]` with `i ≥ j` is used.
+struct Gram {
+    s: Vec<f64>,
+    k: usize,
+}
+
+impl Gram {
+    fn sym(&self, i: usize, j: usize) -> f64 {
+        if i >= j {
+            self.s[j * self.k + i]
+        } else {
+            self.s[i * self.k + j]
+        }
+    }
+}
+
+/// `Z = [Z₊; Z₋]`, `U = M⁻¹ Zᵀ` (`p×k`, column-major) and `S = Z U`.
+fn products(
+    m_inv: MatRef<'_, f64>,
+    plus: MatRef<'_, f64>,
+    minus: MatRef<'_, f64>,
+) -> (Vec<f64>, Gram) {
+    let p = m_inv.nrows();
+    let (a, b) = (plus.nrows(), minus.nrows());
     let k = a + b;
     let par = Par::Seq;
-
-    // Z = [Z₊; Z₋], U = M⁻¹ Zᵀ (p×k), S = Z U (k×k), column-major.
     let mut z = Mat::<f64>::zeros(k, p);
     z.as_mut().subrows_mut(0, a).copy_from(plus);
     z.as_mut().subrows_mut(a, b).copy_from(minus);
@@ -165,25 +214,30 @@ pub fn woodbury(
         par,
     );
     clear_upper_simd_state();
-    // S is symmetric in exact arithmetic; read S[i][j] with i ≥ j only.
-    let sym = |i: usize, j: usize| if i >= j { s[j * k + i] } else { s[i * k + j] };
+    (u, Gram { s, k })
+}
 
-    // A = I + S₊₊ = L_A L_Aᵀ (row-major a×a). A ⪰ I, so it cannot fail for a
-    // positive definite M⁻¹; a failure means M⁻¹ itself is broken.
+/// `A = I + S₊₊ = L_A L_Aᵀ` (row-major `a×a`) and `ln det A`. `A ⪰ I`, so it
+/// cannot fail for a positive definite `M⁻¹`; a failure means `M⁻¹` itself
+/// is broken.
+fn addition_factor(s: &Gram, a: usize) -> Result<(Vec<f64>, f64), Singular> {
     let mut la = vec![0.0; a * a];
     for r in 0..a {
         for c in 0..=r {
-            la[r * a + c] = sym(r, c) + if r == c { 1.0 } else { 0.0 };
+            la[r * a + c] = s.sym(r, c) + if r == c { 1.0 } else { 0.0 };
         }
     }
     let ln_a = chol_in_place(&mut la, a, 0.0).map_err(|pivot| Singular {
         pivot,
         pivot_floor: 0.0,
     })?;
+    Ok((la, ln_a))
+}
 
-    // F (p×k column-major). F₊ = U₊ L_A⁻ᵀ: each row solves L_A y = u
-    // (forward substitution), column by column over the whole of F₊.
-    let mut f = vec![0.0; p * k];
+/// `F₊ = U₊ L_A⁻ᵀ` into the first `a` columns of `f` (`p×k` column-major):
+/// each row solves `L_A y = u` (forward substitution), column by column
+/// over the whole of `F₊`.
+fn added_columns(f: &mut [f64], u: &[f64], la: &[f64], a: usize, p: usize) {
     for r in 0..a {
         let (done, rest) = f.split_at_mut(r * p);
         let fr = &mut rest[..p];
@@ -199,36 +253,29 @@ pub fn woodbury(
             *x /= d;
         }
     }
-    if b == 0 {
-        return Ok(LowRank {
-            ln_det_ratio: ln_a,
-            min_pivot: f64::INFINITY,
-            f,
-            p,
-            n_plus: a,
-        });
-    }
+}
 
-    // Y = L_A⁻¹ S₊₋ (a×b, row-major).
+/// `Y = L_A⁻¹ S₊₋` (`a×b`, row-major) and `B = I − S₋₋ + Yᵀ Y` (full,
+/// row-major `b×b`): the Schur complement of the 2-block system. Its LDLᵀ
+/// pivots (unpivoted) are the factors `(1 − x_r' M_{·}⁻¹ x_r)` of the
+/// cascade (22); the caller factors it with diagonal pivoting,
+/// `P B Pᵀ = L_B L_Bᵀ`, so that a singular `B` shows as a last pivot of
+/// rounding size (see `chol_pivoted_in_place`).
+fn removal_schur(s: &Gram, la: &[f64], a: usize, b: usize) -> (Vec<f64>, Vec<f64>) {
     let mut y = vec![0.0; a * b];
     for c in 0..b {
         for r in 0..a {
-            let mut v = sym(r, a + c);
+            let mut v = s.sym(r, a + c);
             for j in 0..r {
                 v -= la[r * a + j] * y[j * b + c];
             }
             y[r * b + c] = v / la[r * a + r];
         }
     }
-    // B = I − S₋₋ + Yᵀ Y: the Schur complement of the 2-block system. Its
-    // LDLᵀ pivots (unpivoted) are the factors (1 − x_r' M_{·}⁻¹ x_r) of the
-    // cascade (22). Factored with diagonal pivoting, P B Pᵀ = L_B L_Bᵀ, so a
-    // singular B shows as a last pivot of rounding size (see
-    // `chol_pivoted_in_place`).
     let mut lb = vec![0.0; b * b];
     for r in 0..b {
         for c in 0..=r {
-            let mut v = if r == c { 1.0 } else { 0.0 } - sym(a + r, a + c);
+            let mut v = if r == c { 1.0 } else { 0.0 } - s.sym(a + r, a + c);
             for j in 0..a {
                 v += y[j * b + r] * y[j * b + c];
             }
@@ -236,16 +283,24 @@ pub fn woodbury(
             lb[c * b + r] = v;
         }
     }
-    let mut perm = vec![0usize; b];
-    let ln_b = chol_pivoted_in_place(&mut lb, b, pivot_floor, &mut perm)
-        .map_err(|pivot| Singular { pivot, pivot_floor })?;
+    (y, lb)
+}
 
-    // F₋ = (U₋ − F₊ Y) L_B⁻ᵀ. Derivation: after adding Z₊ the inverse is
-    // M₁⁻¹ = M⁻¹ − F₊F₊ᵀ, so M₁⁻¹Z₋ᵀ = U₋ − F₊ (L_A⁻¹S₊₋) = U₋ − F₊Y and
-    // Z₋M₁⁻¹Z₋ᵀ = S₋₋ − YᵀY; removing Z₋ from M₁ by eq. (11) in block form
-    // adds (M₁⁻¹Z₋ᵀ) B⁻¹ (M₁⁻¹Z₋ᵀ)ᵀ. With P B Pᵀ = L_B L_Bᵀ (perm[r] the
-    // original index of position r), B⁻¹ = Pᵀ L_B⁻ᵀ L_B⁻¹ P, so
-    // F₋ = (U₋ − F₊Y)Pᵀ L_B⁻ᵀ: permute the columns, then substitute.
+/// `F₋ = (U₋ − F₊ Y) L_B⁻ᵀ` into the last `b` columns of `f`. Derivation:
+/// after adding `Z₊` the inverse is `M₁⁻¹ = M⁻¹ − F₊F₊ᵀ`, so
+/// `M₁⁻¹Z₋ᵀ = U₋ − F₊ (L_A⁻¹S₊₋) = U₋ − F₊Y` and `Z₋M₁⁻¹Z₋ᵀ = S₋₋ − YᵀY`;
+/// removing `Z₋` from `M₁` by eq. (11) in block form adds
+/// `(M₁⁻¹Z₋ᵀ) B⁻¹ (M₁⁻¹Z₋ᵀ)ᵀ`. With `P B Pᵀ = L_B L_Bᵀ` (`perm[r]` the
+/// original index of position `r`), `B⁻¹ = Pᵀ L_B⁻ᵀ L_B⁻¹ P`, so
+/// `F₋ = (U₋ − F₊Y)Pᵀ L_B⁻ᵀ`: permute the columns, then substitute.
+fn removed_columns(
+    f: &mut [f64],
+    u: &[f64],
+    y: &[f64],
+    lb: &[f64],
+    perm: &[usize],
+    (a, b, p): (usize, usize, usize),
+) {
     for r in 0..b {
         let pr = perm[r];
         let (done, rest) = f.split_at_mut((a + r) * p);
@@ -268,13 +323,6 @@ pub fn woodbury(
             *x /= d;
         }
     }
-    Ok(LowRank {
-        ln_det_ratio: ln_a + ln_b,
-        min_pivot: min_pivot(&lb, b),
-        f,
-        p,
-        n_plus: a,
-    })
 }
 
 /// Result of the row-by-row cascade.

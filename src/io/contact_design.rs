@@ -11,6 +11,7 @@
 //!   configurations, `configurations: [{name: pose_01, id: 17, point:
 //!   front_left/0, joints: {joint_a: 0.1, ...}}]` (as a design's YAML).
 
+use super::design_formats::Joints;
 use crate::error::{Error, Result};
 use crate::identify::contact::socket_design::SocketDesign;
 use serde::Serialize;
@@ -33,23 +34,6 @@ pub fn to_csv(d: &SocketDesign) -> String {
         s += &format!(",{}\n", c.id);
     }
     s
-}
-
-/// Joint values keyed by joint name, in the chain's order.
-struct Joints<'a> {
-    names: &'a [String],
-    q: &'a [f64],
-}
-
-impl Serialize for Joints<'_> {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
-        use serde::ser::SerializeMap;
-        let mut m = s.serialize_map(Some(self.names.len()))?;
-        for (n, v) in self.names.iter().zip(self.q) {
-            m.serialize_entry(n, v)?;
-        }
-        m.end()
-    }
 }
 
 /// One named joint configuration of the YAML form.

@@ -52,10 +52,13 @@ impl DesignFormat {
     }
 }
 
-/// Joint values keyed by joint name, in the chain's order.
-struct Joints<'a> {
-    names: &'a [String],
-    q: &'a [f64],
+/// Joint values keyed by joint name, in the chain's order (the YAML form of
+/// a configuration, shared by every design written as named joints).
+pub(crate) struct Joints<'a> {
+    /// The joints' names.
+    pub(crate) names: &'a [String],
+    /// Their values, in the same order.
+    pub(crate) q: &'a [f64],
 }
 
 impl Serialize for Joints<'_> {

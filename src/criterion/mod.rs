@@ -95,6 +95,7 @@ mod bench;
 mod criteria;
 mod indices;
 pub mod lowrank;
+mod pricing;
 mod prior;
 mod state;
 #[cfg(test)]
@@ -104,9 +105,10 @@ mod variances;
 pub use bench::{ScanTimings, bench_scan, bench_scan_with_threads};
 pub use criteria::{Criterion, DCriterion, OiCriterion, argmax};
 pub use indices::Indices;
+pub use pricing::exchange_gain;
 pub use prior::Prior;
 pub use state::{Drift, InfoState, StateSettings, Status};
-pub use variances::{PoolVariances, exchange_gain};
+pub use variances::PoolVariances;
 
 use thiserror::Error;
 

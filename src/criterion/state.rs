@@ -847,6 +847,9 @@ impl InfoState {
             .iter()
             .zip(&fresh)
             .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+        // `>` and `>=` are equivalent here (mutation sample, issue #30): the
+        // fresh `M` of a state is positive definite (construction and every
+        // update refuse a singular one), so `scale > 0`.
         let information = diff / if scale > 0.0 { scale } else { 1.0 };
         Drift {
             ln_det,
@@ -1166,5 +1169,23 @@ mod tests {
         let (a, b) = (drift_of(1.0), drift_of(1024.0));
         assert!(a > 0.0 && a < 1e-13, "{a}");
         assert_eq!(a, b);
+    }
+
+    /// A pool with no unknowns is refused by name, and `settings` reports
+    /// the settings the state was built with.
+    #[test]
+    fn no_unknowns_is_refused_and_settings_are_kept() {
+        let empty = Blocks::new(Mat::zeros(6, 0), 3);
+        assert!(matches!(
+            InfoState::new(&empty, &[0, 1], StateSettings::default()),
+            Err(CriterionError::UnsupportedShape { .. })
+        ));
+        let pool = random_pool(12, 3, 4, 3);
+        let s = StateSettings::default()
+            .with_ridge(1e-3)
+            .with_refactor_every(7)
+            .with_max_condition(1e10);
+        let st = InfoState::new(&pool, &[0, 1, 2], s).unwrap();
+        assert_eq!(*st.settings(), s);
     }
 }

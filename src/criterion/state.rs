@@ -847,6 +847,9 @@ impl InfoState {
             .iter()
             .zip(&fresh)
             .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+        // `>` and `>=` are equivalent here (mutation sample, issue #30): the
+        // fresh `M` of a state is positive definite (construction and every
+        // update refuse a singular one), so `scale > 0`.
         let information = diff / if scale > 0.0 { scale } else { 1.0 };
         Drift {
             ln_det,
@@ -1008,5 +1011,181 @@ mod tests {
             d.ln_det < 1e-10 && d.inverse < 1e-10 && d.information < 1e-14,
             "{d:?}"
         );
+    }
+
+    /// Issue #30's mutation sample: a ridge must be finite and `≥ 0` (a
+    /// negative or infinite one is refused, as NaN is).
+    #[test]
+    fn a_negative_or_infinite_ridge_is_refused() {
+        let s = StateSettings::default();
+        for r in [-1e-3, f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+            assert!(s.with_ridge(r).validate().is_err(), "ridge {r}");
+        }
+        assert!(s.with_ridge(0.0).validate().is_ok());
+    }
+
+    /// Every construction and every clone has its own id: caches keyed on
+    /// `(id, version)` must never confuse two states.
+    #[test]
+    fn every_state_and_clone_has_its_own_id() {
+        let pool = random_pool(12, 3, 4, 3);
+        let s = StateSettings::default();
+        let a = InfoState::new(&pool, &[0, 1, 2], s).unwrap();
+        let b = InfoState::new(&pool, &[0, 1, 2], s).unwrap();
+        let c = a.clone();
+        assert!(
+            a.id() != b.id() && a.id() != c.id() && b.id() != c.id(),
+            "{} {} {}",
+            a.id(),
+            b.id(),
+            c.id()
+        );
+    }
+
+    /// `r_j = ‖X_pool[:, j]‖² / n_pool`, and `1` for a column that is zero
+    /// on the whole pool. The scales are sums of 30 squares of numbers of
+    /// order 1: a relative tolerance of 1e-14 covers their rounding.
+    #[test]
+    fn ridge_scales_are_the_mean_column_information() {
+        let base = random_pool(10, 3, 4, 9);
+        let mat = Mat::from_fn(30, 5, |r, c| if c == 4 { 0.0 } else { base.mat()[(r, c)] });
+        let pool = Blocks::new(mat, 3);
+        let s = StateSettings::default().with_ridge(1e-2);
+        let st = InfoState::new(&pool, &[0, 1, 2, 3], s).unwrap();
+        for c in 0..4 {
+            let want: f64 = (0..30).map(|r| pool.mat()[(r, c)].powi(2)).sum::<f64>() / 10.0;
+            let got = st.ridge_scales()[c];
+            assert!(
+                (got - want).abs() <= 1e-14 * want,
+                "column {c}: {got} vs {want}"
+            );
+        }
+        assert_eq!(st.ridge_scales()[4], 1.0);
+    }
+
+    /// A prior adds its information: `ln det M = ln det(M0 + X_DᵀX_D)`
+    /// (both sides Cholesky of the same well-conditioned 6×6 sum, so 1e-10
+    /// is generous); a prior of another `p` than the pool's is refused.
+    #[test]
+    fn a_prior_adds_its_information_and_must_match_the_pool() {
+        let pool = random_pool(20, 3, 6, 4);
+        let s = StateSettings::default();
+        let prior = Prior::from_blocks(&random_pool(3, 3, 6, 8)).unwrap();
+        let st = InfoState::with_prior(&pool, &[0, 1], Some(prior.clone()), s).unwrap();
+        let m = prior.matrix().to_owned() + pool.information(&[0, 1]);
+        let (_, want) = cholesky_inverse(m.as_ref()).unwrap();
+        assert!(
+            (st.ln_det() - want).abs() < 1e-10,
+            "{} vs {want}",
+            st.ln_det()
+        );
+        let wrong = Prior::from_blocks(&random_pool(3, 3, 5, 8)).unwrap();
+        assert!(matches!(
+            InfoState::with_prior(&pool, &[0, 1, 2], Some(wrong), s),
+            Err(CriterionError::UnsupportedShape { .. })
+        ));
+    }
+
+    /// `condition_estimate` bounds the 2-norm condition number `κ₂(M̃)` of
+    /// the equilibrated `M̃ = D^-½ M D^-½` from above, by at most a factor
+    /// `p` (`‖A‖₁ ≤ √p ‖A‖₂` for each factor), computed here from
+    /// nalgebra's eigenvalues of `M̃` (relative error ~1e-15·κ, so 1e-9 of
+    /// slack), after construction and after an update.
+    #[test]
+    fn condition_estimate_bounds_the_equilibrated_condition_number() {
+        let pool = random_pool(30, 3, 6, 17);
+        let mut st = InfoState::new(&pool, &[0, 1, 2, 3], StateSettings::default()).unwrap();
+        for step in 0..2 {
+            let m = st.m();
+            let p = m.nrows();
+            let a =
+                nalgebra::DMatrix::from_fn(p, p, |i, j| m[(i, j)] / (m[(i, i)] * m[(j, j)]).sqrt());
+            let ev = a.symmetric_eigenvalues();
+            let (lo, hi) = ev
+                .iter()
+                .fold((f64::INFINITY, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
+            let k2 = hi / lo;
+            let est = st.condition_estimate();
+            assert!(
+                k2 > 2.0,
+                "a random design is not that well conditioned: {k2}"
+            );
+            assert!(
+                est >= k2 * (1.0 - 1e-9) && est <= p as f64 * k2 * (1.0 + 1e-9),
+                "step {step}: estimate {est}, κ₂ {k2}"
+            );
+            st.add(&pool, 10 + step).unwrap().delta().unwrap();
+        }
+    }
+
+    /// Without refactorizations the update log keeps between `LOG_KEEP`
+    /// and `2·LOG_KEEP` entries: 127 updates are all there, the 128th
+    /// drops the oldest 64 and moves the base to 64.
+    #[test]
+    fn the_update_log_is_trimmed_at_twice_log_keep() {
+        let pool = random_pool(12, 3, 4, 21);
+        let s = StateSettings::default().with_refactor_every(10_000);
+        let mut st = InfoState::new(&pool, &[0, 1, 2, 3], s).unwrap();
+        for k in 0..2 * LOG_KEEP {
+            if k % 2 == 0 {
+                st.add(&pool, 5).unwrap().delta().unwrap();
+            } else {
+                st.remove(&pool, 5).unwrap().delta().unwrap();
+            }
+            let (base, log) = st.updates_since();
+            if k + 1 < 2 * LOG_KEEP {
+                assert_eq!((base, log.len()), (0, k + 1), "after {} updates", k + 1);
+            } else {
+                assert_eq!((base, log.len()), (LOG_KEEP as u64, LOG_KEEP));
+            }
+        }
+    }
+
+    /// `drift`'s information error is relative to `max |M|`: scaling the
+    /// pool by 2^10 (exact in binary) scales `M` by 2^20 and every rounding
+    /// with it, so the figure is the same to the bit — and nonzero after
+    /// 32 updates without a refactorization.
+    #[test]
+    fn the_information_drift_is_relative_to_the_information() {
+        let base = random_pool(12, 3, 4, 5);
+        let drift_of = |scale: f64| {
+            let pool = Blocks::new(Mat::from_fn(36, 4, |r, c| scale * base.mat()[(r, c)]), 3);
+            let s = StateSettings::default().with_refactor_every(1000);
+            let mut st = InfoState::new(&pool, &[0, 1, 2, 3], s).unwrap();
+            for q in 4..12 {
+                st.add(&pool, q).unwrap().delta().unwrap();
+            }
+            for q in 4..12 {
+                st.remove(&pool, q).unwrap().delta().unwrap();
+            }
+            for q in (4..12).rev() {
+                st.add(&pool, q).unwrap().delta().unwrap();
+            }
+            for q in 4..12 {
+                st.remove(&pool, q).unwrap().delta().unwrap();
+            }
+            st.drift(&pool).information
+        };
+        let (a, b) = (drift_of(1.0), drift_of(1024.0));
+        assert!(a > 0.0 && a < 1e-13, "{a}");
+        assert_eq!(a, b);
+    }
+
+    /// A pool with no unknowns is refused by name, and `settings` reports
+    /// the settings the state was built with.
+    #[test]
+    fn no_unknowns_is_refused_and_settings_are_kept() {
+        let empty = Blocks::new(Mat::zeros(6, 0), 3);
+        assert!(matches!(
+            InfoState::new(&empty, &[0, 1], StateSettings::default()),
+            Err(CriterionError::UnsupportedShape { .. })
+        ));
+        let pool = random_pool(12, 3, 4, 3);
+        let s = StateSettings::default()
+            .with_ridge(1e-3)
+            .with_refactor_every(7)
+            .with_max_condition(1e10);
+        let st = InfoState::new(&pool, &[0, 1, 2], s).unwrap();
+        assert_eq!(*st.settings(), s);
     }
 }

@@ -77,6 +77,10 @@ fn ln_normal(x: f64) -> f64 {
 }
 
 /// Whether `x` is in the fast path's domain: positive, normal and finite.
+///
+/// `false` for every `x` survives the mutation sample (issue #30) as
+/// equivalent in value: every block then takes `f64::ln`, which the fast
+/// path matches within 1 ulp; it costs time only.
 #[inline(always)]
 fn is_fast_domain(x: f64) -> bool {
     (f64::MIN_POSITIVE..f64::INFINITY).contains(&x)
@@ -98,6 +102,9 @@ const BLOCK: usize = 64;
 pub fn ln_in_place(xs: &mut [f64]) {
     #[cfg(target_arch = "x86_64")]
     {
+        // Mutation sample (issue #30): emptying `wide512` survives on a CPU
+        // without AVX-512 (the sample's), where it never runs; the same
+        // tests kill it on one that has it.
         #[target_feature(enable = "avx512f")]
         fn wide512(xs: &mut [f64]) {
             ln_blocks(xs);

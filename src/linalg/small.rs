@@ -513,6 +513,12 @@ pub(crate) fn exchange_out_ln_det(
         det *= d;
         lo = lo.min(d);
     });
+    // `lo == SUSPECT_PIVOT` for `>` survives the mutation sample (issue
+    // #30) as equivalent in value: it sends every candidate to the pivoted
+    // factorization below, which gives the same determinant up to rounding
+    // and is the reference the fast path defers to; it costs time only (a
+    // refusal could differ only for a pivoted pivot `≤ floor` behind plain
+    // pivots all above SUSPECT_PIVOT, the case the fast path accepts).
     if plain.is_ok() && lo > SUSPECT_PIVOT {
         return Ok(det.ln());
     }
@@ -633,5 +639,38 @@ mod tests {
         }
         let mut perm = [0usize; 6];
         assert!(chol_pivoted_in_place(&mut b, 6, 1e-14, &mut perm).is_err());
+    }
+
+    /// Complete (diagonal) pivoting picks the largest remaining diagonal
+    /// entry, so the pivots of an SPD matrix come out non-increasing (each
+    /// step's Schur complement only lowers the remaining diagonal), and
+    /// their product is the determinant whatever the order. Random SPD
+    /// `A = B Bᵀ + I`, `n = 2…8`; the comparison allows rounding of a few
+    /// ulps of `max A_ii` (a tie decided either way by rounding is fine).
+    #[test]
+    fn pivoted_cholesky_takes_the_pivots_largest_first() {
+        let mut seed = 11u64;
+        let mut rnd = || crate::linalg::test_rng::lcg(&mut seed);
+        for n in 2..=8 {
+            for case in 0..50 {
+                let b = nalgebra::DMatrix::from_fn(n, n, |_, _| rnd());
+                let a0 = &b * b.transpose() + nalgebra::DMatrix::identity(n, n);
+                let mut a: Vec<f64> = (0..n * n).map(|k| a0[(k / n, k % n)]).collect();
+                let mut perm = vec![0usize; n];
+                let mut pivots = Vec::new();
+                chol_pivoted_pivots_in_place(&mut a, n, 0.0, &mut perm, |d| pivots.push(d))
+                    .unwrap();
+                let top = (0..n).map(|i| a0[(i, i)]).fold(0.0f64, f64::max);
+                for k in 1..n {
+                    assert!(
+                        pivots[k] <= pivots[k - 1] + 1e-14 * top,
+                        "n = {n}, case {case}: pivots {pivots:?}"
+                    );
+                }
+                let ln_det: f64 = pivots.iter().map(|d| d.ln()).sum();
+                let want = a0.determinant().ln();
+                assert!((ln_det - want).abs() < 1e-10, "n = {n}, case {case}");
+            }
+        }
     }
 }

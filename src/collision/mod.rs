@@ -6,7 +6,7 @@
 //! `package://` or a path relative to the URDF, [`stl`]) on every link of
 //! the tree — gripper fingers and other links outside the measured chain
 //! included, at joint value 0 (locked joints at their lock value). Placements
-//! come from the URDF's own joint origins and axes ([`tree`]). Meshes are
+//! come from the URDF's own joint origins and axes (`tree`). Meshes are
 //! triangle surfaces, as Coal (hpp-fcl) treats them for Pinocchio, so the two
 //! agree on what touches; the queries are `parry3d`'s (the nalgebra authors'
 //! collision library), after a bounding-sphere test per pair.

@@ -30,11 +30,11 @@ impl PoolVariances {
     /// `out[k] = base + ln det(I + V_i)` for `i = candidates[k]`, or `-∞`
     /// where `skip(i)` (a pose already in the design): the add scan of
     /// [`DCriterion`](super::DCriterion). Parallel over chunks of
-    /// [`SCAN_CHUNK`] candidates, allocation-free. For points (`t = 3`) each
-    /// chunk takes the block determinants first ([`det_i_plus3`]), then
-    /// their logarithms in one vectorised pass ([`ln_in_place`]), then
-    /// [`ln_det_i_plus`] for the rare determinant that is not finite and
-    /// positive, so every value is [`ln_det_i_plus`]'s to within 1 ulp of
+    /// `SCAN_CHUNK` candidates, allocation-free. For points (`t = 3`) each
+    /// chunk takes the block determinants first (`det_i_plus3`), then
+    /// their logarithms in one vectorised pass (`ln_in_place`), then
+    /// `ln_det_i_plus` for the rare determinant that is not finite and
+    /// positive, so every value is `ln_det_i_plus`'s to within 1 ulp of
     /// the logarithm.
     pub fn add_scores(
         &self,

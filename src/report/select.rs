@@ -176,7 +176,7 @@ pub struct SelectReport {
     /// The chain's joint names, in configuration order.
     pub joint_names: Vec<String>,
     /// The design's poses with their joint values (refined ones with
-    /// `--refine`), in visiting order ([`SelectReport::set_visit`]; the
+    /// `--refine`), in visiting order (once a tour is planned; the
     /// selection's order until then).
     pub configurations: Vec<PoseConfig>,
     /// The visiting order's figures, when one was planned.

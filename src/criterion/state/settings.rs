@@ -1,4 +1,4 @@
-//! What an [`InfoState`](super::InfoState) is configured with
+//! What an [`InfoState`](super::InfoState)(super::InfoState) is configured with
 //! ([`StateSettings`]), what an update reports ([`Status`]), and the drift
 //! of its maintained quantities ([`Drift`]).
 
@@ -6,13 +6,13 @@ use super::super::CriterionError;
 use crate::linalg::rank::MAX_CONDITION;
 use serde::{Deserialize, Serialize};
 
-/// Settings of an [`InfoState`]; validated by [`InfoState::new`].
+/// Settings of an [`InfoState`](super::InfoState); validated by [`InfoState::new`](super::InfoState::new).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct StateSettings {
     /// Relative ridge `δ ≥ 0`: `M = XᵀX + δR`, `R = diag(r_j)` with `r_j`
     /// the mean information of column `j` per pool pose
-    /// ([`InfoState::ridge_scales`]), so that scaling a column (a unit
+    /// ([`InfoState::ridge_scales`](super::InfoState::ridge_scales)), so that scaling a column (a unit
     /// change) scales its ridge with it. Lets a selection start from fewer
     /// than `p/t` poses. Default `0`.
     pub ridge: f64,
@@ -21,7 +21,7 @@ pub struct StateSettings {
     pub refactor_every: usize,
     /// Largest accepted condition number of the equilibrated `M` (see the
     /// module docs' singularity rule), `> 1`. Default
-    /// [`MAX_CONDITION`](crate::linalg::rank::MAX_CONDITION) `= 1e13`, the
+    /// `linalg::rank::MAX_CONDITION` `= 1e13`, the
     /// rule every command decides rank by.
     pub max_condition: f64,
 }

@@ -5,7 +5,7 @@ use crate::measure::Visibility;
 use crate::model::{Convention, JointKind, MeasurementKind, Robot, Symbol};
 use serde::Serialize;
 
-/// Writes a robot as a description that [`parse`] reads back to the same
+/// Writes a robot as a description that [`super::parse`] reads back to the same
 /// robot (tables bit for bit: numbers are written as the shortest decimals
 /// that round-trip; limits in radians or metres). A DH frame's β is written
 /// when finite (the paper's marker 10), omitted otherwise.

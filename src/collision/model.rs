@@ -76,6 +76,20 @@ impl std::fmt::Debug for CollisionModel {
 }
 
 impl CollisionModel {
+    /// Every link's placement at configuration `q` (the chain's joint
+    /// values over the rest configuration, locks applied).
+    fn link_placements(&self, q: &[f64]) -> Vec<Isometry3<f64>> {
+        let mut values = self.rest.clone();
+        for (k, &j) in self.drives.iter().enumerate() {
+            if let Some(v) = q.get(k) {
+                values[j] = *v;
+            }
+        }
+        let mut links = vec![Isometry3::identity(); self.tree.links.len()];
+        self.tree.placements(&values, &mut links);
+        links
+    }
+
     /// Geometry pairs checked for self-collision.
     #[must_use]
     pub fn pair_count(&self) -> usize {
@@ -97,14 +111,7 @@ impl CollisionModel {
     /// names it): cheap to count per candidate.
     #[must_use]
     pub fn contact_key(&self, q: &[f64]) -> Option<usize> {
-        let mut values = self.rest.clone();
-        for (k, &j) in self.drives.iter().enumerate() {
-            if let Some(v) = q.get(k) {
-                values[j] = *v;
-            }
-        }
-        let mut links = vec![Isometry3::identity(); self.tree.links.len()];
-        self.tree.placements(&values, &mut links);
+        let links = self.link_placements(q);
         let poses: Vec<Isometry3<f64>> = self
             .geoms
             .iter()
@@ -146,14 +153,7 @@ impl CollisionModel {
     /// that moves no geometry 0.
     #[must_use]
     pub fn sweep_rates(&self, q: &[f64]) -> Vec<f64> {
-        let mut values = self.rest.clone();
-        for (k, &j) in self.drives.iter().enumerate() {
-            if let Some(v) = q.get(k) {
-                values[j] = *v;
-            }
-        }
-        let mut links = vec![Isometry3::identity(); self.tree.links.len()];
-        self.tree.placements(&values, &mut links);
+        let links = self.link_placements(q);
         // The tree joint above each link (None at the root).
         let mut above = vec![None; self.tree.links.len()];
         for (k, j) in self.tree.joints.iter().enumerate() {
@@ -185,14 +185,7 @@ impl CollisionModel {
 
     /// Every geometry's placement in the root frame at `q`.
     pub(super) fn geometry_poses(&self, q: &[f64]) -> Vec<Isometry3<f64>> {
-        let mut values = self.rest.clone();
-        for (k, &j) in self.drives.iter().enumerate() {
-            if let Some(v) = q.get(k) {
-                values[j] = *v;
-            }
-        }
-        let mut links = vec![Isometry3::identity(); self.tree.links.len()];
-        self.tree.placements(&values, &mut links);
+        let links = self.link_placements(q);
         self.geoms
             .iter()
             .map(|g| links[g.link] * g.origin)

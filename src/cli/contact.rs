@@ -50,30 +50,31 @@ pub fn parse_distance(s: &str) -> Result<NamedDistance> {
     })
 }
 
-/// Parses one `--plane NAME=nx,ny,nz,d` (the normal's length is checked
-/// with the file's planes).
-pub fn parse_plane(s: &str) -> Result<NamedPlane> {
-    let bad = || {
-        anyhow::anyhow!(
-            "--plane {s}: expected NAME=nx,ny,nz,d (a plane name, its normal and offset in metres, n · x = d in the base frame, e.g. table=0,0,1,0.02)"
-        )
-    };
-    let (name, rest) = s.split_once('=').ok_or_else(bad)?;
+/// `NAME=v1,…,vN`: a non-empty name and exactly `N` numbers (`None`
+/// otherwise), the form of `--plane` and `select --point`.
+pub fn named_numbers<const N: usize>(s: &str) -> Option<(String, [f64; N])> {
+    let (name, rest) = s.split_once('=')?;
     let v: Vec<f64> = rest
         .split(',')
         .map(|c| c.trim().parse::<f64>())
         .collect::<std::result::Result<_, _>>()
-        .map_err(|_| bad())?;
-    let [nx, ny, nz, d] = v.as_slice() else {
-        return Err(bad());
+        .ok()?;
+    let name = name.trim();
+    (!name.is_empty()).then(|| v.try_into().ok().map(|a| (name.to_string(), a)))?
+}
+
+/// Parses one `--plane NAME=nx,ny,nz,d` (the normal's length is checked
+/// with the file's planes).
+pub fn parse_plane(s: &str) -> Result<NamedPlane> {
+    let Some((name, [nx, ny, nz, d])) = named_numbers::<4>(s) else {
+        anyhow::bail!(
+            "--plane {s}: expected NAME=nx,ny,nz,d (a plane name, its normal and offset in metres, n · x = d in the base frame, e.g. table=0,0,1,0.02)"
+        );
     };
-    if name.trim().is_empty() {
-        return Err(bad());
-    }
     Ok(NamedPlane {
-        name: name.trim().to_string(),
-        normal: [*nx, *ny, *nz],
-        offset: *d,
+        name,
+        normal: [nx, ny, nz],
+        offset: d,
     })
 }
 

@@ -21,27 +21,14 @@ pub const DEFAULT_SAMPLES: usize = 1000;
 
 /// Parses one `--point NAME=x,y,z` (base frame, metres).
 fn parse_socket(s: &str) -> Result<Socket> {
-    let bad = || {
-        anyhow::anyhow!(
+    match super::contact::named_numbers::<3>(s) {
+        Some((name, position)) if position.iter().all(|c| c.is_finite()) => {
+            Ok(Socket { name, position })
+        }
+        _ => anyhow::bail!(
             "--point {s}: expected NAME=X,Y,Z (a point name and its position in the base frame, metres, e.g. front_left/0=0.48,0.23,0.02)"
-        )
-    };
-    let (name, rest) = s.split_once('=').ok_or_else(bad)?;
-    let v: Vec<f64> = rest
-        .split(',')
-        .map(|c| c.trim().parse::<f64>())
-        .collect::<std::result::Result<_, _>>()
-        .map_err(|_| bad())?;
-    let [x, y, z] = v.as_slice() else {
-        return Err(bad());
-    };
-    if name.trim().is_empty() || v.iter().any(|c| !c.is_finite()) {
-        return Err(bad());
+        ),
     }
-    Ok(Socket {
-        name: name.trim().to_string(),
-        position: [*x, *y, *z],
-    })
 }
 
 /// The options of `select` that have no meaning for sockets, refused

@@ -23,6 +23,7 @@ pub mod reproduce;
 pub mod select;
 pub mod simulated;
 pub mod tour;
+pub mod typeset;
 pub mod units;
 
 use activecal::io::{ChainChoice, RobotRef};

@@ -137,7 +137,15 @@ pub fn histograms(
             .axis_desc_style((FONT, 16))
             .label_style((FONT, 13))
             .x_labels(6)
-            .y_label_formatter(&|y| format!("{y:.0}"))
+            // Counts are whole: a tick between two whole numbers stays unlabelled
+            // (it read "2, 2, 2" for 1.5, 2, 2.5).
+            .y_label_formatter(&|y| {
+                if (y - y.round()).abs() < 1e-9 {
+                    format!("{y:.0}")
+                } else {
+                    String::new()
+                }
+            })
             .draw()
             .map_err(err)?;
         c.draw_series(

@@ -28,9 +28,8 @@ pub const DOUBLE: (u32, u32) = (1200, 560);
 /// The size of the parameter and correlation figures, pixels.
 pub const TALL: (u32, u32) = (1100, 950);
 
-/// Monospace: plotters' bitmap text clips a glyph left of its origin, which
-/// in the proportional fonts loses most of a small "j" ("joint" read
-/// ",oint"); the monospace glyphs all start right of it.
+/// Monospace (the embedded DejaVu Sans Mono): labels of numbers and names
+/// line up from one tick to the next.
 const FONT: &str = "monospace";
 const BEFORE: RGBColor = RGBColor(200, 60, 40);
 const AFTER: RGBColor = RGBColor(30, 90, 200);

@@ -56,21 +56,30 @@ mod urdf_chains;
 /// would silently never run.
 #[test]
 fn every_test_file_is_a_module() {
-    let listed: Vec<&str> = include_str!("all.rs")
-        .lines()
-        .filter_map(|l| l.strip_prefix("mod ")?.strip_suffix(';'))
-        .collect();
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests");
-    let mut missing = Vec::new();
-    for e in std::fs::read_dir(&dir).expect("tests/ is readable") {
-        let name = e.expect("a directory entry").file_name();
-        let name = name.to_string_lossy();
-        if let Some(stem) = name.strip_suffix(".rs")
-            && stem != "all"
-            && !listed.contains(&stem)
-        {
-            missing.push(stem.to_string());
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    // The root crate's, the property tests' and verify's test binaries.
+    for crate_dir in [".", "proptests", "verify"] {
+        let tests = root.join(crate_dir).join("tests");
+        let all = std::fs::read_to_string(tests.join("all.rs")).expect("tests/all.rs is readable");
+        // A listed module: `mod NAME;`, possibly behind a `#[cfg(..)]` line.
+        let listed: Vec<&str> = all
+            .lines()
+            .filter_map(|l| l.trim().strip_prefix("mod ")?.strip_suffix(';'))
+            .collect();
+        let mut missing = Vec::new();
+        for e in std::fs::read_dir(&tests).expect("tests/ is readable") {
+            let name = e.expect("a directory entry").file_name();
+            let name = name.to_string_lossy();
+            if let Some(stem) = name.strip_suffix(".rs")
+                && stem != "all"
+                && !listed.contains(&stem)
+            {
+                missing.push(stem.to_string());
+            }
         }
+        assert!(
+            missing.is_empty(),
+            "{crate_dir}/tests/all.rs does not list {missing:?}"
+        );
     }
-    assert!(missing.is_empty(), "tests/all.rs does not list {missing:?}");
 }

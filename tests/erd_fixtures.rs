@@ -6,7 +6,7 @@
 //! `oMf(base)⁻¹ · oMf(tip)` on the same file — to 1e-12 m in position and
 //! 1e-12 in every rotation entry, at 20 joint vectors within Pinocchio's
 //! limits. Every other arm of the table is covered by the live check
-//! (`cargo test -p verify --features live --test live_erd`), which also
+//! (`cargo test -p verify --features live --test all live_erd::`), which also
 //! confirms the chains said to be the same as a fixture's. Regenerate with
 //! `cargo run -p verify --features live -- regen`.
 //!

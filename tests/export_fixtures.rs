@@ -15,7 +15,7 @@
 //!   joint by joint from base to tip, equals Pinocchio's placements to
 //!   1e-9, so the placements are those of today's file.
 //!
-//! The live check `cargo test -p verify --features live --test live_export`
+//! The live check `cargo test -p verify --features live --test all live_export::`
 //! does the same with Pinocchio itself for every arm, at 100 random and
 //! every measured configuration; regenerate with
 //! `cargo run -p verify --features live -- regen`.

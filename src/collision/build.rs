@@ -99,6 +99,27 @@ fn obstacles(
     Ok(obstacles)
 }
 
+/// The URDF limits (lower, upper) of each driven joint; a continuous joint,
+/// or one whose limits are missing, turns through [−π, π].
+fn drive_limits(urdf: &urdf_rs::Robot, tree: &Tree, drives: &[usize]) -> Vec<(f64, f64)> {
+    drives
+        .iter()
+        .map(|&k| {
+            let name = &tree.joints[k].name;
+            let joint = urdf.joints.iter().find(|j| &j.name == name);
+            match joint {
+                Some(j)
+                    if j.joint_type != urdf_rs::JointType::Continuous
+                        && j.limit.lower < j.limit.upper =>
+                {
+                    (j.limit.lower, j.limit.upper)
+                }
+                _ => (-std::f64::consts::PI, std::f64::consts::PI),
+            }
+        })
+        .collect()
+}
+
 impl CollisionModel {
     /// Loads the model of `spec`: errors name the URDF, a missing or broken
     /// mesh file and its link, an SRDF line naming an unknown link, a chain
@@ -159,7 +180,8 @@ impl CollisionModel {
                 spec.clearance
             ));
         }
-        Ok(CollisionModel {
+        let limits = drive_limits(&urdf, &tree, &drives);
+        let mut model = CollisionModel {
             tree,
             geoms,
             pairs,
@@ -168,6 +190,11 @@ impl CollisionModel {
             drives,
             clearance: spec.clearance,
             rest,
-        })
+            always_touching: Vec::new(),
+        };
+        if let Some(rule) = spec.always_touching.as_ref().filter(|_| spec.self_collision) {
+            model.always_touching = model.skip_always_touching(rule, &limits);
+        }
+        Ok(model)
     }
 }

@@ -23,6 +23,7 @@
 //! process, on first use or in [`CollisionFilter::load`], which pool
 //! building calls before any candidate is checked.
 
+mod always;
 mod build;
 pub mod mesh;
 mod model;
@@ -33,9 +34,10 @@ pub mod srdf;
 pub mod stl;
 mod tree;
 
+pub use always::TouchingPair;
 pub use model::{CollisionModel, ContactPair};
 pub use moves::MoveCheck;
-pub use spec::{CollisionSpec, Obstacle};
+pub use spec::{AlwaysTouching, CollisionSpec, Obstacle};
 
 use serde::{Deserialize, Serialize};
 use std::sync::{Arc, OnceLock};

@@ -2,6 +2,7 @@
 //! (closer than the clearance), which pair it is, and how fast each joint
 //! sweeps the geometry.
 
+use super::always::TouchingPair;
 use super::shapes::Geometry;
 use super::tree::{Motion, Tree};
 use parry3d_f64::na::Isometry3;
@@ -10,7 +11,7 @@ use serde::Serialize;
 
 /// What two geometries at `pa`, `pb` are to each other: closer than
 /// `clearance` (touching when it is 0).
-fn too_close(
+pub(super) fn too_close(
     pa: &Isometry3<f64>,
     a: &dyn parry3d_f64::shape::Shape,
     pb: &Isometry3<f64>,
@@ -60,6 +61,9 @@ pub struct CollisionModel {
     pub(super) clearance: f64,
     /// Joint values at a zero configuration (locks applied).
     pub(super) rest: Vec<f64>,
+    /// Link pairs left unchecked because they touch in nearly every
+    /// configuration ([`AlwaysTouching`](super::spec::AlwaysTouching)).
+    pub(super) always_touching: Vec<TouchingPair>,
 }
 
 impl std::fmt::Debug for CollisionModel {
@@ -88,6 +92,14 @@ impl CollisionModel {
         let mut links = vec![Isometry3::identity(); self.tree.links.len()];
         self.tree.placements(&values, &mut links);
         links
+    }
+
+    /// The link pairs left unchecked because they touch in nearly every
+    /// sampled configuration, most often touching first (empty unless the
+    /// spec asks for [`AlwaysTouching`](super::spec::AlwaysTouching)).
+    #[must_use]
+    pub fn always_touching(&self) -> &[TouchingPair] {
+        &self.always_touching
     }
 
     /// Geometry pairs checked for self-collision.

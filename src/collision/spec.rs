@@ -49,6 +49,33 @@ impl Obstacle {
     }
 }
 
+/// The rule that finds link pairs touching by design when no SRDF lists
+/// them: the pairs in contact in at least `fraction` of `samples`
+/// configurations drawn uniformly within the chain's joint limits (from
+/// `seed`; the other joints at their rest values) are not checked — the
+/// "always in collision" rule of MoveIt's setup assistant, at its default
+/// threshold of 95 %.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AlwaysTouching {
+    /// Configurations drawn.
+    pub samples: usize,
+    /// The least fraction of them in which a pair touches to be skipped.
+    pub fraction: f64,
+    /// The draws' seed.
+    pub seed: u64,
+}
+
+impl Default for AlwaysTouching {
+    /// 1,000 configurations, 95 %, seed 0.
+    fn default() -> Self {
+        Self {
+            samples: 1000,
+            fraction: 0.95,
+            seed: 0,
+        }
+    }
+}
+
 /// What a collision filter checks, as stored in a pool spec.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct CollisionSpec {
@@ -73,6 +100,10 @@ pub struct CollisionSpec {
     /// SRDF whose `disable_collisions` pairs are not checked.
     #[serde(default)]
     pub srdf: Option<String>,
+    /// Leave unchecked the link pairs that touch in nearly every
+    /// configuration ([`AlwaysTouching`]): for a URDF without an SRDF.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub always_touching: Option<AlwaysTouching>,
     /// Directories searched for `package://` meshes.
     #[serde(default)]
     pub package_dirs: Vec<String>,

@@ -130,7 +130,7 @@ impl PoolFilter {
 }
 
 /// How many candidates one filter removed.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FilterStat {
     /// The filter ([`PoolFilter::kind`]).
     pub filter: String,
@@ -150,7 +150,7 @@ pub struct FilterStat {
 
 /// What building a pool did: candidates of the source, what each filter
 /// removed, what was kept, and notes (columns of a file that were ignored).
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PoolStats {
     /// Candidates of the source, before filtering.
     pub candidates: usize,

@@ -3,7 +3,7 @@
 //! ten largest first, with a warning when a filter removes nearly all.
 
 use super::FilterStat;
-use crate::collision::{CollisionModel, ContactPair};
+use crate::collision::{CollisionModel, ContactPair, TouchingPair};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -33,7 +33,7 @@ pub struct PairCount {
 }
 
 /// Which contacts removed a collision filter's candidates.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ContactCounts {
     /// Removed by two links touching.
     pub self_collision: usize,
@@ -43,6 +43,10 @@ pub struct ContactCounts {
     pub distinct_pairs: usize,
     /// The [`TOP_PAIRS`] pairs that removed most, most first (ties by name).
     pub top: Vec<PairCount>,
+    /// Link pairs not checked because they touch in nearly every sampled
+    /// configuration ([`AlwaysTouching`](crate::collision::AlwaysTouching)).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub always_touching: Vec<TouchingPair>,
 }
 
 /// Counts the contacts of `verdict` (first failing filter, contact key) for
@@ -83,6 +87,7 @@ fn contact_counts(model: &CollisionModel, verdict: &[(usize, usize)], f: usize) 
                 removed,
             })
             .collect(),
+        always_touching: model.always_touching().to_vec(),
     }
 }
 

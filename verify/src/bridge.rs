@@ -14,7 +14,6 @@ use anyhow::{Context, Result, bail};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyModule};
-use serde::{Deserialize, Serialize};
 use std::ffi::CString;
 use std::path::{Path, PathBuf};
 
@@ -212,15 +211,7 @@ impl Bridge {
 }
 
 /// A placement as the bridge passes it: (rotation row-major, translation).
-/// A placement: rotation (row-major; its columns are the frame's axes) and
-/// position.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Placement {
-    /// Rotation, row-major.
-    pub rotation: [[f64; 3]; 3],
-    /// Position (metres).
-    pub position: [f64; 3],
-}
+pub use crate::placement::Placement;
 
 type PyPlacement = ([[f64; 3]; 3], [f64; 3]);
 

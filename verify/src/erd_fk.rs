@@ -45,7 +45,7 @@ pub const REFERENCE: &str = "Pinocchio buildModelFromUrdf + framesForwardKinemat
      (base: the URDF's root when null); rotation row-major (columns: the tip's axes), \
      position in metres";
 
-pub use crate::bridge::Placement;
+pub use crate::placement::Placement;
 
 /// Largest deviation between two lists of placements.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]

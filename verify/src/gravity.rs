@@ -20,7 +20,9 @@
 //! ~30 composed rigid transforms: rounding is ~1e-14 relative; a centre of
 //! mass off by a micrometre changes a torque by ~1e-6 relative.
 
-use crate::export::{Case, Description, cases, random_configurations};
+#[cfg(feature = "live")]
+use crate::export::random_configurations;
+use crate::export::{Case, Description, cases};
 use crate::fixture::Versions;
 use activecal::io::inertia::{InertiaOptions, gravity_model};
 use activecal::model::Robot;

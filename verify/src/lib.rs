@@ -33,6 +33,7 @@ pub mod fixture;
 pub mod gravity;
 pub mod idjac;
 pub mod model;
+pub mod placement;
 pub mod sample;
 
 #[cfg(feature = "live")]

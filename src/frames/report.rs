@@ -153,6 +153,10 @@ pub struct FramesReport {
     /// torque from the URDF's inertials.
     #[serde(skip_serializing_if = "std::collections::BTreeMap::is_empty")]
     pub compliance: std::collections::BTreeMap<String, ComplianceBlock>,
+    /// The points and planes of a contact fit ([`super::contact`]), in the
+    /// measurement frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contacts: Option<super::contact::ContactsBlock>,
 }
 
 /// One joint's compliance in the frames file.
@@ -317,6 +321,7 @@ impl FramesReport {
             structure: relations(f, &UrdfFrames::of(src).before),
             fit,
             compliance: std::collections::BTreeMap::new(),
+            contacts: None,
         }
     }
 }

@@ -205,7 +205,16 @@ pub fn calibrate_contacts(
         let _ = writeln!(report, "calibrated robot written to {out}");
     }
     if let Some(dir) = a.report {
-        super::report_dir::contacts(dir, robot, &report, &v)?;
+        let r = super::contact_report::ContactReport {
+            robot,
+            file: &file,
+            fit: &fit,
+            figures: &figures,
+            held: held.as_ref(),
+        };
+        super::report_dir::contacts(dir, robot, &report, &v, |d| {
+            super::contact_report::draw(d, &r)
+        })?;
     }
     super::emit(a.json, &v, || report);
     if !fit.converged {

@@ -21,6 +21,7 @@ mod cli_robots;
 mod cli_safety;
 mod collision;
 mod compliance;
+mod contact_export;
 mod erd_fixtures;
 mod export_fixtures;
 mod fixtures;

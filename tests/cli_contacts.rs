@@ -394,3 +394,79 @@ fn description_tables_give_distances_and_planes() {
     );
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// `select --point` with collision filters: the projected configurations
+/// pass the same self-collision and obstacle filters as every pool, each a
+/// filter of its own in `pool_stats` (what reached it, what it removed);
+/// the pool is what they kept; and `pool` on the chosen configurations
+/// with the same filters removes none of them (every chosen one is free).
+/// A socket 6 cm above a floor at 5 cm: the hand's fingers reach below the
+/// tool point in some configurations, so the floor removes some.
+#[test]
+fn select_for_a_socket_through_the_collision_filters() {
+    const ERD_PANDA: &str = "fixtures/example-robot-data/panda.urdf";
+    const ERD_SRDF: &str = "fixtures/example-robot-data/panda.srdf";
+    let dir = common::scratch_dir("cli_contacts", "select_collision");
+    let csv = dir.join("record.csv");
+    let filters = ["--self-collision", "--srdf", ERD_SRDF, "--floor", "0.05"];
+    let mut args = vec![
+        "select",
+        "--robot",
+        ERD_PANDA,
+        "--tip",
+        "panda_hand_tcp",
+        "--point",
+        "s=0.45,0.1,0.11",
+        "--n",
+        "20",
+        "--count",
+        "300",
+        "--json",
+        "--out",
+        csv.to_str().unwrap(),
+    ];
+    args.extend(filters);
+    let v = json_of(&args);
+    let st = &v["pool_stats"];
+    let f = st["filters"].as_array().unwrap();
+    assert_eq!(f.len(), 2, "{st}");
+    assert_eq!(f[0]["filter"], "self-collision");
+    assert_eq!(f[1]["filter"], "obstacles");
+    let reached = v["points"][0]["configurations"].as_u64().unwrap();
+    let kept = st["kept"].as_u64().unwrap();
+    // The candidates are the projected configurations; each filter sees
+    // what the one before kept; the pool is what the last kept.
+    assert_eq!(f[0]["seen"], st["candidates"]);
+    assert_eq!(
+        f[1]["seen"].as_u64().unwrap(),
+        f[0]["seen"].as_u64().unwrap() - f[0]["removed"].as_u64().unwrap()
+    );
+    assert_eq!(
+        kept,
+        f[1]["seen"].as_u64().unwrap() - f[1]["removed"].as_u64().unwrap()
+    );
+    assert_eq!(kept, reached);
+    assert_eq!(v["pool"].as_u64().unwrap(), kept);
+    // The floor acts here (the check can fail: a filter that kept all).
+    assert!(f[1]["removed"].as_u64().unwrap() > 0, "{st}");
+    assert_eq!(v["configurations"].as_array().unwrap().len(), 20);
+    let again = json_of(&[
+        "pool",
+        "--robot",
+        ERD_PANDA,
+        "--tip",
+        "panda_hand_tcp",
+        "--pool",
+        &format!("file:{}", csv.display()),
+        "--margin",
+        "0",
+        "--self-collision",
+        "--srdf",
+        ERD_SRDF,
+        "--floor",
+        "0.05",
+        "--json",
+    ]);
+    assert_eq!(again["pool_stats"]["kept"], 20, "{}", again["pool_stats"]);
+    let _ = std::fs::remove_dir_all(dir);
+}

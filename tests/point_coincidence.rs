@@ -214,6 +214,60 @@ fn panda_2_trained_on_front_left() {
     assert!(h.mean_distance_error_mm.unwrap() <= 0.2, "{:?}", h);
 }
 
+/// Why training on `front_left` alone gives 0.554 mm (L2) and not less:
+/// two of its 60 rows are faulty (file lines 242 and 243, `front_left/1`,
+/// 1.3 and 1.8 mm from their socket's mean after calibration, where the
+/// others are within 0.5 mm), and on one placement they pull the fit. A
+/// Huber loss at 0.5 mm down-weights exactly these two (weights 0.40 and
+/// 0.29) and the held-out mean falls to 0.511 mm (0.407 without `high`);
+/// an L2 fit without the two rows gives 0.502 mm (0.398). Neither the
+/// distance's weight (0.552–0.554 mm for weights 1 to 1000) nor the
+/// contact pivot tolerance (the same unknowns from 3e-4 to 3e-2) moves it.
+/// The bars sit between the L2 figure and the measured ones.
+#[test]
+fn front_left_holds_two_faulty_rows_a_robust_fit_names() {
+    let robot = panda();
+    let file = contacts(&robot);
+    let given = sockets(&file);
+    let train_on = HoldoutMode::TrainOn("front_left".into());
+    let huber = holdout_by_placement(
+        &robot,
+        &robot.nominal,
+        &file,
+        &given,
+        &settings(LossChoice::Huber { scale: 5e-4 }),
+        &train_on,
+    )
+    .unwrap();
+    for f in &huber.folds {
+        let lines: Vec<usize> = f.downweighted.iter().map(|d| d.line).collect();
+        assert_eq!(lines, vec![242, 243], "{:?}", f.downweighted);
+        assert!(f.downweighted.iter().all(|d| d.point == "front_left/1"));
+    }
+    assert!(
+        huber.mean_calibrated_mm < 0.53,
+        "{}",
+        huber.mean_calibrated_mm
+    );
+    let kept: Vec<usize> = (0..file.qs.len())
+        .filter(|&i| ![242, 243].contains(&file.lines[i]))
+        .collect();
+    let without = holdout_by_placement(
+        &robot,
+        &robot.nominal,
+        &file.subset(&kept),
+        &given,
+        &settings(LossChoice::L2),
+        &train_on,
+    )
+    .unwrap();
+    assert!(
+        without.mean_calibrated_mm < 0.52,
+        "{}",
+        without.mean_calibrated_mm
+    );
+}
+
 /// A robust loss names the `high` placement's shifted blocks among the rows
 /// it down-weights (hole_0 rows 9–17 are file lines 320–328).
 #[test]

@@ -155,3 +155,77 @@ fn a_report_path_that_is_a_file_is_refused_before_any_work() {
         "not a directory",
     );
 }
+
+/// Whether the PNG `dir/stem.png` has a pixel of colour `rgb` (the
+/// figures are RGB, 8 bits a channel).
+fn has_colour(dir: &Path, stem: &str, rgb: [u8; 3]) -> bool {
+    let file = std::fs::File::open(dir.join(format!("{stem}.png"))).unwrap();
+    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgb, "{stem}");
+    buf[..info.buffer_size()].chunks(3).any(|p| p == rgb)
+}
+
+/// `calibrate --report` on a contact file draws each placement's
+/// consistency and each distance's error (nominal, calibrated and, with
+/// held-out placements, held out: the held-out bars' green is there only
+/// then) and each row's distance to its point's mean (a second, held-out
+/// panel with held-out placements); report.md lists them.
+#[test]
+fn calibrate_report_on_contacts_draws_placements_distances_and_rows() {
+    const HELD_GREEN: [u8; 3] = [40, 150, 70];
+    let mut args = vec![
+        "calibrate",
+        "--robot",
+        "fixtures/mukca/panda.urdf",
+        "--tip",
+        "ball_link",
+        "--measurements",
+        "fixtures/mukca/panda_2.csv",
+    ];
+    let placements = [
+        "back_left",
+        "back_right",
+        "front_center",
+        "front_left",
+        "front_right",
+        "high",
+        "mid-high",
+        "mid_left",
+        "mid_right",
+    ];
+    let d: Vec<String> = placements
+        .iter()
+        .flat_map(|p| ["--point-distance".to_string(), format!("{p}/0,{p}/1=0.05")])
+        .collect();
+    args.extend(d.iter().map(String::as_str));
+    let root = scratch_dir("reports", "contacts");
+    let (held, plain) = (root.join("held"), root.join("plain"));
+    let mut with_held = args.clone();
+    with_held.extend([
+        "--train-on",
+        "front_left",
+        "--report",
+        held.to_str().unwrap(),
+    ]);
+    ok(&with_held);
+    assert_eq!(png_size(&held, "consistency_by_placement"), (1300, 620));
+    assert_eq!(png_size(&held, "row_distances"), (1300, 980));
+    assert!(has_colour(&held, "consistency_by_placement", HELD_GREEN));
+    let md = std::fs::read_to_string(held.join("report.md")).unwrap();
+    assert!(
+        md.contains("consistency_by_placement.png") && md.contains("row_distances.png"),
+        "{md}"
+    );
+    assert!(md.contains("(mm"), "{md}");
+    let mut without = args.clone();
+    without.extend(["--report", plain.to_str().unwrap()]);
+    ok(&without);
+    assert_eq!(png_size(&plain, "consistency_by_placement"), (1300, 620));
+    assert_eq!(png_size(&plain, "row_distances"), (1300, 560));
+    assert!(!has_colour(&plain, "consistency_by_placement", HELD_GREEN));
+    let _ = std::fs::remove_dir_all(root);
+}

@@ -67,7 +67,8 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
         (_, Some(m)) if super::contact::is_contact_file(m) => {
             let c = super::contact::ContactArgs {
                 holdout: a.holdout.is_some(),
-                out: !a.out.is_empty(),
+                out: &a.out,
+                force: a.force,
                 point_distance: &a.point_distance,
                 plane: &a.plane,
                 setup: &desc.contacts,

@@ -100,8 +100,10 @@ pub fn contact_setup(
 pub struct ContactArgs<'a> {
     /// `--holdout` was given (refused).
     pub holdout: bool,
-    /// `--out` was given (refused).
-    pub out: bool,
+    /// `--out` (checked before the fit, written when it converged).
+    pub out: &'a [std::path::PathBuf],
+    /// `--force`.
+    pub force: bool,
     /// `--point-distance`.
     pub point_distance: &'a [String],
     /// `--plane`.
@@ -142,9 +144,7 @@ pub fn calibrate_contacts(
             "--holdout: contacts are held out by placement (--holdout-by placement or --train-on NAME), not by random rows"
         );
     }
-    if a.out {
-        bail!("--out: writing a robot calibrated from contacts is not supported yet");
-    }
+    super::contact_out::check(a.out, robot)?;
     let (given, planes) = contact_setup(a.setup, a.point_distance, a.plane)?;
     let mut file = read_contacts(path, robot, a.units)?;
     file.set_known_planes(&planes).context("--plane")?;
@@ -176,6 +176,15 @@ pub fn calibrate_contacts(
         None => None,
     };
     let down = downweighted_rows(&fit, &file);
+    let frames = if a.out.is_empty() {
+        None
+    } else {
+        super::contact_out::frames(&fit, &file, &given)?
+    };
+    let written = match &frames {
+        Some(f) if fit.converged => super::contact_out::write(a.out, a.force, &fit.robot, &fit, f)?,
+        _ => Vec::new(),
+    };
     let v = json!({
         "robot": robot.name,
         "measurements": path.display().to_string(),
@@ -184,22 +193,45 @@ pub fn calibrate_contacts(
         "downweighted": down,
         "in_sample": figures,
         "holdout": held,
+        "frames": frames.as_ref().map(|(_, r)| r),
+        "out": written,
         "exit_status": if fit.converged { 0 } else { 3 },
     });
-    let report = text(&file, &fit, &figures, held.as_ref());
+    let mut report = text(&file, &fit, &figures, held.as_ref());
+    if !written.is_empty() {
+        report.push('\n');
+    }
+    for out in &written {
+        let _ = writeln!(report, "calibrated robot written to {out}");
+    }
     if let Some(dir) = a.report {
-        super::report_dir::contacts(dir, robot, &report, &v)?;
+        let r = super::contact_report::ContactReport {
+            robot,
+            file: &file,
+            fit: &fit,
+            figures: &figures,
+            held: held.as_ref(),
+        };
+        super::report_dir::contacts(dir, robot, &report, &v, |d| {
+            super::contact_report::draw(d, &r)
+        })?;
     }
     super::emit(a.json, &v, || report);
     if !fit.converged {
+        let names: Vec<String> = a.out.iter().map(|p| p.display().to_string()).collect();
         return Ok(Some(format!(
-            "the contact fit ended {:?} after {} iterations{}",
+            "the contact fit ended {:?} after {} iterations{}{}",
             fit.stop,
             fit.iterations,
             if fit.std.is_none() {
                 " without a full-rank Jacobian"
             } else {
                 ""
+            },
+            if names.is_empty() {
+                String::new()
+            } else {
+                format!("; {} not written", names.join(", "))
             }
         )));
     }

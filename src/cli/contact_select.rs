@@ -51,9 +51,6 @@ fn refuse_pool_options(a: &SelectArgs) -> Result<()> {
         (p.pool != super::PoolKind::Lattice, "--pool"),
         (p.levels.is_some(), "--levels"),
         (p.visibility.is_some(), "--visibility"),
-        (p.self_collision, "--self-collision"),
-        (!p.obstacles.is_empty(), "--obstacle"),
-        (p.floor.is_some(), "--floor"),
         (p.compliance, "--compliance"),
     ];
     if let Some((_, name)) = given.iter().find(|(g, _)| *g) {
@@ -91,12 +88,14 @@ pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
             robot.name
         );
     }
+    let filters = a.pool.collision_filters(&robot)?;
     let settings = SocketDesignSettings {
         n: a.n,
         samples: a.pool.count.unwrap_or(DEFAULT_SAMPLES),
         margin: margin_deg.to_radians(),
         sample_seed: a.pool.pool_seed.unwrap_or(0),
         draw_seed: a.seed,
+        filters,
         ..SocketDesignSettings::default()
     };
     let d = design_for_sockets(&robot, robot.params(a.pool.params), &sockets, &settings)?;
@@ -119,9 +118,22 @@ fn text(d: &SocketDesign) -> String {
         let x = p.socket.position;
         let _ = writeln!(
             s,
-            "point {} at ({:.4}, {:.4}, {:.4}) m: {} of {} samples reach it",
-            p.socket.name, x[0], x[1], x[2], p.configurations, d.samples_per_point
+            "point {} at ({:.4}, {:.4}, {:.4}) m: {} of {} samples reach it{}",
+            p.socket.name,
+            x[0],
+            x[1],
+            x[2],
+            p.configurations,
+            d.samples_per_point,
+            if d.pool_stats.is_some() {
+                " and pass the pool filters"
+            } else {
+                ""
+            }
         );
+    }
+    if let Some(st) = &d.pool_stats {
+        s += &super::pool_opts::pool_stats_text(st);
     }
     let _ = writeln!(
         s,

@@ -9,6 +9,8 @@ pub mod calibrated;
 pub mod compliance;
 pub mod contact;
 pub mod contact_evaluate;
+pub mod contact_out;
+pub mod contact_report;
 pub mod contact_select;
 pub mod existing;
 pub mod figures;

@@ -441,15 +441,24 @@ fn joint_scale(robot: &Robot) -> Vec<f64> {
 }
 
 /// Writes `calibrate --report DIR` for a contact file: report.md (the text
-/// report: the fit, in-sample and held-out consistency, in mm) and
-/// report.json (the `--json` object). No figures yet.
-pub fn contacts(dir: &Path, robot: &Robot, text: &str, json: &serde_json::Value) -> Result<()> {
+/// report: the fit, in-sample and held-out consistency, in mm, and the
+/// figures), report.json (the `--json` object) and the figures `draw`
+/// writes into the directory (returning each one's stem and caption).
+pub fn contacts(
+    dir: &Path,
+    robot: &Robot,
+    text: &str,
+    json: &serde_json::Value,
+    draw: impl FnOnce(&Path) -> Result<Vec<(String, String)>>,
+) -> Result<()> {
     let staged = StagedDir::new(dir)?;
+    let figs = draw(staged.path())?;
     let md = format!(
-        "# Calibration report (contacts)\n\nRobot: `{}` (chain {}).\n\n```text\n{}```\n",
+        "# Calibration report (contacts)\n\nRobot: `{}` (chain {}).\n\n```text\n{}```\n{}",
         robot.name,
         activecal::report::chain(robot).join(" → "),
-        text
+        text,
+        figure_section(&figs)
     );
     put(&staged, "report.md", &md)?;
     put(

@@ -21,6 +21,7 @@
 
 pub mod align;
 pub mod chain;
+pub mod contact;
 pub mod gauge;
 pub mod report;
 pub mod structure;

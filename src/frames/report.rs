@@ -153,6 +153,10 @@ pub struct FramesReport {
     /// torque from the URDF's inertials.
     #[serde(skip_serializing_if = "std::collections::BTreeMap::is_empty")]
     pub compliance: std::collections::BTreeMap<String, ComplianceBlock>,
+    /// The points and planes of a contact fit ([`super::contact`]), in the
+    /// measurement frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contacts: Option<ContactsBlock>,
 }
 
 /// One joint's compliance in the frames file.
@@ -166,6 +170,52 @@ pub struct ComplianceBlock {
     /// σ of `c`, when the fit has a covariance.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sigma_c: Option<f64>,
+}
+
+/// A fitted contact point in the frames file.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct ContactPointBlock {
+    /// The point's name (as in the contact file).
+    pub name: String,
+    /// Its position in the measurement frame (m).
+    pub xyz: [f64; 3],
+    /// σ of xyz (mm), when the fit has a covariance.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma_xyz_mm: Option<[f64; 3]>,
+}
+
+/// A contact plane in the frames file: `normal · x = offset` in the
+/// measurement frame.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct ContactPlaneBlock {
+    /// The plane's name.
+    pub name: String,
+    /// Whether it was given (not estimated).
+    pub known: bool,
+    /// Its unit normal.
+    pub normal: [f64; 3],
+    /// Its offset (m).
+    pub offset: f64,
+}
+
+/// The contact setup a fit found: what the frames file adds for contacts.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct ContactsBlock {
+    /// The frame the points and planes are expressed in: `measurement`,
+    /// the parent of `measurement_frame`.
+    pub frame: String,
+    /// The fitted tool offset in the model's end frame (m): what the fit
+    /// estimated, before it is folded into the tool (`point` is the ball
+    /// centre on the tip link).
+    pub tool_offset_end_frame: [f64; 3],
+    /// The fitted points.
+    pub points: Vec<ContactPointBlock>,
+    /// The planes.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub planes: Vec<ContactPlaneBlock>,
+    /// The known distances the fit used (m).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub distances: Vec<crate::identify::contact::NamedDistance>,
 }
 
 fn quaternion(t: &Isometry3<f64>) -> [f64; 4] {
@@ -317,6 +367,7 @@ impl FramesReport {
             structure: relations(f, &UrdfFrames::of(src).before),
             fit,
             compliance: std::collections::BTreeMap::new(),
+            contacts: None,
         }
     }
 }

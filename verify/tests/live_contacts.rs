@@ -11,9 +11,15 @@
 //!   and the fitted tool offset, gives each row's tool point; each fitted
 //!   point is the mean of its rows' tool points and each unknown plane the
 //!   least-squares plane of its rows' (what an L2 fit's optimality
-//!   conditions make them).
+//!   conditions make them);
+//! * the files `calibrate --out` writes for a contact fit (the calibrated
+//!   URDF and the frames file), loaded by Pinocchio and the frames reader,
+//!   give the fitted tool point of every row.
 
+use activecal::frames::contact::contact_frames;
 use activecal::frames::decompose;
+use activecal::frames::report::FitBlock;
+use activecal::identify::contact::ContactFit;
 use activecal::identify::contact::project::project_to_point;
 use activecal::identify::contact::select::Socket;
 use activecal::identify::contact::socket_design::{SocketDesignSettings, design_for_sockets};
@@ -22,7 +28,9 @@ use activecal::identify::contact::{
     placement_of, resolve_distances, tool_points,
 };
 use activecal::identify::{LmSettings, LossChoice};
+use activecal::io::calibrated::{Format, render};
 use activecal::io::contacts::read_contacts;
+use activecal::io::frames_file;
 use activecal::io::load_robot;
 use activecal::io::urdf_edit::with_origins;
 use activecal::measure::contact::{DISTANCE_WEIGHT, Plane, PlaneKind};
@@ -173,29 +181,26 @@ fn pinocchio_tool_points(
         .collect()
 }
 
-/// A fit of three placements of `panda_2` (six sockets, 50 mm apart in
-/// pairs) and 30 rows on an unknown table plane, L2: Pinocchio's tool points of the calibrated URDF
-/// equal activecal's calibrated ones to 1e-9 m (the bar of
-/// `live_export`), each fitted point is their mean over its rows (moved by
-/// its known distance's pull) and the plane their least-squares plane, to
-/// 1e-6 m and 1e-6 rad (the fit stops
-/// on a step or gradient tolerance, not at the exact optimum: the
-/// optimality conditions hold to the last step's size, well below the
-/// 0.3 mm residuals; a wrong point or plane convention is off by
-/// millimetres or more).
-#[test]
-fn fitted_points_and_planes_agree_with_pinocchio() {
-    let bridge = Bridge::new().expect("Python bridge (run scripts/setup)");
-    let robot = panda();
-    let real = panda_2(&robot);
+/// An L2 fit of three placements of `panda_2` (six sockets, 50 mm apart
+/// in pairs) and 30 rows on an unknown table plane under them: the file,
+/// the known distances, their indices and the fit.
+fn three_placements_and_a_table(
+    robot: &Robot,
+) -> (
+    ContactFile,
+    Vec<NamedDistance>,
+    Vec<activecal::measure::contact::KnownDistance>,
+    ContactFit,
+) {
+    let real = panda_2(robot);
     let keep = ["back_left", "front_left", "mid_right"];
     let rows: Vec<usize> = (0..real.qs.len())
         .filter(|&i| keep.contains(&placement_of(&real.points[real.groups[i]])))
         .collect();
     let file = real.subset(&rows);
-    let pts = tool_points(&robot, &robot.nominal, &[0.0; 3], &file.qs);
+    let pts = tool_points(robot, &robot.nominal, &[0.0; 3], &file.qs);
     let centre = pts.iter().sum::<Vector3<f64>>() / pts.len() as f64;
-    let file = with_table(&robot, &file, &centre);
+    let file = with_table(robot, &file, &centre);
     let settings = ContactSettings {
         lm: LmSettings::default(),
         loss: LossChoice::L2,
@@ -210,8 +215,26 @@ fn fitted_points_and_planes_agree_with_pinocchio() {
         })
         .collect();
     let known = resolve_distances(&file, &given, true).unwrap();
-    let fit = fit_contacts(&robot, &robot.nominal, &file, &known, &settings).unwrap();
+    let fit = fit_contacts(robot, &robot.nominal, &file, &known, &settings).unwrap();
     assert!(fit.converged, "{:?}", fit.stop);
+    (file, given, known, fit)
+}
+
+/// A fit of three placements of `panda_2` (six sockets, 50 mm apart in
+/// pairs) and 30 rows on an unknown table plane, L2: Pinocchio's tool points of the calibrated URDF
+/// equal activecal's calibrated ones to 1e-9 m (the bar of
+/// `live_export`), each fitted point is their mean over its rows (moved by
+/// its known distance's pull) and the plane their least-squares plane, to
+/// 1e-6 m and 1e-6 rad (the fit stops
+/// on a step or gradient tolerance, not at the exact optimum: the
+/// optimality conditions hold to the last step's size, well below the
+/// 0.3 mm residuals; a wrong point or plane convention is off by
+/// millimetres or more).
+#[test]
+fn fitted_points_and_planes_agree_with_pinocchio() {
+    let bridge = Bridge::new().expect("Python bridge (run scripts/setup)");
+    let robot = panda();
+    let (file, _, known, fit) = three_placements_and_a_table(&robot);
     let pin = pinocchio_tool_points(&bridge, &fit.robot, &fit.table, &fit.tool_offset, &file.qs);
     let ours = tool_points(&fit.robot, &fit.table, &fit.tool_offset, &file.qs);
     let dev = pin
@@ -257,4 +280,73 @@ fn fitted_points_and_planes_agree_with_pinocchio() {
     // rows' plain mean), and a plane offset shifted by a millimetre would be.
     assert!(plain_mean > 1e-5, "{plain_mean}");
     assert!((d + 1e-3 - plane.offset_m).abs() > 1e-4);
+}
+
+/// What `calibrate --out cal.urdf --out cal.yaml` writes for a contact fit
+/// (the same renderers, [`contact_frames`] and [`render`]), written to
+/// files: Pinocchio loads the written URDF, and its `ball_link` placement
+/// composed with the written frames file's measurement frame and `point`
+/// (read back by the reader `--frames` uses) gives activecal's fitted tool
+/// point of every row to 1e-9 m (the bar of `live_export`: rounding is
+/// ~1e-15 m over two chains of ~10 metre-size products and shortest
+/// round-trip decimals; the fitted tool offset alone is over 1 mm, and a
+/// joint origin's change 0.1–1 mm, so a dropped or misplaced frame fails by
+/// six orders of magnitude). The fitted points and plane in the file are
+/// the fit's.
+#[test]
+fn the_written_urdf_and_frames_give_the_fitted_tool_points_in_pinocchio() {
+    let bridge = Bridge::new().expect("Python bridge (run scripts/setup)");
+    let robot = panda();
+    let (file, given, _, fit) = three_placements_and_a_table(&robot);
+    let block = FitBlock {
+        poses: file.qs.len(),
+        position_rms_mm: 0.0,
+        orientation_rms_deg: None,
+    };
+    let (frames, report) = contact_frames(&fit, &given, block)
+        .expect("the split")
+        .expect("a URDF robot");
+    let dir = std::env::temp_dir().join(format!(
+        "activecal-live-contacts-written-{}",
+        std::process::id()
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (urdf, yaml) = (dir.join("cal.urdf"), dir.join("cal.yaml"));
+    for (path, format) in [(&urdf, Format::Urdf), (&yaml, Format::Yaml)] {
+        let text = render(format, &fit.robot, &fit.table, Some((&frames, &report)), "").unwrap();
+        std::fs::write(path, text).unwrap();
+    }
+    let read = frames_file::read(&yaml).expect("the written frames file");
+    let pin = pinocchio_ball(&bridge, &urdf, &robot, &file.qs);
+    let ours = tool_points(&fit.robot, &fit.table, &fit.tool_offset, &file.qs);
+    let at = |p: &verify::erd_fk::Placement| {
+        let r = Matrix3::from_fn(|i, j| p.rotation[i][j]);
+        let ball = Vector3::from(p.position) + r * read.tool.translation.vector;
+        read.mount * nalgebra::Point3::from(ball)
+    };
+    let dev = pin
+        .iter()
+        .zip(&ours)
+        .map(|(p, o)| (at(p).coords - o).norm())
+        .fold(0.0f64, f64::max);
+    // Without the tool point (the chain's tip alone) it is off by the
+    // fitted offset: the check sees a missing tool.
+    let bare = pin
+        .iter()
+        .zip(&ours)
+        .map(|(p, o)| (read.mount * nalgebra::Point3::from(Vector3::from(p.position))).coords - o)
+        .map(|d| d.norm())
+        .fold(f64::INFINITY, f64::min);
+    let text = std::fs::read_to_string(&yaml).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    println!(
+        "written files in Pinocchio: max |tool point − activecal's| {dev:.2e} m over {} rows; the tip alone is off by at least {bare:.2e} m",
+        file.qs.len()
+    );
+    assert!(dev <= 1e-9, "{dev} m");
+    assert!(bare > 1e-4, "{bare} m");
+    for name in &fit.points {
+        assert!(text.contains(&format!("name: {name}")), "{name}");
+    }
+    assert!(text.contains("name: table"));
 }

@@ -2,14 +2,16 @@
 //! as PNG and SVG (plotters): labelled axes with their units, a legend
 //! wherever there are several series, label areas wide enough for the
 //! labels. This file holds what they share (sizes, font, colours, axis
-//! ranges, legends); the figures are in `calibration.rs` and `selection.rs`.
+//! ranges, legends); the figures are in `calibration.rs`, `contacts.rs` and `selection.rs`.
 
 mod calibration;
+mod contacts;
 mod selection;
 
 pub use calibration::{
     ParamBar, correlation, histograms, parameter_changes, sorted_errors, splits,
 };
+pub use contacts::{BarGroup, RowMark, consistency_bars, row_distances};
 pub use selection::{CurveRow, JointRow, how_many, joints_vs_limits, tour};
 
 use anyhow::Result;

@@ -86,6 +86,11 @@ pub struct ContactFit {
     pub estimate: Vec<f64>,
     /// Their standard deviations `√(σ̂² (XᵀX)⁻¹)_jj`, when determined.
     pub std: Option<Vec<f64>>,
+    /// Their covariance `σ̂² (XᵀX)⁻¹` (row-major, in the order of
+    /// [`ContactFit::names`]), when determined: what the calibrated frames'
+    /// standard deviations are carried from.
+    #[serde(skip)]
+    pub covariance: Option<Vec<Vec<f64>>>,
     /// Unknowns fixed at their start values, with why.
     pub fixed: Vec<FixedParameter>,
     /// Whether a tolerance was met with a finite, full-rank Jacobian.
@@ -415,10 +420,17 @@ fn finish(
         .finite
         .then(|| inverse_information(sol.jac.as_ref()))
         .flatten();
-    let std = match (&inv, sigma_hat) {
-        (Some(inv), Some(s)) => Some((0..p).map(|j| s * inv[(j, j)].max(0.0).sqrt()).collect()),
+    let covariance: Option<Vec<Vec<f64>>> = match (&inv, sigma_hat) {
+        (Some(inv), Some(s)) => Some(
+            (0..p)
+                .map(|i| (0..p).map(|j| s * s * inv[(i, j)]).collect())
+                .collect(),
+        ),
         _ => None,
     };
+    let std = covariance
+        .as_ref()
+        .map(|c| (0..p).map(|j| c[j][j].max(0.0).sqrt()).collect());
     let own = &sol.theta[n_kin..];
     let sensor = ContactSensor::new(file.points.clone(), Vec::new())
         .with_planes(planes.to_vec())
@@ -458,6 +470,7 @@ fn finish(
         start: theta0,
         estimate: sol.theta,
         std,
+        covariance,
         fixed,
         converged,
         stop: sol.stop,

@@ -96,6 +96,48 @@ pub struct Figures {
     pub planes: Vec<PlaneFigure>,
 }
 
+/// One row's distance of its predicted tool point to the mean of its
+/// point's rows, millimetres: the per-row figure whose RMS is a point's
+/// consistency (a row far from the rest is a fault of the recording).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct RowDistance {
+    /// Its 1-based file line.
+    pub line: usize,
+    /// The point it touches.
+    pub point: String,
+    /// Under the nominal model, mm.
+    pub nominal_mm: f64,
+    /// Under the calibrated model, mm.
+    pub calibrated_mm: f64,
+}
+
+/// Each row of `test` that touches a point: its distance to its point's
+/// mean under the `nominal` table (no tool offset) and under `fit`.
+#[must_use]
+pub fn row_distances(
+    robot: &Robot,
+    nominal: &ParamTable,
+    fit: &ContactFit,
+    test: &ContactFile,
+) -> Vec<RowDistance> {
+    let nom = tool_points(robot, nominal, &[0.0; 3], &test.qs);
+    let cal = tool_points(&fit.robot, &fit.table, &fit.tool_offset, &test.qs);
+    let all = test.points.len() + test.planes.len();
+    let (sn, sc) = (
+        spreads(&nom, &test.groups, all),
+        spreads(&cal, &test.groups, all),
+    );
+    (0..test.qs.len())
+        .filter(|&i| test.groups[i] < test.points.len())
+        .map(|i| RowDistance {
+            line: test.lines[i],
+            point: test.points[test.groups[i]].clone(),
+            nominal_mm: 1e3 * sn[i],
+            calibrated_mm: 1e3 * sc[i],
+        })
+        .collect()
+}
+
 /// One fold: a fit on some placements, judged on others.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct HoldoutFold {
@@ -113,6 +155,10 @@ pub struct HoldoutFold {
     pub figures: Figures,
     /// Training rows a robust loss down-weighted.
     pub downweighted: Vec<DownweightedRow>,
+    /// Each held-out row's distance to its point's mean (for figures; not
+    /// in the JSON, whose per-point figures summarise them).
+    #[serde(skip)]
+    pub rows: Vec<RowDistance>,
 }
 
 /// Which folds.
@@ -350,6 +396,7 @@ fn fold(
     let fit = fit_contacts(robot, start, &train, &known, settings)?;
     Ok(HoldoutFold {
         figures: judge(robot, start, &fit, &test, distances),
+        rows: row_distances(robot, start, &fit, &test),
         downweighted: downweighted_rows(&fit, &train),
         held_out: held,
         trained_on: train_on,

@@ -25,7 +25,7 @@ pub use data::{ContactFile, NamedPlane};
 pub use fit::{ContactFit, ContactSettings, PlaneEstimate, fit_contacts};
 pub use holdout::{
     DistanceFigure, DownweightedRow, Figures, HoldoutFold, HoldoutMode, HoldoutReport, PlaneFigure,
-    PointFigure, holdout_by_placement, judge, placements,
+    PointFigure, RowDistance, holdout_by_placement, judge, placements, row_distances,
 };
 
 use crate::error::Error;

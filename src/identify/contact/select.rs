@@ -19,6 +19,7 @@ use crate::identify::Residuals;
 use crate::identify::undetermined::fix_undetermined_below;
 use crate::measure::contact::ContactSensor;
 use crate::model::{ParamTable, Robot};
+use crate::pool::{Configurations, PoolFilter, PoolSource, PoolSpec, PoolStats};
 use faer::Mat;
 use nalgebra::{DMatrix, Vector3};
 use rand::{Rng, RngExt};
@@ -68,6 +69,36 @@ pub fn socket_pool<R: Rng + ?Sized>(
     tol: f64,
     rng: &mut R,
 ) -> crate::identify::Result<SocketPool> {
+    let file = projected(robot, table, sockets, count, margin, tol, rng)?;
+    determined_pool(robot, table, file)
+}
+
+/// The pool of the configurations of `file` for the unknowns they
+/// determine (the gauge and the weaker ones fixed).
+pub fn determined_pool(
+    robot: &Robot,
+    table: &ParamTable,
+    file: ContactFile,
+) -> crate::identify::Result<SocketPool> {
+    let reduced = determined(robot, table, &file)?;
+    Ok(pool_of(&reduced, table, file))
+}
+
+/// For each socket, `count` configurations sampled uniformly inside the
+/// limits less `margin`, each projected onto it (to `tol` metres); those
+/// that reach it, as the rows of a contact file (a point per socket). A
+/// socket that fewer than [`MIN_SOCKET_CONFIGURATIONS`] samples reach is
+/// an error naming it.
+#[allow(clippy::too_many_arguments)]
+pub fn projected<R: Rng + ?Sized>(
+    robot: &Robot,
+    table: &ParamTable,
+    sockets: &[Socket],
+    count: usize,
+    margin: f64,
+    tol: f64,
+    rng: &mut R,
+) -> crate::identify::Result<ContactFile> {
     let mut qs = Vec::new();
     let mut groups = Vec::new();
     for (g, s) in sockets.iter().enumerate() {
@@ -96,16 +127,61 @@ pub fn socket_pool<R: Rng + ?Sized>(
             .into());
         }
     }
-    let file = ContactFile {
+    Ok(ContactFile {
         origin: "pool".into(),
         groups,
         points: sockets.iter().map(|s| s.name.clone()).collect(),
         planes: Vec::new(),
         lines: (1..=qs.len()).collect(),
         qs,
+    })
+}
+
+/// What a pool source of projected configurations is called in its
+/// statistics.
+pub const PROJECTED_SOURCE: &str = "configurations projected onto the sockets";
+
+/// The rows of `file` (projected configurations) that pass every one of
+/// `filters` (self-collision, obstacles: the filters of every pool, each
+/// configuration's verdict once, evaluated at `table`), with what each
+/// filter removed. A filter that removes every row, or leaves a socket
+/// fewer than [`MIN_SOCKET_CONFIGURATIONS`] rows, is an error naming it.
+pub fn filter_projected(
+    robot: &Robot,
+    table: &ParamTable,
+    file: &ContactFile,
+    filters: &[PoolFilter],
+) -> crate::identify::Result<(ContactFile, PoolStats)> {
+    let spec = PoolSpec {
+        filters: filters.to_vec(),
+        ..PoolSpec::of(PoolSource::File {
+            path: PROJECTED_SOURCE.into(),
+        })
     };
-    let reduced = determined(robot, table, &file)?;
-    Ok(pool_of(&reduced, table, file))
+    let rows = Configurations {
+        qs: file.qs.clone(),
+        notes: Vec::new(),
+    };
+    let pool = spec.build_listed(robot, table, rows)?;
+    let kept = file.subset(&pool.ids);
+    for (g, name) in file.points.iter().enumerate() {
+        let before = file.rows_of(g).len();
+        let after = kept.point_index(name).map_or(0, |k| kept.rows_of(k).len());
+        if after < MIN_SOCKET_CONFIGURATIONS {
+            let by: Vec<String> = pool
+                .stats
+                .filters
+                .iter()
+                .map(|f| format!("{} removed {} of {}", f.filter, f.removed, f.seen))
+                .collect();
+            return Err(crate::error::Error::Invalid(format!(
+                "point '{name}': {after} of its {before} configurations pass the pool filters ({}), {MIN_SOCKET_CONFIGURATIONS} needed",
+                by.join(", ")
+            ))
+            .into());
+        }
+    }
+    Ok((kept, pool.stats))
 }
 
 /// The pool of `file`'s configurations with `robot`'s unknowns as they are

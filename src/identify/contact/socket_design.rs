@@ -1,6 +1,7 @@
 //! The configurations to record for sockets at given positions, as one
 //! step: a pool projected onto every socket
-//! ([`socket_pool`]), a D-optimal choice with the contact Jacobian
+//! ([`projected`]; with pool filters, the configurations that pass them,
+//! [`filter_projected`]), a D-optimal choice with the contact Jacobian
 //! exchanged for the predicted consistency error
 //! ([`select_d_optimal`], [`refine_for_consistency`]), and the figures that
 //! judge it: the predicted consistency error of the chosen configurations,
@@ -10,8 +11,8 @@
 //! relaxation, certified).
 
 use super::select::{
-    Socket, SocketPool, predicted_consistency, refine_for_consistency, select_d_optimal,
-    socket_pool,
+    Socket, SocketPool, determined_pool, filter_projected, predicted_consistency, projected,
+    refine_for_consistency, select_d_optimal,
 };
 use super::tool_points;
 use crate::error::Error;
@@ -38,6 +39,9 @@ pub struct SocketDesignSettings {
     pub sample_seed: u64,
     /// Seed of the baseline's random draws.
     pub draw_seed: u64,
+    /// Filters the projected configurations pass (self-collision,
+    /// obstacles), as every pool's do; none by default.
+    pub filters: Vec<crate::pool::PoolFilter>,
 }
 
 impl Default for SocketDesignSettings {
@@ -52,6 +56,7 @@ impl Default for SocketDesignSettings {
             draws: 100,
             sample_seed: 0,
             draw_seed: 1,
+            filters: Vec::new(),
         }
     }
 }
@@ -143,6 +148,10 @@ pub struct SocketDesign {
     pub ratio_to_random: f64,
     /// The relaxation bound.
     pub bound: ConsistencyBound,
+    /// What the pool filters removed of the projected configurations
+    /// (absent without a filter).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pool_stats: Option<crate::pool::PoolStats>,
 }
 
 /// Chooses `settings.n` configurations that touch `sockets` for `robot`
@@ -158,7 +167,7 @@ pub fn design_for_sockets(
 ) -> crate::identify::Result<SocketDesign> {
     check(sockets, settings)?;
     let mut rng = crate::identify::trial_rng(settings.sample_seed, 0);
-    let pool = socket_pool(
+    let file = projected(
         robot,
         table,
         sockets,
@@ -167,6 +176,13 @@ pub fn design_for_sockets(
         settings.tol,
         &mut rng,
     )?;
+    let (file, pool_stats) = if settings.filters.is_empty() {
+        (file, None)
+    } else {
+        let (kept, stats) = filter_projected(robot, table, &file, &settings.filters)?;
+        (kept, Some(stats))
+    };
+    let pool = determined_pool(robot, table, file)?;
     let p = pool.blocks[0].ncols();
     if pool.qs.len() < settings.n || 3 * settings.n < p {
         return Err(Error::Invalid(format!(
@@ -197,6 +213,7 @@ pub fn design_for_sockets(
         ratio_to_random: random.median_sigma / predicted_sigma,
         random,
         bound,
+        pool_stats,
     })
 }
 

@@ -1,0 +1,90 @@
+//! `calibrate --out` for a contact fit: the user's URDF with only the
+//! chain's `<origin>`s changed, and the frames file whose `point` is the
+//! fitted tool point (the ball centre) on the tip link and whose `contacts`
+//! block holds the fitted points and planes
+//! ([`activecal::frames::contact`]). Checked before the fit, written only
+//! when it converged, each file atomically and never over an existing one
+//! without `--force`.
+
+use activecal::frames::CalibratedFrames;
+use activecal::frames::contact::contact_frames;
+use activecal::frames::report::{FitBlock, FramesReport};
+use activecal::identify::contact::{ContactFile, ContactFit, NamedDistance, rms, tool_points};
+use activecal::io::calibrated::{Format, render};
+use activecal::model::Robot;
+use anyhow::{Result, bail};
+use std::path::PathBuf;
+
+/// Refuses, before any work, an output a contact calibration cannot be
+/// written as: a `.toml` description (it has no place for the tool offset
+/// and the points), or any output of a robot not imported from a URDF.
+pub fn check(out: &[PathBuf], robot: &Robot) -> Result<()> {
+    for path in out {
+        if Format::of(path)? == Format::Toml {
+            bail!(
+                "--out {}: a calibration from contacts is written as .urdf (your URDF with the calibrated joint origins) and .yaml (the frames file with the tool point, the fitted points and planes); a .toml description has no place for them",
+                path.display()
+            );
+        }
+        if robot.source.is_none() {
+            bail!(
+                "--out {}: robot '{}' was not imported from a URDF; a calibration from contacts is written for a .urdf robot only",
+                path.display(),
+                robot.name
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The fit's own figure for the frames file: the RMS over the rows that
+/// touch a point of the distance of the row's tool point to its fitted
+/// point (mm).
+fn fit_block(fit: &ContactFit, file: &ContactFile) -> FitBlock {
+    let pts = tool_points(&fit.robot, &fit.table, &fit.tool_offset, &file.qs);
+    let d: Vec<f64> = pts
+        .iter()
+        .zip(&file.groups)
+        .filter(|(_, g)| **g < fit.point_positions.len())
+        .map(|(p, &g)| (p - nalgebra::Vector3::from(fit.point_positions[g])).norm())
+        .collect();
+    FitBlock {
+        poses: file.qs.len(),
+        position_rms_mm: 1e3 * rms(&d),
+        orientation_rms_deg: None,
+    }
+}
+
+/// The calibrated frames of a contact fit with their report.
+pub fn frames(
+    fit: &ContactFit,
+    file: &ContactFile,
+    distances: &[NamedDistance],
+) -> Result<Option<(CalibratedFrames, FramesReport)>> {
+    Ok(contact_frames(fit, distances, fit_block(fit, file))?)
+}
+
+/// Writes every `--out` of a converged fit (by extension); returns the
+/// files written.
+pub fn write(
+    out: &[PathBuf],
+    force: bool,
+    robot: &Robot,
+    fit: &ContactFit,
+    frames: &(CalibratedFrames, FramesReport),
+) -> Result<Vec<String>> {
+    let mut written = Vec::new();
+    for path in out {
+        let text = render(
+            Format::of(path)?,
+            robot,
+            &fit.table,
+            Some((&frames.0, &frames.1)),
+            "",
+        )
+        .map_err(|e| anyhow::anyhow!("--out {}: {e}", path.display()))?;
+        super::write_new(path, &text, force)?;
+        written.push(path.display().to_string());
+    }
+    Ok(written)
+}

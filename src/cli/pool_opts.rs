@@ -214,7 +214,12 @@ pub fn pool_stats_text(st: &activecal::pool::PoolStats) -> String {
                     c.always_touching.len()
                 );
                 for p in &c.always_touching {
-                    s += &format!("    {:>5.1} %  {} – {}\n", 100.0 * p.fraction, p.link, p.other);
+                    s += &format!(
+                        "    {:>5.1} %  {} – {}\n",
+                        100.0 * p.fraction,
+                        p.link,
+                        p.other
+                    );
                 }
             }
         }

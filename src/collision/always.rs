@@ -5,23 +5,10 @@
 //! them would remove every candidate.
 
 use super::model::{CollisionModel, too_close};
-use super::spec::AlwaysTouching;
+use super::spec::{AlwaysTouching, TouchingPair};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
-use serde::Serialize;
-
-/// A link pair left unchecked because it touches in nearly every sampled
-/// configuration.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct TouchingPair {
-    /// The first link.
-    pub link: String,
-    /// The other link.
-    pub other: String,
-    /// The fraction of the sampled configurations in which they touch.
-    pub fraction: f64,
-}
 
 /// `n` configurations drawn uniformly within `limits` (lower, upper per
 /// value), from `seed`: the same draws whatever the thread count.
@@ -31,7 +18,13 @@ fn draws(limits: &[(f64, f64)], n: usize, seed: u64) -> Vec<Vec<f64>> {
         .map(|_| {
             limits
                 .iter()
-                .map(|&(lo, hi)| if hi > lo { rng.random_range(lo..hi) } else { lo })
+                .map(|&(lo, hi)| {
+                    if hi > lo {
+                        rng.random_range(lo..hi)
+                    } else {
+                        lo
+                    }
+                })
                 .collect()
         })
         .collect()
@@ -69,7 +62,13 @@ impl CollisionModel {
             let (ga, gb) = (&self.geoms[a], &self.geoms[b]);
             let gap = (poses[a] * ga.center - poses[b] * gb.center).norm();
             if gap <= ga.radius + gb.radius
-                && too_close(&poses[a], ga.shape.as_ref(), &poses[b], gb.shape.as_ref(), 0.0)
+                && too_close(
+                    &poses[a],
+                    ga.shape.as_ref(),
+                    &poses[b],
+                    gb.shape.as_ref(),
+                    0.0,
+                )
             {
                 touching[of_pair[k]] = true;
             }

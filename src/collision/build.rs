@@ -192,7 +192,11 @@ impl CollisionModel {
             rest,
             always_touching: Vec::new(),
         };
-        if let Some(rule) = spec.always_touching.as_ref().filter(|_| spec.self_collision) {
+        if let Some(rule) = spec
+            .always_touching
+            .as_ref()
+            .filter(|_| spec.self_collision)
+        {
             model.always_touching = model.skip_always_touching(rule, &limits);
         }
         Ok(model)

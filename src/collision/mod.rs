@@ -34,10 +34,9 @@ pub mod srdf;
 pub mod stl;
 mod tree;
 
-pub use always::TouchingPair;
 pub use model::{CollisionModel, ContactPair};
 pub use moves::MoveCheck;
-pub use spec::{AlwaysTouching, CollisionSpec, Obstacle};
+pub use spec::{AlwaysTouching, CollisionSpec, Obstacle, TouchingPair};
 
 use serde::{Deserialize, Serialize};
 use std::sync::{Arc, OnceLock};

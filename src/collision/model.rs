@@ -2,8 +2,8 @@
 //! (closer than the clearance), which pair it is, and how fast each joint
 //! sweeps the geometry.
 
-use super::always::TouchingPair;
 use super::shapes::Geometry;
+use super::spec::TouchingPair;
 use super::tree::{Motion, Tree};
 use parry3d_f64::na::Isometry3;
 use parry3d_f64::shape::SharedShape;

@@ -76,6 +76,18 @@ impl Default for AlwaysTouching {
     }
 }
 
+/// A link pair left unchecked because it touches in nearly every sampled
+/// configuration.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TouchingPair {
+    /// The first link.
+    pub link: String,
+    /// The other link.
+    pub other: String,
+    /// The fraction of the sampled configurations in which they touch.
+    pub fraction: f64,
+}
+
 /// What a collision filter checks, as stored in a pool spec.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct CollisionSpec {

@@ -2,7 +2,7 @@
 //! checked for self-collision (SRDF exclusions applied) and the obstacles
 //! placed in the base link's frame.
 
-use super::model::CollisionModel;
+use super::model::{CollisionModel, too_close};
 use super::shapes::{Geometry, geometries};
 use super::spec::{CollisionSpec, Obstacle};
 use super::srdf;
@@ -120,6 +120,63 @@ fn drive_limits(urdf: &urdf_rs::Robot, tree: &Tree, drives: &[usize]) -> Vec<(f6
         .collect()
 }
 
+/// The moving joints on the tree path from link `a` to link `b` (up from
+/// each to their common ancestor): whether any of them is driven. When none
+/// is, the two links keep their relative placement in every configuration.
+fn moved_apart_by(tree: &Tree, drives: &[usize], a: usize, b: usize) -> bool {
+    let up = |l: usize| {
+        let mut joints = Vec::new();
+        let mut body = tree.body[l];
+        while body != 0 {
+            joints.push(body - 1);
+            body = tree.body[tree.joints[body - 1].parent];
+        }
+        joints
+    };
+    let (ua, ub) = (up(a), up(b));
+    let shared = ua
+        .iter()
+        .rev()
+        .zip(ub.iter().rev())
+        .take_while(|(x, y)| x == y)
+        .count();
+    ua[..ua.len() - shared]
+        .iter()
+        .chain(&ub[..ub.len() - shared])
+        .any(|j| drives.contains(j))
+}
+
+/// Drops the pairs that no driven joint moves apart and that are free at
+/// rest: their distance is the same in every configuration, so they never
+/// touch (a hand's fingers and palm while the arm moves). Those touching at
+/// rest touch everywhere and stay checked, to be reported, or skipped as
+/// always touching. Besides time, this keeps a move's check from crawling
+/// at the pace of a gap that never closes.
+fn drop_rigid_free_pairs(model: &mut CollisionModel) {
+    let q: Vec<f64> = model.drives.iter().map(|&j| model.rest[j]).collect();
+    let poses = model.geometry_poses(&q);
+    let keep: Vec<bool> = model
+        .pairs
+        .iter()
+        .map(|&(a, b)| {
+            let (ga, gb) = (&model.geoms[a], &model.geoms[b]);
+            moved_apart_by(&model.tree, &model.drives, ga.link, gb.link)
+                || too_close(
+                    &poses[a],
+                    ga.shape.as_ref(),
+                    &poses[b],
+                    gb.shape.as_ref(),
+                    model.clearance,
+                )
+        })
+        .collect();
+    let mut k = 0;
+    model.pairs.retain(|_| {
+        k += 1;
+        keep[k - 1]
+    });
+}
+
 impl CollisionModel {
     /// Loads the model of `spec`: errors name the URDF, a missing or broken
     /// mesh file and its link, an SRDF line naming an unknown link, a chain
@@ -192,6 +249,7 @@ impl CollisionModel {
             rest,
             always_touching: Vec::new(),
         };
+        drop_rigid_free_pairs(&mut model);
         if let Some(rule) = spec
             .always_touching
             .as_ref()
@@ -200,5 +258,50 @@ impl CollisionModel {
             model.always_touching = model.skip_always_touching(rule, &limits);
         }
         Ok(model)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// base –j1 (driven)→ l1 –j2 (revolute, not driven)→ l2, and
+    /// l1 –j3 (fixed)→ l3, and base –j4 (driven)→ l4.
+    fn tree() -> Tree {
+        let joint = |name: &str, kind: &str, parent: &str, child: &str| {
+            format!(
+                r#"<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>"#
+            )
+        };
+        let text = format!(
+            r#"<robot name="t"><link name="base"/><link name="l1"/><link name="l2"/><link name="l3"/><link name="l4"/>{}{}{}{}</robot>"#,
+            joint("j1", "revolute", "base", "l1"),
+            joint("j2", "revolute", "l1", "l2"),
+            joint("j3", "fixed", "l1", "l3"),
+            joint("j4", "revolute", "base", "l4"),
+        );
+        Tree::new(&urdf_rs::read_from_string(&text).unwrap()).unwrap()
+    }
+
+    #[test]
+    fn only_a_driven_joint_between_two_links_moves_them_apart() {
+        let t = tree();
+        let link = |n: &str| t.index[n];
+        let joint = |n: &str| t.joints.iter().position(|j| j.name == n).unwrap();
+        let drives = [joint("j1"), joint("j4")];
+        let apart = |a: &str, b: &str| moved_apart_by(&t, &drives, link(a), link(b));
+        // j2 is not driven: l1, l2 and l3 keep their relative placements.
+        assert!(!apart("l1", "l2"));
+        assert!(!apart("l2", "l3"));
+        assert!(!apart("l3", "l1"));
+        // j1 lies between the base and l1, l2, l3; j1 and j4 between l1 and l4.
+        assert!(apart("base", "l2"));
+        assert!(apart("l3", "base"));
+        assert!(apart("l1", "l4"));
+        assert!(apart("base", "l4"));
+        // With j2 driven too, l1 and l2 move apart but l1 and l3 do not.
+        let drives = [joint("j1"), joint("j2"), joint("j4")];
+        assert!(moved_apart_by(&t, &drives, link("l1"), link("l2")));
+        assert!(!moved_apart_by(&t, &drives, link("l1"), link("l3")));
     }
 }

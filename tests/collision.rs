@@ -265,3 +265,43 @@ fn bad_collision_inputs_are_clear_errors() {
     );
     std::fs::remove_dir_all(d.parent().unwrap()).ok();
 }
+
+/// A URDF cylinder runs along its z axis (parry's along y): a 1 m cylinder
+/// standing on link `a` reaches a 2 cm box 0.4 m above its centre, and one
+/// 0.4 m to the side only when it lies along that side (turned 90° about
+/// x by its `<origin>`). Built along y, the verdicts would swap.
+#[test]
+fn urdf_cylinders_run_along_z() {
+    let urdf = |rpy: &str| {
+        format!(
+            r#"<robot name="c">
+  <link name="a"><collision><origin xyz="0 0 0" rpy="{rpy}"/><geometry><cylinder radius="0.01" length="1"/></geometry></collision></link>
+  <link name="up"><collision><geometry><box size="0.02 0.02 0.02"/></geometry></collision></link>
+  <link name="side"><collision><geometry><box size="0.02 0.02 0.02"/></geometry></collision></link>
+  <link name="m"/>
+  <joint name="j" type="revolute"><parent link="a"/><child link="m"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <joint name="ju" type="revolute"><parent link="m"/><child link="up"/><origin xyz="0 0 0.4"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <joint name="js" type="revolute"><parent link="m"/><child link="side"/><origin xyz="0 -0.4 0"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>"#
+        )
+    };
+    let contact = |rpy: &str| {
+        let spec = CollisionSpec {
+            urdf: "cylinder.urdf".into(),
+            text: Some(urdf(rpy).into()),
+            joints: vec!["j".into(), "ju".into(), "js".into()],
+            self_collision: true,
+            ..CollisionSpec::default()
+        };
+        CollisionModel::load(&spec)
+            .unwrap()
+            .contact(&[0.0, 0.0, 0.0])
+    };
+    // Standing (along z): it touches the box above, not the one beside.
+    assert_eq!(contact("0 0 0"), Some(("a".into(), "up".into())));
+    // Turned +90° about x, its axis runs along −y: it touches the box beside.
+    assert_eq!(
+        contact("1.5707963267948966 0 0"),
+        Some(("a".into(), "side".into()))
+    );
+}

@@ -44,7 +44,7 @@ fn max_abs(t: &[[[f64; 3]; 3]], axis: usize) -> f64 {
 }
 
 #[test]
-fn collada_units_and_up_axis_are_honoured() {
+fn collada_units_are_honoured_and_the_up_axis_is_not_applied() {
     // Millimetres, z up: 10 mm along x, 20 mm along y.
     let z = mesh::load(&write("z.dae", &dae("0.001", "Z_UP"))).unwrap();
     assert_eq!(z.len(), 1);
@@ -53,10 +53,11 @@ fn collada_units_and_up_axis_are_honoured() {
     assert!((max_abs(&z, 0) - 0.010).abs() < 1e-8);
     assert!((max_abs(&z, 1) - 0.020).abs() < 1e-8);
     assert!(max_abs(&z, 2) < 1e-12);
-    // Y up: the file's y (20 mm) becomes z.
+    // Y up: the coordinates stay as written (the file's y, 20 mm, stays y),
+    // as Pinocchio and Coal load it (verify/tests/live_collision.rs).
     let y = mesh::load(&write("y.dae", &dae("0.001", "Y_UP"))).unwrap();
-    assert!((max_abs(&y, 2) - 0.020).abs() < 1e-8);
-    assert!(max_abs(&y, 1) < 1e-12);
+    assert!((max_abs(&y, 1) - 0.020).abs() < 1e-8);
+    assert!(max_abs(&y, 2) < 1e-12);
     // Metres: no scaling.
     let m = mesh::load(&write("m.dae", &dae("1", "Z_UP"))).unwrap();
     assert!((max_abs(&m, 1) - 20.0).abs() < 1e-8);

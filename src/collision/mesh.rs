@@ -1,9 +1,13 @@
 //! Collision mesh files by format: STL (this crate's own reader, [`stl`]),
 //! COLLADA (`.dae`) and Wavefront OBJ (openrr's `mesh-loader`). A COLLADA
-//! file's `<unit meter>` is applied by the loader; its `<up_axis>` is
-//! applied here as Assimp does (and so Coal, through Assimp): `Y_UP` turns
-//! `(x, y, z)` into `(x, −z, y)`, `X_UP` into `(−y, x, z)`. A `.dae` file
-//! that is not COLLADA (no `<COLLADA>` root element) is refused by name.
+//! file's `<unit meter>` is applied by the loader; its `<up_axis>` is read
+//! (an unknown value is an error) but not applied: the URDF world takes a
+//! mesh's coordinates as written, as Pinocchio (Coal through Assimp, with
+//! COLLADA's up direction ignored) does. Checked on the TIAGo's
+//! `arm_3_collision.dae`, tagged `Y_UP`: Coal's bounding box of the loaded
+//! mesh equals the file's vertices', and only without a turn do activecal's
+//! verdicts agree with Coal's (`verify/tests/live_collision.rs`). A `.dae`
+//! file that is not COLLADA (no `<COLLADA>` root element) is refused by name.
 
 use super::stl::{self, Triangles};
 use std::path::Path;
@@ -25,7 +29,7 @@ pub fn load(path: &Path) -> Result<Triangles, String> {
                 Err::<Vec<u8>, _>(std::io::Error::other("materials are not read"))
             })
             .map_err(|e| format!("{name}: not a readable OBJ file: {e}"))?;
-            triangles(&scene, &name, |v| v)
+            triangles(&scene, &name)
         }
         _ => Err(format!(
             "{name}: collision meshes are read from STL, COLLADA (.dae) or OBJ files"
@@ -33,7 +37,7 @@ pub fn load(path: &Path) -> Result<Triangles, String> {
     }
 }
 
-/// A COLLADA document's triangles, its up axis turned to z.
+/// A COLLADA document's triangles, as written (its up axis not applied).
 fn collada(bytes: &[u8], name: &str) -> Result<Triangles, String> {
     let text = std::str::from_utf8(bytes)
         .map_err(|_| format!("{name}: not a COLLADA file (not UTF-8 XML text)"))?;
@@ -52,25 +56,17 @@ fn collada(bytes: &[u8], name: &str) -> Result<Triangles, String> {
         .and_then(|a| a.children().find(|n| n.tag_name().name() == "up_axis"))
         .and_then(|n| n.text())
         .map_or("Z_UP".to_string(), |t| t.trim().to_string());
-    let turn: fn([f64; 3]) -> [f64; 3] = match up.as_str() {
-        "Y_UP" => |[x, y, z]| [x, -z, y],
-        "X_UP" => |[x, y, z]| [-y, x, z],
-        "Z_UP" => |v| v,
-        other => return Err(format!("{name}: unknown COLLADA <up_axis> '{other}'")),
-    };
+    if !matches!(up.as_str(), "X_UP" | "Y_UP" | "Z_UP") {
+        return Err(format!("{name}: unknown COLLADA <up_axis> '{up}'"));
+    }
     let scene = mesh_loader::collada::from_str(text)
         .map_err(|e| format!("{name}: not a readable COLLADA file: {e}"))?;
-    triangles(&scene, name, turn)
+    triangles(&scene, name)
 }
 
-/// Every face of every mesh of `scene` as a triangle, each vertex turned by
-/// `turn`; a face naming a vertex the mesh lacks, a non-finite vertex or
+/// Every face of every mesh of `scene` as a triangle; a face naming a vertex the mesh lacks, a non-finite vertex or
 /// an empty scene is an error naming the file.
-fn triangles(
-    scene: &mesh_loader::Scene,
-    name: &str,
-    turn: impl Fn([f64; 3]) -> [f64; 3],
-) -> Result<Triangles, String> {
+fn triangles(scene: &mesh_loader::Scene, name: &str) -> Result<Triangles, String> {
     let mut out: Triangles = Vec::new();
     for m in &scene.meshes {
         for f in &m.faces {
@@ -90,7 +86,7 @@ fn triangles(
                         m.name
                     ));
                 }
-                t[k] = turn(v);
+                t[k] = v;
             }
             out.push(t);
         }

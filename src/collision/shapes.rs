@@ -73,7 +73,8 @@ fn shape_of(
         urdf_rs::Geometry::Sphere { radius } => {
             SharedShape::new(Ball::new(positive("sphere radius", *radius)?))
         }
-        // URDF cylinders and capsules run along z; parry's along y.
+        // URDF cylinders and capsules run along z, parry's along y: the
+        // capsule is built along z, the cylinder turned by `along_z`.
         urdf_rs::Geometry::Cylinder { radius, length } => SharedShape::new(Cylinder::new(
             positive("cylinder length", *length)? / 2.0,
             positive("cylinder radius", *radius)?,
@@ -114,6 +115,18 @@ fn shape_of(
     })
 }
 
+/// The turn from a shape's own frame to the URDF element's: a URDF cylinder
+/// runs along its z axis, parry's `Cylinder` along y, so it is turned by
+/// +90° about x (y onto z); other shapes are built in the URDF's frame.
+fn along_z(g: &urdf_rs::Geometry) -> Isometry3<f64> {
+    match g {
+        urdf_rs::Geometry::Cylinder { .. } => {
+            Isometry3::rotation(Vector3::x() * std::f64::consts::FRAC_PI_2)
+        }
+        _ => Isometry3::identity(),
+    }
+}
+
 /// Every collision element of every link, with its shape loaded (meshes
 /// found beside the URDF or in the package directories) and its bounding
 /// sphere.
@@ -134,7 +147,7 @@ pub(super) fn geometries(
             let radius = aabb.half_extents().norm();
             geoms.push(Geometry {
                 link,
-                origin: tree::pose(&c.origin),
+                origin: tree::pose(&c.origin) * along_z(&c.geometry),
                 shape,
                 center,
                 radius,

@@ -187,6 +187,10 @@ fn interior_start(warm: Option<&[f64]>, n: usize, nf: f64) -> Vec<f64> {
     let s: f64 = w.iter().sum();
     if (s - nf).abs() > 1e-12 * nf {
         let a = (nf - s) / (n as f64 * uniform - s);
+        // `a` is 1 to rounding (`n·uniform = N`): the move is all the way to
+        // uniform. Hence `a / uniform` for `a * uniform` is equivalent: it
+        // gives weights `1/uniform > 1`, and the check below falls back to
+        // the same uniform start.
         w.iter_mut().for_each(|v| *v = (1.0 - a) * *v + a * uniform);
     }
     if w.iter().any(|&v| !(v > 0.0 && v < 1.0)) {
@@ -241,6 +245,9 @@ fn line_search(
     for i in 0..n {
         if delta[i] < 0.0 {
             s_max = s_max.min(0.99 * w[i] / -delta[i]);
+        // `delta[i] >= 0.0` is equivalent on every direction without a
+        // component of exactly −0.0 (a zero component's room is then +∞,
+        // which leaves `s_max` as it is).
         } else if delta[i] > 0.0 {
             s_max = s_max.min(0.99 * (1.0 - w[i]) / delta[i]);
         }
@@ -326,6 +333,11 @@ pub(crate) fn solve_scaled(
         // (the decrement of F_μ/μ below CENTERING), which the next, smaller
         // μ corrects anyway. An absolute 1e-12 stalled on a 4,096-pose PUMA
         // lattice: rounding held λ² at 1.2e-12 for 270 steps.
+        // Equivalent in value, time only: `<=` as `>` here (the last stage
+        // centred to CENTERING·μ ≈ 1.5e-10/n, the others to tol) and
+        // `CENTERING * mu` as `+` below (every stage but the last ends
+        // after one step): the last stage still ends at λ² of order tol,
+        // the weights and ln det agree within the tests' 1e-7.
         let centred = if 2.0 * n as f64 * mu <= settings.tol {
             settings.tol
         } else {
@@ -582,7 +594,9 @@ mod tests {
         for (n, n_design, seed) in [(12, 4, 10), (20, 3, 11), (9, 6, 12)] {
             let sc = scaled(n, n_design, seed);
             let settings = NewtonSettings::default();
-            let out = solve_scaled(&sc, n_design, None, &settings, 1.0);
+            // Barrier bounds 0.5, 5e-3, …, 5e-11: the last is the first ≤
+            // tol, and above tol/mu_factor.
+            let out = solve_scaled(&sc, n_design, None, &settings, 0.5);
             assert_eq!(out.status, ConicStatus::Solved, "n = {n}");
             assert!(out.iterations >= 1);
             let w = &out.weights;
@@ -601,7 +615,7 @@ mod tests {
             // 2nμ ≤ tol, read as a difference of two values O(10): 1e-14
             // of rounding.
             assert!(
-                (0.0..=settings.tol + 1e-14).contains(&dual_gap),
+                (settings.tol / settings.mu_factor..=settings.tol + 1e-14).contains(&dual_gap),
                 "{dual_gap}"
             );
             // Warm-started from the optimum, the same point in fewer steps.
@@ -653,5 +667,74 @@ mod tests {
             (out.status, out.iterations),
             (ConicStatus::MaxIterations, 1)
         );
+    }
+
+    /// The first trial of the line search is the step at 0.99 of the way to
+    /// the nearest bound (the full step if that is nearer): asked for no
+    /// rise (`λ² = −∞`), it returns that point. Two directions, one stopped
+    /// by a weight falling to 0 (w₀ at s = 0.5), one by a weight rising to
+    /// 1 (w₄ at s = 0.5); `s_max` recomputed here. One rounding an entry:
+    /// 1e-15.
+    #[test]
+    fn the_first_trial_stops_short_of_the_nearest_bound() {
+        let n = 6;
+        let sc = scaled(n, 3, 15);
+        let w = [0.3, 0.6, 0.5, 0.4, 0.7, 0.5];
+        let ld = ln_det_spd(sc.information(&w).as_ref()).unwrap();
+        for delta in [
+            [-0.6, 0.2, 0.1, 0.1, 0.1, 0.1],
+            [0.1, 0.1, -0.2, -0.1, 0.6, -0.5],
+        ] {
+            let mut s_max = 1.0f64;
+            for i in 0..n {
+                let room = if delta[i] < 0.0 {
+                    w[i] / -delta[i]
+                } else {
+                    (1.0 - w[i]) / delta[i]
+                };
+                s_max = s_max.min(0.99 * room);
+            }
+            assert!((s_max - 0.495).abs() < 1e-15, "{s_max}");
+            let t = line_search(&sc, &w, &delta, f64::NEG_INFINITY, 0.1, ld).expect("interior");
+            for i in 0..n {
+                let want = w[i] + s_max * delta[i];
+                assert!(
+                    (t[i] - want).abs() < 1e-15,
+                    "{delta:?}: w[{i}] {} vs {want}",
+                    t[i]
+                );
+            }
+        }
+    }
+
+    /// A step is accepted only where `F_μ` rose by a quarter of `λ²·s`:
+    /// asked for four times the decrement of a short Newton step (a tenth
+    /// of it, so that the full step is interior), no trial rises enough at
+    /// all (`F_μ` is concave: the rise is at most the first-order `s·c·λ²`,
+    /// the ask `s·c·λ²`), so any point returned (only at a rounding-size
+    /// step) meets the ask.
+    #[test]
+    fn a_step_short_of_the_armijo_rise_is_refused() {
+        let n = 8;
+        let sc = scaled(n, 3, 16);
+        let w = interior(n, 3.0, 17);
+        let mu = 0.05;
+        let ld = ln_det_spd(sc.information(&w).as_ref()).unwrap();
+        let mut q = Mat::zeros(n, n);
+        let mut d = vec![0.0; n];
+        derivatives(&sc, &w, &mut q, &mut d).unwrap();
+        let ones = Mat::from_fn(n, 1, |_, _| 1.0);
+        let (delta, lambda2) = newton_direction(&q, &d, &w, mu, &ones).unwrap();
+        let short: Vec<f64> = delta.iter().map(|v| 0.1 * v).collect();
+        let ask = 4.0 * 0.1 * lambda2;
+        let f0 = barrier_value(&sc, &w, mu).unwrap();
+        if let Some(t) = line_search(&sc, &w, &short, ask, mu, ld) {
+            let s = (t[0] - w[0]) / short[0];
+            let f1 = barrier_value(&sc, &t, mu).unwrap();
+            assert!(
+                f1 >= f0 + 0.25 * s * ask,
+                "accepted at s = {s}: {f1} < {f0} + ¼·s·{ask}"
+            );
+        }
     }
 }

@@ -673,17 +673,17 @@ mod tests {
     /// the nearest bound (the full step if that is nearer): asked for no
     /// rise (`λ² = −∞`), it returns that point. Two directions, one stopped
     /// by a weight falling to 0 (w₀ at s = 0.5), one by a weight rising to
-    /// 1 (w₄ at s = 0.5); `s_max` recomputed here. One rounding an entry:
-    /// 1e-15.
+    /// 1 (w₄ at s = 0.4; no halving of another bound's step lands there);
+    /// `s_max` recomputed here. One rounding an entry: 1e-15.
     #[test]
     fn the_first_trial_stops_short_of_the_nearest_bound() {
         let n = 6;
         let sc = scaled(n, 3, 15);
-        let w = [0.3, 0.6, 0.5, 0.4, 0.7, 0.5];
+        let w = [0.3, 0.6, 0.5, 0.4, 0.76, 0.5];
         let ld = ln_det_spd(sc.information(&w).as_ref()).unwrap();
-        for delta in [
-            [-0.6, 0.2, 0.1, 0.1, 0.1, 0.1],
-            [0.1, 0.1, -0.2, -0.1, 0.6, -0.5],
+        for (delta, nearest) in [
+            ([-0.6, 0.2, 0.1, 0.1, 0.1, 0.1], 0.99 * 0.5),
+            ([0.1, 0.1, -0.2, -0.1, 0.6, -0.5], 0.99 * 0.4),
         ] {
             let mut s_max = 1.0f64;
             for i in 0..n {
@@ -694,7 +694,7 @@ mod tests {
                 };
                 s_max = s_max.min(0.99 * room);
             }
-            assert!((s_max - 0.495).abs() < 1e-15, "{s_max}");
+            assert!((s_max - nearest).abs() < 1e-15, "{s_max}");
             let t = line_search(&sc, &w, &delta, f64::NEG_INFINITY, 0.1, ld).expect("interior");
             for i in 0..n {
                 let want = w[i] + s_max * delta[i];

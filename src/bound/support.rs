@@ -66,6 +66,9 @@ pub(crate) fn reduce(x: &Blocks, w: &mut [f64], cand: &[usize]) -> Vec<usize> {
             let mut step = f64::INFINITY;
             let mut hit = usize::MAX;
             for (k, (&wk, &zk)) in wf.iter().zip(&z).enumerate() {
+                // `zk >= 1e-14` is equivalent: it differs only at exactly
+                // 1e-14, a component of rounding size either way (the step
+                // it allows is as long as the others or not taken).
                 let room = if zk > 1e-14 {
                     (1.0 - wk) / zk
                 } else if zk < -1e-14 {
@@ -73,6 +76,12 @@ pub(crate) fn reduce(x: &Blocks, w: &mut [f64], cand: &[usize]) -> Vec<usize> {
                 } else {
                     continue;
                 };
+                // `room <= step` is equivalent: on a tie it fixes the last
+                // of the tied weights instead of the first; the other lands
+                // on its bound too (to rounding, then clamped) and the next
+                // vector's room for it is 0. Either is a valid Carathéodory
+                // step (M and Σ w kept, one more pose fixed), and exact ties
+                // do not occur on data in general position.
                 if room < step {
                     step = room;
                     hit = k;
@@ -142,5 +151,38 @@ mod tests {
         assert!((w.iter().sum::<f64>() - sum).abs() < 1e-10 * sum);
         let scale = before.norm_l2();
         assert!((&after - &before).norm_l2() < 1e-10 * scale, "M moved");
+    }
+
+    /// Weights already at 0 or 1 are not free: they stay exactly where
+    /// they are, and do not use up null vectors (the free support still
+    /// ends at most `m`). Half of 60 candidates fixed, a third of those at 1.
+    #[test]
+    fn fixed_weights_stay_fixed() {
+        let (n, t, p) = (60, 2, 3);
+        let mut seed = 11u64;
+        let mut rnd = || crate::linalg::test_rng::lcg(&mut seed);
+        let x = Blocks::new(Mat::from_fn(n * t, p, |_, _| rnd()), t);
+        let w0: Vec<f64> = (0..n)
+            .map(|i| match i % 6 {
+                0 => 1.0,
+                1 | 2 => 0.0,
+                _ => 0.05 + 0.8 * ((i * 5) % 11) as f64 / 11.0,
+            })
+            .collect();
+        let mut w = w0.clone();
+        let before = information(&x, &w);
+        let cand: Vec<usize> = (0..n).collect();
+        let kept = reduce(&x, &mut w, &cand);
+        for i in 0..n {
+            if w0[i] == 0.0 || w0[i] == 1.0 {
+                assert_eq!(w[i], w0[i], "pose {i} moved");
+            }
+        }
+        let free = w.iter().filter(|&&v| v > FIXED && v < 1.0 - FIXED).count();
+        assert!(free <= p * (p + 1) / 2 + 1, "{free} free poses");
+        assert!(kept.iter().all(|&i| w[i] > FIXED));
+        // M kept: sums of 60 O(1) products, 1e-10 relative as above.
+        let after = information(&x, &w);
+        assert!((&after - &before).norm_l2() < 1e-10 * before.norm_l2());
     }
 }

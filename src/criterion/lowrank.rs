@@ -174,6 +174,9 @@ struct Gram {
 
 impl Gram {
     fn sym(&self, i: usize, j: usize) -> f64 {
+        // Reading the upper triangle instead (`i < j` here) is equivalent:
+        // `S` is formed whole and its triangles differ by rounding only;
+        // either, read consistently, is exactly symmetric.
         if i >= j {
             self.s[j * self.k + i]
         } else {
@@ -367,6 +370,7 @@ pub fn cascade(
         }
         let s: f64 = (0..p).map(|j| x[j] * u[j]).sum();
         let d = 1.0 + sign * s;
+        // `sign <= 0.0` is equivalent: `sign` is ±1, never 0.
         if sign < 0.0 {
             if !(d > pivot_floor) {
                 return Err(Singular {

@@ -264,4 +264,88 @@ mod tests {
         assert_eq!(s.decode(&v).points, pts.to_vec());
         assert_eq!(s.own_param_names()[4], "marker2_y");
     }
+
+    /// The sizes a caller reads off the sensor follow `K`: one point, three
+    /// rows, three values and three own unknowns per marker; every row a
+    /// position of weight 1 (metres, as a point sensor's); one distinct name
+    /// per own unknown; no orientation in a value (the markers observe it
+    /// through their positions, they do not measure one).
+    #[test]
+    fn sizes_follow_the_number_of_markers() {
+        for k in 1..=4 {
+            let s = MarkerSensor::new(k);
+            assert_eq!(s.kind(), MeasurementKind::Markers(k));
+            assert_eq!(s.points_per_pose(), k);
+            assert_eq!(s.rows(), 3 * k);
+            assert_eq!(s.value_len(), 3 * k);
+            assert_eq!(s.n_own_params(), 3 * k);
+            assert_eq!(s.row_kinds(), vec![RowKind::Position; 3 * k].as_slice());
+            assert_eq!(s.weights(), vec![1.0; 3 * k].as_slice());
+            let names = s.own_param_names();
+            let distinct: std::collections::BTreeSet<&String> = names.iter().collect();
+            assert_eq!((names.len(), distinct.len()), (3 * k, 3 * k), "{names:?}");
+            assert!(names.iter().all(|n| n.starts_with("marker")), "{names:?}");
+            assert!(!s.measures_orientation());
+            assert!(s.decode(&vec![0.5; 3 * k]).orientation.is_none());
+            assert!(s.describe().contains("marker"), "{}", s.describe());
+        }
+        // No markers is read as one.
+        assert_eq!(MarkerSensor::new(0).points_per_pose(), 1);
+    }
+
+    /// `observed_dof` is the rank of the marker rows under the six rigid
+    /// motions of the end frame (three translations, three rotations), and
+    /// the orientation is observed exactly when the rotations add rank to
+    /// the translations' 3: one marker 3, two 5 (the turn about the line
+    /// through them is unseen), three or four off a line 6. Rank cut at
+    /// 1e-9 of the largest singular value: the rows are O(1) and a
+    /// structural zero singular value comes out at rounding size (~1e-16).
+    #[test]
+    fn observed_dof_is_the_rank_of_the_rigid_motion_rows() {
+        let own = [
+            0.1, 0.0, 0.45, -0.05, 0.12, 0.5, 0.0, -0.1, 0.55, 0.2, 0.2, 0.3,
+        ];
+        let end = frame();
+        let motions: Vec<Motion> = (0..6)
+            .map(|c| {
+                let (mut lin, mut ang) = (Vector3::zeros(), Vector3::zeros());
+                if c < 3 {
+                    lin[c] = 1.0;
+                } else {
+                    ang[c - 3] = 1.0;
+                }
+                Motion { lin, ang }
+            })
+            .collect();
+        for k in 1..=4 {
+            let s = MarkerSensor::new(k);
+            let mut rows = vec![0.0; 3 * k * 6];
+            s.motion_rows(&end, &own[..3 * k], &motions, &mut rows, 6);
+            let sv = nalgebra::DMatrix::from_row_slice(3 * k, 6, &rows).singular_values();
+            let rank = sv.iter().filter(|&&v| v > 1e-9 * sv.max()).count();
+            assert_eq!(s.observed_dof(), rank, "{k} markers");
+            assert_eq!(s.observes_orientation(), rank > 3, "{k} markers");
+        }
+    }
+
+    /// `retract` moves a value by `delta` and `residual` is `predicted −
+    /// measured`: a value retracted by `delta` has residual `delta` against
+    /// the original, and the original `−delta` against it. Values O(1),
+    /// one rounding each way: 1e-15 (a few ulps of 1) separates a right
+    /// sign from a wrong one (1e-3).
+    #[test]
+    fn the_residual_of_a_retracted_value_is_its_delta() {
+        let s = MarkerSensor::new(2);
+        let value = [0.4, -0.2, 0.9, 0.5, 0.1, 1.0];
+        let delta = [1e-3, -2e-3, 3e-3, 0.5e-3, 0.0, -1e-3];
+        let mut moved = value;
+        s.retract(&mut moved, &delta);
+        let (mut fwd, mut back) = ([0.0; 6], [0.0; 6]);
+        s.residual(&moved, &value, &mut fwd);
+        s.residual(&value, &moved, &mut back);
+        for i in 0..6 {
+            assert!((fwd[i] - delta[i]).abs() < 1e-15, "row {i}: {}", fwd[i]);
+            assert!((back[i] + delta[i]).abs() < 1e-15, "row {i}: {}", back[i]);
+        }
+    }
 }

@@ -84,3 +84,23 @@ fn the_tour_is_reordered_around_a_colliding_move_or_reports_it() {
     assert_eq!(c.from, None); // from home
     assert_eq!(c.pair.link, "bar");
 }
+
+#[test]
+fn a_colliding_move_is_reported_where_it_first_hits_in_the_direction_of_travel() {
+    // Visiting 2.5 → 0 (the later pose first): one joint, so no order
+    // avoids the cube, and the move is reported. The bar is in the cube for
+    // angles of about π/2 ± 0.21 (1.36…1.78 rad, see the first test);
+    // travelling down from 2.5 it first touches at 1.78, s ≈ (2.5 − 1.78) /
+    // 2.5 ≈ 0.29, not at 0.54 (where the move 0 → 2.5 first touches) nor at
+    // 1 − 0.54 (the last contact travelling down). 0.03 as in the first
+    // test.
+    let m = model();
+    let qs = vec![vec![0.0], vec![2.5]];
+    let mut order = vec![1, 0];
+    let r = check_tour(&[&m], 1e-3, None, &qs, &mut order);
+    assert_eq!(order, vec![1, 0], "two poses: nothing to reorder");
+    assert_eq!(r.colliding.len(), 1, "{r:?}");
+    let c = &r.colliding[0];
+    assert_eq!((c.from, c.to), (Some(0), 1));
+    assert!((c.at - (2.5 - 1.78) / 2.5).abs() < 0.03, "{}", c.at);
+}

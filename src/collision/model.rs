@@ -1,10 +1,9 @@
 //! The loaded model and its queries at a configuration: the first contact
-//! (closer than the clearance), which pair it is, and how fast each joint
-//! sweeps the geometry.
+//! (closer than the clearance) and which pair it is.
 
 use super::shapes::Geometry;
 use super::spec::TouchingPair;
-use super::tree::{Motion, Tree};
+use super::tree::Tree;
 use parry3d_f64::na::Isometry3;
 use parry3d_f64::shape::SharedShape;
 use serde::Serialize;
@@ -155,44 +154,6 @@ impl CollisionModel {
             }
         }
         None
-    }
-
-    /// How far any point of a checked geometry can move per unit change of
-    /// each configuration value at `q`, metres per radian (or per metre):
-    /// for a revolute joint the largest distance from its axis point of a
-    /// geometry it carries (`|centre − axis point| + radius`, which bounds
-    /// the distance to the axis), for a prismatic joint 1, for a value
-    /// that moves no geometry 0.
-    #[must_use]
-    pub fn sweep_rates(&self, q: &[f64]) -> Vec<f64> {
-        let links = self.link_placements(q);
-        // The tree joint above each link (None at the root).
-        let mut above = vec![None; self.tree.links.len()];
-        for (k, j) in self.tree.joints.iter().enumerate() {
-            above[j.child] = Some(k);
-        }
-        let mut rates = vec![0.0f64; self.drives.len()];
-        for g in &self.geoms {
-            let centre = links[g.link] * g.origin * g.center;
-            let mut link = g.link;
-            while let Some(j) = above[link] {
-                let joint = &self.tree.joints[j];
-                if let Some(k) = self.drives.iter().position(|&d| d == j) {
-                    let r = match joint.motion {
-                        Motion::Prismatic => 1.0,
-                        Motion::Fixed => 0.0,
-                        Motion::Revolute => {
-                            let axis_point =
-                                (links[joint.parent] * joint.origin).translation.vector;
-                            (centre.coords - axis_point).norm() + g.radius
-                        }
-                    };
-                    rates[k] = rates[k].max(r);
-                }
-                link = joint.parent;
-            }
-        }
-        rates
     }
 
     /// Every geometry's placement in the root frame at `q`.

@@ -81,6 +81,28 @@ impl Checker<'_> {
         found
     }
 
+    /// The first contact on the move from node `a` to node `b`, in the
+    /// direction of travel: the memo holds each move checked from its
+    /// lower node, whose first contact is the last one when travelling the
+    /// other way, so such a move is checked again from `a`.
+    fn first_contact_along(&mut self, a: usize, b: usize) -> (ContactPair, f64) {
+        let memo = self.contact(a, b).expect("a colliding move");
+        if a < b {
+            return memo;
+        }
+        let (qa, qb) = (self.node(a).to_vec(), self.node(b).to_vec());
+        for m in self.models {
+            let r = m.check_move(&qa, &qb, self.resolution);
+            self.configurations += r.checks;
+            if let Some(found) = r.contact {
+                return found;
+            }
+        }
+        // Unreachable in exact arithmetic (the move collides); the memo's
+        // contact, seen from the travel direction, is the best left.
+        (memo.0, 1.0 - memo.1)
+    }
+
     /// The nodes of a visiting order (home first when given).
     fn path(&self, order: &[usize]) -> Vec<usize> {
         let start = usize::from(self.home.is_none());
@@ -145,7 +167,7 @@ pub fn check_tour(
         .colliding(&path)
         .into_iter()
         .map(|i| {
-            let (pair, at) = c.contact(path[i], path[i + 1]).expect("colliding");
+            let (pair, at) = c.first_contact_along(path[i], path[i + 1]);
             let pos = |n: usize| path[first..].iter().position(|&x| x == n);
             CollidingMove {
                 from: if path[i] == 0 && home.is_some() {

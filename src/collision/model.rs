@@ -5,7 +5,7 @@ use super::shapes::Geometry;
 use super::spec::TouchingPair;
 use super::tree::Tree;
 use parry3d_f64::na::Isometry3;
-use parry3d_f64::shape::SharedShape;
+use parry3d_f64::shape::{Ball, SharedShape};
 use serde::Serialize;
 
 /// What two geometries at `pa`, `pb` are to each other: closer than
@@ -132,7 +132,8 @@ impl CollisionModel {
         for (k, &(a, b)) in self.pairs.iter().enumerate() {
             let (ga, gb) = (&self.geoms[a], &self.geoms[b]);
             let d = (poses[a] * ga.center - poses[b] * gb.center).norm();
-            if d > ga.radius + gb.radius + c {
+            if d > ga.radius + gb.radius + c || self.hull_distance(k, &poses).is_some_and(|h| h > c)
+            {
                 continue;
             }
             if too_close(
@@ -148,8 +149,12 @@ impl CollisionModel {
         for (o, (_, opose, oshape)) in self.obstacles.iter().enumerate() {
             for &g in &self.exposed {
                 let geom = &self.geoms[g];
+                let key = self.pairs.len() + o * self.geoms.len() + g;
+                if self.hull_distance(key, &poses).is_some_and(|h| h > c) {
+                    continue;
+                }
                 if too_close(&poses[g], geom.shape.as_ref(), opose, oshape.as_ref(), c) {
-                    return Some(self.pairs.len() + o * self.geoms.len() + g);
+                    return Some(key);
                 }
             }
         }
@@ -179,8 +184,10 @@ impl CollisionModel {
         keys
     }
 
-    /// The placements and shapes of an item key, and the gap of its
-    /// bounding spheres (−∞ against an obstacle, which has none).
+    /// The placements and shapes of an item key, and a lower bound on its
+    /// distance: the gap of the two bounding spheres, or of the geometry's
+    /// bounding sphere and the obstacle (a distance below 0 means that the
+    /// sphere overlaps it).
     pub(super) fn item<'s>(&'s self, key: usize, poses: &[Isometry3<f64>]) -> Item<'s> {
         if key < self.pairs.len() {
             let (a, b) = self.pairs[key];
@@ -197,13 +204,43 @@ impl CollisionModel {
         let k = key - self.pairs.len();
         let (o, g) = (k / self.geoms.len(), k % self.geoms.len());
         let (_, opose, oshape) = &self.obstacles[o];
-        (
-            poses[g],
-            self.geoms[g].shape.as_ref(),
-            *opose,
+        let geom = &self.geoms[g];
+        // The bounding sphere against the obstacle: an analytic query
+        // (ball against box or half-space), far cheaper than the mesh's.
+        let centre = poses[g] * geom.center;
+        let gap = parry3d_f64::query::distance(
+            &Isometry3::translation(centre.x, centre.y, centre.z),
+            &Ball::new(geom.radius),
+            opose,
             oshape.as_ref(),
-            f64::NEG_INFINITY,
         )
+        .map_or(f64::NEG_INFINITY, |d| d);
+        (poses[g], geom.shape.as_ref(), *opose, oshape.as_ref(), gap)
+    }
+
+    /// A lower bound on an item's distance from the convex hulls of its
+    /// meshes (a primitive stands for itself; an obstacle is a box or a
+    /// half-space): `None` when neither side has a hull, where the bound
+    /// would be the exact distance.
+    pub(super) fn hull_distance(&self, key: usize, poses: &[Isometry3<f64>]) -> Option<f64> {
+        let own = |g: usize| {
+            let geom = &self.geoms[g];
+            geom.hull
+                .as_ref()
+                .map_or(geom.shape.as_ref(), |h| h.as_ref())
+        };
+        if key < self.pairs.len() {
+            let (a, b) = self.pairs[key];
+            if self.geoms[a].hull.is_none() && self.geoms[b].hull.is_none() {
+                return None;
+            }
+            return parry3d_f64::query::distance(&poses[a], own(a), &poses[b], own(b)).ok();
+        }
+        let k = key - self.pairs.len();
+        let (o, g) = (k / self.geoms.len(), k % self.geoms.len());
+        self.geoms[g].hull.as_ref()?;
+        let (_, opose, oshape) = &self.obstacles[o];
+        parry3d_f64::query::distance(&poses[g], own(g), opose, oshape.as_ref()).ok()
     }
 
     /// The links (or link and obstacle) of a [`contact_key`](Self::contact_key).

@@ -18,6 +18,10 @@ pub(super) struct Geometry {
     /// Bounding sphere in the geometry frame: centre and radius.
     pub(super) center: Point3<f64>,
     pub(super) radius: f64,
+    /// A mesh's convex hull (in the geometry frame): it contains the mesh,
+    /// so its distance bounds the mesh's from below at a fraction of the
+    /// cost (`None` for primitive shapes, whose queries are cheap).
+    pub(super) hull: Option<SharedShape>,
 }
 
 /// Where a `package://PKG/rest` or relative mesh file is: the package
@@ -145,12 +149,16 @@ pub(super) fn geometries(
             let aabb = shape.compute_local_aabb();
             let center = aabb.center();
             let radius = aabb.half_extents().norm();
+            let hull = shape
+                .as_trimesh()
+                .and_then(|m| SharedShape::convex_hull(m.vertices()));
             geoms.push(Geometry {
                 link,
                 origin: tree::pose(&c.origin) * along_z(&c.geometry),
                 shape,
                 center,
                 radius,
+                hull,
             });
         }
     }

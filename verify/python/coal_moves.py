@@ -8,7 +8,11 @@ joints, in the order of a configuration's values; every other joint sits at
 0), `base` (the link whose frame the obstacles are given in, or null for
 the root), `floor` (z of the floor in that frame, or null), `boxes`
 ([cx, cy, cz, sx, sy, sz] each), `resolution` (metres) and `moves`
-([[qa, qb], ...]).
+([[qa, qb], ...]). Each move's verdict in OUT: `collides`, `at` (s of the
+first check in contact), `pair` (the two geometries, or a geometry and
+`box K` / `floor`), `checks`, `least_distance` (the least Coal distance
+taken) and `resolution_s` (the step in s that moves the fastest point
+`resolution` metres).
 
 Pairs are built as activecal builds them: every pair of collision
 geometries (Pinocchio's `buildModelsFromUrdf`, meshes as Coal BVH triangle
@@ -18,7 +22,8 @@ geometry not welded to the base link. The floor is a 20 m x 20 m x 10 m box
 whose top face is at `floor` (the half-space as far as an arm reaches).
 
 Each move q(s) = qa + s (qb - qa), s in [0, 1], is checked by conservative
-advancement on Coal's distances, independently of activecal's check: a
+advancement on Coal's distances, independently of activecal's check (no
+convex hulls; Coal's own BVH distances of the meshes): a
 point of geometry g moves, per unit of s, at most sum_j |dq_j| R_jg
 relative to any body above joint j, where R_jg bounds the distance from
 joint j's origin to any point of g whatever the configuration (the sum of
@@ -27,7 +32,9 @@ bounding box's half-diagonal: the triangle inequality). Two geometries whose
 deepest common body is c approach each other at most at the sum of those
 rates over the joints between c and each of them (an obstacle is fixed to
 the base). The next step is the least over the pairs of distance / rate,
-so no pair can meet between checks, but never less than `resolution`
+so no pair can meet between checks (a pair's last distance less what the
+steps since can have closed bounds it until it could limit the step), but
+never less than `resolution`
 metres of the fastest point's motion: near contact, the move is checked at
 that resolution. A check whose least distance is at most 0, or where
 `computeCollisions` finds a contact, is a collision. Revolute joints only
@@ -129,33 +136,47 @@ def rates(model, gmodel, n_links, idx_of, dq):
 
 def check_move(model, gmodel, n_links, idx_of, q_index, qa, qb, resolution):
     data, gdata = model.createData(), gmodel.createData()
-    for r in gdata.distanceRequests:
-        r.enable_nearest_points = False
     qa, qb = np.asarray(qa, dtype=float), np.asarray(qb, dtype=float)
     dq = qb - qa
     pair_rates, fastest = rates(model, gmodel, n_links, idx_of, dq)
     floor_ds = resolution / fastest if fastest > 0 else 1.0
+    # A lower bound on each pair's distance, carried from step to step (the
+    # last Coal distance less what the steps since can have closed): Coal
+    # is asked again only for the pairs whose bound could limit the step.
+    lower = np.full(len(pair_rates), -np.inf)
     s, checks, least = 0.0, 0, float("inf")
     q = pin.neutral(model)
+
+    def allowed(bound, rate):
+        if bound <= 0.0:
+            return 0.0
+        return bound / rate if rate > 0 else np.inf
+
     while True:
         q[q_index] = qa + s * dq
         checks += 1
-        pin.computeDistances(model, data, gmodel, gdata, q)
-        d = np.array([r.min_distance for r in gdata.distanceResults])
-        least = min(least, float(d.min()))
-        hit = int(np.argmin(d)) if d.min() <= 0.0 else None
-        if hit is None and d.min() < 2.0 * resolution:
-            if pin.computeCollisions(model, data, gmodel, gdata, q, True):
-                hit = next(k for k, r in enumerate(gdata.collisionResults) if r.isCollision())
-        if hit is not None:
-            cp = gmodel.collisionPairs[hit]
-            names = [gmodel.geometryObjects[cp.first].name, gmodel.geometryObjects[cp.second].name]
-            return {"collides": True, "at": s, "pair": names, "checks": checks, "least_distance": least}
+        pin.updateGeometryPlacements(model, data, gmodel, gdata, q)
+        step = np.inf
+        for k in sorted(range(len(lower)), key=lambda k: allowed(lower[k], pair_rates[k])):
+            cheap = allowed(lower[k], pair_rates[k])
+            if cheap > 0.0 and cheap >= min(max(step, floor_ds), 1.0 - s):
+                break
+            d = pin.computeDistance(gmodel, gdata, k).min_distance
+            least = min(least, d)
+            hit = d <= 0.0 or (d < 2.0 * resolution and pin.computeCollision(gmodel, gdata, k))
+            if hit:
+                cp = gmodel.collisionPairs[k]
+                names = [gmodel.geometryObjects[cp.first].name, gmodel.geometryObjects[cp.second].name]
+                return {"collides": True, "at": s, "pair": names, "checks": checks, "least_distance": least,
+                        "resolution_s": floor_ds}
+            lower[k] = d
+            step = min(step, allowed(d, pair_rates[k]))
         if s >= 1.0:
-            return {"collides": False, "at": None, "pair": None, "checks": checks, "least_distance": least}
-        with np.errstate(divide="ignore"):
-            safe = np.where(pair_rates > 0, d / pair_rates, np.inf)
-        s = min(1.0, s + max(float(safe.min()), floor_ds))
+            return {"collides": False, "at": None, "pair": None, "checks": checks, "least_distance": least,
+                    "resolution_s": floor_ds}
+        ds = max(step, floor_ds)
+        lower = lower - pair_rates * ds
+        s = min(1.0, s + ds)
 
 
 def main():

@@ -23,3 +23,5 @@ mod live_export;
 mod live_gravity;
 #[cfg(feature = "live")]
 mod live_idjac;
+#[cfg(feature = "live")]
+mod live_tour;

@@ -2,10 +2,12 @@
 //! joint-space move (home → first → … → last) is checked against the
 //! pool's collision models ([`CollisionModel::check_move`]); a move that
 //! collides is replaced, when possible, by reversing a stretch of the tour
-//! (a 2-opt move) whose two new moves are free; what cannot be replaced is
-//! reported with its pair of links.
+//! (a 2-opt move) or moving one of its poses elsewhere (Or-opt) so that
+//! every new move is free; what cannot be replaced is reported with its
+//! pair of links.
 
 use crate::collision::{CollisionModel, ContactPair};
+use crate::select::tour::largest_travel;
 use serde::Serialize;
 use std::collections::HashMap;
 
@@ -122,10 +124,79 @@ impl Checker<'_> {
     }
 }
 
+/// A 2-opt reversal that removes the colliding move `path[i] → path[i+1]`
+/// with free new moves: a stretch after it (`path[i+1..=j]`, whose new
+/// moves are `i → j` and `i+1 → j+1`) or one ending at it (`path[k..=i]`,
+/// new moves `k−1 → i` and `k → i+1`), the nodes before `first` kept.
+fn reversal(c: &mut Checker<'_>, path: &[usize], i: usize, first: usize) -> Option<Vec<usize>> {
+    let n = path.len();
+    for j in (i + 2)..n {
+        if c.contact(path[i], path[j]).is_none()
+            && (j + 1 >= n || c.contact(path[i + 1], path[j + 1]).is_none())
+        {
+            let mut p = path.to_vec();
+            p[i + 1..=j].reverse();
+            return Some(p);
+        }
+    }
+    for k in (first..i).rev() {
+        if (k == 0 || c.contact(path[k - 1], path[i]).is_none())
+            && c.contact(path[k], path[i + 1]).is_none()
+        {
+            let mut p = path.to_vec();
+            p[k..=i].reverse();
+            return Some(p);
+        }
+    }
+    None
+}
+
+/// An Or-opt relocation that removes the colliding move `path[i] →
+/// path[i+1]`: one of its two poses taken out (its neighbours joined) and
+/// put between two other poses, every new move free; insertion places are
+/// tried in order of the joint travel they add (the least first).
+fn relocation(c: &mut Checker<'_>, path: &[usize], i: usize, first: usize) -> Option<Vec<usize>> {
+    for at in [i + 1, i] {
+        if at < first {
+            continue;
+        }
+        let x = path[at];
+        let mut rest = path.to_vec();
+        rest.remove(at);
+        if at > 0 && at < rest.len() && c.contact(rest[at - 1], rest[at]).is_some() {
+            continue;
+        }
+        let travel = |a: usize, b: usize| largest_travel(c.node(a), c.node(b));
+        let mut places: Vec<(f64, usize)> = (first.max(1)..=rest.len())
+            .filter(|&j| j != at)
+            .map(|j| {
+                let added = travel(rest[j - 1], x)
+                    + if j < rest.len() {
+                        travel(x, rest[j]) - travel(rest[j - 1], rest[j])
+                    } else {
+                        0.0
+                    };
+                (added, j)
+            })
+            .collect();
+        places.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (_, j) in places {
+            if c.contact(rest[j - 1], x).is_none()
+                && (j == rest.len() || c.contact(x, rest[j]).is_none())
+            {
+                let mut p = rest.clone();
+                p.insert(j, x);
+                return Some(p);
+            }
+        }
+    }
+    None
+}
+
 /// Checks the moves of visiting `qs` in `order` from `home` against
 /// `models` at `resolution` metres, and reorders `order` (2-opt
-/// reversals whose new moves are free, the home kept first) to remove
-/// colliding moves where it can.
+/// reversals and Or-opt relocations of one pose whose new moves are free,
+/// the home kept first) to remove colliding moves where it can.
 pub fn check_tour(
     models: &[&CollisionModel],
     resolution: f64,
@@ -145,23 +216,17 @@ pub fn check_tour(
     let before = c.colliding(&path).len();
     let first = usize::from(home.is_some()); // the home node never moves
     let mut reordered = false;
-    // Each accepted reversal removes one colliding move and adds none.
-    'repair: for _ in 0..before {
+    // Each accepted change removes at least one colliding move and adds
+    // none (its new moves are all free).
+    for _ in 0..before {
         let bad = c.colliding(&path);
-        for &i in &bad {
-            for j in (i + 1)..path.len() {
-                // Reverse path[i+1..=j]: moves (i, j) and (i+1, j+1) replace
-                // (i, i+1) and (j, j+1).
-                let ok_a = c.contact(path[i], path[j]).is_none();
-                let ok_b = j + 1 >= path.len() || c.contact(path[i + 1], path[j + 1]).is_none();
-                if ok_a && ok_b && j > i + 1 {
-                    path[i + 1..=j].reverse();
-                    reordered = true;
-                    continue 'repair;
-                }
-            }
-        }
-        break;
+        let Some(next) = bad.iter().find_map(|&i| {
+            reversal(&mut c, &path, i, first).or_else(|| relocation(&mut c, &path, i, first))
+        }) else {
+            break;
+        };
+        path = next;
+        reordered = true;
     }
     let colliding: Vec<CollidingMove> = c
         .colliding(&path)

@@ -74,11 +74,11 @@ fn the_tour_is_reordered_around_a_colliding_move_or_reports_it() {
     // avoids that (one joint), so it is reported, from home.
     let qs = vec![vec![-2.0], vec![0.0], vec![1.0]];
     let mut order = vec![2, 0, 1]; // 1 → −2 → 0
-    let r = check_tour(&[&m], 1e-3, None, &qs, &mut order);
+    let r = check_tour(&[&m], 1e-3, None, &qs, &mut order, &[]);
     assert!(r.colliding.is_empty(), "{r:?}");
     assert_eq!(r.colliding_before, 0);
     let mut order = vec![0, 1, 2];
-    let r = check_tour(&[&m], 1e-3, Some(&[2.0]), &qs, &mut order);
+    let r = check_tour(&[&m], 1e-3, Some(&[2.0]), &qs, &mut order, &[]);
     assert_eq!(r.colliding.len(), 1, "{r:?}");
     let c = &r.colliding[0];
     assert_eq!(c.from, None); // from home
@@ -97,7 +97,7 @@ fn a_colliding_move_is_reported_where_it_first_hits_in_the_direction_of_travel()
     let m = model();
     let qs = vec![vec![0.0], vec![2.5]];
     let mut order = vec![1, 0];
-    let r = check_tour(&[&m], 1e-3, None, &qs, &mut order);
+    let r = check_tour(&[&m], 1e-3, None, &qs, &mut order, &[]);
     assert_eq!(order, vec![1, 0], "two poses: nothing to reorder");
     assert_eq!(r.colliding.len(), 1, "{r:?}");
     let c = &r.colliding[0];
@@ -216,4 +216,55 @@ fn moves_on_the_panda_and_the_ur10_are_checked_as_coal_checks_them() {
         // the UR10 when it was written).
         assert!(colliding >= 5, "{}: {colliding} colliding moves", s.scene);
     }
+}
+
+/// A bar on a lift: a prismatic joint along z, then the bar's yaw (the
+/// first test's arm, raised or lowered).
+const LIFT: &str = r#"<robot name="lift">
+  <link name="base"/>
+  <link name="carriage"/>
+  <link name="bar">
+    <collision><origin xyz="0.5 0 0"/><geometry><box size="1.0 0.1 0.1"/></geometry></collision>
+  </link>
+  <joint name="lift" type="prismatic">
+    <parent link="base"/><child link="carriage"/><axis xyz="0 0 1"/>
+    <limit lower="0" upper="1" effort="1" velocity="1"/>
+  </joint>
+  <joint name="yaw" type="revolute">
+    <parent link="carriage"/><child link="bar"/><axis xyz="0 0 1"/>
+    <limit lower="-3.1" upper="3.1" effort="1" velocity="1"/>
+  </joint>
+</robot>"#;
+
+#[test]
+fn a_move_no_order_avoids_goes_through_a_free_via_configuration() {
+    // The cube of the first test (z from −0.1 to 0.1) and the bar at height
+    // 0: yawing from 0 to 2.5 sweeps through it, and with two poses no
+    // order avoids that. Of the two via candidates (both add 2.5 rad of
+    // largest-joint travel, tried in index order), the first sits in the
+    // cube (yaw π/2 at height 0), so moving to it collides; the second
+    // passes over the cube: raised to 0.5 m while yawing to π/2, the bar is
+    // above 0.39 m (clear of the cube's top at 0.1 m plus its half-height)
+    // whenever its yaw is within the cube's 1.36…1.78 rad.
+    let m = CollisionModel::load(&CollisionSpec {
+        urdf: "lift.urdf".into(),
+        text: Some(LIFT.into()),
+        joints: vec!["lift".into(), "yaw".into()],
+        obstacles: vec![Obstacle::parse("box:0,0.8,0,0.2,0.2,0.2").unwrap()],
+        ..CollisionSpec::default()
+    })
+    .unwrap();
+    let half = std::f64::consts::FRAC_PI_2;
+    let qs = vec![vec![0.0, 0.0], vec![0.0, 2.5]];
+    let vias = vec![vec![0.0, half], vec![0.5, half]];
+    let mut order = vec![0, 1];
+    let r = check_tour(&[&m], 1e-3, None, &qs, &mut order, &vias);
+    assert!(r.colliding.is_empty(), "{r:?}");
+    assert_eq!(r.colliding_before, 1);
+    assert_eq!(r.via.len(), 1, "{r:?}");
+    let v = &r.via[0];
+    assert_eq!((v.from, v.to, v.candidate), (Some(0), 1, 1));
+    // Without candidates the move is reported.
+    let r = check_tour(&[&m], 1e-3, None, &qs, &mut order, &[]);
+    assert_eq!((r.via.len(), r.colliding.len()), (0, 1));
 }

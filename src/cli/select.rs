@@ -483,6 +483,20 @@ fn design_file(
         d.refined = true;
     }
     super::tour::reorder_design(&mut d, order);
+    d.via = report
+        .moves
+        .as_ref()
+        .map(|m| {
+            m.via
+                .iter()
+                .map(|v| activecal::io::design::ViaPoint {
+                    from: v.from,
+                    to: v.to,
+                    q: v.q.clone(),
+                })
+                .collect()
+        })
+        .unwrap_or_default();
     d.existing = existing.map(|e| activecal::io::design::ExistingPoses {
         path: e.report.file.clone(),
         q: e.qs.clone(),

@@ -91,7 +91,9 @@ pub fn check_moves(
     let refs: Vec<&activecal::collision::CollisionModel> =
         models.iter().map(|m| m.as_ref()).collect();
     let before = order.clone();
-    let moves = activecal::select::moves::check_tour(&refs, resolution, home, &qs, order);
+    // Via candidates: the pool's configurations, each free of the filters.
+    let vias: Vec<Vec<f64>> = (0..pool.len()).map(|k| pool.q(k)).collect();
+    let moves = activecal::select::moves::check_tour(&refs, resolution, home, &qs, order, &vias);
     if *order != before {
         let by_pos: Vec<usize> = before.clone();
         let old = std::mem::take(&mut report.configurations);
@@ -118,6 +120,28 @@ fn moves_text(m: &activecal::select::moves::MovesReport) -> String {
         m.configurations_checked,
         m.resolution_m * 1e3
     );
+    let named =
+        |from: Option<usize>| from.map_or("home".to_string(), |f| format!("pose {}", f + 1));
+    let via = |s: &mut String| {
+        for v in &m.via {
+            let q: Vec<String> = v.q.iter().map(|x| format!("{x:.4}")).collect();
+            *s += &format!(
+                "  {} -> pose {} goes through the via configuration [{}] (rad or m; not measured)\n",
+                named(v.from),
+                v.to + 1,
+                q.join(", ")
+            );
+        }
+    };
+    if m.colliding.is_empty() && !m.via.is_empty() {
+        s += &format!(
+            "; {} colliding move(s) of the planned order, {} made free through a via configuration, the rest by reordering: every move is free\n",
+            m.colliding_before,
+            m.via.len()
+        );
+        via(&mut s);
+        return s;
+    }
     if m.colliding.is_empty() {
         if m.reordered {
             s += &format!(
@@ -130,14 +154,14 @@ fn moves_text(m: &activecal::select::moves::MovesReport) -> String {
         return s;
     }
     s += &format!(
-        "; {} move(s) COLLIDE and no reorder avoids them:\n",
+        "; {} move(s) COLLIDE and neither a reorder nor a via configuration avoids them:\n",
         m.colliding.len()
     );
+    via(&mut s);
     for c in &m.colliding {
         s += &format!(
             "  {} -> pose {}: {} touches {} at {:.0} % of the move\n",
-            c.from
-                .map_or("home".to_string(), |f| format!("pose {}", f + 1)),
+            named(c.from),
             c.to + 1,
             c.pair.link,
             c.pair.other,

@@ -72,6 +72,11 @@ pub struct DesignFile {
     /// (`select --compliance`): `gap` and `score` give them their columns.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub compliance: Vec<String>,
+    /// Via configurations of the visiting order: a move that collides
+    /// straight goes through one (`select` with collision filters); the
+    /// robot is not measured there.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub via: Vec<ViaPoint>,
     /// Anything else (algorithm, seed, ln_oid, ...), kept as written.
     #[serde(flatten)]
     pub extra: serde_json::Map<String, serde_json::Value>,
@@ -82,8 +87,27 @@ pub struct DesignFile {
 struct NamedIn {
     #[allow(dead_code)]
     name: Option<String>,
-    id: usize,
+    /// Absent on a via configuration.
+    id: Option<usize>,
+    /// A via configuration of the tour, not a pose.
+    #[serde(default)]
+    via: bool,
     joints: std::collections::BTreeMap<String, f64>,
+}
+
+/// A via configuration of a design's visiting order: the robot goes from
+/// the pose at position `from` (`None`: home) through `q` to the pose at
+/// position `to`, two straight joint-space moves, and is not measured at
+/// `q`.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ViaPoint {
+    /// Position in the visiting order of the pose the move starts from
+    /// (`None`: from home).
+    pub from: Option<usize>,
+    /// Position in the visiting order of the pose the move goes to.
+    pub to: usize,
+    /// The via configuration's joint values.
+    pub q: Vec<f64>,
 }
 
 /// Poses measured before a design was chosen, as a design file stores them.
@@ -126,6 +150,7 @@ impl DesignFile {
             existing: None,
             refined: false,
             compliance: compliant_joints(robot),
+            via: Vec::new(),
             extra: serde_json::Map::new(),
         }
     }
@@ -146,6 +171,7 @@ impl DesignFile {
             existing: None,
             refined: false,
             compliance: Vec::new(),
+            via: Vec::new(),
             extra: serde_json::Map::new(),
         }
     }
@@ -194,6 +220,14 @@ impl DesignFile {
         let mut ids = Vec::with_capacity(confs.len());
         let mut qs = Vec::with_capacity(confs.len());
         for (k, c) in confs.iter().enumerate() {
+            if c.via {
+                continue;
+            }
+            let id = c.id.ok_or_else(|| {
+                perr(format!(
+                    "configurations[{k}]: no 'id' (the pose's id in its pool)"
+                ))
+            })?;
             if let Some(extra) = c.joints.keys().find(|n| !names.contains(n)) {
                 return Err(perr(format!(
                     "configurations[{k}]: joint '{extra}' is not one of the design's joints ({})",
@@ -208,7 +242,7 @@ impl DesignFile {
                     })
                 })
                 .collect::<Result<Vec<f64>>>()?;
-            ids.push(c.id);
+            ids.push(id);
             qs.push(q);
         }
         let o = v.as_object_mut().expect("an object: it had configurations");

@@ -3,10 +3,14 @@
 //!
 //! * `.json`: the design file ([`DesignFile`]), with the joint names.
 //! * `.csv`: a header of the joint names and `id`, one pose a row, in
-//!   visiting order (what `--pool file:` and `--existing` read back).
+//!   visiting order (what `--pool file:` and `--existing` read back); a via
+//!   configuration of the tour is a row whose id is `via`, before the pose
+//!   it leads to (the readers skip it).
 //! * `.yaml`: the design file's keys (robot, pool, ids, ...) with the joint
 //!   values as a list of named joint configurations,
-//!   `configurations: [{name: pose_01, id: 17, joints: {joint_a: 0.1, ...}}]`,
+//!   `configurations: [{name: pose_01, id: 17, joints: {joint_a: 0.1, ...}}]`
+//!   (a via configuration of the tour as `{name: via_01_02, via: true,
+//!   joints: ...}` before the pose it leads to),
 //!   the shape robot scripts and ROS tools read (a name and a map of joint
 //!   name to position). [`DesignFile::read`] loads it as it loads JSON
 //!   ([`DesignFile::parse_yaml`]).
@@ -72,12 +76,38 @@ impl Serialize for Joints<'_> {
     }
 }
 
-/// One named joint configuration of the YAML form.
+/// One named joint configuration of the YAML form: a pose (with its id)
+/// or a via configuration of the tour (`via: true`, no id).
 #[derive(Serialize)]
 struct Named<'a> {
     name: String,
-    id: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    id: Option<usize>,
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    via: bool,
     joints: Joints<'a>,
+}
+
+/// The design's configurations in visiting order, each via configuration
+/// just before the pose it leads to: `(name, id or None for a via, q)`.
+fn visiting(d: &DesignFile) -> Vec<(String, Option<usize>, &[f64])> {
+    let qs = d.q.as_deref().unwrap_or_default();
+    let width = qs.len().to_string().len().max(2);
+    let mut out = Vec::with_capacity(qs.len() + d.via.len());
+    for (k, (q, &id)) in qs.iter().zip(&d.poses).enumerate() {
+        for v in d.via.iter().filter(|v| v.to == k) {
+            let from = v
+                .from
+                .map_or("home".to_string(), |f| format!("{:0width$}", f + 1));
+            out.push((
+                format!("via_{from}_{:0width$}", k + 1),
+                None,
+                v.q.as_slice(),
+            ));
+        }
+        out.push((format!("pose_{:0width$}", k + 1), Some(id), q.as_slice()));
+    }
+    out
 }
 
 /// The design's joint names: stored, else an error (a design written
@@ -92,27 +122,38 @@ fn names_of(d: &DesignFile) -> Result<&[String]> {
 /// order.
 pub fn to_csv(d: &DesignFile) -> Result<String> {
     let names = names_of(d)?;
-    let qs = d.q.as_deref().unwrap_or_default();
-    Ok(crate::pool::summary::poses_csv(names, qs, &d.poses))
+    if d.via.is_empty() {
+        let qs = d.q.as_deref().unwrap_or_default();
+        return Ok(crate::pool::summary::poses_csv(names, qs, &d.poses));
+    }
+    // A via configuration is a row whose id is `via` (the readers of
+    // `--pool file:` skip it).
+    let mut s = names.join(",") + ",id\n";
+    for (_, id, q) in visiting(d) {
+        for v in q {
+            s += &format!("{v:?},");
+        }
+        s += &id.map_or(crate::pool::file::VIA_ID.to_string(), |i| i.to_string());
+        s += "\n";
+    }
+    Ok(s)
 }
 
 /// The design as YAML (see the module docs).
 pub fn to_yaml(d: &DesignFile) -> Result<String> {
     let names = names_of(d)?;
-    let qs = d.q.as_deref().unwrap_or_default();
-    let width = qs.len().to_string().len().max(2);
-    let configurations: Vec<Named<'_>> = qs
-        .iter()
-        .zip(&d.poses)
-        .enumerate()
-        .map(|(k, (q, &id))| Named {
-            name: format!("pose_{:0width$}", k + 1),
+    let configurations: Vec<Named<'_>> = visiting(d)
+        .into_iter()
+        .map(|(name, id, q)| Named {
+            name,
             id,
+            via: id.is_none(),
             joints: Joints { names, q },
         })
         .collect();
     let mut rest = d.clone();
     rest.q = None;
+    rest.via = Vec::new();
     #[derive(Serialize)]
     struct Doc<'a> {
         #[serde(flatten)]
@@ -192,6 +233,48 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains(name.as_str()) && e.contains("d.yaml"), "{e}");
+    }
+
+    #[test]
+    fn via_configurations_are_written_in_visiting_order_and_skipped_on_reading() {
+        let r = Robot::puma560();
+        let pool = PoolSpec::of(PoolSource::Random {
+            count: 100,
+            seed: 2,
+        })
+        .build(&r, &r.nominal)
+        .unwrap();
+        let mut d = DesignFile::from_pool(&r, &pool, &[4, 50, 9]);
+        let via = vec![0.25; r.dof()];
+        d.via = vec![crate::io::design::ViaPoint {
+            from: Some(0),
+            to: 1,
+            q: via.clone(),
+        }];
+        // YAML: the via between pose_01 and pose_02, marked, without an id;
+        // read back, only the poses.
+        let text = to_yaml(&d).unwrap();
+        let (a, v, b) = (
+            text.find("pose_01").unwrap(),
+            text.find("via_01_02").unwrap(),
+            text.find("pose_02").unwrap(),
+        );
+        assert!(a < v && v < b, "{text}");
+        assert!(text.contains("via: true"), "{text}");
+        let back = DesignFile::parse_yaml(&text, "d.yaml").unwrap();
+        assert_eq!((back.poses, back.q), (d.poses.clone(), d.q.clone()));
+        // CSV: the via is the second row, id `via`; the pool reader skips
+        // it and says so.
+        let csv = to_csv(&d).unwrap();
+        let rows: Vec<&str> = csv.lines().collect();
+        assert_eq!(rows.len(), 5, "{csv}");
+        assert!(
+            rows[2].ends_with(",via") && rows[2].starts_with("0.25,"),
+            "{csv}"
+        );
+        let c = crate::pool::file::parse_csv(Path::new("d.csv"), &csv, &r).unwrap();
+        assert_eq!(Some(c.qs), d.q);
+        assert!(c.notes.iter().any(|n| n.contains("1 via")), "{:?}", c.notes);
     }
 
     #[test]

@@ -42,6 +42,10 @@ pub struct Configurations {
     pub notes: Vec<String>,
 }
 
+/// The `id` of a via configuration in a design's CSV: a configuration the
+/// robot moves through between two poses, not a pose (skipped on reading).
+pub const VIA_ID: &str = "via";
+
 /// The joint index of a column name: a joint name, or `q1`…`qN`.
 fn joint_of(name: &str, names: &[String]) -> Option<usize> {
     if let Some(j) = names.iter().position(|n| n == name) {
@@ -201,8 +205,10 @@ pub fn parse_csv_in(
         .map(|h| h.trim().trim_matches('"').to_string())
         .collect();
     let (map, ignored) = map_columns(path, &header, &names)?;
+    let id_column = header.iter().position(|h| h == "id");
     let mut qs = Vec::new();
     let mut rows = Vec::new();
+    let mut vias = 0usize;
     for (i, line) in lines {
         let row = format!("line {}", i + 1);
         let cells: Vec<&str> = line.split(',').collect();
@@ -215,6 +221,10 @@ pub fn parse_csv_in(
                     header.len()
                 ),
             ));
+        }
+        if id_column.is_some_and(|c| cells[c].trim().trim_matches('"') == VIA_ID) {
+            vias += 1;
+            continue;
         }
         let mut q = vec![f64::NAN; names.len()];
         for (c, cell) in cells.iter().enumerate() {
@@ -237,6 +247,12 @@ pub fn parse_csv_in(
     }
     check_units(path, robot, units, &header, &map, &rows, &mut qs)?;
     let mut notes = Vec::new();
+    if vias > 0 {
+        notes.push(format!(
+            "{}: {vias} via configuration(s) of a tour (id '{VIA_ID}') skipped: the robot moves through them, it is not measured there",
+            path.display()
+        ));
+    }
     if !ignored.is_empty() {
         notes.push(format!(
             "{}: columns ignored (not joints of the chain): {}",

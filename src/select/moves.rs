@@ -25,6 +25,29 @@ pub struct CollidingMove {
     pub at: f64,
 }
 
+/// A move of the tour made free by passing through a via configuration:
+/// the operator's controller goes `from → q → to` (two straight joint-space
+/// moves, each checked free), and the robot is not measured at `q`.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct ViaMove {
+    /// Position in the visiting order of the pose the move starts from
+    /// (`None`: from home).
+    pub from: Option<usize>,
+    /// Position in the visiting order of the pose the move goes to.
+    pub to: usize,
+    /// The via configuration's joint values.
+    pub q: Vec<f64>,
+    /// Its index among the candidates it was taken from (the pool's kept
+    /// configurations).
+    pub candidate: usize,
+}
+
+/// Via candidates tried for one colliding move, in order of the joint
+/// travel they add (the least first): each try checks up to two moves
+/// (a fraction of a second each on a meshed arm), so the search is kept
+/// short.
+pub const VIA_TRIES: usize = 12;
+
 /// What checking a tour's moves found.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct MovesReport {
@@ -38,6 +61,9 @@ pub struct MovesReport {
     pub colliding_before: usize,
     /// Whether the order was changed to avoid them.
     pub reordered: bool,
+    /// Moves of the final order that collide straight and were made free
+    /// through a via configuration.
+    pub via: Vec<ViaMove>,
     /// Moves of the final order that still collide (none when every move
     /// is free).
     pub colliding: Vec<CollidingMove>,
@@ -193,16 +219,49 @@ fn relocation(c: &mut Checker<'_>, path: &[usize], i: usize, first: usize) -> Op
     None
 }
 
+/// A via configuration for the colliding move from node `a` to node `b`:
+/// among `vias`, the first (of the [`VIA_TRIES`] that add the least
+/// largest-joint travel) whose moves from `a` and to `b` are both free.
+fn via_for(c: &mut Checker<'_>, a: usize, b: usize, vias: &[Vec<f64>]) -> Option<usize> {
+    let (qa, qb) = (c.node(a).to_vec(), c.node(b).to_vec());
+    let mut order: Vec<(f64, usize)> = vias
+        .iter()
+        .enumerate()
+        .map(|(k, v)| (largest_travel(&qa, v) + largest_travel(v, &qb), k))
+        .collect();
+    let tries = VIA_TRIES.min(order.len());
+    if tries == 0 {
+        return None;
+    }
+    order.select_nth_unstable_by(tries - 1, |x, y| x.0.total_cmp(&y.0));
+    order.truncate(tries);
+    order.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    let free = |c: &mut Checker<'_>, x: &[f64], y: &[f64]| {
+        c.models.iter().all(|m| {
+            let r = m.check_move(x, y, c.resolution);
+            c.configurations += r.checks;
+            r.contact.is_none()
+        })
+    };
+    order
+        .into_iter()
+        .map(|(_, k)| k)
+        .find(|&k| free(c, &qa, &vias[k]) && free(c, &vias[k], &qb))
+}
+
 /// Checks the moves of visiting `qs` in `order` from `home` against
 /// `models` at `resolution` metres, and reorders `order` (2-opt
 /// reversals and Or-opt relocations of one pose whose new moves are free,
-/// the home kept first) to remove colliding moves where it can.
+/// the home kept first) to remove colliding moves where it can; a move
+/// that still collides goes through a via configuration from `vias` when
+/// one makes both its halves free ([`ViaMove`]).
 pub fn check_tour(
     models: &[&CollisionModel],
     resolution: f64,
     home: Option<&[f64]>,
     qs: &[Vec<f64>],
     order: &mut Vec<usize>,
+    vias: &[Vec<f64>],
 ) -> MovesReport {
     let mut c = Checker {
         models,
@@ -228,8 +287,28 @@ pub fn check_tour(
         path = next;
         reordered = true;
     }
-    let colliding: Vec<CollidingMove> = c
-        .colliding(&path)
+    let pos = |n: usize| path[first..].iter().position(|&x| x == n);
+    let from_of = |n: usize| {
+        if n == 0 && home.is_some() {
+            None
+        } else {
+            pos(n)
+        }
+    };
+    let mut via = Vec::new();
+    let mut still = Vec::new();
+    for i in c.colliding(&path) {
+        match via_for(&mut c, path[i], path[i + 1], vias) {
+            Some(k) => via.push(ViaMove {
+                from: from_of(path[i]),
+                to: pos(path[i + 1]).unwrap_or(0),
+                q: vias[k].clone(),
+                candidate: k,
+            }),
+            None => still.push(i),
+        }
+    }
+    let colliding: Vec<CollidingMove> = still
         .into_iter()
         .map(|i| {
             let (pair, at) = c.first_contact_along(path[i], path[i + 1]);
@@ -253,6 +332,7 @@ pub fn check_tour(
         configurations_checked: c.configurations,
         colliding_before: before,
         reordered,
+        via,
         colliding,
     }
 }

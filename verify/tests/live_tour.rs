@@ -171,6 +171,23 @@ fn tours_on_the_panda_and_the_ur10_are_checked_as_coal_checks_them() {
         // k + 11), many of which collide: the plain test's colliding cases.
         let n = qs.len();
         moves.extend((0..n).map(|k| [qs[k].clone(), qs[(k + 11) % n].clone()]));
+        // And the two halves of every move made free through a via
+        // configuration.
+        let vias: Vec<(usize, Vec<f64>)> = report["moves"]["via"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| {
+                (
+                    v["from"].as_u64().unwrap() as usize,
+                    serde_json::from_value(v["q"].clone()).unwrap(),
+                )
+            })
+            .collect();
+        for (from, q) in &vias {
+            moves.push([qs[*from].clone(), q.clone()]);
+            moves.push([q.clone(), qs[from + 1].clone()]);
+        }
         let spec = spec(scene, &design["joint_names"], &moves);
         let verdicts = coal(&spec, &dir, scene.name);
         let v = verdicts["moves"].as_array().unwrap();
@@ -184,6 +201,12 @@ fn tours_on_the_panda_and_the_ur10_are_checked_as_coal_checks_them() {
         );
         // activecal's colliding moves (by the position they start from)
         // are Coal's, each first hit at the same place by the same pair.
+        let halves = &v[3 * n - 1..];
+        assert!(
+            halves.iter().all(|h| h["collides"] == false),
+            "{}: a via configuration's move collides by Coal: {halves:?}",
+            scene.name
+        );
         let ours: Vec<(usize, f64, Vec<String>)> = report["moves"]["colliding"]
             .as_array()
             .unwrap()
@@ -197,7 +220,18 @@ fn tours_on_the_panda_and_the_ur10_are_checked_as_coal_checks_them() {
                 )
             })
             .collect();
+        // A move made free through a via collides straight: by Coal too.
+        let straight: Vec<usize> = vias.iter().map(|(from, _)| *from).collect();
+        for &k in &straight {
+            assert_eq!(
+                v[n + k]["collides"],
+                true,
+                "{}: move {k} goes through a via, Coal finds it free straight",
+                scene.name
+            );
+        }
         let theirs: Vec<usize> = (0..qs.len() - 1)
+            .filter(|k| !straight.contains(k))
             .filter(|&k| v[qs.len() + k]["collides"] == true)
             .collect();
         assert_eq!(

@@ -173,6 +173,16 @@ mod tests {
     use crate::model::Robot;
     use crate::pool::{Pool, PoolSource, PoolSpec};
 
+    /// 100 random poses of `r` (seed 2).
+    fn random_pool(r: &Robot) -> Pool {
+        PoolSpec::of(PoolSource::Random {
+            count: 100,
+            seed: 2,
+        })
+        .build(r, &r.nominal)
+        .unwrap()
+    }
+
     #[test]
     fn formats_are_told_by_extension() {
         assert_eq!(
@@ -199,12 +209,7 @@ mod tests {
     #[test]
     fn yaml_round_trips_every_value_exactly() {
         let r = Robot::puma560();
-        let pool = PoolSpec::of(PoolSource::Random {
-            count: 100,
-            seed: 2,
-        })
-        .build(&r, &r.nominal)
-        .unwrap();
+        let pool = random_pool(&r);
         let d = DesignFile::from_pool(&r, &pool, &[4, 50, 9]);
         let text = to_yaml(&d).unwrap();
         assert!(
@@ -238,12 +243,7 @@ mod tests {
     #[test]
     fn via_configurations_are_written_in_visiting_order_and_skipped_on_reading() {
         let r = Robot::puma560();
-        let pool = PoolSpec::of(PoolSource::Random {
-            count: 100,
-            seed: 2,
-        })
-        .build(&r, &r.nominal)
-        .unwrap();
+        let pool = random_pool(&r);
         let mut d = DesignFile::from_pool(&r, &pool, &[4, 50, 9]);
         let via = vec![0.25; r.dof()];
         d.via = vec![crate::io::design::ViaPoint {

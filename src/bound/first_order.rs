@@ -244,6 +244,8 @@ pub(crate) fn solve_scaled(
     // --- start: given weights, or uniform + capped multiplicative steps + pruning
     let started = start.is_some();
     let mut it = start_point(&mut ev, start);
+    // Without a start the weights are uniform, all positive: `v > 0.0` as
+    // `>=` is equivalent (issue #30's sample).
     let support = it.w.iter().filter(|&&v| v > 0.0).count();
     let keep = s.keep.max(n).max(p.div_ceil(t));
     if !started && support > keep {
@@ -334,6 +336,9 @@ fn warm_up_and_prune(ev: &mut Evaluator<'_>, it: &mut Iterate, rounds: usize, ke
         if k >= pool {
             break;
         }
+        // Any growth to the pool ends at a regular prune or the whole pool:
+        // `2 * k` as `2 + k` changes only how many evaluations it takes
+        // (equivalent in value, issue #30's sample).
         k = (2 * k).min(pool);
     }
 }
@@ -352,9 +357,15 @@ fn exchange_rounds(
     let task = crate::progress::Task::start("bound: first-order rounds", None);
     let mut best_w = it.w.clone();
     let mut best_ln_det = it.eval.ln_det;
+    // The smallest gain a pairwise step is taken for; the rounds stop on the
+    // certified gap whatever it is, so `4.0 * n` as `4.0 + n` changes only
+    // the number of steps and rounds (equivalent in value, issue #30's
+    // sample).
     let step_tol = s.gap_tol / (4.0 * n as f64);
     let mut pair = PairWork::new(x.t(), x.p());
     loop {
+        // `>` as `>=` keeps the later of two points of equal ln det:
+        // equivalent in value (issue #30's sample).
         if it.eval.ln_det > best_ln_det {
             best_ln_det = it.eval.ln_det;
             best_w.clone_from(&it.w);
@@ -426,6 +437,9 @@ fn multiplicative_step(w: &mut [f64], d: &[f64], n: usize) -> bool {
     let mut rest: f64 = v.iter().map(|e| e.0).sum();
     let mut capped = 0;
     let mut c = (n as f64) / rest;
+    // `> 1.0` as `>= 1.0` is equivalent in value (issue #30's sample): an
+    // entry with `c·v = 1` is 1 capped or not, and capping it leaves `c` as
+    // it is (`(n − k − 1)/(rest − v) = (n − k)/rest` when `v = rest/(n − k)`).
     while capped < n && c * v[capped].0 > 1.0 {
         rest -= v[capped].0;
         capped += 1;
@@ -612,6 +626,7 @@ mod tests {
         let cold = solve(&x, 5, None, &s).unwrap();
         let warm = solve(&x, 5, Some(&cold.weights), &s).unwrap();
         assert!(warm.converged);
+        assert!(cold.steps > 0, "uniform is not optimal: steps were taken");
         assert!((warm.ln_det - cold.ln_det).abs() <= 2.0 * s.gap_tol);
         assert!(
             warm.rounds <= cold.rounds,
@@ -715,6 +730,70 @@ mod tests {
         // A zero variance carries no weight either.
         let mut w = vec![0.5; 4];
         assert!(!multiplicative_step(&mut w, &[1.0, 1.0, 0.0, 0.0], 3));
+    }
+
+    /// The warm-up runs only from the uniform start on a pool larger than
+    /// `keep` (raised to `N` and `⌈p/t⌉`), one evaluation per
+    /// multiplicative step and one for the pruned weights: with the rounds
+    /// stopped at their first check (`max_rounds = 1`) the solve reports
+    /// `1 + warmup_rounds + 1` evaluations (no step fails from the uniform
+    /// start: every weight stays positive) and the `N` poses kept; a pool
+    /// of exactly `keep` poses gets neither (one evaluation, uniform).
+    #[test]
+    fn the_warm_up_runs_only_above_keep() {
+        let x = pool(40, 8);
+        for warmup_rounds in [0, 1, 3] {
+            let s = ExchangeSettings {
+                keep: 1,
+                warmup_rounds,
+                max_rounds: 1,
+                ..ExchangeSettings::default()
+            };
+            let out = solve(&x, 4, None, &s).unwrap();
+            assert_eq!(out.rounds, warmup_rounds + 2, "warm-up {warmup_rounds}");
+            // `make_feasible` may spread a rounding-size rest of `N` over
+            // the pruned poses: 1e-9 tells them apart.
+            let kept = out.weights.iter().filter(|&&v| v > 1e-9).count();
+            assert_eq!(kept, 4, "warm-up {warmup_rounds}");
+        }
+        let s = ExchangeSettings {
+            keep: 40,
+            max_rounds: 1,
+            ..ExchangeSettings::default()
+        };
+        let out = solve(&x, 4, None, &s).unwrap();
+        assert_eq!(out.rounds, 1);
+        assert!(out.weights.iter().all(|&v| v == 4.0 / 40.0));
+    }
+
+    /// Pruned weights whose `M` is singular are widened (`k` doubled, up to
+    /// the whole pool) until `M` is regular: only the last of 10 poses
+    /// informs the third parameter and, with no warm-up, the uniform
+    /// weights tie and the prune keeps the first `k` poses, so the prunes
+    /// to 2, 4 and 8 poses are singular and the whole pool is kept: one
+    /// evaluation for the start and one for the regular prune (the
+    /// singular ones are not counted), the weights uniform (`make_feasible`
+    /// rescales their sum: 1e-15).
+    #[test]
+    fn a_singular_prune_is_widened_to_a_regular_one() {
+        let mut m = pool(10, 9).mat().to_owned();
+        for r in 0..18 {
+            m[(r, 2)] = 0.0;
+        }
+        let x = Blocks::new(m, 2);
+        let s = ExchangeSettings {
+            keep: 1,
+            warmup_rounds: 0,
+            max_rounds: 1,
+            ..ExchangeSettings::default()
+        };
+        let out = solve(&x, 2, None, &s).unwrap();
+        assert_eq!(out.rounds, 2);
+        assert!(
+            out.weights.iter().all(|&v| (v - 0.2).abs() < 1e-15),
+            "{:?}",
+            out.weights
+        );
     }
 
     #[test]

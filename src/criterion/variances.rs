@@ -113,6 +113,9 @@ pub(super) fn full_product(x: MatRef<'_, f64>, a: MatRef<'_, f64>, t: usize, wor
         work.resize(rows * k, 0.0);
     }
     let w = MatMut::from_column_major_slice_mut(&mut work[..rows * k], rows, k);
+    // Whole poses per chunk for symmetry with `chunked_product`; the product
+    // is row by row, so any chunk height gives the same `W` (to rounding):
+    // `CHUNK / t` for `CHUNK * t` is equivalent in value (issue #30's sample).
     let chunk_rows = CHUNK * t;
     x.par_row_chunks(chunk_rows)
         .zip(w.par_row_chunks_mut(chunk_rows))
@@ -259,6 +262,9 @@ impl PoolVariances {
             && epoch == now.1
         {
             let (base, log) = state.updates_since();
+            // `version < now.2` holds whenever it is reached (same state and
+            // epoch but another key: an older version), so `<` as `<=` is
+            // equivalent (issue #30's sample).
             if version >= base && version < now.2 {
                 let pending = &log[(version - base) as usize..];
                 let total: usize = pending.iter().map(LowRank::rank).sum();
@@ -305,5 +311,85 @@ impl PoolVariances {
     #[must_use]
     pub fn incremental_updates(&self) -> usize {
         self.incremental_updates
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::criterion::state::StateSettings;
+    use crate::criterion::test_util::random_pool;
+
+    /// Pending updates are applied while their total rank stays below `p`
+    /// and replaced by one recomputation once it reaches `p` (the
+    /// recomputation is then no dearer). `t = 5`, `p = 10`: an add is a
+    /// rank-5 update (applied), an exchange a rank-10 one (recomputed), and
+    /// two adds pending at once total 10 (recomputed); a synchronized pool
+    /// is left as it is. The counters are exact.
+    #[test]
+    fn updates_reaching_rank_p_are_recomputed() {
+        let (t, p) = (5, 10);
+        let pool = random_pool(40, t, p, 3);
+        let design: Vec<usize> = (0..4).collect();
+        let mut st = InfoState::new(&pool, &design, StateSettings::default()).unwrap();
+        let mut pv = PoolVariances::new(&pool, &st);
+        assert_eq!(pv.t(), t);
+        let counts = |pv: &PoolVariances| (pv.full_recomputes(), pv.incremental_updates());
+        assert_eq!(counts(&pv), (1, 0));
+        let _ = st.add(&pool, 20).unwrap();
+        pv.sync(&pool, &st);
+        assert_eq!(counts(&pv), (1, 1), "a rank-5 add is applied");
+        let _ = st.exchange(&pool, 1, 21).unwrap();
+        pv.sync(&pool, &st);
+        assert_eq!(counts(&pv), (2, 1), "a rank-10 exchange is recomputed");
+        let _ = st.add(&pool, 22).unwrap();
+        let _ = st.add(&pool, 23).unwrap();
+        pv.sync(&pool, &st);
+        assert_eq!(counts(&pv), (3, 1), "two rank-5 adds are recomputed");
+        pv.sync(&pool, &st);
+        assert_eq!(counts(&pv), (3, 1), "nothing to do");
+    }
+
+    /// A pool of another shape than the one the variances were made for
+    /// is a programming error, refused by a panic (before any work).
+    #[test]
+    #[should_panic(expected = "another shape")]
+    fn a_pool_of_another_shape_is_refused() {
+        let pool = random_pool(20, 3, 9, 1);
+        let design: Vec<usize> = (0..4).collect();
+        let st = InfoState::new(&pool, &design, StateSettings::default()).unwrap();
+        let mut pv = PoolVariances::new(&pool, &st);
+        pv.sync(&random_pool(21, 3, 9, 2), &st);
+    }
+    /// A pool left behind by more updates than the state's log keeps (128
+    /// without a refactorization: the log's base moves past the pool's
+    /// version) is recomputed, not updated from a log that has lost its
+    /// first updates; its variances then match `X_i M⁻¹ X_iᵀ` formed here
+    /// (entries O(1): 1e-10 covers the 128 updates' rounding in `M⁻¹`).
+    #[test]
+    fn a_pool_behind_the_trimmed_log_is_recomputed() {
+        let pool = random_pool(12, 3, 4, 21);
+        let s = StateSettings::default().with_refactor_every(10_000);
+        let mut st = InfoState::new(&pool, &[0, 1, 2, 3], s).unwrap();
+        let mut pv = PoolVariances::new(&pool, &st);
+        for k in 0..128 {
+            if k % 2 == 0 {
+                st.add(&pool, 5).unwrap().delta().unwrap();
+            } else {
+                st.remove(&pool, 5).unwrap().delta().unwrap();
+            }
+        }
+        assert!(st.updates_since().0 > 0, "the log was trimmed");
+        pv.sync(&pool, &st);
+        assert_eq!((pv.full_recomputes(), pv.incremental_updates()), (2, 0));
+        for i in 0..12 {
+            let x = pool.block(i);
+            let v = x * st.m_inv() * x.transpose();
+            for a in 0..3 {
+                for b in 0..3 {
+                    assert!((pv.entry(i, a, b) - v[(a, b)]).abs() < 1e-10, "pose {i}");
+                }
+            }
+        }
     }
 }

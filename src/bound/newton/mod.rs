@@ -168,35 +168,64 @@ fn barrier_value(sc: &Scaled, w: &[f64], mu: f64) -> Option<f64> {
 }
 
 /// A strictly interior start: the warm point (candidate weights, feasible
-/// or not) blended with uniform `N/n`, rescaled to `Σ w = N`; uniform when
-/// there is no warm point or the blend is not interior.
+/// or not) clamped to `[0, 1]` and scaled to `Σ w = N` under the caps
+/// ([`capped_to_sum`]), then blended 9:1 with uniform `N/n` (which keeps
+/// `Σ w = N` and every weight inside `(0, 1)` when `N < n`); uniform when
+/// there is no warm point, its support is too small to carry `N`, or the
+/// blend is not interior.
 fn interior_start(warm: Option<&[f64]>, n: usize, nf: f64) -> Vec<f64> {
     let uniform = nf / n as f64;
-    let mut w: Vec<f64> = match warm {
+    let blend = match warm {
         Some(v) if v.len() == n => {
-            let s: f64 = v.iter().map(|x| x.clamp(0.0, 1.0)).sum();
-            let scale = if s > 0.0 { nf / s } else { 0.0 };
-            v.iter()
-                .map(|&x| 0.9 * (x.clamp(0.0, 1.0) * scale).min(1.0) + 0.1 * uniform)
-                .collect()
+            let clamped: Vec<f64> = v.iter().map(|x| x.clamp(0.0, 1.0)).collect();
+            capped_to_sum(&clamped, nf)
         }
-        _ => vec![uniform; n],
-    };
-    // Rescaling may have capped entries at 1: restore Σ w = N on the rest by
-    // moving towards uniform, which is interior.
-    let s: f64 = w.iter().sum();
-    if (s - nf).abs() > 1e-12 * nf {
-        let a = (nf - s) / (n as f64 * uniform - s);
-        // `a` is 1 to rounding (`n·uniform = N`): the move is all the way to
-        // uniform. Hence `a / uniform` for `a * uniform` is equivalent: it
-        // gives weights `1/uniform > 1`, and the check below falls back to
-        // the same uniform start.
-        w.iter_mut().for_each(|v| *v = (1.0 - a) * *v + a * uniform);
+        _ => None,
     }
-    if w.iter().any(|&v| !(v > 0.0 && v < 1.0)) {
-        w = vec![uniform; n];
+    .map(|p| -> Vec<f64> { p.iter().map(|&x| 0.9 * x + 0.1 * uniform).collect() });
+    match blend {
+        Some(mut w) => {
+            // Σ w is N to rounding; make it N to the last bits the Newton
+            // steps keep (`1ᵀΔ = 0`). `nf / s` is 1 to rounding, so `*=`
+            // as `/=` is equivalent in value (issue #30's sample).
+            let s: f64 = w.iter().sum();
+            w.iter_mut().for_each(|v| *v *= nf / s);
+            // A guard for a rounding-degenerate blend: with `N < n` (the
+            // caller's case) every blended weight lies in
+            // `[0.1·N/n, 0.9 + 0.1·N/n]`, inside `(0, 1)`, so `>` as `>=`,
+            // `<` as `<=` and `&&` as `||` here are equivalent on every
+            // input the tests reach (issue #30's sample).
+            if w.iter().all(|&v| v > 0.0 && v < 1.0) {
+                w
+            } else {
+                vec![uniform; n]
+            }
+        }
+        None => vec![uniform; n],
     }
-    w
+}
+
+/// `min(c·p_i, 1)` with the `c ≥ 0` that makes the entries sum to `N`
+/// (water-filling: the largest entries are capped at 1 in turn and the rest
+/// scaled to what is left, so the uncapped entries keep their ratios), or
+/// `None` when the positive entries cannot sum to `N` under the caps.
+/// Each cap raises `c` (the capped entry had `c·p_i > 1`), so the entries
+/// capped earlier stay capped.
+fn capped_to_sum(p: &[f64], nf: f64) -> Option<Vec<f64>> {
+    let mut order: Vec<usize> = (0..p.len()).collect();
+    order.sort_unstable_by(|&a, &b| p[b].total_cmp(&p[a]));
+    let mut rest: f64 = p.iter().sum();
+    for (capped, &i) in order.iter().enumerate() {
+        let c = (nf - capped as f64) / rest;
+        if !(rest > 0.0 && c >= 0.0) {
+            return None;
+        }
+        if c * p[i] <= 1.0 {
+            return Some(p.iter().map(|&x| (c * x).min(1.0)).collect());
+        }
+        rest -= p[i];
+    }
+    None
 }
 
 /// The Newton direction of `F_μ` on `Σ w = N`: `K = Q + μ D`,
@@ -337,7 +366,12 @@ pub(crate) fn solve_scaled(
         // centred to CENTERING·μ ≈ 1.5e-10/n, the others to tol) and
         // `CENTERING * mu` as `+` below (every stage but the last ends
         // after one step): the last stage still ends at λ² of order tol,
-        // the weights and ln det agree within the tests' 1e-7.
+        // the weights and ln det agree within the tests' 1e-7. So is
+        // `CENTERING * mu` as `/` (every stage but the last ends after one
+        // step, as with `+`). And `2.0 * n as f64 * mu` as `… + mu` (the
+        // test then never holds) is equivalent in value: at the last stage
+        // `CENTERING·μ ≤ 3·tol/(2n) < tol` (`n ≥ 2` here, as `N < n`), so
+        // the other branch's `(CENTERING * mu).max(tol)` is `tol` too.
         let centred = if 2.0 * n as f64 * mu <= settings.tol {
             settings.tol
         } else {

@@ -83,9 +83,10 @@ fn derivatives_are_the_traces_of_their_definition() {
 /// Every start is strictly inside `(0, 1)` with `Σ w = N` (to rounding:
 /// 1e-12 relative), uniform without a usable warm point, and follows a
 /// feasible warm point (its largest weight stays the largest). A warm
-/// point that needs capping at 1 (case 2) gets the uniform start: the
-/// move towards uniform that restores `Σ w = N` is all the way
-/// (`a = (N − s)/(n·N/n − s) = 1`).
+/// point that needs capping at 1 (case 2: clamped weights 1, 1, 0.5, 1
+/// summing to 3.5 < N = 4) keeps its shape: the 0.5 is scaled up to the
+/// cap too, so its four poses get `0.9 + 0.1·N/n` and the others
+/// `0.1·N/n` (a few roundings of O(1) numbers: 1e-12).
 #[test]
 fn interior_starts_are_interior_and_follow_the_warm_point() {
     let (n, nf) = (10, 4.0);
@@ -108,13 +109,53 @@ fn interior_starts_are_interior_and_follow_the_warm_point() {
         assert!(w.iter().all(|&v| v > 0.0 && v < 1.0), "case {k}: {w:?}");
         let s: f64 = w.iter().sum();
         assert!((s - nf).abs() < 1e-12 * nf, "case {k}: Σ w = {s}");
-        if k < 4 {
+        if k == 2 {
+            for (i, &v) in w.iter().enumerate() {
+                let p = if [2, 5, 7, 8].contains(&i) { 1.0 } else { 0.0 };
+                let want = 0.9 * p + 0.1 * nf / n as f64;
+                assert!((v - want).abs() < 1e-12, "case 2, w[{i}] = {v}");
+            }
+        } else if k < 4 {
             assert!(w.iter().all(|&v| v == nf / n as f64), "case {k}: {w:?}");
         }
     }
     let w = interior_start(Some(&feasible), n, nf);
     let top = (0..n).max_by(|&a, &b| w[a].total_cmp(&w[b])).unwrap();
     assert_eq!(top, 0, "{w:?}");
+}
+
+/// A warm point whose rescaling to `Σ w = N` passes 1 (issue #30: it was
+/// dropped for the uniform start) keeps its shape: the weight above 1 is
+/// capped, the others scaled by the `c` that makes the sum `N` (here
+/// clamped `1, 0.7, 0.4, 0.2, 0.2` for `N = 3`: `c = 2/1.5`), keeping
+/// their ratios, then blended 9:1 with uniform. A warm point with fewer
+/// than `N` poses of weight cannot carry `N` under the caps: uniform. A
+/// few roundings of O(1) numbers: 1e-12.
+#[test]
+fn a_warm_point_with_capped_weights_keeps_its_shape() {
+    let (n, nf) = (8, 3.0);
+    let uniform = nf / n as f64;
+    let warm = [2.0, 0.7, 0.4, 0.2, 0.2, 0.0, 0.0, 0.0];
+    let c = 2.0 / 1.5;
+    let w = interior_start(Some(&warm), n, nf);
+    for i in 0..n {
+        let p = if i == 0 { 1.0 } else { c * warm[i] };
+        let want = 0.9 * p + 0.1 * uniform;
+        assert!((w[i] - want).abs() < 1e-12, "w[{i}] = {} vs {want}", w[i]);
+    }
+    let s: f64 = w.iter().sum();
+    assert!((s - nf).abs() < 1e-12 * nf, "Σ w = {s}");
+    let thin = [1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    assert_eq!(capped_to_sum(&thin, nf), None);
+    let w = interior_start(Some(&thin), n, nf);
+    assert!(w.iter().all(|&v| v == uniform), "{w:?}");
+    // Entries that already sum to N are kept as they are (`c = 1`).
+    let exact = [1.0, 0.5, 0.5, 0.5, 0.25, 0.25, 0.0, 0.0];
+    let p = capped_to_sum(&exact, nf).expect("Σ = N");
+    assert!(
+        p.iter().zip(&exact).all(|(a, b)| (a - b).abs() < 1e-15),
+        "{p:?}"
+    );
 }
 
 /// The direction keeps `Σ w` (`1ᵀΔ = 0`), solves `KΔ = g − ν1` (the
@@ -357,4 +398,76 @@ fn a_step_short_of_the_armijo_rise_is_refused() {
             "accepted at s = {s}: {f1} < {f0} + ¼·s·{ask}"
         );
     }
+}
+
+/// A first trial that does not rise enough is halved until one does: asked
+/// for three times the decrement along the Newton direction (on the
+/// quadratic model the rise `s·λ² − s²λ²/2` meets `¼·s·3λ²` only for
+/// `s ≤ ½`), the first trial falls short of Armijo (checked here), and the
+/// point returned lies at `s_max·2⁻ᵏ`, `k ≥ 1`, and meets the rule. The step is read back from the largest
+/// component of the direction: `log₂` within 1e-9 of an integer (a few
+/// roundings of an O(1) ratio).
+#[test]
+fn a_step_too_long_is_halved_until_it_rises() {
+    let n = 8;
+    let sc = scaled(n, 3, 18);
+    let w = interior(n, 3.0, 19);
+    let mu = 0.05;
+    let ld = ln_det_spd(sc.information(&w).as_ref()).unwrap();
+    let mut q = Mat::zeros(n, n);
+    let mut d = vec![0.0; n];
+    derivatives(&sc, &w, &mut q, &mut d).unwrap();
+    let ones = Mat::from_fn(n, 1, |_, _| 1.0);
+    let (delta, lambda2) = newton_direction(&q, &d, &w, mu, &ones).unwrap();
+    let long = delta;
+    let ask = 3.0 * lambda2;
+    let mut s_max = 1.0f64;
+    for i in 0..n {
+        let room = if long[i] < 0.0 {
+            w[i] / -long[i]
+        } else {
+            (1.0 - w[i]) / long[i]
+        };
+        s_max = s_max.min(0.99 * room);
+    }
+    let f0 = barrier_value(&sc, &w, mu).unwrap();
+    let first: Vec<f64> = (0..n).map(|i| w[i] + s_max * long[i]).collect();
+    let f_first = barrier_value(&sc, &first, mu).unwrap();
+    assert!(
+        f_first < f0 + 0.25 * s_max * ask,
+        "the first trial rises enough"
+    );
+    let t = line_search(&sc, &w, &long, ask, mu, ld).expect("a shorter step rises");
+    let k = (0..n)
+        .max_by(|&a, &b| long[a].abs().total_cmp(&long[b].abs()))
+        .unwrap();
+    let s = (t[k] - w[k]) / long[k];
+    let halvings = (s_max / s).log2();
+    assert!(
+        halvings > 0.5 && (halvings - halvings.round()).abs() < 1e-9,
+        "s = {s}, s_max = {s_max}"
+    );
+    let f1 = barrier_value(&sc, &t, mu).unwrap();
+    assert!(f1 >= f0 + 0.25 * s * ask, "{f1} < {f0} + ¼·{s}·{ask}");
+}
+
+/// The barrier weight starts where its bound `2nμ` is the gap known so
+/// far (`gap_hint`): after one step the dual value is the primal plus
+/// `gap_hint`, or a `mu_factor`-th of it if that step found the point
+/// centred. Two values O(10) subtracted: 1e-12 relative to the hint of 1.
+#[test]
+fn the_barrier_weight_starts_at_the_gap_hint() {
+    let sc = scaled(12, 4, 20);
+    let one = NewtonSettings {
+        max_steps: 1,
+        ..NewtonSettings::default()
+    };
+    let hint = 1.0;
+    let out = solve_scaled(&sc, 4, None, &one, hint);
+    assert_eq!(out.status, ConicStatus::MaxIterations);
+    let gap = out.ln_det_dual - out.ln_det_primal;
+    assert!(
+        (gap - hint).abs() < 1e-12 || (gap - hint / one.mu_factor).abs() < 1e-12,
+        "2nμ = {gap}"
+    );
 }

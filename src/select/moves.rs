@@ -89,6 +89,19 @@ impl Checker<'_> {
         }
     }
 
+    /// The first contact on the straight move from `qa` to `qb` against
+    /// the models in turn (not memoised), its configurations counted.
+    fn check(&mut self, qa: &[f64], qb: &[f64]) -> Option<(ContactPair, f64)> {
+        for m in self.models {
+            let r = m.check_move(qa, qb, self.resolution);
+            self.configurations += r.checks;
+            if r.contact.is_some() {
+                return r.contact;
+            }
+        }
+        None
+    }
+
     /// The first contact on the move between nodes `a` and `b`.
     fn contact(&mut self, a: usize, b: usize) -> Option<(ContactPair, f64)> {
         let key = (a.min(b), a.max(b));
@@ -96,15 +109,7 @@ impl Checker<'_> {
             return c.clone();
         }
         let (qa, qb) = (self.node(key.0).to_vec(), self.node(key.1).to_vec());
-        let mut found = None;
-        for m in self.models {
-            let r = m.check_move(&qa, &qb, self.resolution);
-            self.configurations += r.checks;
-            if r.contact.is_some() {
-                found = r.contact;
-                break;
-            }
-        }
+        let found = self.check(&qa, &qb);
         self.memo.insert(key, found.clone());
         found
     }
@@ -119,16 +124,10 @@ impl Checker<'_> {
             return memo;
         }
         let (qa, qb) = (self.node(a).to_vec(), self.node(b).to_vec());
-        for m in self.models {
-            let r = m.check_move(&qa, &qb, self.resolution);
-            self.configurations += r.checks;
-            if let Some(found) = r.contact {
-                return found;
-            }
-        }
-        // Unreachable in exact arithmetic (the move collides); the memo's
-        // contact, seen from the travel direction, is the best left.
-        (memo.0, 1.0 - memo.1)
+        // The fallback is unreachable in exact arithmetic (the move
+        // collides); the memo's contact, seen from the travel direction, is
+        // the best left.
+        self.check(&qa, &qb).unwrap_or((memo.0, 1.0 - memo.1))
     }
 
     /// The nodes of a visiting order (home first when given).
@@ -236,17 +235,10 @@ fn via_for(c: &mut Checker<'_>, a: usize, b: usize, vias: &[Vec<f64>]) -> Option
     order.select_nth_unstable_by(tries - 1, |x, y| x.0.total_cmp(&y.0));
     order.truncate(tries);
     order.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-    let free = |c: &mut Checker<'_>, x: &[f64], y: &[f64]| {
-        c.models.iter().all(|m| {
-            let r = m.check_move(x, y, c.resolution);
-            c.configurations += r.checks;
-            r.contact.is_none()
-        })
-    };
     order
         .into_iter()
         .map(|(_, k)| k)
-        .find(|&k| free(c, &qa, &vias[k]) && free(c, &vias[k], &qb))
+        .find(|&k| c.check(&qa, &vias[k]).is_none() && c.check(&vias[k], &qb).is_none())
 }
 
 /// Checks the moves of visiting `qs` in `order` from `home` against

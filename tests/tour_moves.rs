@@ -4,7 +4,45 @@
 //! around a colliding move when another order is free.
 
 use activecal::collision::{CollisionModel, CollisionSpec, Obstacle};
-use activecal::select::moves::check_tour;
+use activecal::select::moves::{MoveSpace, MovesReport, TurnedPose, check_tour};
+use activecal::select::tour::MoveCost;
+
+/// `check_tour` against `m` at 1 mm with via candidates `vias`, joints
+/// turning whole turns within `turns` (`None`: none does), on a copy of
+/// `qs` (returned with the report).
+fn tour_with(
+    m: &CollisionModel,
+    home: Option<&[f64]>,
+    qs: &[Vec<f64>],
+    order: &mut Vec<usize>,
+    vias: &[Vec<f64>],
+    turns: Option<&[Option<[f64; 2]>]>,
+) -> (MovesReport, Vec<Vec<f64>>) {
+    let models = [m];
+    let none = vec![None; qs[0].len()];
+    let cost = MoveCost::new(&vec![1.0; qs[0].len()]).unwrap();
+    let space = MoveSpace {
+        cost: &cost,
+        models: &models,
+        resolution: 1e-3,
+        vias,
+        turns: turns.unwrap_or(&none),
+    };
+    let mut qs = qs.to_vec();
+    let r = check_tour(&space, home, &mut qs, order);
+    (r, qs)
+}
+
+/// [`tour_with`] without whole turns: the report.
+fn tour(
+    m: &CollisionModel,
+    home: Option<&[f64]>,
+    qs: &[Vec<f64>],
+    order: &mut Vec<usize>,
+    vias: &[Vec<f64>],
+) -> MovesReport {
+    tour_with(m, home, qs, order, vias, None).0
+}
 
 /// A planar arm: one revolute joint about z carrying a 1 m bar along x.
 const ARM: &str = r#"<robot name="bar">
@@ -74,11 +112,11 @@ fn the_tour_is_reordered_around_a_colliding_move_or_reports_it() {
     // avoids that (one joint), so it is reported, from home.
     let qs = vec![vec![-2.0], vec![0.0], vec![1.0]];
     let mut order = vec![2, 0, 1]; // 1 → −2 → 0
-    let r = check_tour(&[&m], 1e-3, None, &qs, &mut order, &[]);
+    let r = tour(&m, None, &qs, &mut order, &[]);
     assert!(r.colliding.is_empty(), "{r:?}");
     assert_eq!(r.colliding_before, 0);
     let mut order = vec![0, 1, 2];
-    let r = check_tour(&[&m], 1e-3, Some(&[2.0]), &qs, &mut order, &[]);
+    let r = tour(&m, Some(&[2.0]), &qs, &mut order, &[]);
     assert_eq!(r.colliding.len(), 1, "{r:?}");
     let c = &r.colliding[0];
     assert_eq!(c.from, None); // from home
@@ -97,7 +135,7 @@ fn a_colliding_move_is_reported_where_it_first_hits_in_the_direction_of_travel()
     let m = model();
     let qs = vec![vec![0.0], vec![2.5]];
     let mut order = vec![1, 0];
-    let r = check_tour(&[&m], 1e-3, None, &qs, &mut order, &[]);
+    let r = tour(&m, None, &qs, &mut order, &[]);
     assert_eq!(order, vec![1, 0], "two poses: nothing to reorder");
     assert_eq!(r.colliding.len(), 1, "{r:?}");
     let c = &r.colliding[0];
@@ -258,13 +296,56 @@ fn a_move_no_order_avoids_goes_through_a_free_via_configuration() {
     let qs = vec![vec![0.0, 0.0], vec![0.0, 2.5]];
     let vias = vec![vec![0.0, half], vec![0.5, half]];
     let mut order = vec![0, 1];
-    let r = check_tour(&[&m], 1e-3, None, &qs, &mut order, &vias);
+    let r = tour(&m, None, &qs, &mut order, &vias);
     assert!(r.colliding.is_empty(), "{r:?}");
     assert_eq!(r.colliding_before, 1);
     assert_eq!(r.via.len(), 1, "{r:?}");
     let v = &r.via[0];
     assert_eq!((v.from, v.to, v.candidate), (Some(0), 1, 1));
     // Without candidates the move is reported.
-    let r = check_tour(&[&m], 1e-3, None, &qs, &mut order, &[]);
+    let r = tour(&m, None, &qs, &mut order, &[]);
     assert_eq!((r.via.len(), r.colliding.len()), (0, 1));
+}
+
+#[test]
+fn a_stretch_of_poses_turned_by_a_whole_turn_goes_round_the_other_way() {
+    // The bar of the first test, its joint turning within ±6.2 rad (more
+    // than a turn: the move check does not read the URDF's limits). Poses
+    // at 0, 2.5 and 2.0, in that order: the cube is at 1.36…1.78 rad, so
+    // 0 → 2.5 crosses it, and with every pose but the first beyond it no
+    // order avoids it (0 → 2.0 crosses it too). Turning 2.5 and 2.0 by −1
+    // turn (−3.78, −4.28: the same angles) makes the move 0 → −3.78 go
+    // round the other way, through −π/2 and −π, while the move between the
+    // two is unchanged. Turning 2.5 alone would leave −3.78 → 2.0 crossing
+    // the cube, and turning 0 does not fit (±2π is beyond ±6.2).
+    let m = model();
+    let qs = vec![vec![0.0], vec![2.5], vec![2.0]];
+    let mut order = vec![0, 1, 2];
+    let turns = [Some([-6.2, 6.2])];
+    let (r, turned) = tour_with(&m, None, &qs, &mut order, &[], Some(&turns));
+    assert!(r.colliding.is_empty() && r.via.is_empty(), "{r:?}");
+    assert_eq!((r.colliding_before, r.reordered), (1, false));
+    assert_eq!(order, vec![0, 1, 2]);
+    let expected = |pose| TurnedPose {
+        pose,
+        turns: vec![-1],
+    };
+    assert_eq!(r.turned, vec![expected(1), expected(2)]);
+    let tau = std::f64::consts::TAU;
+    assert_eq!(turned, vec![vec![0.0], vec![2.5 - tau], vec![2.0 - tau]]);
+    // The new moves are free by the move check, and by dense sampling at
+    // 1e-4 rad (0.1 mm at the bar's 1 m tip, a tenth of the resolution).
+    for w in turned.windows(2) {
+        assert!(m.check_move(&w[0], &w[1], 1e-3).contact.is_none());
+        let (a, b) = (w[0][0], w[1][0]);
+        let steps = ((b - a).abs() / 1e-4).ceil() as usize;
+        for k in 0..=steps {
+            let q = a + (b - a) * k as f64 / steps as f64;
+            assert!(m.contact(&[q]).is_none(), "q = {q}");
+        }
+    }
+    // Within ±3.1 rad (less than a turn) no pose can turn: reported.
+    let (r, same) = tour_with(&m, None, &qs, &mut order, &[], Some(&[Some([-3.1, 3.1])]));
+    assert_eq!((r.turned.len(), r.colliding.len()), (0, 1), "{r:?}");
+    assert_eq!(same, qs);
 }

@@ -339,9 +339,21 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     let pool_bound = with_gap(&a, &ctx, prior.as_ref(), &sel, &mut report)?;
     let refined = refined(&a, &ctx, prior.as_ref(), &sel, pool_bound, &mut report)?;
     let reorder = a.order.map_or(speeds.is_some(), |o| o == Order::Time);
-    let mut order =
-        super::tour::order_design(&mut report, speeds.as_ref(), home.as_deref(), reorder)?;
-    super::tour::check_moves(&mut report, &mut order, &ctx.pool, home.as_deref())?;
+    // A joint that turns all the way round may reach a pose a whole turn
+    // away, within its limits less the pool's margin.
+    let turns = activecal::pool::turn::whole_turn_limits(
+        &ctx.robot,
+        &report.joint_names,
+        ctx.pool.spec.margin,
+    )?;
+    let mut order = super::tour::order_design(
+        &mut report,
+        speeds.as_ref(),
+        home.as_deref(),
+        reorder,
+        &turns,
+    )?;
+    super::tour::check_moves(&mut report, &mut order, &ctx.pool, home.as_deref(), &turns)?;
     if let Some(out) = &a.out {
         let design = design_file(
             &ctx,
@@ -483,6 +495,13 @@ fn design_file(
         d.refined = true;
     }
     super::tour::reorder_design(&mut d, order);
+    // The joint values as visited: some poses may be reached a whole turn
+    // away (the visiting order's choice, or the move check's).
+    if let Some(q) = d.q.as_mut() {
+        for (q, c) in q.iter_mut().zip(&report.configurations) {
+            q.clone_from(&c.q);
+        }
+    }
     d.via = report
         .moves
         .as_ref()

@@ -38,6 +38,7 @@ pub fn order_design(
     speeds: Option<&JointSpeeds>,
     home: Option<&[f64]>,
     reorder: bool,
+    turns: &[Option<[f64; 2]>],
 ) -> Result<Vec<usize>> {
     let names = &report.joint_names;
     let (v, assumed) = match speeds {
@@ -52,10 +53,17 @@ pub fn order_design(
         ),
         None => (vec![FALLBACK_SPEED; names.len()], names.clone()),
     };
-    let qs: Vec<Vec<f64>> = report.configurations.iter().map(|c| c.q.clone()).collect();
-    let (order, tour) = activecal::select::tour::visit(&v, assumed, home, &qs, reorder)?;
+    let mut qs: Vec<Vec<f64>> = report.configurations.iter().map(|c| c.q.clone()).collect();
+    let (order, tour) = activecal::select::tour::visit(&v, assumed, home, &mut qs, reorder, turns)?;
     let old = std::mem::take(&mut report.configurations);
-    report.configurations = order.iter().map(|&k| old[k].clone()).collect();
+    report.configurations = order
+        .iter()
+        .map(|&k| {
+            let mut c = old[k].clone();
+            c.q.clone_from(&qs[k]);
+            c
+        })
+        .collect();
     report.tour = Some(tour);
     Ok(order)
 }
@@ -63,13 +71,15 @@ pub fn order_design(
 /// With collision filters on the pool, checks every move of the visiting
 /// order (from `home` when given) at a step where no link point moves more
 /// than the clearance (1 mm without one), reorders around colliding moves
-/// where it can, and records what it found in the report; `order` (as
-/// [`order_design`] returned it) is updated.
+/// (or turns poses' joints by whole turns) where it can, and records what
+/// it found in the report; `order` (as [`order_design`] returned it) is
+/// updated, and so are the report's configurations.
 pub fn check_moves(
     report: &mut SelectReport,
     order: &mut Vec<usize>,
     pool: &activecal::pool::Pool,
     home: Option<&[f64]>,
+    turns: &[Option<[f64; 2]>],
 ) -> Result<()> {
     let mut models = Vec::new();
     let mut clearance: f64 = 0.0;
@@ -82,7 +92,6 @@ pub fn check_moves(
     if models.is_empty() {
         return Ok(());
     }
-    let resolution = if clearance > 0.0 { clearance } else { 1e-3 };
     // The poses in selection order, as `order` indexes them.
     let mut qs = vec![Vec::new(); order.len()];
     for (c, &k) in report.configurations.iter().zip(order.iter()) {
@@ -90,16 +99,34 @@ pub fn check_moves(
     }
     let refs: Vec<&activecal::collision::CollisionModel> =
         models.iter().map(|m| m.as_ref()).collect();
-    let before = order.clone();
     // Via candidates: the pool's configurations, each free of the filters.
     let vias: Vec<Vec<f64>> = (0..pool.len()).map(|k| pool.q(k)).collect();
-    let moves = activecal::select::moves::check_tour(&refs, resolution, home, &qs, order, &vias);
-    if *order != before {
-        let by_pos: Vec<usize> = before.clone();
+    let speeds = report.tour.as_ref().map_or_else(
+        || vec![FALLBACK_SPEED; report.joint_names.len()],
+        |t| t.speeds.clone(),
+    );
+    let cost = activecal::select::tour::MoveCost::new(&speeds)?;
+    let space = activecal::select::moves::MoveSpace {
+        cost: &cost,
+        models: &refs,
+        resolution: if clearance > 0.0 { clearance } else { 1e-3 },
+        vias: &vias,
+        turns,
+    };
+    let before = order.clone();
+    let moves = activecal::select::moves::check_tour(&space, home, &mut qs, order);
+    if *order != before || !moves.turned.is_empty() {
         let old = std::mem::take(&mut report.configurations);
         let at: std::collections::HashMap<usize, usize> =
-            by_pos.iter().enumerate().map(|(i, &k)| (k, i)).collect();
-        report.configurations = order.iter().map(|k| old[at[k]].clone()).collect();
+            before.iter().enumerate().map(|(i, &k)| (k, i)).collect();
+        report.configurations = order
+            .iter()
+            .map(|k| {
+                let mut c = old[at[k]].clone();
+                c.q.clone_from(&qs[*k]);
+                c
+            })
+            .collect();
         if let Some(t) = report.tour.as_mut() {
             let cost = activecal::select::tour::MoveCost::new(&t.speeds)?;
             t.visiting_order = activecal::select::tour::totals(&cost, home, &qs, order);
@@ -112,52 +139,68 @@ pub fn check_moves(
     Ok(())
 }
 
-/// Text lines of the moves' collision check.
-fn moves_text(m: &activecal::select::moves::MovesReport) -> String {
+/// Text lines of the moves' collision check (`names`: the joints).
+fn moves_text(m: &activecal::select::moves::MovesReport, names: &[String]) -> String {
     let mut s = format!(
         "moves checked for collision: {} moves, {} configurations, at most {} mm of link motion between checks",
         m.moves_checked,
         m.configurations_checked,
         m.resolution_m * 1e3
     );
+    let fixes: Vec<&str> = [
+        m.reordered.then_some("reordering"),
+        (!m.turned.is_empty()).then_some("turning joints by whole turns"),
+        (!m.via.is_empty()).then_some("via configurations"),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    if m.colliding.is_empty() {
+        s += &if m.colliding_before == 0 {
+            "; every move is free\n".to_string()
+        } else {
+            format!(
+                "; the {} colliding move(s) of the planned order avoided by {}: every move is free\n",
+                m.colliding_before,
+                fixes.join(", ")
+            )
+        };
+    } else {
+        s += &format!(
+            "; {} move(s) COLLIDE and no reorder, whole turn or via configuration avoids them{}:\n",
+            m.colliding.len(),
+            if fixes.is_empty() {
+                String::new()
+            } else {
+                format!(" (others avoided by {})", fixes.join(", "))
+            }
+        );
+    }
     let named =
         |from: Option<usize>| from.map_or("home".to_string(), |f| format!("pose {}", f + 1));
-    let via = |s: &mut String| {
-        for v in &m.via {
-            let q: Vec<String> = v.q.iter().map(|x| format!("{x:.4}")).collect();
-            *s += &format!(
-                "  {} -> pose {} goes through the via configuration [{}] (rad or m; not measured)\n",
-                named(v.from),
-                v.to + 1,
-                q.join(", ")
-            );
-        }
-    };
-    if m.colliding.is_empty() && !m.via.is_empty() {
+    for t in &m.turned {
+        let joints: Vec<String> = t
+            .turns
+            .iter()
+            .zip(names)
+            .filter(|(t, _)| **t != 0)
+            .map(|(t, n)| format!("{n} {:+} turn ({:+} deg)", t, f64::from(*t) * 360.0))
+            .collect();
         s += &format!(
-            "; {} colliding move(s) of the planned order, {} made free through a via configuration, the rest by reordering: every move is free\n",
-            m.colliding_before,
-            m.via.len()
+            "  pose {}: {} (the same pose, reached the other way round)\n",
+            t.pose + 1,
+            joints.join(", ")
         );
-        via(&mut s);
-        return s;
     }
-    if m.colliding.is_empty() {
-        if m.reordered {
-            s += &format!(
-                "; the {} colliding move(s) of the planned order avoided by reordering: every move is free\n",
-                m.colliding_before
-            );
-        } else {
-            s += "; every move is free\n";
-        }
-        return s;
+    for v in &m.via {
+        let q: Vec<String> = v.q.iter().map(|x| format!("{x:.4}")).collect();
+        s += &format!(
+            "  {} -> pose {} goes through the via configuration [{}] (rad or m; not measured)\n",
+            named(v.from),
+            v.to + 1,
+            q.join(", ")
+        );
     }
-    s += &format!(
-        "; {} move(s) COLLIDE and neither a reorder nor a via configuration avoids them:\n",
-        m.colliding.len()
-    );
-    via(&mut s);
     for c in &m.colliding {
         s += &format!(
             "  {} -> pose {}: {} touches {} at {:.0} % of the move\n",
@@ -201,6 +244,12 @@ pub fn configurations_text(r: &SelectReport) -> String {
                 "visiting order: move time {:.2} s -> {:.2} s ({:.3} of selection order's), largest-joint travel {:.2} -> {:.2} rad\n",
                 b.time_s, a.time_s, t.time_ratio, b.travel, a.travel
             );
+            if t.turned_poses > 0 {
+                s += &format!(
+                    "  {} pose(s) reached a whole turn (360 deg) away on joints that turn all the way round: the same poses, shorter moves\n",
+                    t.turned_poses
+                );
+            }
         } else {
             s += &format!(
                 "selection order kept: move time {:.2} s, largest-joint travel {:.2} rad\n",
@@ -215,7 +264,7 @@ pub fn configurations_text(r: &SelectReport) -> String {
         }
     }
     if let Some(m) = &r.moves {
-        s += &moves_text(m);
+        s += &moves_text(m, &r.joint_names);
     }
     s += &format!("{:>4} {:>8}", "#", "id");
     for n in &r.joint_names {

@@ -140,6 +140,24 @@ pub fn shrunk_limits(robot: &Robot, names: &[String], margin: f64) -> Result<Vec
         .collect()
 }
 
+/// Per joint, the limits (less `margin`, as [`shrunk_limits`]) within
+/// which its value may change by whole turns without moving any link, for
+/// a joint that turns all the way round ([`is_full_turn`] on its own
+/// limits), else `None`.
+pub fn whole_turn_limits(
+    robot: &Robot,
+    names: &[String],
+    margin: f64,
+) -> Result<Vec<Option<[f64; 2]>>> {
+    let shrunk = shrunk_limits(robot, names, margin)?;
+    Ok(revolute_joints(robot)
+        .into_iter()
+        .zip(&robot.limits)
+        .zip(shrunk)
+        .map(|((r, &lim), s)| is_full_turn(r, lim).then_some(s))
+        .collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -37,6 +37,7 @@ pub mod moves;
 mod random;
 pub mod refine;
 pub mod tour;
+pub mod turns;
 
 pub use exchange::{Selection, detmax, eae, fedorov, multistart, polish};
 pub use random::{

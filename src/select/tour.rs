@@ -11,7 +11,9 @@
 //! either way round, elsewhere) until neither gains.
 
 use crate::error::{Error, Result};
+use crate::select::turns::{choose_turns, turned};
 use serde::Serialize;
+use std::f64::consts::TAU;
 
 /// Gains below this, seconds, are not taken (rounding would otherwise let
 /// two equal orders swap forever).
@@ -25,6 +27,8 @@ const OR_OPT_MAX: usize = 3;
 pub struct MoveCost {
     /// `1 / v_j` per joint (seconds per radian or metre).
     inv_speed: Vec<f64>,
+    /// Joints whose moves are taken the shortest way round (empty: none).
+    wrap: Vec<bool>,
 }
 
 impl MoveCost {
@@ -40,7 +44,19 @@ impl MoveCost {
         }
         Ok(Self {
             inv_speed: speeds.iter().map(|v| 1.0 / v).collect(),
+            wrap: Vec::new(),
         })
+    }
+
+    /// The same speeds, the joints marked in `wrap` (those that turn all
+    /// the way round) moving the shortest way round, at most half a turn:
+    /// the time of the best whole-turn equivalents of the two poses, for
+    /// planning an order before they are chosen
+    /// ([`crate::select::turns::choose_turns`]).
+    #[must_use]
+    pub fn turning(mut self, wrap: Vec<bool>) -> Self {
+        self.wrap = wrap;
+        self
     }
 
     /// Seconds a move from `a` to `b` takes.
@@ -49,7 +65,16 @@ impl MoveCost {
         a.iter()
             .zip(b)
             .zip(&self.inv_speed)
-            .map(|((x, y), w)| (y - x).abs() * w)
+            .enumerate()
+            .map(|(j, ((x, y), w))| {
+                let d = (y - x).abs();
+                if self.wrap.get(j).copied().unwrap_or(false) {
+                    let r = d.rem_euclid(TAU);
+                    r.min(TAU - r) * w
+                } else {
+                    d * w
+                }
+            })
             .fold(0.0, f64::max)
     }
 }
@@ -255,27 +280,61 @@ pub struct TourReport {
     pub visiting_order: PathTotals,
     /// Visiting time over selection order's (1 when not reordered).
     pub time_ratio: f64,
+    /// Poses reached by whole-turn equivalents of their joint values (the
+    /// same poses, [`crate::select::turns`]) to shorten the moves.
+    pub turned_poses: usize,
 }
 
 /// Plans the visiting order of `qs` ([`plan`]) when `reorder`, and reports
 /// it against selection order: the order (indices into `qs`) and the
-/// report (`speeds` and `assumed_speeds` as the cost was made). Errors on
-/// a speed that is not finite and positive.
+/// report (`speeds` and `assumed_speeds` as the cost was made). A joint
+/// with limits in `turns` turns all the way round: the order is planned
+/// with its moves the shortest way round, and each pose of `qs` is then
+/// changed to the whole-turn equivalents within those limits that make the
+/// order's moves take the least time ([`choose_turns`]). Errors on a speed
+/// that is not finite and positive.
 pub fn visit(
     speeds: &[f64],
     assumed_speeds: Vec<String>,
     home: Option<&[f64]>,
-    qs: &[Vec<f64>],
+    qs: &mut [Vec<f64>],
     reorder: bool,
+    turns: &[Option<[f64; 2]>],
 ) -> Result<(Vec<usize>, TourReport)> {
     let cost = MoveCost::new(speeds)?;
     let identity: Vec<usize> = (0..qs.len()).collect();
-    let order = if reorder {
-        plan(&cost, home, qs)
-    } else {
-        identity.clone()
-    };
     let before = totals(&cost, home, qs, &identity);
+    let mut turned_poses = 0;
+    let order = if reorder {
+        let wrap: Vec<bool> = turns.iter().map(Option::is_some).collect();
+        // Planned the shortest way round and as the values are; each with
+        // its best turns, the faster kept (the limits can keep a joint
+        // from going the shortest way, so either may win).
+        let (order, chosen) = [
+            plan(&cost.clone().turning(wrap), home, qs),
+            plan(&cost, home, qs),
+        ]
+        .into_iter()
+        .map(|order| {
+            let chosen = choose_turns(&cost, home, qs, &order, turns);
+            let turned_qs: Vec<Vec<f64>> =
+                qs.iter().zip(&chosen).map(|(q, t)| turned(q, t)).collect();
+            let time = totals(&cost, home, &turned_qs, &order).time_s;
+            (time, order, chosen)
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, o, c)| (o, c))
+        .expect("two plans");
+        for (q, t) in qs.iter_mut().zip(chosen) {
+            if t.iter().any(|&x| x != 0) {
+                *q = turned(q, &t);
+                turned_poses += 1;
+            }
+        }
+        order
+    } else {
+        identity
+    };
     let after = totals(&cost, home, qs, &order);
     let time_ratio = if before.time_s > 0.0 {
         after.time_s / before.time_s
@@ -292,6 +351,7 @@ pub fn visit(
             selection_order: before,
             visiting_order: after,
             time_ratio,
+            turned_poses,
         },
     ))
 }

@@ -2,12 +2,17 @@
 //! joint-space move (home → first → … → last) is checked against the
 //! pool's collision models ([`CollisionModel::check_move`]); a move that
 //! collides is replaced, when possible, by reversing a stretch of the tour
-//! (a 2-opt move) or moving one of its poses elsewhere (Or-opt) so that
-//! every new move is free; what cannot be replaced is reported with its
-//! pair of links.
+//! (a 2-opt move), moving one of its poses elsewhere (Or-opt), or turning
+//! a joint of a stretch of poses by a whole turn (the same poses, reached
+//! the other way round) so that every new move is free; a move that still
+//! collides goes through a via configuration where one makes it free, and
+//! what cannot be replaced is reported with its pair of links.
+
+mod repair;
 
 use crate::collision::{CollisionModel, ContactPair};
-use crate::select::tour::largest_travel;
+use crate::select::tour::{MoveCost, largest_travel};
+use crate::select::turns::turned;
 use serde::Serialize;
 use std::collections::HashMap;
 
@@ -48,6 +53,37 @@ pub struct ViaMove {
 /// short.
 pub const VIA_TRIES: usize = 12;
 
+/// A pose whose joint values were changed by whole turns so that the moves
+/// to and from it are free: the same pose (every link in the same place),
+/// reached the other way round.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct TurnedPose {
+    /// Position in the visiting order.
+    pub pose: usize,
+    /// Whole turns (2π) added to each joint's value (0 for most).
+    pub turns: Vec<i32>,
+}
+
+/// Repairs tried for one colliding move, in order of the move time they
+/// add (the least first): each checks up to three moves (memoised).
+pub const REPAIR_TRIES: usize = 64;
+
+/// What a tour's moves are checked against, and what a repair may use.
+#[derive(Clone, Copy, Debug)]
+pub struct MoveSpace<'a> {
+    /// The collision models every move is checked against.
+    pub models: &'a [&'a CollisionModel],
+    /// Largest motion of a link point between two checks, metres.
+    pub resolution: f64,
+    /// Via candidates: free configurations (the pool's).
+    pub vias: &'a [Vec<f64>],
+    /// Per joint, its limits when it turns all the way round (a pose's
+    /// value may then change by whole turns within them), else `None`.
+    pub turns: &'a [Option<[f64; 2]>],
+    /// The time a move takes: repairs adding the least are tried first.
+    pub cost: &'a MoveCost,
+}
+
 /// What checking a tour's moves found.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct MovesReport {
@@ -61,6 +97,8 @@ pub struct MovesReport {
     pub colliding_before: usize,
     /// Whether the order was changed to avoid them.
     pub reordered: bool,
+    /// Poses whose joint values were turned by whole turns to avoid them.
+    pub turned: Vec<TurnedPose>,
     /// Moves of the final order that collide straight and were made free
     /// through a via configuration.
     pub via: Vec<ViaMove>,
@@ -74,9 +112,33 @@ struct Checker<'a> {
     models: &'a [&'a CollisionModel],
     resolution: f64,
     home: Option<&'a [f64]>,
-    qs: &'a [Vec<f64>],
+    qs: &'a mut [Vec<f64>],
     memo: HashMap<(usize, usize), Option<(ContactPair, f64)>>,
     configurations: usize,
+    /// Whole turns added to each pose's joints.
+    turned: Vec<Vec<i32>>,
+    /// The time a move takes.
+    cost: &'a MoveCost,
+    /// Moves with a turned end checked so far: free or not.
+    turned_memo: HashMap<(End, End), bool>,
+}
+
+/// An end of a move: a node, with whole turns added to its joints (none
+/// when empty).
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub(super) struct End {
+    pub node: usize,
+    pub turns: Vec<i32>,
+}
+
+impl End {
+    /// A node as it is.
+    pub fn at(node: usize) -> Self {
+        Self {
+            node,
+            turns: Vec::new(),
+        }
+    }
 }
 
 impl Checker<'_> {
@@ -87,6 +149,46 @@ impl Checker<'_> {
         } else {
             &self.qs[n - 1]
         }
+    }
+
+    /// Turns pose node `n`'s joints by `turns` whole turns; its memoised
+    /// moves are forgotten.
+    fn turn(&mut self, n: usize, turns: &[i32]) {
+        self.qs[n - 1] = turned(&self.qs[n - 1], turns);
+        for (total, t) in self.turned[n - 1].iter_mut().zip(turns) {
+            *total += t;
+        }
+        self.memo.retain(|k, _| k.0 != n && k.1 != n);
+        self.turned_memo
+            .retain(|k, _| k.0.node != n && k.1.node != n);
+    }
+
+    /// The joint values of an end.
+    fn config(&self, e: &End) -> Vec<f64> {
+        if e.turns.is_empty() {
+            self.node(e.node).to_vec()
+        } else {
+            turned(self.node(e.node), &e.turns)
+        }
+    }
+
+    /// Seconds the move between two ends takes.
+    fn time(&self, a: &End, b: &End) -> f64 {
+        self.cost.time(&self.config(a), &self.config(b))
+    }
+
+    /// Whether the move between two ends is free (memoised).
+    fn free(&mut self, a: &End, b: &End) -> bool {
+        if a.turns.is_empty() && b.turns.is_empty() {
+            return self.contact(a.node, b.node).is_none();
+        }
+        let key = (a.clone(), b.clone());
+        if let Some(&f) = self.turned_memo.get(&key) {
+            return f;
+        }
+        let f = self.check(&self.config(a), &self.config(b)).is_none();
+        self.turned_memo.insert(key, f);
+        f
     }
 
     /// The first contact on the straight move from `qa` to `qb` against
@@ -149,75 +251,6 @@ impl Checker<'_> {
     }
 }
 
-/// A 2-opt reversal that removes the colliding move `path[i] → path[i+1]`
-/// with free new moves: a stretch after it (`path[i+1..=j]`, whose new
-/// moves are `i → j` and `i+1 → j+1`) or one ending at it (`path[k..=i]`,
-/// new moves `k−1 → i` and `k → i+1`), the nodes before `first` kept.
-fn reversal(c: &mut Checker<'_>, path: &[usize], i: usize, first: usize) -> Option<Vec<usize>> {
-    let n = path.len();
-    for j in (i + 2)..n {
-        if c.contact(path[i], path[j]).is_none()
-            && (j + 1 >= n || c.contact(path[i + 1], path[j + 1]).is_none())
-        {
-            let mut p = path.to_vec();
-            p[i + 1..=j].reverse();
-            return Some(p);
-        }
-    }
-    for k in (first..i).rev() {
-        if (k == 0 || c.contact(path[k - 1], path[i]).is_none())
-            && c.contact(path[k], path[i + 1]).is_none()
-        {
-            let mut p = path.to_vec();
-            p[k..=i].reverse();
-            return Some(p);
-        }
-    }
-    None
-}
-
-/// An Or-opt relocation that removes the colliding move `path[i] →
-/// path[i+1]`: one of its two poses taken out (its neighbours joined) and
-/// put between two other poses, every new move free; insertion places are
-/// tried in order of the joint travel they add (the least first).
-fn relocation(c: &mut Checker<'_>, path: &[usize], i: usize, first: usize) -> Option<Vec<usize>> {
-    for at in [i + 1, i] {
-        if at < first {
-            continue;
-        }
-        let x = path[at];
-        let mut rest = path.to_vec();
-        rest.remove(at);
-        if at > 0 && at < rest.len() && c.contact(rest[at - 1], rest[at]).is_some() {
-            continue;
-        }
-        let travel = |a: usize, b: usize| largest_travel(c.node(a), c.node(b));
-        let mut places: Vec<(f64, usize)> = (first.max(1)..=rest.len())
-            .filter(|&j| j != at)
-            .map(|j| {
-                let added = travel(rest[j - 1], x)
-                    + if j < rest.len() {
-                        travel(x, rest[j]) - travel(rest[j - 1], rest[j])
-                    } else {
-                        0.0
-                    };
-                (added, j)
-            })
-            .collect();
-        places.sort_by(|a, b| a.0.total_cmp(&b.0));
-        for (_, j) in places {
-            if c.contact(rest[j - 1], x).is_none()
-                && (j == rest.len() || c.contact(x, rest[j]).is_none())
-            {
-                let mut p = rest.clone();
-                p.insert(j, x);
-                return Some(p);
-            }
-        }
-    }
-    None
-}
-
 /// A via configuration for the colliding move from node `a` to node `b`:
 /// among `vias`, the first (of the [`VIA_TRIES`] that add the least
 /// largest-joint travel) whose moves from `a` and to `b` are both free.
@@ -242,42 +275,50 @@ fn via_for(c: &mut Checker<'_>, a: usize, b: usize, vias: &[Vec<f64>]) -> Option
 }
 
 /// Checks the moves of visiting `qs` in `order` from `home` against
-/// `models` at `resolution` metres, and reorders `order` (2-opt
-/// reversals and Or-opt relocations of one pose whose new moves are free,
-/// the home kept first) to remove colliding moves where it can; a move
-/// that still collides goes through a via configuration from `vias` when
-/// one makes both its halves free ([`ViaMove`]).
+/// `space`'s models at its resolution, and removes colliding moves where
+/// it can: of the 2-opt reversals, Or-opt relocations of one pose and whole
+/// turns of a stretch of poses that replace a colliding move (the home kept
+/// first), the one adding the least move time whose new moves are all free
+/// is applied ([`repair::repair`]); a move that still collides goes through
+/// a via configuration from `space.vias` when one makes both its halves
+/// free ([`ViaMove`]). `order` and the turned poses' values in `qs` are
+/// updated.
 pub fn check_tour(
-    models: &[&CollisionModel],
-    resolution: f64,
+    space: &MoveSpace<'_>,
     home: Option<&[f64]>,
-    qs: &[Vec<f64>],
+    qs: &mut [Vec<f64>],
     order: &mut Vec<usize>,
-    vias: &[Vec<f64>],
 ) -> MovesReport {
+    let dof = qs.first().map_or(0, Vec::len);
+    let turned = vec![vec![0; dof]; qs.len()];
     let mut c = Checker {
-        models,
-        resolution,
+        models: space.models,
+        resolution: space.resolution,
         home,
         qs,
         memo: HashMap::new(),
         configurations: 0,
+        turned,
+        cost: space.cost,
+        turned_memo: HashMap::new(),
     };
     let mut path = c.path(order);
     let before = c.colliding(&path).len();
     let first = usize::from(home.is_some()); // the home node never moves
     let mut reordered = false;
     // Each accepted change removes at least one colliding move and adds
-    // none (its new moves are all free).
+    // none (its new moves are all free; a turned stretch's inner moves are
+    // the same moves).
     for _ in 0..before {
         let bad = c.colliding(&path);
-        let Some(next) = bad.iter().find_map(|&i| {
-            reversal(&mut c, &path, i, first).or_else(|| relocation(&mut c, &path, i, first))
-        }) else {
+        let Some(next) = bad
+            .iter()
+            .find_map(|&i| repair::repair(&mut c, &path, i, first, space.turns))
+        else {
             break;
         };
+        reordered |= next != path;
         path = next;
-        reordered = true;
     }
     let pos = |n: usize| path[first..].iter().position(|&x| x == n);
     let from_of = |n: usize| {
@@ -288,42 +329,43 @@ pub fn check_tour(
         }
     };
     let mut via = Vec::new();
-    let mut still = Vec::new();
+    let mut colliding = Vec::new();
     for i in c.colliding(&path) {
-        match via_for(&mut c, path[i], path[i + 1], vias) {
+        match via_for(&mut c, path[i], path[i + 1], space.vias) {
             Some(k) => via.push(ViaMove {
                 from: from_of(path[i]),
                 to: pos(path[i + 1]).unwrap_or(0),
-                q: vias[k].clone(),
+                q: space.vias[k].clone(),
                 candidate: k,
             }),
-            None => still.push(i),
+            None => {
+                let (pair, at) = c.first_contact_along(path[i], path[i + 1]);
+                colliding.push(CollidingMove {
+                    from: from_of(path[i]),
+                    to: pos(path[i + 1]).unwrap_or(0),
+                    pair,
+                    at,
+                });
+            }
         }
     }
-    let colliding: Vec<CollidingMove> = still
-        .into_iter()
-        .map(|i| {
-            let (pair, at) = c.first_contact_along(path[i], path[i + 1]);
-            let pos = |n: usize| path[first..].iter().position(|&x| x == n);
-            CollidingMove {
-                from: if path[i] == 0 && home.is_some() {
-                    None
-                } else {
-                    pos(path[i])
-                },
-                to: pos(path[i + 1]).unwrap_or(0),
-                pair,
-                at,
-            }
+    let turned = path[first..]
+        .iter()
+        .enumerate()
+        .filter(|&(_, &n)| c.turned[n - 1].iter().any(|&t| t != 0))
+        .map(|(k, &n)| TurnedPose {
+            pose: k,
+            turns: c.turned[n - 1].clone(),
         })
         .collect();
     *order = path[first..].iter().map(|&n| n - 1).collect();
     MovesReport {
-        resolution_m: resolution,
+        resolution_m: space.resolution,
         moves_checked: c.memo.len(),
         configurations_checked: c.configurations,
         colliding_before: before,
         reordered,
+        turned,
         via,
         colliding,
     }

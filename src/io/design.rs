@@ -442,9 +442,11 @@ impl DesignFile {
 
     /// Checks the design against a robot and its pool, returning the pool
     /// positions of its poses: the robot name must match, every id must be
-    /// in the pool with the stored joint values, and no pose may repeat.
+    /// in the pool with the stored joint values (to whole turns of a joint that
+    /// turns all the way round), and no pose may repeat.
     pub fn positions_in(&self, robot: &Robot, pool: &Pool) -> Result<Vec<usize>> {
         let qs = self.joint_values(robot)?;
+        let turning = crate::pool::turn::turning_joints(robot);
         if let (Some(mine), Some(theirs)) = (self.spec()?.levels(), pool.spec.levels())
             && mine != theirs
         {
@@ -457,7 +459,7 @@ impl DesignFile {
             .zip(&qs)
             .map(|(&id, q)| {
                 let k = pool.position_of(id)?;
-                if !same_q(pool.config(k), q) {
+                if !same_q(&turning, pool.config(k), q) {
                     return Err(Error::PoseNotInPool {
                         index: id,
                         reason: "the pool's pose of this id has other joint values".into(),
@@ -472,20 +474,23 @@ impl DesignFile {
     /// joint values); poses outside it are skipped.
     pub fn positions_found_in(&self, robot: &Robot, pool: &Pool) -> Result<Vec<usize>> {
         let qs = self.joint_values(robot)?;
+        let turning = crate::pool::turn::turning_joints(robot);
         Ok(self
             .poses
             .iter()
             .zip(&qs)
             .filter_map(|(&id, q)| {
                 let k = pool.position_of(id).ok()?;
-                same_q(pool.config(k), q).then_some(k)
+                same_q(&turning, pool.config(k), q).then_some(k)
             })
             .collect())
     }
 }
 
-fn same_q(a: &[f64], b: &[f64]) -> bool {
-    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() <= Q_TOL)
+/// The same pose to [`Q_TOL`]: a joint that turns all the way round may be
+/// stored a whole turn away (a visiting order reaches poses so).
+fn same_q(turning: &[bool], a: &[f64], b: &[f64]) -> bool {
+    crate::pool::turn::same_place(turning, a, b, Q_TOL)
 }
 
 /// Errors on a repeated pose index.

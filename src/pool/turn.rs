@@ -140,6 +140,34 @@ pub fn shrunk_limits(robot: &Robot, names: &[String], margin: f64) -> Result<Vec
         .collect()
 }
 
+/// Whether each joint turns all the way round ([`is_full_turn`]), in joint
+/// order.
+#[must_use]
+pub fn turning_joints(robot: &Robot) -> Vec<bool> {
+    revolute_joints(robot)
+        .into_iter()
+        .zip(&robot.limits)
+        .map(|(r, &lim)| is_full_turn(r, lim))
+        .collect()
+}
+
+/// Whether `a` and `b` put the robot in the same place to `tol` (radians or
+/// metres) per joint: a joint that turns all the way round (`turning`)
+/// compared on the circle, so that values a whole turn apart agree.
+#[must_use]
+pub fn same_place(turning: &[bool], a: &[f64], b: &[f64], tol: f64) -> bool {
+    a.len() == b.len()
+        && a.iter().zip(b).enumerate().all(|(j, (x, y))| {
+            let d = (x - y).abs();
+            if turning.get(j).copied().unwrap_or(false) {
+                let r = d.rem_euclid(TAU);
+                r.min(TAU - r) <= tol
+            } else {
+                d <= tol
+            }
+        })
+}
+
 /// Per joint, the limits (less `margin`, as [`shrunk_limits`]) within
 /// which its value may change by whole turns without moving any link, for
 /// a joint that turns all the way round ([`is_full_turn`] on its own
@@ -150,11 +178,10 @@ pub fn whole_turn_limits(
     margin: f64,
 ) -> Result<Vec<Option<[f64; 2]>>> {
     let shrunk = shrunk_limits(robot, names, margin)?;
-    Ok(revolute_joints(robot)
+    Ok(turning_joints(robot)
         .into_iter()
-        .zip(&robot.limits)
         .zip(shrunk)
-        .map(|((r, &lim), s)| is_full_turn(r, lim).then_some(s))
+        .map(|(t, s)| t.then_some(s))
         .collect())
 }
 
@@ -162,6 +189,20 @@ pub fn whole_turn_limits(
 mod tests {
     use super::*;
     use std::f64::consts::PI;
+
+    #[test]
+    fn values_a_whole_turn_apart_are_one_place_only_on_a_turning_joint() {
+        let tol = 1e-9;
+        let (a, b) = ([-5.9, 0.3], [-5.9 + TAU, 0.3]);
+        assert!(same_place(&[true, false], &a, &b, tol));
+        assert!(!same_place(&[false, false], &a, &b, tol));
+        // The second joint a turn away, but it does not turn round.
+        assert!(!same_place(&[true, false], &a, &[-5.9, 0.3 + TAU], tol));
+        // Near the seam of the circle: 2π − 1e-12 is 0 to the tolerance.
+        assert!(same_place(&[true], &[0.0], &[TAU - 1e-12], tol));
+        assert!(!same_place(&[true], &[0.0], &[1e-6], tol));
+        assert!(!same_place(&[true], &[0.0], &[0.0, 0.0], tol));
+    }
 
     #[test]
     fn full_turns_are_told_from_shorter_ranges() {

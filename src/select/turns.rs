@@ -56,8 +56,15 @@ fn combinations(q: &[f64], limits: &[Option<[f64; 2]>]) -> Option<Vec<Vec<i32>>>
     if count > MAX_COMBINATIONS {
         return None;
     }
-    let mut out: Vec<Vec<i32>> = vec![Vec::with_capacity(q.len())];
-    for o in &per_joint {
+    Some(product(&per_joint))
+}
+
+/// Every combination of one choice per joint, in order (the combination of
+/// the first choices first).
+#[must_use]
+pub fn product(per_joint: &[Vec<i32>]) -> Vec<Vec<i32>> {
+    let mut out: Vec<Vec<i32>> = vec![Vec::with_capacity(per_joint.len())];
+    for o in per_joint {
         out = out
             .into_iter()
             .flat_map(|pre| {
@@ -69,7 +76,7 @@ fn combinations(q: &[f64], limits: &[Option<[f64; 2]>]) -> Option<Vec<Vec<i32>>>
             })
             .collect();
     }
-    Some(out)
+    out
 }
 
 /// Per joint, the whole turns of `q` within `limits` that bring it nearest
@@ -108,55 +115,61 @@ pub fn choose_turns(
 ) -> Vec<Vec<i32>> {
     let dof = limits.len();
     let mut chosen = vec![vec![0; dof]; qs.len()];
-    // Stages: each pose's candidate turns, the least time to each, and the
-    // candidate of the stage before it came from.
-    let mut stages: Vec<(Vec<Vec<i32>>, Vec<f64>, Vec<usize>)> = Vec::with_capacity(order.len());
-    for (p, &k) in order.iter().enumerate() {
+    let mut stages: Vec<Stage> = Vec::with_capacity(order.len());
+    for &k in order {
         let prev = stages.last();
-        let cands = match combinations(&qs[k], limits) {
-            Some(c) => c,
-            None => {
-                // One candidate: nearest the previous pose's best.
-                let reference = match prev {
-                    Some((c, t, _)) => turned(&qs[order[p - 1]], &c[argmin(t)]),
-                    None => home.map_or_else(|| qs[k].clone(), <[f64]>::to_vec),
-                };
-                vec![nearest_turns(&reference, &qs[k], limits)]
-            }
-        };
-        let mut times = Vec::with_capacity(cands.len());
-        let mut from = Vec::with_capacity(cands.len());
-        for c in &cands {
-            let q = turned(&qs[k], c);
-            let (t, f) = match prev {
-                Some((pc, pt, _)) => pc
+        let turns = combinations(&qs[k], limits).unwrap_or_else(|| {
+            // One candidate: nearest the previous pose's best.
+            let reference = match prev {
+                Some(s) => s.configs[argmin(&s.times)].clone(),
+                None => home.map_or_else(|| qs[k].clone(), <[f64]>::to_vec),
+            };
+            vec![nearest_turns(&reference, &qs[k], limits)]
+        });
+        let configs: Vec<Vec<f64>> = turns.iter().map(|t| turned(&qs[k], t)).collect();
+        let (times, from) = configs
+            .iter()
+            .map(|q| match prev {
+                Some(s) => s
+                    .configs
                     .iter()
-                    .zip(pt)
+                    .zip(&s.times)
                     .enumerate()
-                    .map(|(i, (t_prev, &acc))| {
-                        (acc + cost.time(&turned(&qs[order[p - 1]], t_prev), &q), i)
-                    })
+                    .map(|(i, (p, &acc))| (acc + cost.time(p, q), i))
                     .fold(
                         (f64::INFINITY, 0),
                         |best, x| if x.0 < best.0 { x } else { best },
                     ),
-                None => (home.map_or(0.0, |h| cost.time(h, &q)), 0),
-            };
-            times.push(t);
-            from.push(f);
-        }
-        stages.push((cands, times, from));
+                None => (home.map_or(0.0, |h| cost.time(h, q)), 0),
+            })
+            .unzip();
+        stages.push(Stage {
+            turns,
+            configs,
+            times,
+            from,
+        });
     }
     // Back from the last pose's best.
-    let Some((_, last_times, _)) = stages.last() else {
+    let Some(last) = stages.last() else {
         return chosen;
     };
-    let mut i = argmin(last_times);
-    for (p, (cands, _, from)) in stages.iter().enumerate().rev() {
-        chosen[order[p]].clone_from(&cands[i]);
-        i = from[i];
+    let mut i = argmin(&last.times);
+    for (s, &k) in stages.iter().zip(order).rev() {
+        chosen[k].clone_from(&s.turns[i]);
+        i = s.from[i];
     }
     chosen
+}
+
+/// One pose of [`choose_turns`]' programme: its candidate turns, their
+/// joint values, the least time to reach each, and the candidate of the
+/// pose before it came from.
+struct Stage {
+    turns: Vec<Vec<i32>>,
+    configs: Vec<Vec<f64>>,
+    times: Vec<f64>,
+    from: Vec<usize>,
 }
 
 /// The position of the least of `t` (the first among equals).

@@ -10,7 +10,7 @@
 //! all free is applied.
 
 use super::{Checker, End, REPAIR_TRIES};
-use std::f64::consts::TAU;
+use crate::select::turns::{product, turns_within};
 
 /// A change that replaces a colliding move.
 struct Candidate {
@@ -23,6 +23,18 @@ struct Candidate {
     turn: Option<(usize, usize, Vec<i32>)>,
     /// The moves it adds: each must be free.
     moves: Vec<(End, End)>,
+}
+
+impl Candidate {
+    /// A new order of the same poses.
+    fn reorder(added: f64, path: Vec<usize>, moves: Vec<(End, End)>) -> Self {
+        Self {
+            added,
+            path: Some(path),
+            turn: None,
+            moves,
+        }
+    }
 }
 
 /// Replaces the colliding move `path[i] → path[i+1]` (positions before
@@ -79,12 +91,7 @@ fn reversals(c: &Checker<'_>, path: &[usize], i: usize, first: usize) -> Vec<Can
         }
         let mut p = path.to_vec();
         p[i + 1..=j].reverse();
-        out.push(Candidate {
-            added,
-            path: Some(p),
-            turn: None,
-            moves,
-        });
+        out.push(Candidate::reorder(added, p, moves));
     }
     for k in first..i {
         let mut moves = vec![mv(path[k], path[i + 1])];
@@ -95,12 +102,7 @@ fn reversals(c: &Checker<'_>, path: &[usize], i: usize, first: usize) -> Vec<Can
         }
         let mut p = path.to_vec();
         p[k..=i].reverse();
-        out.push(Candidate {
-            added,
-            path: Some(p),
-            turn: None,
-            moves,
-        });
+        out.push(Candidate::reorder(added, p, moves));
     }
     out
 }
@@ -146,12 +148,7 @@ fn relocations(c: &Checker<'_>, path: &[usize], i: usize, first: usize) -> Vec<C
             }
             let mut p = rest.clone();
             p.insert(j, x);
-            out.push(Candidate {
-                added,
-                path: Some(p),
-                turn: None,
-                moves,
-            });
+            out.push(Candidate::reorder(added, p, moves));
         }
     }
     out
@@ -169,41 +166,15 @@ fn stretch_turns(
     limits
         .iter()
         .enumerate()
-        .map(|(j, lim)| {
-            let mut ok = vec![0];
-            if let Some([a, b]) = *lim {
-                for t in [-2, -1, 1, 2] {
-                    let fits = path[lo..=hi].iter().all(|&n| {
-                        let v = c.node(n)[j] + f64::from(t) * TAU;
-                        v >= a && v <= b
-                    });
-                    if fits {
-                        ok.push(t);
-                    }
-                }
+        .map(|(j, &lim)| {
+            let mut ok = turns_within(c.node(path[lo])[j], lim);
+            for &n in &path[lo + 1..=hi] {
+                let here = turns_within(c.node(n)[j], lim);
+                ok.retain(|t| here.contains(t));
             }
             ok
         })
         .collect()
-}
-
-/// Every combination of one choice per joint, the all-zero one left out.
-fn combinations(per_joint: &[Vec<i32>]) -> Vec<Vec<i32>> {
-    let mut out: Vec<Vec<i32>> = vec![Vec::with_capacity(per_joint.len())];
-    for o in per_joint {
-        out = out
-            .into_iter()
-            .flat_map(|pre| {
-                o.iter().map(move |&t| {
-                    let mut x = pre.clone();
-                    x.push(t);
-                    x
-                })
-            })
-            .collect();
-    }
-    out.retain(|x| x.iter().any(|&t| t != 0));
-    out
 }
 
 /// Turned stretches: those starting at the move's destination (`i + 1 ..=
@@ -224,7 +195,9 @@ fn stretches(
         .chain((first..=i).map(|lo| (lo, i)));
     let mut out = Vec::new();
     for (lo, hi) in bounds {
-        for turns in combinations(&stretch_turns(c, path, lo, hi, limits)) {
+        let mut all = product(&stretch_turns(c, path, lo, hi, limits));
+        all.retain(|x| x.iter().any(|&t| t != 0));
+        for turns in all {
             let at = |p: usize| End {
                 node: path[p],
                 turns: turns.clone(),

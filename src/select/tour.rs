@@ -316,7 +316,7 @@ pub fn visit(
         ]
         .into_iter()
         .map(|order| {
-            let chosen = choose_turns(&cost, home, qs, &order, turns);
+            let chosen = choose_turns(|a, b| cost.time(a, b), home, qs, &order, turns);
             let turned_qs: Vec<Vec<f64>> =
                 qs.iter().zip(&chosen).map(|(q, t)| turned(q, t)).collect();
             let time = totals(&cost, home, &turned_qs, &order).time_s;

@@ -5,10 +5,9 @@
 //! identification Jacobian are the same (every revolute joint enters them
 //! through its angle's sine and cosine), only the way the arm moves there
 //! changes. A visiting order plans with the shortest way round
-//! ([`MoveCost::turning`]) and then chooses, pose by pose, the equivalents
+//! (`MoveCost::turning` in [`crate::select::tour`]) and then chooses, pose by pose, the equivalents
 //! that make its moves take the least time ([`choose_turns`]).
 
-use crate::select::tour::MoveCost;
 use std::f64::consts::TAU;
 
 /// Most combinations of equivalents of one pose the exact choice weighs
@@ -98,8 +97,9 @@ fn nearest_turns(prev: &[f64], q: &[f64], limits: &[Option<[f64; 2]>]) -> Vec<i3
 }
 
 /// The whole turns to add to each pose of `qs` (indexed as `qs`) so that
-/// visiting them in `order` from `home` takes the least time at `cost`
-/// (which must not itself take the shortest way round): an exact dynamic
+/// visiting them in `order` from `home` takes the least time, a move from
+/// `a` to `b` taking `time(a, b)` (which must not itself take the shortest
+/// way round): an exact dynamic
 /// programme over each pose's combinations of equivalents (the time to a
 /// pose's combination is the least, over the previous pose's
 /// combinations, of the time to that one plus the move), ties kept on the
@@ -107,7 +107,7 @@ fn nearest_turns(prev: &[f64], q: &[f64], limits: &[Option<[f64; 2]>]) -> Vec<i3
 /// joint, the equivalent nearest the pose chosen before it.
 #[must_use]
 pub fn choose_turns(
-    cost: &MoveCost,
+    time: impl Fn(&[f64], &[f64]) -> f64,
     home: Option<&[f64]>,
     qs: &[Vec<f64>],
     order: &[usize],
@@ -135,12 +135,12 @@ pub fn choose_turns(
                     .iter()
                     .zip(&s.times)
                     .enumerate()
-                    .map(|(i, (p, &acc))| (acc + cost.time(p, q), i))
+                    .map(|(i, (p, &acc))| (acc + time(p, q), i))
                     .fold(
                         (f64::INFINITY, 0),
                         |best, x| if x.0 < best.0 { x } else { best },
                     ),
-                None => (home.map_or(0.0, |h| cost.time(h, q)), 0),
+                None => (home.map_or(0.0, |h| time(h, q)), 0),
             })
             .unzip();
         stages.push(Stage {
@@ -189,6 +189,17 @@ fn argmin(t: &[f64]) -> usize {
 mod tests {
     use super::*;
 
+    /// A synchronised move's time at `speeds`: the slowest joint's.
+    fn move_time(speeds: &[f64]) -> impl Fn(&[f64], &[f64]) -> f64 + '_ {
+        move |a, b| {
+            a.iter()
+                .zip(b)
+                .zip(speeds)
+                .map(|((x, y), v)| (y - x).abs() / v)
+                .fold(0.0, f64::max)
+        }
+    }
+
     #[test]
     fn turns_stay_within_the_limits_and_zero_comes_first() {
         let lim = Some([-TAU, TAU]);
@@ -210,7 +221,7 @@ mod tests {
         // home: the dynamic programme's time must equal the least time of
         // every assignment of turns, found by enumeration (4 combinations
         // per pose, 64 assignments), and beat the unturned values.
-        let cost = MoveCost::new(&[1.0, 2.0]).unwrap();
+        let cost = move_time(&[1.0, 2.0]);
         let lim = [Some([-TAU, TAU]), Some([-TAU, TAU])];
         let home = [0.0, 0.0];
         let qs = vec![vec![-5.9, 2.0], vec![-0.4, -5.5], vec![5.0, -3.0]];
@@ -220,7 +231,7 @@ mod tests {
             let mut t = 0.0;
             for &k in &order {
                 let q = turned(&qs[k], &turns[k]);
-                t += cost.time(&prev, &q);
+                t += cost(&prev, &q);
                 prev = q;
             }
             t
@@ -248,7 +259,7 @@ mod tests {
 
     #[test]
     fn without_turning_joints_nothing_turns() {
-        let cost = MoveCost::new(&[1.0]).unwrap();
+        let cost = move_time(&[1.0]);
         let qs = vec![vec![-3.0], vec![3.0]];
         let chosen = choose_turns(&cost, None, &qs, &[0, 1], &[Some([-3.1, 3.1])]);
         assert_eq!(chosen, vec![vec![0], vec![0]]);
@@ -258,7 +269,7 @@ mod tests {
     fn beyond_the_combination_cap_each_joint_takes_its_nearest_equivalent() {
         // 9 turning joints: 2⁹ = 512 combinations, over the cap. From home
         // at 0, −5.9 is nearest as 0.38 (+1 turn), −0.4 as itself.
-        let cost = MoveCost::new(&[1.0; 9]).unwrap();
+        let cost = move_time(&[1.0; 9]);
         let lim = [Some([-TAU, TAU]); 9];
         let mut q = vec![-0.4; 9];
         q[0] = -5.9;

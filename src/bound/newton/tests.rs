@@ -13,6 +13,18 @@ fn scaled(n: usize, n_design: usize, seed: u64) -> Scaled {
 }
 
 /// An interior point of `Σ w = N`: uniform, perturbed by ±20 %.
+/// At `w`: the second derivatives `Q` (lower triangle), the gradient `d`,
+/// and the Newton direction and decrement for barrier weight `mu`.
+fn newton_step(sc: &Scaled, w: &[f64], mu: f64) -> (Mat<f64>, Vec<f64>, Vec<f64>, f64) {
+    let n = w.len();
+    let mut q = Mat::zeros(n, n);
+    let mut d = vec![0.0; n];
+    derivatives(sc, w, &mut q, &mut d).unwrap();
+    let ones = Mat::from_fn(n, 1, |_, _| 1.0);
+    let (delta, lambda2) = newton_direction(&q, &d, w, mu, &ones).unwrap();
+    (q, d, delta, lambda2)
+}
+
 fn interior(n: usize, nf: f64, seed: u64) -> Vec<f64> {
     let mut s = seed;
     let mut w: Vec<f64> = (0..n).map(|_| 1.0 + 0.2 * lcg(&mut s)).collect();
@@ -168,11 +180,7 @@ fn the_newton_direction_solves_its_system() {
     let sc = scaled(n, 3, 6);
     let w = interior(n, 3.0, 7);
     let mu = 0.05;
-    let mut q = Mat::zeros(n, n);
-    let mut d = vec![0.0; n];
-    derivatives(&sc, &w, &mut q, &mut d).unwrap();
-    let ones = Mat::from_fn(n, 1, |_, _| 1.0);
-    let (delta, lambda2) = newton_direction(&q, &d, &w, mu, &ones).unwrap();
+    let (q, d, delta, lambda2) = newton_step(&sc, &w, mu);
     let k = Mat::from_fn(n, n, |i, j| {
         let qij = if i >= j { q[(i, j)] } else { q[(j, i)] };
         let b = 1.0 - w[i];
@@ -223,11 +231,7 @@ fn the_line_search_ascends_inside_the_box() {
     assert!(barrier_value(&sc, &edge, mu).is_none());
     edge[0] = 1.0;
     assert!(barrier_value(&sc, &edge, mu).is_none());
-    let mut q = Mat::zeros(n, n);
-    let mut d = vec![0.0; n];
-    derivatives(&sc, &w, &mut q, &mut d).unwrap();
-    let ones = Mat::from_fn(n, 1, |_, _| 1.0);
-    let (delta, lambda2) = newton_direction(&q, &d, &w, mu, &ones).unwrap();
+    let (_, _, delta, lambda2) = newton_step(&sc, &w, mu);
     let t = line_search(&sc, &w, &delta, lambda2, mu, ld).expect("an ascent direction");
     assert!(t.iter().all(|&v| v > 0.0 && v < 1.0));
     let s: f64 = t.iter().sum();
@@ -382,11 +386,7 @@ fn a_step_short_of_the_armijo_rise_is_refused() {
     let w = interior(n, 3.0, 17);
     let mu = 0.05;
     let ld = ln_det_spd(sc.information(&w).as_ref()).unwrap();
-    let mut q = Mat::zeros(n, n);
-    let mut d = vec![0.0; n];
-    derivatives(&sc, &w, &mut q, &mut d).unwrap();
-    let ones = Mat::from_fn(n, 1, |_, _| 1.0);
-    let (delta, lambda2) = newton_direction(&q, &d, &w, mu, &ones).unwrap();
+    let (_, _, delta, lambda2) = newton_step(&sc, &w, mu);
     let short: Vec<f64> = delta.iter().map(|v| 0.1 * v).collect();
     let ask = 4.0 * 0.1 * lambda2;
     let f0 = barrier_value(&sc, &w, mu).unwrap();
@@ -414,11 +414,7 @@ fn a_step_too_long_is_halved_until_it_rises() {
     let w = interior(n, 3.0, 19);
     let mu = 0.05;
     let ld = ln_det_spd(sc.information(&w).as_ref()).unwrap();
-    let mut q = Mat::zeros(n, n);
-    let mut d = vec![0.0; n];
-    derivatives(&sc, &w, &mut q, &mut d).unwrap();
-    let ones = Mat::from_fn(n, 1, |_, _| 1.0);
-    let (delta, lambda2) = newton_direction(&q, &d, &w, mu, &ones).unwrap();
+    let (_, _, delta, lambda2) = newton_step(&sc, &w, mu);
     let long = delta;
     let ask = 3.0 * lambda2;
     let mut s_max = 1.0f64;

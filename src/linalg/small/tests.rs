@@ -491,3 +491,49 @@ fn an_exchange_that_loses_rank_is_refused() {
         assert!(got.unwrap_err() <= 1e-12, "t = {t}: {got:?}");
     }
 }
+
+/// The plain factorization's verdict on the exchange's `B` stands only
+/// when every pivot exceeds [`SUSPECT_PIVOT`]. `V_in = W = 0` (so
+/// `B = I − V_out`) with `V_out = s·v vᵀ/‖v‖²`, `v` of mixed scales: at
+/// `s = 1` (singular) the plain Cholesky accepts a polluted pivot
+/// between the floor and SUSPECT_PIVOT (7.8e-10, checked here) and the
+/// pivoted one refuses (8e-17); at `s = 1 − 1e-8` the plain factorization's
+/// last pivot is again below SUSPECT_PIVOT (5.9e-7) and the pivoted one
+/// prices it:
+/// `ln det(I − sP) = ln(1 − s)`, up to the rounding of `P`'s entries
+/// (≈ 1e-16 against an eigenvalue of 1e-8: 1e-8 relative), so within 1e-6.
+#[test]
+fn the_pivoted_factorization_decides_small_exchange_pivots() {
+    let v = [-0.3864, 0.1406, -0.0001];
+    let nv: f64 = v.iter().map(|x| x * x).sum();
+    let t = v.len();
+    let floor = 1e-14;
+    let v_in = vec![0.0; packed_len(t)];
+    let v_out = |s: f64| -> Vec<f64> {
+        (0..t)
+            .flat_map(|r| (0..=r).map(move |c| s * v[r] * v[c] / nv))
+            .collect()
+    };
+    // The plain Cholesky's smallest pivot of B = I − V_out.
+    let plain_lo = |v_out: &[f64]| {
+        let mut b = vec![0.0; t * t];
+        for r in 0..t {
+            for c in 0..=r {
+                b[r * t + c] = f64::from(u8::from(r == c)) - v_out[pk(r, c)];
+            }
+        }
+        let mut lo = f64::INFINITY;
+        chol_pivots_in_place(&mut b, t, floor, |d| lo = lo.min(d)).map(|()| lo)
+    };
+    let singular = v_out(1.0);
+    let lo = plain_lo(&singular).unwrap();
+    assert!(lo > floor && lo <= SUSPECT_PIVOT, "plain pivot {lo}");
+    let got = exchange_ln_det(t, &v_in, &singular, |_, _| 0.0, floor);
+    assert!(got.unwrap_err() <= floor, "{got:?}");
+    let s = 1.0 - 1e-8;
+    let lo = plain_lo(&v_out(s)).unwrap();
+    assert!(lo <= SUSPECT_PIVOT, "plain pivot {lo}");
+    let got = exchange_ln_det(t, &v_in, &v_out(s), |_, _| 0.0, floor).unwrap();
+    let want = (1.0 - s).ln();
+    assert!((got - want).abs() < 1e-6, "{got} vs {want}");
+}

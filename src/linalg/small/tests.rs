@@ -537,3 +537,33 @@ fn the_pivoted_factorization_decides_small_exchange_pivots() {
     let want = (1.0 - s).ln();
     assert!((got - want).abs() < 1e-6, "{got} vs {want}");
 }
+
+/// The pivoted factorization refuses a pivot equal to the floor, as the
+/// plain one does (`Err(d)` for the first `d ≤ floor`), and accepts one
+/// above it.
+#[test]
+fn pivoted_cholesky_refuses_a_pivot_at_the_floor() {
+    let mut perm = [0usize; 2];
+    let mut a = [4.0, 0.0, 0.0, 0.5];
+    assert_eq!(chol_pivoted_in_place(&mut a, 2, 0.5, &mut perm), Err(0.5));
+    let mut a = [4.0, 0.0, 0.0, 0.5];
+    let ld = chol_pivoted_in_place(&mut a, 2, 0.25, &mut perm).unwrap();
+    assert!((ld - 2f64.ln()).abs() < 1e-15, "{ld}");
+}
+
+/// An add block whose determinant overflows (`ln det` summed pivot by
+/// pivot) keeps its moderate pivots: `V = diag(1e200, 1e200, 1e-3)`
+/// (and with a fourth entry 0.5 for the general path) gives
+/// `2 ln(1 + 1e200) + ln(1.001) (+ ln 1.5)`. Each logarithm is within an
+/// ulp of its value (≤ 461, so ~1e-13); 1e-9 allows that, far below
+/// the `ln(1e-3/1.001) ≈ −6.9` of a diagonal that dropped the identity.
+#[test]
+fn an_overflowing_add_determinant_keeps_its_small_pivots() {
+    let want = 2.0 * 1e200f64.ln() + 1.001f64.ln();
+    let got = ln_det_i_plus(&[1e200, 0.0, 1e200, 0.0, 0.0, 1e-3], 3);
+    assert!((got - want).abs() < 1e-9, "{got} vs {want}");
+    let v4 = [1e200, 0.0, 1e200, 0.0, 0.0, 1e-3, 0.0, 0.0, 0.0, 0.5];
+    let got = ln_det_i_plus(&v4, 4);
+    let want = want + 1.5f64.ln();
+    assert!((got - want).abs() < 1e-9, "{got} vs {want}");
+}

@@ -54,9 +54,8 @@ impl<T: Copy + Default, const N: usize> std::ops::DerefMut for Scratch<T, N> {
     }
 }
 
-/// A `t×t` block's scratch. (`STACK_T * STACK_T` as `/` survives issue
-/// #30's sample as equivalent in value: every block above 1×1 then goes to
-/// the heap, the same numbers at the cost of an allocation.)
+/// A `t×t` block's scratch: on the stack up to `STACK_T × STACK_T` (a test
+/// checks it, so that `*` as `/`, the same numbers from the heap, is caught).
 pub(crate) type BlockScratch = Scratch<f64, { STACK_T * STACK_T }>;
 /// A permutation of `t` rows.
 pub(crate) type PermScratch = Scratch<usize, STACK_T>;
@@ -156,6 +155,9 @@ pub(crate) fn chol_pivoted_pivots_in_place(
     }
     for k in 0..n {
         // Largest remaining diagonal entry (first on ties: deterministic).
+        // (`k + 1` as `k * 1` survives issue #30's mutation sample as
+        // equivalent: the search then starts at `k` itself, which never beats
+        // itself under the strict `>`.)
         let mut j = k;
         for i in k + 1..n {
             if a[i * n + i] > a[j * n + j] {
@@ -181,6 +183,11 @@ pub(crate) fn chol_pivoted_pivots_in_place(
         for i in k + 1..n {
             a[i * n + k] /= l;
         }
+        // The Schur complement of the rows and columns after `k`. (`k + 1` as
+        // `k * 1` survives issue #30's sample as equivalent: row `k` is then
+        // also updated right of its diagonal, in the upper triangle, which
+        // holds no part of `L` and which no later step reads: later swaps and
+        // updates touch rows after `k` only.)
         for i in k + 1..n {
             let lik = a[i * n + k];
             for c in k + 1..n {
@@ -244,6 +251,11 @@ pub(crate) fn ln_det_i_plus(v: &[f64], t: usize) -> f64 {
         }
         ldl_pivot_product(a, d, t)
     };
+    // `det > 0.0` as `>=` survives issue #30's sample as equivalent: at
+    // `det == 0` the mutant's `ln 0 = −∞` is the fallback's answer too (its
+    // Cholesky at floor 0 refuses the zero pivot); the two factorizations
+    // could disagree only on an exactly singular `I + V`, which needs an
+    // eigenvalue −1 of `V`, never for the PSD blocks of the callers.
     if det.is_finite() && det > 0.0 {
         det.ln()
     } else if v[..packed_len(t)].iter().all(|x| x.is_finite()) {
@@ -405,6 +417,8 @@ pub(crate) fn variance_after_removal(v: &[f64], w: &[f64], u: &[f64], t: usize, 
     for r in 0..t {
         for c in 0..t {
             let mut s = 0.0;
+            // `+=` as `-=` survives issue #30's sample as equivalent: it gives
+            // `Z = −W U`, and only `Z Zᵀ` is used.
             for k in 0..c + 1 {
                 s += w[r * t + k] * u[k * t + c];
             }
@@ -432,6 +446,7 @@ pub(crate) fn variance_after_removal3(v: &[f64], w: &[f64; 9], u: &[f64; 9]) -> 
         for c in 0..3 {
             // U is upper triangular: U[k][c] = 0 for k > c.
             let mut s = 0.0;
+            // `+=` as `-=`: equivalent, as in `variance_after_removal` (`Z Zᵀ`).
             for k in 0..c + 1 {
                 s += w[r * 3 + k] * u[k * 3 + c];
             }

@@ -54,9 +54,8 @@ impl<T: Copy + Default, const N: usize> std::ops::DerefMut for Scratch<T, N> {
     }
 }
 
-/// A `t×t` block's scratch. (`STACK_T * STACK_T` as `/` survives issue
-/// #30's sample as equivalent in value: every block above 1×1 then goes to
-/// the heap, the same numbers at the cost of an allocation.)
+/// A `t×t` block's scratch: on the stack up to `STACK_T × STACK_T` (a test
+/// checks it, so that `*` as `/`, the same numbers from the heap, is caught).
 pub(crate) type BlockScratch = Scratch<f64, { STACK_T * STACK_T }>;
 /// A permutation of `t` rows.
 pub(crate) type PermScratch = Scratch<usize, STACK_T>;
@@ -156,6 +155,9 @@ pub(crate) fn chol_pivoted_pivots_in_place(
     }
     for k in 0..n {
         // Largest remaining diagonal entry (first on ties: deterministic).
+        // (`k + 1` as `k * 1` survives issue #30's mutation sample as
+        // equivalent: the search then starts at `k` itself, which never beats
+        // itself under the strict `>`.)
         let mut j = k;
         for i in k + 1..n {
             if a[i * n + i] > a[j * n + j] {
@@ -181,6 +183,11 @@ pub(crate) fn chol_pivoted_pivots_in_place(
         for i in k + 1..n {
             a[i * n + k] /= l;
         }
+        // The Schur complement of the rows and columns after `k`. (`k + 1` as
+        // `k * 1` survives issue #30's sample as equivalent: row `k` is then
+        // also updated right of its diagonal, in the upper triangle, which
+        // holds no part of `L` and which no later step reads: later swaps and
+        // updates touch rows after `k` only.)
         for i in k + 1..n {
             let lik = a[i * n + k];
             for c in k + 1..n {
@@ -244,6 +251,11 @@ pub(crate) fn ln_det_i_plus(v: &[f64], t: usize) -> f64 {
         }
         ldl_pivot_product(a, d, t)
     };
+    // `det > 0.0` as `>=` survives issue #30's sample as equivalent: at
+    // `det == 0` the mutant's `ln 0 = −∞` is the fallback's answer too (its
+    // Cholesky at floor 0 refuses the zero pivot); the two factorizations
+    // could disagree only on an exactly singular `I + V`, which needs an
+    // eigenvalue −1 of `V`, never for the PSD blocks of the callers.
     if det.is_finite() && det > 0.0 {
         det.ln()
     } else if v[..packed_len(t)].iter().all(|x| x.is_finite()) {
@@ -405,6 +417,8 @@ pub(crate) fn variance_after_removal(v: &[f64], w: &[f64], u: &[f64], t: usize, 
     for r in 0..t {
         for c in 0..t {
             let mut s = 0.0;
+            // `+=` as `-=` survives issue #30's sample as equivalent: it gives
+            // `Z = −W U`, and only `Z Zᵀ` is used.
             for k in 0..c + 1 {
                 s += w[r * t + k] * u[k * t + c];
             }
@@ -432,6 +446,7 @@ pub(crate) fn variance_after_removal3(v: &[f64], w: &[f64; 9], u: &[f64; 9]) -> 
         for c in 0..3 {
             // U is upper triangular: U[k][c] = 0 for k > c.
             let mut s = 0.0;
+            // `+=` as `-=`: equivalent, as in `variance_after_removal` (`Z Zᵀ`).
             for k in 0..c + 1 {
                 s += w[r * 3 + k] * u[k * 3 + c];
             }
@@ -547,132 +562,4 @@ pub(crate) fn exchange_ln_det(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `ln det(I + V)` against the eigenvalues of `I + V` (nalgebra's
-    /// symmetric eigensolver, an independent route): `Σ ln(1 + λ_k(V))`.
-    /// Blocks `V = B Bᵀ` with entries from 1e-3 to 1e3 (V up to 1e6), t = 1…8
-    /// (3 is the unrolled path). Both sides are sums of `t` logarithms of
-    /// numbers `≥ 1` computed stably (the pivots of `I + V ⪰ I` and its
-    /// eigenvalues carry relative errors of a few `t·ε·κ`, κ ≤ 1 + ‖V‖): a
-    /// tolerance of `1e-12·(1 + ln det)` is loose for that and far tighter
-    /// than any wrong pivot (a dropped term changes ln det by O(1)).
-    #[test]
-    fn add_gain_equals_the_eigenvalue_sum() {
-        let mut seed = 7u64;
-        let mut rnd = || crate::linalg::test_rng::lcg(&mut seed);
-        for t in 1..=8 {
-            for case in 0..200 {
-                let scale = 10f64.powf(-3.0 + 6.0 * (case as f64 / 199.0));
-                let b = nalgebra::DMatrix::from_fn(t, t, |_, _| scale * rnd());
-                let v = &b * b.transpose();
-                let packed: Vec<f64> = (0..t)
-                    .flat_map(|r| (0..=r).map(move |c| (r, c)))
-                    .map(|(r, c)| v[(r, c)])
-                    .collect();
-                let got = ln_det_i_plus(&packed, t);
-                let want: f64 = v
-                    .symmetric_eigenvalues()
-                    .iter()
-                    .map(|l| (1.0 + l.max(0.0)).ln())
-                    .sum();
-                assert!(
-                    (got - want).abs() <= 1e-12 * (1.0 + want.abs()),
-                    "t = {t}, case {case}: {got} vs {want}"
-                );
-            }
-        }
-        assert_eq!(
-            ln_det_i_plus(&[f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0], 3),
-            f64::NEG_INFINITY
-        );
-        // Overflowing product: the logarithms are summed.
-        let big = [1e200, 0.0, 1e200, 0.0, 0.0, 1e200];
-        let g = ln_det_i_plus(&big, 3);
-        assert!((g - 3.0 * 1e200f64.ln()).abs() < 1e-9, "{g}");
-    }
-
-    #[test]
-    fn chol_matches_known_determinant() {
-        // [[4, 2], [2, 3]]: det = 8.
-        let mut a = [4.0, 0.0, 2.0, 3.0];
-        let ld = chol_in_place(&mut a, 2, 0.0).unwrap();
-        assert!((ld - 8f64.ln()).abs() < 1e-14);
-        assert!((min_pivot(&a, 2) - 2.0).abs() < 1e-14);
-        let mut s = [1.0, 0.0, 1.0, 1.0];
-        assert!(chol_in_place(&mut s, 2, 1e-12).is_err());
-    }
-
-    #[test]
-    fn pivoted_cholesky_reconstructs_and_detects_projections() {
-        // B = P A Pᵀ = L Lᵀ for a 4×4 SPD matrix.
-        let n = 4;
-        let a0: Vec<f64> = (0..n * n)
-            .map(|k| {
-                let (i, j) = (k / n, k % n);
-                if i == j {
-                    1.0 + i as f64
-                } else {
-                    0.3 / (1.0 + (i + j) as f64)
-                }
-            })
-            .collect();
-        let mut a = a0.clone();
-        let mut perm = [0usize; 4];
-        let ld = chol_pivoted_in_place(&mut a, n, 0.0, &mut perm).unwrap();
-        let mut plain = a0.clone();
-        assert!((ld - chol_in_place(&mut plain, n, 0.0).unwrap()).abs() < 1e-13);
-        for i in 0..n {
-            for j in 0..n {
-                let s: f64 = (0..=i.min(j)).map(|k| a[i * n + k] * a[j * n + k]).sum();
-                assert!((s - a0[perm[i] * n + perm[j]]).abs() < 1e-13);
-            }
-        }
-        // I − v vᵀ/‖v‖² is singular; the pivoted factorization says so at a
-        // floor far below the unpivoted rounding.
-        let v = [1e-3, 1.0, 2e-3, 0.5, 1e-4, 0.7];
-        let nv: f64 = v.iter().map(|x| x * x).sum();
-        let mut b = vec![0.0; 36];
-        for i in 0..6 {
-            for j in 0..6 {
-                b[i * 6 + j] = if i == j { 1.0 } else { 0.0 } - v[i] * v[j] / nv;
-            }
-        }
-        let mut perm = [0usize; 6];
-        assert!(chol_pivoted_in_place(&mut b, 6, 1e-14, &mut perm).is_err());
-    }
-
-    /// Complete (diagonal) pivoting picks the largest remaining diagonal
-    /// entry, so the pivots of an SPD matrix come out non-increasing (each
-    /// step's Schur complement only lowers the remaining diagonal), and
-    /// their product is the determinant whatever the order. Random SPD
-    /// `A = B Bᵀ + I`, `n = 2…8`; the comparison allows rounding of a few
-    /// ulps of `max A_ii` (a tie decided either way by rounding is fine).
-    #[test]
-    fn pivoted_cholesky_takes_the_pivots_largest_first() {
-        let mut seed = 11u64;
-        let mut rnd = || crate::linalg::test_rng::lcg(&mut seed);
-        for n in 2..=8 {
-            for case in 0..50 {
-                let b = nalgebra::DMatrix::from_fn(n, n, |_, _| rnd());
-                let a0 = &b * b.transpose() + nalgebra::DMatrix::identity(n, n);
-                let mut a: Vec<f64> = (0..n * n).map(|k| a0[(k / n, k % n)]).collect();
-                let mut perm = vec![0usize; n];
-                let mut pivots = Vec::new();
-                chol_pivoted_pivots_in_place(&mut a, n, 0.0, &mut perm, |d| pivots.push(d))
-                    .unwrap();
-                let top = (0..n).map(|i| a0[(i, i)]).fold(0.0f64, f64::max);
-                for k in 1..n {
-                    assert!(
-                        pivots[k] <= pivots[k - 1] + 1e-14 * top,
-                        "n = {n}, case {case}: pivots {pivots:?}"
-                    );
-                }
-                let ln_det: f64 = pivots.iter().map(|d| d.ln()).sum();
-                let want = a0.determinant().ln();
-                assert!((ln_det - want).abs() < 1e-10, "n = {n}, case {case}");
-            }
-        }
-    }
-}
+mod tests;

@@ -89,7 +89,9 @@ pub struct MoveSpace<'a> {
 pub struct MovesReport {
     /// Largest motion of a link point between two checks, metres.
     pub resolution_m: f64,
-    /// Moves checked (distinct moves, the repair's trials included).
+    /// Moves checked (the repair's and the via search's trials included;
+    /// a colliding move travelled against the way it was first checked is
+    /// checked again).
     pub moves_checked: usize,
     /// Configurations checked along them.
     pub configurations_checked: usize,
@@ -114,6 +116,8 @@ struct Checker<'a> {
     home: Option<&'a [f64]>,
     qs: &'a mut [Vec<f64>],
     memo: HashMap<(usize, usize), Option<(ContactPair, f64)>>,
+    /// Moves checked, and configurations along them.
+    moves: usize,
     configurations: usize,
     /// Whole turns added to each pose's joints.
     turned: Vec<Vec<i32>>,
@@ -194,6 +198,7 @@ impl Checker<'_> {
     /// The first contact on the straight move from `qa` to `qb` against
     /// the models in turn (not memoised), its configurations counted.
     fn check(&mut self, qa: &[f64], qb: &[f64]) -> Option<(ContactPair, f64)> {
+        self.moves += 1;
         for m in self.models {
             let r = m.check_move(qa, qb, self.resolution);
             self.configurations += r.checks;
@@ -297,6 +302,7 @@ pub fn check_tour(
         home,
         qs,
         memo: HashMap::new(),
+        moves: 0,
         configurations: 0,
         turned,
         cost: space.cost,
@@ -361,7 +367,7 @@ pub fn check_tour(
     *order = path[first..].iter().map(|&n| n - 1).collect();
     MovesReport {
         resolution_m: space.resolution,
-        moves_checked: c.memo.len(),
+        moves_checked: c.moves,
         configurations_checked: c.configurations,
         colliding_before: before,
         reordered,

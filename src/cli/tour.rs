@@ -280,3 +280,55 @@ pub fn configurations_text(r: &SelectReport) -> String {
     }
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use activecal::collision::ContactPair;
+    use activecal::select::moves::{CollidingMove, MovesReport, TurnedPose};
+
+    #[test]
+    fn the_moves_text_names_turned_joints_and_colliding_pairs() {
+        let names = vec!["pan".to_string(), "lift".to_string()];
+        let mut m = MovesReport {
+            resolution_m: 1e-3,
+            moves_checked: 5,
+            configurations_checked: 40,
+            colliding_before: 2,
+            reordered: false,
+            turned: vec![TurnedPose {
+                pose: 2,
+                turns: vec![0, -1],
+            }],
+            via: Vec::new(),
+            colliding: Vec::new(),
+        };
+        let s = moves_text(&m, &names);
+        assert!(
+            s.contains("avoided by turning joints by whole turns: every move is free"),
+            "{s}"
+        );
+        assert!(s.contains("pose 3: lift -1 turn (-360 deg)"), "{s}");
+        assert!(!s.contains("pan "), "an unturned joint is not listed: {s}");
+        m.colliding.push(CollidingMove {
+            from: None,
+            to: 0,
+            pair: ContactPair {
+                link: "arm".into(),
+                other: "floor".into(),
+                obstacle: true,
+            },
+            at: 0.25,
+        });
+        let s = moves_text(&m, &names);
+        assert!(s.contains("1 move(s) COLLIDE"), "{s}");
+        assert!(
+            s.contains("(others avoided by turning joints by whole turns)"),
+            "{s}"
+        );
+        assert!(
+            s.contains("home -> pose 1: arm touches floor at 25 % of the move"),
+            "{s}"
+        );
+    }
+}

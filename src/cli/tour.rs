@@ -55,17 +55,29 @@ pub fn order_design(
     };
     let mut qs: Vec<Vec<f64>> = report.configurations.iter().map(|c| c.q.clone()).collect();
     let (order, tour) = activecal::select::tour::visit(&v, assumed, home, &mut qs, reorder, turns)?;
+    arrange(report, &order, |k| k, &qs);
+    report.tour = Some(tour);
+    Ok(order)
+}
+
+/// Puts the report's configurations in `order` (indices into `qs`; the
+/// configuration of pose `k` stands at `at(k)` now), each with its joint
+/// values from `qs`.
+fn arrange(
+    report: &mut SelectReport,
+    order: &[usize],
+    at: impl Fn(usize) -> usize,
+    qs: &[Vec<f64>],
+) {
     let old = std::mem::take(&mut report.configurations);
     report.configurations = order
         .iter()
         .map(|&k| {
-            let mut c = old[k].clone();
+            let mut c = old[at(k)].clone();
             c.q.clone_from(&qs[k]);
             c
         })
         .collect();
-    report.tour = Some(tour);
-    Ok(order)
 }
 
 /// With collision filters on the pool, checks every move of the visiting
@@ -116,19 +128,10 @@ pub fn check_moves(
     let before = order.clone();
     let moves = activecal::select::moves::check_tour(&space, home, &mut qs, order);
     if *order != before || !moves.turned.is_empty() {
-        let old = std::mem::take(&mut report.configurations);
         let at: std::collections::HashMap<usize, usize> =
             before.iter().enumerate().map(|(i, &k)| (k, i)).collect();
-        report.configurations = order
-            .iter()
-            .map(|k| {
-                let mut c = old[at[k]].clone();
-                c.q.clone_from(&qs[*k]);
-                c
-            })
-            .collect();
+        arrange(report, order, |k| at[&k], &qs);
         if let Some(t) = report.tour.as_mut() {
-            let cost = activecal::select::tour::MoveCost::new(&t.speeds)?;
             t.visiting_order = activecal::select::tour::totals(&cost, home, &qs, order);
             if t.selection_order.time_s > 0.0 {
                 t.time_ratio = t.visiting_order.time_s / t.selection_order.time_s;

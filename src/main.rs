@@ -43,6 +43,14 @@ struct Cli {
     /// its chain's base and tip unless --base/--tip are given).
     #[arg(long, global = true, value_name = "FILE")]
     frames: Option<std::path::PathBuf>,
+    /// A marker (retroreflector, tracked point) on the chain's tip:
+    /// LINK@X,Y,Z, its offset in metres in the link's frame (repeatable:
+    /// one per marker, in the order the measurement files list them).
+    /// Poses are chosen, and the data fitted, for these markers; their
+    /// offsets are unknowns of the fit. LINK is the tip (the default
+    /// --tip when none is given).
+    #[arg(long = "marker", global = true, value_name = "LINK@X,Y,Z", allow_hyphen_values = true)]
+    markers: Vec<String>,
     /// Show progress on stderr even with --json or when stderr is not a
     /// terminal (then as plain lines). Without it, progress is a bar on a
     /// terminal's stderr, and nothing with --json. Never on stdout.
@@ -157,7 +165,7 @@ fn main() {
         .unwrap_or(false);
     cli::progress::install_for(cli.progress, json);
     let mut command = cli.command;
-    let chain = cli::chain_choice(cli.base, cli.tip, cli.lock.as_deref(), cli.frames)
+    let chain = cli::chain_choice(cli.base, cli.tip, cli.lock.as_deref(), cli.frames, &cli.markers)
         .and_then(|c| command.take_chain(&c));
     if let Err(e) = chain {
         report_error(&e);

@@ -1,5 +1,5 @@
-//! Choosing identifiable unknowns, and checking them, on a random design of
-//! the pose lattice.
+//! Choosing identifiable unknowns, and checking them, on generic
+//! configurations of the robot.
 //!
 //! A frame's *candidate* unknowns are its four structural parameters: γ, α,
 //! a, d for a DH frame and γ, α, a, β for a Hayati frame (a Hayati frame's d
@@ -15,9 +15,11 @@
 //! ([`Robot::minimal_unknowns`]): `4R + 2P + 3` for points, `4R + 2P + 6`
 //! for full poses.
 //!
-//! The columns come from a random design of the 5-level pose lattice (each
-//! joint at one of 5 evenly spaced values of its range) at the nominal
-//! parameters, with a fixed seed, so the choice is reproducible.
+//! The columns come from generic configurations ([`generic_configurations`]:
+//! each joint uniform over its range, a joint that turns all the way round
+//! over one turn) at the nominal parameters, with a fixed seed, so the
+//! choice is reproducible. Never from lattice levels, which on a joint whose
+//! limits are ±2π coincide modulo 2π and hide a direction real data see.
 
 use crate::blocks::Blocks;
 use crate::blocks::jacobian_of;
@@ -30,9 +32,6 @@ use crate::model::{Convention, MeasurementKind, ParamId, ParamTable, Robot, Symb
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
-
-/// Lattice levels of the random designs used here.
-pub const DESIGN_LEVELS: usize = 5;
 
 /// A candidate is kept when the component of its unit-norm column orthogonal
 /// to the kept columns has norm above this: `1/√MAX_CONDITION` (3.2e-7),
@@ -273,8 +272,8 @@ impl Robot {
     }
 
     /// Checks numerically that every unknown is identifiable: the stacked
-    /// Jacobian (nominal parameters) of a random design of the 5-level
-    /// lattice, `max(40, 2p)` poses with a fixed seed, has full column rank
+    /// Jacobian (nominal parameters) of `max(40, 2p)` [generic
+    /// configurations](generic_configurations) with a fixed seed, has full column rank
     /// ([`require_identifiable`]).
     pub fn check_identifiable(&self) -> Result<Identifiability> {
         self.check_shape()?;
@@ -412,9 +411,43 @@ impl Robot {
     }
 }
 
-/// The stacked identification Jacobian of `n` random poses of the
-/// [`DESIGN_LEVELS`]-level lattice over the robot's limits, or an error if
-/// any entry is not finite.
+/// `n` generic configurations of the robot, seeded: each joint drawn
+/// uniformly over its whole range, and a revolute joint whose range spans a
+/// turn or more over one turn from its lower limit (the angles beyond
+/// repeat, modulo 2π, the kinematics of those within). Never levels: the
+/// values of a lattice coincide modulo 2π on a joint whose limits are ±2π
+/// (5 levels of [−2π, 2π] are only the angles 0 and π), and such a sample
+/// leaves directions unseen that any real data set determines.
+#[must_use]
+pub fn generic_configurations(robot: &Robot, n: usize, seed: u64) -> Vec<Vec<f64>> {
+    let revolute: Vec<bool> = (0..robot.dof())
+        .map(|j| {
+            !robot
+                .frames
+                .iter()
+                .any(|f| f.joint == Some(j) && f.is_prismatic())
+        })
+        .collect();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..n)
+        .map(|_| {
+            robot
+                .limits
+                .iter()
+                .zip(&revolute)
+                .map(|(&[lo, hi], &rev)| {
+                    let hi = if rev { hi.min(lo + std::f64::consts::TAU) } else { hi };
+                    let f: f64 = rng.random();
+                    lo + (hi - lo) * f
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The stacked identification Jacobian of `n` [generic
+/// configurations](generic_configurations) at `table`, or an error if any
+/// entry is not finite.
 pub fn design_jacobian(robot: &Robot, table: &ParamTable, n: usize, seed: u64) -> Result<Blocks> {
     robot.check_shape()?;
     if robot.unknowns.is_empty() || table.rows.len() != robot.frames.len() {
@@ -423,20 +456,7 @@ pub fn design_jacobian(robot: &Robot, table: &ParamTable, n: usize, seed: u64) -
             robot.name
         )));
     }
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let k = DESIGN_LEVELS;
-    let qs: Vec<Vec<f64>> = (0..n)
-        .map(|_| {
-            robot
-                .limits
-                .iter()
-                .map(|&[lo, hi]| {
-                    let f = rng.random_range(0..k) as f64 / (k - 1) as f64;
-                    lo * (1.0 - f) + hi * f
-                })
-                .collect()
-        })
-        .collect();
+    let qs = generic_configurations(robot, n, seed);
     let x = jacobian_of(robot, table, n, |i, q| q.copy_from_slice(&qs[i]));
     let m = x.mat();
     let finite = (0..m.ncols()).all(|c| (0..m.nrows()).all(|r| m[(r, c)].is_finite()));

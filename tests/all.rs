@@ -30,6 +30,7 @@ mod fuzz_loaders;
 mod gravity_fixtures;
 mod house;
 mod identification_jacobian_fixtures;
+mod identifiability;
 mod identify;
 mod jacobian;
 mod licences;

@@ -84,6 +84,7 @@ fn import(f: &Fixture) -> Robot {
         tip: Some(f.tip.clone()),
         lock: f.lock.clone(),
         frames: None,
+        markers: Vec::new(),
     };
     let name = format!("{}{}", root().join(&f.urdf).display(), choice.fragment());
     load_robot(&name).unwrap_or_else(|e| panic!("{name}: {e}"))

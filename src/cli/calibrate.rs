@@ -109,6 +109,18 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
 /// Identification from a measurement file.
 fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()> {
     let t0 = Instant::now();
+    let mut scaled;
+    let robot = match a.orientation_scale {
+        Some(w) if !(w.is_finite() && w > 0.0) => {
+            bail!("--orientation-scale {w}: must be a finite number > 0 (metres per radian)")
+        }
+        Some(w) => {
+            scaled = robot.clone();
+            scaled.orientation_scale = w;
+            &scaled
+        }
+        None => robot,
+    };
     let lm = LmSettings::default()
         .with_max_iterations(a.max_iterations)
         .with_geodesic(!a.no_geodesic);
@@ -124,7 +136,9 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
                 splits: a.splits,
                 seed: a.seed(),
                 prune: a.compare_pruned,
+                weights: weights_of(a),
             }),
+        weights: weights_of(a),
         units: a.units.units(),
         gravity: if a.compliance || a.compare_compliance {
             Some(super::compliance::gravity_for(
@@ -235,5 +249,14 @@ fn measured_summary<'a>(
         }),
         notes,
         json: json.clone(),
+    }
+}
+
+/// The weights of `--weights` (fixed whenever `--orientation-scale` is given).
+fn weights_of(a: &CalibrateArgs) -> activecal::identify::Weights {
+    use super::calibrate_args::WeightsKind;
+    match (a.weights, a.orientation_scale) {
+        (WeightsKind::Fixed, _) | (_, Some(_)) => activecal::identify::Weights::Fixed,
+        (WeightsKind::Estimated, None) => activecal::identify::Weights::Estimated,
     }
 }

@@ -91,6 +91,18 @@ pub struct CalibrateArgs {
     /// |t| >= 2 and compare held-out errors.
     #[arg(long, requires = "holdout")]
     pub compare_pruned: bool,
+    /// How a full-pose fit weighs orientations against positions (with
+    /// --measurements): `estimated` (the default) estimates each block's σ
+    /// from its own residuals and reweights until they agree (variance
+    /// components; the σ's are printed with their degrees of freedom);
+    /// `fixed` keeps the robot's orientation scale (1 m per rad unless
+    /// --orientation-scale).
+    #[arg(long, value_enum, default_value = "estimated", requires = "measurements")]
+    pub weights: WeightsKind,
+    /// Metres of position error a radian of orientation error counts as
+    /// (a full-pose fit's fixed weight); implies --weights fixed.
+    #[arg(long, value_name = "M_PER_RAD", requires = "measurements", conflicts_with = "weights")]
+    pub orientation_scale: Option<f64>,
     /// A distance known between two contact points (a file with a `point`
     /// column): `A,B=METRES`, repeatable.
     #[arg(long, value_name = "A,B=METRES", requires = "measurements")]
@@ -145,4 +157,13 @@ impl CalibrateArgs {
     pub(super) fn seed(&self) -> u64 {
         self.seed.unwrap_or(0)
     }
+}
+
+/// The weights options of `calibrate`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WeightsKind {
+    /// Each residual block's σ estimated from the data.
+    Estimated,
+    /// The robot's orientation scale as given.
+    Fixed,
 }

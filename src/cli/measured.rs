@@ -86,6 +86,13 @@ pub fn measured_text(r: &MeasuredReport, id: &Identification, status: &str) -> S
             s += &format!("  {} = {:.6} ({})\n", f.name, f.value, f.reason);
         }
     }
+    s += &format!(
+        "unknowns: {} estimated of {} chosen for the robot ({} fixed: the data do not determine them)\n",
+        id.names.len(),
+        id.names.len() + r.fixed.len(),
+        r.fixed.len()
+    );
+    s += &noise_text(&r.noise);
     s += &format!("fitted:  {}\n", r.residuals.summary());
     s += &format!("nominal: {}\n", r.nominal_residuals.summary());
     if !r.downweighted.is_empty() {
@@ -258,4 +265,36 @@ pub fn cmd_evaluate(a: EvaluateArgs) -> Result<()> {
         }
         s
     })
+}
+
+/// The blocks' estimated σ's and the weight between them.
+fn noise_text(n: &activecal::experiment::measured::NoiseReport) -> String {
+    let blocks: Vec<String> = n
+        .blocks
+        .iter()
+        .map(|b| {
+            let (v, unit) = match b.unit {
+                "rad" => (b.sigma.to_degrees(), "°"),
+                _ => (b.sigma * 1e3, " mm"),
+            };
+            format!("{} σ {v:.4}{unit} ({:.1} dof)", b.block, b.redundancy)
+        })
+        .collect();
+    let mut s = format!("noise per coordinate, from the residuals: {}\n", blocks.join(", "));
+    if n.blocks.iter().any(|b| b.unit == "rad") {
+        s += &format!(
+            "orientation weight: {:.4} m/rad ({}{})\n",
+            n.orientation_scale_m_per_rad,
+            match n.weights {
+                activecal::identify::Weights::Estimated => "estimated: σ_position / σ_orientation",
+                activecal::identify::Weights::Fixed => "fixed",
+            },
+            if n.rounds > 0 {
+                format!(", {} reweighting rounds", n.rounds)
+            } else {
+                String::new()
+            }
+        );
+    }
+    s
 }

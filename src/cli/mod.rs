@@ -84,13 +84,14 @@ pub fn parse_robot(s: &str) -> std::result::Result<RobotRef, String> {
 }
 
 /// The chain options typed on the command line (`--base`, `--tip`,
-/// `--lock`, `--frames`), checked: one value, resolved once and given to
+/// `--lock`, `--frames`, `--marker`), checked: one value, resolved once and given to
 /// the command's robot ([`apply_chain`]).
 pub fn chain_choice(
     base: Option<String>,
     tip: Option<String>,
     lock: Option<&str>,
     frames: Option<std::path::PathBuf>,
+    markers: &[String],
 ) -> Result<ChainChoice> {
     let lock = match lock {
         Some(l) => ChainChoice::parse_lock(l).map_err(|e| anyhow::anyhow!("--{e}"))?,
@@ -101,11 +102,16 @@ pub fn chain_choice(
     {
         anyhow::bail!("--frames {}: no such file", f.display());
     }
+    let markers = markers
+        .iter()
+        .map(|m| activecal::io::MarkerChoice::parse(m).map_err(|e| anyhow::anyhow!("--{e}")))
+        .collect::<Result<Vec<_>>>()?;
     Ok(ChainChoice {
         base,
         tip,
         lock,
         frames: frames.map(|f| f.display().to_string()),
+        markers,
     })
 }
 
@@ -143,6 +149,7 @@ pub fn chain_options(c: &ChainChoice) -> String {
     if let Some(f) = &c.frames {
         parts.push(format!("--frames {f}"));
     }
+    parts.extend(c.markers.iter().map(|m| format!("--marker {m}")));
     parts.join(" ")
 }
 

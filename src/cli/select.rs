@@ -278,6 +278,12 @@ pub struct SelectArgs {
     /// errors, metres [default: 0.01, as `calibrate --noise`].
     #[arg(long, requires = "report", allow_negative_numbers = true)]
     pub noise: Option<f64>,
+    /// Orientation noise σ per axis of a full-pose sensor, radians: the
+    /// design weighs a radian of orientation as `--noise`/RAD metres (as
+    /// `calibrate` weighs the data by their estimated σ's), and --report
+    /// predicts with it. Default: the robot's orientation scale (1 m/rad).
+    #[arg(long, value_name = "RAD", allow_negative_numbers = true)]
+    pub orientation_noise: Option<f64>,
     /// Choose configurations that touch a socket at this position instead
     /// of poses of a pool: NAME=X,Y,Z (base frame, metres; repeatable).
     /// Joint-space samples (--count, default 1000 a socket; --pool-seed)
@@ -289,6 +295,25 @@ pub struct SelectArgs {
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
+}
+
+/// The weight of a full-pose sensor's orientation rows (metres per
+/// radian) for position noise `noise` (metres; the report's default
+/// without it) and orientation noise `orientation` (radians): each row
+/// then carries the position's σ. Refused for a sensor that measures no
+/// orientation, or a σ that is not a finite number > 0.
+fn orientation_scale(robot: &activecal::model::Robot, noise: Option<f64>, orientation: f64) -> Result<f64> {
+    if !(orientation.is_finite() && orientation > 0.0) {
+        bail!("--orientation-noise {orientation}: the orientation noise σ must be a finite number > 0 (radians)");
+    }
+    if !activecal::measure::sensor_for(robot).observes_orientation() {
+        bail!(
+            "--orientation-noise: robot '{}' measures {}, no orientation (append ':pose' to --robot for full poses)",
+            robot.name,
+            activecal::measure::sensor_for(robot).describe()
+        );
+    }
+    Ok(noise.unwrap_or(DEFAULT_REPORT_NOISE) / orientation)
 }
 
 /// The noise σ of `select --report` when `--noise` is not given, metres
@@ -308,7 +333,10 @@ pub enum Order {
 pub fn cmd_select(a: SelectArgs) -> Result<()> {
     check_select_outputs(&a)?;
     // Cheap checks of the ordering's inputs before the pool is built.
-    let described = super::load_description(&a.pool.robot)?;
+    let mut described = super::load_description(&a.pool.robot)?;
+    if let Some(so) = a.orientation_noise {
+        described.robot.orientation_scale = orientation_scale(&described.robot, a.noise, so)?;
+    }
     let speeds = activecal::io::joint_speeds::joint_speeds(&described.robot)?;
     let home = super::tour::parse_home(a.home.as_deref(), &described.robot)?;
     // Refused, never clamped (as `reproduce` does).

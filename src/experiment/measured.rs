@@ -11,7 +11,7 @@ use crate::identify::compliance::{ComplianceComparison, compare, with_compliance
 use crate::identify::evaluation::ModelErrors;
 use crate::identify::{
     Fit, FixedParameter, HoldoutSettings, LmSettings, LossChoice, Measurements, ParameterTrust,
-    SplitResult, fit, for_measurements, holdout, prepare_for_data, residuals, trust,
+    SplitResult, for_measurements, holdout, prepare_for_data, residuals, trust,
 };
 use crate::model::gravity::GravityModel;
 use crate::model::{ParamTable, Robot};
@@ -40,6 +40,8 @@ pub struct MeasuredSettings {
     pub fit_compliance: bool,
     /// With held-out splits: fit with and without compliances, side by side.
     pub compare_compliance: bool,
+    /// How the fit weighs its residual blocks.
+    pub weights: crate::identify::Weights,
 }
 
 /// A calibration from measurements: the robot as fitted, the fit, and its
@@ -117,6 +119,22 @@ pub struct MeasuredReport {
     /// Held-out errors with and without compliances on the same splits.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub compliance_comparison: Option<ComplianceComparison>,
+    /// Each residual block's σ at the fit and the weights it ended with.
+    pub noise: NoiseReport,
+}
+
+/// Each residual block's estimated noise and how the blocks were weighed.
+#[derive(Clone, Debug, Serialize)]
+pub struct NoiseReport {
+    /// Estimated from the residuals, or fixed.
+    pub weights: crate::identify::Weights,
+    /// Metres of position a radian of orientation counted as in the final
+    /// fit (full poses).
+    pub orientation_scale_m_per_rad: f64,
+    /// Reweighting rounds.
+    pub rounds: usize,
+    /// Each block's σ (its unit beside it) and redundancy.
+    pub blocks: Vec<crate::identify::variance::BlockSigma>,
 }
 
 /// Held-out figures over splits.
@@ -217,7 +235,11 @@ fn holdout_report(settings: HoldoutSettings, splits: Vec<SplitResult>) -> Holdou
 const MOUNT_GAIN: f64 = 200.0;
 
 /// A URDF robot mounted in the data's frame when the nominal model is far
-/// from it ([`crate::frames::align`]), with a note saying so.
+/// from it ([`crate::frames::align`]), or, for a single measured point whose
+/// nominal lies on the last joint's axis, with the tool point the data imply
+/// when they see it off that axis (the unknowns are then chosen where the
+/// data's point is: the slide along the last axis among them); with a note
+/// saying so.
 fn mounted_start(
     robot: &Robot,
     meas: &Measurements,
@@ -228,11 +250,29 @@ fn mounted_start(
     let Some(a) = crate::frames::align::measurement_frame(robot, meas) else {
         return Ok(None);
     };
-    if !(a.rms_after * MOUNT_GAIN < a.rms_before) {
+    let far = a.rms_after * MOUNT_GAIN < a.rms_before;
+    let on_axis = single_point(robot, meas) && off_last_axis(robot, &robot.nominal) < AXIS_TOL;
+    if !far && !on_axis {
         return Ok(None);
     }
     let mount = a.motion * src.mount;
     let r = crate::io::urdf::remount(robot, mount, src.tool * a.tool)?;
+    if !far {
+        // The point starts on the last axis: the start the data imply puts
+        // it where they see it, and the unknowns are chosen there.
+        let rho = off_last_axis(&r, &r.nominal);
+        if !(rho > AXIS_SEEN * a.rms_after) {
+            return Ok(None);
+        }
+        let note = format!(
+            "the nominal measured point lies on the last joint's axis, the data's {:.1} mm off it: identification starts from the tool point the data imply (RMS {:.3} mm), with the unknowns identifiable there ({}, the nominal point's {})",
+            rho * 1e3,
+            a.rms_after * 1e3,
+            r.n_params(),
+            robot.n_params()
+        );
+        return Ok(Some((r, note)));
+    }
     let t = mount.translation.vector;
     let note = format!(
         "the data are far from the nominal model (RMS {:.1} mm): identification starts from the measurement frame that fits them best (RMS {:.1} mm), {:.3} m away and turned {:.1}°",
@@ -242,6 +282,48 @@ fn mounted_start(
         mount.rotation.angle().to_degrees()
     );
     Ok(Some((r, note)))
+}
+
+/// A measured point closer than this to the last joint's axis (metres) lies
+/// on it: the distance is exactly 0 up to rounding (1e-16 m) for a tip on
+/// the axis, millimetres and more for a real tool.
+const AXIS_TOL: f64 = 1e-9;
+
+/// The data see a tool point off the last axis when its distance from the
+/// axis is this many times the rigid start's RMS residual.
+const AXIS_SEEN: f64 = 3.0;
+
+/// Whether the robot measures one point per pose and the data hold only
+/// that (no orientation, one marker).
+fn single_point(robot: &Robot, meas: &Measurements) -> bool {
+    robot.measurement == crate::model::MeasurementKind::Point
+        && meas.markers() == 1
+        && meas.orientations().is_empty()
+}
+
+/// The distance (m) of the measured point from the last joint's axis at
+/// `table`: a quarter turn of a revolute last joint moves a point at
+/// distance ρ from its axis by ρ√2 (∞ for a prismatic last joint, which
+/// has no axis to lie on).
+fn off_last_axis(robot: &Robot, table: &crate::model::ParamTable) -> f64 {
+    let Some(last) = robot.dof().checked_sub(1) else {
+        return f64::INFINITY;
+    };
+    if robot
+        .frames
+        .iter()
+        .any(|f| f.joint == Some(last) && f.is_prismatic())
+    {
+        return f64::INFINITY;
+    }
+    let q = crate::observability::generic_configurations(robot, 1, 0x0ff_a815)
+        .pop()
+        .unwrap_or_default();
+    let mut turned = q.clone();
+    turned[last] += std::f64::consts::FRAC_PI_2;
+    let (_, p0) = crate::kinematics::pose(robot, table, &q);
+    let (_, p1) = crate::kinematics::pose(robot, table, &turned);
+    (p1 - p0).norm() / std::f64::consts::SQRT_2
 }
 
 /// Identification from the measurement file `path`: each note is passed
@@ -284,8 +366,22 @@ pub fn calibrate_measured(
     };
     let det =
         prepare_for_data(&fitted_robot, &start.table, &meas, &s.fix, &s.free).map_err(in_file)?;
-    let r = det.robot;
-    let f = fit(&r, &start.table, &meas, &s.lm, s.loss).map_err(in_file)?;
+    let weighted = crate::identify::fit_weighted(
+        &det.robot,
+        &start.table,
+        &meas,
+        &s.lm,
+        s.loss,
+        s.weights,
+    )
+    .map_err(in_file)?;
+    let noise = NoiseReport {
+        weights: s.weights,
+        orientation_scale_m_per_rad: weighted.robot.orientation_scale,
+        rounds: weighted.rounds,
+        blocks: weighted.sigmas,
+    };
+    let (r, f) = (weighted.robot, weighted.fit);
     let res = residuals(&r, &f.id.table, &meas)?;
     let nominal = nominal_residuals(given, mounted.is_some(), &r, &meas, &s.lm)?;
     let params = trust(&r, &r.nominal, &f.id);
@@ -320,6 +416,7 @@ pub fn calibrate_measured(
         frames: None,
         compliance,
         compliance_comparison: comparison,
+        noise,
     };
     Ok(MeasuredCalibration {
         robot: r,

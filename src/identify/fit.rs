@@ -99,6 +99,98 @@ pub fn fit(
     Ok(Fit { id, weights: w })
 }
 
+/// How a fit weighs its residual blocks (positions, orientations) against
+/// each other.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Weights {
+    /// Each block's σ estimated from its own residuals, the weights
+    /// iterated to agree ([`fit_weighted`]).
+    #[default]
+    Estimated,
+    /// The robot's [`Robot::orientation_scale`] as given.
+    Fixed,
+}
+
+/// A fit with the weights it ended with and its blocks' σ's.
+#[derive(Clone, Debug)]
+pub struct WeightedFit {
+    /// The robot as fitted: its `orientation_scale` the final weight.
+    pub robot: Robot,
+    /// The table the fit started from (the last round's start).
+    pub start: ParamTable,
+    /// The fit.
+    pub fit: Fit,
+    /// Each residual block's σ at the fit.
+    pub sigmas: Vec<super::variance::BlockSigma>,
+    /// Reweighting rounds (0 with fixed weights or one block).
+    pub rounds: usize,
+}
+
+/// Reweighting rounds at most, and the relative change of the weight below
+/// which they stop (the σ's then agree with the weights to 0.1 %).
+const VCE_ROUNDS: usize = 20;
+const VCE_TOL: f64 = 1e-3;
+
+/// Fits as [`fit`], and with [`Weights::Estimated`] and a sensor that
+/// measures orientations, re-weighs the orientation rows by the ratio of
+/// the position and orientation σ's estimated from the residuals
+/// ([`super::variance`]: `w = σ_p / σ_o`, metres per radian) and refits
+/// from the last estimate until the weight settles. Noise-free data (a σ
+/// below 1e-12) keep the given weight.
+pub fn fit_weighted(
+    robot: &Robot,
+    start: &ParamTable,
+    meas: &Measurements,
+    lm: &LmSettings,
+    loss: LossChoice,
+    weights: Weights,
+) -> Result<WeightedFit> {
+    let mut r = robot.clone();
+    let mut from = start.clone();
+    let mut f = fit(&r, &from, meas, lm, loss)?;
+    let mut sigmas = super::variance::block_sigmas(&r, &from, meas, &f.id)?;
+    let mut rounds = 0;
+    let reweigh = weights == Weights::Estimated && !meas.orientations().is_empty();
+    while reweigh && rounds < VCE_ROUNDS {
+        let Some(w) = position_per_orientation(&sigmas) else {
+            break;
+        };
+        if (w / r.orientation_scale).ln().abs() < VCE_TOL {
+            break;
+        }
+        r.orientation_scale = w;
+        from = f.id.table.clone();
+        f = fit(&r, &from, meas, lm, loss)?;
+        sigmas = super::variance::block_sigmas(&r, &from, meas, &f.id)?;
+        rounds += 1;
+    }
+    Ok(WeightedFit {
+        robot: r,
+        start: from,
+        fit: f,
+        sigmas,
+        rounds,
+    })
+}
+
+/// `σ_p / σ_o` (metres per radian) from the blocks' σ's, the positions'
+/// pooled; `None` without both, or when either is below 1e-12 (noise-free
+/// data say nothing of the ratio).
+fn position_per_orientation(sigmas: &[super::variance::BlockSigma]) -> Option<f64> {
+    let pooled = |unit: &str| {
+        let (ss, red) = sigmas
+            .iter()
+            .filter(|b| b.unit == unit && b.sigma.is_finite())
+            .fold((0.0, 0.0), |(s, r), b| {
+                (s + b.sigma * b.sigma * b.redundancy, r + b.redundancy)
+            });
+        (red > 0.0).then(|| (ss / red).sqrt())
+    };
+    let (p, o) = (pooled("m")?, pooled("rad")?);
+    (p > 1e-12 && o > 1e-12).then(|| (p / o).clamp(1e-4, 1e4))
+}
+
 /// |t| at or above which a parameter's change from nominal is called
 /// significant (about 95 % two-sided for a normal estimate).
 pub const T_SIGNIFICANT: f64 = 2.0;
@@ -258,6 +350,9 @@ pub struct HoldoutSettings {
     /// Also fit a model pruned to the significant parameters (|t| ≥ 2 on
     /// the split's training fit) and evaluate it on the same held-out poses.
     pub prune: bool,
+    /// How each split's fit weighs its residual blocks (estimated on the
+    /// split's training rows only).
+    pub weights: Weights,
 }
 
 /// One split's figures.
@@ -323,7 +418,8 @@ pub fn holdout(
         let (mtr, mte) = (meas.subset(&tr), meas.subset(&te));
         let start = for_measurements(robot, &mtr, lm)?;
         let r = prepare(&start.robot, &start.table, &mtr)?;
-        let f = fit(&r, &start.table, &mtr, lm, loss)?;
+        let WeightedFit { robot: r, fit: f, .. } =
+            fit_weighted(&r, &start.table, &mtr, lm, loss, settings.weights)?;
         let fitted = residuals(&r, &f.id.table, &mtr)?;
         let held_out = residuals(&r, &f.id.table, &mte)?;
         let nominal = if std::ptr::eq(baseline, robot) {

@@ -28,6 +28,8 @@
 //!   poses) and where identification starts.
 //! * [`montecarlo`]: repeated identification over noise realisations, and
 //!   held-out validation poses.
+//! * [`variance`]: each residual block's σ from its own residuals
+//!   (variance components), the weights [`fit_weighted`] iterates.
 //! * [`tables`]: estimates and residuals in the paper's table layout.
 //!
 //! Failures are kept apart as everywhere in the crate: bad input (missing or
@@ -49,11 +51,12 @@ pub mod start;
 
 pub mod tables;
 pub mod undetermined;
+pub mod variance;
 
 pub use evaluation::{ModelErrors, SampleResidual, residuals};
 pub use fit::{
-    Fit, HoldoutSettings, LossChoice, ParameterTrust, SplitResult, fit, holdout, prepare_for_data,
-    trust, with_fixed_and_free,
+    Fit, HoldoutSettings, LossChoice, ParameterTrust, SplitResult, WeightedFit, Weights, fit,
+    fit_weighted, holdout, prepare_for_data, trust, with_fixed_and_free,
 };
 pub use lm::{
     Correlation, Covariance, Identification, LmSettings, Solution, Status, StopReason, identify,

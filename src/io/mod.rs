@@ -24,7 +24,7 @@ use crate::measure::Visibility;
 use crate::model::{BUILTIN, MeasurementKind, Robot};
 use std::path::Path;
 
-pub use crate::model::robot_ref::{ChainChoice, RobotRef};
+pub use crate::model::robot_ref::{ChainChoice, MarkerChoice, RobotRef};
 
 /// A robot as a description gives it: the model and the sensor's visibility
 /// region, if the description names one (used to filter pose pools when no
@@ -150,16 +150,60 @@ fn load_urdf(path: &Path, chain: &ChainChoice, pose: bool) -> Result<Robot> {
         opts.mount = f.mount;
         opts.tool = f.tool;
     }
+    if opts.tip.is_none()
+        && let Some(m) = chain.markers.first()
+    {
+        // The markers' link is the measured link unless a tip is named.
+        opts.tip = Some(m.link.clone());
+    }
     let robot = urdf::load(path, &opts)?;
     let robot = match &frames {
         Some(f) if !f.compliance.is_empty() => with_compliance(robot, &f.compliance, chain)?,
         _ => robot,
     };
-    match frames {
+    let markers = chosen_markers(&robot, chain, frames.as_ref(), pose)?;
+    if markers.is_empty() {
+        Ok(robot)
+    } else {
         // A copy of the robot with markers: its source comes along.
-        Some(f) if !f.markers.is_empty() => robot.with_markers(&f.markers),
-        _ => Ok(robot),
+        robot.with_markers(&markers)
     }
+}
+
+/// The marker offsets a URDF robot is measured with: the chain choice's
+/// (`marker=LINK@X,Y,Z`, each on the chain's tip) or the frames file's,
+/// never both; none for a point or full-pose sensor.
+fn chosen_markers(
+    robot: &Robot,
+    chain: &ChainChoice,
+    frames: Option<&frames_file::Frames>,
+    pose: bool,
+) -> Result<Vec<[f64; 3]>> {
+    let from_file = frames.map(|f| f.markers.clone()).unwrap_or_default();
+    if chain.markers.is_empty() {
+        return Ok(from_file);
+    }
+    let first = &chain.markers[0];
+    if !from_file.is_empty() {
+        return Err(Error::Invalid(format!(
+            "marker {first}: the frames file {} gives markers already ({}); give the markers once",
+            chain.frames.as_deref().unwrap_or_default(),
+            from_file.len()
+        )));
+    }
+    if pose {
+        return Err(Error::Invalid(format!(
+            "marker {first}: a marker measures a point, ':pose' the tip's full pose; give one or the other"
+        )));
+    }
+    let tip = robot.source.as_ref().map(|s| s.tip.clone()).unwrap_or_default();
+    if let Some(m) = chain.markers.iter().find(|m| m.link != tip) {
+        return Err(Error::Invalid(format!(
+            "marker {m}: markers are placed in the chain's tip link '{tip}', not in '{}'; name the tip as the marker's link (or its tip as --tip)",
+            m.link
+        )));
+    }
+    Ok(chain.markers.iter().map(|m| m.offset).collect())
 }
 
 /// The robot deflecting under gravity with the frames file's compliances

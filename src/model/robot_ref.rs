@@ -4,7 +4,7 @@
 //! and the chain options once, [`crate::io`] loads it; design files record one (as a name and a
 //! structured chain) and give it back.
 //!
-//! The text form `NAME[:pose][#base=B;tip=T;lock=J:V,…;frames=F]` is this
+//! The text form `NAME[:pose][#base=B;tip=T;lock=J:V,…;frames=F;marker=L@X,Y,Z…]` is this
 //! value's serialisation, read by [`RobotRef::parse`] and written by its
 //! [`std::fmt::Display`]: a loaded robot's [`crate::model::Robot::name`], and
 //! the `robot` of design files written before the chain was stored apart.
@@ -31,13 +31,68 @@ pub struct ChainChoice {
     /// tool (or markers) to mount the chain with.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub frames: Option<String>,
+    /// Markers measured on the chain's tip, each a link (the tip's) and an
+    /// offset in it (metres): the sensor the poses are chosen and the data
+    /// fitted for. One marker makes a one-marker sensor (its offset
+    /// unknown, `4R + 2P + 3` unknowns), several a `K`-marker sensor.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub markers: Vec<MarkerChoice>,
+}
+
+/// A marker on a link: `LINK@X,Y,Z`, the offset in metres in the link's frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MarkerChoice {
+    /// The link the marker is fixed to (the chain's tip).
+    pub link: String,
+    /// Its position in that link's frame (metres).
+    pub offset: [f64; 3],
+}
+
+impl MarkerChoice {
+    /// Parses `LINK@X,Y,Z` (metres); errors name the text and what is wrong.
+    pub fn parse(text: &str) -> Result<MarkerChoice> {
+        let bad = |what: &str| Error::Invalid(format!("marker '{text}': {what}"));
+        let (link, xyz) = text
+            .split_once('@')
+            .ok_or_else(|| bad("expected LINK@X,Y,Z (the link's name, then the offset in metres)"))?;
+        if link.trim().is_empty() {
+            return Err(bad("no link before '@'"));
+        }
+        let v: Vec<&str> = xyz.split(',').map(str::trim).collect();
+        if v.len() != 3 {
+            return Err(bad(&format!("{} coordinates after '@', expected 3 (X,Y,Z in metres)", v.len())));
+        }
+        let mut offset = [0.0; 3];
+        for (o, t) in offset.iter_mut().zip(&v) {
+            *o = t
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| bad(&format!("'{t}' is not a finite number")))?;
+        }
+        Ok(MarkerChoice {
+            link: link.trim().to_string(),
+            offset,
+        })
+    }
+}
+
+impl fmt::Display for MarkerChoice {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let [x, y, z] = self.offset;
+        write!(f, "{}@{x},{y},{z}", self.link)
+    }
 }
 
 impl ChainChoice {
     /// Whether nothing is chosen.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.base.is_none() && self.tip.is_none() && self.lock.is_empty() && self.frames.is_none()
+        self.base.is_none()
+            && self.tip.is_none()
+            && self.lock.is_empty()
+            && self.frames.is_none()
+            && self.markers.is_empty()
     }
 
     /// The `#…` fragment of the text form (empty when nothing is chosen).
@@ -57,6 +112,7 @@ impl ChainChoice {
         if let Some(f) = &self.frames {
             parts.push(format!("frames={f}"));
         }
+        parts.extend(self.markers.iter().map(|m| format!("marker={m}")));
         if parts.is_empty() {
             String::new()
         } else {
@@ -96,9 +152,10 @@ impl ChainChoice {
                 Some(("tip", v)) => c.tip = Some(v.to_string()),
                 Some(("lock", v)) => c.lock = ChainChoice::parse_lock(v)?,
                 Some(("frames", v)) => c.frames = Some(v.to_string()),
+                Some(("marker", v)) => c.markers.push(MarkerChoice::parse(v)?),
                 _ => {
                     return Err(Error::Invalid(format!(
-                        "robot name: unknown chain choice '{part}' after '#' (expected base=LINK, tip=LINK, lock=JOINT:VALUE,… or frames=FILE)"
+                        "robot name: unknown chain choice '{part}' after '#' (expected base=LINK, tip=LINK, lock=JOINT:VALUE,…, frames=FILE or marker=LINK@X,Y,Z)"
                     )));
                 }
             }
@@ -186,7 +243,7 @@ mod tests {
     /// suffix and a fragment are both read.
     #[test]
     fn text_form_round_trips() {
-        let t = "arm.urdf:pose#base=torso;tip=tool;lock=lift:0.1,head:-0.5;frames=cal.yaml";
+        let t = "arm.urdf:pose#base=torso;tip=tool;lock=lift:0.1,head:-0.5;frames=cal.yaml;marker=tool@0.1,-0.02,0.05";
         let r = RobotRef::parse(t).unwrap();
         assert_eq!(r.name, "arm.urdf");
         assert!(r.pose);
@@ -197,6 +254,13 @@ mod tests {
             vec![("lift".to_string(), 0.1), ("head".to_string(), -0.5)]
         );
         assert_eq!(r.chain.frames.as_deref(), Some("cal.yaml"));
+        assert_eq!(
+            r.chain.markers,
+            vec![MarkerChoice {
+                link: "tool".into(),
+                offset: [0.1, -0.02, 0.05]
+            }]
+        );
         assert_eq!(r.to_string(), t);
         assert_eq!(RobotRef::parse("puma560").unwrap().to_string(), "puma560");
         assert!(RobotRef::parse("a.urdf#colour=red").is_err());

@@ -320,10 +320,9 @@ fn identifiable(
                 .and_then(|n| robot.param_id(n).ok())
                 .and_then(|id| unknown_spans[id.frame].clone());
             let msg = format!(
-                "unknowns {} are not identifiable from {} measurements (numerical rank {rank} of {p} on a random design of the {}-level lattice at the nominal parameters): remove them, or set `unknowns = \"auto\"`",
+                "unknowns {} are not identifiable from {} measurements (numerical rank {rank} of {p} on generic configurations at the nominal parameters): remove them, or set `unknowns = \"auto\"`",
                 names.join(", "),
                 robot.measurement.name(),
-                crate::observability::DESIGN_LEVELS,
             );
             Err(match first {
                 Some(span) => cx.at(span, msg),

@@ -1,0 +1,174 @@
+//! Variance components: each residual block's σ estimated from its own
+//! residuals, so that blocks measured with different noise (a tracker's
+//! positions and its orientations, each marker of a motion-capture body)
+//! are weighted by what the data say of them, not by a fixed scale.
+//!
+//! A sensor's rows fall into blocks by their [`RowKind`]: the position rows
+//! of each measured point (one block, or one per marker) and the
+//! orientation rows. At a fit, block `b` with residuals `r_b` (unweighted:
+//! metres, radians) has the estimate (Förstner's variance-component
+//! estimation)
+//!
+//! `σ_b² = r_bᵀ r_b / ρ_b`,  `ρ_b = n_b − Σ_{i∈b} h_ii`,
+//!
+//! where `h_ii = x_iᵀ (XᵀX)⁻¹ x_i` are the diagonal entries of the hat
+//! matrix of the weighted Jacobian `X`: `ρ_b` is the block's share of the
+//! residual degrees of freedom (`Σ_b ρ_b = rows − p`). Reweighting with `w_b
+//! ∝ 1/σ_b` and refitting until the σ's settle gives the weights the data's
+//! own noise implies ([`crate::identify::fit::fit_weighted`]).
+
+use super::{Calibration, Identification, Measurements, Residuals, Result};
+use crate::measure::RowKind;
+use crate::model::{ParamTable, Robot};
+use nalgebra::DMatrix;
+use serde::Serialize;
+
+/// One residual block's estimated noise.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BlockSigma {
+    /// The block: `position`, `marker K` or `orientation`.
+    pub block: String,
+    /// Its rows over all poses.
+    pub rows: usize,
+    /// Its redundancy `ρ_b` (degrees of freedom of its σ).
+    pub redundancy: f64,
+    /// The estimated σ per coordinate, in the block's unit.
+    pub sigma: f64,
+    /// The unit of `sigma`: `m` or `rad`.
+    pub unit: &'static str,
+}
+
+/// The block of each of a sensor's rows per pose and the blocks' names
+/// (positions grouped by point: one block for one point, one per marker).
+#[must_use]
+pub fn row_blocks(kinds: &[RowKind], points: usize) -> (Vec<usize>, Vec<(String, &'static str)>) {
+    let mut blocks: Vec<(String, &'static str)> = Vec::new();
+    let mut of_row = Vec::with_capacity(kinds.len());
+    let mut position = 0;
+    for kind in kinds {
+        let name = match kind {
+            RowKind::Position => {
+                let k = position / 3;
+                position += 1;
+                (
+                    if points > 1 {
+                        format!("marker {}", k + 1)
+                    } else {
+                        "position".into()
+                    },
+                    "m",
+                )
+            }
+            RowKind::Orientation => ("orientation".to_string(), "rad"),
+        };
+        let b = match blocks.iter().position(|n| n.0 == name.0) {
+            Some(b) => b,
+            None => {
+                blocks.push(name);
+                blocks.len() - 1
+            }
+        };
+        of_row.push(b);
+    }
+    (of_row, blocks)
+}
+
+/// Each residual block's σ at the fit `id` of `robot` to `meas` from
+/// `start` (see the module documentation). A block without redundancy
+/// (every row fitted exactly by the parameters) has σ `NaN`.
+pub fn block_sigmas(
+    robot: &Robot,
+    start: &ParamTable,
+    meas: &Measurements,
+    id: &Identification,
+) -> Result<Vec<BlockSigma>> {
+    let mut cal = Calibration::new(robot, start, meas)?;
+    let (t, n) = (cal.block_rows(), cal.n_params());
+    let kinds = cal.sensor().row_kinds().to_vec();
+    let weights = cal.sensor().weights().to_vec();
+    let (of_row, names) = row_blocks(&kinds, cal.sensor().points_per_pose());
+    let m = cal.n_residuals();
+    let mut r = vec![0.0; m];
+    let mut jac = faer::Mat::<f64>::zeros(m, n);
+    cal.eval(&id.estimate, &mut r, Some(&mut jac));
+    let hat = hat_diagonal(&jac);
+    let mut sum = vec![(0usize, 0.0f64, 0.0f64); names.len()];
+    for i in 0..(t * meas.len()).min(m) {
+        let c = i % t;
+        let b = of_row[c];
+        let unweighted = r[i] / weights[c];
+        sum[b].0 += 1;
+        sum[b].1 += unweighted * unweighted;
+        sum[b].2 += hat.get(i).copied().unwrap_or(f64::NAN);
+    }
+    Ok(names
+        .into_iter()
+        .zip(sum)
+        .map(|((block, unit), (rows, ss, h))| {
+            let redundancy = rows as f64 - h;
+            BlockSigma {
+                block,
+                rows,
+                redundancy,
+                sigma: if redundancy > 1e-9 {
+                    (ss / redundancy).sqrt()
+                } else {
+                    f64::NAN
+                },
+                unit,
+            }
+        })
+        .collect())
+}
+
+/// The diagonal of the hat matrix `X (XᵀX)⁻¹ Xᵀ` (NaN when `XᵀX` is
+/// singular): the leverage of each row.
+fn hat_diagonal(x: &faer::Mat<f64>) -> Vec<f64> {
+    let (m, n) = (x.nrows(), x.ncols());
+    let xm = DMatrix::from_fn(m, n, |i, j| x[(i, j)]);
+    let gram = xm.transpose() * &xm;
+    let Some(chol) = gram.cholesky() else {
+        return vec![f64::NAN; m];
+    };
+    let z = chol.solve(&xm.transpose());
+    (0..m)
+        .map(|i| (0..n).map(|k| xm[(i, k)] * z[(k, i)]).sum())
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measure::RowKind::{Orientation, Position};
+
+    /// A pose's rows make a position and an orientation block; three markers
+    /// make three position blocks.
+    #[test]
+    fn rows_fall_into_blocks_by_kind_and_point() {
+        let (rows, names) = row_blocks(
+            &[Position, Position, Position, Orientation, Orientation, Orientation],
+            1,
+        );
+        assert_eq!(rows, vec![0, 0, 0, 1, 1, 1]);
+        assert_eq!(names[0].0, "position");
+        assert_eq!(names[1], ("orientation".to_string(), "rad"));
+        let (rows, names) = row_blocks(&[Position; 9], 3);
+        assert_eq!(rows, vec![0, 0, 0, 1, 1, 1, 2, 2, 2]);
+        assert_eq!(names[2].0, "marker 3");
+    }
+
+    /// The leverages of a full-column-rank X sum to its rank, and a row
+    /// alone in its direction has leverage 1.
+    #[test]
+    fn leverages_sum_to_the_rank() {
+        let x = faer::Mat::from_fn(5, 2, |i, j| match (i, j) {
+            (0, 0) => 1.0,
+            (0, 1) => 0.0,
+            (_, 0) => 0.0,
+            (i, _) => i as f64,
+        });
+        let h = hat_diagonal(&x);
+        assert!((h.iter().sum::<f64>() - 2.0).abs() < 1e-12);
+        assert!((h[0] - 1.0).abs() < 1e-12);
+    }
+}

@@ -27,6 +27,8 @@ Usage (run with /work/main/.venv/bin/python; every output is JSON or CSV):
       noise of SIGMA_M metres per axis (and RAD per axis of a small
       rotation), written as the CSV `activecal calibrate --measurements`
       reads (x1,y1,z1[,phix1,phiy1,phiz1], one column per joint).
+      Several --design D1 D2 .. --out O1 O2 ..: one file each, the k-th
+      (from 0) with the noise of default_rng((S, k)) (k = 0: of S).
 
   truth.py compare --truth truth.json --urdf cal.urdf --frames cal.yaml
                    [--design D] [--n 1000] --seed S
@@ -430,13 +432,15 @@ def cmd_measure(a):
     if len(a.design) != len(a.out):
         raise SystemExit("measure: %d designs, %d outputs" % (len(a.design), len(a.out)))
     t = Truth(a.truth)
-    done = [measure_one(t, d, o, a) for d, o in zip(a.design, a.out)]
+    # The k-th output's noise: default_rng(SEED) for the first, ((SEED, k))
+    # for the others (independent draws; the same design may be repeated).
+    done = [measure_one(t, d, o, a, np.random.default_rng(a.seed if k == 0 else (a.seed, k)))
+            for k, (d, o) in enumerate(zip(a.design, a.out))]
     print(json.dumps(done[0] if len(done) == 1 else done))
 
 
-def measure_one(t, design, out, a):
+def measure_one(t, design, out, a, rng):
     qs = read_design(design, t.chain.names)
-    rng = np.random.default_rng(a.seed)
     head = ["x1", "y1", "z1"]
     if t.pose:
         head += ["phix1", "phiy1", "phiz1"]

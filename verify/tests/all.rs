@@ -25,3 +25,5 @@ mod live_gravity;
 mod live_idjac;
 #[cfg(feature = "live")]
 mod live_tour;
+#[cfg(feature = "live")]
+mod live_truth;

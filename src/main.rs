@@ -49,7 +49,12 @@ struct Cli {
     /// Poses are chosen, and the data fitted, for these markers; their
     /// offsets are unknowns of the fit. LINK is the tip (the default
     /// --tip when none is given).
-    #[arg(long = "marker", global = true, value_name = "LINK@X,Y,Z", allow_hyphen_values = true)]
+    #[arg(
+        long = "marker",
+        global = true,
+        value_name = "LINK@X,Y,Z",
+        allow_hyphen_values = true
+    )]
     markers: Vec<String>,
     /// Show progress on stderr even with --json or when stderr is not a
     /// terminal (then as plain lines). Without it, progress is a bar on a
@@ -165,8 +170,14 @@ fn main() {
         .unwrap_or(false);
     cli::progress::install_for(cli.progress, json);
     let mut command = cli.command;
-    let chain = cli::chain_choice(cli.base, cli.tip, cli.lock.as_deref(), cli.frames, &cli.markers)
-        .and_then(|c| command.take_chain(&c));
+    let chain = cli::chain_choice(
+        cli.base,
+        cli.tip,
+        cli.lock.as_deref(),
+        cli.frames,
+        &cli.markers,
+    )
+    .and_then(|c| command.take_chain(&c));
     if let Err(e) = chain {
         report_error(&e);
         std::process::exit(1);

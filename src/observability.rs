@@ -189,14 +189,38 @@ impl Robot {
     /// [`Robot::unknowns`] must be. Errors if the kinematics is not finite on
     /// the design (parameters too large).
     pub fn choose_unknowns(&self, preferred: &[ParamId]) -> Result<Vec<ParamId>> {
-        let mut kept: Vec<ParamId> = self
-            .independence(preferred)?
+        let walk = self.independence(preferred)?;
+        let mut kept: Vec<(ParamId, f64)> = walk
             .into_iter()
             .filter(|&(_, r)| r > INDEPENDENCE_TOL)
-            .map(|(u, _)| u)
             .collect();
-        kept.sort();
-        Ok(kept)
+        kept.sort_by_key(|&(u, _)| u);
+        // A pivot above the tolerance is necessary for the rank rule, not
+        // sufficient: near a gimbal of a tool frame's angles a pivot of 1e-6
+        // can still leave the set's condition beyond it. Drop the weakest
+        // flagged unknown until the set passes the check every command makes.
+        while !kept.is_empty() {
+            let mut probe = self.clone();
+            probe.unknowns = kept.iter().map(|&(u, _)| u).collect();
+            let id = match probe.check_identifiable() {
+                Ok(_) => break,
+                Err(Error::Unidentifiable { names, .. }) => names,
+                Err(e) => return Err(e),
+            };
+            let weakest = kept
+                .iter()
+                .enumerate()
+                .filter(|(_, (u, _))| id.contains(&self.param_name(*u)))
+                .min_by(|a, b| a.1.1.total_cmp(&b.1.1))
+                .map(|(k, _)| k);
+            match weakest {
+                Some(k) => {
+                    kept.remove(k);
+                }
+                None => break,
+            }
+        }
+        Ok(kept.into_iter().map(|(u, _)| u).collect())
     }
 
     /// The greedy walk of [`Robot::choose_unknowns`]: every parameter it
@@ -436,7 +460,11 @@ pub fn generic_configurations(robot: &Robot, n: usize, seed: u64) -> Vec<Vec<f64
                 .iter()
                 .zip(&revolute)
                 .map(|(&[lo, hi], &rev)| {
-                    let hi = if rev { hi.min(lo + std::f64::consts::TAU) } else { hi };
+                    let hi = if rev {
+                        hi.min(lo + std::f64::consts::TAU)
+                    } else {
+                        hi
+                    };
                     let f: f64 = rng.random();
                     lo + (hi - lo) * f
                 })

@@ -272,12 +272,16 @@ fn calibrate_from_a_measurement_file_and_write_the_calibrated_robot() {
         &out1,
         "--json",
     ]);
+    // The simulation weighs orientations by the robot's fixed scale (its
+    // noise is known); the same weights on the measured side.
     let real = json_of(&[
         "calibrate",
         "--robot",
         "ur5:pose",
         "--measurements",
         &meas,
+        "--weights",
+        "fixed",
         "--out",
         &out2,
         "--json",

@@ -58,14 +58,27 @@ fn generic_configurations_cover_one_turn_of_a_whole_turn_joint() {
     let qs = activecal::observability::generic_configurations(&ur5, 200, 7);
     for (j, &[lo, hi]) in ur5.limits.iter().enumerate() {
         let v: Vec<f64> = qs.iter().map(|q| q[j]).collect();
-        assert!(v.iter().all(|&x| x >= lo && x <= hi.min(lo + std::f64::consts::TAU)));
-        let mut turns: Vec<f64> = v.iter().map(|x| x.rem_euclid(std::f64::consts::TAU)).collect();
+        assert!(
+            v.iter()
+                .all(|&x| x >= lo && x <= hi.min(lo + std::f64::consts::TAU))
+        );
+        let mut turns: Vec<f64> = v
+            .iter()
+            .map(|x| x.rem_euclid(std::f64::consts::TAU))
+            .collect();
         turns.sort_by(f64::total_cmp);
         turns.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
-        assert_eq!(turns.len(), 200, "joint {j}: values that coincide modulo 2π");
+        assert_eq!(
+            turns.len(),
+            200,
+            "joint {j}: values that coincide modulo 2π"
+        );
     }
     // Seeded: the same sample again.
-    assert_eq!(qs, activecal::observability::generic_configurations(&ur5, 200, 7));
+    assert_eq!(
+        qs,
+        activecal::observability::generic_configurations(&ur5, 200, 7)
+    );
 }
 
 /// Points measured by a tool 13 cm off the last joint's axis, given to a
@@ -124,9 +137,10 @@ fn a_tool_point_off_the_last_axis_is_estimated_from_the_data() {
     );
     let notes = v["notes"].as_array().unwrap();
     assert!(
-        notes
-            .iter()
-            .any(|n| n.as_str().unwrap().contains("lies on the last joint's axis")),
+        notes.iter().any(|n| n
+            .as_str()
+            .unwrap()
+            .contains("lies on the last joint's axis")),
         "{notes:?}"
     );
 }
@@ -136,15 +150,41 @@ fn a_tool_point_off_the_last_axis_is_estimated_from_the_data() {
 #[test]
 fn a_marker_is_refused_where_it_cannot_be() {
     let ur5 = "fixtures/example-robot-data/ur5_robot.urdf";
-    let out = run(&["robots", "--robot", ur5, "--tip", "tool0", "--marker", "wrist_1_link@0.1,0,0", "--json"]);
+    let out = run(&[
+        "robots",
+        "--robot",
+        ur5,
+        "--tip",
+        "tool0",
+        "--marker",
+        "wrist_1_link@0.1,0,0",
+        "--json",
+    ]);
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("wrist_1_link@0.1,0,0") && err.contains("tip link 'tool0'"), "{err}");
+    assert!(
+        err.contains("wrist_1_link@0.1,0,0") && err.contains("tip link 'tool0'"),
+        "{err}"
+    );
     let pose = format!("{ur5}:pose");
-    let out = run(&["robots", "--robot", &pose, "--marker", "tool0@0.1,0,0", "--json"]);
+    let out = run(&[
+        "robots",
+        "--robot",
+        &pose,
+        "--marker",
+        "tool0@0.1,0,0",
+        "--json",
+    ]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("full pose"));
-    let out = run(&["robots", "--robot", ur5, "--marker", "tool0@0.1,0", "--json"]);
+    let out = run(&[
+        "robots",
+        "--robot",
+        ur5,
+        "--marker",
+        "tool0@0.1,0",
+        "--json",
+    ]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("2 coordinates after '@'"));
 }

@@ -611,7 +611,21 @@ fn to_urdf_round_trips_every_builtin() {
                 ..UrdfOptions::default()
             };
             let back = urdf::parse(&text, name, &o).unwrap();
-            assert_eq!(back.n_unknowns(), r.n_unknowns(), "{name}");
+            // At the nominal table the URDF's frames carry every unknown of
+            // the built-in; at the real one, the UR5's tool frame (a Hayati
+            // frame turned −90° by β) leaves α_tool a pivot of 7.6e-7 on
+            // generic configurations, whose set fails the rank rule: it is
+            // dropped (issue #39: choosing and checking agree).
+            match set {
+                ParamSet::Nominal => assert_eq!(back.n_unknowns(), r.n_unknowns(), "{name}"),
+                ParamSet::Real => assert!(
+                    back.n_unknowns() + 1 >= r.n_unknowns() && back.n_unknowns() <= r.n_unknowns(),
+                    "{name}: {} of {}",
+                    back.n_unknowns(),
+                    r.n_unknowns()
+                ),
+            }
+            back.check_identifiable().unwrap();
             assert_eq!(back.limits, r.limits);
             for _ in 0..300 {
                 let q = g.q(&r);

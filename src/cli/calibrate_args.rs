@@ -97,11 +97,21 @@ pub struct CalibrateArgs {
     /// components; the σ's are printed with their degrees of freedom);
     /// `fixed` keeps the robot's orientation scale (1 m per rad unless
     /// --orientation-scale).
-    #[arg(long, value_enum, default_value = "estimated", requires = "measurements")]
+    #[arg(
+        long,
+        value_enum,
+        default_value = "estimated",
+        requires = "measurements"
+    )]
     pub weights: WeightsKind,
     /// Metres of position error a radian of orientation error counts as
     /// (a full-pose fit's fixed weight); implies --weights fixed.
-    #[arg(long, value_name = "M_PER_RAD", requires = "measurements", conflicts_with = "weights")]
+    #[arg(
+        long,
+        value_name = "M_PER_RAD",
+        requires = "measurements",
+        conflicts_with = "weights"
+    )]
     pub orientation_scale: Option<f64>,
     /// A distance known between two contact points (a file with a `point`
     /// column): `A,B=METRES`, repeatable.

@@ -280,7 +280,10 @@ fn noise_text(n: &activecal::experiment::measured::NoiseReport) -> String {
             format!("{} σ {v:.4}{unit} ({:.1} dof)", b.block, b.redundancy)
         })
         .collect();
-    let mut s = format!("noise per coordinate, from the residuals: {}\n", blocks.join(", "));
+    let mut s = format!(
+        "noise per coordinate, from the residuals: {}\n",
+        blocks.join(", ")
+    );
     if n.blocks.iter().any(|b| b.unit == "rad") {
         s += &format!(
             "orientation weight: {:.4} m/rad ({}{})\n",

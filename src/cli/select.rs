@@ -302,9 +302,15 @@ pub struct SelectArgs {
 /// without it) and orientation noise `orientation` (radians): each row
 /// then carries the position's σ. Refused for a sensor that measures no
 /// orientation, or a σ that is not a finite number > 0.
-fn orientation_scale(robot: &activecal::model::Robot, noise: Option<f64>, orientation: f64) -> Result<f64> {
+fn orientation_scale(
+    robot: &activecal::model::Robot,
+    noise: Option<f64>,
+    orientation: f64,
+) -> Result<f64> {
     if !(orientation.is_finite() && orientation > 0.0) {
-        bail!("--orientation-noise {orientation}: the orientation noise σ must be a finite number > 0 (radians)");
+        bail!(
+            "--orientation-noise {orientation}: the orientation noise σ must be a finite number > 0 (radians)"
+        );
     }
     if !activecal::measure::sensor_for(robot).observes_orientation() {
         bail!(

@@ -366,15 +366,9 @@ pub fn calibrate_measured(
     };
     let det =
         prepare_for_data(&fitted_robot, &start.table, &meas, &s.fix, &s.free).map_err(in_file)?;
-    let weighted = crate::identify::fit_weighted(
-        &det.robot,
-        &start.table,
-        &meas,
-        &s.lm,
-        s.loss,
-        s.weights,
-    )
-    .map_err(in_file)?;
+    let weighted =
+        crate::identify::fit_weighted(&det.robot, &start.table, &meas, &s.lm, s.loss, s.weights)
+            .map_err(in_file)?;
     let noise = NoiseReport {
         weights: s.weights,
         orientation_scale_m_per_rad: weighted.robot.orientation_scale,

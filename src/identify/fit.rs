@@ -418,8 +418,9 @@ pub fn holdout(
         let (mtr, mte) = (meas.subset(&tr), meas.subset(&te));
         let start = for_measurements(robot, &mtr, lm)?;
         let r = prepare(&start.robot, &start.table, &mtr)?;
-        let WeightedFit { robot: r, fit: f, .. } =
-            fit_weighted(&r, &start.table, &mtr, lm, loss, settings.weights)?;
+        let WeightedFit {
+            robot: r, fit: f, ..
+        } = fit_weighted(&r, &start.table, &mtr, lm, loss, settings.weights)?;
         let fitted = residuals(&r, &f.id.table, &mtr)?;
         let held_out = residuals(&r, &f.id.table, &mte)?;
         let nominal = if std::ptr::eq(baseline, robot) {

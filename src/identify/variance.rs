@@ -146,7 +146,14 @@ mod tests {
     #[test]
     fn rows_fall_into_blocks_by_kind_and_point() {
         let (rows, names) = row_blocks(
-            &[Position, Position, Position, Orientation, Orientation, Orientation],
+            &[
+                Position,
+                Position,
+                Position,
+                Orientation,
+                Orientation,
+                Orientation,
+            ],
             1,
         );
         assert_eq!(rows, vec![0, 0, 0, 1, 1, 1]);

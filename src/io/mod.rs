@@ -196,7 +196,11 @@ fn chosen_markers(
             "marker {first}: a marker measures a point, ':pose' the tip's full pose; give one or the other"
         )));
     }
-    let tip = robot.source.as_ref().map(|s| s.tip.clone()).unwrap_or_default();
+    let tip = robot
+        .source
+        .as_ref()
+        .map(|s| s.tip.clone())
+        .unwrap_or_default();
     if let Some(m) = chain.markers.iter().find(|m| m.link != tip) {
         return Err(Error::Invalid(format!(
             "marker {m}: markers are placed in the chain's tip link '{tip}', not in '{}'; name the tip as the marker's link (or its tip as --tip)",

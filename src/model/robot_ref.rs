@@ -52,15 +52,18 @@ impl MarkerChoice {
     /// Parses `LINK@X,Y,Z` (metres); errors name the text and what is wrong.
     pub fn parse(text: &str) -> Result<MarkerChoice> {
         let bad = |what: &str| Error::Invalid(format!("marker '{text}': {what}"));
-        let (link, xyz) = text
-            .split_once('@')
-            .ok_or_else(|| bad("expected LINK@X,Y,Z (the link's name, then the offset in metres)"))?;
+        let (link, xyz) = text.split_once('@').ok_or_else(|| {
+            bad("expected LINK@X,Y,Z (the link's name, then the offset in metres)")
+        })?;
         if link.trim().is_empty() {
             return Err(bad("no link before '@'"));
         }
         let v: Vec<&str> = xyz.split(',').map(str::trim).collect();
         if v.len() != 3 {
-            return Err(bad(&format!("{} coordinates after '@', expected 3 (X,Y,Z in metres)", v.len())));
+            return Err(bad(&format!(
+                "{} coordinates after '@', expected 3 (X,Y,Z in metres)",
+                v.len()
+            )));
         }
         let mut offset = [0.0; 3];
         for (o, t) in offset.iter_mut().zip(&v) {

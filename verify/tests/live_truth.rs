@@ -21,7 +21,8 @@
 //! `how_many_poses.points[n = 30].predicted.position_rms_mm`). Its "how
 //! many poses" curve costs a certified bound per design size (20–40 s per
 //! arm in a debug build), so by default only the arms of [`REPORT_ARMS`]
-//! run it; for every arm the figure is computed with the same library
+//! and the full pose (whose `--orientation-noise` needs `--noise`, which
+//! needs `--report`) run it; for every arm the figure is computed with the same library
 //! function (`how_many::predicted_errors`, 1,000 configurations of seed 0)
 //! on the design `select` wrote, and where the report runs, the two must
 //! agree to 1e-9. `TRUTH_REPORT=all` runs the report on every arm.
@@ -90,10 +91,27 @@ const ARMS: &[Arm] = &[
 const N: usize = 30;
 /// Tracker noise per axis, metres.
 const NOISE: f64 = 5e-5;
-/// Orientation noise per axis of a full pose, radians: NOISE over today's
-/// fixed `orientation_scale` (1 m/rad), the weight `select`'s prediction
-/// assumes.
-const ORIENTATION_NOISE: f64 = 5e-5;
+/// Orientation noise per axis of a full pose, radians: 0.01°, when
+/// `select` takes `--orientation-noise` (the design and its prediction
+/// weighted for it, `calibrate` estimating the weights from the data);
+/// otherwise NOISE over the fixed `orientation_scale` (1 m/rad) that the
+/// prediction then assumes.
+fn orientation_noise() -> f64 {
+    if select_weighs_orientation() {
+        0.01f64.to_radians()
+    } else {
+        NOISE
+    }
+}
+
+/// Whether this activecal's `select` takes `--orientation-noise`.
+fn select_weighs_orientation() -> bool {
+    static ONCE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *ONCE.get_or_init(|| {
+        run(Command::new(bin()).args(["select", "--help"]))
+            .is_ok_and(|h| h.contains("--orientation-noise"))
+    })
+}
 /// Candidate poses of the pool (random, within the limits less 2°).
 const POOL: usize = 4096;
 /// The acceptance: true RMS ≤ RATIO × predicted.
@@ -108,14 +126,25 @@ const DRAWS: usize = 10;
 
 /// `truth.py measure` of `designs` into `outs` (the k-th with noise seed
 /// `(seed, k)`, the first with `seed`).
-fn measure_args(a: &Arm, designs: &[String], outs: &[String], noise: f64, seed: u64) -> Vec<String> {
+fn measure_args(
+    a: &Arm,
+    designs: &[String],
+    outs: &[String],
+    noise: f64,
+    seed: u64,
+) -> Vec<String> {
     let mut m: Vec<String> = ["measure", "--truth", "truth.json", "--design"]
         .map(String::from)
         .to_vec();
     m.extend(designs.iter().cloned());
-    m.extend(["--noise".into(), noise.to_string(), "--seed".into(), seed.to_string()]);
+    m.extend([
+        "--noise".into(),
+        noise.to_string(),
+        "--seed".into(),
+        seed.to_string(),
+    ]);
     if a.pose && noise > 0.0 {
-        m.extend(["--orientation-noise".into(), ORIENTATION_NOISE.to_string()]);
+        m.extend(["--orientation-noise".into(), orientation_noise().to_string()]);
     }
     m.push("--out".into());
     m.extend(outs.iter().cloned());
@@ -123,16 +152,20 @@ fn measure_args(a: &Arm, designs: &[String], outs: &[String], noise: f64, seed: 
 }
 
 /// The arms whose `select` writes its `--report` by default.
-const REPORT_ARMS: &[&str] = &["ur5", "xarm7"];
+const REPORT_ARMS: &[&str] = &["ur5"];
 
 /// activecal's predicted true-error RMS (mm) after calibrating with the
 /// design `design.csv` in `dir` (as `select --report` computes it: the
 /// design's information, 1,000 random configurations of seed 0, σ =
 /// [`NOISE`]), and the number of unknowns.
-fn library_prediction(a: &Arm, dir: &Path) -> (usize, f64) {
+fn library_prediction(a: &Arm, dir: &Path) -> (usize, f64, Option<f64>) {
     let mut text = robot(a).into_string().unwrap();
-    text += &format!("#frames={}", dir.join("nominal.yaml").display());
-    let robot = activecal::io::load_robot(&text).unwrap_or_else(|e| panic!("{text}: {e}"));
+    text += &sensor(a, dir).1;
+    let mut robot = activecal::io::load_robot(&text).unwrap_or_else(|e| panic!("{text}: {e}"));
+    if a.pose && select_weighs_orientation() {
+        // As `select --orientation-noise` weighs the design.
+        robot.orientation_scale = NOISE / orientation_noise();
+    }
     let names = activecal::io::measurements::joint_names(&robot);
     let csv = std::fs::read_to_string(dir.join("design.csv")).unwrap();
     let mut lines = csv.lines().filter(|l| !l.trim().is_empty());
@@ -159,15 +192,40 @@ fn library_prediction(a: &Arm, dir: &Path) -> (usize, f64) {
     });
     let e = activecal::how_many::predicted_errors(&robot, &eval, info.as_ref(), NOISE)
         .unwrap_or_else(|| panic!("{}: the design's information is singular", a.name));
-    (x.p(), e.position_rms_mm)
+    (x.p(), e.position_rms_mm, e.orientation_rms_deg)
 }
 
-/// How activecal is told the sensor: the chain's tip and the nominal
-/// marker (or tool of a full pose), as a frames file `truth.py
-/// sensor-frames` writes. The one place to change when `select --marker
-/// LINK@x,y,z` (and `calibrate --marker`) land.
-fn sensor_args(dir: &Path) -> Vec<OsString> {
-    vec!["--frames".into(), dir.join("nominal.yaml").into()]
+/// How activecal is told the sensor, as command-line options and as the
+/// `#…` fragment of the robot's text form: the chain's tip and the nominal
+/// marker (or tool of a full pose). By default a frames file `truth.py
+/// sensor-frames` writes (`--frames`, which every activecal since #26
+/// reads); with `TRUTH_SENSOR=marker`, `--tip T --marker T@x,y,z` for a
+/// point sensor (a full pose keeps the frames file: its tool has a
+/// rotation). The one place to change.
+fn sensor(a: &Arm, dir: &Path) -> (Vec<OsString>, String) {
+    if !a.pose && std::env::var("TRUTH_SENSOR").is_ok_and(|s| s == "marker") {
+        let t: Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap())
+                .unwrap();
+        let xyz: Vec<String> = t["nominal_tool"]["xyz"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap().to_string())
+            .collect();
+        let marker = format!("{}@{}", a.tip, xyz.join(","));
+        let args = ["--tip", a.tip, "--marker", &marker].map(OsString::from);
+        return (args.to_vec(), format!("#tip={};marker={marker}", a.tip));
+    }
+    let frames = dir.join("nominal.yaml");
+    (
+        vec!["--frames".into(), frames.clone().into()],
+        format!("#frames={}", frames.display()),
+    )
+}
+
+fn sensor_args(a: &Arm, dir: &Path) -> Vec<OsString> {
+    sensor(a, dir).0
 }
 
 /// The `--robot` value of an arm.
@@ -226,7 +284,7 @@ where
 /// `calibrate` from `meas` into `stem.urdf` and `stem.yaml`.
 fn calibrate(a: &Arm, dir: &Path, meas: &str, stem: &str) -> Result<(), String> {
     let mut args: Vec<OsString> = vec!["calibrate".into(), "--robot".into(), robot(a)];
-    args.extend(sensor_args(dir));
+    args.extend(sensor_args(a, dir));
     for x in [
         "--measurements",
         meas,
@@ -279,6 +337,10 @@ struct Row {
     true_rms: f64,
     /// The true RMS of each of [`DRAWS`] noise draws (the first first).
     true_draws: Vec<f64>,
+    /// A full pose: (predicted, true over the draws) orientation RMS in
+    /// degrees, and whether the design was weighed for the orientation
+    /// noise (then the prediction is asserted).
+    orientation: Option<(f64, f64, bool)>,
     design_rms: f64,
     exact: f64,
     nominal: f64,
@@ -314,7 +376,14 @@ fn one_arm(a: &Arm, seed: u64, randoms: usize, report: bool, base: &Path) -> Row
     std::fs::create_dir_all(&dir).unwrap();
     let fx = root().join("fixtures/example-robot-data");
     let mut make: Vec<OsString> = vec!["make".into(), "--urdf".into(), fx.join(a.urdf).into()];
-    for x in ["--tip", a.tip, "--seed", &seed.to_string(), "--out", "truth.json"] {
+    for x in [
+        "--tip",
+        a.tip,
+        "--seed",
+        &seed.to_string(),
+        "--out",
+        "truth.json",
+    ] {
         make.push(x.into());
     }
     if a.pose {
@@ -323,9 +392,15 @@ fn one_arm(a: &Arm, seed: u64, randoms: usize, report: bool, base: &Path) -> Row
     truth_py(&dir, &make);
     truth_py(
         &dir,
-        ["sensor-frames", "--truth", "truth.json", "--out", "nominal.yaml"],
+        [
+            "sensor-frames",
+            "--truth",
+            "truth.json",
+            "--out",
+            "nominal.yaml",
+        ],
     );
-    let sensor = sensor_args(&dir);
+    let sensor = sensor_args(a, &dir);
     let fail = |e: String| -> ! { panic!("{}: {e}", a.name) };
     // The pool select chooses from, written so that random designs come
     // from the same one.
@@ -361,20 +436,29 @@ fn one_arm(a: &Arm, seed: u64, randoms: usize, report: bool, base: &Path) -> Row
     ] {
         select.push(x.into());
     }
+    // The design weighed for the orientation noise of a full pose: as
+    // `select --orientation-noise` weighs with `--noise`, which it takes
+    // only with `--report` (else 1 cm), such an arm always has the report.
+    let weighs = a.pose && select_weighs_orientation();
+    let report = report || weighs;
     if report {
-        for x in ["--noise", &NOISE.to_string(), "--report", "report"] {
-            select.push(x.into());
-        }
+        select.extend(["--noise".into(), NOISE.to_string().into()]);
+        select.extend(["--report".into(), "report".into()]);
+    }
+    if weighs {
+        select.extend([
+            "--orientation-noise".into(),
+            orientation_noise().to_string().into(),
+        ]);
     }
     activecal(&dir, &select).unwrap_or_else(|e| fail(e));
-    let (unknowns, predicted) = library_prediction(a, &dir);
+    let (unknowns, predicted, predicted_deg) = library_prediction(a, &dir);
     let mut reported = None;
     let mut same_design = true;
     if report {
-        let r: Value = serde_json::from_str(
-            &std::fs::read_to_string(dir.join("report/report.json")).unwrap(),
-        )
-        .unwrap();
+        let r: Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("report/report.json")).unwrap())
+                .unwrap();
         let curve = &r["how_many_poses"];
         assert_eq!(curve["p"].as_u64(), Some(unknowns as u64), "{}", a.name);
         let point = curve["points"]
@@ -395,6 +479,17 @@ fn one_arm(a: &Arm, seed: u64, randoms: usize, report: bool, base: &Path) -> Row
         };
         same_design = sorted(&point["poses"]) == sorted(&r["selection"]["poses"]);
         let figure = point["predicted"]["position_rms_mm"].as_f64().unwrap();
+        if let (true, Some(deg), Some(lib)) = (
+            same_design,
+            point["predicted"]["orientation_rms_deg"].as_f64(),
+            predicted_deg,
+        ) {
+            assert!(
+                (deg - lib).abs() <= 1e-9 * lib,
+                "{}: select --report predicts {deg}°, the library {lib}° for the same design",
+                a.name
+            );
+        }
         if same_design {
             assert!(
                 (figure - predicted).abs() <= 1e-9 * predicted,
@@ -439,6 +534,15 @@ fn one_arm(a: &Arm, seed: u64, randoms: usize, report: bool, base: &Path) -> Row
     let exact = rms(1);
     let mut true_draws = vec![true_rms];
     true_draws.extend((2..stems.len()).map(rms));
+    // A full pose's orientation error (degrees): RMS over the draws.
+    let orientation = predicted_deg.map(|p| {
+        let deg: Vec<f64> = std::iter::once(0)
+            .chain(2..stems.len())
+            .map(|k| c[k]["random"]["orientation_rms_deg"].as_f64().unwrap())
+            .collect();
+        let rms = (deg.iter().map(|x| x * x).sum::<f64>() / deg.len() as f64).sqrt();
+        (p, rms, weighs)
+    });
     let nominal = truth_py(
         &dir,
         [
@@ -494,6 +598,7 @@ fn one_arm(a: &Arm, seed: u64, randoms: usize, report: bool, base: &Path) -> Row
         reported,
         true_rms,
         true_draws,
+        orientation,
         design_rms,
         exact,
         nominal,
@@ -514,9 +619,10 @@ fn calibrated_arms_match_a_known_true_robot() {
     let only: Option<Vec<String>> = std::env::var("TRUTH_ARMS")
         .ok()
         .map(|s| s.split(',').map(str::to_string).collect());
-    let arms: Vec<&Arm> = ARMS
-        .iter()
-        .filter(|a| only.as_ref().is_none_or(|o| o.iter().any(|n| n == a.name)))
+    // Each arm's seed is its place in ARMS (1, 2, …), whichever run.
+    let arms: Vec<(u64, &Arm)> = (1..)
+        .zip(ARMS)
+        .filter(|(_, a)| only.as_ref().is_none_or(|o| o.iter().any(|n| n == a.name)))
         .collect();
     println!(
         "truth gate: {N} poses, σ = {} mm per axis, {POOL} random pool poses, {randoms} random designs per arm",
@@ -539,9 +645,9 @@ fn calibrated_arms_match_a_known_true_robot() {
         "s"
     );
     let mut failures = Vec::new();
-    for (k, a) in arms.iter().enumerate() {
+    for &(seed, a) in &arms {
         let report = all_reports || REPORT_ARMS.contains(&a.name);
-        let row = one_arm(a, 1 + k as u64, randoms, report, &base);
+        let row = one_arm(a, seed, randoms, report, &base);
         let over_draws = row.rms_of_draws();
         let ratio = over_draws / row.predicted;
         let med = row.median_random();
@@ -570,6 +676,26 @@ fn calibrated_arms_match_a_known_true_robot() {
                 "  (the report's N = 30 design is not the chosen one)"
             }
         );
+        if let Some((p, t, weighed)) = row.orientation {
+            println!(
+                "{:<9} orientation: predicted {p:.5}°, true {t:.5}° over {DRAWS} draws ({:.2}×); σ {:.4}° per axis{}",
+                "",
+                t / p,
+                orientation_noise().to_degrees(),
+                if weighed {
+                    ", the design weighed for it"
+                } else {
+                    " (select without --orientation-noise: not asserted)"
+                }
+            );
+            if weighed && !(t <= RATIO * p) {
+                failures.push(format!(
+                    "{}: true orientation RMS {t:.5}° is {:.2}× the predicted {p:.5}°",
+                    row.name,
+                    t / p
+                ));
+            }
+        }
         // NaN fails too.
         if !(ratio <= RATIO) {
             failures.push(format!(

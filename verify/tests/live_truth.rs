@@ -11,7 +11,9 @@
 //! random configurations. Asserted: the true RMS (over 10 noise draws at
 //! the chosen design) is within 1.3× of the prediction, and noise-free
 //! measurements recover the truth to 1e-6 mm.
-//! Also: activecal's unknowns equal the rank of Pinocchio's identification
+//! Control: the noise-free fit with its last unknown held at nominal (as
+//! the sampler that found 26 of 27 did) leaves more than 1e-3 mm, so the
+//! gate sees a missing unknown. Also: activecal's unknowns equal the rank of Pinocchio's identification
 //! Jacobian of a complete model (every joint origin, tracker, marker) at
 //! random configurations. Reported: the chosen design's true error against
 //! the median of random designs of the same pool (`TRUTH_RANDOM`, default
@@ -283,8 +285,20 @@ where
 
 /// `calibrate` from `meas` into `stem.urdf` and `stem.yaml`.
 fn calibrate(a: &Arm, dir: &Path, meas: &str, stem: &str) -> Result<(), String> {
+    calibrate_with(a, dir, meas, stem, &[])
+}
+
+/// `calibrate` with `extra` options.
+fn calibrate_with(
+    a: &Arm,
+    dir: &Path,
+    meas: &str,
+    stem: &str,
+    extra: &[&str],
+) -> Result<(), String> {
     let mut args: Vec<OsString> = vec!["calibrate".into(), "--robot".into(), robot(a)];
     args.extend(sensor_args(a, dir));
+    args.extend(extra.iter().map(OsString::from));
     for x in [
         "--measurements",
         meas,
@@ -337,6 +351,9 @@ struct Row {
     true_rms: f64,
     /// The true RMS of each of [`DRAWS`] noise draws (the first first).
     true_draws: Vec<f64>,
+    /// The control: the last unknown held at nominal in the noise-free fit,
+    /// and the true RMS that leaves (mm).
+    control: (String, f64),
     /// A full pose: (predicted, true over the draws) orientation RMS in
     /// degrees, and whether the design was weighed for the orientation
     /// noise (then the prediction is asserted).
@@ -515,8 +532,19 @@ fn one_arm(a: &Arm, seed: u64, randoms: usize, report: bool, base: &Path) -> Row
         calibrate(a, &dir, m, stem).unwrap_or_else(|e| fail(e));
     }
     calibrate(a, &dir, "exact.csv", "exact").unwrap_or_else(|e| fail(e));
-    // cal0 (with the design's own poses), exact, then the other draws.
-    let mut stems = vec![draws[0].clone(), "exact".into()];
+    // The control: the same noise-free fit with its last unknown held at
+    // nominal (as the 26-of-27 sampler did) must not recover the truth.
+    let fit: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("exact.json")).unwrap()).unwrap();
+    let last = fit["parameters"]
+        .as_array()
+        .and_then(|p| p.last())
+        .and_then(|p| p["name"].as_str())
+        .unwrap_or_else(|| fail(format!("no parameters in calibrate --json: {fit}")))
+        .to_string();
+    calibrate_with(a, &dir, "exact.csv", "fixed", &["--fix", &last]).unwrap_or_else(|e| fail(e));
+    // cal0 (with the design's own poses), exact, fixed, then the other draws.
+    let mut stems = vec![draws[0].clone(), "exact".into(), "fixed".into()];
     stems.extend(draws[1..].iter().cloned());
     let mut args: Vec<String> = ["compare", "--truth", "truth.json", "--seed"]
         .map(String::from)
@@ -532,12 +560,13 @@ fn one_arm(a: &Arm, seed: u64, randoms: usize, report: bool, base: &Path) -> Row
     let true_rms = rms(0);
     let design_rms = c[0]["design"]["rms_mm"].as_f64().unwrap();
     let exact = rms(1);
+    let control = (last, rms(2));
     let mut true_draws = vec![true_rms];
-    true_draws.extend((2..stems.len()).map(rms));
+    true_draws.extend((3..stems.len()).map(rms));
     // A full pose's orientation error (degrees): RMS over the draws.
     let orientation = predicted_deg.map(|p| {
         let deg: Vec<f64> = std::iter::once(0)
-            .chain(2..stems.len())
+            .chain(3..stems.len())
             .map(|k| c[k]["random"]["orientation_rms_deg"].as_f64().unwrap())
             .collect();
         let rms = (deg.iter().map(|x| x * x).sum::<f64>() / deg.len() as f64).sqrt();
@@ -598,6 +627,7 @@ fn one_arm(a: &Arm, seed: u64, randoms: usize, report: bool, base: &Path) -> Row
         reported,
         true_rms,
         true_draws,
+        control,
         orientation,
         design_rms,
         exact,
@@ -645,6 +675,7 @@ fn calibrated_arms_match_a_known_true_robot() {
         "s"
     );
     let mut failures = Vec::new();
+    let mut controls = Vec::new();
     for &(seed, a) in &arms {
         let report = all_reports || REPORT_ARMS.contains(&a.name);
         let row = one_arm(a, seed, randoms, report, &base);
@@ -676,6 +707,7 @@ fn calibrated_arms_match_a_known_true_robot() {
                 "  (the report's N = 30 design is not the chosen one)"
             }
         );
+        controls.push(format!("{} {} {:.2e}", row.name, row.control.0, row.control.1));
         if let Some((p, t, weighed)) = row.orientation {
             println!(
                 "{:<9} orientation: predicted {p:.5}°, true {t:.5}° over {DRAWS} draws ({:.2}×); σ {:.4}° per axis{}",
@@ -709,6 +741,13 @@ fn calibrated_arms_match_a_known_true_robot() {
                 row.name, row.unknowns, row.rank
             ));
         }
+        // The gate sees a missing unknown.
+        if !(row.control.1 > 1e3 * EXACT_MM) {
+            failures.push(format!(
+                "{}: noise-free data with {} held at nominal leave only {:.3e} mm: the gate cannot see a missing unknown",
+                row.name, row.control.0, row.control.1
+            ));
+        }
         if !(row.exact <= EXACT_MM) {
             failures.push(format!(
                 "{}: noise-free data leave {:.3e} mm of true error",
@@ -718,6 +757,10 @@ fn calibrated_arms_match_a_known_true_robot() {
     }
     println!(
         "mm. predicted: r = select --report's figure, else the same function on the chosen design; rank: Pinocchio's; true(1): the first noise draw, true(10): RMS over {DRAWS} draws, ratio = true(10) / predicted; at design: draw 1 at the design's poses; nominal: the uncalibrated model; rand.med.: median of the random designs (one draw each), chosen/r = true(10) / rand.med."
+    );
+    println!(
+        "control, noise-free with the last unknown held at nominal (mm): {}",
+        controls.join("; ")
     );
     if only.is_none() {
         assert!(arms.len() >= 8, "{} arms", arms.len());

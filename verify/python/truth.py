@@ -38,10 +38,19 @@ Usage (run with /work/main/.venv/bin/python; every output is JSON or CSV):
       random configurations within the joint limits (a joint spanning more
       than a turn drawn over one turn about its range's centre) and at the
       design's poses: RMS (and max) of the 3-D distance, mm; orientation
-      error angle (deg) for a full pose. Printed as one JSON object.
-      Also: --nominal compares the nominal URDF (cal.urdf = the nominal,
-      frames = truth's tracker and the nominal marker) to show the error
-      before calibration.
+      error angle (deg) for a full pose. Printed as one JSON object
+      (`random`, `design`: rms_mm, max_mm, ...); several --urdf U1 U2 ..
+      --frames F1 F2 .. print a list (--design applies to the first; the
+      same configurations for all). --nominal compares the nominal URDF
+      with the true tracker and the nominal marker: the error before
+      calibration.
+
+  truth.py rank --truth truth.json [--n 100] [--seed S]
+      The rank of Pinocchio's identification Jacobian of a complete model
+      (every chain joint origin 6, tracker 6, marker 3, tool rotation 3 for
+      a pose) at N random configurations: what activecal's unknowns should
+      number (27 for a UR with a marker, 31 for the xArm7, 30 for a UR
+      full pose).
 
   truth.py sensor-frames --truth truth.json --out nominal.yaml
       A frames file giving activecal the chain's tip and the NOMINAL marker
@@ -52,9 +61,11 @@ Usage (run with /work/main/.venv/bin/python; every output is JSON or CSV):
       N distinct rows of a pool file written by `activecal pool --out
       pool.csv` (the pool `select --pool file:pool.csv` chooses from),
       uniformly at random (numpy default_rng(S)), written in the same CSV
-      form.
+      form (several --out: one design each).
 
-See verify/python/truth_run.sh for one arm end to end.
+One arm end to end, printing predicted vs true:
+  verify/python/truth_run.sh ur5 [SEED] [RANDOM_DESIGNS]
+The live gate on 9 arms: verify/tests/live_truth.rs.
 """
 import argparse
 import json

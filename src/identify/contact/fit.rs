@@ -35,7 +35,9 @@ pub const IRLS_TOLERANCE: f64 = 1e-9;
 pub const GAUGE_TOL: f64 = 1e-8;
 
 /// The pivot (of a unit column, after the columns kept before it) at or
-/// below which a contact fit fixes an unknown: stricter than the shared
+/// below which a contact fit calls an unknown weakly determined, and
+/// estimates it only when the data's noise makes it worth it
+/// ([`super::worth`]): stricter than the shared
 /// [`crate::identify::undetermined::PIVOT_TOL`] (3.2e-5, which separates
 /// exact dependences from rounding). Contacts carry σ ≈ 0.2 mm on points
 /// ~0.5 m from the base (4e-4 relative), so an unknown with less than 1e-3
@@ -192,7 +194,10 @@ fn jacobian(prob: &mut dyn Residuals, theta: &[f64]) -> Mat<f64> {
 
 /// Fits `robot`'s determined unknowns, the tool offset and the points to
 /// `file`'s contacts with the known `distances` (indices into
-/// `file.points`), from `start`.
+/// `file.points`), from `start`. Unknowns the data determine only weakly
+/// (a pivot at or below [`CONTACT_PIVOT_TOL`]) are estimated when their σ
+/// in a fit of every determined unknown is below the error a joint origin
+/// is expected to carry, and fixed otherwise ([`super::worth`]).
 pub fn fit_contacts(
     robot: &Robot,
     start: &ParamTable,
@@ -201,9 +206,18 @@ pub fn fit_contacts(
     settings: &ContactSettings,
 ) -> Result<ContactFit> {
     settings.lm.validate()?;
+    loss_of(settings.loss)?;
     let own0 = start_own(robot, start, file);
     let planes = start_planes(robot, start, file);
-    let reduced = determined(
+    let setup = Setup {
+        start,
+        file,
+        distances,
+        planes: &planes,
+        own0: &own0,
+        settings,
+    };
+    let strict = determined(
         robot,
         start,
         file,
@@ -211,28 +225,95 @@ pub fn fit_contacts(
         &planes,
         &own0,
         &settings.keep,
+        crate::identify::undetermined::PIVOT_TOL,
     )?;
+    let weak_bar = determined(
+        robot,
+        start,
+        file,
+        distances,
+        &planes,
+        &own0,
+        &settings.keep,
+        CONTACT_PIVOT_TOL,
+    )?;
+    let weak: Vec<String> = weak_bar
+        .fixed
+        .iter()
+        .filter(|f| !strict.fixed.iter().any(|s| s.name == f.name))
+        .map(|f| f.name.clone())
+        .collect();
+    if weak.is_empty() {
+        return Ok(setup.fit(strict));
+    }
+    // Every determined unknown estimated, then the weak ones the noise
+    // makes worthless fixed (`worth`).
+    let all = setup.fit(strict.clone());
+    if !all.converged {
+        return Ok(setup.fit(weak_bar));
+    }
+    let to_fix = super::worth::weak_to_fix(
+        &all.robot,
+        &weak,
+        &all.names,
+        &all.start,
+        all.std.as_deref(),
+    );
+    if to_fix.is_empty() {
+        return Ok(all);
+    }
+    let mut reduced = strict;
+    reduced.robot.unknowns.retain(|&u| {
+        let n = robot.param_name(u);
+        !to_fix.iter().any(|f| f.name == n)
+    });
+    reduced.fixed.extend(to_fix);
+    Ok(setup.fit(reduced))
+}
+
+/// What a contact fit is of: the data, the known distances and planes, the
+/// start, the settings.
+struct Setup<'a> {
+    start: &'a ParamTable,
+    file: &'a ContactFile,
+    distances: &'a [KnownDistance],
+    planes: &'a [Plane],
+    own0: &'a [f64],
+    settings: &'a ContactSettings,
+}
+
+impl Setup<'_> {
+    /// Fits the unknowns of `reduced` (the rest fixed with their reasons).
+    fn fit(&self, reduced: crate::identify::Determined) -> ContactFit {
+        fit_reduced(self, reduced)
+    }
+}
+
+/// The fit of [`fit_contacts`] with the unknowns of `reduced`.
+fn fit_reduced(s: &Setup<'_>, reduced: crate::identify::Determined) -> ContactFit {
+    let (start, file, distances, planes, own0) = (s.start, s.file, s.distances, s.planes, s.own0);
     let r = &reduced.robot;
     let mut theta0 = r.unknown_values(start);
     theta0.extend_from_slice(&own0);
     let mut prob = Weighted {
-        inner: problem(r, start, file, distances, &planes),
+        inner: problem(r, start, file, distances, planes),
         sqrt_w: vec![1.0; file.qs.len()],
     };
-    let loss = loss_of(settings.loss)?;
-    let sol = solve(&mut prob, &theta0, &settings.lm, loss.as_deref());
+    // The loss was checked when the settings were (`loss_of` in `fit_contacts`).
+    let loss = loss_of(s.settings.loss).ok().flatten();
+    let sol = solve(&mut prob, &theta0, &s.settings.lm, loss.as_deref());
     let weights: Vec<f64> = prob.sqrt_w.iter().map(|w| w * w).collect();
-    Ok(finish(
+    finish(
         r,
         start,
         file,
-        &planes,
+        planes,
         &prob,
         theta0,
         sol,
         reduced.fixed,
         weights,
-    ))
+    )
 }
 
 /// The loss of a choice (`None` for least squares).
@@ -281,7 +362,8 @@ fn solve(
 /// The robot reduced to the unknowns the contacts determine: first the
 /// gauge (unknowns whose motion is one rigid motion of the whole setup at
 /// every row, see [`gauge_unknowns`]), then what the shared rule finds on
-/// the Jacobian of the rest.
+/// the Jacobian of the rest, with pivots at or below `pivot_tol` fixed.
+#[allow(clippy::too_many_arguments)]
 fn determined(
     robot: &Robot,
     start: &ParamTable,
@@ -290,6 +372,7 @@ fn determined(
     planes: &[Plane],
     own0: &[f64],
     keep: &[String],
+    pivot_tol: f64,
 ) -> Result<crate::identify::Determined> {
     let names = robot.parameter_names();
     // A known plane pins the setup: no rigid motion is free then.
@@ -314,7 +397,7 @@ fn determined(
     let mut theta = inner.unknown_values(start);
     theta.extend_from_slice(own0);
     let x = jacobian(&mut prob, &theta);
-    let mut d = fix_undetermined_below(&inner, start, &file.qs, &x, keep, CONTACT_PIVOT_TOL)?;
+    let mut d = fix_undetermined_below(&inner, start, &file.qs, &x, keep, pivot_tol)?;
     let mut col_names = inner.parameter_names();
     col_names.truncate(inner.n_unknowns());
     col_names.extend(prob.sensor().own_param_names());

@@ -8,6 +8,8 @@
 //!   its point's mean; distance errors);
 //! * [`fit`](mod@fit): the fit (identifiable unknowns, the gauge, a robust
 //!   loss that names the rows it down-weights);
+//! * [`worth`]: which weakly determined unknowns are worth estimating at
+//!   the data's noise;
 //! * [`holdout`]: held out by placement (the part of a point's name before
 //!   `/`): leave one placement out, and train on one;
 //! * [`select`], [`socket_design`]: the configurations to record for
@@ -20,6 +22,7 @@ pub mod holdout;
 pub mod project;
 pub mod select;
 pub mod socket_design;
+pub mod worth;
 
 pub use data::{ContactFile, NamedPlane};
 pub use fit::{ContactFit, ContactSettings, PlaneEstimate, fit_contacts};

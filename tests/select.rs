@@ -387,3 +387,25 @@ fn iterated_local_search_ends_at_a_local_optimum_above_its_start() {
     assert!((base - a.ln_oid).abs() < 1e-6);
     assert_no_improving_swap(&x, &a.poses, &[0, 400]);
 }
+
+/// `select --noise` without `--report` prints the error predicted after
+/// calibrating with the chosen poses: σ times a figure of the design alone
+/// (the covariance σ²(XᵀX)⁻¹ carried to random configurations), so twice
+/// the noise predicts exactly twice the error, and the figure is the
+/// report's for the same design (`verify/tests/live_truth.rs` checks it
+/// against the truth).
+#[test]
+fn select_predicts_the_calibrated_error_for_a_noise() {
+    let run = |noise: &str| {
+        super::common::json_of(&[
+            "select", "--robot", "ur5", "--levels", "4", "--n", "30", "--noise", noise, "--json",
+        ])
+    };
+    let (a, b) = (run("1e-4"), run("2e-4"));
+    assert_eq!(a["poses"], b["poses"]);
+    let f = |v: &serde_json::Value| v["predicted"]["position_rms_mm"].as_f64().unwrap();
+    assert!(f(&a) > 0.0 && f(&a) < 1.0, "{}", f(&a));
+    assert!((f(&b) / f(&a) - 2.0).abs() < 1e-12, "{} {}", f(&a), f(&b));
+    assert_eq!(a["predicted"]["configurations"], 1000);
+    assert_eq!(a["predicted"]["noise_m"], 1e-4);
+}

@@ -274,9 +274,11 @@ pub struct SelectArgs {
     /// tour. An existing non-empty directory needs --force.
     #[arg(long, value_name = "DIR")]
     pub report: Option<PathBuf>,
-    /// Sensor noise σ per measured coordinate of --report's predicted
-    /// errors, metres [default: 0.01, as `calibrate --noise`].
-    #[arg(long, requires = "report", allow_negative_numbers = true)]
+    /// Sensor noise σ per measured coordinate, metres: the error predicted
+    /// after calibrating with the chosen poses is printed (and in --json,
+    /// `predicted`), and --report's curve uses it [default there: 0.01, as
+    /// `calibrate --noise`].
+    #[arg(long, allow_negative_numbers = true)]
     pub noise: Option<f64>,
     /// Orientation noise σ per axis of a full-pose sensor, radians: the
     /// design weighs a radian of orientation as `--noise`/RAD metres (as
@@ -399,10 +401,60 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         )?;
         super::tour::write_design(&design, out, a.force)?;
     }
+    if let (Some(noise), None) = (a.noise, &existing) {
+        report.predicted = predicted_after(&ctx, a.pool.params, &sel.poses, noise);
+    }
     if let Some(dir) = &a.report {
         report_dir(&a, &ctx, &s, dir, &report)?;
     }
-    emit_report(a.json, &report, || select_text(&a, &ctx, &report, seconds))
+    emit_report(a.json, &report, || {
+        select_text(&a, &ctx, &report, seconds) + &predicted_text(report.predicted.as_ref())
+    })
+}
+
+/// The predicted errors' line of the text output (empty without them).
+fn predicted_text(p: Option<&activecal::report::PredictedAfter>) -> String {
+    let Some(p) = p else {
+        return String::new();
+    };
+    let mut s = format!(
+        "predicted after calibrating with these poses (σ {} mm per coordinate): position RMS {:.4} mm at {} random configurations (95th percentile {:.4} mm)",
+        p.noise_m * 1e3,
+        p.errors.position_rms_mm,
+        p.configurations,
+        p.errors.position_p95_mm
+    );
+    if let Some(o) = p.errors.orientation_rms_deg {
+        s += &format!(", orientation RMS {o:.5}°");
+    }
+    s + "\n"
+}
+
+/// Configurations the predicted errors are taken over (as `--report`'s).
+const PREDICTION_CONFIGURATIONS: usize = 1000;
+
+/// The errors predicted after calibrating with the pool poses `poses`
+/// with noise `noise` (metres), at random configurations of seed 0, as
+/// `--report`'s curve computes them; `None` for a singular design.
+fn predicted_after(
+    ctx: &super::PoolCtx,
+    params: activecal::model::ParamSet,
+    poses: &[usize],
+    noise: f64,
+) -> Option<activecal::report::PredictedAfter> {
+    let robot = &ctx.robot;
+    let info = ctx.x.information(poses);
+    let qs = activecal::how_many::random_configurations(robot, PREDICTION_CONFIGURATIONS, 0);
+    let table = robot.params(params);
+    let eval = activecal::blocks::jacobian_of(robot, table, qs.len(), |k, q| {
+        q.copy_from_slice(&qs[k]);
+    });
+    let errors = activecal::how_many::predicted_errors(robot, &eval, info.as_ref(), noise)?;
+    Some(activecal::report::PredictedAfter {
+        noise_m: noise,
+        configurations: qs.len(),
+        errors,
+    })
 }
 
 /// The outputs and report options of `select`, checked before any work:

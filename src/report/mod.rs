@@ -20,7 +20,9 @@ pub use fk::{FkReport, Orientation};
 pub use gap::GapReport;
 pub use lattice::LatticeReport;
 pub use score::ScoreReport;
-pub use select::{PoseConfig, RefinedPoseReport, RefinementReport, SelectReport, TraceStep};
+pub use select::{
+    PoseConfig, PredictedAfter, RefinedPoseReport, RefinementReport, SelectReport, TraceStep,
+};
 
 use crate::model::Robot;
 use crate::pool::{Pool, PoolSpec, PoolStats};

@@ -173,6 +173,10 @@ pub struct SelectReport {
     /// With `--refine`: the design moved continuously off the pool.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub refinement: Option<RefinementReport>,
+    /// The errors predicted after calibrating with the chosen poses, for a
+    /// given sensor noise (at random configurations).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub predicted: Option<PredictedAfter>,
     /// The chain's joint names, in configuration order.
     pub joint_names: Vec<String>,
     /// The design's poses with their joint values (refined ones with
@@ -195,6 +199,20 @@ pub struct PoseConfig {
     pub id: usize,
     /// Joint values, radians or metres, in the order of `joint_names`.
     pub q: Vec<f64>,
+}
+
+/// The errors predicted after a calibration with a design's poses: the
+/// covariance `σ² (XᵀX)⁻¹` carried to the measured point at random
+/// configurations ([`crate::how_many::predicted_errors`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct PredictedAfter {
+    /// The sensor noise σ per coordinate, metres.
+    pub noise_m: f64,
+    /// How many random configurations (seed 0) the errors are over.
+    pub configurations: usize,
+    /// The errors.
+    #[serde(flatten)]
+    pub errors: crate::how_many::PredictedErrors,
 }
 
 impl SelectReport {
@@ -260,6 +278,7 @@ impl SelectReport {
             ln_oid_new_only: None,
             ln_gain: None,
             refinement: None,
+            predicted: None,
         }
     }
 

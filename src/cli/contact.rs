@@ -175,6 +175,11 @@ pub fn calibrate_contacts(
         )?),
         None => None,
     };
+    let predicted = activecal::identify::contact::predict::predicted_true_error(
+        &fit,
+        activecal::identify::contact::predict::PREDICTION_CONFIGURATIONS,
+        0,
+    );
     let down = downweighted_rows(&fit, &file);
     let frames = if a.out.is_empty() {
         None
@@ -193,11 +198,19 @@ pub fn calibrate_contacts(
         "downweighted": down,
         "in_sample": figures,
         "holdout": held,
+        "predicted_true_error": predicted,
         "frames": frames.as_ref().map(|(_, r)| r),
         "out": written,
         "exit_status": if fit.converged { 0 } else { 3 },
     });
     let mut report = text(&file, &fit, &figures, held.as_ref());
+    if let Some(p) = &predicted {
+        let _ = writeln!(
+            report,
+            "predicted true error of the calibrated tool point (the fit's covariance at {} random configurations): {:.4} mm RMS; it includes what held-out placements cannot see (an error common to a placement's rows)",
+            p.configurations, p.rms_mm
+        );
+    }
     if !written.is_empty() {
         report.push('\n');
     }

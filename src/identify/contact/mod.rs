@@ -8,6 +8,9 @@
 //!   its point's mean; distance errors);
 //! * [`fit`](mod@fit): the fit (identifiable unknowns, the gauge, a robust
 //!   loss that names the rows it down-weights);
+//! * [`predict`]: the true error the fit's covariance predicts for the
+//!   tool point at random configurations (what held-out placements
+//!   cannot see);
 //! * [`worth`]: which weakly determined unknowns are worth estimating at
 //!   the data's noise;
 //! * [`holdout`]: held out by placement (the part of a point's name before
@@ -19,6 +22,7 @@ pub mod data;
 pub mod evaluate;
 pub mod fit;
 pub mod holdout;
+pub mod predict;
 pub mod project;
 pub mod select;
 pub mod socket_design;

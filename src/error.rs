@@ -162,6 +162,27 @@ pub enum Error {
         /// The unit the whole column would fit in, if another.
         hint: Option<UnitHint>,
     },
+    /// Measured positions that move far less than the robot does at their
+    /// poses (`check_positions_in_reach` in [`crate::units`]).
+    #[error(
+        "{file}: the measured positions move {:.3} mm (RMS about their mean) where the nominal model moves {:.1} mm at the same poses (read in {unit}){}",
+        *.spread * 1e3,
+        *.nominal * 1e3,
+        hint.map_or(String::new(), |h| format!("; {}", h.spread_text(unit)))
+    )]
+    PositionsTooSmall {
+        /// The measurement file.
+        file: String,
+        /// The measured positions' RMS about their mean, metres (after
+        /// reading in `unit`).
+        spread: f64,
+        /// The nominal model's points' RMS about their mean, metres.
+        nominal: f64,
+        /// The length unit the positions were read in.
+        unit: &'static str,
+        /// The unit they would pass in, if another.
+        hint: Option<UnitHint>,
+    },
     /// Measured positions whose nominal residuals are far beyond the robot's
     /// reach ([`crate::units::check_positions_in_reach`]).
     #[error(
@@ -238,6 +259,20 @@ impl UnitHint {
             UnitHint::Metres => {
                 "every value of this column fits the limits as metres: it looks like metres, not millimetres"
             }
+        }
+    }
+
+    /// What positions that spread as the robot moves in this unit look
+    /// like.
+    #[must_use]
+    pub fn spread_text(self, read_as: &str) -> String {
+        match self {
+            UnitHint::Millimetres | UnitHint::Degrees => format!(
+                "read as millimetres they move as the robot does: the positions look like millimetres (read as {read_as})"
+            ),
+            UnitHint::Metres | UnitHint::Radians => format!(
+                "read as metres they move as the robot does: the positions look like metres (read as {read_as})"
+            ),
         }
     }
 

@@ -183,7 +183,7 @@ fn main() {
     if std::env::var_os("ACTIVECAL_DEBUG_READS").is_some() {
         // Each input file and how often it was read (once is the rule).
         for (path, n) in activecal::io::read::reads() {
-            eprintln!("read {n}× {}", path.display());
+            cli::diag(&format!("read {n}× {}", path.display()));
         }
     }
     if let Err(e) = r {
@@ -201,9 +201,9 @@ fn main() {
 /// ([`cli::units::flag_hint`]) or the option that gives the input it names
 /// ([`cli::hints::option_hints`]).
 fn report_error(e: &anyhow::Error) {
-    eprintln!("error: {e:#}");
+    cli::diag(&format!("error: {e:#}"));
     let unit = cli::units::flag_hint(e);
     for h in unit.into_iter().chain(cli::hints::option_hints(e)) {
-        eprintln!("hint: {h}");
+        cli::diag(&format!("hint: {h}"));
     }
 }

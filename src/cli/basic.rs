@@ -127,7 +127,7 @@ pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
         };
         match &a.out {
             Some(path) => super::write_new(path, &text, a.force)?,
-            None => print!("{text}"),
+            None => super::print_out(&text)?,
         }
         return Ok(());
     }
@@ -144,8 +144,7 @@ pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
     };
     let described: Vec<Value> = robots.iter().map(robot_json).collect();
     let v = json!({ "robots": described });
-    emit(a.json, &v, || robots.iter().map(robot_text).collect());
-    Ok(())
+    emit(a.json, &v, || robots.iter().map(robot_text).collect())
 }
 
 /// One robot of `robots --json`.

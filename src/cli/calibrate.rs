@@ -7,7 +7,7 @@
 pub use super::calibrate_args::{CalibrateArgs, DEFAULT_NOISE};
 pub use super::calibrated::{EXIT_NOT_CONVERGED, NotConverged};
 use super::calibrated::{
-    exit_status, frames_of, refuse_unconverged, status_text, write_calibrated,
+    exit_status, not_written, frames_of, refuse_unconverged, status_text, write_calibrated,
 };
 use activecal::frames::report::FitBlock;
 use activecal::identify::{Identification, LmSettings};
@@ -143,7 +143,7 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     };
     let mut print_note = |n: &str| {
         if !a.json {
-            eprintln!("note: {n}");
+            super::diag(&format!("note: {n}"));
         }
     };
     let activecal::experiment::measured::MeasuredCalibration {
@@ -160,10 +160,22 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     };
     let frames = frames_of(&fitted, id, Some(fit))?;
     report.frames = frames.as_ref().map(|(_, r)| r.clone());
-    report.base.out =
-        write_calibrated(a, &fitted, id, &path.display().to_string(), frames.as_ref())?;
+    // A converged fit that made another robot of this one is not written.
+    let implausible = id
+        .converged()
+        .then(|| activecal::identify::plausible::implausible(&fitted, &id.table))
+        .flatten();
+    if implausible.is_none() {
+        report.base.out =
+            write_calibrated(a, &fitted, id, &path.display().to_string(), frames.as_ref())?;
+    }
     let mut v = serde_json::to_value(&report)?;
-    v["exit_status"] = exit_status(id).into();
+    v["exit_status"] = if implausible.is_some() {
+        EXIT_NOT_CONVERGED
+    } else {
+        exit_status(id)
+    }
+    .into();
     if let Some(dir) = &a.report {
         super::report_dir::calibration(dir, &measured_summary(&fitted, id, path, &report, &v))?;
     }
@@ -173,7 +185,10 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
             s += &format!("\ncalibrated robot written to {out}\n");
         }
         s
-    });
+    })?;
+    if let Some(why) = implausible {
+        return Err(NotConverged(why + &not_written(a)).into());
+    }
     refuse_unconverged(a, id)
 }
 

@@ -102,10 +102,20 @@ pub struct CalibrateArgs {
     pub plane: Vec<String>,
     /// Contacts held out by placement (the part of a point's name before
     /// '/'): fit on all placements but one, judge on that one, for each.
-    #[arg(long, value_enum, requires = "measurements")]
+    #[arg(
+        long,
+        value_enum,
+        requires = "measurements",
+        conflicts_with_all = ["train_on", "holdout"]
+    )]
     pub holdout_by: Option<super::contact::HoldoutBy>,
     /// Contacts: fit on this placement alone, judge on each other one.
-    #[arg(long, value_name = "PLACEMENT", requires = "measurements")]
+    #[arg(
+        long,
+        value_name = "PLACEMENT",
+        requires = "measurements",
+        conflicts_with = "holdout"
+    )]
     pub train_on: Option<String>,
     /// Also fit a compliance per revolute joint whose gravity torque (from
     /// the URDF's inertials) varies over the data: the joint deflects by

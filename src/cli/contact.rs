@@ -148,8 +148,11 @@ pub fn calibrate_contacts(
     let (given, planes) = contact_setup(a.setup, a.point_distance, a.plane)?;
     let mut file = read_contacts(path, robot, a.units)?;
     file.set_known_planes(&planes).context("--plane")?;
+    activecal::identify::contact::lengths::check_planes(robot, &file).context("--plane")?;
     let known = resolve_distances(&file, &given, true).context("--point-distance")?;
     activecal::identify::contact::check_scale(&file, &known).context("--point-distance")?;
+    activecal::identify::contact::lengths::check_distances(robot, &file, &known)
+        .context("--point-distance")?;
     let settings = ContactSettings {
         lm: LmSettings::default()
             .with_max_iterations(a.max_iterations)
@@ -181,8 +184,12 @@ pub fn calibrate_contacts(
     } else {
         super::contact_out::frames(&fit, &file, &given)?
     };
+    // A converged fit that made another robot of this one is not written.
+    let implausible = fit.converged.then(|| implausible(&fit)).flatten();
     let written = match &frames {
-        Some(f) if fit.converged => super::contact_out::write(a.out, a.force, &fit.robot, &fit, f)?,
+        Some(f) if fit.converged && implausible.is_none() => {
+            super::contact_out::write(a.out, a.force, &fit.robot, &fit, f)?
+        }
         _ => Vec::new(),
     };
     let v = json!({
@@ -195,7 +202,7 @@ pub fn calibrate_contacts(
         "holdout": held,
         "frames": frames.as_ref().map(|(_, r)| r),
         "out": written,
-        "exit_status": if fit.converged { 0 } else { 3 },
+        "exit_status": if fit.converged && implausible.is_none() { 0 } else { 3 },
     });
     let mut report = text(&file, &fit, &figures, held.as_ref());
     if !written.is_empty() {
@@ -216,7 +223,16 @@ pub fn calibrate_contacts(
             super::contact_report::draw(d, &r)
         })?;
     }
-    super::emit(a.json, &v, || report);
+    super::emit(a.json, &v, || report)?;
+    if let Some(why) = implausible {
+        let names: Vec<String> = a.out.iter().map(|p| p.display().to_string()).collect();
+        let lost = if names.is_empty() {
+            String::new()
+        } else {
+            format!("; {} not written", names.join(", "))
+        };
+        return Ok(Some(why + &lost));
+    }
     if !fit.converged {
         let names: Vec<String> = a.out.iter().map(|p| p.display().to_string()).collect();
         return Ok(Some(format!(
@@ -371,4 +387,15 @@ fn holdout_text(h: &HoldoutReport) -> String {
         );
     }
     s
+}
+
+/// Why a contact fit is not a calibration of its robot
+/// ([`activecal::identify::plausible`]): a joint origin moved too far, or
+/// the tool offset beyond the reach.
+fn implausible(fit: &activecal::identify::contact::ContactFit) -> Option<String> {
+    use activecal::identify::plausible;
+    plausible::implausible(&fit.robot, &fit.table).or_else(|| {
+        let reach = activecal::units::reach(&fit.robot);
+        plausible::check_offsets("the tool offset", &[fit.tool_offset], reach)
+    })
 }

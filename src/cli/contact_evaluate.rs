@@ -30,8 +30,7 @@ pub fn cmd_evaluate_contacts(a: &EvaluateArgs) -> Result<()> {
     });
     super::emit(a.json, &v, || {
         text(&robot.name, &file.origin, file.qs.len(), &e)
-    });
-    Ok(())
+    })
 }
 
 /// The evaluation as text.

@@ -150,7 +150,12 @@ fn load_urdf(path: &Path, chain: &ChainChoice, pose: bool) -> Result<Robot> {
         opts.mount = f.mount;
         opts.tool = f.tool;
     }
-    let robot = urdf::load(path, &opts)?;
+    let robot = match &frames {
+        Some(f) => urdf::load(path, &opts)
+            .map_err(|e| f.blame_links(e, chain.base.is_some(), chain.tip.is_some()))
+            .and_then(|r| f.check_names(&r).map(|()| r))?,
+        None => urdf::load(path, &opts)?,
+    };
     let robot = match &frames {
         Some(f) if !f.compliance.is_empty() => with_compliance(robot, &f.compliance, chain)?,
         _ => robot,

@@ -8,6 +8,8 @@
 //!   its point's mean; distance errors);
 //! * [`fit`](mod@fit): the fit (identifiable unknowns, the gauge, a robust
 //!   loss that names the rows it down-weights);
+//! * [`lengths`]: known distances and plane offsets checked against the
+//!   robot's reach;
 //! * [`holdout`]: held out by placement (the part of a point's name before
 //!   `/`): leave one placement out, and train on one;
 //! * [`select`], [`socket_design`]: the configurations to record for
@@ -17,6 +19,7 @@ pub mod data;
 pub mod evaluate;
 pub mod fit;
 pub mod holdout;
+pub mod lengths;
 pub mod project;
 pub mod select;
 pub mod socket_design;

@@ -163,7 +163,10 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     // A converged fit that made another robot of this one is not written.
     let implausible = id
         .converged()
-        .then(|| activecal::identify::plausible::implausible(&fitted, &id.table))
+        .then(|| {
+            let f = frames.as_ref().map(|(f, _)| f);
+            activecal::frames::plausible::implausible(&fitted, &id.table, f)
+        })
         .flatten();
     if implausible.is_none() {
         report.base.out =

@@ -179,13 +179,13 @@ pub fn calibrate_contacts(
         None => None,
     };
     let down = downweighted_rows(&fit, &file);
-    let frames = if a.out.is_empty() {
-        None
-    } else {
-        super::contact_out::frames(&fit, &file, &given)?
-    };
+    let all_frames = super::contact_out::frames(&fit, &file, &given)?;
     // A converged fit that made another robot of this one is not written.
-    let implausible = fit.converged.then(|| implausible(&fit)).flatten();
+    let implausible = fit
+        .converged
+        .then(|| implausible(&fit, all_frames.as_ref().map(|(f, _)| f)))
+        .flatten();
+    let frames = if a.out.is_empty() { None } else { all_frames };
     let written = match &frames {
         Some(f) if fit.converged && implausible.is_none() => {
             super::contact_out::write(a.out, a.force, &fit.robot, &fit, f)?
@@ -390,12 +390,15 @@ fn holdout_text(h: &HoldoutReport) -> String {
 }
 
 /// Why a contact fit is not a calibration of its robot
-/// ([`activecal::identify::plausible`]): a joint origin moved too far, or
+/// ([`activecal::frames::plausible`]): a joint origin moved too far, or
 /// the tool offset beyond the reach.
-fn implausible(fit: &activecal::identify::contact::ContactFit) -> Option<String> {
-    use activecal::identify::plausible;
-    plausible::implausible(&fit.robot, &fit.table).or_else(|| {
+fn implausible(
+    fit: &activecal::identify::contact::ContactFit,
+    frames: Option<&activecal::frames::CalibratedFrames>,
+) -> Option<String> {
+    use activecal::identify::plausible::check_offsets;
+    activecal::frames::plausible::implausible(&fit.robot, &fit.table, frames).or_else(|| {
         let reach = activecal::units::reach(&fit.robot);
-        plausible::check_offsets("the tool offset", &[fit.tool_offset], reach)
+        check_offsets("the tool offset", &[fit.tool_offset], reach)
     })
 }

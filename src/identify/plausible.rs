@@ -16,6 +16,22 @@ fn length(row: &[f64; 5]) -> f64 {
     row[2].hypot(row[3])
 }
 
+/// Why a move of `moved` metres of `what`'s origin, on a link `link`
+/// metres long, is too far ([`LINK_FRACTION`] of the link, at least a tenth
+/// of `reach`), or `None`.
+#[must_use]
+pub fn moved_too_far(what: &str, moved: f64, link: f64, reach: f64) -> Option<String> {
+    let limit = LINK_FRACTION * link.max(0.1 * reach);
+    (moved > limit).then(|| {
+        format!(
+            "the fit moved the origin of {what} by {:.1} mm, more than {} % of its link ({:.1} mm): not a calibration of this robot (the data's unit or robot?)",
+            moved * 1e3,
+            LINK_FRACTION * 100.0,
+            link * 1e3
+        )
+    })
+}
+
 /// Why `fitted` is not a calibration of `robot` (whose nominal table is the
 /// start), or `None`: a joint frame's origin moved by more than
 /// [`LINK_FRACTION`] of its link (at least a tenth of the reach), or the
@@ -40,16 +56,9 @@ pub fn implausible(robot: &Robot, fitted: &ParamTable) -> Option<String> {
         } else {
             (f[2] - n[2]).hypot(f[3] - n[3])
         };
-        let link = length(n);
-        let limit = LINK_FRACTION * link.max(0.1 * reach);
-        if moved > limit {
-            return Some(format!(
-                "the fit moved the origin of frame '{}' by {:.1} mm, more than {} % of its link ({:.1} mm): not a calibration of this robot (the data's unit or robot?)",
-                robot.frames[k].label,
-                moved * 1e3,
-                LINK_FRACTION * 100.0,
-                link * 1e3
-            ));
+        let label = format!("frame '{}'", robot.frames[k].label);
+        if let Some(why) = moved_too_far(&label, moved, length(n), reach) {
+            return Some(why);
         }
     }
     let tool: f64 = fitted.rows[last + 1..].iter().map(length).sum();

@@ -106,7 +106,7 @@ pub enum Error {
     /// A structure whose estimated memory exceeds the budget
     /// ([`crate::resources::MemoryBudget`]), refused before allocating it.
     #[error(
-        "{what} would need {needed} of memory, above the limit of {limit} ({source_of_limit}); use a smaller pool (fewer lattice levels or poses) or raise the limit"
+        "{what} would need {needed} of memory, above the limit of {limit} ({source_of_limit})\n  use a smaller pool (fewer lattice levels or poses) or raise the limit"
     )]
     TooLarge {
         /// What was to be allocated.
@@ -165,7 +165,7 @@ pub enum Error {
     /// Measured positions that move far less than the robot does at their
     /// poses (`check_positions_in_reach` in [`crate::units`]).
     #[error(
-        "{file}: the measured positions move {:.3} mm (RMS about their mean) where the nominal model moves {:.1} mm at the same poses (read in {unit}){}",
+        "{file}: the measured positions move {:.3} mm RMS about their mean, the nominal model's {:.1} mm at the same poses (read in {unit}){}",
         *.spread * 1e3,
         *.nominal * 1e3,
         hint.map_or(String::new(), |h| format!("; {}", h.spread_text(unit)))
@@ -267,12 +267,12 @@ impl UnitHint {
     #[must_use]
     pub fn spread_text(self, read_as: &str) -> String {
         match self {
-            UnitHint::Millimetres | UnitHint::Degrees => format!(
-                "read as millimetres they move as the robot does: the positions look like millimetres (read as {read_as})"
-            ),
-            UnitHint::Metres | UnitHint::Radians => format!(
-                "read as metres they move as the robot does: the positions look like metres (read as {read_as})"
-            ),
+            UnitHint::Millimetres | UnitHint::Degrees => {
+                format!("they look like millimetres (read as {read_as})")
+            }
+            UnitHint::Metres | UnitHint::Radians => {
+                format!("they look like metres (read as {read_as})")
+            }
         }
     }
 

@@ -226,8 +226,8 @@ fn rlimits(root: &Path) -> Option<MemoryBudget> {
     let limits = read_under(root, "/proc/self/limits")?;
     let status = read_under(root, "/proc/self/status").unwrap_or_default();
     [
-        ("Max address space", "RLIMIT_AS (ulimit -v)", "VmSize"),
-        ("Max data size", "RLIMIT_DATA (ulimit -d)", "VmData"),
+        ("Max address space", "ulimit -v", "VmSize"),
+        ("Max data size", "ulimit -d", "VmData"),
     ]
     .into_iter()
     .filter_map(|(line, name, used_key)| {
@@ -236,7 +236,7 @@ fn rlimits(root: &Path) -> Option<MemoryBudget> {
         Some(MemoryBudget {
             limit: limit.saturating_sub(used),
             source: format!(
-                "{name} of {} less the {} this process already maps ({used_key})",
+                "{name} of {} less {} mapped",
                 format_bytes(limit),
                 format_bytes(used)
             ),
@@ -488,10 +488,7 @@ mod tests {
         ];
         let b = budget("rlimit", &files, None);
         assert_eq!(b.limit, 2_048_000_000 - 48_000 * 1024);
-        assert_eq!(
-            b.source,
-            "RLIMIT_AS (ulimit -v) of 2.0 GB less the 49.2 MB this process already maps (VmSize)"
-        );
+        assert_eq!(b.source, "ulimit -v of 2.0 GB less 49.2 MB mapped");
         // A data limit smaller still wins, less VmData.
         let data = LIMITS.replace(
             "Max data size             unlimited",

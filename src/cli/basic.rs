@@ -326,7 +326,7 @@ pub fn cmd_pool(a: PoolArgs) -> Result<()> {
     }
     let d = super::load_description(&a.pool.robot)?;
     let spec = a.pool.spec(&d)?;
-    let pool = spec.build(&d.robot, &d.robot.nominal)?;
+    let pool = spec.build_poses(&d.robot, &d.robot.nominal)?;
     let r = activecal::pool::summary::PoolSummary::new(&d.robot, &pool)?;
     if let Some(out) = &a.out {
         let qs: Vec<Vec<f64>> = (0..pool.len()).map(|k| pool.q(k)).collect();

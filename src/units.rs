@@ -251,7 +251,12 @@ fn check_column(
     } else {
         (units.angle.to_rad(), units.angle.symbol())
     };
-    let fits_as = |factor: f64| qs.iter().all(|q| inside(q[j] / given * factor));
+    // Another unit is named only when at least half the column fails in
+    // this one: one value typed wrong among radians is not a column of
+    // degrees, though all of them, as degrees, would fit.
+    let failing = qs.iter().filter(|q| !inside(q[j])).count();
+    let fits_as =
+        |factor: f64| failing * 2 >= qs.len() && qs.iter().all(|q| inside(q[j] / given * factor));
     let hint = match (prismatic, units.angle, units.length) {
         (false, AngleUnit::Rad, _) if fits_as(AngleUnit::Deg.to_rad()) => Some(UnitHint::Degrees),
         (false, AngleUnit::Deg, _) if fits_as(1.0) => Some(UnitHint::Radians),

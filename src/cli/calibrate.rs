@@ -7,7 +7,7 @@
 pub use super::calibrate_args::{CalibrateArgs, DEFAULT_NOISE};
 pub use super::calibrated::{EXIT_NOT_CONVERGED, NotConverged};
 use super::calibrated::{
-    exit_status, not_written, frames_of, refuse_unconverged, status_text, write_calibrated,
+    exit_status, frames_of, not_written, refuse_unconverged, status_text, write_calibrated,
 };
 use activecal::frames::report::FitBlock;
 use activecal::identify::{Identification, LmSettings};

@@ -297,7 +297,10 @@ mod tests {
         if process_alive(0).is_some() {
             assert!(!dead.exists() && !staged.exists(), "stale temporaries kept");
         }
-        assert!(ours.exists() && other.exists(), "a live or other temporary removed");
+        assert!(
+            ours.exists() && other.exists(),
+            "a live or other temporary removed"
+        );
         std::fs::remove_dir_all(&d).unwrap();
     }
 

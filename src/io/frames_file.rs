@@ -283,7 +283,11 @@ fn build(f: &FileEntry) -> StrResult<Frames> {
         if let Some(p) = &m.value.parent {
             links.push(name_at(format!("{key}.parent"), p));
         }
-        markers.push(numbers(&format!("{key}.xyz"), m.value.xyz.as_ref(), line(&m.referenced))?);
+        markers.push(numbers(
+            &format!("{key}.xyz"),
+            m.value.xyz.as_ref(),
+            line(&m.referenced),
+        )?);
     }
     for (joint, c) in &f.compliance {
         if !c.c.is_finite() {
@@ -300,7 +304,10 @@ fn build(f: &FileEntry) -> StrResult<Frames> {
     }
     let c = &chain.value;
     let Some(chain_joints) = &c.joints else {
-        return Err(format!("chain.joints: missing{}", at(line(&chain.referenced))));
+        return Err(format!(
+            "chain.joints: missing{}",
+            at(line(&chain.referenced))
+        ));
     };
     let chain_joints = chain_joints
         .iter()
@@ -365,11 +372,14 @@ impl Frames {
         let why = self.written_for();
         let all: Vec<String> = src.joints.iter().map(|j| j.name.clone()).collect();
         let driven = src.driven_names();
-        let chain = format!("the chain {} → {} of {}", src.base, src.tip, src.path);
+        let chain = format!("the chain {} → {}", src.base, src.tip);
         for n in self.chain_joints.iter().chain(&self.other_joints) {
             if !all.contains(&n.name) {
                 let near = crate::names::did_you_mean(&n.name, &all);
-                let near = near.trim_start().trim_start_matches('(').trim_end_matches(')');
+                let near = near
+                    .trim_start()
+                    .trim_start_matches('(')
+                    .trim_end_matches(')');
                 let listed = if near.is_empty() {
                     format!("its driven joints: {}", few(&driven))
                 } else {

@@ -23,8 +23,7 @@ pub const SHORT_FACTOR: f64 = 100.0;
 fn as_mm(metres: f64, limit: f64) -> String {
     if metres.abs() * 1e-3 <= limit {
         format!(
-            "; it looks like millimetres ({} mm = {} m): lengths here are metres",
-            Compact(metres),
+            "; it looks like millimetres (= {} m)",
             Compact(metres * 1e-3)
         )
     } else {
@@ -52,7 +51,7 @@ pub fn check_distances(robot: &Robot, file: &ContactFile, known: &[KnownDistance
         );
         if d.metres > limit {
             return Err(Error::Invalid(format!(
-                "{label}: {} m is more than {LENGTH_REACH_FACTOR} times the robot's reach of {reach:.3} m: no two points the tool touches are that far apart{}",
+                "{label}: {} m is more than {LENGTH_REACH_FACTOR} × the robot's reach ({reach:.3} m){}",
                 Compact(d.metres),
                 as_mm(d.metres, limit)
             )));
@@ -60,9 +59,8 @@ pub fn check_distances(robot: &Robot, file: &ContactFile, known: &[KnownDistance
         let nominal = (means[d.a] - means[d.b]).norm();
         if d.metres * SHORT_FACTOR < nominal {
             return Err(Error::Invalid(format!(
-                "{label}: {} m is more than {SHORT_FACTOR} times shorter than the {nominal:.3} m the nominal model puts between the two points' contacts in {}: check the unit (metres) and the points' names",
-                Compact(d.metres),
-                file.origin
+                "{label}: {} m is more than {SHORT_FACTOR} times shorter than the nominal model's {nominal:.3} m between the two points' contacts",
+                Compact(d.metres)
             )));
         }
     }
@@ -83,7 +81,7 @@ pub fn check_planes(robot: &Robot, file: &ContactFile) -> Result<()> {
         let distance = offset / n;
         if distance.abs() > limit {
             return Err(Error::Invalid(format!(
-                "plane {}: offset d = {} m puts it {} m from the base, more than {LENGTH_REACH_FACTOR} times the robot's reach of {reach:.3} m: the robot cannot touch it{}",
+                "plane {}: offset d = {} m puts it {} m from the base, more than {LENGTH_REACH_FACTOR} × the reach ({reach:.3} m): the robot cannot touch it{}",
                 p.name,
                 Compact(*offset),
                 Compact(distance.abs()),

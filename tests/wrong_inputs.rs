@@ -720,3 +720,77 @@ fn unclear_messages_say_what_is_wrong() {
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// More of the messages: identical contact rows name the point and
+/// its lines; an `--inertia` file without `<inertial>` says so; three
+/// full poses for 30 unknowns say that first.
+#[test]
+fn repeated_rows_masses_and_too_few_poses_are_named() {
+    let d = scratch("more");
+    let text = std::fs::read_to_string(PANDA_CSV).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    let (q, _) = lines.next().unwrap().rsplit_once(',').unwrap();
+    let mut csv = format!("{header}\n");
+    for p in ["a/0", "a/0", "a/0", "a/1", "a/1", "a/1"] {
+        csv += &format!("{q},{p}\n");
+    }
+    std::fs::write(d.join("same.csv"), csv).unwrap();
+    let out = panda_contacts(&d, &["same.csv", "--point-distance", "a/0,a/1=0.05"]);
+    refused(
+        &out,
+        1,
+        &[
+            "same.csv",
+            "point 'a/0' has 3 rows (line 2, 3, 4) but 1 different configuration",
+        ],
+        "identical rows",
+    );
+    let ur5 = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/ur5.urdf");
+    let out = run_in(
+        &d,
+        &[
+            "calibrate",
+            "--robot",
+            UR10_POSE,
+            "--tip",
+            "wrist_3_link",
+            "--measurements",
+            UR10_CSV,
+            "--compliance",
+            "--inertia",
+            ur5,
+        ],
+    );
+    refused(
+        &out,
+        1,
+        &["ur5.urdf", "no link has an <inertial> element"],
+        "no inertials",
+    );
+    let all = std::fs::read_to_string(UR10_CSV).unwrap();
+    let head: Vec<&str> = all.lines().take(4).collect();
+    std::fs::write(d.join("three.csv"), head.join("\n") + "\n").unwrap();
+    let out = run_in(
+        &d,
+        &[
+            "calibrate",
+            "--robot",
+            UR10_POSE,
+            "--tip",
+            "wrist_3_link",
+            "--measurements",
+            "three.csv",
+        ],
+    );
+    refused(
+        &out,
+        3,
+        &[
+            "3 poses give 18 measurement rows for 30 unknowns: too few",
+            "at least 5 poses",
+        ],
+        "three poses",
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -189,10 +189,37 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         }
         s
     })?;
+    // Too few poses for the unknowns: the cause, ahead of what it led to.
+    let few = too_few_rows(&fitted, &report);
+    let cause = |why: String| match &few {
+        Some(f) => format!("{f}\n  {why}"),
+        None => why,
+    };
     if let Some(why) = implausible {
-        return Err(NotConverged(why + &not_written(a)).into());
+        return Err(NotConverged(cause(why) + &not_written(a)).into());
     }
-    refuse_unconverged(a, id)
+    refuse_unconverged(a, id).map_err(|e| match e.downcast::<NotConverged>() {
+        Ok(NotConverged(why)) => NotConverged(cause(why)).into(),
+        Err(e) => e,
+    })
+}
+
+/// `N poses give R measurement rows for U unknowns: too few …` when the
+/// data have fewer rows than the fit had unknowns (estimated and fixed).
+fn too_few_rows(
+    fitted: &Robot,
+    r: &activecal::experiment::measured::MeasuredReport,
+) -> Option<String> {
+    let per_pose = fitted.rows_per_pose().max(1);
+    let rows = r.base.poses * per_pose;
+    let unknowns = r.parameters.len() + r.fixed.len();
+    (rows < unknowns).then(|| {
+        format!(
+            "{} poses give {rows} measurement rows for {unknowns} unknowns: too few to determine the model (at least {} poses)",
+            r.base.poses,
+            unknowns.div_ceil(per_pose)
+        )
+    })
 }
 
 /// What `--report` shows of a calibration from measurements.

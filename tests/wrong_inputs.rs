@@ -299,9 +299,9 @@ fn implausible_tables_are_named() {
 }
 
 /// `--holdout-by` with `--train-on` (or `--holdout`): a usage error, not one
-/// silently dropped.
+/// silently dropped; and every other pair that was silently ignored.
 #[test]
-fn conflicting_holdouts_are_refused() {
+fn conflicting_options_are_refused() {
     let d = scratch("conflict");
     for extra in [
         &["--holdout-by", "placement", "--train-on", "front_left"][..],
@@ -317,6 +317,92 @@ fn conflicting_holdouts_are_refused() {
         let out = panda_contacts(&d, &a);
         refused(&out, 2, &["cannot be used with"], &format!("{extra:?}"));
     }
+    // Options of one kind of data, or one algorithm, given with another:
+    // each was silently ignored.
+    let out = run_in(
+        &d,
+        &["select", "--levels", "3", "--n", "30", "--out", "d.json"],
+    );
+    assert!(out.status.success());
+    let cases: [(&[&str], i32, &[&str]); 9] = [
+        (
+            &["calibrate", "--design", "d.json", "--loss", "huber"],
+            2,
+            &["'--loss <LOSS>'", "cannot be used with"],
+        ),
+        (
+            &["calibrate", "--design", "d.json", "--fix", "a_1"],
+            2,
+            &["'--fix <FIX>'"],
+        ),
+        (
+            &["calibrate", "--design", "d.json", "--holdout", "0.2"],
+            2,
+            &["'--holdout <F>'"],
+        ),
+        (
+            &["calibrate", "--design", "d.json", "--compliance"],
+            2,
+            &["'--compliance'"],
+        ),
+        (
+            &["robots", "--robot", "puma560", "--out", "x.toml"],
+            2,
+            &["'--out <OUT>'", "cannot be used with"],
+        ),
+        (
+            &[
+                "select",
+                "--levels",
+                "3",
+                "--algorithm",
+                "fedorov",
+                "--designs",
+                "10",
+            ],
+            1,
+            &["--designs 10", "--algorithm fedorov draws none"],
+        ),
+        (
+            &[
+                "select",
+                "--levels",
+                "3",
+                "--algorithm",
+                "random",
+                "--initial",
+                "5",
+            ],
+            1,
+            &["--initial 5", "--algorithm random does not use it"],
+        ),
+        (
+            &["select", "--levels", "3", "--home", "0,0,0,0,0,0"],
+            1,
+            &["--home", "--order time"],
+        ),
+        (
+            &[
+                "calibrate",
+                "--robot",
+                PANDA,
+                "--tip",
+                "ball_link",
+                "--measurements",
+                PANDA_CSV,
+                "--point-distance",
+                "front_left/0,front_left/1=0.05",
+                "--fix",
+                "d_panda_joint1",
+            ],
+            1,
+            &["--fix is for measured poses", "contact file"],
+        ),
+    ];
+    for (args, status, needs) in cases {
+        refused(&run_in(&d, args), status, needs, &format!("{args:?}"));
+    }
+    assert!(!d.join("x.toml").exists());
     let _ = std::fs::remove_dir_all(&d);
 }
 

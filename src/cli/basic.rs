@@ -18,8 +18,10 @@ pub struct RobotsArgs {
     /// File for `--export` (default: standard output, as TOML), by
     /// extension: .toml (a description), .urdf (the URDF, or a built-in's
     /// chain as URDF), .yaml (a URDF robot's frames file); any other is
-    /// refused.
-    #[arg(long, requires = "export")]
+    /// refused. (Conflicting with --robot and --json as well: clap does not
+    /// check `requires` when an option conflicting with the required one is
+    /// given, and --out was silently ignored.)
+    #[arg(long, requires = "export", conflicts_with_all = ["robot", "json"])]
     pub out: Option<std::path::PathBuf>,
     /// Replace an existing `--out` file.
     #[arg(long, requires = "out")]

@@ -65,6 +65,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     let robot = &desc.robot;
     match (&a.design, &a.measurements) {
         (_, Some(m)) if super::contact::is_contact_file(m) => {
+            refuse_for_contacts(&a, m)?;
             let c = super::contact::ContactArgs {
                 holdout: a.holdout.is_some(),
                 out: &a.out,
@@ -104,6 +105,25 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
         (Some(d), None) => super::simulated::from_design(&a, robot, desc.visibility.as_ref(), d),
         (None, None) => bail!("give --design (simulate) or --measurements (real data)"),
     }
+}
+
+/// The options of a fit of measured poses that a contact fit does not
+/// take: refused rather than silently ignored.
+fn refuse_for_contacts(a: &CalibrateArgs, m: &Path) -> Result<()> {
+    let given = [
+        (!a.fix.is_empty(), "--fix"),
+        (a.compliance, "--compliance"),
+        (a.compare_compliance, "--compare-compliance"),
+        (a.inertia.is_some(), "--inertia"),
+        (a.payload.is_some(), "--payload"),
+    ];
+    if let Some((_, name)) = given.iter().find(|(g, _)| *g) {
+        bail!(
+            "{name} is for measured poses; {} is a contact file (a 'point' or 'plane' column), whose fit does not take it",
+            m.display()
+        );
+    }
+    Ok(())
 }
 
 /// Identification from a measurement file.

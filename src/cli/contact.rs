@@ -147,6 +147,7 @@ pub fn calibrate_contacts(
     super::contact_out::check(a.out, robot)?;
     let (given, planes) = contact_setup(a.setup, a.point_distance, a.plane)?;
     let mut file = read_contacts(path, robot, a.units)?;
+    file.check_distinct()?;
     file.set_known_planes(&planes).context("--plane")?;
     activecal::identify::contact::lengths::check_planes(robot, &file).context("--plane")?;
     let known = resolve_distances(&file, &given, true).context("--point-distance")?;

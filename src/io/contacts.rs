@@ -125,7 +125,6 @@ pub fn parse_contacts(
     };
     joint_values_to_model_units(robot, units, &source, &mut qs)?;
     let (points, planes, groups) = group_rows(&names, &t.lines, &err)?;
-    check_distinct(&qs, &groups, &points, &planes, &t.lines, &err)?;
     Ok(ContactFile {
         origin: origin.to_string(),
         qs,
@@ -265,50 +264,6 @@ fn joint_columns(
                 })
         })
         .collect()
-}
-
-/// Refuses a point or plane whose rows repeat fewer than its minimum of
-/// different configurations ([`MIN_ROWS_PER_POINT`],
-/// [`MIN_ROWS_PER_PLANE`]): the same configuration recorded again adds
-/// nothing, and a fit of such rows has nothing to determine.
-fn check_distinct(
-    qs: &[Vec<f64>],
-    groups: &[usize],
-    points: &[String],
-    planes: &[Plane],
-    lines: &[usize],
-    err: &dyn Fn(String) -> Error,
-) -> Result<()> {
-    let names = points
-        .iter()
-        .map(|p| ("point", p.as_str(), MIN_ROWS_PER_POINT))
-        .chain(
-            planes
-                .iter()
-                .map(|p| ("plane", p.name.as_str(), MIN_ROWS_PER_PLANE)),
-        );
-    for (g, (what, name, min)) in names.enumerate() {
-        let rows: Vec<usize> = (0..qs.len()).filter(|&k| groups[k] == g).collect();
-        let mut distinct: Vec<&Vec<f64>> = Vec::new();
-        for &k in &rows {
-            if !distinct.contains(&&qs[k]) {
-                distinct.push(&qs[k]);
-            }
-        }
-        if distinct.len() < min {
-            let mut at: Vec<String> = rows.iter().take(6).map(|&k| lines[k].to_string()).collect();
-            if rows.len() > 6 {
-                at.push("…".into());
-            }
-            return Err(err(format!(
-                "{what} '{name}' has {} rows (line {}) but {} different configuration(s): a {what} needs at least {min} different ones (a row recorded again adds nothing)",
-                rows.len(),
-                at.join(", "),
-                distinct.len()
-            )));
-        }
-    }
-    Ok(())
 }
 
 /// Point and plane names in order of appearance and each row's group

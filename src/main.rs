@@ -156,6 +156,7 @@ fn main() {
         .and_then(|(_, m)| m.try_get_one::<bool>("json").ok().flatten().copied())
         .unwrap_or(false);
     cli::progress::install_for(cli.progress, json);
+    cap_threads();
     let mut command = cli.command;
     let chain = cli::chain_choice(cli.base, cli.tip, cli.lock.as_deref(), cli.frames)
         .and_then(|c| command.take_chain(&c));
@@ -194,6 +195,31 @@ fn main() {
         } else {
             1
         });
+    }
+}
+
+/// Runs rayon's workers only as many as the linear-algebra backend's
+/// per-thread buffers allow within the memory budget
+/// ([`activecal::resources::threads_within`]): each thread that multiplies
+/// matrices allocates twice the L3 cache, outside any budget, and aborts
+/// when it cannot (`ulimit -v 2000000` with 4 threads and 150 MiB of L3).
+/// `RAYON_NUM_THREADS` (or the core count) is the most it runs.
+fn cap_threads() {
+    use activecal::resources::{MemoryBudget, backend_buffer_bytes, threads_within};
+    // A malformed ACTIVECAL_MAX_MEMORY is reported by the command itself.
+    let Ok(budget) = MemoryBudget::from_env() else {
+        return;
+    };
+    let wanted = std::env::var("RAYON_NUM_THREADS")
+        .ok()
+        .and_then(|v| v.trim().parse::<usize>().ok())
+        .filter(|&n| n > 0)
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from));
+    let n = threads_within(&budget, backend_buffer_bytes(), wanted);
+    if n < wanted {
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global();
     }
 }
 

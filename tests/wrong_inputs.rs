@@ -880,3 +880,35 @@ fn repeated_rows_masses_and_too_few_poses_are_named() {
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// No abort under a memory limit: the linear-algebra backend allocates
+/// twice the L3 cache on every thread that multiplies matrices, outside any
+/// budget; with enough threads under `ulimit -v 2000000` that allocation
+/// failed and the process aborted (exit 134). The thread count is now
+/// capped so the buffers fit in a quarter of the budget. The test asks
+/// for enough threads to exceed the limit on this machine's L3 (at most
+/// 64).
+#[test]
+fn no_abort_under_a_memory_limit_whatever_the_threads() {
+    let d = scratch("threads");
+    let buffer = activecal::resources::backend_buffer_bytes();
+    let over = usize::try_from(2_048_000_000 / buffer.max(1)).unwrap_or(64) + 2;
+    for threads in [1, 4, over.min(64)] {
+        let out = Command::new("sh")
+            .arg("-c")
+            .arg("ulimit -v 2000000 && exec \"$0\" \"$@\"")
+            .arg(env!("CARGO_BIN_EXE_activecal"))
+            .args(["select", "--levels", "4", "--json"])
+            .env("RAYON_NUM_THREADS", threads.to_string())
+            .current_dir(&d)
+            .output()
+            .expect("runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{threads} threads: {err}");
+        assert!(
+            !err.contains("memory allocation"),
+            "{threads} threads: {err}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}

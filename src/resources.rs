@@ -569,7 +569,7 @@ mod tests {
         let b = budget("rdata", &files, None);
         assert_eq!(b.limit, 1_000_000_000 - 1_000 * 1024);
         assert!(
-            b.source.starts_with("RLIMIT_DATA (ulimit -d)"),
+            b.source.starts_with("ulimit -d of"),
             "{}",
             b.source
         );

@@ -568,11 +568,7 @@ mod tests {
         ];
         let b = budget("rdata", &files, None);
         assert_eq!(b.limit, 1_000_000_000 - 1_000 * 1024);
-        assert!(
-            b.source.starts_with("ulimit -d of"),
-            "{}",
-            b.source
-        );
+        assert!(b.source.starts_with("ulimit -d of"), "{}", b.source);
     }
 
     #[test]

@@ -554,6 +554,13 @@ fn frames_files_are_read_strictly() {
             vec!["measurement_frame.quaternion (line", "norm 2.000, not 1"],
         ),
         (
+            "word.yaml",
+            with_quaternion(&text, &["1.0", "abc", "0.0", "0.0"]),
+            vec![
+                "word.yaml: measurement_frame.quaternion (line 35, column 5): invalid floating point",
+            ],
+        ),
+        (
             "cut.yaml",
             with_quaternion(&text, &["1.0"]),
             vec![

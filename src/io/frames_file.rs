@@ -126,7 +126,7 @@ fn short(x: f64) -> String {
     }
 }
 
-/// `at line N` for a known line, nothing for an unknown one.
+/// ` (line N)` for a known line, nothing for an unknown one.
 fn at(line: usize) -> String {
     if line == 0 {
         String::new()
@@ -232,11 +232,81 @@ pub fn parse(text: &str, origin: &str) -> Result<Frames> {
             "the file is empty: a frames file (written by a calibration) has chain, measurement_frame, joints and a tool or markers".into(),
         ));
     }
-    let f: FileEntry =
-        serde_saphyr::from_str(text).map_err(|e| bad(format!("not a frames file: {e}")))?;
+    let f: FileEntry = serde_saphyr::from_str(text).map_err(|e| bad(schema_error(text, &e)))?;
     let mut frames = build(&f).map_err(bad)?;
     frames.origin = origin.to_string();
     Ok(frames)
+}
+
+/// A YAML or schema error as `KEY.PATH (line L, column C): what`, the
+/// source excerpt the parser shows on the lines after it.
+fn schema_error(text: &str, e: &serde_saphyr::Error) -> String {
+    let full = e.to_string();
+    let Some(loc) = e.location() else {
+        return format!("not a frames file: {full}");
+    };
+    let (l, c) = (loc.line() as usize, loc.column());
+    let what = e.without_snippet().to_string();
+    let what = what.trim_start_matches("error: ");
+    let what = what
+        .split_once(": ")
+        .filter(|(head, _)| head.starts_with("line "))
+        .map_or(what, |(_, rest)| rest);
+    let at_end = format!(" at line {l}, column {c}");
+    let what = what.strip_suffix(at_end.as_str()).unwrap_or(what);
+    let key = key_path_at(text, l);
+    let key = if key.is_empty() {
+        "not a frames file".into()
+    } else {
+        key
+    };
+    let detail: String = full.lines().skip(1).map(|x| format!("\n{x}")).collect();
+    format!("{key} (line {l}, column {c}): {what}{detail}")
+}
+
+/// The key path (`measurement_frame.xyz`) of the node at 1-based `line` of
+/// block-style YAML `text`: the keys of the lines above it with less
+/// indentation (a list's items sit at their key's). Best effort: empty
+/// when no key is found.
+fn key_path_at(text: &str, line: usize) -> String {
+    let lines: Vec<&str> = text.lines().collect();
+    let Some(start) = line.checked_sub(1).and_then(|k| lines.get(k)) else {
+        return String::new();
+    };
+    let indent = |l: &str| l.len() - l.trim_start().len();
+    let item = |l: &str| l.trim_start().starts_with('-');
+    let key_of = |l: &str| {
+        let t = l.trim_start().trim_start_matches('-').trim_start();
+        t.split_once(':')
+            .map(|(k, _)| k.trim())
+            .filter(|k| !k.is_empty() && !k.contains(' ') && !k.starts_with('#'))
+            .map(str::to_string)
+    };
+    let mut keys: Vec<String> = key_of(start).into_iter().collect();
+    let mut need = (indent(start), item(start));
+    for l in lines[..line - 1].iter().rev() {
+        if l.trim().is_empty() || l.trim_start().starts_with('#') {
+            continue;
+        }
+        let i = indent(l);
+        let parent = if need.1 {
+            i <= need.0 && (i < need.0 || !item(l))
+        } else {
+            i < need.0
+        };
+        if !parent {
+            continue;
+        }
+        if !item(l) {
+            keys.extend(key_of(l));
+        }
+        need = (i, item(l));
+        if i == 0 && !item(l) {
+            break;
+        }
+    }
+    keys.reverse();
+    keys.join(".")
 }
 
 /// The required top-level block `key`, or an error naming it.
@@ -442,5 +512,32 @@ impl Frames {
             }
         }
         e
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn key_paths_are_found_from_the_indentation() {
+        let text = "robot: r\nmeasurement_frame:\n  parent: m\n  xyz:\n  - 0.1\n  - abc\nmarkers:\n- name: point\n  parent: t\n  xyz:\n  - 1\n";
+        assert_eq!(key_path_at(text, 1), "robot");
+        assert_eq!(key_path_at(text, 3), "measurement_frame.parent");
+        assert_eq!(key_path_at(text, 6), "measurement_frame.xyz");
+        assert_eq!(key_path_at(text, 9), "markers.parent");
+        assert_eq!(key_path_at(text, 11), "markers.xyz");
+        assert_eq!(key_path_at(text, 99), "");
+    }
+
+    #[test]
+    fn a_value_of_the_wrong_type_names_its_key_and_line() {
+        let text = "chain:\n  base: b\n  tip: t\n  joints:\n  - j\nmeasurement_frame:\n  xyz:\n  - 0\n  - 0\n  - 0\n  rpy:\n  - 0\n  - 0\n  - 0\n  quaternion:\n  - 1\n  - x\n";
+        let e = parse(text, "f.yaml").unwrap_err().to_string();
+        let first = e.lines().next().unwrap();
+        assert!(
+            first.starts_with("f.yaml: measurement_frame.quaternion (line 17, column"),
+            "{e}"
+        );
     }
 }

@@ -202,6 +202,27 @@ fn known_distances_in_the_wrong_unit_are_refused() {
         refused(&out, 1, needs, &dist);
         assert!(!d.join("mm.yaml").exists(), "{dist}: written");
     }
+    // `evaluate` reads them the same way.
+    let out = run_in(
+        &d,
+        &[
+            "evaluate",
+            "--robot",
+            PANDA,
+            "--tip",
+            "ball_link",
+            "--measurements",
+            PANDA_CSV,
+            "--point-distance",
+            "front_left/0,front_left/1=50",
+        ],
+    );
+    refused(
+        &out,
+        1,
+        &["--point-distance", "looks like millimetres"],
+        "evaluate =50",
+    );
     let _ = std::fs::remove_dir_all(&d);
 }
 

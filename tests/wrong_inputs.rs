@@ -616,6 +616,30 @@ fn frames_files_are_read_strictly() {
         std::fs::write(d.join(name), body).unwrap();
         refused(&evaluate(name), 1, needs, name);
     }
+    // A joint locked now that the calibration drove.
+    let out = run_in(
+        &d,
+        &[
+            "evaluate",
+            "--robot",
+            "cal.urdf:pose",
+            "--frames",
+            "cal.yaml",
+            "--lock",
+            "wrist_3_joint=0",
+            "--measurements",
+            UR10_CSV,
+        ],
+    );
+    refused(
+        &out,
+        1,
+        &[
+            "cal.yaml: chain.joints (line 11)",
+            "the file's chain drives wrist_3_joint, which this one holds",
+        ],
+        "locked joint",
+    );
     let _ = std::fs::remove_dir_all(&d);
 }
 

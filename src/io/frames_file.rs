@@ -466,11 +466,19 @@ impl Frames {
         let listed: Vec<String> = self.chain_joints.iter().map(|n| n.name.clone()).collect();
         if listed != driven {
             let first = self.chain_joints.first().map_or(0, |n| n.line);
+            let only = |a: &[String], b: &[String]| -> Vec<String> {
+                a.iter().filter(|n| !b.contains(n)).cloned().collect()
+            };
+            let (extra, missing) = (only(&listed, &driven), only(&driven, &listed));
+            let differ = match (extra.is_empty(), missing.is_empty()) {
+                (true, true) => "lists them in another order".to_string(),
+                (false, true) => format!("drives {}, which this one holds", few(&extra)),
+                (true, false) => format!("holds {}, which this one drives", few(&missing)),
+                (false, false) => format!("drives {}, not {}", few(&extra), few(&missing)),
+            };
             return Err(self.bad(format!(
-                "chain.joints{}: [{}] are not the joints {chain} drives: [{}] (a joint locked in the calibration is locked again{why})",
+                "chain.joints{}: the file's chain {differ} ({chain}; lock the joints the calibration locked, no others)",
                 at(first),
-                few(&listed),
-                few(&driven)
             )));
         }
         for n in &self.links {

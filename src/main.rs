@@ -40,7 +40,8 @@ struct Cli {
     lock: Option<String>,
     /// A frames file written by `calibrate --out cal.yaml`: mounts a .urdf
     /// robot in its measurement frame with its tool or markers (and takes
-    /// its chain's base and tip unless --base/--tip are given).
+    /// its chain's base, tip and locked joints unless --base/--tip/--lock
+    /// are given).
     #[arg(long, global = true, value_name = "FILE")]
     frames: Option<std::path::PathBuf>,
     /// Show progress on stderr even with --json or when stderr is not a

@@ -616,6 +616,27 @@ fn frames_files_are_read_strictly() {
         std::fs::write(d.join(name), body).unwrap();
         refused(&evaluate(name), 1, needs, name);
     }
+    // The calibration's locked joints are the default lock.
+    let locked = text.replacen(
+        "  - wrist_3_joint\n  locked: {}",
+        "  locked:\n    wrist_3_joint: 0.0",
+        1,
+    );
+    assert_ne!(locked, text);
+    std::fs::write(d.join("locked.yaml"), locked).unwrap();
+    let out = evaluate("locked.yaml");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        v["chain"].as_array().map(Vec::len),
+        Some(5),
+        "{}",
+        v["chain"]
+    );
     // A joint locked now that the calibration drove.
     let out = run_in(
         &d,

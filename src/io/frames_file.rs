@@ -99,6 +99,9 @@ pub struct Frames {
     pub base: Option<String>,
     /// The tip link.
     pub tip: Option<String>,
+    /// The joints the calibration held still, with their values
+    /// (`chain.locked`, sorted by name).
+    pub locked: Vec<(String, f64)>,
     /// Joint compliances (rad per N·m) by joint name: the chain deflects
     /// under its gravity torques (from the URDF's inertials).
     pub compliance: Vec<(String, f64)>,
@@ -399,6 +402,15 @@ fn build(f: &FileEntry) -> StrResult<Frames> {
         markers,
         base: c.base.as_ref().map(|b| b.value.clone()),
         tip: c.tip.as_ref().map(|t| t.value.clone()),
+        locked: {
+            let mut l: Vec<(String, f64)> = c
+                .locked
+                .iter()
+                .map(|(k, v)| (k.value.clone(), *v))
+                .collect();
+            l.sort_by(|a, b| a.0.cmp(&b.0));
+            l
+        },
         compliance: f.compliance.iter().map(|(j, c)| (j.clone(), c.c)).collect(),
         chain_joints,
         other_joints,

@@ -700,7 +700,7 @@ fn another_robots_frames_file_is_named() {
         &out,
         1,
         &[
-            "error: panda.yaml: chain.base: 'panda_link0' is not a link of",
+            "error: panda.yaml: chain.base (line 8): 'panda_link0' is not a link of",
             "written for panda.urdf",
         ],
         "panda frames on the UR10",

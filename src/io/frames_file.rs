@@ -99,6 +99,8 @@ pub struct Frames {
     pub base: Option<String>,
     /// The tip link.
     pub tip: Option<String>,
+    /// The lines of `chain.base` and `chain.tip` (0 when absent).
+    pub base_tip_lines: (usize, usize),
     /// The joints the calibration held still, with their values
     /// (`chain.locked`, sorted by name).
     pub locked: Vec<(String, f64)>,
@@ -402,6 +404,10 @@ fn build(f: &FileEntry) -> StrResult<Frames> {
         markers,
         base: c.base.as_ref().map(|b| b.value.clone()),
         tip: c.tip.as_ref().map(|t| t.value.clone()),
+        base_tip_lines: (
+            c.base.as_ref().map_or(0, |b| line(&b.referenced)),
+            c.tip.as_ref().map_or(0, |t| line(&t.referenced)),
+        ),
         locked: {
             let mut l: Vec<(String, f64)> = c
                 .locked
@@ -516,17 +522,19 @@ impl Frames {
         let Error::Parse { path, message } = &e else {
             return e;
         };
+        let (base_line, tip_line) = self.base_tip_lines;
         let chosen = [
-            ("chain.base", "base", &self.base, base_given),
-            ("chain.tip", "tip", &self.tip, tip_given),
+            ("chain.base", "base", &self.base, base_given, base_line),
+            ("chain.tip", "tip", &self.tip, tip_given, tip_line),
         ];
-        for (key, what, link, given) in chosen {
+        for (key, what, link, given, line) in chosen {
             let Some(link) = link.as_ref().filter(|_| !given) else {
                 continue;
             };
             if message.contains(&format!("the {what} link '{link}' is not in the URDF")) {
                 return self.bad(format!(
-                    "{key}: '{link}' is not a link of {path}{}",
+                    "{key}{}: '{link}' is not a link of {path}{}",
+                    at(line),
                     self.written_for()
                 ));
             }

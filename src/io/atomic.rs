@@ -124,8 +124,9 @@ fn process_alive(pid: u32) -> Option<bool> {
 }
 
 /// Removes the temporaries a killed write left beside `path`
-/// (`.NAME.tmp-PID-N` whose process is no longer running): they are never
-/// renamed into place. Those of running processes (a concurrent write) and
+/// (`.NAME.tmp-PID-N` whose process is no longer running: they are never
+/// renamed into place; and `.NAME.old-PID`, a replaced directory, when
+/// `path` exists again). Those of running processes (a concurrent write) and
 /// any other file are kept; where the system cannot tell whether a process
 /// runs, nothing is removed. Failures are ignored (the write goes on).
 pub fn remove_stale_temporaries(path: &Path) {
@@ -140,9 +141,18 @@ pub fn remove_stale_temporaries(path: &Path) {
         return;
     };
     let prefix = format!(".{name}.tmp-");
+    let old = format!(".{name}.old-");
     for e in entries.flatten() {
         let file = e.file_name().to_string_lossy().into_owned();
-        let Some((pid, n)) = file.strip_prefix(&prefix).and_then(|r| r.split_once('-')) else {
+        // A replaced directory left aside by a kill between the two renames
+        // of `replace_dir`: stale once the target is back in place.
+        let aside = file.strip_prefix(&old).map(|pid| (pid, "0"));
+        let aside = aside.filter(|_| path.exists());
+        let Some((pid, n)) = file
+            .strip_prefix(&prefix)
+            .and_then(|r| r.split_once('-'))
+            .or(aside)
+        else {
             continue;
         };
         let (Ok(pid), true) = (pid.parse::<u32>(), n.bytes().all(|b| b.is_ascii_digit())) else {
@@ -296,6 +306,18 @@ mod tests {
         write_atomic(&f, b"new").unwrap();
         if process_alive(0).is_some() {
             assert!(!dead.exists() && !staged.exists(), "stale temporaries kept");
+        }
+        // A directory replaced aside by a killed `replace_dir`: removed once
+        // the target is in place, kept while it is the only copy.
+        let report = d.join("report");
+        let aside = d.join(".report.old-0");
+        std::fs::create_dir(&aside).unwrap();
+        remove_stale_temporaries(&report);
+        assert!(aside.exists(), "the only copy was removed");
+        std::fs::create_dir(&report).unwrap();
+        remove_stale_temporaries(&report);
+        if process_alive(0).is_some() {
+            assert!(!aside.exists(), "a stale aside directory kept");
         }
         assert!(
             ours.exists() && other.exists(),

@@ -106,7 +106,7 @@ pub enum Error {
     /// A structure whose estimated memory exceeds the budget
     /// ([`crate::resources::MemoryBudget`]), refused before allocating it.
     #[error(
-        "{what} would need {needed} of memory, above the limit of {limit} ({source_of_limit}); use a smaller pool (fewer lattice levels or poses) or raise the limit"
+        "{what} would need {needed} of memory, above the limit of {limit} ({source_of_limit})\n  use a smaller pool (fewer lattice levels or poses) or raise the limit"
     )]
     TooLarge {
         /// What was to be allocated.
@@ -160,6 +160,27 @@ pub enum Error {
         /// The accepted slack, in that unit.
         tolerance: f64,
         /// The unit the whole column would fit in, if another.
+        hint: Option<UnitHint>,
+    },
+    /// Measured positions that move far less than the robot does at their
+    /// poses (`check_positions_in_reach` in [`crate::units`]).
+    #[error(
+        "{file}: the measured positions move {:.3} mm RMS about their mean, the nominal model's {:.1} mm at the same poses (read in {unit}){}",
+        *.spread * 1e3,
+        *.nominal * 1e3,
+        hint.map_or(String::new(), |h| format!("; {}", h.spread_text(unit)))
+    )]
+    PositionsTooSmall {
+        /// The measurement file.
+        file: String,
+        /// The measured positions' RMS about their mean, metres (after
+        /// reading in `unit`).
+        spread: f64,
+        /// The nominal model's points' RMS about their mean, metres.
+        nominal: f64,
+        /// The length unit the positions were read in.
+        unit: &'static str,
+        /// The unit they would pass in, if another.
         hint: Option<UnitHint>,
     },
     /// Measured positions whose nominal residuals are far beyond the robot's
@@ -237,6 +258,20 @@ impl UnitHint {
             }
             UnitHint::Metres => {
                 "every value of this column fits the limits as metres: it looks like metres, not millimetres"
+            }
+        }
+    }
+
+    /// What positions that spread as the robot moves in this unit look
+    /// like.
+    #[must_use]
+    pub fn spread_text(self, read_as: &str) -> String {
+        match self {
+            UnitHint::Millimetres | UnitHint::Degrees => {
+                format!("they look like millimetres (read as {read_as})")
+            }
+            UnitHint::Metres | UnitHint::Radians => {
+                format!("they look like metres (read as {read_as})")
             }
         }
     }

@@ -40,7 +40,8 @@ struct Cli {
     lock: Option<String>,
     /// A frames file written by `calibrate --out cal.yaml`: mounts a .urdf
     /// robot in its measurement frame with its tool or markers (and takes
-    /// its chain's base and tip unless --base/--tip are given).
+    /// its chain's base, tip and locked joints unless --base/--tip/--lock
+    /// are given).
     #[arg(long, global = true, value_name = "FILE")]
     frames: Option<std::path::PathBuf>,
     /// A marker (retroreflector, tracked point) on the chain's tip:
@@ -169,6 +170,7 @@ fn main() {
         .and_then(|(_, m)| m.try_get_one::<bool>("json").ok().flatten().copied())
         .unwrap_or(false);
     cli::progress::install_for(cli.progress, json);
+    cap_threads();
     let mut command = cli.command;
     let chain = cli::chain_choice(
         cli.base,
@@ -202,7 +204,7 @@ fn main() {
     if std::env::var_os("ACTIVECAL_DEBUG_READS").is_some() {
         // Each input file and how often it was read (once is the rule).
         for (path, n) in activecal::io::read::reads() {
-            eprintln!("read {n}× {}", path.display());
+            cli::diag(&format!("read {n}× {}", path.display()));
         }
     }
     if let Err(e) = r {
@@ -216,13 +218,38 @@ fn main() {
     }
 }
 
+/// Runs rayon's workers only as many as the linear-algebra backend's
+/// per-thread buffers allow within the memory budget
+/// ([`activecal::resources::threads_within`]): each thread that multiplies
+/// matrices allocates twice the L3 cache, outside any budget, and aborts
+/// when it cannot (`ulimit -v 2000000` with 4 threads and 150 MiB of L3).
+/// `RAYON_NUM_THREADS` (or the core count) is the most it runs.
+fn cap_threads() {
+    use activecal::resources::{MemoryBudget, backend_buffer_bytes, threads_within};
+    // A malformed ACTIVECAL_MAX_MEMORY is reported by the command itself.
+    let Ok(budget) = MemoryBudget::from_env() else {
+        return;
+    };
+    let wanted = std::env::var("RAYON_NUM_THREADS")
+        .ok()
+        .and_then(|v| v.trim().parse::<usize>().ok())
+        .filter(|&n| n > 0)
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from));
+    let n = threads_within(&budget, backend_buffer_bytes(), wanted);
+    if n < wanted {
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global();
+    }
+}
+
 /// Prints an error with the options it calls for: a unit to change
 /// ([`cli::units::flag_hint`]) or the option that gives the input it names
 /// ([`cli::hints::option_hints`]).
 fn report_error(e: &anyhow::Error) {
-    eprintln!("error: {e:#}");
+    cli::diag(&format!("error: {e:#}"));
     let unit = cli::units::flag_hint(e);
     for h in unit.into_iter().chain(cli::hints::option_hints(e)) {
-        eprintln!("hint: {h}");
+        cli::diag(&format!("hint: {h}"));
     }
 }

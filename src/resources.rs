@@ -226,8 +226,8 @@ fn rlimits(root: &Path) -> Option<MemoryBudget> {
     let limits = read_under(root, "/proc/self/limits")?;
     let status = read_under(root, "/proc/self/status").unwrap_or_default();
     [
-        ("Max address space", "RLIMIT_AS (ulimit -v)", "VmSize"),
-        ("Max data size", "RLIMIT_DATA (ulimit -d)", "VmData"),
+        ("Max address space", "ulimit -v", "VmSize"),
+        ("Max data size", "ulimit -d", "VmData"),
     ]
     .into_iter()
     .filter_map(|(line, name, used_key)| {
@@ -236,7 +236,7 @@ fn rlimits(root: &Path) -> Option<MemoryBudget> {
         Some(MemoryBudget {
             limit: limit.saturating_sub(used),
             source: format!(
-                "{name} of {} less the {} this process already maps ({used_key})",
+                "{name} of {} less {} mapped",
                 format_bytes(limit),
                 format_bytes(used)
             ),
@@ -295,6 +295,47 @@ impl MemoryBudget {
     }
 }
 
+/// The L3 cache as `/sys` gives it for the first CPU under `root` (the
+/// figure the linear-algebra backend sizes its buffers by), or the
+/// backend's default of 2 MiB when none is found.
+fn l3_bytes(root: &Path) -> u64 {
+    (0..8)
+        .filter_map(|k| {
+            let dir = format!("/sys/devices/system/cpu/cpu0/cache/index{k}");
+            let level = read_under(root, &format!("{dir}/level"))?;
+            (level.trim() == "3").then_some(())?;
+            parse_bytes(read_under(root, &format!("{dir}/size"))?.trim())
+        })
+        .max()
+        .unwrap_or(2 << 20)
+}
+
+/// Bytes the linear-algebra backend keeps on each thread that multiplies
+/// matrices larger than 16×16×16: faer's x86 kernel (`private-gemm-x86`)
+/// allocates twice the L3 cache per thread on its first product, outside
+/// any budget, and the process aborts when that allocation fails.
+#[must_use]
+pub fn backend_buffer_bytes() -> u64 {
+    2 * l3_bytes(Path::new("/"))
+}
+
+/// The share of the budget the backend's per-thread buffers may take.
+pub const BACKEND_SHARE: f64 = 0.25;
+
+/// How many worker threads to run (at most `wanted`, at least 1) so that
+/// the backend's buffers — one per worker and one for the main thread,
+/// `buffer` bytes each ([`backend_buffer_bytes`]) — fit in
+/// [`BACKEND_SHARE`] of the budget: with 150 MiB of L3 and `ulimit -v
+/// 2000000`, one worker, where four aborted.
+#[must_use]
+pub fn threads_within(budget: &MemoryBudget, buffer: u64, wanted: usize) -> usize {
+    let share = (budget.limit as f64 * BACKEND_SHARE) as u64;
+    let fit = (share / buffer.max(1)).saturating_sub(1);
+    usize::try_from(fit)
+        .unwrap_or(usize::MAX)
+        .clamp(1, wanted.max(1))
+}
+
 /// Bytes of `count` values of `size` bytes each, saturating (an estimate
 /// that overflows is simply too large).
 #[must_use]
@@ -350,6 +391,32 @@ mod tests {
         }
         assert_eq!(format_bytes(41_000_000_000), "41.0 GB");
         assert_eq!(format_bytes(999), "999 B");
+    }
+
+    #[test]
+    fn backend_buffers_cap_the_threads_and_the_l3_is_read_from_sys() {
+        let root = fake_root(
+            "l3",
+            &[
+                ("sys/devices/system/cpu/cpu0/cache/index2/level", "2\n"),
+                ("sys/devices/system/cpu/cpu0/cache/index2/size", "1024K\n"),
+                ("sys/devices/system/cpu/cpu0/cache/index3/level", "3\n"),
+                ("sys/devices/system/cpu/cpu0/cache/index3/size", "153600K\n"),
+            ],
+        );
+        assert_eq!(l3_bytes(&root), 150 << 20);
+        assert_eq!(l3_bytes(Path::new("/no/such/root")), 2 << 20);
+        let b = |limit| MemoryBudget {
+            limit,
+            source: String::new(),
+        };
+        // The VM: 300 MiB a thread, 1.9 GB of budget: one worker.
+        assert_eq!(threads_within(&b(1_900_000_000), 300 << 20, 4), 1);
+        // 64 MiB a thread: 7 buffers in a quarter of 1.9 GB, 6 workers.
+        assert_eq!(threads_within(&b(1_900_000_000), 64 << 20, 20), 6);
+        assert_eq!(threads_within(&b(64 << 30), 64 << 20, 8), 8);
+        assert_eq!(threads_within(&b(0), 64 << 20, 8), 1);
+        let _ = std::fs::remove_dir_all(&root);
     }
 
     #[test]
@@ -488,10 +555,7 @@ mod tests {
         ];
         let b = budget("rlimit", &files, None);
         assert_eq!(b.limit, 2_048_000_000 - 48_000 * 1024);
-        assert_eq!(
-            b.source,
-            "RLIMIT_AS (ulimit -v) of 2.0 GB less the 49.2 MB this process already maps (VmSize)"
-        );
+        assert_eq!(b.source, "ulimit -v of 2.0 GB less 49.2 MB mapped");
         // A data limit smaller still wins, less VmData.
         let data = LIMITS.replace(
             "Max data size             unlimited",
@@ -504,11 +568,7 @@ mod tests {
         ];
         let b = budget("rdata", &files, None);
         assert_eq!(b.limit, 1_000_000_000 - 1_000 * 1024);
-        assert!(
-            b.source.starts_with("RLIMIT_DATA (ulimit -d)"),
-            "{}",
-            b.source
-        );
+        assert!(b.source.starts_with("ulimit -d of"), "{}", b.source);
     }
 
     #[test]

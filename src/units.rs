@@ -251,7 +251,12 @@ fn check_column(
     } else {
         (units.angle.to_rad(), units.angle.symbol())
     };
-    let fits_as = |factor: f64| qs.iter().all(|q| inside(q[j] / given * factor));
+    // Another unit is named only when at least half the column fails in
+    // this one: one value typed wrong among radians is not a column of
+    // degrees, though all of them, as degrees, would fit.
+    let failing = qs.iter().filter(|q| !inside(q[j])).count();
+    let fits_as =
+        |factor: f64| failing * 2 >= qs.len() && qs.iter().all(|q| inside(q[j] / given * factor));
     let hint = match (prismatic, units.angle, units.length) {
         (false, AngleUnit::Rad, _) if fits_as(AngleUnit::Deg.to_rad()) => Some(UnitHint::Degrees),
         (false, AngleUnit::Deg, _) if fits_as(1.0) => Some(UnitHint::Radians),
@@ -328,7 +333,7 @@ pub fn check_positions_in_reach(
     let limit = REACH_FACTOR * reach;
     let rms = rms_scaled(1.0);
     if rms.is_nan() || rms <= limit {
-        return Ok(());
+        return check_positions_spread(file, length, points, predicted);
     }
     let hint = match length {
         LengthUnit::M if rms_scaled(1e-3) <= limit => Some(UnitHint::Millimetres),
@@ -342,6 +347,58 @@ pub fn check_positions_in_reach(
         factor: REACH_FACTOR,
         unit: length.symbol(),
         hint,
+    })
+}
+
+/// The RMS distance of `points` from their mean (metres).
+fn spread(points: &[[f64; 3]]) -> f64 {
+    let n = points.len().max(1) as f64;
+    let mean: [f64; 3] = std::array::from_fn(|c| points.iter().map(|p| p[c]).sum::<f64>() / n);
+    let sum: f64 = points
+        .iter()
+        .map(|p| (0..3).map(|c| (p[c] - mean[c]).powi(2)).sum::<f64>())
+        .sum();
+    (sum / n).sqrt()
+}
+
+/// How many times less than the nominal model's points the measured ones
+/// may spread before positions read in millimetres are refused as metres:
+/// a sensor sees the tool move about as far as the model's end frame does
+/// (a tool changes that by its length, not a hundredfold), while metres
+/// read as millimetres move a thousand times less.
+pub const SPREAD_FACTOR: f64 = 100.0;
+
+/// Checks that positions read in millimetres move as the robot does: their
+/// spread (RMS about their mean, a measure no choice of sensor frame
+/// changes) must not be [`SPREAD_FACTOR`] times less than the nominal
+/// model's points' at the same poses when, read as metres, it would be
+/// within that factor. Otherwise an [`Error::PositionsTooSmall`] with the
+/// hint [`UnitHint::Metres`]. (Metres that spread too little have no other
+/// unit to be in: a pivoting tool keeps its tip still.)
+fn check_positions_spread(
+    file: &str,
+    length: LengthUnit,
+    points: &[[f64; 3]],
+    predicted: &[[f64; 3]],
+) -> Result<()> {
+    if length != LengthUnit::Mm {
+        return Ok(());
+    }
+    let (measured, nominal) = (spread(points), spread(predicted));
+    let ratio = measured / nominal;
+    if !ratio.is_finite() || ratio * SPREAD_FACTOR >= 1.0 {
+        return Ok(());
+    }
+    let as_metres = ratio * 1e3;
+    if !(1.0 / SPREAD_FACTOR..=SPREAD_FACTOR).contains(&as_metres) {
+        return Ok(());
+    }
+    Err(Error::PositionsTooSmall {
+        file: file.to_string(),
+        spread: measured,
+        nominal,
+        unit: length.symbol(),
+        hint: Some(UnitHint::Metres),
     })
 }
 

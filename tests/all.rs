@@ -53,6 +53,7 @@ mod undetermined;
 mod unit_invariance;
 mod units;
 mod urdf_chains;
+mod wrong_inputs;
 
 /// Every `tests/*.rs` file is one of the modules above: a file left out
 /// would silently never run.

@@ -280,7 +280,7 @@ const CASES: &[Case] = &[
         &[
             "a pool of 2985984 poses",
             "would need 4.0 GB",
-            "RLIMIT_AS (ulimit -v) of 2.0 GB less the",
+            "ulimit -v of 2.0 GB less",
         ],
     ),
     case_limited(

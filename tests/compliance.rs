@@ -469,7 +469,15 @@ fn the_frames_file_carries_the_compliances_and_reading_it_back_applies_them() {
     assert!((eval(&rigid) - fitted).abs() > 5e-2);
     // A compliance for a joint the chain does not have is refused.
     let bad = d.join("bad.yaml");
-    std::fs::write(&bad, text.replace("  elbow_joint:\n", "  elbow_jiont:\n")).unwrap();
+    // (In the compliance block only: a joint unknown in `joints:` is
+    // refused first, naming that block.)
+    let at = text.find("\ncompliance:").unwrap();
+    let bad_text = format!(
+        "{}{}",
+        &text[..at],
+        text[at..].replace("  elbow_joint:\n", "  elbow_jiont:\n")
+    );
+    std::fs::write(&bad, bad_text).unwrap();
     common::fails_with(
         &[
             "fk",

@@ -349,7 +349,14 @@ fn fix_free_and_robust_loss_from_the_command_line() {
             .collect()
     };
     let all = names(&full);
-    let victim = all[3].clone();
+    // A joint's parameter: fixing one of the measurement frame's (d_base)
+    // bends the arm to fit (elbow and wrist 1 moved by 0.2 m), a fit that
+    // is refused with exit status 3 (tests/wrong_inputs.rs).
+    let victim = all
+        .iter()
+        .find(|n| *n == "d_wrist_2_joint")
+        .expect("a wrist parameter")
+        .clone();
     let fixed = with(&["--fix", &victim]);
     let fixed_names = names(&fixed);
     assert_eq!(fixed_names.len(), all.len() - 1);

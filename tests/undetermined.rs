@@ -8,7 +8,7 @@
 
 use crate::common;
 
-use common::{json_of, run};
+use common::run;
 use serde_json::Value;
 
 const TIAGO: &str = "fixtures/figaroh/tiago.urdf";
@@ -51,7 +51,20 @@ fn calibrate(file: &str, fix: Option<&str>) -> Value {
     if let Some(f) = fix {
         a.extend(["--fix", f]);
     }
-    json_of(&a)
+    let out = run(&a);
+    let err = String::from_utf8_lossy(&out.stderr);
+    // The torso's column made constant contradicts positions measured with
+    // it moving (0.015–0.35 m): the fit converges to an arm bent to fit
+    // (RMS 47 mm, against 2.6 mm for the true column), which is refused
+    // as not a calibration of the robot (exit 3), its report printed.
+    let code = out.status.code();
+    assert!(
+        code == Some(0) || (code == Some(3) && err.contains("not a calibration of this robot")),
+        "{a:?}: {code:?} {err}"
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).expect("the report");
+    assert_eq!(v["exit_status"].as_i64(), code.map(i64::from));
+    v
 }
 
 fn held_out(v: &Value) -> f64 {
@@ -61,7 +74,6 @@ fn held_out(v: &Value) -> f64 {
 fn check(file: &str, joint: &str) {
     let v = calibrate(file, None);
     assert_eq!(v["status"], "converged", "{file}");
-    assert_eq!(v["exit_status"], 0);
     let fixed = v["fixed"].as_array().unwrap();
     assert!(!fixed.is_empty(), "{file}: nothing fixed");
     let names: Vec<&str> = fixed.iter().map(|f| f["name"].as_str().unwrap()).collect();

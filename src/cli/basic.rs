@@ -18,8 +18,10 @@ pub struct RobotsArgs {
     /// File for `--export` (default: standard output, as TOML), by
     /// extension: .toml (a description), .urdf (the URDF, or a built-in's
     /// chain as URDF), .yaml (a URDF robot's frames file); any other is
-    /// refused.
-    #[arg(long, requires = "export")]
+    /// refused. (Conflicting with --robot and --json as well: clap does not
+    /// check `requires` when an option conflicting with the required one is
+    /// given, and --out was silently ignored.)
+    #[arg(long, requires = "export", conflicts_with_all = ["robot", "json"])]
     pub out: Option<std::path::PathBuf>,
     /// Replace an existing `--out` file.
     #[arg(long, requires = "out")]
@@ -127,7 +129,7 @@ pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
         };
         match &a.out {
             Some(path) => super::write_new(path, &text, a.force)?,
-            None => print!("{text}"),
+            None => super::print_out(&text)?,
         }
         return Ok(());
     }
@@ -144,8 +146,7 @@ pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
     };
     let described: Vec<Value> = robots.iter().map(robot_json).collect();
     let v = json!({ "robots": described });
-    emit(a.json, &v, || robots.iter().map(robot_text).collect());
-    Ok(())
+    emit(a.json, &v, || robots.iter().map(robot_text).collect())
 }
 
 /// One robot of `robots --json`.
@@ -327,7 +328,7 @@ pub fn cmd_pool(a: PoolArgs) -> Result<()> {
     }
     let d = super::load_description(&a.pool.robot)?;
     let spec = a.pool.spec(&d)?;
-    let pool = spec.build(&d.robot, &d.robot.nominal)?;
+    let pool = spec.build_poses(&d.robot, &d.robot.nominal)?;
     let r = activecal::pool::summary::PoolSummary::new(&d.robot, &pool)?;
     if let Some(out) = &a.out {
         let qs: Vec<Vec<f64>> = (0..pool.len()).map(|k| pool.q(k)).collect();

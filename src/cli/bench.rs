@@ -169,8 +169,7 @@ pub fn cmd_bench(a: BenchArgs) -> Result<()> {
             .map(|(n, ms, note)| json!({"what": n, "median_ms": ms, "note": note}))
             .collect(),
     );
-    emit(a.json, &v, || bench_text(a.reps, &rows, &robot_rows));
-    Ok(())
+    emit(a.json, &v, || bench_text(a.reps, &rows, &robot_rows))
 }
 
 /// The kernel rows (PUMA, 15,625 poses).
@@ -374,7 +373,9 @@ fn robot_rows() -> Result<Vec<Value>> {
     for (label, spec) in ROBOTS {
         let file = spec.split([':', '#']).next().unwrap_or(spec);
         if file.contains('/') && !std::path::Path::new(file).exists() {
-            eprintln!("bench: {label} skipped: {file} not found (run from the repository)");
+            super::diag(&format!(
+                "bench: {label} skipped: {file} not found (run from the repository)"
+            ));
             continue;
         }
         out.push(robot_row(label, spec)?);

@@ -7,7 +7,7 @@
 pub use super::calibrate_args::{CalibrateArgs, DEFAULT_NOISE};
 pub use super::calibrated::{EXIT_NOT_CONVERGED, NotConverged};
 use super::calibrated::{
-    exit_status, frames_of, refuse_unconverged, status_text, write_calibrated,
+    exit_status, frames_of, not_written, refuse_unconverged, status_text, write_calibrated,
 };
 use activecal::frames::report::FitBlock;
 use activecal::identify::{Identification, LmSettings};
@@ -65,6 +65,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     let robot = &desc.robot;
     match (&a.design, &a.measurements) {
         (_, Some(m)) if super::contact::is_contact_file(m) => {
+            refuse_for_contacts(&a, m)?;
             let c = super::contact::ContactArgs {
                 holdout: a.holdout.is_some(),
                 out: &a.out,
@@ -104,6 +105,25 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
         (Some(d), None) => super::simulated::from_design(&a, robot, desc.visibility.as_ref(), d),
         (None, None) => bail!("give --design (simulate) or --measurements (real data)"),
     }
+}
+
+/// The options of a fit of measured poses that a contact fit does not
+/// take: refused rather than silently ignored.
+fn refuse_for_contacts(a: &CalibrateArgs, m: &Path) -> Result<()> {
+    let given = [
+        (!a.fix.is_empty(), "--fix"),
+        (a.compliance, "--compliance"),
+        (a.compare_compliance, "--compare-compliance"),
+        (a.inertia.is_some(), "--inertia"),
+        (a.payload.is_some(), "--payload"),
+    ];
+    if let Some((_, name)) = given.iter().find(|(g, _)| *g) {
+        bail!(
+            "{name} is for measured poses; {} is a contact file (a 'point' or 'plane' column), whose fit does not take it",
+            m.display()
+        );
+    }
+    Ok(())
 }
 
 /// Identification from a measurement file.
@@ -157,7 +177,7 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     };
     let mut print_note = |n: &str| {
         if !a.json {
-            eprintln!("note: {n}");
+            super::diag(&format!("note: {n}"));
         }
     };
     let activecal::experiment::measured::MeasuredCalibration {
@@ -174,10 +194,25 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     };
     let frames = frames_of(&fitted, id, Some(fit))?;
     report.frames = frames.as_ref().map(|(_, r)| r.clone());
-    report.base.out =
-        write_calibrated(a, &fitted, id, &path.display().to_string(), frames.as_ref())?;
+    // A converged fit that made another robot of this one is not written.
+    let implausible = id
+        .converged()
+        .then(|| {
+            let f = frames.as_ref().map(|(f, _)| f);
+            activecal::frames::plausible::implausible(&fitted, &id.table, f)
+        })
+        .flatten();
+    if implausible.is_none() {
+        report.base.out =
+            write_calibrated(a, &fitted, id, &path.display().to_string(), frames.as_ref())?;
+    }
     let mut v = serde_json::to_value(&report)?;
-    v["exit_status"] = exit_status(id).into();
+    v["exit_status"] = if implausible.is_some() {
+        EXIT_NOT_CONVERGED
+    } else {
+        exit_status(id)
+    }
+    .into();
     if let Some(dir) = &a.report {
         super::report_dir::calibration(dir, &measured_summary(&fitted, id, path, &report, &v))?;
     }
@@ -187,8 +222,38 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
             s += &format!("\ncalibrated robot written to {out}\n");
         }
         s
-    });
-    refuse_unconverged(a, id)
+    })?;
+    // Too few poses for the unknowns: the cause, ahead of what it led to.
+    let few = too_few_rows(&fitted, &report);
+    let cause = |why: String| match &few {
+        Some(f) => format!("{f}\n  {why}"),
+        None => why,
+    };
+    if let Some(why) = implausible {
+        return Err(NotConverged(cause(why) + &not_written(a)).into());
+    }
+    refuse_unconverged(a, id).map_err(|e| match e.downcast::<NotConverged>() {
+        Ok(NotConverged(why)) => NotConverged(cause(why)).into(),
+        Err(e) => e,
+    })
+}
+
+/// `N poses give R measurement rows for U unknowns: too few …` when the
+/// data have fewer rows than the fit had unknowns (estimated and fixed).
+fn too_few_rows(
+    fitted: &Robot,
+    r: &activecal::experiment::measured::MeasuredReport,
+) -> Option<String> {
+    let per_pose = fitted.rows_per_pose().max(1);
+    let rows = r.base.poses * per_pose;
+    let unknowns = r.parameters.len() + r.fixed.len();
+    (rows < unknowns).then(|| {
+        format!(
+            "{} poses give {rows} measurement rows for {unknowns} unknowns: too few to determine the model (at least {} poses)",
+            r.base.poses,
+            unknowns.div_ceil(per_pose)
+        )
+    })
 }
 
 /// What `--report` shows of a calibration from measurements.

@@ -3,7 +3,10 @@
 use clap::Args;
 use std::path::PathBuf;
 
-/// Arguments of the command.
+/// Arguments of the command. The options of measured data conflict with
+/// `--design` (clap's `requires = "measurements"` is not checked when an
+/// argument that conflicts with `--measurements`, such as `--design`, is
+/// given: they were silently ignored).
 #[derive(Args)]
 pub struct CalibrateArgs {
     /// Robot: a built-in name, or a .toml description or .urdf file; append
@@ -66,23 +69,23 @@ pub struct CalibrateArgs {
     pub no_geodesic: bool,
     /// Loss of the fit (with --measurements): l2, or huber / cauchy with
     /// --loss-scale; poses the robust loss down-weights are named.
-    #[arg(long, value_enum, default_value = "l2", requires = "measurements")]
+    #[arg(long, value_enum, default_value = "l2", conflicts_with = "design")]
     pub loss: super::measured::LossKind,
     /// Scale of a robust loss: a pose's residual norm (metres) where it
     /// turns robust.
-    #[arg(long, requires = "measurements")]
+    #[arg(long, conflicts_with = "design")]
     pub loss_scale: Option<f64>,
     /// Unknowns to fix at their nominal values (comma-separated names, as
     /// in the estimate), with --measurements.
-    #[arg(long, value_delimiter = ',', requires = "measurements")]
+    #[arg(long, value_delimiter = ',', conflicts_with = "design")]
     pub fix: Vec<String>,
     /// Parameters to estimate besides the chosen unknowns (names such as
     /// `d_arm_3_joint`), with --measurements.
-    #[arg(long, value_delimiter = ',', requires = "measurements")]
+    #[arg(long, value_delimiter = ',', conflicts_with = "design")]
     pub free: Vec<String>,
     /// Held-out validation: fit on a random 1 − F of the poses, evaluate on
     /// the rest (with --measurements; --splits times, seeded by --seed).
-    #[arg(long, value_name = "F", requires = "measurements")]
+    #[arg(long, value_name = "F", conflicts_with = "design")]
     pub holdout: Option<f64>,
     /// Random splits of --holdout.
     #[arg(long, default_value_t = 4, requires = "holdout")]
@@ -115,24 +118,34 @@ pub struct CalibrateArgs {
     pub orientation_scale: Option<f64>,
     /// A distance known between two contact points (a file with a `point`
     /// column): `A,B=METRES`, repeatable.
-    #[arg(long, value_name = "A,B=METRES", requires = "measurements")]
+    #[arg(long, value_name = "A,B=METRES", conflicts_with = "design")]
     pub point_distance: Vec<String>,
     /// A known contact plane (a file with a `plane` column): `NAME=nx,ny,nz,d`
     /// (base frame, `n · x = d` in metres; the normal is normalised),
     /// repeatable. Planes not given are unknown and estimated.
-    #[arg(long, value_name = "NAME=nx,ny,nz,d", requires = "measurements")]
+    #[arg(long, value_name = "NAME=nx,ny,nz,d", conflicts_with = "design")]
     pub plane: Vec<String>,
     /// Contacts held out by placement (the part of a point's name before
     /// '/'): fit on all placements but one, judge on that one, for each.
-    #[arg(long, value_enum, requires = "measurements")]
+    #[arg(
+        long,
+        value_enum,
+        conflicts_with = "design",
+        conflicts_with_all = ["train_on", "holdout"]
+    )]
     pub holdout_by: Option<super::contact::HoldoutBy>,
     /// Contacts: fit on this placement alone, judge on each other one.
-    #[arg(long, value_name = "PLACEMENT", requires = "measurements")]
+    #[arg(
+        long,
+        value_name = "PLACEMENT",
+        conflicts_with = "design",
+        conflicts_with = "holdout"
+    )]
     pub train_on: Option<String>,
     /// Also fit a compliance per revolute joint whose gravity torque (from
     /// the URDF's inertials) varies over the data: the joint deflects by
     /// c·τ(q); reports c, σ, t, k = −1/c and the largest deflection.
-    #[arg(long, requires = "measurements")]
+    #[arg(long, conflicts_with = "design")]
     pub compliance: bool,
     /// With --holdout: fit with and without compliances on the same splits
     /// and compare held-out errors.
@@ -140,10 +153,10 @@ pub struct CalibrateArgs {
     pub compare_compliance: bool,
     /// Take the links' masses and centres of mass from this URDF (same link
     /// names) instead of the robot's own.
-    #[arg(long, value_name = "FILE")]
+    #[arg(long, value_name = "FILE", conflicts_with = "design")]
     pub inertia: Option<PathBuf>,
     /// A payload on the tip link: KG, or KG@X,Y,Z (metres, tip link frame).
-    #[arg(long, value_name = "KG[@X,Y,Z]", value_parser = super::compliance::parse_payload, allow_hyphen_values = true)]
+    #[arg(long, value_name = "KG[@X,Y,Z]", value_parser = super::compliance::parse_payload, allow_hyphen_values = true, conflicts_with = "design")]
     pub payload: Option<activecal::io::inertia::Payload>,
     /// Write a report directory: report.md, report.json and figures (PNG
     /// and SVG) of the errors before and after, the held-out splits, the

@@ -106,15 +106,21 @@ pub fn refuse_unconverged(a: &CalibrateArgs, id: &Identification) -> Result<()> 
             id.unidentifiable.join(", ")
         );
     }
-    if !a.out.is_empty() {
-        let names: Vec<String> = a.out.iter().map(|p| p.display().to_string()).collect();
-        why += &format!(
-            "; {} {} not written",
-            names.join(", "),
-            if names.len() == 1 { "was" } else { "were" }
-        );
-    }
+    why += &not_written(a);
     Err(NotConverged(why).into())
+}
+
+/// `; A, B were not written` for the `--out` files, or nothing.
+pub fn not_written(a: &CalibrateArgs) -> String {
+    if a.out.is_empty() {
+        return String::new();
+    }
+    let names: Vec<String> = a.out.iter().map(|p| p.display().to_string()).collect();
+    format!(
+        "; {} {} not written",
+        names.join(", "),
+        if names.len() == 1 { "was" } else { "were" }
+    )
 }
 
 pub fn status_text(id: &Identification) -> String {

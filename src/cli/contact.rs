@@ -147,9 +147,13 @@ pub fn calibrate_contacts(
     super::contact_out::check(a.out, robot)?;
     let (given, planes) = contact_setup(a.setup, a.point_distance, a.plane)?;
     let mut file = read_contacts(path, robot, a.units)?;
+    file.check_distinct()?;
     file.set_known_planes(&planes).context("--plane")?;
+    activecal::identify::contact::lengths::check_planes(robot, &file).context("--plane")?;
     let known = resolve_distances(&file, &given, true).context("--point-distance")?;
     activecal::identify::contact::check_scale(&file, &known).context("--point-distance")?;
+    activecal::identify::contact::lengths::check_distances(robot, &file, &known)
+        .context("--point-distance")?;
     let settings = ContactSettings {
         lm: LmSettings::default()
             .with_max_iterations(a.max_iterations)
@@ -181,13 +185,17 @@ pub fn calibrate_contacts(
         0,
     );
     let down = downweighted_rows(&fit, &file);
-    let frames = if a.out.is_empty() {
-        None
-    } else {
-        super::contact_out::frames(&fit, &file, &given)?
-    };
+    let all_frames = super::contact_out::frames(&fit, &file, &given)?;
+    // A converged fit that made another robot of this one is not written.
+    let implausible = fit
+        .converged
+        .then(|| implausible(&fit, all_frames.as_ref().map(|(f, _)| f)))
+        .flatten();
+    let frames = if a.out.is_empty() { None } else { all_frames };
     let written = match &frames {
-        Some(f) if fit.converged => super::contact_out::write(a.out, a.force, &fit.robot, &fit, f)?,
+        Some(f) if fit.converged && implausible.is_none() => {
+            super::contact_out::write(a.out, a.force, &fit.robot, &fit, f)?
+        }
         _ => Vec::new(),
     };
     let v = json!({
@@ -201,7 +209,7 @@ pub fn calibrate_contacts(
         "predicted_true_error": predicted,
         "frames": frames.as_ref().map(|(_, r)| r),
         "out": written,
-        "exit_status": if fit.converged { 0 } else { 3 },
+        "exit_status": if fit.converged && implausible.is_none() { 0 } else { 3 },
     });
     let mut report = text(&file, &fit, &figures, held.as_ref());
     if let Some(p) = &predicted {
@@ -229,7 +237,16 @@ pub fn calibrate_contacts(
             super::contact_report::draw(d, &r)
         })?;
     }
-    super::emit(a.json, &v, || report);
+    super::emit(a.json, &v, || report)?;
+    if let Some(why) = implausible {
+        let names: Vec<String> = a.out.iter().map(|p| p.display().to_string()).collect();
+        let lost = if names.is_empty() {
+            String::new()
+        } else {
+            format!("; {} not written", names.join(", "))
+        };
+        return Ok(Some(why + &lost));
+    }
     if !fit.converged {
         let names: Vec<String> = a.out.iter().map(|p| p.display().to_string()).collect();
         return Ok(Some(format!(
@@ -384,4 +401,18 @@ fn holdout_text(h: &HoldoutReport) -> String {
         );
     }
     s
+}
+
+/// Why a contact fit is not a calibration of its robot
+/// ([`activecal::frames::plausible`]): a joint origin moved too far, or
+/// the tool offset beyond the reach.
+fn implausible(
+    fit: &activecal::identify::contact::ContactFit,
+    frames: Option<&activecal::frames::CalibratedFrames>,
+) -> Option<String> {
+    use activecal::identify::plausible::check_offsets;
+    activecal::frames::plausible::implausible(&fit.robot, &fit.table, frames).or_else(|| {
+        let reach = activecal::units::reach(&fit.robot);
+        check_offsets("the tool offset", &[fit.tool_offset], reach)
+    })
 }

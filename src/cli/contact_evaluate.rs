@@ -19,7 +19,10 @@ pub fn cmd_evaluate_contacts(a: &EvaluateArgs) -> Result<()> {
     let robot = desc.robot;
     let mut file = read_contacts(&a.measurements, &robot, a.units.units())?;
     file.set_known_planes(&planes).context("--plane")?;
-    resolve_distances(&file, &given, true).context("--point-distance")?;
+    activecal::identify::contact::lengths::check_planes(&robot, &file).context("--plane")?;
+    let known = resolve_distances(&file, &given, true).context("--point-distance")?;
+    activecal::identify::contact::lengths::check_distances(&robot, &file, &known)
+        .context("--point-distance")?;
     let e = evaluate_contacts(&robot, &robot.nominal, &[0.0; 3], &file, &given);
     let v = json!({
         "robot": robot.name,
@@ -30,8 +33,7 @@ pub fn cmd_evaluate_contacts(a: &EvaluateArgs) -> Result<()> {
     });
     super::emit(a.json, &v, || {
         text(&robot.name, &file.origin, file.qs.len(), &e)
-    });
-    Ok(())
+    })
 }
 
 /// The evaluation as text.

@@ -39,6 +39,7 @@ fn refuse_pool_options(a: &SelectArgs) -> Result<()> {
         (a.algorithm != Algorithm::Eae, "--algorithm"),
         (a.criterion != CriterionKind::Det, "--criterion"),
         (a.initial.is_some(), "--initial"),
+        (a.designs.is_some(), "--designs"),
         (a.ils.is_some(), "--ils"),
         (a.polish, "--polish"),
         (a.order.is_some(), "--order"),

@@ -62,7 +62,7 @@ pub fn read_measurements(
     let (meas, notes) = activecal::experiment::measured::read_measurement_file(path, robot, units)?;
     if !quiet {
         for n in &notes {
-            eprintln!("note: {n}");
+            super::diag(&format!("note: {n}"));
         }
     }
     Ok((meas, notes))

@@ -204,16 +204,33 @@ pub fn write_new(path: &std::path::Path, text: &str, force: bool) -> Result<()> 
     Ok(())
 }
 
-/// Prints `value` as one JSON line, or the human-readable `text`.
-pub fn emit(json_out: bool, value: &Value, text: impl FnOnce() -> String) {
-    use std::io::Write;
+/// Prints `value` as one JSON line, or the human-readable `text`; a stdout
+/// that cannot be written (a closed pipe) is an error naming stdout.
+pub fn emit(json_out: bool, value: &Value, text: impl FnOnce() -> String) -> Result<()> {
     let s = if json_out {
         format!("{value}\n")
     } else {
         text()
     };
-    // A closed pipe (`activecal ... | head`) is not an error worth a panic.
-    let _ = std::io::stdout().lock().write_all(s.as_bytes());
+    print_out(&s)
+}
+
+/// Writes `text` to stdout and flushes it: a write error (a closed pipe,
+/// `activecal ... | head`) ends the command with a plain error, never a
+/// panic.
+pub fn print_out(text: &str) -> Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(|e| anyhow::anyhow!("cannot write the output to stdout: {e}"))
+}
+
+/// Writes one diagnostic line to stderr; a closed stderr is ignored (a
+/// diagnostic is never worth a panic or a failed command).
+pub fn diag(line: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
 }
 
 /// Prints a typed report as one JSON line, or the human-readable `text`.
@@ -223,8 +240,7 @@ pub fn emit_report<T: serde::Serialize>(
     text: impl FnOnce() -> String,
 ) -> Result<()> {
     let v = serde_json::to_value(report)?;
-    emit(json_out, &v, text);
-    Ok(())
+    emit(json_out, &v, text)
 }
 
 /// Loads a robot with its description's visibility region (validated).

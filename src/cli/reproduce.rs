@@ -137,12 +137,11 @@ pub fn cmd_reproduce(a: ReproduceArgs) -> Result<()> {
     staged.commit()?;
     let out = &a.out;
     drop(steps);
-    println!(
-        "wrote {}/report.md, report.json and figures in {:.1} s",
+    super::print_out(&format!(
+        "wrote {}/report.md, report.json and figures in {:.1} s\n",
         out.display(),
         clock.elapsed().as_secs_f64()
-    );
-    Ok(())
+    ))
 }
 
 /// Figures 2 to 6 of the paper, from the report.

@@ -202,9 +202,9 @@ pub struct SelectArgs {
     /// Design poses exchanged at random per round of --ils.
     #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
     pub kick: usize,
-    /// Random designs drawn by --algorithm random.
-    #[arg(long, default_value_t = 5000, allow_negative_numbers = true)]
-    pub designs: usize,
+    /// Random designs drawn by --algorithm random [default: 5000].
+    #[arg(long, allow_negative_numbers = true)]
+    pub designs: Option<usize>,
     /// Polish the best start with Fedorov exchange.
     #[arg(long)]
     pub polish: bool,
@@ -328,6 +328,33 @@ fn orientation_scale(
 /// (`calibrate`'s default).
 pub const DEFAULT_REPORT_NOISE: f64 = super::calibrate::DEFAULT_NOISE;
 
+/// Random designs drawn by `--algorithm random` when `--designs` is not
+/// given.
+pub const DEFAULT_DESIGNS: usize = 5000;
+
+/// Options of one algorithm given with another, or that the chosen order
+/// leaves unused: refused rather than silently ignored.
+fn refuse_unused(a: &SelectArgs, reorder: bool) -> Result<()> {
+    if let (Some(i), false) = (a.initial, a.algorithm == Algorithm::Eae) {
+        bail!(
+            "--initial {i} sets EAE's initial design; --algorithm {} does not use it",
+            a.algorithm
+        );
+    }
+    if let (Some(d), false) = (a.designs, a.algorithm == Algorithm::Random) {
+        bail!(
+            "--designs {d} is the number of random designs of --algorithm random; --algorithm {} draws none",
+            a.algorithm
+        );
+    }
+    if a.home.is_some() && !reorder {
+        bail!(
+            "--home starts the visiting path of --order time; the design keeps its selection order here (--order none, the default for a robot without joint speed limits)"
+        );
+    }
+    Ok(())
+}
+
 /// How `select` orders the design's poses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Order {
@@ -347,6 +374,7 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     }
     let speeds = activecal::io::joint_speeds::joint_speeds(&described.robot)?;
     let home = super::tour::parse_home(a.home.as_deref(), &described.robot)?;
+    refuse_unused(&a, a.order.map_or(speeds.is_some(), |o| o == Order::Time))?;
     // Refused, never clamped (as `reproduce` does).
     let initial = match a.initial {
         Some(i) if i == 0 || i > a.n => bail!(
@@ -494,7 +522,7 @@ fn selection_settings(
         n: a.n,
         initial: initial.max(fixed.len()),
         starts: a.starts,
-        designs: a.designs,
+        designs: a.designs.unwrap_or(DEFAULT_DESIGNS),
         polish: a.polish,
         ils: a
             .ils

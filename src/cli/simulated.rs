@@ -105,7 +105,7 @@ pub fn from_design(
     }
     emit(a.json, &v, || {
         simulated_text(a, robot, design_path, &sim, &report)
-    });
+    })?;
     refuse_unconverged(a, id)
 }
 

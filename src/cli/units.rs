@@ -82,7 +82,8 @@ pub fn flag_hint(e: &anyhow::Error) -> Option<&'static str> {
             })?;
         match lib {
             activecal::Error::JointOutOfLimits { hint, .. }
-            | activecal::Error::PositionsBeyondReach { hint, .. } => *hint,
+            | activecal::Error::PositionsBeyondReach { hint, .. }
+            | activecal::Error::PositionsTooSmall { hint, .. } => *hint,
             _ => None,
         }
     })?;

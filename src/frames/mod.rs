@@ -23,6 +23,7 @@ pub mod align;
 pub mod chain;
 pub mod contact;
 pub mod gauge;
+pub mod plausible;
 pub mod report;
 pub mod structure;
 pub mod uncertainty;

@@ -45,6 +45,7 @@ pub mod levmar;
 pub mod lm;
 pub mod loss;
 pub mod montecarlo;
+pub mod plausible;
 pub mod residual;
 pub mod simulate;
 pub mod start;

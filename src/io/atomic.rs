@@ -114,10 +114,69 @@ fn io_error(path: &Path, cause: std::io::Error) -> Error {
     }
 }
 
+/// Whether process `pid` is running, when the system can tell (Linux's
+/// `/proc`); `None` where it cannot.
+fn process_alive(pid: u32) -> Option<bool> {
+    if !Path::new("/proc/self").exists() {
+        return None;
+    }
+    Some(Path::new(&format!("/proc/{pid}")).exists())
+}
+
+/// Removes the temporaries a killed write left beside `path`
+/// (`.NAME.tmp-PID-N` whose process is no longer running: they are never
+/// renamed into place; and `.NAME.old-PID`, a replaced directory, when
+/// `path` exists again). Those of running processes (a concurrent write) and
+/// any other file are kept; where the system cannot tell whether a process
+/// runs, nothing is removed. Failures are ignored (the write goes on).
+pub fn remove_stale_temporaries(path: &Path) {
+    let Some(name) = path.file_name().map(|f| f.to_string_lossy().into_owned()) else {
+        return;
+    };
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return;
+    };
+    let prefix = format!(".{name}.tmp-");
+    let old = format!(".{name}.old-");
+    for e in entries.flatten() {
+        let file = e.file_name().to_string_lossy().into_owned();
+        // A replaced directory left aside by a kill between the two renames
+        // of `replace_dir`: stale once the target is back in place.
+        let aside = file.strip_prefix(&old).map(|pid| (pid, "0"));
+        let aside = aside.filter(|_| path.exists());
+        let Some((pid, n)) = file
+            .strip_prefix(&prefix)
+            .and_then(|r| r.split_once('-'))
+            .or(aside)
+        else {
+            continue;
+        };
+        let (Ok(pid), true) = (pid.parse::<u32>(), n.bytes().all(|b| b.is_ascii_digit())) else {
+            continue;
+        };
+        if n.is_empty() || pid == std::process::id() || process_alive(pid) != Some(false) {
+            continue;
+        }
+        let stale = e.path();
+        let _ = if stale.is_dir() && !stale.is_symlink() {
+            std::fs::remove_dir_all(&stale)
+        } else {
+            std::fs::remove_file(&stale)
+        };
+    }
+}
+
 /// Writes `bytes` to `path` atomically: a temporary file in the same
 /// directory, flushed to disk, then renamed over `path`. On any error the
-/// temporary file is removed and `path` is untouched.
+/// temporary file is removed and `path` is untouched. Temporaries an
+/// earlier, killed write left beside `path` are removed
+/// ([`remove_stale_temporaries`]).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    remove_stale_temporaries(path);
     let tmp = temporary_beside(path);
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
@@ -143,6 +202,7 @@ pub struct StagedDir {
 impl StagedDir {
     /// Creates an empty staging directory beside `target`.
     pub fn new(target: &Path) -> Result<StagedDir> {
+        remove_stale_temporaries(target);
         let staging = temporary_beside(target);
         std::fs::create_dir(&staging).map_err(|e| io_error(&staging, e))?;
         Ok(StagedDir {
@@ -226,6 +286,43 @@ mod tests {
         assert_eq!(names.len(), 1, "{names:?}");
         // A write into a missing directory fails and creates nothing.
         assert!(write_atomic(&d.join("no/such/dir.json"), b"x").is_err());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn a_killed_writes_temporaries_go_with_the_next_write() {
+        let d = scratch("stale");
+        let f = d.join("cal.yaml");
+        // PID 0 never names a process that can be a writer; our own PID runs.
+        let dead = d.join(".cal.yaml.tmp-0-3");
+        let ours = d.join(format!(".cal.yaml.tmp-{}-99", std::process::id()));
+        let other = d.join(".other.yaml.tmp-0-1");
+        let staged = d.join(".cal.yaml.tmp-0-4");
+        for p in [&dead, &ours, &other] {
+            std::fs::write(p, "half").unwrap();
+        }
+        std::fs::create_dir(&staged).unwrap();
+        std::fs::write(staged.join("x"), "x").unwrap();
+        write_atomic(&f, b"new").unwrap();
+        if process_alive(0).is_some() {
+            assert!(!dead.exists() && !staged.exists(), "stale temporaries kept");
+        }
+        // A directory replaced aside by a killed `replace_dir`: removed once
+        // the target is in place, kept while it is the only copy.
+        let report = d.join("report");
+        let aside = d.join(".report.old-0");
+        std::fs::create_dir(&aside).unwrap();
+        remove_stale_temporaries(&report);
+        assert!(aside.exists(), "the only copy was removed");
+        std::fs::create_dir(&report).unwrap();
+        remove_stale_temporaries(&report);
+        if process_alive(0).is_some() {
+            assert!(!aside.exists(), "a stale aside directory kept");
+        }
+        assert!(
+            ours.exists() && other.exists(),
+            "a live or other temporary removed"
+        );
         std::fs::remove_dir_all(&d).unwrap();
     }
 

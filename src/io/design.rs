@@ -179,7 +179,8 @@ impl DesignFile {
     /// Reads and parses a design file: JSON ([`DesignFile::parse`]), or
     /// the YAML form `select --out d.yaml` writes
     /// ([`DesignFile::parse_yaml`]) when the name ends in
-    /// `.yaml` or `.yml`.
+    /// `.yaml` or `.yml`. A `.csv` (joint values, no robot or pool) is
+    /// refused saying so.
     pub fn read(path: &Path) -> Result<DesignFile> {
         let text = crate::io::read::read_text(path)?;
         let origin = path.display().to_string();
@@ -189,6 +190,16 @@ impl DesignFile {
             .is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
         if yaml {
             return Self::parse_yaml(&text, &origin);
+        }
+        let csv = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+        if csv {
+            return Err(Error::Parse {
+                path: origin,
+                message: "a .csv design holds only joint values (a pool file, or poses measured before); the design file is the .json or .yaml of the same selection (it names the robot and pool)".into(),
+            });
         }
         Self::parse(&text, &origin)
     }

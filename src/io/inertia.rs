@@ -45,6 +45,12 @@ pub fn gravity_model(robot: &Robot, opts: &InertiaOptions) -> Result<GravityMode
         None => link_masses(&src.text, &src.path)?,
         Some((text, path)) => {
             let other = link_masses(text, path)?;
+            if other.is_empty() {
+                return Err(Error::Parse {
+                    path: path.clone(),
+                    message: "no link has an <inertial> element: a file of masses needs <inertial><mass value=…/></inertial> in the links of the chain".into(),
+                });
+            }
             let missing: Vec<&str> = links
                 .iter()
                 .filter(|l| !other.contains_key(*l))

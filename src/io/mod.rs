@@ -125,8 +125,8 @@ impl UrdfChain {
 
 /// A URDF robot with the chain options, mounted with the frames file's
 /// measurement frame and tool (whose chain, if it names one, is the default
-/// base and tip); two or more markers in the frames file make a marker
-/// robot.
+/// base and tip, and its locked joints the default lock); two or more
+/// markers in the frames file make a marker robot.
 fn load_urdf(path: &Path, chain: &ChainChoice, pose: bool) -> Result<Robot> {
     let frames = chain
         .frames
@@ -147,6 +147,9 @@ fn load_urdf(path: &Path, chain: &ChainChoice, pose: bool) -> Result<Robot> {
     if let Some(f) = &frames {
         opts.base = opts.base.or_else(|| f.base.clone());
         opts.tip = opts.tip.or_else(|| f.tip.clone());
+        if opts.lock.is_empty() {
+            opts.lock.clone_from(&f.locked);
+        }
         opts.mount = f.mount;
         opts.tool = f.tool;
     }
@@ -156,7 +159,12 @@ fn load_urdf(path: &Path, chain: &ChainChoice, pose: bool) -> Result<Robot> {
         // The markers' link is the measured link unless a tip is named.
         opts.tip = Some(m.link.clone());
     }
-    let robot = urdf::load(path, &opts)?;
+    let robot = match &frames {
+        Some(f) => urdf::load(path, &opts)
+            .map_err(|e| f.blame_links(e, chain.base.is_some(), chain.tip.is_some()))
+            .and_then(|r| f.check_names(&r).map(|()| r))?,
+        None => urdf::load(path, &opts)?,
+    };
     let robot = match &frames {
         Some(f) if !f.compliance.is_empty() => with_compliance(robot, &f.compliance, chain)?,
         _ => robot,

@@ -45,6 +45,12 @@ pub(super) fn iso_from_pose(p: &urdf_rs::Pose) -> Option<Isometry3<f64>> {
     ))
 }
 
+/// Largest magnitude of a joint origin's value (metres or radians), as for
+/// a description's parameters: larger values are typing errors and would
+/// overflow the kinematics (a 1e300 origin leaves no parameter
+/// identifiable).
+pub const MAX_ORIGIN: f64 = 1e6;
+
 /// Most moving joints an imported chain may have (as many as a TOML
 /// description's frames, [`crate::io::robot_toml::MAX_FRAMES`]): the choice of
 /// unknowns grows with the cube of the chain's length.
@@ -421,6 +427,19 @@ fn chain_joint(j: &urdf_rs::Joint) -> std::result::Result<ChainJoint, String> {
     use urdf_rs::JointType as T;
     let origin = iso_from_pose(&j.origin)
         .ok_or_else(|| format!("joint '{}': the origin is not finite", j.name))?;
+    for (what, v) in [("xyz", j.origin.xyz.0), ("rpy", j.origin.rpy.0)] {
+        if v.iter().any(|x| x.abs() > MAX_ORIGIN) {
+            let shown: Vec<String> = v
+                .iter()
+                .map(|x| crate::error::Compact(*x).to_string())
+                .collect();
+            return Err(format!(
+                "joint '{}': origin {what}=\"{}\" is out of range (|value| <= {MAX_ORIGIN:e}, metres or radians)",
+                j.name,
+                shown.join(" ")
+            ));
+        }
+    }
     let kind = match j.joint_type {
         T::Fixed => None,
         T::Revolute | T::Continuous => Some(JointKind::Revolute),

@@ -61,13 +61,24 @@ impl PoolSpec {
     /// empty is an error naming the filter that removed the last candidates,
     /// and so is a filter whose region is malformed ([`crate::measure::Visibility::validate`]).
     pub fn build(&self, robot: &Robot, table: &ParamTable) -> Result<Pool> {
+        self.build_budgeted(robot, table, true)
+    }
+
+    /// Builds the pool as [`PoolSpec::build`] does, for a caller that only
+    /// lists or counts its poses: the memory budget counts the poses, not
+    /// the Jacobian such a caller never builds.
+    pub fn build_poses(&self, robot: &Robot, table: &ParamTable) -> Result<Pool> {
+        self.build_budgeted(robot, table, false)
+    }
+
+    fn build_budgeted(&self, robot: &Robot, table: &ParamTable, jacobian: bool) -> Result<Pool> {
         self.validate_filters(robot)?;
         match &self.source {
             PoolSource::File { path } => {
                 let rows = read_configurations(Path::new(path), robot)?;
-                self.build_listed(robot, table, rows)
+                self.listed(robot, table, rows, jacobian)
             }
-            _ => self.build_inner(robot, table, None, Vec::new()),
+            _ => self.build_inner(robot, table, None, Vec::new(), jacobian),
         }
     }
 
@@ -103,6 +114,16 @@ impl PoolSpec {
         rows: Configurations,
     ) -> Result<Pool> {
         self.validate_filters(robot)?;
+        self.listed(robot, table, rows, true)
+    }
+
+    fn listed(
+        &self,
+        robot: &Robot,
+        table: &ParamTable,
+        rows: Configurations,
+        jacobian: bool,
+    ) -> Result<Pool> {
         if !matches!(self.source, PoolSource::File { .. }) {
             return Err(Error::Invalid(format!(
                 "stored configurations given for a {} pool",
@@ -120,7 +141,7 @@ impl PoolSpec {
                 rows.qs[k].len()
             )));
         }
-        self.build_inner(robot, table, Some(rows.qs), rows.notes)
+        self.build_inner(robot, table, Some(rows.qs), rows.notes, jacobian)
     }
 
     fn build_inner(
@@ -129,6 +150,7 @@ impl PoolSpec {
         table: &ParamTable,
         rows: Option<Vec<Vec<f64>>>,
         notes: Vec<String>,
+        jacobian: bool,
     ) -> Result<Pool> {
         let margined = self.margined(robot)?;
         let inside = margined.as_ref().unwrap_or(robot);
@@ -136,7 +158,7 @@ impl PoolSpec {
             Some(n) => n,
             None => rows.as_ref().map_or(0, Vec::len),
         };
-        check_memory(robot, n)?;
+        check_memory(robot, n, jacobian)?;
         let cands = self.candidates(robot, inside, rows.as_deref())?;
         let dof = robot.dof();
         // A file's rows are checked against the margin first (generated
@@ -283,12 +305,27 @@ pub fn memory_estimate(robot: &Robot, n: usize) -> u64 {
     crate::resources::bytes_of(n, per_pose)
 }
 
+/// Bytes a pool of `n` candidates takes when only its poses are listed:
+/// ids, joint values and each candidate's filter verdict.
+#[must_use]
+pub fn poses_memory_estimate(robot: &Robot, n: usize) -> u64 {
+    crate::resources::bytes_of(n, 8 * (1 + robot.dof()) + 16)
+}
+
 /// Refuses, before anything is allocated, a pool whose
-/// [`memory_estimate`] exceeds the memory budget.
-fn check_memory(robot: &Robot, n: usize) -> Result<()> {
-    crate::resources::MemoryBudget::from_env()?.check(
+/// [`memory_estimate`] (with its Jacobian) or [`poses_memory_estimate`]
+/// (without) exceeds the memory budget.
+fn check_memory(robot: &Robot, n: usize, jacobian: bool) -> Result<()> {
+    let budget = crate::resources::MemoryBudget::from_env()?;
+    if !jacobian {
+        return budget.check(
+            &format!("a pool of {n} poses"),
+            poses_memory_estimate(robot, n),
+        );
+    }
+    budget.check(
         &format!(
-            "a pool of {n} poses (its {}×{} Jacobian and one workspace of that size)",
+            "a pool of {n} poses (its {}×{} Jacobian and a workspace)",
             n.saturating_mul(robot.rows_per_pose()),
             robot.n_params()
         ),

@@ -34,7 +34,54 @@ pub struct NamedPlane {
     pub offset: f64,
 }
 
+/// Different configurations a fit needs for each point (its 3 unknown
+/// coordinates) and each plane (3 points span it).
+pub const MIN_DISTINCT: usize = 3;
+
 impl ContactFile {
+    /// Refuses a point or plane with fewer than [`MIN_DISTINCT`] different
+    /// configurations: the same configuration recorded again adds nothing,
+    /// and a fit of such rows has nothing to determine. The error names the
+    /// point, its lines and the file.
+    pub fn check_distinct(&self) -> crate::error::Result<()> {
+        let min = MIN_DISTINCT;
+        let names = self
+            .points
+            .iter()
+            .map(|p| ("point", p.as_str()))
+            .chain(self.planes.iter().map(|p| ("plane", p.name.as_str())));
+        for (g, (what, name)) in names.enumerate() {
+            let rows: Vec<usize> = (0..self.qs.len())
+                .filter(|&k| self.groups[k] == g)
+                .collect();
+            let mut distinct: Vec<&Vec<f64>> = Vec::new();
+            for &k in &rows {
+                if !distinct.contains(&&self.qs[k]) {
+                    distinct.push(&self.qs[k]);
+                }
+            }
+            if distinct.len() < min {
+                let mut at: Vec<String> = rows
+                    .iter()
+                    .take(6)
+                    .map(|&k| self.lines[k].to_string())
+                    .collect();
+                if rows.len() > 6 {
+                    at.push("…".into());
+                }
+                return Err(crate::error::Error::Parse {
+                    path: self.origin.clone(),
+                    message: format!(
+                        "{what} '{name}' has {} rows (line {}) but {} different configuration(s): a fit needs at least {min} different ones a {what} (a row recorded again adds nothing)",
+                        rows.len(),
+                        at.join(", "),
+                        distinct.len()
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
     /// The index of a point by name.
     #[must_use]
     pub fn point_index(&self, name: &str) -> Option<usize> {

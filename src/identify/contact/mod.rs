@@ -13,6 +13,8 @@
 //!   cannot see);
 //! * [`worth`]: which weakly determined unknowns are worth estimating at
 //!   the data's noise;
+//! * [`lengths`]: known distances and plane offsets checked against the
+//!   robot's reach;
 //! * [`holdout`]: held out by placement (the part of a point's name before
 //!   `/`): leave one placement out, and train on one;
 //! * [`select`], [`socket_design`]: the configurations to record for
@@ -22,6 +24,7 @@ pub mod data;
 pub mod evaluate;
 pub mod fit;
 pub mod holdout;
+pub mod lengths;
 pub mod predict;
 pub mod project;
 pub mod select;

@@ -409,3 +409,49 @@ fn select_predicts_the_calibrated_error_for_a_noise() {
     assert_eq!(a["predicted"]["configurations"], 1000);
     assert_eq!(a["predicted"]["noise_m"], 1e-4);
 }
+
+/// `select --out` is repeatable: one run writes each format, the same
+/// design in each; a path given twice is refused before any work.
+#[test]
+fn select_writes_several_formats_in_one_run() {
+    let dir = super::common::scratch_dir("select", "outs");
+    let (csv, json) = (dir.join("d.csv"), dir.join("d.json"));
+    let out = super::common::run(&[
+        "select",
+        "--robot",
+        "ur5",
+        "--levels",
+        "3",
+        "--n",
+        "30",
+        "--out",
+        csv.to_str().unwrap(),
+        "--out",
+        json.to_str().unwrap(),
+        "--force",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let design: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let rows = std::fs::read_to_string(&csv).unwrap().lines().count();
+    assert_eq!(rows, 1 + design["poses"].as_array().unwrap().len());
+    super::common::fails_with(
+        &[
+            "select",
+            "--robot",
+            "ur5",
+            "--levels",
+            "3",
+            "--out",
+            json.to_str().unwrap(),
+            "--out",
+            json.to_str().unwrap(),
+            "--force",
+        ],
+        "given twice",
+    );
+}

@@ -70,10 +70,7 @@ pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
         .map(|s| parse_socket(s))
         .collect::<Result<_>>()?;
     refuse_pool_options(a)?;
-    if let Some(out) = &a.out {
-        super::refuse_overwrite(out, a.force)?;
-        DesignFormat::of(out).map_err(|e| anyhow::anyhow!("--out {e}"))?;
-    }
+    super::select::check_outs(&a.out, a.force)?;
     let margin_deg = a
         .pool
         .margin
@@ -100,7 +97,7 @@ pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
         ..SocketDesignSettings::default()
     };
     let d = design_for_sockets(&robot, robot.params(a.pool.params), &sockets, &settings)?;
-    if let Some(out) = &a.out {
+    for out in &a.out {
         let text = match DesignFormat::of(out)? {
             DesignFormat::Json => contact_design::to_json(&d),
             DesignFormat::Csv => contact_design::to_csv(&d),

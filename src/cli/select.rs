@@ -222,9 +222,11 @@ pub struct SelectArgs {
     /// det (ln OI_D, with O(p²) updates) or oi (the paper's eigenvalue OI, recomputed).
     #[arg(long, value_parser = super::choice::<CriterionKind>(), default_value_t = CriterionKind::Det)]
     pub criterion: CriterionKind,
-    /// Write the design file here.
+    /// Write the design file here, in the format of its extension (.json,
+    /// .csv, .yaml); repeatable: one run, several formats, each written
+    /// atomically.
     #[arg(long)]
-    pub out: Option<PathBuf>,
+    pub out: Vec<PathBuf>,
     /// Overwrite --out if it exists.
     #[arg(long)]
     pub force: bool,
@@ -418,7 +420,7 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         &turns,
     )?;
     super::tour::check_moves(&mut report, &mut order, &ctx.pool, home.as_deref(), &turns)?;
-    if let Some(out) = &a.out {
+    if !a.out.is_empty() {
         let design = design_file(
             &ctx,
             &sel,
@@ -427,7 +429,9 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
             &order,
             &report,
         )?;
-        super::tour::write_design(&design, out, a.force)?;
+        for out in &a.out {
+            super::tour::write_design(&design, out, a.force)?;
+        }
     }
     if let (Some(noise), None) = (a.noise, &existing) {
         report.predicted = predicted_after(&ctx, a.pool.params, &sel.poses, noise);
@@ -485,16 +489,26 @@ fn predicted_after(
     })
 }
 
-/// The outputs and report options of `select`, checked before any work:
-/// the format, an existing file, a missing directory, the noise.
-fn check_select_outputs(a: &SelectArgs) -> Result<()> {
-    if let Some(out) = &a.out {
-        // Checked before the search: the format, an existing file, a missing
-        // directory.
-        super::refuse_overwrite(out, a.force)?;
+/// `--out` files, checked before any work: each one's format, an existing
+/// file without `--force`, a missing directory, and no path given twice.
+pub fn check_outs(outs: &[PathBuf], force: bool) -> Result<()> {
+    for (k, out) in outs.iter().enumerate() {
+        if outs[..k].contains(out) {
+            bail!("--out {}: given twice", out.display());
+        }
+        super::refuse_overwrite(out, force)?;
         activecal::io::design_formats::DesignFormat::of(out)
             .map_err(|e| anyhow::anyhow!("--out {e}"))?;
     }
+    Ok(())
+}
+
+/// The outputs and report options of `select`, checked before any work:
+/// the format, an existing file, a missing directory, the noise.
+fn check_select_outputs(a: &SelectArgs) -> Result<()> {
+    // Checked before the search: the format, an existing file, a missing
+    // directory, a path given twice.
+    check_outs(&a.out, a.force)?;
     if let Some(dir) = &a.report {
         super::report_dir::check(dir, a.force)?;
     }

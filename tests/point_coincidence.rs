@@ -4,7 +4,7 @@
 //! (`fixtures/mukca`).
 
 use activecal::identify::contact::{
-    ContactSettings, HoldoutMode, NamedDistance, fit_contacts, holdout_by_placement,
+    ContactFit, ContactSettings, HoldoutMode, NamedDistance, fit_contacts, holdout_by_placement,
     resolve_distances,
 };
 use activecal::identify::{Calibration, LmSettings, LossChoice, Residuals};
@@ -313,19 +313,12 @@ fn huber_names_the_shifted_high_rows() {
     );
 }
 
-/// Synthetic truth: the Panda with every estimated joint origin off by
-/// ±1 mm or ±1 mrad, five placements of MUKCa's configurations moved onto
-/// their sockets (damped least squares) with 0.02 mm of seat noise: the fit
-/// from nominal recovers every estimated unknown within 3σ, and leaving a
-/// placement out, the calibrated consistency is at the noise floor
-/// (≤ 0.05 mm: √3·0.02 = 0.035 mm is the RMS distance of a noisy row to
-/// its point, plus the spread of the estimate).
-#[test]
-fn synthetic_truth_is_fitted_to_the_noise_floor() {
-    use activecal::identify::contact::{placement_of, project::simulate_contacts};
-    use rand::RngExt as _;
-    let robot = panda();
-    let real = contacts(&robot);
+/// Five placements of MUKCa's configurations (the seeds of the synthetic
+/// truths), their sockets' known distances, and the fit of the real
+/// contacts there (which unknowns these configurations determine).
+fn five_placements(robot: &Robot) -> (ContactFile, Vec<NamedDistance>, ContactFit) {
+    use activecal::identify::contact::placement_of;
+    let real = contacts(robot);
     let keep = [
         "back_left",
         "front_left",
@@ -338,22 +331,49 @@ fn synthetic_truth_is_fitted_to_the_noise_floor() {
         .collect();
     let seeds = real.subset(&rows);
     let given = sockets(&seeds);
-    let l2 = settings(LossChoice::L2);
     let known = resolve_distances(&seeds, &given, true).unwrap();
-    // Which unknowns a fit of these configurations estimates.
-    let first = fit_contacts(&robot, &robot.nominal, &seeds, &known, &l2).unwrap();
-    let fixed: Vec<&str> = first.fixed.iter().map(|f| f.name.as_str()).collect();
+    let first = fit_contacts(
+        robot,
+        &robot.nominal,
+        &seeds,
+        &known,
+        &settings(LossChoice::L2),
+    );
+    (seeds, given, first.unwrap())
+}
+
+/// `robot`'s nominal table with each unknown whose name `perturb` accepts
+/// off by ±1 mm or ±1 mrad (signs drawn from `rng`).
+fn perturbed<R: rand::Rng>(
+    robot: &Robot,
+    perturb: impl Fn(&str) -> bool,
+    rng: &mut R,
+) -> activecal::model::ParamTable {
+    use rand::RngExt as _;
     let names = robot.parameter_names();
-    let mut rng = activecal::identify::trial_rng(29, 0);
     let mut truth = robot.nominal.clone();
     for (k, u) in robot.unknowns.iter().enumerate() {
-        if !fixed.contains(&names[k].as_str()) {
+        if perturb(&names[k]) {
             let s = if rng.random::<bool>() { 1e-3 } else { -1e-3 };
             truth.set(*u, truth.get(*u) + s);
         }
     }
-    let (sim, pts) =
-        simulate_contacts(&robot, &truth, &[0.0; 3], &seeds, 2e-5, 0.0, &mut rng).unwrap();
+    truth
+}
+
+/// Contacts of `truth` at the configurations of `seeds` with seat noise
+/// `sigma` (metres), the sockets' distances as the truth makes them, and
+/// those resolved for a fit.
+fn simulated<R: rand::Rng>(
+    robot: &Robot,
+    truth: &activecal::model::ParamTable,
+    seeds: &ContactFile,
+    given: &[NamedDistance],
+    sigma: f64,
+    rng: &mut R,
+) -> (ContactFile, Vec<NamedDistance>, Vec<KnownDistance>) {
+    use activecal::identify::contact::project::simulate_contacts;
+    let (sim, pts) = simulate_contacts(robot, truth, &[0.0; 3], seeds, sigma, 0.0, rng).unwrap();
     let exact: Vec<NamedDistance> = given
         .iter()
         .map(|d| NamedDistance {
@@ -363,6 +383,28 @@ fn synthetic_truth_is_fitted_to_the_noise_floor() {
         })
         .collect();
     let known = resolve_distances(&sim, &exact, true).unwrap();
+    (sim, exact, known)
+}
+
+/// Synthetic truth: the Panda with every estimated joint origin off by
+/// ±1 mm or ±1 mrad, five placements of MUKCa's configurations moved onto
+/// their sockets (damped least squares) with 0.02 mm of seat noise: the fit
+/// from nominal recovers every estimated unknown within 3σ, and leaving a
+/// placement out, the calibrated consistency is at the noise floor
+/// (≤ 0.05 mm: √3·0.02 = 0.035 mm is the RMS distance of a noisy row to
+/// its point, plus the spread of the estimate).
+#[test]
+fn synthetic_truth_is_fitted_to_the_noise_floor() {
+    let robot = panda();
+    let (seeds, given, first) = five_placements(&robot);
+    let l2 = settings(LossChoice::L2);
+    let mut rng = activecal::identify::trial_rng(29, 0);
+    let truth = perturbed(
+        &robot,
+        |n| !first.fixed.iter().any(|f| f.name == n),
+        &mut rng,
+    );
+    let (sim, exact, known) = simulated(&robot, &truth, &seeds, &given, 2e-5, &mut rng);
     let fit = fit_contacts(&robot, &robot.nominal, &sim, &known, &l2).unwrap();
     assert!(fit.converged, "{:?}", fit.stop);
     let std = fit.std.as_ref().unwrap();
@@ -404,25 +446,9 @@ fn synthetic_truth_is_fitted_to_the_noise_floor() {
 /// fixed them and left 0.01 mm of true error (issue #39).
 #[test]
 fn noise_free_contacts_recover_the_weakly_determined_unknowns() {
-    use activecal::identify::contact::{placement_of, project::simulate_contacts};
-    use rand::RngExt as _;
     let robot = panda();
-    let real = contacts(&robot);
-    let keep = [
-        "back_left",
-        "front_left",
-        "front_center",
-        "mid_right",
-        "mid-high",
-    ];
-    let rows: Vec<usize> = (0..real.qs.len())
-        .filter(|&i| keep.contains(&placement_of(&real.points[real.groups[i]])))
-        .collect();
-    let seeds = real.subset(&rows);
-    let given = sockets(&seeds);
+    let (seeds, given, first) = five_placements(&robot);
     let l2 = settings(LossChoice::L2);
-    let known = resolve_distances(&seeds, &given, true).unwrap();
-    let first = fit_contacts(&robot, &robot.nominal, &seeds, &known, &l2).unwrap();
     let weak: Vec<&str> = first
         .fixed
         .iter()
@@ -434,32 +460,11 @@ fn noise_free_contacts_recover_the_weakly_determined_unknowns() {
         "the real data fix no weak unknown: {:?}",
         first.fixed
     );
-    let undetermined: Vec<&str> = first
-        .fixed
-        .iter()
-        .filter(|f| !weak.contains(&f.name.as_str()))
-        .map(|f| f.name.as_str())
-        .collect();
-    let names = robot.parameter_names();
+    // Every unknown but those the data cannot see at all: the weak ones too.
+    let undetermined = |n: &str| first.fixed.iter().any(|f| f.name == n) && !weak.contains(&n);
     let mut rng = activecal::identify::trial_rng(31, 0);
-    let mut truth = robot.nominal.clone();
-    for (k, u) in robot.unknowns.iter().enumerate() {
-        if !undetermined.contains(&names[k].as_str()) {
-            let s = if rng.random::<bool>() { 1e-3 } else { -1e-3 };
-            truth.set(*u, truth.get(*u) + s);
-        }
-    }
-    let (sim, pts) =
-        simulate_contacts(&robot, &truth, &[0.0; 3], &seeds, 0.0, 0.0, &mut rng).unwrap();
-    let exact: Vec<NamedDistance> = given
-        .iter()
-        .map(|d| NamedDistance {
-            metres: (pts[sim.point_index(&d.a).unwrap()] - pts[sim.point_index(&d.b).unwrap()])
-                .norm(),
-            ..d.clone()
-        })
-        .collect();
-    let known = resolve_distances(&sim, &exact, true).unwrap();
+    let truth = perturbed(&robot, |n| !undetermined(n), &mut rng);
+    let (sim, _, known) = simulated(&robot, &truth, &seeds, &given, 0.0, &mut rng);
     let fit = fit_contacts(&robot, &robot.nominal, &sim, &known, &l2).unwrap();
     assert!(fit.converged, "{:?}", fit.stop);
     for w in &weak {
@@ -495,49 +500,20 @@ fn noise_free_contacts_recover_the_weakly_determined_unknowns() {
 #[test]
 fn contacts_predict_their_true_error() {
     use activecal::identify::contact::predict::predicted_true_error;
-    use activecal::identify::contact::{placement_of, project::simulate_contacts};
-    use rand::RngExt as _;
     let robot = panda();
-    let real = contacts(&robot);
-    let keep = [
-        "back_left",
-        "front_left",
-        "front_center",
-        "mid_right",
-        "mid-high",
-    ];
-    let rows: Vec<usize> = (0..real.qs.len())
-        .filter(|&i| keep.contains(&placement_of(&real.points[real.groups[i]])))
-        .collect();
-    let seeds = real.subset(&rows);
-    let given = sockets(&seeds);
+    let (seeds, given, first) = five_placements(&robot);
     let l2 = settings(LossChoice::L2);
-    let known = resolve_distances(&seeds, &given, true).unwrap();
-    let first = fit_contacts(&robot, &robot.nominal, &seeds, &known, &l2).unwrap();
-    let names = robot.parameter_names();
     let mut rng = activecal::identify::trial_rng(41, 0);
-    let mut truth = robot.nominal.clone();
-    for (k, u) in robot.unknowns.iter().enumerate() {
-        if !first.fixed.iter().any(|f| f.name == names[k]) {
-            let s = if rng.random::<bool>() { 1e-3 } else { -1e-3 };
-            truth.set(*u, truth.get(*u) + s);
-        }
-    }
+    let truth = perturbed(
+        &robot,
+        |n| !first.fixed.iter().any(|f| f.name == n),
+        &mut rng,
+    );
     let eval = activecal::observability::generic_configurations(&robot, 1000, 9);
     let (mut true2, mut pred2) = (0.0, 0.0);
     let draws = 12;
     for _ in 0..draws {
-        let (sim, pts) =
-            simulate_contacts(&robot, &truth, &[0.0; 3], &seeds, 2e-5, 0.0, &mut rng).unwrap();
-        let exact: Vec<NamedDistance> = given
-            .iter()
-            .map(|d| NamedDistance {
-                metres: (pts[sim.point_index(&d.a).unwrap()] - pts[sim.point_index(&d.b).unwrap()])
-                    .norm(),
-                ..d.clone()
-            })
-            .collect();
-        let known = resolve_distances(&sim, &exact, true).unwrap();
+        let (sim, _, known) = simulated(&robot, &truth, &seeds, &given, 2e-5, &mut rng);
         let fit = fit_contacts(&robot, &robot.nominal, &sim, &known, &l2).unwrap();
         assert!(fit.converged, "{:?}", fit.stop);
         let predicted = predicted_true_error(&fit, 1000, 3).unwrap().rms_mm;

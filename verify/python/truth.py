@@ -361,18 +361,29 @@ def read_frames(path):
     return m, tool, markers, chain.get("base"), chain.get("tip"), y
 
 
-def write_yaml_frames(path, base, tip, tool, pose, mount=None):
-    """A frames file activecal reads: the chain, the nominal marker (a point)
-    or tool (a pose), and optionally a measurement frame."""
-    lines = ["# written by verify/python/truth.py", "chain:", "  base: %s" % base, "  tip: %s" % tip]
-    if mount is not None:
-        lines += ["measurement_frame:",
-                  "  xyz: [%s]" % ", ".join(repr(float(v)) for v in mount.translation),
-                  "  rpy: [%s]" % ", ".join(repr(v) for v in matrix_rpy(mount.rotation))]
+def matrix_quat(r):
+    """A rotation matrix's unit quaternion [w, x, y, z] (Shepperd's method)."""
+    import pinocchio
+    q = pinocchio.Quaternion(np.asarray(r, dtype=float))
+    q.normalize()
+    return [q.w, q.x, q.y, q.z]
+
+
+def write_yaml_frames(path, base, tip, tool, pose, mount=None, joints=()):
+    """A frames file activecal reads: the chain (its driven joints), the
+    measurement frame (identity unless given), no joint-origin changes, and
+    the nominal marker (a point) or tool (a pose). activecal reads frames
+    files strictly: every block present, rpy and quaternion agreeing."""
+    def frame(iso):
+        return ["  xyz: [%s]" % ", ".join(repr(float(v)) for v in iso.translation),
+                "  rpy: [%s]" % ", ".join(repr(float(v)) for v in matrix_rpy(iso.rotation)),
+                "  quaternion: [%s]" % ", ".join(repr(float(v)) for v in matrix_quat(iso.rotation))]
+    lines = ["# written by verify/python/truth.py", "chain:", "  base: %s" % base, "  tip: %s" % tip,
+             "  joints: [%s]" % ", ".join(joints)]
+    lines += ["measurement_frame:"] + frame(mount if mount is not None else se3(np.eye(3), np.zeros(3)))
+    lines += ["joints: {}"]
     if pose:
-        lines += ["tool:",
-                  "  xyz: [%s]" % ", ".join(repr(float(v)) for v in tool.translation),
-                  "  rpy: [%s]" % ", ".join(repr(v) for v in matrix_rpy(tool.rotation))]
+        lines += ["tool:"] + frame(tool)
     else:
         lines += ["markers:", "- xyz: [%s]" % ", ".join(repr(float(v)) for v in tool.translation)]
     with open(path, "w") as f:
@@ -574,7 +585,7 @@ def cmd_rank(a):
 def cmd_sensor_frames(a):
     t = Truth(a.truth)
     nominal = iso_from_json(t.j["nominal_tool"])
-    write_yaml_frames(a.out, t.chain.base, t.chain.tip, nominal, t.pose)
+    write_yaml_frames(a.out, t.chain.base, t.chain.tip, nominal, t.pose, joints=t.chain.names)
     print(json.dumps({"out": a.out}))
 
 

@@ -217,26 +217,20 @@ pub fn fit_contacts(
         own0: &own0,
         settings,
     };
-    let strict = determined(
-        robot,
-        start,
-        file,
-        distances,
-        &planes,
-        &own0,
-        &settings.keep,
-        crate::identify::undetermined::PIVOT_TOL,
-    )?;
-    let weak_bar = determined(
-        robot,
-        start,
-        file,
-        distances,
-        &planes,
-        &own0,
-        &settings.keep,
-        CONTACT_PIVOT_TOL,
-    )?;
+    let at = |tol| {
+        determined(
+            robot,
+            start,
+            file,
+            distances,
+            &planes,
+            &own0,
+            &settings.keep,
+            tol,
+        )
+    };
+    let strict = at(crate::identify::undetermined::PIVOT_TOL)?;
+    let weak_bar = at(CONTACT_PIVOT_TOL)?;
     let weak: Vec<String> = weak_bar
         .fixed
         .iter()

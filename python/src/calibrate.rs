@@ -153,7 +153,9 @@ pub fn calibrate(
         )),
         None => Err(arg_err(
             "loss_scale",
-            format!("loss=\"{loss}\" needs loss_scale (metres: the residual norm of one pose where the loss turns robust, e.g. 3 times the sensor noise)"),
+            format!(
+                "loss=\"{loss}\" needs loss_scale (metres: the residual norm of one pose where the loss turns robust, e.g. 3 times the sensor noise)"
+            ),
         )),
     };
     let loss = match loss {
@@ -193,8 +195,15 @@ pub fn calibrate(
         let t0 = std::time::Instant::now();
         let meas = Measurements::with_orientations(&r, d.qs, d.points, d.orientations)
             .map_err(|e| e.to_string())?;
-        let c = calibrate_measurements(&r, &meas, "the arrays given", Vec::new(), &settings, &mut |_| {})
-            .map_err(|e| e.to_string())?;
+        let c = calibrate_measurements(
+            &r,
+            &meas,
+            "the arrays given",
+            Vec::new(),
+            &settings,
+            &mut |_| {},
+        )
+        .map_err(|e| e.to_string())?;
         let mut report = c.report;
         report.base.elapsed_seconds = t0.elapsed().as_secs_f64();
         let id = c.fit.id;

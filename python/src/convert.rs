@@ -73,7 +73,10 @@ pub fn float_array(
         .map_err(|e| arg_err(name, format!("not an array of numbers ({e})")))?;
     let shape: Vec<usize> = a.getattr("shape")?.extract()?;
     let fits = shape.len() == want.len()
-        && shape.iter().zip(want).all(|(s, w)| w.is_none_or(|w| *s == w));
+        && shape
+            .iter()
+            .zip(want)
+            .all(|(s, w)| w.is_none_or(|w| *s == w));
     if !fits {
         let expected: Vec<String> = want
             .iter()

@@ -35,7 +35,10 @@ fn pool_source(
         return Err(arg_err("levels", "applies to pool=\"lattice\" only"));
     }
     if !sampled && count_.is_some() {
-        return Err(arg_err("count", "applies to pool=\"random\" or \"sobol\" only"));
+        return Err(arg_err(
+            "count",
+            "applies to pool=\"random\" or \"sobol\" only",
+        ));
     }
     if !sampled && pool_seed.is_some() {
         return Err(arg_err(
@@ -44,7 +47,9 @@ fn pool_source(
         ));
     }
     let n = count_.map_or(Ok(4096), |c| count("count", c, 1))?;
-    let seed = pool_seed.map(|s| non_negative("pool_seed", s)).transpose()?;
+    let seed = pool_seed
+        .map(|s| non_negative("pool_seed", s))
+        .transpose()?;
     Ok(match pool {
         "lattice" => PoolSource::Lattice {
             levels: levels.map_or(Ok(5), |l| count("levels", l, 2))?,
@@ -104,13 +109,18 @@ pub fn select(
         let names: Vec<&str> = Algorithm::ALL.iter().map(|a| a.name()).collect();
         arg_err(
             "algorithm",
-            format!("unknown algorithm '{algorithm}': one of {}", names.join(", ")),
+            format!(
+                "unknown algorithm '{algorithm}': one of {}",
+                names.join(", ")
+            ),
         )
     })?;
     let seed = non_negative("seed", seed)?;
     let starts = crate::convert::count("starts", starts, 1)?;
     let kick = crate::convert::count("kick", kick, 1)?;
-    let ils = ils.map(|i| crate::convert::count("ils", i, 0)).transpose()?;
+    let ils = ils
+        .map(|i| crate::convert::count("ils", i, 0))
+        .transpose()?;
     if let Some(m) = margin.filter(|m| !(m.is_finite() && *m >= 0.0)) {
         return Err(arg_err("margin", format!("{m}: an angle >= 0 degrees")));
     }

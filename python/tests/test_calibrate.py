@@ -130,3 +130,45 @@ def test_unconverged_fits_are_not_written(tmp_path, puma_data):
     assert not cal.converged
     with pytest.raises(activecal.Error, match="not written"):
         cal.write_urdf(tmp_path / "x.urdf")
+
+
+def rpy_matrix(roll, pitch, yaw):
+    """R = Rz(yaw) Ry(pitch) Rx(roll), as the measurement files' phix/phiy/
+    phiz are read (nalgebra's Rotation3::from_euler_angles, term by term)."""
+    import math
+
+    sr, cr = math.sin(roll), math.cos(roll)
+    sp, cp = math.sin(pitch), math.cos(pitch)
+    sy, cy = math.sin(yaw), math.cos(yaw)
+    return [
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+        [-sp, cp * sr, cp * cr],
+    ]
+
+
+def figaroh_ur10():
+    """FIGAROH's UR10 full-pose data as arrays: q, points, orientations."""
+    from conftest import FIXTURES
+
+    path = FIXTURES / "figaroh" / "ur10_full_pose.csv"
+    head = path.read_text().splitlines()[0].split(",")
+    data = np.loadtxt(path, delimiter=",", skiprows=1)
+    col = {c: k for k, c in enumerate(head)}
+    joints = [c for c in head if c.endswith("_joint")]
+    q = data[:, [col[j] for j in joints]]
+    points = data[:, [col["x1"], col["y1"], col["z1"]]]
+    rot = np.array([rpy_matrix(*row) for row in data[:, [col["phix1"], col["phiy1"], col["phiz1"]]]])
+    return path, joints, q, points, rot
+
+
+def test_figaroh_ur10_full_pose_equals_the_cli():
+    from conftest import FIXTURES
+
+    path, joints, q, points, rot = figaroh_ur10()
+    urdf = FIXTURES / "figaroh" / "ur10_robot.urdf"
+    want = cli("calibrate", "--robot", f"{urdf}:pose", "--tip", "ur10e_tooltip_link", "--measurements", path)
+    r = activecal.Robot.from_urdf(urdf, tip="ur10e_tooltip_link", pose=True)
+    assert r.joint_names == joints
+    cal = activecal.calibrate(r, q, points, orientations=rot)
+    assert_same_fit(cal, want)

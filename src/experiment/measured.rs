@@ -427,12 +427,8 @@ fn calibrate_read(
         (Some(h), true) => Some(splits.compliance_comparison(h)?),
         _ => None,
     };
-    let base = crate::report::MeasuredCalibrationReport::new(
-        &r,
-        &f.id,
-        source.to_string(),
-        meas.len(),
-    );
+    let base =
+        crate::report::MeasuredCalibrationReport::new(&r, &f.id, source.to_string(), meas.len());
     let report = MeasuredReport {
         base,
         loss: s.loss,

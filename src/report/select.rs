@@ -233,8 +233,7 @@ impl PredictedAfter {
         noise: f64,
     ) -> Option<Self> {
         let info = pool.information(poses);
-        let qs =
-            crate::how_many::random_configurations(robot, PREDICTION_CONFIGURATIONS, 0);
+        let qs = crate::how_many::random_configurations(robot, PREDICTION_CONFIGURATIONS, 0);
         let eval = crate::blocks::jacobian_of(robot, table, qs.len(), |k, q| {
             q.copy_from_slice(&qs[k]);
         });

@@ -84,6 +84,14 @@ class Robot:
         the end frame's orientation (3×3 rotation matrix in the base frame)
         and position (shape (3,), metres)."""
 
+    def jacobian(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """The identification Jacobian of the nominal model at joint values
+        q (shape (dof,), radians or metres): shape (rows, len(unknowns)),
+        each measured coordinate's change (metres) per unit of each
+        parameter (metres or radians), columns in the order of `unknowns`;
+        3 rows for a point, 6 for a full pose (orientation rows weighed by
+        the robot's orientation scale, metres per radian), 3 per marker."""
+
 class Design:
     """The poses `select` chose, in selection order."""
 

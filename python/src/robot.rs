@@ -241,6 +241,22 @@ impl Robot {
         ))
     }
 
+    /// The identification Jacobian at joint values q (radians or metres,
+    /// shape (dof,)) of the nominal model: shape (rows, len(unknowns)), the
+    /// change of each measured coordinate (metres; a full pose's
+    /// orientation rows in metres as weighed by the robot's orientation
+    /// scale) per unit of each parameter (metres or radians), the columns
+    /// in the order of `unknowns`; 3 rows for a point, 6 for a pose, 3 per
+    /// marker.
+    fn jacobian<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let q = self.configuration(py, q, "q")?;
+        let r = &self.inner;
+        let (t, n) = (r.rows_per_pose(), r.n_params());
+        let mut jac = vec![0.0; t * n];
+        activecal::measure::JacobianEvaluator::new(r, &r.nominal).eval(&q, &mut jac);
+        ndarray(py, &jac, &[t, n])
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Robot({:?}, dof={}, unknowns={})",

@@ -81,3 +81,14 @@ def test_loading_errors_name_what_is_wrong():
         activecal.Robot.from_urdf(UR5_URDF, tip="nope")
     with pytest.raises(activecal.Error, match="nope_joint"):
         activecal.Robot.from_urdf(UR5_URDF, tip="tool0", lock={"nope_joint": 0.1})
+
+
+@pytest.mark.parametrize("name", ["puma560", "ur5:pose"])
+def test_jacobian_equals_the_cli(name):
+    r = activecal.Robot.builtin(name)
+    q = [0.3, -0.4, 0.5, -0.6, 0.7, -0.8]
+    want = cli("fk", "--robot", name, "--q", ",".join(map(repr, q)), "--jacobian")
+    j = r.jacobian(q)
+    assert j.shape == (6 if r.measures_orientation else 3, len(r.unknowns))
+    assert want["parameter_names"] == r.unknowns
+    assert np.array_equal(j, np.array(want["jacobian"]))

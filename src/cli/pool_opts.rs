@@ -144,10 +144,8 @@ pub struct PoolOpts {
 }
 
 /// The joint-limit margin of a URDF robot when `--margin` is not given,
-/// degrees: clear of the hard stops, where a badly calibrated
-/// arm's controller faults, by more than a calibration's usual joint
-/// offsets (tenths of a degree).
-pub const DEFAULT_MARGIN_DEG: f64 = 2.0;
+/// degrees ([`activecal::pool::DEFAULT_URDF_MARGIN_DEG`]).
+pub const DEFAULT_MARGIN_DEG: f64 = activecal::pool::DEFAULT_URDF_MARGIN_DEG;
 
 /// A robot, its pose pool and the pool's identification Jacobian.
 pub struct PoolCtx {
@@ -296,10 +294,7 @@ impl PoolOpts {
                 anyhow::bail!("--margin {m}: the margin is an angle >= 0 degrees")
             }
             Some(m) => m,
-            None if self.robot.is_urdf() && !matches!(self.pool, PoolKind::File(_)) => {
-                DEFAULT_MARGIN_DEG
-            }
-            None => 0.0,
+            None => activecal::pool::default_margin_deg(self.robot.is_urdf(), &self.source()?),
         };
         Ok(deg.to_radians())
     }

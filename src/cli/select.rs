@@ -462,12 +462,9 @@ fn predicted_text(p: Option<&activecal::report::PredictedAfter>) -> String {
     s + "\n"
 }
 
-/// Configurations the predicted errors are taken over (as `--report`'s).
-const PREDICTION_CONFIGURATIONS: usize = 1000;
-
 /// The errors predicted after calibrating with the pool poses `poses`
-/// with noise `noise` (metres), at random configurations of seed 0, as
-/// `--report`'s curve computes them; `None` for a singular design.
+/// with noise `noise` (metres), as `--report`'s curve computes them;
+/// `None` for a singular design.
 fn predicted_after(
     ctx: &super::PoolCtx,
     params: activecal::model::ParamSet,
@@ -475,18 +472,7 @@ fn predicted_after(
     noise: f64,
 ) -> Option<activecal::report::PredictedAfter> {
     let robot = &ctx.robot;
-    let info = ctx.x.information(poses);
-    let qs = activecal::how_many::random_configurations(robot, PREDICTION_CONFIGURATIONS, 0);
-    let table = robot.params(params);
-    let eval = activecal::blocks::jacobian_of(robot, table, qs.len(), |k, q| {
-        q.copy_from_slice(&qs[k]);
-    });
-    let errors = activecal::how_many::predicted_errors(robot, &eval, info.as_ref(), noise)?;
-    Some(activecal::report::PredictedAfter {
-        noise_m: noise,
-        configurations: qs.len(),
-        errors,
-    })
+    activecal::report::PredictedAfter::of_design(robot, robot.params(params), &ctx.x, poses, noise)
 }
 
 /// `--out` files, checked before any work: each one's format, an existing
@@ -648,22 +634,7 @@ fn design_file(
         path: e.report.file.clone(),
         q: e.qs.clone(),
     });
-    let v = serde_json::to_value(report)?;
-    for k in [
-        "ln_oid",
-        "log10_oid",
-        "oi",
-        "algorithm",
-        "criterion",
-        "seed",
-        "starts",
-        "polish",
-        "ils",
-        "kick",
-        "fixed",
-    ] {
-        d.extra.insert(k.into(), v[k].clone());
-    }
+    d.extra.extend(report.design_keys());
     Ok(d)
 }
 

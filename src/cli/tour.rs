@@ -2,7 +2,7 @@
 //! measure them, written in the robot's terms (.json, .csv, .yaml).
 
 use activecal::io::design::DesignFile;
-use activecal::io::design_formats::{self, DesignFormat};
+use activecal::io::design_formats;
 use activecal::io::joint_speeds::JointSpeeds;
 use activecal::model::Robot;
 use activecal::report::SelectReport;
@@ -228,11 +228,9 @@ pub fn reorder_design(d: &mut DesignFile, order: &[usize]) {
 /// Writes the design in the format its extension names (checked before the
 /// search too).
 pub fn write_design(d: &DesignFile, out: &std::path::Path, force: bool) -> Result<()> {
-    match DesignFormat::of(out)? {
-        DesignFormat::Json => d.write(out, force)?,
-        DesignFormat::Csv => super::write_new(out, &design_formats::to_csv(d)?, force)?,
-        DesignFormat::Yaml => super::write_new(out, &design_formats::to_yaml(d)?, force)?,
-    }
+    // The command's own message for an existing file ("pass --force").
+    super::refuse_overwrite(out, force)?;
+    design_formats::write(d, out, true)?;
     Ok(())
 }
 

@@ -335,11 +335,47 @@ pub fn calibrate_measured(
     s: &MeasuredSettings,
     on_note: &mut dyn FnMut(&str),
 ) -> Result<MeasuredCalibration, ExperimentError> {
+    let (meas, read_notes) = read_measurement_file(path, robot, s.units)?;
+    let source = path.display().to_string();
+    calibrate_read(robot, &meas, &source, read_notes, s, on_note)
+}
+
+/// As [`calibrate_measured`], from measurements already in memory (checked
+/// as a file's are, [`Measurements::check`] and
+/// [`crate::identify::evaluation::check_in_reach`], in metres and radians):
+/// `source` names them in errors and in the report (a file's path), `notes`
+/// are what their reading found. [`MeasuredSettings::units`] is not used.
+pub fn calibrate_measurements(
+    robot: &Robot,
+    meas: &Measurements,
+    source: &str,
+    read_notes: Vec<String>,
+    s: &MeasuredSettings,
+    on_note: &mut dyn FnMut(&str),
+) -> Result<MeasuredCalibration, ExperimentError> {
     let in_file = |e: crate::identify::IdentifyError| ExperimentError::InFile {
-        path: path.display().to_string(),
+        path: source.to_string(),
         error: e,
     };
-    let (meas, read_notes) = read_measurement_file(path, robot, s.units)?;
+    meas.check(robot).map_err(in_file)?;
+    crate::identify::evaluation::check_in_reach(robot, meas, source, crate::units::LengthUnit::M)
+        .map_err(in_file)?;
+    calibrate_read(robot, meas, source, read_notes, s, on_note)
+}
+
+/// The calibration of measurements read and checked.
+fn calibrate_read(
+    robot: &Robot,
+    meas: &Measurements,
+    source: &str,
+    read_notes: Vec<String>,
+    s: &MeasuredSettings,
+    on_note: &mut dyn FnMut(&str),
+) -> Result<MeasuredCalibration, ExperimentError> {
+    let in_file = |e: crate::identify::IdentifyError| ExperimentError::InFile {
+        path: source.to_string(),
+        error: e,
+    };
     let mut notes = Vec::new();
     let mut note = |n: &str| {
         on_note(n);
@@ -347,7 +383,7 @@ pub fn calibrate_measured(
     };
     read_notes.iter().for_each(|n| note(n));
     let given = robot;
-    let mounted = mounted_start(robot, &meas)?;
+    let mounted = mounted_start(robot, meas)?;
     let robot = match &mounted {
         Some((r, n)) => {
             note(n);
@@ -355,19 +391,19 @@ pub fn calibrate_measured(
         }
         None => robot,
     };
-    let start = for_measurements(robot, &meas, &s.lm).map_err(in_file)?;
+    let start = for_measurements(robot, meas, &s.lm).map_err(in_file)?;
     start.notes.iter().for_each(|n| note(n));
     let (fitted_robot, without) = match (&s.gravity, s.fit_compliance) {
         (Some(g), true) => {
-            let (r, w) = with_compliance(&start.robot, g, &meas);
+            let (r, w) = with_compliance(&start.robot, g, meas);
             (r, Some(w))
         }
         _ => (start.robot.clone(), None),
     };
     let det =
-        prepare_for_data(&fitted_robot, &start.table, &meas, &s.fix, &s.free).map_err(in_file)?;
+        prepare_for_data(&fitted_robot, &start.table, meas, &s.fix, &s.free).map_err(in_file)?;
     let weighted =
-        crate::identify::fit_weighted(&det.robot, &start.table, &meas, &s.lm, s.loss, s.weights)
+        crate::identify::fit_weighted(&det.robot, &start.table, meas, &s.lm, s.loss, s.weights)
             .map_err(in_file)?;
     let noise = NoiseReport {
         weights: s.weights,
@@ -376,14 +412,14 @@ pub fn calibrate_measured(
         blocks: weighted.sigmas,
     };
     let (r, f) = (weighted.robot, weighted.fit);
-    let res = residuals(&r, &f.id.table, &meas)?;
-    let nominal = nominal_residuals(given, mounted.is_some(), &r, &meas, &s.lm)?;
+    let res = residuals(&r, &f.id.table, meas)?;
+    let nominal = nominal_residuals(given, mounted.is_some(), &r, meas, &s.lm)?;
     let params = trust(&r, &r.nominal, &f.id);
-    let compliance = without.map(|w| crate::identify::compliance::report(&r, &f.id, &meas, w));
+    let compliance = without.map(|w| crate::identify::compliance::report(&r, &f.id, meas, w));
     let splits = Splits {
         robot,
         given,
-        meas: &meas,
+        meas,
         s,
     };
     let ho = s.holdout.map(|h| splits.holdout_report(h)).transpose()?;
@@ -391,12 +427,8 @@ pub fn calibrate_measured(
         (Some(h), true) => Some(splits.compliance_comparison(h)?),
         _ => None,
     };
-    let base = crate::report::MeasuredCalibrationReport::new(
-        &r,
-        &f.id,
-        path.display().to_string(),
-        meas.len(),
-    );
+    let base =
+        crate::report::MeasuredCalibrationReport::new(&r, &f.id, source.to_string(), meas.len());
     let report = MeasuredReport {
         base,
         loss: s.loss,

@@ -56,6 +56,27 @@ impl DesignFormat {
     }
 }
 
+/// Writes `d` to `path` in the format of its extension ([`DesignFormat`]):
+/// what `select --out` writes. An existing file is only replaced when
+/// `overwrite` is set.
+pub fn write(d: &DesignFile, path: &Path, overwrite: bool) -> Result<()> {
+    let format = DesignFormat::of(path)?;
+    let text = match format {
+        DesignFormat::Json => return d.write(path, overwrite),
+        DesignFormat::Csv => to_csv(d)?,
+        DesignFormat::Yaml => to_yaml(d)?,
+    };
+    super::atomic::check_outputs(
+        &[super::atomic::Output {
+            label: "design file",
+            path,
+        }],
+        &[],
+        overwrite,
+    )?;
+    super::atomic::write_atomic(path, text.as_bytes())
+}
+
 /// Joint values keyed by joint name, in the chain's order (the YAML form of
 /// a configuration, shared by every design written as named joints).
 pub(crate) struct Joints<'a> {

@@ -184,6 +184,26 @@ fn is_zero(x: &f64) -> bool {
     *x == 0.0
 }
 
+/// The joint-limit margin of a URDF robot's generated pool when none is
+/// given, degrees: clear of the hard stops, where a badly calibrated arm's
+/// controller faults, by more than a calibration's usual joint offsets
+/// (tenths of a degree).
+pub const DEFAULT_URDF_MARGIN_DEG: f64 = 2.0;
+
+/// The joint-limit margin of a pool when none is given, degrees:
+/// [`DEFAULT_URDF_MARGIN_DEG`] for a URDF robot (`urdf`) and a generated
+/// pool, else 0 (a built-in arm keeps the paper's lattice, a `.toml`
+/// description states its limits as its pools should use them, listed
+/// configurations are taken as given).
+#[must_use]
+pub fn default_margin_deg(urdf: bool, source: &PoolSource) -> f64 {
+    if urdf && !matches!(source, PoolSource::File { .. }) {
+        DEFAULT_URDF_MARGIN_DEG
+    } else {
+        0.0
+    }
+}
+
 impl PoolSpec {
     /// Every pose of a `levels`-value lattice, unfiltered.
     #[must_use]

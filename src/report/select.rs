@@ -215,6 +215,37 @@ pub struct PredictedAfter {
     pub errors: crate::how_many::PredictedErrors,
 }
 
+/// Random configurations (seed 0) the errors predicted after a selection
+/// are taken over, as `select --report`'s curve takes them.
+pub const PREDICTION_CONFIGURATIONS: usize = 1000;
+
+impl PredictedAfter {
+    /// The errors predicted after calibrating with the pool positions
+    /// `poses` of `pool` (its identification Jacobian at `table`) with noise
+    /// σ `noise` metres per coordinate, at [`PREDICTION_CONFIGURATIONS`]
+    /// random configurations of seed 0; `None` for a singular design.
+    #[must_use]
+    pub fn of_design(
+        robot: &Robot,
+        table: &crate::model::ParamTable,
+        pool: &crate::blocks::Blocks,
+        poses: &[usize],
+        noise: f64,
+    ) -> Option<Self> {
+        let info = pool.information(poses);
+        let qs = crate::how_many::random_configurations(robot, PREDICTION_CONFIGURATIONS, 0);
+        let eval = crate::blocks::jacobian_of(robot, table, qs.len(), |k, q| {
+            q.copy_from_slice(&qs[k]);
+        });
+        let errors = crate::how_many::predicted_errors(robot, &eval, info.as_ref(), noise)?;
+        Some(Self {
+            noise_m: noise,
+            configurations: qs.len(),
+            errors,
+        })
+    }
+}
+
 impl SelectReport {
     /// The report of `sel`, chosen from `pool` with settings `s`.
     #[must_use]
@@ -288,6 +319,30 @@ impl SelectReport {
         self.ln_gain = Some(existing.ln_det.map(|l0| self.ln_oid - l0));
         self.ln_oid_new_only = Some(ln_oid_new_only);
         self.existing = Some(existing);
+    }
+
+    /// The report's figures a design file keeps beside its poses (its
+    /// extra keys: `ln_oid`, `algorithm`, `seed`, …), as `select --out`
+    /// writes them.
+    #[must_use]
+    pub fn design_keys(&self) -> serde_json::Map<String, serde_json::Value> {
+        let v = serde_json::to_value(self).expect("a selection report serializes");
+        [
+            "ln_oid",
+            "log10_oid",
+            "oi",
+            "algorithm",
+            "criterion",
+            "seed",
+            "starts",
+            "polish",
+            "ils",
+            "kick",
+            "fixed",
+        ]
+        .into_iter()
+        .map(|k| (k.to_string(), v[k].clone()))
+        .collect()
     }
 
     /// Adds the design's gap to a bound.

@@ -1,0 +1,220 @@
+"""activecal from Python: choose the poses to measure for kinematic robot
+calibration (D-optimal design), then calibrate from the measurements.
+
+Units: lengths in metres and angles in radians (joint values, limits,
+marker offsets, estimates and their σ); the errors reported in
+`Calibration.residuals` and `Design.predicted` are in millimetres and
+degrees, as their keys say (`position_rms_mm`, `orientation_rms_deg`).
+Arrays are float64 NumPy arrays; anything NumPy reads as one is accepted,
+checked for shape and finiteness. Wrong input raises `Error` whose message
+starts with the argument's name.
+"""
+
+from os import PathLike
+from typing import Any, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+_Path = Union[str, "PathLike[str]"]
+_Marker = Union[str, Tuple[str, Sequence[float]]]
+
+class Error(Exception):
+    """Bad input or a failed computation, with the library's message: the
+    argument's name first when one argument is wrong (``q: expected shape
+    (6,) ...``)."""
+
+class Robot:
+    """A robot model: a serial chain, its joint limits, the unknowns a
+    calibration estimates and the sensor it is measured with. Immutable."""
+
+    @staticmethod
+    def from_urdf(
+        path: _Path,
+        tip: Optional[str] = None,
+        base: Optional[str] = None,
+        marker: Optional[Union[_Marker, Sequence[_Marker]]] = None,
+        lock: Optional[Mapping[str, float]] = None,
+        frames: Optional[_Path] = None,
+        pose: bool = False,
+    ) -> "Robot":
+        """Imports the chain base..tip of a URDF file.
+
+        tip, base: link names (base defaults to the URDF's root; the tip is
+        required on a tree). marker: a marker measured on the tip,
+        ``"LINK@X,Y,Z"`` or ``(link, (x, y, z))``, the offset in metres in
+        the link's frame, or a list of them; each offset is estimated by
+        `calibrate`. lock: joints held fixed, {joint: value} in radians or
+        metres. frames: a frames file (as `Calibration.write_frames`
+        writes) mounting the chain in its measurement frame with its tool.
+        pose: full-pose measurements (position and orientation).
+        """
+    @staticmethod
+    def builtin(name: str) -> "Robot":
+        """A built-in robot: ``"puma560"``, ``"ur5"`` or ``"stanford"``;
+        ``"NAME:pose"`` for full-pose measurements."""
+    @property
+    def name(self) -> str:
+        """The robot's name as design files record it (a built-in name or
+        the URDF's path with its chain)."""
+    @property
+    def dof(self) -> int:
+        """Number of joints."""
+    @property
+    def joint_names(self) -> list[str]:
+        """The joints' names in configuration order (a URDF's joint names)."""
+    @property
+    def limits(self) -> npt.NDArray[np.float64]:
+        """Joint limits, shape (dof, 2), [lower, upper]: radians for a
+        revolute joint, metres for a prismatic one."""
+    @property
+    def unknowns(self) -> list[str]:
+        """Names of the parameters a calibration estimates, in order: the
+        robot's unknowns, then each marker's offset (``marker1_x`` ...)."""
+    @property
+    def measures_orientation(self) -> bool:
+        """Whether orientations are measured too (a full-pose sensor)."""
+    def fk(
+        self, q: npt.ArrayLike
+    ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """Forward kinematics of the nominal model at joint values q (shape
+        (dof,), radians or metres, each within its joint's limits): (R, p),
+        the end frame's orientation (3×3 rotation matrix in the base frame)
+        and position (shape (3,), metres)."""
+
+    def jacobian(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """The identification Jacobian of the nominal model at joint values
+        q (shape (dof,), radians or metres): shape (rows, len(unknowns)),
+        each measured coordinate's change (metres) per unit of each
+        parameter (metres or radians), columns in the order of `unknowns`;
+        3 rows for a point, 6 for a full pose (orientation rows weighed by
+        the robot's orientation scale, metres per radian), 3 per marker."""
+
+class Design:
+    """The poses `select` chose, in selection order."""
+
+    @property
+    def q(self) -> npt.NDArray[np.float64]:
+        """Joint values of the poses, shape (n, dof), radians or metres."""
+    @property
+    def ids(self) -> list[int]:
+        """Each pose's id in its pool (a sample's number, a lattice index)."""
+    @property
+    def joint_names(self) -> list[str]:
+        """The columns of `q`."""
+    @property
+    def ln_oid(self) -> float:
+        """ln OI_D = ln det(XᵀX), X the design's identification Jacobian
+        (metres per parameter unit) at the nominal parameters."""
+    @property
+    def predicted(self) -> Optional[dict[str, Any]]:
+        """With `noise`: the error predicted after calibrating with these
+        poses, at 1000 random configurations (keys ``noise_m``,
+        ``configurations``, ``position_rms_mm``, ``position_p95_mm`` and
+        for full poses ``orientation_rms_deg``); else None (also for a
+        design that cannot identify the robot)."""
+    @property
+    def report(self) -> dict[str, Any]:
+        """The dict ``activecal select --json`` prints for the same inputs
+        (with ``--order none``)."""
+    def write(self, path: _Path, overwrite: bool = False) -> None:
+        """Writes the design by the extension of path, as ``activecal
+        select --out`` does: .json (the design file), .csv (joint values,
+        one pose a row, a header of joint names) or .yaml (named joint
+        configurations). An existing file is replaced only with
+        overwrite=True."""
+    def __len__(self) -> int: ...
+
+def select(
+    robot: Robot,
+    n: int,
+    pool: str = "random",
+    count: Optional[int] = None,
+    levels: Optional[int] = None,
+    pool_seed: Optional[int] = None,
+    margin: Optional[float] = None,
+    algorithm: str = "eae",
+    seed: int = 1,
+    starts: int = 2,
+    ils: Optional[int] = None,
+    kick: int = 3,
+    noise: Optional[float] = None,
+) -> Design:
+    """Chooses n poses to measure from a pool of candidates by D-optimal
+    design (maximising ln det XᵀX), as ``activecal select --order none``
+    does with the same options. The GIL is released while it runs.
+
+    pool: ``"random"`` or ``"sobol"`` (count samples inside the joint
+    limits, default 4096; pool_seed: the random stream's seed, default 0,
+    or the Sobol scramble's, default none) or ``"lattice"`` (levels values
+    per joint, default 5). margin: degrees kept inside every revolute
+    joint's limits (default 2 for a URDF robot's generated pool, else 0).
+    algorithm: ``"eae"``, ``"fedorov"``, ``"detmax"``, ``"random"`` ... as
+    the command line names them. seed: every random choice of the search
+    (default 1, the command line's). starts: independent starts, the best
+    kept. ils: rounds of iterated local search (default: by pool size, as
+    the command line). kick: poses exchanged per round. noise: the
+    sensor's σ per coordinate, metres; the design then predicts the error
+    after calibration (`Design.predicted`).
+    """
+
+class Calibration:
+    """The result of `calibrate`."""
+
+    @property
+    def converged(self) -> bool:
+        """Whether the fit converged (only then is the robot written)."""
+    @property
+    def estimate(self) -> dict[str, float]:
+        """{parameter name: estimated value}, metres and radians."""
+    @property
+    def sigma(self) -> Optional[dict[str, float]]:
+        """{parameter name: standard deviation}, metres and radians; None
+        when the fit is rank deficient."""
+    @property
+    def residuals(self) -> dict[str, Any]:
+        """Errors of the fitted model on the data: ``position_rms_mm``,
+        ``position_max_mm``, ``orientation_rms_deg`` (full poses) and per
+        pose."""
+    @property
+    def report(self) -> dict[str, Any]:
+        """The dict ``activecal calibrate --measurements FILE --json``
+        prints for a file holding the same values (``measurements`` names
+        the arrays here, not a file)."""
+    def write_urdf(self, path: _Path, overwrite: bool = False) -> None:
+        """Writes the calibrated URDF: the robot's own file with only the
+        chain's joint origins changed (a built-in robot: its chain as a
+        URDF). Refused (Error) when the fit did not converge."""
+    def write_frames(self, path: _Path, overwrite: bool = False) -> None:
+        """Writes the frames file (YAML): the measurement frame, the tool
+        or markers and the joint-origin changes with their σ, as
+        ``activecal calibrate --out cal.yaml`` does. URDF robots only;
+        refused when the fit did not converge."""
+
+def calibrate(
+    robot: Robot,
+    q: npt.ArrayLike,
+    points: npt.ArrayLike,
+    orientations: Optional[npt.ArrayLike] = None,
+    fix: Optional[Sequence[str]] = None,
+    free: Optional[Sequence[str]] = None,
+    max_iterations: int = 200,
+    loss: str = "l2",
+    loss_scale: Optional[float] = None,
+) -> Calibration:
+    """Calibrates the robot from measured poses, as ``activecal calibrate
+    --measurements FILE`` does from a file holding the same values. The
+    GIL is released while it runs.
+
+    q: shape (n, dof), joint values in radians or metres. points: shape
+    (n, 3), the measured positions in the sensor's frame, metres (shape
+    (n, K, 3) for a robot with K markers). orientations: shape (n, 3, 3),
+    measured rotation matrices, for a full-pose robot only. fix: unknowns
+    held at their nominal values; free: parameters estimated besides the
+    unknowns (names as in `Calibration.estimate`). max_iterations:
+    Levenberg–Marquardt's limit. loss: ``"l2"``, or ``"huber"`` /
+    ``"cauchy"`` with loss_scale (metres: a pose's residual norm where the
+    loss turns robust).
+    """

@@ -1,0 +1,322 @@
+//! `activecal.calibrate`: identification from measured poses held in
+//! memory, as `activecal calibrate --measurements FILE` does from a file,
+//! and the `Calibration` it returns.
+
+use crate::convert::{arg_err, count, detached, err, float_array, json_to_py, rows};
+use crate::robot::Robot;
+use activecal::experiment::measured::{MeasuredSettings, calibrate_measurements};
+use activecal::frames::CalibratedFrames;
+use activecal::frames::report::{FitBlock, FramesReport};
+use activecal::identify::{Identification, LmSettings, LossChoice, Measurements};
+use activecal::io::calibrated::Format;
+use pyo3::prelude::*;
+use std::sync::Arc;
+
+/// A calibration: the estimate, its σ, the residuals, and the calibrated
+/// robot to write.
+#[pyclass(module = "activecal", name = "Calibration", frozen)]
+pub struct Calibration {
+    robot: Arc<activecal::model::Robot>,
+    id: Identification,
+    frames: Option<(CalibratedFrames, FramesReport)>,
+    report: serde_json::Value,
+}
+
+/// What `calibrate` reads from its array arguments.
+struct Data {
+    qs: Vec<Vec<f64>>,
+    points: Vec<[f64; 3]>,
+    orientations: Vec<[[f64; 3]; 3]>,
+}
+
+/// The arrays checked against the robot: q (n, dof), points (n, 3) or
+/// (n, K, 3) for K markers, orientations (n, 3, 3) for a full-pose robot.
+fn data(
+    py: Python<'_>,
+    wrapper: &Robot,
+    q: &Bound<'_, PyAny>,
+    points: &Bound<'_, PyAny>,
+    orientations: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Data> {
+    let robot: &activecal::model::Robot = &wrapper.inner;
+    let dof = robot.dof();
+    let (qv, qshape) = float_array(
+        py,
+        q,
+        "q",
+        &[None, Some(dof)],
+        "one row of joint values per pose, radians or metres",
+    )?;
+    let n = qshape[0];
+    let k = activecal::measure::sensor_for(robot).points_per_pose();
+    let (pv, _) = if k == 1 {
+        float_array(
+            py,
+            points,
+            "points",
+            &[Some(n), Some(3)],
+            "one measured position x, y, z per pose of q, metres",
+        )?
+    } else {
+        float_array(
+            py,
+            points,
+            "points",
+            &[Some(n), Some(k), Some(3)],
+            "each pose's markers' positions x, y, z, metres",
+        )?
+    };
+    let orientations = match (
+        orientations,
+        activecal::measure::sensor_for(robot).measures_orientation(),
+    ) {
+        (Some(o), true) => {
+            let (ov, _) = float_array(
+                py,
+                o,
+                "orientations",
+                &[Some(n), Some(3), Some(3)],
+                "one measured rotation matrix per pose of q, base frame",
+            )?;
+            ov.chunks(9)
+                .map(|m| [[m[0], m[1], m[2]], [m[3], m[4], m[5]], [m[6], m[7], m[8]]])
+                .collect()
+        }
+        (Some(_), false) => {
+            return Err(arg_err(
+                "orientations",
+                format!(
+                    "robot '{}' measures points, not orientations (load it with pose=True, or \"NAME:pose\", for full poses)",
+                    robot.name
+                ),
+            ));
+        }
+        (None, true) => {
+            return Err(arg_err(
+                "orientations",
+                format!(
+                    "robot '{}' measures full poses: give one rotation matrix per pose",
+                    robot.name
+                ),
+            ));
+        }
+        (None, false) => Vec::new(),
+    };
+    let mut qs = rows(&qv, dof);
+    wrapper.check_joint_values("q", &mut qs)?;
+    Ok(Data {
+        qs,
+        points: pv.chunks(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        orientations,
+    })
+}
+
+/// Names given to a wrapper as an iterable of str.
+fn names(v: Option<Vec<String>>) -> Vec<String> {
+    v.unwrap_or_default()
+}
+
+/// Calibrates the robot from measured poses, as `activecal calibrate
+/// --measurements FILE --json` does with a file holding the same values.
+///
+/// q: (n, dof) joint values, radians or metres. points: (n, 3) measured
+/// positions, metres, in the sensor's frame (or (n, K, 3) for K markers).
+/// orientations: (n, 3, 3) measured rotation matrices, for a full-pose robot
+/// only. fix: unknowns held at their nominal values; free: parameters
+/// estimated besides the unknowns (names as in `estimate`).
+/// max_iterations: Levenberg–Marquardt's limit. loss: "l2", or "huber" /
+/// "cauchy" with loss_scale (metres, a pose's residual norm where the loss
+/// turns robust).
+#[pyfunction]
+#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn calibrate(
+    py: Python<'_>,
+    robot: &Robot,
+    q: &Bound<'_, PyAny>,
+    points: &Bound<'_, PyAny>,
+    orientations: Option<&Bound<'_, PyAny>>,
+    fix: Option<Vec<String>>,
+    free: Option<Vec<String>>,
+    max_iterations: i64,
+    loss: &str,
+    loss_scale: Option<f64>,
+) -> PyResult<Calibration> {
+    let inner = robot.inner.clone();
+    let d = data(py, robot, q, points, orientations)?;
+    let max_iterations = count("max_iterations", max_iterations, 1)?;
+    let scale = |s: Option<f64>| match s {
+        Some(s) if s.is_finite() && s > 0.0 => Ok(s),
+        Some(s) => Err(arg_err(
+            "loss_scale",
+            format!("{s}: must be a finite number > 0 (metres)"),
+        )),
+        None => Err(arg_err(
+            "loss_scale",
+            format!(
+                "loss=\"{loss}\" needs loss_scale (metres: the residual norm of one pose where the loss turns robust, e.g. 3 times the sensor noise)"
+            ),
+        )),
+    };
+    let loss = match loss {
+        "l2" if loss_scale.is_some() => {
+            return Err(arg_err("loss_scale", "is for loss=\"huber\" or \"cauchy\""));
+        }
+        "l2" => LossChoice::L2,
+        "huber" => LossChoice::Huber {
+            scale: scale(loss_scale)?,
+        },
+        "cauchy" => LossChoice::Cauchy {
+            scale: scale(loss_scale)?,
+        },
+        other => {
+            return Err(arg_err(
+                "loss",
+                format!("unknown loss '{other}': \"l2\", \"huber\" or \"cauchy\""),
+            ));
+        }
+    };
+    let settings = MeasuredSettings {
+        lm: LmSettings::default()
+            .with_max_iterations(max_iterations)
+            .with_geodesic(true),
+        loss,
+        fix: names(fix),
+        free: names(free),
+        holdout: None,
+        units: activecal::units::Units::default(),
+        gravity: None,
+        fit_compliance: false,
+        compare_compliance: false,
+        weights: activecal::identify::Weights::Estimated,
+    };
+    let r = inner.clone();
+    let (fitted, id, frames, report) = detached(py, move || {
+        let t0 = std::time::Instant::now();
+        let meas = Measurements::with_orientations(&r, d.qs, d.points, d.orientations)
+            .map_err(|e| e.to_string())?;
+        let c = calibrate_measurements(
+            &r,
+            &meas,
+            "the arrays given",
+            Vec::new(),
+            &settings,
+            &mut |_| {},
+        )
+        .map_err(|e| e.to_string())?;
+        let mut report = c.report;
+        report.base.elapsed_seconds = t0.elapsed().as_secs_f64();
+        let id = c.fit.id;
+        let fit = FitBlock {
+            poses: report.base.poses,
+            position_rms_mm: report.residuals.position_rms_mm,
+            orientation_rms_deg: report.residuals.orientation_rms_deg,
+        };
+        let cov = id.covariance.as_ref().map(|c| c.matrix.as_slice());
+        let frames = activecal::frames::calibrated(&c.robot, &id.table, cov, Some(fit))
+            .map_err(|e| e.to_string())?;
+        report.frames = frames.as_ref().map(|(_, r)| r.clone());
+        let v = serde_json::to_value(&report).map_err(|e| e.to_string())?;
+        Ok((c.robot, id, frames, v))
+    })?;
+    Ok(Calibration {
+        robot: Arc::new(fitted),
+        id,
+        frames,
+        report,
+    })
+}
+
+impl Calibration {
+    /// Writes the calibrated robot in `format` to `path`, refused when the
+    /// fit did not converge.
+    fn write_as(&self, format: Format, path: &std::path::Path, overwrite: bool) -> PyResult<()> {
+        if !self.id.converged() {
+            return Err(err(format!(
+                "{}: not written: the identification ended {:?} ({:?}) after {} iterations; a calibrated robot is written only from a converged fit",
+                path.display(),
+                self.id.status,
+                self.id.stop,
+                self.id.iterations
+            )));
+        }
+        let text = activecal::io::calibrated::render(
+            format,
+            &self.robot,
+            &self.id.table,
+            self.frames.as_ref().map(|(f, r)| (f, r)),
+            "# Calibrated by activecal (Python).\n",
+        )
+        .map_err(|e| arg_err("path", format!("{}: {e}", path.display())))?;
+        activecal::io::atomic::check_outputs(
+            &[activecal::io::atomic::Output {
+                label: "path",
+                path,
+            }],
+            &[],
+            overwrite,
+        )
+        .map_err(err)?;
+        activecal::io::atomic::write_atomic(path, text.as_bytes()).map_err(err)
+    }
+}
+
+#[pymethods]
+impl Calibration {
+    /// Whether the fit converged (only then is the estimate trustworthy and
+    /// the robot written).
+    #[getter]
+    fn converged(&self) -> bool {
+        self.id.converged()
+    }
+
+    /// The estimate: {parameter name: value} in metres and radians.
+    #[getter]
+    fn estimate<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.report["estimate"])
+    }
+
+    /// Standard deviations of the estimate, {name: σ} in metres and
+    /// radians; None for a rank-deficient fit.
+    #[getter]
+    fn sigma<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.report["std"])
+    }
+
+    /// Errors of the fitted model on the data: position_rms_mm,
+    /// position_max_mm, orientation_rms_deg (full poses), per pose, ….
+    #[getter]
+    fn residuals<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.report["residuals"])
+    }
+
+    /// The whole report: the dict `activecal calibrate --measurements FILE
+    /// --json` prints (here "measurements" names the arrays, not a file).
+    #[getter]
+    fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.report)
+    }
+
+    /// Writes the calibrated robot as URDF: the robot's own URDF with only
+    /// the chain's joint origins changed (a built-in robot: its chain as
+    /// URDF). Refused when the fit did not converge.
+    #[pyo3(signature = (path, overwrite=false))]
+    fn write_urdf(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
+        self.write_as(Format::Urdf, &path, overwrite)
+    }
+
+    /// Writes the frames file (YAML): measurement frame, tool or markers and
+    /// joint-origin changes with σ, metres and degrees as the command line
+    /// writes it. URDF robots only; refused when the fit did not converge.
+    #[pyo3(signature = (path, overwrite=false))]
+    fn write_frames(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
+        self.write_as(Format::Yaml, &path, overwrite)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Calibration({:?}, {:?}, {} iterations)",
+            self.robot.name, self.id.status, self.id.iterations
+        )
+    }
+}

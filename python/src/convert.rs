@@ -1,0 +1,188 @@
+//! Arguments in (any array-like, as float64, shape and finiteness checked,
+//! errors naming the argument), results out (NumPy arrays, dicts), library
+//! errors and panics as `activecal.Error`.
+
+use crate::Error;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use std::fmt::Display;
+
+/// A library error as `activecal.Error`, with its message.
+pub fn err(e: impl Display) -> PyErr {
+    Error::new_err(e.to_string())
+}
+
+/// A wrong argument as `activecal.Error`, the message starting with its name.
+pub fn arg_err(name: &str, msg: impl Display) -> PyErr {
+    Error::new_err(format!("{name}: {msg}"))
+}
+
+/// Runs library work with the GIL released; a panic becomes
+/// `activecal.Error` (never unwinds into Python).
+pub fn detached<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce() -> Result<T, String> + Send,
+) -> PyResult<T> {
+    let out = py.detach(|| std::panic::catch_unwind(std::panic::AssertUnwindSafe(work)));
+    match out {
+        Ok(Ok(v)) => Ok(v),
+        Ok(Err(msg)) => Err(Error::new_err(msg)),
+        Err(p) => {
+            let what = p
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| p.downcast_ref::<&str>().map(|s| (*s).to_string()))
+                .unwrap_or_else(|| "a panic".into());
+            Err(Error::new_err(format!(
+                "internal error in activecal (please report it): {what}"
+            )))
+        }
+    }
+}
+
+/// The text of a shape, `(n, 6)`.
+fn shape_text(shape: &[usize]) -> String {
+    match shape {
+        [n] => format!("({n},)"),
+        _ => format!(
+            "({})",
+            shape
+                .iter()
+                .map(ToString::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+/// An array argument read as float64: its values (row-major) and shape.
+/// `want` is the expected shape, `None` for any length along an axis; `what`
+/// says what it holds (with units) for messages. Every value must be finite.
+pub fn float_array(
+    py: Python<'_>,
+    obj: &Bound<'_, PyAny>,
+    name: &str,
+    want: &[Option<usize>],
+    what: &str,
+) -> PyResult<(Vec<f64>, Vec<usize>)> {
+    let np = py.import("numpy")?;
+    let kw = PyDict::new(py);
+    kw.set_item("dtype", "float64")?;
+    let a = np
+        .call_method("asarray", (obj,), Some(&kw))
+        .map_err(|e| arg_err(name, format!("not an array of numbers ({e})")))?;
+    let shape: Vec<usize> = a.getattr("shape")?.extract()?;
+    let fits = shape.len() == want.len()
+        && shape
+            .iter()
+            .zip(want)
+            .all(|(s, w)| w.is_none_or(|w| *s == w));
+    if !fits {
+        let expected: Vec<String> = want
+            .iter()
+            .zip(["n", "m", "k"].iter().cycle())
+            .map(|(w, v)| w.map_or_else(|| (*v).to_string(), |w| w.to_string()))
+            .collect();
+        let expected = if expected.len() == 1 {
+            format!("({},)", expected[0])
+        } else {
+            format!("({})", expected.join(", "))
+        };
+        return Err(arg_err(
+            name,
+            format!(
+                "expected shape {expected} ({what}), got {}",
+                shape_text(&shape)
+            ),
+        ));
+    }
+    let values: Vec<f64> = a.call_method0("ravel")?.call_method0("tolist")?.extract()?;
+    if let Some(k) = values.iter().position(|v| !v.is_finite()) {
+        let mut idx = Vec::with_capacity(shape.len());
+        let mut rest = k;
+        for d in (0..shape.len()).rev() {
+            idx.push(rest % shape[d].max(1));
+            rest /= shape[d].max(1);
+        }
+        idx.reverse();
+        let idx: Vec<String> = idx.iter().map(ToString::to_string).collect();
+        return Err(arg_err(
+            name,
+            format!(
+                "{name}[{}] is {}, not a finite number ({what})",
+                idx.join(", "),
+                values[k]
+            ),
+        ));
+    }
+    Ok((values, shape))
+}
+
+/// Rows of `cols` values each from a row-major buffer.
+pub fn rows(values: &[f64], cols: usize) -> Vec<Vec<f64>> {
+    values.chunks(cols.max(1)).map(<[f64]>::to_vec).collect()
+}
+
+/// A float64 NumPy array of `shape` from row-major values.
+pub fn ndarray<'py>(
+    py: Python<'py>,
+    values: &[f64],
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyAny>> {
+    let np = py.import("numpy")?;
+    let kw = PyDict::new(py);
+    kw.set_item("dtype", "float64")?;
+    let a = np.call_method("array", (PyList::new(py, values)?,), Some(&kw))?;
+    a.call_method1("reshape", (shape.to_vec(),))
+}
+
+/// A JSON value as Python objects (dict, list, str, int, float, bool, None).
+pub fn json_to_py<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+    use serde_json::Value;
+    Ok(match v {
+        Value::Null => py.None().into_bound(py),
+        Value::Bool(b) => b.into_pyobject(py)?.to_owned().into_any(),
+        Value::Number(n) => {
+            if let Some(i) = n.as_i64() {
+                i.into_pyobject(py)?.into_any()
+            } else if let Some(u) = n.as_u64() {
+                u.into_pyobject(py)?.into_any()
+            } else {
+                n.as_f64().unwrap_or(f64::NAN).into_pyobject(py)?.into_any()
+            }
+        }
+        Value::String(s) => s.into_pyobject(py)?.into_any(),
+        Value::Array(a) => {
+            let l = PyList::empty(py);
+            for x in a {
+                l.append(json_to_py(py, x)?)?;
+            }
+            l.into_any()
+        }
+        Value::Object(o) => {
+            let d = PyDict::new(py);
+            for (k, x) in o {
+                d.set_item(k, json_to_py(py, x)?)?;
+            }
+            d.into_any()
+        }
+    })
+}
+
+/// A non-negative integer argument that fits `u64` (a seed, a count).
+pub fn non_negative(name: &str, v: i128) -> PyResult<u64> {
+    u64::try_from(v).map_err(|_| {
+        arg_err(
+            name,
+            format!("{v}: must be an integer from 0 to {}", u64::MAX),
+        )
+    })
+}
+
+/// A count argument: an integer >= `min`.
+pub fn count(name: &str, v: i64, min: usize) -> PyResult<usize> {
+    usize::try_from(v)
+        .ok()
+        .filter(|&n| n >= min)
+        .ok_or_else(|| arg_err(name, format!("{v}: must be an integer >= {min}")))
+}

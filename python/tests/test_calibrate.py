@@ -1,0 +1,174 @@
+"""calibrate: the same estimate as `activecal calibrate --measurements FILE`
+on the same values, the same calibrated files, errors, threads."""
+
+import json
+import threading
+
+import numpy as np
+import pytest
+
+import activecal
+from conftest import UR5_URDF, cli
+
+MARKER = "tool0@0.031,-0.024,0.097"
+
+
+def simulated(tmp_path, robot_args, n=30, seed=3):
+    """Measurements of a robot's `real` table at a selected design, written
+    by the CLI (--save-measurements), and the CLI's calibration of them."""
+    design = tmp_path / "d.json"
+    cli("select", *robot_args, "--pool", "random", "--count", 1000, "--n", n,
+        "--order", "none", "--out", design)
+    meas = tmp_path / "m.json"
+    cli("calibrate", *robot_args, "--design", design, "--save-measurements", meas,
+        "--noise", 1e-4, "--seed", seed)
+    m = json.loads(meas.read_text())
+    return meas, m
+
+
+def assert_same_fit(cal, want):
+    assert set(cal.estimate) == set(want["estimate"])
+    for k, v in want["estimate"].items():
+        assert cal.estimate[k] == pytest.approx(v, abs=1e-12, rel=0), k
+    for k, v in want["std"].items():
+        assert cal.sigma[k] == pytest.approx(v, abs=1e-12, rel=1e-9), k
+    assert cal.residuals["position_rms_mm"] == pytest.approx(want["residuals"]["position_rms_mm"], abs=1e-12)
+    report = cal.report
+    for k in ("status", "converged", "iterations", "rank", "unidentifiable", "parameters", "fixed", "notes"):
+        assert report[k] == want[k], k
+
+
+def test_puma_points_equal_the_cli(tmp_path):
+    meas, m = simulated(tmp_path, ["--robot", "puma560"])
+    want = cli("calibrate", "--robot", "puma560", "--measurements", meas)
+    r = activecal.Robot.builtin("puma560")
+    cal = activecal.calibrate(r, np.array(m["qs"]), np.array(m["points"]))
+    assert cal.converged
+    assert_same_fit(cal, want)
+
+
+def test_ur5_marker_urdf_and_frames_equal_the_clis(tmp_path):
+    args = ["--robot", UR5_URDF, "--tip", "tool0", "--marker", MARKER]
+    meas, m = simulated(tmp_path, args)
+    urdf, frames = tmp_path / "cli.urdf", tmp_path / "cli.yaml"
+    want = cli("calibrate", *args, "--measurements", meas, "--out", urdf, "--out", frames)
+    r = activecal.Robot.from_urdf(UR5_URDF, tip="tool0", marker=MARKER)
+    cal = activecal.calibrate(r, m["qs"], m["points"])
+    assert_same_fit(cal, want)
+    assert cal.report["frames"] == want["frames"]
+    cal.write_urdf(tmp_path / "py.urdf")
+    cal.write_frames(tmp_path / "py.yaml")
+    assert (tmp_path / "py.urdf").read_text() == urdf.read_text()
+    assert (tmp_path / "py.yaml").read_text() == frames.read_text()
+
+
+def test_full_pose_equals_the_cli(tmp_path):
+    args = ["--robot", f"{UR5_URDF}:pose", "--tip", "tool0"]
+    meas, m = simulated(tmp_path, args)
+    want = cli("calibrate", *args, "--measurements", meas)
+    r = activecal.Robot.from_urdf(UR5_URDF, tip="tool0", pose=True)
+    assert r.measures_orientation
+    cal = activecal.calibrate(r, m["qs"], m["points"], orientations=m["orientations"])
+    assert_same_fit(cal, want)
+
+
+def test_two_calibrations_at_once_from_threads(tmp_path):
+    meas, m = simulated(tmp_path, ["--robot", "puma560"])
+    r = activecal.Robot.builtin("puma560")
+    alone = activecal.calibrate(r, m["qs"], m["points"]).estimate
+    out = [None, None]
+
+    def run(k):
+        out[k] = activecal.calibrate(r, m["qs"], m["points"]).estimate
+
+    ts = [threading.Thread(target=run, args=(k,)) for k in range(2)]
+    for t in ts:
+        t.start()
+    for t in ts:
+        t.join()
+    assert out[0] == alone and out[1] == alone
+
+
+@pytest.fixture(scope="module")
+def puma_data(tmp_path_factory):
+    _, m = simulated(tmp_path_factory.mktemp("data"), ["--robot", "puma560"])
+    return np.array(m["qs"]), np.array(m["points"])
+
+
+def errors_of(call):
+    with pytest.raises(activecal.Error) as e:
+        call()
+    return str(e.value)
+
+
+def test_calibrate_errors_name_the_argument(puma_data):
+    qs, pts = puma_data
+    r = activecal.Robot.builtin("puma560")
+    msg = errors_of(lambda: activecal.calibrate(r, qs[:, :5], pts))
+    assert msg.startswith("q: expected shape (n, 6)"), msg
+    msg = errors_of(lambda: activecal.calibrate(r, qs, pts[:-1]))
+    assert msg.startswith("points: expected shape (30, 3)"), msg
+    bad = pts.copy()
+    bad[4, 1] = np.nan
+    msg = errors_of(lambda: activecal.calibrate(r, qs, bad))
+    assert msg.startswith("points: points[4, 1] is NaN"), msg
+    deg = np.degrees(qs)
+    msg = errors_of(lambda: activecal.calibrate(r, deg, pts))
+    assert msg.startswith("q") and "degree" in msg, msg
+    msg = errors_of(lambda: activecal.calibrate(r, qs, pts, orientations=np.zeros((30, 3, 3))))
+    assert msg.startswith("orientations: "), msg
+    msg = errors_of(lambda: activecal.calibrate(r, qs, pts, fix=["nope_9"]))
+    assert "nope_9" in msg, msg
+    msg = errors_of(lambda: activecal.calibrate(r, qs, pts, loss="huber"))
+    assert msg.startswith("loss_scale: "), msg
+
+
+def test_unconverged_fits_are_not_written(tmp_path, puma_data):
+    qs, pts = puma_data
+    r = activecal.Robot.builtin("puma560")
+    cal = activecal.calibrate(r, qs, pts, max_iterations=1)
+    assert not cal.converged
+    with pytest.raises(activecal.Error, match="not written"):
+        cal.write_urdf(tmp_path / "x.urdf")
+
+
+def rpy_matrix(roll, pitch, yaw):
+    """R = Rz(yaw) Ry(pitch) Rx(roll), as the measurement files' phix/phiy/
+    phiz are read (nalgebra's Rotation3::from_euler_angles, term by term)."""
+    import math
+
+    sr, cr = math.sin(roll), math.cos(roll)
+    sp, cp = math.sin(pitch), math.cos(pitch)
+    sy, cy = math.sin(yaw), math.cos(yaw)
+    return [
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+        [-sp, cp * sr, cp * cr],
+    ]
+
+
+def figaroh_ur10():
+    """FIGAROH's UR10 full-pose data as arrays: q, points, orientations."""
+    from conftest import FIXTURES
+
+    path = FIXTURES / "figaroh" / "ur10_full_pose.csv"
+    head = path.read_text().splitlines()[0].split(",")
+    data = np.loadtxt(path, delimiter=",", skiprows=1)
+    col = {c: k for k, c in enumerate(head)}
+    joints = [c for c in head if c.endswith("_joint")]
+    q = data[:, [col[j] for j in joints]]
+    points = data[:, [col["x1"], col["y1"], col["z1"]]]
+    rot = np.array([rpy_matrix(*row) for row in data[:, [col["phix1"], col["phiy1"], col["phiz1"]]]])
+    return path, joints, q, points, rot
+
+
+def test_figaroh_ur10_full_pose_equals_the_cli():
+    from conftest import FIXTURES
+
+    path, joints, q, points, rot = figaroh_ur10()
+    urdf = FIXTURES / "figaroh" / "ur10_robot.urdf"
+    want = cli("calibrate", "--robot", f"{urdf}:pose", "--tip", "ur10e_tooltip_link", "--measurements", path)
+    r = activecal.Robot.from_urdf(urdf, tip="ur10e_tooltip_link", pose=True)
+    assert r.joint_names == joints
+    cal = activecal.calibrate(r, q, points, orientations=rot)
+    assert_same_fit(cal, want)

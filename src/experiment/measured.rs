@@ -353,14 +353,21 @@ pub fn calibrate_measurements(
     s: &MeasuredSettings,
     on_note: &mut dyn FnMut(&str),
 ) -> Result<MeasuredCalibration, ExperimentError> {
-    let in_file = |e: crate::identify::IdentifyError| ExperimentError::InFile {
-        path: source.to_string(),
-        error: e,
-    };
+    let in_file = in_source(source);
     meas.check(robot).map_err(in_file)?;
     crate::identify::evaluation::check_in_reach(robot, meas, source, crate::units::LengthUnit::M)
         .map_err(in_file)?;
     calibrate_read(robot, meas, source, read_notes, s, on_note)
+}
+
+/// An identification error of the measurements named `source`.
+fn in_source(
+    source: &str,
+) -> impl Fn(crate::identify::IdentifyError) -> ExperimentError + Copy + '_ {
+    move |error| ExperimentError::InFile {
+        path: source.to_string(),
+        error,
+    }
 }
 
 /// The calibration of measurements read and checked.
@@ -372,10 +379,7 @@ fn calibrate_read(
     s: &MeasuredSettings,
     on_note: &mut dyn FnMut(&str),
 ) -> Result<MeasuredCalibration, ExperimentError> {
-    let in_file = |e: crate::identify::IdentifyError| ExperimentError::InFile {
-        path: source.to_string(),
-        error: e,
-    };
+    let in_file = in_source(source);
     let mut notes = Vec::new();
     let mut note = |n: &str| {
         on_note(n);

@@ -280,16 +280,8 @@ impl DesignFile {
     /// Writes the design as pretty JSON. An existing file is only replaced
     /// when `overwrite` is set: nothing the user has is lost without asking.
     pub fn write(&self, path: &Path, overwrite: bool) -> Result<()> {
-        super::atomic::check_outputs(
-            &[super::atomic::Output {
-                label: "design file",
-                path,
-            }],
-            &[],
-            overwrite,
-        )?;
         let text = serde_json::to_string_pretty(self).expect("a design serializes");
-        super::atomic::write_atomic(path, (text + "\n").as_bytes())
+        write_design_text(path, &(text + "\n"), overwrite)
     }
 
     /// The pool the design was chosen from.
@@ -515,6 +507,20 @@ pub fn check_unique(poses: &[usize]) -> Result<()> {
         )));
     }
     Ok(())
+}
+
+/// Writes a design file's text atomically; an existing file is only
+/// replaced when `overwrite` is set.
+pub(crate) fn write_design_text(path: &Path, text: &str, overwrite: bool) -> Result<()> {
+    super::atomic::check_outputs(
+        &[super::atomic::Output {
+            label: "design file",
+            path,
+        }],
+        &[],
+        overwrite,
+    )?;
+    super::atomic::write_atomic(path, text.as_bytes())
 }
 
 #[cfg(test)]

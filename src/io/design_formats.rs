@@ -66,15 +66,7 @@ pub fn write(d: &DesignFile, path: &Path, overwrite: bool) -> Result<()> {
         DesignFormat::Csv => to_csv(d)?,
         DesignFormat::Yaml => to_yaml(d)?,
     };
-    super::atomic::check_outputs(
-        &[super::atomic::Output {
-            label: "design file",
-            path,
-        }],
-        &[],
-        overwrite,
-    )?;
-    super::atomic::write_atomic(path, text.as_bytes())
+    super::design::write_design_text(path, &text, overwrite)
 }
 
 /// Joint values keyed by joint name, in the chain's order (the YAML form of

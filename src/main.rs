@@ -11,7 +11,8 @@ use cli::bound::{BoundArgs, GapArgs};
 use cli::calibrate::CalibrateArgs;
 use cli::measured::EvaluateArgs;
 use cli::reproduce::ReproduceArgs;
-use cli::select::{ScoreArgs, SelectArgs};
+use cli::score::ScoreArgs;
+use cli::select::SelectArgs;
 
 #[derive(Parser)]
 #[command(
@@ -188,7 +189,7 @@ fn main() {
         Command::Robots(a) => cli::basic::cmd_robots(a),
         Command::Fk(a) => cli::basic::cmd_fk(a),
         Command::Pool(a) => cli::basic::cmd_pool(a),
-        Command::Score(a) => cli::select::cmd_score(a, &given("score")),
+        Command::Score(a) => cli::score::cmd_score(a, &given("score")),
         Command::Select(a) if !a.points.is_empty() => cli::contact_select::cmd_select_points(&a),
         Command::Select(a) => cli::select::cmd_select(a),
         Command::Bench(a) => cli::bench::cmd_bench(a),

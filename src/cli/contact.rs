@@ -163,22 +163,7 @@ pub fn calibrate_contacts(
     };
     let fit = fit_contacts(robot, &robot.nominal, &file, &known, &settings)?;
     let figures = judge(robot, &robot.nominal, &fit, &file, &given);
-    let mode = match (&a.holdout_by, &a.train_on) {
-        (_, Some(t)) => Some(HoldoutMode::TrainOn((*t).to_string())),
-        (Some(HoldoutBy::Placement), None) => Some(HoldoutMode::LeaveOneOut),
-        (None, None) => None,
-    };
-    let held = match &mode {
-        Some(m) => Some(holdout_by_placement(
-            robot,
-            &robot.nominal,
-            &file,
-            &given,
-            &settings,
-            m,
-        )?),
-        None => None,
-    };
+    let held = held_out(a, robot, &file, &given, &settings)?;
     let predicted = activecal::identify::contact::predict::predicted_true_error(
         &fit,
         activecal::identify::contact::predict::PREDICTION_CONFIGURATIONS,
@@ -266,6 +251,24 @@ pub fn calibrate_contacts(
         )));
     }
     Ok(None)
+}
+
+/// The placements held out (`--holdout-by placement`, `--train-on NAME`),
+/// if asked.
+fn held_out(
+    a: &ContactArgs<'_>,
+    robot: &Robot,
+    file: &ContactFile,
+    given: &[activecal::identify::contact::NamedDistance],
+    settings: &ContactSettings,
+) -> Result<Option<HoldoutReport>> {
+    let mode = match (&a.holdout_by, &a.train_on) {
+        (_, Some(t)) => HoldoutMode::TrainOn((*t).to_string()),
+        (Some(HoldoutBy::Placement), None) => HoldoutMode::LeaveOneOut,
+        (None, None) => return Ok(None),
+    };
+    let h = holdout_by_placement(robot, &robot.nominal, file, given, settings, &mode)?;
+    Ok(Some(h))
 }
 
 /// The report as text.

@@ -22,6 +22,7 @@ pub mod progress;
 pub mod report_dir;
 pub mod report_plots;
 pub mod reproduce;
+pub mod score;
 pub mod select;
 pub mod simulated;
 pub mod tour;

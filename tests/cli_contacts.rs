@@ -490,8 +490,20 @@ fn select_for_a_socket_through_the_collision_filters() {
 fn select_for_two_sockets_counts_their_known_distance() {
     let b = "front_left/1=0.53379650178936034,0.2299961560616272,0.02337560921181476";
     let base = [
-        "select", "--robot", URDF, "--tip", "ball_link", "--point", FRONT_LEFT_0, "--point", b,
-        "--n", "30", "--count", "150", "--json",
+        "select",
+        "--robot",
+        URDF,
+        "--tip",
+        "ball_link",
+        "--point",
+        FRONT_LEFT_0,
+        "--point",
+        b,
+        "--n",
+        "30",
+        "--count",
+        "150",
+        "--json",
     ];
     let without = json_of(&base);
     let mut args = base.to_vec();

@@ -741,7 +741,17 @@ fn selected_contacts_judged_at_other_placements() {
     };
     let mut rng = activecal::identify::trial_rng(29, 1);
     let margin = 2f64.to_radians();
-    let pool = socket_pool(&robot, &robot.nominal, &[at], &[], 600, margin, 1e-7, &mut rng).unwrap();
+    let pool = socket_pool(
+        &robot,
+        &robot.nominal,
+        &[at],
+        &[],
+        600,
+        margin,
+        1e-7,
+        &mut rng,
+    )
+    .unwrap();
     let rows: Vec<usize> = (0..real.qs.len())
         .filter(|&i| placement_of(&real.points[real.groups[i]]) != "front_left")
         .collect();
@@ -826,7 +836,16 @@ fn select_point_predicts_the_true_error_of_its_choice_and_of_random_draws() {
     }];
     let mut rng = activecal::identify::trial_rng(43, 0);
     let margin = 2f64.to_radians();
-    let file = projected(&robot, &robot.nominal, &sockets, 300, margin, 1e-7, &mut rng).unwrap();
+    let file = projected(
+        &robot,
+        &robot.nominal,
+        &sockets,
+        300,
+        margin,
+        1e-7,
+        &mut rng,
+    )
+    .unwrap();
     let known = resolve_distances(&file, &given, true).unwrap();
     let pool = determined_pool(&robot, &robot.nominal, file.clone(), &known).unwrap();
     let without = determined_pool(&robot, &robot.nominal, file.clone(), &[]).unwrap();
@@ -887,6 +906,9 @@ fn select_point_predicts_the_true_error_of_its_choice_and_of_random_draws() {
         chosen_true / median
     );
     for (t, p) in [(chosen_true, chosen_pred), (rand_true, rand_pred)] {
-        assert!(t / p < 1.3 && p / t < 1.3, "true {t:.5} mm, predicted {p:.5} mm");
+        assert!(
+            t / p < 1.3 && p / t < 1.3,
+            "true {t:.5} mm, predicted {p:.5} mm"
+        );
     }
 }

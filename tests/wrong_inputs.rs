@@ -1037,7 +1037,8 @@ fn fixed_coordinates_have_no_sigma_zero() {
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
-        stdout.contains("fixed (held at the file's value") && stdout.contains("shoulder_pan_joint x y z"),
+        stdout.contains("fixed (held at the file's value")
+            && stdout.contains("shoulder_pan_joint x y z"),
         "{stdout}"
     );
     let _ = std::fs::remove_dir_all(&d);

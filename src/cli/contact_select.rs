@@ -9,8 +9,8 @@ use activecal::identify::contact::socket_design::{
     Judged, SocketDesign, SocketDesignSettings, design_for_sockets,
 };
 use activecal::io::contact_design;
-use activecal::measure::contact::KnownDistance;
 use activecal::io::design_formats::DesignFormat;
+use activecal::measure::contact::KnownDistance;
 use activecal::model::MeasurementKind;
 use activecal::select::{Algorithm, CriterionKind};
 use anyhow::{Result, bail};

@@ -153,7 +153,7 @@ pub struct SelectArgs {
 /// without it) and orientation noise `orientation` (radians): each row
 /// then carries the position's σ. Refused for a sensor that measures no
 /// orientation, or a σ that is not a finite number > 0.
-fn orientation_scale(
+pub(super) fn orientation_scale(
     robot: &activecal::model::Robot,
     noise: Option<f64>,
     orientation: f64,

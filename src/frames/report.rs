@@ -335,7 +335,9 @@ fn joint_block(j: &super::JointOrigin, s: Option<(&FrameSigma, f64)>) -> JointBl
         sigma_xyz_mm: s.map(|(s, _)| estimated(mm(s.xyz))),
         sigma_rotation_deg: s.map(|(s, _)| estimated(deg(s.rot))),
         sigma_offset_deg: s.map(|(_, o)| (o != 0.0).then(|| o.to_degrees())),
-        fixed: s.map_or_else(Vec::new, |(s, o)| fixed_coordinates(&s.xyz, &s.rot, Some(o))),
+        fixed: s.map_or_else(Vec::new, |(s, o)| {
+            fixed_coordinates(&s.xyz, &s.rot, Some(o))
+        }),
         max_t,
     }
 }
@@ -377,7 +379,8 @@ impl FramesReport {
                     parent: src.tip.clone(),
                     xyz: f.tool.translation.vector.into(),
                     sigma_xyz_mm: sigma.map(|s| estimated(mm(s.tool.xyz))),
-                    fixed: sigma.map_or_else(Vec::new, |s| fixed_coordinates(&s.tool.xyz, &[], None)),
+                    fixed: sigma
+                        .map_or_else(Vec::new, |s| fixed_coordinates(&s.tool.xyz, &[], None)),
                 }],
             ),
             MeasurementKind::Markers(_) => (

@@ -45,8 +45,13 @@ pub fn predicted_true_error(
     if cov.len() < p || configurations == 0 {
         return None;
     }
-    let (w, used) =
-        tool_point_moment(&fit.robot, &fit.table, fit.tool_offset, configurations, seed);
+    let (w, used) = tool_point_moment(
+        &fit.robot,
+        &fit.table,
+        fit.tool_offset,
+        configurations,
+        seed,
+    );
     // tr(C W): the mean over configurations of tr(J C Jᵀ).
     let trace: f64 = (0..p)
         .flat_map(|a| (0..p).map(move |c| (a, c)))
@@ -97,10 +102,17 @@ pub fn tool_point_moment(
 /// which no configuration away from the sockets sees.
 #[must_use]
 pub fn true_error_moment(pool: &SocketPool, table: &ParamTable, seed: u64) -> DMatrix<f64> {
-    let (w, _) = tool_point_moment(&pool.robot, table, [0.0; 3], PREDICTION_CONFIGURATIONS, seed);
+    let (w, _) = tool_point_moment(
+        &pool.robot,
+        table,
+        [0.0; 3],
+        PREDICTION_CONFIGURATIONS,
+        seed,
+    );
     let p = pool.blocks.first().map_or(w.nrows(), DMatrix::ncols);
     let mut full = DMatrix::zeros(p, p);
     let k = w.nrows().min(p);
-    full.view_mut((0, 0), (k, k)).copy_from(&w.view((0, 0), (k, k)));
+    full.view_mut((0, 0), (k, k))
+        .copy_from(&w.view((0, 0), (k, k)));
     full
 }

@@ -19,9 +19,11 @@ from ._activecal import (
     Calibration,
     Design,
     Error,
+    Pool,
     Robot,
     __version__,
     calibrate,
+    pool,
     select,
 )
 
@@ -29,8 +31,10 @@ __all__ = [
     "Calibration",
     "Design",
     "Error",
+    "Pool",
     "Robot",
     "__version__",
     "calibrate",
+    "pool",
     "select",
 ]

@@ -125,12 +125,65 @@ class Design:
         one pose a row, a header of joint names) or .yaml (named joint
         configurations). An existing file is replaced only with
         overwrite=True."""
+    def bound(self) -> dict[str, Any]:
+        """The certified bound on ln det of every design of this size from
+        the same pool (the continuous relaxation, with the existing poses'
+        information when given) and this design's D-efficiency against it:
+        the dict ``activecal gap --json`` prints (``ln_oid``, ``ln_bound``,
+        ``d_efficiency`` in (0, 1], ``bound_status``, ``certificate_gap``).
+        Computed on each call; the GIL is released."""
     def __len__(self) -> int: ...
+
+class Pool:
+    """Candidate poses and their identification Jacobian: what `select`
+    chooses from."""
+
+    @property
+    def q(self) -> npt.NDArray[np.float64]:
+        """Joint values of the candidates, shape (n, dof), radians or metres."""
+    @property
+    def ids(self) -> list[int]:
+        """Each candidate's id (a sample's number, a lattice index, a row of
+        the array given)."""
+    @property
+    def joint_names(self) -> list[str]:
+        """The columns of `q`."""
+    @property
+    def stats(self) -> dict[str, Any]:
+        """What the filters kept and removed (``candidates``, ``kept``,
+        ``filters``: each one's ``removed`` of ``seen``), as the command
+        line's ``pool_stats``."""
+    def __len__(self) -> int: ...
+
+def pool(
+    robot: Robot,
+    source: Union[str, npt.ArrayLike, None] = None,
+    count: Optional[int] = None,
+    levels: Optional[int] = None,
+    pool_seed: Optional[int] = None,
+    margin: Optional[float] = None,
+    self_collision: bool = False,
+    srdf: Optional[_Path] = None,
+    package_dirs: Optional[list[_Path]] = None,
+    floor: Optional[float] = None,
+    obstacles: Optional[list[str]] = None,
+    clearance: float = 0.0,
+) -> Pool:
+    """Candidate poses for `select`. source: ``"random"`` (default) or
+    ``"sobol"`` (count samples inside the joint limits less margin degrees,
+    default 4096; pool_seed), ``"lattice"`` (levels values per joint,
+    default 5) or an (n, dof) array of your own joint values (radians or
+    metres). Poses the sensor does not see are dropped; with
+    self_collision (pairs listed by srdf skipped), floor (a height in the
+    base frame, metres) or obstacles (``"box:x,y,z,sx,sy,sz"`` ..., base
+    frame, metres, as ``--obstacle``), the poses where the robot touches
+    itself or them within clearance metres (meshes found in package_dirs).
+    The GIL is released while it runs."""
 
 def select(
     robot: Robot,
     n: int,
-    pool: str = "random",
+    pool: Union[str, Pool, npt.ArrayLike, None] = None,
     count: Optional[int] = None,
     levels: Optional[int] = None,
     pool_seed: Optional[int] = None,
@@ -141,12 +194,14 @@ def select(
     ils: Optional[int] = None,
     kick: int = 3,
     noise: Optional[float] = None,
+    existing: Optional[npt.ArrayLike] = None,
 ) -> Design:
     """Chooses n poses to measure from a pool of candidates by D-optimal
     design (maximising ln det XᵀX), as ``activecal select --order none``
     does with the same options. The GIL is released while it runs.
 
-    pool: ``"random"`` or ``"sobol"`` (count samples inside the joint
+    pool: a `Pool` (from `pool`, with its filters), an (n, dof) array of
+    your own candidate joint values, or ``"random"`` (default) or ``"sobol"`` (count samples inside the joint
     limits, default 4096; pool_seed: the random stream's seed, default 0,
     or the Sobol scramble's, default none) or ``"lattice"`` (levels values
     per joint, default 5). margin: degrees kept inside every revolute
@@ -157,7 +212,9 @@ def select(
     kept. ils: rounds of iterated local search (default: by pool size, as
     the command line). kick: poses exchanged per round. noise: the
     sensor's σ per coordinate, metres; the design then predicts the error
-    after calibration (`Design.predicted`).
+    after calibration (`Design.predicted`). existing: an (m, dof) array
+    of poses already measured: the new poses add most to their
+    information (as ``--existing``).
     """
 
 class Calibration:

@@ -8,6 +8,7 @@ use pyo3::prelude::*;
 
 mod calibrate;
 mod convert;
+mod pool;
 mod robot;
 mod select;
 
@@ -25,6 +26,8 @@ fn _activecal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<robot::Robot>()?;
     m.add_class::<select::Design>()?;
+    m.add_class::<pool::Pool>()?;
+    m.add_function(wrap_pyfunction!(pool::pool, m)?)?;
     m.add_class::<calibrate::Calibration>()?;
     m.add_function(wrap_pyfunction!(select::select, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate::calibrate, m)?)?;

@@ -236,6 +236,20 @@ class Calibration:
         ``position_max_mm``, ``orientation_rms_deg`` (full poses) and per
         pose."""
     @property
+    def holdout(self) -> Optional[dict[str, Any]]:
+        """With `holdout`: each split's errors of the fitted and the nominal
+        model on the poses it did not see, and their means (mm, degrees)."""
+    @property
+    def noise(self) -> Optional[dict[str, Any]]:
+        """The residual blocks' σ's the fit weighed by (mm, degrees) with
+        their degrees of freedom."""
+    @property
+    def frames(self) -> Optional[dict[str, Any]]:
+        """The calibrated robot in its URDF's terms (measurement frame,
+        tool or markers, each joint origin's change with σ; a coordinate no
+        estimated unknown moves has σ None and is listed under ``fixed``):
+        the frames file's content. None for a built-in robot."""
+    @property
     def report(self) -> dict[str, Any]:
         """The dict ``activecal calibrate --measurements FILE --json``
         prints for a file holding the same values (``measurements`` names
@@ -260,6 +274,11 @@ def calibrate(
     max_iterations: int = 200,
     loss: str = "l2",
     loss_scale: Optional[float] = None,
+    weights: Optional[str] = None,
+    orientation_scale: Optional[float] = None,
+    holdout: Optional[float] = None,
+    splits: int = 4,
+    seed: int = 0,
 ) -> Calibration:
     """Calibrates the robot from measured poses, as ``activecal calibrate
     --measurements FILE`` does from a file holding the same values. The
@@ -273,5 +292,9 @@ def calibrate(
     unknowns (names as in `Calibration.estimate`). max_iterations:
     Levenberg–Marquardt's limit. loss: ``"l2"``, or ``"huber"`` /
     ``"cauchy"`` with loss_scale (metres: a pose's residual norm where the
-    loss turns robust).
+    loss turns robust). weights: ``"estimated"`` (default: each residual
+    block's σ from its own residuals) or ``"fixed"`` (a radian of
+    orientation weighs orientation_scale metres; giving orientation_scale
+    implies ``"fixed"``). holdout: the fraction of poses held out in each
+    of `splits` random splits seeded by `seed` (`Calibration.holdout`).
     """

@@ -111,6 +111,60 @@ fn data(
     })
 }
 
+/// The `weights` and `orientation_scale` arguments, checked.
+fn weights_of(
+    weights: Option<&str>,
+    orientation_scale: Option<f64>,
+) -> PyResult<activecal::identify::Weights> {
+    use activecal::identify::Weights;
+    if let Some(w) = orientation_scale.filter(|w| !(w.is_finite() && *w > 0.0)) {
+        return Err(arg_err(
+            "orientation_scale",
+            format!("{w}: must be a finite number > 0 (metres per radian)"),
+        ));
+    }
+    match (weights, orientation_scale) {
+        (Some("estimated"), Some(_)) => Err(arg_err(
+            "orientation_scale",
+            "fixes the orientation weight: it implies weights=\"fixed\", not \"estimated\"",
+        )),
+        (None | Some("estimated"), None) => Ok(Weights::Estimated),
+        (None | Some("fixed"), _) => Ok(Weights::Fixed),
+        (Some(other), _) => Err(arg_err(
+            "weights",
+            format!("unknown weights '{other}': \"estimated\" or \"fixed\""),
+        )),
+    }
+}
+
+/// The held-out splits of `holdout` (a fraction in (0, 1)), checked.
+fn holdout_of(
+    holdout: Option<f64>,
+    splits: i64,
+    seed: i128,
+    weights: activecal::identify::Weights,
+) -> PyResult<Option<activecal::identify::HoldoutSettings>> {
+    let splits = count("splits", splits, 1)?;
+    let seed = crate::convert::non_negative("seed", seed)?;
+    holdout
+        .map(|fraction| {
+            if !(fraction > 0.0 && fraction < 1.0) {
+                return Err(arg_err(
+                    "holdout",
+                    format!("{fraction}: the fraction of poses held out is in (0, 1)"),
+                ));
+            }
+            Ok(activecal::identify::HoldoutSettings {
+                fraction,
+                splits,
+                seed,
+                prune: false,
+                weights,
+            })
+        })
+        .transpose()
+}
+
 /// Names given to a wrapper as an iterable of str.
 fn names(v: Option<Vec<String>>) -> Vec<String> {
     v.unwrap_or_default()
@@ -126,9 +180,14 @@ fn names(v: Option<Vec<String>>) -> Vec<String> {
 /// estimated besides the unknowns (names as in `estimate`).
 /// max_iterations: Levenberg–Marquardt's limit. loss: "l2", or "huber" /
 /// "cauchy" with loss_scale (metres, a pose's residual norm where the loss
-/// turns robust).
+/// turns robust). weights: "estimated" (default: each residual block's σ —
+/// position, orientation, each marker — from its own residuals) or
+/// "fixed" (a radian of orientation weighs orientation_scale metres,
+/// default the robot's, 1 m/rad; giving orientation_scale implies
+/// "fixed"). holdout: a fraction of the poses held out in each of `splits`
+/// random splits (seeded by `seed`), the fit judged on them (`holdout`).
 #[pyfunction]
-#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None))]
+#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
@@ -141,8 +200,19 @@ pub fn calibrate(
     max_iterations: i64,
     loss: &str,
     loss_scale: Option<f64>,
+    weights: Option<&str>,
+    orientation_scale: Option<f64>,
+    holdout: Option<f64>,
+    splits: i64,
+    seed: i128,
 ) -> PyResult<Calibration> {
-    let inner = robot.inner.clone();
+    let weights = weights_of(weights, orientation_scale)?;
+    let mut scaled = (*robot.inner).clone();
+    if let Some(w) = orientation_scale {
+        scaled.orientation_scale = w;
+    }
+    let inner = Arc::new(scaled);
+    let holdout = holdout_of(holdout, splits, seed, weights)?;
     let d = data(py, robot, q, points, orientations)?;
     let max_iterations = count("max_iterations", max_iterations, 1)?;
     let scale = |s: Option<f64>| match s {
@@ -183,12 +253,12 @@ pub fn calibrate(
         loss,
         fix: names(fix),
         free: names(free),
-        holdout: None,
+        holdout,
         units: activecal::units::Units::default(),
         gravity: None,
         fit_compliance: false,
         compare_compliance: false,
-        weights: activecal::identify::Weights::Estimated,
+        weights,
     };
     let r = inner.clone();
     let (fitted, id, frames, report) = detached(py, move || {
@@ -288,6 +358,29 @@ impl Calibration {
     #[getter]
     fn residuals<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         json_to_py(py, &self.report["residuals"])
+    }
+
+    /// Held-out evidence (with `holdout`): each split's errors of the fitted
+    /// and the nominal model on the poses it did not see, and their means
+    /// (mm, degrees); None without `holdout`.
+    #[getter]
+    fn holdout<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.report["holdout"])
+    }
+
+    /// The residual blocks' σ's the fit weighed by (position in mm,
+    /// orientation in degrees, each marker), with their degrees of freedom.
+    #[getter]
+    fn noise<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.report["noise"])
+    }
+
+    /// The calibrated robot in the URDF's terms (URDF robots): the
+    /// measurement frame, the tool or markers and each joint origin's
+    /// change with σ — the dict the frames file holds; None otherwise.
+    #[getter]
+    fn frames<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.report["frames"])
     }
 
     /// The whole report: the dict `activecal calibrate --measurements FILE

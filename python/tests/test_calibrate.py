@@ -172,3 +172,34 @@ def test_figaroh_ur10_full_pose_equals_the_cli():
     assert r.joint_names == joints
     cal = activecal.calibrate(r, q, points, orientations=rot)
     assert_same_fit(cal, want)
+
+
+def test_holdout_and_weights_equal_the_cli(tmp_path):
+    args = ["--robot", f"{UR5_URDF}:pose", "--tip", "tool0"]
+    meas, m = simulated(tmp_path, args)
+    r = activecal.Robot.from_urdf(UR5_URDF, tip="tool0", pose=True)
+    for extra, kw in [
+        (["--holdout", 0.25, "--splits", 3, "--seed", 5], dict(holdout=0.25, splits=3, seed=5)),
+        (["--weights", "fixed"], dict(weights="fixed")),
+        (["--orientation-scale", 0.2], dict(orientation_scale=0.2)),
+    ]:
+        want = cli("calibrate", *args, "--measurements", meas, *extra)
+        cal = activecal.calibrate(r, m["qs"], m["points"], orientations=m["orientations"], **kw)
+        assert_same_fit(cal, want)
+        assert cal.noise == want["noise"]
+        got = cal.holdout
+        if "holdout" in kw:
+            # The same splits and fits: the same numbers, bit for bit.
+            assert got == want["holdout"] and len(got["splits"]) == 3
+        else:
+            assert got is None and "holdout" not in want
+    assert cal.frames == want["frames"]
+    for kw, words in [
+        (dict(weights="estimated", orientation_scale=0.2), "orientation_scale: fixes"),
+        (dict(weights="robust"), "weights: unknown"),
+        (dict(orientation_scale=-1.0), "orientation_scale: -1"),
+        (dict(holdout=1.5), "holdout: 1.5"),
+        (dict(holdout=0.2, splits=0), "splits:"),
+    ]:
+        with pytest.raises(activecal.Error, match=words):
+            activecal.calibrate(r, m["qs"], m["points"], orientations=m["orientations"], **kw)

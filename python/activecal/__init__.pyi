@@ -24,7 +24,24 @@ _Marker = Union[str, Tuple[str, Sequence[float]]]
 class Error(Exception):
     """Bad input or a failed computation, with the library's message: the
     argument's name first when one argument is wrong (``q: expected shape
-    (6,) ...``)."""
+    (6,) ...``). Every error activecal raises is one of its subclasses."""
+
+class InputError(Error):
+    """A wrong argument (its name first) or a wrong value in an input file
+    (the file and the place named)."""
+
+class FileError(Error):
+    """A file that could not be read or written, or an output that exists
+    (pass overwrite=True)."""
+
+class ResourceError(Error):
+    """Work too large for the memory or size limits, with the figure."""
+
+class ComputationError(Error):
+    """A computation that cannot be done on these (valid) inputs."""
+
+class InternalError(Error):
+    """A defect in activecal: please report it with the message."""
 
 class Robot:
     """A robot model: a serial chain, its joint limits, the unknowns a

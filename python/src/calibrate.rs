@@ -263,8 +263,7 @@ pub fn calibrate(
     let r = inner.clone();
     let (fitted, id, frames, report) = detached(py, move || {
         let t0 = std::time::Instant::now();
-        let meas = Measurements::with_orientations(&r, d.qs, d.points, d.orientations)
-            .map_err(|e| e.to_string())?;
+        let meas = Measurements::with_orientations(&r, d.qs, d.points, d.orientations)?;
         let c = calibrate_measurements(
             &r,
             &meas,
@@ -272,8 +271,7 @@ pub fn calibrate(
             Vec::new(),
             &settings,
             &mut |_| {},
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         let mut report = c.report;
         report.base.elapsed_seconds = t0.elapsed().as_secs_f64();
         let id = c.fit.id;
@@ -284,9 +282,9 @@ pub fn calibrate(
         };
         let cov = id.covariance.as_ref().map(|c| c.matrix.as_slice());
         let frames = activecal::frames::calibrated(&c.robot, &id.table, cov, Some(fit))
-            .map_err(|e| e.to_string())?;
+            .map_err(crate::convert::Fail::compute)?;
         report.frames = frames.as_ref().map(|(_, r)| r.clone());
-        let v = serde_json::to_value(&report).map_err(|e| e.to_string())?;
+        let v = serde_json::to_value(&report)?;
         Ok((c.robot, id, frames, v))
     })?;
     Ok(Calibration {
@@ -326,8 +324,9 @@ impl Calibration {
             &[],
             overwrite,
         )
-        .map_err(err)?;
-        activecal::io::atomic::write_atomic(path, text.as_bytes()).map_err(err)
+        .map_err(|e| crate::convert::Fail::from(e).into_py())?;
+        activecal::io::atomic::write_atomic(path, text.as_bytes())
+            .map_err(|e| crate::convert::Fail::from(e).into_py())
     }
 }
 

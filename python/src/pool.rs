@@ -135,7 +135,9 @@ fn collision_filters(
         .chain(choice.package_dirs.iter().map(|p| ("package_dirs", p)))
     {
         if !std::path::Path::new(p).exists() {
-            return Err(arg_err(name, format!("{p}: no such file or directory")));
+            return Err(crate::FileError::new_err(format!(
+                "{name}: {p}: no such file or directory"
+            )));
         }
     }
     let Some(chain) = activecal::io::UrdfChain::of(robot) else {
@@ -160,22 +162,19 @@ pub(crate) fn build(
 ) -> PyResult<Pool> {
     let r = robot.clone();
     let (pool, x) = detached(py, move || {
-        let e = |e: activecal::Error| e.to_string();
         let table = &r.nominal;
         let pool = match listed {
-            Some(qs) => spec
-                .build_listed(
-                    &r,
-                    table,
-                    Configurations {
-                        qs,
-                        notes: Vec::new(),
-                    },
-                )
-                .map_err(e)?,
-            None => spec.build(&r, table).map_err(e)?,
+            Some(qs) => spec.build_listed(
+                &r,
+                table,
+                Configurations {
+                    qs,
+                    notes: Vec::new(),
+                },
+            )?,
+            None => spec.build(&r, table)?,
         };
-        let x = pool.try_jacobian(&r, table).map_err(e)?;
+        let x = pool.try_jacobian(&r, table)?;
         Ok((pool, x))
     })?;
     Ok(Pool {

@@ -107,7 +107,6 @@ pub fn select(
     let (x, built) = (candidates.x.clone(), candidates.pool.clone());
     let closure_prior = prior.clone();
     let (file, report, ids, q, sel) = detached(py, move || {
-        let e = |e: activecal::Error| e.to_string();
         let table = &r.nominal;
         let s = Settings {
             n,
@@ -120,7 +119,7 @@ pub fn select(
             ..Settings::default()
         };
         let t0 = std::time::Instant::now();
-        let sel = activecal::select::select(&x, CriterionKind::Det, algorithm, &s).map_err(e)?;
+        let sel = activecal::select::select(&x, CriterionKind::Det, algorithm, &s)?;
         let mut report = SelectReport::new(
             &r,
             &built,
@@ -136,7 +135,7 @@ pub fn select(
         file.extra.extend(report.design_keys());
         let q: Vec<Vec<f64>> = sel.poses.iter().map(|&k| built.q(k)).collect();
         let ids = built.ids_of(&sel.poses);
-        let v = serde_json::to_value(&report).map_err(|e| e.to_string())?;
+        let v = serde_json::to_value(&report)?;
         Ok((file, v, ids, q, sel))
     })?;
     let mut file = file;
@@ -236,7 +235,7 @@ fn existing_poses(
         let x = activecal::blocks::jacobian_of(&r, &r.nominal, qs2.len(), |k, q| {
             q.copy_from_slice(&qs2[k]);
         });
-        Prior::from_blocks(&x).map_err(|e| format!("existing: {e}"))
+        Prior::from_blocks(&x).map_err(|e| crate::convert::Fail::input(format!("existing: {e}")))
     })?;
     Ok((qs, prior))
 }
@@ -289,11 +288,9 @@ impl Design {
         let v = detached(py, move || {
             let settings = activecal::bound::BoundSettings::default();
             let b =
-                activecal::bound::relaxation_bound(&x, prior.as_ref(), positions.len(), &settings)
-                    .map_err(|e| e.to_string())?;
-            let g = activecal::bound::gap::design_gap(&x, prior.as_ref(), &positions, &b)
-                .map_err(|e| e.to_string())?;
-            serde_json::to_value(&g).map_err(|e| e.to_string())
+                activecal::bound::relaxation_bound(&x, prior.as_ref(), positions.len(), &settings)?;
+            let g = activecal::bound::gap::design_gap(&x, prior.as_ref(), &positions, &b)?;
+            Ok(serde_json::to_value(&g)?)
         })?;
         json_to_py(py, &v)
     }
@@ -311,7 +308,7 @@ impl Design {
     #[pyo3(signature = (path, overwrite=false))]
     fn write(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
         activecal::io::design_formats::write(&self.file, &path, overwrite)
-            .map_err(|e| arg_err("path", e))
+            .map_err(|e| crate::convert::Fail::from(e).into_py())
     }
 
     fn __len__(&self) -> usize {

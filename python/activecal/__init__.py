@@ -32,6 +32,7 @@ from ._activecal import (
     Robot,
     __version__,
     calibrate,
+    evaluate,
     pool,
     select,
 )
@@ -49,6 +50,7 @@ __all__ = [
     "Robot",
     "__version__",
     "calibrate",
+    "evaluate",
     "pool",
     "select",
 ]

@@ -315,3 +315,17 @@ def calibrate(
     implies ``"fixed"``). holdout: the fraction of poses held out in each
     of `splits` random splits seeded by `seed` (`Calibration.holdout`).
     """
+
+def evaluate(
+    model: Union[Robot, Calibration],
+    q: npt.ArrayLike,
+    points: npt.ArrayLike,
+    orientations: Optional[npt.ArrayLike] = None,
+) -> dict[str, Any]:
+    """The errors of a model on measured poses (``position_rms_mm``,
+    ``position_max_mm``, ``orientation_rms_deg`` for full poses, and per
+    pose), as ``activecal evaluate --json`` prints them under
+    ``residuals``. model: a `Robot` (e.g. the calibrated URDF and frames
+    file loaded back) or a `Calibration` (its fitted model). q, points and
+    orientations as `calibrate` takes them: poses the fit did not see
+    judge it."""

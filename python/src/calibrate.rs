@@ -412,3 +412,39 @@ impl Calibration {
         )
     }
 }
+
+/// The errors of a model on measured poses, as `activecal evaluate
+/// --measurements FILE --json` prints them (`residuals`): `model` is a
+/// `Robot` (for example the calibrated URDF and frames file loaded back) or
+/// a `Calibration` (its fitted model). q, points and orientations are as
+/// `calibrate` takes them: poses the fit did not see judge it.
+#[pyfunction]
+#[pyo3(signature = (model, q, points, orientations=None))]
+pub fn evaluate<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+    points: &Bound<'py, PyAny>,
+    orientations: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (robot, table) = if let Ok(c) = model.cast::<Calibration>() {
+        let c = c.get();
+        (c.robot.clone(), c.id.table.clone())
+    } else if let Ok(r) = model.cast::<Robot>() {
+        let r = r.get();
+        (r.inner.clone(), r.inner.nominal.clone())
+    } else {
+        return Err(arg_err("model", "a Robot or a Calibration"));
+    };
+    let wrapper = Robot {
+        inner: robot.clone(),
+        visibility: None,
+    };
+    let d = data(py, &wrapper, q, points, orientations)?;
+    let v = detached(py, move || {
+        let meas = Measurements::with_orientations(&robot, d.qs, d.points, d.orientations)?;
+        let res = activecal::identify::residuals(&robot, &table, &meas)?;
+        Ok(serde_json::to_value(&res)?)
+    })?;
+    json_to_py(py, &v)
+}

@@ -66,5 +66,6 @@ fn _activecal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<calibrate::Calibration>()?;
     m.add_function(wrap_pyfunction!(select::select, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate::calibrate, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate::evaluate, m)?)?;
     Ok(())
 }

@@ -203,3 +203,31 @@ def test_holdout_and_weights_equal_the_cli(tmp_path):
     ]:
         with pytest.raises(activecal.Error, match=words):
             activecal.calibrate(r, m["qs"], m["points"], orientations=m["orientations"], **kw)
+
+
+def test_evaluate_on_poses_the_fit_did_not_see_equals_the_cli(tmp_path):
+    args = ["--robot", UR5_URDF, "--tip", "tool0", "--marker", MARKER]
+    meas, m = simulated(tmp_path, args)
+    r = activecal.Robot.from_urdf(UR5_URDF, tip="tool0", marker=MARKER)
+    q, p = np.array(m["qs"]), np.array(m["points"])
+    cal = activecal.calibrate(r, q[:22], p[:22])
+    got = activecal.evaluate(cal, q[22:], p[22:])
+    cal.write_urdf(tmp_path / "cal.urdf")
+    cal.write_frames(tmp_path / "cal.yaml")
+    test = tmp_path / "test.csv"
+    np.savetxt(
+        test, np.hstack([p[22:], q[22:]]), delimiter=",", comments="", fmt="%.17g",
+        header=",".join(["x", "y", "z", *r.joint_names]),
+    )
+    want = cli(
+        "evaluate", "--robot", tmp_path / "cal.urdf", "--tip", "tool0", "--frames",
+        tmp_path / "cal.yaml", "--measurements", test,
+    )["residuals"]
+    assert got["position_rms_mm"] == pytest.approx(want["position_rms_mm"], abs=1e-9)
+    assert len(got["per_sample"]) == 8
+    # The nominal model is far worse on the same poses (the truth's origins
+    # are off by millimetres).
+    nominal = activecal.evaluate(r, q[22:], p[22:])
+    assert nominal["position_rms_mm"] > 10 * got["position_rms_mm"]
+    with pytest.raises(activecal.InputError, match="^model"):
+        activecal.evaluate("ur5", q, p)

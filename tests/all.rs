@@ -49,6 +49,7 @@ mod robots_describe;
 mod score_design;
 mod select;
 mod tour_moves;
+mod truth_fixtures;
 mod undetermined;
 mod unit_invariance;
 mod units;

@@ -11,7 +11,7 @@ starts with the argument's name.
 """
 
 from os import PathLike
-from typing import Any, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -142,7 +142,9 @@ class Design:
         one pose a row, a header of joint names) or .yaml (named joint
         configurations). An existing file is replaced only with
         overwrite=True."""
-    def bound(self) -> dict[str, Any]:
+    def bound(
+        self, progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None
+    ) -> dict[str, Any]:
         """The certified bound on ln det of every design of this size from
         the same pool (the continuous relaxation, with the existing poses'
         information when given) and this design's D-efficiency against it:
@@ -185,6 +187,7 @@ def pool(
     floor: Optional[float] = None,
     obstacles: Optional[list[str]] = None,
     clearance: float = 0.0,
+    progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
 ) -> Pool:
     """Candidate poses for `select`. source: ``"random"`` (default) or
     ``"sobol"`` (count samples inside the joint limits less margin degrees,
@@ -212,6 +215,7 @@ def select(
     kick: int = 3,
     noise: Optional[float] = None,
     existing: Optional[npt.ArrayLike] = None,
+    progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
 ) -> Design:
     """Chooses n poses to measure from a pool of candidates by D-optimal
     design (maximising ln det XᵀX), as ``activecal select --order none``
@@ -231,7 +235,11 @@ def select(
     sensor's σ per coordinate, metres; the design then predicts the error
     after calibration (`Design.predicted`). existing: an (m, dof) array
     of poses already measured: the new poses add most to their
-    information (as ``--existing``).
+    information (as ``--existing``). progress: a callable
+    ``progress(task, done, total, note)`` called as the work advances (at
+    most every 0.1 s per task; total None when unknown; note ``"done"`` at a
+    task's end); an exception it raises is raised when the work ends. The
+    same argument on `pool`, `calibrate` and `Design.bound`.
     """
 
 class Calibration:
@@ -296,6 +304,7 @@ def calibrate(
     holdout: Optional[float] = None,
     splits: int = 4,
     seed: int = 0,
+    progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
 ) -> Calibration:
     """Calibrates the robot from measured poses, as ``activecal calibrate
     --measurements FILE`` does from a file holding the same values. The

@@ -186,8 +186,10 @@ fn names(v: Option<Vec<String>>) -> Vec<String> {
 /// default the robot's, 1 m/rad; giving orientation_scale implies
 /// "fixed"). holdout: a fraction of the poses held out in each of `splits`
 /// random splits (seeded by `seed`), the fit judged on them (`holdout`).
+/// progress: a callable `progress(task, done, total, note)`, as `select`
+/// takes it.
 #[pyfunction]
-#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0))]
+#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
@@ -205,6 +207,7 @@ pub fn calibrate(
     holdout: Option<f64>,
     splits: i64,
     seed: i128,
+    progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Calibration> {
     let weights = weights_of(weights, orientation_scale)?;
     let mut scaled = (*robot.inner).clone();
@@ -261,31 +264,33 @@ pub fn calibrate(
         weights,
     };
     let r = inner.clone();
-    let (fitted, id, frames, report) = detached(py, move || {
-        let t0 = std::time::Instant::now();
-        let meas = Measurements::with_orientations(&r, d.qs, d.points, d.orientations)?;
-        let c = calibrate_measurements(
-            &r,
-            &meas,
-            "the arrays given",
-            Vec::new(),
-            &settings,
-            &mut |_| {},
-        )?;
-        let mut report = c.report;
-        report.base.elapsed_seconds = t0.elapsed().as_secs_f64();
-        let id = c.fit.id;
-        let fit = FitBlock {
-            poses: report.base.poses,
-            position_rms_mm: report.residuals.position_rms_mm,
-            orientation_rms_deg: report.residuals.orientation_rms_deg,
-        };
-        let cov = id.covariance.as_ref().map(|c| c.matrix.as_slice());
-        let frames = activecal::frames::calibrated(&c.robot, &id.table, cov, Some(fit))
-            .map_err(crate::convert::Fail::compute)?;
-        report.frames = frames.as_ref().map(|(_, r)| r.clone());
-        let v = serde_json::to_value(&report)?;
-        Ok((c.robot, id, frames, v))
+    let (fitted, id, frames, report) = crate::progress::with_callback(progress, || {
+        detached(py, move || {
+            let t0 = std::time::Instant::now();
+            let meas = Measurements::with_orientations(&r, d.qs, d.points, d.orientations)?;
+            let c = calibrate_measurements(
+                &r,
+                &meas,
+                "the arrays given",
+                Vec::new(),
+                &settings,
+                &mut |_| {},
+            )?;
+            let mut report = c.report;
+            report.base.elapsed_seconds = t0.elapsed().as_secs_f64();
+            let id = c.fit.id;
+            let fit = FitBlock {
+                poses: report.base.poses,
+                position_rms_mm: report.residuals.position_rms_mm,
+                orientation_rms_deg: report.residuals.orientation_rms_deg,
+            };
+            let cov = id.covariance.as_ref().map(|c| c.matrix.as_slice());
+            let frames = activecal::frames::calibrated(&c.robot, &id.table, cov, Some(fit))
+                .map_err(crate::convert::Fail::compute)?;
+            report.frames = frames.as_ref().map(|(_, r)| r.clone());
+            let v = serde_json::to_value(&report)?;
+            Ok((c.robot, id, frames, v))
+        })
     })?;
     Ok(Calibration {
         robot: Arc::new(fitted),

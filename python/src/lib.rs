@@ -9,6 +9,7 @@ use pyo3::prelude::*;
 mod calibrate;
 mod convert;
 mod pool;
+mod progress;
 mod robot;
 mod select;
 

@@ -261,9 +261,10 @@ pub(crate) fn pool_of(
 /// metres, as the command line's `--obstacle`), the poses where the robot
 /// touches itself or them, within `clearance` metres (meshes found in
 /// `package_dirs`). The pool holds the survivors' joint values (`q`), ids
-/// and what each filter removed (`stats`).
+/// and what each filter removed (`stats`). progress: a callable
+/// `progress(task, done, total, note)`, as `select` takes it.
 #[pyfunction]
-#[pyo3(signature = (robot, source=None, count=None, levels=None, pool_seed=None, margin=None, self_collision=false, srdf=None, package_dirs=None, floor=None, obstacles=None, clearance=0.0))]
+#[pyo3(signature = (robot, source=None, count=None, levels=None, pool_seed=None, margin=None, self_collision=false, srdf=None, package_dirs=None, floor=None, obstacles=None, clearance=0.0, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn pool(
     py: Python<'_>,
@@ -279,6 +280,7 @@ pub fn pool(
     floor: Option<f64>,
     obstacles: Option<Vec<String>>,
     clearance: f64,
+    progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Pool> {
     let filters = collision_filters(
         &robot.inner,
@@ -295,9 +297,11 @@ pub fn pool(
     )?;
     let default = PyString::new(py, "random").into_any();
     let source = source.unwrap_or(&default);
-    pool_of(
-        py, robot, "source", source, count, levels, pool_seed, margin, filters,
-    )
+    crate::progress::with_callback(progress, || {
+        pool_of(
+            py, robot, "source", source, count, levels, pool_seed, margin, filters,
+        )
+    })
 }
 
 #[pymethods]

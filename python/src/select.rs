@@ -51,8 +51,12 @@ pub struct Design {
 /// iterated local search (default: the command line's, by pool size).
 /// noise: the sensor's σ per coordinate, metres: the design then carries
 /// the position error predicted after calibrating with it (`predicted`).
+/// progress: a callable `progress(task, done, total, note)` called as the
+/// work advances (at most every 0.1 s per task; `total` None when unknown;
+/// `note` "done" at a task's end); an exception it raises is raised when
+/// the work ends.
 #[pyfunction]
-#[pyo3(signature = (robot, n, pool=None, count=None, levels=None, pool_seed=None, margin=None, algorithm="eae", seed=1, starts=2, ils=None, kick=3, noise=None, existing=None))]
+#[pyo3(signature = (robot, n, pool=None, count=None, levels=None, pool_seed=None, margin=None, algorithm="eae", seed=1, starts=2, ils=None, kick=3, noise=None, existing=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn select(
     py: Python<'_>,
@@ -70,6 +74,7 @@ pub fn select(
     kick: i64,
     noise: Option<f64>,
     existing: Option<&Bound<'_, PyAny>>,
+    progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Design> {
     let n = crate::convert::count("n", n, 1)?;
     let algorithm = Algorithm::from_name(algorithm).ok_or_else(|| {
@@ -106,37 +111,40 @@ pub fn select(
     let r = inner.clone();
     let (x, built) = (candidates.x.clone(), candidates.pool.clone());
     let closure_prior = prior.clone();
-    let (file, report, ids, q, sel) = detached(py, move || {
-        let table = &r.nominal;
-        let s = Settings {
-            n,
-            initial: Settings::default().initial.min(n),
-            starts,
-            ils: ils.unwrap_or_else(|| activecal::select::default_ils_rounds(x.n_poses(), x.t())),
-            kick,
-            seed,
-            prior: closure_prior.clone(),
-            ..Settings::default()
-        };
-        let t0 = std::time::Instant::now();
-        let sel = activecal::select::select(&x, CriterionKind::Det, algorithm, &s)?;
-        let mut report = SelectReport::new(
-            &r,
-            &built,
-            &sel,
-            CriterionKind::Det,
-            &s,
-            t0.elapsed().as_secs_f64(),
-        );
-        if let (Some(noise), None) = (noise, &closure_prior) {
-            report.predicted = PredictedAfter::of_design(&r, table, &x, &sel.poses, noise);
-        }
-        let mut file = DesignFile::from_pool(&r, &built, &sel.poses);
-        file.extra.extend(report.design_keys());
-        let q: Vec<Vec<f64>> = sel.poses.iter().map(|&k| built.q(k)).collect();
-        let ids = built.ids_of(&sel.poses);
-        let v = serde_json::to_value(&report)?;
-        Ok((file, v, ids, q, sel))
+    let (file, report, ids, q, sel) = crate::progress::with_callback(progress, || {
+        detached(py, move || {
+            let table = &r.nominal;
+            let s = Settings {
+                n,
+                initial: Settings::default().initial.min(n),
+                starts,
+                ils: ils
+                    .unwrap_or_else(|| activecal::select::default_ils_rounds(x.n_poses(), x.t())),
+                kick,
+                seed,
+                prior: closure_prior.clone(),
+                ..Settings::default()
+            };
+            let t0 = std::time::Instant::now();
+            let sel = activecal::select::select(&x, CriterionKind::Det, algorithm, &s)?;
+            let mut report = SelectReport::new(
+                &r,
+                &built,
+                &sel,
+                CriterionKind::Det,
+                &s,
+                t0.elapsed().as_secs_f64(),
+            );
+            if let (Some(noise), None) = (noise, &closure_prior) {
+                report.predicted = PredictedAfter::of_design(&r, table, &x, &sel.poses, noise);
+            }
+            let mut file = DesignFile::from_pool(&r, &built, &sel.poses);
+            file.extra.extend(report.design_keys());
+            let q: Vec<Vec<f64>> = sel.poses.iter().map(|&k| built.q(k)).collect();
+            let ids = built.ids_of(&sel.poses);
+            let v = serde_json::to_value(&report)?;
+            Ok((file, v, ids, q, sel))
+        })
     })?;
     let mut file = file;
     file.existing = existing_qs.map(|qs| activecal::io::design::ExistingPoses {
@@ -282,15 +290,27 @@ impl Design {
     /// information when given) and this design's D-efficiency against it:
     /// the dict `activecal gap --json` prints (`ln_oid`, `ln_bound`,
     /// `d_efficiency` in (0, 1], `bound_status`, `certificate_gap`, …).
-    /// Computed on each call (seconds on large pools).
-    fn bound<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+    /// Computed on each call (seconds on large pools); progress as
+    /// `select` takes it.
+    #[pyo3(signature = (progress=None))]
+    fn bound<'py>(
+        &self,
+        py: Python<'py>,
+        progress: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let (x, prior, positions) = (self.x.clone(), self.prior.clone(), self.positions.clone());
-        let v = detached(py, move || {
-            let settings = activecal::bound::BoundSettings::default();
-            let b =
-                activecal::bound::relaxation_bound(&x, prior.as_ref(), positions.len(), &settings)?;
-            let g = activecal::bound::gap::design_gap(&x, prior.as_ref(), &positions, &b)?;
-            Ok(serde_json::to_value(&g)?)
+        let v = crate::progress::with_callback(progress, || {
+            detached(py, move || {
+                let settings = activecal::bound::BoundSettings::default();
+                let b = activecal::bound::relaxation_bound(
+                    &x,
+                    prior.as_ref(),
+                    positions.len(),
+                    &settings,
+                )?;
+                let g = activecal::bound::gap::design_gap(&x, prior.as_ref(), &positions, &b)?;
+                Ok(serde_json::to_value(&g)?)
+            })
         })?;
         json_to_py(py, &v)
     }

@@ -455,3 +455,39 @@ fn select_writes_several_formats_in_one_run() {
         "given twice",
     );
 }
+
+/// A stuck pose's replacements (`select::swap`) are ranked by the design's
+/// ln OI_D after the exchange, priced by the determinant lemma on the
+/// design without the pose: each equals `design_ln_det` of the exchanged
+/// design recomputed from scratch (to 1e-9 of a ln det of O(100): the
+/// lemma's rounding), they come best first, and the first is the best
+/// exchange of that pose over the whole pool.
+#[test]
+fn replacements_of_a_pose_are_ranked_by_the_ln_det_they_keep() {
+    let x = puma_pool(3);
+    let design: Vec<usize> = (0..30).map(|k| (k * 97 + 13) % x.n_poses()).collect();
+    let k = 4;
+    let ranked = activecal::select::swap::ranked_replacements(&x, None, &design, k, 8);
+    assert_eq!(ranked.len(), 8);
+    for w in ranked.windows(2) {
+        assert!(w[0].1 >= w[1].1, "{ranked:?}");
+    }
+    let with = |c: usize| {
+        let mut d = design.clone();
+        d[k] = c;
+        design_ln_det(&x, None, &d).unwrap()
+    };
+    for &(c, l) in &ranked {
+        assert!(!design.contains(&c));
+        assert!(
+            (with(c) - l).abs() < 1e-9 * l.abs(),
+            "{c}: {l} vs {}",
+            with(c)
+        );
+    }
+    let best = (0..x.n_poses())
+        .filter(|i| !design.contains(i))
+        .map(with)
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert!((best - ranked[0].1).abs() < 1e-9 * best.abs());
+}

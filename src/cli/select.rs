@@ -242,31 +242,54 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     let prior = existing.as_ref().map(|e| e.prior.clone());
     let s = selection_settings(&a, &ctx, initial, prior.clone())?;
     let t0 = Instant::now();
-    let sel = select(&ctx.x, a.criterion, a.algorithm, &s)?;
+    let mut sel = select(&ctx.x, a.criterion, a.algorithm, &s)?;
     let seconds = t0.elapsed().as_secs_f64();
-    let mut report = SelectReport::new(&ctx.robot, &ctx.pool, &sel, a.criterion, &s, seconds);
-    if let Some(e) = &existing {
-        let alone = activecal::criterion::design_ln_det(&ctx.x, None, &sel.poses);
-        report.set_existing(e.report.clone(), alone);
-    }
-    let pool_bound = with_gap(&a, &ctx, prior.as_ref(), &sel, &mut report)?;
-    let refined = refined(&a, &ctx, prior.as_ref(), &sel, pool_bound, &mut report)?;
     let reorder = a.order.map_or(speeds.is_some(), |o| o == Order::Time);
     // A joint that turns all the way round may reach a pose a whole turn
     // away, within its limits less the pool's margin.
     let turns = activecal::pool::turn::whole_turn_limits(
         &ctx.robot,
-        &report.joint_names,
+        &activecal::units::joint_names(&ctx.robot),
         ctx.pool.spec.margin,
     )?;
-    let mut order = super::tour::order_design(
-        &mut report,
-        speeds.as_ref(),
-        home.as_deref(),
-        reorder,
-        &turns,
-    )?;
-    super::tour::check_moves(&mut report, &mut order, &ctx.pool, home.as_deref(), &turns)?;
+    let mut swapped = Vec::new();
+    let (mut report, refined, order) = loop {
+        let mut report = SelectReport::new(&ctx.robot, &ctx.pool, &sel, a.criterion, &s, seconds);
+        if let Some(e) = &existing {
+            let alone = activecal::criterion::design_ln_det(&ctx.x, None, &sel.poses);
+            report.set_existing(e.report.clone(), alone);
+        }
+        let pool_bound = with_gap(&a, &ctx, prior.as_ref(), &sel, &mut report)?;
+        let refined = refined(&a, &ctx, prior.as_ref(), &sel, pool_bound, &mut report)?;
+        let mut order = super::tour::order_design(
+            &mut report,
+            speeds.as_ref(),
+            home.as_deref(),
+            reorder,
+            &turns,
+        )?;
+        super::tour::check_moves(&mut report, &mut order, &ctx.pool, home.as_deref(), &turns)?;
+        // A pose the tour cannot leave or reach freely is exchanged (D
+        // criterion, poses of the pool: not refined ones) and the tour
+        // planned again, a few times at most.
+        let may_swap =
+            a.criterion == CriterionKind::Det && refined.is_none() && swapped.len() < MAX_SWAPS;
+        if may_swap
+            && let Some(w) = super::tour::swap_stuck(
+                &ctx,
+                prior.as_ref(),
+                &mut sel,
+                &report,
+                &order,
+                home.as_deref(),
+            )?
+        {
+            swapped.push(w);
+            continue;
+        }
+        break (report, refined, order);
+    };
+    report.swapped = swapped;
     if !a.out.is_empty() {
         let design = design_file(
             &ctx,
@@ -290,6 +313,9 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         select_text(&a, &ctx, &report, seconds) + &predicted_text(report.predicted.as_ref())
     })
 }
+
+/// Poses `select` may exchange because its tour cannot leave or reach them.
+pub const MAX_SWAPS: usize = 3;
 
 /// The predicted errors' line of the text output (empty without them).
 fn predicted_text(p: Option<&activecal::report::PredictedAfter>) -> String {

@@ -93,14 +93,7 @@ pub fn check_moves(
     home: Option<&[f64]>,
     turns: &[Option<[f64; 2]>],
 ) -> Result<()> {
-    let mut models = Vec::new();
-    let mut clearance: f64 = 0.0;
-    for f in &pool.spec.filters {
-        if let activecal::pool::PoolFilter::Collision(c) = f {
-            models.push(c.load().map_err(|e| anyhow::anyhow!(e))?);
-            clearance = clearance.max(c.spec.clearance);
-        }
-    }
+    let (models, clearance) = collision_models(pool)?;
     if models.is_empty() {
         return Ok(());
     }
@@ -140,6 +133,91 @@ pub fn check_moves(
     }
     report.moves = Some(moves);
     Ok(())
+}
+
+/// The collision models of a pool's filters and their largest clearance.
+fn collision_models(
+    pool: &activecal::pool::Pool,
+) -> Result<(
+    Vec<std::sync::Arc<activecal::collision::CollisionModel>>,
+    f64,
+)> {
+    let mut models = Vec::new();
+    let mut clearance: f64 = 0.0;
+    for f in &pool.spec.filters {
+        if let activecal::pool::PoolFilter::Collision(c) = f {
+            models.push(c.load().map_err(|e| anyhow::anyhow!(e))?);
+            clearance = clearance.max(c.spec.clearance);
+        }
+    }
+    Ok((models, clearance))
+}
+
+/// Replacements of a stuck pose tried, best first by the `ln OI_D` kept.
+pub const SWAP_TRIES: usize = 32;
+
+/// The first colliding move of the report's tour, if any, made avoidable by
+/// exchanging the pose it cannot leave (a contact in the first half of the
+/// move) or reach (in the second half) for the pool pose that keeps the
+/// most `ln OI_D` ([`activecal::select::swap::ranked_replacements`], at most
+/// [`SWAP_TRIES`]) whose moves from the pose before it and to the pose after
+/// it in the visiting order are free. `sel` is updated (its `ln_oid`,
+/// `score` and `oi` recomputed); `None` when nothing collides or no
+/// replacement is free.
+pub fn swap_stuck(
+    ctx: &super::PoolCtx,
+    prior: Option<&activecal::criterion::Prior>,
+    sel: &mut activecal::select::Selection,
+    report: &SelectReport,
+    order: &[usize],
+    home: Option<&[f64]>,
+) -> Result<Option<activecal::select::swap::SwappedPose>> {
+    let Some(c) = report.moves.as_ref().and_then(|m| m.colliding.first()) else {
+        return Ok(None);
+    };
+    let pos = match c.from {
+        Some(f) if c.at < 0.5 => f,
+        _ => c.to,
+    };
+    let k = order[pos];
+    let (models, clearance) = collision_models(&ctx.pool)?;
+    let resolution = if clearance > 0.0 { clearance } else { 1e-3 };
+    let prev: Option<Vec<f64>> = if pos == 0 {
+        home.map(<[f64]>::to_vec)
+    } else {
+        Some(report.configurations[pos - 1].q.clone())
+    };
+    let next = report.configurations.get(pos + 1).map(|p| p.q.clone());
+    let free = |a: &[f64], b: &[f64]| {
+        models
+            .iter()
+            .all(|m| m.check_move(a, b, resolution).contact.is_none())
+    };
+    let ranked =
+        activecal::select::swap::ranked_replacements(&ctx.x, prior, &sel.poses, k, SWAP_TRIES);
+    for (cand, ln_after) in ranked {
+        let q = ctx.pool.q(cand);
+        if prev.as_ref().is_some_and(|p| !free(p, &q))
+            || next.as_ref().is_some_and(|n| !free(&q, n))
+        {
+            continue;
+        }
+        let old = sel.poses[k];
+        let before = sel.ln_oid;
+        sel.poses[k] = cand;
+        sel.ln_oid = ln_after;
+        sel.score = ln_after;
+        sel.oi = activecal::criterion::Indices::from_design(&ctx.x, &sel.poses).oi;
+        return Ok(Some(activecal::select::swap::SwappedPose {
+            pose: pos,
+            removed_id: ctx.pool.ids[old],
+            added_id: ctx.pool.ids[cand],
+            ln_oid_before: before,
+            ln_oid_after: ln_after,
+            pair: c.pair.clone(),
+        }));
+    }
+    Ok(None)
 }
 
 /// Text lines of the moves' collision check (`names`: the joints).
@@ -266,6 +344,18 @@ pub fn configurations_text(r: &SelectReport) -> String {
     }
     if let Some(m) = &r.moves {
         s += &moves_text(m, &r.joint_names);
+    }
+    for w in &r.swapped {
+        s += &format!(
+            "pose id {} exchanged for pool pose {} (visited {}th): no move could leave or reach it ({} touches {}); ln OI_D {:.4} -> {:.4}\n",
+            w.removed_id,
+            w.added_id,
+            w.pose + 1,
+            w.pair.link,
+            w.pair.other,
+            w.ln_oid_before,
+            w.ln_oid_after
+        );
     }
     s += &format!("{:>4} {:>8}", "#", "id");
     for n in &r.joint_names {

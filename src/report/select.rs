@@ -190,6 +190,11 @@ pub struct SelectReport {
     /// filter).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub moves: Option<crate::select::moves::MovesReport>,
+    /// Design poses exchanged because the tour could not leave or reach
+    /// them without a collision (the search's design, then these
+    /// exchanges).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub swapped: Vec<crate::select::swap::SwappedPose>,
 }
 
 /// One pose of a design with its joint values.
@@ -274,6 +279,7 @@ impl SelectReport {
                 .collect(),
             tour: None,
             moves: None,
+            swapped: Vec::new(),
             ln_oid: sel.ln_oid,
             log10_oid: l10(sel.ln_oid),
             oi: sel.oi,

@@ -36,6 +36,7 @@ mod exchange;
 pub mod moves;
 mod random;
 pub mod refine;
+pub mod swap;
 pub mod tour;
 pub mod turns;
 

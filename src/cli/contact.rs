@@ -7,8 +7,7 @@
 use activecal::identify::LmSettings;
 use activecal::identify::contact::{
     ContactFit, ContactSettings, HoldoutMode, HoldoutReport, NamedDistance, NamedPlane,
-    fit_contacts,
-    holdout::{Figures, downweighted_rows, judge},
+    holdout::{Figures, downweighted_rows},
     holdout_by_placement, resolve_distances,
 };
 use activecal::io::contacts::{ContactFile, read_contacts};
@@ -161,21 +160,17 @@ pub fn calibrate_contacts(
         loss: super::measured::loss_choice(a.loss, a.loss_scale)?,
         keep: a.free.to_vec(),
     };
-    let fit = fit_contacts(robot, &robot.nominal, &file, &known, &settings)?;
-    let figures = judge(robot, &robot.nominal, &fit, &file, &given);
+    let activecal::experiment::contacts::ContactCalibration {
+        fit,
+        in_sample: figures,
+        downweighted: down,
+        predicted,
+        frames: all_frames,
+        implausible,
+    } = activecal::experiment::contacts::calibrate_contacts(
+        robot, &file, &known, &given, &settings,
+    )?;
     let held = held_out(a, robot, &file, &given, &settings)?;
-    let predicted = activecal::identify::contact::predict::predicted_true_error(
-        &fit,
-        activecal::identify::contact::predict::PREDICTION_CONFIGURATIONS,
-        0,
-    );
-    let down = downweighted_rows(&fit, &file);
-    let all_frames = super::contact_out::frames(&fit, &file, &given)?;
-    // A converged fit that made another robot of this one is not written.
-    let implausible = fit
-        .converged
-        .then(|| implausible(&fit, all_frames.as_ref().map(|(f, _)| f)))
-        .flatten();
     let frames = if a.out.is_empty() { None } else { all_frames };
     let written = match &frames {
         Some(f) if fit.converged && implausible.is_none() => {
@@ -404,18 +399,4 @@ fn holdout_text(h: &HoldoutReport) -> String {
         );
     }
     s
-}
-
-/// Why a contact fit is not a calibration of its robot
-/// ([`activecal::frames::plausible`]): a joint origin moved too far, or
-/// the tool offset beyond the reach.
-fn implausible(
-    fit: &activecal::identify::contact::ContactFit,
-    frames: Option<&activecal::frames::CalibratedFrames>,
-) -> Option<String> {
-    use activecal::identify::plausible::check_offsets;
-    activecal::frames::plausible::implausible(&fit.robot, &fit.table, frames).or_else(|| {
-        let reach = activecal::units::reach(&fit.robot);
-        check_offsets("the tool offset", &[fit.tool_offset], reach)
-    })
 }

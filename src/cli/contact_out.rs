@@ -7,9 +7,8 @@
 //! without `--force`.
 
 use activecal::frames::CalibratedFrames;
-use activecal::frames::contact::contact_frames;
-use activecal::frames::report::{FitBlock, FramesReport};
-use activecal::identify::contact::{ContactFile, ContactFit, NamedDistance, rms, tool_points};
+use activecal::frames::report::FramesReport;
+use activecal::identify::contact::ContactFit;
 use activecal::io::calibrated::{Format, render};
 use activecal::model::Robot;
 use anyhow::{Result, bail};
@@ -35,33 +34,6 @@ pub fn check(out: &[PathBuf], robot: &Robot) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// The fit's own figure for the frames file: the RMS over the rows that
-/// touch a point of the distance of the row's tool point to its fitted
-/// point (mm).
-fn fit_block(fit: &ContactFit, file: &ContactFile) -> FitBlock {
-    let pts = tool_points(&fit.robot, &fit.table, &fit.tool_offset, &file.qs);
-    let d: Vec<f64> = pts
-        .iter()
-        .zip(&file.groups)
-        .filter(|(_, g)| **g < fit.point_positions.len())
-        .map(|(p, &g)| (p - nalgebra::Vector3::from(fit.point_positions[g])).norm())
-        .collect();
-    FitBlock {
-        poses: file.qs.len(),
-        position_rms_mm: 1e3 * rms(&d),
-        orientation_rms_deg: None,
-    }
-}
-
-/// The calibrated frames of a contact fit with their report.
-pub fn frames(
-    fit: &ContactFit,
-    file: &ContactFile,
-    distances: &[NamedDistance],
-) -> Result<Option<(CalibratedFrames, FramesReport)>> {
-    Ok(contact_frames(fit, distances, fit_block(fit, file))?)
 }
 
 /// Writes every `--out` of a converged fit (by extension); returns the

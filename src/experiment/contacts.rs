@@ -1,0 +1,114 @@
+//! Calibration from contacts as one step: the checks of the data against
+//! the robot (distinct configurations, the known distances and planes in
+//! scale), the fit, and what judges it — the in-sample consistency, the rows
+//! a robust loss down-weighted, the tool point's predicted true error, the
+//! calibrated frames (URDF robots) and whether the result is plausible.
+//! The command line and the Python package both call it; held-out
+//! placements are the caller's ([`crate::identify::contact::holdout`]).
+
+use crate::frames::CalibratedFrames;
+use crate::frames::report::{FitBlock, FramesReport};
+use crate::identify::contact::holdout::{DownweightedRow, Figures, downweighted_rows, judge};
+use crate::identify::contact::predict::{PREDICTION_CONFIGURATIONS, PredictedTrueError};
+use crate::identify::contact::{
+    ContactFile, ContactFit, ContactSettings, NamedDistance, fit_contacts, resolve_distances, rms,
+    tool_points,
+};
+use crate::measure::contact::KnownDistance;
+use crate::model::Robot;
+
+/// A contact calibration and its figures.
+#[derive(Clone, Debug)]
+pub struct ContactCalibration {
+    /// The fit.
+    pub fit: ContactFit,
+    /// Consistency of the calibrated and the nominal model on the rows.
+    pub in_sample: Figures,
+    /// Rows a robust loss weighed down.
+    pub downweighted: Vec<DownweightedRow>,
+    /// The tool point's predicted true error (with a covariance).
+    pub predicted: Option<PredictedTrueError>,
+    /// The calibrated frames and their report (URDF robots).
+    pub frames: Option<(CalibratedFrames, FramesReport)>,
+    /// Why a converged fit is not a plausible robot (a joint origin moved
+    /// by more than a tenth of its link, a tool beyond reach); `None` when
+    /// it is.
+    pub implausible: Option<String>,
+}
+
+/// The known distances of `file`'s points (`given` by name) after the
+/// checks a contact fit needs (the library's messages; callers add the
+/// input's name): configurations distinct enough, known planes within
+/// reach, every distance naming two of the file's points, at least one
+/// distance (contacts alone leave the scale free), distances in scale.
+pub fn checked_distances(
+    robot: &Robot,
+    file: &ContactFile,
+    given: &[NamedDistance],
+) -> crate::identify::Result<Vec<KnownDistance>> {
+    file.check_distinct()?;
+    crate::identify::contact::lengths::check_planes(robot, file)?;
+    let known = resolve_distances(file, given, true)?;
+    crate::identify::contact::check_scale(file, &known)?;
+    crate::identify::contact::lengths::check_distances(robot, file, &known)?;
+    Ok(known)
+}
+
+/// Fits `file` with the `known` distances (as [`checked_distances`] gives
+/// them; `given` by name for the frames file) and judges the fit (see the
+/// module documentation).
+pub fn calibrate_contacts(
+    robot: &Robot,
+    file: &ContactFile,
+    known: &[KnownDistance],
+    given: &[NamedDistance],
+    settings: &ContactSettings,
+) -> crate::identify::Result<ContactCalibration> {
+    let fit = fit_contacts(robot, &robot.nominal, file, known, settings)?;
+    let in_sample = judge(robot, &robot.nominal, &fit, file, given);
+    let predicted =
+        crate::identify::contact::predict::predicted_true_error(&fit, PREDICTION_CONFIGURATIONS, 0);
+    let downweighted = downweighted_rows(&fit, file);
+    let frames = crate::frames::contact::contact_frames(&fit, given, fit_block(&fit, file))
+        .map_err(|e| crate::Error::Invalid(e.to_string()))?;
+    let implausible = fit
+        .converged
+        .then(|| implausible(&fit, frames.as_ref().map(|(f, _)| f)))
+        .flatten();
+    Ok(ContactCalibration {
+        fit,
+        in_sample,
+        downweighted,
+        predicted,
+        frames,
+        implausible,
+    })
+}
+
+/// The fit's figures for the frames file: the rows and the RMS distance of
+/// each calibrated tool point to its fitted point.
+#[must_use]
+pub fn fit_block(fit: &ContactFit, file: &ContactFile) -> FitBlock {
+    let pts = tool_points(&fit.robot, &fit.table, &fit.tool_offset, &file.qs);
+    let d: Vec<f64> = pts
+        .iter()
+        .zip(&file.groups)
+        .filter(|(_, g)| **g < fit.point_positions.len())
+        .map(|(p, &g)| (p - nalgebra::Vector3::from(fit.point_positions[g])).norm())
+        .collect();
+    FitBlock {
+        poses: file.qs.len(),
+        position_rms_mm: 1e3 * rms(&d),
+        orientation_rms_deg: None,
+    }
+}
+
+/// Why a converged contact fit is not a plausible robot, if it is not.
+#[must_use]
+pub fn implausible(fit: &ContactFit, frames: Option<&CalibratedFrames>) -> Option<String> {
+    use crate::identify::plausible::check_offsets;
+    crate::frames::plausible::implausible(&fit.robot, &fit.table, frames).or_else(|| {
+        let reach = crate::units::reach(&fit.robot);
+        check_offsets("the tool offset", &[fit.tool_offset], reach)
+    })
+}

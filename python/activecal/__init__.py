@@ -21,6 +21,7 @@ inputs) or ``InternalError`` (a defect: please report it).
 
 from ._activecal import (
     Calibration,
+    ContactCalibration,
     Design,
     ComputationError,
     Error,
@@ -32,6 +33,7 @@ from ._activecal import (
     Robot,
     __version__,
     calibrate,
+    calibrate_contacts,
     evaluate,
     pool,
     select,
@@ -39,6 +41,7 @@ from ._activecal import (
 
 __all__ = [
     "Calibration",
+    "ContactCalibration",
     "Design",
     "ComputationError",
     "Error",
@@ -50,6 +53,7 @@ __all__ = [
     "Robot",
     "__version__",
     "calibrate",
+    "calibrate_contacts",
     "evaluate",
     "pool",
     "select",

@@ -338,3 +338,56 @@ def evaluate(
     file loaded back) or a `Calibration` (its fitted model). q, points and
     orientations as `calibrate` takes them: poses the fit did not see
     judge it."""
+
+class ContactCalibration:
+    """The result of `calibrate_contacts`."""
+
+    @property
+    def converged(self) -> bool: ...
+    @property
+    def estimate(self) -> dict[str, float]:
+        """{parameter: value}, metres and radians: the robot's unknowns, the
+        tool offset and each point's coordinates."""
+    @property
+    def sigma(self) -> Optional[dict[str, float]]:
+        """{parameter: σ}; None without a full-rank Jacobian."""
+    @property
+    def points(self) -> dict[str, Tuple[float, float, float]]:
+        """The fitted points in the base frame, metres."""
+    @property
+    def tool_offset(self) -> Tuple[float, float, float]:
+        """The tool point (ball centre) on the tip link, metres."""
+    @property
+    def predicted_true_error(self) -> Optional[dict[str, Any]]:
+        """The tool point's predicted true error at 1000 random
+        configurations (``rms_mm``, ``configurations``): what held-out
+        placements cannot see."""
+    @property
+    def report(self) -> dict[str, Any]:
+        """The dict ``activecal calibrate --measurements FILE --json``
+        prints for a contact file with the same rows."""
+    def write_urdf(self, path: _Path, overwrite: bool = False) -> None:
+        """The calibrated URDF (refused unless converged and plausible)."""
+    def write_frames(self, path: _Path, overwrite: bool = False) -> None:
+        """The frames file: the ball centre as ``point``, the fitted points
+        under ``contacts``."""
+
+def calibrate_contacts(
+    robot: Robot,
+    q: npt.ArrayLike,
+    points: Sequence[str],
+    distances: Union[Mapping[Tuple[str, str], float], Sequence[Tuple[str, str, float]]],
+    free: Optional[Sequence[str]] = None,
+    max_iterations: int = 200,
+    loss: str = "l2",
+    loss_scale: Optional[float] = None,
+    progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
+) -> ContactCalibration:
+    """Calibrates the robot from contacts, as ``activecal calibrate
+    --measurements FILE --point-distance A,B=M`` does with a contact file of
+    the same rows. q: (n, dof) joint values at which the tool point (the
+    chain's tip, a ball centre) touched a fixed point; points: the name of
+    the point each row touched; distances: lengths known between points,
+    metres (at least one: contacts alone leave the scale free). free:
+    parameters never fixed; loss, loss_scale, max_iterations and progress
+    as `calibrate` takes them."""

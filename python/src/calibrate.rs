@@ -165,6 +165,41 @@ fn holdout_of(
         .transpose()
 }
 
+/// The `loss` and `loss_scale` arguments, checked.
+pub(crate) fn loss_of(loss: &str, loss_scale: Option<f64>) -> PyResult<LossChoice> {
+    let scale = |s: Option<f64>| match s {
+        Some(s) if s.is_finite() && s > 0.0 => Ok(s),
+        Some(s) => Err(arg_err(
+            "loss_scale",
+            format!("{s}: must be a finite number > 0 (metres)"),
+        )),
+        None => Err(arg_err(
+            "loss_scale",
+            format!(
+                "loss=\"{loss}\" needs loss_scale (metres: the residual norm of one pose where the loss turns robust, e.g. 3 times the sensor noise)"
+            ),
+        )),
+    };
+    Ok(match loss {
+        "l2" if loss_scale.is_some() => {
+            return Err(arg_err("loss_scale", "is for loss=\"huber\" or \"cauchy\""));
+        }
+        "l2" => LossChoice::L2,
+        "huber" => LossChoice::Huber {
+            scale: scale(loss_scale)?,
+        },
+        "cauchy" => LossChoice::Cauchy {
+            scale: scale(loss_scale)?,
+        },
+        other => {
+            return Err(arg_err(
+                "loss",
+                format!("unknown loss '{other}': \"l2\", \"huber\" or \"cauchy\""),
+            ));
+        }
+    })
+}
+
 /// Names given to a wrapper as an iterable of str.
 fn names(v: Option<Vec<String>>) -> Vec<String> {
     v.unwrap_or_default()
@@ -218,37 +253,7 @@ pub fn calibrate(
     let holdout = holdout_of(holdout, splits, seed, weights)?;
     let d = data(py, robot, q, points, orientations)?;
     let max_iterations = count("max_iterations", max_iterations, 1)?;
-    let scale = |s: Option<f64>| match s {
-        Some(s) if s.is_finite() && s > 0.0 => Ok(s),
-        Some(s) => Err(arg_err(
-            "loss_scale",
-            format!("{s}: must be a finite number > 0 (metres)"),
-        )),
-        None => Err(arg_err(
-            "loss_scale",
-            format!(
-                "loss=\"{loss}\" needs loss_scale (metres: the residual norm of one pose where the loss turns robust, e.g. 3 times the sensor noise)"
-            ),
-        )),
-    };
-    let loss = match loss {
-        "l2" if loss_scale.is_some() => {
-            return Err(arg_err("loss_scale", "is for loss=\"huber\" or \"cauchy\""));
-        }
-        "l2" => LossChoice::L2,
-        "huber" => LossChoice::Huber {
-            scale: scale(loss_scale)?,
-        },
-        "cauchy" => LossChoice::Cauchy {
-            scale: scale(loss_scale)?,
-        },
-        other => {
-            return Err(arg_err(
-                "loss",
-                format!("unknown loss '{other}': \"l2\", \"huber\" or \"cauchy\""),
-            ));
-        }
-    };
+    let loss = loss_of(loss, loss_scale)?;
     let settings = MeasuredSettings {
         lm: LmSettings::default()
             .with_max_iterations(max_iterations)

@@ -7,6 +7,7 @@
 use pyo3::prelude::*;
 
 mod calibrate;
+mod contacts;
 mod convert;
 mod pool;
 mod progress;
@@ -68,5 +69,7 @@ fn _activecal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(select::select, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate::evaluate, m)?)?;
+    m.add_class::<contacts::ContactCalibration>()?;
+    m.add_function(wrap_pyfunction!(contacts::calibrate_contacts, m)?)?;
     Ok(())
 }

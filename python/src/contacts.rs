@@ -1,0 +1,284 @@
+//! `activecal.calibrate_contacts`: calibration from configurations at which
+//! the tool touched named points (sockets), with distances known between
+//! some of them, as `activecal calibrate --measurements FILE` does for a
+//! contact file; and the `ContactCalibration` it returns.
+
+use crate::convert::{Fail, arg_err, count, detached, float_array, json_to_py, rows};
+use crate::robot::Robot;
+use activecal::experiment::contacts::{
+    ContactCalibration as Calibrated, calibrate_contacts as fit,
+};
+use activecal::identify::LmSettings;
+use activecal::identify::contact::{ContactFile, ContactSettings, NamedDistance};
+use activecal::io::calibrated::Format;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::sync::Arc;
+
+/// A calibration from contacts: the estimate with its σ, the fitted points
+/// and tool offset, the figures that judge it, and the calibrated robot to
+/// write.
+#[pyclass(module = "activecal", name = "ContactCalibration", frozen)]
+pub struct ContactCalibration {
+    robot: Arc<activecal::model::Robot>,
+    c: Calibrated,
+    report: serde_json::Value,
+}
+
+/// The distances argument: a dict {(a, b): metres} or pairs (a, b, metres).
+fn distances_of(d: &Bound<'_, PyAny>) -> PyResult<Vec<NamedDistance>> {
+    let bad = || {
+        arg_err(
+            "distances",
+            "a dict {(a, b): metres} or a list of (a, b, metres): point names and a length in metres",
+        )
+    };
+    let items: Vec<(String, String, f64)> = if let Ok(m) = d.cast::<PyDict>() {
+        m.iter()
+            .map(|(k, v)| {
+                let (a, b): (String, String) = k.extract().map_err(|_| bad())?;
+                Ok((a, b, v.extract().map_err(|_| bad())?))
+            })
+            .collect::<PyResult<_>>()?
+    } else {
+        d.extract().map_err(|_| bad())?
+    };
+    Ok(items
+        .into_iter()
+        .map(|(a, b, metres)| NamedDistance { a, b, metres })
+        .collect())
+}
+
+/// The rows as a contact file: each configuration of `q` and the point it
+/// touches, the points in order of first appearance.
+fn contact_file(qs: Vec<Vec<f64>>, touched: Vec<String>) -> ContactFile {
+    let mut points: Vec<String> = Vec::new();
+    let groups = touched
+        .iter()
+        .map(|n| {
+            points.iter().position(|p| p == n).unwrap_or_else(|| {
+                points.push(n.clone());
+                points.len() - 1
+            })
+        })
+        .collect();
+    ContactFile {
+        origin: "the arrays given".into(),
+        lines: (1..=qs.len()).collect(),
+        qs,
+        groups,
+        points,
+        planes: Vec::new(),
+    }
+}
+
+/// Calibrates the robot from contacts, as `activecal calibrate
+/// --measurements FILE --point-distance A,B=M --json` does with a contact
+/// file holding the same rows.
+///
+/// q: (n, dof) joint values (radians or metres) at which the tool point
+/// (the chain's tip, a ball centre) touched a fixed point. points: n point
+/// names, the one each row touched (a socket; "placement/k" names group
+/// sockets of one block for held-out figures). distances: the lengths known
+/// between points (metres), a dict {(a, b): m} or a list of (a, b, m); at
+/// least one, since contacts alone leave the scale free. free: parameters
+/// never fixed. max_iterations, loss and loss_scale as `calibrate` takes
+/// them; progress too.
+#[pyfunction]
+#[pyo3(signature = (robot, q, points, distances, free=None, max_iterations=200, loss="l2", loss_scale=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn calibrate_contacts(
+    py: Python<'_>,
+    robot: &Robot,
+    q: &Bound<'_, PyAny>,
+    points: Vec<String>,
+    distances: &Bound<'_, PyAny>,
+    free: Option<Vec<String>>,
+    max_iterations: i64,
+    loss: &str,
+    loss_scale: Option<f64>,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<ContactCalibration> {
+    let inner = robot.inner.clone();
+    let dof = inner.dof();
+    let (v, shape) = float_array(
+        py,
+        q,
+        "q",
+        &[None, Some(dof)],
+        "one row of joint values per contact, radians or metres",
+    )?;
+    if points.len() != shape[0] {
+        return Err(arg_err(
+            "points",
+            format!(
+                "{} names for {} rows of q: one point name per row",
+                points.len(),
+                shape[0]
+            ),
+        ));
+    }
+    let mut qs = rows(&v, dof);
+    robot.check_joint_values("q", &mut qs)?;
+    let given = distances_of(distances)?;
+    let settings = ContactSettings {
+        lm: LmSettings::default()
+            .with_max_iterations(count("max_iterations", max_iterations, 1)?)
+            .with_geodesic(true),
+        loss: crate::calibrate::loss_of(loss, loss_scale)?,
+        keep: free.unwrap_or_default(),
+    };
+    let file = contact_file(qs, points);
+    file.check_distinct().map_err(|e| arg_err("q", e))?;
+    let known = activecal::experiment::contacts::checked_distances(&inner, &file, &given)
+        .map_err(|e| arg_err("distances", e))?;
+    let r = inner.clone();
+    let (c, report) = crate::progress::with_callback(progress, || {
+        detached(py, move || {
+            let c = fit(&r, &file, &known, &given, &settings).map_err(Fail::input)?;
+            let report = serde_json::json!({
+                "robot": r.name,
+                "measurements": file.origin,
+                "rows": file.qs.len(),
+                "fit": c.fit,
+                "downweighted": c.downweighted,
+                "in_sample": c.in_sample,
+                "holdout": null,
+                "predicted_true_error": c.predicted,
+                "frames": c.frames.as_ref().map(|(_, f)| f),
+                "out": [],
+                "exit_status": if c.fit.converged && c.implausible.is_none() { 0 } else { 3 },
+            });
+            Ok((c, report))
+        })
+    })?;
+    Ok(ContactCalibration {
+        robot: inner,
+        c,
+        report,
+    })
+}
+
+impl ContactCalibration {
+    /// Writes the calibrated robot as `format`, refused when the fit did
+    /// not converge or is not a plausible robot.
+    fn write_as(&self, format: Format, path: &std::path::Path, overwrite: bool) -> PyResult<()> {
+        let fit = &self.c.fit;
+        if !fit.converged {
+            return Err(Fail::Compute(format!(
+                "{}: not written: the contact fit ended {:?} after {} iterations",
+                path.display(),
+                fit.stop,
+                fit.iterations
+            ))
+            .into_py());
+        }
+        if let Some(why) = &self.c.implausible {
+            return Err(Fail::Compute(format!("{}: not written: {why}", path.display())).into_py());
+        }
+        let Some((f, r)) = &self.c.frames else {
+            return Err(arg_err(
+                "path",
+                format!(
+                    "{}: robot '{}' was not imported from a URDF: there is no URDF or frames file to write",
+                    path.display(),
+                    self.robot.name
+                ),
+            ));
+        };
+        let text =
+            activecal::io::calibrated::render(format, &fit.robot, &fit.table, Some((f, r)), "")
+                .map_err(|e| arg_err("path", format!("{}: {e}", path.display())))?;
+        let out = [activecal::io::atomic::Output {
+            label: "path",
+            path,
+        }];
+        activecal::io::atomic::check_outputs(&out, &[], overwrite)
+            .map_err(|e| Fail::from(e).into_py())?;
+        activecal::io::atomic::write_atomic(path, text.as_bytes())
+            .map_err(|e| Fail::from(e).into_py())
+    }
+}
+
+#[pymethods]
+impl ContactCalibration {
+    /// Whether the fit converged.
+    #[getter]
+    fn converged(&self) -> bool {
+        self.c.fit.converged
+    }
+
+    /// The estimate: {parameter name: value}, metres and radians (the
+    /// robot's unknowns, the tool offset and each point's coordinates).
+    #[getter]
+    fn estimate(&self) -> std::collections::BTreeMap<String, f64> {
+        let f = &self.c.fit;
+        f.names
+            .iter()
+            .cloned()
+            .zip(f.estimate.iter().copied())
+            .collect()
+    }
+
+    /// Standard deviations of the estimate {name: σ}; None without a
+    /// full-rank Jacobian.
+    #[getter]
+    fn sigma(&self) -> Option<std::collections::BTreeMap<String, f64>> {
+        let f = &self.c.fit;
+        f.std
+            .as_ref()
+            .map(|s| f.names.iter().cloned().zip(s.iter().copied()).collect())
+    }
+
+    /// The fitted points {name: (x, y, z)} in the base frame, metres.
+    #[getter]
+    fn points(&self) -> std::collections::BTreeMap<String, [f64; 3]> {
+        let f = &self.c.fit;
+        f.points
+            .iter()
+            .cloned()
+            .zip(f.point_positions.iter().copied())
+            .collect()
+    }
+
+    /// The tool point (ball centre) on the tip link, metres.
+    #[getter]
+    fn tool_offset(&self) -> [f64; 3] {
+        self.c.fit.tool_offset
+    }
+
+    /// The tool point's predicted true error at 1000 random configurations
+    /// (`rms_mm`, `configurations`): what held-out placements cannot see.
+    #[getter]
+    fn predicted_true_error<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.report["predicted_true_error"])
+    }
+
+    /// The whole report: the dict `activecal calibrate --measurements FILE
+    /// --json` prints for a contact file with the same rows.
+    #[getter]
+    fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.report)
+    }
+
+    /// Writes the calibrated robot as URDF (URDF robots; refused when the
+    /// fit did not converge or is implausible).
+    #[pyo3(signature = (path, overwrite=false))]
+    fn write_urdf(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
+        self.write_as(Format::Urdf, &path, overwrite)
+    }
+
+    /// Writes the frames file (YAML) with the ball centre as `point` and
+    /// the fitted points under `contacts`.
+    #[pyo3(signature = (path, overwrite=false))]
+    fn write_frames(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
+        self.write_as(Format::Yaml, &path, overwrite)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "ContactCalibration({:?}, {} rows, converged={})",
+            self.robot.name, self.report["rows"], self.c.fit.converged
+        )
+    }
+}

@@ -212,6 +212,22 @@ pub fn first_unmatched(expected: &[String], output: &str) -> Option<(usize, usiz
     None
 }
 
+/// The relative links of a page (`](path)` or `](path#anchor)`) whose
+/// file does not exist, from the page's directory.
+fn broken_links(page: &Path, text: &str) -> Vec<String> {
+    let dir = page.parent().expect("a page is in a directory");
+    text.split("](")
+        .skip(1)
+        .filter_map(|rest| rest.split(')').next())
+        .filter(|t| !t.starts_with("http") && !t.starts_with('#') && !t.contains(' '))
+        .filter(|t| {
+            let file = t.split('#').next().unwrap_or(t);
+            !dir.join(file).exists()
+        })
+        .map(str::to_string)
+        .collect()
+}
+
 /// The pages whose examples run: the README and every chapter of `docs/`.
 fn pages(root: &Path) -> Vec<PathBuf> {
     let mut docs: Vec<PathBuf> = std::fs::read_dir(root.join("docs"))
@@ -291,6 +307,9 @@ fn every_shell_example_in_the_readme_and_docs_runs_and_prints_what_it_says() {
     let start = Instant::now();
     for page in pages(root) {
         let text = std::fs::read_to_string(&page).expect("the page is readable");
+        for link in broken_links(&page, &text) {
+            failures.push(format!("{}: the link {link} leads nowhere", page.display()));
+        }
         let page = page.strip_prefix(root).unwrap_or(&page).to_path_buf();
         let parsed = parse_page(&text);
         for line in parsed.unexplained {

@@ -259,7 +259,14 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         reorder,
         &turns,
     )?;
-    super::tour::check_moves(&mut report, &mut order, &ctx.pool, home.as_deref(), &turns)?;
+    super::tour::check_moves(
+        &mut report,
+        &mut order,
+        &ctx.pool,
+        home.as_deref(),
+        &turns,
+        !reorder,
+    )?;
     if !a.out.is_empty() {
         let design = design_file(
             &ctx,

@@ -61,6 +61,10 @@ pub struct CurveSettings {
     pub also: Vec<usize>,
     /// Most sizes on the curve (evenly spaced beyond this, ends kept).
     pub max_points: usize,
+    /// The position error (RMS, mm) the user wants to reach: the curve
+    /// then recommends the smallest size predicted to reach it, else its
+    /// knee ([`recommend`]).
+    pub target_mm: Option<f64>,
 }
 
 impl CurveSettings {
@@ -78,6 +82,7 @@ impl CurveSettings {
             seed: 0,
             also: Vec::new(),
             max_points: 20,
+            target_mm: None,
         }
     }
 }
@@ -136,6 +141,106 @@ pub struct PoseCountCurve {
     pub points: Vec<CurvePoint>,
     /// Sizes where no identifying design was found, with why.
     pub skipped: Vec<(usize, String)>,
+    /// The largest step between consecutive sizes from `n_min` to
+    /// `3·n_min` (1: every size; more when the range was thinned).
+    pub step: usize,
+    /// The size the curve recommends, and by which rule.
+    pub recommended: Option<Recommendation>,
+}
+
+/// More poses, in percent (at least one pose), that the knee looks ahead
+/// by.
+pub const KNEE_MORE_PERCENT: usize = 10;
+
+/// The predicted error's relative gain under which more poses are not
+/// worth measuring (at the knee).
+pub const KNEE_GAIN: f64 = 0.05;
+
+/// The design size a curve recommends, and why.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+#[serde(tag = "rule", rename_all = "snake_case")]
+pub enum Recommendation {
+    /// The smallest size whose predicted position RMS reaches the target.
+    Target {
+        /// The size.
+        n: usize,
+        /// The target, mm.
+        target_mm: f64,
+        /// Its predicted position RMS, mm.
+        predicted_mm: f64,
+    },
+    /// No size of the curve reaches the target: the one that comes
+    /// closest.
+    TargetNotReached {
+        /// The size that comes closest.
+        n: usize,
+        /// The target, mm.
+        target_mm: f64,
+        /// Its predicted position RMS, mm.
+        predicted_mm: f64,
+    },
+    /// The knee: the smallest size where [`KNEE_MORE_PERCENT`] more poses gain
+    /// less than [`KNEE_GAIN`] of the predicted position RMS.
+    Knee {
+        /// The size.
+        n: usize,
+        /// The size it is compared with (at least 10 % more poses).
+        next_n: usize,
+        /// Its predicted position RMS, mm.
+        predicted_mm: f64,
+        /// The relative gain of `next_n` over `n` (below [`KNEE_GAIN`]).
+        gain: f64,
+    },
+    /// The curve still gains at its end: its largest size, with the gain
+    /// of its last step.
+    NoKnee {
+        /// The largest size.
+        n: usize,
+        /// Its predicted position RMS, mm.
+        predicted_mm: f64,
+    },
+}
+
+impl Recommendation {
+    /// The recommended size.
+    #[must_use]
+    pub fn n(&self) -> usize {
+        match self {
+            Self::Target { n, .. }
+            | Self::TargetNotReached { n, .. }
+            | Self::Knee { n, .. }
+            | Self::NoKnee { n, .. } => *n,
+        }
+    }
+}
+
+/// The size `points` (increasing `n`) recommend: with a target (mm), the
+/// smallest whose predicted position RMS reaches it (or the closest when
+/// none does); without, the knee — the smallest `n` such that the first
+/// size with at least [`KNEE_MORE_PERCENT`] more poses is predicted better by less
+/// than [`KNEE_GAIN`]. `None` for an empty curve.
+#[must_use]
+pub fn recommend(points: &[CurvePoint], target_mm: Option<f64>) -> Option<Recommendation> {
+    let rms = |p: &CurvePoint| p.predicted.position_rms_mm;
+    if let Some(target_mm) = target_mm {
+        if let Some(p) = points.iter().find(|p| rms(p) <= target_mm) {
+            return Some(Recommendation::Target { n: p.n, target_mm, predicted_mm: rms(p) });
+        }
+        let p = points.iter().min_by(|a, b| rms(a).total_cmp(&rms(b)))?;
+        return Some(Recommendation::TargetNotReached { n: p.n, target_mm, predicted_mm: rms(p) });
+    }
+    for (i, p) in points.iter().enumerate() {
+        let want = p.n + (p.n * KNEE_MORE_PERCENT).div_ceil(100).max(1);
+        let Some(q) = points[i + 1..].iter().find(|q| q.n >= want) else {
+            break;
+        };
+        let gain = 1.0 - rms(q) / rms(p);
+        if gain < KNEE_GAIN {
+            return Some(Recommendation::Knee { n: p.n, next_n: q.n, predicted_mm: rms(p), gain });
+        }
+    }
+    let last = points.last()?;
+    Some(Recommendation::NoKnee { n: last.n, predicted_mm: rms(last) })
 }
 
 /// The sizes of the curve: `n_min..=3·n_min` (evenly thinned to at most
@@ -153,6 +258,13 @@ pub fn curve_sizes(n_min: usize, also: &[usize], max_points: usize, pool: usize)
     v.sort_unstable();
     v.dedup();
     v
+}
+
+/// The largest step between consecutive `sizes` within `n_min..=3·n_min`
+/// (1 when there is at most one).
+fn sizes_step(sizes: &[usize], n_min: usize) -> usize {
+    let range: Vec<usize> = sizes.iter().copied().filter(|&n| n >= n_min && n <= 3 * n_min).collect();
+    range.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(1)
 }
 
 /// `configurations` joint vectors drawn uniformly within the robot's joint
@@ -262,9 +374,17 @@ pub fn pose_count_curve(
     let n_min = if prior.is_some() { 1 } else { p.div_ceil(t) };
     let qs = random_configurations(robot, settings.configurations, settings.seed);
     let eval = jacobian_of(robot, table, qs.len(), |k, q| q.copy_from_slice(&qs[k]));
+    if let Some(t) = settings.target_mm
+        && !(t.is_finite() && t > 0.0)
+    {
+        return Err(crate::Error::Invalid(format!(
+            "target error {t}: the position error to reach must be a finite number > 0 (mm)"
+        ))
+        .into());
+    }
     let sizes = curve_sizes(n_min, &settings.also, settings.max_points, x.n_poses());
     let (mut points, mut skipped) = (Vec::new(), Vec::new());
-    for n in sizes {
+    for &n in &sizes {
         if n < settings.select.fixed.len() {
             skipped.push((n, "fewer poses than the fixed ones".into()));
             continue;
@@ -314,6 +434,8 @@ pub fn pose_count_curve(
             poses: sel.poses.iter().map(|&k| ids[k]).collect(),
         });
     }
+    let step = sizes_step(&sizes, n_min);
+    let recommended = recommend(&points, settings.target_mm);
     Ok(PoseCountCurve {
         p,
         rows_per_pose: t,
@@ -323,6 +445,8 @@ pub fn pose_count_curve(
         seed: settings.seed,
         points,
         skipped,
+        step,
+        recommended,
     })
 }
 
@@ -342,6 +466,57 @@ mod tests {
         assert_eq!(v.len(), 5);
         // Never above the pool.
         assert_eq!(curve_sizes(4, &[100], 20, 10), vec![4, 5, 6, 7, 8, 9, 10]);
+    }
+
+    /// A curve point of size `n` predicting `rms` mm.
+    fn point(n: usize, rms: f64) -> CurvePoint {
+        CurvePoint {
+            n,
+            ln_oid: 0.0,
+            ln_bound: 0.0,
+            d_efficiency: 1.0,
+            predicted: PredictedErrors {
+                position_rms_mm: rms,
+                position_p95_mm: rms,
+                orientation_rms_deg: None,
+                orientation_p95_deg: None,
+            },
+            poses: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn the_curve_recommends_the_target_s_smallest_size_or_its_knee() {
+        // 1/√N-like, then flat from N = 14 on.
+        let pts: Vec<CurvePoint> = [(10, 0.20), (11, 0.18), (12, 0.165), (13, 0.155), (14, 0.150), (15, 0.149), (16, 0.148), (17, 0.147)]
+            .iter()
+            .map(|&(n, r)| point(n, r))
+            .collect();
+        // Knee: 12 → 14 (≥ 10 % more) gains 9 %; 13 → 15 gains 3.9 %.
+        match recommend(&pts, None).unwrap() {
+            Recommendation::Knee { n, next_n, gain, .. } => {
+                assert_eq!((n, next_n), (13, 15));
+                assert!((gain - (1.0 - 0.149 / 0.155)).abs() < 1e-12);
+            }
+            r => panic!("{r:?}"),
+        }
+        assert_eq!(recommend(&pts, Some(0.16)).unwrap().n(), 13);
+        assert_eq!(recommend(&pts, Some(0.2)).unwrap().n(), 10);
+        assert!(matches!(
+            recommend(&pts, Some(0.1)).unwrap(),
+            Recommendation::TargetNotReached { n: 17, .. }
+        ));
+        // Still steep at the end: no knee, the largest size.
+        let steep: Vec<CurvePoint> = (10..=20).map(|n| point(n, 100.0 / (n * n) as f64)).collect();
+        assert!(matches!(recommend(&steep, None).unwrap(), Recommendation::NoKnee { n: 20, .. }));
+        assert!(recommend(&[], None).is_none());
+    }
+
+    #[test]
+    fn the_step_is_that_of_the_thinned_range() {
+        assert_eq!(sizes_step(&curve_sizes(9, &[30], 20, 15_625), 9), 1);
+        assert_eq!(sizes_step(&curve_sizes(20, &[], 5, 15_625), 20), 10);
+        assert_eq!(sizes_step(&curve_sizes(20, &[], 20, 15_625), 20), 3);
     }
 
     #[test]

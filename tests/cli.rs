@@ -354,3 +354,73 @@ fn bound_status_is_lowercase_everywhere() {
     ]);
     assert_eq!(s["bound_status"], "certified");
 }
+
+/// A tracker 3 m away and turned 100°: the nominal line first says what
+/// the robot's own geometry is off by (the nominal geometry in the best
+/// rigid placement of the measurement frame, millimetres), then the
+/// as-given figure (metres off); `--json` keeps `nominal_residuals` as
+/// given and adds `nominal_placed_position_rms_mm`.
+#[test]
+fn a_far_tracker_s_nominal_line_leads_with_the_best_rigid_placement() {
+    let dir = std::env::temp_dir().join(format!("activecal-far-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let (design, near, far) = (dir.join("d.json"), dir.join("near.json"), dir.join("far.json"));
+    let robot = [
+        "--robot",
+        "fixtures/example-robot-data/ur5_robot.urdf",
+        "--tip",
+        "tool0",
+        "--marker",
+        "tool0@0.03,-0.02,0.1",
+    ];
+    // The command first, then the robot, then the command's options.
+    fn with<'a>(robot: &[&'a str], cmd: &[&'a str]) -> Vec<&'a str> {
+        cmd[..1].iter().chain(robot).chain(&cmd[1..]).copied().collect()
+    }
+    let sel = ["select", "--pool", "sobol", "--count", "256", "--n", "30", "--out", design.to_str().unwrap()];
+    assert!(run(&with(&robot, &sel)).status.success());
+    let sim = [
+        "calibrate",
+        "--design",
+        design.to_str().unwrap(),
+        "--noise",
+        "5e-5",
+        "--validation",
+        "100",
+        "--save-measurements",
+        near.to_str().unwrap(),
+    ];
+    assert!(run(&with(&robot, &sim)).status.success());
+    let mut m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&near).unwrap()).unwrap();
+    // 100° about z, then 3 m away.
+    let (c, s) = (100f64.to_radians().cos(), 100f64.to_radians().sin());
+    for p in m["points"].as_array_mut().unwrap() {
+        let v: Vec<f64> = p.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        *p = serde_json::json!([c * v[0] - s * v[1] + 2.0, s * v[0] + c * v[1] - 2.2, v[2] + 0.3]);
+    }
+    std::fs::write(&far, m.to_string()).unwrap();
+    let cal = ["calibrate", "--measurements", far.to_str().unwrap()];
+    let v = json_of(&with(&robot, &[&cal[..], &["--json"]].concat()));
+    let placed = v["nominal_placed_position_rms_mm"].as_f64().unwrap();
+    let given = v["nominal_residuals"]["position_rms_mm"].as_f64().unwrap();
+    // The simulated robot is a few mm off its URDF (12.8 mm RMS at the
+    // tour's poses); as given, the points are metres away.
+    assert!(placed > 1.0 && placed < 30.0, "{placed}");
+    assert!(given > 1000.0, "{given}");
+    let out = run(&with(&robot, &cal));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let first = text
+        .find("nominal geometry, best rigid placement of the measurement frame: position RMS")
+        .unwrap_or_else(|| panic!("{text}"));
+    let second = text
+        .find("nominal as given (the measurement frame at the base): position RMS")
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(first < second, "{text}");
+    // Data near the nominal model keep the one nominal line.
+    let out = run(&with(&robot, &["calibrate", "--measurements", near.to_str().unwrap()]));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("\nnominal: position RMS") && !text.contains("best rigid placement"), "{text}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

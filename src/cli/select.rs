@@ -116,6 +116,12 @@ pub struct SelectArgs {
     /// tour. An existing non-empty directory needs --force.
     #[arg(long, value_name = "DIR")]
     pub report: Option<PathBuf>,
+    /// With --report: the position error you want to reach, mm (RMS at
+    /// random configurations); the curve then recommends the smallest N
+    /// predicted to reach it. Without it, the curve's knee: the smallest N
+    /// where 10 % more poses gain less than 5 %.
+    #[arg(long, value_name = "MM", requires = "report", allow_negative_numbers = true)]
+    pub target_error: Option<f64>,
     /// Sensor noise σ per measured coordinate, metres: the error predicted
     /// after calibrating with the chosen poses is printed (and in --json,
     /// `predicted`), and --report's curve uses it [default there: 0.01, as
@@ -283,11 +289,14 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     if let (Some(noise), None) = (a.noise, &existing) {
         report.predicted = predicted_after(&ctx, a.pool.params, &sel.poses, noise);
     }
-    if let Some(dir) = &a.report {
-        report_dir(&a, &ctx, &s, dir, &report)?;
-    }
+    let recommended = match &a.report {
+        Some(dir) => report_dir(&a, &ctx, &s, dir, &report)?,
+        None => None,
+    };
     emit_report(a.json, &report, || {
-        select_text(&a, &ctx, &report, seconds) + &predicted_text(report.predicted.as_ref())
+        select_text(&a, &ctx, &report, seconds)
+            + &predicted_text(report.predicted.as_ref())
+            + &recommended.map_or(String::new(), |r| super::report_dir::recommendation_text(&r))
     })
 }
 
@@ -485,19 +494,21 @@ fn design_file(
     Ok(d)
 }
 
-/// `--report DIR`: the "how many poses" curve and the selection's figures.
+/// `--report DIR`: the "how many poses" curve and the selection's figures;
+/// returns the size the curve recommends.
 fn report_dir(
     a: &SelectArgs,
     ctx: &super::PoolCtx,
     s: &Settings,
     dir: &std::path::Path,
     report: &SelectReport,
-) -> Result<()> {
+) -> Result<Option<activecal::how_many::Recommendation>> {
     let mut cs =
         activecal::how_many::CurveSettings::new(s.clone(), a.noise.unwrap_or(DEFAULT_REPORT_NOISE));
     cs.criterion = a.criterion;
     cs.algorithm = a.algorithm;
     cs.also = vec![a.n];
+    cs.target_mm = a.target_error;
     let curve = activecal::how_many::pose_count_curve(
         &ctx.robot,
         ctx.robot.params(a.pool.params),
@@ -505,7 +516,8 @@ fn report_dir(
         &ctx.pool.ids,
         &cs,
     )?;
-    super::report_dir::selection(dir, &ctx.robot, report, &curve, a.noise.is_none())
+    super::report_dir::selection(dir, &ctx.robot, report, &curve, a.noise.is_none())?;
+    Ok(curve.recommended)
 }
 
 /// The text report of `select`.

@@ -424,3 +424,46 @@ fn a_far_tracker_s_nominal_line_leads_with_the_best_rigid_placement() {
     assert!(text.contains("\nnominal: position RMS") && !text.contains("best rigid placement"), "{text}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Hints name what the user gave: a URDF on the command line gets `--tip`,
+/// a description file its `tip = "…"` key (and the error no longer tells a
+/// command-line user about descriptions); a missing package mesh names
+/// the directory `--package-dir` should point to.
+#[test]
+fn hints_name_the_option_the_user_actually_used() {
+    let stderr = |args: &[&str]| {
+        let out = run(args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let e = stderr(&["select", "--robot", "fixtures/figaroh/tiago.urdf", "--n", "10"]);
+    assert!(e.contains("hint: --tip LINK names the chain's tip"), "{e}");
+    assert!(!e.contains("description"), "{e}");
+    let dir = std::env::temp_dir().join(format!("activecal-hints-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let toml = dir.join("setup.toml");
+    let urdf = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/figaroh/tiago.urdf");
+    std::fs::write(&toml, format!("urdf = {:?}\n", urdf.to_str().unwrap())).unwrap();
+    let e = stderr(&["robots", "--robot", toml.to_str().unwrap()]);
+    assert!(e.contains("hint: tip = \"LINK\" in the description names the chain's tip"), "{e}");
+    assert!(!e.contains("--tip"), "{e}");
+    let e = stderr(&[
+        "select",
+        "--robot",
+        "fixtures/figaroh/tiago.urdf",
+        "--tip",
+        "arm_tool_link",
+        "--self-collision",
+        "--pool",
+        "sobol",
+        "--count",
+        "64",
+        "--n",
+        "10",
+    ]);
+    assert!(
+        e.contains("hint: --package-dir DIR names a package directory (repeatable): the directory that holds tiago_description/ (or tiago_description itself)"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

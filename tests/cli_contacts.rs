@@ -146,6 +146,17 @@ fn select_for_a_socket() {
     );
     assert!(predicted < median, "{predicted} vs {median}");
     assert!((v["ratio_to_random"].as_f64().unwrap() - median / predicted).abs() < 1e-12);
+    // The criterion: the tool point's predicted true error, judged the same
+    // way (the exchanges lower it from the D-optimal choice's).
+    let t = &v["true_error"];
+    let (tp, td) = (
+        t["predicted_sigma"].as_f64().unwrap(),
+        t["d_optimal_sigma"].as_f64().unwrap(),
+    );
+    let tb = t["bound"]["certified_sigma"].as_f64().unwrap();
+    assert!(tb > 0.0 && tb <= tp + 1e-9 && tp <= td + 1e-12, "{t}");
+    assert!(tp < t["random"]["median_sigma"].as_f64().unwrap(), "{t}");
+    assert_eq!(v["known_distances"], 0);
     let robot = activecal::io::load_robot(&format!("{URDF}#tip=ball_link")).unwrap();
     let file = activecal::io::contacts::read_contacts(&csv, &robot, Default::default()).unwrap();
     assert_eq!(file.qs.len(), 30);
@@ -469,4 +480,51 @@ fn select_for_a_socket_through_the_collision_filters() {
     ]);
     assert_eq!(again["pool_stats"]["kept"], 20, "{}", again["pool_stats"]);
     let _ = std::fs::remove_dir_all(dir);
+}
+
+/// `select --point A --point B --point-distance A,B=0.05`: the known
+/// distance fixes the scale contacts alone leave free, so the design counts
+/// one more robot unknown (20 where it counted 19: issue #39), and a
+/// distance naming no `--point` is refused, naming the points.
+#[test]
+fn select_for_two_sockets_counts_their_known_distance() {
+    let b = "front_left/1=0.53379650178936034,0.2299961560616272,0.02337560921181476";
+    let base = [
+        "select",
+        "--robot",
+        URDF,
+        "--tip",
+        "ball_link",
+        "--point",
+        FRONT_LEFT_0,
+        "--point",
+        b,
+        "--n",
+        "30",
+        "--count",
+        "150",
+        "--json",
+    ];
+    let without = json_of(&base);
+    let mut args = base.to_vec();
+    args.extend(["--point-distance", "front_left/0,front_left/1=0.05"]);
+    let with = json_of(&args);
+    assert_eq!(with["known_distances"], 1);
+    assert_eq!(
+        with["robot_unknowns"].as_u64().unwrap(),
+        without["robot_unknowns"].as_u64().unwrap() + 1,
+        "{} vs {}",
+        with["robot_unknowns"],
+        without["robot_unknowns"]
+    );
+    let mut args = base.to_vec();
+    args.extend(["--point-distance", "front_left/0,back/1=0.05"]);
+    let out = common::run(&args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("--point-distance front_left/0,back/1=0.05")
+            && err.contains("no --point is named 'back/1'"),
+        "{err}"
+    );
 }

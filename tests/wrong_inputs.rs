@@ -985,3 +985,61 @@ fn no_abort_under_a_memory_limit_whatever_the_threads() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A frame coordinate no estimated unknown moves is said to be fixed, never
+/// given σ 0 (issue #39, item 7). On FIGAROH's UR10 full poses the
+/// measurement frame absorbs the first joint's whole origin: in the frames
+/// file every σ is either positive or null, each null coordinate is listed
+/// under its block's `fixed`, and the text names them "fixed".
+#[test]
+fn fixed_coordinates_have_no_sigma_zero() {
+    let d = scratch("fixed_sigma");
+    let text = ur10_frames(&d);
+    let mut nulls = 0;
+    let mut in_sigma = false;
+    for l in text.lines() {
+        let t = l.trim();
+        if t.starts_with("sigma_") {
+            in_sigma = true;
+            if let Some(v) = t.split_once(':').map(|(_, v)| v.trim())
+                && !v.is_empty()
+            {
+                in_sigma = false;
+                nulls += usize::from(v == "null");
+                assert!(v == "null" || v.parse::<f64>().unwrap() > 0.0, "{l}");
+            }
+            continue;
+        }
+        if in_sigma && let Some(v) = t.strip_prefix("- ") {
+            nulls += usize::from(v == "null");
+            assert!(v == "null" || v.parse::<f64>().unwrap() > 0.0, "{l}");
+            continue;
+        }
+        in_sigma = false;
+    }
+    let listed = text.matches("\n    - offset").count();
+    assert!(nulls > 0, "no coordinate fixed in\n{text}");
+    assert!(
+        text.contains("fixed:") && listed >= 1,
+        "the fixed offset is not listed:\n{text}"
+    );
+    let out = run_in(
+        &d,
+        &[
+            "calibrate",
+            "--robot",
+            UR10_POSE,
+            "--tip",
+            "wrist_3_link",
+            "--measurements",
+            UR10_CSV,
+        ],
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("fixed (held at the file's value")
+            && stdout.contains("shoulder_pan_joint x y z"),
+        "{stdout}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -12,25 +12,45 @@ calibration (D-optimal design), then calibrate from the measurements.
 Lengths are metres, angles radians (joint values, limits, estimates), the
 residuals and predicted errors millimetres and degrees (their keys say so).
 Arrays are float64 NumPy arrays; anything NumPy reads as one is accepted.
-Wrong input raises ``activecal.Error`` naming the argument.
+Every error is an ``activecal.Error``: ``InputError`` (a wrong argument,
+its name first, or a wrong value in a file, with its place), ``FileError``
+(a file not read or written, or an output that exists), ``ResourceError``
+(too large, with the figure), ``ComputationError`` (cannot be done on these
+inputs) or ``InternalError`` (a defect: please report it).
 """
 
 from ._activecal import (
     Calibration,
     Design,
+    ComputationError,
     Error,
+    FileError,
+    InputError,
+    InternalError,
+    Pool,
+    ResourceError,
     Robot,
     __version__,
     calibrate,
+    evaluate,
+    pool,
     select,
 )
 
 __all__ = [
     "Calibration",
     "Design",
+    "ComputationError",
     "Error",
+    "FileError",
+    "InputError",
+    "InternalError",
+    "Pool",
+    "ResourceError",
     "Robot",
     "__version__",
     "calibrate",
+    "evaluate",
+    "pool",
     "select",
 ]

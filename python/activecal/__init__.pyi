@@ -24,7 +24,24 @@ _Marker = Union[str, Tuple[str, Sequence[float]]]
 class Error(Exception):
     """Bad input or a failed computation, with the library's message: the
     argument's name first when one argument is wrong (``q: expected shape
-    (6,) ...``)."""
+    (6,) ...``). Every error activecal raises is one of its subclasses."""
+
+class InputError(Error):
+    """A wrong argument (its name first) or a wrong value in an input file
+    (the file and the place named)."""
+
+class FileError(Error):
+    """A file that could not be read or written, or an output that exists
+    (pass overwrite=True)."""
+
+class ResourceError(Error):
+    """Work too large for the memory or size limits, with the figure."""
+
+class ComputationError(Error):
+    """A computation that cannot be done on these (valid) inputs."""
+
+class InternalError(Error):
+    """A defect in activecal: please report it with the message."""
 
 class Robot:
     """A robot model: a serial chain, its joint limits, the unknowns a
@@ -125,12 +142,65 @@ class Design:
         one pose a row, a header of joint names) or .yaml (named joint
         configurations). An existing file is replaced only with
         overwrite=True."""
+    def bound(self) -> dict[str, Any]:
+        """The certified bound on ln det of every design of this size from
+        the same pool (the continuous relaxation, with the existing poses'
+        information when given) and this design's D-efficiency against it:
+        the dict ``activecal gap --json`` prints (``ln_oid``, ``ln_bound``,
+        ``d_efficiency`` in (0, 1], ``bound_status``, ``certificate_gap``).
+        Computed on each call; the GIL is released."""
     def __len__(self) -> int: ...
+
+class Pool:
+    """Candidate poses and their identification Jacobian: what `select`
+    chooses from."""
+
+    @property
+    def q(self) -> npt.NDArray[np.float64]:
+        """Joint values of the candidates, shape (n, dof), radians or metres."""
+    @property
+    def ids(self) -> list[int]:
+        """Each candidate's id (a sample's number, a lattice index, a row of
+        the array given)."""
+    @property
+    def joint_names(self) -> list[str]:
+        """The columns of `q`."""
+    @property
+    def stats(self) -> dict[str, Any]:
+        """What the filters kept and removed (``candidates``, ``kept``,
+        ``filters``: each one's ``removed`` of ``seen``), as the command
+        line's ``pool_stats``."""
+    def __len__(self) -> int: ...
+
+def pool(
+    robot: Robot,
+    source: Union[str, npt.ArrayLike, None] = None,
+    count: Optional[int] = None,
+    levels: Optional[int] = None,
+    pool_seed: Optional[int] = None,
+    margin: Optional[float] = None,
+    self_collision: bool = False,
+    srdf: Optional[_Path] = None,
+    package_dirs: Optional[list[_Path]] = None,
+    floor: Optional[float] = None,
+    obstacles: Optional[list[str]] = None,
+    clearance: float = 0.0,
+) -> Pool:
+    """Candidate poses for `select`. source: ``"random"`` (default) or
+    ``"sobol"`` (count samples inside the joint limits less margin degrees,
+    default 4096; pool_seed), ``"lattice"`` (levels values per joint,
+    default 5) or an (n, dof) array of your own joint values (radians or
+    metres). Poses the sensor does not see are dropped; with
+    self_collision (pairs listed by srdf skipped), floor (a height in the
+    base frame, metres) or obstacles (``"box:x,y,z,sx,sy,sz"`` ..., base
+    frame, metres, as ``--obstacle``), the poses where the robot touches
+    itself or them within clearance metres (meshes found in package_dirs).
+    The GIL is released while it runs."""
 
 def select(
     robot: Robot,
     n: int,
-    pool: str = "random",
+    pool: Union[str, Pool, npt.ArrayLike, None] = None,
     count: Optional[int] = None,
     levels: Optional[int] = None,
     pool_seed: Optional[int] = None,
@@ -141,12 +211,14 @@ def select(
     ils: Optional[int] = None,
     kick: int = 3,
     noise: Optional[float] = None,
+    existing: Optional[npt.ArrayLike] = None,
 ) -> Design:
     """Chooses n poses to measure from a pool of candidates by D-optimal
     design (maximising ln det XᵀX), as ``activecal select --order none``
     does with the same options. The GIL is released while it runs.
 
-    pool: ``"random"`` or ``"sobol"`` (count samples inside the joint
+    pool: a `Pool` (from `pool`, with its filters), an (n, dof) array of
+    your own candidate joint values, or ``"random"`` (default) or ``"sobol"`` (count samples inside the joint
     limits, default 4096; pool_seed: the random stream's seed, default 0,
     or the Sobol scramble's, default none) or ``"lattice"`` (levels values
     per joint, default 5). margin: degrees kept inside every revolute
@@ -157,7 +229,9 @@ def select(
     kept. ils: rounds of iterated local search (default: by pool size, as
     the command line). kick: poses exchanged per round. noise: the
     sensor's σ per coordinate, metres; the design then predicts the error
-    after calibration (`Design.predicted`).
+    after calibration (`Design.predicted`). existing: an (m, dof) array
+    of poses already measured: the new poses add most to their
+    information (as ``--existing``).
     """
 
 class Calibration:
@@ -178,6 +252,20 @@ class Calibration:
         """Errors of the fitted model on the data: ``position_rms_mm``,
         ``position_max_mm``, ``orientation_rms_deg`` (full poses) and per
         pose."""
+    @property
+    def holdout(self) -> Optional[dict[str, Any]]:
+        """With `holdout`: each split's errors of the fitted and the nominal
+        model on the poses it did not see, and their means (mm, degrees)."""
+    @property
+    def noise(self) -> Optional[dict[str, Any]]:
+        """The residual blocks' σ's the fit weighed by (mm, degrees) with
+        their degrees of freedom."""
+    @property
+    def frames(self) -> Optional[dict[str, Any]]:
+        """The calibrated robot in its URDF's terms (measurement frame,
+        tool or markers, each joint origin's change with σ; a coordinate no
+        estimated unknown moves has σ None and is listed under ``fixed``):
+        the frames file's content. None for a built-in robot."""
     @property
     def report(self) -> dict[str, Any]:
         """The dict ``activecal calibrate --measurements FILE --json``
@@ -203,6 +291,11 @@ def calibrate(
     max_iterations: int = 200,
     loss: str = "l2",
     loss_scale: Optional[float] = None,
+    weights: Optional[str] = None,
+    orientation_scale: Optional[float] = None,
+    holdout: Optional[float] = None,
+    splits: int = 4,
+    seed: int = 0,
 ) -> Calibration:
     """Calibrates the robot from measured poses, as ``activecal calibrate
     --measurements FILE`` does from a file holding the same values. The
@@ -216,5 +309,23 @@ def calibrate(
     unknowns (names as in `Calibration.estimate`). max_iterations:
     Levenberg–Marquardt's limit. loss: ``"l2"``, or ``"huber"`` /
     ``"cauchy"`` with loss_scale (metres: a pose's residual norm where the
-    loss turns robust).
+    loss turns robust). weights: ``"estimated"`` (default: each residual
+    block's σ from its own residuals) or ``"fixed"`` (a radian of
+    orientation weighs orientation_scale metres; giving orientation_scale
+    implies ``"fixed"``). holdout: the fraction of poses held out in each
+    of `splits` random splits seeded by `seed` (`Calibration.holdout`).
     """
+
+def evaluate(
+    model: Union[Robot, Calibration],
+    q: npt.ArrayLike,
+    points: npt.ArrayLike,
+    orientations: Optional[npt.ArrayLike] = None,
+) -> dict[str, Any]:
+    """The errors of a model on measured poses (``position_rms_mm``,
+    ``position_max_mm``, ``orientation_rms_deg`` for full poses, and per
+    pose), as ``activecal evaluate --json`` prints them under
+    ``residuals``. model: a `Robot` (e.g. the calibrated URDF and frames
+    file loaded back) or a `Calibration` (its fitted model). q, points and
+    orientations as `calibrate` takes them: poses the fit did not see
+    judge it."""

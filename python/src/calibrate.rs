@@ -111,6 +111,60 @@ fn data(
     })
 }
 
+/// The `weights` and `orientation_scale` arguments, checked.
+fn weights_of(
+    weights: Option<&str>,
+    orientation_scale: Option<f64>,
+) -> PyResult<activecal::identify::Weights> {
+    use activecal::identify::Weights;
+    if let Some(w) = orientation_scale.filter(|w| !(w.is_finite() && *w > 0.0)) {
+        return Err(arg_err(
+            "orientation_scale",
+            format!("{w}: must be a finite number > 0 (metres per radian)"),
+        ));
+    }
+    match (weights, orientation_scale) {
+        (Some("estimated"), Some(_)) => Err(arg_err(
+            "orientation_scale",
+            "fixes the orientation weight: it implies weights=\"fixed\", not \"estimated\"",
+        )),
+        (None | Some("estimated"), None) => Ok(Weights::Estimated),
+        (None | Some("fixed"), _) => Ok(Weights::Fixed),
+        (Some(other), _) => Err(arg_err(
+            "weights",
+            format!("unknown weights '{other}': \"estimated\" or \"fixed\""),
+        )),
+    }
+}
+
+/// The held-out splits of `holdout` (a fraction in (0, 1)), checked.
+fn holdout_of(
+    holdout: Option<f64>,
+    splits: i64,
+    seed: i128,
+    weights: activecal::identify::Weights,
+) -> PyResult<Option<activecal::identify::HoldoutSettings>> {
+    let splits = count("splits", splits, 1)?;
+    let seed = crate::convert::non_negative("seed", seed)?;
+    holdout
+        .map(|fraction| {
+            if !(fraction > 0.0 && fraction < 1.0) {
+                return Err(arg_err(
+                    "holdout",
+                    format!("{fraction}: the fraction of poses held out is in (0, 1)"),
+                ));
+            }
+            Ok(activecal::identify::HoldoutSettings {
+                fraction,
+                splits,
+                seed,
+                prune: false,
+                weights,
+            })
+        })
+        .transpose()
+}
+
 /// Names given to a wrapper as an iterable of str.
 fn names(v: Option<Vec<String>>) -> Vec<String> {
     v.unwrap_or_default()
@@ -126,9 +180,14 @@ fn names(v: Option<Vec<String>>) -> Vec<String> {
 /// estimated besides the unknowns (names as in `estimate`).
 /// max_iterations: Levenberg–Marquardt's limit. loss: "l2", or "huber" /
 /// "cauchy" with loss_scale (metres, a pose's residual norm where the loss
-/// turns robust).
+/// turns robust). weights: "estimated" (default: each residual block's σ —
+/// position, orientation, each marker — from its own residuals) or
+/// "fixed" (a radian of orientation weighs orientation_scale metres,
+/// default the robot's, 1 m/rad; giving orientation_scale implies
+/// "fixed"). holdout: a fraction of the poses held out in each of `splits`
+/// random splits (seeded by `seed`), the fit judged on them (`holdout`).
 #[pyfunction]
-#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None))]
+#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
@@ -141,8 +200,19 @@ pub fn calibrate(
     max_iterations: i64,
     loss: &str,
     loss_scale: Option<f64>,
+    weights: Option<&str>,
+    orientation_scale: Option<f64>,
+    holdout: Option<f64>,
+    splits: i64,
+    seed: i128,
 ) -> PyResult<Calibration> {
-    let inner = robot.inner.clone();
+    let weights = weights_of(weights, orientation_scale)?;
+    let mut scaled = (*robot.inner).clone();
+    if let Some(w) = orientation_scale {
+        scaled.orientation_scale = w;
+    }
+    let inner = Arc::new(scaled);
+    let holdout = holdout_of(holdout, splits, seed, weights)?;
     let d = data(py, robot, q, points, orientations)?;
     let max_iterations = count("max_iterations", max_iterations, 1)?;
     let scale = |s: Option<f64>| match s {
@@ -183,18 +253,17 @@ pub fn calibrate(
         loss,
         fix: names(fix),
         free: names(free),
-        holdout: None,
+        holdout,
         units: activecal::units::Units::default(),
         gravity: None,
         fit_compliance: false,
         compare_compliance: false,
-        weights: activecal::identify::Weights::Estimated,
+        weights,
     };
     let r = inner.clone();
     let (fitted, id, frames, report) = detached(py, move || {
         let t0 = std::time::Instant::now();
-        let meas = Measurements::with_orientations(&r, d.qs, d.points, d.orientations)
-            .map_err(|e| e.to_string())?;
+        let meas = Measurements::with_orientations(&r, d.qs, d.points, d.orientations)?;
         let c = calibrate_measurements(
             &r,
             &meas,
@@ -202,8 +271,7 @@ pub fn calibrate(
             Vec::new(),
             &settings,
             &mut |_| {},
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         let mut report = c.report;
         report.base.elapsed_seconds = t0.elapsed().as_secs_f64();
         let id = c.fit.id;
@@ -214,9 +282,9 @@ pub fn calibrate(
         };
         let cov = id.covariance.as_ref().map(|c| c.matrix.as_slice());
         let frames = activecal::frames::calibrated(&c.robot, &id.table, cov, Some(fit))
-            .map_err(|e| e.to_string())?;
+            .map_err(crate::convert::Fail::compute)?;
         report.frames = frames.as_ref().map(|(_, r)| r.clone());
-        let v = serde_json::to_value(&report).map_err(|e| e.to_string())?;
+        let v = serde_json::to_value(&report)?;
         Ok((c.robot, id, frames, v))
     })?;
     Ok(Calibration {
@@ -256,8 +324,9 @@ impl Calibration {
             &[],
             overwrite,
         )
-        .map_err(err)?;
-        activecal::io::atomic::write_atomic(path, text.as_bytes()).map_err(err)
+        .map_err(|e| crate::convert::Fail::from(e).into_py())?;
+        activecal::io::atomic::write_atomic(path, text.as_bytes())
+            .map_err(|e| crate::convert::Fail::from(e).into_py())
     }
 }
 
@@ -290,6 +359,29 @@ impl Calibration {
         json_to_py(py, &self.report["residuals"])
     }
 
+    /// Held-out evidence (with `holdout`): each split's errors of the fitted
+    /// and the nominal model on the poses it did not see, and their means
+    /// (mm, degrees); None without `holdout`.
+    #[getter]
+    fn holdout<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.report["holdout"])
+    }
+
+    /// The residual blocks' σ's the fit weighed by (position in mm,
+    /// orientation in degrees, each marker), with their degrees of freedom.
+    #[getter]
+    fn noise<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.report["noise"])
+    }
+
+    /// The calibrated robot in the URDF's terms (URDF robots): the
+    /// measurement frame, the tool or markers and each joint origin's
+    /// change with σ — the dict the frames file holds; None otherwise.
+    #[getter]
+    fn frames<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.report["frames"])
+    }
+
     /// The whole report: the dict `activecal calibrate --measurements FILE
     /// --json` prints (here "measurements" names the arrays, not a file).
     #[getter]
@@ -319,4 +411,40 @@ impl Calibration {
             self.robot.name, self.id.status, self.id.iterations
         )
     }
+}
+
+/// The errors of a model on measured poses, as `activecal evaluate
+/// --measurements FILE --json` prints them (`residuals`): `model` is a
+/// `Robot` (for example the calibrated URDF and frames file loaded back) or
+/// a `Calibration` (its fitted model). q, points and orientations are as
+/// `calibrate` takes them: poses the fit did not see judge it.
+#[pyfunction]
+#[pyo3(signature = (model, q, points, orientations=None))]
+pub fn evaluate<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+    points: &Bound<'py, PyAny>,
+    orientations: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (robot, table) = if let Ok(c) = model.cast::<Calibration>() {
+        let c = c.get();
+        (c.robot.clone(), c.id.table.clone())
+    } else if let Ok(r) = model.cast::<Robot>() {
+        let r = r.get();
+        (r.inner.clone(), r.inner.nominal.clone())
+    } else {
+        return Err(arg_err("model", "a Robot or a Calibration"));
+    };
+    let wrapper = Robot {
+        inner: robot.clone(),
+        visibility: None,
+    };
+    let d = data(py, &wrapper, q, points, orientations)?;
+    let v = detached(py, move || {
+        let meas = Measurements::with_orientations(&robot, d.qs, d.points, d.orientations)?;
+        let res = activecal::identify::residuals(&robot, &table, &meas)?;
+        Ok(serde_json::to_value(&res)?)
+    })?;
+    json_to_py(py, &v)
 }

@@ -2,7 +2,7 @@
 //! errors naming the argument), results out (NumPy arrays, dicts), library
 //! errors and panics as `activecal.Error`.
 
-use crate::Error;
+use crate::{ComputationError, Error, FileError, InputError, InternalError, ResourceError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::fmt::Display;
@@ -12,28 +12,118 @@ pub fn err(e: impl Display) -> PyErr {
     Error::new_err(e.to_string())
 }
 
-/// A wrong argument as `activecal.Error`, the message starting with its name.
+/// A wrong argument as `activecal.InputError`, the message starting with
+/// its name.
 pub fn arg_err(name: &str, msg: impl Display) -> PyErr {
-    Error::new_err(format!("{name}: {msg}"))
+    InputError::new_err(format!("{name}: {msg}"))
 }
 
-/// Runs library work with the GIL released; a panic becomes
-/// `activecal.Error` (never unwinds into Python).
+/// Why library work failed, as the Python exception it becomes: the
+/// `activecal.Error` subclass and the library's message.
+#[derive(Debug)]
+pub enum Fail {
+    /// Wrong input (a value, a file's content): `InputError`.
+    Input(String),
+    /// A file could not be read or written, or exists: `FileError`.
+    File(String),
+    /// Too large for the memory or size limits: `ResourceError`.
+    Resource(String),
+    /// The computation could not be done on valid input: `ComputationError`.
+    Compute(String),
+}
+
+impl Fail {
+    /// A computation's failure (any error type) with its message.
+    pub fn compute(e: impl Display) -> Self {
+        Fail::Compute(e.to_string())
+    }
+
+    /// Wrong input (any error type) with its message.
+    pub fn input(e: impl Display) -> Self {
+        Fail::Input(e.to_string())
+    }
+
+    /// The Python exception.
+    pub fn into_py(self) -> PyErr {
+        match self {
+            Fail::Input(m) => InputError::new_err(m),
+            Fail::File(m) => FileError::new_err(m),
+            Fail::Resource(m) => ResourceError::new_err(m),
+            Fail::Compute(m) => ComputationError::new_err(m),
+        }
+    }
+}
+
+impl From<activecal::Error> for Fail {
+    fn from(e: activecal::Error) -> Self {
+        use activecal::Error as E;
+        let m = e.to_string();
+        match e {
+            E::Io { .. } | E::OutputExists { .. } => Fail::File(m),
+            E::TooLarge { .. } | E::OutOfMemory { .. } => Fail::Resource(m),
+            E::Unidentifiable { .. } => Fail::Compute(m),
+            _ => Fail::Input(m),
+        }
+    }
+}
+
+impl From<activecal::identify::IdentifyError> for Fail {
+    /// Bad input to identification (its own description).
+    fn from(e: activecal::identify::IdentifyError) -> Self {
+        Fail::Input(e.to_string())
+    }
+}
+
+impl From<activecal::bound::BoundError> for Fail {
+    fn from(e: activecal::bound::BoundError) -> Self {
+        Fail::Compute(e.to_string())
+    }
+}
+
+impl From<activecal::experiment::paper::ExperimentError> for Fail {
+    fn from(e: activecal::experiment::paper::ExperimentError) -> Self {
+        use activecal::experiment::paper::ExperimentError as E;
+        match e {
+            E::Input(e) => e.into(),
+            E::Bound(e) => e.into(),
+            E::Identify(_) | E::InFile { .. } => Fail::Input(e.to_string()),
+        }
+    }
+}
+
+impl From<serde_json::Error> for Fail {
+    /// A report that does not serialise: a defect.
+    fn from(e: serde_json::Error) -> Self {
+        Fail::Compute(format!(
+            "internal error in activecal (please report it): {e}"
+        ))
+    }
+}
+
+impl From<String> for Fail {
+    fn from(m: String) -> Self {
+        Fail::Compute(m)
+    }
+}
+
+/// Runs library work with the GIL released; its failure becomes the
+/// `activecal.Error` subclass of its [`Fail`], a panic
+/// `activecal.InternalError` (never unwinds into Python).
 pub fn detached<T: Send>(
     py: Python<'_>,
-    work: impl FnOnce() -> Result<T, String> + Send,
+    work: impl FnOnce() -> Result<T, Fail> + Send,
 ) -> PyResult<T> {
     let out = py.detach(|| std::panic::catch_unwind(std::panic::AssertUnwindSafe(work)));
     match out {
         Ok(Ok(v)) => Ok(v),
-        Ok(Err(msg)) => Err(Error::new_err(msg)),
+        Ok(Err(f)) => Err(f.into_py()),
         Err(p) => {
             let what = p
                 .downcast_ref::<String>()
                 .cloned()
                 .or_else(|| p.downcast_ref::<&str>().map(|s| (*s).to_string()))
                 .unwrap_or_else(|| "a panic".into());
-            Err(Error::new_err(format!(
+            Err(InternalError::new_err(format!(
                 "internal error in activecal (please report it): {what}"
             )))
         }

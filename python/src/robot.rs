@@ -22,12 +22,12 @@ impl Robot {
     /// at least one joint).
     fn load(py: Python<'_>, r: RobotRef) -> PyResult<Self> {
         let d = detached(py, move || {
-            let d = r.load().map_err(|e| e.to_string())?;
-            d.robot.validate().map_err(|e| e.to_string())?;
+            let d = r.load()?;
+            d.robot.validate()?;
             if d.robot.dof() == 0 {
-                return Err(format!(
+                return Err(crate::convert::Fail::Input(format!(
                     "{r}: this robot has no joints (every frame of its chain is fixed); a robot needs at least one revolute or prismatic joint"
-                ));
+                )));
             }
             Ok(d)
         })?;
@@ -154,10 +154,16 @@ impl Robot {
             return Err(arg_err("lock", format!("{j}: {v} is not a finite number")));
         }
         if !path.is_file() {
-            return Err(arg_err("path", format!("{}: no such file", path.display())));
+            return Err(crate::FileError::new_err(format!(
+                "path: {}: no such file",
+                path.display()
+            )));
         }
         if let Some(f) = frames.as_ref().filter(|f| !f.is_file()) {
-            return Err(arg_err("frames", format!("{}: no such file", f.display())));
+            return Err(crate::FileError::new_err(format!(
+                "frames: {}: no such file",
+                f.display()
+            )));
         }
         let r = RobotRef {
             name: path.display().to_string(),

@@ -1,11 +1,13 @@
 //! `activecal.select`: a D-optimal design from a pool of candidate poses,
 //! as `activecal select` chooses it, and the `Design` it returns.
 
-use crate::convert::{arg_err, count, detached, json_to_py, ndarray, non_negative};
+use crate::convert::{arg_err, detached, json_to_py, ndarray, non_negative};
+use crate::pool::Pool;
 use crate::robot::Robot;
+use activecal::blocks::Blocks;
+use activecal::criterion::Prior;
 use activecal::io::design::DesignFile;
 use activecal::names::Choice;
-use activecal::pool::{PoolFilter, PoolSource, PoolSpec};
 use activecal::report::{PredictedAfter, SelectReport};
 use activecal::select::{Algorithm, CriterionKind, Settings};
 use pyo3::prelude::*;
@@ -21,51 +23,12 @@ pub struct Design {
     q: Vec<Vec<f64>>,
     ids: Vec<usize>,
     ln_oid: f64,
-}
-
-/// The pool source named by `pool` and its size options.
-fn pool_source(
-    pool: &str,
-    count_: Option<i64>,
-    levels: Option<i64>,
-    pool_seed: Option<i128>,
-) -> PyResult<PoolSource> {
-    let sampled = matches!(pool, "random" | "sobol");
-    if levels.is_some() && pool != "lattice" {
-        return Err(arg_err("levels", "applies to pool=\"lattice\" only"));
-    }
-    if !sampled && count_.is_some() {
-        return Err(arg_err(
-            "count",
-            "applies to pool=\"random\" or \"sobol\" only",
-        ));
-    }
-    if !sampled && pool_seed.is_some() {
-        return Err(arg_err(
-            "pool_seed",
-            "applies to pool=\"random\" or \"sobol\" only",
-        ));
-    }
-    let n = count_.map_or(Ok(4096), |c| count("count", c, 1))?;
-    let seed = pool_seed
-        .map(|s| non_negative("pool_seed", s))
-        .transpose()?;
-    Ok(match pool {
-        "lattice" => PoolSource::Lattice {
-            levels: levels.map_or(Ok(5), |l| count("levels", l, 2))?,
-        },
-        "random" => PoolSource::Random {
-            count: n,
-            seed: seed.unwrap_or(0),
-        },
-        "sobol" => PoolSource::Sobol { count: n, seed },
-        other => {
-            return Err(arg_err(
-                "pool",
-                format!("unknown pool '{other}': use \"random\", \"sobol\" or \"lattice\""),
-            ));
-        }
-    })
+    /// The chosen poses' positions in the pool.
+    positions: Vec<usize>,
+    /// The pool's Jacobian (for the bound).
+    x: Arc<Blocks>,
+    /// The existing poses' information, when given.
+    prior: Option<Prior>,
 }
 
 /// Chooses `n` poses to measure from a pool of candidates by D-optimal
@@ -73,25 +36,29 @@ fn pool_source(
 /// nominal parameters), as `activecal select` does with the same options
 /// and `--order none`.
 ///
-/// pool: "random" or "sobol" (count samples inside the joint limits, default
-/// 4096; pool_seed: the random stream's seed, default 0, or the Sobol
-/// scramble's, default none) or "lattice" (levels values per joint, default
-/// 5). margin: degrees kept inside every revolute joint's limits (default:
-/// 2 for a URDF robot's generated pool, else 0). algorithm: "eae" (default),
-/// "fedorov", "detmax", "random" … as the command line names them. seed:
-/// seed of every random choice of the search (default 1, the command
-/// line's). starts: independent starts (default 2). ils: rounds of iterated
-/// local search (default: the command line's, by pool size). noise: the
-/// sensor's σ per coordinate, metres: the design then carries the position
-/// error predicted after calibrating with it (`predicted`).
+/// pool: a `Pool` (from `activecal.pool`, with its filters), an (n, dof)
+/// array of your own candidate joint values (radians or metres), or a
+/// source name: "random" or "sobol" (count samples inside the joint limits,
+/// default 4096; pool_seed: the random stream's seed, default 0, or the
+/// Sobol scramble's, default none) or "lattice" (levels values per joint,
+/// default 5). margin: degrees kept inside every revolute joint's limits
+/// (default: 2 for a URDF robot's generated pool, else 0). existing: an
+/// (m, dof) array of poses already measured: the new poses are chosen to
+/// add most to their information (`--existing`). algorithm: "eae"
+/// (default), "fedorov", "detmax", "random" … as the command line names
+/// them. seed: seed of every random choice of the search (default 1, the
+/// command line's). starts: independent starts (default 2). ils: rounds of
+/// iterated local search (default: the command line's, by pool size).
+/// noise: the sensor's σ per coordinate, metres: the design then carries
+/// the position error predicted after calibrating with it (`predicted`).
 #[pyfunction]
-#[pyo3(signature = (robot, n, pool="random", count=None, levels=None, pool_seed=None, margin=None, algorithm="eae", seed=1, starts=2, ils=None, kick=3, noise=None))]
+#[pyo3(signature = (robot, n, pool=None, count=None, levels=None, pool_seed=None, margin=None, algorithm="eae", seed=1, starts=2, ils=None, kick=3, noise=None, existing=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn select(
     py: Python<'_>,
     robot: &Robot,
     n: i64,
-    pool: &str,
+    pool: Option<&Bound<'_, PyAny>>,
     count: Option<i64>,
     levels: Option<i64>,
     pool_seed: Option<i128>,
@@ -102,9 +69,9 @@ pub fn select(
     ils: Option<i64>,
     kick: i64,
     noise: Option<f64>,
+    existing: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Design> {
     let n = crate::convert::count("n", n, 1)?;
-    let source = pool_source(pool, count, levels, pool_seed)?;
     let algorithm = Algorithm::from_name(algorithm).ok_or_else(|| {
         let names: Vec<&str> = Algorithm::ALL.iter().map(|a| a.name()).collect();
         arg_err(
@@ -121,33 +88,26 @@ pub fn select(
     let ils = ils
         .map(|i| crate::convert::count("ils", i, 0))
         .transpose()?;
-    if let Some(m) = margin.filter(|m| !(m.is_finite() && *m >= 0.0)) {
-        return Err(arg_err("margin", format!("{m}: an angle >= 0 degrees")));
-    }
     if let Some(s) = noise.filter(|s| !(s.is_finite() && *s > 0.0)) {
         return Err(arg_err(
             "noise",
             format!("{s}: the sensor noise σ must be a finite number > 0 (metres)"),
         ));
     }
-    let inner = robot.inner.clone();
-    let margin_deg = margin
-        .unwrap_or_else(|| activecal::pool::default_margin_deg(inner.source.is_some(), &source));
-    let spec = PoolSpec {
-        source,
-        filters: robot
-            .visibility
-            .iter()
-            .map(|v| PoolFilter::Visibility(v.clone()))
-            .collect(),
-        margin: margin_deg.to_radians(),
+    let candidates = candidates(py, robot, pool, count, levels, pool_seed, margin)?;
+    let (existing_qs, prior) = match existing {
+        Some(e) => {
+            let (qs, p) = existing_poses(py, robot, e)?;
+            (Some(qs), Some(p))
+        }
+        None => (None, None),
     };
+    let inner = robot.inner.clone();
     let r = inner.clone();
-    let (file, report, ids, q, ln_oid) = detached(py, move || {
-        let e = |e: activecal::Error| e.to_string();
+    let (x, built) = (candidates.x.clone(), candidates.pool.clone());
+    let closure_prior = prior.clone();
+    let (file, report, ids, q, sel) = detached(py, move || {
         let table = &r.nominal;
-        let pool = spec.build(&r, table).map_err(e)?;
-        let x = pool.try_jacobian(&r, table).map_err(e)?;
         let s = Settings {
             n,
             initial: Settings::default().initial.min(n),
@@ -155,36 +115,129 @@ pub fn select(
             ils: ils.unwrap_or_else(|| activecal::select::default_ils_rounds(x.n_poses(), x.t())),
             kick,
             seed,
+            prior: closure_prior.clone(),
             ..Settings::default()
         };
         let t0 = std::time::Instant::now();
-        let sel = activecal::select::select(&x, CriterionKind::Det, algorithm, &s).map_err(e)?;
+        let sel = activecal::select::select(&x, CriterionKind::Det, algorithm, &s)?;
         let mut report = SelectReport::new(
             &r,
-            &pool,
+            &built,
             &sel,
             CriterionKind::Det,
             &s,
             t0.elapsed().as_secs_f64(),
         );
-        if let Some(noise) = noise {
+        if let (Some(noise), None) = (noise, &closure_prior) {
             report.predicted = PredictedAfter::of_design(&r, table, &x, &sel.poses, noise);
         }
-        let mut file = DesignFile::from_pool(&r, &pool, &sel.poses);
+        let mut file = DesignFile::from_pool(&r, &built, &sel.poses);
         file.extra.extend(report.design_keys());
-        let q: Vec<Vec<f64>> = sel.poses.iter().map(|&k| pool.q(k)).collect();
-        let ids = pool.ids_of(&sel.poses);
-        let v = serde_json::to_value(&report).map_err(|e| e.to_string())?;
-        Ok((file, v, ids, q, sel.ln_oid))
+        let q: Vec<Vec<f64>> = sel.poses.iter().map(|&k| built.q(k)).collect();
+        let ids = built.ids_of(&sel.poses);
+        let v = serde_json::to_value(&report)?;
+        Ok((file, v, ids, q, sel))
     })?;
+    let mut file = file;
+    file.existing = existing_qs.map(|qs| activecal::io::design::ExistingPoses {
+        path: "existing".into(),
+        q: qs,
+    });
     Ok(Design {
         robot: inner,
         file,
         report,
         q,
         ids,
-        ln_oid,
+        ln_oid: sel.ln_oid,
+        positions: sel.poses,
+        x: candidates.x,
+        prior,
     })
+}
+
+/// The candidates a `pool` argument names: a `Pool` as built (no size
+/// option beside it), an array of configurations or a source name.
+fn candidates(
+    py: Python<'_>,
+    robot: &Robot,
+    pool: Option<&Bound<'_, PyAny>>,
+    count: Option<i64>,
+    levels: Option<i64>,
+    pool_seed: Option<i128>,
+    margin: Option<f64>,
+) -> PyResult<Pool> {
+    if let Some(built) = pool.and_then(|p| p.cast::<Pool>().ok()) {
+        for (given, name) in [
+            (count.is_some(), "count"),
+            (levels.is_some(), "levels"),
+            (pool_seed.is_some(), "pool_seed"),
+            (margin.is_some(), "margin"),
+        ] {
+            if given {
+                return Err(arg_err(
+                    name,
+                    "is the pool's own: give it to activecal.pool, not beside a Pool",
+                ));
+            }
+        }
+        let b = built.get();
+        let same = |r: &activecal::model::Robot| (r.name.clone(), r.dof(), r.parameter_names());
+        if !Arc::ptr_eq(&b.robot, &robot.inner) && same(&b.robot) != same(&robot.inner) {
+            return Err(arg_err(
+                "pool",
+                format!(
+                    "was built for robot '{}', not '{}'",
+                    b.robot.name, robot.inner.name
+                ),
+            ));
+        }
+        return Ok(Pool {
+            robot: b.robot.clone(),
+            pool: b.pool.clone(),
+            x: b.x.clone(),
+        });
+    }
+    let default = pyo3::types::PyString::new(py, "random").into_any();
+    crate::pool::pool_of(
+        py,
+        robot,
+        "pool",
+        pool.unwrap_or(&default),
+        count,
+        levels,
+        pool_seed,
+        margin,
+        Vec::new(),
+    )
+}
+
+/// Poses already measured (an (m, dof) array, checked as joint values are)
+/// and their information `M0` at the nominal parameters.
+fn existing_poses(
+    py: Python<'_>,
+    robot: &Robot,
+    e: &Bound<'_, PyAny>,
+) -> PyResult<(Vec<Vec<f64>>, Prior)> {
+    let dof = robot.inner.dof();
+    let (v, _) = crate::convert::float_array(
+        py,
+        e,
+        "existing",
+        &[None, Some(dof)],
+        "one row of joint values per pose already measured, radians or metres",
+    )?;
+    let mut qs = crate::convert::rows(&v, dof);
+    robot.check_joint_values("existing", &mut qs)?;
+    let r = robot.inner.clone();
+    let qs2 = qs.clone();
+    let prior = detached(py, move || {
+        let x = activecal::blocks::jacobian_of(&r, &r.nominal, qs2.len(), |k, q| {
+            q.copy_from_slice(&qs2[k]);
+        });
+        Prior::from_blocks(&x).map_err(|e| crate::convert::Fail::input(format!("existing: {e}")))
+    })?;
+    Ok((qs, prior))
 }
 
 #[pymethods]
@@ -224,6 +277,24 @@ impl Design {
         json_to_py(py, &self.report["predicted"])
     }
 
+    /// The certified bound on ln det of every design of this size from the
+    /// same pool (the continuous relaxation, with the existing poses'
+    /// information when given) and this design's D-efficiency against it:
+    /// the dict `activecal gap --json` prints (`ln_oid`, `ln_bound`,
+    /// `d_efficiency` in (0, 1], `bound_status`, `certificate_gap`, …).
+    /// Computed on each call (seconds on large pools).
+    fn bound<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let (x, prior, positions) = (self.x.clone(), self.prior.clone(), self.positions.clone());
+        let v = detached(py, move || {
+            let settings = activecal::bound::BoundSettings::default();
+            let b =
+                activecal::bound::relaxation_bound(&x, prior.as_ref(), positions.len(), &settings)?;
+            let g = activecal::bound::gap::design_gap(&x, prior.as_ref(), &positions, &b)?;
+            Ok(serde_json::to_value(&g)?)
+        })?;
+        json_to_py(py, &v)
+    }
+
     /// The selection's report: the dict `activecal select --json` prints.
     #[getter]
     fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
@@ -237,7 +308,7 @@ impl Design {
     #[pyo3(signature = (path, overwrite=false))]
     fn write(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
         activecal::io::design_formats::write(&self.file, &path, overwrite)
-            .map_err(|e| arg_err("path", e))
+            .map_err(|e| crate::convert::Fail::from(e).into_py())
     }
 
     fn __len__(&self) -> usize {

@@ -172,3 +172,62 @@ def test_figaroh_ur10_full_pose_equals_the_cli():
     assert r.joint_names == joints
     cal = activecal.calibrate(r, q, points, orientations=rot)
     assert_same_fit(cal, want)
+
+
+def test_holdout_and_weights_equal_the_cli(tmp_path):
+    args = ["--robot", f"{UR5_URDF}:pose", "--tip", "tool0"]
+    meas, m = simulated(tmp_path, args)
+    r = activecal.Robot.from_urdf(UR5_URDF, tip="tool0", pose=True)
+    for extra, kw in [
+        (["--holdout", 0.25, "--splits", 3, "--seed", 5], dict(holdout=0.25, splits=3, seed=5)),
+        (["--weights", "fixed"], dict(weights="fixed")),
+        (["--orientation-scale", 0.2], dict(orientation_scale=0.2)),
+    ]:
+        want = cli("calibrate", *args, "--measurements", meas, *extra)
+        cal = activecal.calibrate(r, m["qs"], m["points"], orientations=m["orientations"], **kw)
+        assert_same_fit(cal, want)
+        assert cal.noise == want["noise"]
+        got = cal.holdout
+        if "holdout" in kw:
+            # The same splits and fits: the same numbers, bit for bit.
+            assert got == want["holdout"] and len(got["splits"]) == 3
+        else:
+            assert got is None and "holdout" not in want
+    assert cal.frames == want["frames"]
+    for kw, words in [
+        (dict(weights="estimated", orientation_scale=0.2), "orientation_scale: fixes"),
+        (dict(weights="robust"), "weights: unknown"),
+        (dict(orientation_scale=-1.0), "orientation_scale: -1"),
+        (dict(holdout=1.5), "holdout: 1.5"),
+        (dict(holdout=0.2, splits=0), "splits:"),
+    ]:
+        with pytest.raises(activecal.Error, match=words):
+            activecal.calibrate(r, m["qs"], m["points"], orientations=m["orientations"], **kw)
+
+
+def test_evaluate_on_poses_the_fit_did_not_see_equals_the_cli(tmp_path):
+    args = ["--robot", UR5_URDF, "--tip", "tool0", "--marker", MARKER]
+    meas, m = simulated(tmp_path, args)
+    r = activecal.Robot.from_urdf(UR5_URDF, tip="tool0", marker=MARKER)
+    q, p = np.array(m["qs"]), np.array(m["points"])
+    cal = activecal.calibrate(r, q[:22], p[:22])
+    got = activecal.evaluate(cal, q[22:], p[22:])
+    cal.write_urdf(tmp_path / "cal.urdf")
+    cal.write_frames(tmp_path / "cal.yaml")
+    test = tmp_path / "test.csv"
+    np.savetxt(
+        test, np.hstack([p[22:], q[22:]]), delimiter=",", comments="", fmt="%.17g",
+        header=",".join(["x", "y", "z", *r.joint_names]),
+    )
+    want = cli(
+        "evaluate", "--robot", tmp_path / "cal.urdf", "--tip", "tool0", "--frames",
+        tmp_path / "cal.yaml", "--measurements", test,
+    )["residuals"]
+    assert got["position_rms_mm"] == pytest.approx(want["position_rms_mm"], abs=1e-9)
+    assert len(got["per_sample"]) == 8
+    # The nominal model is far worse on the same poses (the truth's origins
+    # are off by millimetres).
+    nominal = activecal.evaluate(r, q[22:], p[22:])
+    assert nominal["position_rms_mm"] > 10 * got["position_rms_mm"]
+    with pytest.raises(activecal.InputError, match="^model"):
+        activecal.evaluate("ur5", q, p)

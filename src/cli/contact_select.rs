@@ -6,10 +6,11 @@
 use super::select::SelectArgs;
 use activecal::identify::contact::select::Socket;
 use activecal::identify::contact::socket_design::{
-    SocketDesign, SocketDesignSettings, design_for_sockets,
+    Judged, SocketDesign, SocketDesignSettings, design_for_sockets,
 };
 use activecal::io::contact_design;
 use activecal::io::design_formats::DesignFormat;
+use activecal::measure::contact::KnownDistance;
 use activecal::model::MeasurementKind;
 use activecal::select::{Algorithm, CriterionKind};
 use anyhow::{Result, bail};
@@ -29,6 +30,37 @@ fn parse_socket(s: &str) -> Result<Socket> {
             "--point {s}: expected NAME=X,Y,Z (a point name and its position in the base frame, metres, e.g. front_left/0=0.48,0.23,0.02)"
         ),
     }
+}
+
+/// The `--point-distance A,B=METRES` between sockets, as indices into
+/// `sockets`; a name that is no socket's is refused, naming the sockets.
+fn known_distances(sockets: &[Socket], given: &[String]) -> Result<Vec<KnownDistance>> {
+    let names: Vec<&str> = sockets.iter().map(|s| s.name.as_str()).collect();
+    given
+        .iter()
+        .map(|s| {
+            let d = super::contact::parse_distance(s)?;
+            let index = |n: &str| {
+                names.iter().position(|m| *m == n).ok_or_else(|| {
+                    anyhow::anyhow!(
+                        "--point-distance {s}: no --point is named '{n}' (the points: {})",
+                        names.join(", ")
+                    )
+                })
+            };
+            let (ia, ib) = (index(&d.a)?, index(&d.b)?);
+            if ia == ib || !(d.metres.is_finite() && d.metres > 0.0) {
+                bail!(
+                    "--point-distance {s}: a distance needs two different points and a finite length > 0 (metres)"
+                );
+            }
+            Ok(KnownDistance {
+                a: ia,
+                b: ib,
+                metres: d.metres,
+            })
+        })
+        .collect()
 }
 
 /// The options of `select` that have no meaning for sockets, refused
@@ -56,7 +88,7 @@ fn refuse_pool_options(a: &SelectArgs) -> Result<()> {
     ];
     if let Some((_, name)) = given.iter().find(|(g, _)| *g) {
         bail!(
-            "{name}: not available with --point (the pool is configurations projected onto each socket from --count joint-space samples, chosen D-optimally then exchanged for the predicted consistency error, in selection order)"
+            "{name}: not available with --point (the pool is configurations projected onto each socket from --count joint-space samples, chosen D-optimally then exchanged for the predicted true error, in selection order)"
         );
     }
     Ok(())
@@ -86,6 +118,7 @@ pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
             robot.name
         );
     }
+    let distances = known_distances(&sockets, &a.point_distance)?;
     let filters = a.pool.collision_filters(&robot)?;
     let settings = SocketDesignSettings {
         n: a.n,
@@ -94,6 +127,7 @@ pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
         sample_seed: a.pool.pool_seed.unwrap_or(0),
         draw_seed: a.seed,
         filters,
+        distances,
         ..SocketDesignSettings::default()
     };
     let d = design_for_sockets(&robot, robot.params(a.pool.params), &sockets, &settings)?;
@@ -106,6 +140,25 @@ pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
         super::write_new(out, &text, a.force)?;
     }
     super::emit_report(a.json, &d, || text(&d))
+}
+
+/// One criterion's figures: the chosen configurations', the D-optimal
+/// choice's, random draws' and the pool's bound, in units of σ.
+fn judged_lines(s: &mut String, what: &str, j: &Judged) {
+    let r = &j.random;
+    let _ = writeln!(
+        s,
+        "{what}, σ = contact noise per coordinate: chosen {:.4} σ (D-optimal {:.4} σ), median of {} random draws {:.4} σ (quartiles {:.4}–{:.4} σ): {:.3}× lower; no design of this pool can be below {:.4} σ (convex relaxation, certified; {} configurations carry weight)",
+        j.predicted_sigma,
+        j.d_optimal_sigma,
+        r.draws,
+        r.median_sigma,
+        r.q1_sigma,
+        r.q3_sigma,
+        j.ratio_to_random,
+        j.bound.certified_sigma,
+        j.bound.support
+    );
 }
 
 /// The design as text: the figures, then the configurations with their
@@ -141,22 +194,24 @@ fn text(d: &SocketDesign) -> String {
         d.unknowns,
         d.robot_unknowns
     );
-    let r = &d.random;
-    let _ = writeln!(
-        s,
-        "predicted consistency error (σ = contact noise per coordinate): chosen {:.4} σ (D-optimal {:.4} σ), median of {} random draws {:.4} σ (quartiles {:.4}–{:.4} σ): {:.3}× lower",
-        d.predicted_sigma,
-        d.d_optimal_sigma,
-        r.draws,
-        r.median_sigma,
-        r.q1_sigma,
-        r.q3_sigma,
-        d.ratio_to_random
+    if d.known_distances == 0 {
+        s += "no known distance between the points (--point-distance): contacts alone leave the scale free, and calibrate will need one\n";
+    } else {
+        let _ = writeln!(
+            s,
+            "{} known distance(s) between the points, counted as calibrate will count them",
+            d.known_distances
+        );
+    }
+    judged_lines(
+        &mut s,
+        "predicted true error of the tool point (3-D RMS at 1000 random configurations; the criterion)",
+        &d.true_error,
     );
-    let _ = writeln!(
-        s,
-        "no design of this pool can be below {:.4} σ (convex relaxation, certified; {} configurations carry weight)",
-        d.bound.certified_sigma, d.bound.support
+    judged_lines(
+        &mut s,
+        "predicted consistency error (RMS about each point, per coordinate; what held-out contacts see)",
+        &d.consistency,
     );
     let _ = write!(s, "{:>4} {:>6} {:<16}", "#", "id", "point");
     for n in &d.joint_names {

@@ -7,6 +7,12 @@ fn v3(v: [f64; 3], d: usize) -> String {
     format!("[{:.d$}, {:.d$}, {:.d$}]", v[0], v[1], v[2])
 }
 
+/// σ's with a not-estimated coordinate shown as `fixed` (never 0).
+fn s3(v: [Option<f64>; 3], d: usize) -> String {
+    let one = |x: Option<f64>| x.map_or_else(|| "fixed".to_string(), |x| format!("{x:.d$}"));
+    format!("[{}, {}, {}]", one(v[0]), one(v[1]), one(v[2]))
+}
+
 fn frame_lines(name: &str, f: &FrameBlock) -> String {
     let mut s = format!(
         "{name} ({} → {}):\n  xyz {} m, rpy {} rad = {} deg, quaternion [w x y z] {}\n",
@@ -23,8 +29,8 @@ fn frame_lines(name: &str, f: &FrameBlock) -> String {
     if let (Some(x), Some(r)) = (f.sigma_xyz_mm, f.sigma_rotation_deg) {
         s += &format!(
             "  σ xyz {} mm, σ of a rotation about its x, y, z {} deg\n",
-            v3(x, 3),
-            v3(r, 4)
+            s3(x, 3),
+            s3(r, 4)
         );
     }
     s
@@ -43,7 +49,7 @@ pub fn frames_text(r: &FramesReport) -> String {
     for m in &r.markers {
         s += &format!("{} on {}: xyz {} m", m.name, m.parent, v3(m.xyz, 6));
         if let Some(x) = m.sigma_xyz_mm {
-            s += &format!(", σ {} mm", v3(x, 3));
+            s += &format!(", σ {} mm", s3(x, 3));
         }
         s += "\n";
     }
@@ -60,6 +66,19 @@ pub fn frames_text(r: &FramesReport) -> String {
             v3(j.delta_rotation_deg, 4),
             j.offset_deg,
             j.max_t.map_or("-".into(), |t| format!("{t:.1}"))
+        );
+    }
+    let held: Vec<String> = r
+        .joints
+        .0
+        .iter()
+        .filter(|j| !j.fixed.is_empty())
+        .map(|j| format!("{} {}", j.name, j.fixed.join(" ")))
+        .collect();
+    if !held.is_empty() {
+        s += &format!(
+            "fixed (held at the file's value: no estimated unknown moves them, so they have no σ): {}\n",
+            held.join("; ")
         );
     }
     let broken: Vec<_> = r.structure.iter().filter(|a| !a.kept).collect();

@@ -304,7 +304,7 @@ impl PoolOpts {
     /// statistics say what each removed); `--srdf` and `--package-dir`
     /// without them are errors.
     pub fn collision_filters(&self, robot: &Robot) -> Result<Vec<PoolFilter>> {
-        use activecal::collision::{CollisionFilter, CollisionSpec, Obstacle};
+        use activecal::collision::Obstacle;
         let obstacles = self
             .obstacles
             .iter()
@@ -354,12 +354,9 @@ impl PoolOpts {
                 anyhow::bail!("{opt} {}: no such file or directory", p.display());
             }
         }
-        let base_spec = CollisionSpec {
-            urdf: chain.file,
-            text: Some(chain.text),
-            joints: chain.joints,
-            lock: chain.lock,
-            base: Some(chain.base),
+        let choice = activecal::io::collision_choice::CollisionChoice {
+            self_collision: self.self_collision,
+            skip_always_touching: self.skip_always_touching,
             srdf: self.srdf.as_ref().map(|p| p.display().to_string()),
             package_dirs: self
                 .package_dirs
@@ -367,26 +364,10 @@ impl PoolOpts {
                 .map(|p| p.display().to_string())
                 .collect(),
             clearance: self.clearance,
-            ..CollisionSpec::default()
+            obstacles,
+            floor: self.floor,
         };
-        let mut out = Vec::new();
-        if self.self_collision {
-            out.push(PoolFilter::Collision(CollisionFilter::new(CollisionSpec {
-                self_collision: true,
-                always_touching: self
-                    .skip_always_touching
-                    .then(activecal::collision::AlwaysTouching::default),
-                ..base_spec.clone()
-            })));
-        }
-        if any_obstacle {
-            out.push(PoolFilter::Collision(CollisionFilter::new(CollisionSpec {
-                obstacles,
-                floor: self.floor,
-                srdf: None,
-                ..base_spec
-            })));
-        }
+        let out = choice.filters(chain);
         Ok(out)
     }
 

@@ -22,6 +22,18 @@ pub struct ScoreArgs {
     /// stored joint values are scored.
     #[arg(long, conflicts_with = "poses")]
     pub design: Option<PathBuf>,
+    /// Position noise σ per axis of the measurements, metres: with
+    /// --orientation-noise, sets the weight of a full pose's orientation
+    /// rows (as `select --noise` does) [default: 0.01, as `select`].
+    #[arg(long, value_name = "M", requires = "orientation_noise")]
+    pub noise: Option<f64>,
+    /// Orientation noise σ per axis of a full-pose sensor, radians: the
+    /// design is scored with a radian of orientation weighed as
+    /// `--noise`/RAD metres, as `select --orientation-noise` chooses it
+    /// (and as `calibrate` weighs data by their estimated σ's). Default:
+    /// the robot's orientation scale (1 m/rad).
+    #[arg(long, value_name = "RAD", allow_negative_numbers = true)]
+    pub orientation_noise: Option<f64>,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -96,6 +108,23 @@ fn check_design_options(
     Ok(())
 }
 
+/// The description with its orientation rows weighed as
+/// `--noise`/`--orientation-noise` say (unchanged without them).
+fn weighted(
+    a: &ScoreArgs,
+    mut d: activecal::io::Description,
+) -> Result<activecal::io::Description> {
+    if let Some(so) = a.orientation_noise {
+        if let Some(n) = a.noise
+            && !(n.is_finite() && n > 0.0)
+        {
+            bail!("--noise {n}: the position noise σ must be a finite number > 0 (metres)");
+        }
+        d.robot.orientation_scale = super::select::orientation_scale(&d.robot, a.noise, so)?;
+    }
+    Ok(d)
+}
+
 /// Runs `score`; `given` names the pool options given on the command line
 /// (not defaulted), which must agree with a `--design`.
 pub fn cmd_score(a: ScoreArgs, given: &[&str]) -> Result<()> {
@@ -103,7 +132,9 @@ pub fn cmd_score(a: ScoreArgs, given: &[&str]) -> Result<()> {
         (Some(p), None) => {
             let ids: Vec<usize> = parse_list(p, "--poses")?;
             activecal::io::design::check_unique(&ids)?;
-            let ctx = a.pool.load()?;
+            let ctx = a
+                .pool
+                .load_for(weighted(&a, load_description(&a.pool.robot)?)?)?;
             let positions = ctx.pool.positions_of(&ids)?;
             ScoreReport::new(
                 PoolInfo::new(&ctx.robot, &ctx.pool),
@@ -114,7 +145,7 @@ pub fn cmd_score(a: ScoreArgs, given: &[&str]) -> Result<()> {
         (None, Some(path)) => {
             let d = DesignFile::read(path)?;
             check_design_options(&a, given, &d, path)?;
-            let desc = load_description(&d.robot_ref()?)?;
+            let desc = weighted(&a, load_description(&d.robot_ref()?)?)?;
             let robot = super::design_compliance(desc.robot, &d)?;
             let qs = d
                 .joint_values(&robot)
@@ -136,7 +167,9 @@ pub fn cmd_score(a: ScoreArgs, given: &[&str]) -> Result<()> {
         }
         (None, None) if matches!(a.pool.pool, super::PoolKind::File(_)) => {
             // Every pose of the file: a design written as .csv or .json.
-            let ctx = a.pool.load()?;
+            let ctx = a
+                .pool
+                .load_for(weighted(&a, load_description(&a.pool.robot)?)?)?;
             let all: Vec<usize> = (0..ctx.pool.len()).collect();
             ScoreReport::new(
                 PoolInfo::new(&ctx.robot, &ctx.pool),

@@ -138,10 +138,17 @@ pub struct SelectArgs {
     /// of poses of a pool: NAME=X,Y,Z (base frame, metres; repeatable).
     /// Joint-space samples (--count, default 1000 a socket; --pool-seed)
     /// are projected onto each socket within the limits less --margin,
-    /// and --n are chosen with the contact Jacobian; the predicted
-    /// consistency error is compared with random draws (--seed).
+    /// and --n are chosen with the contact Jacobian for the tool point's
+    /// predicted true error; it and the predicted consistency error are
+    /// compared with random draws (--seed) and the pool's bound.
     #[arg(long = "point", value_name = "NAME=X,Y,Z", allow_hyphen_values = true)]
     pub points: Vec<String>,
+    /// A distance known between two --point sockets, `A,B=METRES`
+    /// (repeatable), as `calibrate` will be given it: it fixes the scale
+    /// that contacts alone leave free, so the design determines one more
+    /// unknown.
+    #[arg(long, value_name = "A,B=METRES", requires = "points")]
+    pub point_distance: Vec<String>,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -152,7 +159,7 @@ pub struct SelectArgs {
 /// without it) and orientation noise `orientation` (radians): each row
 /// then carries the position's σ. Refused for a sensor that measures no
 /// orientation, or a σ that is not a finite number > 0.
-fn orientation_scale(
+pub(super) fn orientation_scale(
     robot: &activecal::model::Robot,
     noise: Option<f64>,
     orientation: f64,

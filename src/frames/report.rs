@@ -43,12 +43,19 @@ pub struct FrameBlock {
     pub rpy_deg: [f64; 3],
     /// Rotation as a unit quaternion `[w, x, y, z]`.
     pub quaternion: [f64; 4],
-    /// σ of xyz (mm), when the fit has a covariance.
+    /// σ of xyz (mm), when the fit has a covariance; `None` (null) for a
+    /// coordinate no estimated unknown moves (see `fixed`).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub sigma_xyz_mm: Option<[f64; 3]>,
-    /// σ of a small rotation about the frame's own x, y, z axes (degrees).
+    pub sigma_xyz_mm: Option<[Option<f64>; 3]>,
+    /// σ of a small rotation about the frame's own x, y, z axes (degrees);
+    /// `None` (null) as for `sigma_xyz_mm`.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub sigma_rotation_deg: Option<[f64; 3]>,
+    pub sigma_rotation_deg: Option<[Option<f64>; 3]>,
+    /// The coordinates held at the file's value (no estimated unknown
+    /// moves them: their σ is not 0, it is undefined), named `x y z rx ry
+    /// rz`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub fixed: Vec<String>,
 }
 
 /// A marker (or the measured point) on the tip link.
@@ -60,9 +67,13 @@ pub struct MarkerBlock {
     pub parent: String,
     /// Position in the tip link's frame (m).
     pub xyz: [f64; 3],
-    /// σ of xyz (mm).
+    /// σ of xyz (mm); `None` (null) for a coordinate no estimated unknown
+    /// moves (see `fixed`).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub sigma_xyz_mm: Option<[f64; 3]>,
+    pub sigma_xyz_mm: Option<[Option<f64>; 3]>,
+    /// The coordinates held at their nominal value (`x y z`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub fixed: Vec<String>,
 }
 
 /// A driven joint's calibrated origin.
@@ -86,15 +97,22 @@ pub struct JointBlock {
     pub delta_rotation_deg: [f64; 3],
     /// Zero offset: the origin's turn about the joint's own axis (degrees).
     pub offset_deg: f64,
-    /// σ of xyz (mm).
+    /// σ of xyz (mm); `None` (null) for a coordinate no estimated unknown
+    /// moves (see `fixed`).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub sigma_xyz_mm: Option<[f64; 3]>,
-    /// σ of the rotation change (degrees).
+    pub sigma_xyz_mm: Option<[Option<f64>; 3]>,
+    /// σ of the rotation change (degrees); `None` (null) as for
+    /// `sigma_xyz_mm`.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub sigma_rotation_deg: Option<[f64; 3]>,
-    /// σ of the offset (degrees).
+    pub sigma_rotation_deg: Option<[Option<f64>; 3]>,
+    /// σ of the offset (degrees); `None` (null) when it is fixed.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub sigma_offset_deg: Option<f64>,
+    pub sigma_offset_deg: Option<Option<f64>>,
+    /// The coordinates held at the file's value (no estimated unknown
+    /// moves them: their σ is not 0, it is undefined), named `x y z rx ry
+    /// rz offset`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub fixed: Vec<String>,
     /// Largest |change / σ| over xyz and the rotation change.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_t: Option<f64>,
@@ -245,9 +263,37 @@ fn frame_block(
         rpy: r,
         rpy_deg: deg(r),
         quaternion: quaternion(t),
-        sigma_xyz_mm: s.map(|s| mm(s.xyz)),
-        sigma_rotation_deg: s.map(|s| deg(s.rot)),
+        sigma_xyz_mm: s.map(|s| estimated(mm(s.xyz))),
+        sigma_rotation_deg: s.map(|s| estimated(deg(s.rot))),
+        fixed: s.map_or_else(Vec::new, |s| fixed_coordinates(&s.xyz, &s.rot, None)),
     }
+}
+
+/// Names of the coordinates a σ of exactly 0 marks as not estimated: the
+/// split's derivatives below its noise are set to 0 (see
+/// [`super::uncertainty::sigmas`]), so only a coordinate that no estimated
+/// unknown moves has σ 0.
+const COORDINATES: [&str; 6] = ["x", "y", "z", "rx", "ry", "rz"];
+
+/// σ's with the not-estimated ones (exactly 0) as `None`.
+fn estimated(v: [f64; 3]) -> [Option<f64>; 3] {
+    v.map(|x| (x != 0.0).then_some(x))
+}
+
+/// The names of the coordinates whose σ is exactly 0 (translation, then
+/// rotation when given, then the joint offset when given).
+fn fixed_coordinates(xyz: &[f64; 3], rot: &[f64], offset: Option<f64>) -> Vec<String> {
+    let mut out: Vec<String> = xyz
+        .iter()
+        .chain(rot)
+        .zip(COORDINATES)
+        .filter(|(v, _)| **v == 0.0)
+        .map(|(_, n)| n.to_string())
+        .collect();
+    if offset == Some(0.0) {
+        out.push("offset".into());
+    }
+    out
 }
 
 /// `a − b` of rpy angles, each wrapped into (−π, π], with `a` replaced by
@@ -286,9 +332,12 @@ fn joint_block(j: &super::JointOrigin, s: Option<(&FrameSigma, f64)>) -> JointBl
         delta_rpy_deg: deg(dr),
         delta_rotation_deg: deg(rot.into()),
         offset_deg: j.offset().to_degrees(),
-        sigma_xyz_mm: s.map(|(s, _)| mm(s.xyz)),
-        sigma_rotation_deg: s.map(|(s, _)| deg(s.rot)),
-        sigma_offset_deg: s.map(|(_, o)| o.to_degrees()),
+        sigma_xyz_mm: s.map(|(s, _)| estimated(mm(s.xyz))),
+        sigma_rotation_deg: s.map(|(s, _)| estimated(deg(s.rot))),
+        sigma_offset_deg: s.map(|(_, o)| (o != 0.0).then(|| o.to_degrees())),
+        fixed: s.map_or_else(Vec::new, |(s, o)| {
+            fixed_coordinates(&s.xyz, &s.rot, Some(o))
+        }),
         max_t,
     }
 }
@@ -329,7 +378,9 @@ impl FramesReport {
                     name: "point".into(),
                     parent: src.tip.clone(),
                     xyz: f.tool.translation.vector.into(),
-                    sigma_xyz_mm: sigma.map(|s| mm(s.tool.xyz)),
+                    sigma_xyz_mm: sigma.map(|s| estimated(mm(s.tool.xyz))),
+                    fixed: sigma
+                        .map_or_else(Vec::new, |s| fixed_coordinates(&s.tool.xyz, &[], None)),
                 }],
             ),
             MeasurementKind::Markers(_) => (
@@ -341,7 +392,9 @@ impl FramesReport {
                         name: format!("marker{}", k + 1),
                         parent: src.tip.clone(),
                         xyz: (*m).into(),
-                        sigma_xyz_mm: sigma.map(|s| mm(s.markers[k])),
+                        sigma_xyz_mm: sigma.map(|s| estimated(mm(s.markers[k]))),
+                        fixed: sigma
+                            .map_or_else(Vec::new, |s| fixed_coordinates(&s.markers[k], &[], None)),
                     })
                     .collect(),
             ),

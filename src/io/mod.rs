@@ -4,6 +4,7 @@
 
 pub mod atomic;
 pub mod calibrated;
+pub mod collision_choice;
 pub mod contact_design;
 pub mod contacts;
 pub mod design;

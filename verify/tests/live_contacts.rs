@@ -107,7 +107,10 @@ fn selected_configurations_reach_the_socket_in_pinocchio() {
         .fold(0.0f64, f64::max);
     println!(
         "predicted {:.4} σ, random median {:.4} σ ({:.3}×), bound {:.4} σ; largest distance to the socket by Pinocchio: {worst:.3e} m",
-        d.predicted_sigma, d.random.median_sigma, d.ratio_to_random, d.bound.certified_sigma
+        d.consistency.predicted_sigma,
+        d.consistency.random.median_sigma,
+        d.consistency.ratio_to_random,
+        d.consistency.bound.certified_sigma
     );
     // NaN fails too.
     assert!(worst <= 1e-4, "{worst} m");

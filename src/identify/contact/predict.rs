@@ -13,8 +13,10 @@
 //! best rigid motion between the two models' tool points.
 
 use super::fit::ContactFit;
+use super::select::SocketPool;
 use crate::blocks::jacobian_of;
-use crate::model::MeasurementKind;
+use crate::model::{MeasurementKind, ParamTable, Robot};
+use nalgebra::DMatrix;
 use serde::Serialize;
 
 /// Configurations the prediction is taken over.
@@ -39,33 +41,78 @@ pub fn predicted_true_error(
     seed: u64,
 ) -> Option<PredictedTrueError> {
     let cov = fit.covariance.as_ref()?;
-    let n_kin = fit.robot.n_unknowns();
-    let p = n_kin + 3;
+    let p = fit.robot.n_unknowns() + 3;
     if cov.len() < p || configurations == 0 {
         return None;
     }
-    // The tool point as a one-marker sensor at the fitted offset, with the
-    // fit's unknowns: columns are the robot's unknowns, then the offset —
-    // the first `p` of the fit's.
-    let mut tool = fit.robot.clone();
+    let (w, used) = tool_point_moment(
+        &fit.robot,
+        &fit.table,
+        fit.tool_offset,
+        configurations,
+        seed,
+    );
+    // tr(C W): the mean over configurations of tr(J C Jᵀ).
+    let trace: f64 = (0..p)
+        .flat_map(|a| (0..p).map(move |c| (a, c)))
+        .map(|(a, c)| cov[a][c] * w[(c, a)])
+        .sum();
+    Some(PredictedTrueError {
+        rms_mm: trace.max(0.0).sqrt() * 1e3,
+        configurations: used,
+    })
+}
+
+/// The tool point's second moment `W = Σ_q J_qᵀ J_q / N` over `configurations`
+/// generic configurations of `seed` (`J_q` the 3 rows of the tool point at
+/// `tool_offset` in the end frame, columns `robot`'s unknowns then the
+/// offset): `tr(C W)` is the mean squared true error of the tool point for a
+/// covariance `C` of those unknowns. Returns `W` and `N`.
+#[must_use]
+pub fn tool_point_moment(
+    robot: &Robot,
+    table: &ParamTable,
+    tool_offset: [f64; 3],
+    configurations: usize,
+    seed: u64,
+) -> (DMatrix<f64>, usize) {
+    // The tool point as a one-marker sensor at the offset: columns are the
+    // robot's unknowns, then the offset.
+    let mut tool = robot.clone();
     tool.measurement = MeasurementKind::Markers(1);
-    let mut table = fit.table.clone();
-    table.markers = vec![fit.tool_offset];
-    let qs = crate::observability::generic_configurations(&fit.robot, configurations, seed);
+    let mut table = table.clone();
+    table.markers = vec![tool_offset];
+    let qs = crate::observability::generic_configurations(robot, configurations, seed);
     let x = jacobian_of(&tool, &table, qs.len(), |k, q| q.copy_from_slice(&qs[k]));
-    let mut sum = 0.0;
+    let p = robot.n_unknowns() + 3;
+    let mut w = DMatrix::zeros(p, p);
     for i in 0..x.n_poses() {
         let b = x.block(i);
-        for r in 0..b.nrows() {
-            for a in 0..p {
-                for c in 0..p {
-                    sum += b[(r, a)] * cov[a][c] * b[(r, c)];
-                }
-            }
-        }
+        let b = DMatrix::from_fn(b.nrows(), p, |r, c| b[(r, c)]);
+        w += b.transpose() * b;
     }
-    Some(PredictedTrueError {
-        rms_mm: (sum.max(0.0) / qs.len() as f64).sqrt() * 1e3,
-        configurations: qs.len(),
-    })
+    (w / qs.len().max(1) as f64, qs.len())
+}
+
+/// The moment of a socket pool's columns whose `tr(M⁻¹ W)` is the tool
+/// point's predicted true error (3-D, squared, in units of σ², σ the contact
+/// noise per coordinate) at [`PREDICTION_CONFIGURATIONS`] generic
+/// configurations: [`tool_point_moment`] of the pool's robot (tool offset
+/// 0, the pool's own) in the leading columns, zero on the sockets' points,
+/// which no configuration away from the sockets sees.
+#[must_use]
+pub fn true_error_moment(pool: &SocketPool, table: &ParamTable, seed: u64) -> DMatrix<f64> {
+    let (w, _) = tool_point_moment(
+        &pool.robot,
+        table,
+        [0.0; 3],
+        PREDICTION_CONFIGURATIONS,
+        seed,
+    );
+    let p = pool.blocks.first().map_or(w.nrows(), DMatrix::ncols);
+    let mut full = DMatrix::zeros(p, p);
+    let k = w.nrows().min(p);
+    full.view_mut((0, 0), (k, k))
+        .copy_from(&w.view((0, 0), (k, k)));
+    full
 }

@@ -17,7 +17,7 @@ use super::project::project_to_point;
 use crate::identify::Calibration;
 use crate::identify::Residuals;
 use crate::identify::undetermined::fix_undetermined_below;
-use crate::measure::contact::ContactSensor;
+use crate::measure::contact::{ContactSensor, KnownDistance};
 use crate::model::{ParamTable, Robot};
 use crate::pool::{Configurations, PoolFilter, PoolSource, PoolSpec, PoolStats};
 use faer::Mat;
@@ -48,6 +48,10 @@ pub struct SocketPool {
     /// Each configuration's 3 × p rows (unknowns: the robot's, the tool
     /// offset, every socket's point).
     pub blocks: Vec<DMatrix<f64>>,
+    /// The known distances' rows (`c × p`, weighted as a fit weighs them,
+    /// [`crate::measure::contact::DISTANCE_WEIGHT`]): information every
+    /// design has, whichever configurations it holds.
+    pub constraints: DMatrix<f64>,
 }
 
 /// Fewest configurations a socket of a pool needs (as a contact file's
@@ -57,31 +61,36 @@ pub const MIN_SOCKET_CONFIGURATIONS: usize = 3;
 /// For each socket, samples `count` configurations uniformly inside the
 /// limits less `margin` and keeps those that project onto it (to `tol`
 /// metres), then builds their Jacobian blocks for the unknowns the pool
-/// determines. A socket that fewer than [`MIN_SOCKET_CONFIGURATIONS`]
+/// determines with the known `distances` between sockets (indices into
+/// `sockets`). A socket that fewer than [`MIN_SOCKET_CONFIGURATIONS`]
 /// samples reach is an error naming it.
 #[allow(clippy::too_many_arguments)]
 pub fn socket_pool<R: Rng + ?Sized>(
     robot: &Robot,
     table: &ParamTable,
     sockets: &[Socket],
+    distances: &[KnownDistance],
     count: usize,
     margin: f64,
     tol: f64,
     rng: &mut R,
 ) -> crate::identify::Result<SocketPool> {
     let file = projected(robot, table, sockets, count, margin, tol, rng)?;
-    determined_pool(robot, table, file)
+    determined_pool(robot, table, file, distances)
 }
 
 /// The pool of the configurations of `file` for the unknowns they
-/// determine (the gauge and the weaker ones fixed).
+/// determine with the known `distances` (the gauge and the weaker ones
+/// fixed): a known distance fixes the scale that contacts alone leave
+/// free, so it adds an unknown a fit estimates.
 pub fn determined_pool(
     robot: &Robot,
     table: &ParamTable,
     file: ContactFile,
+    distances: &[KnownDistance],
 ) -> crate::identify::Result<SocketPool> {
-    let reduced = determined(robot, table, &file)?;
-    Ok(pool_of(&reduced, table, file))
+    let reduced = determined(robot, table, &file, distances)?;
+    Ok(pool_of(&reduced, table, file, distances))
 }
 
 /// For each socket, `count` configurations sampled uniformly inside the
@@ -185,18 +194,27 @@ pub fn filter_projected(
 }
 
 /// The pool of `file`'s configurations with `robot`'s unknowns as they are
-/// (no gauge or rank reduction): each row's 3 × p block.
-fn pool_of(robot: &Robot, table: &ParamTable, file: ContactFile) -> SocketPool {
-    let x = jacobian(robot, table, &file);
+/// (no gauge or rank reduction): each row's 3 × p block, and the rows of
+/// the known `distances` after them.
+fn pool_of(
+    robot: &Robot,
+    table: &ParamTable,
+    file: ContactFile,
+    distances: &[KnownDistance],
+) -> SocketPool {
+    let x = jacobian(robot, table, &file, distances);
     let p = x.ncols();
-    let blocks = (0..file.qs.len())
+    let n = file.qs.len();
+    let blocks = (0..n)
         .map(|i| DMatrix::from_fn(3, p, |r, c| x[(3 * i + r, c)]))
         .collect();
+    let constraints = DMatrix::from_fn(x.nrows() - 3 * n, p, |r, c| x[(3 * n + r, c)]);
     SocketPool {
         robot: robot.clone(),
         qs: file.qs,
         sockets: file.groups,
         blocks,
+        constraints,
     }
 }
 
@@ -221,7 +239,7 @@ pub fn with_unknowns_of(
         planes: Vec::new(),
         qs,
     };
-    pool_of(&pool.robot, table, file)
+    pool_of(&pool.robot, table, file, &[])
 }
 
 /// The robot without the gauge and the unknowns the pool does not determine.
@@ -229,6 +247,7 @@ fn determined(
     robot: &Robot,
     table: &ParamTable,
     file: &ContactFile,
+    distances: &[KnownDistance],
 ) -> crate::identify::Result<Robot> {
     let gauge = gauge_unknowns(robot, table, &file.qs);
     let mut inner = robot.clone();
@@ -236,14 +255,20 @@ fn determined(
         .filter(|k| !gauge.contains(k))
         .map(|k| robot.unknowns[k])
         .collect();
-    let x = jacobian(&inner, table, file);
+    let x = jacobian(&inner, table, file, distances);
     Ok(fix_undetermined_below(&inner, table, &file.qs, &x, &[], CONTACT_PIVOT_TOL)?.robot)
 }
 
-/// The contact Jacobian of `file` at `table` (tool offset 0, the point at
-/// the mean tool point).
-fn jacobian(robot: &Robot, table: &ParamTable, file: &ContactFile) -> Mat<f64> {
-    let sensor = ContactSensor::new(file.points.clone(), Vec::new());
+/// The contact Jacobian of `file` with the known `distances` at `table`
+/// (tool offset 0, the point at the mean tool point): the poses' rows, then
+/// the distances'.
+fn jacobian(
+    robot: &Robot,
+    table: &ParamTable,
+    file: &ContactFile,
+    distances: &[KnownDistance],
+) -> Mat<f64> {
+    let sensor = ContactSensor::new(file.points.clone(), distances.to_vec());
     let measured: Vec<f64> = file
         .groups
         .iter()
@@ -258,10 +283,11 @@ fn jacobian(robot: &Robot, table: &ParamTable, file: &ContactFile) -> Mat<f64> {
     x
 }
 
-/// `M = Σ X_iᵀ X_i` over `design`.
-fn information(pool: &SocketPool, design: &[usize]) -> DMatrix<f64> {
-    let p = pool.blocks[0].ncols();
-    let mut m = DMatrix::zeros(p, p);
+/// `M = CᵀC + Σ X_iᵀ X_i` over `design` (`C` the known distances' rows,
+/// [`SocketPool::constraints`]).
+#[must_use]
+pub fn information(pool: &SocketPool, design: &[usize]) -> DMatrix<f64> {
+    let mut m = pool.constraints.transpose() * &pool.constraints;
     for &i in design {
         m += pool.blocks[i].transpose() * &pool.blocks[i];
     }
@@ -303,6 +329,16 @@ pub fn consistency_moment(pool: &SocketPool) -> DMatrix<f64> {
 /// equilibrated information above 1e13).
 #[must_use]
 pub fn predicted_consistency(pool: &SocketPool, design: &[usize]) -> f64 {
+    predicted_error(pool, design, &consistency_moment(pool))
+}
+
+/// The predicted error `√tr(M⁻¹ W)` of `design` for a moment `w` (p × p,
+/// in units of σ²): [`consistency_moment`] gives the consistency error,
+/// `predict::true_error_moment` the tool point's true error.
+/// Infinite when `M` is singular by the shared rank rule (condition of the
+/// equilibrated information above 1e13).
+#[must_use]
+pub fn predicted_error(pool: &SocketPool, design: &[usize], w: &DMatrix<f64>) -> f64 {
     let m = information(pool, design);
     let d: Vec<f64> = (0..m.nrows()).map(|i| m[(i, i)].max(0.0).sqrt()).collect();
     if d.iter().any(|&v| v <= 0.0) {
@@ -313,7 +349,6 @@ pub fn predicted_consistency(pool: &SocketPool, design: &[usize]) -> f64 {
     if eig.min() <= eig.max() / crate::linalg::rank::MAX_CONDITION {
         return f64::INFINITY;
     }
-    let w = consistency_moment(pool);
     let ws = DMatrix::from_fn(w.nrows(), w.ncols(), |i, j| w[(i, j)] / (d[i] * d[j]));
     match scaled.cholesky() {
         Some(ch) => (ch.inverse() * ws).trace().max(0.0).sqrt(),
@@ -322,12 +357,18 @@ pub fn predicted_consistency(pool: &SocketPool, design: &[usize]) -> f64 {
 }
 
 /// Improves `design` by exchanges that lower its predicted consistency
-/// error `tr(M⁻¹ W)` (the I-optimal criterion of [`predicted_consistency`]),
-/// each swap priced by the Sherman–Morrison–Woodbury update, until no swap
-/// lowers it (at most 10 sweeps).
+/// error (see [`refine_for`] with [`consistency_moment`]).
 #[must_use]
-pub fn refine_for_consistency(pool: &SocketPool, mut design: Vec<usize>) -> Vec<usize> {
-    let w = consistency_moment(pool);
+pub fn refine_for_consistency(pool: &SocketPool, design: Vec<usize>) -> Vec<usize> {
+    refine_for(pool, design, &consistency_moment(pool))
+}
+
+/// Improves `design` by exchanges that lower `tr(M⁻¹ W)` for the moment `w`
+/// (an I-optimal criterion, [`predicted_error`]), each swap priced by the
+/// Sherman–Morrison–Woodbury update, until no swap lowers it (at most 10
+/// sweeps).
+#[must_use]
+pub fn refine_for(pool: &SocketPool, mut design: Vec<usize>, w: &DMatrix<f64>) -> Vec<usize> {
     let p = w.nrows();
     let ridge = DMatrix::identity(p, p) * 1e-12 * information(pool, &design).trace() / p as f64;
     // tr((A + BᵀB)⁻¹ W) = tr(A⁻¹W) − tr((I + B A⁻¹ Bᵀ)⁻¹ B A⁻¹ W A⁻¹ Bᵀ).
@@ -345,7 +386,7 @@ pub fn refine_for_consistency(pool: &SocketPool, mut design: Vec<usize>) -> Vec<
             let Some(a_inv) = (information(pool, &rest) + &ridge).try_inverse() else {
                 continue;
             };
-            let g = &a_inv * &w * &a_inv;
+            let g = &a_inv * w * &a_inv;
             let keep = drop(&a_inv, &g, out);
             let best = (0..pool.qs.len())
                 .filter(|i| !design.contains(i))

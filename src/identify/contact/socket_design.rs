@@ -1,21 +1,26 @@
 //! The configurations to record for sockets at given positions, as one
 //! step: a pool projected onto every socket
 //! ([`projected`]; with pool filters, the configurations that pass them,
-//! [`filter_projected`]), a D-optimal choice with the contact Jacobian
-//! exchanged for the predicted consistency error
-//! ([`select_d_optimal`], [`refine_for_consistency`]), and the figures that
-//! judge it: the predicted consistency error of the chosen configurations,
-//! the median (and quartiles) of random draws of as many configurations
-//! from the same pool (the hand-recorded baseline), and the smallest error
-//! any design of the pool can reach ([`consistency_bound`], the convex
-//! relaxation, certified).
+//! [`filter_projected`]) whose unknowns are those a fit with the known
+//! distances between sockets determines, a D-optimal choice with the
+//! contact Jacobian (the distances' rows included) exchanged for the
+//! predicted true error of the tool point — the whole model's covariance
+//! carried to it at generic configurations
+//! ([`select_d_optimal`], [`refine_for`], [`true_error_moment`]) — and the
+//! figures that judge it, for the true error and for the consistency error
+//! held-out contacts measure: the chosen configurations', the median (and
+//! quartiles) of random draws of as many configurations from the same pool
+//! (the hand-recorded baseline), and the smallest error any design of the
+//! pool can reach ([`error_bound`], the convex relaxation, certified).
 
+use super::predict::true_error_moment;
 use super::select::{
-    Socket, SocketPool, determined_pool, filter_projected, predicted_consistency, projected,
-    refine_for_consistency, select_d_optimal,
+    Socket, SocketPool, consistency_moment, determined_pool, filter_projected, information,
+    predicted_error, projected, refine_for, select_d_optimal,
 };
 use super::tool_points;
 use crate::error::Error;
+use crate::measure::contact::KnownDistance;
 use crate::model::{ParamTable, Robot};
 use nalgebra::{DMatrix, Vector3};
 use rand::seq::SliceRandom;
@@ -42,6 +47,12 @@ pub struct SocketDesignSettings {
     /// Filters the projected configurations pass (self-collision,
     /// obstacles), as every pool's do; none by default.
     pub filters: Vec<crate::pool::PoolFilter>,
+    /// Distances known between sockets (indices into the sockets), as the
+    /// fit will be given them: a known distance fixes the scale, which
+    /// contacts alone leave free. None by default.
+    pub distances: Vec<KnownDistance>,
+    /// Seed of the generic configurations the true error is predicted at.
+    pub prediction_seed: u64,
 }
 
 impl Default for SocketDesignSettings {
@@ -57,6 +68,8 @@ impl Default for SocketDesignSettings {
             sample_seed: 0,
             draw_seed: 1,
             filters: Vec::new(),
+            distances: Vec::new(),
+            prediction_seed: 3,
         }
     }
 }
@@ -117,6 +130,23 @@ pub struct ConsistencyBound {
     pub iterations: usize,
 }
 
+/// A design judged by one predicted error (units of σ, the contact noise
+/// per coordinate): the chosen configurations', the D-optimal choice's, random
+/// draws' from the same pool and the pool's certified bound.
+#[derive(Clone, Debug, Serialize)]
+pub struct Judged {
+    /// The D-optimal choice's predicted error, σ.
+    pub d_optimal_sigma: f64,
+    /// The chosen configurations' predicted error, σ.
+    pub predicted_sigma: f64,
+    /// The random baseline.
+    pub random: RandomBaseline,
+    /// `random.median_sigma / predicted_sigma`.
+    pub ratio_to_random: f64,
+    /// The relaxation bound.
+    pub bound: ConsistencyBound,
+}
+
 /// The design for sockets, with its figures. Consistency errors are in
 /// units of σ, the contact noise per coordinate.
 #[derive(Clone, Debug, Serialize)]
@@ -137,17 +167,19 @@ pub struct SocketDesign {
     pub unknowns: usize,
     /// The chosen configurations.
     pub configurations: Vec<ChosenContact>,
-    /// The D-optimal choice's predicted consistency error, σ.
-    pub d_optimal_sigma: f64,
-    /// The chosen configurations' predicted consistency error (the
-    /// D-optimal choice exchanged for it), σ.
-    pub predicted_sigma: f64,
-    /// The random baseline.
-    pub random: RandomBaseline,
-    /// `random.median_sigma / predicted_sigma`.
-    pub ratio_to_random: f64,
-    /// The relaxation bound.
-    pub bound: ConsistencyBound,
+    /// The known distances between sockets the design counts on.
+    pub known_distances: usize,
+    /// The chosen configurations' predicted consistency error (how far a
+    /// calibrated model's contacts scatter about their socket, per
+    /// coordinate), against the D-optimal choice's, random draws' and the
+    /// pool's bound (the keys of earlier versions, kept).
+    #[serde(flatten)]
+    pub consistency: Judged,
+    /// The chosen configurations' predicted true error of the tool point
+    /// (3-D RMS at generic configurations, the whole model's covariance
+    /// carried to it), the criterion they are chosen by, against the
+    /// D-optimal choice's, random draws' and the pool's bound.
+    pub true_error: Judged,
     /// What the pool filters removed of the projected configurations
     /// (absent without a filter).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -166,6 +198,9 @@ pub fn design_for_sockets(
     settings: &SocketDesignSettings,
 ) -> crate::identify::Result<SocketDesign> {
     check(sockets, settings)?;
+    // Steps: projection, D-optimal choice, exchanges, two judgements.
+    let task = crate::progress::Task::start("configurations for the sockets", Some(5));
+    task.note(|| "projecting samples onto the sockets".into());
     let mut rng = crate::identify::trial_rng(settings.sample_seed, 0);
     let file = projected(
         robot,
@@ -182,23 +217,32 @@ pub fn design_for_sockets(
         let (kept, stats) = filter_projected(robot, table, &file, &settings.filters)?;
         (kept, Some(stats))
     };
-    let pool = determined_pool(robot, table, file)?;
+    let pool = determined_pool(robot, table, file, &settings.distances)?;
     let p = pool.blocks[0].ncols();
-    if pool.qs.len() < settings.n || 3 * settings.n < p {
+    if pool.qs.len() < settings.n || 3 * settings.n + pool.constraints.nrows() < p {
         return Err(Error::Invalid(format!(
             "{} configurations: the pool has {} configurations and {p} unknowns (3 rows a configuration: at least {} configurations)",
             settings.n,
             pool.qs.len(),
-            p.div_ceil(3)
+            p.saturating_sub(pool.constraints.nrows()).div_ceil(3)
         ))
         .into());
     }
+    task.inc(1);
+    task.note(|| "D-optimal choice".into());
     let start = select_d_optimal(&pool, settings.n);
-    let d_optimal_sigma = predicted_consistency(&pool, &start);
-    let chosen = refine_for_consistency(&pool, start);
-    let predicted_sigma = predicted_consistency(&pool, &chosen);
-    let random = random_baseline(&pool, settings);
-    let bound = consistency_bound(&pool, settings.n);
+    task.inc(1);
+    task.note(|| "exchanges for the predicted true error".into());
+    let true_w = true_error_moment(&pool, table, settings.prediction_seed);
+    let chosen = refine_for(&pool, start.clone(), &true_w);
+    task.inc(1);
+    task.note(|| "judging: random draws and the bound, consistency".into());
+    let consistency_w = consistency_moment(&pool);
+    let consistency = judged(&pool, &start, &chosen, &consistency_w, settings);
+    task.inc(1);
+    task.note(|| "judging: random draws and the bound, true error".into());
+    let true_error = judged(&pool, &start, &chosen, &true_w, settings);
+    task.inc(1);
     Ok(SocketDesign {
         robot: robot.name.clone(),
         joint_names: crate::units::joint_names(robot),
@@ -208,13 +252,32 @@ pub fn design_for_sockets(
         robot_unknowns: pool.robot.n_unknowns(),
         unknowns: p,
         configurations: chosen_contacts(robot, table, sockets, &pool, &chosen),
-        d_optimal_sigma,
+        known_distances: settings.distances.len(),
+        consistency,
+        true_error,
+        pool_stats,
+    })
+}
+
+/// The D-optimal `start` and the `chosen` configurations judged by the
+/// predicted error of moment `w`, against random draws and the pool's
+/// bound.
+fn judged(
+    pool: &SocketPool,
+    start: &[usize],
+    chosen: &[usize],
+    w: &DMatrix<f64>,
+    settings: &SocketDesignSettings,
+) -> Judged {
+    let predicted_sigma = predicted_error(pool, chosen, w);
+    let random = random_baseline(pool, w, settings);
+    Judged {
+        d_optimal_sigma: predicted_error(pool, start, w),
         predicted_sigma,
         ratio_to_random: random.median_sigma / predicted_sigma,
         random,
-        bound,
-        pool_stats,
-    })
+        bound: error_bound(pool, settings.n, w),
+    }
 }
 
 /// The inputs checked before the pool is built.
@@ -281,15 +344,19 @@ fn chosen_contacts(
         .collect()
 }
 
-/// The predicted consistency errors of `settings.draws` random draws of
+/// The predicted errors (moment `w`) of `settings.draws` random draws of
 /// `settings.n` pool configurations (without replacement).
-fn random_baseline(pool: &SocketPool, settings: &SocketDesignSettings) -> RandomBaseline {
+fn random_baseline(
+    pool: &SocketPool,
+    w: &DMatrix<f64>,
+    settings: &SocketDesignSettings,
+) -> RandomBaseline {
     let mut rng = crate::identify::trial_rng(settings.draw_seed, 1);
     let mut ids: Vec<usize> = (0..pool.qs.len()).collect();
     let mut v: Vec<f64> = (0..settings.draws)
         .map(|_| {
             ids.shuffle(&mut rng);
-            predicted_consistency(pool, &ids[..settings.n])
+            predicted_error(pool, &ids[..settings.n], w)
         })
         .collect();
     v.sort_by(f64::total_cmp);
@@ -312,32 +379,41 @@ fn quantile(v: &[f64], f: f64) -> f64 {
     v[lo] + (x - lo as f64) * (v[hi] - v[lo])
 }
 
-/// Most iterations of [`consistency_bound`].
+/// Most iterations of [`error_bound`].
 pub const BOUND_ITERATIONS: usize = 3000;
 /// Relative distance between the relaxation's value and its certified
-/// bound at which [`consistency_bound`] stops.
+/// bound at which [`error_bound`] stops.
 pub const BOUND_GAP: f64 = 1e-3;
 
-/// The convex relaxation of choosing `n` configurations for the smallest
-/// predicted consistency error: weights `w_q ≥ 0` on the pool summing to
-/// `n`, minimising `φ(w) = tr(M(w)⁻¹ W)` (`M(w) = Σ w_q X_qᵀX_q`, `W` the
-/// [`consistency_moment`](super::select::consistency_moment)), by the
-/// multiplicative algorithm `w_q ← w_q √(n d_q / φ)`, `d_q = tr(X_q M⁻¹ W
-/// M⁻¹ X_qᵀ)` (Silvey–Titterington–Torsney).
-/// Every `n`-configuration design is such a weighting, and for any `M`,
-/// `tr(M⁻¹W) ≥ 2t·φ − t²·tr(M₀⁻¹WM₀⁻¹M)` (completing the square with
-/// `M₀` the weights reached), which at the best `t` gives
-/// `φ* ≥ φ² / (n · max_q d_q)`: the certified bound. Columns are
-/// equilibrated to the pool's unit diagonal first (the trace is unchanged).
+/// [`error_bound`] for the predicted consistency error
+/// ([`consistency_moment`]).
 #[must_use]
 pub fn consistency_bound(pool: &SocketPool, n: usize) -> ConsistencyBound {
-    let (blocks, w_mom) = equilibrated(pool);
-    let (k, p, nf) = (blocks.len(), w_mom.nrows(), n as f64);
+    error_bound(pool, n, &consistency_moment(pool))
+}
+
+/// The convex relaxation of choosing `n` configurations for the smallest
+/// predicted error of moment `w_mom` ([`predicted_error`]): weights
+/// `w_q ≥ 0` on the pool summing to `n`, minimising `φ(w) = tr(M(w)⁻¹ W)`
+/// (`M(w) = M₀ + Σ w_q X_qᵀX_q`, `M₀ = CᵀC` the known distances' rows,
+/// which every design has), by the multiplicative algorithm
+/// `w_q ← w_q √d_q` renormalised to `n`, `d_q = tr(X_q M⁻¹ W M⁻¹ X_qᵀ)`
+/// (Silvey–Titterington–Torsney).
+/// Every `n`-configuration design is such a weighting, and for any `M`,
+/// `tr(M⁻¹W) ≥ 2t·φ − t²·tr(G M)` with `G = M̂⁻¹WM̂⁻¹` at the weights
+/// reached `M̂` (completing the square); `tr(G M) ≤ tr(G M₀) + n · max_q d_q`,
+/// so at the best `t`, `φ* ≥ φ² / (tr(G M₀) + n · max_q d_q)`: the certified
+/// bound. Columns are equilibrated to the pool's unit diagonal first (the
+/// trace is unchanged).
+#[must_use]
+pub fn error_bound(pool: &SocketPool, n: usize, w_mom: &DMatrix<f64>) -> ConsistencyBound {
+    let (blocks, fixed, w_mom) = equilibrated(pool, w_mom);
+    let (k, nf) = (blocks.len(), n as f64);
     let mut w = vec![nf / k as f64; k];
     let (mut phi, mut lower, mut iterations) = (f64::INFINITY, 0.0, 0);
     while iterations < BOUND_ITERATIONS {
         iterations += 1;
-        let mut m = DMatrix::zeros(p, p);
+        let mut m = fixed.clone();
         for (b, &wi) in blocks.iter().zip(&w) {
             m += b.transpose() * b * wi;
         }
@@ -351,12 +427,12 @@ pub fn consistency_bound(pool: &SocketPool, n: usize) -> ConsistencyBound {
             .map(|b| (b * &g * b.transpose()).trace())
             .collect();
         let dmax = d.iter().copied().fold(0.0, f64::max);
-        lower = phi * phi / (nf * dmax);
+        lower = phi * phi / ((&g * &fixed).trace() + nf * dmax);
         if phi - lower <= BOUND_GAP * phi {
             break;
         }
         for (wi, di) in w.iter_mut().zip(&d) {
-            *wi *= (nf * di / phi).sqrt();
+            *wi *= di.max(0.0).sqrt();
         }
         let s: f64 = w.iter().sum();
         w.iter_mut().for_each(|v| *v *= nf / s);
@@ -369,22 +445,21 @@ pub fn consistency_bound(pool: &SocketPool, n: usize) -> ConsistencyBound {
     }
 }
 
-/// The pool's blocks and consistency moment with columns scaled to the
-/// pool information's unit diagonal.
-fn equilibrated(pool: &SocketPool) -> (Vec<DMatrix<f64>>, DMatrix<f64>) {
-    let p = pool.blocks[0].ncols();
-    let mut diag = vec![0.0; p];
-    for b in &pool.blocks {
-        for (c, d) in diag.iter_mut().enumerate() {
-            *d += b.column(c).norm_squared();
-        }
-    }
-    let s: Vec<f64> = diag
-        .iter()
-        .map(|&d| if d > 0.0 { 1.0 / d.sqrt() } else { 1.0 })
+/// The pool's blocks, its fixed information `CᵀC` and the moment `w` with
+/// columns scaled to the pool information's unit diagonal.
+fn equilibrated(
+    pool: &SocketPool,
+    w: &DMatrix<f64>,
+) -> (Vec<DMatrix<f64>>, DMatrix<f64>, DMatrix<f64>) {
+    let all = information(pool, &(0..pool.qs.len()).collect::<Vec<_>>());
+    let s: Vec<f64> = (0..all.nrows())
+        .map(|c| {
+            let d = all[(c, c)];
+            if d > 0.0 { 1.0 / d.sqrt() } else { 1.0 }
+        })
         .collect();
     let scale = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(s));
     let blocks = pool.blocks.iter().map(|b| b * &scale).collect();
-    let w = super::select::consistency_moment(pool);
-    (blocks, &scale * w * &scale)
+    let c = &pool.constraints * &scale;
+    (blocks, c.transpose() * c, &scale * w * &scale)
 }

@@ -1,0 +1,72 @@
+//! The collision filters of a pool, from what the user chose (self-collision,
+//! an SRDF's pairs, obstacles, a floor, a clearance) and the URDF chain the
+//! robot was imported from: one construction for the command line and the
+//! Python package, each of which checks its own arguments first (and names
+//! them in its own terms).
+
+use super::UrdfChain;
+use crate::collision::{AlwaysTouching, CollisionFilter, CollisionSpec, Obstacle};
+use crate::pool::PoolFilter;
+
+/// What the user asked the collision check to do; the defaults check nothing.
+#[derive(Clone, Debug, Default)]
+pub struct CollisionChoice {
+    /// Check every pair of the chain's links (less the SRDF's pairs).
+    pub self_collision: bool,
+    /// Skip pairs of links that touch at every sampled configuration (with
+    /// `self_collision`).
+    pub skip_always_touching: bool,
+    /// An SRDF whose `disable_collisions` pairs are not checked.
+    pub srdf: Option<String>,
+    /// Directories `package://` mesh paths resolve in.
+    pub package_dirs: Vec<String>,
+    /// Distance below which two bodies count as touching, metres.
+    pub clearance: f64,
+    /// Obstacles in the base frame.
+    pub obstacles: Vec<Obstacle>,
+    /// A floor at this height of the base frame, metres.
+    pub floor: Option<f64>,
+}
+
+impl CollisionChoice {
+    /// Whether anything is to be checked.
+    #[must_use]
+    pub fn any(&self) -> bool {
+        self.self_collision || !self.obstacles.is_empty() || self.floor.is_some()
+    }
+
+    /// The pool filters of this choice for the robot of `chain`: one for
+    /// self-collision, one for obstacles and the floor (each only when
+    /// asked for), in that order.
+    #[must_use]
+    pub fn filters(&self, chain: UrdfChain) -> Vec<PoolFilter> {
+        let base_spec = CollisionSpec {
+            urdf: chain.file,
+            text: Some(chain.text),
+            joints: chain.joints,
+            lock: chain.lock,
+            base: Some(chain.base),
+            srdf: self.srdf.clone(),
+            package_dirs: self.package_dirs.clone(),
+            clearance: self.clearance,
+            ..CollisionSpec::default()
+        };
+        let mut out = Vec::new();
+        if self.self_collision {
+            out.push(PoolFilter::Collision(CollisionFilter::new(CollisionSpec {
+                self_collision: true,
+                always_touching: self.skip_always_touching.then(AlwaysTouching::default),
+                ..base_spec.clone()
+            })));
+        }
+        if !self.obstacles.is_empty() || self.floor.is_some() {
+            out.push(PoolFilter::Collision(CollisionFilter::new(CollisionSpec {
+                obstacles: self.obstacles.clone(),
+                floor: self.floor,
+                srdf: None,
+                ..base_spec
+            })));
+        }
+        out
+    }
+}

@@ -96,6 +96,11 @@ pub struct PredictedErrors {
     /// 95th percentile over configurations of the predicted RMS position
     /// error at one configuration, mm.
     pub position_p95_mm: f64,
+    /// 95th percentile of the position error a measured point shows (its
+    /// distance from the prediction, mm): of the error's distribution over
+    /// the configurations and the noise, each configuration's error drawn
+    /// [`ERROR_DRAWS`] times from its Gaussian `N(0, σ² J M⁻¹ Jᵀ)` (seeded).
+    pub position_error_p95_mm: f64,
     /// RMS orientation error angle, degrees (full-pose sensors).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub orientation_rms_deg: Option<f64>,
@@ -297,6 +302,40 @@ fn spd_inverse(m: MatRef<'_, f64>) -> Option<Mat<f64>> {
     Some(Mat::from_fn(p, p, |i, j| inv[(i, j)] / (d[i] * d[j])))
 }
 
+/// Draws of each configuration's position error for
+/// [`PredictedErrors::position_error_p95_mm`].
+pub const ERROR_DRAWS: usize = 32;
+
+/// Appends to `out` [`ERROR_DRAWS`] norms (mm) of a point's position error
+/// `e ~ N(0, cov)`, `cov` a 3×3 covariance (m²), drawn from `rng`.
+fn error_norms(cov: &[[f64; 3]; 3], rng: &mut ChaCha8Rng, out: &mut Vec<f64>) {
+    // Cholesky of a positive semi-definite 3×3, a zero pivot left zero.
+    let mut l = [[0.0f64; 3]; 3];
+    for i in 0..3 {
+        for j in 0..=i {
+            let s: f64 = cov[i][j] - (0..j).map(|k| l[i][k] * l[j][k]).sum::<f64>();
+            l[i][j] = if i == j {
+                s.max(0.0).sqrt()
+            } else if l[j][j] > 0.0 {
+                s / l[j][j]
+            } else {
+                0.0
+            };
+        }
+    }
+    for _ in 0..ERROR_DRAWS {
+        let z: [f64; 3] = std::array::from_fn(|_| {
+            // Box–Muller: a standard normal from two uniforms in (0, 1].
+            let (u1, u2) = (1.0 - rng.random::<f64>(), rng.random::<f64>());
+            (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+        });
+        let e: f64 = (0..3)
+            .map(|i| (0..=i).map(|k| l[i][k] * z[k]).sum::<f64>().powi(2))
+            .sum();
+        out.push(e.sqrt() * 1e3);
+    }
+}
+
 /// The value at quantile `q` (0..=1) of `v` (sorted in place; nearest rank).
 fn quantile(v: &mut [f64], q: f64) -> f64 {
     if v.is_empty() {
@@ -330,7 +369,10 @@ pub fn predicted_errors(
     let points = kinds.iter().filter(|&&k| k == RowKind::Position).count() as f64 / 3.0;
     let full = kinds.contains(&RowKind::Orientation);
     let s2 = noise * noise;
-    let (mut pos, mut ori) = (Vec::new(), Vec::new());
+    // The position rows, a point's three in a row.
+    let rows: Vec<usize> = (0..kinds.len()).filter(|&r| kinds[r] == RowKind::Position).collect();
+    let mut rng = ChaCha8Rng::seed_from_u64(0);
+    let (mut pos, mut ori, mut norms) = (Vec::new(), Vec::new(), Vec::new());
     for i in 0..eval.n_poses() {
         let b = eval.block(i);
         let xc = b * inv.as_ref();
@@ -341,11 +383,20 @@ pub fn predicted_errors(
         }
         pos.push((s2 * tr[0] / points.max(1.0)).sqrt() * 1e3);
         ori.push((s2 * tr[1]).sqrt() / w * 180.0 / std::f64::consts::PI);
+        for t in rows.chunks_exact(3) {
+            let cov: [[f64; 3]; 3] = std::array::from_fn(|a| {
+                std::array::from_fn(|c| {
+                    s2 * (0..b.ncols()).map(|k| xc[(t[a], k)] * b[(t[c], k)]).sum::<f64>()
+                })
+            });
+            error_norms(&cov, &mut rng, &mut norms);
+        }
     }
     let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt();
     Some(PredictedErrors {
         position_rms_mm: rms(&pos),
         position_p95_mm: quantile(&mut pos.clone(), 0.95),
+        position_error_p95_mm: quantile(&mut norms, 0.95),
         orientation_rms_deg: full.then(|| rms(&ori)),
         orientation_p95_deg: full.then(|| quantile(&mut ori, 0.95)),
     })
@@ -478,6 +529,7 @@ mod tests {
             predicted: PredictedErrors {
                 position_rms_mm: rms,
                 position_p95_mm: rms,
+                position_error_p95_mm: rms,
                 orientation_rms_deg: None,
                 orientation_p95_deg: None,
             },
@@ -538,6 +590,51 @@ mod tests {
         assert!(c.position_rms_mm < a.position_rms_mm);
         assert!(a.position_p95_mm >= a.position_rms_mm * 0.5);
         assert!(a.orientation_rms_deg.is_none());
+    }
+
+    /// The error percentile against simulated calibrations: a PUMA
+    /// calibrated from 40 poses with σ = 0.1 mm, 40 noise draws, each
+    /// calibrated model judged at 200 other configurations. The predicted
+    /// 95th percentile of the error is that of the errors seen (within
+    /// 10 %), and closer to it than the percentile of the per-configuration
+    /// RMS.
+    #[test]
+    fn the_error_percentile_is_that_of_simulated_calibrations() {
+        use crate::identify::{LmSettings, identify, simulate};
+        let robot = Robot::puma560();
+        let qs = random_configurations(&robot, 240, 11);
+        let (design, judged) = qs.split_at(40);
+        let x = jacobian_of(&robot, &robot.real, 40, |k, q| q.copy_from_slice(&design[k]));
+        let eval = jacobian_of(&robot, &robot.real, 200, |k, q| q.copy_from_slice(&judged[k]));
+        let sigma = 1e-4;
+        let info = x.information(&(0..40).collect::<Vec<_>>());
+        let p = predicted_errors(&robot, &eval, info.as_ref(), sigma).unwrap();
+        let truth = simulate(&robot, &robot.real, judged, 0.0, &mut ChaCha8Rng::seed_from_u64(0)).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let mut seen = Vec::new();
+        for _ in 0..40 {
+            let meas = simulate(&robot, &robot.real, design, sigma, &mut rng).unwrap();
+            let id = identify(&robot, &robot.nominal, &meas, &LmSettings::default()).unwrap();
+            let got = simulate(&robot, &id.table, judged, 0.0, &mut rng).unwrap();
+            for (a, b) in got.points().iter().zip(truth.points()) {
+                let d: f64 = (0..3).map(|c| (a[c] - b[c]).powi(2)).sum();
+                seen.push(d.sqrt() * 1e3);
+            }
+        }
+        let rms = (seen.iter().map(|v| v * v).sum::<f64>() / seen.len() as f64).sqrt();
+        let p95 = quantile(&mut seen, 0.95);
+        eprintln!(
+            "RMS {} predicted, {rms} seen; 95th percentile of the error {} predicted, {p95} seen (of the RMS: {})",
+            p.position_rms_mm, p.position_error_p95_mm, p.position_p95_mm
+        );
+        assert!((p.position_rms_mm / rms - 1.0).abs() < 0.1, "{} {rms}", p.position_rms_mm);
+        assert!((p.position_error_p95_mm / p95 - 1.0).abs() < 0.1, "{} {p95}", p.position_error_p95_mm);
+        assert!(
+            (p.position_error_p95_mm - p95).abs() < (p.position_p95_mm - p95).abs(),
+            "error p95 {} and RMS p95 {} against {p95} seen",
+            p.position_error_p95_mm,
+            p.position_p95_mm
+        );
     }
 
     #[test]

@@ -321,7 +321,7 @@ fn how_many_text(curve: &PoseCountCurve, noise_is_default: bool) -> String {
         .map(|p| p.n.to_string())
         .collect();
     let mut md = format!(
-        "\n## How many poses\n\nFor N from the fewest whose rows can determine the {} unknowns ({}) to three times that ({hi}), {}{}, the best design the selection finds, its D-efficiency ((det M / det M*)^(1/p), M* the certified bound of every N-pose design of the pool), and the position error predicted after calibrating with it, from its covariance σ² (XᵀX)⁻¹ (no fitting), at {} random configurations within the joint limits (seed {}): the RMS over them, and the 95th percentile of the RMS at one configuration. Sensor noise σ = {noise_mm} mm per coordinate{}.\n\n",
+        "\n## How many poses\n\nFor N from the fewest whose rows can determine the {} unknowns ({}) to three times that ({hi}), {}{}, the best design the selection finds, its D-efficiency ((det M / det M*)^(1/p), M* the certified bound of every N-pose design of the pool), and the position error predicted after calibrating with it, from its covariance σ² (XᵀX)⁻¹ (no fitting), at {} random configurations within the joint limits (seed {}): the RMS over them, the 95th percentile of the error a measured point shows (over the configurations and the noise), and the 95th percentile of the RMS at one configuration. Sensor noise σ = {noise_mm} mm per coordinate{}.\n\n",
         curve.p,
         curve.n_min,
         if curve.step <= 1 {
@@ -342,12 +342,13 @@ fn how_many_text(curve: &PoseCountCurve, noise_is_default: bool) -> String {
             ""
         }
     );
-    md += "| N | D-efficiency | predicted RMS (mm) | predicted 95th percentile (mm) |\n|---|---|---|---|\n";
+    md += "| N | D-efficiency | predicted RMS (mm) | 95th percentile of the error (mm) | 95th percentile of a configuration's RMS (mm) |\n|---|---|---|---|---|\n";
     for p in &curve.points {
+        let e = &p.predicted;
         let _ = writeln!(
             md,
-            "| {} | {:.4} | {:.4} | {:.4} |",
-            p.n, p.d_efficiency, p.predicted.position_rms_mm, p.predicted.position_p95_mm
+            "| {} | {:.4} | {:.4} | {:.4} | {:.4} |",
+            p.n, p.d_efficiency, e.position_rms_mm, e.position_error_p95_mm, e.position_p95_mm
         );
     }
     if let Some(r) = &curve.recommended {
@@ -397,7 +398,7 @@ pub fn selection(
             n: p.n,
             d_efficiency: p.d_efficiency,
             rms_mm: p.predicted.position_rms_mm,
-            p95_mm: p.predicted.position_p95_mm,
+            p95_mm: p.predicted.position_error_p95_mm,
         })
         .collect();
     let noise_mm = curve.noise_m * 1e3;

@@ -313,11 +313,11 @@ fn predicted_text(p: Option<&activecal::report::PredictedAfter>) -> String {
         return String::new();
     };
     let mut s = format!(
-        "predicted after calibrating with these poses (σ {} mm per coordinate): position RMS {:.4} mm at {} random configurations (95th percentile {:.4} mm)",
+        "predicted after calibrating with these poses (σ {} mm per coordinate): position RMS {:.4} mm at {} random configurations (95th percentile of the error {:.4} mm)",
         p.noise_m * 1e3,
         p.errors.position_rms_mm,
         p.configurations,
-        p.errors.position_p95_mm
+        p.errors.position_error_p95_mm
     );
     if let Some(o) = p.errors.orientation_rms_deg {
         s += &format!(", orientation RMS {o:.5}°");

@@ -1,5 +1,5 @@
 //! Errors for bad input. Numerical outcomes (a singular design, a solver that
-//! stalls) are statuses in results, not errors; see the style notes in README.
+//! stalls) are statuses in results, not errors; see docs/contributing.md.
 
 use thiserror::Error;
 

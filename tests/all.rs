@@ -22,6 +22,7 @@ mod cli_safety;
 mod collision;
 mod compliance;
 mod contact_export;
+mod docs_examples;
 mod erd_fixtures;
 mod export_fixtures;
 mod fixtures;

@@ -354,3 +354,158 @@ fn bound_status_is_lowercase_everywhere() {
     ]);
     assert_eq!(s["bound_status"], "certified");
 }
+
+/// A tracker 3 m away and turned 100°: the nominal line first says what
+/// the robot's own geometry is off by (the nominal geometry in the best
+/// rigid placement of the measurement frame, millimetres), then the
+/// as-given figure (metres off); `--json` keeps `nominal_residuals` as
+/// given and adds `nominal_placed_position_rms_mm`.
+#[test]
+fn a_far_tracker_s_nominal_line_leads_with_the_best_rigid_placement() {
+    let dir = std::env::temp_dir().join(format!("activecal-far-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let (design, near, far) = (dir.join("d.json"), dir.join("near.json"), dir.join("far.json"));
+    let robot = [
+        "--robot",
+        "fixtures/example-robot-data/ur5_robot.urdf",
+        "--tip",
+        "tool0",
+        "--marker",
+        "tool0@0.03,-0.02,0.1",
+    ];
+    // The command first, then the robot, then the command's options.
+    fn with<'a>(robot: &[&'a str], cmd: &[&'a str]) -> Vec<&'a str> {
+        cmd[..1].iter().chain(robot).chain(&cmd[1..]).copied().collect()
+    }
+    let sel = ["select", "--pool", "sobol", "--count", "256", "--n", "30", "--out", design.to_str().unwrap()];
+    assert!(run(&with(&robot, &sel)).status.success());
+    let sim = [
+        "calibrate",
+        "--design",
+        design.to_str().unwrap(),
+        "--noise",
+        "5e-5",
+        "--validation",
+        "100",
+        "--save-measurements",
+        near.to_str().unwrap(),
+    ];
+    assert!(run(&with(&robot, &sim)).status.success());
+    let mut m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&near).unwrap()).unwrap();
+    // 100° about z, then 3 m away.
+    let (c, s) = (100f64.to_radians().cos(), 100f64.to_radians().sin());
+    for p in m["points"].as_array_mut().unwrap() {
+        let v: Vec<f64> = p.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        *p = serde_json::json!([c * v[0] - s * v[1] + 2.0, s * v[0] + c * v[1] - 2.2, v[2] + 0.3]);
+    }
+    std::fs::write(&far, m.to_string()).unwrap();
+    let cal = ["calibrate", "--measurements", far.to_str().unwrap()];
+    let v = json_of(&with(&robot, &[&cal[..], &["--json"]].concat()));
+    let placed = v["nominal_placed_position_rms_mm"].as_f64().unwrap();
+    let given = v["nominal_residuals"]["position_rms_mm"].as_f64().unwrap();
+    // The simulated robot is a few mm off its URDF (12.8 mm RMS at the
+    // tour's poses); as given, the points are metres away.
+    assert!(placed > 1.0 && placed < 30.0, "{placed}");
+    assert!(given > 1000.0, "{given}");
+    let out = run(&with(&robot, &cal));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let first = text
+        .find("nominal geometry, best rigid placement of the measurement frame: position RMS")
+        .unwrap_or_else(|| panic!("{text}"));
+    let second = text
+        .find("nominal as given (the measurement frame at the base): position RMS")
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(first < second, "{text}");
+    // Data near the nominal model keep the one nominal line.
+    let out = run(&with(&robot, &["calibrate", "--measurements", near.to_str().unwrap()]));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("\nnominal: position RMS") && !text.contains("best rigid placement"), "{text}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Hints name what the user gave: a URDF on the command line gets `--tip`,
+/// a description file its `tip = "…"` key (and the error no longer tells a
+/// command-line user about descriptions); a missing package mesh names
+/// the directory `--package-dir` should point to.
+#[test]
+fn hints_name_the_option_the_user_actually_used() {
+    let stderr = |args: &[&str]| {
+        let out = run(args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let e = stderr(&["select", "--robot", "fixtures/figaroh/tiago.urdf", "--n", "10"]);
+    assert!(e.contains("hint: --tip LINK names the chain's tip"), "{e}");
+    assert!(!e.contains("description"), "{e}");
+    let dir = std::env::temp_dir().join(format!("activecal-hints-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let toml = dir.join("setup.toml");
+    let urdf = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/figaroh/tiago.urdf");
+    std::fs::write(&toml, format!("urdf = {:?}\n", urdf.to_str().unwrap())).unwrap();
+    let e = stderr(&["robots", "--robot", toml.to_str().unwrap()]);
+    assert!(e.contains("hint: tip = \"LINK\" in the description names the chain's tip"), "{e}");
+    assert!(!e.contains("--tip"), "{e}");
+    let e = stderr(&[
+        "select",
+        "--robot",
+        "fixtures/figaroh/tiago.urdf",
+        "--tip",
+        "arm_tool_link",
+        "--self-collision",
+        "--pool",
+        "sobol",
+        "--count",
+        "64",
+        "--n",
+        "10",
+    ]);
+    assert!(
+        e.contains("hint: --package-dir DIR names a package directory (repeatable): the directory that holds tiago_description/ (or tiago_description itself)"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `calibrate --design … --save-measurements m.csv` writes the CSV a
+/// tracker exports (joint columns, `x1,y1,z1`, a quaternion for full
+/// poses), and calibrating from it gives what the JSON file gives.
+#[test]
+fn simulated_measurements_saved_as_csv_calibrate_as_the_json_does() {
+    let dir = std::env::temp_dir().join(format!("activecal-savecsv-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = |n: &str| dir.join(n).to_str().unwrap().to_string();
+    for (robot, head) in [
+        ("ur5:pose", "q1,q2,q3,q4,q5,q6,x1,y1,z1,qw1,qx1,qy1,qz1"),
+        ("fixtures/ur5.urdf", ""),
+    ] {
+        let d = p("d.json");
+        let _ = std::fs::remove_file(&d);
+        let sel = run(&["select", "--robot", robot, "--levels", "3", "--n", "20", "--out", &d]);
+        assert!(sel.status.success(), "{}", String::from_utf8_lossy(&sel.stderr));
+        for m in ["m.csv", "m.json"] {
+            let _ = std::fs::remove_file(p(m));
+            let args = [
+                "calibrate", "--robot", robot, "--design", &d, "--noise", "1e-4", "--validation", "10",
+                "--save-measurements", &p(m),
+            ];
+            assert!(run(&args).status.success(), "{args:?}");
+        }
+        let csv = std::fs::read_to_string(p("m.csv")).unwrap();
+        assert!(csv.starts_with(head), "{csv}");
+        assert_eq!(csv.lines().count(), 21);
+        let fit = |m: &str| json_of(&["calibrate", "--robot", robot, "--measurements", &p(m), "--json"]);
+        let (a, b) = (fit("m.csv"), fit("m.json"));
+        let est = |v: &serde_json::Value| -> Vec<f64> {
+            v["estimate"].as_object().unwrap().values().map(|x| x.as_f64().unwrap()).collect()
+        };
+        let (ea, eb) = (est(&a), est(&b));
+        assert_eq!(ea.len(), eb.len());
+        for (x, y) in ea.iter().zip(&eb) {
+            assert!((x - y).abs() < 1e-9, "{robot}: {x} vs {y}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -537,3 +537,38 @@ fn exported_descriptions_load_and_carry_the_orientation_scale() {
     fails_with(&["robots", "--export", "nosuch"], "unknown robot 'nosuch'");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `robots` on a URDF says that its "real" rows are made up (a URDF has
+/// no measured values), within the bound it states; the paper's PUMA,
+/// whose real values are the paper's, has no such line.
+#[test]
+fn robots_explains_a_urdf_s_made_up_real_rows() {
+    let out = run(&["robots", "--robot", "fixtures/example-robot-data/ur5_robot.urdf", "--tip", "tool0"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("real: not your robot — the URDF's values with a made-up error of at most 5 mm or 5 mrad on each unknown"),
+        "{text}"
+    );
+    // Each frame's real row, then its nominal row: the differences are
+    // within the stated 5 mm / 5 mrad, and some are not zero.
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .filter(|l| l.contains(" real ") || l.contains(" nom "))
+        .map(|l| {
+            let tail = l.split(if l.contains(" real ") { " real " } else { " nom " }).nth(1).unwrap();
+            tail.split_whitespace().map(|v| v.parse().unwrap()).collect()
+        })
+        .collect();
+    assert!(rows.len() >= 14 && rows.len() % 2 == 0, "{text}");
+    let mut largest: f64 = 0.0;
+    for pair in rows.chunks(2) {
+        for (r, n) in pair[0].iter().zip(&pair[1]) {
+            largest = largest.max((r - n).abs());
+        }
+    }
+    // Printed to 1e-4.
+    assert!(largest > 1e-3 && largest <= 5e-3 + 1e-4, "{largest}");
+    let out = run(&["robots", "--robot", "puma560"]);
+    assert!(!String::from_utf8_lossy(&out.stdout).contains("made-up"));
+}

@@ -135,6 +135,57 @@ fn select_report_draws_the_curve_the_limits_and_the_tour() {
         .as_f64()
         .unwrap();
     assert!(last < first, "{first} -> {last}");
+    // Every size from 6 to 18 (step 1), and the curve's recommendation by
+    // its rule: the knee, recomputed here from the points.
+    assert_eq!(curve["step"], 1);
+    let rms = |k: usize| pts[k]["predicted"]["position_rms_mm"].as_f64().unwrap();
+    let knee = (0..pts.len()).find_map(|i| {
+        let want = ns[i] + (ns[i] * 10).div_ceil(100).max(1);
+        let j = (i + 1..pts.len()).find(|&j| ns[j] >= want)?;
+        (1.0 - rms(j) / rms(i) < 0.05).then_some(ns[i])
+    });
+    let rec = &curve["recommended"];
+    match knee {
+        Some(n) => assert_eq!((rec["rule"].as_str(), rec["n"].as_u64()), (Some("knee"), Some(n))),
+        None => assert_eq!((rec["rule"].as_str(), rec["n"].as_u64()), (Some("no_knee"), Some(18))),
+    }
+    // A target between two sizes' predictions: the smaller size reaching it.
+    let target = 0.5 * (rms(3) + rms(4));
+    let want = ns[(0..pts.len()).find(|&k| rms(k) <= target).unwrap()];
+    let d2 = scratch_dir("reports", "select-target").join("rep");
+    let out = run(&[
+        "--tip",
+        "panda_hand_tcp",
+        "select",
+        "--robot",
+        "fixtures/example-robot-data/panda.urdf:pose",
+        "--pool",
+        "sobol",
+        "--count",
+        "256",
+        "--n",
+        "12",
+        "--starts",
+        "1",
+        "--report",
+        d2.to_str().unwrap(),
+        "--noise",
+        "0.001",
+        "--target-error",
+        &target.to_string(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains(&format!("how many poses: N = {want} recommended, the fewest predicted to reach {target} mm")),
+        "{text}"
+    );
+    let v2: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d2.join("report.json")).unwrap()).unwrap();
+    assert_eq!(v2["how_many_poses"]["recommended"]["rule"], "target");
+    assert_eq!(v2["how_many_poses"]["recommended"]["n"].as_u64(), Some(want));
+    // Without --report there is no curve to read a target from.
+    fails_with(&["select", "--robot", "puma560", "--levels", "3", "--target-error", "1"], "--report");
 }
 
 #[test]

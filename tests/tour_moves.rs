@@ -27,6 +27,7 @@ fn tour_with(
         resolution: 1e-3,
         vias,
         turns: turns.unwrap_or(&none),
+        keep_order: false,
     };
     let mut qs = qs.to_vec();
     let r = check_tour(&space, home, &mut qs, order);
@@ -121,6 +122,40 @@ fn the_tour_is_reordered_around_a_colliding_move_or_reports_it() {
     let c = &r.colliding[0];
     assert_eq!(c.from, None); // from home
     assert_eq!(c.pair.link, "bar");
+}
+
+#[test]
+fn a_kept_order_is_never_changed_to_avoid_a_colliding_move() {
+    // Poses at 1.0, 2.5 and 2.0 visited 2.5 → 1.0 → 2.0: both moves cross
+    // the cube (1.36…1.78 rad). Reversing the last two (2.5 → 2.0 → 1.0)
+    // frees the first move, so the repair reorders; with the user's order
+    // kept (`--order none`) it may not, and both moves are reported.
+    let m = model();
+    let qs = vec![vec![1.0], vec![2.5], vec![2.0]];
+    let models = [&m];
+    let cost = MoveCost::new(&[1.0]).unwrap();
+    let none = vec![None];
+    let run = |keep_order: bool| {
+        let space = MoveSpace {
+            cost: &cost,
+            models: &models,
+            resolution: 1e-3,
+            vias: &[],
+            turns: &none,
+            keep_order,
+        };
+        let mut order = vec![1, 0, 2];
+        let mut q = qs.clone();
+        let r = check_tour(&space, None, &mut q, &mut order);
+        (order, r)
+    };
+    let (order, r) = run(false);
+    assert_ne!(order, vec![1, 0, 2]);
+    assert!(r.reordered && r.colliding.len() == 1, "{r:?}");
+    let (order, r) = run(true);
+    assert_eq!(order, vec![1, 0, 2]);
+    assert!(!r.reordered, "{r:?}");
+    assert_eq!((r.colliding_before, r.colliding.len()), (2, 2), "{r:?}");
 }
 
 #[test]

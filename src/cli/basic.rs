@@ -171,6 +171,10 @@ fn robot_json(r: &Robot) -> Value {
     })
 }
 
+/// The largest made-up error of a URDF robot's "real" parameters (metres
+/// or radians, [`activecal::model::catalogue::perturbation`]).
+const URDF_REAL_MAX: f64 = 5e-3;
+
 /// One robot of `robots`' text: chain, joints with limits, parameter
 /// tables (lengths in metres, angles in radians), unknowns.
 fn robot_text(r: &Robot) -> String {
@@ -203,6 +207,14 @@ fn robot_text(r: &Robot) -> String {
         .max()
         .unwrap_or(5)
         .max(5);
+    if r.source.is_some() {
+        // A URDF has no measured values: say what the "real" rows are.
+        s += &format!(
+            "real: not your robot — the URDF's values with a made-up error of at most {:.0} mm or {:.0} mrad on each unknown: the robot `calibrate --design` simulates measuring (--params real)\n",
+            URDF_REAL_MAX * 1e3,
+            URDF_REAL_MAX * 1e3
+        );
+    }
     s += &format!(
         "{:>w$}  conv    joint   gamma(rad)  alpha(rad)        a(m)        d(m)   beta(rad)   (real | nominal)\n",
         "frame"

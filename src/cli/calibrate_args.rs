@@ -31,8 +31,10 @@ pub struct CalibrateArgs {
         conflicts_with_all = ["design", "trials", "save_measurements", "noise", "validation"]
     )]
     pub measurements: Option<PathBuf>,
-    /// Write the simulated measurements (trial 0 of the seed) to this JSON
-    /// file, in the format `--measurements` reads.
+    /// Write the simulated measurements (trial 0 of the seed) to this file,
+    /// in a format `--measurements` reads: a .csv as a tracker exports it
+    /// (a column per joint, x1,y1,z1 …, qw1,qx1,qy1,qz1 for full poses),
+    /// anything else JSON.
     #[arg(long)]
     pub save_measurements: Option<PathBuf>,
     /// Write the calibrated robot, by extension (repeatable): .urdf — your

@@ -49,16 +49,57 @@ const OPTIONS: &[(&str, &str)] = &[
     ),
 ];
 
+/// The chain's phrases as a description file gives them: a robot read
+/// from a `.toml` description takes its chain from the file's keys, not
+/// from the command line's options.
+const IN_DESCRIPTION: &[(&str, &str)] = &[
+    (
+        "the chain's tip",
+        "tip = \"LINK\" in the description names the chain's tip",
+    ),
+    (
+        "the chain's base",
+        "base = \"LINK\" in the description names the chain's base",
+    ),
+    (
+        "locked joint",
+        "a [lock] table (NAME = VALUE) in the description holds a joint still",
+    ),
+];
+
 /// The options an error's message (its whole chain) calls for, in the
-/// table's order, each once.
+/// table's order, each once: the description's keys instead of the chain
+/// options when the robot came from a description file, and the package
+/// a missing mesh belongs to.
 #[must_use]
-pub fn option_hints(e: &anyhow::Error) -> Vec<&'static str> {
+pub fn option_hints(e: &anyhow::Error) -> Vec<String> {
     let text = format!("{e:#}");
+    let description = text.contains(".toml: ");
     OPTIONS
         .iter()
         .filter(|(phrase, _)| text.contains(phrase))
-        .map(|&(_, hint)| hint)
+        .map(|&(phrase, hint)| {
+            let key = IN_DESCRIPTION.iter().find(|(p, _)| *p == phrase);
+            match key {
+                Some((_, in_file)) if description => (*in_file).to_string(),
+                _ if phrase == "name the package directory" => package_hint(&text, hint),
+                _ => hint.to_string(),
+            }
+        })
         .collect()
+}
+
+/// `--package-dir`'s hint, naming the directory to give when the message
+/// names the package (`… holds package 'PKG'`).
+fn package_hint(text: &str, hint: &str) -> String {
+    let pkg = text
+        .split("holds package '")
+        .nth(1)
+        .and_then(|r| r.split('\'').next());
+    match pkg {
+        Some(pkg) => format!("{hint}: the directory that holds {pkg}/ (or {pkg} itself)"),
+        None => hint.to_string(),
+    }
 }
 
 #[cfg(test)]
@@ -74,5 +115,24 @@ mod tests {
         );
         let e = anyhow::anyhow!("expected 6 joint angles, got 5");
         assert!(option_hints(&e).is_empty());
+    }
+
+    #[test]
+    fn a_description_s_chain_is_named_by_its_keys_and_a_package_by_its_directory() {
+        let tree = "the URDF is a tree with 26 branches below 'base_footprint': choose the measured link as the chain's tip; candidate tips: a, b";
+        let e = anyhow::anyhow!("{tree}").context("tiago.urdf");
+        assert_eq!(option_hints(&e), vec!["--tip LINK names the chain's tip"]);
+        let e = anyhow::anyhow!("{tree}").context("setup.toml: line 1, column 8: tiago.urdf");
+        assert_eq!(
+            option_hints(&e),
+            vec!["tip = \"LINK\" in the description names the chain's tip"]
+        );
+        let e = anyhow::anyhow!(
+            "link 'arm_1_link': mesh 'package://tiago_description/meshes/arm/arm_1.dae' not found (searched the URDF's directory . and its ancestors; name the package directory that holds package 'tiago_description')"
+        );
+        assert_eq!(
+            option_hints(&e),
+            vec!["--package-dir DIR names a package directory (repeatable): the directory that holds tiago_description/ (or tiago_description itself)"]
+        );
     }
 }

@@ -94,7 +94,18 @@ pub fn measured_text(r: &MeasuredReport, id: &Identification, status: &str) -> S
     );
     s += &noise_text(&r.noise);
     s += &format!("fitted:  {}\n", r.residuals.summary());
-    s += &format!("nominal: {}\n", r.nominal_residuals.summary());
+    match r.nominal_placed_position_rms_mm {
+        Some(placed) => {
+            s += &format!(
+                "nominal geometry, best rigid placement of the measurement frame: position RMS {placed:.3} mm\n"
+            );
+            s += &format!(
+                "nominal as given (the measurement frame at the base): {}\n",
+                r.nominal_residuals.summary()
+            );
+        }
+        None => s += &format!("nominal: {}\n", r.nominal_residuals.summary()),
+    }
     if !r.downweighted.is_empty() {
         let v: Vec<String> = r
             .downweighted

@@ -309,6 +309,77 @@ fn joint_rows(robot: &Robot, names: &[String], qs: &[Vec<f64>]) -> Vec<JointRow>
         .collect()
 }
 
+/// The report's "How many poses" section: what the curve is, every size
+/// it computed with its figures, and the size it recommends.
+fn how_many_text(curve: &PoseCountCurve, noise_is_default: bool) -> String {
+    let noise_mm = curve.noise_m * 1e3;
+    let hi = 3 * curve.n_min;
+    let asked: Vec<String> = curve
+        .points
+        .iter()
+        .filter(|p| p.n > hi)
+        .map(|p| p.n.to_string())
+        .collect();
+    let mut md = format!(
+        "\n## How many poses\n\nFor N from the fewest whose rows can determine the {} unknowns ({}) to three times that ({hi}), {}{}, the best design the selection finds, its D-efficiency ((det M / det M*)^(1/p), M* the certified bound of every N-pose design of the pool), and the position error predicted after calibrating with it, from its covariance σ² (XᵀX)⁻¹ (no fitting), at {} random configurations within the joint limits (seed {}): the RMS over them, the 95th percentile of the error a measured point shows (over the configurations and the noise), and the 95th percentile of the RMS at one configuration. Sensor noise σ = {noise_mm} mm per coordinate{}.\n\n",
+        curve.p,
+        curve.n_min,
+        if curve.step <= 1 {
+            "every N".to_string()
+        } else {
+            format!("in steps of up to {} (the table is thinned to 20 sizes)", curve.step)
+        },
+        if asked.is_empty() {
+            String::new()
+        } else {
+            format!(", and N = {} (asked)", asked.join(", "))
+        },
+        curve.configurations,
+        curve.seed,
+        if noise_is_default {
+            " (the default of --noise)"
+        } else {
+            ""
+        }
+    );
+    md += "| N | D-efficiency | predicted RMS (mm) | 95th percentile of the error (mm) | 95th percentile of a configuration's RMS (mm) |\n|---|---|---|---|---|\n";
+    for p in &curve.points {
+        let e = &p.predicted;
+        let _ = writeln!(
+            md,
+            "| {} | {:.4} | {:.4} | {:.4} | {:.4} |",
+            p.n, p.d_efficiency, e.position_rms_mm, e.position_error_p95_mm, e.position_p95_mm
+        );
+    }
+    if let Some(r) = &curve.recommended {
+        md += "\n";
+        md += &recommendation_text(r);
+    }
+    md
+}
+
+/// One line: the size a curve recommends, and why.
+pub fn recommendation_text(r: &activecal::how_many::Recommendation) -> String {
+    use activecal::how_many::{KNEE_GAIN, KNEE_MORE_PERCENT, Recommendation as R};
+    match r {
+        R::Target { n, target_mm, predicted_mm } => format!(
+            "how many poses: N = {n} recommended, the fewest predicted to reach {target_mm} mm (position RMS {predicted_mm:.4} mm)\n"
+        ),
+        R::TargetNotReached { n, target_mm, predicted_mm } => format!(
+            "how many poses: no N of the curve is predicted to reach {target_mm} mm; the closest is N = {n} (position RMS {predicted_mm:.4} mm): a less noisy sensor, or more poses than the curve's range (--n)\n"
+        ),
+        R::Knee { n, next_n, predicted_mm, gain } => format!(
+            "how many poses: N = {n} recommended (position RMS {predicted_mm:.4} mm), the knee of the curve: {KNEE_MORE_PERCENT} % more poses (N = {next_n}) gain {:.1} %, under {:.0} % (--target-error MM: the fewest reaching an error)\n",
+            gain * 100.0,
+            KNEE_GAIN * 100.0
+        ),
+        R::NoKnee { n, predicted_mm } => format!(
+            "how many poses: N = {n} recommended (position RMS {predicted_mm:.4} mm), the curve's largest: {KNEE_MORE_PERCENT} % more poses still gain {:.0} % or more up to its end (--target-error MM: the fewest reaching an error)\n",
+            KNEE_GAIN * 100.0
+        ),
+    }
+}
+
 /// Writes `select --report DIR`: the "how many poses" curve, the selected
 /// poses against the joint limits, the tour when ordered.
 pub fn selection(
@@ -327,7 +398,7 @@ pub fn selection(
             n: p.n,
             d_efficiency: p.d_efficiency,
             rms_mm: p.predicted.position_rms_mm,
-            p95_mm: p.predicted.position_p95_mm,
+            p95_mm: p.predicted.position_error_p95_mm,
         })
         .collect();
     let noise_mm = curve.noise_m * 1e3;
@@ -377,27 +448,7 @@ pub fn selection(
         report.poses.len(),
         report.log10_oid
     );
-    let _ = writeln!(
-        md,
-        "\n## How many poses\n\nFor each N from the fewest whose rows can determine the {} unknowns ({}) to three times that, the best design the selection finds, its D-efficiency ((det M / det M*)^(1/p), M* the certified bound of every N-pose design of the pool), and the position error predicted after calibrating with it, from its covariance σ² (XᵀX)⁻¹ (no fitting), at {} random configurations within the joint limits (seed {}). Sensor noise σ = {noise_mm} mm per coordinate{}.\n",
-        curve.p,
-        curve.n_min,
-        curve.configurations,
-        curve.seed,
-        if noise_is_default {
-            " (the default of --noise)"
-        } else {
-            ""
-        }
-    );
-    md += "| N | D-efficiency | predicted RMS (mm) | predicted 95th percentile (mm) |\n|---|---|---|---|\n";
-    for p in &curve.points {
-        let _ = writeln!(
-            md,
-            "| {} | {:.4} | {:.4} | {:.4} |",
-            p.n, p.d_efficiency, p.predicted.position_rms_mm, p.predicted.position_p95_mm
-        );
-    }
+    md += &how_many_text(curve, noise_is_default);
     if let Some(m) = &report.moves {
         let _ = writeln!(
             md,

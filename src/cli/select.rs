@@ -116,6 +116,12 @@ pub struct SelectArgs {
     /// tour. An existing non-empty directory needs --force.
     #[arg(long, value_name = "DIR")]
     pub report: Option<PathBuf>,
+    /// With --report: the position error you want to reach, mm (RMS at
+    /// random configurations); the curve then recommends the smallest N
+    /// predicted to reach it. Without it, the curve's knee: the smallest N
+    /// where 10 % more poses gain less than 5 %.
+    #[arg(long, value_name = "MM", requires = "report", allow_negative_numbers = true)]
+    pub target_error: Option<f64>,
     /// Sensor noise σ per measured coordinate, metres: the error predicted
     /// after calibrating with the chosen poses is printed (and in --json,
     /// `predicted`), and --report's curve uses it [default there: 0.01, as
@@ -268,7 +274,14 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
             reorder,
             &turns,
         )?;
-        super::tour::check_moves(&mut report, &mut order, &ctx.pool, home.as_deref(), &turns)?;
+        super::tour::check_moves(
+            &mut report,
+            &mut order,
+            &ctx.pool,
+            home.as_deref(),
+            &turns,
+            !reorder,
+        )?;
         // A pose the tour cannot leave or reach freely is exchanged (D
         // criterion, poses of the pool: not refined ones) and the tour
         // planned again, a few times at most.
@@ -306,11 +319,14 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     if let (Some(noise), None) = (a.noise, &existing) {
         report.predicted = predicted_after(&ctx, a.pool.params, &sel.poses, noise);
     }
-    if let Some(dir) = &a.report {
-        report_dir(&a, &ctx, &s, dir, &report)?;
-    }
+    let recommended = match &a.report {
+        Some(dir) => report_dir(&a, &ctx, &s, dir, &report)?,
+        None => None,
+    };
     emit_report(a.json, &report, || {
-        select_text(&a, &ctx, &report, seconds) + &predicted_text(report.predicted.as_ref())
+        select_text(&a, &ctx, &report, seconds)
+            + &predicted_text(report.predicted.as_ref())
+            + &recommended.map_or(String::new(), |r| super::report_dir::recommendation_text(&r))
     })
 }
 
@@ -323,11 +339,11 @@ fn predicted_text(p: Option<&activecal::report::PredictedAfter>) -> String {
         return String::new();
     };
     let mut s = format!(
-        "predicted after calibrating with these poses (σ {} mm per coordinate): position RMS {:.4} mm at {} random configurations (95th percentile {:.4} mm)",
+        "predicted after calibrating with these poses (σ {} mm per coordinate): position RMS {:.4} mm at {} random configurations (95th percentile of the error {:.4} mm)",
         p.noise_m * 1e3,
         p.errors.position_rms_mm,
         p.configurations,
-        p.errors.position_p95_mm
+        p.errors.position_error_p95_mm
     );
     if let Some(o) = p.errors.orientation_rms_deg {
         s += &format!(", orientation RMS {o:.5}°");
@@ -511,19 +527,21 @@ fn design_file(
     Ok(d)
 }
 
-/// `--report DIR`: the "how many poses" curve and the selection's figures.
+/// `--report DIR`: the "how many poses" curve and the selection's figures;
+/// returns the size the curve recommends.
 fn report_dir(
     a: &SelectArgs,
     ctx: &super::PoolCtx,
     s: &Settings,
     dir: &std::path::Path,
     report: &SelectReport,
-) -> Result<()> {
+) -> Result<Option<activecal::how_many::Recommendation>> {
     let mut cs =
         activecal::how_many::CurveSettings::new(s.clone(), a.noise.unwrap_or(DEFAULT_REPORT_NOISE));
     cs.criterion = a.criterion;
     cs.algorithm = a.algorithm;
     cs.also = vec![a.n];
+    cs.target_mm = a.target_error;
     let curve = activecal::how_many::pose_count_curve(
         &ctx.robot,
         ctx.robot.params(a.pool.params),
@@ -531,7 +549,8 @@ fn report_dir(
         &ctx.pool.ids,
         &cs,
     )?;
-    super::report_dir::selection(dir, &ctx.robot, report, &curve, a.noise.is_none())
+    super::report_dir::selection(dir, &ctx.robot, report, &curve, a.noise.is_none())?;
+    Ok(curve.recommended)
 }
 
 /// The text report of `select`.

@@ -60,7 +60,14 @@ pub fn from_design(
     let (mc, mc_seconds) = (sim.monte_carlo.clone(), sim.monte_carlo_seconds);
     let id = &tables.identification;
     if let Some(path) = &a.save_measurements {
-        let text = serde_json::to_string_pretty(&tables.measurements)? + "\n";
+        // A .csv as a tracker's export (what `--measurements` reads back);
+        // anything else JSON.
+        let csv = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+        let text = if csv {
+            activecal::io::measurements::to_csv(&tables.measurements, robot)
+        } else {
+            serde_json::to_string_pretty(&tables.measurements)? + "\n"
+        };
         write_new(path, &text, a.force)?;
     }
     let source = format!("simulated measurements at {}", design_path.display());

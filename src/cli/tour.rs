@@ -85,13 +85,16 @@ fn arrange(
 /// than the clearance (1 mm without one), reorders around colliding moves
 /// (or turns poses' joints by whole turns) where it can, and records what
 /// it found in the report; `order` (as [`order_design`] returned it) is
-/// updated, and so are the report's configurations.
+/// updated, and so are the report's configurations. With `keep_order`
+/// (`--order none`) the poses stay in selection order: only whole turns
+/// and via configurations avoid a colliding move.
 pub fn check_moves(
     report: &mut SelectReport,
     order: &mut Vec<usize>,
     pool: &activecal::pool::Pool,
     home: Option<&[f64]>,
     turns: &[Option<[f64; 2]>],
+    keep_order: bool,
 ) -> Result<()> {
     let (models, clearance) = collision_models(pool)?;
     if models.is_empty() {
@@ -117,6 +120,7 @@ pub fn check_moves(
         resolution: if clearance > 0.0 { clearance } else { 1e-3 },
         vias: &vias,
         turns,
+        keep_order,
     };
     let before = order.clone();
     let moves = activecal::select::moves::check_tour(&space, home, &mut qs, order);

@@ -89,8 +89,12 @@ fn shape_of(
         )),
         urdf_rs::Geometry::Mesh { filename, scale } => {
             let path = resolve(filename, urdf_dir, &spec.package_dirs).ok_or_else(|| {
+                let holds = filename
+                    .strip_prefix("package://")
+                    .and_then(|r| r.split('/').next())
+                    .map_or("it".to_string(), |pkg| format!("package '{pkg}'"));
                 format!(
-                    "link '{link}': mesh '{filename}' not found (searched {}the URDF's directory {} and its ancestors; name the package directory that holds it)",
+                    "link '{link}': mesh '{filename}' not found (searched {}the URDF's directory {} and its ancestors; name the package directory that holds {holds})",
                     spec.package_dirs.iter().map(|d| format!("{d}, ")).collect::<String>(),
                     if urdf_dir.as_os_str().is_empty() {
                         Path::new(".").display()

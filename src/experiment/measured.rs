@@ -96,8 +96,16 @@ pub struct MeasuredReport {
     pub loss: LossChoice,
     /// Errors of the fitted model on the data, mm and degrees.
     pub residuals: ModelErrors,
-    /// Errors of the nominal model on the data.
+    /// Errors of the nominal model on the data, as given (with the best
+    /// marker offsets for it).
     pub nominal_residuals: ModelErrors,
+    /// When the data are far from the nominal model (a tracker metres away
+    /// and turned): the RMS position error, mm, of the nominal geometry
+    /// placed by the rigid motion of the measurement frame (and the
+    /// measured point on the tip) that fits the data best — what the
+    /// robot's own geometry is off by.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nominal_placed_position_rms_mm: Option<f64>,
     /// Each parameter's estimate, change, σ, t and verdict.
     pub parameters: Vec<ParameterTrust>,
     /// Unknowns the data do not determine, fixed at nominal, with why.
@@ -239,11 +247,11 @@ const MOUNT_GAIN: f64 = 200.0;
 /// nominal lies on the last joint's axis, with the tool point the data imply
 /// when they see it off that axis (the unknowns are then chosen where the
 /// data's point is: the slide along the last axis among them); with a note
-/// saying so.
+/// saying so; and when far, the rigid fit's RMS position error (mm).
 fn mounted_start(
     robot: &Robot,
     meas: &Measurements,
-) -> Result<Option<(Robot, String)>, crate::Error> {
+) -> Result<Option<(Robot, String, Option<f64>)>, crate::Error> {
     let Some(src) = robot.source.as_ref() else {
         return Ok(None);
     };
@@ -271,7 +279,7 @@ fn mounted_start(
             r.n_params(),
             robot.n_params()
         );
-        return Ok(Some((r, note)));
+        return Ok(Some((r, note, None)));
     }
     let t = mount.translation.vector;
     let note = format!(
@@ -281,7 +289,7 @@ fn mounted_start(
         t.norm(),
         mount.rotation.angle().to_degrees()
     );
-    Ok(Some((r, note)))
+    Ok(Some((r, note, Some(a.rms_after * 1e3))))
 }
 
 /// A measured point closer than this to the last joint's axis (metres) lies
@@ -389,7 +397,7 @@ fn calibrate_read(
     let given = robot;
     let mounted = mounted_start(robot, meas)?;
     let robot = match &mounted {
-        Some((r, n)) => {
+        Some((r, n, _)) => {
             note(n);
             r
         }
@@ -397,6 +405,7 @@ fn calibrate_read(
     };
     let start = for_measurements(robot, meas, &s.lm).map_err(in_file)?;
     start.notes.iter().for_each(|n| note(n));
+
     let (fitted_robot, without) = match (&s.gravity, s.fit_compliance) {
         (Some(g), true) => {
             let (r, w) = with_compliance(&start.robot, g, meas);
@@ -438,6 +447,7 @@ fn calibrate_read(
         loss: s.loss,
         residuals: res,
         nominal_residuals: nominal,
+        nominal_placed_position_rms_mm: mounted.as_ref().and_then(|m| m.2),
         parameters: params,
         fixed: det.fixed,
         downweighted: f.downweighted(),

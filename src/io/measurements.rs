@@ -105,6 +105,42 @@ pub fn read_in(path: &Path, robot: &Robot, units: Units) -> Result<MeasurementFi
     }
 }
 
+/// The CSV form of `meas` for `robot`, as [`read`] reads it back: a column
+/// per joint (named as a URDF robot's joints, else `q1`…`qN`; radians,
+/// metres for prismatic joints), `x1,y1,z1` (… one triple per marker; metres) and, for full
+/// poses, the orientation as a unit quaternion `qw1,qx1,qy1,qz1`; one row
+/// a pose, every value at full precision.
+#[must_use]
+pub fn to_csv(meas: &Measurements, robot: &Robot) -> String {
+    let k = meas.markers();
+    let full = !meas.orientations().is_empty();
+    let mut head: Vec<String> = if robot.source.is_some() {
+        joint_names(robot)
+    } else {
+        (1..=robot.dof()).map(|j| format!("q{j}")).collect()
+    };
+    for m in 1..=k {
+        head.extend(["x", "y", "z"].iter().map(|c| format!("{c}{m}")));
+    }
+    if full {
+        head.extend(["qw1", "qx1", "qy1", "qz1"].map(String::from));
+    }
+    let mut out = head.join(",") + "\n";
+    for (i, q) in meas.qs().iter().enumerate() {
+        let mut row: Vec<String> = q.iter().map(f64::to_string).collect();
+        for p in &meas.points()[k * i..k * (i + 1)] {
+            row.extend(p.iter().map(f64::to_string));
+        }
+        if let Some(r) = meas.orientations().get(i) {
+            let m = nalgebra::Matrix3::from_row_slice(&r.concat());
+            let u = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(m));
+            row.extend([u.w, u.i, u.j, u.k].iter().map(f64::to_string));
+        }
+        out += &(row.join(",") + "\n");
+    }
+    out
+}
+
 /// Parses measurement CSV `text` (see the module documentation), radians
 /// and metres.
 pub fn parse_csv_measurements(text: &str, origin: &str, robot: &Robot) -> Result<MeasurementFile> {

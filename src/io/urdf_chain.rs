@@ -246,7 +246,7 @@ impl<'u> Tree<'u> {
                     .map(|(l, n)| format!("{l} ({n} joint{})", if *n == 1 { "" } else { "s" }))
                     .collect();
                 Err(format!(
-                    "the URDF is a tree with {} branches below '{base}': choose the measured link as the chain's tip (`tip = \"…\"` in a description); candidate tips: {}",
+                    "the URDF is a tree with {} branches below '{base}': choose the measured link as the chain's tip; candidate tips: {}",
                     many.len(),
                     list_names(&c)
                 ))

@@ -127,7 +127,7 @@ pub struct Settings {
     /// each start climbs to a local optimum of single exchanges (modified
     /// Fedorov), then `k` times exchanges [`kick`](Self::kick) random design
     /// poses, climbs again and keeps the better design: this is what gets
-    /// past the local optima where EAE and Fedorov stop (see the README's
+    /// past the local optima where EAE and Fedorov stop (see docs/bound.md's
     /// "Selection quality").
     pub ils: usize,
     /// Design poses exchanged at random per round of [`ils`](Self::ils)

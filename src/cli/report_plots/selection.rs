@@ -15,7 +15,7 @@ pub struct CurveRow {
     pub d_efficiency: f64,
     /// Predicted RMS position error, mm.
     pub rms_mm: f64,
-    /// Predicted 95th percentile, mm.
+    /// Predicted 95th percentile of the error, mm.
     pub p95_mm: f64,
 }
 
@@ -89,7 +89,7 @@ pub fn how_many(base: &Path, rows: &[CurveRow], chosen: usize, noise_mm: f64) ->
                 AFTER,
                 "RMS",
             ),
-            (&|r: &CurveRow| r.p95_mm, BEFORE, "95th percentile"),
+            (&|r: &CurveRow| r.p95_mm, BEFORE, "95th percentile of the error"),
         ] {
             e.draw_series(LineSeries::new(
                 rows.iter().map(|r| (r.n as f64, f(r))),

@@ -82,6 +82,10 @@ pub struct MoveSpace<'a> {
     pub turns: &'a [Option<[f64; 2]>],
     /// The time a move takes: repairs adding the least are tried first.
     pub cost: &'a MoveCost,
+    /// The order is the user's (selection order kept): a colliding move
+    /// may be avoided by whole turns or a via configuration, never by
+    /// visiting the poses in another order.
+    pub keep_order: bool,
 }
 
 /// What checking a tour's moves found.
@@ -284,7 +288,7 @@ fn via_for(c: &mut Checker<'_>, a: usize, b: usize, vias: &[Vec<f64>]) -> Option
 /// it can: of the 2-opt reversals, Or-opt relocations of one pose and whole
 /// turns of a stretch of poses that replace a colliding move (the home kept
 /// first), the one adding the least move time whose new moves are all free
-/// is applied ([`repair::repair`]); a move that still collides goes through
+/// is applied ([`repair::repair`]; only the turns when `space.keep_order`); a move that still collides goes through
 /// a via configuration from `space.vias` when one makes both its halves
 /// free ([`ViaMove`]). `order` and the turned poses' values in `qs` are
 /// updated.
@@ -319,7 +323,7 @@ pub fn check_tour(
         let bad = c.colliding(&path);
         let Some(next) = bad
             .iter()
-            .find_map(|&i| repair::repair(&mut c, &path, i, first, space.turns))
+            .find_map(|&i| repair::repair(&mut c, &path, i, first, space))
         else {
             break;
         };

@@ -9,7 +9,7 @@
 //! priced by the move time it adds, and the cheapest whose new moves are
 //! all free is applied.
 
-use super::{Checker, End, REPAIR_TRIES};
+use super::{Checker, End, MoveSpace, REPAIR_TRIES};
 use crate::select::turns::{product, turns_within};
 
 /// A change that replaces a colliding move.
@@ -39,19 +39,25 @@ impl Candidate {
 
 /// Replaces the colliding move `path[i] → path[i+1]` (positions before
 /// `first` stay): of the candidate reversals, relocations and turned
-/// stretches, the [`REPAIR_TRIES`] adding the least move time are tried in
-/// that order, and the first whose new moves are all free is applied (a
-/// turned stretch to the checker's poses). Returns the new path.
+/// stretches (only the turned stretches when `space.keep_order`), the
+/// [`REPAIR_TRIES`] adding the least move time are tried in that order,
+/// and the first whose new moves are all free is applied (a turned stretch
+/// to the checker's poses). Returns the new path.
 pub(super) fn repair(
     c: &mut Checker<'_>,
     path: &[usize],
     i: usize,
     first: usize,
-    limits: &[Option<[f64; 2]>],
+    space: &MoveSpace<'_>,
 ) -> Option<Vec<usize>> {
-    let mut all = reversals(c, path, i, first);
-    all.extend(relocations(c, path, i, first));
-    all.extend(stretches(c, path, i, first, limits));
+    let mut all = if space.keep_order {
+        Vec::new()
+    } else {
+        let mut v = reversals(c, path, i, first);
+        v.extend(relocations(c, path, i, first));
+        v
+    };
+    all.extend(stretches(c, path, i, first, space.turns));
     // Stable: on equal times, reorders before turns.
     all.sort_by(|a, b| a.added.total_cmp(&b.added));
     let found = all

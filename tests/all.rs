@@ -11,6 +11,7 @@ mod common;
 mod atomic_writes;
 mod bad_inputs;
 mod bound;
+mod camera;
 mod cli;
 mod cli_contacts;
 mod cli_existing;

@@ -125,6 +125,22 @@ pub struct CameraSensor {
     ones: Vec<f64>,
 }
 
+/// How a camera sees its target at one pose ([`CameraSensor::view`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    /// Points in front of the camera and inside the image with the margin.
+    pub seen: usize,
+    /// The viewing angle, radians: between the target's z axis and the
+    /// line of sight from the camera to the points' centroid. 0 when the
+    /// camera looks straight at the target's face: a target's z axis
+    /// points away from the camera that sees it un-mirrored (OpenCV's
+    /// convention: a checkerboard's x along its rows, y down its columns,
+    /// z = x × y into the board); above 90° the camera sees its back.
+    pub angle: f64,
+    /// The distance from the camera to the points' centroid, metres.
+    pub distance: f64,
+}
+
 /// The frames one pose's rows need.
 struct Frames {
     /// The camera's rotation in its parent, transposed.
@@ -258,6 +274,39 @@ impl CameraSensor {
                 None => [0.0, 0.0, 0.0],
             })
             .collect()
+    }
+
+    /// How the camera sees the target at end frame `end` and own unknowns
+    /// `own`: how many points are in front of it and inside the image at
+    /// least `margin` pixels from its border, the viewing angle and the
+    /// distance of the points' centroid.
+    #[must_use]
+    pub fn view(&self, end: &EndFrame, own: &[f64], margin: f64) -> View {
+        let f = self.frames(end, own);
+        let mut seen = 0;
+        let mut centroid = Vector3::zeros();
+        for k in 0..self.points.len() {
+            let (x, _) = self.point(end, &f, k);
+            centroid += x;
+            seen += usize::from(
+                self.intrinsics
+                    .project(&x)
+                    .is_some_and(|p| self.intrinsics.inside(p.pixel, margin)),
+            );
+        }
+        centroid /= self.points.len().max(1) as f64;
+        // The target's z axis in the optical frame: A maps a direction of
+        // the target's parent to the optical frame (up to the sign of
+        // eye-in-hand's B, which a direction does not share).
+        let normal = f.a * f.rt * Vector3::z();
+        let distance = centroid.norm();
+        View {
+            seen,
+            angle: (normal.dot(&centroid) / distance.max(f64::MIN_POSITIVE))
+                .clamp(-1.0, 1.0)
+                .acos(),
+            distance,
+        }
     }
 
     fn frames(&self, end: &EndFrame, own: &[f64]) -> Frames {

@@ -6,6 +6,7 @@ pub mod bound;
 pub mod calibrate;
 pub mod calibrate_args;
 pub mod calibrated;
+pub mod camera;
 pub mod compliance;
 pub mod contact;
 pub mod contact_evaluate;

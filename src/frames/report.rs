@@ -157,6 +157,10 @@ pub struct FramesReport {
     /// measurement frame.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contacts: Option<ContactsBlock>,
+    /// The camera and target placements of a camera fit
+    /// ([`super::camera`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub camera: Option<super::camera::CameraBlock>,
 }
 
 /// One joint's compliance in the frames file.
@@ -231,7 +235,8 @@ fn deg(v: [f64; 3]) -> [f64; 3] {
     v.map(f64::to_degrees)
 }
 
-fn frame_block(
+/// A frame's block: `t` places `child` in `parent`, with σ's.
+pub(crate) fn frame_block(
     parent: &str,
     child: Option<&str>,
     t: &Isometry3<f64>,
@@ -368,6 +373,7 @@ impl FramesReport {
             fit,
             compliance: std::collections::BTreeMap::new(),
             contacts: None,
+            camera: None,
         }
     }
 }

@@ -268,7 +268,7 @@ distortion_coefficients: !!opencv-matrix
         let cases = [
             (ROS.replace("rows: 3\n  cols: 3\n  data: [900", "rows: 2\n  cols: 3\n  data: [900"), "line 5", "2×3"),
             (ROS.replace("data: [900.0", "data: [-900.0"), "line 5", "focal"),
-            (ROS.replace("plumb_bob", "equidistant"), "line 9", "equidistant"),
+            (ROS.replace("plumb_bob", "equidistant"), "line 8", "equidistant"),
             (ROS.replace("image_width: 1280", "image_width: 0"), "line 1", "image_width"),
             (ROS.replace("640.5", "6400.5"), "line 5", "principal point"),
             (ROS.replace("0.0, 905.0", "0.3, 905.0"), "line 5", "pinhole"),

@@ -1,0 +1,88 @@
+//! The calibrated robot of a camera fit ([`crate::identify::camera`]) in
+//! the user's terms: the split of [`super::decompose`] (measurement frame,
+//! joint origins) and a `camera` block with the camera's and the target's
+//! placements in the URDF's links and the pixel noise.
+//!
+//! The fit places the fixed one of the two (the camera in eye-to-hand,
+//! the target in eye-in-hand) in the model's base frame, which the split's
+//! measurement frame `M` places the chain's base link in: its placement in
+//! the base link is `M⁻¹ T`. The moving one rides on the model's end
+//! frame, which the split's tool `T_tool` places in the tip link: its
+//! placement in the tip link is `T_tool T`. Their σ's are those of the
+//! fit's own placement unknowns (translations along the parent's axes,
+//! small rotations about the placed frame's own axes), the robot's
+//! unknowns held at the estimate: the placements' share of the
+//! covariance.
+
+use super::report::{FrameBlock, FramesReport, frame_block};
+use super::uncertainty::FrameSigma;
+use super::{CalibratedFrames, FramesError, calibrated};
+use crate::identify::camera::CameraFit;
+use crate::measure::camera::Mounting;
+use crate::model::MeasurementKind;
+use serde::Serialize;
+
+/// What the frames file adds for a camera.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct CameraBlock {
+    /// `eye-to-hand` or `eye-in-hand`.
+    pub mounting: Mounting,
+    /// The camera's optical frame (x right, y down, z forward) in its
+    /// link.
+    pub camera: FrameBlock,
+    /// The target's frame in its link.
+    pub target: FrameBlock,
+    /// The pixel noise the fit estimated (σ per image coordinate), px.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pixel_sigma_px: Option<f64>,
+    /// The RMS pixel error at the estimate, px.
+    pub rms_px: f64,
+    /// Rows of seen points (2 per point).
+    pub pixel_rows: usize,
+}
+
+/// The split of a camera fit's robot and its report with the `camera`
+/// block. `None` for a robot not imported from a URDF.
+pub fn camera_frames(fit: &CameraFit) -> Result<Option<(CalibratedFrames, FramesReport)>, FramesError> {
+    let mut robot = fit.robot.clone();
+    // As a full pose: the split's tool is the end frame in the tip link.
+    robot.measurement = MeasurementKind::Pose;
+    let n = robot.n_unknowns();
+    let cov: Option<Vec<Vec<f64>>> = fit
+        .covariance
+        .as_ref()
+        .map(|c| c.iter().take(n).map(|r| r[..n].to_vec()).collect());
+    let Some((f, mut report)) = calibrated(&robot, &fit.table, cov.as_deref(), None)? else {
+        return Ok(None);
+    };
+    // The end frame is the tip link's (no tool frame): the camera block
+    // places what rides on it.
+    report.tool = None;
+    let src = robot.source.as_ref().expect("calibrated gives frames for a URDF robot");
+    let sigma = |k: usize| {
+        fit.std.as_ref().map(|s| FrameSigma {
+            xyz: [s[n + k], s[n + k + 1], s[n + k + 2]],
+            rot: [s[n + k + 3], s[n + k + 4], s[n + k + 5]],
+        })
+    };
+    let (in_base, on_end) = (f.measurement.inverse(), f.tool);
+    let (camera, target) = match fit.sensor.mounting() {
+        Mounting::EyeToHand => (
+            frame_block(&src.base, Some("camera_optical"), &(in_base * fit.camera), sigma(0).as_ref()),
+            frame_block(&src.tip, Some("target"), &(on_end * fit.target), sigma(6).as_ref()),
+        ),
+        Mounting::EyeInHand => (
+            frame_block(&src.tip, Some("camera_optical"), &(on_end * fit.camera), sigma(0).as_ref()),
+            frame_block(&src.base, Some("target"), &(in_base * fit.target), sigma(6).as_ref()),
+        ),
+    };
+    report.camera = Some(CameraBlock {
+        mounting: fit.sensor.mounting(),
+        camera,
+        target,
+        pixel_sigma_px: fit.sigma_px,
+        rms_px: fit.rms_px,
+        pixel_rows: fit.rows,
+    });
+    Ok(Some((f, report)))
+}

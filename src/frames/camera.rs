@@ -3,6 +3,13 @@
 //! joint origins) and a `camera` block with the camera's and the target's
 //! placements in the URDF's links and the pixel noise.
 //!
+//! The frames file mounts the calibrated URDF in the frame of the fixed
+//! one of the two (its `measurement_frame` is the base link's pose in the
+//! camera's optical frame for eye-to-hand, in the target's frame for
+//! eye-in-hand) with the moving one as its `tool` (the target's frame,
+//! or the camera's optical frame, in the tip link), so that a reader of
+//! frames files maps a point of the moving one into the fixed one's frame.
+//!
 //! The fit places the fixed one of the two (the camera in eye-to-hand,
 //! the target in eye-in-hand) in the model's base frame, which the split's
 //! measurement frame `M` places the chain's base link in: its placement in
@@ -55,9 +62,6 @@ pub fn camera_frames(fit: &CameraFit) -> Result<Option<(CalibratedFrames, Frames
     let Some((f, mut report)) = calibrated(&robot, &fit.table, cov.as_deref(), None)? else {
         return Ok(None);
     };
-    // The end frame is the tip link's (no tool frame): the camera block
-    // places what rides on it.
-    report.tool = None;
     let src = robot.source.as_ref().expect("calibrated gives frames for a URDF robot");
     let sigma = |k: usize| {
         fit.std.as_ref().map(|s| FrameSigma {
@@ -76,6 +80,15 @@ pub fn camera_frames(fit: &CameraFit) -> Result<Option<(CalibratedFrames, Frames
             frame_block(&src.base, Some("target"), &(in_base * fit.target), sigma(6).as_ref()),
         ),
     };
+    // Mounted as a frames file mounts any calibration: in the fixed one's
+    // frame (the sensor's), with the moving one as the tool.
+    // (The own unknowns: the camera's from 0, the target's from 6.)
+    let (fixed, moving, moving_own) = match fit.sensor.mounting() {
+        Mounting::EyeToHand => (in_base * fit.camera, on_end * fit.target, 6),
+        Mounting::EyeInHand => (in_base * fit.target, on_end * fit.camera, 0),
+    };
+    report.measurement_frame = frame_block("measurement", Some(&src.base), &fixed.inverse(), None);
+    report.tool = Some(frame_block(&src.tip, None, &moving, sigma(moving_own).as_ref()));
     report.camera = Some(CameraBlock {
         mounting: fit.sensor.mounting(),
         camera,

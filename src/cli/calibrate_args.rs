@@ -186,7 +186,7 @@ pub struct CalibrateArgs {
     /// Where the camera is: eye-to-hand (fixed camera, target on the
     /// flange) or eye-in-hand (camera on the flange, fixed target).
     #[arg(long, value_enum, requires = "observations")]
-    pub mounting: Option<super::camera::MountingArg>,
+    pub mounting: Option<MountingArg>,
     /// The camera's optical frame (z forward, x right, y down), roughly:
     /// in the base link (eye-to-hand) or the tip link (eye-in-hand),
     /// metres and radians (rpy as in URDF). The start of the fit: within a
@@ -222,4 +222,23 @@ pub enum WeightsKind {
     Estimated,
     /// The robot's orientation scale as given.
     Fixed,
+}
+
+/// `--mounting`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MountingArg {
+    /// A fixed camera sees a target on the flange.
+    EyeToHand,
+    /// A camera on the flange sees a fixed target.
+    EyeInHand,
+}
+
+impl From<MountingArg> for activecal::measure::camera::Mounting {
+    fn from(m: MountingArg) -> Self {
+        use activecal::measure::camera::Mounting;
+        match m {
+            MountingArg::EyeToHand => Mounting::EyeToHand,
+            MountingArg::EyeInHand => Mounting::EyeInHand,
+        }
+    }
 }

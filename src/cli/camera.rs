@@ -6,7 +6,7 @@
 //! converged, each file atomically and never over an existing one without
 //! `--force`.
 
-use super::calibrate::CalibrateArgs;
+use super::calibrate_args::CalibrateArgs;
 use activecal::frames::camera::camera_frames;
 use activecal::identify::LmSettings;
 use activecal::identify::camera::{CameraFit, fit_camera};
@@ -14,31 +14,13 @@ use activecal::io::calibrated::{Format, render};
 use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_observations::read_observations;
 use activecal::io::camera_target::read_target;
-use activecal::measure::camera::{CameraSensor, Mounting};
+use activecal::measure::camera::CameraSensor;
 use activecal::model::Robot;
 use anyhow::{Context, Result, bail};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::Path;
-
-/// `--mounting`.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MountingArg {
-    /// A fixed camera sees a target on the flange.
-    EyeToHand,
-    /// A camera on the flange sees a fixed target.
-    EyeInHand,
-}
-
-impl From<MountingArg> for Mounting {
-    fn from(m: MountingArg) -> Self {
-        match m {
-            MountingArg::EyeToHand => Mounting::EyeToHand,
-            MountingArg::EyeInHand => Mounting::EyeInHand,
-        }
-    }
-}
 
 /// Parses `X,Y,Z,ROLL,PITCH,YAW` (metres, radians; rpy as in URDF).
 fn parse_placement(flag: &str, s: &str) -> Result<Isometry3<f64>> {

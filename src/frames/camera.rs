@@ -21,32 +21,12 @@
 //! unknowns held at the estimate: the placements' share of the
 //! covariance.
 
-use super::report::{FrameBlock, FramesReport, frame_block};
+use super::report::{CameraBlock, FramesReport, frame_block};
 use super::uncertainty::FrameSigma;
 use super::{CalibratedFrames, FramesError, calibrated};
 use crate::identify::camera::CameraFit;
 use crate::measure::camera::Mounting;
 use crate::model::MeasurementKind;
-use serde::Serialize;
-
-/// What the frames file adds for a camera.
-#[derive(Clone, Debug, Serialize, PartialEq)]
-pub struct CameraBlock {
-    /// `eye-to-hand` or `eye-in-hand`.
-    pub mounting: Mounting,
-    /// The camera's optical frame (x right, y down, z forward) in its
-    /// link.
-    pub camera: FrameBlock,
-    /// The target's frame in its link.
-    pub target: FrameBlock,
-    /// The pixel noise the fit estimated (σ per image coordinate), px.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub pixel_sigma_px: Option<f64>,
-    /// The RMS pixel error at the estimate, px.
-    pub rms_px: f64,
-    /// Rows of seen points (2 per point).
-    pub pixel_rows: usize,
-}
 
 /// The split of a camera fit's robot and its report with the `camera`
 /// block. `None` for a robot not imported from a URDF.

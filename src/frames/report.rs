@@ -160,7 +160,7 @@ pub struct FramesReport {
     /// The camera and target placements of a camera fit
     /// ([`super::camera`]).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub camera: Option<super::camera::CameraBlock>,
+    pub camera: Option<CameraBlock>,
 }
 
 /// One joint's compliance in the frames file.
@@ -200,6 +200,25 @@ pub struct ContactPlaneBlock {
     pub normal: [f64; 3],
     /// Its offset (m).
     pub offset: f64,
+}
+
+/// What the frames file adds for a camera.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct CameraBlock {
+    /// `eye-to-hand` or `eye-in-hand`.
+    pub mounting: crate::measure::camera::Mounting,
+    /// The camera's optical frame (x right, y down, z forward) in its
+    /// link.
+    pub camera: FrameBlock,
+    /// The target's frame in its link.
+    pub target: FrameBlock,
+    /// The pixel noise the fit estimated (σ per image coordinate), px.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pixel_sigma_px: Option<f64>,
+    /// The RMS pixel error at the estimate, px.
+    pub rms_px: f64,
+    /// Rows of seen points (2 per point).
+    pub pixel_rows: usize,
 }
 
 /// The contact setup a fit found: what the frames file adds for contacts.

@@ -60,6 +60,10 @@ use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vect
 /// Own unknowns of a camera sensor: two placements of 6.
 pub const OWN_PARAMS: usize = 12;
 
+/// Fewest target points a pose must see: a camera places a target from
+/// four points or more (three leave up to four solutions, P3P).
+pub const MIN_POINTS_PER_POSE: usize = 4;
+
 /// Where the camera and the target are.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]

@@ -4,7 +4,8 @@
 //! poses that see at least [`MIN_POINTS_PER_POSE`] of them.
 
 use crate::identify::simulate::fill_standard_normal;
-use crate::io::camera_observations::{CameraObservations, MIN_POINTS_PER_POSE};
+use super::CameraObservations;
+use crate::measure::camera::MIN_POINTS_PER_POSE;
 use crate::kinematics::Evaluator;
 use crate::measure::Sensor;
 use crate::measure::camera::CameraSensor;

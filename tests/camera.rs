@@ -176,6 +176,50 @@ fn true_error(c: &Case, fit: &CameraFit) -> f64 {
     (ss / qs.len() as f64).sqrt()
 }
 
+/// The probe of [`true_error`] for the fit's parameters `theta` (robot
+/// unknowns, then own unknowns in the fit's charts) at `q`.
+fn probe_at(c: &Case, fit: &CameraFit, theta: &[f64], q: &[f64]) -> Vector3<f64> {
+    let n = c.robot.n_unknowns();
+    let table = c.robot.with_unknowns(&c.robot.nominal, &theta[..n]);
+    let (cam, tgt) = fit.sensor.placements(&theta[n..]);
+    let e = Evaluator::new(&c.robot, &table).end_frame(q);
+    let end = Isometry3::from_parts(
+        e.position.into(),
+        UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(e.rotation)),
+    );
+    match fit.sensor.mounting() {
+        Mounting::EyeToHand => (cam.inverse() * end * tgt * Point3::from(board().centroid())).coords,
+        Mounting::EyeInHand => (tgt.inverse() * end * cam * Point3::origin()).coords,
+    }
+}
+
+/// The RMS of [`true_error`]'s figure that the fit's covariance `C`
+/// predicts, metres: `√(mean_q tr(J_q C J_qᵀ))`, `J_q` the probe's
+/// derivative in the parameters by central differences (step 1e-7: the
+/// probe is smooth, O(1) in metres and radians; truncation ~1e-14).
+fn predicted_error(c: &Case, fit: &CameraFit) -> f64 {
+    let cov = fit.covariance.as_ref().expect("a covariance");
+    let p = fit.estimate.len();
+    let qs = generic_configurations(&c.robot, 200, 7);
+    let mut sum = 0.0;
+    for q in &qs {
+        let cols: Vec<Vector3<f64>> = (0..p)
+            .map(|k| {
+                let (mut a, mut b) = (fit.estimate.clone(), fit.estimate.clone());
+                a[k] += 1e-7;
+                b[k] -= 1e-7;
+                (probe_at(c, fit, &a, q) - probe_at(c, fit, &b, q)) / 2e-7
+            })
+            .collect();
+        for i in 0..p {
+            for j in 0..p {
+                sum += cols[i].dot(&cols[j]) * cov[i][j];
+            }
+        }
+    }
+    (sum / qs.len() as f64).sqrt()
+}
+
 /// The truth in the fit's parameters: the robot's true unknowns, then the
 /// true placements in the fit's charts.
 fn truth_vector(c: &Case, fit: &CameraFit) -> Vec<f64> {
@@ -202,6 +246,7 @@ fn noise_free_pixels_recover_the_truth() {
         assert!(fit.given_rms_px > 10.0, "{m:?}: the start is off ({} px)", fit.given_rms_px);
         assert!(fit.rms_px < 1e-6, "{m:?}: {} px", fit.rms_px);
         let e = true_error(&c, &fit);
+        println!("{}: noise-free, true 3-D error {e:.1e} m, {:.1e} px", m.name(), fit.rms_px);
         assert!(e < 1e-9, "{m:?}: true error {} mm", 1e3 * e);
         assert_eq!(fit.estimate.len(), 30);
     }
@@ -227,7 +272,31 @@ fn noisy_pixels_put_every_unknown_within_three_sigma() {
             assert!(z.abs() < 3.0, "{m:?} {name}: {} off by {z:.2}σ", fit.estimate[k]);
         }
         let e = true_error(&c, &fit);
+        println!("{}: σ {s:.4} px, true 3-D error {:.4} mm", m.name(), 1e3 * e);
         assert!(e < 1e-3, "{m:?}: true error {} mm", 1e3 * e);
+    }
+}
+
+/// The true 3-D error (RMS over 10 noise draws at σ 0.3 px) is within
+/// 1.3× of what the fit's covariance predicts, both ways, for both
+/// mountings: the gate for `select --report`'s prediction, here
+/// for the fit's own (one draw's error is a quadratic form dominated by a
+/// few directions and can stray by 2×; ten draws pool ≈ 10× the degrees
+/// of freedom).
+#[test]
+fn true_error_matches_the_predicted_error() {
+    for m in [Mounting::EyeToHand, Mounting::EyeInHand] {
+        let (mut true_ss, mut pred_ss) = (0.0, 0.0);
+        for draw in 0..10 {
+            let c = case(m, 0.3, 100 + draw);
+            let fit = fit_camera(&c.robot, &c.sensor, &c.own_start, &c.obs, &LmSettings::default()).unwrap();
+            assert!(fit.converged, "{m:?} draw {draw}");
+            true_ss += true_error(&c, &fit).powi(2);
+            pred_ss += predicted_error(&c, &fit).powi(2);
+        }
+        let (t, p) = ((true_ss / 10.0).sqrt(), (pred_ss / 10.0).sqrt());
+        println!("{}: true 3-D error {:.4} mm RMS over 10 draws, predicted {:.4} mm", m.name(), 1e3 * t, 1e3 * p);
+        assert!(t < 1.3 * p && p < 1.3 * t, "{m:?}: true {} mm, predicted {} mm", 1e3 * t, 1e3 * p);
     }
 }
 

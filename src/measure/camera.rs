@@ -65,7 +65,7 @@ pub const OWN_PARAMS: usize = 12;
 pub const MIN_POINTS_PER_POSE: usize = 4;
 
 /// Where the camera and the target are.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Mounting {
     /// A fixed camera (placement in the base) sees a target on the end

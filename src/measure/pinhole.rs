@@ -20,7 +20,7 @@ use nalgebra::{Matrix2x3, Matrix3, Vector3};
 
 /// A camera's intrinsics: image size, focal lengths and principal point
 /// (pixels) and plumb_bob distortion.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Intrinsics {
     /// Image width, pixels.
     pub width: u32,

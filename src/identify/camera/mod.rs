@@ -16,6 +16,7 @@
 //! [`super::variance`]), in pixels; the covariance of the estimate is
 //! `σ̂² (XᵀX)⁻¹`.
 
+pub mod predict;
 pub mod simulate;
 pub mod unknowns;
 

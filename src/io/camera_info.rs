@@ -177,14 +177,14 @@ fn build(f: &InfoEntry) -> std::result::Result<Intrinsics, String> {
 
 /// The plumb_bob coefficients `k1, k2, p1, p2, k3`.
 fn distortion(f: &InfoEntry) -> std::result::Result<[f64; 5], String> {
-    if let Some(m) = &f.distortion_model {
-        if m.value != "plumb_bob" {
-            return Err(format!(
-                "{} ('distortion_model'): '{}' is not supported; this camera model reads plumb_bob (k1, k2, p1, p2, k3)",
-                at(m),
-                m.value
-            ));
-        }
+    if let Some(m) = &f.distortion_model
+        && m.value != "plumb_bob"
+    {
+        return Err(format!(
+            "{} ('distortion_model'): '{}' is not supported; this camera model reads plumb_bob (k1, k2, p1, p2, k3)",
+            at(m),
+            m.value
+        ));
     }
     let Some(dm) = &f.distortion_coefficients else {
         return Err(

@@ -19,6 +19,7 @@ use rand::Rng;
 /// (unless the noise carries one out of the image). Poses that
 /// see fewer than 4 points are left out; pose ids are the indices into
 /// `qs`.
+#[allow(clippy::too_many_arguments)]
 pub fn simulate_observations<R: Rng + ?Sized>(
     robot: &Robot,
     table: &ParamTable,

@@ -68,8 +68,9 @@ pub fn camera_robot(robot: &Robot) -> Result<Robot> {
         }
     }
     let mut basis: Vec<Vec<f64>> = Vec::new();
-    for c in all.len()..cols.len() {
-        let _ = independent(&cols[c], &mut basis);
+    // The placements' rigid motions first (independent of each other).
+    for col in &cols[all.len()..] {
+        let _ = independent(col, &mut basis);
     }
     let mut kept: Vec<ParamId> = order
         .into_iter()

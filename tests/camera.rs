@@ -512,3 +512,39 @@ fn cli_refuses_wrong_inputs() {
     common::fails_with(&args, "--angle-unit deg");
     common::fails_with(&EXAMPLE[..12], "--target-pose");
 }
+
+/// `select` for a camera: the chosen poses each see the whole board, one
+/// CSV row a pose with its points seen; an existing --out is refused.
+#[test]
+fn cli_selects_poses_for_a_camera() {
+    let dir = common::scratch_dir("camera", "select");
+    let out = dir.join("design.csv");
+    let o = out.display().to_string();
+    let args = [
+        "select",
+        "--robot",
+        "fixtures/ur5.urdf",
+        "--camera-info",
+        "fixtures/camera/camera_info.yaml",
+        "--target",
+        "fixtures/camera/board.yaml",
+        "--mounting",
+        "eye-to-hand",
+        "--camera-pose=1.2,0.6,0.9,-2.0985,0,2.0779",
+        "--target-pose=-0.0853,0.0568,0.02,3.1416,0,0.03",
+        "--n",
+        "12",
+        "--count",
+        "1500",
+        "--out",
+        &o,
+        "--json",
+    ];
+    let v = common::json_of(&args);
+    assert_eq!(v["n"], 12);
+    assert!(v["points_seen"].as_array().unwrap().iter().all(|s| s == 48), "{v}");
+    let csv = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(csv.lines().count(), 13);
+    assert!(csv.starts_with("candidate,shoulder_pan_joint,") && csv.lines().next().unwrap().ends_with(",points_seen"));
+    common::fails_with(&args, "exists");
+}

@@ -136,6 +136,9 @@ pub struct SelectArgs {
     /// consistency error is compared with random draws (--seed).
     #[arg(long = "point", value_name = "NAME=X,Y,Z", allow_hyphen_values = true)]
     pub points: Vec<String>,
+    /// Poses chosen for a camera (`--camera-info` and its options).
+    #[command(flatten)]
+    pub camera: super::camera_select::CameraOpts,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,

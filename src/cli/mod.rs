@@ -7,6 +7,7 @@ pub mod calibrate;
 pub mod calibrate_args;
 pub mod calibrated;
 pub mod camera;
+pub mod camera_opts;
 pub mod camera_select;
 pub mod compliance;
 pub mod contact;

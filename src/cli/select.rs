@@ -138,7 +138,7 @@ pub struct SelectArgs {
     pub points: Vec<String>,
     /// Poses chosen for a camera (`--camera-info` and its options).
     #[command(flatten)]
-    pub camera: super::camera_select::CameraOpts,
+    pub camera: super::camera_opts::CameraOpts,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,

@@ -189,8 +189,8 @@ pub struct CalibrateArgs {
     pub mounting: Option<MountingArg>,
     /// The camera's optical frame (z forward, x right, y down), roughly:
     /// in the base link (eye-to-hand) or the tip link (eye-in-hand),
-    /// metres and radians (rpy as in URDF). The start of the fit: within a
-    /// few centimetres and degrees.
+    /// metres and radians (rpy as in URDF). The start of the fit: a rough
+    /// guess, with every seen point in front of the camera.
     #[arg(long, value_name = "X,Y,Z,ROLL,PITCH,YAW", allow_hyphen_values = true, requires = "observations")]
     pub camera_pose: Option<String>,
     /// The target's frame (its points' frame), roughly: in the tip link

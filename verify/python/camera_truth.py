@@ -12,7 +12,8 @@ Usage (run with the project venv's python; outputs are JSON or CSV):
       truth.py's format: `tracker` is the base link's pose in the camera's
       optical frame and `tool` the target's frame in the tip link, so that
       `truth.py compare` measures the true error of the target's origin in
-      the camera's frame (and its orientation: `pose` is true).
+      the camera's frame (and its orientation: `pose` is true). --exact:
+      no perturbation (the URDF is the truth).
 
   camera_truth.py observe --truth truth.json --camera-info cam.yaml
                           --board ROWS,COLS,SQUARE --configs q.csv
@@ -25,6 +26,21 @@ Usage (run with the project venv's python; outputs are JSON or CSV):
       camera and inside the image; a configuration with fewer than 4 is
       left out. Written as `activecal calibrate --observations` reads it:
       pose, joints, feature, u, v.
+
+  camera_truth.py handeye --truth truth.json --camera-info cam.yaml
+                          --board ROWS,COLS,SQUARE --observations obs.csv
+                          [--frames cal.yaml] [--n 1000] --seed S
+      OpenCV's hand-eye calibration from the same pixels (eye-to-hand):
+      cv2.solvePnP per pose (camera <- target), the gripper poses from
+      the NOMINAL robot (Pinocchio, the URDF as given: what a hand-eye
+      tool assumes), cv2.calibrateHandEye with each of its five methods
+      (base <- camera), the target on the tip link as the mean over poses
+      of tip <- base <- camera <- target. For each method, and for
+      activecal's frames file (--frames: its measurement_frame is the base
+      link in the camera's frame), against the truth: the camera
+      placement's error (mm, deg) and the true error of the target's
+      origin in the camera's frame at N random configurations (mm RMS;
+      activecal with its calibrated URDF given as --urdf).
 """
 import argparse
 import json
@@ -57,6 +73,8 @@ def cmd_make(a):
     for name in chain.names:
         t = truth.unit(rng) * rng.uniform(0.5e-3, 2e-3)
         w = truth.unit(rng) * math.radians(rng.uniform(0.05, 0.3))
+        if a.exact:
+            t, w = 0.0 * t, 0.0 * w
         joints.append({"name": name, "t": t.tolist(), "w": w.tolist()})
     camera = placement(a.camera, "--camera")
     target = placement(a.target, "--target")
@@ -117,6 +135,79 @@ def cmd_observe(a):
     print(json.dumps({"out": a.out, "poses": poses, "rows": len(lines) - 1, "noise_px": a.noise}))
 
 
+def read_observations(path, names):
+    """{pose: (q, {feature: (u, v)})} of an observation CSV."""
+    lines = [l.strip() for l in open(path) if l.strip()]
+    head = lines[0].split(",")
+    out = {}
+    for l in lines[1:]:
+        row = dict(zip(head, l.split(",")))
+        p = int(row["pose"])
+        q = [float(row[n]) for n in names]
+        out.setdefault(p, (q, {}))[1][int(row["feature"])] = (float(row["u"]), float(row["v"]))
+    return out
+
+
+def mean_se3(ms):
+    """The mean of rigid transforms: translations averaged, rotation the
+    projection of the mean matrix onto SO(3)."""
+    t = np.mean([np.asarray(m.translation) for m in ms], axis=0)
+    u, _, vt = np.linalg.svd(np.mean([np.asarray(m.rotation) for m in ms], axis=0))
+    r = u @ vt
+    if np.linalg.det(r) < 0:
+        r = u @ np.diag([1, 1, -1]) @ vt
+    return truth.se3(r, t)
+
+
+def placement_error(est, want):
+    d = want.inverse() * est
+    return float(np.linalg.norm(d.translation) * 1e3), float(np.degrees(np.linalg.norm(truth.log3(d.rotation))))
+
+
+def cmd_handeye(a):
+    import cv2
+    t = truth.Truth(a.truth)
+    k, dist, _, _ = camera_info(a.camera_info)
+    rows_, cols_, sq = numbers(a.board, 3, "--board")
+    cols_ = int(cols_)
+    obs = read_observations(a.observations, t.chain.names)
+    r_t2c, t_t2c, r_b2g, t_b2g, tips = [], [], [], [], []
+    for p, (q, feats) in sorted(obs.items()):
+        ids = sorted(feats)
+        obj = np.array([[(i % cols_) * sq, (i // cols_) * sq, 0.0] for i in ids])
+        img = np.array([feats[i] for i in ids])
+        ok, rvec, tvec = cv2.solvePnP(obj, img, k, dist, flags=cv2.SOLVEPNP_ITERATIVE)
+        if not ok:
+            continue
+        r_t2c.append(cv2.Rodrigues(rvec)[0])
+        t_t2c.append(tvec.reshape(3))
+        g = t.nominal.relative(q)  # base <- tip, nominal
+        gi = g.inverse()
+        r_b2g.append(np.asarray(gi.rotation))
+        t_b2g.append(np.asarray(gi.translation))
+        tips.append((g, truth.se3(r_t2c[-1], t_t2c[-1])))
+    cam_true = t.tracker.inverse()  # base <- camera
+    rng = np.random.default_rng(a.seed)
+    qs = t.chain.random_configurations(a.n, rng)
+    out = {}
+    methods = {"tsai": cv2.CALIB_HAND_EYE_TSAI, "park": cv2.CALIB_HAND_EYE_PARK,
+               "horaud": cv2.CALIB_HAND_EYE_HORAUD, "andreff": cv2.CALIB_HAND_EYE_ANDREFF,
+               "daniilidis": cv2.CALIB_HAND_EYE_DANIILIDIS}
+    for name, m in methods.items():
+        r, tt = cv2.calibrateHandEye(r_b2g, t_b2g, r_t2c, t_t2c, method=m)
+        cam = truth.se3(r, tt.reshape(3))  # base <- camera (eye-to-hand)
+        target = mean_se3([g.inverse() * cam * c for g, c in tips])  # tip <- target
+        e_t, e_r = placement_error(cam, cam_true)
+        out[name] = {"camera_mm": e_t, "camera_deg": e_r,
+                     "true": truth.errors(t, t.nominal, cam.inverse(), target, qs)}
+    if a.frames:
+        m, tool, _, base, tip, _ = truth.read_frames(a.frames)
+        e_t, e_r = placement_error(m.inverse(), cam_true)
+        cal = truth.Chain(a.urdf, base or t.chain.base, tip or t.chain.tip)
+        out["activecal"] = {"camera_mm": e_t, "camera_deg": e_r, "true": truth.errors(t, cal, m, tool, qs)}
+    print(json.dumps(out))
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="cmd", required=True)
@@ -128,6 +219,7 @@ def main(argv=None):
     m.add_argument("--camera", required=True)
     m.add_argument("--target", required=True)
     m.add_argument("--out", required=True)
+    m.add_argument("--exact", action="store_true", help="no perturbation: the URDF is the truth")
     o = sub.add_parser("observe")
     o.add_argument("--truth", required=True)
     o.add_argument("--camera-info", required=True)
@@ -136,8 +228,17 @@ def main(argv=None):
     o.add_argument("--noise", type=float, default=0.0)
     o.add_argument("--seed", type=int, default=0)
     o.add_argument("--out", required=True)
+    h = sub.add_parser("handeye")
+    h.add_argument("--truth", required=True)
+    h.add_argument("--camera-info", required=True)
+    h.add_argument("--board", required=True)
+    h.add_argument("--observations", required=True)
+    h.add_argument("--frames")
+    h.add_argument("--urdf")
+    h.add_argument("--n", type=int, default=1000)
+    h.add_argument("--seed", type=int, default=1)
     a = p.parse_args(argv)
-    {"make": cmd_make, "observe": cmd_observe}[a.cmd](a)
+    {"make": cmd_make, "observe": cmd_observe, "handeye": cmd_handeye}[a.cmd](a)
 
 
 if __name__ == "__main__":

@@ -36,7 +36,8 @@ distortion_coefficients:
 ";
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let intrinsics = activecal::io::camera_info::parse_camera_info(CAMERA_INFO, "camera_info.yaml")?;
+    let intrinsics =
+        activecal::io::camera_info::parse_camera_info(CAMERA_INFO, "camera_info.yaml")?;
     let target = Target::checkerboard(6, 8, 0.025);
     let robot = camera_robot(&activecal::io::load_robot("fixtures/ur5.urdf")?)?;
     let mut rng = activecal::identify::trial_rng(41, 0);
@@ -58,14 +59,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Translation3::new(0.004, -0.003, 0.02),
         UnitQuaternion::from_euler_angles(std::f64::consts::PI, 0.0, 0.03),
     ) * Translation3::from(-target.centroid());
-    let sensor = CameraSensor::new(intrinsics.clone(), Mounting::EyeToHand, target.points.clone(), &camera, &board);
+    let sensor = CameraSensor::new(
+        intrinsics.clone(),
+        Mounting::EyeToHand,
+        target.points.clone(),
+        &camera,
+        &board,
+    );
     let own = CameraSensor::start_own(&camera, &board);
     let mut ev = Evaluator::new(&robot, &truth);
     let qs: Vec<Vec<f64>> = generic_configurations(&robot, 40_000, 41)
         .into_iter()
         .filter(|q| {
             let v = sensor.view(&ev.end_frame(q), &own, 20.0);
-            v.seen == target.points.len() && v.angle < 60f64.to_radians() && (0.3..2.0).contains(&v.distance)
+            v.seen == target.points.len()
+                && v.angle < 60f64.to_radians()
+                && (0.3..2.0).contains(&v.distance)
         })
         .take(40)
         .collect();
@@ -77,7 +86,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "fixtures/camera/board.yaml",
         "# A 6 × 8 checkerboard (inner corners) of 25 mm squares.\ncheckerboard: {rows: 6, cols: 8, square: 0.025}\n",
     )?;
-    std::fs::write("fixtures/camera/ur5_eye_to_hand.csv", observations_csv(&obs, &robot, &target))?;
+    std::fs::write(
+        "fixtures/camera/ur5_eye_to_hand.csv",
+        observations_csv(&obs, &robot, &target),
+    )?;
     let off = Isometry3::from_parts(
         Translation3::new(0.02, -0.015, 0.01),
         UnitQuaternion::from_euler_angles(0.03, -0.02, 0.025),
@@ -85,7 +97,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let show = |name: &str, t: &Isometry3<f64>| {
         let (r, p, y) = t.rotation.euler_angles();
         let v = t.translation.vector;
-        println!("{name}: {:.4},{:.4},{:.4},{r:.4},{p:.4},{y:.4}", v.x, v.y, v.z);
+        println!(
+            "{name}: {:.4},{:.4},{:.4},{r:.4},{p:.4},{y:.4}",
+            v.x, v.y, v.z
+        );
     };
     show("true camera", &camera);
     show("true target", &board);

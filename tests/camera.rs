@@ -10,7 +10,9 @@ use crate::common;
 use activecal::identify::LmSettings;
 use activecal::identify::camera::simulate::simulate_observations;
 use activecal::identify::camera::{CameraFit, camera_robot, fit_camera};
-use activecal::io::camera_observations::{CameraObservations, observations_csv, parse_observations};
+use activecal::io::camera_observations::{
+    CameraObservations, observations_csv, parse_observations,
+};
 use activecal::io::camera_target::Target;
 use activecal::kinematics::Evaluator;
 use activecal::measure::camera::{CameraSensor, Mounting};
@@ -58,8 +60,10 @@ fn truth_placements(m: Mounting, target: &Target) -> (Isometry3<f64>, Isometry3<
     // The board's face looks along its parent's +z: its own z (into the
     // board) along −z, centred on the parent's axis.
     let face = |t: Vector3<f64>| {
-        Isometry3::from_parts(Translation3::from(t), UnitQuaternion::from_euler_angles(std::f64::consts::PI, 0.0, 0.03))
-            * Translation3::from(-c)
+        Isometry3::from_parts(
+            Translation3::from(t),
+            UnitQuaternion::from_euler_angles(std::f64::consts::PI, 0.0, 0.03),
+        ) * Translation3::from(-c)
     };
     match m {
         Mounting::EyeToHand => (
@@ -94,14 +98,22 @@ fn truth(robot: &Robot, seed: u64) -> ParamTable {
 
 /// `n` configurations at which the true camera sees every point at least
 /// 20 px inside the image, at most 60° off the board's face, 0.3–2 m away.
-fn visible(robot: &Robot, table: &ParamTable, sensor: &CameraSensor, own: &[f64], n: usize) -> Vec<Vec<f64>> {
+fn visible(
+    robot: &Robot,
+    table: &ParamTable,
+    sensor: &CameraSensor,
+    own: &[f64],
+    n: usize,
+) -> Vec<Vec<f64>> {
     let mut ev = Evaluator::new(robot, table);
     let all = generic_configurations(robot, 40_000, 41);
     let out: Vec<Vec<f64>> = all
         .into_iter()
         .filter(|q| {
             let v = sensor.view(&ev.end_frame(q), own, 20.0);
-            v.seen == sensor.points().len() && v.angle < 60f64.to_radians() && (0.3..2.0).contains(&v.distance)
+            v.seen == sensor.points().len()
+                && v.angle < 60f64.to_radians()
+                && (0.3..2.0).contains(&v.distance)
         })
         .take(n)
         .collect();
@@ -139,7 +151,9 @@ fn case_at(mounting: Mounting, sigma: f64, seed: u64, qs: Option<&[Vec<f64>]>) -
         None => visible(&robot, &truth, &sensor, &own_true, 40),
     };
     let mut rng = activecal::identify::trial_rng(seed, 1);
-    let obs = simulate_observations(&robot, &truth, &sensor, &own_true, &qs, sigma, 0.0, &mut rng);
+    let obs = simulate_observations(
+        &robot, &truth, &sensor, &own_true, &qs, sigma, 0.0, &mut rng,
+    );
     let off = Isometry3::from_parts(
         Translation3::new(0.02, -0.015, 0.01),
         UnitQuaternion::from_euler_angles(0.03, -0.02, 0.025),
@@ -166,7 +180,9 @@ fn true_error(c: &Case, fit: &CameraFit) -> f64 {
         let e = Evaluator::new(&c.robot, table).end_frame(q);
         let end = Isometry3::from_parts(
             e.position.into(),
-            UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(e.rotation)),
+            UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(
+                e.rotation,
+            )),
         );
         match fit.sensor.mounting() {
             Mounting::EyeToHand => cam.inverse() * end * tgt * Point3::from(board().centroid()),
@@ -194,10 +210,14 @@ fn probe_at(c: &Case, fit: &CameraFit, theta: &[f64], q: &[f64]) -> Vector3<f64>
     let e = Evaluator::new(&c.robot, &table).end_frame(q);
     let end = Isometry3::from_parts(
         e.position.into(),
-        UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(e.rotation)),
+        UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(
+            e.rotation,
+        )),
     );
     match fit.sensor.mounting() {
-        Mounting::EyeToHand => (cam.inverse() * end * tgt * Point3::from(board().centroid())).coords,
+        Mounting::EyeToHand => {
+            (cam.inverse() * end * tgt * Point3::from(board().centroid())).coords
+        }
         Mounting::EyeInHand => (tgt.inverse() * end * cam * Point3::origin()).coords,
     }
 }
@@ -250,12 +270,27 @@ fn truth_vector(c: &Case, fit: &CameraFit) -> Vec<f64> {
 fn noise_free_pixels_recover_the_truth() {
     for m in [Mounting::EyeToHand, Mounting::EyeInHand] {
         let c = case(m, 0.0, 3);
-        let fit = fit_camera(&c.robot, &c.sensor, &c.own_start, &c.obs, &LmSettings::default()).unwrap();
+        let fit = fit_camera(
+            &c.robot,
+            &c.sensor,
+            &c.own_start,
+            &c.obs,
+            &LmSettings::default(),
+        )
+        .unwrap();
         assert!(fit.converged, "{m:?}: {:?}", fit.stop);
-        assert!(fit.given_rms_px > 10.0, "{m:?}: the start is off ({} px)", fit.given_rms_px);
+        assert!(
+            fit.given_rms_px > 10.0,
+            "{m:?}: the start is off ({} px)",
+            fit.given_rms_px
+        );
         assert!(fit.rms_px < 1e-6, "{m:?}: {} px", fit.rms_px);
         let e = true_error(&c, &fit);
-        println!("{}: noise-free, true 3-D error {e:.1e} m, {:.1e} px", m.name(), fit.rms_px);
+        println!(
+            "{}: noise-free, true 3-D error {e:.1e} m, {:.1e} px",
+            m.name(),
+            fit.rms_px
+        );
         assert!(e < 1e-9, "{m:?}: true error {} mm", 1e3 * e);
         assert_eq!(fit.estimate.len(), 30);
     }
@@ -270,7 +305,14 @@ fn noise_free_pixels_recover_the_truth() {
 fn noisy_pixels_put_every_unknown_within_three_sigma() {
     for m in [Mounting::EyeToHand, Mounting::EyeInHand] {
         let c = case(m, 0.3, 5);
-        let fit = fit_camera(&c.robot, &c.sensor, &c.own_start, &c.obs, &LmSettings::default()).unwrap();
+        let fit = fit_camera(
+            &c.robot,
+            &c.sensor,
+            &c.own_start,
+            &c.obs,
+            &LmSettings::default(),
+        )
+        .unwrap();
         assert!(fit.converged, "{m:?}: {:?}", fit.stop);
         let s = fit.sigma_px.unwrap();
         assert!((s / 0.3 - 1.0).abs() < 0.05, "{m:?}: σ {s} px");
@@ -278,10 +320,18 @@ fn noisy_pixels_put_every_unknown_within_three_sigma() {
         let std = fit.std.as_ref().unwrap();
         for (k, name) in fit.names.iter().enumerate() {
             let z = (fit.estimate[k] - truth[k]) / std[k];
-            assert!(z.abs() < 3.0, "{m:?} {name}: {} off by {z:.2}σ", fit.estimate[k]);
+            assert!(
+                z.abs() < 3.0,
+                "{m:?} {name}: {} off by {z:.2}σ",
+                fit.estimate[k]
+            );
         }
         let e = true_error(&c, &fit);
-        println!("{}: σ {s:.4} px, true 3-D error {:.4} mm", m.name(), 1e3 * e);
+        println!(
+            "{}: σ {s:.4} px, true 3-D error {:.4} mm",
+            m.name(),
+            1e3 * e
+        );
         assert!(e < 1e-3, "{m:?}: true error {} mm", 1e3 * e);
     }
 }
@@ -298,14 +348,31 @@ fn true_error_matches_the_predicted_error() {
         let (mut true_ss, mut pred_ss) = (0.0, 0.0);
         for draw in 0..10 {
             let c = case(m, 0.3, 100 + draw);
-            let fit = fit_camera(&c.robot, &c.sensor, &c.own_start, &c.obs, &LmSettings::default()).unwrap();
+            let fit = fit_camera(
+                &c.robot,
+                &c.sensor,
+                &c.own_start,
+                &c.obs,
+                &LmSettings::default(),
+            )
+            .unwrap();
             assert!(fit.converged, "{m:?} draw {draw}");
             true_ss += true_error(&c, &fit).powi(2);
             pred_ss += predicted_error(&c, &fit).powi(2);
         }
         let (t, p) = ((true_ss / 10.0).sqrt(), (pred_ss / 10.0).sqrt());
-        println!("{}: true 3-D error {:.4} mm RMS over 10 draws, predicted {:.4} mm", m.name(), 1e3 * t, 1e3 * p);
-        assert!(t < 1.3 * p && p < 1.3 * t, "{m:?}: true {} mm, predicted {} mm", 1e3 * t, 1e3 * p);
+        println!(
+            "{}: true 3-D error {:.4} mm RMS over 10 draws, predicted {:.4} mm",
+            m.name(),
+            1e3 * t,
+            1e3 * p
+        );
+        assert!(
+            t < 1.3 * p && p < 1.3 * t,
+            "{m:?}: true {} mm, predicted {} mm",
+            1e3 * t,
+            1e3 * p
+        );
     }
 }
 
@@ -316,7 +383,15 @@ fn observation_files_round_trip_and_refuse_bad_rows() {
     let c = case(Mounting::EyeToHand, 0.3, 9);
     let target = board();
     let text = observations_csv(&c.obs, &c.robot, &target);
-    let read = parse_observations(&text, "obs.csv", &c.robot, &target, &intrinsics(), Units::default()).unwrap();
+    let read = parse_observations(
+        &text,
+        "obs.csv",
+        &c.robot,
+        &target,
+        &intrinsics(),
+        Units::default(),
+    )
+    .unwrap();
     assert_eq!(read.pose_ids, c.obs.pose_ids);
     assert_eq!(read.n_seen(), c.obs.n_seen());
     let lines: Vec<&str> = text.lines().collect();
@@ -339,16 +414,34 @@ fn observation_files_round_trip_and_refuse_bad_rows() {
     }
     let first_pose: String = lines[0].to_string() + "\n" + &lines[1..4].join("\n") + "\n";
     let cases = [
-        (with_line(2, bad_feature.join(",")), "line 3, column 8", "no point 99"),
-        (with_line(3, outside.join(",")), "line 4, column 9", "outside the 1280×960 image"),
+        (
+            with_line(2, bad_feature.join(",")),
+            "line 3, column 8",
+            "no point 99",
+        ),
+        (
+            with_line(3, outside.join(",")),
+            "line 4, column 9",
+            "outside the 1280×960 image",
+        ),
         (first_pose, "pose 0", "3 point(s) seen"),
         (degrees, "shoulder_lift_joint", "degrees"),
     ];
     for (text, place, what) in cases {
-        let e = parse_observations(&text, "obs.csv", &c.robot, &target, &intrinsics(), Units::default())
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("obs.csv") && e.contains(place) && e.contains(what), "{e}");
+        let e = parse_observations(
+            &text,
+            "obs.csv",
+            &c.robot,
+            &target,
+            &intrinsics(),
+            Units::default(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("obs.csv") && e.contains(place) && e.contains(what),
+            "{e}"
+        );
     }
 }
 
@@ -387,7 +480,10 @@ fn chosen_poses_beat_random_ones() {
         distance: [0.3, 2.0],
     };
     let candidates = generic_configurations(&robot, 5_000, 13);
-    let settings = activecal::select::Settings { n: 20, ..Default::default() };
+    let settings = activecal::select::Settings {
+        n: 20,
+        ..Default::default()
+    };
     let d = camera_design(&robot, &view, &candidates, &settings).unwrap();
     assert_eq!(d.qs.len(), 20);
     assert!(d.seen.iter().all(|&s| s == 48), "{:?}", d.seen);
@@ -400,7 +496,14 @@ fn chosen_poses_beat_random_ones() {
     let blocks = camera_blocks(&robot, &view, &pool);
     let mut rng = activecal::identify::trial_rng(17, 0);
     let chosen = case_at(Mounting::EyeToHand, 0.3, 21, Some(&d.qs));
-    let fit = fit_camera(&chosen.robot, &chosen.sensor, &chosen.own_start, &chosen.obs, &LmSettings::default()).unwrap();
+    let fit = fit_camera(
+        &chosen.robot,
+        &chosen.sensor,
+        &chosen.own_start,
+        &chosen.obs,
+        &LmSettings::default(),
+    )
+    .unwrap();
     let chosen_error = true_error(&chosen, &fit);
     let mut random_errors = Vec::new();
     for _ in 0..20 {
@@ -412,11 +515,24 @@ fn chosen_poses_beat_random_ones() {
         idx.truncate(20);
         let m = blocks.information(&idx);
         let m = nalgebra::DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)]);
-        let ln_det = m.cholesky().map_or(f64::NEG_INFINITY, |c| 2.0 * c.l().diagonal().iter().map(|v| v.ln()).sum::<f64>());
-        assert!(ln_det < d.ln_det, "a random design: {ln_det} against {}", d.ln_det);
+        let ln_det = m.cholesky().map_or(f64::NEG_INFINITY, |c| {
+            2.0 * c.l().diagonal().iter().map(|v| v.ln()).sum::<f64>()
+        });
+        assert!(
+            ln_det < d.ln_det,
+            "a random design: {ln_det} against {}",
+            d.ln_det
+        );
         let qs: Vec<Vec<f64>> = idx.iter().map(|&k| pool[k].clone()).collect();
         let c = case_at(Mounting::EyeToHand, 0.3, 21, Some(&qs));
-        let f = fit_camera(&c.robot, &c.sensor, &c.own_start, &c.obs, &LmSettings::default()).unwrap();
+        let f = fit_camera(
+            &c.robot,
+            &c.sensor,
+            &c.own_start,
+            &c.obs,
+            &LmSettings::default(),
+        )
+        .unwrap();
         random_errors.push(true_error(&c, &f));
     }
     random_errors.sort_by(f64::total_cmp);
@@ -473,9 +589,16 @@ fn cli_calibrates_the_example_files() {
     let miss = (Vector3::new(xyz[0], xyz[1], xyz[2]) - Vector3::new(1.2, 0.6, 0.9)).norm();
     assert!(miss < 1e-3, "camera {xyz:?}: {} mm off", 1e3 * miss);
     let text = std::fs::read_to_string(&yaml).unwrap();
-    assert!(text.contains("camera:") && text.contains("pixel_sigma_px"), "{text}");
+    assert!(
+        text.contains("camera:") && text.contains("pixel_sigma_px"),
+        "{text}"
+    );
     activecal::io::frames_file::parse(&text, "cal.yaml").expect("the frames reader reads it");
-    assert!(std::fs::read_to_string(&urdf).unwrap().contains("shoulder_pan_joint"));
+    assert!(
+        std::fs::read_to_string(&urdf)
+            .unwrap()
+            .contains("shoulder_pan_joint")
+    );
 }
 
 /// Wrong inputs on the command line: an intrinsics file with a negative
@@ -489,7 +612,10 @@ fn cli_refuses_wrong_inputs() {
     let info = info.display().to_string();
     let mut args = EXAMPLE.to_vec();
     args[6] = &info;
-    common::fails_with(&args, "bad.yaml: line 5, column 3 ('camera_matrix'): focal lengths");
+    common::fails_with(
+        &args,
+        "bad.yaml: line 5, column 3 ('camera_matrix'): focal lengths",
+    );
     let obs = dir.join("deg.csv");
     let csv = std::fs::read_to_string("fixtures/camera/ur5_eye_to_hand.csv").unwrap();
     let deg: String = csv
@@ -542,9 +668,15 @@ fn cli_selects_poses_for_a_camera() {
     ];
     let v = common::json_of(&args);
     assert_eq!(v["n"], 12);
-    assert!(v["points_seen"].as_array().unwrap().iter().all(|s| s == 48), "{v}");
+    assert!(
+        v["points_seen"].as_array().unwrap().iter().all(|s| s == 48),
+        "{v}"
+    );
     let csv = std::fs::read_to_string(&out).unwrap();
     assert_eq!(csv.lines().count(), 13);
-    assert!(csv.starts_with("candidate,shoulder_pan_joint,") && csv.lines().next().unwrap().ends_with(",points_seen"));
+    assert!(
+        csv.starts_with("candidate,shoulder_pan_joint,")
+            && csv.lines().next().unwrap().ends_with(",points_seen")
+    );
     common::fails_with(&args, "exists");
 }

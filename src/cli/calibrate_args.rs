@@ -191,11 +191,21 @@ pub struct CalibrateArgs {
     /// in the base link (eye-to-hand) or the tip link (eye-in-hand),
     /// metres and radians (rpy as in URDF). The start of the fit: a rough
     /// guess, with every seen point in front of the camera.
-    #[arg(long, value_name = "X,Y,Z,ROLL,PITCH,YAW", allow_hyphen_values = true, requires = "observations")]
+    #[arg(
+        long,
+        value_name = "X,Y,Z,ROLL,PITCH,YAW",
+        allow_hyphen_values = true,
+        requires = "observations"
+    )]
     pub camera_pose: Option<String>,
     /// The target's frame (its points' frame), roughly: in the tip link
     /// (eye-to-hand) or the base link (eye-in-hand), metres and radians.
-    #[arg(long, value_name = "X,Y,Z,ROLL,PITCH,YAW", allow_hyphen_values = true, requires = "observations")]
+    #[arg(
+        long,
+        value_name = "X,Y,Z,ROLL,PITCH,YAW",
+        allow_hyphen_values = true,
+        requires = "observations"
+    )]
     pub target_pose: Option<String>,
     /// Units of the --measurements file.
     #[command(flatten)]

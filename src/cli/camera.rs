@@ -50,7 +50,11 @@ fn check_out(a: &CalibrateArgs, robot: &Robot) -> Result<()> {
 
 /// Calibrates from a camera's observations; `Ok(Some(why))` when the fit
 /// did not converge (the report is printed, nothing written).
-pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot, obs_path: &Path) -> Result<Option<String>> {
+pub fn calibrate_camera(
+    a: &CalibrateArgs,
+    robot: &Robot,
+    obs_path: &Path,
+) -> Result<Option<String>> {
     check_out(a, robot)?;
     let (Some(info), Some(target), Some(mounting), Some(cp), Some(tp)) = (
         &a.camera_info,
@@ -59,25 +63,48 @@ pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot, obs_path: &Path) -> Re
         &a.camera_pose,
         &a.target_pose,
     ) else {
-        bail!("--observations needs --camera-info, --target, --mounting, --camera-pose and --target-pose");
+        bail!(
+            "--observations needs --camera-info, --target, --mounting, --camera-pose and --target-pose"
+        );
     };
     let intrinsics = read_camera_info(info).context("--camera-info")?;
     let target = read_target(target).context("--target")?;
     let obs = read_observations(obs_path, robot, &target, &intrinsics, a.units.units())?;
-    let (cam0, tgt0) = (parse_placement("--camera-pose", cp)?, parse_placement("--target-pose", tp)?);
-    let sensor = CameraSensor::new(intrinsics, mounting.into(), target.points.clone(), &cam0, &tgt0);
+    let (cam0, tgt0) = (
+        parse_placement("--camera-pose", cp)?,
+        parse_placement("--target-pose", tp)?,
+    );
+    let sensor = CameraSensor::new(
+        intrinsics,
+        mounting.into(),
+        target.points.clone(),
+        &cam0,
+        &tgt0,
+    );
     let lm = LmSettings::default()
         .with_max_iterations(a.max_iterations)
         .with_geodesic(!a.no_geodesic);
-    let fit = fit_camera(robot, &sensor, &CameraSensor::start_own(&cam0, &tgt0), &obs, &lm)?;
+    let fit = fit_camera(
+        robot,
+        &sensor,
+        &CameraSensor::start_own(&cam0, &tgt0),
+        &obs,
+        &lm,
+    )?;
     let frames = camera_frames(&fit)?;
     let mut written = Vec::new();
     if fit.converged
         && let Some(f) = &frames
     {
         for path in &a.out {
-            let text = render(Format::of(path)?, &fit.robot, &fit.table, Some((&f.0, &f.1)), "")
-                .map_err(|e| anyhow::anyhow!("--out {}: {e}", path.display()))?;
+            let text = render(
+                Format::of(path)?,
+                &fit.robot,
+                &fit.table,
+                Some((&f.0, &f.1)),
+                "",
+            )
+            .map_err(|e| anyhow::anyhow!("--out {}: {e}", path.display()))?;
             super::write_new(path, &text, a.force)?;
             written.push(path.display().to_string());
         }
@@ -101,8 +128,21 @@ pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot, obs_path: &Path) -> Re
         "camera": frames.as_ref().and_then(|f| f.1.camera.clone()),
         "out": written,
     });
-    super::emit(a.json, &v, || text(&fit, obs_path, obs.qs.len(), frames.as_ref().map(|f| &f.1), &written))?;
-    Ok((!fit.converged).then(|| format!("the camera fit did not converge ({:?} after {} iterations)", fit.stop, fit.iterations)))
+    super::emit(a.json, &v, || {
+        text(
+            &fit,
+            obs_path,
+            obs.qs.len(),
+            frames.as_ref().map(|f| &f.1),
+            &written,
+        )
+    })?;
+    Ok((!fit.converged).then(|| {
+        format!(
+            "the camera fit did not converge ({:?} after {} iterations)",
+            fit.stop, fit.iterations
+        )
+    }))
 }
 
 /// The human-readable report.
@@ -135,7 +175,11 @@ fn text(
     );
     match fit.sigma_px {
         Some(sg) => {
-            let _ = writeln!(s, "pixel σ (variance component): {sg:.3} px, {} degrees of freedom", fit.redundancy);
+            let _ = writeln!(
+                s,
+                "pixel σ (variance component): {sg:.3} px, {} degrees of freedom",
+                fit.redundancy
+            );
         }
         None => s.push_str("pixel σ: not estimated\n"),
     }
@@ -165,10 +209,19 @@ fn text(
         };
         let change = (fit.estimate[k] - fit.start[k]) * unit.0;
         let sd = fit.std.as_ref().map_or(f64::NAN, |sd| sd[k] * unit.0);
-        let _ = writeln!(s, "  {:<28} {change:+.4} {u}  σ {sd:.4} {u}", fit.names[k], u = unit.1);
+        let _ = writeln!(
+            s,
+            "  {:<28} {change:+.4} {u}  σ {sd:.4} {u}",
+            fit.names[k],
+            u = unit.1
+        );
     }
     if !fit.converged {
-        let _ = writeln!(s, "NOT CONVERGED ({:?} after {} iterations): nothing written", fit.stop, fit.iterations);
+        let _ = writeln!(
+            s,
+            "NOT CONVERGED ({:?} after {} iterations): nothing written",
+            fit.stop, fit.iterations
+        );
     }
     for w in written {
         let _ = writeln!(s, "wrote {w}");

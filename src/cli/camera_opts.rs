@@ -20,11 +20,21 @@ pub struct CameraOpts {
     pub mounting: Option<super::calibrate_args::MountingArg>,
     /// The camera's optical frame in the base link (eye-to-hand) or the
     /// tip link (eye-in-hand): X,Y,Z,ROLL,PITCH,YAW (metres, radians).
-    #[arg(long, value_name = "X,Y,Z,ROLL,PITCH,YAW", allow_hyphen_values = true, requires = "camera_info")]
+    #[arg(
+        long,
+        value_name = "X,Y,Z,ROLL,PITCH,YAW",
+        allow_hyphen_values = true,
+        requires = "camera_info"
+    )]
     pub camera_pose: Option<String>,
     /// The target's frame in the tip link (eye-to-hand) or the base link
     /// (eye-in-hand): X,Y,Z,ROLL,PITCH,YAW.
-    #[arg(long, value_name = "X,Y,Z,ROLL,PITCH,YAW", allow_hyphen_values = true, requires = "camera_info")]
+    #[arg(
+        long,
+        value_name = "X,Y,Z,ROLL,PITCH,YAW",
+        allow_hyphen_values = true,
+        requires = "camera_info"
+    )]
     pub target_pose: Option<String>,
     /// The fraction of the target's points a pose must see.
     #[arg(long, default_value_t = 1.0, requires = "camera_info")]
@@ -37,6 +47,11 @@ pub struct CameraOpts {
     #[arg(long, default_value_t = DEFAULT_MAX_VIEW_ANGLE_DEG, requires = "camera_info")]
     pub max_view_angle: f64,
     /// The range of the target's distance from the camera: LO,HI metres.
-    #[arg(long, value_name = "LO,HI", default_value = "0.2,3.0", requires = "camera_info")]
+    #[arg(
+        long,
+        value_name = "LO,HI",
+        default_value = "0.2,3.0",
+        requires = "camera_info"
+    )]
     pub distance: String,
 }

@@ -23,15 +23,22 @@ const DEFAULT_SAMPLES: usize = 20_000;
 
 fn six(flag: &str, s: &str) -> Result<[f64; 6]> {
     let v = super::parse_list::<f64>(s, flag)?;
-    v.try_into()
-        .map_err(|_| anyhow::anyhow!("{flag} {s}: expected X,Y,Z,ROLL,PITCH,YAW (six numbers, metres and radians)"))
+    v.try_into().map_err(|_| {
+        anyhow::anyhow!(
+            "{flag} {s}: expected X,Y,Z,ROLL,PITCH,YAW (six numbers, metres and radians)"
+        )
+    })
 }
 
 /// The camera view the options describe.
 fn view(c: &CameraOpts) -> Result<CameraView> {
-    let (Some(info), Some(target), Some(m), Some(cp), Some(tp)) =
-        (&c.camera_info, &c.target, c.mounting, &c.camera_pose, &c.target_pose)
-    else {
+    let (Some(info), Some(target), Some(m), Some(cp), Some(tp)) = (
+        &c.camera_info,
+        &c.target,
+        c.mounting,
+        &c.camera_pose,
+        &c.target_pose,
+    ) else {
         bail!("--camera-info needs --target, --mounting, --camera-pose and --target-pose");
     };
     let d = super::parse_list::<f64>(&c.distance, "--distance")?;
@@ -54,7 +61,8 @@ fn view(c: &CameraOpts) -> Result<CameraView> {
         max_view_angle: c.max_view_angle.to_radians(),
         distance: [lo, hi],
     };
-    v.validate().map_err(|e| anyhow::anyhow!("camera view: {e}"))?;
+    v.validate()
+        .map_err(|e| anyhow::anyhow!("camera view: {e}"))?;
     Ok(v)
 }
 
@@ -63,7 +71,9 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
     let out = match &a.out[..] {
         [] => None,
         [o] if o.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv")) => Some(o),
-        _ => bail!("--out: a camera design is written as one .csv (candidate, the joints, points_seen)"),
+        _ => bail!(
+            "--out: a camera design is written as one .csv (candidate, the joints, points_seen)"
+        ),
     };
     if let Some(o) = out {
         super::refuse_overwrite(o, a.force)?;
@@ -109,7 +119,11 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
             d.qs.len(),
             d.names.len(),
             d.ln_det,
-            d.seen.iter().map(usize::to_string).collect::<Vec<_>>().join(", ")
+            d.seen
+                .iter()
+                .map(usize::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
         );
         match out {
             None => s += &csv,

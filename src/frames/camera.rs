@@ -30,7 +30,9 @@ use crate::model::MeasurementKind;
 
 /// The split of a camera fit's robot and its report with the `camera`
 /// block. `None` for a robot not imported from a URDF.
-pub fn camera_frames(fit: &CameraFit) -> Result<Option<(CalibratedFrames, FramesReport)>, FramesError> {
+pub fn camera_frames(
+    fit: &CameraFit,
+) -> Result<Option<(CalibratedFrames, FramesReport)>, FramesError> {
     let mut robot = fit.robot.clone();
     // As a full pose: the split's tool is the end frame in the tip link.
     robot.measurement = MeasurementKind::Pose;
@@ -42,7 +44,10 @@ pub fn camera_frames(fit: &CameraFit) -> Result<Option<(CalibratedFrames, Frames
     let Some((f, mut report)) = calibrated(&robot, &fit.table, cov.as_deref(), None)? else {
         return Ok(None);
     };
-    let src = robot.source.as_ref().expect("calibrated gives frames for a URDF robot");
+    let src = robot
+        .source
+        .as_ref()
+        .expect("calibrated gives frames for a URDF robot");
     let sigma = |k: usize| {
         fit.std.as_ref().map(|s| FrameSigma {
             xyz: [s[n + k], s[n + k + 1], s[n + k + 2]],
@@ -52,12 +57,32 @@ pub fn camera_frames(fit: &CameraFit) -> Result<Option<(CalibratedFrames, Frames
     let (in_base, on_end) = (f.measurement.inverse(), f.tool);
     let (camera, target) = match fit.sensor.mounting() {
         Mounting::EyeToHand => (
-            frame_block(&src.base, Some("camera_optical"), &(in_base * fit.camera), sigma(0).as_ref()),
-            frame_block(&src.tip, Some("target"), &(on_end * fit.target), sigma(6).as_ref()),
+            frame_block(
+                &src.base,
+                Some("camera_optical"),
+                &(in_base * fit.camera),
+                sigma(0).as_ref(),
+            ),
+            frame_block(
+                &src.tip,
+                Some("target"),
+                &(on_end * fit.target),
+                sigma(6).as_ref(),
+            ),
         ),
         Mounting::EyeInHand => (
-            frame_block(&src.tip, Some("camera_optical"), &(on_end * fit.camera), sigma(0).as_ref()),
-            frame_block(&src.base, Some("target"), &(in_base * fit.target), sigma(6).as_ref()),
+            frame_block(
+                &src.tip,
+                Some("camera_optical"),
+                &(on_end * fit.camera),
+                sigma(0).as_ref(),
+            ),
+            frame_block(
+                &src.base,
+                Some("target"),
+                &(in_base * fit.target),
+                sigma(6).as_ref(),
+            ),
         ),
     };
     // Mounted as a frames file mounts any calibration: in the fixed one's
@@ -68,7 +93,12 @@ pub fn camera_frames(fit: &CameraFit) -> Result<Option<(CalibratedFrames, Frames
         Mounting::EyeInHand => (in_base * fit.target, on_end * fit.camera, 0),
     };
     report.measurement_frame = frame_block("measurement", Some(&src.base), &fixed.inverse(), None);
-    report.tool = Some(frame_block(&src.tip, None, &moving, sigma(moving_own).as_ref()));
+    report.tool = Some(frame_block(
+        &src.tip,
+        None,
+        &moving,
+        sigma(moving_own).as_ref(),
+    ));
     report.camera = Some(CameraBlock {
         mounting: fit.sensor.mounting(),
         camera,

@@ -98,7 +98,13 @@ fn size(key: &str, v: Option<&Spanned<i64>>) -> std::result::Result<u32, String>
     u32::try_from(v.value)
         .ok()
         .filter(|&n| n > 0)
-        .ok_or_else(|| format!("{} ('{key}'): {} is not a positive number of pixels", at(v), v.value))
+        .ok_or_else(|| {
+            format!(
+                "{} ('{key}'): {} is not a positive number of pixels",
+                at(v),
+                v.value
+            )
+        })
 }
 
 /// A matrix's data, its shape checked against `shapes` (rows, cols) when
@@ -114,7 +120,9 @@ fn data(
         .as_ref()
         .ok_or_else(|| format!("{} ('{key}'): no 'data'", at(m)))?;
     if let (Some(r), Some(c)) = (&m.value.rows, &m.value.cols) {
-        let ok = shapes.iter().any(|&(sr, sc)| sr == r.value && sc == c.value)
+        let ok = shapes
+            .iter()
+            .any(|&(sr, sc)| sr == r.value && sc == c.value)
             && (r.value * c.value) as usize == d.value.len();
         if !ok {
             let want: Vec<String> = shapes.iter().map(|(r, c)| format!("{r}×{c}")).collect();
@@ -129,7 +137,11 @@ fn data(
         }
     }
     if let Some(k) = d.value.iter().position(|v| !v.is_finite()) {
-        return Err(format!("{} ('{key}.data'): entry {} is not a finite number", at(d), k + 1));
+        return Err(format!(
+            "{} ('{key}.data'): entry {} is not a finite number",
+            at(d),
+            k + 1
+        ));
     }
     Ok(d.value.clone())
 }
@@ -171,7 +183,8 @@ fn build(f: &InfoEntry) -> std::result::Result<Intrinsics, String> {
         cy: k[5],
         distortion,
     };
-    c.check().map_err(|e| format!("{} ('camera_matrix'): {e}", at(km)))?;
+    c.check()
+        .map_err(|e| format!("{} ('camera_matrix'): {e}", at(km)))?;
     Ok(c)
 }
 
@@ -255,7 +268,10 @@ distortion_coefficients: !!opencv-matrix
     #[test]
     fn both_formats_are_read() {
         let c = parse_camera_info(ROS, "ros.yaml").unwrap();
-        assert_eq!((c.width, c.height, c.fx, c.fy, c.cx, c.cy), (1280, 960, 900.0, 905.0, 640.5, 480.2));
+        assert_eq!(
+            (c.width, c.height, c.fx, c.fy, c.cx, c.cy),
+            (1280, 960, 900.0, 905.0, 640.5, 480.2)
+        );
         assert_eq!(c.distortion, [-0.1, 0.05, 0.001, -0.0005, -0.01]);
         let c = parse_camera_info(OPENCV, "cv.yaml").unwrap();
         assert_eq!((c.width, c.fx, c.cy), (640, 500.0, 240.0));
@@ -266,17 +282,46 @@ distortion_coefficients: !!opencv-matrix
     #[test]
     fn bad_files_are_refused_with_their_place() {
         let cases = [
-            (ROS.replace("rows: 3\n  cols: 3\n  data: [900", "rows: 2\n  cols: 3\n  data: [900"), "line 5", "2×3"),
-            (ROS.replace("data: [900.0", "data: [-900.0"), "line 5", "focal"),
-            (ROS.replace("plumb_bob", "equidistant"), "line 8", "equidistant"),
-            (ROS.replace("image_width: 1280", "image_width: 0"), "line 1", "image_width"),
+            (
+                ROS.replace(
+                    "rows: 3\n  cols: 3\n  data: [900",
+                    "rows: 2\n  cols: 3\n  data: [900",
+                ),
+                "line 5",
+                "2×3",
+            ),
+            (
+                ROS.replace("data: [900.0", "data: [-900.0"),
+                "line 5",
+                "focal",
+            ),
+            (
+                ROS.replace("plumb_bob", "equidistant"),
+                "line 8",
+                "equidistant",
+            ),
+            (
+                ROS.replace("image_width: 1280", "image_width: 0"),
+                "line 1",
+                "image_width",
+            ),
             (ROS.replace("640.5", "6400.5"), "line 5", "principal point"),
             (ROS.replace("0.0, 905.0", "0.3, 905.0"), "line 5", "pinhole"),
-            (ROS.replace("image_height: 960\n", ""), "image_height", "image size"),
-            ("camera_matrix: [1, 2\n".to_string(), "line", "not a camera_info"),
+            (
+                ROS.replace("image_height: 960\n", ""),
+                "image_height",
+                "image size",
+            ),
+            (
+                "camera_matrix: [1, 2\n".to_string(),
+                "line",
+                "not a camera_info",
+            ),
         ];
         for (text, place, what) in cases {
-            let e = parse_camera_info(&text, "cam.yaml").unwrap_err().to_string();
+            let e = parse_camera_info(&text, "cam.yaml")
+                .unwrap_err()
+                .to_string();
             assert!(e.starts_with("cam.yaml: "), "{e}");
             assert!(e.contains(place) && e.contains(what), "{e}");
         }

@@ -42,7 +42,14 @@ pub fn read_observations(
     units: Units,
 ) -> Result<CameraObservations> {
     let text = super::read::read_text(path)?;
-    parse_observations(&text, &path.display().to_string(), robot, target, intrinsics, units)
+    parse_observations(
+        &text,
+        &path.display().to_string(),
+        robot,
+        target,
+        intrinsics,
+        units,
+    )
 }
 
 /// The columns of an observation file: pose, joints, feature, u, v.
@@ -151,7 +158,11 @@ pub fn parse_observations(
         })?;
         let px = [cell(c.u, "a pixel")?, cell(c.v, "a pixel")?];
         if !intrinsics.inside(px, 0.0) {
-            let col = if px[0] < -0.5 || px[0] > f64::from(intrinsics.width) - 0.5 { c.u } else { c.v };
+            let col = if px[0] < -0.5 || px[0] > f64::from(intrinsics.width) - 0.5 {
+                c.u
+            } else {
+                c.v
+            };
             return Err(err(format!(
                 "line {line}, column {} ('{}'): pixel ({}, {}) lies outside the {}×{} image",
                 col + 1,
@@ -169,19 +180,7 @@ pub fn parse_observations(
             )));
         }
     }
-    if obs.pose_ids.is_empty() {
-        return Err(err("no observations: the file has a header but no rows".into()));
-    }
-    for (p, s) in obs.seen.iter().enumerate() {
-        let n = s.iter().filter(|x| x.is_some()).count();
-        if n < MIN_POINTS_PER_POSE {
-            return Err(err(format!(
-                "pose {} (line {}): {n} point(s) seen; a pose needs at least {MIN_POINTS_PER_POSE} (remove it or add its detections)",
-                obs.pose_ids[p],
-                lines_of[p].iter().map(usize::to_string).collect::<Vec<_>>().join(", ")
-            )));
-        }
-    }
+    check_poses(&obs, &lines_of).map_err(err)?;
     let rows: Vec<String> = first_lines.iter().map(|l| format!("line {l}")).collect();
     let cols: Vec<String> = c.joints.iter().map(|&k| t.columns[k].clone()).collect();
     let source = JointSource {
@@ -191,6 +190,32 @@ pub fn parse_observations(
     };
     joint_values_to_model_units(robot, units, &source, &mut obs.qs)?;
     Ok(obs)
+}
+
+/// Refuses a file without rows and a pose that sees fewer than
+/// [`MIN_POINTS_PER_POSE`] points (`lines_of`: each pose's lines).
+fn check_poses(
+    obs: &CameraObservations,
+    lines_of: &[Vec<usize>],
+) -> std::result::Result<(), String> {
+    if obs.pose_ids.is_empty() {
+        return Err("no observations: the file has a header but no rows".into());
+    }
+    for (p, s) in obs.seen.iter().enumerate() {
+        let n = s.iter().filter(|x| x.is_some()).count();
+        if n < MIN_POINTS_PER_POSE {
+            return Err(format!(
+                "pose {} (line {}): {n} point(s) seen; a pose needs at least {MIN_POINTS_PER_POSE} (remove it or add its detections)",
+                obs.pose_ids[p],
+                lines_of[p]
+                    .iter()
+                    .map(usize::to_string)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The value of an id column, which must be an integer.
@@ -211,7 +236,12 @@ fn id_range(t: &Target) -> String {
     let (lo, hi) = (t.ids.iter().min(), t.ids.iter().max());
     match (lo, hi) {
         (Some(&lo), Some(&hi)) if (hi - lo) as usize + 1 == t.ids.len() => format!("{lo}–{hi}"),
-        _ => t.ids.iter().map(i64::to_string).collect::<Vec<_>>().join(", "),
+        _ => t
+            .ids
+            .iter()
+            .map(i64::to_string)
+            .collect::<Vec<_>>()
+            .join(", "),
     }
 }
 
@@ -226,7 +256,12 @@ pub fn observations_csv(obs: &CameraObservations, robot: &Robot, target: &Target
         let joints: Vec<String> = q.iter().map(|v| format!("{v:.17}")).collect();
         for (k, px) in seen.iter().enumerate() {
             if let Some([u, v]) = px {
-                let _ = writeln!(s, "{id},{},{},{u:.6},{v:.6}", joints.join(","), target.ids[k]);
+                let _ = writeln!(
+                    s,
+                    "{id},{},{},{u:.6},{v:.6}",
+                    joints.join(","),
+                    target.ids[k]
+                );
             }
         }
     }

@@ -94,7 +94,11 @@ pub fn read_target(path: &Path) -> Result<Target> {
 }
 
 fn at<T>(s: &Spanned<T>) -> String {
-    format!("line {}, column {}", s.referenced.line(), s.referenced.column())
+    format!(
+        "line {}, column {}",
+        s.referenced.line(),
+        s.referenced.column()
+    )
 }
 
 /// Parses a target from `text` (from `origin`, for messages).
@@ -134,7 +138,13 @@ fn board(b: &Spanned<Board>) -> std::result::Result<Target, String> {
         usize::try_from(v.value)
             .ok()
             .filter(|&n| n >= 2)
-            .ok_or_else(|| format!("{} ('checkerboard.{key}'): {} inner corners; at least 2", at(v), v.value))
+            .ok_or_else(|| {
+                format!(
+                    "{} ('checkerboard.{key}'): {} inner corners; at least 2",
+                    at(v),
+                    v.value
+                )
+            })
     };
     let (rows, cols) = (count(&b.value.rows, "rows")?, count(&b.value.cols, "cols")?);
     let sq = &b.value.square;
@@ -179,7 +189,8 @@ fn list(p: &Spanned<Vec<Spanned<PointEntry>>>) -> std::result::Result<Target, St
             ));
         }
         t.ids.push(id.value);
-        t.points.push(Vector3::new(xyz.value[0], xyz.value[1], xyz.value[2]));
+        t.points
+            .push(Vector3::new(xyz.value[0], xyz.value[1], xyz.value[2]));
     }
     Ok(t)
 }
@@ -223,16 +234,39 @@ mod tests {
     #[test]
     fn bad_targets_are_refused_with_their_place() {
         let cases = [
-            ("points:\n  - {id: 3, xyz: [0, 0, 0]}\n  - {id: 3, xyz: [0.1, 0, 0]}\n", "line 3", "given twice"),
-            ("checkerboard: {rows: 1, cols: 4, square: 0.02}\n", "line 1", "at least 2"),
-            ("checkerboard: {rows: 3, cols: 4, square: 25}\n", "line 1", "millimetres"),
-            ("points:\n  - {id: 0, xyz: [0, 0]}\n", "line 2", "three finite"),
-            ("points:\n  - {id: 0, xyz: [0, 0, 0]}\n  - {id: 1, xyz: [1, 0, 0]}\n  - {id: 2, xyz: [2, 0, 0]}\n  - {id: 4, xyz: [3, 0, 0]}\n", "t.yaml", "one line"),
+            (
+                "points:\n  - {id: 3, xyz: [0, 0, 0]}\n  - {id: 3, xyz: [0.1, 0, 0]}\n",
+                "line 3",
+                "given twice",
+            ),
+            (
+                "checkerboard: {rows: 1, cols: 4, square: 0.02}\n",
+                "line 1",
+                "at least 2",
+            ),
+            (
+                "checkerboard: {rows: 3, cols: 4, square: 25}\n",
+                "line 1",
+                "millimetres",
+            ),
+            (
+                "points:\n  - {id: 0, xyz: [0, 0]}\n",
+                "line 2",
+                "three finite",
+            ),
+            (
+                "points:\n  - {id: 0, xyz: [0, 0, 0]}\n  - {id: 1, xyz: [1, 0, 0]}\n  - {id: 2, xyz: [2, 0, 0]}\n  - {id: 4, xyz: [3, 0, 0]}\n",
+                "t.yaml",
+                "one line",
+            ),
             ("board: 3\n", "line 1", "not a target file"),
         ];
         for (text, place, what) in cases {
             let e = parse_target(text, "t.yaml").unwrap_err().to_string();
-            assert!(e.starts_with("t.yaml: ") && e.contains(place) && e.contains(what), "{e}");
+            assert!(
+                e.starts_with("t.yaml: ") && e.contains(place) && e.contains(what),
+                "{e}"
+            );
         }
     }
 }

@@ -179,7 +179,11 @@ mod tests {
             let (pa, pb) = (c.project(&a).unwrap().pixel, c.project(&b).unwrap().pixel);
             for r in 0..2 {
                 let fd = (pa[r] - pb[r]) / (2.0 * h);
-                assert!((j[(r, k)] - fd).abs() < 1e-4, "({r},{k}): {} vs {fd}", j[(r, k)]);
+                assert!(
+                    (j[(r, k)] - fd).abs() < 1e-4,
+                    "({r},{k}): {} vs {fd}",
+                    j[(r, k)]
+                );
             }
         }
     }

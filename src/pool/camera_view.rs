@@ -67,10 +67,16 @@ impl CameraView {
             return Err(format!("{} target points; at least 4", self.points.len()));
         }
         if !(self.min_fraction > 0.0 && self.min_fraction <= 1.0) {
-            return Err(format!("fraction of points seen {}: must be in (0, 1]", self.min_fraction));
+            return Err(format!(
+                "fraction of points seen {}: must be in (0, 1]",
+                self.min_fraction
+            ));
         }
         if !(self.margin_px >= 0.0 && self.margin_px.is_finite()) {
-            return Err(format!("margin {} px: must be finite and ≥ 0", self.margin_px));
+            return Err(format!(
+                "margin {} px: must be finite and ≥ 0",
+                self.margin_px
+            ));
         }
         if !(self.max_view_angle > 0.0 && self.max_view_angle <= std::f64::consts::FRAC_PI_2) {
             return Err(format!(
@@ -83,7 +89,8 @@ impl CameraView {
             return Err(format!("distance range [{lo}, {hi}] m: need 0 ≤ lo < hi"));
         }
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-        if !(finite(&self.camera) && finite(&self.target) && self.points.iter().all(|p| finite(p))) {
+        if !(finite(&self.camera) && finite(&self.target) && self.points.iter().all(|p| finite(p)))
+        {
             return Err("a placement or a target point is not finite".into());
         }
         Ok(())
@@ -95,7 +102,8 @@ impl CameraView {
         let (c, t) = (placement(&self.camera), placement(&self.target));
         let pts = self.points.iter().map(|p| Vector3::from(*p)).collect();
         (
-            CameraSensor::new(self.intrinsics.clone(), self.mounting, pts, &c, &t).with_margin(self.margin_px),
+            CameraSensor::new(self.intrinsics.clone(), self.mounting, pts, &c, &t)
+                .with_margin(self.margin_px),
             CameraSensor::start_own(&c, &t),
         )
     }
@@ -104,7 +112,11 @@ impl CameraView {
     #[must_use]
     pub fn view(&self, robot: &Robot, table: &ParamTable, q: &[f64]) -> View {
         let (s, own) = self.sensor();
-        s.view(&Evaluator::new(robot, table).end_frame(q), &own, self.margin_px)
+        s.view(
+            &Evaluator::new(robot, table).end_frame(q),
+            &own,
+            self.margin_px,
+        )
     }
 
     /// Whether the camera sees the target well at `q`.
@@ -136,10 +148,13 @@ mod tests {
         let axis = e.rotation.column(2).into_owned();
         // Camera z against the flange's z; the board's z (into it) away from
         // the camera, along the flange's −z.
-        let rc = Rotation3::from_matrix_unchecked(e.rotation) * Rotation3::from_euler_angles(std::f64::consts::PI, 0.0, 0.0);
+        let rc = Rotation3::from_matrix_unchecked(e.rotation)
+            * Rotation3::from_euler_angles(std::f64::consts::PI, 0.0, 0.0);
         let (r, p, y) = rc.euler_angles();
         let eye = e.position + 0.8 * axis;
-        let board: Vec<[f64; 3]> = (0..20).map(|k| [0.02 * (k % 5) as f64, 0.02 * (k / 5) as f64, 0.0]).collect();
+        let board: Vec<[f64; 3]> = (0..20)
+            .map(|k| [0.02 * (k % 5) as f64, 0.02 * (k / 5) as f64, 0.0])
+            .collect();
         let f = CameraView {
             intrinsics: Intrinsics {
                 width: 1280,
@@ -160,9 +175,16 @@ mod tests {
             distance: [0.3, 1.5],
         };
         f.validate().unwrap();
-        assert!(f.keeps(&robot, &robot.nominal, &q0), "{:?}", f.view(&robot, &robot.nominal, &q0));
+        assert!(
+            f.keeps(&robot, &robot.nominal, &q0),
+            "{:?}",
+            f.view(&robot, &robot.nominal, &q0)
+        );
         let qs = crate::observability::generic_configurations(&robot, 5000, 3);
-        let kept: Vec<&Vec<f64>> = qs.iter().filter(|q| f.keeps(&robot, &robot.nominal, q)).collect();
+        let kept: Vec<&Vec<f64>> = qs
+            .iter()
+            .filter(|q| f.keeps(&robot, &robot.nominal, q))
+            .collect();
         assert!(kept.len() < qs.len() / 2, "{} of {}", kept.len(), qs.len());
         let (s, own) = f.sensor();
         let mut ev = Evaluator::new(&robot, &robot.nominal);
@@ -173,7 +195,10 @@ mod tests {
             let mut pred = vec![0.0; 60];
             crate::measure::Sensor::predict(&s, &e, &own, &mut pred);
             for p in pred.chunks_exact(3) {
-                assert!(p[2] == 1.0 && (10.0 - 0.5..=1280.0 - 10.5).contains(&p[0]), "{p:?}");
+                assert!(
+                    p[2] == 1.0 && (10.0 - 0.5..=1280.0 - 10.5).contains(&p[0]),
+                    "{p:?}"
+                );
             }
         }
         let mut bad = f.clone();

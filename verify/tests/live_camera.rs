@@ -26,7 +26,11 @@ def project(points, rvec, tvec, k, dist):
 
 /// OpenCV's pixels and Jacobian (2n × (6 + 4 + 5): rvec, tvec, fx fy cx
 /// cy, distortion) of `points` (object frame) under `rvec, tvec`.
-fn opencv(points: &[Vector3<f64>], pose: &Isometry3<f64>, c: &Intrinsics) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+fn opencv(
+    points: &[Vector3<f64>],
+    pose: &Isometry3<f64>,
+    c: &Intrinsics,
+) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
     let pts: Vec<[f64; 3]> = points.iter().map(|p| [p.x, p.y, p.z]).collect();
     let rvec: [f64; 3] = pose.rotation.scaled_axis().into();
     let tvec: [f64; 3] = pose.translation.vector.into();
@@ -39,7 +43,10 @@ fn opencv(points: &[Vector3<f64>], pose: &Isometry3<f64>, c: &Intrinsics) -> (Ve
             .call1((pts, rvec, tvec, k, c.distortion))
             .unwrap();
         let (img, jac, version): (Vec<Vec<f64>>, Vec<Vec<f64>>, String) = r.extract().unwrap();
-        assert!(version.starts_with("4.14"), "OpenCV {version}: verify/requirements.txt pins 4.14");
+        assert!(
+            version.starts_with("4.14"),
+            "OpenCV {version}: verify/requirements.txt pins 4.14"
+        );
         (img, jac)
     })
 }
@@ -98,7 +105,10 @@ fn projection_and_its_jacobian_equal_opencv() {
             }
         }
     }
-    println!("{} points: pixels within {dp:.2e} px, Jacobian within {dj:.2e} px/m (largest {big:.0})", pts.len());
+    println!(
+        "{} points: pixels within {dp:.2e} px, Jacobian within {dj:.2e} px/m (largest {big:.0})",
+        pts.len()
+    );
     assert!(dp < 1e-9, "pixels differ by {dp} px");
     assert!(dj < 1e-9 * big, "Jacobian differs by {dj} px/m");
 }
@@ -135,7 +145,13 @@ fn camera_sensor_pixels_equal_opencv() {
             Mounting::EyeInHand => (placed, end * placed * want),
         };
         let target_pts: Vec<Vector3<f64>> = (0..20)
-            .map(|k| Vector3::new(0.03 * (k % 5) as f64 - 0.06, 0.03 * (k / 5) as f64 - 0.045, 0.0))
+            .map(|k| {
+                Vector3::new(
+                    0.03 * (k % 5) as f64 - 0.06,
+                    0.03 * (k / 5) as f64 - 0.045,
+                    0.0,
+                )
+            })
             .collect();
         let s = CameraSensor::new(c.clone(), m, target_pts.clone(), &camera, &target);
         let mut own = CameraSensor::start_own(&camera, &target);
@@ -153,7 +169,11 @@ fn camera_sensor_pixels_equal_opencv() {
         let d = img
             .iter()
             .enumerate()
-            .map(|(k, px)| (pred[3 * k] - px[0]).abs().max((pred[3 * k + 1] - px[1]).abs()))
+            .map(|(k, px)| {
+                (pred[3 * k] - px[0])
+                    .abs()
+                    .max((pred[3 * k + 1] - px[1]).abs())
+            })
             .fold(0.0f64, f64::max);
         println!("{}: {} points within {d:.2e} px", m.name(), img.len());
         assert!(d < 1e-9, "{m:?}: {d} px");

@@ -31,7 +31,10 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .to_path_buf()
 }
 
 fn run(c: &mut Command) -> String {
@@ -78,11 +81,23 @@ fn camera_calibration_matches_a_known_true_robot() {
     );
     let truth = dir.join("truth.json");
     let script = r.join("verify/python/camera_truth.py");
-    run(python().arg(&script).args(["make", "--base", "base_link", "--tip", "target", "--seed", "3"])
-        .arg("--urdf").arg(&urdf)
+    run(python()
+        .arg(&script)
+        .args([
+            "make",
+            "--base",
+            "base_link",
+            "--tip",
+            "target",
+            "--seed",
+            "3",
+        ])
+        .arg("--urdf")
+        .arg(&urdf)
         .arg(format!("--camera={}", six(&camera)))
         .arg(format!("--target={}", six(&target)))
-        .arg("--out").arg(&truth));
+        .arg("--out")
+        .arg(&truth));
     // Configurations where the nominal robot shows the whole board.
     let robot = activecal::io::load_robot(urdf.to_str().unwrap()).unwrap();
     let intrinsics = read_camera_info(&info).unwrap();
@@ -91,8 +106,18 @@ fn camera_calibration_matches_a_known_true_robot() {
         intrinsics: intrinsics.clone(),
         mounting: Mounting::EyeToHand,
         points: tgt.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
-        camera: six(&camera).split(',').map(|v| v.parse().unwrap()).collect::<Vec<f64>>().try_into().unwrap(),
-        target: six(&target).split(',').map(|v| v.parse().unwrap()).collect::<Vec<f64>>().try_into().unwrap(),
+        camera: six(&camera)
+            .split(',')
+            .map(|v| v.parse().unwrap())
+            .collect::<Vec<f64>>()
+            .try_into()
+            .unwrap(),
+        target: six(&target)
+            .split(',')
+            .map(|v| v.parse().unwrap())
+            .collect::<Vec<f64>>()
+            .try_into()
+            .unwrap(),
         min_fraction: 1.0,
         margin_px: 20.0,
         max_view_angle: 60f64.to_radians(),
@@ -107,7 +132,12 @@ fn camera_calibration_matches_a_known_true_robot() {
     let names = activecal::units::joint_names(&robot);
     let mut csv = names.join(",") + "\n";
     for q in &qs {
-        csv += &(q.iter().map(|v| format!("{v:.17}")).collect::<Vec<_>>().join(",") + "\n");
+        csv += &(q
+            .iter()
+            .map(|v| format!("{v:.17}"))
+            .collect::<Vec<_>>()
+            .join(",")
+            + "\n");
     }
     let configs = dir.join("q.csv");
     std::fs::write(&configs, csv).unwrap();
@@ -118,24 +148,77 @@ fn camera_calibration_matches_a_known_true_robot() {
     let (cam0, tgt0) = (camera * off, target * off.inverse());
     let calibrated = |noise: f64, seed: u64| -> (f64, Option<f64>) {
         let obs = dir.join(format!("obs{seed}.csv"));
-        run(python().arg(&script).arg("observe").arg("--truth").arg(&truth)
-            .arg("--camera-info").arg(&info).args(["--board", "6,8,0.025", "--noise", &noise.to_string(), "--seed", &seed.to_string()])
-            .arg("--configs").arg(&configs).arg("--out").arg(&obs));
-        let (u, y) = (dir.join(format!("cal{seed}.urdf")), dir.join(format!("cal{seed}.yaml")));
-        run(Command::new(r.join("target/debug/activecal")).arg("calibrate").arg("--robot").arg(&urdf)
-            .arg("--observations").arg(&obs).arg("--camera-info").arg(&info).arg("--target").arg(&board)
+        run(python()
+            .arg(&script)
+            .arg("observe")
+            .arg("--truth")
+            .arg(&truth)
+            .arg("--camera-info")
+            .arg(&info)
+            .args([
+                "--board",
+                "6,8,0.025",
+                "--noise",
+                &noise.to_string(),
+                "--seed",
+                &seed.to_string(),
+            ])
+            .arg("--configs")
+            .arg(&configs)
+            .arg("--out")
+            .arg(&obs));
+        let (u, y) = (
+            dir.join(format!("cal{seed}.urdf")),
+            dir.join(format!("cal{seed}.yaml")),
+        );
+        run(Command::new(r.join("target/debug/activecal"))
+            .arg("calibrate")
+            .arg("--robot")
+            .arg(&urdf)
+            .arg("--observations")
+            .arg(&obs)
+            .arg("--camera-info")
+            .arg(&info)
+            .arg("--target")
+            .arg(&board)
             .args(["--mounting", "eye-to-hand", "--json", "--force"])
-            .arg(format!("--camera-pose={}", six(&cam0))).arg(format!("--target-pose={}", six(&tgt0)))
-            .arg("--out").arg(&u).arg("--out").arg(&y));
-        let cmp: Value = serde_json::from_str(&run(python().arg(r.join("verify/python/truth.py")).arg("compare")
-            .arg("--truth").arg(&truth).arg("--urdf").arg(&u).arg("--frames").arg(&y)
-            .args(["--n", "1000", "--seed", "1"]))).unwrap();
+            .arg(format!("--camera-pose={}", six(&cam0)))
+            .arg(format!("--target-pose={}", six(&tgt0)))
+            .arg("--out")
+            .arg(&u)
+            .arg("--out")
+            .arg(&y));
+        let cmp: Value = serde_json::from_str(&run(python()
+            .arg(r.join("verify/python/truth.py"))
+            .arg("compare")
+            .arg("--truth")
+            .arg(&truth)
+            .arg("--urdf")
+            .arg(&u)
+            .arg("--frames")
+            .arg(&y)
+            .args(["--n", "1000", "--seed", "1"])))
+        .unwrap();
         let true_mm = cmp["random"]["rms_mm"].as_f64().unwrap();
         // The prediction of the same fit, in the library.
         let o = read_observations(&obs, &robot, &tgt, &intrinsics, Default::default()).unwrap();
-        let s = CameraSensor::new(intrinsics.clone(), Mounting::EyeToHand, tgt.points.clone(), &cam0, &tgt0);
-        let fit = fit_camera(&robot, &s, &CameraSensor::start_own(&cam0, &tgt0), &o, &LmSettings::default()).unwrap();
-        let predicted = predicted_error(&fit, &generic_configurations(&fit.robot, 1000, 0)).map(|p| 1e3 * p);
+        let s = CameraSensor::new(
+            intrinsics.clone(),
+            Mounting::EyeToHand,
+            tgt.points.clone(),
+            &cam0,
+            &tgt0,
+        );
+        let fit = fit_camera(
+            &robot,
+            &s,
+            &CameraSensor::start_own(&cam0, &tgt0),
+            &o,
+            &LmSettings::default(),
+        )
+        .unwrap();
+        let predicted =
+            predicted_error(&fit, &generic_configurations(&fit.robot, 1000, 0)).map(|p| 1e3 * p);
         (true_mm, predicted)
     };
     let (exact, _) = calibrated(0.0, 0);
@@ -150,8 +233,14 @@ fn camera_calibration_matches_a_known_true_robot() {
         p2 += p * p;
     }
     let (t, p) = ((t2 / DRAWS as f64).sqrt(), (p2 / DRAWS as f64).sqrt());
-    println!("RMS over {DRAWS} draws: true {t:.4} mm, predicted {p:.4} mm (ratio {:.2})", t / p);
-    assert!(t < 1.3 * p && p < 1.3 * t, "true {t} mm against predicted {p} mm");
+    println!(
+        "RMS over {DRAWS} draws: true {t:.4} mm, predicted {p:.4} mm (ratio {:.2})",
+        t / p
+    );
+    assert!(
+        t < 1.3 * p && p < 1.3 * t,
+        "true {t} mm against predicted {p} mm"
+    );
 }
 
 /// The configurations of the example observations (`fixtures/camera`), as
@@ -195,28 +284,79 @@ fn activecal_against_opencv_hand_eye() {
         let tag = if exact { "exact" } else { "off" };
         let truth = dir.join(format!("truth_{tag}.json"));
         let mut make = python();
-        make.arg(&script).args(["make", "--base", "base_link", "--tip", "target", "--seed", "3"])
-            .arg("--urdf").arg(r.join("fixtures/ur5.urdf"))
-            .args(["--camera=1.2,0.6,0.9,-2.0985,0,2.0779", "--target=-0.0853,0.0568,0.0200,3.1416,0,0.03"])
-            .arg("--out").arg(&truth);
+        make.arg(&script)
+            .args([
+                "make",
+                "--base",
+                "base_link",
+                "--tip",
+                "target",
+                "--seed",
+                "3",
+            ])
+            .arg("--urdf")
+            .arg(r.join("fixtures/ur5.urdf"))
+            .args([
+                "--camera=1.2,0.6,0.9,-2.0985,0,2.0779",
+                "--target=-0.0853,0.0568,0.0200,3.1416,0,0.03",
+            ])
+            .arg("--out")
+            .arg(&truth);
         if exact {
             make.arg("--exact");
         }
         run(&mut make);
         let obs = dir.join(format!("obs_{tag}.csv"));
-        run(python().arg(&script).arg("observe").arg("--truth").arg(&truth).arg("--camera-info").arg(&info)
-            .args(["--board", "6,8,0.025", "--noise", "0.3", "--seed", "1"]).arg("--configs").arg(&configs)
-            .arg("--out").arg(&obs));
-        let (u, y) = (dir.join(format!("cal_{tag}.urdf")), dir.join(format!("cal_{tag}.yaml")));
-        run(Command::new(r.join("target/debug/activecal")).arg("calibrate").arg("--robot").arg(r.join("fixtures/ur5.urdf"))
-            .arg("--observations").arg(&obs).arg("--camera-info").arg(&info)
-            .arg("--target").arg(r.join("fixtures/camera/board.yaml"))
+        run(python()
+            .arg(&script)
+            .arg("observe")
+            .arg("--truth")
+            .arg(&truth)
+            .arg("--camera-info")
+            .arg(&info)
+            .args(["--board", "6,8,0.025", "--noise", "0.3", "--seed", "1"])
+            .arg("--configs")
+            .arg(&configs)
+            .arg("--out")
+            .arg(&obs));
+        let (u, y) = (
+            dir.join(format!("cal_{tag}.urdf")),
+            dir.join(format!("cal_{tag}.yaml")),
+        );
+        run(Command::new(r.join("target/debug/activecal"))
+            .arg("calibrate")
+            .arg("--robot")
+            .arg(r.join("fixtures/ur5.urdf"))
+            .arg("--observations")
+            .arg(&obs)
+            .arg("--camera-info")
+            .arg(&info)
+            .arg("--target")
+            .arg(r.join("fixtures/camera/board.yaml"))
             .args(["--mounting", "eye-to-hand", "--force", "--json"])
-            .args(["--camera-pose=1.1761,0.6096,0.9079,-2.0681,0.0317,2.0826", "--target-pose=-0.1047,0.0411,0.0301,3.1111,-0.0192,0.0556"])
-            .arg("--out").arg(&u).arg("--out").arg(&y));
-        let v: Value = serde_json::from_str(&run(python().arg(&script).arg("handeye").arg("--truth").arg(&truth)
-            .arg("--camera-info").arg(&info).args(["--board", "6,8,0.025"]).arg("--observations").arg(&obs)
-            .arg("--frames").arg(&y).arg("--urdf").arg(&u))).unwrap();
+            .args([
+                "--camera-pose=1.1761,0.6096,0.9079,-2.0681,0.0317,2.0826",
+                "--target-pose=-0.1047,0.0411,0.0301,3.1111,-0.0192,0.0556",
+            ])
+            .arg("--out")
+            .arg(&u)
+            .arg("--out")
+            .arg(&y));
+        let v: Value = serde_json::from_str(&run(python()
+            .arg(&script)
+            .arg("handeye")
+            .arg("--truth")
+            .arg(&truth)
+            .arg("--camera-info")
+            .arg(&info)
+            .args(["--board", "6,8,0.025"])
+            .arg("--observations")
+            .arg(&obs)
+            .arg("--frames")
+            .arg(&y)
+            .arg("--urdf")
+            .arg(&u)))
+        .unwrap();
         println!("arm geometry {tag}:");
         let ours = v["activecal"]["true"]["rms_mm"].as_f64().unwrap();
         for (name, e) in v.as_object().unwrap() {

@@ -146,7 +146,12 @@ fn rms_px(prob: &mut Calibration<'_>, theta: &[f64], rows: usize) -> f64 {
 
 /// Seen points predicted behind the camera by `sensor` at `own` with the
 /// nominal robot, and the first pose with one.
-fn behind(robot: &Robot, sensor: &CameraSensor, own: &[f64], obs: &CameraObservations) -> Option<(usize, i64)> {
+fn behind(
+    robot: &Robot,
+    sensor: &CameraSensor,
+    own: &[f64],
+    obs: &CameraObservations,
+) -> Option<(usize, i64)> {
     use crate::measure::Sensor;
     let mut ev = crate::kinematics::Evaluator::new(robot, &robot.nominal);
     let mut pred = vec![0.0; sensor.value_len()];
@@ -208,7 +213,16 @@ pub fn fit_camera(
         values,
     );
     let sol = levenberg_marquardt(&mut prob, &theta0, lm);
-    Ok(finish(robot, sensor, theta0, sol, sol0.stop, given_rms_px, rigid_rms_px, rows))
+    Ok(finish(
+        robot,
+        sensor,
+        theta0,
+        sol,
+        sol0.stop,
+        given_rms_px,
+        rigid_rms_px,
+        rows,
+    ))
 }
 
 /// Whether a stop means the solver found a minimum.
@@ -234,7 +248,10 @@ fn finish(
     let p = theta0.len();
     let redundancy = rows - p;
     let sigma_px = (sol.rss.is_finite()).then(|| (sol.rss / redundancy as f64).sqrt());
-    let inv = sol.finite.then(|| inverse_information(sol.jac.as_ref())).flatten();
+    let inv = sol
+        .finite
+        .then(|| inverse_information(sol.jac.as_ref()))
+        .flatten();
     let covariance: Option<Vec<Vec<f64>>> = match (&inv, sigma_px) {
         (Some(inv), Some(s)) => Some(
             (0..p)

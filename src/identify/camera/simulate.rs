@@ -3,12 +3,12 @@
 //! camera sees (in front of it, inside the image with a margin) and the
 //! poses that see at least [`MIN_POINTS_PER_POSE`] of them.
 
-use crate::identify::simulate::fill_standard_normal;
 use super::CameraObservations;
-use crate::measure::camera::MIN_POINTS_PER_POSE;
+use crate::identify::simulate::fill_standard_normal;
 use crate::kinematics::Evaluator;
 use crate::measure::Sensor;
 use crate::measure::camera::CameraSensor;
+use crate::measure::camera::MIN_POINTS_PER_POSE;
 use crate::model::{ParamTable, Robot};
 use rand::Rng;
 

@@ -57,10 +57,22 @@ pub fn camera_robot(robot: &Robot) -> Result<Robot> {
             let e = Vector3::ith(i, 1.0);
             let re = end.rotation * e;
             let rigid = [
-                Motion { lin: e, ang: Vector3::zeros() },
-                Motion { lin: e.cross(&end.position), ang: e },
-                Motion { lin: re, ang: Vector3::zeros() },
-                Motion { lin: Vector3::zeros(), ang: re },
+                Motion {
+                    lin: e,
+                    ang: Vector3::zeros(),
+                },
+                Motion {
+                    lin: e.cross(&end.position),
+                    ang: e,
+                },
+                Motion {
+                    lin: re,
+                    ang: Vector3::zeros(),
+                },
+                Motion {
+                    lin: Vector3::zeros(),
+                    ang: re,
+                },
             ];
             for (k, m) in rigid.iter().enumerate() {
                 push(all.len() + 3 * k + i, m);

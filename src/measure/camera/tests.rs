@@ -23,7 +23,13 @@ fn end() -> EndFrame {
 /// A 3 × 4 grid of 30 mm squares about the target's origin.
 fn grid() -> Vec<Vector3<f64>> {
     (0..12)
-        .map(|k| Vector3::new(0.03 * (k % 4) as f64 - 0.045, 0.03 * (k / 4) as f64 - 0.03, 0.0))
+        .map(|k| {
+            Vector3::new(
+                0.03 * (k % 4) as f64 - 0.045,
+                0.03 * (k / 4) as f64 - 0.03,
+                0.0,
+            )
+        })
         .collect()
 }
 
@@ -61,7 +67,14 @@ fn setup(mounting: Mounting) -> (CameraSensor, Vec<f64>) {
     };
     let s = CameraSensor::new(intrinsics(), mounting, grid(), &camera, &target);
     let mut own = CameraSensor::start_own(&camera, &target);
-    for (k, d) in [(3, 0.02), (4, -0.01), (5, 0.015), (9, -0.03), (10, 0.02), (11, 0.01)] {
+    for (k, d) in [
+        (3, 0.02),
+        (4, -0.01),
+        (5, 0.015),
+        (9, -0.03),
+        (10, 0.02),
+        (11, 0.01),
+    ] {
         own[k] = d;
     }
     (s, own)
@@ -114,7 +127,11 @@ fn rows_are_derivatives_of_the_prediction() {
                 for r in 0..2 {
                     let fd = (a[3 * k + r] - b[3 * k + r]) / 2e-6;
                     let j = jac[(2 * k + r) * n + c];
-                    assert!((j - fd).abs() < 1e-4, "{mounting:?} row {} col {c}: {j} vs {fd}", 2 * k + r);
+                    assert!(
+                        (j - fd).abs() < 1e-4,
+                        "{mounting:?} row {} col {c}: {j} vs {fd}",
+                        2 * k + r
+                    );
                     seen += usize::from(j.abs() > 1.0);
                 }
             }
@@ -187,10 +204,19 @@ fn recentring_keeps_the_placements() {
     let (s, own) = setup(Mounting::EyeToHand);
     let (r, own2) = s.recentred(&own);
     let (a, b) = (s.placements(&own), r.placements(&own2));
-    assert!((a.0.inverse() * b.0).to_homogeneous().iter().zip(nalgebra::Matrix4::<f64>::identity().iter()).all(|(x, y)| (x - y).abs() < 1e-14));
+    assert!(
+        (a.0.inverse() * b.0)
+            .to_homogeneous()
+            .iter()
+            .zip(nalgebra::Matrix4::<f64>::identity().iter())
+            .all(|(x, y)| (x - y).abs() < 1e-14)
+    );
     assert!((a.1.inverse() * b.1).rotation.angle() < 1e-14);
     assert_eq!(own2[3..6], [0.0; 3]);
     let names = s.own_param_names();
-    assert_eq!((names[0].as_str(), names[5].as_str(), names[6].as_str()), ("camera_x", "camera_rz", "target_x"));
+    assert_eq!(
+        (names[0].as_str(), names[5].as_str(), names[6].as_str()),
+        ("camera_x", "camera_rz", "target_x")
+    );
     assert_eq!(s.rows(), 24);
 }

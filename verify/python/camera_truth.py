@@ -6,14 +6,17 @@ Usage (run with the project venv's python; outputs are JSON or CSV):
   camera_truth.py make --urdf U --base LINK --tip LINK --seed S
                        --camera x,y,z,r,p,y --target x,y,z,r,p,y --out truth.json
       A true robot as truth.py make perturbs it (every chain joint's
-      <origin> composed with 0.5-2 mm and 0.05-0.3 deg, seeded), a fixed
-      camera (eye-to-hand: its optical frame in the base link, metres and
-      radians, rpy as in URDF) and a target on the tip link. truth.json is
-      truth.py's format: `tracker` is the base link's pose in the camera's
-      optical frame and `tool` the target's frame in the tip link, so that
-      `truth.py compare` measures the true error of the target's origin in
-      the camera's frame (and its orientation: `pose` is true). --exact:
-      no perturbation (the URDF is the truth).
+      <origin> composed with 0.5-2 mm and 0.05-0.3 deg, seeded), the
+      camera's optical frame and the target's frame (metres and radians,
+      rpy as in URDF): eye-to-hand (--mounting, the default), the camera in
+      the base link and the target on the tip link; eye-in-hand, the
+      camera on the tip link and the target in the base link. truth.json
+      is truth.py's format: `tracker` is the base link's pose in the fixed
+      one's frame and `tool` the moving one's frame in the tip link, so
+      that `truth.py compare` measures the true error of the moving one's
+      origin in the fixed one's frame (and its orientation: `pose` is
+      true), as activecal's frames file places them. --exact: no
+      perturbation (the URDF is the truth).
 
   camera_truth.py observe --truth truth.json --camera-info cam.yaml
                           --board ROWS,COLS,SQUARE --configs q.csv
@@ -78,6 +81,9 @@ def cmd_make(a):
         joints.append({"name": name, "t": t.tolist(), "w": w.tolist()})
     camera = placement(a.camera, "--camera")
     target = placement(a.target, "--target")
+    # The fixed one's frame is the sensor's: the base link in it is the
+    # "tracker", the moving one on the tip link the "tool".
+    fixed, moving = (camera, target) if a.mounting == "eye-to-hand" else (target, camera)
     out = {
         "format": 1,
         "urdf": os.path.abspath(a.urdf),
@@ -87,11 +93,13 @@ def cmd_make(a):
         "pose": True,
         "joint_names": chain.names,
         "joints": joints,
-        "tracker": truth.iso_json(camera.inverse()),
-        "tool": truth.iso_json(target),
-        "nominal_tool": truth.iso_json(target),
-        "note": "camera truth: tracker = the base link in the camera's optical frame; "
-                "tool = the target's frame in the tip link",
+        "mounting": a.mounting,
+        "tracker": truth.iso_json(fixed.inverse()),
+        "tool": truth.iso_json(moving),
+        "nominal_tool": truth.iso_json(moving),
+        "note": "camera truth: tracker = the base link in the fixed one's frame (the camera's "
+                "optical frame for eye-to-hand, the target's for eye-in-hand); tool = the "
+                "moving one's frame in the tip link",
     }
     with open(a.out, "w") as f:
         json.dump(out, f, indent=1)
@@ -118,7 +126,9 @@ def cmd_observe(a):
     lines = ["pose," + ",".join(t.chain.names) + ",feature,u,v"]
     poses = 0
     for n, q in enumerate(qs):
-        m = t.measured(q)  # camera <- target
+        m = t.measured(q)  # fixed <- moving
+        if t.j.get("mounting", "eye-to-hand") == "eye-in-hand":
+            m = m.inverse()  # camera <- target
         r, tv = np.asarray(m.rotation), np.asarray(m.translation)
         z = (pts @ r.T + tv)[:, 2]
         img, _ = cv2.projectPoints(pts.reshape(-1, 1, 3), cv2.Rodrigues(r)[0], tv, k, dist)
@@ -220,6 +230,7 @@ def main(argv=None):
     m.add_argument("--target", required=True)
     m.add_argument("--out", required=True)
     m.add_argument("--exact", action="store_true", help="no perturbation: the URDF is the truth")
+    m.add_argument("--mounting", choices=["eye-to-hand", "eye-in-hand"], default="eye-to-hand")
     o = sub.add_parser("observe")
     o.add_argument("--truth", required=True)
     o.add_argument("--camera-info", required=True)

@@ -2,8 +2,9 @@
 //! venv with Pinocchio and OpenCV, and `target/debug/activecal`): Pinocchio
 //! plays the real UR5 (`fixtures/ur5.urdf`, every chain joint's `<origin>`
 //! off by 0.5–2 mm and 0.05–0.3° in all six directions, seeded), OpenCV's
-//! `projectPoints` the real camera (eye-to-hand, 1.3 m away; a 6 × 8 board
-//! of 25 mm squares on the flange), `verify/python/camera_truth.py`. 40
+//! `projectPoints` the real camera (eye-to-hand, 1.3 m away, a 6 × 8 board
+//! of 25 mm squares on the flange; and eye-in-hand, the camera on the
+//! flange, the board fixed 0.45 m out), `verify/python/camera_truth.py`. 40
 //! configurations in which the nominal robot shows the whole board (the
 //! camera view filter, `activecal::pool::camera_view`); `activecal
 //! calibrate --observations` from start placements 2 cm and ~2° off writes
@@ -62,15 +63,6 @@ const DRAWS: u64 = 20;
 
 #[test]
 fn camera_calibration_matches_a_known_true_robot() {
-    let dir = std::env::temp_dir().join(format!("activecal-camera-truth-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let r = root();
-    let (urdf, info, board) = (
-        r.join("fixtures/ur5.urdf"),
-        r.join("fixtures/camera/camera_info.yaml"),
-        r.join("fixtures/camera/board.yaml"),
-    );
     let camera = Isometry3::from_parts(
         Translation3::new(1.2, 0.6, 0.9),
         UnitQuaternion::from_euler_angles(-2.0985, 0.0, 2.0779),
@@ -78,6 +70,41 @@ fn camera_calibration_matches_a_known_true_robot() {
     let target = Isometry3::from_parts(
         Translation3::new(-0.0853, 0.0568, 0.02),
         UnitQuaternion::from_euler_angles(std::f64::consts::PI, 0.0, 0.03),
+    );
+    truth_gate(Mounting::EyeToHand, camera, target);
+}
+
+/// As [`camera_calibration_matches_a_known_true_robot`], eye-in-hand: the
+/// camera on the tip link looking along its z, the board fixed in the base
+/// link 0.45 m out, face up.
+#[test]
+fn eye_in_hand_calibration_matches_a_known_true_robot() {
+    let camera = Isometry3::from_parts(
+        Translation3::new(0.06, 0.0, 0.03),
+        UnitQuaternion::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+    );
+    let target = Isometry3::from_parts(
+        Translation3::new(0.45, 0.15, 0.0),
+        UnitQuaternion::from_euler_angles(std::f64::consts::PI, 0.0, 0.03),
+    ) * Translation3::new(-0.0875, -0.0625, 0.0);
+    truth_gate(Mounting::EyeInHand, camera, target);
+}
+
+/// The gate for one mounting and true placements (see the module
+/// documentation).
+fn truth_gate(mounting: Mounting, camera: Isometry3<f64>, target: Isometry3<f64>) {
+    let dir = std::env::temp_dir().join(format!(
+        "activecal-camera-truth-{}-{}",
+        mounting.name(),
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let r = root();
+    let (urdf, info, board) = (
+        r.join("fixtures/ur5.urdf"),
+        r.join("fixtures/camera/camera_info.yaml"),
+        r.join("fixtures/camera/board.yaml"),
     );
     let truth = dir.join("truth.json");
     let script = r.join("verify/python/camera_truth.py");
@@ -91,6 +118,8 @@ fn camera_calibration_matches_a_known_true_robot() {
             "target",
             "--seed",
             "3",
+            "--mounting",
+            mounting.name(),
         ])
         .arg("--urdf")
         .arg(&urdf)
@@ -104,7 +133,7 @@ fn camera_calibration_matches_a_known_true_robot() {
     let tgt = read_target(&board).unwrap();
     let view = CameraView {
         intrinsics: intrinsics.clone(),
-        mounting: Mounting::EyeToHand,
+        mounting,
         points: tgt.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
         camera: six(&camera)
             .split(',')
@@ -181,7 +210,7 @@ fn camera_calibration_matches_a_known_true_robot() {
             .arg(&info)
             .arg("--target")
             .arg(&board)
-            .args(["--mounting", "eye-to-hand", "--json", "--force"])
+            .args(["--mounting", mounting.name(), "--json", "--force"])
             .arg(format!("--camera-pose={}", six(&cam0)))
             .arg(format!("--target-pose={}", six(&tgt0)))
             .arg("--out")
@@ -204,7 +233,7 @@ fn camera_calibration_matches_a_known_true_robot() {
         let o = read_observations(&obs, &robot, &tgt, &intrinsics, Default::default()).unwrap();
         let s = CameraSensor::new(
             intrinsics.clone(),
-            Mounting::EyeToHand,
+            mounting,
             tgt.points.clone(),
             &cam0,
             &tgt0,
@@ -222,7 +251,7 @@ fn camera_calibration_matches_a_known_true_robot() {
         (true_mm, predicted)
     };
     let (exact, _) = calibrated(0.0, 0);
-    println!("noise-free: true error {exact:.2e} mm");
+    println!("{}: noise-free: true error {exact:.2e} mm", mounting.name());
     assert!(exact < 1e-6, "noise-free pixels leave {exact} mm");
     let (mut t2, mut p2) = (0.0, 0.0);
     for seed in 1..=DRAWS {
@@ -234,7 +263,8 @@ fn camera_calibration_matches_a_known_true_robot() {
     }
     let (t, p) = ((t2 / DRAWS as f64).sqrt(), (p2 / DRAWS as f64).sqrt());
     println!(
-        "RMS over {DRAWS} draws: true {t:.4} mm, predicted {p:.4} mm (ratio {:.2})",
+        "{}: RMS over {DRAWS} draws: true {t:.4} mm, predicted {p:.4} mm (ratio {:.2})",
+        mounting.name(),
         t / p
     );
     assert!(

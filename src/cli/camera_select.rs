@@ -107,13 +107,23 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         "n": d.qs.len(),
         "unknowns": d.names,
         "ln_det": d.ln_det,
+        "predicted_error_mm_per_px": d.predicted_error_per_px.map(|e| 1e3 * e),
         "poses": d.qs,
         "points_seen": d.seen,
         "out": out.map(|p| p.display().to_string()),
     });
     super::emit(a.json, &value, || {
+        let predicted = d.predicted_error_per_px.map_or_else(
+            || "not predicted (singular design)".to_string(),
+            |e| {
+                format!(
+                    "{:.4} mm per px of pixel noise σ (RMS over 1,000 configurations)",
+                    1e3 * e
+                )
+            },
+        );
         let mut s = format!(
-            "camera: the target is seen well at {} of {} sampled configurations\nchose {} poses on the pixel Jacobian ({} unknowns): ln det XᵀX = {:.3} (unit pixel noise)\npoints seen per pose: {}\n",
+            "camera: the target is seen well at {} of {} sampled configurations\nchose {} poses on the pixel Jacobian ({} unknowns): ln det XᵀX = {:.3} (unit pixel noise)\npredicted true error: {predicted}\npoints seen per pose: {}\n",
             d.visible,
             candidates.len(),
             d.qs.len(),

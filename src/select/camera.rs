@@ -33,10 +33,20 @@ pub struct CameraDesign {
     /// `ln det(XᵀX)` of the design (pixels per metre or radian, unit
     /// noise).
     pub ln_det: f64,
+    /// The true error the design predicts per pixel of noise σ (metres
+    /// per px): the RMS error of the moving one's origin in the fixed
+    /// one's frame at [`PREDICTION_CONFIGURATIONS`] generic configurations
+    /// (seed 0), from `σ² (XᵀX)⁻¹` at σ = 1 px
+    /// ([`crate::identify::camera::predict`]); linear in σ. `None` for a
+    /// singular design.
+    pub predicted_error_per_px: Option<f64>,
     /// The selection's own record.
     #[serde(skip)]
     pub selection: Selection,
 }
+
+/// Configurations the predicted error is averaged over.
+pub const PREDICTION_CONFIGURATIONS: usize = 1000;
 
 /// The pixel Jacobian blocks (`2N × p` a pose) of `qs` for `robot` (its
 /// unknowns those of [`camera_robot`]) seen as `view` says, nominal
@@ -89,9 +99,10 @@ pub fn camera_design(
         .iter()
         .map(|&k| view.view(&robot, &robot.nominal, &qs[k]).seen)
         .collect();
-    let (sensor, _) = view.sensor();
+    let (sensor, own) = view.sensor();
     let mut names = robot.parameter_names();
     names.extend(sensor.own_param_names());
+    let predicted_error_per_px = predicted(&robot, &sensor, &own, &blocks, &sel.poses);
     Ok(CameraDesign {
         qs: sel.poses.iter().map(|&k| qs[k].clone()).collect(),
         candidates: sel.poses.iter().map(|&k| kept[k]).collect(),
@@ -99,6 +110,41 @@ pub fn camera_design(
         visible: kept.len(),
         names,
         ln_det: sel.ln_oid,
+        predicted_error_per_px,
         selection: sel,
     })
+}
+
+/// The predicted error per px of noise of the design `poses` of `blocks`
+/// (see [`CameraDesign::predicted_error_per_px`]).
+fn predicted(
+    robot: &Robot,
+    sensor: &crate::measure::camera::CameraSensor,
+    own: &[f64],
+    blocks: &Blocks,
+    poses: &[usize],
+) -> Option<f64> {
+    let m = blocks.information(poses);
+    let m = nalgebra::DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)]);
+    // Scaled to unit diagonal before inverting (columns mix px/m and
+    // px/rad); a non-positive-definite M is a singular design.
+    let d: Vec<f64> = (0..m.nrows()).map(|i| m[(i, i)].sqrt()).collect();
+    if d.iter().any(|v| !(*v > 0.0)) {
+        return None;
+    }
+    let scaled = nalgebra::DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)] / (d[i] * d[j]));
+    let inv = scaled.cholesky()?.inverse();
+    let cov: Vec<Vec<f64>> = (0..m.nrows())
+        .map(|i| {
+            (0..m.ncols())
+                .map(|j| inv[(i, j)] / (d[i] * d[j]))
+                .collect()
+        })
+        .collect();
+    let mut theta = robot.unknown_values(&robot.nominal);
+    theta.extend_from_slice(own);
+    let qs = crate::observability::generic_configurations(robot, PREDICTION_CONFIGURATIONS, 0);
+    Some(crate::identify::camera::predict::predicted_error_of(
+        robot, sensor, &theta, &cov, &qs,
+    ))
 }

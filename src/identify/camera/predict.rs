@@ -5,7 +5,8 @@
 
 use super::CameraFit;
 use crate::kinematics::Evaluator;
-use crate::measure::camera::Mounting;
+use crate::measure::camera::{CameraSensor, Mounting};
+use crate::model::Robot;
 use nalgebra::{Isometry3, Point3, Rotation3, UnitQuaternion, Vector3};
 
 /// The moving one's origin in the fixed one's frame at the fit's
@@ -13,15 +14,22 @@ use nalgebra::{Isometry3, Point3, Rotation3, UnitQuaternion, Vector3};
 /// charts) and configuration `q`, metres.
 #[must_use]
 pub fn probe(fit: &CameraFit, theta: &[f64], q: &[f64]) -> Vector3<f64> {
-    let n = fit.robot.n_unknowns();
-    let table = fit.robot.with_unknowns(&fit.robot.nominal, &theta[..n]);
-    let (cam, tgt) = fit.sensor.placements(&theta[n..]);
-    let e = Evaluator::new(&fit.robot, &table).end_frame(q);
+    probe_of(&fit.robot, &fit.sensor, theta, q)
+}
+
+/// [`probe`] for `robot` (its unknowns, then `sensor`'s own, in
+/// `theta`; other parameters nominal).
+#[must_use]
+pub fn probe_of(robot: &Robot, sensor: &CameraSensor, theta: &[f64], q: &[f64]) -> Vector3<f64> {
+    let n = robot.n_unknowns();
+    let table = robot.with_unknowns(&robot.nominal, &theta[..n]);
+    let (cam, tgt) = sensor.placements(&theta[n..]);
+    let e = Evaluator::new(robot, &table).end_frame(q);
     let end = Isometry3::from_parts(
         e.position.into(),
         UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(e.rotation)),
     );
-    let p = match fit.sensor.mounting() {
+    let p = match sensor.mounting() {
         Mounting::EyeToHand => cam.inverse() * end * tgt,
         Mounting::EyeInHand => tgt.inverse() * end * cam,
     };
@@ -36,16 +44,35 @@ pub fn probe(fit: &CameraFit, theta: &[f64], q: &[f64]) -> Vector3<f64> {
 #[must_use]
 pub fn predicted_error(fit: &CameraFit, qs: &[Vec<f64>]) -> Option<f64> {
     let cov = fit.covariance.as_ref()?;
-    let p = fit.estimate.len();
+    Some(predicted_error_of(
+        &fit.robot,
+        &fit.sensor,
+        &fit.estimate,
+        cov,
+        qs,
+    ))
+}
+
+/// [`predicted_error`] for `robot` and `sensor` at parameters `theta` with
+/// covariance `cov` (row-major, `theta.len()` square).
+#[must_use]
+pub fn predicted_error_of(
+    robot: &Robot,
+    sensor: &CameraSensor,
+    theta: &[f64],
+    cov: &[Vec<f64>],
+    qs: &[Vec<f64>],
+) -> f64 {
+    let p = theta.len();
     let h = 1e-7;
     let mut sum = 0.0;
     for q in qs {
         let cols: Vec<Vector3<f64>> = (0..p)
             .map(|k| {
-                let (mut a, mut b) = (fit.estimate.clone(), fit.estimate.clone());
+                let (mut a, mut b) = (theta.to_vec(), theta.to_vec());
                 a[k] += h;
                 b[k] -= h;
-                (probe(fit, &a, q) - probe(fit, &b, q)) / (2.0 * h)
+                (probe_of(robot, sensor, &a, q) - probe_of(robot, sensor, &b, q)) / (2.0 * h)
             })
             .collect();
         for i in 0..p {
@@ -54,5 +81,5 @@ pub fn predicted_error(fit: &CameraFit, qs: &[Vec<f64>]) -> Option<f64> {
             }
         }
     }
-    Some((sum / qs.len().max(1) as f64).sqrt())
+    (sum / qs.len().max(1) as f64).sqrt()
 }

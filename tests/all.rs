@@ -12,6 +12,7 @@ mod atomic_writes;
 mod bad_inputs;
 mod bound;
 mod camera;
+mod camera_cli;
 mod cli;
 mod cli_contacts;
 mod cli_existing;

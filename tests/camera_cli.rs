@@ -139,3 +139,12 @@ fn cli_selects_poses_for_a_camera() {
     );
     common::fails_with(&args, "exists");
 }
+
+/// A start that puts the seen points behind the camera (the camera turned
+/// away from the robot) is refused with what to give, not fitted.
+#[test]
+fn cli_refuses_a_start_behind_the_camera() {
+    let mut args = EXAMPLE.to_vec();
+    args[11] = "--camera-pose=1.1761,0.6096,0.9079,-2.0681,0.0317,-1.0590";
+    common::fails_with(&args, "lie behind the camera");
+}

@@ -191,6 +191,9 @@ fn main() {
         Command::Pool(a) => cli::basic::cmd_pool(a),
         Command::Score(a) => cli::score::cmd_score(a, &given("score")),
         Command::Select(a) if !a.points.is_empty() => cli::contact_select::cmd_select_points(&a),
+        Command::Select(a) if a.camera.camera_info.is_some() => {
+            cli::camera_select::cmd_select_camera(&a)
+        }
         Command::Select(a) => cli::select::cmd_select(a),
         Command::Bench(a) => cli::bench::cmd_bench(a),
         Command::Reproduce(a) => cli::reproduce::cmd_reproduce(a),

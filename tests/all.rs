@@ -11,6 +11,8 @@ mod common;
 mod atomic_writes;
 mod bad_inputs;
 mod bound;
+mod camera;
+mod camera_cli;
 mod cli;
 mod cli_contacts;
 mod cli_existing;

@@ -1,6 +1,6 @@
 //! `calibrate`: the choice between simulated (`--design`, rendered in
-//! `simulated.rs`), measured (`--measurements`, here) and contact
-//! (`contact.rs`) calibration. Its arguments are in `calibrate_args.rs`,
+//! `simulated.rs`), measured (`--measurements`, here), contact
+//! (`contact.rs`) and camera (`--observations`, `camera.rs`) calibration. Its arguments are in `calibrate_args.rs`,
 //! what the three share on the way out (the calibrated robot, exit
 //! statuses) in `calibrated.rs`.
 
@@ -49,6 +49,9 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     let inputs: Vec<&std::path::Path> = [
         a.design.as_deref(),
         a.measurements.as_deref(),
+        a.observations.as_deref(),
+        a.camera_info.as_deref(),
+        a.target.as_deref(),
         Some(robot_path),
     ]
     .into_iter()
@@ -63,6 +66,12 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     }
     let desc = super::load_description(&a.robot)?;
     let robot = &desc.robot;
+    if let Some(obs) = &a.observations {
+        return match super::camera::calibrate_camera(&a, robot, obs)? {
+            Some(why) => Err(NotConverged(why).into()),
+            None => Ok(()),
+        };
+    }
     match (&a.design, &a.measurements) {
         (_, Some(m)) if super::contact::is_contact_file(m) => {
             refuse_for_contacts(&a, m)?;

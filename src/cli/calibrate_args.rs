@@ -15,7 +15,7 @@ pub struct CalibrateArgs {
     pub robot: activecal::io::RobotRef,
     /// Design file (JSON with robot, levels, poses), as written by `select`:
     /// measurements are simulated there.
-    #[arg(long, required_unless_present = "measurements")]
+    #[arg(long, required_unless_present_any = ["measurements", "observations"])]
     pub design: Option<PathBuf>,
     /// Measurement file: identify from these real measurements instead of
     /// simulating a design. CSV (`x1,y1,z1`, `x2,y2,z2`… for several
@@ -166,6 +166,49 @@ pub struct CalibrateArgs {
     /// non-empty directory needs --force.
     #[arg(long, value_name = "DIR")]
     pub report: Option<PathBuf>,
+    /// Calibrate from a camera's pixels: a CSV with one row per detected
+    /// target point, `pose, <joints as in the URDF>, feature, u, v`
+    /// (pixels). Needs --camera-info, --target, --mounting, --camera-pose
+    /// and --target-pose.
+    #[arg(
+        long,
+        value_name = "FILE",
+        conflicts_with_all = ["design", "measurements", "trials", "save_measurements", "noise", "validation"],
+        requires_all = ["camera_info", "target", "mounting", "camera_pose", "target_pose"]
+    )]
+    pub observations: Option<PathBuf>,
+    /// The camera's intrinsics: a ROS camera_info YAML or an OpenCV
+    /// calibration YAML (plumb_bob distortion).
+    #[arg(long, value_name = "FILE", requires = "observations")]
+    pub camera_info: Option<PathBuf>,
+    /// The target's points: a YAML `checkerboard: {rows, cols, square}`
+    /// (inner corners, metres) or `points: [{id, xyz}, …]`.
+    #[arg(long, value_name = "FILE", requires = "observations")]
+    pub target: Option<PathBuf>,
+    /// Where the camera is: eye-to-hand (fixed camera, target on the
+    /// flange) or eye-in-hand (camera on the flange, fixed target).
+    #[arg(long, value_enum, requires = "observations")]
+    pub mounting: Option<MountingArg>,
+    /// The camera's optical frame (z forward, x right, y down), roughly:
+    /// in the base link (eye-to-hand) or the tip link (eye-in-hand),
+    /// metres and radians (rpy as in URDF). The start of the fit: a rough
+    /// guess, with every seen point in front of the camera.
+    #[arg(
+        long,
+        value_name = "X,Y,Z,ROLL,PITCH,YAW",
+        allow_hyphen_values = true,
+        requires = "observations"
+    )]
+    pub camera_pose: Option<String>,
+    /// The target's frame (its points' frame), roughly: in the tip link
+    /// (eye-to-hand) or the base link (eye-in-hand), metres and radians.
+    #[arg(
+        long,
+        value_name = "X,Y,Z,ROLL,PITCH,YAW",
+        allow_hyphen_values = true,
+        requires = "observations"
+    )]
+    pub target_pose: Option<String>,
     /// Units of the --measurements file.
     #[command(flatten)]
     pub units: super::units::UnitOpts,
@@ -191,4 +234,23 @@ pub enum WeightsKind {
     Estimated,
     /// The robot's orientation scale as given.
     Fixed,
+}
+
+/// `--mounting`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MountingArg {
+    /// A fixed camera sees a target on the flange.
+    EyeToHand,
+    /// A camera on the flange sees a fixed target.
+    EyeInHand,
+}
+
+impl From<MountingArg> for activecal::measure::camera::Mounting {
+    fn from(m: MountingArg) -> Self {
+        use activecal::measure::camera::Mounting;
+        match m {
+            MountingArg::EyeToHand => Mounting::EyeToHand,
+            MountingArg::EyeInHand => Mounting::EyeInHand,
+        }
+    }
 }

@@ -8,7 +8,7 @@ fn v3(v: [f64; 3], d: usize) -> String {
 }
 
 /// σ's with a not-estimated coordinate shown as `fixed` (never 0).
-fn s3(v: [Option<f64>; 3], d: usize) -> String {
+pub(super) fn s3(v: [Option<f64>; 3], d: usize) -> String {
     let one = |x: Option<f64>| x.map_or_else(|| "fixed".to_string(), |x| format!("{x:.d$}"));
     format!("[{}, {}, {}]", one(v[0]), one(v[1]), one(v[2]))
 }

@@ -149,6 +149,9 @@ pub struct SelectArgs {
     /// unknown.
     #[arg(long, value_name = "A,B=METRES", requires = "points")]
     pub point_distance: Vec<String>,
+    /// Poses chosen for a camera (`--camera-info` and its options).
+    #[command(flatten)]
+    pub camera: super::camera_opts::CameraOpts,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,

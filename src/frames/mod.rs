@@ -20,6 +20,7 @@
 //! covariance carried through this map by central differences.
 
 pub mod align;
+pub mod camera;
 pub mod chain;
 pub mod contact;
 pub mod gauge;

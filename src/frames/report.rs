@@ -175,6 +175,10 @@ pub struct FramesReport {
     /// measurement frame.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contacts: Option<ContactsBlock>,
+    /// The camera and target placements of a camera fit
+    /// ([`super::camera`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub camera: Option<CameraBlock>,
 }
 
 /// One joint's compliance in the frames file.
@@ -216,6 +220,25 @@ pub struct ContactPlaneBlock {
     pub offset: f64,
 }
 
+/// What the frames file adds for a camera.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct CameraBlock {
+    /// `eye-to-hand` or `eye-in-hand`.
+    pub mounting: crate::measure::camera::Mounting,
+    /// The camera's optical frame (x right, y down, z forward) in its
+    /// link.
+    pub camera: FrameBlock,
+    /// The target's frame in its link.
+    pub target: FrameBlock,
+    /// The pixel noise the fit estimated (σ per image coordinate), px.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pixel_sigma_px: Option<f64>,
+    /// The RMS pixel error at the estimate, px.
+    pub rms_px: f64,
+    /// Rows of seen points (2 per point).
+    pub pixel_rows: usize,
+}
+
 /// The contact setup a fit found: what the frames file adds for contacts.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct ContactsBlock {
@@ -249,7 +272,8 @@ fn deg(v: [f64; 3]) -> [f64; 3] {
     v.map(f64::to_degrees)
 }
 
-fn frame_block(
+/// A frame's block: `t` places `child` in `parent`, with σ's.
+pub(crate) fn frame_block(
     parent: &str,
     child: Option<&str>,
     t: &Isometry3<f64>,
@@ -421,6 +445,7 @@ impl FramesReport {
             fit,
             compliance: std::collections::BTreeMap::new(),
             contacts: None,
+            camera: None,
         }
     }
 }

@@ -74,6 +74,9 @@ pub fn residuals(robot: &Robot, table: &ParamTable, meas: &Measurements) -> Resu
             match kind[0] {
                 RowKind::Position => pos.push(1e3 * norm),
                 RowKind::Orientation => ori.push(norm.to_degrees()),
+                // A camera's pixels have figures of their own
+                // (`identify::camera`); no robot's own sensor has them.
+                RowKind::Pixel => {}
             }
         }
         per_sample.push(SampleResidual {

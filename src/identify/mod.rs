@@ -31,12 +31,15 @@
 //! * [`variance`]: each residual block's σ from its own residuals
 //!   (variance components), the weights [`fit_weighted`] iterates.
 //! * [`tables`]: estimates and residuals in the paper's table layout.
+//! * [`camera`](mod@camera): calibration from a camera's pixels (the robot
+//!   and the camera's and target's placements).
 //!
 //! Failures are kept apart as everywhere in the crate: bad input (missing or
 //! NaN measurements, wrong joint counts, invalid settings) is an
 //! [`IdentifyError`]; a numerical outcome (no convergence, divergence, a rank
 //! deficient design) is the [`Status`] of the result.
 
+pub mod camera;
 pub mod compliance;
 pub mod contact;
 pub mod evaluation;

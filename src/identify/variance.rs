@@ -26,7 +26,7 @@ use serde::Serialize;
 /// One residual block's estimated noise.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct BlockSigma {
-    /// The block: `position`, `marker K` or `orientation`.
+    /// The block: `position`, `marker K`, `orientation` or `pixels`.
     pub block: String,
     /// Its rows over all poses.
     pub rows: usize,
@@ -34,7 +34,7 @@ pub struct BlockSigma {
     pub redundancy: f64,
     /// The estimated σ per coordinate, in the block's unit.
     pub sigma: f64,
-    /// The unit of `sigma`: `m` or `rad`.
+    /// The unit of `sigma`: `m`, `rad` or `px`.
     pub unit: &'static str,
 }
 
@@ -60,6 +60,7 @@ pub fn row_blocks(kinds: &[RowKind], points: usize) -> (Vec<usize>, Vec<(String,
                 )
             }
             RowKind::Orientation => ("orientation".to_string(), "rad"),
+            RowKind::Pixel => ("pixels".to_string(), "px"),
         };
         let b = match blocks.iter().position(|n| n.0 == name.0) {
             Some(b) => b,

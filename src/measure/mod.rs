@@ -1,12 +1,15 @@
 //! What a sensor measures at a pose: the measurement seam ([`Sensor`], with
-//! [`point`] and [`pose`] sensors), the region it sees ([`visibility`]) and
-//! the rotation maps of full-pose measurements ([`so3`]).
+//! [`point`], [`pose`], [`markers`], [`contact`] and [`camera`] sensors; a
+//! camera's projection in [`pinhole`]), the region it sees ([`visibility`])
+//! and the rotation maps of full-pose measurements ([`so3`]).
 //!
 //! [`JacobianEvaluator`] joins the kinematics' per-unknown motions and a
 //! sensor's rows into the identification Jacobian of one pose.
 
+pub mod camera;
 pub mod contact;
 pub mod markers;
+pub mod pinhole;
 pub mod point;
 pub mod pose;
 pub mod sensor;

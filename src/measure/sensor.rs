@@ -50,6 +50,8 @@ pub enum RowKind {
     /// An orientation coordinate (a rotation-vector component), radians
     /// before weighting.
     Orientation,
+    /// An image coordinate (`u` or `v`), pixels ([`super::camera`]).
+    Pixel,
 }
 
 /// One pose's observation as measurement files hold it: measured points
@@ -85,6 +87,9 @@ pub struct ObservationBuf {
 /// [`super::pose::PoseSensor`] (6 rows, the end point and the end frame's orientation)
 /// and [`super::markers::MarkerSensor`] (`3K` rows, `K` markers with their own offsets).
 /// [`super::sensor_for`] picks one from [`crate::model::Robot::measurement`].
+/// Sensors that are not a robot's own are built by their fits:
+/// [`super::contact::ContactSensor`] (contacts with fixed points) and
+/// [`super::camera::CameraSensor`] (`2N` pixel rows of `N` target points).
 ///
 /// The hot path, the pool Jacobian of up to 10⁶ poses, calls
 /// [`Sensor::motion_rows`] once per pose; every other method is per pose or

@@ -99,6 +99,9 @@ impl PoolSpec {
                     c.load_sharing(source)
                         .map_err(|e| Error::Invalid(format!("{} filter: {e}", c.kind())))?;
                 }
+                PoolFilter::Camera(c) => c
+                    .validate()
+                    .map_err(|e| Error::Invalid(format!("camera view filter: {e}")))?,
             }
         }
         Ok(())
@@ -179,7 +182,7 @@ impl PoolSpec {
         let mut models = vec![None; usize::from(margin_limits.is_some())];
         models.extend(self.filters.iter().map(|f| match f {
             PoolFilter::Collision(c) => c.load().ok(),
-            PoolFilter::Visibility(_) => None,
+            PoolFilter::Visibility(_) | PoolFilter::Camera(_) => None,
         }));
         let filters = stats::filter_stats(&names, &models, &verdict, cands.size());
         debug_assert_eq!(

@@ -15,6 +15,7 @@
 //! changes.
 
 mod build;
+pub mod camera_view;
 pub mod file;
 pub mod lattice;
 pub mod sampled;
@@ -106,6 +107,9 @@ pub enum PoolFilter {
     /// Keep the poses where no two links touch and no link touches an
     /// obstacle ([`crate::collision`]).
     Collision(CollisionFilter),
+    /// Keep the poses where a camera sees its target well
+    /// ([`camera_view`]).
+    Camera(camera_view::CameraView),
 }
 
 impl PoolFilter {
@@ -115,16 +119,18 @@ impl PoolFilter {
         match self {
             PoolFilter::Visibility(v) => v.sees(&position(robot, table, q)),
             PoolFilter::Collision(c) => c.keeps(q),
+            PoolFilter::Camera(c) => c.keeps(robot, table, q),
         }
     }
 
-    /// A short name: `visibility`, `self-collision`, `obstacles` or
-    /// `collision`.
+    /// A short name: `visibility`, `self-collision`, `obstacles`,
+    /// `collision` or `camera view`.
     #[must_use]
     pub fn kind(&self) -> &'static str {
         match self {
             PoolFilter::Visibility(_) => "visibility",
             PoolFilter::Collision(c) => c.kind(),
+            PoolFilter::Camera(_) => "camera view",
         }
     }
 }

@@ -32,6 +32,7 @@ use crate::criterion::{DCriterion, OiCriterion, Prior};
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
+pub mod camera;
 mod exchange;
 pub mod moves;
 mod random;

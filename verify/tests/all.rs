@@ -12,6 +12,10 @@ mod live;
 #[cfg(feature = "live")]
 mod live_bound;
 #[cfg(feature = "live")]
+mod live_camera;
+#[cfg(feature = "live")]
+mod live_camera_truth;
+#[cfg(feature = "live")]
 mod live_collision;
 #[cfg(feature = "live")]
 mod live_contacts;

@@ -1,0 +1,57 @@
+//! The camera options of `select` (`camera_select.rs` runs them).
+
+use activecal::pool::camera_view::DEFAULT_MAX_VIEW_ANGLE_DEG;
+use clap::Args;
+use std::path::PathBuf;
+
+/// The camera options of `select`.
+#[derive(Args, Debug, Default)]
+pub struct CameraOpts {
+    /// Choose poses for a camera (see --target, --mounting): its
+    /// intrinsics, a ROS camera_info or OpenCV calibration YAML.
+    #[arg(long, value_name = "FILE", requires_all = ["target", "mounting", "camera_pose", "target_pose"])]
+    pub camera_info: Option<PathBuf>,
+    /// The camera's target: a YAML checkerboard {rows, cols, square} or
+    /// points [{id, xyz}].
+    #[arg(long, value_name = "FILE", requires = "camera_info")]
+    pub target: Option<PathBuf>,
+    /// eye-to-hand or eye-in-hand.
+    #[arg(long, value_enum, requires = "camera_info")]
+    pub mounting: Option<super::calibrate_args::MountingArg>,
+    /// The camera's optical frame in the base link (eye-to-hand) or the
+    /// tip link (eye-in-hand): X,Y,Z,ROLL,PITCH,YAW (metres, radians).
+    #[arg(
+        long,
+        value_name = "X,Y,Z,ROLL,PITCH,YAW",
+        allow_hyphen_values = true,
+        requires = "camera_info"
+    )]
+    pub camera_pose: Option<String>,
+    /// The target's frame in the tip link (eye-to-hand) or the base link
+    /// (eye-in-hand): X,Y,Z,ROLL,PITCH,YAW.
+    #[arg(
+        long,
+        value_name = "X,Y,Z,ROLL,PITCH,YAW",
+        allow_hyphen_values = true,
+        requires = "camera_info"
+    )]
+    pub target_pose: Option<String>,
+    /// The fraction of the target's points a pose must see.
+    #[arg(long, default_value_t = 1.0, requires = "camera_info")]
+    pub min_visible: f64,
+    /// How far inside the image a seen point must be, pixels.
+    #[arg(long, default_value_t = 10.0, requires = "camera_info")]
+    pub image_margin: f64,
+    /// The largest angle between the target's normal and the line of
+    /// sight, degrees.
+    #[arg(long, default_value_t = DEFAULT_MAX_VIEW_ANGLE_DEG, requires = "camera_info")]
+    pub max_view_angle: f64,
+    /// The range of the target's distance from the camera: LO,HI metres.
+    #[arg(
+        long,
+        value_name = "LO,HI",
+        default_value = "0.2,3.0",
+        requires = "camera_info"
+    )]
+    pub distance: String,
+}

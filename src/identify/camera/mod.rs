@@ -1,0 +1,291 @@
+//! Calibration from pixels: a camera ([`crate::measure::camera`]) sees a
+//! target at measured configurations; the robot's unknowns and the
+//! camera's and target's placements are fitted to the pixels.
+//!
+//! Two steps ([`fit_camera`]):
+//! 1. **rigid start**: the 12 placement unknowns alone, the robot at its
+//!    nominal parameters, by Levenberg–Marquardt from the start placements
+//!    the caller gives (rough: every seen point must lie in front of the
+//!    camera there; the example files' fit converges from guesses 30 cm
+//!    and 20° off);
+//! 2. **full fit**: the robot's unknowns ([`unknowns::camera_robot`]) and
+//!    the placements together, the placements' charts re-centred on the
+//!    rigid start's.
+//!
+//! The pixel block's σ is the variance-component estimate of one block
+//! (`σ̂² = rᵀr / (n − p)`, `n` the rows of seen points, `p` the unknowns;
+//! [`super::variance`]), in pixels; the covariance of the estimate is
+//! `σ̂² (XᵀX)⁻¹`.
+
+pub mod predict;
+pub mod simulate;
+pub mod unknowns;
+
+pub use unknowns::camera_robot;
+
+use super::lm::{LmSettings, Solution, StopReason, levenberg_marquardt};
+use super::residual::{Calibration, Residuals};
+use crate::linalg::qr::inverse_information;
+use crate::measure::camera::{CameraSensor, OWN_PARAMS};
+use crate::model::{ParamTable, Robot};
+use nalgebra::Isometry3;
+
+/// The observations of a camera, by pose.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CameraObservations {
+    /// The file, for messages.
+    pub origin: String,
+    /// Each pose's id, in the order poses first appear.
+    pub pose_ids: Vec<i64>,
+    /// Each pose's joint values (radians, metres).
+    pub qs: Vec<Vec<f64>>,
+    /// Each pose's pixel of every target point (target order), `None`
+    /// where the point was not seen.
+    pub seen: Vec<Vec<Option<[f64; 2]>>>,
+}
+
+impl CameraObservations {
+    /// The measured values in the camera sensor's layout
+    /// ([`crate::measure::camera`]: `u, v, seen` per target point), pose
+    /// after pose.
+    #[must_use]
+    pub fn values(&self) -> Vec<f64> {
+        self.seen
+            .iter()
+            .flat_map(|s| crate::measure::camera::CameraSensor::value_of(s))
+            .collect()
+    }
+
+    /// The number of points seen over all poses.
+    #[must_use]
+    pub fn n_seen(&self) -> usize {
+        self.seen.iter().flatten().filter(|s| s.is_some()).count()
+    }
+}
+
+/// A camera calibration's result.
+#[derive(Clone, Debug)]
+pub struct CameraFit {
+    /// The robot as fitted (its unknowns those of [`camera_robot`]).
+    pub robot: Robot,
+    /// The calibrated parameter table.
+    pub table: ParamTable,
+    /// The sensor, its charts centred on the rigid start.
+    pub sensor: CameraSensor,
+    /// The camera's placement (in the base for eye-to-hand, in the end
+    /// frame for eye-in-hand).
+    pub camera: Isometry3<f64>,
+    /// The target's placement (in the end frame for eye-to-hand, in the
+    /// base for eye-in-hand).
+    pub target: Isometry3<f64>,
+    /// Names of the unknowns: the robot's, then `camera_x … target_rz`.
+    pub names: Vec<String>,
+    /// The unknowns at the start of the full fit (after the rigid start).
+    pub start: Vec<f64>,
+    /// The unknowns at the estimate.
+    pub estimate: Vec<f64>,
+    /// Their standard deviations (metres, radians), when the estimate's
+    /// information is regular.
+    pub std: Option<Vec<f64>>,
+    /// Their covariance `σ̂² (XᵀX)⁻¹`, row-major.
+    pub covariance: Option<Vec<Vec<f64>>>,
+    /// RMS pixel error of the seen points with the start placements and
+    /// the nominal robot, pixels.
+    pub given_rms_px: f64,
+    /// RMS pixel error after the rigid start (nominal robot), pixels.
+    pub rigid_rms_px: f64,
+    /// RMS pixel error at the estimate, pixels.
+    pub rms_px: f64,
+    /// The pixel block's σ (see the module documentation), pixels.
+    pub sigma_px: Option<f64>,
+    /// Rows of seen points (2 per point seen).
+    pub rows: usize,
+    /// Degrees of freedom of `sigma_px`: rows less unknowns.
+    pub redundancy: usize,
+    /// Whether both steps converged and the estimate has a covariance.
+    pub converged: bool,
+    /// Why the full fit stopped.
+    pub stop: StopReason,
+    /// Its iterations.
+    pub iterations: usize,
+}
+
+/// Why a camera fit could not be made at all (bad input, or a start from
+/// which the camera does not see what the file says it saw).
+#[derive(Debug, thiserror::Error)]
+pub enum CameraFitError {
+    /// The start placements put seen points behind the camera.
+    #[error(
+        "with the start placements of the camera and the target, {behind} seen point(s) lie behind the camera (first: pose {pose}); give start placements within a few centimetres and degrees of the real ones"
+    )]
+    BehindCamera {
+        /// Seen points behind the camera.
+        behind: usize,
+        /// The first pose with one (its id).
+        pose: i64,
+    },
+    /// Fewer rows than unknowns.
+    #[error("{rows} pixel rows for {p} unknowns: observe more poses")]
+    TooFewRows {
+        /// Rows of seen points.
+        rows: usize,
+        /// Unknowns.
+        p: usize,
+    },
+    /// The robot's unknowns could not be chosen.
+    #[error(transparent)]
+    Robot(#[from] crate::error::Error),
+}
+
+/// The RMS over seen rows of a problem's residuals at `theta`, pixels.
+fn rms_px(prob: &mut Calibration<'_>, theta: &[f64], rows: usize) -> f64 {
+    let mut r = vec![0.0; prob.n_residuals()];
+    prob.eval(theta, &mut r, None);
+    (r.iter().map(|v| v * v).sum::<f64>() / rows.max(1) as f64).sqrt()
+}
+
+/// Seen points predicted behind the camera by `sensor` at `own` with the
+/// nominal robot, and the first pose with one.
+fn behind(
+    robot: &Robot,
+    sensor: &CameraSensor,
+    own: &[f64],
+    obs: &CameraObservations,
+) -> Option<(usize, i64)> {
+    use crate::measure::Sensor;
+    let mut ev = crate::kinematics::Evaluator::new(robot, &robot.nominal);
+    let mut pred = vec![0.0; sensor.value_len()];
+    let (mut n, mut first) = (0, None);
+    for (i, q) in obs.qs.iter().enumerate() {
+        sensor.predict(&ev.end_frame(q), own, &mut pred);
+        for (k, s) in obs.seen[i].iter().enumerate() {
+            if s.is_some() && pred[3 * k + 2] == 0.0 {
+                n += 1;
+                first.get_or_insert(obs.pose_ids[i]);
+            }
+        }
+    }
+    first.map(|p| (n, p))
+}
+
+/// Calibrates `robot` (nominal parameters) from `obs` seen by `sensor`
+/// whose charts are centred on the start placements `own0` stands for
+/// ([`CameraSensor::start_own`]); see the module documentation.
+pub fn fit_camera(
+    robot: &Robot,
+    sensor: &CameraSensor,
+    own0: &[f64],
+    obs: &CameraObservations,
+    lm: &LmSettings,
+) -> Result<CameraFit, CameraFitError> {
+    let robot = camera_robot(robot)?;
+    let rows = 2 * obs.n_seen();
+    let p = robot.n_unknowns() + OWN_PARAMS;
+    if rows <= p {
+        return Err(CameraFitError::TooFewRows { rows, p });
+    }
+    if let Some((behind, pose)) = behind(&robot, sensor, own0, obs) {
+        return Err(CameraFitError::BehindCamera { behind, pose });
+    }
+    let values = obs.values();
+    // 1. The placements alone, the robot nominal.
+    let mut rigid_robot = robot.clone();
+    rigid_robot.unknowns.clear();
+    let mut rigid = Calibration::with_sensor(
+        &rigid_robot,
+        &robot.nominal,
+        &obs.qs,
+        Box::new(sensor.clone()),
+        values.clone(),
+    );
+    let given_rms_px = rms_px(&mut rigid, own0, rows);
+    let sol0 = levenberg_marquardt(&mut rigid, own0, lm);
+    let rigid_rms_px = (sol0.rss / rows as f64).sqrt();
+    // 2. Everything, the charts re-centred on the rigid start.
+    let (sensor, own1) = sensor.recentred(&sol0.theta);
+    let mut theta0 = robot.unknown_values(&robot.nominal);
+    theta0.extend_from_slice(&own1);
+    let mut prob = Calibration::with_sensor(
+        &robot,
+        &robot.nominal,
+        &obs.qs,
+        Box::new(sensor.clone()),
+        values,
+    );
+    let sol = levenberg_marquardt(&mut prob, &theta0, lm);
+    Ok(finish(
+        robot,
+        sensor,
+        theta0,
+        sol,
+        sol0.stop,
+        given_rms_px,
+        rigid_rms_px,
+        rows,
+    ))
+}
+
+/// Whether a stop means the solver found a minimum.
+fn converged(s: StopReason) -> bool {
+    !matches!(
+        s,
+        StopReason::MaxIterations | StopReason::NonFinite | StopReason::DampingLimit
+    )
+}
+
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    robot: Robot,
+    sensor: CameraSensor,
+    theta0: Vec<f64>,
+    sol: Solution,
+    rigid_stop: StopReason,
+    given_rms_px: f64,
+    rigid_rms_px: f64,
+    rows: usize,
+) -> CameraFit {
+    use crate::measure::Sensor;
+    let p = theta0.len();
+    let redundancy = rows - p;
+    let sigma_px = (sol.rss.is_finite()).then(|| (sol.rss / redundancy as f64).sqrt());
+    let inv = sol
+        .finite
+        .then(|| inverse_information(sol.jac.as_ref()))
+        .flatten();
+    let covariance: Option<Vec<Vec<f64>>> = match (&inv, sigma_px) {
+        (Some(inv), Some(s)) => Some(
+            (0..p)
+                .map(|i| (0..p).map(|j| s * s * inv[(i, j)]).collect())
+                .collect(),
+        ),
+        _ => None,
+    };
+    let std = covariance
+        .as_ref()
+        .map(|c| (0..p).map(|j| c[j][j].max(0.0).sqrt()).collect());
+    let n_kin = robot.n_unknowns();
+    let (camera, target) = sensor.placements(&sol.theta[n_kin..]);
+    let mut names = robot.parameter_names();
+    names.extend(sensor.own_param_names());
+    CameraFit {
+        table: robot.with_unknowns(&robot.nominal, &sol.theta[..n_kin]),
+        converged: sol.finite && std.is_some() && converged(sol.stop) && converged(rigid_stop),
+        robot,
+        sensor,
+        camera,
+        target,
+        names,
+        start: theta0,
+        rms_px: (sol.rss / rows as f64).sqrt(),
+        estimate: sol.theta,
+        std,
+        covariance,
+        given_rms_px,
+        rigid_rms_px,
+        sigma_px,
+        rows,
+        redundancy,
+        stop: sol.stop,
+        iterations: sol.iterations,
+    }
+}

@@ -1,0 +1,150 @@
+//! Poses chosen for a camera: the configurations of a pool in which the
+//! camera sees its target well ([`CameraView`]), and a D-optimal choice
+//! among them on the pixel Jacobian (the robot's unknowns a camera
+//! identifies and the 12 placement unknowns; each pose's `2N` rows those of
+//! the points predicted inside the image with the view's margin, zero for
+//! the others, [`crate::measure::camera`]). Each chosen pose says how many
+//! points it will see.
+
+use super::{Algorithm, CriterionKind, Selection, Settings, select};
+use crate::blocks::Blocks;
+use crate::error::{Error, Result};
+use crate::identify::camera::camera_robot;
+use crate::kinematics::{Evaluator, Motion};
+use crate::measure::Sensor;
+use crate::measure::camera::OWN_PARAMS;
+use crate::model::Robot;
+use crate::pool::camera_view::CameraView;
+use serde::Serialize;
+
+/// A design for a camera.
+#[derive(Clone, Debug, Serialize)]
+pub struct CameraDesign {
+    /// The chosen configurations (radians, metres), in the order chosen.
+    pub qs: Vec<Vec<f64>>,
+    /// Each one's index in the candidates given.
+    pub candidates: Vec<usize>,
+    /// The points each one will see (inside the image with the margin).
+    pub seen: Vec<usize>,
+    /// The candidates the view kept.
+    pub visible: usize,
+    /// Unknowns: the robot's, then the camera's and the target's 6 each.
+    pub names: Vec<String>,
+    /// `ln det(XᵀX)` of the design (pixels per metre or radian, unit
+    /// noise).
+    pub ln_det: f64,
+    /// The true error the design predicts per pixel of noise σ (metres
+    /// per px): the RMS error of the moving one's origin in the fixed
+    /// one's frame at [`PREDICTION_CONFIGURATIONS`] generic configurations
+    /// (seed 0), from `σ² (XᵀX)⁻¹` at σ = 1 px
+    /// ([`crate::identify::camera::predict`]); linear in σ. `None` for a
+    /// singular design.
+    pub predicted_error_per_px: Option<f64>,
+    /// The selection's own record.
+    #[serde(skip)]
+    pub selection: Selection,
+}
+
+/// Configurations the predicted error is averaged over.
+pub const PREDICTION_CONFIGURATIONS: usize = 1000;
+
+/// The pixel Jacobian blocks (`2N × p` a pose) of `qs` for `robot` (its
+/// unknowns those of [`camera_robot`]) seen as `view` says, nominal
+/// parameters.
+#[must_use]
+pub fn camera_blocks(robot: &Robot, view: &CameraView, qs: &[Vec<f64>]) -> Blocks {
+    let (sensor, own) = view.sensor();
+    let n = robot.n_unknowns();
+    let (t, p) = (sensor.rows(), n + OWN_PARAMS);
+    let mut ev = Evaluator::new(robot, &robot.nominal);
+    let mut motions = vec![Motion::default(); n];
+    let mut rows = vec![0.0; qs.len() * t * p];
+    for (q, block) in qs.iter().zip(rows.chunks_exact_mut(t * p)) {
+        let end = ev.motions(q, &mut motions);
+        sensor.motion_rows(&end, &own, &motions, block, p);
+        sensor.own_rows(&end, &own, &mut block[n..], p);
+    }
+    Blocks::from_row_major(&rows, t, p)
+}
+
+/// Chooses `settings.n` of the `candidates` (joint vectors of `robot`)
+/// for `view` by exchange-add-exchange on the D criterion: the candidates
+/// the view keeps (at the nominal parameters) form the pool. Errors when
+/// the view is malformed or keeps fewer candidates than the design needs.
+pub fn camera_design(
+    robot: &Robot,
+    view: &CameraView,
+    candidates: &[Vec<f64>],
+    settings: &Settings,
+) -> Result<CameraDesign> {
+    view.validate()
+        .map_err(|e| Error::Invalid(format!("camera view: {e}")))?;
+    let robot = camera_robot(robot)?;
+    let kept: Vec<usize> = (0..candidates.len())
+        .filter(|&i| view.keeps(&robot, &robot.nominal, &candidates[i]))
+        .collect();
+    if kept.len() < settings.n {
+        return Err(Error::Invalid(format!(
+            "the camera sees its target well at {} of {} candidate configurations, fewer than the {} poses asked for: a larger pool, a wider view (fraction of points, margin, viewing angle, distance) or fewer poses",
+            kept.len(),
+            candidates.len(),
+            settings.n
+        )));
+    }
+    let qs: Vec<Vec<f64>> = kept.iter().map(|&i| candidates[i].clone()).collect();
+    let blocks = camera_blocks(&robot, view, &qs);
+    let sel = select(&blocks, CriterionKind::Det, Algorithm::Eae, settings)?;
+    let seen = sel
+        .poses
+        .iter()
+        .map(|&k| view.view(&robot, &robot.nominal, &qs[k]).seen)
+        .collect();
+    let (sensor, own) = view.sensor();
+    let mut names = robot.parameter_names();
+    names.extend(sensor.own_param_names());
+    let predicted_error_per_px = predicted(&robot, &sensor, &own, &blocks, &sel.poses);
+    Ok(CameraDesign {
+        qs: sel.poses.iter().map(|&k| qs[k].clone()).collect(),
+        candidates: sel.poses.iter().map(|&k| kept[k]).collect(),
+        seen,
+        visible: kept.len(),
+        names,
+        ln_det: sel.ln_oid,
+        predicted_error_per_px,
+        selection: sel,
+    })
+}
+
+/// The predicted error per px of noise of the design `poses` of `blocks`
+/// (see [`CameraDesign::predicted_error_per_px`]).
+fn predicted(
+    robot: &Robot,
+    sensor: &crate::measure::camera::CameraSensor,
+    own: &[f64],
+    blocks: &Blocks,
+    poses: &[usize],
+) -> Option<f64> {
+    let m = blocks.information(poses);
+    let m = nalgebra::DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)]);
+    // Scaled to unit diagonal before inverting (columns mix px/m and
+    // px/rad); a non-positive-definite M is a singular design.
+    let d: Vec<f64> = (0..m.nrows()).map(|i| m[(i, i)].sqrt()).collect();
+    if d.iter().any(|v| !(*v > 0.0)) {
+        return None;
+    }
+    let scaled = nalgebra::DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)] / (d[i] * d[j]));
+    let inv = scaled.cholesky()?.inverse();
+    let cov: Vec<Vec<f64>> = (0..m.nrows())
+        .map(|i| {
+            (0..m.ncols())
+                .map(|j| inv[(i, j)] / (d[i] * d[j]))
+                .collect()
+        })
+        .collect();
+    let mut theta = robot.unknown_values(&robot.nominal);
+    theta.extend_from_slice(own);
+    let qs = crate::observability::generic_configurations(robot, PREDICTION_CONFIGURATIONS, 0);
+    Some(crate::identify::camera::predict::predicted_error_of(
+        robot, sensor, &theta, &cov, &qs,
+    ))
+}

@@ -229,10 +229,18 @@ pub fn recommend(points: &[CurvePoint], target_mm: Option<f64>) -> Option<Recomm
     let rms = |p: &CurvePoint| p.predicted.position_rms_mm;
     if let Some(target_mm) = target_mm {
         if let Some(p) = points.iter().find(|p| rms(p) <= target_mm) {
-            return Some(Recommendation::Target { n: p.n, target_mm, predicted_mm: rms(p) });
+            return Some(Recommendation::Target {
+                n: p.n,
+                target_mm,
+                predicted_mm: rms(p),
+            });
         }
         let p = points.iter().min_by(|a, b| rms(a).total_cmp(&rms(b)))?;
-        return Some(Recommendation::TargetNotReached { n: p.n, target_mm, predicted_mm: rms(p) });
+        return Some(Recommendation::TargetNotReached {
+            n: p.n,
+            target_mm,
+            predicted_mm: rms(p),
+        });
     }
     for (i, p) in points.iter().enumerate() {
         let want = p.n + (p.n * KNEE_MORE_PERCENT).div_ceil(100).max(1);
@@ -241,11 +249,19 @@ pub fn recommend(points: &[CurvePoint], target_mm: Option<f64>) -> Option<Recomm
         };
         let gain = 1.0 - rms(q) / rms(p);
         if gain < KNEE_GAIN {
-            return Some(Recommendation::Knee { n: p.n, next_n: q.n, predicted_mm: rms(p), gain });
+            return Some(Recommendation::Knee {
+                n: p.n,
+                next_n: q.n,
+                predicted_mm: rms(p),
+                gain,
+            });
         }
     }
     let last = points.last()?;
-    Some(Recommendation::NoKnee { n: last.n, predicted_mm: rms(last) })
+    Some(Recommendation::NoKnee {
+        n: last.n,
+        predicted_mm: rms(last),
+    })
 }
 
 /// The sizes of the curve: `n_min..=3·n_min` (evenly thinned to at most
@@ -268,7 +284,11 @@ pub fn curve_sizes(n_min: usize, also: &[usize], max_points: usize, pool: usize)
 /// The largest step between consecutive `sizes` within `n_min..=3·n_min`
 /// (1 when there is at most one).
 fn sizes_step(sizes: &[usize], n_min: usize) -> usize {
-    let range: Vec<usize> = sizes.iter().copied().filter(|&n| n >= n_min && n <= 3 * n_min).collect();
+    let range: Vec<usize> = sizes
+        .iter()
+        .copied()
+        .filter(|&n| n >= n_min && n <= 3 * n_min)
+        .collect();
     range.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(1)
 }
 
@@ -370,7 +390,9 @@ pub fn predicted_errors(
     let full = kinds.contains(&RowKind::Orientation);
     let s2 = noise * noise;
     // The position rows, a point's three in a row.
-    let rows: Vec<usize> = (0..kinds.len()).filter(|&r| kinds[r] == RowKind::Position).collect();
+    let rows: Vec<usize> = (0..kinds.len())
+        .filter(|&r| kinds[r] == RowKind::Position)
+        .collect();
     let mut rng = ChaCha8Rng::seed_from_u64(0);
     let (mut pos, mut ori, mut norms) = (Vec::new(), Vec::new(), Vec::new());
     for i in 0..eval.n_poses() {
@@ -386,7 +408,9 @@ pub fn predicted_errors(
         for t in rows.chunks_exact(3) {
             let cov: [[f64; 3]; 3] = std::array::from_fn(|a| {
                 std::array::from_fn(|c| {
-                    s2 * (0..b.ncols()).map(|k| xc[(t[a], k)] * b[(t[c], k)]).sum::<f64>()
+                    s2 * (0..b.ncols())
+                        .map(|k| xc[(t[a], k)] * b[(t[c], k)])
+                        .sum::<f64>()
                 })
             });
             error_norms(&cov, &mut rng, &mut norms);
@@ -540,13 +564,24 @@ mod tests {
     #[test]
     fn the_curve_recommends_the_target_s_smallest_size_or_its_knee() {
         // 1/√N-like, then flat from N = 14 on.
-        let pts: Vec<CurvePoint> = [(10, 0.20), (11, 0.18), (12, 0.165), (13, 0.155), (14, 0.150), (15, 0.149), (16, 0.148), (17, 0.147)]
-            .iter()
-            .map(|&(n, r)| point(n, r))
-            .collect();
+        let pts: Vec<CurvePoint> = [
+            (10, 0.20),
+            (11, 0.18),
+            (12, 0.165),
+            (13, 0.155),
+            (14, 0.150),
+            (15, 0.149),
+            (16, 0.148),
+            (17, 0.147),
+        ]
+        .iter()
+        .map(|&(n, r)| point(n, r))
+        .collect();
         // Knee: 12 → 14 (≥ 10 % more) gains 9 %; 13 → 15 gains 3.9 %.
         match recommend(&pts, None).unwrap() {
-            Recommendation::Knee { n, next_n, gain, .. } => {
+            Recommendation::Knee {
+                n, next_n, gain, ..
+            } => {
                 assert_eq!((n, next_n), (13, 15));
                 assert!((gain - (1.0 - 0.149 / 0.155)).abs() < 1e-12);
             }
@@ -559,8 +594,13 @@ mod tests {
             Recommendation::TargetNotReached { n: 17, .. }
         ));
         // Still steep at the end: no knee, the largest size.
-        let steep: Vec<CurvePoint> = (10..=20).map(|n| point(n, 100.0 / (n * n) as f64)).collect();
-        assert!(matches!(recommend(&steep, None).unwrap(), Recommendation::NoKnee { n: 20, .. }));
+        let steep: Vec<CurvePoint> = (10..=20)
+            .map(|n| point(n, 100.0 / (n * n) as f64))
+            .collect();
+        assert!(matches!(
+            recommend(&steep, None).unwrap(),
+            Recommendation::NoKnee { n: 20, .. }
+        ));
         assert!(recommend(&[], None).is_none());
     }
 
@@ -604,12 +644,23 @@ mod tests {
         let robot = Robot::puma560();
         let qs = random_configurations(&robot, 240, 11);
         let (design, judged) = qs.split_at(40);
-        let x = jacobian_of(&robot, &robot.real, 40, |k, q| q.copy_from_slice(&design[k]));
-        let eval = jacobian_of(&robot, &robot.real, 200, |k, q| q.copy_from_slice(&judged[k]));
+        let x = jacobian_of(&robot, &robot.real, 40, |k, q| {
+            q.copy_from_slice(&design[k])
+        });
+        let eval = jacobian_of(&robot, &robot.real, 200, |k, q| {
+            q.copy_from_slice(&judged[k])
+        });
         let sigma = 1e-4;
         let info = x.information(&(0..40).collect::<Vec<_>>());
         let p = predicted_errors(&robot, &eval, info.as_ref(), sigma).unwrap();
-        let truth = simulate(&robot, &robot.real, judged, 0.0, &mut ChaCha8Rng::seed_from_u64(0)).unwrap();
+        let truth = simulate(
+            &robot,
+            &robot.real,
+            judged,
+            0.0,
+            &mut ChaCha8Rng::seed_from_u64(0),
+        )
+        .unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let mut seen = Vec::new();
         for _ in 0..40 {
@@ -627,8 +678,16 @@ mod tests {
             "RMS {} predicted, {rms} seen; 95th percentile of the error {} predicted, {p95} seen (of the RMS: {})",
             p.position_rms_mm, p.position_error_p95_mm, p.position_p95_mm
         );
-        assert!((p.position_rms_mm / rms - 1.0).abs() < 0.1, "{} {rms}", p.position_rms_mm);
-        assert!((p.position_error_p95_mm / p95 - 1.0).abs() < 0.1, "{} {p95}", p.position_error_p95_mm);
+        assert!(
+            (p.position_rms_mm / rms - 1.0).abs() < 0.1,
+            "{} {rms}",
+            p.position_rms_mm
+        );
+        assert!(
+            (p.position_error_p95_mm / p95 - 1.0).abs() < 0.1,
+            "{} {p95}",
+            p.position_error_p95_mm
+        );
         assert!(
             (p.position_error_p95_mm - p95).abs() < (p.position_p95_mm - p95).abs(),
             "error p95 {} and RMS p95 {} against {p95} seen",

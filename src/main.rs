@@ -253,7 +253,11 @@ fn cap_threads() {
 fn report_error(e: &anyhow::Error) {
     cli::diag(&format!("error: {e:#}"));
     let unit = cli::units::flag_hint(e);
-    for h in unit.map(str::to_string).into_iter().chain(cli::hints::option_hints(e)) {
+    for h in unit
+        .map(str::to_string)
+        .into_iter()
+        .chain(cli::hints::option_hints(e))
+    {
         cli::diag(&format!("hint: {h}"));
     }
 }

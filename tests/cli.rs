@@ -365,7 +365,11 @@ fn a_far_tracker_s_nominal_line_leads_with_the_best_rigid_placement() {
     let dir = std::env::temp_dir().join(format!("activecal-far-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    let (design, near, far) = (dir.join("d.json"), dir.join("near.json"), dir.join("far.json"));
+    let (design, near, far) = (
+        dir.join("d.json"),
+        dir.join("near.json"),
+        dir.join("far.json"),
+    );
     let robot = [
         "--robot",
         "fixtures/example-robot-data/ur5_robot.urdf",
@@ -376,9 +380,24 @@ fn a_far_tracker_s_nominal_line_leads_with_the_best_rigid_placement() {
     ];
     // The command first, then the robot, then the command's options.
     fn with<'a>(robot: &[&'a str], cmd: &[&'a str]) -> Vec<&'a str> {
-        cmd[..1].iter().chain(robot).chain(&cmd[1..]).copied().collect()
+        cmd[..1]
+            .iter()
+            .chain(robot)
+            .chain(&cmd[1..])
+            .copied()
+            .collect()
     }
-    let sel = ["select", "--pool", "sobol", "--count", "256", "--n", "30", "--out", design.to_str().unwrap()];
+    let sel = [
+        "select",
+        "--pool",
+        "sobol",
+        "--count",
+        "256",
+        "--n",
+        "30",
+        "--out",
+        design.to_str().unwrap(),
+    ];
     assert!(run(&with(&robot, &sel)).status.success());
     let sim = [
         "calibrate",
@@ -397,8 +416,17 @@ fn a_far_tracker_s_nominal_line_leads_with_the_best_rigid_placement() {
     // 100° about z, then 3 m away.
     let (c, s) = (100f64.to_radians().cos(), 100f64.to_radians().sin());
     for p in m["points"].as_array_mut().unwrap() {
-        let v: Vec<f64> = p.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
-        *p = serde_json::json!([c * v[0] - s * v[1] + 2.0, s * v[0] + c * v[1] - 2.2, v[2] + 0.3]);
+        let v: Vec<f64> = p
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        *p = serde_json::json!([
+            c * v[0] - s * v[1] + 2.0,
+            s * v[0] + c * v[1] - 2.2,
+            v[2] + 0.3
+        ]);
     }
     std::fs::write(&far, m.to_string()).unwrap();
     let cal = ["calibrate", "--measurements", far.to_str().unwrap()];
@@ -419,9 +447,15 @@ fn a_far_tracker_s_nominal_line_leads_with_the_best_rigid_placement() {
         .unwrap_or_else(|| panic!("{text}"));
     assert!(first < second, "{text}");
     // Data near the nominal model keep the one nominal line.
-    let out = run(&with(&robot, &["calibrate", "--measurements", near.to_str().unwrap()]));
+    let out = run(&with(
+        &robot,
+        &["calibrate", "--measurements", near.to_str().unwrap()],
+    ));
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("\nnominal: position RMS") && !text.contains("best rigid placement"), "{text}");
+    assert!(
+        text.contains("\nnominal: position RMS") && !text.contains("best rigid placement"),
+        "{text}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -436,7 +470,13 @@ fn hints_name_the_option_the_user_actually_used() {
         assert_eq!(out.status.code(), Some(1), "{args:?}");
         String::from_utf8_lossy(&out.stderr).into_owned()
     };
-    let e = stderr(&["select", "--robot", "fixtures/figaroh/tiago.urdf", "--n", "10"]);
+    let e = stderr(&[
+        "select",
+        "--robot",
+        "fixtures/figaroh/tiago.urdf",
+        "--n",
+        "10",
+    ]);
     assert!(e.contains("hint: --tip LINK names the chain's tip"), "{e}");
     assert!(!e.contains("description"), "{e}");
     let dir = std::env::temp_dir().join(format!("activecal-hints-{}", std::process::id()));
@@ -445,7 +485,10 @@ fn hints_name_the_option_the_user_actually_used() {
     let urdf = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/figaroh/tiago.urdf");
     std::fs::write(&toml, format!("urdf = {:?}\n", urdf.to_str().unwrap())).unwrap();
     let e = stderr(&["robots", "--robot", toml.to_str().unwrap()]);
-    assert!(e.contains("hint: tip = \"LINK\" in the description names the chain's tip"), "{e}");
+    assert!(
+        e.contains("hint: tip = \"LINK\" in the description names the chain's tip"),
+        "{e}"
+    );
     assert!(!e.contains("--tip"), "{e}");
     let e = stderr(&[
         "select",
@@ -483,23 +526,52 @@ fn simulated_measurements_saved_as_csv_calibrate_as_the_json_does() {
     ] {
         let d = p("d.json");
         let _ = std::fs::remove_file(&d);
-        let sel = run(&["select", "--robot", robot, "--levels", "3", "--n", "20", "--out", &d]);
-        assert!(sel.status.success(), "{}", String::from_utf8_lossy(&sel.stderr));
+        let sel = run(&[
+            "select", "--robot", robot, "--levels", "3", "--n", "20", "--out", &d,
+        ]);
+        assert!(
+            sel.status.success(),
+            "{}",
+            String::from_utf8_lossy(&sel.stderr)
+        );
         for m in ["m.csv", "m.json"] {
             let _ = std::fs::remove_file(p(m));
             let args = [
-                "calibrate", "--robot", robot, "--design", &d, "--noise", "1e-4", "--validation", "10",
-                "--save-measurements", &p(m),
+                "calibrate",
+                "--robot",
+                robot,
+                "--design",
+                &d,
+                "--noise",
+                "1e-4",
+                "--validation",
+                "10",
+                "--save-measurements",
+                &p(m),
             ];
             assert!(run(&args).status.success(), "{args:?}");
         }
         let csv = std::fs::read_to_string(p("m.csv")).unwrap();
         assert!(csv.starts_with(head), "{csv}");
         assert_eq!(csv.lines().count(), 21);
-        let fit = |m: &str| json_of(&["calibrate", "--robot", robot, "--measurements", &p(m), "--json"]);
+        let fit = |m: &str| {
+            json_of(&[
+                "calibrate",
+                "--robot",
+                robot,
+                "--measurements",
+                &p(m),
+                "--json",
+            ])
+        };
         let (a, b) = (fit("m.csv"), fit("m.json"));
         let est = |v: &serde_json::Value| -> Vec<f64> {
-            v["estimate"].as_object().unwrap().values().map(|x| x.as_f64().unwrap()).collect()
+            v["estimate"]
+                .as_object()
+                .unwrap()
+                .values()
+                .map(|x| x.as_f64().unwrap())
+                .collect()
         };
         let (ea, eb) = (est(&a), est(&b));
         assert_eq!(ea.len(), eb.len());

@@ -543,7 +543,13 @@ fn exported_descriptions_load_and_carry_the_orientation_scale() {
 /// whose real values are the paper's, has no such line.
 #[test]
 fn robots_explains_a_urdf_s_made_up_real_rows() {
-    let out = run(&["robots", "--robot", "fixtures/example-robot-data/ur5_robot.urdf", "--tip", "tool0"]);
+    let out = run(&[
+        "robots",
+        "--robot",
+        "fixtures/example-robot-data/ur5_robot.urdf",
+        "--tip",
+        "tool0",
+    ]);
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
@@ -556,8 +562,17 @@ fn robots_explains_a_urdf_s_made_up_real_rows() {
         .lines()
         .filter(|l| l.contains(" real ") || l.contains(" nom "))
         .map(|l| {
-            let tail = l.split(if l.contains(" real ") { " real " } else { " nom " }).nth(1).unwrap();
-            tail.split_whitespace().map(|v| v.parse().unwrap()).collect()
+            let tail = l
+                .split(if l.contains(" real ") {
+                    " real "
+                } else {
+                    " nom "
+                })
+                .nth(1)
+                .unwrap();
+            tail.split_whitespace()
+                .map(|v| v.parse().unwrap())
+                .collect()
         })
         .collect();
     assert!(rows.len() >= 14 && rows.len() % 2 == 0, "{text}");

@@ -70,7 +70,8 @@ pub fn parse_page(text: &str) -> Page {
             .find(|&k| lines[k].trim_start().starts_with("```"))
             .unwrap_or(lines.len());
         if lang == "console" {
-            page.examples.extend(parse_console(&lines[i + 1..end], i + 2));
+            page.examples
+                .extend(parse_console(&lines[i + 1..end], i + 2));
         } else if matches!(lang, "sh" | "bash" | "shell" | "zsh") {
             let reason = lines[..i]
                 .iter()
@@ -110,7 +111,11 @@ fn parse_console(block: &[&str], first_line: usize) -> Vec<Example> {
                     }
                 }
             }
-            out.push(Example { line: first_line + start, command, expected: Vec::new() });
+            out.push(Example {
+                line: first_line + start,
+                command,
+                expected: Vec::new(),
+            });
         } else if let Some(ex) = out.last_mut()
             && !line.trim().is_empty()
         {
@@ -252,7 +257,8 @@ fn scratch(root: &Path, page: &Path) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("activecal-docs-{}-{stem}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("a scratch directory");
-    std::os::unix::fs::symlink(root.join("fixtures"), dir.join("fixtures")).expect("fixtures linked");
+    std::os::unix::fs::symlink(root.join("fixtures"), dir.join("fixtures"))
+        .expect("fixtures linked");
     dir
 }
 
@@ -323,7 +329,13 @@ fn every_shell_example_in_the_readme_and_docs_runs_and_prints_what_it_says() {
             let t = Instant::now();
             let output = run_example(&dir, &ex.command);
             count += 1;
-            eprintln!("{}:{} ({:.2} s): {}", page.display(), ex.line, t.elapsed().as_secs_f64(), ex.command);
+            eprintln!(
+                "{}:{} ({:.2} s): {}",
+                page.display(),
+                ex.line,
+                t.elapsed().as_secs_f64(),
+                ex.command
+            );
             if show {
                 eprintln!("{output}");
             }
@@ -333,12 +345,20 @@ fn every_shell_example_in_the_readme_and_docs_runs_and_prints_what_it_says() {
     }
     eprintln!("{count} examples in {:.1} s", start.elapsed().as_secs_f64());
     assert!(count > 0, "no example ran");
-    assert!(failures.is_empty(), "{} of {count} examples differ:\n\n{}", failures.len(), failures.join("\n\n"));
+    assert!(
+        failures.is_empty(),
+        "{} of {count} examples differ:\n\n{}",
+        failures.len(),
+        failures.join("\n\n")
+    );
 }
 
 #[test]
 fn a_figure_outside_its_tolerance_fails_and_elisions_match_anything() {
-    assert!(line_matches("fitted: position RMS 0.085 mm", "fitted: position RMS 0.0851 mm"));
+    assert!(line_matches(
+        "fitted: position RMS 0.085 mm",
+        "fitted: position RMS 0.0851 mm"
+    ));
     assert!(line_matches("RMS 2.598 mm", "RMS 2.599 mm"));
     assert!(!line_matches("RMS 2.598 mm", "RMS 2.601 mm"));
     assert!(!line_matches("RMS 0.085 mm", "RMS 0.095 mm"));
@@ -352,8 +372,14 @@ fn a_figure_outside_its_tolerance_fails_and_elisions_match_anything() {
     assert!(!line_matches("x-1", "x-2"));
     // In order, lines between skipped; a missing one is named.
     let out = "one 1.0\ntwo  2.0\nthree 3.0\n";
-    assert_eq!(first_unmatched(&["one 1.0".into(), "three 3.0".into()], out), None);
-    assert_eq!(first_unmatched(&["two 2.0".into(), "one 1.0".into()], out), Some((1, 2)));
+    assert_eq!(
+        first_unmatched(&["one 1.0".into(), "three 3.0".into()], out),
+        None
+    );
+    assert_eq!(
+        first_unmatched(&["two 2.0".into(), "one 1.0".into()], out),
+        Some((1, 2))
+    );
 }
 
 #[test]

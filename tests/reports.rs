@@ -146,8 +146,14 @@ fn select_report_draws_the_curve_the_limits_and_the_tour() {
     });
     let rec = &curve["recommended"];
     match knee {
-        Some(n) => assert_eq!((rec["rule"].as_str(), rec["n"].as_u64()), (Some("knee"), Some(n))),
-        None => assert_eq!((rec["rule"].as_str(), rec["n"].as_u64()), (Some("no_knee"), Some(18))),
+        Some(n) => assert_eq!(
+            (rec["rule"].as_str(), rec["n"].as_u64()),
+            (Some("knee"), Some(n))
+        ),
+        None => assert_eq!(
+            (rec["rule"].as_str(), rec["n"].as_u64()),
+            (Some("no_knee"), Some(18))
+        ),
     }
     // A target between two sizes' predictions: the smaller size reaching it.
     let target = 0.5 * (rms(3) + rms(4));
@@ -174,18 +180,38 @@ fn select_report_draws_the_curve_the_limits_and_the_tour() {
         "--target-error",
         &target.to_string(),
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
-        text.contains(&format!("how many poses: N = {want} recommended, the fewest predicted to reach {target} mm")),
+        text.contains(&format!(
+            "how many poses: N = {want} recommended, the fewest predicted to reach {target} mm"
+        )),
         "{text}"
     );
     let v2: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(d2.join("report.json")).unwrap()).unwrap();
     assert_eq!(v2["how_many_poses"]["recommended"]["rule"], "target");
-    assert_eq!(v2["how_many_poses"]["recommended"]["n"].as_u64(), Some(want));
+    assert_eq!(
+        v2["how_many_poses"]["recommended"]["n"].as_u64(),
+        Some(want)
+    );
     // Without --report there is no curve to read a target from.
-    fails_with(&["select", "--robot", "puma560", "--levels", "3", "--target-error", "1"], "--report");
+    fails_with(
+        &[
+            "select",
+            "--robot",
+            "puma560",
+            "--levels",
+            "3",
+            "--target-error",
+            "1",
+        ],
+        "--report",
+    );
 }
 
 #[test]

@@ -318,26 +318,40 @@ impl Calibration {
                 self.id.iterations
             )));
         }
-        let text = activecal::io::calibrated::render(
+        write_robot(
             format,
             &self.robot,
             &self.id.table,
             self.frames.as_ref().map(|(f, r)| (f, r)),
             "# Calibrated by activecal (Python).\n",
-        )
-        .map_err(|e| arg_err("path", format!("{}: {e}", path.display())))?;
-        activecal::io::atomic::check_outputs(
-            &[activecal::io::atomic::Output {
-                label: "path",
-                path,
-            }],
-            &[],
+            path,
             overwrite,
         )
-        .map_err(|e| crate::convert::Fail::from(e).into_py())?;
-        activecal::io::atomic::write_atomic(path, text.as_bytes())
-            .map_err(|e| crate::convert::Fail::from(e).into_py())
     }
+}
+
+/// Writes a calibrated robot (`table`, with its frames when it has them) as
+/// `format` to `path` after `header`, atomically; an existing file only with
+/// `overwrite`.
+pub(crate) fn write_robot(
+    format: Format,
+    robot: &activecal::model::Robot,
+    table: &activecal::model::ParamTable,
+    frames: Option<(&CalibratedFrames, &FramesReport)>,
+    header: &str,
+    path: &std::path::Path,
+    overwrite: bool,
+) -> PyResult<()> {
+    let text = activecal::io::calibrated::render(format, robot, table, frames, header)
+        .map_err(|e| arg_err("path", format!("{}: {e}", path.display())))?;
+    let out = [activecal::io::atomic::Output {
+        label: "path",
+        path,
+    }];
+    activecal::io::atomic::check_outputs(&out, &[], overwrite)
+        .map_err(|e| crate::convert::Fail::from(e).into_py())?;
+    activecal::io::atomic::write_atomic(path, text.as_bytes())
+        .map_err(|e| crate::convert::Fail::from(e).into_py())
 }
 
 #[pymethods]

@@ -186,17 +186,15 @@ impl ContactCalibration {
                 ),
             ));
         };
-        let text =
-            activecal::io::calibrated::render(format, &fit.robot, &fit.table, Some((f, r)), "")
-                .map_err(|e| arg_err("path", format!("{}: {e}", path.display())))?;
-        let out = [activecal::io::atomic::Output {
-            label: "path",
+        crate::calibrate::write_robot(
+            format,
+            &fit.robot,
+            &fit.table,
+            Some((f, r)),
+            "",
             path,
-        }];
-        activecal::io::atomic::check_outputs(&out, &[], overwrite)
-            .map_err(|e| Fail::from(e).into_py())?;
-        activecal::io::atomic::write_atomic(path, text.as_bytes())
-            .map_err(|e| Fail::from(e).into_py())
+            overwrite,
+        )
     }
 }
 

@@ -132,7 +132,9 @@ mod tests {
         );
         assert_eq!(
             option_hints(&e),
-            vec!["--package-dir DIR names a package directory (repeatable): the directory that holds tiago_description/ (or tiago_description itself)"]
+            vec![
+                "--package-dir DIR names a package directory (repeatable): the directory that holds tiago_description/ (or tiago_description itself)"
+            ]
         );
     }
 }

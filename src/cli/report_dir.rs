@@ -327,7 +327,10 @@ fn how_many_text(curve: &PoseCountCurve, noise_is_default: bool) -> String {
         if curve.step <= 1 {
             "every N".to_string()
         } else {
-            format!("in steps of up to {} (the table is thinned to 20 sizes)", curve.step)
+            format!(
+                "in steps of up to {} (the table is thinned to 20 sizes)",
+                curve.step
+            )
         },
         if asked.is_empty() {
             String::new()
@@ -362,13 +365,26 @@ fn how_many_text(curve: &PoseCountCurve, noise_is_default: bool) -> String {
 pub fn recommendation_text(r: &activecal::how_many::Recommendation) -> String {
     use activecal::how_many::{KNEE_GAIN, KNEE_MORE_PERCENT, Recommendation as R};
     match r {
-        R::Target { n, target_mm, predicted_mm } => format!(
+        R::Target {
+            n,
+            target_mm,
+            predicted_mm,
+        } => format!(
             "how many poses: N = {n} recommended, the fewest predicted to reach {target_mm} mm (position RMS {predicted_mm:.4} mm)\n"
         ),
-        R::TargetNotReached { n, target_mm, predicted_mm } => format!(
+        R::TargetNotReached {
+            n,
+            target_mm,
+            predicted_mm,
+        } => format!(
             "how many poses: no N of the curve is predicted to reach {target_mm} mm; the closest is N = {n} (position RMS {predicted_mm:.4} mm): a less noisy sensor, or more poses than the curve's range (--n)\n"
         ),
-        R::Knee { n, next_n, predicted_mm, gain } => format!(
+        R::Knee {
+            n,
+            next_n,
+            predicted_mm,
+            gain,
+        } => format!(
             "how many poses: N = {n} recommended (position RMS {predicted_mm:.4} mm), the knee of the curve: {KNEE_MORE_PERCENT} % more poses (N = {next_n}) gain {:.1} %, under {:.0} % (--target-error MM: the fewest reaching an error)\n",
             gain * 100.0,
             KNEE_GAIN * 100.0

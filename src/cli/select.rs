@@ -120,7 +120,12 @@ pub struct SelectArgs {
     /// random configurations); the curve then recommends the smallest N
     /// predicted to reach it. Without it, the curve's knee: the smallest N
     /// where 10 % more poses gain less than 5 %.
-    #[arg(long, value_name = "MM", requires = "report", allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "MM",
+        requires = "report",
+        allow_negative_numbers = true
+    )]
     pub target_error: Option<f64>,
     /// Sensor noise σ per measured coordinate, metres: the error predicted
     /// after calibrating with the chosen poses is printed (and in --json,
@@ -329,7 +334,9 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     emit_report(a.json, &report, || {
         select_text(&a, &ctx, &report, seconds)
             + &predicted_text(report.predicted.as_ref())
-            + &recommended.map_or(String::new(), |r| super::report_dir::recommendation_text(&r))
+            + &recommended.map_or(String::new(), |r| {
+                super::report_dir::recommendation_text(&r)
+            })
     })
 }
 

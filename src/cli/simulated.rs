@@ -62,7 +62,9 @@ pub fn from_design(
     if let Some(path) = &a.save_measurements {
         // A .csv as a tracker's export (what `--measurements` reads back);
         // anything else JSON.
-        let csv = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+        let csv = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
         let text = if csv {
             activecal::io::measurements::to_csv(&tables.measurements, robot)
         } else {

@@ -4,10 +4,10 @@
 
 pub mod atomic;
 pub mod calibrated;
-pub mod collision_choice;
 pub mod camera_info;
 pub mod camera_observations;
 pub mod camera_target;
+pub mod collision_choice;
 pub mod contact_design;
 pub mod contacts;
 pub mod design;

@@ -89,7 +89,11 @@ pub fn how_many(base: &Path, rows: &[CurveRow], chosen: usize, noise_mm: f64) ->
                 AFTER,
                 "RMS",
             ),
-            (&|r: &CurveRow| r.p95_mm, BEFORE, "95th percentile of the error"),
+            (
+                &|r: &CurveRow| r.p95_mm,
+                BEFORE,
+                "95th percentile of the error",
+            ),
         ] {
             e.draw_series(LineSeries::new(
                 rows.iter().map(|r| (r.n as f64, f(r))),

@@ -130,6 +130,20 @@ struct Case {
     obs: CameraObservations,
 }
 
+impl Case {
+    /// The case fitted from its start with the default solver settings.
+    fn fit(&self) -> CameraFit {
+        fit_camera(
+            &self.robot,
+            &self.sensor,
+            &self.own_start,
+            &self.obs,
+            &LmSettings::default(),
+        )
+        .expect("a simulated case fits")
+    }
+}
+
 /// A simulated calibration of `mounting` with pixel noise `sigma`, the
 /// fit started from placements 2 cm and about 2° off the truth, at 40
 /// configurations that see the whole board.
@@ -295,14 +309,7 @@ fn truth_vector(c: &Case, fit: &CameraFit) -> Vec<f64> {
 fn noise_free_pixels_recover_the_truth() {
     for m in [Mounting::EyeToHand, Mounting::EyeInHand] {
         let c = case(m, 0.0, 3);
-        let fit = fit_camera(
-            &c.robot,
-            &c.sensor,
-            &c.own_start,
-            &c.obs,
-            &LmSettings::default(),
-        )
-        .unwrap();
+        let fit = c.fit();
         assert!(fit.converged, "{m:?}: {:?}", fit.stop);
         assert!(
             fit.given_rms_px > 10.0,
@@ -330,14 +337,7 @@ fn noise_free_pixels_recover_the_truth() {
 fn noisy_pixels_put_every_unknown_within_three_sigma() {
     for m in [Mounting::EyeToHand, Mounting::EyeInHand] {
         let c = case(m, 0.3, 5);
-        let fit = fit_camera(
-            &c.robot,
-            &c.sensor,
-            &c.own_start,
-            &c.obs,
-            &LmSettings::default(),
-        )
-        .unwrap();
+        let fit = c.fit();
         assert!(fit.converged, "{m:?}: {:?}", fit.stop);
         let s = fit.sigma_px.unwrap();
         assert!((s / 0.3 - 1.0).abs() < 0.05, "{m:?}: σ {s} px");
@@ -373,14 +373,7 @@ fn true_error_matches_the_predicted_error() {
         let (mut true_ss, mut pred_ss) = (0.0, 0.0);
         for draw in 0..10 {
             let c = case(m, 0.3, 100 + draw);
-            let fit = fit_camera(
-                &c.robot,
-                &c.sensor,
-                &c.own_start,
-                &c.obs,
-                &LmSettings::default(),
-            )
-            .unwrap();
+            let fit = c.fit();
             assert!(fit.converged, "{m:?} draw {draw}");
             true_ss += true_error(&c, &fit).powi(2);
             pred_ss += predicted_error(&c, &fit).powi(2);
@@ -521,14 +514,7 @@ fn chosen_poses_beat_random_ones() {
     let blocks = camera_blocks(&robot, &view, &pool);
     let mut rng = activecal::identify::trial_rng(17, 0);
     let chosen = case_at(Mounting::EyeToHand, 0.3, 21, Some(&d.qs));
-    let fit = fit_camera(
-        &chosen.robot,
-        &chosen.sensor,
-        &chosen.own_start,
-        &chosen.obs,
-        &LmSettings::default(),
-    )
-    .unwrap();
+    let fit = chosen.fit();
     let chosen_error = true_error(&chosen, &fit);
     let mut random_errors = Vec::new();
     for _ in 0..20 {
@@ -550,14 +536,7 @@ fn chosen_poses_beat_random_ones() {
         );
         let qs: Vec<Vec<f64>> = idx.iter().map(|&k| pool[k].clone()).collect();
         let c = case_at(Mounting::EyeToHand, 0.3, 21, Some(&qs));
-        let f = fit_camera(
-            &c.robot,
-            &c.sensor,
-            &c.own_start,
-            &c.obs,
-            &LmSettings::default(),
-        )
-        .unwrap();
+        let f = c.fit();
         random_errors.push(true_error(&c, &f));
     }
     // select's prediction against the truth: the chosen design fitted
@@ -569,14 +548,7 @@ fn chosen_poses_beat_random_ones() {
     let mut ss = 0.0;
     for draw in 0..20 {
         let c = case_at(Mounting::EyeToHand, 0.3, 200 + draw, Some(&d.qs));
-        let f = fit_camera(
-            &c.robot,
-            &c.sensor,
-            &c.own_start,
-            &c.obs,
-            &LmSettings::default(),
-        )
-        .unwrap();
+        let f = c.fit();
         ss += true_origin_error(&c, &f).powi(2);
     }
     let rms = (ss / 20.0).sqrt();

@@ -26,6 +26,7 @@
 mod always;
 mod build;
 pub mod mesh;
+mod mesh_tree;
 mod model;
 mod moves;
 mod shapes;

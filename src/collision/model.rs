@@ -1,6 +1,7 @@
 //! The loaded model and its queries at a configuration: the first contact
 //! (closer than the clearance) and which pair it is.
 
+use super::mesh_tree;
 use super::shapes::Geometry;
 use super::spec::TouchingPair;
 use super::tree::Tree;
@@ -136,13 +137,21 @@ impl CollisionModel {
             {
                 continue;
             }
-            if too_close(
-                &poses[a],
-                ga.shape.as_ref(),
-                &poses[b],
-                gb.shape.as_ref(),
-                c,
-            ) {
+            let close = match (&ga.tree, &gb.tree) {
+                // With a clearance, two meshes' distance by their trees
+                // (parry's mesh–mesh distance is far slower).
+                (Some(ta), Some(tb)) if c > 0.0 => {
+                    mesh_tree::distance(ta, &poses[a], tb, &poses[b], c) < c
+                }
+                _ => too_close(
+                    &poses[a],
+                    ga.shape.as_ref(),
+                    &poses[b],
+                    gb.shape.as_ref(),
+                    c,
+                ),
+            };
+            if close {
                 return Some(k);
             }
         }
@@ -216,6 +225,21 @@ impl CollisionModel {
         )
         .map_or(f64::NEG_INFINITY, |d| d);
         (poses[g], geom.shape.as_ref(), *opose, oshape.as_ref(), gap)
+    }
+
+    /// An item's distance (0 when its shapes touch or cross), exact below
+    /// `enough` and a lower bound of at least `enough` above it: two meshes
+    /// by walking their box trees together ([`mesh_tree::distance`]), any
+    /// other pair by parry's query.
+    pub(super) fn item_distance(&self, key: usize, poses: &[Isometry3<f64>], enough: f64) -> f64 {
+        if key < self.pairs.len() {
+            let (a, b) = self.pairs[key];
+            if let (Some(ta), Some(tb)) = (&self.geoms[a].tree, &self.geoms[b].tree) {
+                return mesh_tree::distance(ta, &poses[a], tb, &poses[b], enough);
+            }
+        }
+        let (pa, sa, pb, sb, _) = self.item(key, poses);
+        parry3d_f64::query::distance(&pa, sa, &pb, sb).unwrap_or(0.0)
     }
 
     /// A lower bound on an item's distance from the convex hulls of its

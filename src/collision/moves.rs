@@ -96,11 +96,12 @@ impl CollisionModel {
                         continue;
                     }
                 }
-                let (pa, sa, pb, sb, _) = self.item(keys[i], &poses);
-                // One query: parry's distance is 0 for shapes that touch or
-                // overlap (meshes as triangle surfaces, as the intersection
-                // test treats them).
-                let d = parry3d_f64::query::distance(&pa, sa, &pb, sb).unwrap_or(0.0);
+                // One query, 0 for shapes that touch or overlap (meshes as
+                // triangle surfaces, as the intersection test treats them);
+                // no farther than what would let this item's step reach the
+                // move's end.
+                let enough = c + (1.0 - s) * rates[i] / STEP_SHARE;
+                let d = self.item_distance(keys[i], &poses, enough);
                 if d <= 0.0 || (c > 0.0 && d < c) {
                     return MoveCheck {
                         checks,

@@ -3,6 +3,7 @@
 //! and its bounding sphere.
 
 use super::mesh;
+use super::mesh_tree::MeshTree;
 use super::spec::CollisionSpec;
 use super::tree::{self, Tree};
 use parry3d_f64::na::{Isometry3, Point3, Vector3};
@@ -22,6 +23,9 @@ pub(super) struct Geometry {
     /// so its distance bounds the mesh's from below at a fraction of the
     /// cost (`None` for primitive shapes, whose queries are cheap).
     pub(super) hull: Option<SharedShape>,
+    /// A mesh's triangles in a box tree, for the mesh–mesh distances of
+    /// move checks ([`mesh_tree::distance`]; `None` for primitive shapes).
+    pub(super) tree: Option<MeshTree>,
 }
 
 /// Where a `package://PKG/rest` or relative mesh file is: the package
@@ -156,6 +160,9 @@ pub(super) fn geometries(
             let hull = shape
                 .as_trimesh()
                 .and_then(|m| SharedShape::convex_hull(m.vertices()));
+            let tree = shape
+                .as_trimesh()
+                .map(|m| MeshTree::new(m.triangles().collect()));
             geoms.push(Geometry {
                 link,
                 origin: tree::pose(&c.origin) * along_z(&c.geometry),
@@ -163,6 +170,7 @@ pub(super) fn geometries(
                 center,
                 radius,
                 hull,
+                tree,
             });
         }
     }

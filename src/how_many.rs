@@ -459,7 +459,10 @@ pub fn pose_count_curve(
     }
     let sizes = curve_sizes(n_min, &settings.also, settings.max_points, x.n_poses());
     let (mut points, mut skipped) = (Vec::new(), Vec::new());
+    let task = crate::progress::Task::start("how many poses", Some(sizes.len() as u64));
     for &n in &sizes {
+        let _size_done = task.tick();
+        task.note(|| format!("N = {n}"));
         if n < settings.select.fixed.len() {
             skipped.push((n, "fewer poses than the fixed ones".into()));
             continue;

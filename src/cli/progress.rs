@@ -2,8 +2,9 @@
 //! stderr, never on stdout.
 //!
 //! * On a terminal: one bar (`indicatif`) showing the innermost open task,
-//!   its count, what it is doing and the elapsed time; cleared when the
-//!   last task ends.
+//!   its count, what it is doing and the elapsed time, and the time left
+//!   as estimated by the outermost task with a count ([`time_left`]);
+//!   cleared when the last task ends.
 //! * Not a terminal, when asked with `--progress`: plain lines, one when a
 //!   task starts, at most one every half second while it runs, and one when
 //!   it ends (with its time), so that a log file or a CI job shows them.
@@ -81,7 +82,7 @@ impl Stderr {
         }
     }
 
-    fn line(e: &Entry, what: &str) {
+    fn line(e: &Entry, what: &str, left: &str) {
         let count = match e.total {
             Some(t) => format!(" {}/{t}", e.done),
             None if e.done > 0 => format!(" {}", e.done),
@@ -92,8 +93,14 @@ impl Stderr {
         } else {
             format!(" ({})", e.note)
         };
-        let line = format!("progress: {}{count}{note} {what}", e.name);
-        let _ = writeln!(std::io::stderr().lock(), "{}", line.trim_end());
+        let head = format!("progress: {}{count}{note}", e.name);
+        let line = [head.as_str(), what, left.trim_start()]
+            .iter()
+            .filter(|p| !p.is_empty())
+            .copied()
+            .collect::<Vec<_>>()
+            .join(" ");
+        let _ = writeln!(std::io::stderr().lock(), "{line}");
     }
 
     fn draw(st: &mut State) {
@@ -117,7 +124,39 @@ impl Stderr {
         bar.set_prefix(top.name.clone());
         bar.set_length(top.total.unwrap_or(0));
         bar.set_position(top.done);
-        bar.set_message(top.note.clone());
+        bar.set_message(format!("{}{}", top.note, time_left(&st.open)));
+    }
+}
+
+/// The time left as the outermost open task with a count estimates it
+/// (its elapsed time over its share done, once a unit is done): ` · about
+/// 6 s left (how many poses 3/12)`, or empty while nothing can be said.
+fn time_left(open: &[Entry]) -> String {
+    let Some((e, total)) = open.iter().find_map(|e| {
+        e.total
+            .filter(|&t| t > e.done && e.done > 0)
+            .map(|t| (e, t))
+    }) else {
+        return String::new();
+    };
+    let seconds = e.started.elapsed().as_secs_f64() * (total - e.done) as f64 / e.done as f64;
+    format!(
+        " · about {} left ({} {}/{total})",
+        human_seconds(seconds),
+        e.name,
+        e.done
+    )
+}
+
+/// Seconds as a person reads them: `4 s`, `2 min 5 s`.
+fn human_seconds(s: f64) -> String {
+    let s = s.round() as u64;
+    if s == 0 {
+        "under 1 s".into()
+    } else if s < 60 {
+        format!("{s} s")
+    } else {
+        format!("{} min {} s", s / 60, s % 60)
     }
 }
 
@@ -136,7 +175,7 @@ impl Sink for Stderr {
         });
         match self.mode {
             Mode::Bar => Self::draw(&mut st),
-            Mode::Lines => Self::line(st.open.last().expect("just pushed"), "started"),
+            Mode::Lines => Self::line(st.open.last().expect("just pushed"), "started", ""),
             Mode::Off => {}
         }
     }
@@ -155,16 +194,17 @@ impl Sink for Stderr {
         }
         let top = k + 1 == st.open.len();
         match self.mode {
-            Mode::Bar if top => {
-                let (done, note) = (st.open[k].done, st.open[k].note.clone());
+            Mode::Bar => {
+                let shown = st.open.last().expect("an open task");
+                let message = format!("{}{}", shown.note, time_left(&st.open));
                 if let Some(b) = &st.bar {
-                    b.set_position(done);
-                    b.set_message(note);
+                    b.set_position(shown.done);
+                    b.set_message(message);
                 }
             }
             Mode::Lines if top && st.last_line.elapsed() >= LINE_EVERY => {
                 st.last_line = Instant::now();
-                Self::line(&st.open[k], "");
+                Self::line(&st.open[k], "", &time_left(&st.open));
             }
             _ => {}
         }
@@ -183,6 +223,7 @@ impl Sink for Stderr {
             Mode::Lines => Self::line(
                 &e,
                 &format!("done in {:.2} s", e.started.elapsed().as_secs_f64()),
+                "",
             ),
             Mode::Off => {}
         }
@@ -192,6 +233,33 @@ impl Sink for Stderr {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn entry(name: &str, total: Option<u64>, done: u64, ago: u64) -> Entry {
+        Entry {
+            id: 0,
+            name: name.into(),
+            total,
+            done,
+            note: String::new(),
+            started: Instant::now() - Duration::from_secs(ago),
+        }
+    }
+
+    /// The outermost task with a count and a unit done speaks: 2 of 8
+    /// sizes in 10 s leave 30 s; an inner task's count does not.
+    #[test]
+    fn time_left_is_the_outermost_counted_task_s() {
+        let open = [
+            entry("select", None, 0, 12),
+            entry("how many poses", Some(8), 2, 10),
+            entry("jacobian", Some(100), 99, 1),
+        ];
+        assert_eq!(time_left(&open), " · about 30 s left (how many poses 2/8)");
+        let starting = [entry("how many poses", Some(8), 0, 3)];
+        assert_eq!(time_left(&starting), "");
+        assert_eq!(human_seconds(125.2), "2 min 5 s");
+        assert_eq!(human_seconds(0.3), "under 1 s");
+    }
 
     #[test]
     fn json_is_silent_unless_asked_and_pipes_get_lines_only_when_asked() {

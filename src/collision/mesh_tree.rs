@@ -365,6 +365,9 @@ mod tests {
                 }
             }
         }
-        assert!(exact_seen > 0 && bounded_seen > 0, "{exact_seen} {bounded_seen}");
+        assert!(
+            exact_seen > 0 && bounded_seen > 0,
+            "{exact_seen} {bounded_seen}"
+        );
     }
 }

@@ -13,6 +13,7 @@ mod repair;
 use crate::collision::{CollisionModel, ContactPair};
 use crate::select::tour::{MoveCost, largest_travel};
 use crate::select::turns::turned;
+use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::HashMap;
 
@@ -202,15 +203,32 @@ impl Checker<'_> {
     /// The first contact on the straight move from `qa` to `qb` against
     /// the models in turn (not memoised), its configurations counted.
     fn check(&mut self, qa: &[f64], qb: &[f64]) -> Option<(ContactPair, f64)> {
+        let (checks, contact) = check_against(self.models, qa, qb, self.resolution);
         self.moves += 1;
-        for m in self.models {
-            let r = m.check_move(qa, qb, self.resolution);
-            self.configurations += r.checks;
-            if r.contact.is_some() {
-                return r.contact;
-            }
+        self.configurations += checks;
+        contact
+    }
+
+    /// Checks the moves between the node pairs `keys` not checked yet, in
+    /// parallel, and memoises them: the same verdicts as checking them one
+    /// by one (each move's check is its own), in a fraction of the time.
+    fn prefetch(&mut self, keys: &[(usize, usize)]) {
+        let mut todo: Vec<(usize, usize)> = keys
+            .iter()
+            .map(|&(a, b)| (a.min(b), a.max(b)))
+            .filter(|k| !self.memo.contains_key(k))
+            .collect();
+        todo.sort_unstable();
+        todo.dedup();
+        let found: Vec<(usize, Option<(ContactPair, f64)>)> = todo
+            .par_iter()
+            .map(|&(a, b)| check_against(self.models, self.node(a), self.node(b), self.resolution))
+            .collect();
+        for (key, (checks, contact)) in todo.into_iter().zip(found) {
+            self.moves += 1;
+            self.configurations += checks;
+            self.memo.insert(key, contact);
         }
-        None
     }
 
     /// The first contact on the move between nodes `a` and `b`.
@@ -254,10 +272,31 @@ impl Checker<'_> {
 
     /// Positions `i` in `path` whose move `path[i] → path[i+1]` collides.
     fn colliding(&mut self, path: &[usize]) -> Vec<usize> {
+        let keys: Vec<(usize, usize)> = path.windows(2).map(|w| (w[0], w[1])).collect();
+        self.prefetch(&keys);
         (0..path.len().saturating_sub(1))
             .filter(|&i| self.contact(path[i], path[i + 1]).is_some())
             .collect()
     }
+}
+
+/// The configurations checked on the straight move from `qa` to `qb`
+/// against `models` in turn, and the first contact.
+fn check_against(
+    models: &[&CollisionModel],
+    qa: &[f64],
+    qb: &[f64],
+    resolution: f64,
+) -> (usize, Option<(ContactPair, f64)>) {
+    let mut checks = 0;
+    for m in models {
+        let r = m.check_move(qa, qb, resolution);
+        checks += r.checks;
+        if r.contact.is_some() {
+            return (checks, r.contact);
+        }
+    }
+    (checks, None)
 }
 
 /// A via configuration for the colliding move from node `a` to node `b`:

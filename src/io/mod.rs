@@ -21,6 +21,7 @@ pub mod robot_toml;
 pub mod table;
 pub mod urdf;
 mod urdf_chain;
+pub mod urdf_branch;
 pub mod urdf_edit;
 
 use crate::error::{Error, Result};

@@ -92,7 +92,11 @@ impl Tree {
                 [v[0], v[1], v[2]]
             })
         };
-        for j in doc.root_element().children().filter(|c| c.has_tag_name("joint")) {
+        for j in doc
+            .root_element()
+            .children()
+            .filter(|c| c.has_tag_name("joint"))
+        {
             let child = |tag: &str| j.children().find(|c| c.has_tag_name(tag));
             let link = |tag: &str| child(tag).unwrap().attribute("link").unwrap().to_string();
             let o = child("origin");
@@ -101,7 +105,13 @@ impl Tree {
             let kind = j.attribute("type").unwrap().to_string();
             m.insert(
                 link("child"),
-                (j.attribute("name").unwrap().to_string(), kind, link("parent"), origin, axis),
+                (
+                    j.attribute("name").unwrap().to_string(),
+                    kind,
+                    link("parent"),
+                    origin,
+                    axis,
+                ),
             );
         }
         Tree(m)
@@ -142,7 +152,11 @@ fn perturbed_text(seed: u64) -> String {
     };
     let mut names: Vec<&String> = tree.0.values().map(|j| &j.0).collect();
     names.sort();
-    let chosen = |n: &str| n.starts_with("arm_") && n.ends_with("_joint") || n.starts_with("head_") || n == "torso_lift_joint";
+    let chosen = |n: &str| {
+        n.starts_with("arm_") && n.ends_with("_joint")
+            || n.starts_with("head_")
+            || n == "torso_lift_joint"
+    };
     let mut origins = Vec::new();
     for j in tree.0.values().filter(|j| chosen(&j.0)) {
         let (d, s) = unit();
@@ -176,7 +190,12 @@ fn the_head_chain_is_the_tree_seen_from_the_head() {
     // 9 revolute joints and a whole frame seen: 4·9 + 6, less the 12
     // rigid motions the two placements take.
     let cr = camera_robot(&r).unwrap();
-    assert_eq!(cr.n_unknowns(), 4 * 9 + 6 - 12, "{:?}", cr.parameter_names());
+    assert_eq!(
+        cr.n_unknowns(),
+        4 * 9 + 6 - 12,
+        "{:?}",
+        cr.parameter_names()
+    );
     let tree = Tree::of(&text);
     let mut rng = activecal::identify::trial_rng(1, 0);
     for q in generic_configurations(&r, 200, 3) {
@@ -231,8 +250,14 @@ struct Head {
 
 impl Head {
     fn fit(&self) -> CameraFit {
-        fit_camera(&self.robot, &self.start, &self.own_start, &self.obs, &LmSettings::default())
-            .expect("a simulated head case fits")
+        fit_camera(
+            &self.robot,
+            &self.start,
+            &self.own_start,
+            &self.obs,
+            &LmSettings::default(),
+        )
+        .expect("a simulated head case fits")
     }
 
     /// A point of the board (its centroid, `at = true`, or its frame's
@@ -240,7 +265,11 @@ impl Head {
     /// random configurations (seen or not), metres.
     fn true_error(&self, fit: &CameraFit, centroid: bool) -> f64 {
         let (cam_t, tgt_t) = self.placements;
-        let s = if centroid { board().centroid() } else { Vector3::zeros() };
+        let s = if centroid {
+            board().centroid()
+        } else {
+            Vector3::zeros()
+        };
         let qs = generic_configurations(&self.robot, 1000, 7);
         let ss: f64 = qs
             .iter()
@@ -274,11 +303,26 @@ fn head(truth_seed: u64, sigma: f64, seed: u64, qs: Option<&[Vec<f64>]>) -> Head
     let truth = camera_branch(&arm(&perturbed_text(truth_seed)), HEAD).unwrap();
     let (cam, tgt) = truth_placements();
     let points = board().points;
-    let sensor = CameraSensor::new(intrinsics(), Mounting::EyeToHand, points.clone(), &cam, &tgt);
+    let sensor = CameraSensor::new(
+        intrinsics(),
+        Mounting::EyeToHand,
+        points.clone(),
+        &cam,
+        &tgt,
+    );
     let own = CameraSensor::start_own(&cam, &tgt);
     let qs = qs.map_or_else(|| visible(&robot, 40_000, 40), <[Vec<f64>]>::to_vec);
     let mut rng = activecal::identify::trial_rng(seed, 1);
-    let obs = simulate_observations(&truth, &truth.nominal, &sensor, &own, &qs, sigma, 0.0, &mut rng);
+    let obs = simulate_observations(
+        &truth,
+        &truth.nominal,
+        &sensor,
+        &own,
+        &qs,
+        sigma,
+        0.0,
+        &mut rng,
+    );
     let off = Isometry3::from_parts(
         Translation3::new(0.02, -0.015, 0.01),
         UnitQuaternion::from_euler_angles(0.03, -0.02, 0.025),
@@ -307,15 +351,30 @@ fn noise_free_pixels_recover_the_true_tiago() {
     let h = head(1, 0.0, 3, None);
     let fit = h.fit();
     assert!(fit.converged, "{:?}", fit.stop);
-    assert!(fit.given_rms_px > 10.0, "the start is off: {} px", fit.given_rms_px);
+    assert!(
+        fit.given_rms_px > 10.0,
+        "the start is off: {} px",
+        fit.given_rms_px
+    );
     assert!(fit.rms_px < 1e-6, "{} px", fit.rms_px);
     assert_eq!(fit.estimate.len(), 42);
     let e = h.true_error(&fit, true);
-    println!("head camera, noise-free: true 3-D error {:.1e} mm, {:.1e} px", 1e3 * e, fit.rms_px);
+    println!(
+        "head camera, noise-free: true 3-D error {:.1e} mm, {:.1e} px",
+        1e3 * e,
+        fit.rms_px
+    );
     assert!(e < 1e-9, "true error {} mm", 1e3 * e);
     // The URDF and the frames file written.
     let (f, report) = camera_frames(&fit).unwrap().expect("a URDF robot");
-    let written = render(Format::Urdf, &fit.robot, &fit.table, Some((&f, &report)), "").unwrap();
+    let written = render(
+        Format::Urdf,
+        &fit.robot,
+        &fit.table,
+        Some((&f, &report)),
+        "",
+    )
+    .unwrap();
     let cal = camera_branch(&arm(&written), HEAD).unwrap();
     let cam = f.measurement.inverse() * fit.camera;
     let tgt = f.tool * fit.target;
@@ -327,8 +386,15 @@ fn noise_free_pixels_recover_the_true_tiago() {
         let b = cam.inverse() * end(&cal, &cal.nominal, &q) * tgt * c;
         worst = worst.max((a - b).norm());
     }
-    println!("head camera, written URDF: worst 3-D error {:.1e} mm", 1e3 * worst);
-    assert!(worst < 1e-9, "the written URDF is off by {} mm", 1e3 * worst);
+    println!(
+        "head camera, written URDF: worst 3-D error {:.1e} mm",
+        1e3 * worst
+    );
+    assert!(
+        worst < 1e-9,
+        "the written URDF is off by {} mm",
+        1e3 * worst
+    );
     let (before, after) = (Tree::of(&text()), Tree::of(&written));
     let origin = |t: &Tree, name: &str| t.0.values().find(|j| j.0 == name).unwrap().3;
     for name in ["torso_lift_joint", "head_1_joint"] {
@@ -336,13 +402,21 @@ fn noise_free_pixels_recover_the_true_tiago() {
     }
     for name in ["head_2_joint", "arm_1_joint", "arm_4_joint"] {
         let d = origin(&before, name).inverse() * origin(&after, name);
-        assert!(d.translation.vector.norm() > 1e-5 || d.rotation.angle() > 1e-5, "{name} unchanged");
+        assert!(
+            d.translation.vector.norm() > 1e-5 || d.rotation.angle() > 1e-5,
+            "{name} unchanged"
+        );
     }
 }
 
 /// The true robot in the fit's parameters (an `r`-perturbed model robot):
 /// the chain's true unknowns, then the true placements in the charts.
-fn truth_vector(robot: &Robot, truth: &ParamTable, fit: &CameraFit, p: (Isometry3<f64>, Isometry3<f64>)) -> Vec<f64> {
+fn truth_vector(
+    robot: &Robot,
+    truth: &ParamTable,
+    fit: &CameraFit,
+    p: (Isometry3<f64>, Isometry3<f64>),
+) -> Vec<f64> {
     let mut v = robot.unknown_values(truth);
     let (cam0, tgt0) = fit.sensor.placements(&[0.0; 12]);
     for (t, t0) in [(p.0, cam0), (p.1, tgt0)] {
@@ -372,11 +446,26 @@ fn noisy_pixels_put_every_head_unknown_within_three_sigma() {
         truth.set(u, truth.get(u) + sign * size);
     }
     let (cam, tgt) = h.placements;
-    let sensor = CameraSensor::new(intrinsics(), Mounting::EyeToHand, board().points, &cam, &tgt);
+    let sensor = CameraSensor::new(
+        intrinsics(),
+        Mounting::EyeToHand,
+        board().points,
+        &cam,
+        &tgt,
+    );
     let own = CameraSensor::start_own(&cam, &tgt);
     let mut rng = activecal::identify::trial_rng(5, 1);
-    let obs = simulate_observations(&h.robot, &truth, &sensor, &own, &h.obs.qs, 0.3, 0.0, &mut rng);
-    let fit = fit_camera(&h.robot, &h.start, &h.own_start, &obs, &LmSettings::default()).unwrap();
+    let obs = simulate_observations(
+        &h.robot, &truth, &sensor, &own, &h.obs.qs, 0.3, 0.0, &mut rng,
+    );
+    let fit = fit_camera(
+        &h.robot,
+        &h.start,
+        &h.own_start,
+        &obs,
+        &LmSettings::default(),
+    )
+    .unwrap();
     assert!(fit.converged, "{:?}", fit.stop);
     let s = fit.sigma_px.unwrap();
     assert!((s / 0.3 - 1.0).abs() < 0.05, "σ {s} px");
@@ -409,7 +498,10 @@ fn select_predicts_the_head_cameras_true_error() {
     let v = view();
     let candidates = generic_configurations(&robot, 20_000, 13);
     let n = 30;
-    let settings = activecal::select::Settings { n, ..Default::default() };
+    let settings = activecal::select::Settings {
+        n,
+        ..Default::default()
+    };
     let d = camera_design(&branch, &v, &candidates, &settings).unwrap();
     assert_eq!(d.qs.len(), n);
     assert!(d.seen.iter().all(|&s| s == 35), "{:?}", d.seen);
@@ -430,7 +522,10 @@ fn select_predicts_the_head_cameras_true_error() {
         1e3 * rms,
         rms / predicted
     );
-    assert!(rms < 1.3 * predicted && predicted < 1.3 * rms, "true {rms} m, predicted {predicted} m");
+    assert!(
+        rms < 1.3 * predicted && predicted < 1.3 * rms,
+        "true {rms} m, predicted {predicted} m"
+    );
     // Against 20 random designs from the same visible pool.
     let pool: Vec<Vec<f64>> = candidates
         .iter()
@@ -452,10 +547,14 @@ fn select_predicts_the_head_cameras_true_error() {
         idx.truncate(n);
         let m = blocks.information(&idx);
         let m = nalgebra::DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)]);
-        let ln_det = m
-            .cholesky()
-            .map_or(f64::NEG_INFINITY, |c| 2.0 * c.l().diagonal().iter().map(|x| x.ln()).sum::<f64>());
-        assert!(ln_det < d.ln_det, "a random design: {ln_det} against {}", d.ln_det);
+        let ln_det = m.cholesky().map_or(f64::NEG_INFINITY, |c| {
+            2.0 * c.l().diagonal().iter().map(|x| x.ln()).sum::<f64>()
+        });
+        assert!(
+            ln_det < d.ln_det,
+            "a random design: {ln_det} against {}",
+            d.ln_det
+        );
         let qs: Vec<Vec<f64>> = idx.iter().map(|&k| pool[k].clone()).collect();
         let h = head(1, 0.3, 21, Some(&qs));
         random.push(h.true_error(&h.fit(), false));

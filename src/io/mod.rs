@@ -20,8 +20,8 @@ pub mod read;
 pub mod robot_toml;
 pub mod table;
 pub mod urdf;
-mod urdf_chain;
 pub mod urdf_branch;
+mod urdf_chain;
 pub mod urdf_edit;
 
 use crate::error::{Error, Result};

@@ -36,7 +36,10 @@ use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion, Vector3};
 use std::collections::HashMap;
 
 /// The joints from `link` up to the root, child first.
-fn up_path<'u>(by_child: &HashMap<&str, &'u urdf_rs::Joint>, link: &str) -> Vec<&'u urdf_rs::Joint> {
+fn up_path<'u>(
+    by_child: &HashMap<&str, &'u urdf_rs::Joint>,
+    link: &str,
+) -> Vec<&'u urdf_rs::Joint> {
     let mut out = Vec::new();
     let mut at = link;
     while let Some(j) = by_child.get(at) {
@@ -101,7 +104,10 @@ fn reversed_joints(
     let mut link = camera_link.to_string();
     for j in up {
         if j.mimic.is_some() {
-            return Err(format!("joint '{}' of the camera's chain is a mimic joint", j.name));
+            return Err(format!(
+                "joint '{}' of the camera's chain is a mimic joint",
+                j.name
+            ));
         }
         if moving(j).is_none() {
             pending *= iso(&j.origin).inverse();
@@ -160,11 +166,17 @@ pub fn camera_branch(robot: &Robot, camera_link: &str) -> Result<Robot> {
         message,
     };
     let urdf = parsed(&src.text).map_err(bad)?;
-    let by_child: HashMap<&str, &urdf_rs::Joint> =
-        urdf.joints.iter().map(|j| (j.child.link.as_str(), j)).collect();
-    let known = urdf.links.iter().any(|l| l.name == camera_link) || by_child.contains_key(camera_link);
+    let by_child: HashMap<&str, &urdf_rs::Joint> = urdf
+        .joints
+        .iter()
+        .map(|j| (j.child.link.as_str(), j))
+        .collect();
+    let known =
+        urdf.links.iter().any(|l| l.name == camera_link) || by_child.contains_key(camera_link);
     if !known {
-        return Err(bad(format!("the camera's link '{camera_link}' is not a link of the URDF")));
+        return Err(bad(format!(
+            "the camera's link '{camera_link}' is not a link of the URDF"
+        )));
     }
     let cam_up = up_path(&by_child, camera_link);
     let tip_up = up_path(&by_child, &src.tip);
@@ -175,7 +187,10 @@ pub fn camera_branch(robot: &Robot, camera_link: &str) -> Result<Robot> {
         .chain(cam_up.iter().map(|j| j.parent.link.as_str()))
         .position(|l| tip_links.contains(&l))
     else {
-        return Err(bad(format!("the camera's link '{camera_link}' and the tip '{}' are not in one tree", src.tip)));
+        return Err(bad(format!(
+            "the camera's link '{camera_link}' and the tip '{}' are not in one tree",
+            src.tip
+        )));
     };
     if k == 0 {
         return Err(bad(format!(
@@ -185,10 +200,16 @@ pub fn camera_branch(robot: &Robot, camera_link: &str) -> Result<Robot> {
     }
     let a = cam_up[k - 1].parent.link.clone();
     if a == src.tip {
-        return Err(bad(format!("the tip '{}' is on the camera's chain", src.tip)));
+        return Err(bad(format!(
+            "the tip '{}' is on the camera's chain",
+            src.tip
+        )));
     }
     let (mut joints, reversed) = reversed_joints(&cam_up[..k], camera_link, &a).map_err(bad)?;
-    let down = tip_up.iter().position(|j| j.parent.link == a).expect("A is on the tip's path");
+    let down = tip_up
+        .iter()
+        .position(|j| j.parent.link == a)
+        .expect("A is on the tip's path");
     joints.extend(tip_up[..=down].iter().rev().map(|j| (*j).clone()));
     let mut tree = urdf.clone();
     tree.links.clear();

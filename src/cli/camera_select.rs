@@ -32,14 +32,15 @@ fn six(flag: &str, s: &str) -> Result<[f64; 6]> {
 
 /// The camera view the options describe.
 fn view(c: &CameraOpts) -> Result<CameraView> {
-    let (Some(info), Some(target), Some(m), Some(cp), Some(tp)) = (
-        &c.camera_info,
-        &c.target,
-        c.mounting,
-        &c.camera_pose,
-        &c.target_pose,
-    ) else {
-        bail!("--camera-info needs --target, --mounting, --camera-pose and --target-pose");
+    let (Some(info), Some(target), Some(cp), Some(tp)) =
+        (&c.camera_info, &c.target, &c.camera_pose, &c.target_pose)
+    else {
+        bail!("--camera-info needs --target, --camera-pose and --target-pose");
+    };
+    let m = match (c.mounting, &c.camera_link) {
+        (Some(m), None) => m.into(),
+        (None, Some(_)) => activecal::measure::camera::Mounting::EyeToHand,
+        _ => bail!("--camera-info needs --mounting or --camera-link"),
     };
     let d = super::parse_list::<f64>(&c.distance, "--distance")?;
     let [lo, hi] = d[..] else {
@@ -47,7 +48,7 @@ fn view(c: &CameraOpts) -> Result<CameraView> {
     };
     let v = CameraView {
         intrinsics: read_camera_info(info).context("--camera-info")?,
-        mounting: m.into(),
+        mounting: m,
         points: read_target(target)
             .context("--target")?
             .points
@@ -79,6 +80,11 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         super::refuse_overwrite(o, a.force)?;
     }
     let robot = super::load_robot(&a.pool.robot)?;
+    let robot = match &a.camera.camera_link {
+        Some(link) => activecal::io::urdf_branch::camera_branch(&robot, link)
+            .with_context(|| format!("--camera-link {link}"))?,
+        None => robot,
+    };
     let v = view(&a.camera)?;
     let candidates = activecal::observability::generic_configurations(
         &robot,

@@ -148,3 +148,57 @@ fn cli_refuses_a_start_behind_the_camera() {
     args[11] = "--camera-pose=1.1761,0.6096,0.9079,-2.0681,0.0317,-1.0590";
     common::fails_with(&args, "lie behind the camera");
 }
+
+/// `select --camera-info --gap --out design.json`: the design against
+/// its visible pool's certified bound (D-efficiency in (0, 1], the
+/// design's `log10 det` below the bound: a design of the pool cannot
+/// exceed it), and the design as JSON with the chosen joint values and
+/// the figures; options a camera design does not
+/// take are refused, not ignored.
+#[test]
+fn cli_selects_a_camera_design_with_its_bound() {
+    let dir = common::scratch_dir("camera", "select-gap");
+    let out = dir.join("design.json");
+    let o = out.display().to_string();
+    let args = [
+        "select",
+        "--robot",
+        "fixtures/ur5.urdf",
+        "--camera-info",
+        "fixtures/camera/camera_info.yaml",
+        "--target",
+        "fixtures/camera/board.yaml",
+        "--mounting",
+        "eye-to-hand",
+        "--camera-pose=1.2,0.6,0.9,-2.0985,0,2.0779",
+        "--target-pose=-0.0853,0.0568,0.02,3.1416,0,0.03",
+        "--n",
+        "12",
+        "--count",
+        "1500",
+        "--gap",
+        "--out",
+        &o,
+        "--json",
+    ];
+    let v = common::json_of(&args);
+    let g = &v["gap"];
+    let eff = g["d_efficiency"].as_f64().unwrap();
+    assert!(eff > 0.0 && eff <= 1.0, "{g}");
+    assert!(g["log10_oid"].as_f64().unwrap() <= g["log10_bound"].as_f64().unwrap());
+    let ln_det = v["ln_det"].as_f64().unwrap();
+    assert!(
+        (g["ln_oid"].as_f64().unwrap() - ln_det).abs() < 1e-6 * ln_det.abs(),
+        "{v}"
+    );
+    let d: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert_eq!(d["poses"], v["poses"]);
+    assert_eq!(d["poses"].as_array().unwrap().len(), 12);
+    assert_eq!(d["gap"], v["gap"]);
+    assert_eq!(d["joint_names"][0], "shoulder_pan_joint");
+    let mut report = args.to_vec();
+    report.truncate(15);
+    report.extend(["--report", "somewhere"]);
+    common::fails_with(&report, "--report is not available with --camera-info");
+}

@@ -293,8 +293,8 @@ fn example_configurations(dir: &Path) -> PathBuf {
 }
 
 /// Against OpenCV's hand-eye calibration (`cv2.calibrateHandEye`, all five
-/// methods, fed `solvePnP` per pose and the gripper poses of the nominal
-/// robot) on the same pixels (σ 0.3 px, the example's 40 configurations):
+/// methods, and `cv2.calibrateRobotWorldHandEye`, Shah and Li, fed
+/// `solvePnP` per pose and the gripper poses of the nominal robot) on the same pixels (σ 0.3 px, the example's 40 configurations):
 /// the camera placement's error and the true error of the target's origin
 /// in the camera's frame at 1,000 random configurations, with the arm's
 /// geometry off (seed 3) and exact (`--exact`). Asserted: activecal's true

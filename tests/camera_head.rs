@@ -367,6 +367,17 @@ fn noise_free_pixels_recover_the_true_tiago() {
     assert!(e < 1e-9, "true error {} mm", 1e3 * e);
     // The URDF and the frames file written.
     let (f, report) = camera_frames(&fit).unwrap().expect("a URDF robot");
+    // The frames file's joints: the file's joints whose origins the chain
+    // holds, each once (the head's first joint has no origin of its own).
+    let names: Vec<&str> = report.joints.0.iter().map(|j| j.name.as_str()).collect();
+    let arm_joints: Vec<String> = (1..=7).map(|k| format!("arm_{k}_joint")).collect();
+    assert_eq!(names[0], "head_2_joint");
+    assert_eq!(
+        names[1..],
+        arm_joints.iter().map(String::as_str).collect::<Vec<_>>()[..]
+    );
+    let cam_block = &report.camera.as_ref().unwrap().camera;
+    assert_eq!(cam_block.parent, HEAD);
     let written = render(
         Format::Urdf,
         &fit.robot,

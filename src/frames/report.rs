@@ -423,10 +423,15 @@ impl FramesReport {
                     .collect(),
             ),
         };
+        // A chain's first joint walked against the file's tree has no
+        // origin of the file (the split keeps it; the camera's placement
+        // holds what it would take): not a joint of the file's to report.
+        let skip = usize::from(src.reversed.iter().any(|r| r.neighbour.is_none()));
         let joints = f
             .joints
             .iter()
             .enumerate()
+            .skip(skip)
             .map(|(k, j)| joint_block(j, sigma.map(|s| (&s.joints[k], s.offsets[k]))))
             .collect();
         FramesReport {

@@ -79,8 +79,11 @@ fn truth_placements() -> (Isometry3<f64>, Isometry3<f64>) {
     (cam, tgt)
 }
 
-/// The joints of a URDF by child link: (name, type, parent, origin, axis).
-struct Tree(HashMap<String, (String, String, String, Isometry3<f64>, Vector3<f64>)>);
+/// A URDF joint: name, type, parent link, origin, axis.
+type Joint = (String, String, String, Isometry3<f64>, Vector3<f64>);
+
+/// The joints of a URDF by child link.
+struct Tree(HashMap<String, Joint>);
 
 impl Tree {
     fn of(text: &str) -> Tree {

@@ -1,6 +1,7 @@
 //! `calibrate --observations pixels.csv --camera-info cam.yaml --target
-//! board.yaml --mounting …`: calibration from a camera's pixels. Reads the
-//! files, fits (`activecal::identify::camera`), renders the fit and writes
+//! board.yaml --mounting …` (or `--camera-link LINK` for a camera on the
+//! robot's own link, `activecal::io::urdf_branch`): calibration from a
+//! camera's pixels. Reads the files, fits (`activecal::identify::camera`), renders the fit and writes
 //! `--out` (the URDF with the calibrated joint origins, the frames file
 //! with the camera's and target's placements). Written only when the fit
 //! converged, each file atomically and never over an existing one without

@@ -6,7 +6,11 @@
 //! `--target-pose`), and `--n` of them are chosen D-optimally on the pixel
 //! Jacobian (`activecal::select::camera`). `--out design.csv` writes them:
 //! one row a pose, `candidate`, the joints (radians, metres), and
-//! `points_seen`, the target points the pose will see.
+//! `points_seen`, the target points the pose will see; `--out
+//! design.json` the design with its figures. `--gap` scores it against
+//! its visible pool's certified bound (`CameraDesign::gap`).
+//! `--camera-link LINK` chooses for a camera on the robot's own link
+//! (the chain from LINK to the tip, `activecal::io::urdf_branch`).
 
 use super::camera_opts::CameraOpts;
 use super::select::SelectArgs;

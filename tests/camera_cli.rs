@@ -265,4 +265,7 @@ fn cli_calibrates_a_head_camera() {
     let mut both = args[..14].to_vec();
     both.extend(["--mounting", "eye-to-hand"]);
     common::fails_with(&both, "cannot be used with");
+    let mut neither = args[..14].to_vec();
+    neither.drain(3..5);
+    common::fails_with(&neither, "needs --mounting or --camera-link");
 }

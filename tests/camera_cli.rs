@@ -237,6 +237,8 @@ fn cli_calibrates_a_head_camera() {
     assert_eq!(v["converged"], true, "{v}");
     assert_eq!(v["names"].as_array().unwrap().len(), 42);
     assert_eq!(v["camera_link"], "head_2_link");
+    assert_eq!(v["camera"]["camera_link"], "head_2_link");
+    assert_eq!(v["camera"]["camera"]["parent"], "head_2_link");
     let s = v["sigma_px"].as_f64().unwrap();
     assert!((s / 0.3 - 1.0).abs() < 0.05, "σ {s} px");
     let before = std::fs::read_to_string("fixtures/figaroh/tiago.urdf").unwrap();

@@ -94,7 +94,10 @@ pub fn calibrate_camera(
         &obs,
         &lm,
     )?;
-    let frames = camera_frames(&fit)?;
+    let mut frames = camera_frames(&fit)?;
+    if let Some(c) = frames.as_mut().and_then(|f| f.1.camera.as_mut()) {
+        c.camera_link.clone_from(&a.camera_link);
+    }
     let mut written = Vec::new();
     if fit.converged
         && let Some(f) = &frames

@@ -225,6 +225,12 @@ pub struct ContactPlaneBlock {
 pub struct CameraBlock {
     /// `eye-to-hand` or `eye-in-hand`.
     pub mounting: crate::measure::camera::Mounting,
+    /// For a camera on the robot's own link (a head): that link, the
+    /// chain's base (the chain runs from it to the tip through the tree,
+    /// [`crate::io::urdf_branch`]; the mounting is eye-to-hand of that
+    /// chain). Absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub camera_link: Option<String>,
     /// The camera's optical frame (x right, y down, z forward) in its
     /// link.
     pub camera: FrameBlock,

@@ -13,6 +13,7 @@ mod bad_inputs;
 mod bound;
 mod camera;
 mod camera_cli;
+mod camera_head;
 mod cli;
 mod cli_contacts;
 mod cli_existing;

@@ -148,3 +148,126 @@ fn cli_refuses_a_start_behind_the_camera() {
     args[11] = "--camera-pose=1.1761,0.6096,0.9079,-2.0681,0.0317,-1.0590";
     common::fails_with(&args, "lie behind the camera");
 }
+
+/// `select --camera-info --gap --out design.json`: the design against
+/// its visible pool's certified bound (D-efficiency in (0, 1], the
+/// design's `log10 det` below the bound: a design of the pool cannot
+/// exceed it), and the design as JSON with the chosen joint values and
+/// the figures; options a camera design does not
+/// take are refused, not ignored.
+#[test]
+fn cli_selects_a_camera_design_with_its_bound() {
+    let dir = common::scratch_dir("camera", "select-gap");
+    let out = dir.join("design.json");
+    let o = out.display().to_string();
+    let args = [
+        "select",
+        "--robot",
+        "fixtures/ur5.urdf",
+        "--camera-info",
+        "fixtures/camera/camera_info.yaml",
+        "--target",
+        "fixtures/camera/board.yaml",
+        "--mounting",
+        "eye-to-hand",
+        "--camera-pose=1.2,0.6,0.9,-2.0985,0,2.0779",
+        "--target-pose=-0.0853,0.0568,0.02,3.1416,0,0.03",
+        "--n",
+        "12",
+        "--count",
+        "1500",
+        "--gap",
+        "--out",
+        &o,
+        "--json",
+    ];
+    let v = common::json_of(&args);
+    let g = &v["gap"];
+    let eff = g["d_efficiency"].as_f64().unwrap();
+    assert!(eff > 0.0 && eff <= 1.0, "{g}");
+    assert!(g["log10_oid"].as_f64().unwrap() <= g["log10_bound"].as_f64().unwrap());
+    let ln_det = v["ln_det"].as_f64().unwrap();
+    assert!(
+        (g["ln_oid"].as_f64().unwrap() - ln_det).abs() < 1e-6 * ln_det.abs(),
+        "{v}"
+    );
+    let d: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert_eq!(d["poses"], v["poses"]);
+    assert_eq!(d["poses"].as_array().unwrap().len(), 12);
+    assert_eq!(d["gap"], v["gap"]);
+    assert_eq!(d["joint_names"][0], "shoulder_pan_joint");
+    let mut report = args.to_vec();
+    report.truncate(15);
+    report.extend(["--report", "somewhere"]);
+    common::fails_with(&report, "--report is not available with --camera-info");
+}
+
+/// The head camera's example (`cargo run --example camera_head_simulate`)
+/// from the command line: `--camera-link head_2_link` fits 30 + 12
+/// unknowns, σ within 5 % of 0.3 px (2758 degrees of freedom), and writes
+/// the TIAGo URDF with only the head's and the arm's origins changed (the
+/// torso's and the first head joint's kept); a camera link on the arm's
+/// own chain, a link the URDF lacks, and `--mounting` beside it are
+/// refused.
+#[test]
+fn cli_calibrates_a_head_camera() {
+    let dir = common::scratch_dir("camera", "head");
+    let u = dir.join("tiago.urdf");
+    let us = u.display().to_string();
+    let args = [
+        "calibrate",
+        "--robot",
+        "fixtures/figaroh/tiago.urdf#tip=arm_tool_link",
+        "--camera-link",
+        "head_2_link",
+        "--observations",
+        "fixtures/camera/tiago_head.csv",
+        "--camera-info",
+        "fixtures/camera/tiago_xtion.yaml",
+        "--target",
+        "fixtures/camera/tiago_board.yaml",
+        "--camera-pose=0.1008,0.0950,-0.0020,-2.2154,-1.5388,-0.8959",
+        "--target-pose=0.0699,-0.0248,0.0798,-2.2457,1.5388,-2.2154",
+        "--json",
+        "--out",
+        &us,
+    ];
+    let v = common::json_of(&args);
+    assert_eq!(v["converged"], true, "{v}");
+    assert_eq!(v["names"].as_array().unwrap().len(), 42);
+    assert_eq!(v["camera_link"], "head_2_link");
+    assert_eq!(v["camera"]["camera_link"], "head_2_link");
+    assert_eq!(v["camera"]["camera"]["parent"], "head_2_link");
+    let s = v["sigma_px"].as_f64().unwrap();
+    assert!((s / 0.3 - 1.0).abs() < 0.05, "σ {s} px");
+    let before = std::fs::read_to_string("fixtures/figaroh/tiago.urdf").unwrap();
+    let after = std::fs::read_to_string(&u).unwrap();
+    let changed: Vec<usize> = before
+        .lines()
+        .zip(after.lines())
+        .enumerate()
+        .filter(|(_, (a, b))| a != b)
+        .map(|(k, _)| k)
+        .collect();
+    // head_2_joint's origin and the seven arm joints' origins.
+    assert_eq!(changed.len(), 8, "{changed:?}");
+    for k in changed {
+        assert!(
+            before.lines().nth(k).unwrap().contains("<origin"),
+            "line {}",
+            k + 1
+        );
+    }
+    let mut wrong = args[..14].to_vec();
+    wrong[4] = "arm_3_link";
+    common::fails_with(&wrong, "is eye-in-hand");
+    wrong[4] = "no_such_link";
+    common::fails_with(&wrong, "is not a link of the URDF");
+    let mut both = args[..14].to_vec();
+    both.extend(["--mounting", "eye-to-hand"]);
+    common::fails_with(&both, "cannot be used with");
+    let mut neither = args[..14].to_vec();
+    neither.drain(3..5);
+    common::fails_with(&neither, "needs --mounting or --camera-link");
+}

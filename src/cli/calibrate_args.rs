@@ -168,13 +168,13 @@ pub struct CalibrateArgs {
     pub report: Option<PathBuf>,
     /// Calibrate from a camera's pixels: a CSV with one row per detected
     /// target point, `pose, <joints as in the URDF>, feature, u, v`
-    /// (pixels). Needs --camera-info, --target, --mounting, --camera-pose
-    /// and --target-pose.
+    /// (pixels). Needs --camera-info, --target, --mounting (or
+    /// --camera-link), --camera-pose and --target-pose.
     #[arg(
         long,
         value_name = "FILE",
         conflicts_with_all = ["design", "measurements", "trials", "save_measurements", "noise", "validation"],
-        requires_all = ["camera_info", "target", "mounting", "camera_pose", "target_pose"]
+        requires_all = ["camera_info", "target", "camera_pose", "target_pose"]
     )]
     pub observations: Option<PathBuf>,
     /// The camera's intrinsics: a ROS camera_info YAML or an OpenCV
@@ -189,8 +189,20 @@ pub struct CalibrateArgs {
     /// flange) or eye-in-hand (camera on the flange, fixed target).
     #[arg(long, value_enum, requires = "observations")]
     pub mounting: Option<MountingArg>,
+    /// A camera on the robot's own link LINK (a head camera) seeing a
+    /// target on the tip: the chain from LINK down to where the two
+    /// branches of the URDF tree meet and up to the tip is calibrated,
+    /// --camera-pose is in LINK, --target-pose in the tip link.
+    #[arg(
+        long,
+        value_name = "LINK",
+        requires = "observations",
+        conflicts_with = "mounting"
+    )]
+    pub camera_link: Option<String>,
     /// The camera's optical frame (z forward, x right, y down), roughly:
-    /// in the base link (eye-to-hand) or the tip link (eye-in-hand),
+    /// in the base link (eye-to-hand), the tip link (eye-in-hand) or the
+    /// camera's link (--camera-link),
     /// metres and radians (rpy as in URDF). The start of the fit: a rough
     /// guess, with every seen point in front of the camera.
     #[arg(

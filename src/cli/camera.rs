@@ -1,6 +1,7 @@
 //! `calibrate --observations pixels.csv --camera-info cam.yaml --target
-//! board.yaml --mounting …`: calibration from a camera's pixels. Reads the
-//! files, fits (`activecal::identify::camera`), renders the fit and writes
+//! board.yaml --mounting …` (or `--camera-link LINK` for a camera on the
+//! robot's own link, `activecal::io::urdf_branch`): calibration from a
+//! camera's pixels. Reads the files, fits (`activecal::identify::camera`), renders the fit and writes
 //! `--out` (the URDF with the calibrated joint origins, the frames file
 //! with the camera's and target's placements). Written only when the fit
 //! converged, each file atomically and never over an existing one without
@@ -14,7 +15,8 @@ use activecal::io::calibrated::{Format, render};
 use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_observations::read_observations;
 use activecal::io::camera_target::read_target;
-use activecal::measure::camera::CameraSensor;
+use activecal::io::urdf_branch::camera_branch;
+use activecal::measure::camera::{CameraSensor, Mounting};
 use activecal::model::Robot;
 use anyhow::{Context, Result, bail};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
@@ -56,17 +58,24 @@ pub fn calibrate_camera(
     obs_path: &Path,
 ) -> Result<Option<String>> {
     check_out(a, robot)?;
-    let (Some(info), Some(target), Some(mounting), Some(cp), Some(tp)) = (
-        &a.camera_info,
-        &a.target,
-        a.mounting,
-        &a.camera_pose,
-        &a.target_pose,
-    ) else {
-        bail!(
-            "--observations needs --camera-info, --target, --mounting, --camera-pose and --target-pose"
-        );
+    let (Some(info), Some(target), Some(cp), Some(tp)) =
+        (&a.camera_info, &a.target, &a.camera_pose, &a.target_pose)
+    else {
+        bail!("--observations needs --camera-info, --target, --camera-pose and --target-pose");
     };
+    let (branch, mounting) = match (&a.camera_link, a.mounting) {
+        (Some(link), _) => (
+            Some(camera_branch(robot, link).with_context(|| format!("--camera-link {link}"))?),
+            Mounting::EyeToHand,
+        ),
+        (None, Some(m)) => (None, m.into()),
+        (None, None) => bail!("--observations needs --mounting or --camera-link"),
+    };
+    let robot = branch.as_ref().unwrap_or(robot);
+    let label = a
+        .camera_link
+        .as_ref()
+        .map_or_else(|| mounting.name().to_string(), |l| format!("camera on {l}"));
     let intrinsics = read_camera_info(info).context("--camera-info")?;
     let target = read_target(target).context("--target")?;
     let obs = read_observations(obs_path, robot, &target, &intrinsics, a.units.units())?;
@@ -74,13 +83,7 @@ pub fn calibrate_camera(
         parse_placement("--camera-pose", cp)?,
         parse_placement("--target-pose", tp)?,
     );
-    let sensor = CameraSensor::new(
-        intrinsics,
-        mounting.into(),
-        target.points.clone(),
-        &cam0,
-        &tgt0,
-    );
+    let sensor = CameraSensor::new(intrinsics, mounting, target.points.clone(), &cam0, &tgt0);
     let lm = LmSettings::default()
         .with_max_iterations(a.max_iterations)
         .with_geodesic(!a.no_geodesic);
@@ -91,7 +94,10 @@ pub fn calibrate_camera(
         &obs,
         &lm,
     )?;
-    let frames = camera_frames(&fit)?;
+    let mut frames = camera_frames(&fit)?;
+    if let Some(c) = frames.as_mut().and_then(|f| f.1.camera.as_mut()) {
+        c.camera_link.clone_from(&a.camera_link);
+    }
     let mut written = Vec::new();
     if fit.converged
         && let Some(f) = &frames
@@ -113,6 +119,7 @@ pub fn calibrate_camera(
         "robot": robot.name,
         "observations": obs_path.display().to_string(),
         "mounting": fit.sensor.mounting(),
+        "camera_link": a.camera_link,
         "poses": obs.qs.len(),
         "points_seen": obs.n_seen(),
         "names": fit.names,
@@ -131,6 +138,7 @@ pub fn calibrate_camera(
     super::emit(a.json, &v, || {
         text(
             &fit,
+            &label,
             obs_path,
             obs.qs.len(),
             frames.as_ref().map(|f| &f.1),
@@ -148,6 +156,7 @@ pub fn calibrate_camera(
 /// The human-readable report.
 fn text(
     fit: &CameraFit,
+    label: &str,
     path: &Path,
     poses: usize,
     frames: Option<&activecal::frames::report::FramesReport>,
@@ -157,8 +166,7 @@ fn text(
     let n_kin = fit.robot.n_unknowns();
     let _ = writeln!(
         s,
-        "camera calibration ({}) from {}: {poses} poses, {} pixel rows ({} points seen)",
-        fit.sensor.mounting().name(),
+        "camera calibration ({label}) from {}: {poses} poses, {} pixel rows ({} points seen)",
         path.display(),
         fit.rows,
         fit.rows / 2

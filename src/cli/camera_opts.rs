@@ -7,9 +7,9 @@ use std::path::PathBuf;
 /// The camera options of `select`.
 #[derive(Args, Debug, Default)]
 pub struct CameraOpts {
-    /// Choose poses for a camera (see --target, --mounting): its
+    /// Choose poses for a camera (see --target, --mounting, --camera-link): its
     /// intrinsics, a ROS camera_info or OpenCV calibration YAML.
-    #[arg(long, value_name = "FILE", requires_all = ["target", "mounting", "camera_pose", "target_pose"])]
+    #[arg(long, value_name = "FILE", requires_all = ["target", "camera_pose", "target_pose"])]
     pub camera_info: Option<PathBuf>,
     /// The camera's target: a YAML checkerboard {rows, cols, square} or
     /// points [{id, xyz}].
@@ -18,6 +18,16 @@ pub struct CameraOpts {
     /// eye-to-hand or eye-in-hand.
     #[arg(long, value_enum, requires = "camera_info")]
     pub mounting: Option<super::calibrate_args::MountingArg>,
+    /// A camera on the robot's own link LINK (a head camera) seeing a
+    /// target on the tip (see `calibrate --camera-link`): the poses move
+    /// the joints from LINK to the tip; --camera-pose is in LINK.
+    #[arg(
+        long,
+        value_name = "LINK",
+        requires = "camera_info",
+        conflicts_with = "mounting"
+    )]
+    pub camera_link: Option<String>,
     /// The camera's optical frame in the base link (eye-to-hand) or the
     /// tip link (eye-in-hand): X,Y,Z,ROLL,PITCH,YAW (metres, radians).
     #[arg(

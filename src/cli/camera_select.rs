@@ -6,17 +6,22 @@
 //! `--target-pose`), and `--n` of them are chosen D-optimally on the pixel
 //! Jacobian (`activecal::select::camera`). `--out design.csv` writes them:
 //! one row a pose, `candidate`, the joints (radians, metres), and
-//! `points_seen`, the target points the pose will see.
+//! `points_seen`, the target points the pose will see; `--out
+//! design.json` the design with its figures. `--gap` scores it against
+//! its visible pool's certified bound (`CameraDesign::gap`).
+//! `--camera-link LINK` chooses for a camera on the robot's own link
+//! (the chain from LINK to the tip, `activecal::io::urdf_branch`).
 
 use super::camera_opts::CameraOpts;
 use super::select::SelectArgs;
 use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_target::read_target;
 use activecal::pool::camera_view::CameraView;
-use activecal::select::camera::camera_design;
+use activecal::select::camera::{CameraDesign, camera_design};
 use anyhow::{Context, Result, bail};
 use serde_json::json;
 use std::fmt::Write as _;
+use std::path::PathBuf;
 
 /// Joint-space samples when `--count` is not given.
 const DEFAULT_SAMPLES: usize = 20_000;
@@ -32,14 +37,15 @@ fn six(flag: &str, s: &str) -> Result<[f64; 6]> {
 
 /// The camera view the options describe.
 fn view(c: &CameraOpts) -> Result<CameraView> {
-    let (Some(info), Some(target), Some(m), Some(cp), Some(tp)) = (
-        &c.camera_info,
-        &c.target,
-        c.mounting,
-        &c.camera_pose,
-        &c.target_pose,
-    ) else {
-        bail!("--camera-info needs --target, --mounting, --camera-pose and --target-pose");
+    let (Some(info), Some(target), Some(cp), Some(tp)) =
+        (&c.camera_info, &c.target, &c.camera_pose, &c.target_pose)
+    else {
+        bail!("--camera-info needs --target, --camera-pose and --target-pose");
+    };
+    let m = match (c.mounting, &c.camera_link) {
+        (Some(m), None) => m.into(),
+        (None, Some(_)) => activecal::measure::camera::Mounting::EyeToHand,
+        _ => bail!("--camera-info needs --mounting or --camera-link"),
     };
     let d = super::parse_list::<f64>(&c.distance, "--distance")?;
     let [lo, hi] = d[..] else {
@@ -47,7 +53,7 @@ fn view(c: &CameraOpts) -> Result<CameraView> {
     };
     let v = CameraView {
         intrinsics: read_camera_info(info).context("--camera-info")?,
-        mounting: m.into(),
+        mounting: m,
         points: read_target(target)
             .context("--target")?
             .points
@@ -66,19 +72,60 @@ fn view(c: &CameraOpts) -> Result<CameraView> {
     Ok(v)
 }
 
-/// Runs `select` for a camera.
-pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
-    let out = match &a.out[..] {
-        [] => None,
-        [o] if o.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv")) => Some(o),
-        _ => bail!(
-            "--out: a camera design is written as one .csv (candidate, the joints, points_seen)"
-        ),
-    };
-    if let Some(o) = out {
+/// Options of `select` a camera design does not take (yet), refused
+/// rather than ignored.
+fn refuse_unused(a: &SelectArgs) -> Result<()> {
+    let unused = [
+        ("--report", a.report.is_some()),
+        ("--existing", a.existing.is_some()),
+        ("--refine", a.refine),
+        ("--order", a.order.is_some()),
+        ("--home", a.home.is_some()),
+        ("--fixed", a.fixed.is_some()),
+    ];
+    if let Some((flag, _)) = unused.iter().find(|(_, used)| *used) {
+        bail!(
+            "{flag} is not available with --camera-info: a camera design is chosen on the pixel Jacobian of its visible pool, with --gap, --out .csv/.json and --json"
+        );
+    }
+    Ok(())
+}
+
+/// The `--out` files: at most one `.csv` and one `.json`.
+fn outputs(a: &SelectArgs) -> Result<(Option<&PathBuf>, Option<&PathBuf>)> {
+    let ext = |o: &PathBuf, e: &str| o.extension().is_some_and(|x| x.eq_ignore_ascii_case(e));
+    let (mut csv, mut json) = (None, None);
+    for o in &a.out {
+        let slot = if ext(o, "csv") {
+            &mut csv
+        } else if ext(o, "json") {
+            &mut json
+        } else {
+            bail!(
+                "--out {}: a camera design is written as .csv (candidate, the joints, points_seen) or .json (the design and its figures, as --json prints them)",
+                o.display()
+            );
+        };
+        if slot.replace(o).is_some() {
+            bail!("--out {}: one file of each kind (.csv, .json)", o.display());
+        }
+    }
+    for o in csv.iter().chain(json.iter()) {
         super::refuse_overwrite(o, a.force)?;
     }
+    Ok((csv, json))
+}
+
+/// Runs `select` for a camera.
+pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
+    refuse_unused(a)?;
+    let (csv_out, json_out) = outputs(a)?;
     let robot = super::load_robot(&a.pool.robot)?;
+    let robot = match &a.camera.camera_link {
+        Some(link) => activecal::io::urdf_branch::camera_branch(&robot, link)
+            .with_context(|| format!("--camera-link {link}"))?,
+        None => robot,
+    };
     let v = view(&a.camera)?;
     let candidates = activecal::observability::generic_configurations(
         &robot,
@@ -91,56 +138,103 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         ..Default::default()
     };
     let d = camera_design(&robot, &v, &candidates, &settings)?;
+    let gap = if a.gap {
+        let bs = activecal::bound::BoundSettings::builder()
+            .solver(a.gap_solver)
+            .build()?;
+        Some(d.gap(&bs)?)
+    } else {
+        None
+    };
     let names = activecal::units::joint_names(&robot);
     let mut csv = format!("candidate,{},points_seen\n", names.join(","));
     for ((q, c), s) in d.qs.iter().zip(&d.candidates).zip(&d.seen) {
         let joints: Vec<String> = q.iter().map(|v| format!("{v:.17}")).collect();
         let _ = writeln!(csv, "{c},{},{s}", joints.join(","));
     }
-    if let Some(o) = out {
-        super::write_new(o, &csv, a.force)?;
-    }
-    let value = json!({
-        "robot": robot.name,
+    let figures = json!({
+        "camera_link": a.camera.camera_link,
+        "mounting": v.mounting,
         "candidates": candidates.len(),
+        "pool_seed": a.pool.pool_seed.unwrap_or(0),
         "visible": d.visible,
-        "n": d.qs.len(),
         "unknowns": d.names,
         "ln_det": d.ln_det,
+        "log10_bound": gap.as_ref().map(|g| g.log10_bound),
+        "d_efficiency": gap.as_ref().map(|g| g.d_efficiency),
         "predicted_error_mm_per_px": d.predicted_error_per_px.map(|e| 1e3 * e),
-        "poses": d.qs,
         "points_seen": d.seen,
-        "out": out.map(|p| p.display().to_string()),
     });
+    if let Some(o) = csv_out {
+        super::write_new(o, &csv, a.force)?;
+    }
+    let mut value = figures;
+    value["robot"] = json!(a.pool.robot.head());
+    value["chain"] = json!(a.pool.robot.chain);
+    value["joint_names"] = json!(names);
+    value["n"] = json!(d.qs.len());
+    value["chosen_candidates"] = json!(d.candidates);
+    value["poses"] = json!(d.qs);
+    value["gap"] = json!(gap);
+    if let Some(o) = json_out {
+        let text = serde_json::to_string_pretty(&value)? + "\n";
+        super::write_new(o, &text, a.force)?;
+    }
+    let written: Vec<String> = csv_out
+        .iter()
+        .chain(json_out.iter())
+        .map(|p| p.display().to_string())
+        .collect();
+    value["out"] = json!(written);
     super::emit(a.json, &value, || {
-        let predicted = d.predicted_error_per_px.map_or_else(
-            || "not predicted (singular design)".to_string(),
-            |e| {
-                format!(
-                    "{:.4} mm per px of pixel noise σ (RMS over 1,000 configurations)",
-                    1e3 * e
-                )
-            },
-        );
-        let mut s = format!(
-            "camera: the target is seen well at {} of {} sampled configurations\nchose {} poses on the pixel Jacobian ({} unknowns): ln det XᵀX = {:.3} (unit pixel noise)\npredicted true error: {predicted}\npoints seen per pose: {}\n",
-            d.visible,
-            candidates.len(),
-            d.qs.len(),
-            d.names.len(),
-            d.ln_det,
-            d.seen
-                .iter()
-                .map(usize::to_string)
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-        match out {
-            None => s += &csv,
-            Some(o) => {
-                let _ = writeln!(s, "wrote {}", o.display());
-            }
-        }
-        s
+        text(&d, candidates.len(), gap.as_ref(), &csv, &written)
     })
+}
+
+/// The human-readable report of a camera design.
+fn text(
+    d: &CameraDesign,
+    candidates: usize,
+    gap: Option<&activecal::bound::DesignGap>,
+    csv: &str,
+    written: &[String],
+) -> String {
+    let predicted = d.predicted_error_per_px.map_or_else(
+        || "not predicted (singular design)".to_string(),
+        |e| {
+            format!(
+                "{:.4} mm per px of pixel noise σ (RMS over 1,000 configurations)",
+                1e3 * e
+            )
+        },
+    );
+    let mut s = format!(
+        "camera: the target is seen well at {} of {candidates} sampled configurations\nchose {} poses on the pixel Jacobian ({} unknowns): ln det XᵀX = {:.3} (unit pixel noise)\n",
+        d.visible,
+        d.qs.len(),
+        d.names.len(),
+        d.ln_det,
+    );
+    if let Some(g) = gap {
+        let _ = writeln!(
+            s,
+            "log10 det XᵀX {:.4}  log10 bound {:.4}  D-efficiency >= {:.6} (the visible pool's certified bound)",
+            g.log10_oid.unwrap_or(f64::NEG_INFINITY),
+            g.log10_bound,
+            g.d_efficiency
+        );
+    }
+    let seen: Vec<String> = d.seen.iter().map(usize::to_string).collect();
+    let _ = writeln!(
+        s,
+        "predicted true error: {predicted}\npoints seen per pose: {}",
+        seen.join(", ")
+    );
+    if written.is_empty() {
+        s += csv;
+    }
+    for w in written {
+        let _ = writeln!(s, "wrote {w}");
+    }
+    s
 }

@@ -101,6 +101,7 @@ pub fn camera_frames(
     ));
     report.camera = Some(CameraBlock {
         mounting: fit.sensor.mounting(),
+        camera_link: None,
         camera,
         target,
         pixel_sigma_px: fit.sigma_px,

@@ -99,6 +99,39 @@ fn length_scale(urdf: &UrdfFrames) -> f64 {
     l.max(1e-3)
 }
 
+/// Driven joint `k`'s origin, nominal and `calibrated` (the split's), in
+/// the file's terms: a joint the chain walks against the file's tree
+/// ([`crate::model::source::Reversed`]) gives its neighbour's origin, the
+/// inverse of its own in the chain.
+fn in_file(
+    src: &crate::model::source::UrdfSource,
+    urdf: &UrdfFrames,
+    k: usize,
+    calibrated: Isometry3<f64>,
+) -> JointOrigin {
+    let neighbour = src
+        .reversed
+        .iter()
+        .find(|r| r.joint == urdf.name[k])
+        .and_then(|r| r.neighbour.as_ref());
+    match neighbour {
+        Some(n) => JointOrigin {
+            name: n.name.clone(),
+            kind: n.kind.unwrap_or(JointKind::Revolute),
+            axis: n.axis.normalize(),
+            nominal: n.origin,
+            calibrated: calibrated.inverse(),
+        },
+        None => JointOrigin {
+            name: urdf.name[k].clone(),
+            kind: urdf.kind[k],
+            axis: urdf.axis[k],
+            nominal: urdf.origin[k],
+            calibrated,
+        },
+    }
+}
+
 /// Splits `robot` at `table` into the measurement frame, the tool, the
 /// markers and the joint origins of its URDF (see the module
 /// documentation).
@@ -128,13 +161,7 @@ pub fn decompose(robot: &Robot, table: &ParamTable) -> Result<CalibratedFrames, 
         .map(|p| p.coords)
         .collect();
     let joints = (0..urdf.len())
-        .map(|k| JointOrigin {
-            name: urdf.name[k].clone(),
-            kind: urdf.kind[k],
-            axis: urdf.axis[k],
-            nominal: urdf.origin[k],
-            calibrated: split.origin[k],
-        })
+        .map(|k| in_file(src, &urdf, k, split.origin[k]))
         .collect();
     Ok(CalibratedFrames {
         measurement,

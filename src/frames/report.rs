@@ -225,6 +225,12 @@ pub struct ContactPlaneBlock {
 pub struct CameraBlock {
     /// `eye-to-hand` or `eye-in-hand`.
     pub mounting: crate::measure::camera::Mounting,
+    /// For a camera on the robot's own link (a head): that link, the
+    /// chain's base (the chain runs from it to the tip through the tree,
+    /// [`crate::io::urdf_branch`]; the mounting is eye-to-hand of that
+    /// chain). Absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub camera_link: Option<String>,
     /// The camera's optical frame (x right, y down, z forward) in its
     /// link.
     pub camera: FrameBlock,
@@ -423,10 +429,15 @@ impl FramesReport {
                     .collect(),
             ),
         };
+        // A chain's first joint walked against the file's tree has no
+        // origin of the file (the split keeps it; the camera's placement
+        // holds what it would take): not a joint of the file's to report.
+        let skip = usize::from(src.reversed.iter().any(|r| r.neighbour.is_none()));
         let joints = f
             .joints
             .iter()
             .enumerate()
+            .skip(skip)
             .map(|(k, j)| joint_block(j, sigma.map(|s| (&s.joints[k], s.offsets[k]))))
             .collect();
         FramesReport {

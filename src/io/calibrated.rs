@@ -71,9 +71,13 @@ pub fn render(
         }
         Format::Urdf => match (&robot.source, frames) {
             (Some(src), Some((f, _))) => {
+                // A chain's first joint walked against the file's tree has
+                // no origin of the file (the camera's placement holds it).
+                let skip_first = usize::from(src.reversed.iter().any(|r| r.neighbour.is_none()));
                 let origins: Vec<(String, nalgebra::Isometry3<f64>)> = f
                     .joints
                     .iter()
+                    .skip(skip_first)
                     .map(|j| (j.name.clone(), j.calibrated))
                     .collect();
                 super::urdf_edit::with_origins(&src.text, &src.path, &origins)

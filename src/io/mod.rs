@@ -20,6 +20,7 @@ pub mod read;
 pub mod robot_toml;
 pub mod table;
 pub mod urdf;
+pub mod urdf_branch;
 mod urdf_chain;
 pub mod urdf_edit;
 

@@ -143,11 +143,31 @@ pub fn parse(text: &str, origin: &str, opts: &UrdfOptions) -> Result<Robot> {
             opts.parallel_threshold
         )));
     }
-    let urdf = kinematic_part(text)
+    let urdf = parsed(text).map_err(bad)?;
+    from_parsed(&urdf, text, origin, opts)
+}
+
+/// The kinematic part of URDF text parsed (see [`kinematic_part`]).
+pub(super) fn parsed(text: &str) -> std::result::Result<urdf_rs::Robot, String> {
+    kinematic_part(text)
         .and_then(|k| urdf_rs::read_from_string(&k).map_err(|e| e.to_string()))
-        .map_err(|e| bad(format!("not a valid URDF: {e}")))?;
+        .map_err(|e| format!("not a valid URDF: {e}"))
+}
+
+/// [`parse`] of a parsed URDF `urdf`, whose file text `text` the robot
+/// keeps as its source (the text a calibrated URDF edits).
+pub(super) fn from_parsed(
+    urdf: &urdf_rs::Robot,
+    text: &str,
+    origin: &str,
+    opts: &UrdfOptions,
+) -> Result<Robot> {
+    let bad = |message: String| Error::Parse {
+        path: origin.to_string(),
+        message,
+    };
     let chain =
-        extract_chain(&urdf, opts.base.as_deref(), opts.tip.as_deref(), &opts.lock).map_err(bad)?;
+        extract_chain(urdf, opts.base.as_deref(), opts.tip.as_deref(), &opts.lock).map_err(bad)?;
     let name = if urdf.name.is_empty() {
         Path::new(origin)
             .file_stem()
@@ -176,7 +196,7 @@ pub fn parse(text: &str, origin: &str, opts: &UrdfOptions) -> Result<Robot> {
     robot.validate().map_err(|e| bad(e.to_string()))?;
     robot.check_identifiable().map_err(|e| bad(e.to_string()))?;
     robot.source = Some(std::sync::Arc::new(source_of(
-        &urdf, &chain, text, origin, opts,
+        urdf, &chain, text, origin, opts,
     )));
     Ok(robot)
 }
@@ -214,6 +234,7 @@ fn source_of(
         joints: chain.iter().map(|j| j.source.clone()).collect(),
         mount: opts.mount,
         tool: opts.tool,
+        reversed: Vec::new(),
     }
 }
 

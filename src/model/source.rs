@@ -78,6 +78,28 @@ pub struct UrdfSource {
     /// The tool: tip link → measured frame (identity unless a frames file
     /// gave one).
     pub tool: Isometry3<f64>,
+    /// The chain's driven joints that the file's tree walks the other way
+    /// (a chain from a camera's link down to a branch point and up to an
+    /// arm's tip, [`crate::io::urdf_branch`]); empty for a chain from the
+    /// root.
+    pub reversed: Vec<Reversed>,
+}
+
+/// A driven joint of a chain walked against the file's tree, from child
+/// link to parent link. Its motion is the file's joint's inverse (the
+/// chain's axis is the file's negated, its value the file's), and its
+/// origin in the chain is the inverse of the `<origin>` of the file's
+/// joint on its other side (`neighbour`): a calibrated chain writes that
+/// joint's origin.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reversed {
+    /// The joint's name (the chain's and the file's).
+    pub joint: String,
+    /// The driven joint of the file whose child link is this joint's
+    /// parent link (the previous joint of the chain), as the file gives
+    /// it; `None` for the chain's first joint, whose origin the split
+    /// keeps as it is ([`crate::frames::gauge`]) and nothing writes.
+    pub neighbour: Option<SourceJoint>,
 }
 
 impl UrdfSource {

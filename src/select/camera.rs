@@ -43,6 +43,25 @@ pub struct CameraDesign {
     /// The selection's own record.
     #[serde(skip)]
     pub selection: Selection,
+    /// The pixel Jacobian blocks of the visible pool (the candidates the
+    /// view kept, in order), which the selection's positions index.
+    #[serde(skip)]
+    pub blocks: Blocks,
+}
+
+impl CameraDesign {
+    /// The design against the certified bound of its visible pool: the
+    /// relaxation bound on `ln det XᵀX` of every design of its size from
+    /// the candidates the view kept ([`crate::bound::relaxation_bound`] on
+    /// the pixel Jacobian blocks) and the design's D-efficiency against it
+    /// ([`crate::bound::design_gap`]), as for any sensor's pool.
+    pub fn gap(
+        &self,
+        settings: &crate::bound::BoundSettings,
+    ) -> std::result::Result<crate::bound::DesignGap, crate::bound::BoundError> {
+        let bound = crate::bound::relaxation_bound(&self.blocks, None, self.qs.len(), settings)?;
+        crate::bound::design_gap(&self.blocks, None, &self.selection.poses, &bound)
+    }
 }
 
 /// Configurations the predicted error is averaged over.
@@ -112,6 +131,7 @@ pub fn camera_design(
         ln_det: sel.ln_oid,
         predicted_error_per_px,
         selection: sel,
+        blocks,
     })
 }
 

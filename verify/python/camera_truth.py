@@ -38,7 +38,9 @@ Usage (run with the project venv's python; outputs are JSON or CSV):
       the NOMINAL robot (Pinocchio, the URDF as given: what a hand-eye
       tool assumes), cv2.calibrateHandEye with each of its five methods
       (base <- camera), the target on the tip link as the mean over poses
-      of tip <- base <- camera <- target. For each method, and for
+      of tip <- base <- camera <- target; and cv2.calibrateRobotWorldHandEye
+      (Shah, Li: camera and target placements together, from the same
+      solvePnP poses and nominal gripper poses). For each method, and for
       activecal's frames file (--frames: its measurement_frame is the base
       link in the camera's frame), against the truth: the camera
       placement's error (mm, deg) and the true error of the target's
@@ -207,6 +209,21 @@ def cmd_handeye(a):
         r, tt = cv2.calibrateHandEye(r_b2g, t_b2g, r_t2c, t_t2c, method=m)
         cam = truth.se3(r, tt.reshape(3))  # base <- camera (eye-to-hand)
         target = mean_se3([g.inverse() * cam * c for g, c in tips])  # tip <- target
+        e_t, e_r = placement_error(cam, cam_true)
+        out[name] = {"camera_mm": e_t, "camera_deg": e_r,
+                     "true": truth.errors(t, t.nominal, cam.inverse(), target, qs)}
+    # cv2.calibrateRobotWorldHandEye solves cTw wTb = cTg gTb for a camera
+    # on the gripper and a fixed "world"; eye-to-hand maps onto it with the
+    # target as the world, the tip-in-base pose (bTg) as "base2gripper",
+    # so that "gripper2cam" is the camera <- base and "base2world" the
+    # target <- tip: cTt = cTb bTg gTt.
+    r_g = [np.asarray(g.rotation) for g, _ in tips]
+    t_g = [np.asarray(g.translation) for g, _ in tips]
+    for name, m in {"shah": cv2.CALIB_ROBOT_WORLD_HAND_EYE_SHAH,
+                    "li": cv2.CALIB_ROBOT_WORLD_HAND_EYE_LI}.items():
+        r_w, t_w, r_c, t_c = cv2.calibrateRobotWorldHandEye(r_t2c, t_t2c, r_g, t_g, method=m)
+        cam = truth.se3(r_c, t_c.reshape(3)).inverse()  # base <- camera
+        target = truth.se3(r_w, t_w.reshape(3)).inverse()  # tip <- target
         e_t, e_r = placement_error(cam, cam_true)
         out[name] = {"camera_mm": e_t, "camera_deg": e_r,
                      "true": truth.errors(t, t.nominal, cam.inverse(), target, qs)}

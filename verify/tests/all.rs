@@ -14,6 +14,8 @@ mod live_bound;
 #[cfg(feature = "live")]
 mod live_camera;
 #[cfg(feature = "live")]
+mod live_camera_head;
+#[cfg(feature = "live")]
 mod live_camera_truth;
 #[cfg(feature = "live")]
 mod live_collision;

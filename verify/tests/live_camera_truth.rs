@@ -17,6 +17,9 @@
 //! 1–20: it is dominated by a few directions, the camera's rotations seen
 //! over 1.3 m); 5 draws gave 0.61×, 20 give 0.98×. Also against OpenCV's
 //! hand-eye calibration on the same pixels ([`activecal_against_opencv_hand_eye`]).
+//! The same gate eye-to-hand on example-robot-data's Panda (to
+//! `panda_hand_tcp`), with the hand-eye comparison on its configurations
+//! ([`panda_eye_to_hand_calibration_matches_a_known_true_robot`]).
 
 use activecal::identify::LmSettings;
 use activecal::identify::camera::{fit_camera, predict::predicted_error};
@@ -71,7 +74,7 @@ fn camera_calibration_matches_a_known_true_robot() {
         Translation3::new(-0.0853, 0.0568, 0.02),
         UnitQuaternion::from_euler_angles(std::f64::consts::PI, 0.0, 0.03),
     );
-    truth_gate(Mounting::EyeToHand, camera, target);
+    truth_gate(&UR5, Mounting::EyeToHand, camera, target);
 }
 
 /// As [`camera_calibration_matches_a_known_true_robot`], eye-in-hand: the
@@ -87,14 +90,80 @@ fn eye_in_hand_calibration_matches_a_known_true_robot() {
         Translation3::new(0.45, 0.15, 0.0),
         UnitQuaternion::from_euler_angles(std::f64::consts::PI, 0.0, 0.03),
     ) * Translation3::new(-0.0875, -0.0625, 0.0);
-    truth_gate(Mounting::EyeInHand, camera, target);
+    truth_gate(&UR5, Mounting::EyeInHand, camera, target);
 }
 
-/// The gate for one mounting and true placements (see the module
+/// An arm of the gate: its URDF (from the repository's root), the chain's
+/// base and tip links.
+struct Arm {
+    name: &'static str,
+    urdf: &'static str,
+    base: &'static str,
+    tip: &'static str,
+}
+
+impl Arm {
+    /// The robot as `--robot` names it.
+    fn robot_ref(&self) -> String {
+        format!("{}#tip={}", root().join(self.urdf).display(), self.tip)
+    }
+}
+
+const UR5: Arm = Arm {
+    name: "ur5",
+    urdf: "fixtures/ur5.urdf",
+    base: "base_link",
+    tip: "target",
+};
+
+/// example-robot-data's Panda (the repository's copy), to the hand's TCP.
+const PANDA: Arm = Arm {
+    name: "panda",
+    urdf: "fixtures/example-robot-data/panda.urdf",
+    base: "panda_link0",
+    tip: "panda_hand_tcp",
+};
+
+/// The gate eye-to-hand on a Panda: the camera as for the UR5 (1.3 m
+/// away), the board 2 cm past the hand's TCP, facing along its z; then
+/// against OpenCV's hand-eye methods on the gate's configurations
+/// ([`hand_eye`]).
+#[test]
+fn panda_eye_to_hand_calibration_matches_a_known_true_robot() {
+    let camera = Isometry3::from_parts(
+        Translation3::new(1.2, 0.6, 0.9),
+        UnitQuaternion::from_euler_angles(-2.0985, 0.0, 2.0779),
+    );
+    let target = Isometry3::from_parts(
+        Translation3::new(-0.0853, 0.0568, 0.02),
+        UnitQuaternion::from_euler_angles(std::f64::consts::PI, 0.0, 0.03),
+    );
+    let (dir, configs) = truth_gate(&PANDA, Mounting::EyeToHand, camera, target);
+    let off = Isometry3::from_parts(
+        Translation3::new(0.02, -0.015, 0.01),
+        UnitQuaternion::from_euler_angles(0.03, -0.02, 0.025),
+    );
+    let (cam0, tgt0) = (six(&(camera * off)), six(&(target * off.inverse())));
+    hand_eye(
+        &PANDA,
+        &dir,
+        &configs,
+        [&six(&camera), &six(&target)],
+        [&cam0, &tgt0],
+    );
+}
+
+/// The gate for one arm, mounting and true placements (see the module
 /// documentation).
-fn truth_gate(mounting: Mounting, camera: Isometry3<f64>, target: Isometry3<f64>) {
+fn truth_gate(
+    arm: &Arm,
+    mounting: Mounting,
+    camera: Isometry3<f64>,
+    target: Isometry3<f64>,
+) -> (PathBuf, PathBuf) {
     let dir = std::env::temp_dir().join(format!(
-        "activecal-camera-truth-{}-{}",
+        "activecal-camera-truth-{}-{}-{}",
+        arm.name,
         mounting.name(),
         std::process::id()
     ));
@@ -102,7 +171,7 @@ fn truth_gate(mounting: Mounting, camera: Isometry3<f64>, target: Isometry3<f64>
     std::fs::create_dir_all(&dir).unwrap();
     let r = root();
     let (urdf, info, board) = (
-        r.join("fixtures/ur5.urdf"),
+        r.join(arm.urdf),
         r.join("fixtures/camera/camera_info.yaml"),
         r.join("fixtures/camera/board.yaml"),
     );
@@ -113,9 +182,9 @@ fn truth_gate(mounting: Mounting, camera: Isometry3<f64>, target: Isometry3<f64>
         .args([
             "make",
             "--base",
-            "base_link",
+            arm.base,
             "--tip",
-            "target",
+            arm.tip,
             "--seed",
             "3",
             "--mounting",
@@ -128,7 +197,7 @@ fn truth_gate(mounting: Mounting, camera: Isometry3<f64>, target: Isometry3<f64>
         .arg("--out")
         .arg(&truth));
     // Configurations where the nominal robot shows the whole board.
-    let robot = activecal::io::load_robot(urdf.to_str().unwrap()).unwrap();
+    let robot = activecal::io::load_robot(&arm.robot_ref()).unwrap();
     let intrinsics = read_camera_info(&info).unwrap();
     let tgt = read_target(&board).unwrap();
     let view = CameraView {
@@ -203,7 +272,7 @@ fn truth_gate(mounting: Mounting, camera: Isometry3<f64>, target: Isometry3<f64>
         run(Command::new(r.join("target/debug/activecal"))
             .arg("calibrate")
             .arg("--robot")
-            .arg(&urdf)
+            .arg(arm.robot_ref())
             .arg("--observations")
             .arg(&obs)
             .arg("--camera-info")
@@ -251,7 +320,11 @@ fn truth_gate(mounting: Mounting, camera: Isometry3<f64>, target: Isometry3<f64>
         (true_mm, predicted)
     };
     let (exact, _) = calibrated(0.0, 0);
-    println!("{}: noise-free: true error {exact:.2e} mm", mounting.name());
+    println!(
+        "{} {}: noise-free: true error {exact:.2e} mm",
+        arm.name,
+        mounting.name()
+    );
     assert!(exact < 1e-6, "noise-free pixels leave {exact} mm");
     let (mut t2, mut p2) = (0.0, 0.0);
     for seed in 1..=DRAWS {
@@ -263,7 +336,8 @@ fn truth_gate(mounting: Mounting, camera: Isometry3<f64>, target: Isometry3<f64>
     }
     let (t, p) = ((t2 / DRAWS as f64).sqrt(), (p2 / DRAWS as f64).sqrt());
     println!(
-        "{}: RMS over {DRAWS} draws: true {t:.4} mm, predicted {p:.4} mm (ratio {:.2})",
+        "{} {}: RMS over {DRAWS} draws: true {t:.4} mm, predicted {p:.4} mm (ratio {:.2})",
+        arm.name,
         mounting.name(),
         t / p
     );
@@ -271,6 +345,7 @@ fn truth_gate(mounting: Mounting, camera: Isometry3<f64>, target: Isometry3<f64>
         t < 1.3 * p && p < 1.3 * t,
         "true {t} mm against predicted {p} mm"
     );
+    (dir, configs)
 }
 
 /// The configurations of the example observations (`fixtures/camera`), as
@@ -293,21 +368,41 @@ fn example_configurations(dir: &Path) -> PathBuf {
 }
 
 /// Against OpenCV's hand-eye calibration (`cv2.calibrateHandEye`, all five
-/// methods, fed `solvePnP` per pose and the gripper poses of the nominal
-/// robot) on the same pixels (σ 0.3 px, the example's 40 configurations):
-/// the camera placement's error and the true error of the target's origin
-/// in the camera's frame at 1,000 random configurations, with the arm's
-/// geometry off (seed 3) and exact (`--exact`). Asserted: activecal's true
-/// error is below every method's in both (the hand-eye methods take the
-/// nominal arm as exact and solve linear forms of per-pose PnP poses;
-/// activecal fits the pixels).
+/// methods, and `cv2.calibrateRobotWorldHandEye`, Shah and Li, fed
+/// `solvePnP` per pose and the gripper poses of the nominal robot) on the
+/// same pixels (σ 0.3 px, the example's 40 configurations): the camera
+/// placement's error and the true error of the target's origin in the
+/// camera's frame at 1,000 random configurations, with the arm's geometry
+/// off (seed 3) and exact (`--exact`). Asserted: activecal's true error is
+/// below every method's in both (the hand-eye methods take the nominal arm
+/// as exact and solve linear forms of per-pose PnP poses; activecal fits
+/// the pixels).
 #[test]
 fn activecal_against_opencv_hand_eye() {
     let dir = std::env::temp_dir().join(format!("activecal-camera-handeye-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    let r = root();
     let configs = example_configurations(&dir);
+    hand_eye(
+        &UR5,
+        &dir,
+        &configs,
+        [
+            "1.2,0.6,0.9,-2.0985,0,2.0779",
+            "-0.0853,0.0568,0.0200,3.1416,0,0.03",
+        ],
+        [
+            "1.1761,0.6096,0.9079,-2.0681,0.0317,2.0826",
+            "-0.1047,0.0411,0.0301,3.1111,-0.0192,0.0556",
+        ],
+    );
+}
+
+/// The hand-eye comparison of [`activecal_against_opencv_hand_eye`] for
+/// `arm` at the configurations of `configs`: the true placements
+/// (camera, target) and the fit's start, as `X,Y,Z,ROLL,PITCH,YAW`.
+fn hand_eye(arm: &Arm, dir: &Path, configs: &Path, truth_at: [&str; 2], start: [&str; 2]) {
+    let r = root();
     let script = r.join("verify/python/camera_truth.py");
     let info = r.join("fixtures/camera/camera_info.yaml");
     for exact in [false, true] {
@@ -315,21 +410,11 @@ fn activecal_against_opencv_hand_eye() {
         let truth = dir.join(format!("truth_{tag}.json"));
         let mut make = python();
         make.arg(&script)
-            .args([
-                "make",
-                "--base",
-                "base_link",
-                "--tip",
-                "target",
-                "--seed",
-                "3",
-            ])
+            .args(["make", "--base", arm.base, "--tip", arm.tip, "--seed", "3"])
             .arg("--urdf")
-            .arg(r.join("fixtures/ur5.urdf"))
-            .args([
-                "--camera=1.2,0.6,0.9,-2.0985,0,2.0779",
-                "--target=-0.0853,0.0568,0.0200,3.1416,0,0.03",
-            ])
+            .arg(r.join(arm.urdf))
+            .arg(format!("--camera={}", truth_at[0]))
+            .arg(format!("--target={}", truth_at[1]))
             .arg("--out")
             .arg(&truth);
         if exact {
@@ -346,7 +431,7 @@ fn activecal_against_opencv_hand_eye() {
             .arg(&info)
             .args(["--board", "6,8,0.025", "--noise", "0.3", "--seed", "1"])
             .arg("--configs")
-            .arg(&configs)
+            .arg(configs)
             .arg("--out")
             .arg(&obs));
         let (u, y) = (
@@ -356,7 +441,7 @@ fn activecal_against_opencv_hand_eye() {
         run(Command::new(r.join("target/debug/activecal"))
             .arg("calibrate")
             .arg("--robot")
-            .arg(r.join("fixtures/ur5.urdf"))
+            .arg(arm.robot_ref())
             .arg("--observations")
             .arg(&obs)
             .arg("--camera-info")
@@ -364,10 +449,8 @@ fn activecal_against_opencv_hand_eye() {
             .arg("--target")
             .arg(r.join("fixtures/camera/board.yaml"))
             .args(["--mounting", "eye-to-hand", "--force", "--json"])
-            .args([
-                "--camera-pose=1.1761,0.6096,0.9079,-2.0681,0.0317,2.0826",
-                "--target-pose=-0.1047,0.0411,0.0301,3.1111,-0.0192,0.0556",
-            ])
+            .arg(format!("--camera-pose={}", start[0]))
+            .arg(format!("--target-pose={}", start[1]))
             .arg("--out")
             .arg(&u)
             .arg("--out")
@@ -387,7 +470,7 @@ fn activecal_against_opencv_hand_eye() {
             .arg("--urdf")
             .arg(&u)))
         .unwrap();
-        println!("arm geometry {tag}:");
+        println!("{}, arm geometry {tag}:", arm.name);
         let ours = v["activecal"]["true"]["rms_mm"].as_f64().unwrap();
         for (name, e) in v.as_object().unwrap() {
             let t = e["true"]["rms_mm"].as_f64().unwrap();

@@ -384,3 +384,43 @@ fn a_stretch_of_poses_turned_by_a_whole_turn_goes_round_the_other_way() {
     assert_eq!((r.turned.len(), r.colliding.len()), (0, 1), "{r:?}");
     assert_eq!(same, qs);
 }
+
+/// The moves checked in parallel (a path's moves at once, repairs two at a
+/// time) give the same tour and counts on one thread as on two: the
+/// Panda's fixture scene, its moves' first ends as a tour of 30 poses.
+#[test]
+fn a_tour_s_checks_do_not_depend_on_the_thread_count() {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let text = std::fs::read_to_string(format!(
+        "{root}/fixtures/example-robot-data/tour_moves_coal.json"
+    ))
+    .unwrap();
+    let fixture: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let scenes: Vec<Scene> = serde_json::from_value(fixture["scenes"].clone()).unwrap();
+    let s = scenes.iter().find(|s| s.scene == "panda").unwrap();
+    let sp = &s.spec;
+    let m = CollisionModel::load(&CollisionSpec {
+        urdf: format!("{root}/{}", sp.urdf),
+        joints: sp.joints.clone(),
+        self_collision: true,
+        srdf: sp.srdf.as_ref().map(|f| format!("{root}/{f}")),
+        floor: sp.floor,
+        ..CollisionSpec::default()
+    })
+    .unwrap();
+    let qs: Vec<Vec<f64>> = sp.moves.iter().take(30).map(|[a, _]| a.clone()).collect();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut order: Vec<usize> = (0..qs.len()).collect();
+            let (r, turned) = tour_with(&m, None, &qs, &mut order, &[], None);
+            (r, order, turned)
+        })
+    };
+    let one = run(1);
+    assert!(one.0.colliding_before > 0, "the scene exercises repairs: {:?}", one.0);
+    assert_eq!(one, run(2));
+}

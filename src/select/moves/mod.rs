@@ -69,6 +69,12 @@ pub struct TurnedPose {
 /// add (the least first): each checks up to three moves (memoised).
 pub const REPAIR_TRIES: usize = 64;
 
+/// Repairs whose moves are checked together (in parallel) before the
+/// first free one of them is taken: the same repair is chosen as one by
+/// one; a fixed number, so that the moves checked do not depend on the
+/// number of threads.
+pub const REPAIR_BATCH: usize = 2;
+
 /// What a tour's moves are checked against, and what a repair may use.
 #[derive(Clone, Copy, Debug)]
 pub struct MoveSpace<'a> {
@@ -268,6 +274,37 @@ impl Checker<'_> {
         }
         p.extend(order.iter().map(|&k| k + 1));
         p
+    }
+
+    /// Checks the moves between ends `moves` not checked yet, in parallel,
+    /// and memoises them, as [`Self::prefetch`] does for plain nodes.
+    fn prefetch_ends(&mut self, moves: &[(End, End)]) {
+        let plain = |(a, b): &(End, End)| a.turns.is_empty() && b.turns.is_empty();
+        let nodes: Vec<(usize, usize)> = moves
+            .iter()
+            .filter(|m| plain(m))
+            .map(|(a, b)| (a.node, b.node))
+            .collect();
+        self.prefetch(&nodes);
+        let mut todo: Vec<(End, End)> = Vec::new();
+        for m in moves.iter().filter(|m| !plain(m)) {
+            if !self.turned_memo.contains_key(m) && !todo.contains(m) {
+                todo.push(m.clone());
+            }
+        }
+        let found: Vec<(usize, bool)> = todo
+            .par_iter()
+            .map(|(a, b)| {
+                let (qa, qb) = (self.config(a), self.config(b));
+                let (checks, contact) = check_against(self.models, &qa, &qb, self.resolution);
+                (checks, contact.is_none())
+            })
+            .collect();
+        for (key, (checks, free)) in todo.into_iter().zip(found) {
+            self.moves += 1;
+            self.configurations += checks;
+            self.turned_memo.insert(key, free);
+        }
     }
 
     /// Positions `i` in `path` whose move `path[i] → path[i+1]` collides.

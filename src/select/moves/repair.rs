@@ -9,7 +9,7 @@
 //! priced by the move time it adds, and the cheapest whose new moves are
 //! all free is applied.
 
-use super::{Checker, End, MoveSpace, REPAIR_TRIES};
+use super::{Checker, End, MoveSpace, REPAIR_BATCH, REPAIR_TRIES};
 use crate::select::turns::{product, turns_within};
 
 /// A change that replaces a colliding move.
@@ -40,8 +40,9 @@ impl Candidate {
 /// Replaces the colliding move `path[i] → path[i+1]` (positions before
 /// `first` stay): of the candidate reversals, relocations and turned
 /// stretches (only the turned stretches when `space.keep_order`), the
-/// [`REPAIR_TRIES`] adding the least move time are tried in that order,
-/// and the first whose new moves are all free is applied (a turned stretch
+/// [`REPAIR_TRIES`] adding the least move time are tried in that order
+/// ([`REPAIR_BATCH`] at a time, their moves checked in parallel), and the
+/// first whose new moves are all free is applied (a turned stretch
 /// to the checker's poses). Returns the new path.
 pub(super) fn repair(
     c: &mut Checker<'_>,
@@ -60,16 +61,24 @@ pub(super) fn repair(
     all.extend(stretches(c, path, i, first, space.turns));
     // Stable: on equal times, reorders before turns.
     all.sort_by(|a, b| a.added.total_cmp(&b.added));
-    let found = all
-        .into_iter()
-        .take(REPAIR_TRIES)
-        .find(|k| k.moves.iter().all(|(a, b)| c.free(a, b)))?;
-    if let Some((lo, hi, turns)) = &found.turn {
-        for &n in &path[*lo..=*hi] {
-            c.turn(n, turns);
+    all.truncate(REPAIR_TRIES);
+    for batch in all.chunks(REPAIR_BATCH) {
+        let moves: Vec<(End, End)> = batch.iter().flat_map(|k| k.moves.iter().cloned()).collect();
+        c.prefetch_ends(&moves);
+        let Some(found) = batch
+            .iter()
+            .find(|k| k.moves.iter().all(|(a, b)| c.free(a, b)))
+        else {
+            continue;
+        };
+        if let Some((lo, hi, turns)) = &found.turn {
+            for &n in &path[*lo..=*hi] {
+                c.turn(n, turns);
+            }
         }
+        return Some(found.path.clone().unwrap_or_else(|| path.to_vec()));
     }
-    Some(found.path.unwrap_or_else(|| path.to_vec()))
+    None
 }
 
 /// The seconds of the move between nodes `a` and `b` as they are.

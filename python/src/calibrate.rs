@@ -154,13 +154,13 @@ fn holdout_of(
                     format!("{fraction}: the fraction of poses held out is in (0, 1)"),
                 ));
             }
-            Ok(activecal::identify::HoldoutSettings {
-                fraction,
-                splits,
-                seed,
-                prune: false,
-                weights,
-            })
+            activecal::identify::HoldoutSettings::builder()
+                .fraction(fraction)
+                .splits(splits)
+                .seed(seed)
+                .weights(weights)
+                .build()
+                .map_err(|e| crate::convert::Fail::from(e).into_py())
         })
         .transpose()
 }
@@ -255,9 +255,11 @@ pub fn calibrate(
     let max_iterations = count("max_iterations", max_iterations, 1)?;
     let loss = loss_of(loss, loss_scale)?;
     let settings = MeasuredSettings {
-        lm: LmSettings::default()
-            .with_max_iterations(max_iterations)
-            .with_geodesic(true),
+        lm: LmSettings::builder()
+            .max_iterations(max_iterations)
+            .geodesic(true)
+            .build()
+            .map_err(|e| crate::convert::Fail::from(e).into_py())?,
         loss,
         fix: names(fix),
         free: names(free),

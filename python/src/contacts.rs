@@ -122,9 +122,11 @@ pub fn calibrate_contacts(
     robot.check_joint_values("q", &mut qs)?;
     let given = distances_of(distances)?;
     let settings = ContactSettings {
-        lm: LmSettings::default()
-            .with_max_iterations(count("max_iterations", max_iterations, 1)?)
-            .with_geodesic(true),
+        lm: LmSettings::builder()
+            .max_iterations(count("max_iterations", max_iterations, 1)?)
+            .geodesic(true)
+            .build()
+            .map_err(|e| crate::convert::Fail::from(e).into_py())?,
         loss: crate::calibrate::loss_of(loss, loss_scale)?,
         keep: free.unwrap_or_default(),
     };

@@ -114,17 +114,18 @@ pub fn select(
     let (file, report, ids, q, sel) = crate::progress::with_callback(progress, || {
         detached(py, move || {
             let table = &r.nominal;
-            let s = Settings {
-                n,
-                initial: Settings::default().initial.min(n),
-                starts,
-                ils: ils
-                    .unwrap_or_else(|| activecal::select::default_ils_rounds(x.n_poses(), x.t())),
-                kick,
-                seed,
-                prior: closure_prior.clone(),
-                ..Settings::default()
-            };
+            let s =
+                Settings::builder()
+                    .n(n)
+                    .initial(Settings::default().initial.min(n))
+                    .starts(starts)
+                    .ils(ils.unwrap_or_else(|| {
+                        activecal::select::default_ils_rounds(x.n_poses(), x.t())
+                    }))
+                    .kick(kick)
+                    .seed(seed)
+                    .prior(closure_prior.clone())
+                    .build()?;
             let t0 = std::time::Instant::now();
             let sel = activecal::select::select(&x, CriterionKind::Det, algorithm, &s)?;
             let mut report = SelectReport::new(

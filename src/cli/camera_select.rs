@@ -85,11 +85,10 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         a.pool.count.unwrap_or(DEFAULT_SAMPLES),
         a.pool.pool_seed.unwrap_or(0),
     );
-    let settings = activecal::select::Settings {
-        n: a.n,
-        seed: a.seed,
-        ..Default::default()
-    };
+    let settings = activecal::select::Settings::builder()
+        .n(a.n)
+        .seed(a.seed)
+        .build()?;
     let d = camera_design(&robot, &v, &candidates, &settings)?;
     let names = activecal::units::joint_names(&robot);
     let mut csv = format!("candidate,{},points_seen\n", names.join(","));

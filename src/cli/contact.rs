@@ -154,9 +154,10 @@ pub fn calibrate_contacts(
     activecal::identify::contact::lengths::check_distances(robot, &file, &known)
         .context("--point-distance")?;
     let settings = ContactSettings {
-        lm: LmSettings::default()
-            .with_max_iterations(a.max_iterations)
-            .with_geodesic(!a.no_geodesic),
+        lm: LmSettings::builder()
+            .max_iterations(a.max_iterations)
+            .geodesic(!a.no_geodesic)
+            .build()?,
         loss: super::measured::loss_choice(a.loss, a.loss_scale)?,
         keep: a.free.to_vec(),
     };

@@ -417,21 +417,21 @@ fn selection_settings(
     };
     activecal::io::design::check_unique(&fixed_ids)?;
     let fixed = ctx.pool.positions_of(&fixed_ids)?;
-    Ok(Settings {
-        n: a.n,
-        initial: initial.max(fixed.len()),
-        starts: a.starts,
-        designs: a.designs.unwrap_or(DEFAULT_DESIGNS),
-        polish: a.polish,
-        ils: a
-            .ils
-            .unwrap_or_else(|| default_ils_rounds(ctx.x.n_poses(), ctx.x.t())),
-        kick: a.kick,
-        seed: a.seed,
-        fixed,
-        prior,
-        ..Settings::default()
-    })
+    Ok(Settings::builder()
+        .n(a.n)
+        .initial(initial.max(fixed.len()))
+        .starts(a.starts)
+        .designs(a.designs.unwrap_or(DEFAULT_DESIGNS))
+        .polish(a.polish)
+        .ils(
+            a.ils
+                .unwrap_or_else(|| default_ils_rounds(ctx.x.n_poses(), ctx.x.t())),
+        )
+        .kick(a.kick)
+        .seed(a.seed)
+        .fixed(fixed)
+        .prior(prior)
+        .build()?)
 }
 
 /// `--gap`: the design against the pool's bound; returns the bound.

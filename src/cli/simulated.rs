@@ -12,7 +12,7 @@ use super::{emit, write_new};
 use activecal::identify::{LmSettings, MonteCarloSettings, MonteCarloSummary};
 use activecal::io::design::DesignFile;
 use activecal::model::Robot;
-use activecal::report::{IdentificationReport, SimulatedCalibrationReport};
+use activecal::report::SimulatedCalibrationReport;
 use anyhow::Result;
 use std::path::Path;
 use std::time::Instant;
@@ -82,7 +82,7 @@ pub fn from_design(
     let full = activecal::measure::sensor_for(robot).observes_orientation();
 
     let report = SimulatedCalibrationReport {
-        identification: IdentificationReport::from(id),
+        identification: id.clone(),
         robot: robot.name.clone(),
         chain: activecal::report::chain(robot),
         design: design_path.display().to_string(),

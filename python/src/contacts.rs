@@ -101,6 +101,8 @@ pub fn calibrate_contacts(
 ) -> PyResult<ContactCalibration> {
     let inner = robot.inner.clone();
     let dof = inner.dof();
+    let joints = activecal::units::joint_names(&inner);
+    let q = &crate::convert::named_columns(q, "q", &joints, "joint")?;
     let (v, shape) = float_array(
         py,
         q,

@@ -313,6 +313,58 @@ fn bad_input_is_an_error() {
     assert!(MonteCarloSettings::builder().trials(0).build().is_err());
 }
 
+/// Every settings builder starts from the documented defaults and refuses
+/// an out-of-range field in `build`, naming it.
+#[test]
+fn settings_builders_start_from_the_defaults_and_validate() {
+    use activecal::identify::HoldoutSettings;
+    let h = HoldoutSettings::builder().build().unwrap();
+    assert_eq!((h.fraction, h.splits, h.seed, h.prune), (0.2, 4, 0, false));
+    for f in [0.0, 1.0, f64::NAN] {
+        let e = HoldoutSettings::builder().fraction(f).build().unwrap_err();
+        assert!(
+            matches!(
+                e,
+                IdentifyError::Setting {
+                    name: "held-out fraction",
+                    ..
+                }
+            ),
+            "{f}: {e}"
+        );
+    }
+    let e = HoldoutSettings::builder().splits(0).build().unwrap_err();
+    assert!(matches!(
+        e,
+        IdentifyError::Setting {
+            name: "held-out splits",
+            ..
+        }
+    ));
+    // into_builder keeps the other fields.
+    let h2 = h.into_builder().seed(9).build().unwrap();
+    assert_eq!((h2.fraction, h2.splits, h2.seed), (0.2, 4, 9));
+    let lm = LmSettings::builder().max_iterations(7).build().unwrap();
+    assert_eq!(lm, {
+        let mut d = LmSettings::default();
+        d.max_iterations = 7;
+        d
+    });
+    let e = LmSettings::builder().max_iterations(0).build().unwrap_err();
+    assert!(matches!(
+        e,
+        IdentifyError::Setting {
+            name: "max_iterations",
+            ..
+        }
+    ));
+    let e = MonteCarloSettings::builder()
+        .sigma(-1.0)
+        .build()
+        .unwrap_err();
+    assert!(matches!(e, IdentifyError::Setting { name: "sigma", .. }));
+}
+
 /// A full-pose robot (UR5, 30 unknowns) and a 30-pose selected design in
 /// its 3-level lattice, with orientation rows weighted by `w`.
 fn pose_data(w: f64) -> (Robot, Pool, Vec<usize>, Vec<Vec<f64>>) {

@@ -172,9 +172,10 @@ impl Default for Settings {
 crate::settings::settings_builder! {
     /// Validated construction of [`Settings`] (the checks that need no pool).
     SettingsBuilder for Settings, error Error {
-        /// Poses in the final design, `N` (default 30).
+        /// Poses in the final design, `N` (default 30; `initial` must not
+        /// exceed it).
         n: usize,
-        /// Initial random poses of EAE (default 12).
+        /// Initial random poses of EAE, `1..=N` (default 12).
         initial: usize,
         /// Independent random starts (default 1).
         starts: usize,

@@ -448,10 +448,9 @@ fn refined(
         &ctx.pool.spec.filters,
         prior,
         &qs,
-        &activecal::select::RefineSettings {
-            sweeps: a.refine_sweeps,
-            ..activecal::select::RefineSettings::default()
-        },
+        &activecal::select::RefineSettings::builder()
+            .sweeps(a.refine_sweeps)
+            .build()?,
     )?;
     let mut rr = activecal::report::RefinementReport::new(&ctx.pool, &sel.poses, &r);
     if let Some(lb) = pool_bound {

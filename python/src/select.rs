@@ -96,29 +96,9 @@ pub fn select(
     order: Option<&str>,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Design> {
-    let reorder = match order {
-        Some("time") => true,
-        Some("none") => false,
-        Some(o) => {
-            return Err(arg_err(
-                "order",
-                format!("unknown order '{o}': \"time\" or \"none\""),
-            ));
-        }
-        None => activecal::experiment::visiting::default_reorder(&robot.inner)
-            .map_err(|e| crate::convert::Fail::from(e).into_py())?,
-    };
+    let reorder = reorder_of(robot, order)?;
     let n = crate::convert::count("n", n, 1)?;
-    let algorithm = Algorithm::from_name(algorithm).ok_or_else(|| {
-        let names: Vec<&str> = Algorithm::ALL.iter().map(|a| a.name()).collect();
-        arg_err(
-            "algorithm",
-            format!(
-                "unknown algorithm '{algorithm}': one of {}",
-                names.join(", ")
-            ),
-        )
-    })?;
+    let algorithm = algorithm_of(algorithm)?;
     let seed = non_negative("seed", seed)?;
     let starts = crate::convert::count("starts", starts, 1)?;
     let kick = crate::convert::count("kick", kick, 1)?;
@@ -161,30 +141,16 @@ pub fn select(
             let t0 = std::time::Instant::now();
             let mut sel = activecal::select::select(&x, CriterionKind::Det, algorithm, &s)?;
             let seconds = t0.elapsed().as_secs_f64();
-            let how = Visiting {
-                reorder,
-                home: None,
-                may_swap: true,
-            };
-            let (mut report, order, swapped) = visit_selection(
+            let (mut report, order) = visit(
                 &r,
                 &built,
                 &x,
                 closure_prior.as_ref(),
                 &mut sel,
-                &how,
-                |sel| {
-                    Ok::<_, activecal::Error>(SelectReport::new(
-                        &r,
-                        &built,
-                        sel,
-                        CriterionKind::Det,
-                        &s,
-                        seconds,
-                    ))
-                },
+                &s,
+                seconds,
+                reorder,
             )?;
-            report.swapped = swapped;
             if let (Some(noise), None) = (noise, &closure_prior) {
                 report.predicted = PredictedAfter::of_design(&r, table, &x, &sel.poses, noise);
             }
@@ -215,6 +181,65 @@ pub fn select(
         algorithm,
         noise,
     })
+}
+
+/// Whether the `order` argument asks for the visiting order by time: by
+/// default when the robot's description states joint speeds, as the CLI.
+fn reorder_of(robot: &Robot, order: Option<&str>) -> PyResult<bool> {
+    match order {
+        Some("time") => Ok(true),
+        Some("none") => Ok(false),
+        Some(o) => Err(arg_err(
+            "order",
+            format!("unknown order '{o}': \"time\" or \"none\""),
+        )),
+        None => activecal::experiment::visiting::default_reorder(&robot.inner)
+            .map_err(|e| crate::convert::Fail::from(e).into_py()),
+    }
+}
+
+/// The `algorithm` argument, by the command line's names.
+fn algorithm_of(name: &str) -> PyResult<Algorithm> {
+    Algorithm::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = Algorithm::ALL.iter().map(|a| a.name()).collect();
+        arg_err(
+            "algorithm",
+            format!("unknown algorithm '{name}': one of {}", names.join(", ")),
+        )
+    })
+}
+
+/// The selection's report in visiting order (`reorder`) or selection
+/// order, its moves checked, stuck poses exchanged (as `select` does), and
+/// the order (positions in selection order).
+#[allow(clippy::too_many_arguments)]
+fn visit(
+    r: &activecal::model::Robot,
+    built: &activecal::pool::Pool,
+    x: &Blocks,
+    prior: Option<&Prior>,
+    sel: &mut activecal::select::Selection,
+    s: &Settings,
+    seconds: f64,
+    reorder: bool,
+) -> activecal::Result<(SelectReport, Vec<usize>)> {
+    let how = Visiting {
+        reorder,
+        home: None,
+        may_swap: true,
+    };
+    let (mut report, order, swapped) = visit_selection(r, built, x, prior, sel, &how, |sel| {
+        Ok::<_, activecal::Error>(SelectReport::new(
+            r,
+            built,
+            sel,
+            CriterionKind::Det,
+            s,
+            seconds,
+        ))
+    })?;
+    report.swapped = swapped;
+    Ok((report, order))
 }
 
 /// The candidates a `pool` argument names: a `Pool` as built (no size

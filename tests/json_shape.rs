@@ -1,9 +1,9 @@
 //! The `--json` keys users parse stay as they were: `bound`, `gap`,
 //! `select --gap` and `calibrate` (measured data and a simulated design)
 //! print exactly the key paths recorded in `tests/golden/json_keys/` (from
-//! the release before `Bound` and `Identification` became their own report
-//! types). A key added, renamed or dropped fails here; refresh a list on
-//! purpose only.
+//! the binary of 2026-11-28 that still had `BoundReport` and
+//! `IdentificationReport` beside `Bound` and `Identification`). A key
+//! added, renamed or dropped fails here; refresh a list on purpose only.
 
 use crate::common;
 

@@ -14,22 +14,19 @@ fn main() {
     let mut one = vec![];
     let mut pol = vec![];
     for seed in 1..=20u64 {
-        let s = Settings {
-            seed,
-            ..Default::default()
-        };
+        let s = Settings::builder().seed(seed).build().unwrap();
         let sel = eae(&x, &mut DCriterion::new(), &s, &mut design_rng(seed, 0)).unwrap();
         one.push(sel.ln_oid / l10);
         let m = multistart(
             &x,
             DCriterion::new,
             Algorithm::Eae,
-            &Settings {
-                seed,
-                starts: 8,
-                polish: true,
-                ..Default::default()
-            },
+            &Settings::builder()
+                .seed(seed)
+                .starts(8)
+                .polish(true)
+                .build()
+                .unwrap(),
         )
         .unwrap();
         pol.push(m.ln_oid / l10);
@@ -47,10 +44,7 @@ fn main() {
     println!("8-start EAE + polish, 20 seeds: {}", f(&mut pol));
     let mut same = 0;
     for seed in 1..=5u64 {
-        let s = Settings {
-            seed,
-            ..Default::default()
-        };
+        let s = Settings::builder().seed(seed).build().unwrap();
         let d = eae(&x, &mut DCriterion::new(), &s, &mut design_rng(seed, 0)).unwrap();
         let o = eae(&x, &mut OiCriterion::new(), &s, &mut design_rng(seed, 0)).unwrap();
         if d.poses == o.poses {
@@ -69,12 +63,12 @@ fn main() {
         &x,
         DCriterion::new,
         Algorithm::Eae,
-        &Settings {
-            seed: 1,
-            starts: 20,
-            polish: true,
-            ..Default::default()
-        },
+        &Settings::builder()
+            .seed(1)
+            .starts(20)
+            .polish(true)
+            .build()
+            .unwrap(),
     )
     .unwrap();
     println!(

@@ -467,14 +467,9 @@ pub fn pose_count_curve(
             skipped.push((n, "fewer poses than the fixed ones".into()));
             continue;
         }
-        let s = Settings {
-            n,
-            initial: settings
-                .select
-                .initial
-                .clamp(settings.select.fixed.len().max(1), n),
-            ..settings.select.clone()
-        };
+        let mut s = settings.select.clone();
+        s.n = n;
+        s.initial = s.initial.clamp(s.fixed.len().max(1), n);
         let sel = match select(x, settings.criterion, settings.algorithm, &s) {
             Ok(sel) if sel.ln_oid.is_finite() => sel,
             Ok(_) => {

@@ -28,6 +28,7 @@ pub mod progress;
 pub mod report;
 pub mod resources;
 pub mod select;
+mod settings;
 pub mod units;
 
 pub use error::{Error, Result};

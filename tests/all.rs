@@ -37,6 +37,7 @@ mod identifiability;
 mod identification_jacobian_fixtures;
 mod identify;
 mod jacobian;
+mod json_shape;
 mod licences;
 mod mesh_formats;
 mod paper_golden;

@@ -107,10 +107,7 @@ fn small_pools_bound_the_enumerated_optimum_and_solvers_agree() {
                 "ln_primal is ln det M(weights)"
             );
 
-            let fo_settings = ExchangeSettings {
-                gap_tol: 1e-9,
-                ..ExchangeSettings::default()
-            };
+            let fo_settings = ExchangeSettings::builder().gap_tol(1e-9).build().unwrap();
             let fo = first_order::solve(&x, n, None, &fo_settings).unwrap();
             assert!(fo.converged, "{name} N={n}: first-order gap {}", fo.gap);
             assert!(fo.ln_bound >= best);
@@ -227,16 +224,20 @@ fn a_stalled_solver_still_gives_a_valid_bound() {
     let s = BoundSettings::builder()
         .polish(false)
         .solver(RelaxationSolver::Clarabel)
-        .first_order(ExchangeSettings {
-            max_rounds: 1,
-            warmup_rounds: 0,
-            ..ExchangeSettings::default()
-        })
-        .conic(ConicSettings {
-            max_iter: 2,
-            retry_without_equilibration: false,
-            ..ConicSettings::default()
-        })
+        .first_order(
+            ExchangeSettings::builder()
+                .max_rounds(1)
+                .warmup_rounds(0)
+                .build()
+                .unwrap(),
+        )
+        .conic(
+            ConicSettings::builder()
+                .max_iter(2)
+                .retry_without_equilibration(false)
+                .build()
+                .unwrap(),
+        )
         .build()
         .unwrap();
     let b = relaxation_bound(&x, None, n, &s).unwrap();
@@ -264,10 +265,7 @@ fn active_box_constraints_are_respected() {
         &x,
         n,
         None,
-        &ExchangeSettings {
-            gap_tol: 1e-9,
-            ..ExchangeSettings::default()
-        },
+        &ExchangeSettings::builder().gap_tol(1e-9).build().unwrap(),
     )
     .unwrap();
     assert!((fo.ln_det - b.ln_primal).abs() <= 1e-6);
@@ -303,10 +301,7 @@ fn screening_reaches_the_same_optimum_as_the_whole_pool() {
         &x,
         n,
         None,
-        &ExchangeSettings {
-            gap_tol: 1e-8,
-            ..ExchangeSettings::default()
-        },
+        &ExchangeSettings::builder().gap_tol(1e-8).build().unwrap(),
     )
     .unwrap();
     assert!(fo.converged, "first-order gap {}", fo.gap);
@@ -447,15 +442,14 @@ fn a_stalled_newton_solve_still_gives_a_valid_bound() {
     let s = BoundSettings::builder()
         .solver(RelaxationSolver::Newton)
         .polish(false)
-        .first_order(ExchangeSettings {
-            max_rounds: 1,
-            warmup_rounds: 0,
-            ..ExchangeSettings::default()
-        })
-        .newton(NewtonSettings {
-            max_steps: 1,
-            ..NewtonSettings::default()
-        })
+        .first_order(
+            ExchangeSettings::builder()
+                .max_rounds(1)
+                .warmup_rounds(0)
+                .build()
+                .unwrap(),
+        )
+        .newton(NewtonSettings::builder().max_steps(1).build().unwrap())
         .build()
         .unwrap();
     let b = relaxation_bound(&x, None, n, &s).unwrap();
@@ -467,21 +461,20 @@ fn a_stalled_newton_solve_still_gives_a_valid_bound() {
         b.ln_bound
     );
     assert!(b.ln_primal <= b.ln_bound);
-    // Invalid Newton settings are refused.
+    // Invalid Newton settings are refused by their builder, and by the
+    // bound's when set field by field.
+    let with = |f: fn(&mut NewtonSettings)| {
+        let mut s = NewtonSettings::default();
+        f(&mut s);
+        s
+    };
     for bad in [
-        NewtonSettings {
-            tol: 0.0,
-            ..NewtonSettings::default()
-        },
-        NewtonSettings {
-            mu_factor: 1.0,
-            ..NewtonSettings::default()
-        },
-        NewtonSettings {
-            max_steps: 0,
-            ..NewtonSettings::default()
-        },
+        with(|s| s.tol = 0.0),
+        with(|s| s.mu_factor = 1.0),
+        with(|s| s.max_steps = 0),
     ] {
+        let e = bad.clone().into_builder().build().unwrap_err();
+        assert!(e.to_string().contains("newton."), "{e}");
         let e = BoundSettings::builder().newton(bad).build().unwrap_err();
         assert!(e.to_string().contains("newton."), "{e}");
     }

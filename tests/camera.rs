@@ -498,10 +498,10 @@ fn chosen_poses_beat_random_ones() {
         distance: [0.3, 2.0],
     };
     let candidates = generic_configurations(&robot, 5_000, 13);
-    let settings = activecal::select::Settings {
-        n: 20,
-        ..Default::default()
-    };
+    let settings = activecal::select::Settings::builder()
+        .n(20)
+        .build()
+        .unwrap();
     let d = camera_design(&robot, &view, &candidates, &settings).unwrap();
     assert_eq!(d.qs.len(), 20);
     assert!(d.seen.iter().all(|&s| s == 48), "{:?}", d.seen);

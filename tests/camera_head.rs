@@ -512,10 +512,7 @@ fn select_predicts_the_head_cameras_true_error() {
     let v = view();
     let candidates = generic_configurations(&robot, 20_000, 13);
     let n = 30;
-    let settings = activecal::select::Settings {
-        n,
-        ..Default::default()
-    };
+    let settings = activecal::select::Settings::builder().n(n).build().unwrap();
     let d = camera_design(&branch, &v, &candidates, &settings).unwrap();
     assert_eq!(d.qs.len(), n);
     assert!(d.seen.iter().all(|&s| s == 35), "{:?}", d.seen);

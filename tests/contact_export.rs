@@ -10,7 +10,6 @@ use crate::common;
 use activecal::identify::contact::{
     ContactSettings, NamedDistance, fit_contacts, resolve_distances, tool_points,
 };
-use activecal::identify::{LmSettings, LossChoice};
 use activecal::io::contacts::read_contacts;
 use activecal::io::load_robot;
 use common::{fails_with, json_of};
@@ -95,11 +94,7 @@ fn the_written_urdf_and_frames_give_the_fitted_tool_points() {
         })
         .collect();
     let known = resolve_distances(&file, &given, true).unwrap();
-    let settings = ContactSettings {
-        lm: LmSettings::default(),
-        loss: LossChoice::L2,
-        keep: Vec::new(),
-    };
+    let settings = ContactSettings::default();
     let fit = fit_contacts(&robot, &robot.nominal, &file, &known, &settings).unwrap();
     let ours = tool_points(&fit.robot, &fit.table, &fit.tool_offset, &file.qs);
 

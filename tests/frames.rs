@@ -329,7 +329,7 @@ fn synthetic_truth(path: &str, tip: &str, m: MeasurementKind, base: Option<&str>
     let meas = measure(&truth, &qs, sigma, &mut rng);
     // Start: the nominal robot mounted by the rigid fit of its points.
     let a = activecal::frames::align::measurement_frame(&nominal, &meas).unwrap();
-    let lm = LmSettings::default().with_max_iterations(500);
+    let lm = LmSettings::builder().max_iterations(500).build().unwrap();
     let mounted = remount(&nominal, a.motion, a.tool).unwrap();
     // The data's sensor (markers: offsets from a first fit), as calibrate.
     let s0 = activecal::identify::for_measurements(&mounted, &meas, &lm).unwrap();

@@ -92,7 +92,7 @@ fn zero_noise_recovery_also_without_geodesic_and_from_twice_as_far() {
         &robot,
         &robot.nominal,
         &meas,
-        &LmSettings::default().with_geodesic(false),
+        &LmSettings::builder().geodesic(false).build().unwrap(),
     )
     .unwrap();
     assert_eq!(plain.status, Status::Converged);
@@ -220,7 +220,7 @@ fn iteration_limit_and_divergence_are_statuses() {
         &robot,
         &robot.nominal,
         &meas,
-        &LmSettings::default().with_max_iterations(2),
+        &LmSettings::builder().max_iterations(2).build().unwrap(),
     )
     .unwrap();
     assert_eq!(
@@ -302,16 +302,67 @@ fn bad_input_is_an_error() {
     let e = identify(&robot, &start, &good, &LmSettings::default()).unwrap_err();
     assert!(e.to_string().contains("alpha_1"), "{e}");
 
-    let bad = LmSettings::default().with_tolerances(-1.0, 1e-12, 1e-10);
+    let e = LmSettings::builder().xtol(-1.0).build().unwrap_err();
+    assert!(matches!(e, IdentifyError::Setting { name: "xtol", .. }));
+    // Public fields can still be set out of range: `identify` checks too.
+    let mut bad = LmSettings::default();
+    bad.xtol = -1.0;
     let e = identify(&robot, &robot.nominal, &good, &bad).unwrap_err();
     assert!(matches!(e, IdentifyError::Setting { name: "xtol", .. }));
     assert!(simulate(&robot, &robot.real, &qs, -0.01, &mut trial_rng(0, 0)).is_err());
-    assert!(
-        MonteCarloSettings::default()
-            .with_trials(0)
-            .validate()
-            .is_err()
-    );
+    assert!(MonteCarloSettings::builder().trials(0).build().is_err());
+}
+
+/// Every settings builder starts from the documented defaults and refuses
+/// an out-of-range field in `build`, naming it.
+#[test]
+fn settings_builders_start_from_the_defaults_and_validate() {
+    use activecal::identify::HoldoutSettings;
+    let h = HoldoutSettings::builder().build().unwrap();
+    assert_eq!((h.fraction, h.splits, h.seed, h.prune), (0.2, 4, 0, false));
+    for f in [0.0, 1.0, f64::NAN] {
+        let e = HoldoutSettings::builder().fraction(f).build().unwrap_err();
+        assert!(
+            matches!(
+                e,
+                IdentifyError::Setting {
+                    name: "held-out fraction",
+                    ..
+                }
+            ),
+            "{f}: {e}"
+        );
+    }
+    let e = HoldoutSettings::builder().splits(0).build().unwrap_err();
+    assert!(matches!(
+        e,
+        IdentifyError::Setting {
+            name: "held-out splits",
+            ..
+        }
+    ));
+    // into_builder keeps the other fields.
+    let h2 = h.into_builder().seed(9).build().unwrap();
+    assert_eq!((h2.fraction, h2.splits, h2.seed), (0.2, 4, 9));
+    let lm = LmSettings::builder().max_iterations(7).build().unwrap();
+    assert_eq!(lm, {
+        let mut d = LmSettings::default();
+        d.max_iterations = 7;
+        d
+    });
+    let e = LmSettings::builder().max_iterations(0).build().unwrap_err();
+    assert!(matches!(
+        e,
+        IdentifyError::Setting {
+            name: "max_iterations",
+            ..
+        }
+    ));
+    let e = MonteCarloSettings::builder()
+        .sigma(-1.0)
+        .build()
+        .unwrap_err();
+    assert!(matches!(e, IdentifyError::Setting { name: "sigma", .. }));
 }
 
 /// A full-pose robot (UR5, 30 unknowns) and a 30-pose selected design in
@@ -470,12 +521,14 @@ fn simulated_orientation_noise_has_the_stated_spread() {
 #[test]
 fn pose_monte_carlo_agrees_with_linear_theory() {
     let (robot, pool, design, qs) = pose_data(0.2);
-    let settings = MonteCarloSettings::default()
-        .with_trials(150)
-        .with_sigma(0.001)
-        .with_seed(3)
-        .with_validation_poses(150)
-        .with_bootstrap(0);
+    let settings = MonteCarloSettings::builder()
+        .trials(150)
+        .sigma(0.001)
+        .seed(3)
+        .validation_poses(150)
+        .bootstrap(0)
+        .build()
+        .unwrap();
     let validation = ValidationSet::sample(&robot, &pool, &design, 150, 3).unwrap();
     let s = monte_carlo(&robot, "ur5-pose", &qs, &validation, &settings).unwrap();
     assert_eq!((s.trials, s.converged), (150, 150));
@@ -563,11 +616,13 @@ fn designs_that_do_not_match_the_robot_are_errors() {
 #[test]
 fn monte_carlo_agrees_with_linear_theory() {
     let (robot, pool, design, qs) = data();
-    let settings = MonteCarloSettings::default()
-        .with_trials(120)
-        .with_seed(11)
-        .with_validation_poses(200)
-        .with_bootstrap(50);
+    let settings = MonteCarloSettings::builder()
+        .trials(120)
+        .seed(11)
+        .validation_poses(200)
+        .bootstrap(50)
+        .build()
+        .unwrap();
     let validation = ValidationSet::sample(&robot, &pool, &design, 200, 11).unwrap();
     assert!(
         validation
@@ -600,11 +655,13 @@ fn monte_carlo_agrees_with_linear_theory() {
 #[test]
 fn monte_carlo_does_not_depend_on_thread_count() {
     let (robot, pool, design, qs) = data();
-    let settings = MonteCarloSettings::default()
-        .with_trials(30)
-        .with_seed(3)
-        .with_validation_poses(50)
-        .with_bootstrap(20);
+    let settings = MonteCarloSettings::builder()
+        .trials(30)
+        .seed(3)
+        .validation_poses(50)
+        .bootstrap(20)
+        .build()
+        .unwrap();
     let run = |threads: usize| {
         let tp = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -646,10 +703,12 @@ fn paper_tables_have_the_papers_layout() {
 fn comparison_shares_validation_and_checks_designs() {
     let (robot, pool, design, _) = data();
     let other = random_design(&pool, 30, 2);
-    let settings = MonteCarloSettings::default()
-        .with_trials(3)
-        .with_validation_poses(40)
-        .with_bootstrap(0);
+    let settings = MonteCarloSettings::builder()
+        .trials(3)
+        .validation_poses(40)
+        .bootstrap(0)
+        .build()
+        .unwrap();
     let c = compare_designs(
         &robot,
         &pool,

@@ -13,7 +13,6 @@ use activecal::identify::contact::{
     ContactFile, ContactSettings, NamedDistance, NamedPlane, fit_contacts, placement_of,
     resolve_distances, tool_points,
 };
-use activecal::identify::{LmSettings, LossChoice};
 use activecal::io::contacts::{parse_contacts, read_contacts};
 use activecal::io::load_robot;
 use activecal::measure::contact::{Plane, PlaneKind};
@@ -36,11 +35,7 @@ fn panda() -> Robot {
 }
 
 fn settings() -> ContactSettings {
-    ContactSettings {
-        lm: LmSettings::default(),
-        loss: LossChoice::L2,
-        keep: Vec::new(),
-    }
+    ContactSettings::default()
 }
 
 /// The sockets of three placements of `panda_2` (their joint values are

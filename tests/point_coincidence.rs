@@ -7,7 +7,7 @@ use activecal::identify::contact::{
     ContactFit, ContactSettings, HoldoutMode, NamedDistance, fit_contacts, holdout_by_placement,
     resolve_distances,
 };
-use activecal::identify::{Calibration, LmSettings, LossChoice, Residuals};
+use activecal::identify::{Calibration, LossChoice, Residuals};
 use activecal::io::contacts::{ContactFile, parse_contacts, read_contacts};
 use activecal::io::load_robot;
 use activecal::measure::contact::{ContactSensor, KnownDistance};
@@ -142,11 +142,7 @@ fn bad_inputs_are_explained() {
 }
 
 fn settings(loss: LossChoice) -> ContactSettings {
-    ContactSettings {
-        lm: LmSettings::default(),
-        loss,
-        keep: Vec::new(),
-    }
+    ContactSettings::builder().loss(loss).build().unwrap()
 }
 
 /// Issue 29's acceptance on MUKCa's `panda_2`: leave one placement out.

@@ -187,13 +187,13 @@ fn the_state_and_selection_work_on_top_of_the_prior() {
     assert!((st.ln_det() - direct).abs() < 1e-10 * direct.abs().max(1.0));
     // Two poses (4 rows) cannot determine 6 unknowns alone; with the prior
     // they can, and the selection maximises ln det(M0 + new).
-    let s = Settings {
-        n: 2,
-        initial: 1,
-        starts: 4,
-        prior: Some(prior.clone()),
-        ..Settings::default()
-    };
+    let s = Settings::builder()
+        .n(2)
+        .initial(1)
+        .starts(4)
+        .prior(Some(prior.clone()))
+        .build()
+        .unwrap();
     let sel = select(&x, CriterionKind::Det, Algorithm::Eae, &s).unwrap();
     let recomputed = with_prior(&x, &prior, &sel.poses).unwrap();
     assert!((sel.ln_oid - recomputed).abs() < 1e-9 * recomputed.abs().max(1.0));
@@ -207,27 +207,17 @@ fn the_state_and_selection_work_on_top_of_the_prior() {
         g.d_efficiency
     );
     // Without the prior, N = 2 is refused as singular.
-    let plain = Settings {
-        prior: None,
-        ..s.clone()
-    };
+    let plain = s.clone().into_builder().prior(None).build().unwrap();
     assert!(select(&x, CriterionKind::Det, Algorithm::Eae, &plain).is_err());
     // A zero prior changes nothing.
     let zero = Prior::from_matrix(Mat::<f64>::zeros(p, p).as_ref(), 0).unwrap();
-    let s6 = Settings {
-        n: 6,
-        initial: 3,
-        ..Settings::default()
-    };
+    let s6 = Settings::builder().n(6).initial(3).build().unwrap();
     let a = select(&x, CriterionKind::Det, Algorithm::Fedorov, &s6).unwrap();
     let b = select(
         &x,
         CriterionKind::Det,
         Algorithm::Fedorov,
-        &Settings {
-            prior: Some(zero),
-            ..s6.clone()
-        },
+        &s6.clone().into_builder().prior(Some(zero)).build().unwrap(),
     )
     .unwrap();
     assert_eq!(a.poses, b.poses);

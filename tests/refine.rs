@@ -28,10 +28,7 @@ fn refinement_never_lowers_ln_det_and_respects_limits_and_filters() {
         .build(&r, &r.nominal)
         .unwrap();
     let x = pool.jacobian(&r, &r.nominal);
-    let settings = RefineSettings {
-        sweeps: 2,
-        ..RefineSettings::default()
-    };
+    let settings = RefineSettings::builder().sweeps(2).build().unwrap();
     for seed in 1..=4u64 {
         let sel = eae(
             &x,

@@ -85,12 +85,12 @@ fn one_eae_start_reaches_paper_level() {
 #[test]
 fn same_seed_same_design_whatever_the_thread_count() {
     let x = puma_pool(4);
-    let s = Settings {
-        starts: 3,
-        polish: true,
-        seed: 7,
-        ..Settings::default()
-    };
+    let s = Settings::builder()
+        .starts(3)
+        .polish(true)
+        .seed(7)
+        .build()
+        .unwrap();
     let run = |threads: usize| {
         on_threads(threads, || {
             multistart(&x, DCriterion::new, Algorithm::Eae, &s).unwrap()
@@ -106,10 +106,7 @@ fn same_seed_same_design_whatever_the_thread_count() {
             &x,
             DCriterion::new,
             Algorithm::Random,
-            &Settings {
-                designs: 200,
-                ..s.clone()
-            },
+            &s.clone().into_builder().designs(200).build().unwrap(),
         )
         .unwrap()
     });
@@ -117,10 +114,7 @@ fn same_seed_same_design_whatever_the_thread_count() {
         &x,
         DCriterion::new,
         Algorithm::Random,
-        &Settings {
-            designs: 200,
-            ..s.clone()
-        },
+        &s.clone().into_builder().designs(200).build().unwrap(),
     )
     .unwrap();
     assert_eq!(ra.poses, rb.poses);
@@ -129,10 +123,7 @@ fn same_seed_same_design_whatever_the_thread_count() {
         &x,
         DCriterion::new,
         Algorithm::Eae,
-        &Settings {
-            seed: 8,
-            ..s.clone()
-        },
+        &s.clone().into_builder().seed(8).build().unwrap(),
     )
     .unwrap();
     assert_ne!(a.trace[0], c.trace[0]);
@@ -143,10 +134,7 @@ fn fedorov_result_has_no_improving_exchange() {
     // Brute-force check on a 729-pose pool: no (out, in) swap improves ln det
     // by more than the search's own tolerance.
     let x = puma_pool(3);
-    let s = Settings {
-        n: 12,
-        ..Settings::default()
-    };
+    let s = Settings::builder().n(12).build().unwrap();
     let sel = fedorov(&x, &mut DCriterion::new(), &s, &mut design_rng(3, 0)).unwrap();
     assert_no_improving_swap(&x, &sel.poses, &[]);
 }
@@ -170,11 +158,11 @@ fn fixed_poses_stay_and_rank_deficient_start_works() {
     let x = puma_pool(4);
     let fixed = vec![0, 100, 4095];
     // n0 = 3 poses: 9 rows < 27 unknowns, so the start needs the ridge.
-    let s = Settings {
-        initial: 3,
-        fixed: fixed.clone(),
-        ..Settings::default()
-    };
+    let s = Settings::builder()
+        .initial(3)
+        .fixed(fixed.clone())
+        .build()
+        .unwrap();
     let sel = eae(&x, &mut DCriterion::new(), &s, &mut design_rng(2, 0)).unwrap();
     for f in &fixed {
         assert!(sel.poses.contains(f));
@@ -212,11 +200,7 @@ fn oi_and_det_criteria_choose_the_same_design() {
     // full-rank designs, so the searches agree unless two candidates tie to
     // rounding.
     let x = puma_pool(3);
-    let s = Settings {
-        n: 15,
-        initial: 10,
-        ..Settings::default()
-    };
+    let s = Settings::builder().n(15).initial(10).build().unwrap();
     let d = eae(&x, &mut DCriterion::new(), &s, &mut design_rng(4, 0)).unwrap();
     let o = eae(&x, &mut OiCriterion::new(), &s, &mut design_rng(4, 0)).unwrap();
     assert_eq!(d.poses, o.poses);
@@ -226,57 +210,25 @@ fn oi_and_det_criteria_choose_the_same_design() {
 #[test]
 fn bad_settings_are_errors() {
     let x = puma_pool(3);
-    let bad = |s: Settings| {
-        eae(&x, &mut DCriterion::new(), &s, &mut design_rng(0, 0))
+    // The checks that need no pool fail in `build`, the others in `eae`.
+    let bad = |b: activecal::select::SettingsBuilder| match b.build() {
+        Err(e) => e.to_string(),
+        Ok(s) => eae(&x, &mut DCriterion::new(), &s, &mut design_rng(0, 0))
             .unwrap_err()
-            .to_string()
+            .to_string(),
     };
+    assert!(bad(Settings::builder().n(1000)).contains("larger than the pool"));
+    assert!(bad(Settings::builder().n(8).initial(8)).contains("fewer than the 27 unknowns"));
+    assert!(bad(Settings::builder().fixed(vec![729])).contains("not in the pool"));
+    assert!(bad(Settings::builder().fixed(vec![3, 3])).contains("more than once"));
     assert!(
-        bad(Settings {
-            n: 1000,
-            ..Settings::default()
-        })
-        .contains("larger than the pool")
-    );
-    assert!(
-        bad(Settings {
-            n: 8,
-            initial: 8,
-            ..Settings::default()
-        })
-        .contains("fewer than the 27 unknowns")
-    );
-    assert!(
-        bad(Settings {
-            fixed: vec![729],
-            ..Settings::default()
-        })
-        .contains("not in the pool")
-    );
-    assert!(
-        bad(Settings {
-            fixed: vec![3, 3],
-            ..Settings::default()
-        })
-        .contains("more than once")
-    );
-    assert!(
-        bad(Settings {
-            n: 10,
-            initial: 10,
-            fixed: (0..11).collect(),
-            ..Settings::default()
-        })
+        bad(Settings::builder()
+            .n(10)
+            .initial(10)
+            .fixed((0..11).collect()))
         .contains("do not fit")
     );
-    assert!(
-        bad(Settings {
-            ils: 3,
-            kick: 0,
-            ..Settings::default()
-        })
-        .contains("kick must be at least 1")
-    );
+    assert!(bad(Settings::builder().ils(3).kick(0)).contains("kick must be at least 1"));
 }
 
 #[test]
@@ -315,13 +267,13 @@ fn score_indices_agree_with_an_independent_cholesky_to_1e_10() {
 fn multistart_ranks_starts_by_the_criterion_score() {
     use activecal::criterion::{Criterion, InfoState, StateSettings};
     let x = puma_pool(3);
-    let s = Settings {
-        n: 15,
-        initial: 10,
-        starts: 4,
-        seed: 3,
-        ..Settings::default()
-    };
+    let s = Settings::builder()
+        .n(15)
+        .initial(10)
+        .starts(4)
+        .seed(3)
+        .build()
+        .unwrap();
     let d = multistart(&x, DCriterion::new, Algorithm::Eae, &s).unwrap();
     assert_eq!(d.start_score, d.start_ln_oid);
     assert_eq!(d.score, d.ln_oid);
@@ -359,17 +311,14 @@ fn iterated_local_search_ends_at_a_local_optimum_above_its_start() {
     // recomputed from scratch), (3) keep fixed poses, and (4) give the same
     // design and trace on 1 and 3 threads.
     let x = puma_pool(3);
-    let plain = Settings {
-        n: 12,
-        starts: 2,
-        seed: 3,
-        fixed: vec![0, 400],
-        ..Settings::default()
-    };
-    let s = Settings {
-        ils: 6,
-        ..plain.clone()
-    };
+    let plain = Settings::builder()
+        .n(12)
+        .starts(2)
+        .seed(3)
+        .fixed(vec![0, 400])
+        .build()
+        .unwrap();
+    let s = plain.clone().into_builder().ils(6).build().unwrap();
     let run = |threads: usize, s: &Settings| {
         on_threads(threads, || {
             multistart(&x, DCriterion::new, Algorithm::Eae, s).unwrap()

@@ -64,10 +64,7 @@ fn puma_in_millimetres_gets_the_same_designs_from_every_algorithm() {
     assert_eq!(angles, 15);
     let shift = 2.0 * angles as f64 * 1000f64.ln();
     let (xm, xmm) = (pool(&m, 5), pool(&mm, 5));
-    let s = Settings {
-        designs: 2000,
-        ..Settings::default()
-    };
+    let s = Settings::builder().designs(2000).build().unwrap();
     for alg in [
         Algorithm::Eae,
         Algorithm::Fedorov,
@@ -90,11 +87,7 @@ fn puma_in_millimetres_gets_the_same_designs_from_every_algorithm() {
     }
     // The eigenvalue OI criterion too (O(p³) per candidate: the 3-level pool).
     let (xm, xmm) = (pool(&m, 3), pool(&mm, 3));
-    let s = Settings {
-        n: 15,
-        initial: 10,
-        ..Settings::default()
-    };
+    let s = Settings::builder().n(15).initial(10).build().unwrap();
     let a = select(&xm, CriterionKind::Oi, Algorithm::Eae, &s).unwrap();
     let b = select(&xmm, CriterionKind::Oi, Algorithm::Eae, &s).unwrap();
     assert_eq!(a.poses, b.poses, "OI criterion");
@@ -111,12 +104,12 @@ fn column_scales_change_no_design_even_from_a_ridge_start() {
     let xs = scale_columns(&x, &s);
     // Five initial poses give 15 rows for 27 unknowns: the start needs the
     // ridge, which must scale with its column.
-    let settings = Settings {
-        initial: 5,
-        starts: 2,
-        designs: 500,
-        ..Settings::default()
-    };
+    let settings = Settings::builder()
+        .initial(5)
+        .starts(2)
+        .designs(500)
+        .build()
+        .unwrap();
     for alg in [
         Algorithm::Eae,
         Algorithm::Fedorov,
@@ -177,10 +170,7 @@ fn near_parallel_dh_axes() -> Robot {
 /// select found, or on 40 poses spread over the pool when it found none.
 fn verdicts(robot: &Robot) -> [bool; 4] {
     let x = pool(robot, 3);
-    let s = Settings {
-        n: 30,
-        ..Settings::default()
-    };
+    let s = Settings::builder().n(30).build().unwrap();
     let sel = select(&x, CriterionKind::Det, Algorithm::Eae, &s);
     // The Newton solver: certified the same way as Clarabel's, ten times
     // faster on this pool.

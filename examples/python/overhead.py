@@ -3,7 +3,8 @@
 `select` on the PUMA 560's 5-level lattice (15,625 poses, 30 chosen) and
 `calibrate` on FIGAROH's UR10 full poses, each timed 10 times from Python
 and through the CLI in alternation (paired); prints the medians and the
-median of the paired ratios Python / CLI as JSON.
+median of the paired ratios Python / CLI as JSON, of wall-clock time and
+of CPU time (this process's threads, or the CLI's process).
 
     .venv/bin/python examples/python/overhead.py [--reps 10]
 
@@ -14,6 +15,7 @@ JSON); Python's is the call from loading the robot to the result's dict.
 import argparse
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -34,9 +36,15 @@ TIP = "ur10e_tooltip_link"
 
 
 def timed(f):
-    t0 = time.perf_counter()
+    """Wall-clock seconds of f() and the CPU seconds it used: this
+    process's (all threads) plus its children's (the CLI's process)."""
+    def cpu():
+        me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+        return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
+
+    t0, c0 = time.perf_counter(), cpu()
     f()
-    return time.perf_counter() - t0
+    return time.perf_counter() - t0, cpu() - c0
 
 
 def run_cli(*args):
@@ -72,10 +80,15 @@ def main():
             else:
                 p, c = timed(py), timed(cli)
             pairs.append((p, c))
+        med = statistics.median
         out[name] = {
-            "python_median_s": statistics.median(p for p, _ in pairs),
-            "cli_median_s": statistics.median(c for _, c in pairs),
-            "median_ratio_python_over_cli": statistics.median(p / c for p, c in pairs),
+            "python_median_s": med(p[0] for p, _ in pairs),
+            "cli_median_s": med(c[0] for _, c in pairs),
+            "median_ratio_python_over_cli": med(p[0] / c[0] for p, c in pairs),
+            # CPU time is what a loaded machine disturbs least.
+            "python_median_cpu_s": med(p[1] for p, _ in pairs),
+            "cli_median_cpu_s": med(c[1] for _, c in pairs),
+            "median_cpu_ratio_python_over_cli": med(p[1] / c[1] for p, c in pairs),
             "reps": a.reps,
         }
     print(json.dumps(out, indent=1))

@@ -307,7 +307,7 @@ fn ridge_start_and_removal() {
                 &x,
                 c.t,
                 &design,
-                StateSettings::default().with_ridge(ridge),
+                StateSettings::builder().ridge(ridge).build().unwrap(),
                 guard,
             )?
             else {

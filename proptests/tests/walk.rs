@@ -35,7 +35,7 @@ proptest! {
         let x = rng.matrix(n * t, p);
         let pool = to_blocks(&x, t);
         let design: Vec<usize> = (0..kmin + 2).collect();
-        let settings = StateSettings::default().with_refactor_every(k);
+        let settings = StateSettings::builder().refactor_every(k).build().unwrap();
         let mut st = InfoState::new(&pool, &design, settings).unwrap();
         let mut pv = PoolVariances::new(&pool, &st);
         let mut epoch = st.epoch();

@@ -110,14 +110,17 @@ class Robot:
         the robot's orientation scale, metres per radian), 3 per marker."""
 
 class Design:
-    """The poses `select` chose, in selection order."""
+    """The poses `select` chose, in visiting order (see `select`'s order)."""
 
     @property
     def q(self) -> npt.NDArray[np.float64]:
-        """Joint values of the poses, shape (n, dof), radians or metres."""
+        """Joint values of the poses in visiting order, shape (n, dof),
+        radians or metres, as visited (a joint may stand a whole turn from
+        the pool's value)."""
     @property
     def ids(self) -> list[int]:
-        """Each pose's id in its pool (a sample's number, a lattice index)."""
+        """Each pose's id in its pool (a sample's number, a lattice index),
+        in visiting order (the rows of `q`)."""
     @property
     def joint_names(self) -> list[str]:
         """The columns of `q`."""
@@ -135,7 +138,8 @@ class Design:
     @property
     def report(self) -> dict[str, Any]:
         """The dict ``activecal select --json`` prints for the same inputs
-        (with ``--order none``)."""
+        and order (``tour``: the visiting order's figures; ``moves``: the
+        moves' collision check, with collision filters)."""
     def write(self, path: _Path, overwrite: bool = False) -> None:
         """Writes the design by the extension of path, as ``activecal
         select --out`` does: .json (the design file), .csv (joint values,
@@ -151,6 +155,24 @@ class Design:
         the dict ``activecal gap --json`` prints (``ln_oid``, ``ln_bound``,
         ``d_efficiency`` in (0, 1], ``bound_status``, ``certificate_gap``).
         Computed on each call; the GIL is released."""
+    def how_many(
+        self,
+        noise: Optional[float] = None,
+        target_error: Optional[float] = None,
+        progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
+    ) -> dict[str, Any]:
+        """How many poses to measure: for each design size from the fewest
+        that identify the unknowns (``n_min``) to three times that, and this
+        design's, the best design this selection's settings find, its
+        D-efficiency against the certified bound and the position error
+        predicted after calibrating with it at 1000 random configurations
+        (mm); the dict ``activecal select --report DIR`` writes as
+        ``how_many_poses`` (``points``, ``skipped``, ``recommended``: the
+        size and its rule, ``target`` or ``knee``). noise: the sensor's σ
+        per coordinate, metres (default: select's noise, else 0.01 as the
+        command line). target_error: the position RMS to reach, mm.
+        A selection and a bound per size: seconds to minutes; the GIL is
+        released."""
     def __len__(self) -> int: ...
 
 class Pool:
@@ -215,11 +237,12 @@ def select(
     kick: int = 3,
     noise: Optional[float] = None,
     existing: Optional[npt.ArrayLike] = None,
+    order: Optional[str] = None,
     progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
 ) -> Design:
     """Chooses n poses to measure from a pool of candidates by D-optimal
-    design (maximising ln det XᵀX), as ``activecal select --order none``
-    does with the same options. The GIL is released while it runs.
+    design (maximising ln det XᵀX), as ``activecal select`` does with the
+    same options. The GIL is released while it runs.
 
     pool: a `Pool` (from `pool`, with its filters), an (n, dof) array of
     your own candidate joint values, or ``"random"`` (default) or ``"sobol"`` (count samples inside the joint
@@ -235,7 +258,15 @@ def select(
     sensor's σ per coordinate, metres; the design then predicts the error
     after calibration (`Design.predicted`). existing: an (m, dof) array
     of poses already measured: the new poses add most to their
-    information (as ``--existing``). progress: a callable
+    information (as ``--existing``). Arrays of joint values may be pandas
+    DataFrames with a column per joint (by name, in any order). order:
+    ``"time"`` (the poses in the order quickest to visit at the joint speed
+    limits of the robot's description, 1 rad/s where it states none) or
+    ``"none"`` (selection order); default ``"time"`` when the description
+    states joint speeds, else ``"none"``, as ``--order``. Either way, with
+    collision filters on the pool the moves are checked and a pose the path
+    cannot reach freely is turned, routed round or exchanged
+    (``report["moves"]``, ``report["swapped"]``). progress: a callable
     ``progress(task, done, total, note)`` called as the work advances (at
     most every 0.1 s per task; total None when unknown; note ``"done"`` at a
     task's end); an exception it raises is raised when the work ends. The
@@ -304,6 +335,7 @@ def calibrate(
     holdout: Optional[float] = None,
     splits: int = 4,
     seed: int = 0,
+    compliance: bool = False,
     progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
 ) -> Calibration:
     """Calibrates the robot from measured poses, as ``activecal calibrate
@@ -323,6 +355,12 @@ def calibrate(
     orientation weighs orientation_scale metres; giving orientation_scale
     implies ``"fixed"``). holdout: the fraction of poses held out in each
     of `splits` random splits seeded by `seed` (`Calibration.holdout`).
+    compliance: also estimate a torsional compliance per joint (rad/(N·m))
+    deflected by the gravity torques of the URDF's <inertial> elements
+    (``report["compliance"]``), as ``--compliance``. q and points may be
+    pandas DataFrames: q with a column per joint (by name, in any order,
+    others ignored), points with columns ``x, y, z`` (``x1, y1, z1`` ...
+    for K markers).
     """
 
 def evaluate(

@@ -2,7 +2,7 @@
 //! memory, as `activecal calibrate --measurements FILE` does from a file,
 //! and the `Calibration` it returns.
 
-use crate::convert::{arg_err, count, detached, err, float_array, json_to_py, rows};
+use crate::convert::{arg_err, count, detached, err, float_array, json_to_py, named_columns, rows};
 use crate::robot::Robot;
 use activecal::experiment::measured::{MeasuredSettings, calibrate_measurements};
 use activecal::frames::CalibratedFrames;
@@ -29,6 +29,23 @@ struct Data {
     orientations: Vec<[[f64; 3]; 3]>,
 }
 
+/// A DataFrame of measured points as an array: columns x, y, z for one
+/// point a pose, x1, y1, z1 … xK, yK, zK for K markers (then (n, K, 3)).
+fn points_frame<'py>(points: &Bound<'py, PyAny>, k: usize) -> PyResult<Bound<'py, PyAny>> {
+    let columns: Vec<String> = if k == 1 {
+        ["x", "y", "z"].map(String::from).to_vec()
+    } else {
+        (1..=k)
+            .flat_map(|i| ["x", "y", "z"].map(|c| format!("{c}{i}")))
+            .collect()
+    };
+    let a = named_columns(points, "points", &columns, "coordinate")?;
+    if k > 1 && !a.is(points) {
+        return a.call_method1("reshape", ((-1i64, k, 3usize),));
+    }
+    Ok(a)
+}
+
 /// The arrays checked against the robot: q (n, dof), points (n, 3) or
 /// (n, K, 3) for K markers, orientations (n, 3, 3) for a full-pose robot.
 fn data(
@@ -40,6 +57,8 @@ fn data(
 ) -> PyResult<Data> {
     let robot: &activecal::model::Robot = &wrapper.inner;
     let dof = robot.dof();
+    let joints = activecal::units::joint_names(robot);
+    let q = &named_columns(q, "q", &joints, "joint")?;
     let (qv, qshape) = float_array(
         py,
         q,
@@ -49,6 +68,7 @@ fn data(
     )?;
     let n = qshape[0];
     let k = activecal::measure::sensor_for(robot).points_per_pose();
+    let points = &points_frame(points, k)?;
     let (pv, _) = if k == 1 {
         float_array(
             py,
@@ -154,13 +174,13 @@ fn holdout_of(
                     format!("{fraction}: the fraction of poses held out is in (0, 1)"),
                 ));
             }
-            Ok(activecal::identify::HoldoutSettings {
-                fraction,
-                splits,
-                seed,
-                prune: false,
-                weights,
-            })
+            activecal::identify::HoldoutSettings::builder()
+                .fraction(fraction)
+                .splits(splits)
+                .seed(seed)
+                .weights(weights)
+                .build()
+                .map_err(|e| crate::convert::Fail::from(e).into_py())
         })
         .transpose()
 }
@@ -221,10 +241,13 @@ fn names(v: Option<Vec<String>>) -> Vec<String> {
 /// default the robot's, 1 m/rad; giving orientation_scale implies
 /// "fixed"). holdout: a fraction of the poses held out in each of `splits`
 /// random splits (seeded by `seed`), the fit judged on them (`holdout`).
+/// compliance: also estimate a torsional compliance per joint (rad/(N·m)),
+/// the joints deflected by the gravity torques of the robot's URDF
+/// <inertial> elements (`report["compliances"]`), as `--compliance` does.
 /// progress: a callable `progress(task, done, total, note)`, as `select`
 /// takes it.
 #[pyfunction]
-#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, progress=None))]
+#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, compliance=false, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
@@ -242,9 +265,21 @@ pub fn calibrate(
     holdout: Option<f64>,
     splits: i64,
     seed: i128,
+    compliance: bool,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Calibration> {
     let weights = weights_of(weights, orientation_scale)?;
+    let gravity = compliance
+        .then(|| {
+            let opts = activecal::io::inertia::InertiaOptions {
+                inertials: None,
+                payload: None,
+            };
+            activecal::io::inertia::gravity_model(&robot.inner, &opts)
+                .map(Arc::new)
+                .map_err(|e| arg_err("compliance", e))
+        })
+        .transpose()?;
     let mut scaled = (*robot.inner).clone();
     if let Some(w) = orientation_scale {
         scaled.orientation_scale = w;
@@ -255,16 +290,18 @@ pub fn calibrate(
     let max_iterations = count("max_iterations", max_iterations, 1)?;
     let loss = loss_of(loss, loss_scale)?;
     let settings = MeasuredSettings {
-        lm: LmSettings::default()
-            .with_max_iterations(max_iterations)
-            .with_geodesic(true),
+        lm: LmSettings::builder()
+            .max_iterations(max_iterations)
+            .geodesic(true)
+            .build()
+            .map_err(|e| crate::convert::Fail::from(e).into_py())?,
         loss,
         fix: names(fix),
         free: names(free),
         holdout,
         units: activecal::units::Units::default(),
-        gravity: None,
-        fit_compliance: false,
+        gravity,
+        fit_compliance: compliance,
         compare_compliance: false,
         weights,
     };

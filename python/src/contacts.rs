@@ -101,6 +101,8 @@ pub fn calibrate_contacts(
 ) -> PyResult<ContactCalibration> {
     let inner = robot.inner.clone();
     let dof = inner.dof();
+    let joints = activecal::units::joint_names(&inner);
+    let q = &crate::convert::named_columns(q, "q", &joints, "joint")?;
     let (v, shape) = float_array(
         py,
         q,
@@ -121,13 +123,17 @@ pub fn calibrate_contacts(
     let mut qs = rows(&v, dof);
     robot.check_joint_values("q", &mut qs)?;
     let given = distances_of(distances)?;
-    let settings = ContactSettings {
-        lm: LmSettings::default()
-            .with_max_iterations(count("max_iterations", max_iterations, 1)?)
-            .with_geodesic(true),
-        loss: crate::calibrate::loss_of(loss, loss_scale)?,
-        keep: free.unwrap_or_default(),
-    };
+    let lm = LmSettings::builder()
+        .max_iterations(count("max_iterations", max_iterations, 1)?)
+        .geodesic(true);
+    let settings = ContactSettings::builder()
+        .lm(lm
+            .build()
+            .map_err(|e| crate::convert::Fail::from(e).into_py())?)
+        .loss(crate::calibrate::loss_of(loss, loss_scale)?)
+        .keep(free.unwrap_or_default())
+        .build()
+        .map_err(|e| crate::convert::Fail::from(e).into_py())?;
     let file = contact_file(qs, points);
     file.check_distinct().map_err(|e| arg_err("q", e))?;
     let known = activecal::experiment::contacts::checked_distances(&inner, &file, &given)

@@ -208,6 +208,38 @@ pub fn float_array(
     Ok((values, shape))
 }
 
+/// A pandas DataFrame argument (anything with `columns` and `to_numpy`)
+/// cut to `columns`, in that order, as a NumPy array; any other object as
+/// it is. A frame without one of them is refused naming the column
+/// (`what`: what the columns are, for the message).
+pub fn named_columns<'py>(
+    obj: &Bound<'py, PyAny>,
+    name: &str,
+    columns: &[String],
+    what: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    if !(obj.hasattr("columns")? && obj.hasattr("to_numpy")?) {
+        return Ok(obj.clone());
+    }
+    let have: Vec<String> = obj
+        .getattr("columns")?
+        .try_iter()?
+        .map(|c| c.and_then(|c| c.str().map(|s| s.to_string())))
+        .collect::<PyResult<_>>()?;
+    if let Some(m) = columns.iter().find(|c| !have.contains(c)) {
+        return Err(arg_err(
+            name,
+            format!(
+                "a DataFrame needs a column per {what} ({}): no column '{m}' among {}",
+                columns.join(", "),
+                have.join(", ")
+            ),
+        ));
+    }
+    let cut = obj.get_item(PyList::new(obj.py(), columns)?)?;
+    cut.call_method0("to_numpy")
+}
+
 /// Rows of `cols` values each from a row-major buffer.
 pub fn rows(values: &[f64], cols: usize) -> Vec<Vec<f64>> {
     values.chunks(cols.max(1)).map(<[f64]>::to_vec).collect()

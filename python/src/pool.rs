@@ -230,6 +230,8 @@ pub(crate) fn pool_of(
             }
         }
         let dof = inner.dof();
+        let joints = activecal::units::joint_names(&inner);
+        let source = &crate::convert::named_columns(source, arg, &joints, "joint")?;
         let (v, _) = float_array(
             py,
             source,

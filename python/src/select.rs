@@ -6,6 +6,7 @@ use crate::pool::Pool;
 use crate::robot::Robot;
 use activecal::blocks::Blocks;
 use activecal::criterion::Prior;
+use activecal::experiment::visiting::{Visiting, ordered_design, visit_selection};
 use activecal::io::design::DesignFile;
 use activecal::names::Choice;
 use activecal::report::{PredictedAfter, SelectReport};
@@ -29,7 +30,18 @@ pub struct Design {
     x: Arc<Blocks>,
     /// The existing poses' information, when given.
     prior: Option<Prior>,
+    /// The selection's settings and algorithm (for the how-many curve).
+    settings: Settings,
+    algorithm: Algorithm,
+    /// The pool's pose ids, by position.
+    pool_ids: Vec<usize>,
+    /// The sensor noise given to `select`, metres.
+    noise: Option<f64>,
 }
+
+/// The noise of the how-many curve when none is given, metres: the
+/// command line's (`select --report` without `--noise`).
+const DEFAULT_CURVE_NOISE: f64 = 0.01;
 
 /// Chooses `n` poses to measure from a pool of candidates by D-optimal
 /// design (maximising ln det XᵀX of the identification Jacobian X at the
@@ -51,12 +63,19 @@ pub struct Design {
 /// iterated local search (default: the command line's, by pool size).
 /// noise: the sensor's σ per coordinate, metres: the design then carries
 /// the position error predicted after calibrating with it (`predicted`).
+/// order: "time" (the poses in the order that takes least time to visit,
+/// at the joint speed limits of the robot's description, 1 rad/s where it
+/// states none) or "none" (selection order); default "time" for a robot
+/// whose description states joint speed limits, else "none", as the
+/// command line's `--order`. Either way, with collision filters on the
+/// pool, the moves between poses are checked and a pose the path cannot
+/// reach freely is turned, routed round or exchanged (`report["moves"]`).
 /// progress: a callable `progress(task, done, total, note)` called as the
 /// work advances (at most every 0.1 s per task; `total` None when unknown;
 /// `note` "done" at a task's end); an exception it raises is raised when
 /// the work ends.
 #[pyfunction]
-#[pyo3(signature = (robot, n, pool=None, count=None, levels=None, pool_seed=None, margin=None, algorithm="eae", seed=1, starts=2, ils=None, kick=3, noise=None, existing=None, progress=None))]
+#[pyo3(signature = (robot, n, pool=None, count=None, levels=None, pool_seed=None, margin=None, algorithm="eae", seed=1, starts=2, ils=None, kick=3, noise=None, existing=None, order=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn select(
     py: Python<'_>,
@@ -74,19 +93,12 @@ pub fn select(
     kick: i64,
     noise: Option<f64>,
     existing: Option<&Bound<'_, PyAny>>,
+    order: Option<&str>,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Design> {
+    let reorder = reorder_of(robot, order)?;
     let n = crate::convert::count("n", n, 1)?;
-    let algorithm = Algorithm::from_name(algorithm).ok_or_else(|| {
-        let names: Vec<&str> = Algorithm::ALL.iter().map(|a| a.name()).collect();
-        arg_err(
-            "algorithm",
-            format!(
-                "unknown algorithm '{algorithm}': one of {}",
-                names.join(", ")
-            ),
-        )
-    })?;
+    let algorithm = algorithm_of(algorithm)?;
     let seed = non_negative("seed", seed)?;
     let starts = crate::convert::count("starts", starts, 1)?;
     let kick = crate::convert::count("kick", kick, 1)?;
@@ -111,39 +123,42 @@ pub fn select(
     let r = inner.clone();
     let (x, built) = (candidates.x.clone(), candidates.pool.clone());
     let closure_prior = prior.clone();
-    let (file, report, ids, q, sel) = crate::progress::with_callback(progress, || {
+    let (file, report, ids, q, sel, settings) = crate::progress::with_callback(progress, || {
         detached(py, move || {
             let table = &r.nominal;
-            let s = Settings {
-                n,
-                initial: Settings::default().initial.min(n),
-                starts,
-                ils: ils
-                    .unwrap_or_else(|| activecal::select::default_ils_rounds(x.n_poses(), x.t())),
-                kick,
-                seed,
-                prior: closure_prior.clone(),
-                ..Settings::default()
-            };
+            let s =
+                Settings::builder()
+                    .n(n)
+                    .initial(Settings::default().initial.min(n))
+                    .starts(starts)
+                    .ils(ils.unwrap_or_else(|| {
+                        activecal::select::default_ils_rounds(x.n_poses(), x.t())
+                    }))
+                    .kick(kick)
+                    .seed(seed)
+                    .prior(closure_prior.clone())
+                    .build()?;
             let t0 = std::time::Instant::now();
-            let sel = activecal::select::select(&x, CriterionKind::Det, algorithm, &s)?;
-            let mut report = SelectReport::new(
+            let mut sel = activecal::select::select(&x, CriterionKind::Det, algorithm, &s)?;
+            let seconds = t0.elapsed().as_secs_f64();
+            let (mut report, order) = visit(
                 &r,
                 &built,
-                &sel,
-                CriterionKind::Det,
+                &x,
+                closure_prior.as_ref(),
+                &mut sel,
                 &s,
-                t0.elapsed().as_secs_f64(),
-            );
+                seconds,
+                reorder,
+            )?;
             if let (Some(noise), None) = (noise, &closure_prior) {
                 report.predicted = PredictedAfter::of_design(&r, table, &x, &sel.poses, noise);
             }
-            let mut file = DesignFile::from_pool(&r, &built, &sel.poses);
-            file.extra.extend(report.design_keys());
-            let q: Vec<Vec<f64>> = sel.poses.iter().map(|&k| built.q(k)).collect();
-            let ids = built.ids_of(&sel.poses);
+            let file = ordered_design(&r, &built, &sel, None, &order, &report);
+            let q: Vec<Vec<f64>> = report.configurations.iter().map(|c| c.q.clone()).collect();
+            let ids: Vec<usize> = report.configurations.iter().map(|c| c.id).collect();
             let v = serde_json::to_value(&report)?;
-            Ok((file, v, ids, q, sel))
+            Ok((file, v, ids, q, sel, s))
         })
     })?;
     let mut file = file;
@@ -159,9 +174,72 @@ pub fn select(
         ids,
         ln_oid: sel.ln_oid,
         positions: sel.poses,
+        pool_ids: candidates.pool.ids.clone(),
         x: candidates.x,
         prior,
+        settings,
+        algorithm,
+        noise,
     })
+}
+
+/// Whether the `order` argument asks for the visiting order by time: by
+/// default when the robot's description states joint speeds, as the CLI.
+fn reorder_of(robot: &Robot, order: Option<&str>) -> PyResult<bool> {
+    match order {
+        Some("time") => Ok(true),
+        Some("none") => Ok(false),
+        Some(o) => Err(arg_err(
+            "order",
+            format!("unknown order '{o}': \"time\" or \"none\""),
+        )),
+        None => activecal::experiment::visiting::default_reorder(&robot.inner)
+            .map_err(|e| crate::convert::Fail::from(e).into_py()),
+    }
+}
+
+/// The `algorithm` argument, by the command line's names.
+fn algorithm_of(name: &str) -> PyResult<Algorithm> {
+    Algorithm::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = Algorithm::ALL.iter().map(|a| a.name()).collect();
+        arg_err(
+            "algorithm",
+            format!("unknown algorithm '{name}': one of {}", names.join(", ")),
+        )
+    })
+}
+
+/// The selection's report in visiting order (`reorder`) or selection
+/// order, its moves checked, stuck poses exchanged (as `select` does), and
+/// the order (positions in selection order).
+#[allow(clippy::too_many_arguments)]
+fn visit(
+    r: &activecal::model::Robot,
+    built: &activecal::pool::Pool,
+    x: &Blocks,
+    prior: Option<&Prior>,
+    sel: &mut activecal::select::Selection,
+    s: &Settings,
+    seconds: f64,
+    reorder: bool,
+) -> activecal::Result<(SelectReport, Vec<usize>)> {
+    let how = Visiting {
+        reorder,
+        home: None,
+        may_swap: true,
+    };
+    let (mut report, order, swapped) = visit_selection(r, built, x, prior, sel, &how, |sel| {
+        Ok::<_, activecal::Error>(SelectReport::new(
+            r,
+            built,
+            sel,
+            CriterionKind::Det,
+            s,
+            seconds,
+        ))
+    })?;
+    report.swapped = swapped;
+    Ok((report, order))
 }
 
 /// The candidates a `pool` argument names: a `Pool` as built (no size
@@ -228,6 +306,8 @@ fn existing_poses(
     e: &Bound<'_, PyAny>,
 ) -> PyResult<(Vec<Vec<f64>>, Prior)> {
     let dof = robot.inner.dof();
+    let joints = activecal::units::joint_names(&robot.inner);
+    let e = &crate::convert::named_columns(e, "existing", &joints, "joint")?;
     let (v, _) = crate::convert::float_array(
         py,
         e,
@@ -251,14 +331,16 @@ fn existing_poses(
 #[pymethods]
 impl Design {
     /// Joint values of the chosen poses, an (n, dof) float64 array in
-    /// selection order (radians or metres).
+    /// visiting order (see `order`; radians or metres, as visited: a joint
+    /// may be a whole turn from the pool's value).
     #[getter]
     fn q<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let flat: Vec<f64> = self.q.iter().flatten().copied().collect();
         ndarray(py, &flat, &[self.q.len(), self.robot.dof()])
     }
 
-    /// The poses' ids in the pool (a lattice index, a sample's number).
+    /// The poses' ids in the pool (a lattice index, a sample's number), in
+    /// visiting order (the rows of `q`).
     #[getter]
     fn ids(&self) -> Vec<usize> {
         self.ids.clone()
@@ -310,6 +392,60 @@ impl Design {
                 )?;
                 let g = activecal::bound::gap::design_gap(&x, prior.as_ref(), &positions, &b)?;
                 Ok(serde_json::to_value(&g)?)
+            })
+        })?;
+        json_to_py(py, &v)
+    }
+
+    /// "How many poses do I need?": for each design size from the fewest
+    /// that can identify the unknowns to three times that (and this
+    /// design's), the best design found by this selection's algorithm and
+    /// settings, its D-efficiency against the certified bound and the
+    /// position error predicted after calibrating with it at 1,000 random
+    /// configurations; the dict `activecal select --report DIR` writes as
+    /// `how_many_poses` in report.json (`n_min`, `points` with `n`,
+    /// `ln_oid`, `ln_bound`, `d_efficiency`, `predicted` in mm,
+    /// `recommended` …). noise: the sensor's σ per coordinate, metres
+    /// (default: the noise given to `select`, else 0.01 as the command
+    /// line). target_error: the position RMS to reach, mm: the smallest
+    /// size predicted to reach it is recommended (else the curve's knee).
+    /// Seconds to minutes: a selection and a bound per size.
+    #[pyo3(signature = (noise=None, target_error=None, progress=None))]
+    fn how_many<'py>(
+        &self,
+        py: Python<'py>,
+        noise: Option<f64>,
+        target_error: Option<f64>,
+        progress: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let noise = noise.or(self.noise).unwrap_or(DEFAULT_CURVE_NOISE);
+        if !(noise.is_finite() && noise > 0.0) {
+            return Err(arg_err(
+                "noise",
+                format!("{noise}: the sensor noise σ must be a finite number > 0 (metres)"),
+            ));
+        }
+        if let Some(t) = target_error.filter(|t| !(t.is_finite() && *t > 0.0)) {
+            return Err(arg_err(
+                "target_error",
+                format!("{t}: the position error to reach must be a finite number > 0 (mm)"),
+            ));
+        }
+        let mut cs = activecal::how_many::CurveSettings::new(self.settings.clone(), noise);
+        cs.algorithm = self.algorithm;
+        cs.also = vec![self.q.len()];
+        cs.target_mm = target_error;
+        let (r, x, ids) = (self.robot.clone(), self.x.clone(), self.pool_ids.clone());
+        let v = crate::progress::with_callback(progress, || {
+            detached(py, move || {
+                let curve = activecal::how_many::pose_count_curve(&r, &r.nominal, &x, &ids, &cs)
+                    .map_err(|e| match e {
+                        activecal::how_many::HowManyError::Input(e) => {
+                            crate::convert::Fail::from(e)
+                        }
+                        activecal::how_many::HowManyError::Bound(e) => e.into(),
+                    })?;
+                Ok(serde_json::to_value(&curve)?)
             })
         })?;
         json_to_py(py, &v)

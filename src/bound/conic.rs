@@ -24,9 +24,11 @@ use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, S
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
-/// Settings of the Clarabel solve. Defaults in [`Default`].
+/// Settings of the Clarabel solve: [`ConicSettings::builder`] (validated)
+/// or the defaults in [`Default`].
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(default)]
+#[non_exhaustive]
 pub struct ConicSettings {
     /// Interior-point iteration limit. Default 200.
     pub max_iter: u32,
@@ -63,6 +65,30 @@ impl Default for ConicSettings {
             chordal_merge: "clique_graph".into(),
             verbose: false,
         }
+    }
+}
+
+crate::settings::settings_builder! {
+    /// Validated construction of [`ConicSettings`].
+    ConicSettingsBuilder for ConicSettings, error BoundError {
+        /// Interior-point iteration limit (default 200).
+        max_iter: u32,
+        /// Seconds per solve (default 120).
+        time_limit: f64,
+        /// Duality-gap tolerance (default 1e-10).
+        tol_gap: f64,
+        /// Feasibility tolerance (default 1e-10).
+        tol_feas: f64,
+        /// Data equilibration (default true).
+        equilibrate: bool,
+        /// One re-solve without equilibration (default true).
+        retry_without_equilibration: bool,
+        /// Chordal decomposition (default true).
+        chordal: bool,
+        /// Clique merging: "none", "parent_child" or "clique_graph" (default).
+        chordal_merge: String,
+        /// Clarabel's progress printing (default false).
+        verbose: bool,
     }
 }
 

@@ -46,6 +46,6 @@ pub mod variance;
 
 pub use error::BoundError;
 pub use gap::{DesignGap, design_gap};
-pub use outcome::{Bound, BoundReport, BoundStatus, ConicSummary, ExchangeSummary, SUPPORT_TOL};
+pub use outcome::{Bound, BoundStatus, ConicSummary, ExchangeSummary, SUPPORT_TOL};
 pub use relaxation::{pool_bound, relaxation_bound};
 pub use settings::{BoundSettings, BoundSettingsBuilder, RelaxationSolver};

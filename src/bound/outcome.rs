@@ -1,5 +1,5 @@
 //! What the relaxation bound returns: [`Bound`] (the certified bound, its
-//! point, the stages' summaries and status) and its serialisable report.
+//! point, the stages' summaries and status), serialised as reports print it.
 
 use super::conic::ConicStatus;
 use super::settings::RelaxationSolver;
@@ -55,8 +55,9 @@ pub struct ConicSummary {
     pub polish_steps: usize,
 }
 
-/// The certified upper bound on `ln OI_D` of every `N`-pose design of a pool.
-#[derive(Clone, Debug, Serialize)]
+/// The certified upper bound on `ln OI_D` of every `N`-pose design of a
+/// pool. It serialises as every report prints it (see its `Serialize`).
+#[derive(Clone, Debug)]
 pub struct Bound {
     /// Upper bound on `ln det M` of every `N`-pose design (and on the
     /// relaxation's optimum): the smallest certificate (eq. C) seen.
@@ -88,56 +89,28 @@ pub struct Bound {
     pub with_prior: bool,
 }
 
-/// The summary of a [`Bound`] that every report prints: the bound, its
-/// status and what each stage did (the weights left out). Serialised the
-/// same way everywhere: the status in snake case (`certified`).
-#[derive(Clone, Debug, Serialize)]
-pub struct BoundReport {
-    /// See [`Bound::ln_bound`].
-    pub ln_bound: f64,
-    /// `log10` of the bound on OI_D.
-    pub log10_bound: f64,
-    /// See [`Bound::ln_primal`].
-    pub ln_primal: f64,
-    /// See [`Bound::certificate_gap`].
-    pub certificate_gap: f64,
-    /// How it ended.
-    pub status: BoundStatus,
-    /// Poses per design.
-    pub n: usize,
-    /// Unknowns.
-    pub p: usize,
-    /// Pool size.
-    pub pool_size: usize,
-    /// Poses with weight above [`SUPPORT_TOL`].
-    pub support_size: usize,
-    /// Wall-clock seconds, all stages.
-    pub seconds: f64,
-    /// The candidate-set stage.
-    pub solver: ConicSummary,
-    /// The first-order stage.
-    pub first_order: ExchangeSummary,
-    /// Whether the relaxation included prior information `M0`.
-    pub with_prior: bool,
-}
-
-impl From<&Bound> for BoundReport {
-    fn from(b: &Bound) -> Self {
-        Self {
-            ln_bound: b.ln_bound,
-            log10_bound: b.log10_bound(),
-            ln_primal: b.ln_primal,
-            certificate_gap: b.certificate_gap,
-            status: b.status,
-            n: b.n,
-            p: b.p,
-            pool_size: b.pool_size,
-            support_size: b.support_size,
-            seconds: b.seconds,
-            solver: b.conic.clone(),
-            first_order: b.first_order.clone(),
-            with_prior: b.with_prior,
-        }
+impl Serialize for Bound {
+    /// The summary every report prints: the bound, its `log10_bound`, its
+    /// status in snake case (`certified`), the sizes, the candidate-set
+    /// stage as `solver` and the first-order stage; the weights stay out
+    /// (a report lists the ones it needs).
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut st = s.serialize_struct("Bound", 13)?;
+        st.serialize_field("ln_bound", &self.ln_bound)?;
+        st.serialize_field("log10_bound", &self.log10_bound())?;
+        st.serialize_field("ln_primal", &self.ln_primal)?;
+        st.serialize_field("certificate_gap", &self.certificate_gap)?;
+        st.serialize_field("status", &self.status)?;
+        st.serialize_field("n", &self.n)?;
+        st.serialize_field("p", &self.p)?;
+        st.serialize_field("pool_size", &self.pool_size)?;
+        st.serialize_field("support_size", &self.support_size)?;
+        st.serialize_field("seconds", &self.seconds)?;
+        st.serialize_field("solver", &self.conic)?;
+        st.serialize_field("first_order", &self.first_order)?;
+        st.serialize_field("with_prior", &self.with_prior)?;
+        st.end()
     }
 }
 

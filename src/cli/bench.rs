@@ -76,11 +76,10 @@ fn robot_row(label: &str, spec: &str) -> Result<Value> {
     let t0 = Instant::now();
     let one = eae(&x, &mut DCriterion::new(), &s, &mut design_rng(1, 0))?;
     let t_one = t0.elapsed().as_secs_f64();
-    let ds = Settings {
-        starts: 2,
-        ils: default_ils_rounds(x.n_poses(), x.t()),
-        ..Settings::default()
-    };
+    let ds = Settings::builder()
+        .starts(2)
+        .ils(default_ils_rounds(x.n_poses(), x.t()))
+        .build()?;
     let t0 = Instant::now();
     let best = select(&x, CriterionKind::Det, Algorithm::Eae, &ds)?;
     let t_def = t0.elapsed().as_secs_f64();
@@ -323,10 +322,7 @@ fn scale_rows(robot: &Robot, rows: &mut Vec<Row>) -> Result<Value> {
         let t0 = Instant::now();
         let xb = big.jacobian(&robot, &robot.nominal);
         let t_bj = t0.elapsed().as_secs_f64();
-        let sb = Settings {
-            n: 145,
-            ..Settings::default()
-        };
+        let sb = Settings::builder().n(145).build()?;
         let t0 = Instant::now();
         let selb = eae(&xb, &mut DCriterion::new(), &sb, &mut design_rng(1, 0))?;
         let t_be = t0.elapsed().as_secs_f64();

@@ -150,9 +150,10 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         }
         None => robot,
     };
-    let lm = LmSettings::default()
-        .with_max_iterations(a.max_iterations)
-        .with_geodesic(!a.no_geodesic);
+    let lm = LmSettings::builder()
+        .max_iterations(a.max_iterations)
+        .geodesic(!a.no_geodesic)
+        .build()?;
     let o = activecal::experiment::measured::MeasuredSettings {
         lm,
         loss: super::measured::loss_choice(a.loss, a.loss_scale)?,
@@ -160,13 +161,16 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         free: a.free.clone(),
         holdout: a
             .holdout
-            .map(|fraction| activecal::identify::HoldoutSettings {
-                fraction,
-                splits: a.splits,
-                seed: a.seed(),
-                prune: a.compare_pruned,
-                weights: weights_of(a),
-            }),
+            .map(|fraction| {
+                activecal::identify::HoldoutSettings::builder()
+                    .fraction(fraction)
+                    .splits(a.splits)
+                    .seed(a.seed())
+                    .prune(a.compare_pruned)
+                    .weights(weights_of(a))
+                    .build()
+            })
+            .transpose()?,
         weights: weights_of(a),
         units: a.units.units(),
         gravity: if a.compliance || a.compare_compliance {

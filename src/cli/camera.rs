@@ -84,9 +84,10 @@ pub fn calibrate_camera(
         parse_placement("--target-pose", tp)?,
     );
     let sensor = CameraSensor::new(intrinsics, mounting, target.points.clone(), &cam0, &tgt0);
-    let lm = LmSettings::default()
-        .with_max_iterations(a.max_iterations)
-        .with_geodesic(!a.no_geodesic);
+    let lm = LmSettings::builder()
+        .max_iterations(a.max_iterations)
+        .geodesic(!a.no_geodesic)
+        .build()?;
     let fit = fit_camera(
         robot,
         &sensor,

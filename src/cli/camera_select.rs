@@ -132,11 +132,10 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         a.pool.count.unwrap_or(DEFAULT_SAMPLES),
         a.pool.pool_seed.unwrap_or(0),
     );
-    let settings = activecal::select::Settings {
-        n: a.n,
-        seed: a.seed,
-        ..Default::default()
-    };
+    let settings = activecal::select::Settings::builder()
+        .n(a.n)
+        .seed(a.seed)
+        .build()?;
     let d = camera_design(&robot, &v, &candidates, &settings)?;
     let gap = if a.gap {
         let bs = activecal::bound::BoundSettings::builder()

@@ -153,13 +153,15 @@ pub fn calibrate_contacts(
     activecal::identify::contact::check_scale(&file, &known).context("--point-distance")?;
     activecal::identify::contact::lengths::check_distances(robot, &file, &known)
         .context("--point-distance")?;
-    let settings = ContactSettings {
-        lm: LmSettings::default()
-            .with_max_iterations(a.max_iterations)
-            .with_geodesic(!a.no_geodesic),
-        loss: super::measured::loss_choice(a.loss, a.loss_scale)?,
-        keep: a.free.to_vec(),
-    };
+    let lm = LmSettings::builder()
+        .max_iterations(a.max_iterations)
+        .geodesic(!a.no_geodesic)
+        .build()?;
+    let settings = ContactSettings::builder()
+        .lm(lm)
+        .loss(super::measured::loss_choice(a.loss, a.loss_scale)?)
+        .keep(a.free.to_vec())
+        .build()?;
     let activecal::experiment::contacts::ContactCalibration {
         fit,
         in_sample: figures,

@@ -258,58 +258,33 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     let t0 = Instant::now();
     let mut sel = select(&ctx.x, a.criterion, a.algorithm, &s)?;
     let seconds = t0.elapsed().as_secs_f64();
-    let reorder = a.order.map_or(speeds.is_some(), |o| o == Order::Time);
-    // A joint that turns all the way round may reach a pose a whole turn
-    // away, within its limits less the pool's margin.
-    let turns = activecal::pool::turn::whole_turn_limits(
-        &ctx.robot,
-        &activecal::units::joint_names(&ctx.robot),
-        ctx.pool.spec.margin,
-    )?;
-    let mut swapped = Vec::new();
-    let (mut report, refined, order) = loop {
-        let mut report = SelectReport::new(&ctx.robot, &ctx.pool, &sel, a.criterion, &s, seconds);
-        if let Some(e) = &existing {
-            let alone = activecal::criterion::design_ln_det(&ctx.x, None, &sel.poses);
-            report.set_existing(e.report.clone(), alone);
-        }
-        let pool_bound = with_gap(&a, &ctx, prior.as_ref(), &sel, &mut report)?;
-        let refined = refined(&a, &ctx, prior.as_ref(), &sel, pool_bound, &mut report)?;
-        let mut order = super::tour::order_design(
-            &mut report,
-            speeds.as_ref(),
-            home.as_deref(),
-            reorder,
-            &turns,
-        )?;
-        super::tour::check_moves(
-            &mut report,
-            &mut order,
-            &ctx.pool,
-            home.as_deref(),
-            &turns,
-            !reorder,
-        )?;
-        // A pose the tour cannot leave or reach freely is exchanged (D
-        // criterion, poses of the pool: not refined ones) and the tour
-        // planned again, a few times at most.
-        let may_swap =
-            a.criterion == CriterionKind::Det && refined.is_none() && swapped.len() < MAX_SWAPS;
-        if may_swap
-            && let Some(w) = super::tour::swap_stuck(
-                &ctx,
-                prior.as_ref(),
-                &mut sel,
-                &report,
-                &order,
-                home.as_deref(),
-            )?
-        {
-            swapped.push(w);
-            continue;
-        }
-        break (report, refined, order);
+    let how = activecal::experiment::visiting::Visiting {
+        reorder: a.order.map_or(speeds.is_some(), |o| o == Order::Time),
+        home,
+        // Pool poses under the D criterion: not refined ones.
+        may_swap: a.criterion == CriterionKind::Det && !a.refine,
     };
+    let mut refined_last = None;
+    let (mut report, order, swapped) = activecal::experiment::visiting::visit_selection(
+        &ctx.robot,
+        &ctx.pool,
+        &ctx.x,
+        prior.as_ref(),
+        &mut sel,
+        &how,
+        |sel| -> Result<SelectReport> {
+            let mut report =
+                SelectReport::new(&ctx.robot, &ctx.pool, sel, a.criterion, &s, seconds);
+            if let Some(e) = &existing {
+                let alone = activecal::criterion::design_ln_det(&ctx.x, None, &sel.poses);
+                report.set_existing(e.report.clone(), alone);
+            }
+            let pool_bound = with_gap(&a, &ctx, prior.as_ref(), sel, &mut report)?;
+            refined_last = refined(&a, &ctx, prior.as_ref(), sel, pool_bound, &mut report)?;
+            Ok(report)
+        },
+    )?;
+    let refined = refined_last;
     report.swapped = swapped;
     if !a.out.is_empty() {
         let design = design_file(
@@ -339,9 +314,6 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
             })
     })
 }
-
-/// Poses `select` may exchange because its tour cannot leave or reach them.
-pub const MAX_SWAPS: usize = 3;
 
 /// The predicted errors' line of the text output (empty without them).
 fn predicted_text(p: Option<&activecal::report::PredictedAfter>) -> String {
@@ -417,21 +389,21 @@ fn selection_settings(
     };
     activecal::io::design::check_unique(&fixed_ids)?;
     let fixed = ctx.pool.positions_of(&fixed_ids)?;
-    Ok(Settings {
-        n: a.n,
-        initial: initial.max(fixed.len()),
-        starts: a.starts,
-        designs: a.designs.unwrap_or(DEFAULT_DESIGNS),
-        polish: a.polish,
-        ils: a
-            .ils
-            .unwrap_or_else(|| default_ils_rounds(ctx.x.n_poses(), ctx.x.t())),
-        kick: a.kick,
-        seed: a.seed,
-        fixed,
-        prior,
-        ..Settings::default()
-    })
+    Ok(Settings::builder()
+        .n(a.n)
+        .initial(initial.max(fixed.len()))
+        .starts(a.starts)
+        .designs(a.designs.unwrap_or(DEFAULT_DESIGNS))
+        .polish(a.polish)
+        .ils(
+            a.ils
+                .unwrap_or_else(|| default_ils_rounds(ctx.x.n_poses(), ctx.x.t())),
+        )
+        .kick(a.kick)
+        .seed(a.seed)
+        .fixed(fixed)
+        .prior(prior)
+        .build()?)
 }
 
 /// `--gap`: the design against the pool's bound; returns the bound.
@@ -476,10 +448,9 @@ fn refined(
         &ctx.pool.spec.filters,
         prior,
         &qs,
-        &activecal::select::RefineSettings {
-            sweeps: a.refine_sweeps,
-            ..activecal::select::RefineSettings::default()
-        },
+        &activecal::select::RefineSettings::builder()
+            .sweeps(a.refine_sweeps)
+            .build()?,
     )?;
     let mut rr = activecal::report::RefinementReport::new(&ctx.pool, &sel.poses, &r);
     if let Some(lb) = pool_bound {
@@ -502,38 +473,13 @@ fn design_file(
     order: &[usize],
     report: &SelectReport,
 ) -> Result<DesignFile> {
-    let mut d = DesignFile::from_pool(&ctx.robot, &ctx.pool, &sel.poses);
-    if let Some(r) = refined {
-        d.q = Some(r.poses.iter().map(|p| p.q.clone()).collect());
-        d.refined = true;
-    }
-    super::tour::reorder_design(&mut d, order);
-    // The joint values as visited: some poses may be reached a whole turn
-    // away (the visiting order's choice, or the move check's).
-    if let Some(q) = d.q.as_mut() {
-        for (q, c) in q.iter_mut().zip(&report.configurations) {
-            q.clone_from(&c.q);
-        }
-    }
-    d.via = report
-        .moves
-        .as_ref()
-        .map(|m| {
-            m.via
-                .iter()
-                .map(|v| activecal::io::design::ViaPoint {
-                    from: v.from,
-                    to: v.to,
-                    q: v.q.clone(),
-                })
-                .collect()
-        })
-        .unwrap_or_default();
+    let mut d = activecal::experiment::visiting::ordered_design(
+        &ctx.robot, &ctx.pool, sel, refined, order, report,
+    );
     d.existing = existing.map(|e| activecal::io::design::ExistingPoses {
         path: e.report.file.clone(),
         q: e.qs.clone(),
     });
-    d.extra.extend(report.design_keys());
     Ok(d)
 }
 

@@ -12,7 +12,7 @@ use super::{emit, write_new};
 use activecal::identify::{LmSettings, MonteCarloSettings, MonteCarloSummary};
 use activecal::io::design::DesignFile;
 use activecal::model::Robot;
-use activecal::report::{IdentificationReport, SimulatedCalibrationReport};
+use activecal::report::SimulatedCalibrationReport;
 use anyhow::Result;
 use std::path::Path;
 use std::time::Instant;
@@ -39,15 +39,17 @@ pub fn from_design(
         // robot description's visibility region.
         spec.filters = super::filters(None, described)?;
     }
-    let lm = LmSettings::default()
-        .with_max_iterations(a.max_iterations)
-        .with_geodesic(!a.no_geodesic);
-    let settings = MonteCarloSettings::default()
-        .with_trials(a.trials)
-        .with_sigma(a.noise)
-        .with_seed(a.seed())
-        .with_validation_poses(a.validation);
-    let settings = MonteCarloSettings { lm, ..settings };
+    let lm = LmSettings::builder()
+        .max_iterations(a.max_iterations)
+        .geodesic(!a.no_geodesic)
+        .build()?;
+    let settings = MonteCarloSettings::builder()
+        .trials(a.trials)
+        .sigma(a.noise)
+        .seed(a.seed())
+        .validation_poses(a.validation)
+        .lm(lm)
+        .build()?;
     let name = design_path
         .file_stem()
         .map_or("design".into(), |s| s.to_string_lossy().into_owned());
@@ -80,7 +82,7 @@ pub fn from_design(
     let full = activecal::measure::sensor_for(robot).observes_orientation();
 
     let report = SimulatedCalibrationReport {
-        identification: IdentificationReport::from(id),
+        identification: id.clone(),
         robot: robot.name.clone(),
         chain: activecal::report::chain(robot),
         design: design_path.display().to_string(),

@@ -369,7 +369,10 @@ mod tests {
     #[test]
     fn a_pool_behind_the_trimmed_log_is_recomputed() {
         let pool = random_pool(12, 3, 4, 21);
-        let s = StateSettings::default().with_refactor_every(10_000);
+        let s = StateSettings::builder()
+            .refactor_every(10_000)
+            .build()
+            .unwrap();
         let mut st = InfoState::new(&pool, &[0, 1, 2, 3], s).unwrap();
         let mut pv = PoolVariances::new(&pool, &st);
         for k in 0..128 {

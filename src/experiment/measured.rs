@@ -545,7 +545,8 @@ impl Splits<'_> {
         &self,
         h: &HoldoutSettings,
     ) -> crate::identify::Result<ComplianceComparison> {
-        let plain = HoldoutSettings { prune: false, ..*h };
+        let mut plain = *h;
+        plain.prune = false;
         let geo = self.run(&plain, None)?;
         let com = self.run(&plain, self.s.gravity.clone())?;
         Ok(compare(&geo, &com))

@@ -4,3 +4,4 @@ pub mod contacts;
 pub mod measured;
 pub mod paper;
 pub mod simulated;
+pub mod visiting;

@@ -338,21 +338,74 @@ fn setting(what: &'static str, name: &str, reason: &'static str) -> IdentifyErro
     }
 }
 
-/// Held-out validation settings.
+/// Held-out validation settings: build with [`HoldoutSettings::builder`]
+/// (validated) or take [`HoldoutSettings::default`]. Whether a fraction
+/// leaves a pose on each side depends on the data: [`holdout`] checks that.
 #[derive(Clone, Copy, Debug, Serialize)]
+#[non_exhaustive]
 pub struct HoldoutSettings {
-    /// Fraction of the poses held out per split, in (0, 1).
+    /// Fraction of the poses held out per split, in (0, 1). Default 0.2.
     pub fraction: f64,
-    /// Number of random splits.
+    /// Number of random splits, `≥ 1`. Default 4.
     pub splits: usize,
-    /// Seed of the splits.
+    /// Seed of the splits. Default 0.
     pub seed: u64,
     /// Also fit a model pruned to the significant parameters (|t| ≥ 2 on
     /// the split's training fit) and evaluate it on the same held-out poses.
+    /// Default false.
     pub prune: bool,
     /// How each split's fit weighs its residual blocks (estimated on the
-    /// split's training rows only).
+    /// split's training rows only). Default [`Weights::Estimated`].
     pub weights: Weights,
+}
+
+impl Default for HoldoutSettings {
+    fn default() -> Self {
+        Self {
+            fraction: 0.2,
+            splits: 4,
+            seed: 0,
+            prune: false,
+            weights: Weights::Estimated,
+        }
+    }
+}
+
+crate::settings::settings_builder! {
+    /// Validated construction of [`HoldoutSettings`].
+    HoldoutSettingsBuilder for HoldoutSettings, error IdentifyError {
+        /// Fraction held out per split, in (0, 1) (default 0.2).
+        fraction: f64,
+        /// Random splits (default 4).
+        splits: usize,
+        /// Seed of the splits (default 0).
+        seed: u64,
+        /// Also evaluate a pruned model (default false).
+        prune: bool,
+        /// Block weights of each split's fit (default estimated).
+        weights: Weights,
+    }
+}
+
+impl HoldoutSettings {
+    /// Checks the fraction is in (0, 1) and there is at least one split.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.fraction > 0.0 && self.fraction < 1.0) {
+            return Err(IdentifyError::Setting {
+                name: "held-out fraction",
+                value: self.fraction.to_string(),
+                reason: "the held-out fraction must be in (0, 1)",
+            });
+        }
+        if self.splits == 0 {
+            return Err(IdentifyError::Setting {
+                name: "held-out splits",
+                value: "0".into(),
+                reason: "at least one split",
+            });
+        }
+        Ok(())
+    }
 }
 
 /// One split's figures.
@@ -390,20 +443,14 @@ pub fn holdout(
     settings: &HoldoutSettings,
     prepare: &dyn Fn(&Robot, &ParamTable, &Measurements) -> Result<Robot>,
 ) -> Result<Vec<SplitResult>> {
+    settings.validate()?;
     let n = meas.len();
     let test = (settings.fraction * n as f64).round() as usize;
-    if !(settings.fraction > 0.0 && settings.fraction < 1.0) || test == 0 || test >= n {
+    if test == 0 || test >= n {
         return Err(IdentifyError::Setting {
             name: "held-out fraction",
             value: format!("{} of {n} poses", settings.fraction),
             reason: "the held-out fraction must be in (0, 1) and leave at least one pose on each side",
-        });
-    }
-    if settings.splits == 0 {
-        return Err(IdentifyError::Setting {
-            name: "held-out splits",
-            value: "0".into(),
-            reason: "at least one split",
         });
     }
     let mut out = Vec::with_capacity(settings.splits);

@@ -24,10 +24,12 @@ use crate::linalg::qr::SeqQr;
 use faer::Mat;
 use serde::{Deserialize, Serialize};
 
-/// Settings of the solver, with documented defaults; [`LmSettings::validate`]
-/// is called by [`super::identify`].
+/// Settings of the solver, with documented defaults: build with
+/// [`LmSettings::builder`] (validated) or take [`LmSettings::default`];
+/// [`LmSettings::validate`] is also called by [`super::identify`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
+#[non_exhaustive]
 pub struct LmSettings {
     /// Most outer iterations (Jacobian evaluations after the first). Default 200.
     pub max_iterations: usize,
@@ -60,30 +62,26 @@ impl Default for LmSettings {
     }
 }
 
+crate::settings::settings_builder! {
+    /// Validated construction of [`LmSettings`]: `LmSettings::builder()`,
+    /// setters, `build()`.
+    LmSettingsBuilder for LmSettings, error IdentifyError {
+        /// Most outer iterations (default 200).
+        max_iterations: usize,
+        /// Step tolerance (default 1e-10).
+        xtol: f64,
+        /// Cost tolerance (default 1e-12).
+        ftol: f64,
+        /// Gradient tolerance (default 1e-10).
+        gtol: f64,
+        /// Initial relative damping (default 1e-3).
+        initial_damping: f64,
+        /// Geodesic acceleration (default true).
+        geodesic: bool,
+    }
+}
+
 impl LmSettings {
-    /// Sets [`LmSettings::max_iterations`].
-    #[must_use]
-    pub fn with_max_iterations(mut self, n: usize) -> Self {
-        self.max_iterations = n;
-        self
-    }
-
-    /// Sets [`LmSettings::xtol`], [`LmSettings::ftol`] and [`LmSettings::gtol`].
-    #[must_use]
-    pub fn with_tolerances(mut self, xtol: f64, ftol: f64, gtol: f64) -> Self {
-        self.xtol = xtol;
-        self.ftol = ftol;
-        self.gtol = gtol;
-        self
-    }
-
-    /// Sets [`LmSettings::geodesic`].
-    #[must_use]
-    pub fn with_geodesic(mut self, on: bool) -> Self {
-        self.geodesic = on;
-        self
-    }
-
     /// Checks every setting is in range.
     pub fn validate(&self) -> Result<()> {
         let bad = |name, value: f64, reason| IdentifyError::Setting {

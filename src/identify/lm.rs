@@ -57,8 +57,10 @@ pub struct Covariance {
     pub correlation: Correlation,
 }
 
-/// Result of [`identify`].
-#[derive(Clone, Debug, Serialize)]
+/// Result of [`identify`]. It serialises as every calibration report prints
+/// it (see its `Serialize`): the estimate and standard deviations by
+/// unknown's name, not the raw vectors and tables.
+#[derive(Clone, Debug)]
 pub struct Identification {
     /// Outcome; the estimate is trustworthy only when `Converged`.
     pub status: Status,
@@ -101,6 +103,43 @@ impl Identification {
     #[must_use]
     pub fn converged(&self) -> bool {
         self.status == Status::Converged
+    }
+
+    /// `{name: value}` of `values` (one per unknown), in name order.
+    #[must_use]
+    pub fn named(&self, values: &[f64]) -> std::collections::BTreeMap<String, f64> {
+        self.names
+            .iter()
+            .cloned()
+            .zip(values.iter().copied())
+            .collect()
+    }
+}
+
+impl Serialize for Identification {
+    /// The keys every calibration report prints: `status`, `stop`,
+    /// `converged`, `iterations`, `evaluations`, `estimate` and `std` by
+    /// unknown (`std` and `correlation` null below full rank), `sigma_hat`,
+    /// `rss`, `initial_rss`, `rank`, `unidentifiable`. The start, the table,
+    /// the history and the covariance matrix stay out.
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let cov = self.covariance.as_ref();
+        let mut st = s.serialize_struct("Identification", 13)?;
+        st.serialize_field("status", &self.status)?;
+        st.serialize_field("stop", &self.stop)?;
+        st.serialize_field("converged", &self.converged())?;
+        st.serialize_field("iterations", &self.iterations)?;
+        st.serialize_field("evaluations", &self.evaluations)?;
+        st.serialize_field("estimate", &self.named(&self.estimate))?;
+        st.serialize_field("std", &cov.map(|c| self.named(&c.std)))?;
+        st.serialize_field("correlation", &cov.map(|c| &c.correlation))?;
+        st.serialize_field("sigma_hat", &self.sigma_hat)?;
+        st.serialize_field("rss", &self.rss)?;
+        st.serialize_field("initial_rss", &self.initial_rss)?;
+        st.serialize_field("rank", &self.rank)?;
+        st.serialize_field("unidentifiable", &self.unidentifiable)?;
+        st.end()
     }
 }
 

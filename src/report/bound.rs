@@ -2,7 +2,7 @@
 //! carry its weight.
 
 use super::{ExistingReport, PoolInfo};
-use crate::bound::{Bound, BoundReport, SUPPORT_TOL};
+use crate::bound::{Bound, SUPPORT_TOL};
 use crate::model::{ParamSet, Robot};
 use crate::pool::Pool;
 use serde::Serialize;
@@ -21,7 +21,7 @@ pub struct WeightedPose {
 pub struct BoundCommandReport {
     /// The bound.
     #[serde(flatten)]
-    pub bound: BoundReport,
+    pub bound: Bound,
     /// The pool.
     #[serde(flatten)]
     pub pool: PoolInfo,
@@ -50,7 +50,7 @@ impl BoundCommandReport {
         with_support: bool,
     ) -> Self {
         Self {
-            bound: BoundReport::from(b),
+            bound: b.clone(),
             pool: PoolInfo::new(robot, pool),
             params,
             settings,

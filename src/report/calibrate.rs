@@ -1,74 +1,18 @@
-//! `calibrate`'s reports: the identification every calibration reports,
-//! and the measured-data and simulated (design) calibrations around it.
+//! `calibrate`'s reports: the measured-data and simulated (design)
+//! calibrations around the identification every calibration reports (an
+//! [`Identification`](crate::identify::Identification) serialises as that).
 
 use super::chain;
 use crate::model::Robot;
 use crate::pool::PoolSpec;
 use serde::Serialize;
 
-/// `{name: value}`, in name order.
-fn named(names: &[String], values: &[f64]) -> std::collections::BTreeMap<String, f64> {
-    names.iter().cloned().zip(values.iter().copied()).collect()
-}
-
-/// What every calibration reports about its identification.
-#[derive(Clone, Debug, Serialize)]
-pub struct IdentificationReport {
-    /// Outcome.
-    pub status: crate::identify::Status,
-    /// Which rule stopped the iteration.
-    pub stop: crate::identify::StopReason,
-    /// Whether the status is converged.
-    pub converged: bool,
-    /// Outer iterations.
-    pub iterations: usize,
-    /// Residual evaluations.
-    pub evaluations: usize,
-    /// The estimate, by unknown.
-    pub estimate: std::collections::BTreeMap<String, f64>,
-    /// Standard deviations, by unknown (full rank only).
-    pub std: Option<std::collections::BTreeMap<String, f64>>,
-    /// The labelled correlation matrix (full rank only).
-    pub correlation: Option<crate::identify::Correlation>,
-    /// `σ̂`.
-    pub sigma_hat: Option<f64>,
-    /// Residual sum of squares at the estimate.
-    pub rss: f64,
-    /// Residual sum of squares at the start.
-    pub initial_rss: f64,
-    /// Numerical rank.
-    pub rank: usize,
-    /// Unknowns in the null space.
-    pub unidentifiable: Vec<String>,
-}
-
-impl From<&crate::identify::Identification> for IdentificationReport {
-    fn from(id: &crate::identify::Identification) -> Self {
-        let names = &id.names;
-        Self {
-            status: id.status,
-            stop: id.stop,
-            converged: id.converged(),
-            iterations: id.iterations,
-            evaluations: id.evaluations,
-            estimate: named(names, &id.estimate),
-            std: id.covariance.as_ref().map(|c| named(names, &c.std)),
-            correlation: id.covariance.as_ref().map(|c| c.correlation.clone()),
-            sigma_hat: id.sigma_hat,
-            rss: id.rss,
-            initial_rss: id.initial_rss,
-            rank: id.rank,
-            unidentifiable: id.unidentifiable.clone(),
-        }
-    }
-}
-
 /// `calibrate --measurements`: identification from measured data.
 #[derive(Clone, Debug, Serialize)]
 pub struct MeasuredCalibrationReport {
     /// The identification.
     #[serde(flatten)]
-    pub identification: IdentificationReport,
+    pub identification: crate::identify::Identification,
     /// Robot name or description path.
     pub robot: String,
     /// Driven frames.
@@ -110,13 +54,13 @@ impl MeasuredCalibrationReport {
             .map(|(e, s)| e - s)
             .collect();
         Self {
-            identification: IdentificationReport::from(id),
+            identification: id.clone(),
             robot: robot.name.clone(),
             chain: chain(robot),
             measurements: file,
             poses,
             measurement: robot.measurement,
-            change: named(&id.names, &change),
+            change: id.named(&change),
             rms_residual: (id.rss / rows).sqrt(),
             initial_rms_residual: (id.initial_rss / rows).sqrt(),
             out: Vec::new(),
@@ -131,7 +75,7 @@ impl MeasuredCalibrationReport {
 pub struct SimulatedCalibrationReport {
     /// The identification (trial 0 of the seed).
     #[serde(flatten)]
-    pub identification: IdentificationReport,
+    pub identification: crate::identify::Identification,
     /// Robot name or description path.
     pub robot: String,
     /// Driven frames.

@@ -1,7 +1,7 @@
 //! `gap`'s report: a design's D-efficiency against the bound over its pool.
 
 use super::{ExistingReport, PoolInfo};
-use crate::bound::{Bound, BoundReport, DesignGap};
+use crate::bound::{Bound, DesignGap};
 use crate::model::ParamSet;
 use serde::Serialize;
 
@@ -36,7 +36,7 @@ pub struct GapReport {
     /// Relaxation weight of every design pose.
     pub weights: Vec<f64>,
     /// The bound.
-    pub bound: BoundReport,
+    pub bound: Bound,
     /// The poses measured before, when the design was chosen on top of
     /// them (`ln_oid` and the bound then include their information).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -75,7 +75,7 @@ impl GapReport {
             log10_bound: g.log10_bound,
             d_efficiency: g.d_efficiency,
             weights: g.weights.clone(),
-            bound: BoundReport::from(b),
+            bound: b.clone(),
             existing: None,
             refined: false,
             exceeds_bound: None,

@@ -1,7 +1,7 @@
 //! Typed reports of the commands: what `select`, `score`, `bound` and `gap`
 //! found, with pool positions translated to stable pose ids. Each derives
 //! `Serialize`; the command line prints them as text or JSON and never
-//! rebuilds them. (The bound's summary is [`crate::bound::BoundReport`]; the paper's
+//! rebuilds them. (The bound's summary is how [`crate::bound::Bound`] serialises; the paper's
 //! experiment is [`crate::experiment::paper::PaperReport`].)
 
 mod bound;
@@ -14,7 +14,7 @@ mod score;
 mod select;
 
 pub use bound::{BoundCommandReport, WeightedPose};
-pub use calibrate::{IdentificationReport, MeasuredCalibrationReport, SimulatedCalibrationReport};
+pub use calibrate::{MeasuredCalibrationReport, SimulatedCalibrationReport};
 pub use existing::ExistingReport;
 pub use fk::{FkReport, Orientation};
 pub use gap::GapReport;

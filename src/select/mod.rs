@@ -110,8 +110,11 @@ pub fn default_ils_rounds(n_pool: usize, t: usize) -> usize {
     }
 }
 
-/// Settings of a selection run; check them with [`Settings::validate`].
+/// Settings of a selection run: build with [`Settings::builder`] (validated
+/// without a pool) or take [`Settings::default`]; the algorithms check them
+/// against their pool with [`Settings::validate_for`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct Settings {
     /// Poses in the final design, `N` (default 30).
     pub n: usize,
@@ -166,10 +169,70 @@ impl Default for Settings {
     }
 }
 
+crate::settings::settings_builder! {
+    /// Validated construction of [`Settings`] (the checks that need no pool).
+    SettingsBuilder for Settings, error Error {
+        /// Poses in the final design, `N` (default 30; `initial` must not
+        /// exceed it).
+        n: usize,
+        /// Initial random poses of EAE, `1..=N` (default 12).
+        initial: usize,
+        /// Independent random starts (default 1).
+        starts: usize,
+        /// Random designs of [`Algorithm::Random`] (default 5,000).
+        designs: usize,
+        /// A Fedorov polish of the best start (default false).
+        polish: bool,
+        /// Rounds of iterated local search per start (default 0).
+        ils: usize,
+        /// Poses exchanged per round of iterated local search (default 3).
+        kick: usize,
+        /// Seed of every random choice (default 1).
+        seed: u64,
+        /// Pool positions every design contains (default none).
+        fixed: Vec<usize>,
+        /// Most exchange iterations per phase (default 1,000).
+        max_iter: usize,
+        /// Information already measured, `M0` (default none).
+        prior: Option<Prior>,
+    }
+}
+
 impl Settings {
-    /// Checks the settings against a pool: `N` within the pool, `N·t ≥ p`,
-    /// fixed poses in the pool, unique, and no more of them than `N`.
-    pub fn validate(&self, pool: &Blocks) -> Result<()> {
+    /// Checks the fields that need no pool: at least one start, design and
+    /// iteration, a kick with iterated local search, `initial` in `1..=N`,
+    /// fixed poses unique and no more of them than `N`.
+    pub fn validate(&self) -> Result<()> {
+        crate::io::design::check_unique(&self.fixed)?;
+        if self.fixed.len() > self.n {
+            return Err(Error::Invalid(format!(
+                "{} fixed poses do not fit in a design of N = {}",
+                self.fixed.len(),
+                self.n
+            )));
+        }
+        if self.starts == 0 || self.designs == 0 || self.max_iter == 0 {
+            return Err(Error::Invalid(
+                "starts, designs and max_iter must be at least 1".into(),
+            ));
+        }
+        if self.ils > 0 && self.kick == 0 {
+            return Err(Error::Invalid(
+                "kick must be at least 1 when ils rounds are asked for".into(),
+            ));
+        }
+        if self.initial == 0 || self.initial > self.n {
+            return Err(Error::Invalid(format!(
+                "the initial design size must be in 1..=N, got {}",
+                self.initial
+            )));
+        }
+        Ok(())
+    }
+
+    /// Checks the settings ([`Settings::validate`]) and then against a pool:
+    /// `N` within the pool, `N·t ≥ p`, fixed poses in the pool.
+    pub fn validate_for(&self, pool: &Blocks) -> Result<()> {
         let (n_pool, t, p) = (pool.n_poses(), pool.t(), pool.p());
         if n_pool == 0 {
             return Err(Error::Invalid("the pose pool is empty".into()));
@@ -204,31 +267,7 @@ impl Settings {
                 reason: format!("pool position {f} >= pool size {n_pool}"),
             });
         }
-        crate::io::design::check_unique(&self.fixed)?;
-        if self.fixed.len() > self.n {
-            return Err(Error::Invalid(format!(
-                "{} fixed poses do not fit in a design of N = {}",
-                self.fixed.len(),
-                self.n
-            )));
-        }
-        if self.starts == 0 || self.designs == 0 || self.max_iter == 0 {
-            return Err(Error::Invalid(
-                "starts, designs and max_iter must be at least 1".into(),
-            ));
-        }
-        if self.ils > 0 && self.kick == 0 {
-            return Err(Error::Invalid(
-                "kick must be at least 1 when ils rounds are asked for".into(),
-            ));
-        }
-        if self.initial == 0 || self.initial > self.n {
-            return Err(Error::Invalid(format!(
-                "the initial design size must be in 1..=N, got {}",
-                self.initial
-            )));
-        }
-        Ok(())
+        self.validate()
     }
 }
 

@@ -25,9 +25,11 @@ use crate::pool::PoolFilter;
 use faer::Mat;
 use serde::{Deserialize, Serialize};
 
-/// Settings of [`refine`].
+/// Settings of [`refine`]: [`RefineSettings::builder`] (validated) or the
+/// defaults.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
+#[non_exhaustive]
 pub struct RefineSettings {
     /// Passes over all poses (default 3); fewer when a pass gains less than
     /// `tol`.
@@ -56,6 +58,35 @@ impl Default for RefineSettings {
             fd_step: 1e-6,
             tol: 1e-9,
         }
+    }
+}
+
+crate::settings::settings_builder! {
+    /// Validated construction of [`RefineSettings`].
+    RefineSettingsBuilder for RefineSettings, error Error {
+        /// Passes over all poses (default 3).
+        sweeps: usize,
+        /// Accepted steps per pose per pass (default 20).
+        steps: usize,
+        /// Largest joint move of a first trial step, `> 0` (default 0.2).
+        max_move: f64,
+        /// Central-difference step, `> 0` (default 1e-6).
+        fd_step: f64,
+        /// Smallest gain of ln det that counts, `≥ 0` (default 1e-9).
+        tol: f64,
+    }
+}
+
+impl RefineSettings {
+    /// Checks `max_move > 0`, `fd_step > 0` and `tol ≥ 0` (all finite).
+    pub fn validate(&self) -> Result<()> {
+        let ok = |v: f64, min_ok: bool| v.is_finite() && (v > 0.0 || (min_ok && v == 0.0));
+        if !(ok(self.max_move, false) && ok(self.fd_step, false) && ok(self.tol, true)) {
+            return Err(Error::Invalid(
+                "refinement needs max_move > 0, fd_step > 0 and tol >= 0".into(),
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -225,11 +256,7 @@ pub fn refine(
     s: &RefineSettings,
 ) -> Result<Refinement> {
     let (t, p) = (robot.rows_per_pose(), robot.n_unknowns());
-    if !(s.max_move > 0.0 && s.fd_step > 0.0 && s.tol >= 0.0) {
-        return Err(Error::Invalid(
-            "refinement needs max_move > 0, fd_step > 0 and tol >= 0".into(),
-        ));
-    }
+    s.validate()?;
     let mut pb = Problem {
         robot,
         filter_table,

@@ -27,7 +27,6 @@ use activecal::identify::contact::{
     ContactFile, ContactSettings, NamedDistance, best_plane, fit_contacts, group_means,
     placement_of, resolve_distances, tool_points,
 };
-use activecal::identify::{LmSettings, LossChoice};
 use activecal::io::calibrated::{Format, render};
 use activecal::io::contacts::read_contacts;
 use activecal::io::frames_file;
@@ -204,11 +203,7 @@ fn three_placements_and_a_table(
     let pts = tool_points(robot, &robot.nominal, &[0.0; 3], &file.qs);
     let centre = pts.iter().sum::<Vector3<f64>>() / pts.len() as f64;
     let file = with_table(robot, &file, &centre);
-    let settings = ContactSettings {
-        lm: LmSettings::default(),
-        loss: LossChoice::L2,
-        keep: Vec::new(),
-    };
+    let settings = ContactSettings::default();
     let given: Vec<NamedDistance> = keep
         .iter()
         .map(|p| NamedDistance {

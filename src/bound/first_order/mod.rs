@@ -33,10 +33,12 @@ use faer::Mat;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
-/// Settings of the first-order solver. Defaults in [`Default`]; check with
-/// [`ExchangeSettings::validate`].
+/// Settings of the first-order solver: [`ExchangeSettings::builder`]
+/// (validated by [`ExchangeSettings::validate`]) or the defaults in
+/// [`Default`].
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(default)]
+#[non_exhaustive]
 pub struct ExchangeSettings {
     /// Stop when the certificate gap (eq. C) in ln det is at most this.
     /// Default 1e-7.
@@ -73,6 +75,26 @@ impl Default for ExchangeSettings {
             extra: 100,
             max_steps: 3000,
         }
+    }
+}
+
+crate::settings::settings_builder! {
+    /// Validated construction of [`ExchangeSettings`].
+    ExchangeSettingsBuilder for ExchangeSettings, error BoundError {
+        /// Certificate gap to stop at (default 1e-7).
+        gap_tol: f64,
+        /// Most rounds (default 2000).
+        max_rounds: usize,
+        /// Wall-clock safety net, seconds (default one day).
+        time_limit: f64,
+        /// Capped multiplicative warm-up steps (default 30).
+        warmup_rounds: usize,
+        /// Largest weights kept after the warm-up (default 1000).
+        keep: usize,
+        /// Candidates added per round (default 100).
+        extra: usize,
+        /// Most pairwise steps per round (default 3000).
+        max_steps: usize,
     }
 }
 

@@ -155,10 +155,7 @@ fn warm_starts_and_round_limits() {
         warm.rounds,
         cold.rounds
     );
-    let one = ExchangeSettings {
-        max_rounds: 1,
-        ..ExchangeSettings::default()
-    };
+    let one = ExchangeSettings::builder().max_rounds(1).build().unwrap();
     let out = solve(&x, 5, None, &one).unwrap();
     assert_eq!((out.rounds, out.steps, out.converged), (1, 0, false));
     assert!(out.gap > one.gap_tol);
@@ -176,11 +173,11 @@ fn pruning_after_the_warm_up_keeps_the_optimum() {
     let s = ExchangeSettings::default();
     let reference = solve(&x, 4, None, &s).unwrap();
     for warmup_rounds in [30, 0] {
-        let pruned = ExchangeSettings {
-            keep: 1,
-            warmup_rounds,
-            ..ExchangeSettings::default()
-        };
+        let pruned = ExchangeSettings::builder()
+            .keep(1)
+            .warmup_rounds(warmup_rounds)
+            .build()
+            .unwrap();
         let out = solve(&x, 4, None, &pruned).unwrap();
         assert!(out.converged, "warm-up {warmup_rounds}");
         assert!(
@@ -264,12 +261,12 @@ fn the_multiplicative_step_shares_n_in_proportion() {
 fn the_warm_up_runs_only_above_keep() {
     let x = pool(40, 8);
     for warmup_rounds in [0, 1, 3] {
-        let s = ExchangeSettings {
-            keep: 1,
-            warmup_rounds,
-            max_rounds: 1,
-            ..ExchangeSettings::default()
-        };
+        let s = ExchangeSettings::builder()
+            .keep(1)
+            .warmup_rounds(warmup_rounds)
+            .max_rounds(1)
+            .build()
+            .unwrap();
         let out = solve(&x, 4, None, &s).unwrap();
         assert_eq!(out.rounds, warmup_rounds + 2, "warm-up {warmup_rounds}");
         // `make_feasible` may spread a rounding-size rest of `N` over
@@ -277,11 +274,11 @@ fn the_warm_up_runs_only_above_keep() {
         let kept = out.weights.iter().filter(|&&v| v > 1e-9).count();
         assert_eq!(kept, 4, "warm-up {warmup_rounds}");
     }
-    let s = ExchangeSettings {
-        keep: 40,
-        max_rounds: 1,
-        ..ExchangeSettings::default()
-    };
+    let s = ExchangeSettings::builder()
+        .keep(40)
+        .max_rounds(1)
+        .build()
+        .unwrap();
     let out = solve(&x, 4, None, &s).unwrap();
     assert_eq!(out.rounds, 1);
     assert!(out.weights.iter().all(|&v| v == 4.0 / 40.0));
@@ -302,12 +299,12 @@ fn a_singular_prune_is_widened_to_a_regular_one() {
         m[(r, 2)] = 0.0;
     }
     let x = Blocks::new(m, 2);
-    let s = ExchangeSettings {
-        keep: 1,
-        warmup_rounds: 0,
-        max_rounds: 1,
-        ..ExchangeSettings::default()
-    };
+    let s = ExchangeSettings::builder()
+        .keep(1)
+        .warmup_rounds(0)
+        .max_rounds(1)
+        .build()
+        .unwrap();
     let out = solve(&x, 2, None, &s).unwrap();
     assert_eq!(out.rounds, 2);
     assert!(

@@ -35,9 +35,11 @@ use faer::{Mat, Par, Side};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
-/// Settings of the Newton barrier solve. Defaults in [`Default`].
+/// Settings of the Newton barrier solve: [`NewtonSettings::builder`]
+/// (validated) or the defaults in [`Default`].
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(default)]
+#[non_exhaustive]
 pub struct NewtonSettings {
     /// Target of the barrier's suboptimality bound `2nμ` (ln det units).
     /// Default 1e-10.
@@ -57,6 +59,18 @@ impl Default for NewtonSettings {
             max_steps: 300,
             mu_factor: 100.0,
         }
+    }
+}
+
+crate::settings::settings_builder! {
+    /// Validated construction of [`NewtonSettings`].
+    NewtonSettingsBuilder for NewtonSettings, error super::BoundError {
+        /// Target of the suboptimality bound `2nμ` (default 1e-10).
+        tol: f64,
+        /// Most Newton steps (default 300).
+        max_steps: usize,
+        /// Barrier weight reduction per stage, `> 1` (default 100).
+        mu_factor: f64,
     }
 }
 

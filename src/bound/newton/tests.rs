@@ -324,10 +324,7 @@ fn the_edge_cases_have_their_status() {
     }
 
     let sc = scaled(12, 4, 14);
-    let one = NewtonSettings {
-        max_steps: 1,
-        ..NewtonSettings::default()
-    };
+    let one = NewtonSettings::builder().max_steps(1).build().unwrap();
     let out = solve_scaled(&sc, 4, None, &one, 1.0);
     assert_eq!(
         (out.status, out.iterations),
@@ -454,10 +451,7 @@ fn a_step_too_long_is_halved_until_it_rises() {
 #[test]
 fn the_barrier_weight_starts_at_the_gap_hint() {
     let sc = scaled(12, 4, 20);
-    let one = NewtonSettings {
-        max_steps: 1,
-        ..NewtonSettings::default()
-    };
+    let one = NewtonSettings::builder().max_steps(1).build().unwrap();
     let hint = 1.0;
     let out = solve_scaled(&sc, 4, None, &one, hint);
     assert_eq!(out.status, ConicStatus::MaxIterations);

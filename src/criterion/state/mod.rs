@@ -526,7 +526,8 @@ impl InfoState {
     /// under the construction rule) the state is unchanged.
     pub fn set_ridge(&mut self, pool: &Blocks, ridge: f64) -> Result<(), CriterionError> {
         self.check_pool(pool);
-        let settings = self.settings.with_ridge(ridge);
+        let mut settings = self.settings;
+        settings.ridge = ridge;
         settings.validate()?;
         let diag = ridge_diagonal(&self.ridge_scale, ridge);
         let f = Self::factor(
@@ -544,7 +545,8 @@ impl InfoState {
 
     /// Sets [`StateSettings::refactor_every`].
     pub fn set_refactor_every(&mut self, k: usize) -> Result<(), CriterionError> {
-        let settings = self.settings.with_refactor_every(k);
+        let mut settings = self.settings;
+        settings.refactor_every = k;
         settings.validate()?;
         self.settings = settings;
         Ok(())

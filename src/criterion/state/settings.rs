@@ -6,9 +6,12 @@ use super::super::CriterionError;
 use crate::linalg::rank::MAX_CONDITION;
 use serde::{Deserialize, Serialize};
 
-/// Settings of an [`InfoState`](super::InfoState); validated by [`InfoState::new`](super::InfoState::new).
+/// Settings of an [`InfoState`](super::InfoState): build with
+/// [`StateSettings::builder`] or take the default; validated again by
+/// [`InfoState::new`](super::InfoState::new).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
+#[non_exhaustive]
 pub struct StateSettings {
     /// Relative ridge `δ ≥ 0`: `M = XᵀX + δR`, `R = diag(r_j)` with `r_j`
     /// the mean information of column `j` per pool pose
@@ -36,28 +39,19 @@ impl Default for StateSettings {
     }
 }
 
+crate::settings::settings_builder! {
+    /// Validated construction of [`StateSettings`].
+    StateSettingsBuilder for StateSettings, error CriterionError {
+        /// Relative ridge `δ ≥ 0` (default 0).
+        ridge: f64,
+        /// Updates between refactorizations, `≥ 1` (default 64).
+        refactor_every: usize,
+        /// Largest accepted condition number, `> 1` (default 1e13).
+        max_condition: f64,
+    }
+}
+
 impl StateSettings {
-    /// Sets [`ridge`](Self::ridge).
-    #[must_use]
-    pub fn with_ridge(mut self, ridge: f64) -> Self {
-        self.ridge = ridge;
-        self
-    }
-
-    /// Sets [`refactor_every`](Self::refactor_every).
-    #[must_use]
-    pub fn with_refactor_every(mut self, k: usize) -> Self {
-        self.refactor_every = k;
-        self
-    }
-
-    /// Sets [`max_condition`](Self::max_condition).
-    #[must_use]
-    pub fn with_max_condition(mut self, c: f64) -> Self {
-        self.max_condition = c;
-        self
-    }
-
     /// Checks every field's range.
     pub fn validate(&self) -> Result<(), CriterionError> {
         if !(self.ridge.is_finite() && self.ridge >= 0.0) {

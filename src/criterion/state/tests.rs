@@ -97,7 +97,12 @@ fn bad_input_and_singular() {
         }
     );
     // With a ridge it works, and dropping the ridge is refused.
-    let mut st = InfoState::new(&pool, &[0, 1], s.with_ridge(1e-3)).unwrap();
+    let mut st = InfoState::new(
+        &pool,
+        &[0, 1],
+        s.into_builder().ridge(1e-3).build().unwrap(),
+    )
+    .unwrap();
     assert!(matches!(
         st.set_ridge(&pool, 0.0),
         Err(CriterionError::Singular { .. })
@@ -119,12 +124,7 @@ fn bad_input_and_singular() {
         st.add(&pool, 0),
         Err(CriterionError::AlreadyInDesign { pose: 0 })
     ));
-    assert!(
-        StateSettings::default()
-            .with_ridge(f64::NAN)
-            .validate()
-            .is_err()
-    );
+    assert!(StateSettings::builder().ridge(f64::NAN).build().is_err());
 }
 
 #[test]
@@ -134,7 +134,7 @@ fn refactorizes_periodically_and_drift_is_small() {
     let mut st = InfoState::new(
         &pool,
         &design,
-        StateSettings::default().with_refactor_every(8),
+        StateSettings::builder().refactor_every(8).build().unwrap(),
     )
     .unwrap();
     let mut next = 10;
@@ -159,9 +159,9 @@ fn refactorizes_periodically_and_drift_is_small() {
 fn a_negative_or_infinite_ridge_is_refused() {
     let s = StateSettings::default();
     for r in [-1e-3, f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
-        assert!(s.with_ridge(r).validate().is_err(), "ridge {r}");
+        assert!(s.into_builder().ridge(r).build().is_err(), "ridge {r}");
     }
-    assert!(s.with_ridge(0.0).validate().is_ok());
+    assert!(s.into_builder().ridge(0.0).build().is_ok());
 }
 
 /// Every construction and every clone has its own id: caches keyed on
@@ -190,7 +190,7 @@ fn ridge_scales_are_the_mean_column_information() {
     let base = random_pool(10, 3, 4, 9);
     let mat = Mat::from_fn(30, 5, |r, c| if c == 4 { 0.0 } else { base.mat()[(r, c)] });
     let pool = Blocks::new(mat, 3);
-    let s = StateSettings::default().with_ridge(1e-2);
+    let s = StateSettings::builder().ridge(1e-2).build().unwrap();
     let st = InfoState::new(&pool, &[0, 1, 2, 3], s).unwrap();
     for c in 0..4 {
         let want: f64 = (0..30).map(|r| pool.mat()[(r, c)].powi(2)).sum::<f64>() / 10.0;
@@ -263,7 +263,10 @@ fn condition_estimate_bounds_the_equilibrated_condition_number() {
 #[test]
 fn the_update_log_is_trimmed_at_twice_log_keep() {
     let pool = random_pool(12, 3, 4, 21);
-    let s = StateSettings::default().with_refactor_every(10_000);
+    let s = StateSettings::builder()
+        .refactor_every(10_000)
+        .build()
+        .unwrap();
     let mut st = InfoState::new(&pool, &[0, 1, 2, 3], s).unwrap();
     for k in 0..2 * LOG_KEEP {
         if k % 2 == 0 {
@@ -289,7 +292,10 @@ fn the_information_drift_is_relative_to_the_information() {
     let base = random_pool(12, 3, 4, 5);
     let drift_of = |scale: f64| {
         let pool = Blocks::new(Mat::from_fn(36, 4, |r, c| scale * base.mat()[(r, c)]), 3);
-        let s = StateSettings::default().with_refactor_every(1000);
+        let s = StateSettings::builder()
+            .refactor_every(1000)
+            .build()
+            .unwrap();
         let mut st = InfoState::new(&pool, &[0, 1, 2, 3], s).unwrap();
         for q in 4..12 {
             st.add(&pool, q).unwrap().delta().unwrap();
@@ -320,10 +326,12 @@ fn no_unknowns_is_refused_and_settings_are_kept() {
         Err(CriterionError::UnsupportedShape { .. })
     ));
     let pool = random_pool(12, 3, 4, 3);
-    let s = StateSettings::default()
-        .with_ridge(1e-3)
-        .with_refactor_every(7)
-        .with_max_condition(1e10);
+    let s = StateSettings::builder()
+        .ridge(1e-3)
+        .refactor_every(7)
+        .max_condition(1e10)
+        .build()
+        .unwrap();
     let st = InfoState::new(&pool, &[0, 1, 2], s).unwrap();
     assert_eq!(*st.settings(), s);
 }

@@ -169,15 +169,14 @@ pub fn run(
     let robot = Robot::puma560();
     let pool = PoolSpec::lattice(a.levels).build(&robot, &robot.nominal)?;
     let x = pool.try_jacobian(&robot, &robot.nominal)?;
-    let s = Settings {
-        n: a.n,
-        initial: a.initial,
-        starts: a.starts,
-        designs: a.designs,
-        seed: a.seed,
-        ..Settings::default()
-    };
-    s.validate(&x)?;
+    let s = Settings::builder()
+        .n(a.n)
+        .initial(a.initial)
+        .starts(a.starts)
+        .designs(a.designs)
+        .seed(a.seed)
+        .build()?;
+    s.validate_for(&x)?;
     // 1. Random baseline (§V-C).
     progress("random designs");
     let random = random_baseline(&x, a);
@@ -220,12 +219,11 @@ pub fn run(
         &robot,
         &pool,
         &mc_designs,
-        &MonteCarloSettings {
-            trials: a.trials,
-            sigma: a.noise,
-            seed: a.seed,
-            ..MonteCarloSettings::default()
-        },
+        &MonteCarloSettings::builder()
+            .trials(a.trials)
+            .sigma(a.noise)
+            .seed(a.seed)
+            .build()?,
     )?;
 
     let lattice = pool.lattice().expect("a lattice pool");

@@ -52,15 +52,46 @@ pub const CONTACT_PIVOT_TOL: f64 = 1e-3;
 /// The reason given for an unknown that moves every point together.
 pub const GAUGE_REASON: &str = "moves every contact point together (a rigid motion of the whole setup, e.g. about the base's vertical): the unknown points absorb it";
 
-/// How to fit.
+/// How to fit: [`ContactSettings::builder`] (validated) or the defaults.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct ContactSettings {
-    /// The solver's settings.
+    /// The solver's settings. Default [`LmSettings::default`].
     pub lm: LmSettings,
-    /// The loss.
+    /// The loss. Default least squares.
     pub loss: LossChoice,
-    /// Parameters never fixed (nor counted as the gauge).
+    /// Parameters never fixed (nor counted as the gauge). Default none.
     pub keep: Vec<String>,
+}
+
+impl Default for ContactSettings {
+    fn default() -> Self {
+        Self {
+            lm: LmSettings::default(),
+            loss: LossChoice::L2,
+            keep: Vec::new(),
+        }
+    }
+}
+
+crate::settings::settings_builder! {
+    /// Validated construction of [`ContactSettings`].
+    ContactSettingsBuilder for ContactSettings, error crate::identify::IdentifyError {
+        /// The solver's settings (default [`LmSettings::default`]).
+        lm: LmSettings,
+        /// The loss (default least squares).
+        loss: LossChoice,
+        /// Parameters never fixed (default none).
+        keep: Vec<String>,
+    }
+}
+
+impl ContactSettings {
+    /// Checks the solver's settings and the loss's scale.
+    pub fn validate(&self) -> Result<()> {
+        self.lm.validate()?;
+        loss_of(self.loss).map(|_| ())
+    }
 }
 
 /// A contact calibration.
@@ -205,8 +236,7 @@ pub fn fit_contacts(
     distances: &[KnownDistance],
     settings: &ContactSettings,
 ) -> Result<ContactFit> {
-    settings.lm.validate()?;
-    loss_of(settings.loss)?;
+    settings.validate()?;
     let own0 = start_own(robot, start, file);
     let planes = start_planes(robot, start, file);
     let setup = Setup {

@@ -4,9 +4,11 @@ use crate::identify::lm::LmSettings;
 use crate::identify::{IdentifyError, Result};
 use serde::{Deserialize, Serialize};
 
-/// Settings of a Monte-Carlo run, with documented defaults.
+/// Settings of a Monte-Carlo run, with documented defaults: build with
+/// [`MonteCarloSettings::builder`] (validated) or take the default.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
+#[non_exhaustive]
 pub struct MonteCarloSettings {
     /// Noise realisations `R`. Default 200.
     pub trials: usize,
@@ -36,42 +38,25 @@ impl Default for MonteCarloSettings {
     }
 }
 
+crate::settings::settings_builder! {
+    /// Validated construction of [`MonteCarloSettings`].
+    MonteCarloSettingsBuilder for MonteCarloSettings, error IdentifyError {
+        /// Noise realisations (default 200).
+        trials: usize,
+        /// Noise σ per coordinate, metres (default 0.01).
+        sigma: f64,
+        /// Seed (default 0).
+        seed: u64,
+        /// Held-out validation poses (default 500).
+        validation_poses: usize,
+        /// Bootstrap resamples, 0 to skip (default 200).
+        bootstrap: usize,
+        /// The solver's settings (default [`LmSettings::default`]).
+        lm: LmSettings,
+    }
+}
+
 impl MonteCarloSettings {
-    /// Sets [`MonteCarloSettings::trials`].
-    #[must_use]
-    pub fn with_trials(mut self, trials: usize) -> Self {
-        self.trials = trials;
-        self
-    }
-
-    /// Sets [`MonteCarloSettings::sigma`].
-    #[must_use]
-    pub fn with_sigma(mut self, sigma: f64) -> Self {
-        self.sigma = sigma;
-        self
-    }
-
-    /// Sets [`MonteCarloSettings::seed`].
-    #[must_use]
-    pub fn with_seed(mut self, seed: u64) -> Self {
-        self.seed = seed;
-        self
-    }
-
-    /// Sets [`MonteCarloSettings::validation_poses`].
-    #[must_use]
-    pub fn with_validation_poses(mut self, n: usize) -> Self {
-        self.validation_poses = n;
-        self
-    }
-
-    /// Sets [`MonteCarloSettings::bootstrap`].
-    #[must_use]
-    pub fn with_bootstrap(mut self, b: usize) -> Self {
-        self.bootstrap = b;
-        self
-    }
-
     /// Checks every setting is in range.
     pub fn validate(&self) -> Result<()> {
         if self.trials == 0 {

@@ -103,7 +103,8 @@ impl<'a, C: Criterion> Run<'a, C> {
         let state = match state(StateSettings::default()) {
             Ok(s) => s,
             Err(CriterionError::Singular { .. }) => {
-                state(StateSettings::default().with_ridge(START_RIDGE)).map_err(crit_err)?
+                let ridged = StateSettings::builder().ridge(START_RIDGE).build();
+                state(ridged.map_err(crit_err)?).map_err(crit_err)?
             }
             Err(e) => return Err(crit_err(e)),
         };
@@ -414,7 +415,7 @@ fn run_from_random<C: Criterion>(
     algorithm: Algorithm,
     phases: impl FnOnce(&mut Run<'_, C>),
 ) -> Result<Selection> {
-    s.validate(pool)?;
+    s.validate_for(pool)?;
     let init = start_design(pool, s, size, rng);
     let mut run = Run::new(pool, crit, &init, &s.fixed, s.prior.as_ref())?;
     phases(&mut run);
@@ -496,7 +497,7 @@ where
     C: Criterion,
     F: Fn() -> C + Sync,
 {
-    s.validate(pool)?;
+    s.validate_for(pool)?;
     if algorithm == Algorithm::Random {
         let r = super::random_search(
             pool,

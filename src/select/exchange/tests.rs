@@ -23,11 +23,7 @@ fn pool(seed: u64) -> Blocks {
 }
 
 fn settings() -> Settings {
-    Settings {
-        n: 6,
-        initial: 3,
-        ..Settings::default()
-    }
+    Settings::builder().n(6).initial(3).build().unwrap()
 }
 
 fn ln_det(x: &Blocks, poses: &[usize]) -> f64 {
@@ -178,11 +174,12 @@ fn detmax_stops_when_the_added_pose_is_removed() {
 #[test]
 fn fixed_poses_stay_and_a_singular_start_runs_on_a_ridge() {
     let x = pool(5);
-    let s = Settings {
-        initial: 1,
-        fixed: vec![7, 11],
-        ..settings()
-    };
+    let s = settings()
+        .into_builder()
+        .initial(1)
+        .fixed(vec![7, 11])
+        .build()
+        .unwrap();
     for algorithm in [Algorithm::Eae, Algorithm::Fedorov, Algorithm::Detmax] {
         let sel = multistart(&x, DCriterion::new, algorithm, &s).unwrap();
         assert_consistent(&x, &sel, 6);
@@ -202,10 +199,7 @@ fn fixed_poses_stay_and_a_singular_start_runs_on_a_ridge() {
     let sel = eae(
         &x,
         &mut DCriterion::new(),
-        &Settings {
-            fixed: vec![],
-            ..s.clone()
-        },
+        &s.clone().into_builder().fixed(vec![]).build().unwrap(),
         &mut design_rng(1, 0),
     )
     .unwrap();
@@ -227,12 +221,13 @@ fn fixed_poses_stay_and_a_singular_start_runs_on_a_ridge() {
 fn multistart_keeps_the_best_start() {
     let x = pool(2);
     // One exchange per phase, so that the starts end apart.
-    let s = Settings {
-        starts: 5,
-        seed: 9,
-        max_iter: 1,
-        ..settings()
-    };
+    let s = settings()
+        .into_builder()
+        .starts(5)
+        .seed(9)
+        .max_iter(1)
+        .build()
+        .unwrap();
     let sel = multistart(&x, DCriterion::new, Algorithm::Eae, &s).unwrap();
     assert_consistent(&x, &sel, 6);
     assert_eq!(sel.start_score.len(), 5);
@@ -264,19 +259,13 @@ fn multistart_keeps_the_best_start() {
 #[test]
 fn polish_continues_the_trace_to_a_swap_optimum() {
     let x = pool(3);
-    let s = Settings {
-        starts: 2,
-        ..settings()
-    };
+    let s = settings().into_builder().starts(2).build().unwrap();
     let plain = multistart(&x, DCriterion::new, Algorithm::Detmax, &s).unwrap();
     let polished = multistart(
         &x,
         DCriterion::new,
         Algorithm::Detmax,
-        &Settings {
-            polish: true,
-            ..s.clone()
-        },
+        &s.clone().into_builder().polish(true).build().unwrap(),
     )
     .unwrap();
     assert_consistent(&x, &polished, 6);
@@ -297,11 +286,7 @@ fn iterated_local_search_ends_at_a_swap_optimum_above_its_start() {
     for seed in 1..4 {
         let x = pool(seed);
         let plain = settings();
-        let s = Settings {
-            ils: 4,
-            kick: 2,
-            ..plain.clone()
-        };
+        let s = plain.clone().into_builder().ils(4).kick(2).build().unwrap();
         let a = eae(&x, &mut DCriterion::new(), &plain, &mut design_rng(seed, 0)).unwrap();
         let b = eae(&x, &mut DCriterion::new(), &s, &mut design_rng(seed, 0)).unwrap();
         assert_consistent(&x, &b, 6);
@@ -319,10 +304,7 @@ fn a_rank_deficient_pool_is_an_error() {
     let mut m = x.mat().to_owned();
     m.col_mut(3).fill(0.0);
     let x = Blocks::new(m, 2);
-    let s = Settings {
-        designs: 20,
-        ..settings()
-    };
+    let s = settings().into_builder().designs(20).build().unwrap();
     for algorithm in [
         Algorithm::Eae,
         Algorithm::Fedorov,
@@ -340,10 +322,7 @@ fn a_rank_deficient_pool_is_an_error() {
 #[test]
 fn random_search_keeps_its_best_design() {
     let x = pool(6);
-    let s = Settings {
-        designs: 40,
-        ..settings()
-    };
+    let s = settings().into_builder().designs(40).build().unwrap();
     let sel = multistart(&x, DCriterion::new, Algorithm::Random, &s).unwrap();
     assert_consistent(&x, &sel, 6);
     assert_eq!(sel.algorithm, Algorithm::Random);

@@ -429,6 +429,10 @@ fn a_tour_s_checks_do_not_depend_on_the_thread_count() {
         })
     };
     let one = run(1);
-    assert!(one.0.colliding_before >= 4, "the scene exercises repairs: {:?}", one.0);
+    assert!(
+        one.0.colliding_before >= 4,
+        "the scene exercises repairs: {:?}",
+        one.0
+    );
     assert_eq!(one, run(2));
 }

@@ -115,7 +115,10 @@ fn head_camera_calibration_matches_a_true_tiago() {
         distance: [0.25, 1.5],
     };
     let candidates = generic_configurations(&branch, 20_000, 13);
-    let settings = activecal::select::Settings::builder().n(30).build().unwrap();
+    let settings = activecal::select::Settings::builder()
+        .n(30)
+        .build()
+        .unwrap();
     let d = camera_design(&branch, &view, &candidates, &settings).unwrap();
     let predicted = 1e3 * 0.3 * d.predicted_error_per_px.expect("a regular design");
     let names = activecal::units::joint_names(&branch);

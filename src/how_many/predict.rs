@@ -1,0 +1,167 @@
+//! The errors a calibrated robot is predicted to keep at random
+//! configurations, from a design's information alone.
+
+use crate::blocks::Blocks;
+use crate::measure::{RowKind, sensor_for};
+use crate::model::Robot;
+use faer::linalg::solvers::DenseSolveCore;
+use faer::{Mat, MatRef, Side};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+
+/// The errors predicted at a set of configurations.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PredictedErrors {
+    /// RMS over configurations of the position error of a measured point,
+    /// mm.
+    pub position_rms_mm: f64,
+    /// 95th percentile over configurations of the predicted RMS position
+    /// error at one configuration, mm.
+    pub position_p95_mm: f64,
+    /// 95th percentile of the position error a measured point shows (its
+    /// distance from the prediction, mm): of the error's distribution over
+    /// the configurations and the noise, each configuration's error drawn
+    /// [`ERROR_DRAWS`] times from its Gaussian `N(0, σ² J M⁻¹ Jᵀ)` (seeded).
+    pub position_error_p95_mm: f64,
+    /// RMS orientation error angle, degrees (full-pose sensors).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orientation_rms_deg: Option<f64>,
+    /// 95th percentile of the orientation error angle, degrees.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orientation_p95_deg: Option<f64>,
+}
+
+/// `configurations` joint vectors drawn uniformly within the robot's joint
+/// limits (seeded).
+#[must_use]
+pub fn random_configurations(robot: &Robot, count: usize, seed: u64) -> Vec<Vec<f64>> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..count)
+        .map(|_| {
+            robot
+                .limits
+                .iter()
+                .map(|&[lo, hi]| lo + (hi - lo) * rng.random::<f64>())
+                .collect()
+        })
+        .collect()
+}
+
+/// `M⁻¹` of a symmetric positive definite `M`, through the Cholesky factor
+/// of its unit-diagonal equilibration; `None` when it is not positive
+/// definite.
+fn spd_inverse(m: MatRef<'_, f64>) -> Option<Mat<f64>> {
+    let p = m.nrows();
+    let d: Vec<f64> = (0..p).map(|i| m[(i, i)].max(0.0).sqrt()).collect();
+    if d.iter().any(|&v| !(v > 0.0 && v.is_finite())) {
+        return None;
+    }
+    let e = Mat::from_fn(p, p, |i, j| m[(i, j)] / (d[i] * d[j]));
+    let inv = e.llt(Side::Lower).ok()?.inverse();
+    Some(Mat::from_fn(p, p, |i, j| inv[(i, j)] / (d[i] * d[j])))
+}
+
+/// Draws of each configuration's position error for
+/// [`PredictedErrors::position_error_p95_mm`].
+pub const ERROR_DRAWS: usize = 32;
+
+/// Appends to `out` [`ERROR_DRAWS`] norms (mm) of a point's position error
+/// `e ~ N(0, cov)`, `cov` a 3×3 covariance (m²), drawn from `rng`.
+fn error_norms(cov: &[[f64; 3]; 3], rng: &mut ChaCha8Rng, out: &mut Vec<f64>) {
+    // Cholesky of a positive semi-definite 3×3, a zero pivot left zero.
+    let mut l = [[0.0f64; 3]; 3];
+    for i in 0..3 {
+        for j in 0..=i {
+            let s: f64 = cov[i][j] - (0..j).map(|k| l[i][k] * l[j][k]).sum::<f64>();
+            l[i][j] = if i == j {
+                s.max(0.0).sqrt()
+            } else if l[j][j] > 0.0 {
+                s / l[j][j]
+            } else {
+                0.0
+            };
+        }
+    }
+    for _ in 0..ERROR_DRAWS {
+        let z: [f64; 3] = std::array::from_fn(|_| {
+            // Box–Muller: a standard normal from two uniforms in (0, 1].
+            let (u1, u2) = (1.0 - rng.random::<f64>(), rng.random::<f64>());
+            (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+        });
+        let e: f64 = (0..3)
+            .map(|i| (0..=i).map(|k| l[i][k] * z[k]).sum::<f64>().powi(2))
+            .sum();
+        out.push(e.sqrt() * 1e3);
+    }
+}
+
+/// The value at quantile `q` (0..=1) of `v` (sorted in place; nearest rank).
+pub(super) fn quantile(v: &mut [f64], q: f64) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_unstable_by(f64::total_cmp);
+    let k = ((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1;
+    v[k]
+}
+
+/// The errors predicted at the configurations of `eval` (their Jacobian
+/// rows, as the robot's sensor stacks them) after a calibration whose
+/// information matrix is `info` and noise σ is `noise` metres; `None` when
+/// `info` is singular.
+#[must_use]
+pub fn predicted_errors(
+    robot: &Robot,
+    eval: &Blocks,
+    info: MatRef<'_, f64>,
+    noise: f64,
+) -> Option<PredictedErrors> {
+    let inv = spd_inverse(info)?;
+    let sensor = sensor_for(robot);
+    let kinds = sensor.row_kinds();
+    let w = sensor
+        .weights()
+        .iter()
+        .zip(kinds)
+        .find(|&(_, &k)| k == RowKind::Orientation)
+        .map_or(1.0, |(w, _)| *w);
+    let points = kinds.iter().filter(|&&k| k == RowKind::Position).count() as f64 / 3.0;
+    let full = kinds.contains(&RowKind::Orientation);
+    let s2 = noise * noise;
+    // The position rows, a point's three in a row.
+    let rows: Vec<usize> = (0..kinds.len())
+        .filter(|&r| kinds[r] == RowKind::Position)
+        .collect();
+    let mut rng = ChaCha8Rng::seed_from_u64(0);
+    let (mut pos, mut ori, mut norms) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..eval.n_poses() {
+        let b = eval.block(i);
+        let xc = b * inv.as_ref();
+        let mut tr = [0.0f64; 2];
+        for r in 0..b.nrows() {
+            let v: f64 = (0..b.ncols()).map(|c| xc[(r, c)] * b[(r, c)]).sum();
+            tr[usize::from(kinds[r] == RowKind::Orientation)] += v.max(0.0);
+        }
+        pos.push((s2 * tr[0] / points.max(1.0)).sqrt() * 1e3);
+        ori.push((s2 * tr[1]).sqrt() / w * 180.0 / std::f64::consts::PI);
+        for t in rows.chunks_exact(3) {
+            let cov: [[f64; 3]; 3] = std::array::from_fn(|a| {
+                std::array::from_fn(|c| {
+                    s2 * (0..b.ncols())
+                        .map(|k| xc[(t[a], k)] * b[(t[c], k)])
+                        .sum::<f64>()
+                })
+            });
+            error_norms(&cov, &mut rng, &mut norms);
+        }
+    }
+    let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt();
+    Some(PredictedErrors {
+        position_rms_mm: rms(&pos),
+        position_p95_mm: quantile(&mut pos.clone(), 0.95),
+        position_error_p95_mm: quantile(&mut norms, 0.95),
+        orientation_rms_deg: full.then(|| rms(&ori)),
+        orientation_p95_deg: full.then(|| quantile(&mut ori, 0.95)),
+    })
+}

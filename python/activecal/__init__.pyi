@@ -273,6 +273,34 @@ def select(
     same argument on `pool`, `calibrate` and `Design.bound`.
     """
 
+def bound(
+    robot: Robot,
+    n: int,
+    pool: Union["Pool", npt.ArrayLike, str, None] = None,
+    count: Optional[int] = None,
+    levels: Optional[int] = None,
+    pool_seed: Optional[int] = None,
+    margin: Optional[float] = None,
+    existing: Optional[npt.ArrayLike] = None,
+    weights: bool = False,
+    progress: Optional[Callable[[str, int, Optional[int], str], None]] = None,
+) -> dict[str, Any]:
+    """The certified upper bound on ln det(XᵀX) of every design of `n`
+    poses from the pool (the D criterion's continuous relaxation, solved to
+    a certified duality gap): the dict `activecal bound --json` prints
+    (`ln_bound`, `status`, the pool, the settings; `support`, the
+    relaxation's weight per pose, when `weights`). Pool arguments as
+    `select`; `existing`: joint values (radians) of poses already measured."""
+    ...
+
+def gap(
+    design: Design,
+    progress: Optional[Callable[[str, int, Optional[int], str], None]] = None,
+) -> dict[str, Any]:
+    """`design.bound()`: the design's D-efficiency against the certified
+    bound over its own pool, the dict `activecal gap --json` prints."""
+    ...
+
 class Calibration:
     """The result of `calibrate`."""
 

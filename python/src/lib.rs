@@ -6,6 +6,7 @@
 
 use pyo3::prelude::*;
 
+mod bound;
 mod calibrate;
 mod contacts;
 mod convert;
@@ -67,6 +68,8 @@ fn _activecal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(pool::pool, m)?)?;
     m.add_class::<calibrate::Calibration>()?;
     m.add_function(wrap_pyfunction!(select::select, m)?)?;
+    m.add_function(wrap_pyfunction!(bound::bound, m)?)?;
+    m.add_function(wrap_pyfunction!(bound::gap, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate::evaluate, m)?)?;
     m.add_class::<contacts::ContactCalibration>()?;

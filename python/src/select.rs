@@ -183,6 +183,32 @@ pub fn select(
     })
 }
 
+impl Design {
+    /// The design against the certified bound over its own pool: the dict
+    /// `activecal gap --json` prints.
+    pub(crate) fn gap_dict<'py>(
+        &self,
+        py: Python<'py>,
+        progress: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (x, prior, positions) = (self.x.clone(), self.prior.clone(), self.positions.clone());
+        let v = crate::progress::with_callback(progress, || {
+            detached(py, move || {
+                let settings = activecal::bound::BoundSettings::default();
+                let b = activecal::bound::relaxation_bound(
+                    &x,
+                    prior.as_ref(),
+                    positions.len(),
+                    &settings,
+                )?;
+                let g = activecal::bound::gap::design_gap(&x, prior.as_ref(), &positions, &b)?;
+                Ok(serde_json::to_value(&g)?)
+            })
+        })?;
+        json_to_py(py, &v)
+    }
+}
+
 /// Whether the `order` argument asks for the visiting order by time: by
 /// default when the robot's description states joint speeds, as the CLI.
 fn reorder_of(robot: &Robot, order: Option<&str>) -> PyResult<bool> {
@@ -244,7 +270,7 @@ fn visit(
 
 /// The candidates a `pool` argument names: a `Pool` as built (no size
 /// option beside it), an array of configurations or a source name.
-fn candidates(
+pub(crate) fn candidates(
     py: Python<'_>,
     robot: &Robot,
     pool: Option<&Bound<'_, PyAny>>,
@@ -300,7 +326,7 @@ fn candidates(
 
 /// Poses already measured (an (m, dof) array, checked as joint values are)
 /// and their information `M0` at the nominal parameters.
-fn existing_poses(
+pub(crate) fn existing_poses(
     py: Python<'_>,
     robot: &Robot,
     e: &Bound<'_, PyAny>,
@@ -380,21 +406,7 @@ impl Design {
         py: Python<'py>,
         progress: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (x, prior, positions) = (self.x.clone(), self.prior.clone(), self.positions.clone());
-        let v = crate::progress::with_callback(progress, || {
-            detached(py, move || {
-                let settings = activecal::bound::BoundSettings::default();
-                let b = activecal::bound::relaxation_bound(
-                    &x,
-                    prior.as_ref(),
-                    positions.len(),
-                    &settings,
-                )?;
-                let g = activecal::bound::gap::design_gap(&x, prior.as_ref(), &positions, &b)?;
-                Ok(serde_json::to_value(&g)?)
-            })
-        })?;
-        json_to_py(py, &v)
+        self.gap_dict(py, progress)
     }
 
     /// "How many poses do I need?": for each design size from the fewest

@@ -61,6 +61,29 @@ def test_existing_poses_and_the_bound_equal_the_cli(tmp_path):
     assert 0.0 < g["d_efficiency"] <= 1.0
 
 
+def test_the_bound_and_gap_functions_equal_the_cli(tmp_path):
+    r = activecal.Robot.builtin("puma560")
+    b = activecal.bound(r, 30, pool="lattice", levels=3, weights=True)
+    want = cli("bound", "--robot", "puma560", "--levels", 3, "--n", 30, "--weights")
+    # The same bound to rounding (one solve, the same pool); every key the
+    # command prints, with the same support poses.
+    assert abs(b["ln_bound"] - want["ln_bound"]) < 1e-9 * abs(want["ln_bound"])
+    assert set(b) == set(want)
+    assert [w["pose"] for w in b["support"]] == [w["pose"] for w in want["support"]]
+    # Existing poses raise the bound of the poses to add, as --existing does.
+    first = activecal.select(r, 12, pool="lattice", levels=3)
+    f = tmp_path / "first.csv"
+    first.write(str(f))
+    with_prior = activecal.bound(r, 10, pool="lattice", levels=3, existing=first.q)
+    want = cli("bound", "--robot", "puma560", "--levels", 3, "--n", 10, "--existing", f)
+    assert abs(with_prior["ln_bound"] - want["ln_bound"]) < 1e-9 * abs(want["ln_bound"])
+    # gap(design) is design.bound().
+    d = activecal.select(r, 30, pool="lattice", levels=3)
+    assert activecal.gap(d) == d.bound()
+    with pytest.raises(activecal.InputError, match="n"):
+        activecal.bound(r, 0, pool="lattice", levels=3)
+
+
 def test_collision_filters_equal_the_cli():
     ur10 = FIXTURES / "example-robot-data" / "ur10_robot.urdf"
     r = activecal.Robot.from_urdf(ur10, tip="tool0")

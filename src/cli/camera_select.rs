@@ -14,10 +14,10 @@
 
 use super::camera_opts::CameraOpts;
 use super::select::SelectArgs;
-use activecal::io::camera_info::read_camera_info;
-use activecal::io::camera_target::read_target;
 use activecal::collision::{CollisionSpec, Obstacle};
 use activecal::io::UrdfChain;
+use activecal::io::camera_info::read_camera_info;
+use activecal::io::camera_target::read_target;
 use activecal::model::Robot;
 use activecal::pool::PoolFilter;
 use activecal::pool::camera_view::CameraView;
@@ -263,7 +263,14 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         .collect();
     value["out"] = json!(written);
     super::emit(a.json, &value, || {
-        text(&d, candidates.len(), collision_removed, gap.as_ref(), &csv, &written)
+        text(
+            &d,
+            candidates.len(),
+            collision_removed,
+            gap.as_ref(),
+            &csv,
+            &written,
+        )
     })
 }
 
@@ -287,7 +294,10 @@ fn text(
     );
     let mut s = String::new();
     if let Some(c) = collision_removed {
-        let _ = writeln!(s, "collision: removed {c} of {candidates} sampled configurations");
+        let _ = writeln!(
+            s,
+            "collision: removed {c} of {candidates} sampled configurations"
+        );
     }
     let sight = d.out_of_sight.map_or(String::new(), |o| {
         format!(" in sight ({o} more seen but blocked by the robot's collision geometry)")

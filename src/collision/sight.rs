@@ -81,3 +81,102 @@ fn segment_near(
     let t = (centre - from).dot(&ray.dir).clamp(0.0, reach);
     (from + ray.dir * t - centre).norm() <= radius
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::collision::CollisionSpec;
+
+    /// base –j1 (revolute about z)→ arm, a 0.1 m box centred 0.5 m out
+    /// along the arm's x; –j2 (revolute)→ tip, carrying a 0.2 m box at its
+    /// origin (the carrier of a target).
+    fn model() -> CollisionModel {
+        let text = r#"<robot name="t">
+<link name="base"/>
+<link name="arm"><collision><origin xyz="0.5 0 0"/><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+<link name="tip"><collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
+<joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+<joint name="j2" type="revolute"><parent link="arm"/><child link="tip"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+</robot>"#;
+        CollisionModel::load(&CollisionSpec {
+            urdf: "t.urdf".into(),
+            text: Some(text.into()),
+            joints: vec!["j1".into(), "j2".into()],
+            base: Some("base".into()),
+            ..CollisionSpec::default()
+        })
+        .unwrap()
+    }
+
+    /// A ray along x from the base's origin crosses the arm's box (at x
+    /// 0.45–0.55) when j1 = 0 and misses it when j1 turns the arm by 90°;
+    /// a ray ending on the box's face (x = 0.45) is blocked only without
+    /// the stop; the tip's own box (around x = 1) blocks only when it is
+    /// not skipped; a ray starting inside a box is blocked.
+    #[test]
+    fn rays_are_blocked_by_the_geometry_between() {
+        let m = model();
+        let eye = Point3::origin();
+        let far = Point3::new(2.0, 0.0, 0.0);
+        let side = Point3::new(0.0, 2.0, 0.0);
+        assert_eq!(
+            m.blocked_rays(&[0.0, 0.0], &eye, &[far, side], 1e-3, true),
+            [true, false]
+        );
+        // Turned by 90°: the arm's box now lies on the y axis.
+        assert_eq!(
+            m.blocked_rays(
+                &[std::f64::consts::FRAC_PI_2, 0.0],
+                &eye,
+                &[far, side],
+                1e-3,
+                true
+            ),
+            [false, true]
+        );
+        // Ending on the face at x = 0.45: stopped 1 mm short it is free;
+        // without the stop the face is reached.
+        let face = Point3::new(0.45, 0.0, 0.0);
+        assert_eq!(
+            m.blocked_rays(
+                &[1.0, 0.0],
+                &eye,
+                &[Point3::new(0.45 * 1f64.cos(), 0.45 * 1f64.sin(), 0.0)],
+                1e-3,
+                true
+            ),
+            [false]
+        );
+        assert_eq!(
+            m.blocked_rays(&[0.0, 0.0], &eye, &[face], 1e-3, true),
+            [false]
+        );
+        assert_eq!(
+            m.blocked_rays(&[0.0, 0.0], &eye, &[face], 0.0, true),
+            [true]
+        );
+        // The tip's box (x 0.9–1.1 at j1 = 0): a ray from above to a point
+        // past it, with the arm's box out of the way (z = 0.3 above it).
+        let (hi, past) = (Point3::new(1.0, 0.0, 0.5), Point3::new(1.0, 0.0, -0.5));
+        assert_eq!(
+            m.blocked_rays(&[0.0, 0.0], &hi, &[past], 1e-3, true),
+            [false]
+        );
+        assert_eq!(
+            m.blocked_rays(&[0.0, 0.0], &hi, &[past], 1e-3, false),
+            [true]
+        );
+        // From inside the arm's box outwards, away from everything.
+        let inside = Point3::new(0.5, 0.0, 0.0);
+        assert_eq!(
+            m.blocked_rays(
+                &[0.0, 0.0],
+                &inside,
+                &[Point3::new(0.5, 0.0, 3.0)],
+                1e-3,
+                true
+            ),
+            [true]
+        );
+    }
+}

@@ -96,3 +96,61 @@ fn a_link_between_camera_and_board_removes_the_configuration() {
     assert!(inside.iter().all(|i| *i));
     assert!(sight.keeps(&clear, &robot, &robot.nominal, &q));
 }
+
+/// `select --line-of-sight` on the Panda eye-to-hand: the JSON says how
+/// many seen configurations the line of sight removed, every chosen pose
+/// sees all 48 points; `--self-collision` turns it on with the collision
+/// filter, whose removals are reported; a built-in robot (no collision
+/// geometry) is refused.
+#[test]
+fn cli_line_of_sight_reports_its_removals_and_refuses_what_it_cannot_check() {
+    let base = [
+        "select",
+        "--robot",
+        "fixtures/example-robot-data/panda.urdf#tip=panda_hand_tcp",
+        "--camera-info",
+        "fixtures/camera/camera_info.yaml",
+        "--target",
+        "fixtures/camera/board.yaml",
+        "--mounting",
+        "eye-to-hand",
+        "--camera-pose=1.2,0.6,0.9,-2.0985,0,2.0779",
+        "--target-pose=-0.0853,0.0568,0.02,3.141592653589793,0,0.03",
+        "--image-margin",
+        "20",
+        "--distance",
+        "0.3,2.0",
+        "--n",
+        "20",
+        "--count",
+        "2000",
+        "--json",
+    ];
+    let plain = crate::common::json_of(&base);
+    assert!(plain["out_of_sight"].is_null() && plain["collision_removed"].is_null());
+    let mut args = base.to_vec();
+    args.push("--line-of-sight");
+    let v = crate::common::json_of(&args);
+    let (seen, out) = (
+        plain["visible"].as_u64().unwrap(),
+        v["out_of_sight"].as_u64().unwrap(),
+    );
+    assert!(
+        out > 0 && v["visible"].as_u64().unwrap() + out == seen,
+        "{v}"
+    );
+    assert!(v["points_seen"].as_array().unwrap().iter().all(|s| s == 48));
+    let mut args = base.to_vec();
+    args.extend([
+        "--self-collision",
+        "--srdf",
+        "fixtures/example-robot-data/panda.srdf",
+    ]);
+    let c = crate::common::json_of(&args);
+    assert!(c["collision_removed"].as_u64().unwrap() > 0);
+    assert!(c["out_of_sight"].as_u64().unwrap() > 0);
+    let mut args = base.to_vec();
+    args[2] = "ur5";
+    args.push("--line-of-sight");
+    crate::common::fails_with(&args, "needs a URDF robot with collision geometry");
+}

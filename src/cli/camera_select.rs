@@ -299,12 +299,15 @@ fn text(
             "collision: removed {c} of {candidates} sampled configurations"
         );
     }
-    let sight = d.out_of_sight.map_or(String::new(), |o| {
-        format!(" in sight ({o} more seen but blocked by the robot's collision geometry)")
+    let (well, blocked) = d.out_of_sight.map_or((String::new(), String::new()), |o| {
+        (
+            " and in sight".to_string(),
+            format!(" ({o} more seen well, but the robot's collision geometry blocks a ray)"),
+        )
     });
     let _ = write!(
         s,
-        "camera: the target is seen well{sight} at {} of {candidates} sampled configurations\nchose {} poses on the pixel Jacobian ({} unknowns): ln det XᵀX = {:.3} (unit pixel noise)\n",
+        "camera: the target is seen well{well} at {} of {candidates} sampled configurations{blocked}\nchose {} poses on the pixel Jacobian ({} unknowns): ln det XᵀX = {:.3} (unit pixel noise)\n",
         d.visible,
         d.qs.len(),
         d.names.len(),

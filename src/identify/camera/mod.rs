@@ -110,6 +110,17 @@ pub struct CameraFit {
     pub iterations: usize,
 }
 
+impl CameraFit {
+    /// The intrinsics at the estimate: refined ones when the sensor
+    /// refines them ([`CameraSensor::with_intrinsics_refined`]), else the
+    /// sensor's.
+    #[must_use]
+    pub fn intrinsics(&self) -> crate::measure::pinhole::Intrinsics {
+        self.sensor
+            .intrinsics_at(&self.estimate[self.robot.n_unknowns()..])
+    }
+}
+
 /// Why a camera fit could not be made at all (bad input, or a start from
 /// which the camera does not see what the file says it saw).
 #[derive(Debug, thiserror::Error)]
@@ -180,7 +191,7 @@ pub fn fit_camera(
 ) -> Result<CameraFit, CameraFitError> {
     let robot = camera_robot(robot)?;
     let rows = 2 * obs.n_seen();
-    let p = robot.n_unknowns() + OWN_PARAMS;
+    let p = robot.n_unknowns() + crate::measure::Sensor::n_own_params(sensor);
     if rows <= p {
         return Err(CameraFitError::TooFewRows { rows, p });
     }
@@ -191,18 +202,24 @@ pub fn fit_camera(
     // 1. The placements alone, the robot nominal.
     let mut rigid_robot = robot.clone();
     rigid_robot.unknowns.clear();
+    // (with the intrinsics as given).
+    let own0 = &own0[..OWN_PARAMS];
     let mut rigid = Calibration::with_sensor(
         &rigid_robot,
         &robot.nominal,
         &obs.qs,
-        Box::new(sensor.clone()),
+        Box::new(sensor.clone().with_intrinsics_refined(false)),
         values.clone(),
     );
     let given_rms_px = rms_px(&mut rigid, own0, rows);
     let sol0 = levenberg_marquardt(&mut rigid, own0, lm);
     let rigid_rms_px = (sol0.rss / rows as f64).sqrt();
-    // 2. Everything, the charts re-centred on the rigid start.
-    let (sensor, own1) = sensor.recentred(&sol0.theta);
+    // 2. Everything, the charts re-centred on the rigid start (the
+    // intrinsics, when refined, starting from the sensor's).
+    let (sensor, mut own1) = sensor.recentred(&sol0.theta);
+    if sensor.refines_intrinsics() {
+        own1.extend_from_slice(&sensor.intrinsics().values());
+    }
     let mut theta0 = robot.unknown_values(&robot.nominal);
     theta0.extend_from_slice(&own1);
     let mut prob = Calibration::with_sensor(

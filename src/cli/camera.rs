@@ -58,6 +58,28 @@ pub fn calibrate_camera(
     obs_path: &Path,
 ) -> Result<Option<String>> {
     check_out(a, robot)?;
+    if let Some(o) = &a.out_camera_info {
+        let yaml = o
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
+        if !yaml {
+            bail!(
+                "--out-camera-info {}: the refined intrinsics are written as a ROS camera_info .yaml",
+                o.display()
+            );
+        }
+        let mut outs: Vec<(&str, &Path)> = vec![("--out-camera-info", o.as_path())];
+        outs.extend(a.out.iter().map(|p| ("--out", p.as_path())));
+        let ins: Vec<&Path> = [
+            a.camera_info.as_deref(),
+            a.target.as_deref(),
+            Some(obs_path),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        super::check_outputs(&outs, &ins, a.force)?;
+    }
     let (Some(info), Some(target), Some(cp), Some(tp)) =
         (&a.camera_info, &a.target, &a.camera_pose, &a.target_pose)
     else {
@@ -83,7 +105,8 @@ pub fn calibrate_camera(
         parse_placement("--camera-pose", cp)?,
         parse_placement("--target-pose", tp)?,
     );
-    let sensor = CameraSensor::new(intrinsics, mounting, target.points.clone(), &cam0, &tgt0);
+    let sensor = CameraSensor::new(intrinsics, mounting, target.points.clone(), &cam0, &tgt0)
+        .with_intrinsics_refined(a.refine_intrinsics);
     let lm = LmSettings::default()
         .with_max_iterations(a.max_iterations)
         .with_geodesic(!a.no_geodesic);
@@ -115,6 +138,21 @@ pub fn calibrate_camera(
             written.push(path.display().to_string());
         }
     }
+    if fit.converged
+        && let Some(o) = &a.out_camera_info
+    {
+        let name = o
+            .file_stem()
+            .map_or_else(|| "camera".into(), |s| s.to_string_lossy());
+        let comment = format!(
+            "intrinsics refined by activecal calibrate --refine-intrinsics from {}",
+            obs_path.display()
+        );
+        let text =
+            activecal::io::camera_info::render_camera_info(&fit.intrinsics(), &name, &comment);
+        super::write_new(o, &text, a.force)?;
+        written.push(o.display().to_string());
+    }
     let v = json!({
         "robot": robot.name,
         "observations": obs_path.display().to_string(),
@@ -133,6 +171,7 @@ pub fn calibrate_camera(
         "converged": fit.converged,
         "stop": format!("{:?}", fit.stop),
         "camera": frames.as_ref().and_then(|f| f.1.camera.clone()),
+        "intrinsics": a.refine_intrinsics.then(|| fit.intrinsics()),
         "out": written,
     });
     super::emit(a.json, &v, || {
@@ -171,10 +210,12 @@ fn text(
         fit.rows,
         fit.rows / 2
     );
+    let refined = fit.sensor.refines_intrinsics();
     let _ = writeln!(
         s,
-        "unknowns: {} = {n_kin} of the robot + 6 of the camera + 6 of the target",
-        fit.names.len()
+        "unknowns: {} = {n_kin} of the robot + 6 of the camera + 6 of the target{}",
+        fit.names.len(),
+        if refined { " + 9 intrinsics" } else { "" }
     );
     let _ = writeln!(
         s,
@@ -209,6 +250,9 @@ fn text(
             s.push('\n');
         }
     }
+    if refined {
+        intrinsics_text(fit, &mut s);
+    }
     s.push_str("robot unknowns (change from nominal, σ):\n");
     for k in 0..n_kin {
         let unit = if fit.names[k].starts_with("a_") || fit.names[k].starts_with("d_") {
@@ -236,4 +280,24 @@ fn text(
         let _ = writeln!(s, "wrote {w}");
     }
     s
+}
+
+/// The refined intrinsics with their change from the given ones and σ.
+fn intrinsics_text(fit: &CameraFit, s: &mut String) {
+    let k0 = fit.robot.n_unknowns() + activecal::measure::camera::OWN_PARAMS;
+    s.push_str("intrinsics (refined, change from given, σ):\n");
+    for (j, name) in activecal::measure::pinhole::INTRINSIC_NAMES
+        .iter()
+        .enumerate()
+    {
+        let k = k0 + j;
+        let unit = if j < 4 { " px" } else { "" };
+        let sd = fit.std.as_ref().map_or(f64::NAN, |sd| sd[k]);
+        let _ = writeln!(
+            s,
+            "  {name:<3} {:.6}{unit}  ({:+.6})  σ {sd:.6}{unit}",
+            fit.estimate[k],
+            fit.estimate[k] - fit.start[k]
+        );
+    }
 }

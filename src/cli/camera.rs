@@ -58,28 +58,7 @@ pub fn calibrate_camera(
     obs_path: &Path,
 ) -> Result<Option<String>> {
     check_out(a, robot)?;
-    if let Some(o) = &a.out_camera_info {
-        let yaml = o
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
-        if !yaml {
-            bail!(
-                "--out-camera-info {}: the refined intrinsics are written as a ROS camera_info .yaml",
-                o.display()
-            );
-        }
-        let mut outs: Vec<(&str, &Path)> = vec![("--out-camera-info", o.as_path())];
-        outs.extend(a.out.iter().map(|p| ("--out", p.as_path())));
-        let ins: Vec<&Path> = [
-            a.camera_info.as_deref(),
-            a.target.as_deref(),
-            Some(obs_path),
-        ]
-        .into_iter()
-        .flatten()
-        .collect();
-        super::check_outputs(&outs, &ins, a.force)?;
-    }
+    check_camera_info_out(a, obs_path)?;
     let (Some(info), Some(target), Some(cp), Some(tp)) =
         (&a.camera_info, &a.target, &a.camera_pose, &a.target_pose)
     else {
@@ -141,16 +120,7 @@ pub fn calibrate_camera(
     if fit.converged
         && let Some(o) = &a.out_camera_info
     {
-        let name = o
-            .file_stem()
-            .map_or_else(|| "camera".into(), |s| s.to_string_lossy());
-        let comment = format!(
-            "intrinsics refined by activecal calibrate --refine-intrinsics from {}",
-            obs_path.display()
-        );
-        let text =
-            activecal::io::camera_info::render_camera_info(&fit.intrinsics(), &name, &comment);
-        super::write_new(o, &text, a.force)?;
+        write_camera_info(o, &fit, obs_path, a.force)?;
         written.push(o.display().to_string());
     }
     let v = json!({
@@ -190,6 +160,47 @@ pub fn calibrate_camera(
             fit.stop, fit.iterations
         )
     }))
+}
+
+/// Refuses an `--out-camera-info` that is not a `.yaml` or exists (without
+/// `--force`), before any work.
+fn check_camera_info_out(a: &CalibrateArgs, obs_path: &Path) -> Result<()> {
+    if let Some(o) = &a.out_camera_info {
+        let yaml = o
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
+        if !yaml {
+            bail!(
+                "--out-camera-info {}: the refined intrinsics are written as a ROS camera_info .yaml",
+                o.display()
+            );
+        }
+        let mut outs: Vec<(&str, &Path)> = vec![("--out-camera-info", o.as_path())];
+        outs.extend(a.out.iter().map(|p| ("--out", p.as_path())));
+        let ins: Vec<&Path> = [
+            a.camera_info.as_deref(),
+            a.target.as_deref(),
+            Some(obs_path),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        super::check_outputs(&outs, &ins, a.force)?;
+    }
+    Ok(())
+}
+
+/// Writes the refined intrinsics of `fit` to `o` as a ROS camera_info.
+fn write_camera_info(o: &Path, fit: &CameraFit, obs_path: &Path, force: bool) -> Result<()> {
+    let name = o
+        .file_stem()
+        .map_or_else(|| "camera".into(), |s| s.to_string_lossy());
+    let comment = format!(
+        "intrinsics refined by activecal calibrate --refine-intrinsics from {}",
+        obs_path.display()
+    );
+    let text = activecal::io::camera_info::render_camera_info(&fit.intrinsics(), &name, &comment);
+    super::write_new(o, &text, force)
 }
 
 /// The human-readable report.

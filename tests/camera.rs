@@ -637,4 +637,10 @@ fn refined_intrinsics_are_recovered_within_three_sigma() {
         refined.intrinsics().values().to_vec(),
         refined.estimate[n..]
     );
+    // The 40 spread poses determine all nine: none is held.
+    assert!(
+        refined.fixed_intrinsics.is_empty(),
+        "{:?}",
+        refined.fixed_intrinsics
+    );
 }

@@ -139,6 +139,7 @@ pub fn calibrate_camera(
         "sigma_px": fit.sigma_px,
         "redundancy": fit.redundancy,
         "converged": fit.converged,
+        "fixed_intrinsics": fit.fixed_intrinsics,
         "stop": format!("{:?}", fit.stop),
         "camera": frames.as_ref().and_then(|f| f.1.camera.clone()),
         "intrinsics": a.refine_intrinsics.then(|| fit.intrinsics()),
@@ -221,12 +222,16 @@ fn text(
         fit.rows,
         fit.rows / 2
     );
-    let refined = fit.sensor.refines_intrinsics();
+    let refined = fit.sensor.refines_intrinsics() || !fit.fixed_intrinsics.is_empty();
     let _ = writeln!(
         s,
         "unknowns: {} = {n_kin} of the robot + 6 of the camera + 6 of the target{}",
         fit.names.len(),
-        if refined { " + 9 intrinsics" } else { "" }
+        if refined {
+            format!(" + {} intrinsics", fit.names.len() - n_kin - 12)
+        } else {
+            String::new()
+        }
     );
     let _ = writeln!(
         s,
@@ -293,15 +298,14 @@ fn text(
     s
 }
 
-/// The refined intrinsics with their change from the given ones and σ.
+/// The refined intrinsics with their change from the given ones and σ,
+/// and those held at their given values with the reason.
 fn intrinsics_text(fit: &CameraFit, s: &mut String) {
     let k0 = fit.robot.n_unknowns() + activecal::measure::camera::OWN_PARAMS;
     s.push_str("intrinsics (refined, change from given, σ):\n");
-    for (j, name) in activecal::measure::pinhole::INTRINSIC_NAMES
-        .iter()
-        .enumerate()
-    {
-        let k = k0 + j;
+    let free = (0..9).filter(|&j| fit.sensor.free_intrinsics()[j]);
+    for (k, j) in (k0..).zip(free) {
+        let name = activecal::measure::pinhole::INTRINSIC_NAMES[j];
         let unit = if j < 4 { " px" } else { "" };
         let sd = fit.std.as_ref().map_or(f64::NAN, |sd| sd[k]);
         let _ = writeln!(
@@ -310,5 +314,8 @@ fn intrinsics_text(fit: &CameraFit, s: &mut String) {
             fit.estimate[k],
             fit.estimate[k] - fit.start[k]
         );
+    }
+    for f in &fit.fixed_intrinsics {
+        let _ = writeln!(s, "  {} held at {}: {}", f.name, f.value, f.reason);
     }
 }

@@ -127,8 +127,10 @@ pub struct CameraSensor {
     margin: f64,
     kinds: Vec<RowKind>,
     ones: Vec<f64>,
-    /// Whether the intrinsics are unknowns too (own unknowns 12..21).
-    refine: bool,
+    /// Which intrinsics are unknowns (in the order of
+    /// [`Intrinsics::values`]; own unknowns from 12 on, the free ones in
+    /// that order).
+    refine: [bool; 9],
 }
 
 /// How a camera sees its target at one pose ([`CameraSensor::view`]).
@@ -190,7 +192,7 @@ impl CameraSensor {
             margin: 0.0,
             kinds: vec![RowKind::Pixel; 2 * n],
             ones: vec![1.0; 2 * n],
-            refine: false,
+            refine: [false; 9],
         }
     }
 
@@ -198,27 +200,51 @@ impl CameraSensor {
     /// cx, cy, k1, k2, p1, p2, k3` after the 12 placement unknowns, their
     /// values rather than corrections) when `refine` is set.
     #[must_use]
-    pub fn with_intrinsics_refined(mut self, refine: bool) -> Self {
-        self.refine = refine;
+    pub fn with_intrinsics_refined(self, refine: bool) -> Self {
+        self.with_free_intrinsics([refine; 9])
+    }
+
+    /// The sensor whose own unknowns hold the intrinsics `free` marks (in
+    /// the order of [`Intrinsics::values`]); the others stay as given.
+    #[must_use]
+    pub fn with_free_intrinsics(mut self, free: [bool; 9]) -> Self {
+        self.refine = free;
         self
     }
 
-    /// Whether the intrinsics are unknowns ([`CameraSensor::with_intrinsics_refined`]).
+    /// Which intrinsics are unknowns ([`CameraSensor::with_free_intrinsics`]).
     #[must_use]
-    pub fn refines_intrinsics(&self) -> bool {
+    pub fn free_intrinsics(&self) -> [bool; 9] {
         self.refine
     }
 
-    /// The intrinsics at own unknowns `own`: the sensor's, or with the
-    /// refined ones those `own` holds.
+    /// Whether any intrinsic is an unknown ([`CameraSensor::with_intrinsics_refined`]).
+    #[must_use]
+    pub fn refines_intrinsics(&self) -> bool {
+        self.refine.iter().any(|f| *f)
+    }
+
+    /// The values of the free intrinsics as the sensor holds them (the
+    /// start of their unknowns).
+    #[must_use]
+    pub fn free_intrinsic_values(&self) -> Vec<f64> {
+        let v = self.intrinsics.values();
+        (0..9).filter(|&j| self.refine[j]).map(|j| v[j]).collect()
+    }
+
+    /// The intrinsics at own unknowns `own`: the sensor's, with the free
+    /// ones those `own` holds after the placements.
     #[must_use]
     pub fn intrinsics_at(&self, own: &[f64]) -> Intrinsics {
-        if self.refine && own.len() >= OWN_PARAMS + 9 {
-            self.intrinsics
-                .with_values(&own[OWN_PARAMS..OWN_PARAMS + 9])
-        } else {
-            self.intrinsics.clone()
+        let mut v = self.intrinsics.values();
+        let mut k = OWN_PARAMS;
+        for (j, free) in self.refine.iter().enumerate() {
+            if *free && k < own.len() {
+                v[j] = own[k];
+                k += 1;
+            }
         }
+        self.intrinsics.with_values(&v)
     }
 
     /// The sensor whose design rows keep the points at least `margin`
@@ -449,11 +475,14 @@ impl CameraSensor {
                 rows[ld..ld + n_own].fill(0.0);
                 continue;
             };
-            if self.refine
+            if self.refines_intrinsics()
                 && let Some(ji) = cam.intrinsic_jacobian(&x)
             {
-                rows[OWN_PARAMS..n_own].copy_from_slice(&ji[0]);
-                rows[ld + OWN_PARAMS..ld + n_own].copy_from_slice(&ji[1]);
+                let free = (0..9).filter(|&j| self.refine[j]);
+                for (c, j) in (OWN_PARAMS..n_own).zip(free) {
+                    rows[c] = ji[0][j];
+                    rows[ld + c] = ji[1][j];
+                }
             }
             let blocks = [
                 -f.rct,
@@ -516,7 +545,7 @@ impl Sensor for CameraSensor {
     }
 
     fn n_own_params(&self) -> usize {
-        OWN_PARAMS + if self.refine { 9 } else { 0 }
+        OWN_PARAMS + self.refine.iter().filter(|f| **f).count()
     }
 
     fn own_param_names(&self) -> Vec<String> {
@@ -524,13 +553,13 @@ impl Sensor for CameraSensor {
             .iter()
             .flat_map(|w| ["x", "y", "z", "rx", "ry", "rz"].map(|c| format!("{w}_{c}")))
             .collect();
-        if self.refine {
-            names.extend(
-                crate::measure::pinhole::INTRINSIC_NAMES
-                    .iter()
-                    .map(|n| format!("camera_{n}")),
-            );
-        }
+        names.extend(
+            crate::measure::pinhole::INTRINSIC_NAMES
+                .iter()
+                .zip(self.refine)
+                .filter(|(_, free)| *free)
+                .map(|(n, _)| format!("camera_{n}")),
+        );
         names
     }
 

@@ -14,6 +14,7 @@ mod bound;
 mod camera;
 mod camera_cli;
 mod camera_head;
+mod camera_sight;
 mod cli;
 mod cli_contacts;
 mod cli_existing;

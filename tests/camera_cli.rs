@@ -271,3 +271,51 @@ fn cli_calibrates_a_head_camera() {
     neither.drain(3..5);
     common::fails_with(&neither, "needs --mounting or --camera-link");
 }
+
+/// `calibrate --refine-intrinsics --out-camera-info refined.yaml`: nine
+/// more unknowns, each with a σ; the refined file is a camera_info that
+/// reads back to the estimate and lies within 3σ of the intrinsics the
+/// example was simulated with (`fixtures/camera/camera_info.yaml`, which
+/// the fit starts from); an existing file is refused without --force, a
+/// non-YAML name refused before any work.
+#[test]
+fn cli_refines_intrinsics_and_writes_them() {
+    let dir = common::scratch_dir("camera", "refine-intrinsics");
+    let out = dir.join("refined.yaml");
+    let mut args = EXAMPLE.to_vec();
+    let o = out.to_str().unwrap();
+    args.extend(["--refine-intrinsics", "--out-camera-info", o]);
+    let v = common::json_of(&args);
+    assert_eq!(v["converged"], true);
+    let names: Vec<&str> = v["names"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_str().unwrap())
+        .collect();
+    let k0 = names.iter().position(|n| *n == "camera_fx").unwrap();
+    assert_eq!(names.len(), k0 + 9);
+    let read = activecal::io::camera_info::read_camera_info(&out).unwrap();
+    let given = activecal::io::camera_info::read_camera_info(std::path::Path::new(
+        "fixtures/camera/camera_info.yaml",
+    ))
+    .unwrap();
+    for (j, (r, g)) in read.values().iter().zip(given.values()).enumerate() {
+        assert_eq!(*r, v["estimate"][k0 + j].as_f64().unwrap());
+        let sd = v["std"][k0 + j].as_f64().unwrap();
+        assert!(
+            (r - g).abs() < 3.0 * sd,
+            "{}: {r} against {g}, σ {sd}",
+            names[k0 + j]
+        );
+    }
+    common::fails_with(&args, "exists");
+    let mut bad = EXAMPLE.to_vec();
+    let txt = dir.join("refined.txt");
+    bad.extend([
+        "--refine-intrinsics",
+        "--out-camera-info",
+        txt.to_str().unwrap(),
+    ]);
+    common::fails_with(&bad, "camera_info .yaml");
+}

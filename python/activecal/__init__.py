@@ -32,9 +32,11 @@ from ._activecal import (
     ResourceError,
     Robot,
     __version__,
+    bound,
     calibrate,
     calibrate_contacts,
     evaluate,
+    gap,
     pool,
     select,
 )
@@ -52,9 +54,11 @@ __all__ = [
     "ResourceError",
     "Robot",
     "__version__",
+    "bound",
     "calibrate",
     "calibrate_contacts",
     "evaluate",
+    "gap",
     "pool",
     "select",
 ]

@@ -221,6 +221,16 @@ pub struct CalibrateArgs {
         requires = "observations"
     )]
     pub target_pose: Option<String>,
+    /// With --observations: fit the camera's intrinsics too (fx, fy, cx,
+    /// cy and the plumb_bob k1, k2, p1, p2, k3, started from --camera-info),
+    /// each reported with its σ.
+    #[arg(long, requires = "observations")]
+    pub refine_intrinsics: bool,
+    /// With --refine-intrinsics: write the refined intrinsics as a ROS
+    /// camera_info YAML (written only when the fit converged; an existing
+    /// file only with --force).
+    #[arg(long, value_name = "FILE.yaml", requires = "refine_intrinsics")]
+    pub out_camera_info: Option<PathBuf>,
     /// Units of the --measurements file.
     #[command(flatten)]
     pub units: super::units::UnitOpts,

@@ -58,6 +58,7 @@ pub fn calibrate_camera(
     obs_path: &Path,
 ) -> Result<Option<String>> {
     check_out(a, robot)?;
+    check_camera_info_out(a, obs_path)?;
     let (Some(info), Some(target), Some(cp), Some(tp)) =
         (&a.camera_info, &a.target, &a.camera_pose, &a.target_pose)
     else {
@@ -83,7 +84,8 @@ pub fn calibrate_camera(
         parse_placement("--camera-pose", cp)?,
         parse_placement("--target-pose", tp)?,
     );
-    let sensor = CameraSensor::new(intrinsics, mounting, target.points.clone(), &cam0, &tgt0);
+    let sensor = CameraSensor::new(intrinsics, mounting, target.points.clone(), &cam0, &tgt0)
+        .with_intrinsics_refined(a.refine_intrinsics);
     let lm = LmSettings::builder()
         .max_iterations(a.max_iterations)
         .geodesic(!a.no_geodesic)
@@ -116,6 +118,12 @@ pub fn calibrate_camera(
             written.push(path.display().to_string());
         }
     }
+    if fit.converged
+        && let Some(o) = &a.out_camera_info
+    {
+        write_camera_info(o, &fit, obs_path, a.force)?;
+        written.push(o.display().to_string());
+    }
     let v = json!({
         "robot": robot.name,
         "observations": obs_path.display().to_string(),
@@ -132,8 +140,10 @@ pub fn calibrate_camera(
         "sigma_px": fit.sigma_px,
         "redundancy": fit.redundancy,
         "converged": fit.converged,
+        "fixed_intrinsics": fit.fixed_intrinsics,
         "stop": format!("{:?}", fit.stop),
         "camera": frames.as_ref().and_then(|f| f.1.camera.clone()),
+        "intrinsics": a.refine_intrinsics.then(|| fit.intrinsics()),
         "out": written,
     });
     super::emit(a.json, &v, || {
@@ -154,6 +164,47 @@ pub fn calibrate_camera(
     }))
 }
 
+/// Refuses an `--out-camera-info` that is not a `.yaml` or exists (without
+/// `--force`), before any work.
+fn check_camera_info_out(a: &CalibrateArgs, obs_path: &Path) -> Result<()> {
+    if let Some(o) = &a.out_camera_info {
+        let yaml = o
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
+        if !yaml {
+            bail!(
+                "--out-camera-info {}: the refined intrinsics are written as a ROS camera_info .yaml",
+                o.display()
+            );
+        }
+        let mut outs: Vec<(&str, &Path)> = vec![("--out-camera-info", o.as_path())];
+        outs.extend(a.out.iter().map(|p| ("--out", p.as_path())));
+        let ins: Vec<&Path> = [
+            a.camera_info.as_deref(),
+            a.target.as_deref(),
+            Some(obs_path),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        super::check_outputs(&outs, &ins, a.force)?;
+    }
+    Ok(())
+}
+
+/// Writes the refined intrinsics of `fit` to `o` as a ROS camera_info.
+fn write_camera_info(o: &Path, fit: &CameraFit, obs_path: &Path, force: bool) -> Result<()> {
+    let name = o
+        .file_stem()
+        .map_or_else(|| "camera".into(), |s| s.to_string_lossy());
+    let comment = format!(
+        "intrinsics refined by activecal calibrate --refine-intrinsics from {}",
+        obs_path.display()
+    );
+    let text = activecal::io::camera_info::render_camera_info(&fit.intrinsics(), &name, &comment);
+    super::write_new(o, &text, force)
+}
+
 /// The human-readable report.
 fn text(
     fit: &CameraFit,
@@ -172,10 +223,16 @@ fn text(
         fit.rows,
         fit.rows / 2
     );
+    let refined = fit.sensor.refines_intrinsics() || !fit.fixed_intrinsics.is_empty();
     let _ = writeln!(
         s,
-        "unknowns: {} = {n_kin} of the robot + 6 of the camera + 6 of the target",
-        fit.names.len()
+        "unknowns: {} = {n_kin} of the robot + 6 of the camera + 6 of the target{}",
+        fit.names.len(),
+        if refined {
+            format!(" + {} intrinsics", fit.names.len() - n_kin - 12)
+        } else {
+            String::new()
+        }
     );
     let _ = writeln!(
         s,
@@ -210,6 +267,9 @@ fn text(
             s.push('\n');
         }
     }
+    if refined {
+        intrinsics_text(fit, &mut s);
+    }
     s.push_str("robot unknowns (change from nominal, σ):\n");
     for k in 0..n_kin {
         let unit = if fit.names[k].starts_with("a_") || fit.names[k].starts_with("d_") {
@@ -237,4 +297,26 @@ fn text(
         let _ = writeln!(s, "wrote {w}");
     }
     s
+}
+
+/// The refined intrinsics with their change from the given ones and σ,
+/// and those held at their given values with the reason.
+fn intrinsics_text(fit: &CameraFit, s: &mut String) {
+    let k0 = fit.robot.n_unknowns() + activecal::measure::camera::OWN_PARAMS;
+    s.push_str("intrinsics (refined, change from given, σ):\n");
+    let free = (0..9).filter(|&j| fit.sensor.free_intrinsics()[j]);
+    for (k, j) in (k0..).zip(free) {
+        let name = activecal::measure::pinhole::INTRINSIC_NAMES[j];
+        let unit = if j < 4 { " px" } else { "" };
+        let sd = fit.std.as_ref().map_or(f64::NAN, |sd| sd[k]);
+        let _ = writeln!(
+            s,
+            "  {name:<3} {:.6}{unit}  ({:+.6})  σ {sd:.6}{unit}",
+            fit.estimate[k],
+            fit.estimate[k] - fit.start[k]
+        );
+    }
+    for f in &fit.fixed_intrinsics {
+        let _ = writeln!(s, "  {} held at {}: {}", f.name, f.value, f.reason);
+    }
 }

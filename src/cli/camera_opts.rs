@@ -64,4 +64,10 @@ pub struct CameraOpts {
         requires = "camera_info"
     )]
     pub distance: String,
+    /// Keep only configurations whose rays from the camera's centre to the
+    /// target's points (stopped 1 mm short) cross none of the URDF's
+    /// collision geometry (nor an --obstacle); on whenever --self-collision,
+    /// --obstacle or --floor is given. Meshes found as --package-dir says.
+    #[arg(long, requires = "camera_info")]
+    pub line_of_sight: bool,
 }

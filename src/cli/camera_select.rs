@@ -14,10 +14,15 @@
 
 use super::camera_opts::CameraOpts;
 use super::select::SelectArgs;
+use activecal::collision::{CollisionSpec, Obstacle};
+use activecal::io::UrdfChain;
 use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_target::read_target;
+use activecal::model::Robot;
+use activecal::pool::PoolFilter;
 use activecal::pool::camera_view::CameraView;
-use activecal::select::camera::{CameraDesign, camera_design};
+use activecal::pool::line_of_sight::LineOfSight;
+use activecal::select::camera::{CameraDesign, camera_design_in_sight};
 use anyhow::{Context, Result, bail};
 use serde_json::json;
 use std::fmt::Write as _;
@@ -70,6 +75,61 @@ fn view(c: &CameraOpts) -> Result<CameraView> {
     v.validate()
         .map_err(|e| anyhow::anyhow!("camera view: {e}"))?;
     Ok(v)
+}
+
+/// The collision filters (`--self-collision`, `--obstacle`, `--floor`) and
+/// the line of sight (`--line-of-sight`, on with any of them) of a camera
+/// design.
+fn sight(a: &SelectArgs, robot: &Robot) -> Result<(Vec<PoolFilter>, Option<LineOfSight>)> {
+    let p = &a.pool;
+    let collision = p.self_collision || !p.obstacles.is_empty() || p.floor.is_some();
+    if !(collision || a.camera.line_of_sight) {
+        return Ok((Vec::new(), None));
+    }
+    if a.camera.camera_link.is_some() {
+        bail!(
+            "--line-of-sight, --self-collision, --obstacle and --floor are not available with --camera-link yet (the head's chain is not the URDF chain the collision model drives)"
+        );
+    }
+    let filters = if collision {
+        p.collision_filters(robot)?
+    } else if p.srdf.is_some() {
+        bail!("--srdf lists pairs of links for --self-collision, which is not given");
+    } else {
+        Vec::new()
+    };
+    let Some(chain) = UrdfChain::of(robot) else {
+        bail!(
+            "--line-of-sight needs a URDF robot with collision geometry (--robot FILE.urdf); {} has none",
+            p.robot
+        );
+    };
+    for d in &p.package_dirs {
+        if !d.exists() {
+            bail!("--package-dir {}: no such directory", d.display());
+        }
+    }
+    let obstacles = p
+        .obstacles
+        .iter()
+        .map(|o| Obstacle::parse(o).map_err(anyhow::Error::msg))
+        .collect::<Result<Vec<_>>>()?;
+    let spec = CollisionSpec {
+        urdf: chain.file,
+        text: Some(chain.text),
+        joints: chain.joints,
+        lock: chain.lock,
+        base: Some(chain.base),
+        package_dirs: p
+            .package_dirs
+            .iter()
+            .map(|d| d.display().to_string())
+            .collect(),
+        obstacles,
+        floor: p.floor,
+        ..CollisionSpec::default()
+    };
+    Ok((filters, Some(LineOfSight::new(spec))))
 }
 
 /// Options of `select` a camera design does not take (yet), refused
@@ -127,16 +187,30 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         None => robot,
     };
     let v = view(&a.camera)?;
+    let (filters, los) = sight(a, &robot)?;
     let candidates = activecal::observability::generic_configurations(
         &robot,
         a.pool.count.unwrap_or(DEFAULT_SAMPLES),
         a.pool.pool_seed.unwrap_or(0),
     );
+    // Candidates the collision filters keep, by their index in the samples.
+    let free: Vec<usize> = (0..candidates.len())
+        .filter(|&i| {
+            filters
+                .iter()
+                .all(|f| f.keeps(&robot, &robot.nominal, &candidates[i]))
+        })
+        .collect();
+    let collision_removed = (!filters.is_empty()).then(|| candidates.len() - free.len());
+    let free_qs: Vec<Vec<f64>> = free.iter().map(|&i| candidates[i].clone()).collect();
     let settings = activecal::select::Settings::builder()
         .n(a.n)
         .seed(a.seed)
         .build()?;
-    let d = camera_design(&robot, &v, &candidates, &settings)?;
+    let mut d = camera_design_in_sight(&robot, &v, los.as_ref(), &free_qs, &settings)?;
+    for c in &mut d.candidates {
+        *c = free[*c];
+    }
     let gap = if a.gap {
         let bs = activecal::bound::BoundSettings::builder()
             .solver(a.gap_solver)
@@ -157,6 +231,8 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         "candidates": candidates.len(),
         "pool_seed": a.pool.pool_seed.unwrap_or(0),
         "visible": d.visible,
+        "collision_removed": collision_removed,
+        "out_of_sight": d.out_of_sight,
         "unknowns": d.names,
         "ln_det": d.ln_det,
         "log10_bound": gap.as_ref().map(|g| g.log10_bound),
@@ -186,7 +262,14 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         .collect();
     value["out"] = json!(written);
     super::emit(a.json, &value, || {
-        text(&d, candidates.len(), gap.as_ref(), &csv, &written)
+        text(
+            &d,
+            candidates.len(),
+            collision_removed,
+            gap.as_ref(),
+            &csv,
+            &written,
+        )
     })
 }
 
@@ -194,6 +277,7 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
 fn text(
     d: &CameraDesign,
     candidates: usize,
+    collision_removed: Option<usize>,
     gap: Option<&activecal::bound::DesignGap>,
     csv: &str,
     written: &[String],
@@ -207,8 +291,22 @@ fn text(
             )
         },
     );
-    let mut s = format!(
-        "camera: the target is seen well at {} of {candidates} sampled configurations\nchose {} poses on the pixel Jacobian ({} unknowns): ln det XᵀX = {:.3} (unit pixel noise)\n",
+    let mut s = String::new();
+    if let Some(c) = collision_removed {
+        let _ = writeln!(
+            s,
+            "collision: removed {c} of {candidates} sampled configurations"
+        );
+    }
+    let (well, blocked) = d.out_of_sight.map_or((String::new(), String::new()), |o| {
+        (
+            " and in sight".to_string(),
+            format!(" ({o} more seen well, but the robot's collision geometry blocks a ray)"),
+        )
+    });
+    let _ = write!(
+        s,
+        "camera: the target is seen well{well} at {} of {candidates} sampled configurations{blocked}\nchose {} poses on the pixel Jacobian ({} unknowns): ln det XᵀX = {:.3} (unit pixel noise)\n",
         d.visible,
         d.qs.len(),
         d.names.len(),

@@ -245,6 +245,7 @@ impl CollisionModel {
             obstacles,
             exposed,
             drives,
+            base,
             clearance: spec.clearance,
             rest,
             always_touching: Vec::new(),

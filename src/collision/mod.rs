@@ -30,6 +30,7 @@ mod mesh_tree;
 mod model;
 mod moves;
 mod shapes;
+mod sight;
 mod spec;
 pub mod srdf;
 pub mod stl;

@@ -57,6 +57,9 @@ pub struct CollisionModel {
     pub(super) exposed: Vec<usize>,
     /// For each configuration value `k`, the tree joint it drives.
     pub(super) drives: Vec<usize>,
+    /// The chain's base link (the frame of obstacles and of line-of-sight
+    /// rays).
+    pub(super) base: usize,
     /// Least distance kept, metres ([`CollisionSpec::clearance`](super::CollisionSpec::clearance)).
     pub(super) clearance: f64,
     /// Joint values at a zero configuration (locks applied).
@@ -82,7 +85,7 @@ impl std::fmt::Debug for CollisionModel {
 impl CollisionModel {
     /// Every link's placement at configuration `q` (the chain's joint
     /// values over the rest configuration, locks applied).
-    fn link_placements(&self, q: &[f64]) -> Vec<Isometry3<f64>> {
+    pub(super) fn link_placements(&self, q: &[f64]) -> Vec<Isometry3<f64>> {
         let mut values = self.rest.clone();
         for (k, &j) in self.drives.iter().enumerate() {
             if let Some(v) = q.get(k) {

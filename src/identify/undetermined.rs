@@ -212,6 +212,16 @@ fn jacobian_at(robot: &Robot, start: &ParamTable, meas: &Measurements) -> Result
     Ok(x)
 }
 
+/// The columns of `x` the rule leaves undetermined (see the module
+/// documentation), ascending: `group[c]` is column `c`'s group (0 always
+/// kept, then 1, 2, … pivoted in that order), `pivot_tol` the pivot bar
+/// ([`PIVOT_TOL`] for the shared rule).
+#[must_use]
+pub fn undetermined_columns(x: &Mat<f64>, group: &[usize], pivot_tol: f64) -> Vec<usize> {
+    let kept = pivoted_selection(x, group, pivot_tol);
+    (0..x.ncols()).filter(|c| !kept.contains(c)).collect()
+}
+
 /// The columns kept by the grouped column-pivoted QR (see the module
 /// documentation), in pivot order.
 fn pivoted_selection(x: &Mat<f64>, group: &[usize], pivot_tol: f64) -> Vec<usize> {
@@ -289,6 +299,26 @@ fn passes_rank_rule(x: &Mat<f64>, cols: &[usize]) -> bool {
 
 #[cfg(test)]
 mod tests {
+
+    /// Columns 0, 1 (group 0) and 2, 3 (group 1), column 3 a multiple of
+    /// column 1 plus column 0: it is the one left undetermined (a later
+    /// group yields), column 2 (independent) is kept; with column 2 equal
+    /// to column 0 as well, both group-1 columns are reported.
+    #[test]
+    fn undetermined_columns_names_the_later_groups_dependent_column() {
+        let x = Mat::<f64>::from_fn(6, 4, |i, c| {
+            let (a, b) = (i as f64, ((i * i) % 5) as f64);
+            match c {
+                0 => a,
+                1 => b,
+                2 => (i as f64).sin(),
+                _ => 3.0 * b - 0.5 * a,
+            }
+        });
+        assert_eq!(undetermined_columns(&x, &[0, 0, 1, 1], PIVOT_TOL), [3]);
+        let y = Mat::<f64>::from_fn(6, 4, |i, c| if c == 2 { x[(i, 0)] } else { x[(i, c)] });
+        assert_eq!(undetermined_columns(&y, &[0, 0, 1, 1], PIVOT_TOL), [2, 3]);
+    }
     use super::*;
     use crate::identify::simulate;
     use crate::identify::trial_rng;

@@ -227,6 +227,43 @@ fn distortion(f: &InfoEntry) -> std::result::Result<[f64; 5], String> {
     Ok([d[0], d[1], d[2], d[3], d.get(4).copied().unwrap_or(0.0)])
 }
 
+/// A ROS `camera_info` YAML of `intrinsics` (as `camera_calibration`
+/// writes it: image size, `camera_name`, the camera matrix, `plumb_bob`
+/// distortion, an identity rectification and the projection matrix `[K |
+/// 0]`), every number in Rust's shortest form that reads back to the same
+/// value; `comment` goes first, on `#` lines.
+#[must_use]
+pub fn render_camera_info(intrinsics: &Intrinsics, camera_name: &str, comment: &str) -> String {
+    let i = intrinsics;
+    let f = |v: f64| format!("{v:?}");
+    let list = |v: &[f64]| v.iter().map(|x| f(*x)).collect::<Vec<_>>().join(", ");
+    let mut s = String::new();
+    for line in comment.lines() {
+        s += &format!("# {line}\n");
+    }
+    s += &format!(
+        "image_width: {}\nimage_height: {}\ncamera_name: {camera_name}\n",
+        i.width, i.height
+    );
+    s += &format!(
+        "camera_matrix:\n  rows: 3\n  cols: 3\n  data: [{}]\n",
+        list(&[i.fx, 0.0, i.cx, 0.0, i.fy, i.cy, 0.0, 0.0, 1.0])
+    );
+    s += "distortion_model: plumb_bob\n";
+    s += &format!(
+        "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [{}]\n",
+        list(&i.distortion)
+    );
+    s += "rectification_matrix:\n  rows: 3\n  cols: 3\n  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n";
+    s += &format!(
+        "projection_matrix:\n  rows: 3\n  cols: 4\n  data: [{}]\n",
+        list(&[
+            i.fx, 0.0, i.cx, 0.0, 0.0, i.fy, i.cy, 0.0, 0.0, 0.0, 1.0, 0.0
+        ])
+    );
+    s
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -276,6 +313,25 @@ distortion_coefficients: !!opencv-matrix
         let c = parse_camera_info(OPENCV, "cv.yaml").unwrap();
         assert_eq!((c.width, c.fx, c.cy), (640, 500.0, 240.0));
         assert_eq!(c.distortion, [0.1, -0.2, 0.0, 0.0, 0.05]);
+    }
+
+    /// A rendered camera_info reads back to the same values (17 digits),
+    /// and other tools' keys are there (rectification, projection).
+    #[test]
+    fn rendered_camera_info_reads_back_exactly() {
+        let c = Intrinsics {
+            width: 1280,
+            height: 960,
+            fx: 1000.123_456_789_012_3,
+            fy: 999.876_543_210_987_6,
+            cx: 640.1 + 1e-9,
+            cy: 479.9,
+            distortion: [-0.081_234, 0.041, 5.1e-4, -2.9e-4, -0.011],
+        };
+        let text = render_camera_info(&c, "cam", "refined\nby a test");
+        assert!(text.starts_with("# refined\n# by a test\n"));
+        assert!(text.contains("projection_matrix:") && text.contains("rectification_matrix:"));
+        assert_eq!(parse_camera_info(&text, "r.yaml").unwrap(), c);
     }
 
     /// Each wrong file is refused with the file, the key and its line.

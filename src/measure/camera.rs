@@ -127,6 +127,10 @@ pub struct CameraSensor {
     margin: f64,
     kinds: Vec<RowKind>,
     ones: Vec<f64>,
+    /// Which intrinsics are unknowns (in the order of
+    /// [`Intrinsics::values`]; own unknowns from 12 on, the free ones in
+    /// that order).
+    refine: [bool; 9],
 }
 
 /// How a camera sees its target at one pose ([`CameraSensor::view`]).
@@ -188,7 +192,59 @@ impl CameraSensor {
             margin: 0.0,
             kinds: vec![RowKind::Pixel; 2 * n],
             ones: vec![1.0; 2 * n],
+            refine: [false; 9],
         }
+    }
+
+    /// The sensor whose own unknowns also hold the intrinsics (`fx, fy,
+    /// cx, cy, k1, k2, p1, p2, k3` after the 12 placement unknowns, their
+    /// values rather than corrections) when `refine` is set.
+    #[must_use]
+    pub fn with_intrinsics_refined(self, refine: bool) -> Self {
+        self.with_free_intrinsics([refine; 9])
+    }
+
+    /// The sensor whose own unknowns hold the intrinsics `free` marks (in
+    /// the order of [`Intrinsics::values`]); the others stay as given.
+    #[must_use]
+    pub fn with_free_intrinsics(mut self, free: [bool; 9]) -> Self {
+        self.refine = free;
+        self
+    }
+
+    /// Which intrinsics are unknowns ([`CameraSensor::with_free_intrinsics`]).
+    #[must_use]
+    pub fn free_intrinsics(&self) -> [bool; 9] {
+        self.refine
+    }
+
+    /// Whether any intrinsic is an unknown ([`CameraSensor::with_intrinsics_refined`]).
+    #[must_use]
+    pub fn refines_intrinsics(&self) -> bool {
+        self.refine.iter().any(|f| *f)
+    }
+
+    /// The values of the free intrinsics as the sensor holds them (the
+    /// start of their unknowns).
+    #[must_use]
+    pub fn free_intrinsic_values(&self) -> Vec<f64> {
+        let v = self.intrinsics.values();
+        (0..9).filter(|&j| self.refine[j]).map(|j| v[j]).collect()
+    }
+
+    /// The intrinsics at own unknowns `own`: the sensor's, with the free
+    /// ones those `own` holds after the placements.
+    #[must_use]
+    pub fn intrinsics_at(&self, own: &[f64]) -> Intrinsics {
+        let mut v = self.intrinsics.values();
+        let mut k = OWN_PARAMS;
+        for (j, free) in self.refine.iter().enumerate() {
+            if *free && k < own.len() {
+                v[j] = own[k];
+                k += 1;
+            }
+        }
+        self.intrinsics.with_values(&v)
     }
 
     /// The sensor whose design rows keep the points at least `margin`
@@ -258,7 +314,9 @@ impl CameraSensor {
             c.rotation.to_rotation_matrix().into_inner(),
             t.rotation.to_rotation_matrix().into_inner(),
         ];
-        (s, Self::start_own(&c, &t))
+        let mut own1 = Self::start_own(&c, &t);
+        own1.extend_from_slice(&own[OWN_PARAMS.min(own.len())..]);
+        (s, own1)
     }
 
     /// The pixel rows of a measured value that hold a seen point (2 per
@@ -287,14 +345,14 @@ impl CameraSensor {
     #[must_use]
     pub fn view(&self, end: &EndFrame, own: &[f64], margin: f64) -> View {
         let f = self.frames(end, own);
+        let cam = self.intrinsics_at(own);
         let mut seen = 0;
         let mut centroid = Vector3::zeros();
         for k in 0..self.points.len() {
             let (x, _) = self.point(end, &f, k);
             centroid += x;
             seen += usize::from(
-                self.intrinsics
-                    .project(&x)
+                cam.project(&x)
                     .is_some_and(|p| self.intrinsics.inside(p.pixel, margin)),
             );
         }
@@ -374,9 +432,10 @@ impl CameraSensor {
         ld: usize,
     ) {
         let f = self.frames(end, own);
+        let cam = self.intrinsics_at(own);
         for k in 0..self.points.len() {
             let (x, l) = self.point(end, &f, k);
-            let proj = self.intrinsics.project(&x);
+            let proj = cam.project(&x);
             let rows = &mut out[2 * k * ld..];
             match proj.filter(|p| self.kept(k, Some(p), measured)) {
                 Some(p) => {
@@ -405,15 +464,26 @@ impl CameraSensor {
         ld: usize,
     ) {
         let f = self.frames(end, own);
+        let cam = self.intrinsics_at(own);
+        let n_own = self.n_own_params();
         for k in 0..self.points.len() {
             let (x, _) = self.point(end, &f, k);
-            let proj = self.intrinsics.project(&x);
+            let proj = cam.project(&x);
             let rows = &mut out[2 * k * ld..];
             let Some(p) = proj.filter(|p| self.kept(k, Some(p), measured)) else {
-                rows[..OWN_PARAMS].fill(0.0);
-                rows[ld..ld + OWN_PARAMS].fill(0.0);
+                rows[..n_own].fill(0.0);
+                rows[ld..ld + n_own].fill(0.0);
                 continue;
             };
+            if self.refines_intrinsics()
+                && let Some(ji) = cam.intrinsic_jacobian(&x)
+            {
+                let free = (0..9).filter(|&j| self.refine[j]);
+                for (c, j) in (OWN_PARAMS..n_own).zip(free) {
+                    rows[c] = ji[0][j];
+                    rows[ld + c] = ji[1][j];
+                }
+            }
             let blocks = [
                 -f.rct,
                 skew(&x) * f.jc,
@@ -475,14 +545,22 @@ impl Sensor for CameraSensor {
     }
 
     fn n_own_params(&self) -> usize {
-        OWN_PARAMS
+        OWN_PARAMS + self.refine.iter().filter(|f| **f).count()
     }
 
     fn own_param_names(&self) -> Vec<String> {
-        ["camera", "target"]
+        let mut names: Vec<String> = ["camera", "target"]
             .iter()
             .flat_map(|w| ["x", "y", "z", "rx", "ry", "rz"].map(|c| format!("{w}_{c}")))
-            .collect()
+            .collect();
+        names.extend(
+            crate::measure::pinhole::INTRINSIC_NAMES
+                .iter()
+                .zip(self.refine)
+                .filter(|(_, free)| *free)
+                .map(|(n, _)| format!("camera_{n}")),
+        );
+        names
     }
 
     fn encode(&self, obs: &Observation<'_>, out: &mut [f64]) {
@@ -503,10 +581,11 @@ impl Sensor for CameraSensor {
     /// not), `NaN, NaN, 0` for one behind it.
     fn predict(&self, end: &EndFrame, own: &[f64], out: &mut [f64]) {
         let f = self.frames(end, own);
+        let cam = self.intrinsics_at(own);
         for k in 0..self.points.len() {
             let (x, _) = self.point(end, &f, k);
             let o = &mut out[3 * k..3 * k + 3];
-            match self.intrinsics.project(&x) {
+            match cam.project(&x) {
                 Some(p) => o.copy_from_slice(&[p.pixel[0], p.pixel[1], 1.0]),
                 None => o.copy_from_slice(&[f64::NAN, f64::NAN, 0.0]),
             }

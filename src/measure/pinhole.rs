@@ -38,6 +38,10 @@ pub struct Intrinsics {
     pub distortion: [f64; 5],
 }
 
+/// The names of the intrinsics as unknowns, in the order of
+/// [`Intrinsics::values`].
+pub const INTRINSIC_NAMES: [&str; 9] = ["fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"];
+
 /// A projected point: its pixel and the derivative of the pixel with
 /// respect to the point in the optical frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -78,6 +82,71 @@ impl Intrinsics {
             pixel: [self.fx * xd + self.cx, self.fy * yd + self.cy],
             jacobian: d * n,
         })
+    }
+
+    /// The intrinsics as a vector: `fx, fy, cx, cy, k1, k2, p1, p2, k3`
+    /// (the order of [`INTRINSIC_NAMES`]).
+    #[must_use]
+    pub fn values(&self) -> [f64; 9] {
+        let d = self.distortion;
+        [
+            self.fx, self.fy, self.cx, self.cy, d[0], d[1], d[2], d[3], d[4],
+        ]
+    }
+
+    /// The same camera (image size kept) with the values `v` in the order
+    /// of [`Intrinsics::values`].
+    #[must_use]
+    pub fn with_values(&self, v: &[f64]) -> Intrinsics {
+        Intrinsics {
+            fx: v[0],
+            fy: v[1],
+            cx: v[2],
+            cy: v[3],
+            distortion: [v[4], v[5], v[6], v[7], v[8]],
+            ..self.clone()
+        }
+    }
+
+    /// `∂(u, v)/∂(fx, fy, cx, cy, k1, k2, p1, p2, k3)` at `p` (optical
+    /// frame), or `None` behind the camera (as [`Intrinsics::project`]).
+    #[must_use]
+    pub fn intrinsic_jacobian(&self, p: &Vector3<f64>) -> Option<[[f64; 9]; 2]> {
+        if !(p.z > 1e-9) {
+            return None;
+        }
+        let [k1, k2, p1, p2, k3] = self.distortion;
+        let (x, y) = (p.x / p.z, p.y / p.z);
+        let r2 = x * x + y * y;
+        let (r4, r6) = (r2 * r2, r2 * r2 * r2);
+        let rho = 1.0 + k1 * r2 + k2 * r4 + k3 * r6;
+        let xd = x * rho + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
+        let yd = y * rho + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
+        let (fx, fy) = (self.fx, self.fy);
+        Some([
+            [
+                xd,
+                0.0,
+                1.0,
+                0.0,
+                fx * x * r2,
+                fx * x * r4,
+                fx * 2.0 * x * y,
+                fx * (r2 + 2.0 * x * x),
+                fx * x * r6,
+            ],
+            [
+                0.0,
+                yd,
+                0.0,
+                1.0,
+                fy * y * r2,
+                fy * y * r4,
+                fy * (r2 + 2.0 * y * y),
+                fy * 2.0 * x * y,
+                fy * y * r6,
+            ],
+        ])
     }
 
     /// Whether a pixel lies inside the image, at least `margin` pixels

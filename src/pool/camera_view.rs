@@ -12,8 +12,8 @@
 //!
 //! Evaluated with the placements the filter is given (the start of a
 //! calibration, or a design's assumption) and the build's parameter table.
-//! Not checked here: the line of sight against the robot's own collision
-//! geometry (ray casts against [`crate::collision`]'s model are for later).
+//! The line of sight against the robot's own collision geometry is a
+//! separate check, [`crate::pool::line_of_sight`].
 
 use crate::kinematics::Evaluator;
 use crate::measure::camera::{CameraSensor, Mounting, View};
@@ -50,7 +50,7 @@ pub struct CameraView {
     pub distance: [f64; 2],
 }
 
-fn placement(v: &[f64; 6]) -> Isometry3<f64> {
+pub(crate) fn placement(v: &[f64; 6]) -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::new(v[0], v[1], v[2]),
         UnitQuaternion::from_euler_angles(v[3], v[4], v[5]),

@@ -18,6 +18,7 @@ mod build;
 pub mod camera_view;
 pub mod file;
 pub mod lattice;
+pub mod line_of_sight;
 pub mod sampled;
 pub mod stats;
 pub mod summary;

@@ -15,6 +15,8 @@ use crate::measure::Sensor;
 use crate::measure::camera::OWN_PARAMS;
 use crate::model::Robot;
 use crate::pool::camera_view::CameraView;
+use crate::pool::line_of_sight::LineOfSight;
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// A design for a camera.
@@ -24,10 +26,15 @@ pub struct CameraDesign {
     pub qs: Vec<Vec<f64>>,
     /// Each one's index in the candidates given.
     pub candidates: Vec<usize>,
-    /// The points each one will see (inside the image with the margin).
+    /// The points each one will see (inside the image with the margin, and
+    /// in sight with a line of sight).
     pub seen: Vec<usize>,
-    /// The candidates the view kept.
+    /// The candidates the view kept (and, with a line of sight, that
+    /// passed it).
     pub visible: usize,
+    /// Of the candidates the view kept, those the line of sight removed
+    /// ([`crate::pool::line_of_sight`]); `None` without one.
+    pub out_of_sight: Option<usize>,
     /// Unknowns: the robot's, then the camera's and the target's 6 each.
     pub names: Vec<String>,
     /// `ln det(XᵀX)` of the design (pixels per metre or radian, unit
@@ -96,17 +103,45 @@ pub fn camera_design(
     candidates: &[Vec<f64>],
     settings: &Settings,
 ) -> Result<CameraDesign> {
+    camera_design_in_sight(robot, view, None, candidates, settings)
+}
+
+/// As [`camera_design`], the pool also filtered by a line of sight
+/// ([`LineOfSight`]: the candidates the view keeps whose rays to enough
+/// target points the robot's collision geometry does not block); the
+/// design says how many it removed. Errors when its model cannot be loaded.
+pub fn camera_design_in_sight(
+    robot: &Robot,
+    view: &CameraView,
+    sight: Option<&LineOfSight>,
+    candidates: &[Vec<f64>],
+    settings: &Settings,
+) -> Result<CameraDesign> {
     view.validate()
         .map_err(|e| Error::Invalid(format!("camera view: {e}")))?;
+    if let Some(s) = sight {
+        s.load()
+            .map_err(|e| Error::Invalid(format!("line of sight: {e}")))?;
+    }
     let robot = camera_robot(robot)?;
-    let kept: Vec<usize> = (0..candidates.len())
+    let viewed: Vec<usize> = (0..candidates.len())
         .filter(|&i| view.keeps(&robot, &robot.nominal, &candidates[i]))
         .collect();
+    let kept: Vec<usize> = match sight {
+        Some(s) => viewed
+            .par_iter()
+            .copied()
+            .filter(|&i| s.keeps(view, &robot, &robot.nominal, &candidates[i]))
+            .collect(),
+        None => viewed.clone(),
+    };
+    let out_of_sight = sight.map(|_| viewed.len() - kept.len());
     if kept.len() < settings.n {
         return Err(Error::Invalid(format!(
-            "the camera sees its target well at {} of {} candidate configurations, fewer than the {} poses asked for: a larger pool, a wider view (fraction of points, margin, viewing angle, distance) or fewer poses",
+            "the camera sees its target well at {} of {} candidate configurations{}, fewer than the {} poses asked for: a larger pool, a wider view (fraction of points, margin, viewing angle, distance) or fewer poses",
             kept.len(),
             candidates.len(),
+            out_of_sight.map_or(String::new(), |b| format!(" ({b} more out of sight)")),
             settings.n
         )));
     }
@@ -116,7 +151,14 @@ pub fn camera_design(
     let seen = sel
         .poses
         .iter()
-        .map(|&k| view.view(&robot, &robot.nominal, &qs[k]).seen)
+        .map(|&k| match sight {
+            Some(s) => s
+                .seen_in_sight(view, &robot, &robot.nominal, &qs[k])
+                .iter()
+                .filter(|b| **b)
+                .count(),
+            None => view.view(&robot, &robot.nominal, &qs[k]).seen,
+        })
         .collect();
     let (sensor, own) = view.sensor();
     let mut names = robot.parameter_names();
@@ -127,6 +169,7 @@ pub fn camera_design(
         candidates: sel.poses.iter().map(|&k| kept[k]).collect(),
         seen,
         visible: kept.len(),
+        out_of_sight,
         names,
         ln_det: sel.ln_oid,
         predicted_error_per_px,

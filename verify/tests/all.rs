@@ -16,6 +16,8 @@ mod live_camera;
 #[cfg(feature = "live")]
 mod live_camera_head;
 #[cfg(feature = "live")]
+mod live_camera_sight;
+#[cfg(feature = "live")]
 mod live_camera_truth;
 #[cfg(feature = "live")]
 mod live_collision;

@@ -113,6 +113,37 @@ fn projection_and_its_jacobian_equal_opencv() {
     assert!(dj < 1e-9 * big, "Jacobian differs by {dj} px/m");
 }
 
+/// `∂(u, v)/∂(fx, fy, cx, cy, k1, k2, p1, p2, k3)`
+/// ([`Intrinsics::intrinsic_jacobian`], the columns `--refine-intrinsics`
+/// fits with) equal to OpenCV's focal, principal-point and distortion
+/// columns (6..15 of `projectPoints`' Jacobian) to 1e-9 relative to the
+/// largest entry (the same closed form in doubles).
+#[test]
+fn intrinsic_jacobian_equals_opencv() {
+    let _bridge = Bridge::new().expect("Python bridge (run scripts/setup)");
+    let c = intrinsics();
+    let pose = Isometry3::from_parts(
+        Translation3::new(0.05, -0.02, 0.1),
+        UnitQuaternion::from_euler_angles(0.2, -0.3, 0.4),
+    );
+    let pts = points(&pose);
+    let (_, jac) = opencv(&pts, &pose, &c);
+    let (mut dj, mut big) = (0.0f64, 0.0f64);
+    for (k, p) in pts.iter().enumerate() {
+        let x = pose * nalgebra::Point3::from(*p);
+        let ours = c.intrinsic_jacobian(&x.coords).expect("in front");
+        for r in 0..2 {
+            for col in 0..9 {
+                let theirs = jac[2 * k + r][6 + col];
+                big = big.max(theirs.abs());
+                dj = dj.max((ours[r][col] - theirs).abs());
+            }
+        }
+    }
+    println!("intrinsic Jacobian within {dj:.2e} (largest entry {big:.0})");
+    assert!(dj < 1e-9 * big, "intrinsic Jacobian differs by {dj}");
+}
+
 /// The sensor's predicted pixels of a target, both mountings, equal
 /// OpenCV's projection of the target's points under the camera-from-target
 /// transform the placements and the end frame compose (eye-to-hand:

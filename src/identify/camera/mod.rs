@@ -25,8 +25,12 @@ pub use unknowns::camera_robot;
 
 use super::lm::{LmSettings, Solution, StopReason, levenberg_marquardt};
 use super::residual::{Calibration, Residuals};
+use crate::identify::undetermined::{
+    FixedParameter, GENERIC_REASON, PIVOT_TOL, undetermined_columns,
+};
 use crate::linalg::qr::inverse_information;
 use crate::measure::camera::{CameraSensor, OWN_PARAMS};
+use crate::measure::pinhole::INTRINSIC_NAMES;
 use crate::model::{ParamTable, Robot};
 use nalgebra::Isometry3;
 
@@ -108,6 +112,22 @@ pub struct CameraFit {
     pub stop: StopReason,
     /// Its iterations.
     pub iterations: usize,
+    /// The intrinsics asked to be refined that the data do not determine,
+    /// held at their given values, with the reason
+    /// ([`crate::identify::undetermined`]'s rule, the intrinsics pivoted
+    /// after every other unknown).
+    pub fixed_intrinsics: Vec<FixedParameter>,
+}
+
+impl CameraFit {
+    /// The intrinsics at the estimate: refined ones when the sensor
+    /// refines them ([`CameraSensor::with_intrinsics_refined`]), else the
+    /// sensor's.
+    #[must_use]
+    pub fn intrinsics(&self) -> crate::measure::pinhole::Intrinsics {
+        self.sensor
+            .intrinsics_at(&self.estimate[self.robot.n_unknowns()..])
+    }
 }
 
 /// Why a camera fit could not be made at all (bad input, or a start from
@@ -180,7 +200,7 @@ pub fn fit_camera(
 ) -> Result<CameraFit, CameraFitError> {
     let robot = camera_robot(robot)?;
     let rows = 2 * obs.n_seen();
-    let p = robot.n_unknowns() + OWN_PARAMS;
+    let p = robot.n_unknowns() + crate::measure::Sensor::n_own_params(sensor);
     if rows <= p {
         return Err(CameraFitError::TooFewRows { rows, p });
     }
@@ -191,18 +211,22 @@ pub fn fit_camera(
     // 1. The placements alone, the robot nominal.
     let mut rigid_robot = robot.clone();
     rigid_robot.unknowns.clear();
+    // (with the intrinsics as given).
+    let own0 = &own0[..OWN_PARAMS];
     let mut rigid = Calibration::with_sensor(
         &rigid_robot,
         &robot.nominal,
         &obs.qs,
-        Box::new(sensor.clone()),
+        Box::new(sensor.clone().with_intrinsics_refined(false)),
         values.clone(),
     );
     let given_rms_px = rms_px(&mut rigid, own0, rows);
     let sol0 = levenberg_marquardt(&mut rigid, own0, lm);
     let rigid_rms_px = (sol0.rss / rows as f64).sqrt();
-    // 2. Everything, the charts re-centred on the rigid start.
+    // 2. Everything, the charts re-centred on the rigid start (the
+    // intrinsics, when refined, starting from the sensor's).
     let (sensor, own1) = sensor.recentred(&sol0.theta);
+    let (sensor, own1, fixed_intrinsics) = free_intrinsics(&robot, sensor, own1, obs);
     let mut theta0 = robot.unknown_values(&robot.nominal);
     theta0.extend_from_slice(&own1);
     let mut prob = Calibration::with_sensor(
@@ -213,7 +237,7 @@ pub fn fit_camera(
         values,
     );
     let sol = levenberg_marquardt(&mut prob, &theta0, lm);
-    Ok(finish(
+    let mut fit = finish(
         robot,
         sensor,
         theta0,
@@ -222,7 +246,9 @@ pub fn fit_camera(
         given_rms_px,
         rigid_rms_px,
         rows,
-    ))
+    );
+    fit.fixed_intrinsics = fixed_intrinsics;
+    Ok(fit)
 }
 
 /// Whether a stop means the solver found a minimum.
@@ -287,5 +313,62 @@ fn finish(
         redundancy,
         stop: sol.stop,
         iterations: sol.iterations,
+        fixed_intrinsics: Vec::new(),
     }
+}
+
+/// The sensor and own start of the full fit, with the intrinsics refined
+/// only where the data determine them: the own unknowns `own1` (the
+/// placements) extended by the free intrinsics' given values, the
+/// Jacobian at that start checked by [`undetermined_columns`] with the
+/// intrinsics pivoted last; those left undetermined are fixed at their
+/// given values, each with the reason.
+fn free_intrinsics(
+    robot: &Robot,
+    sensor: CameraSensor,
+    mut own1: Vec<f64>,
+    obs: &CameraObservations,
+) -> (CameraSensor, Vec<f64>, Vec<FixedParameter>) {
+    if !sensor.refines_intrinsics() {
+        return (sensor, own1, Vec::new());
+    }
+    let placed = own1.len();
+    own1.extend(sensor.free_intrinsic_values());
+    let mut theta = robot.unknown_values(&robot.nominal);
+    theta.extend_from_slice(&own1);
+    let mut prob = Calibration::with_sensor(
+        robot,
+        &robot.nominal,
+        &obs.qs,
+        Box::new(sensor.clone()),
+        obs.values(),
+    );
+    let mut r = vec![0.0; prob.n_residuals()];
+    let mut x = faer::Mat::<f64>::zeros(prob.n_residuals(), prob.n_params());
+    prob.eval(&theta, &mut r, Some(&mut x));
+    let first = robot.n_unknowns() + placed;
+    let group: Vec<usize> = (0..x.ncols()).map(|c| usize::from(c >= first)).collect();
+    let out = undetermined_columns(&x, &group, PIVOT_TOL);
+    if out.is_empty() {
+        return (sensor, own1, Vec::new());
+    }
+    let free: Vec<usize> = (0..9).filter(|&j| sensor.free_intrinsics()[j]).collect();
+    let given = sensor.intrinsics().values();
+    let mut mask = sensor.free_intrinsics();
+    let fixed = out
+        .iter()
+        .map(|&c| {
+            let j = free[c - first];
+            mask[j] = false;
+            FixedParameter {
+                name: format!("camera_{}", INTRINSIC_NAMES[j]),
+                value: given[j],
+                reason: GENERIC_REASON.to_string(),
+            }
+        })
+        .collect();
+    let sensor = sensor.with_free_intrinsics(mask);
+    own1.truncate(placed);
+    own1.extend(sensor.free_intrinsic_values());
+    (sensor, own1, fixed)
 }

@@ -1,0 +1,124 @@
+//! The line of sight of a camera pool ([`super::camera_view`]): a
+//! configuration is kept when enough of the target's points are both inside
+//! the image (with the view's margin) and in sight, the straight segment
+//! from the camera's centre to the point crossing none of the robot's
+//! collision geometry ([`crate::collision`]'s model, loaded from the URDF's
+//! `<collision>` elements as the self-collision filter loads it) nor an
+//! obstacle of its spec.
+//!
+//! Each segment stops [`DEFAULT_STOP`] (1 mm) short of its point, so that a
+//! ray ending on the target's own surface is not blocked by it; the link
+//! the target (eye-to-hand) or the camera (eye-in-hand) is mounted on — the
+//! chain's tip and every link fixed to it — is not checked: the board or
+//! camera is fixed to it, and a flange behind the board is already excluded
+//! by the viewing angle. Moving links past the tip (gripper fingers) are
+//! checked.
+
+use crate::collision::{CollisionFilter, CollisionModel, CollisionSpec};
+use crate::kinematics::Evaluator;
+use crate::measure::camera::Mounting;
+use crate::model::{ParamTable, Robot};
+use crate::pool::camera_view::{CameraView, placement};
+use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion};
+use std::sync::Arc;
+
+/// How far short of a target point a ray stops, metres.
+pub const DEFAULT_STOP: f64 = 1e-3;
+
+/// The line-of-sight check of a camera pool (see the module documentation).
+#[derive(Clone, Debug)]
+pub struct LineOfSight {
+    /// The collision model's spec (its URDF, chain, package directories,
+    /// obstacles); its pairs and clearance are not used.
+    pub collision: CollisionFilter,
+    /// How far short of each point a ray stops, metres (≥ 0).
+    pub stop: f64,
+}
+
+/// The points of the target and the camera's centre in the base frame at
+/// `q`, and which points the camera sees inside the image with the margin.
+#[must_use]
+pub fn rays(
+    view: &CameraView,
+    robot: &Robot,
+    table: &ParamTable,
+    q: &[f64],
+) -> (Point3<f64>, Vec<Point3<f64>>, Vec<bool>) {
+    let e = Evaluator::new(robot, table).end_frame(q);
+    let end = Isometry3::from_parts(
+        Translation3::from(e.position),
+        UnitQuaternion::from_matrix(&e.rotation),
+    );
+    let (cam, tgt) = (placement(&view.camera), placement(&view.target));
+    let (cam, tgt) = match view.mounting {
+        Mounting::EyeToHand => (cam, end * tgt),
+        Mounting::EyeInHand => (end * cam, tgt),
+    };
+    let pts: Vec<Point3<f64>> = view
+        .points
+        .iter()
+        .map(|p| tgt * Point3::new(p[0], p[1], p[2]))
+        .collect();
+    let inside = pts
+        .iter()
+        .map(|p| {
+            let x = cam.inverse_transform_point(p).coords;
+            view.intrinsics
+                .project(&x)
+                .is_some_and(|pr| view.intrinsics.inside(pr.pixel, view.margin_px))
+        })
+        .collect();
+    (Point3::from(cam.translation.vector), pts, inside)
+}
+
+impl LineOfSight {
+    /// The check against the model of `spec` (loaded on first use), rays
+    /// stopping [`DEFAULT_STOP`] short.
+    #[must_use]
+    pub fn new(spec: CollisionSpec) -> Self {
+        Self {
+            collision: CollisionFilter::new(spec),
+            stop: DEFAULT_STOP,
+        }
+    }
+
+    /// The loaded model, or why it cannot be loaded.
+    pub fn load(&self) -> Result<Arc<CollisionModel>, String> {
+        self.collision.load()
+    }
+
+    /// For each target point at `q`: seen inside the image and in sight.
+    /// Empty when the model cannot be loaded ([`LineOfSight::load`] says why).
+    #[must_use]
+    pub fn seen_in_sight(
+        &self,
+        view: &CameraView,
+        robot: &Robot,
+        table: &ParamTable,
+        q: &[f64],
+    ) -> Vec<bool> {
+        let Ok(model) = self.load() else {
+            return Vec::new();
+        };
+        let (eye, pts, inside) = rays(view, robot, table, q);
+        let blocked = model.blocked_rays(q, &eye, &pts, self.stop, true);
+        inside
+            .iter()
+            .zip(&blocked)
+            .map(|(i, b)| *i && !*b)
+            .collect()
+    }
+
+    /// Whether at least the view's fraction of the target's points are seen
+    /// and in sight at `q` (the view's other tests are
+    /// [`CameraView::keeps`]'s).
+    #[must_use]
+    pub fn keeps(&self, view: &CameraView, robot: &Robot, table: &ParamTable, q: &[f64]) -> bool {
+        let n = self
+            .seen_in_sight(view, robot, table, q)
+            .iter()
+            .filter(|s| **s)
+            .count();
+        n > 0 && n as f64 >= view.min_fraction * view.points.len() as f64
+    }
+}

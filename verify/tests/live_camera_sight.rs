@@ -1,0 +1,214 @@
+//! Live check of the camera pool's line of sight
+//! (`activecal::pool::line_of_sight`) against Pinocchio + Coal
+//! (`verify/python/coal_sight.py`, feature `live`): on example-robot-data's
+//! Panda eye-to-hand (the camera and board of `live_camera_truth`'s Panda
+//! gate), `activecal select --line-of-sight` chooses 20 poses whose every
+//! ray to the board's 48 points is free in Coal too; and on 150
+//! configurations the view keeps (before the line of sight), activecal's
+//! parry ray casts and Coal's segment collisions agree ray by ray, a
+//! disagreement allowed only for a ray that grazes the geometry (Coal's
+//! distance from the segment under 0.1 mm: a mesh edge met at a glancing
+//! angle, where the two libraries' floating-point tests may differ).
+
+use activecal::collision::CollisionSpec;
+use activecal::io::UrdfChain;
+use activecal::io::camera_info::read_camera_info;
+use activecal::io::camera_target::read_target;
+use activecal::measure::camera::Mounting;
+use activecal::pool::camera_view::CameraView;
+use activecal::pool::line_of_sight::{DEFAULT_STOP, LineOfSight, rays};
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .to_path_buf()
+}
+
+const JOINTS: &str =
+    "panda_joint1,panda_joint2,panda_joint3,panda_joint4,panda_joint5,panda_joint6,panda_joint7";
+const CAMERA: &str = "1.2,0.6,0.9,-2.0985,0,2.0779";
+const TARGET: &str = "-0.0853,0.0568,0.02,3.141592653589793,0,0.03";
+
+fn six(s: &str) -> [f64; 6] {
+    s.split(',')
+        .map(|v| v.parse().unwrap())
+        .collect::<Vec<f64>>()
+        .try_into()
+        .unwrap()
+}
+
+/// Coal's verdicts on `cases` ([{q, eye, points}], base frame).
+fn coal(cases: &Value, dir: &Path, name: &str) -> Value {
+    let r = root();
+    let (rays_file, out) = (
+        dir.join(format!("{name}.json")),
+        dir.join(format!("{name}_coal.json")),
+    );
+    std::fs::write(&rays_file, cases.to_string()).unwrap();
+    let status = Command::new(r.join(".venv/bin/python"))
+        .arg(r.join("verify/python/coal_sight.py"))
+        .arg(r.join("fixtures/example-robot-data/panda.urdf"))
+        .arg(r.join("fixtures"))
+        .args([JOINTS, "panda_link0", "panda_joint7"])
+        .arg(&rays_file)
+        .arg(&out)
+        .status()
+        .expect("the venv's python (run scripts/setup)");
+    assert!(status.success());
+    serde_json::from_str(&std::fs::read_to_string(out).unwrap()).unwrap()
+}
+
+#[test]
+fn panda_line_of_sight_agrees_with_coal() {
+    let dir = std::env::temp_dir().join(format!("activecal-live-sight-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let r = root();
+    let robot_ref = format!(
+        "{}#tip=panda_hand_tcp",
+        r.join("fixtures/example-robot-data/panda.urdf").display()
+    );
+    let robot = activecal::io::load_robot(&robot_ref).unwrap();
+    let view = CameraView {
+        intrinsics: read_camera_info(&r.join("fixtures/camera/camera_info.yaml")).unwrap(),
+        mounting: Mounting::EyeToHand,
+        points: read_target(&r.join("fixtures/camera/board.yaml"))
+            .unwrap()
+            .points
+            .iter()
+            .map(|p| [p.x, p.y, p.z])
+            .collect(),
+        camera: six(CAMERA),
+        target: six(TARGET),
+        min_fraction: 1.0,
+        margin_px: 20.0,
+        max_view_angle: 60f64.to_radians(),
+        distance: [0.3, 2.0],
+    };
+    let case = |q: &[f64]| {
+        let (eye, pts, _) = rays(&view, &robot, &robot.nominal, q);
+        json!({"q": q, "eye": [eye.x, eye.y, eye.z],
+               "points": pts.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>()})
+    };
+    // The chosen poses of `select --line-of-sight`: every ray free in Coal.
+    let bin = r.join("target/debug/activecal");
+    let design = dir.join("design.json");
+    let out = Command::new(&bin)
+        .current_dir(&r)
+        .args([
+            "select",
+            "--robot",
+            &robot_ref,
+            "--camera-info",
+            "fixtures/camera/camera_info.yaml",
+        ])
+        .args([
+            "--target",
+            "fixtures/camera/board.yaml",
+            "--mounting",
+            "eye-to-hand",
+        ])
+        .arg(format!("--camera-pose={CAMERA}"))
+        .arg(format!("--target-pose={TARGET}"))
+        .args([
+            "--image-margin",
+            "20",
+            "--distance",
+            "0.3,2.0",
+            "--n",
+            "20",
+            "--count",
+            "5000",
+        ])
+        .args(["--line-of-sight", "--force", "--out"])
+        .arg(&design)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let d: Value = serde_json::from_str(&std::fs::read_to_string(&design).unwrap()).unwrap();
+    let removed = d["out_of_sight"].as_u64().unwrap();
+    eprintln!(
+        "Panda eye-to-hand: {} in sight, {removed} more seen but out of sight",
+        d["visible"]
+    );
+    assert!(
+        removed > 0,
+        "the line of sight removed nothing: the check would be vacuous"
+    );
+    let chosen: Vec<Vec<f64>> = serde_json::from_value(d["poses"].clone()).unwrap();
+    assert_eq!(chosen.len(), 20);
+    let cases = Value::Array(chosen.iter().map(|q| case(q)).collect());
+    let verdict = coal(&cases, &dir, "chosen");
+    for (k, b) in verdict["blocked"].as_array().unwrap().iter().enumerate() {
+        let hits = b
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|x| x.as_bool().unwrap())
+            .count();
+        assert_eq!(
+            hits, 0,
+            "chosen pose {k}: {hits} of its rays blocked in Coal"
+        );
+    }
+    // A sample the view keeps, before the line of sight: ray by ray.
+    let chain = UrdfChain::of(&robot).unwrap();
+    let sight = LineOfSight::new(CollisionSpec {
+        urdf: chain.file,
+        text: Some(chain.text),
+        joints: chain.joints,
+        lock: chain.lock,
+        base: Some(chain.base),
+        ..CollisionSpec::default()
+    });
+    let model = sight.load().unwrap();
+    let sample: Vec<Vec<f64>> = activecal::observability::generic_configurations(&robot, 5000, 7)
+        .into_iter()
+        .filter(|q| view.keeps(&robot, &robot.nominal, q))
+        .take(150)
+        .collect();
+    assert_eq!(sample.len(), 150);
+    let verdict = coal(
+        &Value::Array(sample.iter().map(|q| case(q)).collect()),
+        &dir,
+        "sample",
+    );
+    let (mut rays_n, mut blocked_n, mut grazing, mut configs_blocked) = (0, 0, 0, 0);
+    for (k, q) in sample.iter().enumerate() {
+        let (eye, pts, _) = rays(&view, &robot, &robot.nominal, q);
+        let ours = model.blocked_rays(q, &eye, &pts, DEFAULT_STOP, true);
+        configs_blocked += usize::from(ours.iter().any(|b| *b));
+        for (i, b) in ours.iter().enumerate() {
+            rays_n += 1;
+            blocked_n += usize::from(*b);
+            let theirs = verdict["blocked"][k][i].as_bool().unwrap();
+            if *b != theirs {
+                let dist = verdict["distance"][k][i].as_f64().unwrap();
+                assert!(
+                    dist < 1e-4,
+                    "configuration {k} ray {i}: activecal {b}, Coal {theirs}, Coal distance {dist} m"
+                );
+                grazing += 1;
+            }
+        }
+    }
+    eprintln!(
+        "{rays_n} rays at 150 configurations: {blocked_n} blocked ({configs_blocked} configurations), {grazing} grazing disagreements"
+    );
+    assert!(
+        configs_blocked > 10 && configs_blocked < 140,
+        "{configs_blocked} of 150 blocked: the sample must hold both"
+    );
+    assert!(
+        grazing * 1000 <= rays_n,
+        "{grazing} of {rays_n} rays disagree"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

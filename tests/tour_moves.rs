@@ -221,35 +221,47 @@ fn link_names(pair: &[String; 2]) -> [String; 2] {
     v
 }
 
-#[test]
-fn moves_on_the_panda_and_the_ur10_are_checked_as_coal_checks_them() {
+/// The Coal fixture's scenes (the Panda and the UR10 with their moves and
+/// Coal's verdicts).
+fn coal_scenes() -> Vec<Scene> {
     let root = env!("CARGO_MANIFEST_DIR");
     let text = std::fs::read_to_string(format!(
         "{root}/fixtures/example-robot-data/tour_moves_coal.json"
     ))
     .unwrap();
     let fixture: serde_json::Value = serde_json::from_str(&text).unwrap();
-    let scenes: Vec<Scene> = serde_json::from_value(fixture["scenes"].clone()).unwrap();
+    serde_json::from_value(fixture["scenes"].clone()).unwrap()
+}
+
+/// A scene's collision model: self-collision, its SRDF, floor and boxes.
+fn scene_model(sp: &SceneSpec) -> CollisionModel {
+    let root = env!("CARGO_MANIFEST_DIR");
+    CollisionModel::load(&CollisionSpec {
+        urdf: format!("{root}/{}", sp.urdf),
+        joints: sp.joints.clone(),
+        self_collision: true,
+        srdf: sp.srdf.as_ref().map(|f| format!("{root}/{f}")),
+        floor: sp.floor,
+        obstacles: sp
+            .boxes
+            .iter()
+            .map(|b| Obstacle::Box {
+                center: [b[0], b[1], b[2]],
+                size: [b[3], b[4], b[5]],
+            })
+            .collect(),
+        ..CollisionSpec::default()
+    })
+    .unwrap()
+}
+
+#[test]
+fn moves_on_the_panda_and_the_ur10_are_checked_as_coal_checks_them() {
+    let scenes = coal_scenes();
     assert_eq!(scenes.len(), 2);
     for s in &scenes {
         let sp = &s.spec;
-        let m = CollisionModel::load(&CollisionSpec {
-            urdf: format!("{root}/{}", sp.urdf),
-            joints: sp.joints.clone(),
-            self_collision: true,
-            srdf: sp.srdf.as_ref().map(|f| format!("{root}/{f}")),
-            floor: sp.floor,
-            obstacles: sp
-                .boxes
-                .iter()
-                .map(|b| Obstacle::Box {
-                    center: [b[0], b[1], b[2]],
-                    size: [b[3], b[4], b[5]],
-                })
-                .collect(),
-            ..CollisionSpec::default()
-        })
-        .unwrap();
+        let m = scene_model(sp);
         let mut colliding = 0;
         for (k, ([a, b], coal)) in sp.moves.iter().zip(&s.coal).enumerate() {
             let ours = m.check_move(a, b, sp.resolution);
@@ -390,24 +402,10 @@ fn a_stretch_of_poses_turned_by_a_whole_turn_goes_round_the_other_way() {
 /// Panda's fixture scene, the ends of its colliding moves as a tour.
 #[test]
 fn a_tour_s_checks_do_not_depend_on_the_thread_count() {
-    let root = env!("CARGO_MANIFEST_DIR");
-    let text = std::fs::read_to_string(format!(
-        "{root}/fixtures/example-robot-data/tour_moves_coal.json"
-    ))
-    .unwrap();
-    let fixture: serde_json::Value = serde_json::from_str(&text).unwrap();
-    let scenes: Vec<Scene> = serde_json::from_value(fixture["scenes"].clone()).unwrap();
+    let scenes = coal_scenes();
     let s = scenes.iter().find(|s| s.scene == "panda").unwrap();
     let sp = &s.spec;
-    let m = CollisionModel::load(&CollisionSpec {
-        urdf: format!("{root}/{}", sp.urdf),
-        joints: sp.joints.clone(),
-        self_collision: true,
-        srdf: sp.srdf.as_ref().map(|f| format!("{root}/{f}")),
-        floor: sp.floor,
-        ..CollisionSpec::default()
-    })
-    .unwrap();
+    let m = scene_model(sp);
     // The ends of the moves Coal finds colliding, in turn: the tour's
     // moves a → b collide and have to be repaired.
     let qs: Vec<Vec<f64>> = sp

@@ -46,14 +46,8 @@ pub fn bound<'py>(
         detached(py, move || {
             let settings = BoundSettings::default();
             let b = relaxation_bound(&c.x, prior.as_ref(), n, &settings)?;
-            let report = BoundCommandReport::new(
-                &r,
-                &c.pool,
-                &b,
-                ParamSet::Nominal,
-                settings,
-                weights,
-            );
+            let report =
+                BoundCommandReport::new(&r, &c.pool, &b, ParamSet::Nominal, settings, weights);
             Ok(serde_json::to_value(&report)?)
         })
     })?;

@@ -28,6 +28,33 @@ struct Loaded {
 
 static LOADED: PyOnceLock<Loaded> = PyOnceLock::new();
 
+/// The workspace's root directory (where `fixtures/` and `verify/` are).
+#[must_use]
+pub fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("verify/ is inside the workspace")
+        .to_path_buf()
+}
+
+/// The project venv's Python as a command to run a script with.
+#[must_use]
+pub fn python() -> std::process::Command {
+    std::process::Command::new(venv_dir().join("bin/python"))
+}
+
+/// Runs `c` and returns its stdout; panics with its stderr when it fails
+/// (the live tests' way of running the binary and the Python checks).
+pub fn run(c: &mut std::process::Command) -> String {
+    let out = c.output().expect("the command starts");
+    assert!(
+        out.status.success(),
+        "{c:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("UTF-8 output")
+}
+
 /// The project venv: `$ACTIVECAL_VENV` if set, else `<workspace>/.venv`.
 #[must_use]
 pub fn venv_dir() -> PathBuf {

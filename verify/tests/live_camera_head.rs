@@ -27,29 +27,9 @@ use activecal::observability::generic_configurations;
 use activecal::pool::camera_view::CameraView;
 use activecal::select::camera::camera_design;
 use serde_json::Value;
-use std::path::{Path, PathBuf};
+
 use std::process::Command;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-fn run(c: &mut Command) -> String {
-    let out = c.output().expect("runs");
-    assert!(
-        out.status.success(),
-        "{c:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
-
-fn python() -> Command {
-    Command::new(verify::bridge::venv_dir().join("bin/python"))
-}
+use verify::bridge::{python, repo_root as root, run};
 
 /// The true placements (the Xtion's RGB optical frame in `head_2_link`,
 /// the board in `arm_tool_link`) and the fit's start (2 cm and ~2° off),

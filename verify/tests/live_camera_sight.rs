@@ -18,15 +18,9 @@ use activecal::measure::camera::Mounting;
 use activecal::pool::camera_view::CameraView;
 use activecal::pool::line_of_sight::{DEFAULT_STOP, LineOfSight, rays};
 use serde_json::{Value, json};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
+use verify::bridge::repo_root as root;
 
 const JOINTS: &str =
     "panda_joint1,panda_joint2,panda_joint3,panda_joint4,panda_joint5,panda_joint6,panda_joint7";

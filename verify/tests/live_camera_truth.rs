@@ -33,27 +33,7 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-fn run(c: &mut Command) -> String {
-    let out = c.output().expect("runs");
-    assert!(
-        out.status.success(),
-        "{c:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
-
-fn python() -> Command {
-    Command::new(verify::bridge::venv_dir().join("bin/python"))
-}
+use verify::bridge::{python, repo_root as root, run};
 
 fn six(t: &Isometry3<f64>) -> String {
     let (r, p, y) = t.rotation.euler_angles();

@@ -168,6 +168,33 @@ pub struct Solution {
     pub lambda: f64,
 }
 
+impl Solution {
+    /// The estimate's covariance `σ² (JᵀJ)⁻¹` at the solution for a
+    /// residual σ `sigma`, and its standard deviations (the roots of its
+    /// diagonal): both `None` when σ is unknown or the Jacobian is not
+    /// finite or not of full rank.
+    #[must_use]
+    pub fn covariance(&self, sigma: Option<f64>) -> (Option<Vec<Vec<f64>>>, Option<Vec<f64>>) {
+        let p = self.theta.len();
+        let inv = self
+            .finite
+            .then(|| crate::linalg::qr::inverse_information(self.jac.as_ref()))
+            .flatten();
+        let covariance: Option<Vec<Vec<f64>>> = match (inv, sigma) {
+            (Some(inv), Some(s)) => Some(
+                (0..p)
+                    .map(|i| (0..p).map(|j| s * s * inv[(i, j)]).collect())
+                    .collect(),
+            ),
+            _ => None,
+        };
+        let std = covariance
+            .as_ref()
+            .map(|c| (0..p).map(|j| c[j][j].max(0.0).sqrt()).collect());
+        (covariance, std)
+    }
+}
+
 /// Ceiling on the scaled damping: past it a step is ~1e-32 of a gradient step.
 const MAX_DAMPING: f64 = 1e32;
 /// Smallest gain ratio for accepting a step.

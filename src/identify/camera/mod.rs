@@ -28,7 +28,6 @@ use super::residual::{Calibration, Residuals};
 use crate::identify::undetermined::{
     FixedParameter, GENERIC_REASON, PIVOT_TOL, undetermined_columns,
 };
-use crate::linalg::qr::inverse_information;
 use crate::measure::camera::{CameraSensor, OWN_PARAMS};
 use crate::measure::pinhole::INTRINSIC_NAMES;
 use crate::model::{ParamTable, Robot};
@@ -274,21 +273,7 @@ fn finish(
     let p = theta0.len();
     let redundancy = rows - p;
     let sigma_px = (sol.rss.is_finite()).then(|| (sol.rss / redundancy as f64).sqrt());
-    let inv = sol
-        .finite
-        .then(|| inverse_information(sol.jac.as_ref()))
-        .flatten();
-    let covariance: Option<Vec<Vec<f64>>> = match (&inv, sigma_px) {
-        (Some(inv), Some(s)) => Some(
-            (0..p)
-                .map(|i| (0..p).map(|j| s * s * inv[(i, j)]).collect())
-                .collect(),
-        ),
-        _ => None,
-    };
-    let std = covariance
-        .as_ref()
-        .map(|c| (0..p).map(|j| c[j][j].max(0.0).sqrt()).collect());
+    let (covariance, std) = sol.covariance(sigma_px);
     let n_kin = robot.n_unknowns();
     let (camera, target) = sensor.placements(&sol.theta[n_kin..]);
     let mut names = robot.parameter_names();

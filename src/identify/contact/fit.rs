@@ -19,7 +19,6 @@ use crate::identify::lm::{Solution, StopReason, levenberg_marquardt};
 use crate::identify::loss::{Cauchy, Huber, Loss};
 use crate::identify::undetermined::{FixedParameter, fix_undetermined_below};
 use crate::identify::{Calibration, LmSettings, LossChoice, Residuals, Result};
-use crate::linalg::qr::inverse_information;
 use crate::measure::contact::{ContactSensor, KnownDistance, Plane, PlaneKind};
 use crate::model::{ParamTable, Robot};
 use faer::Mat;
@@ -523,21 +522,7 @@ fn finish(
     let m = prob.n_residuals();
     let dof = m.saturating_sub(p);
     let sigma_hat = (dof > 0 && sol.rss.is_finite()).then(|| (sol.rss / dof as f64).sqrt());
-    let inv = sol
-        .finite
-        .then(|| inverse_information(sol.jac.as_ref()))
-        .flatten();
-    let covariance: Option<Vec<Vec<f64>>> = match (&inv, sigma_hat) {
-        (Some(inv), Some(s)) => Some(
-            (0..p)
-                .map(|i| (0..p).map(|j| s * s * inv[(i, j)]).collect())
-                .collect(),
-        ),
-        _ => None,
-    };
-    let std = covariance
-        .as_ref()
-        .map(|c| (0..p).map(|j| c[j][j].max(0.0).sqrt()).collect());
+    let (covariance, std) = sol.covariance(sigma_hat);
     let own = &sol.theta[n_kin..];
     let sensor = ContactSensor::new(file.points.clone(), Vec::new())
         .with_planes(planes.to_vec())

@@ -50,8 +50,15 @@ pub struct CameraDesign {
     /// The selection's own record.
     #[serde(skip)]
     pub selection: Selection,
+    /// The largest rank of a visible pose's pixel information `XᵢᵀXᵢ`
+    /// (6 for a camera that sees a rigid target: the pixels move with the
+    /// target's placement in the camera only); each pose's block is
+    /// compressed to this many rows ([`Blocks::compressed`]).
+    pub rank_per_pose: usize,
     /// The pixel Jacobian blocks of the visible pool (the candidates the
-    /// view kept, in order), which the selection's positions index.
+    /// view kept, in order), which the selection's positions index,
+    /// compressed to [`Self::rank_per_pose`] rows a pose (the same
+    /// information).
     #[serde(skip)]
     pub blocks: Blocks,
 }
@@ -146,7 +153,7 @@ pub fn camera_design_in_sight(
         )));
     }
     let qs: Vec<Vec<f64>> = kept.iter().map(|&i| candidates[i].clone()).collect();
-    let blocks = camera_blocks(&robot, view, &qs);
+    let (blocks, rank_per_pose) = camera_blocks(&robot, view, &qs).compressed();
     let sel = select(&blocks, CriterionKind::Det, Algorithm::Eae, settings)?;
     let seen = sel
         .poses
@@ -174,6 +181,7 @@ pub fn camera_design_in_sight(
         ln_det: sel.ln_oid,
         predicted_error_per_px,
         selection: sel,
+        rank_per_pose,
         blocks,
     })
 }

@@ -162,3 +162,6 @@ where
             task.inc((chunk.nrows() / t) as u64);
         });
 }
+
+mod compress;
+pub use compress::COMPRESS_MAX_CONDITION;

@@ -197,10 +197,107 @@ fn cli_selects_a_camera_design_with_its_bound() {
     assert_eq!(d["poses"].as_array().unwrap().len(), 12);
     assert_eq!(d["gap"], v["gap"]);
     assert_eq!(d["joint_names"][0], "shoulder_pan_joint");
-    let mut report = args.to_vec();
-    report.truncate(15);
-    report.extend(["--report", "somewhere"]);
-    common::fails_with(&report, "--report is not available with --camera-info");
+    let mut existing = args.to_vec();
+    existing.truncate(15);
+    existing.extend(["--existing", "somewhere.csv"]);
+    common::fails_with(&existing, "--existing is not available with --camera-info");
+    let mut noise = args.to_vec();
+    noise.truncate(15);
+    noise.extend(["--noise", "0.0003"]);
+    common::fails_with(&noise, "a camera's is --pixel-noise PX");
+}
+
+/// `select --camera-info --report DIR`: the "how many poses" curve on the
+/// pixel Jacobian. A pose's pixels move only with the target's rigid
+/// placement in the camera, so a pose gives 6 independent rows and the
+/// curve starts at ⌈p / 6⌉ poses; at the design's own size the curve's
+/// selection (same settings and seed) finds the design `select` chose,
+/// with its D-efficiency and the true error `select` predicts at
+/// `--pixel-noise` (the same covariance carried to the same 1,000
+/// configurations: equal to rounding, 1e-9 relative).
+#[test]
+fn cli_reports_how_many_poses_for_a_camera() {
+    let dir = common::scratch_dir("camera", "select-report");
+    let report = dir.join("report");
+    let r = report.display().to_string();
+    let args = [
+        "select",
+        "--robot",
+        "fixtures/ur5.urdf",
+        "--camera-info",
+        "fixtures/camera/camera_info.yaml",
+        "--target",
+        "fixtures/camera/board.yaml",
+        "--mounting",
+        "eye-to-hand",
+        "--camera-pose=1.2,0.6,0.9,-2.0985,0,2.0779",
+        "--target-pose=-0.0853,0.0568,0.02,3.1416,0,0.03",
+        "--n",
+        "12",
+        "--count",
+        "1500",
+        "--gap",
+        "--pixel-noise",
+        "0.25",
+        "--report",
+        &r,
+        "--json",
+    ];
+    let v = common::json_of(&args);
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report.join("report.json")).unwrap())
+            .unwrap();
+    let c = &j["how_many_poses"];
+    let p = v["unknowns"].as_array().unwrap().len();
+    assert_eq!(c["p"], p);
+    assert_eq!(c["rows_per_pose"], 6, "{c}");
+    assert_eq!(c["n_min"], p.div_ceil(6));
+    assert_eq!(c["noise_px"], 0.25);
+    assert!(c.get("noise_m").is_none());
+    let at12 = c["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|q| q["n"] == 12)
+        .expect("the asked size is on the curve");
+    let close = |a: &serde_json::Value, b: &serde_json::Value| {
+        let (a, b) = (a.as_f64().unwrap(), b.as_f64().unwrap());
+        assert!((a - b).abs() <= 1e-9 * b.abs(), "{a} against {b}");
+    };
+    close(
+        &at12["predicted"]["position_rms_mm"],
+        &v["predicted_error_mm"],
+    );
+    let per_px = v["predicted_error_mm_per_px"].as_f64().unwrap();
+    close(&v["predicted_error_mm"], &serde_json::json!(per_px * 0.25));
+    close(&at12["d_efficiency"], &v["gap"]["d_efficiency"]);
+    close(&at12["ln_oid"], &v["ln_det"]);
+    let mut a: Vec<u64> = at12["poses"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_u64().unwrap())
+        .collect();
+    let mut b: Vec<u64> = v["chosen_candidates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_u64().unwrap())
+        .collect();
+    a.sort_unstable();
+    b.sort_unstable();
+    assert_eq!(a, b);
+    assert_eq!(j["selection"]["chosen_candidates"], v["chosen_candidates"]);
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+    assert!(md.contains("Sensor noise σ = 0.25 px."), "{md}");
+    for f in [
+        "how_many_poses.png",
+        "how_many_poses.svg",
+        "joints_vs_limits.png",
+    ] {
+        assert!(report.join(f).is_file(), "{f}");
+    }
+    common::fails_with(&args, "exists and is not empty");
 }
 
 /// The head camera's example (`cargo run --example camera_head_simulate`)

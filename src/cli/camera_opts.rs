@@ -70,4 +70,15 @@ pub struct CameraOpts {
     /// --obstacle or --floor is given. Meshes found as --package-dir says.
     #[arg(long, requires = "camera_info")]
     pub line_of_sight: bool,
+    /// The pixel noise σ of the detected points, px: the true error the
+    /// design predicts is printed at it (and in --json,
+    /// `predicted_error_mm`), and --report's curve uses it [default
+    /// there: 0.3 px].
+    #[arg(
+        long,
+        value_name = "PX",
+        requires = "camera_info",
+        allow_negative_numbers = true
+    )]
+    pub pixel_noise: Option<f64>,
 }

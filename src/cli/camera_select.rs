@@ -31,6 +31,12 @@ use std::path::PathBuf;
 /// Joint-space samples when `--count` is not given.
 const DEFAULT_SAMPLES: usize = 20_000;
 
+/// The pixel noise σ of `--report`'s curve when `--pixel-noise` is not
+/// given, px: a corner detector's typical sub-pixel error (OpenCV's
+/// `cornerSubPix` on a sharp checkerboard gives 0.1–0.5 px), and the σ of
+/// the project's camera examples.
+pub const DEFAULT_PIXEL_NOISE: f64 = 0.3;
+
 fn six(flag: &str, s: &str) -> Result<[f64; 6]> {
     let v = super::parse_list::<f64>(s, flag)?;
     v.try_into().map_err(|_| {
@@ -135,8 +141,17 @@ fn sight(a: &SelectArgs, robot: &Robot) -> Result<(Vec<PoolFilter>, Option<LineO
 /// Options of `select` a camera design does not take (yet), refused
 /// rather than ignored.
 fn refuse_unused(a: &SelectArgs) -> Result<()> {
+    if a.noise.is_some() {
+        bail!(
+            "--noise is a point's noise in metres; a camera's is --pixel-noise PX (the detected points' σ in pixels)"
+        );
+    }
+    if let Some(px) = a.camera.pixel_noise
+        && !(px.is_finite() && px > 0.0)
+    {
+        bail!("--pixel-noise {px}: the pixel noise σ must be a finite number > 0 (px)");
+    }
     let unused = [
-        ("--report", a.report.is_some()),
         ("--existing", a.existing.is_some()),
         ("--refine", a.refine),
         ("--order", a.order.is_some()),
@@ -145,7 +160,7 @@ fn refuse_unused(a: &SelectArgs) -> Result<()> {
     ];
     if let Some((flag, _)) = unused.iter().find(|(_, used)| *used) {
         bail!(
-            "{flag} is not available with --camera-info: a camera design is chosen on the pixel Jacobian of its visible pool, with --gap, --out .csv/.json and --json"
+            "{flag} is not available with --camera-info: a camera design is chosen on the pixel Jacobian of its visible pool, with --gap, --report, --out .csv/.json and --json"
         );
     }
     Ok(())
@@ -180,6 +195,9 @@ fn outputs(a: &SelectArgs) -> Result<(Option<&PathBuf>, Option<&PathBuf>)> {
 pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
     refuse_unused(a)?;
     let (csv_out, json_out) = outputs(a)?;
+    if let Some(dir) = &a.report {
+        super::report_dir::check(dir, a.force)?;
+    }
     let robot = super::load_robot(&a.pool.robot)?;
     let robot = match &a.camera.camera_link {
         Some(link) => activecal::io::urdf_branch::camera_branch(&robot, link)
@@ -219,6 +237,10 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
     } else {
         None
     };
+    let curve = match &a.report {
+        Some(_) => Some(curve(a, &settings, &d, &free)?),
+        None => None,
+    };
     let names = activecal::units::joint_names(&robot);
     let mut csv = format!("candidate,{},points_seen\n", names.join(","));
     for ((q, c), s) in d.qs.iter().zip(&d.candidates).zip(&d.seen) {
@@ -238,6 +260,8 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         "log10_bound": gap.as_ref().map(|g| g.log10_bound),
         "d_efficiency": gap.as_ref().map(|g| g.d_efficiency),
         "predicted_error_mm_per_px": d.predicted_error_per_px.map(|e| 1e3 * e),
+        "pixel_noise_px": a.camera.pixel_noise,
+        "predicted_error_mm": a.camera.pixel_noise.zip(d.predicted_error_per_px).map(|(s, e)| 1e3 * e * s),
         "points_seen": d.seen,
     });
     if let Some(o) = csv_out {
@@ -260,17 +284,63 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         .chain(json_out.iter())
         .map(|p| p.display().to_string())
         .collect();
-    value["out"] = json!(written);
-    super::emit(a.json, &value, || {
-        text(
+    let mut written = written;
+    let rendered = |written: &[String]| {
+        let mut s = text(
             &d,
             candidates.len(),
             collision_removed,
             gap.as_ref(),
+            a.camera.pixel_noise,
             &csv,
-            &written,
-        )
-    })
+            written,
+        );
+        if let Some(r) = curve.as_ref().and_then(|c| c.recommended.as_ref()) {
+            s += &super::report_dir::recommendation_text(r);
+        }
+        s
+    };
+    if let (Some(dir), Some(c)) = (&a.report, &curve) {
+        written.push(dir.display().to_string());
+        super::report_dir::camera_selection(
+            dir,
+            &robot,
+            &names,
+            &d.qs,
+            &rendered(&written[..written.len() - 1]),
+            &value,
+            c,
+            a.camera.pixel_noise.is_none(),
+        )?;
+    }
+    value["out"] = json!(written);
+    super::emit(a.json, &value, || rendered(&written))
+}
+
+/// `--report`'s "how many poses" curve of a camera design, its pose ids
+/// those of the sampled configurations.
+fn curve(
+    a: &SelectArgs,
+    settings: &activecal::select::Settings,
+    d: &CameraDesign,
+    free: &[usize],
+) -> Result<activecal::how_many::PoseCountCurve> {
+    let mut cs = activecal::how_many::CurveSettings::new(
+        settings.clone(),
+        a.camera.pixel_noise.unwrap_or(DEFAULT_PIXEL_NOISE),
+    );
+    cs.bound = activecal::bound::BoundSettings::builder()
+        .solver(a.gap_solver)
+        .build()?;
+    cs.also = vec![a.n];
+    cs.target_mm = a.target_error;
+    let mut curve = d.how_many(&cs)?;
+    for p in &mut curve.points {
+        for c in &mut p.poses {
+            *c = free[*c];
+        }
+    }
+    Ok(curve)
 }
 
 /// The human-readable report of a camera design.
@@ -279,14 +349,18 @@ fn text(
     candidates: usize,
     collision_removed: Option<usize>,
     gap: Option<&activecal::bound::DesignGap>,
+    pixel_noise: Option<f64>,
     csv: &str,
     written: &[String],
 ) -> String {
     let predicted = d.predicted_error_per_px.map_or_else(
         || "not predicted (singular design)".to_string(),
         |e| {
+            let at = pixel_noise.map_or(String::new(), |s| {
+                format!(", {:.4} mm at σ = {s} px", 1e3 * e * s)
+            });
             format!(
-                "{:.4} mm per px of pixel noise σ (RMS over 1,000 configurations)",
+                "{:.4} mm per px of pixel noise σ (RMS over 1,000 configurations){at}",
                 1e3 * e
             )
         },

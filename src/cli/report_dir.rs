@@ -312,7 +312,6 @@ fn joint_rows(robot: &Robot, names: &[String], qs: &[Vec<f64>]) -> Vec<JointRow>
 /// The report's "How many poses" section: what the curve is, every size
 /// it computed with its figures, and the size it recommends.
 fn how_many_text(curve: &PoseCountCurve, noise_is_default: bool) -> String {
-    let noise_mm = curve.noise_m * 1e3;
     let hi = 3 * curve.n_min;
     let asked: Vec<String> = curve
         .points
@@ -321,7 +320,7 @@ fn how_many_text(curve: &PoseCountCurve, noise_is_default: bool) -> String {
         .map(|p| p.n.to_string())
         .collect();
     let mut md = format!(
-        "\n## How many poses\n\nFor N from the fewest whose rows can determine the {} unknowns ({}) to three times that ({hi}), {}{}, the best design the selection finds, its D-efficiency ((det M / det M*)^(1/p), M* the certified bound of every N-pose design of the pool), and the position error predicted after calibrating with it, from its covariance σ² (XᵀX)⁻¹ (no fitting), at {} random configurations within the joint limits (seed {}): the RMS over them, the 95th percentile of the error a measured point shows (over the configurations and the noise), and the 95th percentile of the RMS at one configuration. Sensor noise σ = {noise_mm} mm per coordinate{}.\n\n",
+        "\n## How many poses\n\nFor N from the fewest whose rows can determine the {} unknowns ({}) to three times that ({hi}), {}{}, the best design the selection finds, its D-efficiency ((det M / det M*)^(1/p), M* the certified bound of every N-pose design of the pool), and the position error predicted after calibrating with it, from its covariance σ² (XᵀX)⁻¹ (no fitting), at {} random configurations within the joint limits (seed {}): the RMS over them, the 95th percentile of the error {} shows (over the configurations and the noise), and the 95th percentile of the RMS at one configuration. Sensor noise σ = {}{}.\n\n",
         curve.p,
         curve.n_min,
         if curve.step <= 1 {
@@ -339,7 +338,15 @@ fn how_many_text(curve: &PoseCountCurve, noise_is_default: bool) -> String {
         },
         curve.configurations,
         curve.seed,
-        if noise_is_default {
+        if curve.noise_px.is_some() {
+            "the moving one's origin (the target's, or a camera's on the flange)"
+        } else {
+            "a measured point"
+        },
+        noise_text(curve),
+        if noise_is_default && curve.noise_px.is_some() {
+            " (the default of --pixel-noise)"
+        } else if noise_is_default {
             " (the default of --noise)"
         } else {
             ""
@@ -359,6 +366,40 @@ fn how_many_text(curve: &PoseCountCurve, noise_is_default: bool) -> String {
         md += &recommendation_text(r);
     }
     md
+}
+
+/// The curve's noise σ with its unit: "0.01 mm per coordinate" or
+/// "0.3 px".
+pub fn noise_text(curve: &PoseCountCurve) -> String {
+    match (curve.noise_m, curve.noise_px) {
+        (_, Some(px)) => format!("{px} px"),
+        (m, None) => format!("{} mm per coordinate", m.unwrap_or(f64::NAN) * 1e3),
+    }
+}
+
+/// The "how many poses" figure of a report: writes it into `out` and
+/// returns its (stem, caption); `chosen` the design's size.
+fn how_many_figure(out: &Path, curve: &PoseCountCurve, chosen: usize) -> Result<(String, String)> {
+    let rows: Vec<CurveRow> = curve
+        .points
+        .iter()
+        .map(|p| CurveRow {
+            n: p.n,
+            d_efficiency: p.d_efficiency,
+            rms_mm: p.predicted.position_rms_mm,
+            p95_mm: p.predicted.position_error_p95_mm,
+        })
+        .collect();
+    let noise = noise_text(curve);
+    let short = noise.trim_end_matches(" per coordinate");
+    plots::how_many(&out.join("how_many_poses"), &rows, chosen, short)?;
+    Ok((
+        "how_many_poses".to_string(),
+        format!(
+            "the best design found at each N: D-efficiency against the certified bound, and the position error predicted at {} random configurations (mm) for σ = {short}",
+            curve.configurations
+        ),
+    ))
 }
 
 /// One line: the size a curve recommends, and why.
@@ -407,30 +448,7 @@ pub fn selection(
 ) -> Result<()> {
     let staged = StagedDir::new(dir)?;
     let out = staged.path();
-    let rows: Vec<CurveRow> = curve
-        .points
-        .iter()
-        .map(|p| CurveRow {
-            n: p.n,
-            d_efficiency: p.d_efficiency,
-            rms_mm: p.predicted.position_rms_mm,
-            p95_mm: p.predicted.position_error_p95_mm,
-        })
-        .collect();
-    let noise_mm = curve.noise_m * 1e3;
-    plots::how_many(
-        &out.join("how_many_poses"),
-        &rows,
-        report.poses.len(),
-        noise_mm,
-    )?;
-    let mut figs = vec![(
-        "how_many_poses".to_string(),
-        format!(
-            "the best design found at each N: D-efficiency against the certified bound, and the position error predicted at {} random configurations (mm) for σ = {noise_mm} mm",
-            curve.configurations
-        ),
-    )];
+    let mut figs = vec![how_many_figure(out, curve, report.poses.len())?];
     let qs: Vec<Vec<f64>> = report.configurations.iter().map(|c| c.q.clone()).collect();
     plots::joints_vs_limits(
         &out.join("joints_vs_limits"),
@@ -487,6 +505,54 @@ pub fn selection(
     md += &figure_section(&figs);
     put(&staged, "report.md", &md)?;
     let json = serde_json::json!({ "selection": report, "how_many_poses": curve });
+    put(
+        &staged,
+        "report.json",
+        &(serde_json::to_string_pretty(&json)? + "\n"),
+    )?;
+    staged.commit()?;
+    Ok(())
+}
+
+/// Writes `select --camera-info … --report DIR`: report.md (the text
+/// report, the "how many poses" curve on the pixel Jacobian, the figures),
+/// report.json (`{"selection": the --json object, "how_many_poses": the
+/// curve}`), the curve's figure and the chosen poses against the joint
+/// limits (`names` the robot's joints, `qs` the poses).
+#[allow(clippy::too_many_arguments)]
+pub fn camera_selection(
+    dir: &Path,
+    robot: &Robot,
+    names: &[String],
+    qs: &[Vec<f64>],
+    text: &str,
+    json: &serde_json::Value,
+    curve: &PoseCountCurve,
+    noise_is_default: bool,
+) -> Result<()> {
+    let staged = StagedDir::new(dir)?;
+    let out = staged.path();
+    let mut figs = vec![how_many_figure(out, curve, qs.len())?];
+    plots::joints_vs_limits(&out.join("joints_vs_limits"), &joint_rows(robot, names, qs))?;
+    figs.push((
+        "joints_vs_limits".into(),
+        "the selected poses' joint values within each joint's limits".into(),
+    ));
+    let mut md = format!(
+        "# Pose selection report (camera)\n\nRobot: `{}` (chain {}), {} unknowns; a pose's pixel rows compressed to the {} of their information's rank.\n\n```text\n{}```\n",
+        robot.name,
+        activecal::report::chain(robot).join(" → "),
+        curve.p,
+        curve.rows_per_pose,
+        text
+    );
+    md += &how_many_text(curve, noise_is_default);
+    for (n, why) in &curve.skipped {
+        let _ = writeln!(md, "\nN = {n}: no identifying design ({why}).");
+    }
+    md += &figure_section(&figs);
+    put(&staged, "report.md", &md)?;
+    let json = serde_json::json!({ "selection": json, "how_many_poses": curve });
     put(
         &staged,
         "report.json",

@@ -1,10 +1,10 @@
 //! The curve itself: for each size, the best design, its certified
 //! D-efficiency and its predicted errors.
 
-use super::predict::{predicted_errors, random_configurations};
+use super::predict::{ErrorRows, random_configurations};
 use super::recommend::{curve_sizes, recommend, sizes_step};
-use super::{CurvePoint, CurveSettings, HowManyError, PoseCountCurve};
-use crate::blocks::{Blocks, jacobian_of};
+use super::{CurvePoint, CurveSettings, HowManyError, NoiseUnit, PoseCountCurve};
+use crate::blocks::Blocks;
 use crate::bound::{BoundError, design_gap, relaxation_bound};
 use crate::criterion::Prior;
 use crate::model::{ParamTable, Robot};
@@ -14,7 +14,11 @@ use rayon::prelude::*;
 /// The curve on the pool `x` (Jacobian blocks at `table`; `ids` its pose
 /// ids): for every size of [`curve_sizes`], the best design of
 /// `settings.select`, its certified D-efficiency and its predicted errors at
-/// [`random_configurations`].
+/// [`random_configurations`]. The curve starts at the fewest poses whose
+/// information can have full rank, `⌈p / r⌉` with `r` the rank of one
+/// pose's information ([`Blocks::sample_rank`]; its rows `t` for a point or
+/// a pose, fewer for markers: a rigid body shows 6 however many points it
+/// carries), 1 on top of poses already measured.
 pub fn pose_count_curve(
     robot: &Robot,
     table: &ParamTable,
@@ -22,18 +26,33 @@ pub fn pose_count_curve(
     ids: &[usize],
     settings: &CurveSettings,
 ) -> Result<PoseCountCurve, HowManyError> {
+    check(settings)?;
+    let qs = random_configurations(robot, settings.configurations, settings.seed);
+    let rows = ErrorRows::of_robot(robot, table, &qs);
+    let n_min = fewest_poses(x, settings);
+    pose_count_curve_on(x, ids, settings, &rows, n_min, NoiseUnit::Metres)
+}
+
+/// The fewest poses of the curve: `⌈p / r⌉` (see [`pose_count_curve`]),
+/// 1 with a prior.
+#[must_use]
+pub fn fewest_poses(x: &Blocks, settings: &CurveSettings) -> usize {
+    if settings.select.prior.is_some() {
+        1
+    } else {
+        x.p().div_ceil(x.sample_rank().max(1))
+    }
+}
+
+/// Refuses a noise or target error that is not a finite number > 0.
+fn check(settings: &CurveSettings) -> Result<(), HowManyError> {
     if !(settings.noise.is_finite() && settings.noise > 0.0) {
         return Err(crate::Error::Invalid(format!(
-            "noise {}: the sensor noise σ must be a finite number > 0 (metres)",
+            "noise {}: the sensor noise σ must be a finite number > 0",
             settings.noise
         ))
         .into());
     }
-    let (p, t) = (x.p(), x.t());
-    let prior: Option<&Prior> = settings.select.prior.as_ref();
-    let n_min = if prior.is_some() { 1 } else { p.div_ceil(t) };
-    let qs = random_configurations(robot, settings.configurations, settings.seed);
-    let eval = jacobian_of(robot, table, qs.len(), |k, q| q.copy_from_slice(&qs[k]));
     if let Some(t) = settings.target_mm
         && !(t.is_finite() && t > 0.0)
     {
@@ -42,6 +61,21 @@ pub fn pose_count_curve(
         ))
         .into());
     }
+    Ok(())
+}
+
+/// The curve on the pool `x` with the errors predicted from `rows` (see
+/// [`ErrorRows`]), from `n_min` poses; `settings.noise` is in `unit`,
+/// the unit of `x`'s rows.
+pub fn pose_count_curve_on(
+    x: &Blocks,
+    ids: &[usize],
+    settings: &CurveSettings,
+    rows: &ErrorRows,
+    n_min: usize,
+    unit: NoiseUnit,
+) -> Result<PoseCountCurve, HowManyError> {
+    check(settings)?;
     let sizes = curve_sizes(n_min, &settings.also, settings.max_points, x.n_poses());
     // The sizes are independent: computed in parallel, gathered in order
     // (each size's design and bound do not depend on the thread count).
@@ -50,7 +84,7 @@ pub fn pose_count_curve(
         .par_iter()
         .map(|&n| {
             let _size_done = task.tick();
-            curve_point(robot, &eval, x, ids, settings, n)
+            curve_point(rows, x, ids, settings, n)
         })
         .collect();
     drop(task);
@@ -63,12 +97,17 @@ pub fn pose_count_curve(
     }
     let step = sizes_step(&sizes, n_min);
     let recommended = recommend(&points, settings.target_mm);
+    let (noise_m, noise_px) = match unit {
+        NoiseUnit::Metres => (Some(settings.noise), None),
+        NoiseUnit::Pixels => (None, Some(settings.noise)),
+    };
     Ok(PoseCountCurve {
-        p,
-        rows_per_pose: t,
+        p: x.p(),
+        rows_per_pose: x.t(),
         n_min,
-        noise_m: settings.noise,
-        configurations: qs.len(),
+        noise_m,
+        noise_px,
+        configurations: rows.eval.n_poses(),
         seed: settings.seed,
         points,
         skipped,
@@ -86,11 +125,10 @@ enum Size {
 
 /// The curve's point at `n` poses: the best design of `settings.select`,
 /// its certified D-efficiency and its predicted errors at the
-/// configurations whose Jacobian is `eval`; skipped (with the reason) when
+/// configurations of `rows`; skipped (with the reason) when
 /// no regular design or bound exists at that size.
 fn curve_point(
-    robot: &Robot,
-    eval: &Blocks,
+    rows: &ErrorRows,
     x: &Blocks,
     ids: &[usize],
     settings: &CurveSettings,
@@ -118,7 +156,7 @@ fn curve_point(
     if let Some(pr) = prior {
         info += pr.matrix();
     }
-    let Some(predicted) = predicted_errors(robot, eval, info.as_ref(), settings.noise) else {
+    let Some(predicted) = rows.errors(info.as_ref(), settings.noise) else {
         return Ok(Size::Skipped(
             "the design's information matrix is singular".into(),
         ));

@@ -20,8 +20,10 @@ mod recommend;
 #[cfg(test)]
 mod tests;
 
-pub use curve::pose_count_curve;
-pub use predict::{ERROR_DRAWS, PredictedErrors, predicted_errors, random_configurations};
+pub use curve::{fewest_poses, pose_count_curve, pose_count_curve_on};
+pub use predict::{
+    ERROR_DRAWS, ErrorRows, PredictedErrors, predicted_errors, random_configurations,
+};
 pub use recommend::{KNEE_GAIN, KNEE_MORE_PERCENT, Recommendation, curve_sizes, recommend};
 
 use crate::bound::{BoundError, BoundSettings};
@@ -52,7 +54,8 @@ pub struct CurveSettings {
     pub algorithm: Algorithm,
     /// The bound's settings.
     pub bound: BoundSettings,
-    /// Sensor noise σ per measured coordinate, metres.
+    /// Sensor noise σ per measured coordinate: metres (pixels for a
+    /// camera's curve, [`NoiseUnit`]).
     pub noise: f64,
     /// Random configurations the errors are predicted at (uniform within
     /// the joint limits).
@@ -89,6 +92,15 @@ impl CurveSettings {
     }
 }
 
+/// The unit of a curve's noise σ: the unit of its sensor's rows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NoiseUnit {
+    /// Metres per coordinate (points, poses, markers).
+    Metres,
+    /// Pixels (a camera).
+    Pixels,
+}
+
 /// One design size on the curve.
 #[derive(Clone, Debug, Serialize)]
 pub struct CurvePoint {
@@ -111,13 +123,22 @@ pub struct CurvePoint {
 pub struct PoseCountCurve {
     /// Unknowns.
     pub p: usize,
-    /// Rows per pose.
+    /// Rows per pose (for a camera, the rank of a pose's pixel
+    /// information its rows were compressed to, [`Blocks::compressed`]).
+    ///
+    /// [`Blocks::compressed`]: crate::blocks::Blocks::compressed
     pub rows_per_pose: usize,
-    /// The fewest poses whose rows can determine the unknowns
-    /// (`⌈p / rows⌉`, 1 on top of poses already measured).
+    /// The fewest poses whose information can determine the unknowns
+    /// (`⌈p / r⌉`, `r` a pose's rank, 1 on top of poses already measured;
+    /// [`fewest_poses`]).
     pub n_min: usize,
-    /// Sensor noise σ, metres.
-    pub noise_m: f64,
+    /// Sensor noise σ per coordinate, metres (a point, pose or marker
+    /// sensor's curve).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise_m: Option<f64>,
+    /// Pixel noise σ, px (a camera's curve).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise_px: Option<f64>,
     /// Random configurations the errors are predicted at.
     pub configurations: usize,
     /// Their seed.

@@ -106,6 +106,69 @@ pub(super) fn quantile(v: &mut [f64], q: f64) -> f64 {
     v[k]
 }
 
+/// The rows errors are predicted from: a set of configurations' Jacobian
+/// blocks, what each row measures, and the weight of orientation rows.
+/// [`ErrorRows::of_robot`] stacks them as the robot's sensor does; a
+/// sensor whose rows are not positions (a camera's pixels) gives the
+/// Jacobian of the point whose error matters instead (3 position rows a
+/// configuration, [`crate::select::camera::CameraDesign::how_many`]).
+#[derive(Clone, Debug)]
+pub struct ErrorRows {
+    /// One block a configuration (`kinds.len()` rows, the unknowns'
+    /// columns), metres (or radians times the weight) per unit of each
+    /// unknown.
+    pub eval: Blocks,
+    /// What each row of a block is.
+    pub kinds: Vec<RowKind>,
+    /// The weight the orientation rows carry (metres per radian; 1 when
+    /// there are none).
+    pub orientation_weight: f64,
+}
+
+impl ErrorRows {
+    /// The robot's sensor rows (at `table`) at the configurations `qs`.
+    #[must_use]
+    pub fn of_robot(robot: &Robot, table: &crate::model::ParamTable, qs: &[Vec<f64>]) -> Self {
+        let eval = crate::blocks::jacobian_of(robot, table, qs.len(), |k, q| {
+            q.copy_from_slice(&qs[k]);
+        });
+        let (kinds, orientation_weight) = sensor_rows(robot);
+        ErrorRows {
+            eval,
+            kinds,
+            orientation_weight,
+        }
+    }
+
+    /// The errors these rows predict after a calibration whose
+    /// information matrix is `info` and noise σ is `noise` (the unit of
+    /// the information's rows: metres, or pixels for a camera); `None`
+    /// when `info` is singular.
+    #[must_use]
+    pub fn errors(&self, info: MatRef<'_, f64>, noise: f64) -> Option<PredictedErrors> {
+        errors_of_rows(
+            &self.eval,
+            &self.kinds,
+            self.orientation_weight,
+            info,
+            noise,
+        )
+    }
+}
+
+/// The robot's sensor's row kinds and orientation weight.
+fn sensor_rows(robot: &Robot) -> (Vec<RowKind>, f64) {
+    let sensor = sensor_for(robot);
+    let kinds = sensor.row_kinds().to_vec();
+    let w = sensor
+        .weights()
+        .iter()
+        .zip(&kinds)
+        .find(|&(_, &k)| k == RowKind::Orientation)
+        .map_or(1.0, |(w, _)| *w);
+    (kinds, w)
+}
+
 /// The errors predicted at the configurations of `eval` (their Jacobian
 /// rows, as the robot's sensor stacks them) after a calibration whose
 /// information matrix is `info` and noise σ is `noise` metres; `None` when
@@ -117,15 +180,19 @@ pub fn predicted_errors(
     info: MatRef<'_, f64>,
     noise: f64,
 ) -> Option<PredictedErrors> {
+    let (kinds, w) = sensor_rows(robot);
+    errors_of_rows(eval, &kinds, w, info, noise)
+}
+
+/// [`ErrorRows::errors`] on borrowed rows.
+fn errors_of_rows(
+    eval: &Blocks,
+    kinds: &[RowKind],
+    w: f64,
+    info: MatRef<'_, f64>,
+    noise: f64,
+) -> Option<PredictedErrors> {
     let inv = spd_inverse(info)?;
-    let sensor = sensor_for(robot);
-    let kinds = sensor.row_kinds();
-    let w = sensor
-        .weights()
-        .iter()
-        .zip(kinds)
-        .find(|&(_, &k)| k == RowKind::Orientation)
-        .map_or(1.0, |(w, _)| *w);
     let points = kinds.iter().filter(|&&k| k == RowKind::Position).count() as f64 / 3.0;
     let full = kinds.contains(&RowKind::Orientation);
     let s2 = noise * noise;

@@ -9,9 +9,16 @@
 use super::{Algorithm, CriterionKind, Selection, Settings, select};
 use crate::blocks::Blocks;
 use crate::error::{Error, Result};
+use crate::how_many::{
+    CurveSettings, ErrorRows, HowManyError, NoiseUnit, PoseCountCurve, fewest_poses,
+    pose_count_curve_on,
+};
 use crate::identify::camera::camera_robot;
+use crate::identify::camera::predict::probe_jacobians;
 use crate::kinematics::{Evaluator, Motion};
+use crate::measure::RowKind;
 use crate::measure::Sensor;
+use crate::measure::camera::CameraSensor;
 use crate::measure::camera::OWN_PARAMS;
 use crate::model::Robot;
 use crate::pool::camera_view::CameraView;
@@ -50,6 +57,20 @@ pub struct CameraDesign {
     /// The selection's own record.
     #[serde(skip)]
     pub selection: Selection,
+    /// Each visible pose's index in the candidates given (the pool the
+    /// selection's positions index).
+    #[serde(skip)]
+    pub pool: Vec<usize>,
+    /// The robot as the camera sees it ([`camera_robot`]: its unknowns
+    /// those a camera identifies).
+    #[serde(skip)]
+    pub robot: Robot,
+    /// The camera and the target, at the view's placements.
+    #[serde(skip)]
+    pub sensor: CameraSensor,
+    /// The placements' own unknowns' values.
+    #[serde(skip)]
+    pub own: Vec<f64>,
     /// The largest rank of a visible pose's pixel information `XᵢᵀXᵢ`
     /// (6 for a camera that sees a rigid target: the pixels move with the
     /// target's placement in the camera only); each pose's block is
@@ -75,6 +96,46 @@ impl CameraDesign {
     ) -> std::result::Result<crate::bound::DesignGap, crate::bound::BoundError> {
         let bound = crate::bound::relaxation_bound(&self.blocks, None, self.qs.len(), settings)?;
         crate::bound::design_gap(&self.blocks, None, &self.selection.poses, &bound)
+    }
+
+    /// The rows a camera design's errors are predicted from: the
+    /// derivative of the moving one's origin in the fixed one's frame
+    /// ([`crate::identify::camera::predict::probe_jacobians`]) at
+    /// `configurations` generic configurations of seed `seed`.
+    #[must_use]
+    pub fn error_rows(&self, configurations: usize, seed: u64) -> ErrorRows {
+        let mut theta = self.robot.unknown_values(&self.robot.nominal);
+        theta.extend_from_slice(&self.own);
+        let qs = crate::observability::generic_configurations(&self.robot, configurations, seed);
+        ErrorRows {
+            eval: probe_jacobians(&self.robot, &self.sensor, &theta, &qs),
+            kinds: vec![RowKind::Position; 3],
+            orientation_weight: 1.0,
+        }
+    }
+
+    /// "How many poses" for this camera's visible pool: for each size, the
+    /// best design, its D-efficiency against the certified bound and the
+    /// true error it predicts for pixel noise `settings.noise` (px) at
+    /// `settings.configurations` generic configurations (seed
+    /// `settings.seed`), from `⌈p / 6⌉` poses (a pose's pixel information
+    /// has rank 6, [`Self::rank_per_pose`]). The curve's point at this
+    /// design's size predicts what [`Self::predicted_error_per_px`] does
+    /// (same configurations by default: 1,000, seed 0).
+    pub fn how_many(
+        &self,
+        settings: &CurveSettings,
+    ) -> std::result::Result<PoseCountCurve, HowManyError> {
+        let rows = self.error_rows(settings.configurations, settings.seed);
+        let n_min = fewest_poses(&self.blocks, settings);
+        pose_count_curve_on(
+            &self.blocks,
+            &self.pool,
+            settings,
+            &rows,
+            n_min,
+            NoiseUnit::Pixels,
+        )
     }
 }
 
@@ -170,8 +231,7 @@ pub fn camera_design_in_sight(
     let (sensor, own) = view.sensor();
     let mut names = robot.parameter_names();
     names.extend(sensor.own_param_names());
-    let predicted_error_per_px = predicted(&robot, &sensor, &own, &blocks, &sel.poses);
-    Ok(CameraDesign {
+    let mut d = CameraDesign {
         qs: sel.poses.iter().map(|&k| qs[k].clone()).collect(),
         candidates: sel.poses.iter().map(|&k| kept[k]).collect(),
         seen,
@@ -179,43 +239,18 @@ pub fn camera_design_in_sight(
         out_of_sight,
         names,
         ln_det: sel.ln_oid,
-        predicted_error_per_px,
+        predicted_error_per_px: None,
         selection: sel,
+        pool: kept,
+        robot,
+        sensor,
+        own,
         rank_per_pose,
         blocks,
-    })
-}
-
-/// The predicted error per px of noise of the design `poses` of `blocks`
-/// (see [`CameraDesign::predicted_error_per_px`]).
-fn predicted(
-    robot: &Robot,
-    sensor: &crate::measure::camera::CameraSensor,
-    own: &[f64],
-    blocks: &Blocks,
-    poses: &[usize],
-) -> Option<f64> {
-    let m = blocks.information(poses);
-    let m = nalgebra::DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)]);
-    // Scaled to unit diagonal before inverting (columns mix px/m and
-    // px/rad); a non-positive-definite M is a singular design.
-    let d: Vec<f64> = (0..m.nrows()).map(|i| m[(i, i)].sqrt()).collect();
-    if d.iter().any(|v| !(*v > 0.0)) {
-        return None;
-    }
-    let scaled = nalgebra::DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)] / (d[i] * d[j]));
-    let inv = scaled.cholesky()?.inverse();
-    let cov: Vec<Vec<f64>> = (0..m.nrows())
-        .map(|i| {
-            (0..m.ncols())
-                .map(|j| inv[(i, j)] / (d[i] * d[j]))
-                .collect()
-        })
-        .collect();
-    let mut theta = robot.unknown_values(&robot.nominal);
-    theta.extend_from_slice(own);
-    let qs = crate::observability::generic_configurations(robot, PREDICTION_CONFIGURATIONS, 0);
-    Some(crate::identify::camera::predict::predicted_error_of(
-        robot, sensor, &theta, &cov, &qs,
-    ))
+    };
+    d.predicted_error_per_px = d
+        .error_rows(PREDICTION_CONFIGURATIONS, 0)
+        .errors(d.blocks.information(&d.selection.poses).as_ref(), 1.0)
+        .map(|e| e.position_rms_mm * 1e-3);
+    Ok(d)
 }

@@ -22,12 +22,12 @@ pub struct CurveRow {
 /// The "how many poses" curve: D-efficiency (left) and the predicted
 /// position error, RMS and 95th percentile (right), against N; the chosen N
 /// marked.
-pub fn how_many(base: &Path, rows: &[CurveRow], chosen: usize, noise_mm: f64) -> Result<()> {
+pub fn how_many(base: &Path, rows: &[CurveRow], chosen: usize, noise: &str) -> Result<()> {
     fn draw<DB: DrawingBackend>(
         root: &Area<DB>,
         rows: &[CurveRow],
         chosen: usize,
-        noise_mm: f64,
+        noise: &str,
     ) -> Result<()> {
         let (l, r) = root.split_horizontally(DOUBLE.0 / 2);
         let n0 = rows.first().map_or(1, |r| r.n) as f64 - 0.5;
@@ -67,7 +67,7 @@ pub fn how_many(base: &Path, rows: &[CurveRow], chosen: usize, noise_mm: f64) ->
         let (_, hi) = range(&all, true);
         let mut e = ChartBuilder::on(&r)
             .caption(
-                format!("Predicted error after calibration (σ = {noise_mm} mm)"),
+                format!("Predicted error after calibration (σ = {noise})"),
                 (FONT, 19),
             )
             .margin(15)
@@ -119,7 +119,7 @@ pub fn how_many(base: &Path, rows: &[CurveRow], chosen: usize, noise_mm: f64) ->
         }
         legend(&mut e, SeriesLabelPosition::UpperRight)
     }
-    both!(base, DOUBLE, |r| draw(r, rows, chosen, noise_mm))
+    both!(base, DOUBLE, |r| draw(r, rows, chosen, noise))
 }
 
 /// One joint of [`joints_vs_limits`].

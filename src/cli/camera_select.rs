@@ -85,26 +85,27 @@ fn view(c: &CameraOpts) -> Result<CameraView> {
 
 /// The collision filters (`--self-collision`, `--obstacle`, `--floor`) and
 /// the line of sight (`--line-of-sight`, on with any of them) of a camera
-/// design.
+/// design. With `--camera-link` the chain's joints drive the whole tree by
+/// name, obstacles and the floor are in the tree's root link, and the rays
+/// leave from the camera's link.
 fn sight(a: &SelectArgs, robot: &Robot) -> Result<(Vec<PoolFilter>, Option<LineOfSight>)> {
     let p = &a.pool;
     let collision = p.self_collision || !p.obstacles.is_empty() || p.floor.is_some();
     if !(collision || a.camera.line_of_sight) {
         return Ok((Vec::new(), None));
     }
-    if a.camera.camera_link.is_some() {
-        bail!(
-            "--line-of-sight, --self-collision, --obstacle and --floor are not available with --camera-link yet (the head's chain is not the URDF chain the collision model drives)"
-        );
+    let mut chain = UrdfChain::of(robot);
+    if let (Some(_), Some(c)) = (&a.camera.camera_link, chain.as_mut()) {
+        c.base = activecal::io::urdf_branch::tree_root(robot)?;
     }
     let filters = if collision {
-        p.collision_filters(robot)?
+        p.collision_filters_on(chain.clone())?
     } else if p.srdf.is_some() {
         bail!("--srdf lists pairs of links for --self-collision, which is not given");
     } else {
         Vec::new()
     };
-    let Some(chain) = UrdfChain::of(robot) else {
+    let Some(chain) = chain else {
         bail!(
             "--line-of-sight needs a URDF robot with collision geometry (--robot FILE.urdf); {} has none",
             p.robot
@@ -135,7 +136,11 @@ fn sight(a: &SelectArgs, robot: &Robot) -> Result<(Vec<PoolFilter>, Option<LineO
         floor: p.floor,
         ..CollisionSpec::default()
     };
-    Ok((filters, Some(LineOfSight::new(spec))))
+    let los = match &a.camera.camera_link {
+        Some(link) => LineOfSight::from_link(spec, link),
+        None => LineOfSight::new(spec),
+    };
+    Ok((filters, Some(los)))
 }
 
 /// Options of `select` a camera design does not take (yet), refused

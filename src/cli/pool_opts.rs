@@ -304,6 +304,14 @@ impl PoolOpts {
     /// statistics say what each removed); `--srdf` and `--package-dir`
     /// without them are errors.
     pub fn collision_filters(&self, robot: &Robot) -> Result<Vec<PoolFilter>> {
+        self.collision_filters_on(UrdfChain::of(robot))
+    }
+
+    /// [`Self::collision_filters`] of a chain of a URDF tree given as it
+    /// is (`None`: a robot not imported from a URDF): for a camera's chain
+    /// from its own link, whose joints drive the whole tree by name with
+    /// the tree's root as the frame of obstacles.
+    pub fn collision_filters_on(&self, chain: Option<UrdfChain>) -> Result<Vec<PoolFilter>> {
         use activecal::collision::Obstacle;
         let obstacles = self
             .obstacles
@@ -338,7 +346,7 @@ impl PoolOpts {
         if self.srdf.is_some() && !self.self_collision {
             anyhow::bail!("--srdf lists pairs of links for --self-collision, which is not given");
         }
-        let Some(chain) = UrdfChain::of(robot) else {
+        let Some(chain) = chain else {
             anyhow::bail!(
                 "--self-collision, --obstacle and --floor need a URDF robot with collision geometry (--robot FILE.urdf); {} has none",
                 self.robot

@@ -33,20 +33,65 @@ impl CollisionModel {
         skip_tip: bool,
     ) -> Vec<bool> {
         let links = self.link_placements(q);
-        let base = links[self.base];
-        let tip = self.tip_body();
+        let skip: Vec<usize> = if skip_tip {
+            vec![self.tip_body()]
+        } else {
+            Vec::new()
+        };
+        self.cast(&links, &links[self.base], &skip, eye, points, stop)
+    }
+
+    /// [`Self::blocked_rays`] for a camera on the robot's own link `link`
+    /// (a head camera): `eye` and `points` are in that link's frame, and
+    /// neither its rigid body (the camera is fixed to it) nor the tip's
+    /// (the target's carrier) is checked. `None` when the model has no
+    /// link of that name.
+    #[must_use]
+    pub fn blocked_rays_from_link(
+        &self,
+        q: &[f64],
+        link: &str,
+        eye: &Point3<f64>,
+        points: &[Point3<f64>],
+        stop: f64,
+    ) -> Option<Vec<bool>> {
+        let at = *self.tree.index.get(link)?;
+        let links = self.link_placements(q);
+        let skip = [self.tip_body(), self.tree.body[at]];
+        Some(self.cast(&links, &links[at], &skip, eye, points, stop))
+    }
+
+    /// Whether the model has a link of this name.
+    #[must_use]
+    pub fn has_link(&self, link: &str) -> bool {
+        self.tree.index.contains_key(link)
+    }
+
+    /// The rays of [`Self::blocked_rays`] from `eye` to `points`, both in
+    /// the frame placed at `frame` (root frame), against the geometries at
+    /// the link placements `links` except those on the rigid bodies
+    /// `skip`, and the obstacles.
+    fn cast(
+        &self,
+        links: &[Isometry3<f64>],
+        frame: &Isometry3<f64>,
+        skip: &[usize],
+        eye: &Point3<f64>,
+        points: &[Point3<f64>],
+        stop: f64,
+    ) -> Vec<bool> {
         let shapes: Vec<(Isometry3<f64>, usize)> = self
             .geoms
             .iter()
             .enumerate()
-            .filter(|(_, g)| !(skip_tip && self.tree.body[g.link] == tip))
+            .filter(|(_, g)| !skip.contains(&self.tree.body[g.link]))
             .map(|(k, g)| (links[g.link] * g.origin, k))
             .collect();
-        let from = base * eye;
+        let from = frame * eye;
         points
             .iter()
             .map(|p| {
-                let to = base * p;
+                let to = frame * p;
                 let d = to - from;
                 let len = d.norm();
                 if len <= stop {
@@ -165,6 +210,31 @@ mod tests {
         assert_eq!(
             m.blocked_rays(&[0.0, 0.0], &hi, &[past], 1e-3, false),
             [true]
+        );
+        // Rays from the tip's own frame (a camera on the tip's link): the
+        // arm's box, 0.5 m behind the tip along the arm, is at the tip's
+        // (-0.5, 0, 0) when j2 = 0 and at (0, 0.5, 0) when j2 turns the
+        // tip by 90° (whatever j1 is); the tip's own box is not checked.
+        let (back, left) = (Point3::new(-2.0, 0.0, 0.0), Point3::new(0.0, 2.0, 0.0));
+        for j1 in [0.0, 1.0] {
+            assert_eq!(
+                m.blocked_rays_from_link(&[j1, 0.0], "tip", &eye, &[back, left], 1e-3),
+                Some(vec![true, false])
+            );
+            assert_eq!(
+                m.blocked_rays_from_link(
+                    &[j1, std::f64::consts::FRAC_PI_2],
+                    "tip",
+                    &eye,
+                    &[back, left],
+                    1e-3
+                ),
+                Some(vec![false, true])
+            );
+        }
+        assert!(
+            m.blocked_rays_from_link(&[0.0, 0.0], "head", &eye, &[far], 1e-3)
+                .is_none()
         );
         // From inside the arm's box outwards, away from everything.
         let inside = Point3::new(0.5, 0.0, 0.0);

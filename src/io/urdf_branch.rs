@@ -232,3 +232,27 @@ pub fn camera_branch(robot: &Robot, camera_link: &str) -> Result<Robot> {
     out.source = Some(std::sync::Arc::new(source));
     Ok(out)
 }
+
+/// The root link of the URDF tree a camera chain ([`camera_branch`]) was
+/// built from: the frame its collision model places obstacles and a floor
+/// in (the camera chain's own base is the camera's link, which moves).
+pub fn tree_root(robot: &Robot) -> Result<String> {
+    let src = robot.source.as_ref().ok_or_else(|| {
+        Error::Invalid(format!(
+            "robot '{}' was not imported from a URDF",
+            robot.name
+        ))
+    })?;
+    let urdf = parsed(&src.text).map_err(|message| Error::Parse {
+        path: src.path.clone(),
+        message,
+    })?;
+    urdf.links
+        .iter()
+        .find(|l| !urdf.joints.iter().any(|j| j.child.link == l.name))
+        .map(|l| l.name.clone())
+        .ok_or_else(|| Error::Parse {
+            path: src.path.clone(),
+            message: "the URDF has no root link (every link is a joint's child)".into(),
+        })
+}

@@ -33,6 +33,11 @@ pub struct LineOfSight {
     pub collision: CollisionFilter,
     /// How far short of each point a ray stops, metres (≥ 0).
     pub stop: f64,
+    /// A camera on the robot's own link (a head camera,
+    /// [`crate::io::urdf_branch`]): the link, whose frame is the camera
+    /// chain's base (the rays are cast from it, and its rigid body is not
+    /// checked). `None`: the rays are in the collision model's base link.
+    pub camera_link: Option<String>,
 }
 
 /// The points of the target and the camera's centre in the base frame at
@@ -79,12 +84,33 @@ impl LineOfSight {
         Self {
             collision: CollisionFilter::new(spec),
             stop: DEFAULT_STOP,
+            camera_link: None,
         }
     }
 
-    /// The loaded model, or why it cannot be loaded.
+    /// The check for a camera on the robot's own link `link`, the base of
+    /// the camera chain whose configurations it is given (see
+    /// [`LineOfSight::camera_link`]); `spec` drives the same joints, by
+    /// name, in the whole tree.
+    #[must_use]
+    pub fn from_link(spec: CollisionSpec, link: &str) -> Self {
+        Self {
+            camera_link: Some(link.to_string()),
+            ..Self::new(spec)
+        }
+    }
+
+    /// The loaded model, or why it cannot be loaded (or lacks the camera's
+    /// link).
     pub fn load(&self) -> Result<Arc<CollisionModel>, String> {
-        self.collision.load()
+        let m = self.collision.load()?;
+        match &self.camera_link {
+            Some(l) if !m.has_link(l) => Err(format!(
+                "{}: no link '{l}' for the camera",
+                self.collision.spec.urdf
+            )),
+            _ => Ok(m),
+        }
     }
 
     /// For each target point at `q`: seen inside the image and in sight.
@@ -101,7 +127,12 @@ impl LineOfSight {
             return Vec::new();
         };
         let (eye, pts, inside) = rays(view, robot, table, q);
-        let blocked = model.blocked_rays(q, &eye, &pts, self.stop, true);
+        let blocked = match &self.camera_link {
+            Some(l) => model
+                .blocked_rays_from_link(q, l, &eye, &pts, self.stop)
+                .unwrap_or_else(|| vec![true; pts.len()]),
+            None => model.blocked_rays(q, &eye, &pts, self.stop, true),
+        };
         inside
             .iter()
             .zip(&blocked)

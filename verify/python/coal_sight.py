@@ -1,7 +1,7 @@
 """Reference line-of-sight verdicts of Pinocchio + Coal for activecal's
 camera pool filter (issue #41, item 4).
 
-Usage: coal_sight.py URDF PACKAGE_DIR JOINTS(comma) BASE CARRIER_JOINT RAYS.json OUT.json
+Usage: coal_sight.py URDF PACKAGE_DIR JOINTS(comma) BASE CARRIER_JOINTS(comma) RAYS.json OUT.json
 
 RAYS.json: [{"q": [...], "eye": [x, y, z], "points": [[x, y, z], ...]}],
 positions in the BASE link's frame (metres), q the values of JOINTS (the
@@ -9,8 +9,9 @@ URDF's other joints at 0). Each segment from the eye to a point, stopped
 STOP = 1 mm short of the point, is a Coal capsule of radius RADIUS = 1e-6 m
 along it; it is blocked when it collides (coal.collide) with a collision
 geometry of the URDF (Pinocchio's COLLISION model: meshes as BVH triangle
-surfaces) whose parent joint is not CARRIER_JOINT (the rigid body the target
-is fixed to). OUT.json: per configuration, per point, blocked or not, and
+surfaces) whose parent joint is none of CARRIER_JOINTS (the rigid bodies the
+target and, for a camera on the robot's own link, the camera are fixed to).
+BASE is the frame of the rays: the chain's base link, or the camera's link. OUT.json: per configuration, per point, blocked or not, and
 the least Coal distance from the segment to the checked geometries.
 """
 import json
@@ -43,8 +44,8 @@ def main():
     joints = joints.split(",")
     model, gmodel = pin.buildModelsFromUrdf(urdf, package_dirs=[pkg], geometry_types=pin.GeometryType.COLLISION)
     idx = [model.joints[model.getJointId(j)].idx_q for j in joints]
-    skip = model.getJointId(carrier)
-    checked = [k for k, g in enumerate(gmodel.geometryObjects) if g.parentJoint != skip]
+    skip = {model.getJointId(c) for c in carrier.split(",")}
+    checked = [k for k, g in enumerate(gmodel.geometryObjects) if g.parentJoint not in skip]
     data, gdata = model.createData(), gmodel.createData()
     with open(rays) as f:
         cases = json.load(f)
@@ -78,7 +79,7 @@ def main():
     res.update(
         reference=f"Pinocchio {pin.__version__} + Coal {coal.__version__}: buildModelsFromUrdf(COLLISION), "
         f"segments as capsules of radius {RADIUS} m stopped {STOP} m short, collide per geometry, "
-        f"geometries on joint {carrier} skipped",
+        f"geometries on joints {carrier} skipped",
         checked=len(checked),
     )
     with open(out, "w") as f:

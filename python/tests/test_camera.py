@@ -258,3 +258,22 @@ def test_select_camera_refusals():
         lambda: activecal.select_camera(r, INFO, BOARD, mounting="eye-to-hand", camera_link="x", **kw),
         "^camera_link: ",
     )
+
+
+def test_the_docs_camera_block_runs_and_says_what_it_prints(tmp_path, monkeypatch, capsys):
+    from conftest import REPO
+
+    text = (REPO / "docs" / "python.md").read_text()
+    section = text[text.index("\n## A camera\n"):]
+    block = section.split("```python\n", 1)[1].split("```", 1)[0]
+    monkeypatch.chdir(tmp_path)
+    ns = {}
+    exec(block.replace('"fixtures/', f'"{REPO}/fixtures/'), ns)
+    # The figures the prose after the block gives.
+    after = section.split("```python\n", 1)[1].split("```", 1)[1]
+    d, cal = ns["design"], ns["cal"]
+    assert f"predicts {d.report['predicted_error_mm_per_px']:.2f} mm" in after
+    assert f"{cal.rms_px:.3f} px RMS, σ̂ {cal.sigma_px:.3f} px" in after
+    assert "({:.3f}, {:.3f}, {:.3f}) m".format(*cal.camera[:3, 3]) in after
+    for f in ("cal.urdf", "cal.yaml", "refined.yaml"):
+        assert (tmp_path / f).is_file()

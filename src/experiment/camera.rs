@@ -46,10 +46,16 @@ pub enum CameraCalibrationError {
     /// The fit could not be made (bad input, a start that does not see
     /// what the observations say).
     #[error(transparent)]
-    Fit(#[from] CameraFitError),
+    Fit(Box<CameraFitError>),
     /// The calibrated robot could not be split into frames.
     #[error(transparent)]
     Frames(#[from] FramesError),
+}
+
+impl From<CameraFitError> for CameraCalibrationError {
+    fn from(e: CameraFitError) -> Self {
+        Self::Fit(Box::new(e))
+    }
 }
 
 /// A calibration from a camera's pixels.

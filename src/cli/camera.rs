@@ -18,21 +18,21 @@ use activecal::io::camera_target::read_target;
 use activecal::io::urdf_branch::camera_branch;
 use activecal::measure::camera::Mounting;
 use activecal::model::Robot;
+use activecal::pool::camera_view::placement;
 use anyhow::{Context, Result, bail};
-use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+use nalgebra::Isometry3;
 use std::fmt::Write as _;
 use std::path::Path;
 
 /// Parses `X,Y,Z,ROLL,PITCH,YAW` (metres, radians; rpy as in URDF).
 fn parse_placement(flag: &str, s: &str) -> Result<Isometry3<f64>> {
     let v = super::parse_list::<f64>(s, flag)?;
-    if v.len() != 6 || v.iter().any(|x| !x.is_finite()) {
-        bail!("{flag} {s}: expected six finite numbers X,Y,Z,ROLL,PITCH,YAW (metres and radians)");
+    match <[f64; 6]>::try_from(v) {
+        Ok(v) if v.iter().all(|x| x.is_finite()) => Ok(placement(&v)),
+        _ => bail!(
+            "{flag} {s}: expected six finite numbers X,Y,Z,ROLL,PITCH,YAW (metres and radians)"
+        ),
     }
-    Ok(Isometry3::from_parts(
-        Translation3::new(v[0], v[1], v[2]),
-        UnitQuaternion::from_euler_angles(v[3], v[4], v[5]),
-    ))
 }
 
 /// Refuses an output a camera calibration cannot be written as, before
@@ -164,7 +164,7 @@ fn check_camera_info_out(a: &CalibrateArgs, obs_path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Writes the refined intrinsics of `fit` to `o` as a ROS camera_info.
+/// Writes the refined intrinsics of `cal` to `o` as a ROS camera_info.
 fn write_camera_info(
     o: &Path,
     cal: &CameraCalibration,

@@ -21,6 +21,8 @@ inputs) or ``InternalError`` (a defect: please report it).
 
 from ._activecal import (
     Calibration,
+    CameraCalibration,
+    CameraDesign,
     ContactCalibration,
     Design,
     ComputationError,
@@ -34,15 +36,19 @@ from ._activecal import (
     __version__,
     bound,
     calibrate,
+    calibrate_camera,
     calibrate_contacts,
     evaluate,
     gap,
     pool,
     select,
+    select_camera,
 )
 
 __all__ = [
     "Calibration",
+    "CameraCalibration",
+    "CameraDesign",
     "ContactCalibration",
     "Design",
     "ComputationError",
@@ -56,9 +62,11 @@ __all__ = [
     "__version__",
     "bound",
     "calibrate",
+    "calibrate_camera",
     "calibrate_contacts",
     "evaluate",
     "gap",
     "pool",
     "select",
+    "select_camera",
 ]

@@ -457,3 +457,138 @@ def calibrate_contacts(
     metres (at least one: contacts alone leave the scale free). free:
     parameters never fixed; loss, loss_scale, max_iterations and progress
     as `calibrate` takes them."""
+
+class CameraCalibration:
+    """The result of `calibrate_camera`."""
+
+    @property
+    def converged(self) -> bool:
+        """Whether the fit converged (only then are files written)."""
+    @property
+    def estimate(self) -> dict[str, float]:
+        """{unknown: value}: the robot's unknowns (metres, radians),
+        ``camera_x … target_rz`` (the fit's placements) and, refined, the
+        intrinsics ``fx fy cx cy`` (px) and ``k1 k2 p1 p2 k3``."""
+    @property
+    def sigma(self) -> Optional[dict[str, float]]:
+        """{unknown: σ}; None without a covariance."""
+    @property
+    def sigma_px(self) -> Optional[float]:
+        """The pixel noise σ estimated from the residuals (one variance
+        component), px."""
+    @property
+    def rms_px(self) -> float:
+        """The RMS pixel error calibrated, px."""
+    @property
+    def camera(self) -> Optional[npt.NDArray[np.float64]]:
+        """The camera's optical frame (x right, y down, z forward) in its
+        link (``report["camera"]["camera"]["parent"]``: the base link
+        eye-to-hand, the tip link eye-in-hand, the camera's link), a 4×4
+        homogeneous matrix, metres; None for a robot not from a URDF."""
+    @property
+    def target(self) -> Optional[npt.NDArray[np.float64]]:
+        """The target's frame in its link (``report["camera"]["target"]
+        ["parent"]``), a 4×4 homogeneous matrix, metres; None as for
+        ``camera``."""
+    @property
+    def report(self) -> dict[str, Any]:
+        """The dict ``activecal calibrate --observations FILE --json``
+        prints (``out`` empty)."""
+    def write_urdf(self, path: _Path, overwrite: bool = False) -> None:
+        """Your URDF with the calibrated joint origins (refused unless
+        converged)."""
+    def write_frames(self, path: _Path, overwrite: bool = False) -> None:
+        """The frames file with the ``camera`` block (both placements with
+        σ, the pixel σ and RMS)."""
+    def write_camera_info(self, path: _Path, overwrite: bool = False) -> None:
+        """The refined intrinsics as a ROS camera_info ``.yaml``, the camera
+        named by the file's stem (only with ``refine_intrinsics=True`` and
+        a converged fit), as ``--out-camera-info`` writes it."""
+
+def calibrate_camera(
+    robot: Robot,
+    observations: Union[_Path, Any],
+    camera_info: Union[_Path, Mapping[str, Any]],
+    target: Union[_Path, Mapping[str, Any]],
+    *,
+    camera_pose: Sequence[float],
+    target_pose: Sequence[float],
+    mounting: Optional[str] = None,
+    camera_link: Optional[str] = None,
+    refine_intrinsics: bool = False,
+    progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
+) -> CameraCalibration:
+    """Calibrates the robot from a camera's pixels of a target, as
+    ``activecal calibrate --observations FILE --json`` does with the same
+    files. observations: a CSV path or a pandas DataFrame with its columns
+    ``pose, <joint names>, feature, u, v`` (one row a point seen, pixels;
+    a DataFrame's errors name the line of its CSV, line 2 its first row).
+    camera_info: a ROS camera_info or OpenCV YAML path, or a dict of a ROS
+    camera_info's keys. target: a target YAML path, or a dict
+    (``{"checkerboard": {"rows": 6, "cols": 8, "square": 0.025}}`` or
+    ``{"points": [{"id": 0, "xyz": [x, y, z]}, ...]}``). mounting:
+    ``"eye-to-hand"`` (the camera fixed, the target on the tip link) or
+    ``"eye-in-hand"``; or camera_link: the robot's link a camera is on (a
+    head; the chain from it to the tip is fitted). camera_pose,
+    target_pose: rough placements X, Y, Z, ROLL, PITCH, YAW (metres,
+    radians, rpy as in URDF), the fit's start. refine_intrinsics: fit the
+    intrinsics too. Bad input raises `InputError` naming the argument (and
+    the file, line and column)."""
+
+class CameraDesign:
+    """The result of `select_camera`."""
+
+    @property
+    def q(self) -> npt.NDArray[np.float64]:
+        """(n, dof) chosen configurations, radians or metres, in the order
+        chosen."""
+    @property
+    def candidates(self) -> list[int]:
+        """Each one's index in the samples."""
+    @property
+    def points_seen(self) -> list[int]:
+        """The target points each will see."""
+    @property
+    def joint_names(self) -> list[str]:
+        """The columns of ``q``."""
+    @property
+    def poses(self) -> Any:
+        """A pandas DataFrame with the columns of ``select --out
+        design.csv``: candidate, the joints, points_seen."""
+    @property
+    def report(self) -> dict[str, Any]:
+        """The dict ``activecal select --camera-info ... --json`` prints
+        (``out`` empty)."""
+
+def select_camera(
+    robot: Robot,
+    camera_info: Union[_Path, Mapping[str, Any]],
+    target: Union[_Path, Mapping[str, Any]],
+    *,
+    n: int,
+    camera_pose: Sequence[float],
+    target_pose: Sequence[float],
+    mounting: Optional[str] = None,
+    camera_link: Optional[str] = None,
+    count: int = 20000,
+    pool_seed: int = 0,
+    seed: int = 1,
+    min_visible: float = 1.0,
+    image_margin: float = 10.0,
+    max_view_angle: float = 60.0,
+    distance: Tuple[float, float] = (0.2, 3.0),
+    gap: bool = False,
+    progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
+) -> CameraDesign:
+    """Chooses n poses for a camera, as ``activecal select --camera-info
+    ... --json`` does with the same files and options (no collision
+    filters or line of sight yet). camera_info, target, mounting,
+    camera_link, camera_pose and target_pose as `calibrate_camera` takes
+    them. count joint-space samples (seed pool_seed) are kept where at
+    least min_visible of the target's points lie image_margin px inside
+    the image, the target faces the camera within max_view_angle degrees
+    and lies within distance (lo, hi) metres; n of them are chosen
+    D-optimally on the pixel Jacobian (seed: the search's; 1 as the
+    command line's). gap: score the design against its visible pool's
+    certified bound (``report["gap"]``, ``report["d_efficiency"]``; a
+    minute or two on large pools)."""

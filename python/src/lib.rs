@@ -8,6 +8,8 @@ use pyo3::prelude::*;
 
 mod bound;
 mod calibrate;
+mod camera;
+mod camera_select;
 mod contacts;
 mod convert;
 mod pool;
@@ -72,6 +74,10 @@ fn _activecal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(bound::gap, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate::evaluate, m)?)?;
+    m.add_class::<camera::CameraCalibration>()?;
+    m.add_function(wrap_pyfunction!(camera::calibrate_camera, m)?)?;
+    m.add_class::<camera_select::CameraDesign>()?;
+    m.add_function(wrap_pyfunction!(camera_select::select_camera, m)?)?;
     m.add_class::<contacts::ContactCalibration>()?;
     m.add_function(wrap_pyfunction!(contacts::calibrate_contacts, m)?)?;
     Ok(())

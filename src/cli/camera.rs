@@ -1,39 +1,38 @@
 //! `calibrate --observations pixels.csv --camera-info cam.yaml --target
 //! board.yaml --mounting …` (or `--camera-link LINK` for a camera on the
 //! robot's own link, `activecal::io::urdf_branch`): calibration from a
-//! camera's pixels. Reads the files, fits (`activecal::identify::camera`), renders the fit and writes
+//! camera's pixels. Reads the files, fits (`activecal::experiment::camera`), renders the fit and writes
 //! `--out` (the URDF with the calibrated joint origins, the frames file
 //! with the camera's and target's placements). Written only when the fit
 //! converged, each file atomically and never over an existing one without
 //! `--force`.
 
 use super::calibrate_args::CalibrateArgs;
-use activecal::frames::camera::camera_frames;
+use activecal::experiment::camera::{CameraCalibration, CameraSetup};
 use activecal::identify::LmSettings;
-use activecal::identify::camera::{CameraFit, fit_camera};
+use activecal::identify::camera::CameraFit;
 use activecal::io::calibrated::{Format, render};
 use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_observations::read_observations;
 use activecal::io::camera_target::read_target;
 use activecal::io::urdf_branch::camera_branch;
-use activecal::measure::camera::{CameraSensor, Mounting};
+use activecal::measure::camera::Mounting;
 use activecal::model::Robot;
+use activecal::pool::camera_view::placement;
 use anyhow::{Context, Result, bail};
-use nalgebra::{Isometry3, Translation3, UnitQuaternion};
-use serde_json::json;
+use nalgebra::Isometry3;
 use std::fmt::Write as _;
 use std::path::Path;
 
 /// Parses `X,Y,Z,ROLL,PITCH,YAW` (metres, radians; rpy as in URDF).
 fn parse_placement(flag: &str, s: &str) -> Result<Isometry3<f64>> {
     let v = super::parse_list::<f64>(s, flag)?;
-    if v.len() != 6 || v.iter().any(|x| !x.is_finite()) {
-        bail!("{flag} {s}: expected six finite numbers X,Y,Z,ROLL,PITCH,YAW (metres and radians)");
+    match <[f64; 6]>::try_from(v) {
+        Ok(v) if v.iter().all(|x| x.is_finite()) => Ok(placement(&v)),
+        _ => bail!(
+            "{flag} {s}: expected six finite numbers X,Y,Z,ROLL,PITCH,YAW (metres and radians)"
+        ),
     }
-    Ok(Isometry3::from_parts(
-        Translation3::new(v[0], v[1], v[2]),
-        UnitQuaternion::from_euler_angles(v[3], v[4], v[5]),
-    ))
 }
 
 /// Refuses an output a camera calibration cannot be written as, before
@@ -80,30 +79,24 @@ pub fn calibrate_camera(
     let intrinsics = read_camera_info(info).context("--camera-info")?;
     let target = read_target(target).context("--target")?;
     let obs = read_observations(obs_path, robot, &target, &intrinsics, a.units.units())?;
-    let (cam0, tgt0) = (
-        parse_placement("--camera-pose", cp)?,
-        parse_placement("--target-pose", tp)?,
-    );
-    let sensor = CameraSensor::new(intrinsics, mounting, target.points.clone(), &cam0, &tgt0)
-        .with_intrinsics_refined(a.refine_intrinsics);
+    let setup = CameraSetup {
+        intrinsics,
+        target,
+        mounting,
+        camera_link: a.camera_link.clone(),
+        camera: parse_placement("--camera-pose", cp)?,
+        target_pose: parse_placement("--target-pose", tp)?,
+        refine_intrinsics: a.refine_intrinsics,
+    };
     let lm = LmSettings::builder()
         .max_iterations(a.max_iterations)
         .geodesic(!a.no_geodesic)
         .build()?;
-    let fit = fit_camera(
-        robot,
-        &sensor,
-        &CameraSensor::start_own(&cam0, &tgt0),
-        &obs,
-        &lm,
-    )?;
-    let mut frames = camera_frames(&fit)?;
-    if let Some(c) = frames.as_mut().and_then(|f| f.1.camera.as_mut()) {
-        c.camera_link.clone_from(&a.camera_link);
-    }
+    let cal = activecal::experiment::camera::calibrate_camera(robot, obs, &setup, &lm)?;
+    let (fit, frames) = (&cal.fit, &cal.frames);
     let mut written = Vec::new();
     if fit.converged
-        && let Some(f) = &frames
+        && let Some(f) = frames
     {
         for path in &a.out {
             let text = render(
@@ -121,37 +114,16 @@ pub fn calibrate_camera(
     if fit.converged
         && let Some(o) = &a.out_camera_info
     {
-        write_camera_info(o, &fit, obs_path, a.force)?;
+        write_camera_info(o, &cal, obs_path, a.force)?;
         written.push(o.display().to_string());
     }
-    let v = json!({
-        "robot": robot.name,
-        "observations": obs_path.display().to_string(),
-        "mounting": fit.sensor.mounting(),
-        "camera_link": a.camera_link,
-        "poses": obs.qs.len(),
-        "points_seen": obs.n_seen(),
-        "names": fit.names,
-        "estimate": fit.estimate,
-        "std": fit.std,
-        "start_rms_px": fit.given_rms_px,
-        "rigid_rms_px": fit.rigid_rms_px,
-        "rms_px": fit.rms_px,
-        "sigma_px": fit.sigma_px,
-        "redundancy": fit.redundancy,
-        "converged": fit.converged,
-        "fixed_intrinsics": fit.fixed_intrinsics,
-        "stop": format!("{:?}", fit.stop),
-        "camera": frames.as_ref().and_then(|f| f.1.camera.clone()),
-        "intrinsics": a.refine_intrinsics.then(|| fit.intrinsics()),
-        "out": written,
-    });
+    let v = serde_json::to_value(cal.report(written.clone()))?;
     super::emit(a.json, &v, || {
         text(
-            &fit,
+            fit,
             &label,
             obs_path,
-            obs.qs.len(),
+            cal.observations.qs.len(),
             frames.as_ref().map(|f| &f.1),
             &written,
         )
@@ -192,8 +164,13 @@ fn check_camera_info_out(a: &CalibrateArgs, obs_path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Writes the refined intrinsics of `fit` to `o` as a ROS camera_info.
-fn write_camera_info(o: &Path, fit: &CameraFit, obs_path: &Path, force: bool) -> Result<()> {
+/// Writes the refined intrinsics of `cal` to `o` as a ROS camera_info.
+fn write_camera_info(
+    o: &Path,
+    cal: &CameraCalibration,
+    obs_path: &Path,
+    force: bool,
+) -> Result<()> {
     let name = o
         .file_stem()
         .map_or_else(|| "camera".into(), |s| s.to_string_lossy());
@@ -201,7 +178,7 @@ fn write_camera_info(o: &Path, fit: &CameraFit, obs_path: &Path, force: bool) ->
         "intrinsics refined by activecal calibrate --refine-intrinsics from {}",
         obs_path.display()
     );
-    let text = activecal::io::camera_info::render_camera_info(&fit.intrinsics(), &name, &comment);
+    let text = cal.camera_info_text(&name, &comment);
     super::write_new(o, &text, force)
 }
 

@@ -22,6 +22,7 @@ use activecal::model::Robot;
 use activecal::pool::PoolFilter;
 use activecal::pool::camera_view::CameraView;
 use activecal::pool::line_of_sight::LineOfSight;
+use activecal::report::{CameraDesignReport, CameraPoolInfo};
 use activecal::select::camera::{CameraDesign, camera_design_in_sight};
 use anyhow::{Context, Result, bail};
 use serde_json::json;
@@ -252,34 +253,20 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         let joints: Vec<String> = q.iter().map(|v| format!("{v:.17}")).collect();
         let _ = writeln!(csv, "{c},{},{s}", joints.join(","));
     }
-    let figures = json!({
-        "camera_link": a.camera.camera_link,
-        "mounting": v.mounting,
-        "candidates": candidates.len(),
-        "pool_seed": a.pool.pool_seed.unwrap_or(0),
-        "visible": d.visible,
-        "collision_removed": collision_removed,
-        "out_of_sight": d.out_of_sight,
-        "unknowns": d.names,
-        "ln_det": d.ln_det,
-        "log10_bound": gap.as_ref().map(|g| g.log10_bound),
-        "d_efficiency": gap.as_ref().map(|g| g.d_efficiency),
-        "predicted_error_mm_per_px": d.predicted_error_per_px.map(|e| 1e3 * e),
-        "pixel_noise_px": a.camera.pixel_noise,
-        "predicted_error_mm": a.camera.pixel_noise.zip(d.predicted_error_per_px).map(|(s, e)| 1e3 * e * s),
-        "points_seen": d.seen,
-    });
     if let Some(o) = csv_out {
         super::write_new(o, &csv, a.force)?;
     }
-    let mut value = figures;
-    value["robot"] = json!(a.pool.robot.head());
-    value["chain"] = json!(a.pool.robot.chain);
-    value["joint_names"] = json!(names);
-    value["n"] = json!(d.qs.len());
-    value["chosen_candidates"] = json!(d.candidates);
-    value["poses"] = json!(d.qs);
-    value["gap"] = json!(gap);
+    let pool = CameraPoolInfo {
+        robot: a.pool.robot.head(),
+        chain: a.pool.robot.chain.clone(),
+        camera_link: a.camera.camera_link.clone(),
+        candidates: candidates.len(),
+        pool_seed: a.pool.pool_seed.unwrap_or(0),
+        collision_removed,
+        pixel_noise: a.camera.pixel_noise,
+    };
+    let report = CameraDesignReport::new(&d, pool, v.mounting, names.clone(), gap.clone());
+    let mut value = serde_json::to_value(&report)?;
     if let Some(o) = json_out {
         let text = serde_json::to_string_pretty(&value)? + "\n";
         super::write_new(o, &text, a.force)?;

@@ -1,5 +1,6 @@
 //! Experiments: whole pipelines that return typed reports.
 
+pub mod camera;
 pub mod contacts;
 pub mod measured;
 pub mod paper;

@@ -50,7 +50,10 @@ pub struct CameraView {
     pub distance: [f64; 2],
 }
 
-pub(crate) fn placement(v: &[f64; 6]) -> Isometry3<f64> {
+/// The placement `X,Y,Z,ROLL,PITCH,YAW` stands for (metres, radians; rpy
+/// as in URDF).
+#[must_use]
+pub fn placement(v: &[f64; 6]) -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::new(v[0], v[1], v[2]),
         UnitQuaternion::from_euler_angles(v[3], v[4], v[5]),

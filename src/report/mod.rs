@@ -6,6 +6,7 @@
 
 mod bound;
 mod calibrate;
+mod camera;
 mod existing;
 mod fk;
 mod gap;
@@ -15,6 +16,7 @@ mod select;
 
 pub use bound::{BoundCommandReport, WeightedPose};
 pub use calibrate::{MeasuredCalibrationReport, SimulatedCalibrationReport};
+pub use camera::{CameraCalibrationReport, CameraDesignReport, CameraPoolInfo};
 pub use existing::ExistingReport;
 pub use fk::{FkReport, Orientation};
 pub use gap::GapReport;

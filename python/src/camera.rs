@@ -1,0 +1,444 @@
+//! `activecal.calibrate_camera`: calibration from a camera's pixels of a
+//! target, as `activecal calibrate --observations FILE` does, and the
+//! `CameraCalibration` it returns.
+
+use crate::convert::{Fail, arg_err, detached, float_array, json_to_py, ndarray};
+use crate::robot::Robot;
+use activecal::experiment::camera::{CameraCalibration as Calibrated, CameraSetup};
+use activecal::identify::LmSettings;
+use activecal::io::calibrated::Format;
+use activecal::measure::camera::Mounting;
+use activecal::measure::pinhole::Intrinsics;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::{Path, PathBuf};
+
+/// The command line's Levenberg–Marquardt limit (`--max-iterations`).
+const MAX_ITERATIONS: usize = 200;
+
+/// An input given as a file or in memory: the text and where it is from.
+pub(crate) enum Source {
+    /// A file's path.
+    File(PathBuf),
+    /// Text in the file's format, named `origin` in messages.
+    Text(String),
+}
+
+/// A library error about input `name`: its kind, the message starting
+/// with the input's name (unless the library's already does).
+pub(crate) fn named(name: &str, e: impl Into<Fail>) -> Fail {
+    let prefix = |m: String| {
+        if m.starts_with(&format!("{name}: ")) {
+            m
+        } else {
+            format!("{name}: {m}")
+        }
+    };
+    match e.into() {
+        Fail::Input(m) => Fail::Input(prefix(m)),
+        Fail::File(m) => Fail::File(prefix(m)),
+        Fail::Resource(m) => Fail::Resource(prefix(m)),
+        Fail::Compute(m) => Fail::Compute(prefix(m)),
+    }
+}
+
+/// A YAML input (`camera_info`, `target`): a path, or a dict of the
+/// file's content (written as JSON, which YAML reads).
+pub(crate) fn yaml_source(py: Python<'_>, obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Source> {
+    if obj.cast::<PyDict>().is_ok() {
+        let text: String = py
+            .import("json")?
+            .call_method1("dumps", (obj,))
+            .map_err(|e| arg_err(name, format!("a dict that is not JSON-serialisable ({e})")))?
+            .extract()?;
+        return Ok(Source::Text(text));
+    }
+    let path: PathBuf = obj
+        .extract()
+        .map_err(|_| arg_err(name, "expected a path (str or os.PathLike) or a dict"))?;
+    Ok(Source::File(path))
+}
+
+/// The observations argument: a CSV path, or a pandas DataFrame with the
+/// file's columns (written as CSV by pandas, floats round-tripping).
+fn observations_source(obj: &Bound<'_, PyAny>) -> PyResult<Source> {
+    if obj.hasattr("to_csv")? && obj.hasattr("columns")? {
+        let kw = PyDict::new(obj.py());
+        kw.set_item("index", false)?;
+        let text: String = obj.call_method("to_csv", (), Some(&kw))?.extract()?;
+        return Ok(Source::Text(text));
+    }
+    let path: PathBuf = obj.extract().map_err(|_| {
+        arg_err(
+            "observations",
+            "expected a CSV path (str or os.PathLike) or a pandas DataFrame with columns pose, the joints, feature, u, v",
+        )
+    })?;
+    Ok(Source::File(path))
+}
+
+/// Reads the intrinsics of `camera_info`.
+pub(crate) fn read_intrinsics(s: &Source) -> Result<Intrinsics, Fail> {
+    use activecal::io::camera_info::{parse_camera_info, read_camera_info};
+    match s {
+        Source::File(p) => read_camera_info(p),
+        Source::Text(t) => parse_camera_info(t, "the dict"),
+    }
+    .map_err(|e| named("camera_info", e))
+}
+
+/// Reads the target's points.
+pub(crate) fn read_target(s: &Source) -> Result<activecal::io::camera_target::Target, Fail> {
+    use activecal::io::camera_target::{parse_target, read_target};
+    match s {
+        Source::File(p) => read_target(p),
+        Source::Text(t) => parse_target(t, "the dict"),
+    }
+    .map_err(|e| named("target", e))
+}
+
+/// A placement argument: six numbers X, Y, Z, ROLL, PITCH, YAW.
+pub(crate) fn six(py: Python<'_>, obj: &Bound<'_, PyAny>, name: &str) -> PyResult<[f64; 6]> {
+    let (v, _) = float_array(
+        py,
+        obj,
+        name,
+        &[Some(6)],
+        "X, Y, Z, ROLL, PITCH, YAW: metres and radians, rpy as in URDF",
+    )?;
+    Ok([v[0], v[1], v[2], v[3], v[4], v[5]])
+}
+
+/// The mounting and camera link arguments: the mounting they give.
+pub(crate) fn mounting_of(mounting: Option<&str>, camera_link: Option<&str>) -> PyResult<Mounting> {
+    match (mounting, camera_link) {
+        (Some(_), Some(_)) => Err(arg_err(
+            "camera_link",
+            "a camera on the robot's own link is mounted on it: give mounting or camera_link, not both",
+        )),
+        (None, Some(_)) => Ok(Mounting::EyeToHand),
+        (Some(m), None) => Mounting::from_name(m).ok_or_else(|| {
+            arg_err(
+                "mounting",
+                format!("unknown mounting '{m}': \"eye-to-hand\" or \"eye-in-hand\""),
+            )
+        }),
+        (None, None) => Err(arg_err(
+            "mounting",
+            "none given: \"eye-to-hand\" (the camera fixed, the target on the tip link), \"eye-in-hand\" (the camera on the tip link), or camera_link=LINK for a camera on the robot's own link",
+        )),
+    }
+}
+
+/// The chain a camera sees: `robot`'s, or for a camera on the robot's own
+/// link the chain from it to the tip.
+pub(crate) fn chain_of(
+    robot: &activecal::model::Robot,
+    camera_link: Option<&str>,
+) -> Result<Option<activecal::model::Robot>, Fail> {
+    camera_link
+        .map(|l| {
+            activecal::io::urdf_branch::camera_branch(robot, l)
+                .map_err(|e| named("camera_link", Fail::Input(format!("{l}: {e}"))))
+        })
+        .transpose()
+}
+
+/// A calibration from a camera's pixels: the estimate with its σ, the
+/// camera's and the target's placements, the pixel noise, the calibrated
+/// robot and the refined intrinsics to write.
+#[pyclass(module = "activecal", name = "CameraCalibration", frozen)]
+pub struct CameraCalibration {
+    cal: Calibrated,
+    report: serde_json::Value,
+}
+
+/// Calibrates the robot from a camera's pixels of a target, as `activecal
+/// calibrate --observations FILE --json` does with the same files.
+///
+/// observations: a CSV path or a pandas DataFrame with the file's columns
+/// `pose, <joint names>, feature, u, v` (a row per point seen; pixels).
+/// camera_info: a ROS camera_info or OpenCV YAML path, or a dict of a ROS
+/// camera_info's content. target: a target YAML path, or a dict
+/// ({"checkerboard": {"rows", "cols", "square"}} or {"points": [...]}).
+/// mounting: "eye-to-hand" or "eye-in-hand"; or camera_link: the robot's
+/// link a camera is on (a head). camera_pose, target_pose: the rough
+/// placements X, Y, Z, ROLL, PITCH, YAW (metres, radians), the fit's
+/// start. refine_intrinsics: fit the intrinsics too. progress as
+/// `calibrate` takes it.
+#[pyfunction]
+#[pyo3(signature = (robot, observations, camera_info, target, *, camera_pose, target_pose, mounting=None, camera_link=None, refine_intrinsics=false, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn calibrate_camera(
+    py: Python<'_>,
+    robot: &Robot,
+    observations: &Bound<'_, PyAny>,
+    camera_info: &Bound<'_, PyAny>,
+    target: &Bound<'_, PyAny>,
+    camera_pose: &Bound<'_, PyAny>,
+    target_pose: &Bound<'_, PyAny>,
+    mounting: Option<&str>,
+    camera_link: Option<String>,
+    refine_intrinsics: bool,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<CameraCalibration> {
+    let m = mounting_of(mounting, camera_link.as_deref())?;
+    let (cam0, tgt0) = (
+        six(py, camera_pose, "camera_pose")?,
+        six(py, target_pose, "target_pose")?,
+    );
+    let obs_src = observations_source(observations)?;
+    let info_src = yaml_source(py, camera_info, "camera_info")?;
+    let target_src = yaml_source(py, target, "target")?;
+    let inner = robot.inner.clone();
+    let (cal, report) = crate::progress::with_callback(progress, || {
+        detached(py, move || {
+            let branch = chain_of(&inner, camera_link.as_deref())?;
+            let r = branch.as_ref().unwrap_or(&inner);
+            let intrinsics = read_intrinsics(&info_src)?;
+            let target = read_target(&target_src)?;
+            let obs = read_observations(&obs_src, r, &target, &intrinsics)?;
+            let setup = CameraSetup {
+                intrinsics,
+                target,
+                mounting: m,
+                camera_link,
+                camera: activecal::pool::camera_view::placement(&cam0),
+                target_pose: activecal::pool::camera_view::placement(&tgt0),
+                refine_intrinsics,
+            };
+            let lm = LmSettings::builder()
+                .max_iterations(MAX_ITERATIONS)
+                .geodesic(true)
+                .build()?;
+            let cal = activecal::experiment::camera::calibrate_camera(r, obs, &setup, &lm)
+                .map_err(Fail::input)?;
+            let report = serde_json::to_value(cal.report(Vec::new()))?;
+            Ok((cal, report))
+        })
+    })?;
+    Ok(CameraCalibration { cal, report })
+}
+
+/// Reads the observations for the chain `robot`.
+fn read_observations(
+    s: &Source,
+    robot: &activecal::model::Robot,
+    target: &activecal::io::camera_target::Target,
+    intrinsics: &Intrinsics,
+) -> Result<activecal::identify::camera::CameraObservations, Fail> {
+    use activecal::io::camera_observations::{parse_observations, read_observations};
+    let units = activecal::units::Units::default();
+    match s {
+        Source::File(p) => read_observations(p, robot, target, intrinsics, units),
+        Source::Text(t) => parse_observations(t, "observations", robot, target, intrinsics, units),
+    }
+    .map_err(|e| named("observations", e))
+}
+
+/// Writes `text` to `path` atomically; an existing file only with
+/// `overwrite`.
+fn write_text(path: &Path, text: &str, overwrite: bool) -> PyResult<()> {
+    let out = [activecal::io::atomic::Output {
+        label: "path",
+        path,
+    }];
+    activecal::io::atomic::check_outputs(&out, &[], overwrite)
+        .map_err(|e| Fail::from(e).into_py())?;
+    activecal::io::atomic::write_atomic(path, text.as_bytes()).map_err(|e| Fail::from(e).into_py())
+}
+
+impl CameraCalibration {
+    /// Refuses to write from a fit that did not converge.
+    fn check_converged(&self, path: &Path) -> PyResult<()> {
+        let fit = &self.cal.fit;
+        if fit.converged {
+            return Ok(());
+        }
+        Err(Fail::Compute(format!(
+            "{}: not written: the camera fit did not converge ({:?} after {} iterations)",
+            path.display(),
+            fit.stop,
+            fit.iterations
+        ))
+        .into_py())
+    }
+
+    /// Writes the calibrated robot as `format`.
+    fn write_as(&self, format: Format, path: &Path, overwrite: bool) -> PyResult<()> {
+        self.check_converged(path)?;
+        let fit = &self.cal.fit;
+        let Some((f, r)) = &self.cal.frames else {
+            return Err(arg_err(
+                "path",
+                format!(
+                    "{}: robot '{}' was not imported from a URDF: there is no URDF or frames file to write",
+                    path.display(),
+                    self.cal.robot_name
+                ),
+            ));
+        };
+        crate::calibrate::write_robot(
+            format,
+            &fit.robot,
+            &fit.table,
+            Some((f, r)),
+            "",
+            path,
+            overwrite,
+        )
+    }
+
+    /// A placement of the `camera` block (`which`: "camera" or "target")
+    /// as a 4×4 homogeneous matrix.
+    fn placement<'py>(&self, py: Python<'py>, which: &str) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let Some(c) = self.cal.frames.as_ref().and_then(|f| f.1.camera.as_ref()) else {
+            return Ok(None);
+        };
+        let b = if which == "camera" {
+            &c.camera
+        } else {
+            &c.target
+        };
+        let (t, r) = (b.xyz, b.rpy);
+        let m = activecal::pool::camera_view::placement(&[t[0], t[1], t[2], r[0], r[1], r[2]])
+            .to_homogeneous();
+        let rows: Vec<f64> = (0..4)
+            .flat_map(|i| (0..4).map(move |j| (i, j)))
+            .map(|(i, j)| m[(i, j)])
+            .collect();
+        ndarray(py, &rows, &[4, 4]).map(Some)
+    }
+}
+
+#[pymethods]
+impl CameraCalibration {
+    /// Whether the fit converged (only then are files written).
+    #[getter]
+    fn converged(&self) -> bool {
+        self.cal.fit.converged
+    }
+
+    /// The estimate {name: value}: the robot's unknowns (metres, radians),
+    /// `camera_x … target_rz`, and the refined intrinsics (px, unitless).
+    #[getter]
+    fn estimate(&self) -> std::collections::BTreeMap<String, f64> {
+        let f = &self.cal.fit;
+        f.names
+            .iter()
+            .cloned()
+            .zip(f.estimate.iter().copied())
+            .collect()
+    }
+
+    /// Standard deviations of the estimate {name: σ}; None without a
+    /// covariance.
+    #[getter]
+    fn sigma(&self) -> Option<std::collections::BTreeMap<String, f64>> {
+        let f = &self.cal.fit;
+        f.std
+            .as_ref()
+            .map(|s| f.names.iter().cloned().zip(s.iter().copied()).collect())
+    }
+
+    /// The pixel noise σ the fit estimated from its residuals, px (None
+    /// without degrees of freedom).
+    #[getter]
+    fn sigma_px(&self) -> Option<f64> {
+        self.cal.fit.sigma_px
+    }
+
+    /// The RMS pixel error calibrated, px.
+    #[getter]
+    fn rms_px(&self) -> f64 {
+        self.cal.fit.rms_px
+    }
+
+    /// The camera's optical frame (x right, y down, z forward) in its link
+    /// (`report["camera"]["camera"]["parent"]`: the base link, the tip
+    /// link or the camera's own link), a 4×4 matrix (metres); None for a
+    /// robot not imported from a URDF.
+    #[getter]
+    fn camera<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.placement(py, "camera")
+    }
+
+    /// The target's frame in its link (`report["camera"]["target"]
+    /// ["parent"]`), a 4×4 matrix (metres); None as for `camera`.
+    #[getter]
+    fn target<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.placement(py, "target")
+    }
+
+    /// The whole report: the dict `activecal calibrate --observations FILE
+    /// --json` prints (`out` empty: files are written by the methods).
+    #[getter]
+    fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.report)
+    }
+
+    /// Writes your URDF with the calibrated joint origins (URDF robots;
+    /// refused when the fit did not converge).
+    #[pyo3(signature = (path, overwrite=false))]
+    fn write_urdf(&self, path: PathBuf, overwrite: bool) -> PyResult<()> {
+        self.write_as(Format::Urdf, &path, overwrite)
+    }
+
+    /// Writes the frames file (YAML) with the `camera` block: the
+    /// camera's and the target's placements with σ, the pixel σ and RMS.
+    #[pyo3(signature = (path, overwrite=false))]
+    fn write_frames(&self, path: PathBuf, overwrite: bool) -> PyResult<()> {
+        self.write_as(Format::Yaml, &path, overwrite)
+    }
+
+    /// Writes the refined intrinsics as a ROS camera_info YAML (only with
+    /// refine_intrinsics=True and a converged fit), as `--out-camera-info`
+    /// does: the camera named by the file's stem.
+    #[pyo3(signature = (path, overwrite=false))]
+    fn write_camera_info(&self, path: PathBuf, overwrite: bool) -> PyResult<()> {
+        if !self.cal.refine_intrinsics {
+            return Err(arg_err(
+                "path",
+                format!(
+                    "{}: the intrinsics were not refined (calibrate_camera(..., refine_intrinsics=True))",
+                    path.display()
+                ),
+            ));
+        }
+        let yaml = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
+        if !yaml {
+            return Err(arg_err(
+                "path",
+                format!(
+                    "{}: the refined intrinsics are written as a ROS camera_info .yaml",
+                    path.display()
+                ),
+            ));
+        }
+        self.check_converged(&path)?;
+        let name = path
+            .file_stem()
+            .map_or_else(|| "camera".into(), |s| s.to_string_lossy());
+        let comment = format!(
+            "intrinsics refined by activecal calibrate --refine-intrinsics from {}",
+            self.cal.observations.origin
+        );
+        write_text(
+            &path,
+            &self.cal.camera_info_text(&name, &comment),
+            overwrite,
+        )
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "CameraCalibration({:?}, {} poses, rms {:.3} px, converged={})",
+            self.cal.robot_name,
+            self.cal.observations.qs.len(),
+            self.cal.fit.rms_px,
+            self.cal.fit.converged
+        )
+    }
+}

@@ -1,0 +1,148 @@
+//! Calibration from a camera's pixels as one step: the sensor the setup
+//! describes, the fit ([`crate::identify::camera::fit_camera`]), the
+//! calibrated frames with the camera's and the target's placements in the
+//! URDF's links, and the report
+//! ([`crate::report::CameraCalibrationReport`]). The command line
+//! and the Python package both call it; reading the files and writing the
+//! results are theirs.
+
+use crate::frames::camera::camera_frames;
+use crate::frames::report::FramesReport;
+use crate::frames::{CalibratedFrames, FramesError};
+use crate::identify::LmSettings;
+use crate::identify::camera::{CameraFit, CameraFitError, CameraObservations, fit_camera};
+use crate::io::camera_target::Target;
+use crate::measure::camera::{CameraSensor, Mounting};
+use crate::measure::pinhole::Intrinsics;
+use crate::model::Robot;
+use crate::report::CameraCalibrationReport;
+use nalgebra::Isometry3;
+
+/// What a camera calibration is given besides the robot and the
+/// observations: the camera, the target, how they are mounted and where
+/// they roughly are.
+#[derive(Clone, Debug)]
+pub struct CameraSetup {
+    /// The camera's intrinsics (the start, when refined).
+    pub intrinsics: Intrinsics,
+    /// The target's points.
+    pub target: Target,
+    /// Which of the two rides on the tip link.
+    pub mounting: Mounting,
+    /// The robot's link the camera is on (a head), when the robot given
+    /// is the chain from it ([`crate::io::urdf_branch::camera_branch`]).
+    pub camera_link: Option<String>,
+    /// The camera's rough placement (the start of the fit).
+    pub camera: Isometry3<f64>,
+    /// The target's rough placement (the start of the fit).
+    pub target_pose: Isometry3<f64>,
+    /// Whether the intrinsics are unknowns of the fit too.
+    pub refine_intrinsics: bool,
+}
+
+/// Why a camera calibration could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum CameraCalibrationError {
+    /// The fit could not be made (bad input, a start that does not see
+    /// what the observations say).
+    #[error(transparent)]
+    Fit(Box<CameraFitError>),
+    /// The calibrated robot could not be split into frames.
+    #[error(transparent)]
+    Frames(#[from] FramesError),
+}
+
+impl From<CameraFitError> for CameraCalibrationError {
+    fn from(e: CameraFitError) -> Self {
+        Self::Fit(Box::new(e))
+    }
+}
+
+/// A calibration from a camera's pixels.
+#[derive(Clone, Debug)]
+pub struct CameraCalibration {
+    /// The name of the robot fitted.
+    pub robot_name: String,
+    /// The observations fitted.
+    pub observations: CameraObservations,
+    /// The fit.
+    pub fit: CameraFit,
+    /// The calibrated frames and their report with the `camera` block
+    /// (robots imported from a URDF).
+    pub frames: Option<(CalibratedFrames, FramesReport)>,
+    /// The robot's link the camera is on, if any.
+    pub camera_link: Option<String>,
+    /// Whether the intrinsics were refined.
+    pub refine_intrinsics: bool,
+}
+
+/// Calibrates `robot` (the chain from the camera's link for a camera on
+/// the robot's own link) from `observations` of `setup`'s target.
+pub fn calibrate_camera(
+    robot: &Robot,
+    observations: CameraObservations,
+    setup: &CameraSetup,
+    lm: &LmSettings,
+) -> Result<CameraCalibration, CameraCalibrationError> {
+    let (cam0, tgt0) = (&setup.camera, &setup.target_pose);
+    let sensor = CameraSensor::new(
+        setup.intrinsics.clone(),
+        setup.mounting,
+        setup.target.points.clone(),
+        cam0,
+        tgt0,
+    )
+    .with_intrinsics_refined(setup.refine_intrinsics);
+    let own0 = CameraSensor::start_own(cam0, tgt0);
+    let fit = fit_camera(robot, &sensor, &own0, &observations, lm)?;
+    let mut frames = camera_frames(&fit)?;
+    if let Some(c) = frames.as_mut().and_then(|f| f.1.camera.as_mut()) {
+        c.camera_link.clone_from(&setup.camera_link);
+    }
+    Ok(CameraCalibration {
+        robot_name: robot.name.clone(),
+        observations,
+        fit,
+        frames,
+        camera_link: setup.camera_link.clone(),
+        refine_intrinsics: setup.refine_intrinsics,
+    })
+}
+
+impl CameraCalibration {
+    /// The report, with the files `out` written from it.
+    #[must_use]
+    pub fn report(&self, out: Vec<String>) -> CameraCalibrationReport {
+        let fit = &self.fit;
+        CameraCalibrationReport {
+            robot: self.robot_name.clone(),
+            observations: self.observations.origin.clone(),
+            mounting: fit.sensor.mounting(),
+            camera_link: self.camera_link.clone(),
+            poses: self.observations.qs.len(),
+            points_seen: self.observations.n_seen(),
+            names: fit.names.clone(),
+            estimate: fit.estimate.clone(),
+            std: fit.std.clone(),
+            start_rms_px: fit.given_rms_px,
+            rigid_rms_px: fit.rigid_rms_px,
+            rms_px: fit.rms_px,
+            sigma_px: fit.sigma_px,
+            redundancy: fit.redundancy,
+            converged: fit.converged,
+            fixed_intrinsics: fit.fixed_intrinsics.clone(),
+            stop: format!("{:?}", fit.stop),
+            camera: self.frames.as_ref().and_then(|f| f.1.camera.clone()),
+            intrinsics: self.refine_intrinsics.then(|| fit.intrinsics()),
+            out,
+        }
+    }
+
+    /// The intrinsics at the estimate as a ROS `camera_info` YAML naming
+    /// the camera `camera_name`, with `comment` at its top
+    /// ([`crate::io::camera_info::render_camera_info`]).
+    #[must_use]
+    pub fn camera_info_text(&self, camera_name: &str, comment: &str) -> String {
+        crate::io::camera_info::render_camera_info(&self.fit.intrinsics(), camera_name, comment)
+    }
+}

@@ -1,0 +1,180 @@
+//! The reports of a camera: what a calibration from a camera's pixels
+//! (built by [`crate::experiment::camera::CameraCalibration::report`]) and a design chosen for a camera
+//! ([`crate::select::camera`]) found, as the command line prints them as
+//! JSON (and writes a design's JSON file) and the Python package returns
+//! them. Built here once, so that both give the same values.
+
+use crate::bound::DesignGap;
+use crate::identify::FixedParameter;
+use crate::measure::camera::Mounting;
+use crate::measure::pinhole::Intrinsics;
+use crate::model::robot_ref::ChainChoice;
+use crate::select::camera::CameraDesign;
+use serde::Serialize;
+
+/// A calibration from a camera's pixels: the unknowns' estimate with its
+/// σ, the pixel errors, the placements found and the files written.
+#[derive(Clone, Debug, Serialize)]
+pub struct CameraCalibrationReport {
+    /// The name of the robot fitted (the chain from the camera's link for
+    /// a camera on the robot's own link).
+    pub robot: String,
+    /// Where the observations came from (a file's path).
+    pub observations: String,
+    /// `eye-to-hand` or `eye-in-hand`.
+    pub mounting: Mounting,
+    /// The robot's link the camera is on, for a camera on the robot's own
+    /// link (a head); `None` (null) otherwise.
+    pub camera_link: Option<String>,
+    /// Configurations observed.
+    pub poses: usize,
+    /// Target points seen over all of them.
+    pub points_seen: usize,
+    /// Names of the unknowns: the robot's, `camera_x … target_rz`, then
+    /// the refined intrinsics.
+    pub names: Vec<String>,
+    /// The estimate (metres, radians, pixels), in the order of `names`.
+    pub estimate: Vec<f64>,
+    /// Its standard deviations, when the estimate has a covariance.
+    pub std: Option<Vec<f64>>,
+    /// RMS pixel error at the given placements (nominal robot), px.
+    pub start_rms_px: f64,
+    /// RMS pixel error after fitting the placements alone, px.
+    pub rigid_rms_px: f64,
+    /// RMS pixel error calibrated, px.
+    pub rms_px: f64,
+    /// The pixel noise σ estimated from the residuals, px.
+    pub sigma_px: Option<f64>,
+    /// Degrees of freedom of `sigma_px`.
+    pub redundancy: usize,
+    /// Whether the fit converged (only then is anything written).
+    pub converged: bool,
+    /// Intrinsics asked to be refined that the data do not determine, held
+    /// at their given values with the reason.
+    pub fixed_intrinsics: Vec<FixedParameter>,
+    /// Why the fit stopped.
+    pub stop: String,
+    /// The camera's and the target's placements in the URDF's links
+    /// (robots imported from a URDF).
+    pub camera: Option<crate::frames::report::CameraBlock>,
+    /// The intrinsics at the estimate, when they were refined.
+    pub intrinsics: Option<Intrinsics>,
+    /// The files written.
+    pub out: Vec<String>,
+}
+
+/// Where a camera design's candidates came from: the robot as its
+/// reference names it, the camera's link, the samples and what the
+/// collision filters removed.
+#[derive(Clone, Debug)]
+pub struct CameraPoolInfo {
+    /// The robot's name or description path, without the chain.
+    pub robot: String,
+    /// The chain of the robot's URDF tree.
+    pub chain: ChainChoice,
+    /// The robot's link the camera is on (a head), if any.
+    pub camera_link: Option<String>,
+    /// Configurations sampled.
+    pub candidates: usize,
+    /// The samples' seed.
+    pub pool_seed: u64,
+    /// Samples the collision filters removed; `None` without filters.
+    pub collision_removed: Option<usize>,
+    /// The pixel noise σ the user gave, px (the design's true error is
+    /// then also predicted at it).
+    pub pixel_noise: Option<f64>,
+}
+
+/// A design chosen for a camera: the chosen configurations, the points
+/// each will see, its figures and, when asked for, its gap to the visible
+/// pool's certified bound.
+#[derive(Clone, Debug, Serialize)]
+pub struct CameraDesignReport {
+    /// The robot's name or description path, without the chain.
+    pub robot: String,
+    /// The chain of the robot's URDF tree.
+    pub chain: ChainChoice,
+    /// The robot's link the camera is on (a head), if any.
+    pub camera_link: Option<String>,
+    /// `eye-to-hand` or `eye-in-hand`.
+    pub mounting: Mounting,
+    /// Configurations sampled.
+    pub candidates: usize,
+    /// The samples' seed.
+    pub pool_seed: u64,
+    /// Candidates the view kept (and in sight, with a line of sight).
+    pub visible: usize,
+    /// Samples the collision filters removed; `None` without filters.
+    pub collision_removed: Option<usize>,
+    /// Candidates seen well whose rays the robot blocks; `None` without a
+    /// line of sight.
+    pub out_of_sight: Option<usize>,
+    /// Names of the unknowns.
+    pub unknowns: Vec<String>,
+    /// `ln det XᵀX` of the design (unit pixel noise).
+    pub ln_det: f64,
+    /// `log10` of the certified bound, with a gap.
+    pub log10_bound: Option<f64>,
+    /// The D-efficiency against the bound, with a gap.
+    pub d_efficiency: Option<f64>,
+    /// The true error predicted per pixel of noise σ, mm per px.
+    pub predicted_error_mm_per_px: Option<f64>,
+    /// The pixel noise σ given, px.
+    pub pixel_noise_px: Option<f64>,
+    /// The true error predicted at that noise, mm.
+    pub predicted_error_mm: Option<f64>,
+    /// The points each chosen configuration will see.
+    pub points_seen: Vec<usize>,
+    /// The joints' names, in the order of `poses`.
+    pub joint_names: Vec<String>,
+    /// Configurations chosen.
+    pub n: usize,
+    /// Each one's index in the samples.
+    pub chosen_candidates: Vec<usize>,
+    /// The chosen configurations (radians, metres).
+    pub poses: Vec<Vec<f64>>,
+    /// The gap to the visible pool's certified bound, when asked for.
+    pub gap: Option<DesignGap>,
+}
+
+impl CameraDesignReport {
+    /// The report of design `d` (its candidates indexed in the samples)
+    /// chosen from `pool`, for a robot with joints `joint_names`, with its
+    /// `gap` when one was computed.
+    #[must_use]
+    pub fn new(
+        d: &CameraDesign,
+        pool: CameraPoolInfo,
+        mounting: Mounting,
+        joint_names: Vec<String>,
+        gap: Option<DesignGap>,
+    ) -> Self {
+        Self {
+            robot: pool.robot,
+            chain: pool.chain,
+            camera_link: pool.camera_link,
+            mounting,
+            candidates: pool.candidates,
+            pool_seed: pool.pool_seed,
+            visible: d.visible,
+            collision_removed: pool.collision_removed,
+            out_of_sight: d.out_of_sight,
+            unknowns: d.names.clone(),
+            ln_det: d.ln_det,
+            log10_bound: gap.as_ref().map(|g| g.log10_bound),
+            d_efficiency: gap.as_ref().map(|g| g.d_efficiency),
+            predicted_error_mm_per_px: d.predicted_error_per_px.map(|e| 1e3 * e),
+            pixel_noise_px: pool.pixel_noise,
+            predicted_error_mm: pool
+                .pixel_noise
+                .zip(d.predicted_error_per_px)
+                .map(|(s, e)| 1e3 * e * s),
+            points_seen: d.seen.clone(),
+            joint_names,
+            n: d.qs.len(),
+            chosen_candidates: d.candidates.clone(),
+            poses: d.qs.clone(),
+            gap,
+        }
+    }
+}

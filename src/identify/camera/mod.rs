@@ -19,6 +19,7 @@
 
 pub mod predict;
 pub mod simulate;
+pub mod start;
 pub mod unknowns;
 
 pub use unknowns::camera_robot;

@@ -10,7 +10,8 @@
 use super::calibrate_args::CalibrateArgs;
 use activecal::frames::camera::camera_frames;
 use activecal::identify::LmSettings;
-use activecal::identify::camera::{CameraFit, fit_camera};
+use activecal::identify::camera::start::{CameraStart, start_placements};
+use activecal::identify::camera::{CameraFit, CameraObservations, fit_camera};
 use activecal::io::calibrated::{Format, render};
 use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_observations::read_observations;
@@ -19,7 +20,7 @@ use activecal::io::urdf_branch::camera_branch;
 use activecal::measure::camera::{CameraSensor, Mounting};
 use activecal::model::Robot;
 use anyhow::{Context, Result, bail};
-use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -34,6 +35,79 @@ fn parse_placement(flag: &str, s: &str) -> Result<Isometry3<f64>> {
         Translation3::new(v[0], v[1], v[2]),
         UnitQuaternion::from_euler_angles(v[3], v[4], v[5]),
     ))
+}
+
+/// The start placements (camera, target): `--camera-pose` and
+/// `--target-pose` as given, those not given computed from the pixels
+/// (`activecal::identify::camera::start`), with what was computed.
+fn start(
+    a: &CalibrateArgs,
+    robot: &Robot,
+    intrinsics: &activecal::measure::pinhole::Intrinsics,
+    mounting: Mounting,
+    points: &[Vector3<f64>],
+    obs: &CameraObservations,
+) -> Result<(Isometry3<f64>, Isometry3<f64>, Option<CameraStart>)> {
+    let cam = a
+        .camera_pose
+        .as_ref()
+        .map(|s| parse_placement("--camera-pose", s))
+        .transpose()?;
+    let tgt = a
+        .target_pose
+        .as_ref()
+        .map(|s| parse_placement("--target-pose", s))
+        .transpose()?;
+    if let (Some(c), Some(t)) = (cam, tgt) {
+        return Ok((c, t, None));
+    }
+    let st = start_placements(
+        robot,
+        intrinsics,
+        mounting,
+        points,
+        obs,
+        cam.as_ref(),
+        tgt.as_ref(),
+    )
+    .with_context(|| {
+        format!(
+            "{}: no start computed from the pixels; give --camera-pose and --target-pose",
+            obs.origin
+        )
+    })?;
+    Ok((st.camera, st.target, Some(st)))
+}
+
+/// What a computed start computed, in words.
+fn start_phrase(st: &CameraStart) -> &'static str {
+    match (st.camera_computed, st.target_computed) {
+        (true, true) => "computed from the pixels (PnP + closed-form hand-eye)",
+        (true, false) => {
+            "the camera's placement computed from the pixels (PnP, the target's as given)"
+        }
+        _ => "the target's placement computed from the pixels (PnP, the camera's as given)",
+    }
+}
+
+/// The JSON `start` of a fit: which placements were given and which
+/// computed, and how.
+fn start_json(st: Option<&CameraStart>) -> serde_json::Value {
+    let word = |c: bool| if c { "computed" } else { "given" };
+    match st {
+        None => json!({"camera": "given", "target": "given"}),
+        Some(st) => json!({
+            "camera": word(st.camera_computed),
+            "target": word(st.target_computed),
+            "method": if st.camera_computed && st.target_computed {
+                "PnP + closed-form hand-eye"
+            } else {
+                "PnP"
+            },
+            "poses_placed": st.poses_placed,
+            "pnp_rms_px": st.pnp_rms_px,
+        }),
+    }
 }
 
 /// Refuses an output a camera calibration cannot be written as, before
@@ -59,10 +133,8 @@ pub fn calibrate_camera(
 ) -> Result<Option<String>> {
     check_out(a, robot)?;
     check_camera_info_out(a, obs_path)?;
-    let (Some(info), Some(target), Some(cp), Some(tp)) =
-        (&a.camera_info, &a.target, &a.camera_pose, &a.target_pose)
-    else {
-        bail!("--observations needs --camera-info, --target, --camera-pose and --target-pose");
+    let (Some(info), Some(target)) = (&a.camera_info, &a.target) else {
+        bail!("--observations needs --camera-info and --target");
     };
     let (branch, mounting) = match (&a.camera_link, a.mounting) {
         (Some(link), _) => (
@@ -80,10 +152,7 @@ pub fn calibrate_camera(
     let intrinsics = read_camera_info(info).context("--camera-info")?;
     let target = read_target(target).context("--target")?;
     let obs = read_observations(obs_path, robot, &target, &intrinsics, a.units.units())?;
-    let (cam0, tgt0) = (
-        parse_placement("--camera-pose", cp)?,
-        parse_placement("--target-pose", tp)?,
-    );
+    let (cam0, tgt0, start) = start(a, robot, &intrinsics, mounting, &target.points, &obs)?;
     let sensor = CameraSensor::new(intrinsics, mounting, target.points.clone(), &cam0, &tgt0)
         .with_intrinsics_refined(a.refine_intrinsics);
     let lm = LmSettings::builder()
@@ -134,6 +203,7 @@ pub fn calibrate_camera(
         "names": fit.names,
         "estimate": fit.estimate,
         "std": fit.std,
+        "start": start_json(start.as_ref()),
         "start_rms_px": fit.given_rms_px,
         "rigid_rms_px": fit.rigid_rms_px,
         "rms_px": fit.rms_px,
@@ -154,6 +224,7 @@ pub fn calibrate_camera(
             obs.qs.len(),
             frames.as_ref().map(|f| &f.1),
             &written,
+            start.as_ref(),
         )
     })?;
     Ok((!fit.converged).then(|| {
@@ -213,6 +284,7 @@ fn text(
     poses: usize,
     frames: Option<&activecal::frames::report::FramesReport>,
     written: &[String],
+    start: Option<&CameraStart>,
 ) -> String {
     let mut s = String::new();
     let n_kin = fit.robot.n_unknowns();
@@ -234,10 +306,26 @@ fn text(
             String::new()
         }
     );
+    if let Some(st) = start {
+        let _ = writeln!(
+            s,
+            "start: {}: the target placed at {} of {poses} poses, their PnP pixel RMS {:.3} px",
+            start_phrase(st),
+            st.poses_placed,
+            st.pnp_rms_px
+        );
+    }
     let _ = writeln!(
         s,
-        "pixel error RMS: {:.3} px at the given placements, {:.3} px after fitting them alone, {:.3} px calibrated",
-        fit.given_rms_px, fit.rigid_rms_px, fit.rms_px
+        "pixel error RMS: {:.3} px at the {} placements, {:.3} px after fitting them alone, {:.3} px calibrated",
+        fit.given_rms_px,
+        match start {
+            None => "given",
+            Some(st) if st.camera_computed && st.target_computed => "computed",
+            Some(_) => "start",
+        },
+        fit.rigid_rms_px,
+        fit.rms_px
     );
     match fit.sigma_px {
         Some(sg) => {

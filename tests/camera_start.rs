@@ -81,11 +81,11 @@ fn agree(label: &str, a: &CameraFit, b: &CameraFit, tol: Tol) -> f64 {
     let (limit, mut worst) = match tol {
         Tol::Relative(t) | Tol::Sigma(t) => (t, 0.0f64),
     };
-    for k in 0..n {
+    for (k, s) in sd.iter().enumerate().take(n) {
         let (x, y) = (a.estimate[k], b.estimate[k]);
         let scale = match tol {
             Tol::Relative(_) => x.abs().max(y.abs()),
-            Tol::Sigma(_) => sd[k],
+            Tol::Sigma(_) => *s,
         };
         let d = (x - y).abs() / scale;
         worst = worst.max(d);

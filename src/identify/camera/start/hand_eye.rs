@@ -88,7 +88,8 @@ pub fn solve_ax_zb(
     }
     let ra: Vec<Matrix3<f64>> = a.iter().map(rotation).collect();
     let spread_deg = orientation_spread(&ra);
-    if !(spread_deg >= MIN_SPREAD_DEG) {
+    // NaN (non-finite poses) refused too.
+    if spread_deg.is_nan() || spread_deg < MIN_SPREAD_DEG {
         return Err(HandEyeError::OneAxis { spread_deg });
     }
     let mut k = SMatrix::<f64, 9, 9>::zeros();

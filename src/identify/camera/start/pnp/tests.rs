@@ -25,7 +25,11 @@ fn iso(t: [f64; 3], rpy: [f64; 3]) -> Isometry3<f64> {
 
 /// A 6 × 8 board of 25 mm squares, in the plane of its frame (z = 0).
 fn board() -> Vec<Vector3<f64>> {
-    crate::io::camera_target::Target::checkerboard(6, 8, 0.025).points
+    (0..6)
+        .flat_map(|r| {
+            (0..8).map(move |c| Vector3::new(0.025 * f64::from(c), 0.025 * f64::from(r), 0.0))
+        })
+        .collect()
 }
 
 /// The board moved off its own frame's plane: still planar, but on a

@@ -286,7 +286,8 @@ const EXAMPLE: [&str; 11] = [
 /// From the command line without `--camera-pose` and `--target-pose`:
 /// the text says the start was computed, with its pixel RMS, and the
 /// calibration is the guessed one's (the camera's placement and σ̂ as
-/// printed); JSON `start` says what was computed; one guess given, the
+/// printed); JSON `start` says what was computed and gives the computed
+/// placements, which given back start the same fit; one guess given, the
 /// other is computed.
 #[test]
 fn cli_calibrates_without_guesses() {
@@ -323,6 +324,55 @@ fn cli_calibrates_without_guesses() {
     // degrees of freedom: 96 rows less 6 a pose).
     let pnp = v["start"]["pnp_rms_px"].as_f64().unwrap();
     assert!((0.25..0.31).contains(&pnp), "{pnp}");
+    // The start's placements, as the options read them: given back, they
+    // start the same fit.
+    let pose = |w: &str| {
+        let a: Vec<String> = v["start"][w]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.to_string())
+            .collect();
+        a.join(",")
+    };
+    let (cp, tp) = (
+        format!("--camera-pose={}", pose("camera_pose")),
+        format!("--target-pose={}", pose("target_pose")),
+    );
+    let mut again = json.clone();
+    again.extend([cp.as_str(), tp.as_str()]);
+    let w = common::json_of(&again);
+    assert_eq!(w["start"]["camera"], "given");
+    assert!(
+        (w["start_rms_px"].as_f64().unwrap() / v["start_rms_px"].as_f64().unwrap() - 1.0).abs()
+            < 1e-9
+    );
+    // (The same start to rounding of the round trip through roll, pitch
+    // and yaw: the robot's unknowns and the camera's position agree far
+    // inside 1e-9 relative; the placements' own unknowns are corrections
+    // in charts about the start, near 0, not compared.)
+    let names: Vec<&str> = v["names"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_str().unwrap())
+        .collect();
+    let num = |v: &serde_json::Value| v.as_f64().unwrap();
+    let (x, y) = (
+        w["estimate"].as_array().unwrap(),
+        v["estimate"].as_array().unwrap(),
+    );
+    let xyz = |v: &serde_json::Value| v["camera"]["camera"]["xyz"].as_array().unwrap().clone();
+    let (cw, cv) = (xyz(&w), xyz(&v));
+    let pairs: Vec<(f64, f64)> = (0..names.len())
+        .filter(|&k| !names[k].starts_with("camera_") && !names[k].starts_with("target_"))
+        .map(|k| (num(&x[k]), num(&y[k])))
+        .chain(cw.iter().zip(&cv).map(|(a, b)| (num(a), num(b))))
+        .collect();
+    assert_eq!(pairs.len(), 21);
+    for (x, y) in pairs {
+        assert!((x - y).abs() <= 1e-9 * x.abs().max(y.abs()), "{x} vs {y}");
+    }
     // One guess: the other computed.
     json.push(guessed[11]);
     let v = common::json_of(&json);

@@ -79,6 +79,14 @@ fn start(
     Ok((st.camera, st.target, Some(st)))
 }
 
+/// A placement as `X, Y, Z, ROLL, PITCH, YAW` (metres, radians; what
+/// `--camera-pose` and `--target-pose` read).
+fn six(m: &Isometry3<f64>) -> [f64; 6] {
+    let t = m.translation.vector;
+    let (r, p, y) = m.rotation.euler_angles();
+    [t.x, t.y, t.z, r, p, y]
+}
+
 /// What a computed start computed, in words.
 fn start_phrase(st: &CameraStart) -> &'static str {
     match (st.camera_computed, st.target_computed) {
@@ -106,6 +114,8 @@ fn start_json(st: Option<&CameraStart>) -> serde_json::Value {
             },
             "poses_placed": st.poses_placed,
             "pnp_rms_px": st.pnp_rms_px,
+            "camera_pose": six(&st.camera),
+            "target_pose": six(&st.target),
         }),
     }
 }
@@ -313,6 +323,13 @@ fn text(
             start_phrase(st),
             st.poses_placed,
             st.pnp_rms_px
+        );
+        let f = |m: &Isometry3<f64>| six(m).map(|v| format!("{v:.4}")).join(",");
+        let _ = writeln!(
+            s,
+            "start placements: --camera-pose={} --target-pose={}",
+            f(&st.camera),
+            f(&st.target)
         );
     }
     let _ = writeln!(

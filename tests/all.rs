@@ -15,6 +15,7 @@ mod camera;
 mod camera_cli;
 mod camera_head;
 mod camera_sight;
+mod camera_start;
 mod cli;
 mod cli_contacts;
 mod cli_existing;

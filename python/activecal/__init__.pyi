@@ -511,8 +511,8 @@ def calibrate_camera(
     camera_info: Union[_Path, Mapping[str, Any]],
     target: Union[_Path, Mapping[str, Any]],
     *,
-    camera_pose: Sequence[float],
-    target_pose: Sequence[float],
+    camera_pose: Optional[Sequence[float]] = None,
+    target_pose: Optional[Sequence[float]] = None,
     mounting: Optional[str] = None,
     camera_link: Optional[str] = None,
     refine_intrinsics: bool = False,
@@ -531,7 +531,9 @@ def calibrate_camera(
     ``"eye-in-hand"``; or camera_link: the robot's link a camera is on (a
     head; the chain from it to the tip is fitted). camera_pose,
     target_pose: rough placements X, Y, Z, ROLL, PITCH, YAW (metres,
-    radians, rpy as in URDF), the fit's start. refine_intrinsics: fit the
+    radians, rpy as in URDF), the fit's start; one left out is computed
+    from the pixels (PnP and the closed-form hand-eye; the report's
+    ``start`` says which). refine_intrinsics: fit the
     intrinsics too. Bad input raises `InputError` naming the argument (and
     the file, line and column)."""
 

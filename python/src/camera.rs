@@ -164,10 +164,11 @@ pub struct CameraCalibration {
 /// mounting: "eye-to-hand" or "eye-in-hand"; or camera_link: the robot's
 /// link a camera is on (a head). camera_pose, target_pose: the rough
 /// placements X, Y, Z, ROLL, PITCH, YAW (metres, radians), the fit's
-/// start. refine_intrinsics: fit the intrinsics too. progress as
+/// start; one left out (None) is computed from the pixels (PnP and the
+/// closed-form hand-eye, the report's `start`). refine_intrinsics: fit the intrinsics too. progress as
 /// `calibrate` takes it.
 #[pyfunction]
-#[pyo3(signature = (robot, observations, camera_info, target, *, camera_pose, target_pose, mounting=None, camera_link=None, refine_intrinsics=false, progress=None))]
+#[pyo3(signature = (robot, observations, camera_info, target, *, camera_pose=None, target_pose=None, mounting=None, camera_link=None, refine_intrinsics=false, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate_camera(
     py: Python<'_>,
@@ -175,8 +176,8 @@ pub fn calibrate_camera(
     observations: &Bound<'_, PyAny>,
     camera_info: &Bound<'_, PyAny>,
     target: &Bound<'_, PyAny>,
-    camera_pose: &Bound<'_, PyAny>,
-    target_pose: &Bound<'_, PyAny>,
+    camera_pose: Option<&Bound<'_, PyAny>>,
+    target_pose: Option<&Bound<'_, PyAny>>,
     mounting: Option<&str>,
     camera_link: Option<String>,
     refine_intrinsics: bool,
@@ -184,8 +185,8 @@ pub fn calibrate_camera(
 ) -> PyResult<CameraCalibration> {
     let m = mounting_of(mounting, camera_link.as_deref())?;
     let (cam0, tgt0) = (
-        six(py, camera_pose, "camera_pose")?,
-        six(py, target_pose, "target_pose")?,
+        camera_pose.map(|c| six(py, c, "camera_pose")).transpose()?,
+        target_pose.map(|t| six(py, t, "target_pose")).transpose()?,
     );
     let obs_src = observations_source(observations)?;
     let info_src = yaml_source(py, camera_info, "camera_info")?;
@@ -203,8 +204,8 @@ pub fn calibrate_camera(
                 target,
                 mounting: m,
                 camera_link,
-                camera: activecal::pool::camera_view::placement(&cam0),
-                target_pose: activecal::pool::camera_view::placement(&tgt0),
+                camera: cam0.map(|c| activecal::pool::camera_view::placement(&c)),
+                target_pose: tgt0.map(|t| activecal::pool::camera_view::placement(&t)),
                 refine_intrinsics,
             };
             let lm = LmSettings::builder()

@@ -168,13 +168,14 @@ pub struct CalibrateArgs {
     pub report: Option<PathBuf>,
     /// Calibrate from a camera's pixels: a CSV with one row per detected
     /// target point, `pose, <joints as in the URDF>, feature, u, v`
-    /// (pixels). Needs --camera-info, --target, --mounting (or
-    /// --camera-link), --camera-pose and --target-pose.
+    /// (pixels). Needs --camera-info, --target and --mounting (or
+    /// --camera-link); --camera-pose and --target-pose are optional (the
+    /// start computed from the pixels when not given).
     #[arg(
         long,
         value_name = "FILE",
         conflicts_with_all = ["design", "measurements", "trials", "save_measurements", "noise", "validation"],
-        requires_all = ["camera_info", "target", "camera_pose", "target_pose"]
+        requires_all = ["camera_info", "target"]
     )]
     pub observations: Option<PathBuf>,
     /// The camera's intrinsics: a ROS camera_info YAML or an OpenCV
@@ -204,7 +205,10 @@ pub struct CalibrateArgs {
     /// in the base link (eye-to-hand), the tip link (eye-in-hand) or the
     /// camera's link (--camera-link),
     /// metres and radians (rpy as in URDF). The start of the fit: a rough
-    /// guess, with every seen point in front of the camera.
+    /// guess, with every seen point in front of the camera. Optional: when
+    /// not given it is computed from the pixels (each pose's target placed
+    /// by PnP, then the closed-form hand-eye solution, or from
+    /// --target-pose when that is given).
     #[arg(
         long,
         value_name = "X,Y,Z,ROLL,PITCH,YAW",
@@ -214,6 +218,7 @@ pub struct CalibrateArgs {
     pub camera_pose: Option<String>,
     /// The target's frame (its points' frame), roughly: in the tip link
     /// (eye-to-hand) or the base link (eye-in-hand), metres and radians.
+    /// Optional, as --camera-pose.
     #[arg(
         long,
         value_name = "X,Y,Z,ROLL,PITCH,YAW",

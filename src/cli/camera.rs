@@ -8,9 +8,10 @@
 //! `--force`.
 
 use super::calibrate_args::CalibrateArgs;
-use activecal::experiment::camera::{CameraCalibration, CameraSetup};
+use activecal::experiment::camera::{CameraCalibration, CameraCalibrationError, CameraSetup};
 use activecal::identify::LmSettings;
 use activecal::identify::camera::CameraFit;
+use activecal::identify::camera::start::CameraStart;
 use activecal::io::calibrated::{Format, render};
 use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_observations::read_observations;
@@ -32,6 +33,17 @@ fn parse_placement(flag: &str, s: &str) -> Result<Isometry3<f64>> {
         _ => bail!(
             "{flag} {s}: expected six finite numbers X,Y,Z,ROLL,PITCH,YAW (metres and radians)"
         ),
+    }
+}
+
+/// What a computed start computed, in words.
+fn start_phrase(st: &CameraStart) -> &'static str {
+    match (st.camera_computed, st.target_computed) {
+        (true, true) => "computed from the pixels (PnP + closed-form hand-eye)",
+        (true, false) => {
+            "the camera's placement computed from the pixels (PnP, the target's as given)"
+        }
+        _ => "the target's placement computed from the pixels (PnP, the camera's as given)",
     }
 }
 
@@ -58,10 +70,8 @@ pub fn calibrate_camera(
 ) -> Result<Option<String>> {
     check_out(a, robot)?;
     check_camera_info_out(a, obs_path)?;
-    let (Some(info), Some(target), Some(cp), Some(tp)) =
-        (&a.camera_info, &a.target, &a.camera_pose, &a.target_pose)
-    else {
-        bail!("--observations needs --camera-info, --target, --camera-pose and --target-pose");
+    let (Some(info), Some(target)) = (&a.camera_info, &a.target) else {
+        bail!("--observations needs --camera-info and --target");
     };
     let (branch, mounting) = match (&a.camera_link, a.mounting) {
         (Some(link), _) => (
@@ -79,20 +89,29 @@ pub fn calibrate_camera(
     let intrinsics = read_camera_info(info).context("--camera-info")?;
     let target = read_target(target).context("--target")?;
     let obs = read_observations(obs_path, robot, &target, &intrinsics, a.units.units())?;
+    let parse =
+        |flag: &str, s: &Option<String>| s.as_ref().map(|s| parse_placement(flag, s)).transpose();
     let setup = CameraSetup {
         intrinsics,
         target,
         mounting,
         camera_link: a.camera_link.clone(),
-        camera: parse_placement("--camera-pose", cp)?,
-        target_pose: parse_placement("--target-pose", tp)?,
+        camera: parse("--camera-pose", &a.camera_pose)?,
+        target_pose: parse("--target-pose", &a.target_pose)?,
         refine_intrinsics: a.refine_intrinsics,
     };
     let lm = LmSettings::builder()
         .max_iterations(a.max_iterations)
         .geodesic(!a.no_geodesic)
         .build()?;
-    let cal = activecal::experiment::camera::calibrate_camera(robot, obs, &setup, &lm)?;
+    let cal = activecal::experiment::camera::calibrate_camera(robot, obs, &setup, &lm).map_err(
+        |e| match e {
+            CameraCalibrationError::Start { origin, error } => anyhow::Error::new(error).context(
+                format!("{origin}: no start computed from the pixels; give --camera-pose and --target-pose"),
+            ),
+            e => e.into(),
+        },
+    )?;
     let (fit, frames) = (&cal.fit, &cal.frames);
     let mut written = Vec::new();
     if fit.converged
@@ -126,6 +145,7 @@ pub fn calibrate_camera(
             cal.observations.qs.len(),
             frames.as_ref().map(|f| &f.1),
             &written,
+            cal.start.as_ref(),
         )
     })?;
     Ok((!fit.converged).then(|| {
@@ -190,6 +210,7 @@ fn text(
     poses: usize,
     frames: Option<&activecal::frames::report::FramesReport>,
     written: &[String],
+    start: Option<&CameraStart>,
 ) -> String {
     let mut s = String::new();
     let n_kin = fit.robot.n_unknowns();
@@ -211,10 +232,37 @@ fn text(
             String::new()
         }
     );
+    if let Some(st) = start {
+        let _ = writeln!(
+            s,
+            "start: {}: the target placed at {} of {poses} poses, their PnP pixel RMS {:.3} px",
+            start_phrase(st),
+            st.poses_placed,
+            st.pnp_rms_px
+        );
+        let f = |m: &Isometry3<f64>| {
+            activecal::report::xyz_rpy(m)
+                .map(|v| format!("{v:.4}"))
+                .join(",")
+        };
+        let _ = writeln!(
+            s,
+            "start placements: --camera-pose={} --target-pose={}",
+            f(&st.camera),
+            f(&st.target)
+        );
+    }
     let _ = writeln!(
         s,
-        "pixel error RMS: {:.3} px at the given placements, {:.3} px after fitting them alone, {:.3} px calibrated",
-        fit.given_rms_px, fit.rigid_rms_px, fit.rms_px
+        "pixel error RMS: {:.3} px at the {} placements, {:.3} px after fitting them alone, {:.3} px calibrated",
+        fit.given_rms_px,
+        match start {
+            None => "given",
+            Some(st) if st.camera_computed && st.target_computed => "computed",
+            Some(_) => "start",
+        },
+        fit.rigid_rms_px,
+        fit.rms_px
     );
     match fit.sigma_px {
         Some(sg) => {

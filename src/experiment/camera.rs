@@ -10,12 +10,13 @@ use crate::frames::camera::camera_frames;
 use crate::frames::report::FramesReport;
 use crate::frames::{CalibratedFrames, FramesError};
 use crate::identify::LmSettings;
+use crate::identify::camera::start::{CameraStart, StartError, start_placements};
 use crate::identify::camera::{CameraFit, CameraFitError, CameraObservations, fit_camera};
 use crate::io::camera_target::Target;
 use crate::measure::camera::{CameraSensor, Mounting};
 use crate::measure::pinhole::Intrinsics;
 use crate::model::Robot;
-use crate::report::CameraCalibrationReport;
+use crate::report::{CameraCalibrationReport, CameraStartReport};
 use nalgebra::Isometry3;
 
 /// What a camera calibration is given besides the robot and the
@@ -32,10 +33,12 @@ pub struct CameraSetup {
     /// The robot's link the camera is on (a head), when the robot given
     /// is the chain from it ([`crate::io::urdf_branch::camera_branch`]).
     pub camera_link: Option<String>,
-    /// The camera's rough placement (the start of the fit).
-    pub camera: Isometry3<f64>,
-    /// The target's rough placement (the start of the fit).
-    pub target_pose: Isometry3<f64>,
+    /// The camera's rough placement (the start of the fit); `None`:
+    /// computed from the pixels ([`crate::identify::camera::start`]).
+    pub camera: Option<Isometry3<f64>>,
+    /// The target's rough placement (the start of the fit); `None`:
+    /// computed from the pixels.
+    pub target_pose: Option<Isometry3<f64>>,
     /// Whether the intrinsics are unknowns of the fit too.
     pub refine_intrinsics: bool,
 }
@@ -50,6 +53,14 @@ pub enum CameraCalibrationError {
     /// The calibrated robot could not be split into frames.
     #[error(transparent)]
     Frames(#[from] FramesError),
+    /// A placement not given could not be computed from the pixels.
+    #[error("{origin}: no start computed from the pixels ({error}); give both rough placements")]
+    Start {
+        /// Where the observations came from.
+        origin: String,
+        /// Why.
+        error: StartError,
+    },
 }
 
 impl From<CameraFitError> for CameraCalibrationError {
@@ -74,6 +85,9 @@ pub struct CameraCalibration {
     pub camera_link: Option<String>,
     /// Whether the intrinsics were refined.
     pub refine_intrinsics: bool,
+    /// The start computed from the pixels, when a placement was not
+    /// given.
+    pub start: Option<CameraStart>,
 }
 
 /// Calibrates `robot` (the chain from the camera's link for a camera on
@@ -84,7 +98,31 @@ pub fn calibrate_camera(
     setup: &CameraSetup,
     lm: &LmSettings,
 ) -> Result<CameraCalibration, CameraCalibrationError> {
-    let (cam0, tgt0) = (&setup.camera, &setup.target_pose);
+    let start = match (setup.camera, setup.target_pose) {
+        (Some(_), Some(_)) => None,
+        (cam, tgt) => Some(
+            start_placements(
+                robot,
+                &setup.intrinsics,
+                setup.mounting,
+                &setup.target.points,
+                &observations,
+                cam.as_ref(),
+                tgt.as_ref(),
+            )
+            .map_err(|error| CameraCalibrationError::Start {
+                origin: observations.origin.clone(),
+                error,
+            })?,
+        ),
+    };
+    let (cam0, tgt0) = match &start {
+        Some(st) => (&st.camera, &st.target),
+        None => (
+            setup.camera.as_ref().expect("given"),
+            setup.target_pose.as_ref().expect("given"),
+        ),
+    };
     let sensor = CameraSensor::new(
         setup.intrinsics.clone(),
         setup.mounting,
@@ -106,6 +144,7 @@ pub fn calibrate_camera(
         frames,
         camera_link: setup.camera_link.clone(),
         refine_intrinsics: setup.refine_intrinsics,
+        start,
     })
 }
 
@@ -124,6 +163,7 @@ impl CameraCalibration {
             names: fit.names.clone(),
             estimate: fit.estimate.clone(),
             std: fit.std.clone(),
+            start: CameraStartReport::of(self.start.as_ref()),
             start_rms_px: fit.given_rms_px,
             rigid_rms_px: fit.rigid_rms_px,
             rms_px: fit.rms_px,

@@ -6,6 +6,7 @@
 
 use crate::bound::DesignGap;
 use crate::identify::FixedParameter;
+use crate::identify::camera::start::CameraStart;
 use crate::measure::camera::Mounting;
 use crate::measure::pinhole::Intrinsics;
 use crate::model::robot_ref::ChainChoice;
@@ -37,7 +38,10 @@ pub struct CameraCalibrationReport {
     pub estimate: Vec<f64>,
     /// Its standard deviations, when the estimate has a covariance.
     pub std: Option<Vec<f64>>,
-    /// RMS pixel error at the given placements (nominal robot), px.
+    /// Where the fit started: each placement given or computed from the
+    /// pixels, and how.
+    pub start: CameraStartReport,
+    /// RMS pixel error at the start placements (nominal robot), px.
     pub start_rms_px: f64,
     /// RMS pixel error after fitting the placements alone, px.
     pub rigid_rms_px: f64,
@@ -61,6 +65,75 @@ pub struct CameraCalibrationReport {
     pub intrinsics: Option<Intrinsics>,
     /// The files written.
     pub out: Vec<String>,
+}
+
+/// Where a camera fit started: each placement `given` or `computed` from
+/// the pixels ([`crate::identify::camera::start`]) and, when one was
+/// computed, the method, the poses whose target PnP placed, their pixel
+/// RMS and both start placements as `X, Y, Z, ROLL, PITCH, YAW` (metres,
+/// radians: what the options that give them read).
+#[derive(Clone, Debug, Serialize)]
+pub struct CameraStartReport {
+    /// `given` or `computed`.
+    pub camera: &'static str,
+    /// `given` or `computed`.
+    pub target: &'static str,
+    /// `PnP + closed-form hand-eye` (both computed) or `PnP` (one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub method: Option<&'static str>,
+    /// Poses whose target was placed from its pixels.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub poses_placed: Option<usize>,
+    /// Their PnP pixel RMS, px.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pnp_rms_px: Option<f64>,
+    /// The camera's start placement.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub camera_pose: Option<[f64; 6]>,
+    /// The target's start placement.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub target_pose: Option<[f64; 6]>,
+}
+
+impl CameraStartReport {
+    /// The report of a computed start, or of two given placements.
+    #[must_use]
+    pub fn of(start: Option<&CameraStart>) -> Self {
+        let word = |c: bool| if c { "computed" } else { "given" };
+        match start {
+            None => Self {
+                camera: "given",
+                target: "given",
+                method: None,
+                poses_placed: None,
+                pnp_rms_px: None,
+                camera_pose: None,
+                target_pose: None,
+            },
+            Some(st) => Self {
+                camera: word(st.camera_computed),
+                target: word(st.target_computed),
+                method: Some(if st.camera_computed && st.target_computed {
+                    "PnP + closed-form hand-eye"
+                } else {
+                    "PnP"
+                }),
+                poses_placed: Some(st.poses_placed),
+                pnp_rms_px: Some(st.pnp_rms_px),
+                camera_pose: Some(xyz_rpy(&st.camera)),
+                target_pose: Some(xyz_rpy(&st.target)),
+            },
+        }
+    }
+}
+
+/// A placement as `X, Y, Z, ROLL, PITCH, YAW` (metres, radians; URDF's
+/// rpy).
+#[must_use]
+pub fn xyz_rpy(m: &nalgebra::Isometry3<f64>) -> [f64; 6] {
+    let t = m.translation.vector;
+    let (r, p, y) = m.rotation.euler_angles();
+    [t.x, t.y, t.z, r, p, y]
 }
 
 /// Where a camera design's candidates came from: the robot as its

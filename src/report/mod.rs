@@ -16,7 +16,9 @@ mod select;
 
 pub use bound::{BoundCommandReport, WeightedPose};
 pub use calibrate::{MeasuredCalibrationReport, SimulatedCalibrationReport};
-pub use camera::{CameraCalibrationReport, CameraDesignReport, CameraPoolInfo};
+pub use camera::{
+    CameraCalibrationReport, CameraDesignReport, CameraPoolInfo, CameraStartReport, xyz_rpy,
+};
 pub use existing::ExistingReport;
 pub use fk::{FkReport, Orientation};
 pub use gap::GapReport;

@@ -226,7 +226,9 @@ def cmd_handeye(a):
         target = truth.se3(r_w, t_w.reshape(3)).inverse()  # tip <- target
         e_t, e_r = placement_error(cam, cam_true)
         out[name] = {"camera_mm": e_t, "camera_deg": e_r,
-                     "true": truth.errors(t, t.nominal, cam.inverse(), target, qs)}
+                     "true": truth.errors(t, t.nominal, cam.inverse(), target, qs),
+                     "camera": np.asarray(cam.homogeneous).tolist(),
+                     "target": np.asarray(target.homogeneous).tolist()}
     if a.frames:
         m, tool, _, base, tip, _ = truth.read_frames(a.frames)
         e_t, e_r = placement_error(m.inverse(), cam_true)

@@ -7,7 +7,8 @@
 //!    nominal parameters, by Levenberg–Marquardt from the start placements
 //!    the caller gives (rough: every seen point must lie in front of the
 //!    camera there; the example files' fit converges from guesses 30 cm
-//!    and 20° off);
+//!    and 20° off), or computes from the pixels ([`start`]: per-pose PnP
+//!    and the closed-form hand-eye placements);
 //! 2. **full fit**: the robot's unknowns ([`unknowns::camera_robot`]) and
 //!    the placements together, the placements' charts re-centred on the
 //!    rigid start's.
@@ -19,6 +20,7 @@
 
 pub mod predict;
 pub mod simulate;
+pub mod start;
 pub mod unknowns;
 
 pub use unknowns::camera_robot;

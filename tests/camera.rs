@@ -15,7 +15,7 @@ use activecal::io::camera_observations::{
 use activecal::io::camera_target::Target;
 use activecal::kinematics::Evaluator;
 use activecal::measure::camera::{CameraSensor, Mounting};
-use activecal::measure::pinhole::Intrinsics;
+use activecal::measure::pinhole::{Distortion, Intrinsics};
 use activecal::model::{ParamTable, Robot, Symbol};
 use activecal::observability::generic_configurations;
 use activecal::units::Units;
@@ -34,7 +34,7 @@ fn intrinsics() -> Intrinsics {
         fy: 1000.0,
         cx: 640.0,
         cy: 480.0,
-        distortion: [-0.08, 0.04, 5e-4, -3e-4, -0.01],
+        distortion: Distortion::PlumbBob([-0.08, 0.04, 5e-4, -3e-4, -0.01]),
     }
 }
 
@@ -490,6 +490,7 @@ fn chosen_poses_beat_random_ones() {
         intrinsics: intrinsics(),
         mounting: Mounting::EyeToHand,
         points: target.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
+        face: [0.0, 0.0, 1.0],
         camera: six(&cam),
         target: six(&tgt),
         min_fraction: 1.0,
@@ -588,7 +589,7 @@ fn refined_intrinsics_are_recovered_within_three_sigma() {
     let c = case(m, 0.3, 5);
     let (cam0, tgt0) = c.sensor.placements(&c.own_start);
     let truth = intrinsics().values();
-    let mut off = truth;
+    let mut off = truth.clone();
     for (v, d) in off.iter_mut().zip([4.0, -3.0, 5.0, -4.0, 0.01]) {
         *v += d;
     }

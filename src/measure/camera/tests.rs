@@ -1,4 +1,5 @@
 use super::*;
+use crate::measure::pinhole::Distortion;
 use nalgebra::Rotation3;
 
 fn intrinsics() -> Intrinsics {
@@ -9,7 +10,7 @@ fn intrinsics() -> Intrinsics {
         fy: 905.0,
         cx: 640.0,
         cy: 480.0,
-        distortion: [-0.1, 0.05, 1e-3, -5e-4, -0.01],
+        distortion: Distortion::PlumbBob([-0.1, 0.05, 1e-3, -5e-4, -0.01]),
     }
 }
 

@@ -40,7 +40,7 @@ fn opencv(
         let r = m
             .getattr("project")
             .unwrap()
-            .call1((pts, rvec, tvec, k, c.distortion))
+            .call1((pts, rvec, tvec, k, c.distortion.coefficients().to_vec()))
             .unwrap();
         let (img, jac, version): (Vec<Vec<f64>>, Vec<Vec<f64>>, String) = r.extract().unwrap();
         assert!(

@@ -22,7 +22,7 @@ use activecal::units::Units;
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use rand::RngExt as _;
 
-fn ur5() -> Robot {
+pub(crate) fn ur5() -> Robot {
     activecal::io::load_robot("fixtures/ur5.urdf").expect("the UR5 fixture")
 }
 
@@ -45,7 +45,7 @@ fn board() -> Target {
 
 /// A camera at `eye` looking at `at` (optical z along the line of sight,
 /// x roughly horizontal).
-fn looking(eye: Vector3<f64>, at: Vector3<f64>) -> Isometry3<f64> {
+pub(crate) fn looking(eye: Vector3<f64>, at: Vector3<f64>) -> Isometry3<f64> {
     let z = (at - eye).normalize();
     let x = z.cross(&Vector3::z()).normalize();
     let y = z.cross(&x);
@@ -81,7 +81,7 @@ fn truth_placements(m: Mounting, target: &Target) -> (Isometry3<f64>, Isometry3<
 
 /// The true robot: each chosen unknown off its nominal by ±(0.5–2) mm or
 /// ±(0.05–0.3)°, seeded.
-fn truth(robot: &Robot, seed: u64) -> ParamTable {
+pub(crate) fn truth(robot: &Robot, seed: u64) -> ParamTable {
     let mut rng = activecal::identify::trial_rng(seed, 0);
     let mut t = robot.nominal.clone();
     for &u in &robot.unknowns {

@@ -59,63 +59,15 @@ use crate::kinematics::{EndFrame, Motion};
 use crate::model::MeasurementKind;
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
+mod mounting;
+pub use mounting::Mounting;
+
 /// Own unknowns of a camera sensor: two placements of 6.
 pub const OWN_PARAMS: usize = 12;
 
 /// Fewest target points a pose must see: a camera places a target from
 /// four points or more (three leave up to four solutions, P3P).
 pub const MIN_POINTS_PER_POSE: usize = 4;
-
-/// Where the camera and the target are.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Mounting {
-    /// A fixed camera (placement in the base) sees a target on the end
-    /// frame.
-    EyeToHand,
-    /// A camera on the end frame sees a fixed target (placement in the
-    /// base).
-    EyeInHand,
-}
-
-impl Mounting {
-    /// `eye-to-hand` or `eye-in-hand`.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Mounting::EyeToHand => "eye-to-hand",
-            Mounting::EyeInHand => "eye-in-hand",
-        }
-    }
-
-    /// Reads a mounting's name (`eye-to-hand`, `eye-in-hand`).
-    #[must_use]
-    pub fn from_name(s: &str) -> Option<Self> {
-        match s {
-            "eye-to-hand" => Some(Mounting::EyeToHand),
-            "eye-in-hand" => Some(Mounting::EyeInHand),
-            _ => None,
-        }
-    }
-
-    /// What the camera's placement is relative to: `base` or `end frame`.
-    #[must_use]
-    pub fn camera_parent(self) -> &'static str {
-        match self {
-            Mounting::EyeToHand => "base",
-            Mounting::EyeInHand => "end frame",
-        }
-    }
-
-    /// What the target's placement is relative to.
-    #[must_use]
-    pub fn target_parent(self) -> &'static str {
-        match self {
-            Mounting::EyeToHand => "end frame",
-            Mounting::EyeInHand => "base",
-        }
-    }
-}
 
 /// A camera seeing `N` target points: `2N` pixel rows per pose, 12 own
 /// unknowns (see the module documentation).

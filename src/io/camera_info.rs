@@ -436,7 +436,7 @@ distortion_coefficients: {rows: 1, cols: 4, data: [-0.01, 0.002, -0.001, 0.0001]
         let c = Intrinsics {
             width: 1280,
             height: 960,
-            fx: 1000.123_456_789_012_3,
+            fx: 1_000.123_456_789_012_3,
             fy: 999.876_543_210_987_6,
             cx: 640.1 + 1e-9,
             cy: 479.9,

@@ -186,7 +186,7 @@ impl Intrinsics {
     /// field ([`Intrinsics::sees`] checks that).
     #[must_use]
     pub fn project(&self, p: &Vector3<f64>) -> Option<Projection> {
-        if !(p.z > 1e-9) {
+        if p.z.is_nan() || p.z <= 1e-9 {
             return None;
         }
         let iz = 1.0 / p.z;
@@ -271,7 +271,7 @@ impl Intrinsics {
     /// [`Intrinsics::project`]).
     #[must_use]
     pub fn intrinsic_jacobian(&self, p: &Vector3<f64>) -> Option<[Vec<f64>; 2]> {
-        if !(p.z > 1e-9) {
+        if p.z.is_nan() || p.z <= 1e-9 {
             return None;
         }
         let (x, y) = (p.x / p.z, p.y / p.z);

@@ -260,3 +260,110 @@ fn fisheye_refined_intrinsics_are_recovered_within_three_sigma() {
         Distortion::Equidistant(_)
     ));
 }
+
+/// `X,Y,Z,ROLL,PITCH,YAW` of a placement.
+fn six(t: &Isometry3<f64>) -> String {
+    let (r, p, y) = t.rotation.euler_angles();
+    let v = t.translation.vector;
+    format!("{},{},{},{r},{p},{y}", v.x, v.y, v.z)
+}
+
+/// The command line with a fisheye: the simulated case (σ 0.3 px) as
+/// files (a ROS `equidistant` camera_info, the board, the pixels), fitted
+/// by `calibrate --refine-intrinsics --out-camera-info`: 8 intrinsics
+/// named `camera_fx … camera_k4`, the written file an `equidistant`
+/// camera_info that reads back to the estimate; a fisheye file with 5
+/// coefficients and an unknown model are refused naming the file and
+/// what is wrong.
+#[test]
+fn fisheye_from_the_command_line() {
+    use crate::common;
+    use activecal::io::camera_info::{read_camera_info, render_camera_info};
+    let dir = common::scratch_dir("camera", "fisheye");
+    let c = case(0.3, 5, fisheye());
+    let path = |name: &str| dir.join(name).display().to_string();
+    let (info, board_file, obs, out) = (
+        path("fish.yaml"),
+        path("board.yaml"),
+        path("obs.csv"),
+        path("refined.yaml"),
+    );
+    std::fs::write(&info, render_camera_info(&fisheye(), "fish", "")).unwrap();
+    std::fs::write(
+        &board_file,
+        "checkerboard: {rows: 7, cols: 9, square: 0.04}\n",
+    )
+    .unwrap();
+    let csv = activecal::io::camera_observations::observations_csv(&c.obs, &c.robot, &board());
+    std::fs::write(&obs, csv).unwrap();
+    let (cam0, tgt0) = c.start.placements(&c.own_start);
+    let (cp, tp) = (
+        format!("--camera-pose={}", six(&cam0)),
+        format!("--target-pose={}", six(&tgt0)),
+    );
+    let args = [
+        "calibrate",
+        "--robot",
+        "fixtures/ur5.urdf",
+        "--mounting",
+        "eye-to-hand",
+        "--camera-info",
+        &info,
+        "--target",
+        &board_file,
+        "--observations",
+        &obs,
+        &cp,
+        &tp,
+        "--refine-intrinsics",
+        "--out-camera-info",
+        &out,
+        "--json",
+    ];
+    let v = common::json_of(&args);
+    assert_eq!(v["converged"], true, "{v}");
+    let names: Vec<&str> = v["names"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_str().unwrap())
+        .collect();
+    let k0 = names.iter().position(|n| *n == "camera_fx").unwrap();
+    assert_eq!(
+        names[k0..].join(" "),
+        "camera_fx camera_fy camera_cx camera_cy camera_k1 camera_k2 camera_k3 camera_k4"
+    );
+    assert_eq!(v["intrinsics"]["distortion_model"], "equidistant", "{v}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.contains("distortion_model: equidistant\n"), "{text}");
+    let read = read_camera_info(std::path::Path::new(&out)).unwrap();
+    for (j, r) in read.values().iter().enumerate() {
+        assert_eq!(
+            *r,
+            v["estimate"][k0 + j].as_f64().unwrap(),
+            "{}",
+            names[k0 + j]
+        );
+    }
+    // The refined file's own lines (a comment heads it) for the places.
+    let line = |key: &str| 1 + text.lines().position(|l| l.starts_with(key)).unwrap();
+    let five = text.replace("cols: 4\n  data: [", "cols: 5\n  data: [0.0, ");
+    std::fs::write(&info, five).unwrap();
+    let mut wrong = args.to_vec();
+    wrong.truncate(13);
+    common::fails_with(
+        &wrong,
+        &format!(
+            "fish.yaml: line {}, column 3 ('distortion_coefficients'): 5 coefficients; equidistant (fisheye) has 4",
+            line("distortion_coefficients") + 1
+        ),
+    );
+    std::fs::write(&info, text.replace("equidistant", "kannala_brandt")).unwrap();
+    common::fails_with(
+        &wrong,
+        &format!(
+            "fish.yaml: line {}, column 19 ('distortion_model'): 'kannala_brandt' is not supported",
+            line("distortion_model")
+        ),
+    );
+}

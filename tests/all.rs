@@ -13,6 +13,7 @@ mod bad_inputs;
 mod bound;
 mod camera;
 mod camera_cli;
+mod camera_fisheye;
 mod camera_head;
 mod camera_sight;
 mod camera_start;

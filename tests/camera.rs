@@ -15,14 +15,14 @@ use activecal::io::camera_observations::{
 use activecal::io::camera_target::Target;
 use activecal::kinematics::Evaluator;
 use activecal::measure::camera::{CameraSensor, Mounting};
-use activecal::measure::pinhole::Intrinsics;
+use activecal::measure::pinhole::{Distortion, Intrinsics};
 use activecal::model::{ParamTable, Robot, Symbol};
 use activecal::observability::generic_configurations;
 use activecal::units::Units;
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use rand::RngExt as _;
 
-fn ur5() -> Robot {
+pub(crate) fn ur5() -> Robot {
     activecal::io::load_robot("fixtures/ur5.urdf").expect("the UR5 fixture")
 }
 
@@ -34,7 +34,7 @@ fn intrinsics() -> Intrinsics {
         fy: 1000.0,
         cx: 640.0,
         cy: 480.0,
-        distortion: [-0.08, 0.04, 5e-4, -3e-4, -0.01],
+        distortion: Distortion::PlumbBob([-0.08, 0.04, 5e-4, -3e-4, -0.01]),
     }
 }
 
@@ -45,7 +45,7 @@ fn board() -> Target {
 
 /// A camera at `eye` looking at `at` (optical z along the line of sight,
 /// x roughly horizontal).
-fn looking(eye: Vector3<f64>, at: Vector3<f64>) -> Isometry3<f64> {
+pub(crate) fn looking(eye: Vector3<f64>, at: Vector3<f64>) -> Isometry3<f64> {
     let z = (at - eye).normalize();
     let x = z.cross(&Vector3::z()).normalize();
     let y = z.cross(&x);
@@ -81,7 +81,7 @@ fn truth_placements(m: Mounting, target: &Target) -> (Isometry3<f64>, Isometry3<
 
 /// The true robot: each chosen unknown off its nominal by ±(0.5–2) mm or
 /// ±(0.05–0.3)°, seeded.
-fn truth(robot: &Robot, seed: u64) -> ParamTable {
+pub(crate) fn truth(robot: &Robot, seed: u64) -> ParamTable {
     let mut rng = activecal::identify::trial_rng(seed, 0);
     let mut t = robot.nominal.clone();
     for &u in &robot.unknowns {
@@ -490,6 +490,7 @@ fn chosen_poses_beat_random_ones() {
         intrinsics: intrinsics(),
         mounting: Mounting::EyeToHand,
         points: target.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
+        face: [0.0, 0.0, 1.0],
         camera: six(&cam),
         target: six(&tgt),
         min_fraction: 1.0,
@@ -588,7 +589,7 @@ fn refined_intrinsics_are_recovered_within_three_sigma() {
     let c = case(m, 0.3, 5);
     let (cam0, tgt0) = c.sensor.placements(&c.own_start);
     let truth = intrinsics().values();
-    let mut off = truth;
+    let mut off = truth.clone();
     for (v, d) in off.iter_mut().zip([4.0, -3.0, 5.0, -4.0, 0.01]) {
         *v += d;
     }

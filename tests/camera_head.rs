@@ -17,7 +17,7 @@ use activecal::io::urdf::{UrdfOptions, parse};
 use activecal::io::urdf_branch::camera_branch;
 use activecal::kinematics::Evaluator;
 use activecal::measure::camera::{CameraSensor, Mounting};
-use activecal::measure::pinhole::Intrinsics;
+use activecal::measure::pinhole::{Distortion, Intrinsics};
 use activecal::model::{ParamTable, Robot, Symbol};
 use activecal::observability::generic_configurations;
 use nalgebra::{Isometry3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
@@ -50,7 +50,7 @@ fn intrinsics() -> Intrinsics {
         fy: 525.0,
         cx: 319.5,
         cy: 239.5,
-        distortion: [0.03, -0.08, 2e-4, -1e-4, 0.0],
+        distortion: Distortion::PlumbBob([0.03, -0.08, 2e-4, -1e-4, 0.0]),
     }
 }
 
@@ -229,6 +229,7 @@ fn view() -> activecal::pool::camera_view::CameraView {
         intrinsics: intrinsics(),
         mounting: Mounting::EyeToHand,
         points: board().points.iter().map(|p| [p.x, p.y, p.z]).collect(),
+        face: [0.0, 0.0, 1.0],
         camera: six(&cam),
         target: six(&tgt),
         min_fraction: 1.0,

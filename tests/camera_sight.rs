@@ -30,6 +30,7 @@ fn view_from(eye: &Point3<f64>, at: &Point3<f64>) -> CameraView {
             .iter()
             .map(|p| [p.x, p.y, p.z])
             .collect(),
+        face: [0.0, 0.0, 1.0],
         camera: [eye.x, eye.y, eye.z, roll, pitch, yaw],
         target: [-0.0853, 0.0568, 0.02, std::f64::consts::PI, 0.0, 0.03],
         min_fraction: 1.0,

@@ -234,7 +234,9 @@ fn eye_in_hand_converges_to_the_same_fit_without_guesses() {
         fy: 1000.0,
         cx: 640.0,
         cy: 480.0,
-        distortion: [-0.08, 0.04, 5e-4, -3e-4, -0.01],
+        distortion: activecal::measure::pinhole::Distortion::PlumbBob([
+            -0.08, 0.04, 5e-4, -3e-4, -0.01,
+        ]),
     };
     let target = Target::checkerboard(6, 8, 0.025);
     let c = target.centroid();

@@ -86,14 +86,12 @@ pub fn select_camera(
         detached(py, move || {
             let branch = chain_of(&inner, camera_link.as_deref())?;
             let r = branch.as_ref().unwrap_or(&inner);
+            let board = read_target(&target_src)?;
             let view = CameraView {
                 intrinsics: read_intrinsics(&info_src)?,
                 mounting: m,
-                points: read_target(&target_src)?
-                    .points
-                    .iter()
-                    .map(|p| [p.x, p.y, p.z])
-                    .collect(),
+                points: board.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
+                face: board.face.into(),
                 camera: cam,
                 target: tgt,
                 min_fraction: min_visible,

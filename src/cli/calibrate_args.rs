@@ -179,11 +179,13 @@ pub struct CalibrateArgs {
     )]
     pub observations: Option<PathBuf>,
     /// The camera's intrinsics: a ROS camera_info YAML or an OpenCV
-    /// calibration YAML (plumb_bob distortion).
+    /// calibration YAML (plumb_bob or equidistant fisheye distortion).
     #[arg(long, value_name = "FILE", requires = "observations")]
     pub camera_info: Option<PathBuf>,
     /// The target's points: a YAML `checkerboard: {rows, cols, square}`
-    /// (inner corners, metres) or `points: [{id, xyz}, …]`.
+    /// (inner corners, metres), `charuco: {rows, cols, square, marker}`,
+    /// `aprilgrid: {rows, cols, tag_size, tag_spacing}` or `points: [{id,
+    /// xyz}, …]`.
     #[arg(long, value_name = "FILE", requires = "observations")]
     pub target: Option<PathBuf>,
     /// Where the camera is: eye-to-hand (fixed camera, target on the
@@ -227,7 +229,8 @@ pub struct CalibrateArgs {
     )]
     pub target_pose: Option<String>,
     /// With --observations: fit the camera's intrinsics too (fx, fy, cx,
-    /// cy and the plumb_bob k1, k2, p1, p2, k3, started from --camera-info),
+    /// cy and the distortion's coefficients: plumb_bob's k1, k2, p1, p2,
+    /// k3 or equidistant's k1 … k4; started from --camera-info),
     /// each reported with its σ.
     #[arg(long, requires = "observations")]
     pub refine_intrinsics: bool,

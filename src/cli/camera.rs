@@ -329,9 +329,10 @@ fn text(
 fn intrinsics_text(fit: &CameraFit, s: &mut String) {
     let k0 = fit.robot.n_unknowns() + activecal::measure::camera::OWN_PARAMS;
     s.push_str("intrinsics (refined, change from given, σ):\n");
-    let free = (0..9).filter(|&j| fit.sensor.free_intrinsics()[j]);
+    let mask = fit.sensor.free_intrinsics();
+    let free = (0..mask.len()).filter(|&j| mask[j]);
     for (k, j) in (k0..).zip(free) {
-        let name = activecal::measure::pinhole::INTRINSIC_NAMES[j];
+        let name = fit.sensor.intrinsics().names()[j];
         let unit = if j < 4 { " px" } else { "" };
         let sd = fit.std.as_ref().map_or(f64::NAN, |sd| sd[k]);
         let _ = writeln!(

@@ -63,15 +63,12 @@ fn view(c: &CameraOpts) -> Result<CameraView> {
     let [lo, hi] = d[..] else {
         bail!("--distance {}: expected LO,HI (metres)", c.distance);
     };
+    let target = read_target(target).context("--target")?;
     let v = CameraView {
         intrinsics: read_camera_info(info).context("--camera-info")?,
         mounting: m,
-        points: read_target(target)
-            .context("--target")?
-            .points
-            .iter()
-            .map(|p| [p.x, p.y, p.z])
-            .collect(),
+        points: target.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
+        face: target.face.into(),
         camera: six("--camera-pose", cp)?,
         target: six("--target-pose", tp)?,
         min_fraction: c.min_visible,

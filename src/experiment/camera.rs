@@ -130,6 +130,7 @@ pub fn calibrate_camera(
         cam0,
         tgt0,
     )
+    .with_face(setup.target.face)
     .with_intrinsics_refined(setup.refine_intrinsics);
     let own0 = CameraSensor::start_own(cam0, tgt0);
     let fit = fit_camera(robot, &sensor, &own0, &observations, lm)?;

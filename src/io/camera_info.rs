@@ -4,22 +4,31 @@
 //!   `image_width`, `image_height`, `camera_matrix: {rows: 3, cols: 3,
 //!   data: [fx, 0, cx, 0, fy, cy, 0, 0, 1]}`, `distortion_model:
 //!   plumb_bob`, `distortion_coefficients: {rows: 1, cols: 5, data: [k1,
-//!   k2, p1, p2, k3]}` (the rectification and projection matrices are not
-//!   read);
+//!   k2, p1, p2, k3]}`, or `distortion_model: equidistant` with 4
+//!   coefficients `[k1, k2, k3, k4]` (the fisheye model,
+//!   [`crate::measure::fisheye`]; the rectification and projection
+//!   matrices are not read);
 //! * OpenCV's `FileStorage` YAML (`%YAML:1.0` on the first line, matrices
 //!   tagged `!!opencv-matrix` with `rows`, `cols`, `dt`, `data`; the
 //!   calibration sample's keys `camera_matrix` / `cameraMatrix` and
-//!   `distortion_coefficients` / `distCoeffs`).
+//!   `distortion_coefficients` / `distCoeffs`). A fisheye file is
+//!   recognised by `fisheye_model: 1`, the key OpenCV's calibration
+//!   tutorial (`camera_calibration.cpp`) writes (or by a ROS-style
+//!   `distortion_model: equidistant`); without either, its coefficients are
+//!   plumb_bob's (4 of them are `k1, k2, p1, p2` with k3 = 0, as
+//!   `cv::calibrateCamera` reads them), so an unmarked fisheye file is read
+//!   wrongly: mark it.
 //!
 //! Checked: the image size (both > 0 pixels), a 3 × 3 camera matrix with
 //! its zeros and 1 where a pinhole has them, positive focal lengths, a
-//! principal point inside the image, the distortion model named (ROS) and
-//! supported (plumb_bob: 5 coefficients, or 4 with k3 = 0; OpenCV's 8, 12
-//! or 14 only when the coefficients past the fifth are zero). Every error
-//! names the file, the key and its line and column.
+//! principal point inside the image, the distortion model named (ROS),
+//! known and supported (plumb_bob: 5 coefficients, or 4 with k3 = 0;
+//! OpenCV's 8, 12 or 14 only when the coefficients past the fifth are
+//! zero; equidistant: exactly 4). Every error names the file, the key and
+//! its line and column.
 
 use crate::error::{Error, Result};
-use crate::measure::pinhole::Intrinsics;
+use crate::measure::pinhole::{Distortion, Intrinsics};
 use serde::Deserialize;
 use serde_saphyr::Spanned;
 use std::path::Path;
@@ -40,6 +49,8 @@ struct InfoEntry {
     distortion_model: Option<Spanned<String>>,
     #[serde(alias = "distCoeffs", alias = "dist_coeffs")]
     distortion_coefficients: Option<Spanned<MatrixEntry>>,
+    /// OpenCV's calibration tutorial's fisheye flag (0 or 1).
+    fisheye_model: Option<Spanned<i64>>,
 }
 
 /// Reads a camera's intrinsics from a ROS `camera_info` or OpenCV YAML
@@ -188,27 +199,72 @@ fn build(f: &InfoEntry) -> std::result::Result<Intrinsics, String> {
     Ok(c)
 }
 
-/// The plumb_bob coefficients `k1, k2, p1, p2, k3`.
-fn distortion(f: &InfoEntry) -> std::result::Result<[f64; 5], String> {
-    if let Some(m) = &f.distortion_model
-        && m.value != "plumb_bob"
-    {
-        return Err(format!(
-            "{} ('distortion_model'): '{}' is not supported; this camera model reads plumb_bob (k1, k2, p1, p2, k3)",
-            at(m),
-            m.value
-        ));
-    }
-    let Some(dm) = &f.distortion_coefficients else {
-        return Err(
-            "no 'distortion_coefficients': give them (k1, k2, p1, p2, k3; all 0 for an undistorted image)".into(),
-        );
+/// The distortion model a file names: ROS's `distortion_model` or
+/// OpenCV's `fisheye_model` flag, plumb_bob when neither is given.
+fn model(f: &InfoEntry) -> std::result::Result<&'static str, String> {
+    let flag = match &f.fisheye_model {
+        None => None,
+        Some(v) if v.value == 0 || v.value == 1 => Some(v.value == 1),
+        Some(v) => {
+            return Err(format!(
+                "{} ('fisheye_model'): {}; OpenCV writes 0 (plumb_bob) or 1 (equidistant fisheye)",
+                at(v),
+                v.value
+            ));
+        }
     };
-    let shapes: Vec<(i64, i64)> = [4, 5, 8, 12, 14]
-        .iter()
-        .flat_map(|&n| [(1, n), (n, 1)])
-        .collect();
+    let named = match &f.distortion_model {
+        None => None,
+        Some(m) => match m.value.as_str() {
+            "plumb_bob" => Some("plumb_bob"),
+            "equidistant" => Some("equidistant"),
+            other => {
+                return Err(format!(
+                    "{} ('distortion_model'): '{other}' is not supported; this camera model reads plumb_bob (k1, k2, p1, p2, k3) and equidistant (the fisheye model: k1, k2, k3, k4)",
+                    at(m)
+                ));
+            }
+        },
+    };
+    match (named, flag) {
+        (Some(n), Some(fish)) if (n == "equidistant") != fish => Err(format!(
+            "{} ('fisheye_model'): {} contradicts distortion_model '{n}'",
+            f.fisheye_model.as_ref().map(at).unwrap_or_default(),
+            u8::from(fish)
+        )),
+        (Some(n), _) => Ok(n),
+        (None, Some(true)) => Ok("equidistant"),
+        (None, _) => Ok("plumb_bob"),
+    }
+}
+
+/// The distortion model and its coefficients.
+fn distortion(f: &InfoEntry) -> std::result::Result<Distortion, String> {
+    let model = model(f)?;
+    let Some(dm) = &f.distortion_coefficients else {
+        return Err(format!(
+            "no 'distortion_coefficients': give them ({}; all 0 for an undistorted image)",
+            if model == "plumb_bob" {
+                "k1, k2, p1, p2, k3"
+            } else {
+                "k1, k2, k3, k4"
+            }
+        ));
+    };
+    // A row or a column of coefficients; the count a model takes is
+    // checked after.
+    let shapes: Vec<(i64, i64)> = (1..=14).flat_map(|n| [(1, n), (n, 1)]).collect();
     let d = data("distortion_coefficients", dm, &shapes)?;
+    if model == "equidistant" {
+        return match d[..] {
+            [k1, k2, k3, k4] => Ok(Distortion::Equidistant([k1, k2, k3, k4])),
+            _ => Err(format!(
+                "{} ('distortion_coefficients'): {} coefficients; equidistant (fisheye) has 4 (k1, k2, k3, k4)",
+                at(dm),
+                d.len()
+            )),
+        };
+    }
     if !matches!(d.len(), 4 | 5 | 8 | 12 | 14) {
         return Err(format!(
             "{} ('distortion_coefficients'): {} coefficients; plumb_bob has 5 (k1, k2, p1, p2, k3)",
@@ -224,12 +280,19 @@ fn distortion(f: &InfoEntry) -> std::result::Result<[f64; 5], String> {
             d[k + 5]
         ));
     }
-    Ok([d[0], d[1], d[2], d[3], d.get(4).copied().unwrap_or(0.0)])
+    Ok(Distortion::PlumbBob([
+        d[0],
+        d[1],
+        d[2],
+        d[3],
+        d.get(4).copied().unwrap_or(0.0),
+    ]))
 }
 
 /// A ROS `camera_info` YAML of `intrinsics` (as `camera_calibration`
-/// writes it: image size, `camera_name`, the camera matrix, `plumb_bob`
-/// distortion, an identity rectification and the projection matrix `[K |
+/// writes it: image size, `camera_name`, the camera matrix, the distortion
+/// model, `plumb_bob` or `equidistant`, with its 5 or 4 coefficients, an
+/// identity rectification and the projection matrix `[K |
 /// 0]`), every number in Rust's shortest form that reads back to the same
 /// value; `comment` goes first, on `#` lines.
 #[must_use]
@@ -249,10 +312,12 @@ pub fn render_camera_info(intrinsics: &Intrinsics, camera_name: &str, comment: &
         "camera_matrix:\n  rows: 3\n  cols: 3\n  data: [{}]\n",
         list(&[i.fx, 0.0, i.cx, 0.0, i.fy, i.cy, 0.0, 0.0, 1.0])
     );
-    s += "distortion_model: plumb_bob\n";
+    let d = i.distortion.coefficients();
+    s += &format!("distortion_model: {}\n", i.distortion.model());
     s += &format!(
-        "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [{}]\n",
-        list(&i.distortion)
+        "distortion_coefficients:\n  rows: 1\n  cols: {}\n  data: [{}]\n",
+        d.len(),
+        list(d)
     );
     s += "rectification_matrix:\n  rows: 3\n  cols: 3\n  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n";
     s += &format!(
@@ -302,6 +367,49 @@ distortion_coefficients: !!opencv-matrix
    data: [ 0.1, -0.2, 0., 0., 0.05 ]
 ";
 
+    const FISHEYE: &str = "image_width: 1280
+image_height: 960
+camera_matrix:
+  rows: 3
+  cols: 3
+  data: [400.0, 0.0, 640.5, 0.0, 401.0, 480.2, 0.0, 0.0, 1.0]
+distortion_model: equidistant
+distortion_coefficients: {rows: 1, cols: 4, data: [-0.01, 0.002, -0.001, 0.0001]}
+";
+
+    /// A fisheye from ROS (`equidistant`) and from OpenCV's tutorial file
+    /// (`fisheye_model: 1`, a 4 × 1 matrix); an unmarked OpenCV file with
+    /// 4 coefficients stays plumb_bob (`k1, k2, p1, p2`); a fisheye writes
+    /// back as `equidistant` with its 4 coefficients and reads back
+    /// exactly.
+    #[test]
+    fn fisheye_files_are_read_and_written() {
+        let c = parse_camera_info(FISHEYE, "fish.yaml").unwrap();
+        let k = Distortion::Equidistant([-0.01, 0.002, -0.001, 0.0001]);
+        assert_eq!((c.fx, c.fy, c.distortion), (400.0, 401.0, k));
+        let cv = OPENCV.replace(
+            "distortion_coefficients: !!opencv-matrix\n   rows: 5",
+            "fisheye_model: 1\ndistortion_coefficients: !!opencv-matrix\n   rows: 4",
+        );
+        let cv = cv.replace("0.1, -0.2, 0., 0., 0.05", "0.1, -0.2, 0.03, -0.004");
+        let c = parse_camera_info(&cv, "cv.yaml").unwrap();
+        assert_eq!(
+            c.distortion,
+            Distortion::Equidistant([0.1, -0.2, 0.03, -0.004])
+        );
+        let unmarked = cv.replace("fisheye_model: 1\n", "");
+        let c = parse_camera_info(&unmarked, "cv.yaml").unwrap();
+        assert_eq!(
+            c.distortion,
+            Distortion::PlumbBob([0.1, -0.2, 0.03, -0.004, 0.0])
+        );
+        let f = parse_camera_info(FISHEYE, "fish.yaml").unwrap();
+        let text = render_camera_info(&f, "fish", "");
+        assert!(text.contains("distortion_model: equidistant\n"), "{text}");
+        assert!(text.contains("cols: 4\n"), "{text}");
+        assert_eq!(parse_camera_info(&text, "r.yaml").unwrap(), f);
+    }
+
     #[test]
     fn both_formats_are_read() {
         let c = parse_camera_info(ROS, "ros.yaml").unwrap();
@@ -309,10 +417,16 @@ distortion_coefficients: !!opencv-matrix
             (c.width, c.height, c.fx, c.fy, c.cx, c.cy),
             (1280, 960, 900.0, 905.0, 640.5, 480.2)
         );
-        assert_eq!(c.distortion, [-0.1, 0.05, 0.001, -0.0005, -0.01]);
+        assert_eq!(
+            c.distortion,
+            Distortion::PlumbBob([-0.1, 0.05, 0.001, -0.0005, -0.01])
+        );
         let c = parse_camera_info(OPENCV, "cv.yaml").unwrap();
         assert_eq!((c.width, c.fx, c.cy), (640, 500.0, 240.0));
-        assert_eq!(c.distortion, [0.1, -0.2, 0.0, 0.0, 0.05]);
+        assert_eq!(
+            c.distortion,
+            Distortion::PlumbBob([0.1, -0.2, 0.0, 0.0, 0.05])
+        );
     }
 
     /// A rendered camera_info reads back to the same values (17 digits),
@@ -322,11 +436,11 @@ distortion_coefficients: !!opencv-matrix
         let c = Intrinsics {
             width: 1280,
             height: 960,
-            fx: 1000.123_456_789_012_3,
+            fx: 1_000.123_456_789_012_3,
             fy: 999.876_543_210_987_6,
             cx: 640.1 + 1e-9,
             cy: 479.9,
-            distortion: [-0.081_234, 0.041, 5.1e-4, -2.9e-4, -0.011],
+            distortion: Distortion::PlumbBob([-0.081_234, 0.041, 5.1e-4, -2.9e-4, -0.011]),
         };
         let text = render_camera_info(&c, "cam", "refined\nby a test");
         assert!(text.starts_with("# refined\n# by a test\n"));
@@ -352,9 +466,14 @@ distortion_coefficients: !!opencv-matrix
                 "focal",
             ),
             (
-                ROS.replace("plumb_bob", "equidistant"),
+                ROS.replace("plumb_bob", "rational_polynomial"),
                 "line 8",
-                "equidistant",
+                "'rational_polynomial' is not supported",
+            ),
+            (
+                ROS.replace("plumb_bob", "equidistant"),
+                "line 10",
+                "5 coefficients; equidistant (fisheye) has 4",
             ),
             (
                 ROS.replace("image_width: 1280", "image_width: 0"),
@@ -367,6 +486,24 @@ distortion_coefficients: !!opencv-matrix
                 ROS.replace("image_height: 960\n", ""),
                 "image_height",
                 "image size",
+            ),
+            (
+                OPENCV.replace("---\n", "---\nfisheye_model: 2\n"),
+                "line 3",
+                "fisheye_model",
+            ),
+            (
+                FISHEYE.replace("equidistant", "plumb_bob\nfisheye_model: 1"),
+                "line 8",
+                "contradicts distortion_model 'plumb_bob'",
+            ),
+            (
+                FISHEYE.replace(
+                    "cols: 4, data: [-0.01, 0.002, -0.001, 0.0001]",
+                    "cols: 3, data: [-0.01, 0.002, -0.001]",
+                ),
+                "line 8",
+                "3 coefficients; equidistant (fisheye) has 4",
             ),
             (
                 "camera_matrix: [1, 2\n".to_string(),

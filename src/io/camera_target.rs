@@ -1,29 +1,41 @@
 //! A camera's target: a set of points in the target's own frame (metres),
 //! each with an integer id that observation files name.
 //!
-//! A YAML file holds either a checkerboard's inner corners
+//! A YAML file holds one of
 //!
-//! ```yaml
-//! checkerboard: {rows: 6, cols: 9, square: 0.025}
-//! ```
+//! * a checkerboard's inner corners, `checkerboard: {rows: 6, cols: 9,
+//!   square: 0.025}`: `rows × cols` inner corners, ids `0 … rows·cols − 1`
+//!   row by row as OpenCV's `findChessboardCorners` returns them for a
+//!   pattern size `(cols, rows)`: id `i·cols + j` at `(j·square, i·square,
+//!   0)`;
+//! * a ChArUco board's chessboard corners, `charuco: {rows: 5, cols: 7,
+//!   square: 0.04, marker: 0.03}` (`rows × cols` squares, the markers'
+//!   side `marker` < `square`; an optional `dictionary` is not read, the
+//!   corners do not depend on it): the `(rows − 1) × (cols − 1)` inner
+//!   corners with OpenCV's ids and positions (`cv2.aruco.CharucoBoard((cols,
+//!   rows), square, marker, dictionary).getChessboardCorners()`: id
+//!   `i·(cols − 1) + j` at `((j + 1)·square, (i + 1)·square, 0)`), the ids
+//!   `interpolateCornersCharuco` / `CharucoDetector` report;
+//! * a Kalibr aprilgrid's tag corners, `aprilgrid: {rows: 6, cols: 6,
+//!   tag_size: 0.088, tag_spacing: 0.3}` (Kalibr's `tagRows`, `tagCols`,
+//!   `tagSize` in metres and `tagSpacing`, the gap between tags as a
+//!   ratio of `tagSize`): tag `k` (row `k / cols`, column `k % cols`, row
+//!   0 at the bottom) has its lower-left corner at `(c·(1 + s)·t,
+//!   r·(1 + s)·t, 0)` and its 4 corners get ids `4k … 4k + 3` in Kalibr's
+//!   order: lower left, lower right, upper right, upper left (x right, y
+//!   up on the printed face, the AprilTag detector's `p[0..3]`; Kalibr's
+//!   `GridCalibrationTargetAprilgrid`, `aslam_cameras_april`). Kalibr's z
+//!   axis points out of the printed face, towards the camera that sees it:
+//!   the target's [`Target::face`] is `−z` (OpenCV's boards: `+z`);
+//! * an explicit list, `points: [{id: 0, xyz: [0.0, 0.0, 0.0]}, …]`
+//!   (AprilTag centres, any other target, with their ids).
 //!
-//! (`rows × cols` inner corners, ids `0 … rows·cols − 1` row by row as
-//! OpenCV's `findChessboardCorners` returns them for a pattern size `(cols,
-//! rows)`: id `i·cols + j` at `(j·square, i·square, 0)`), or an explicit
-//! list
-//!
-//! ```yaml
-//! points:
-//!   - {id: 0, xyz: [0.0, 0.0, 0.0]}
-//!   - {id: 17, xyz: [0.05, 0.0, 0.0]}
-//! ```
-//!
-//! (AprilTag centres, ChArUco corners with their ids). Refused: both or
-//! neither, a checkerboard of fewer than 2 × 2 corners or a square that is
-//! not a finite length > 0, an id given twice, a point that is not three
-//! finite numbers, fewer than 4 points, and points all on one line (a
-//! camera cannot place such a target). Errors name the file, line and
-//! column.
+//! Refused: more than one or none, a grid too small for 4 points, a length
+//! that is not a finite number > 0 (or over 1 m: millimetres?), a ChArUco
+//! marker not smaller than its square, an id given twice, a point that is
+//! not three finite numbers, fewer than 4 points, and points all on one
+//! line (a camera cannot place such a target). Errors name the file, the
+//! field, line and column.
 
 use crate::error::{Error, Result};
 use nalgebra::Vector3;
@@ -38,6 +50,10 @@ pub struct Target {
     pub ids: Vec<i64>,
     /// Each point in the target's frame, metres.
     pub points: Vec<Vector3<f64>>,
+    /// The direction, in the target's frame, from the face a camera sees
+    /// into the target: `+z` for OpenCV's boards and point lists, `−z` for
+    /// Kalibr's aprilgrid (see the module documentation).
+    pub face: Vector3<f64>,
 }
 
 impl Target {
@@ -51,7 +67,48 @@ impl Target {
             points: (0..n)
                 .map(|k| Vector3::new((k % cols) as f64 * square, (k / cols) as f64 * square, 0.0))
                 .collect(),
+            face: Vector3::z(),
         }
+    }
+
+    /// A ChArUco board of `rows × cols` squares of side `square`: its
+    /// `(rows − 1) × (cols − 1)` inner chessboard corners with OpenCV's ids
+    /// and positions (see the module documentation; the markers' side
+    /// does not move them).
+    #[must_use]
+    pub fn charuco(rows: usize, cols: usize, square: f64) -> Self {
+        let mut t = Self::checkerboard(rows - 1, cols - 1, square);
+        for p in &mut t.points {
+            *p += Vector3::new(square, square, 0.0);
+        }
+        t
+    }
+
+    /// A Kalibr aprilgrid of `rows × cols` tags of side `tag_size`, tags
+    /// `tag_spacing · tag_size` apart: tag `k`'s corners, ids `4k … 4k +
+    /// 3` (see the module documentation).
+    #[must_use]
+    pub fn aprilgrid(rows: usize, cols: usize, tag_size: f64, tag_spacing: f64) -> Self {
+        let pitch = (1.0 + tag_spacing) * tag_size;
+        // Kalibr's corner order: lower left, lower right, upper right,
+        // upper left.
+        let corners = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let mut t = Self {
+            ids: (0..(4 * rows * cols) as i64).collect(),
+            points: Vec::with_capacity(4 * rows * cols),
+            face: -Vector3::z(),
+        };
+        for k in 0..rows * cols {
+            let (r, c) = ((k / cols) as f64, (k % cols) as f64);
+            for [dx, dy] in corners {
+                t.points.push(Vector3::new(
+                    c * pitch + dx * tag_size,
+                    r * pitch + dy * tag_size,
+                    0.0,
+                ));
+            }
+        }
+        t
     }
 
     /// The index of the point with id `id`.
@@ -67,11 +124,88 @@ impl Target {
     }
 }
 
+/// A grid's size as the file wrote it: a number, or what else stood there
+/// (refused with its field named, [`count`] and [`length`]).
+#[derive(Debug)]
+enum Num {
+    Value(f64),
+    Other(String),
+}
+
+impl<'de> Deserialize<'de> for Num {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = Num;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number")
+            }
+            fn visit_i64<E>(self, v: i64) -> std::result::Result<Num, E> {
+                Ok(Num::Value(v as f64))
+            }
+            fn visit_u64<E>(self, v: u64) -> std::result::Result<Num, E> {
+                Ok(Num::Value(v as f64))
+            }
+            fn visit_f64<E>(self, v: f64) -> std::result::Result<Num, E> {
+                Ok(Num::Value(v))
+            }
+            fn visit_bool<E>(self, v: bool) -> std::result::Result<Num, E> {
+                Ok(Num::Other(v.to_string()))
+            }
+            fn visit_str<E>(self, v: &str) -> std::result::Result<Num, E> {
+                Ok(Num::Other(format!("'{v}'")))
+            }
+            fn visit_unit<E>(self) -> std::result::Result<Num, E> {
+                Ok(Num::Other("nothing".into()))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut a: A,
+            ) -> std::result::Result<Num, A::Error> {
+                while a.next_element::<serde::de::IgnoredAny>()?.is_some() {}
+                Ok(Num::Other("a list".into()))
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                mut a: A,
+            ) -> std::result::Result<Num, A::Error> {
+                while a
+                    .next_entry::<serde::de::IgnoredAny, serde::de::IgnoredAny>()?
+                    .is_some()
+                {}
+                Ok(Num::Other("a mapping".into()))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
 #[derive(Deserialize)]
 struct Board {
-    rows: Spanned<i64>,
-    cols: Spanned<i64>,
-    square: Spanned<f64>,
+    rows: Spanned<Num>,
+    cols: Spanned<Num>,
+    square: Spanned<Num>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Charuco {
+    rows: Spanned<Num>,
+    cols: Spanned<Num>,
+    square: Spanned<Num>,
+    marker: Spanned<Num>,
+    /// Not read: the corners do not depend on the markers' dictionary.
+    #[allow(dead_code)]
+    dictionary: Option<serde::de::IgnoredAny>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Aprilgrid {
+    rows: Spanned<Num>,
+    cols: Spanned<Num>,
+    tag_size: Spanned<Num>,
+    tag_spacing: Spanned<Num>,
 }
 
 #[derive(Deserialize)]
@@ -84,8 +218,13 @@ struct PointEntry {
 #[serde(deny_unknown_fields)]
 struct TargetEntry {
     checkerboard: Option<Spanned<Board>>,
+    charuco: Option<Spanned<Charuco>>,
+    aprilgrid: Option<Spanned<Aprilgrid>>,
     points: Option<Spanned<Vec<Spanned<PointEntry>>>>,
 }
+
+/// The four kinds a target file may give, for messages.
+const KINDS: &str = "a 'checkerboard: {rows, cols, square}', a 'charuco: {rows, cols, square, marker}', an 'aprilgrid: {rows, cols, tag_size, tag_spacing}' or a 'points' list of {id, xyz}";
 
 /// Reads a target file (see the module documentation).
 pub fn read_target(path: &Path) -> Result<Target> {
@@ -113,62 +252,135 @@ pub fn parse_target(text: &str, origin: &str) -> Result<Target> {
             .map(|l| format!("line {}, column {}: ", l.line(), l.column()))
             .unwrap_or_default();
         err(format!(
-            "{at}not a target file (a 'checkerboard: {{rows, cols, square}}' or a 'points' list of {{id, xyz}}): {}",
+            "{at}not a target file ({KINDS}): {}",
             e.without_snippet()
         ))
     })?;
-    let t = match (&f.checkerboard, &f.points) {
-        (Some(b), None) => board(b),
-        (None, Some(p)) => list(p),
-        (Some(b), Some(_)) => Err(format!(
-            "{}: both 'checkerboard' and 'points'; give one",
-            at(b)
-        )),
-        (None, None) => Err(
-            "no 'checkerboard' and no 'points': a target is a checkerboard {rows, cols, square} or a list of points {id, xyz}".into(),
-        ),
+    let given: Vec<String> = [
+        f.checkerboard.as_ref().map(|b| (at(b), "checkerboard")),
+        f.charuco.as_ref().map(|b| (at(b), "charuco")),
+        f.aprilgrid.as_ref().map(|b| (at(b), "aprilgrid")),
+        f.points.as_ref().map(|b| (at(b), "points")),
+    ]
+    .into_iter()
+    .flatten()
+    .map(|(place, key)| format!("'{key}' ({place})"))
+    .collect();
+    if given.len() > 1 {
+        return Err(err(format!("{}; give one", given.join(" and "))));
+    }
+    let t = if let Some(b) = &f.checkerboard {
+        board(b)
+    } else if let Some(b) = &f.charuco {
+        charuco(b)
+    } else if let Some(b) = &f.aprilgrid {
+        aprilgrid(b)
+    } else if let Some(p) = &f.points {
+        list(p)
+    } else {
+        Err(format!("no target: give {KINDS}"))
     }
     .map_err(err)?;
     check_spread(&t).map_err(err)?;
     Ok(t)
 }
 
+/// A count of a grid's `what` (`key` in `kind`): a whole number, at
+/// least `least`.
+fn count(
+    v: &Spanned<Num>,
+    kind: &str,
+    key: &str,
+    what: &str,
+    least: usize,
+) -> std::result::Result<usize, String> {
+    match &v.value {
+        Num::Value(n) if n.fract() == 0.0 && *n >= least as f64 && *n <= 1e6 => Ok(*n as usize),
+        Num::Value(n) => Err(format!(
+            "{} ('{kind}.{key}'): {n} {what}; a whole number, at least {least}",
+            at(v)
+        )),
+        Num::Other(o) => Err(format!(
+            "{} ('{kind}.{key}'): {o} is not a number of {what}",
+            at(v)
+        )),
+    }
+}
+
+/// A positive finite number (`key` in `kind`), else what is wrong with it
+/// (`unit` names what it should be).
+fn positive(
+    v: &Spanned<Num>,
+    kind: &str,
+    key: &str,
+    unit: &str,
+) -> std::result::Result<f64, String> {
+    match &v.value {
+        Num::Value(n) if n.is_finite() && *n > 0.0 => Ok(*n),
+        Num::Value(n) => Err(format!("{} ('{kind}.{key}'): {n} is not {unit}", at(v))),
+        Num::Other(o) => Err(format!("{} ('{kind}.{key}'): {o} is not {unit}", at(v))),
+    }
+}
+
+/// A length in metres (`key` in `kind`): finite, > 0 and at most 1 m.
+fn length(v: &Spanned<Num>, kind: &str, key: &str) -> std::result::Result<f64, String> {
+    let l = positive(v, kind, key, "a length > 0 (metres)")?;
+    if l > 1.0 {
+        return Err(format!(
+            "{} ('{kind}.{key}'): {l} m; lengths are in metres (millimetres?)",
+            at(v)
+        ));
+    }
+    Ok(l)
+}
+
 fn board(b: &Spanned<Board>) -> std::result::Result<Target, String> {
-    let count = |v: &Spanned<i64>, key: &str| {
-        usize::try_from(v.value)
-            .ok()
-            .filter(|&n| n >= 2)
-            .ok_or_else(|| {
-                format!(
-                    "{} ('checkerboard.{key}'): {} inner corners; at least 2",
-                    at(v),
-                    v.value
-                )
-            })
-    };
-    let (rows, cols) = (count(&b.value.rows, "rows")?, count(&b.value.cols, "cols")?);
-    let sq = &b.value.square;
-    if !(sq.value.is_finite() && sq.value > 0.0) {
+    let (rows, cols) = (
+        count(&b.value.rows, "checkerboard", "rows", "inner corners", 2)?,
+        count(&b.value.cols, "checkerboard", "cols", "inner corners", 2)?,
+    );
+    let sq = length(&b.value.square, "checkerboard", "square")?;
+    Ok(Target::checkerboard(rows, cols, sq))
+}
+
+fn charuco(b: &Spanned<Charuco>) -> std::result::Result<Target, String> {
+    let c = &b.value;
+    let (rows, cols) = (
+        count(&c.rows, "charuco", "rows", "squares", 3)?,
+        count(&c.cols, "charuco", "cols", "squares", 3)?,
+    );
+    let square = length(&c.square, "charuco", "square")?;
+    let marker = length(&c.marker, "charuco", "marker")?;
+    if marker >= square {
         return Err(format!(
-            "{} ('checkerboard.square'): {} is not a length > 0 (metres)",
-            at(sq),
-            sq.value
+            "{} ('charuco.marker'): a {marker} m marker in a {square} m square; the marker must be smaller",
+            at(&c.marker)
         ));
     }
-    if sq.value > 1.0 {
-        return Err(format!(
-            "{} ('checkerboard.square'): {} m squares; the square is in metres (millimetres?)",
-            at(sq),
-            sq.value
-        ));
-    }
-    Ok(Target::checkerboard(rows, cols, sq.value))
+    Ok(Target::charuco(rows, cols, square))
+}
+
+fn aprilgrid(b: &Spanned<Aprilgrid>) -> std::result::Result<Target, String> {
+    let g = &b.value;
+    let (rows, cols) = (
+        count(&g.rows, "aprilgrid", "rows", "tags", 1)?,
+        count(&g.cols, "aprilgrid", "cols", "tags", 1)?,
+    );
+    let size = length(&g.tag_size, "aprilgrid", "tag_size")?;
+    let spacing = positive(
+        &g.tag_spacing,
+        "aprilgrid",
+        "tag_spacing",
+        "a ratio > 0 (the gap between tags over the tag's size, Kalibr's tagSpacing)",
+    )?;
+    Ok(Target::aprilgrid(rows, cols, size, spacing))
 }
 
 fn list(p: &Spanned<Vec<Spanned<PointEntry>>>) -> std::result::Result<Target, String> {
     let mut t = Target {
         ids: Vec::new(),
         points: Vec::new(),
+        face: Vector3::z(),
     };
     let mut first_line = std::collections::HashMap::new();
     for e in &p.value {
@@ -231,6 +443,45 @@ mod tests {
         assert_eq!((l.index_of(9), l.index_of(2)), (Some(1), None));
     }
 
+    /// A ChArUco board of 4 × 5 squares: its 3 × 4 inner corners, id
+    /// `i·4 + j` one square in from the board's corner; a 2 × 1 aprilgrid:
+    /// tag 1's corners 4 … 7 one pitch `(1 + s)·t` to the right, in
+    /// Kalibr's order (lower left, lower right, upper right, upper left),
+    /// seen from −z.
+    #[test]
+    fn charuco_and_aprilgrid_points() {
+        let t = parse_target(
+            "charuco: {rows: 4, cols: 5, square: 0.04, marker: 0.03, dictionary: DICT_4X4_50}\n",
+            "c.yaml",
+        )
+        .unwrap();
+        assert_eq!(t.points.len(), 12);
+        assert_eq!(t.ids, (0..12).collect::<Vec<i64>>());
+        let near = |a: Vector3<f64>, b: [f64; 3]| (a - Vector3::from(b)).norm() < 1e-15;
+        assert!(near(t.points[0], [0.04, 0.04, 0.0]));
+        assert!(near(t.points[6], [0.12, 0.08, 0.0]), "{:?}", t.points[6]);
+        assert_eq!(t.face, Vector3::z());
+        let g = parse_target(
+            "aprilgrid: {rows: 1, cols: 2, tag_size: 0.05, tag_spacing: 0.3}\n",
+            "g.yaml",
+        )
+        .unwrap();
+        assert_eq!(g.ids, (0..8).collect::<Vec<i64>>());
+        let x0 = 1.3 * 0.05;
+        for (k, want) in [
+            [x0, 0.0, 0.0],
+            [x0 + 0.05, 0.0, 0.0],
+            [x0 + 0.05, 0.05, 0.0],
+            [x0, 0.05, 0.0],
+        ]
+        .iter()
+        .enumerate()
+        {
+            assert!(near(g.points[4 + k], *want), "{k}: {:?}", g.points[4 + k]);
+        }
+        assert_eq!(g.face, -Vector3::z());
+    }
+
     #[test]
     fn bad_targets_are_refused_with_their_place() {
         let cases = [
@@ -242,7 +493,7 @@ mod tests {
             (
                 "checkerboard: {rows: 1, cols: 4, square: 0.02}\n",
                 "line 1",
-                "at least 2",
+                "('checkerboard.rows'): 1 inner corners; a whole number, at least 2",
             ),
             (
                 "checkerboard: {rows: 3, cols: 4, square: 25}\n",
@@ -260,6 +511,51 @@ mod tests {
                 "one line",
             ),
             ("board: 3\n", "line 1", "not a target file"),
+            (
+                "charuco: {rows: 4, cols: 5, square: 0.04, marker: 0.05}\n",
+                "line 1",
+                "'charuco.marker'): a 0.05 m marker in a 0.04 m square",
+            ),
+            (
+                "charuco: {rows: 4, cols: 2, square: 0.04, marker: 0.03}\n",
+                "line 1",
+                "'charuco.cols'): 2 squares; a whole number, at least 3",
+            ),
+            (
+                "charuco:\n  rows: 4\n  cols: 5\n  square: -0.04\n  marker: 0.03\n",
+                "line 4",
+                "'charuco.square'): -0.04 is not a length > 0",
+            ),
+            (
+                "aprilgrid: {rows: 6, cols: 6, tag_size: 88, tag_spacing: 0.3}\n",
+                "line 1",
+                "'aprilgrid.tag_size'): 88 m",
+            ),
+            (
+                "aprilgrid:\n  rows: 6\n  cols: 6\n  tag_size: 0.088\n  tag_spacing: 0\n",
+                "line 5",
+                "'aprilgrid.tag_spacing'): 0 is not a ratio > 0",
+            ),
+            (
+                "aprilgrid: {rows: 0, cols: 6, tag_size: 0.088, tag_spacing: 0.3}\n",
+                "line 1",
+                "'aprilgrid.rows'): 0 tags; a whole number, at least 1",
+            ),
+            (
+                "aprilgrid: {rows: 6, cols: 6, tagSize: 0.088, tag_spacing: 0.3}\n",
+                "line 1",
+                "tagSize",
+            ),
+            (
+                "aprilgrid: {rows: 6, cols: 6, tag_size: 0.088, tag_spacing: 0.3}\ncheckerboard: {rows: 3, cols: 4, square: 0.02}\n",
+                "line 2",
+                "'checkerboard' (line 2, column 15) and 'aprilgrid' (line 1",
+            ),
+            (
+                "charuco: {rows: four, cols: 5, square: 0.04, marker: 0.03}\n",
+                "line 1, column 17",
+                "('charuco.rows'): 'four' is not a number of squares",
+            ),
         ];
         for (text, place, what) in cases {
             let e = parse_target(text, "t.yaml").unwrap_err().to_string();

@@ -1,4 +1,5 @@
-//! The camera sensor: a calibrated pinhole camera ([`super::pinhole`])
+//! The camera sensor: a calibrated camera ([`super::pinhole`]: plumb_bob
+//! or equidistant fisheye distortion)
 //! sees the points of a target (a checkerboard's corners, tags' centres);
 //! its residuals are pixels, two rows per target point.
 //!
@@ -47,8 +48,9 @@
 //! values say which points were detected ([`Sensor::residual_rows`],
 //! [`Sensor::own_rows_of`]); the design rows ([`Sensor::motion_rows`],
 //! [`Sensor::own_rows`]), which have no measured value, keep the points the
-//! camera is predicted to see: in front of it and inside the image at least
-//! [`CameraSensor::margin`] pixels from its border. A residual block's
+//! camera is predicted to see: in front of it, inside its model's field
+//! ([`super::pinhole::Intrinsics::field_angle`]) and inside the image at
+//! least [`CameraSensor::margin`] pixels from its border. A residual block's
 //! redundancy counts the rows seen only ([`CameraSensor::seen_rows`]).
 
 use super::pinhole::{Intrinsics, Projection, right_jacobian, skew};
@@ -57,63 +59,15 @@ use crate::kinematics::{EndFrame, Motion};
 use crate::model::MeasurementKind;
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
+mod mounting;
+pub use mounting::Mounting;
+
 /// Own unknowns of a camera sensor: two placements of 6.
 pub const OWN_PARAMS: usize = 12;
 
 /// Fewest target points a pose must see: a camera places a target from
 /// four points or more (three leave up to four solutions, P3P).
 pub const MIN_POINTS_PER_POSE: usize = 4;
-
-/// Where the camera and the target are.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Mounting {
-    /// A fixed camera (placement in the base) sees a target on the end
-    /// frame.
-    EyeToHand,
-    /// A camera on the end frame sees a fixed target (placement in the
-    /// base).
-    EyeInHand,
-}
-
-impl Mounting {
-    /// `eye-to-hand` or `eye-in-hand`.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Mounting::EyeToHand => "eye-to-hand",
-            Mounting::EyeInHand => "eye-in-hand",
-        }
-    }
-
-    /// Reads a mounting's name (`eye-to-hand`, `eye-in-hand`).
-    #[must_use]
-    pub fn from_name(s: &str) -> Option<Self> {
-        match s {
-            "eye-to-hand" => Some(Mounting::EyeToHand),
-            "eye-in-hand" => Some(Mounting::EyeInHand),
-            _ => None,
-        }
-    }
-
-    /// What the camera's placement is relative to: `base` or `end frame`.
-    #[must_use]
-    pub fn camera_parent(self) -> &'static str {
-        match self {
-            Mounting::EyeToHand => "base",
-            Mounting::EyeInHand => "end frame",
-        }
-    }
-
-    /// What the target's placement is relative to.
-    #[must_use]
-    pub fn target_parent(self) -> &'static str {
-        match self {
-            Mounting::EyeToHand => "end frame",
-            Mounting::EyeInHand => "base",
-        }
-    }
-}
 
 /// A camera seeing `N` target points: `2N` pixel rows per pose, 12 own
 /// unknowns (see the module documentation).
@@ -130,13 +84,20 @@ pub struct CameraSensor {
     /// Which intrinsics are unknowns (in the order of
     /// [`Intrinsics::values`]; own unknowns from 12 on, the free ones in
     /// that order).
-    refine: [bool; 9],
+    refine: Vec<bool>,
+    /// The given intrinsics' [`Intrinsics::field_angle`], radians.
+    field: f64,
+    /// The direction, in the target's frame, from its seen face into it
+    /// (away from a camera that sees the face): `+z` unless
+    /// [`CameraSensor::with_face`] says otherwise.
+    face: Vector3<f64>,
 }
 
 /// How a camera sees its target at one pose ([`CameraSensor::view`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct View {
-    /// Points in front of the camera and inside the image with the margin.
+    /// Points in front of the camera, inside its model's field and inside
+    /// the image with the margin.
     pub seen: usize,
     /// The viewing angle, radians: between the target's z axis and the
     /// line of sight from the camera to the points' centroid. 0 when the
@@ -182,6 +143,9 @@ impl CameraSensor {
     ) -> Self {
         let n = points.len();
         Self {
+            refine: vec![false; intrinsics.values().len()],
+            field: intrinsics.field_angle(),
+            face: Vector3::z(),
             intrinsics,
             mounting,
             points,
@@ -192,30 +156,48 @@ impl CameraSensor {
             margin: 0.0,
             kinds: vec![RowKind::Pixel; 2 * n],
             ones: vec![1.0; 2 * n],
-            refine: [false; 9],
         }
     }
 
     /// The sensor whose own unknowns also hold the intrinsics (`fx, fy,
-    /// cx, cy, k1, k2, p1, p2, k3` after the 12 placement unknowns, their
-    /// values rather than corrections) when `refine` is set.
+    /// cx, cy` and the distortion's coefficients, [`Intrinsics::values`],
+    /// after the 12 placement unknowns, their values rather than
+    /// corrections) when `refine` is set.
     #[must_use]
     pub fn with_intrinsics_refined(self, refine: bool) -> Self {
-        self.with_free_intrinsics([refine; 9])
+        let n = self.intrinsics.values().len();
+        self.with_free_intrinsics(vec![refine; n])
     }
 
     /// The sensor whose own unknowns hold the intrinsics `free` marks (in
-    /// the order of [`Intrinsics::values`]); the others stay as given.
+    /// the order of [`Intrinsics::values`], one flag each); the others
+    /// stay as given.
     #[must_use]
-    pub fn with_free_intrinsics(mut self, free: [bool; 9]) -> Self {
+    pub fn with_free_intrinsics(mut self, free: Vec<bool>) -> Self {
+        assert_eq!(
+            free.len(),
+            self.intrinsics.values().len(),
+            "one flag per intrinsic"
+        );
         self.refine = free;
         self
     }
 
     /// Which intrinsics are unknowns ([`CameraSensor::with_free_intrinsics`]).
     #[must_use]
-    pub fn free_intrinsics(&self) -> [bool; 9] {
-        self.refine
+    pub fn free_intrinsics(&self) -> &[bool] {
+        &self.refine
+    }
+
+    /// The sensor whose target is seen from the side `face` points away
+    /// from (a direction in the target's frame, into the target): `+z` for
+    /// OpenCV's boards (the default), `−z` for Kalibr's aprilgrid (its z
+    /// points out of the printed face). Only the viewing angle
+    /// ([`CameraSensor::view`]) uses it.
+    #[must_use]
+    pub fn with_face(mut self, face: Vector3<f64>) -> Self {
+        self.face = face.normalize();
+        self
     }
 
     /// Whether any intrinsic is an unknown ([`CameraSensor::with_intrinsics_refined`]).
@@ -229,7 +211,11 @@ impl CameraSensor {
     #[must_use]
     pub fn free_intrinsic_values(&self) -> Vec<f64> {
         let v = self.intrinsics.values();
-        (0..9).filter(|&j| self.refine[j]).map(|j| v[j]).collect()
+        v.iter()
+            .zip(&self.refine)
+            .filter(|(_, free)| **free)
+            .map(|(v, _)| *v)
+            .collect()
     }
 
     /// The intrinsics at own unknowns `own`: the sensor's, with the free
@@ -339,9 +325,10 @@ impl CameraSensor {
     }
 
     /// How the camera sees the target at end frame `end` and own unknowns
-    /// `own`: how many points are in front of it and inside the image at
-    /// least `margin` pixels from its border, the viewing angle and the
-    /// distance of the points' centroid.
+    /// `own`: how many points it sees (in front of it, inside the model's
+    /// field and the image at least `margin` pixels from its border,
+    /// [`Intrinsics::sees`]), the viewing angle and the distance of the
+    /// points' centroid.
     #[must_use]
     pub fn view(&self, end: &EndFrame, own: &[f64], margin: f64) -> View {
         let f = self.frames(end, own);
@@ -351,16 +338,13 @@ impl CameraSensor {
         for k in 0..self.points.len() {
             let (x, _) = self.point(end, &f, k);
             centroid += x;
-            seen += usize::from(
-                cam.project(&x)
-                    .is_some_and(|p| self.intrinsics.inside(p.pixel, margin)),
-            );
+            seen += usize::from(cam.sees(&x, self.field, margin).is_some());
         }
         centroid /= self.points.len().max(1) as f64;
         // The target's z axis in the optical frame: A maps a direction of
         // the target's parent to the optical frame (up to the sign of
         // eye-in-hand's B, which a direction does not share).
-        let normal = f.a * f.rt * Vector3::z();
+        let normal = f.a * f.rt * self.face;
         let distance = centroid.norm();
         View {
             seen,
@@ -411,12 +395,26 @@ impl CameraSensor {
         }
     }
 
-    /// Whether point `k`'s rows are kept: seen in `measured` when given,
-    /// else predicted inside the image with the margin.
-    fn kept(&self, k: usize, proj: Option<&Projection>, measured: Option<&[f64]>) -> bool {
+    /// Whether the camera sees `x` (optical frame) with its given
+    /// intrinsics, at least `margin` pixels inside the image
+    /// ([`Intrinsics::sees`] with the model's field).
+    #[must_use]
+    pub fn sees(&self, x: &Vector3<f64>, margin: f64) -> bool {
+        self.intrinsics.sees(x, self.field, margin).is_some()
+    }
+
+    /// Whether point `k` (at `x`, optical frame) keeps its rows: seen in
+    /// `measured` when given, else predicted seen with the margin.
+    fn kept(
+        &self,
+        k: usize,
+        x: &Vector3<f64>,
+        proj: Option<&Projection>,
+        measured: Option<&[f64]>,
+    ) -> bool {
         match (measured, proj) {
             (Some(m), Some(_)) => m[3 * k + 2] != 0.0,
-            (None, Some(p)) => self.intrinsics.inside(p.pixel, self.margin),
+            (None, Some(_)) => self.sees(x, self.margin),
             (_, None) => false,
         }
     }
@@ -437,7 +435,7 @@ impl CameraSensor {
             let (x, l) = self.point(end, &f, k);
             let proj = cam.project(&x);
             let rows = &mut out[2 * k * ld..];
-            match proj.filter(|p| self.kept(k, Some(p), measured)) {
+            match proj.filter(|p| self.kept(k, &x, Some(p), measured)) {
                 Some(p) => {
                     let jb = p.jacobian * f.b;
                     for (c, m) in motions.iter().enumerate() {
@@ -470,7 +468,7 @@ impl CameraSensor {
             let (x, _) = self.point(end, &f, k);
             let proj = cam.project(&x);
             let rows = &mut out[2 * k * ld..];
-            let Some(p) = proj.filter(|p| self.kept(k, Some(p), measured)) else {
+            let Some(p) = proj.filter(|p| self.kept(k, &x, Some(p), measured)) else {
                 rows[..n_own].fill(0.0);
                 rows[ld..ld + n_own].fill(0.0);
                 continue;
@@ -478,7 +476,7 @@ impl CameraSensor {
             if self.refines_intrinsics()
                 && let Some(ji) = cam.intrinsic_jacobian(&x)
             {
-                let free = (0..9).filter(|&j| self.refine[j]);
+                let free = (0..self.refine.len()).filter(|&j| self.refine[j]);
                 for (c, j) in (OWN_PARAMS..n_own).zip(free) {
                     rows[c] = ji[0][j];
                     rows[ld + c] = ji[1][j];
@@ -554,10 +552,11 @@ impl Sensor for CameraSensor {
             .flat_map(|w| ["x", "y", "z", "rx", "ry", "rz"].map(|c| format!("{w}_{c}")))
             .collect();
         names.extend(
-            crate::measure::pinhole::INTRINSIC_NAMES
+            self.intrinsics
+                .names()
                 .iter()
-                .zip(self.refine)
-                .filter(|(_, free)| *free)
+                .zip(&self.refine)
+                .filter(|(_, free)| **free)
                 .map(|(n, _)| format!("camera_{n}")),
         );
         names
@@ -577,15 +576,18 @@ impl Sensor for CameraSensor {
         }
     }
 
-    /// `u, v, 1` for a point in front of the camera (inside the image or
-    /// not), `NaN, NaN, 0` for one behind it.
+    /// `u, v, 1` for a point in front of the camera and inside its model's
+    /// field (inside the image or not), `NaN, NaN, 0` for one behind it or
+    /// beyond the field ([`Intrinsics::field_angle`]: the model's formula
+    /// would draw it back towards the image).
     fn predict(&self, end: &EndFrame, own: &[f64], out: &mut [f64]) {
         let f = self.frames(end, own);
         let cam = self.intrinsics_at(own);
         for k in 0..self.points.len() {
             let (x, _) = self.point(end, &f, k);
             let o = &mut out[3 * k..3 * k + 3];
-            match cam.project(&x) {
+            let off_axis = x.x.hypot(x.y).atan2(x.z);
+            match cam.project(&x).filter(|_| off_axis < self.field) {
                 Some(p) => o.copy_from_slice(&[p.pixel[0], p.pixel[1], 1.0]),
                 None => o.copy_from_slice(&[f64::NAN, f64::NAN, 0.0]),
             }

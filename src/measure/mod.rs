@@ -8,6 +8,7 @@
 
 pub mod camera;
 pub mod contact;
+pub mod fisheye;
 pub mod markers;
 pub mod pinhole;
 pub mod point;

@@ -1,8 +1,11 @@
 //! The camera filter of a pool: keep the configurations in which a camera
 //! sees its target well ([`crate::measure::camera`]):
 //!
-//! * at least `min_fraction` of the target's points in front of the camera
-//!   and inside the image, `margin_px` pixels or more from its border;
+//! * at least `min_fraction` of the target's points in front of the camera,
+//!   inside its model's field (a fisheye's too: a point behind the camera
+//!   or past the angle where the distortion folds back is not seen,
+//!   [`crate::measure::pinhole::Intrinsics::sees`]) and inside the image,
+//!   `margin_px` pixels or more from its border;
 //! * the target facing the camera: the viewing angle (between the target's
 //!   z axis and the line of sight, [`crate::measure::camera::View`]) at most
 //!   `max_view_angle` (radians; 60° by default: past it corner detectors
@@ -35,6 +38,12 @@ pub struct CameraView {
     pub mounting: Mounting,
     /// The target's points, its frame, metres.
     pub points: Vec<[f64; 3]>,
+    /// The direction in the target's frame from its seen face into it
+    /// (`[0, 0, 1]` for OpenCV's boards, `[0, 0, −1]` for Kalibr's
+    /// aprilgrid: [`crate::io::camera_target::Target::face`]); the viewing
+    /// angle is measured from it.
+    #[serde(default = "into_the_board")]
+    pub face: [f64; 3],
     /// The camera's placement in its parent: x, y, z (m), roll, pitch, yaw
     /// (rad, as in URDF).
     pub camera: [f64; 6],
@@ -48,6 +57,11 @@ pub struct CameraView {
     pub max_view_angle: f64,
     /// The range of the target's distance from the camera, metres.
     pub distance: [f64; 2],
+}
+
+/// `+z`: OpenCV's boards are seen from the side their z points away from.
+fn into_the_board() -> [f64; 3] {
+    [0.0, 0.0, 1.0]
 }
 
 /// The placement `X,Y,Z,ROLL,PITCH,YAW` stands for (metres, radians; rpy
@@ -96,6 +110,12 @@ impl CameraView {
         {
             return Err("a placement or a target point is not finite".into());
         }
+        if !(finite(&self.face) && Vector3::from(self.face).norm() > 0.0) {
+            return Err(format!(
+                "the target's face direction {:?} is not a finite non-zero vector",
+                self.face
+            ));
+        }
         Ok(())
     }
 
@@ -106,7 +126,8 @@ impl CameraView {
         let pts = self.points.iter().map(|p| Vector3::from(*p)).collect();
         (
             CameraSensor::new(self.intrinsics.clone(), self.mounting, pts, &c, &t)
-                .with_margin(self.margin_px),
+                .with_margin(self.margin_px)
+                .with_face(Vector3::from(self.face)),
             CameraSensor::start_own(&c, &t),
         )
     }
@@ -166,10 +187,11 @@ mod tests {
                 fy: 900.0,
                 cx: 640.0,
                 cy: 480.0,
-                distortion: [0.0; 5],
+                distortion: crate::measure::pinhole::Distortion::PlumbBob([0.0; 5]),
             },
             mounting: Mounting::EyeToHand,
             points: board,
+            face: into_the_board(),
             camera: [eye.x, eye.y, eye.z, r, p, y],
             target: [-0.04, -0.03, 0.01, std::f64::consts::PI, 0.0, 0.0],
             min_fraction: 1.0,

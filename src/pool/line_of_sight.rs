@@ -41,7 +41,8 @@ pub struct LineOfSight {
 }
 
 /// The points of the target and the camera's centre in the base frame at
-/// `q`, and which points the camera sees inside the image with the margin.
+/// `q`, and which points the camera sees (in front, inside its model's
+/// field and the image with the margin).
 #[must_use]
 pub fn rays(
     view: &CameraView,
@@ -64,13 +65,12 @@ pub fn rays(
         .iter()
         .map(|p| tgt * Point3::new(p[0], p[1], p[2]))
         .collect();
+    let field = view.intrinsics.field_angle();
     let inside = pts
         .iter()
         .map(|p| {
             let x = cam.inverse_transform_point(p).coords;
-            view.intrinsics
-                .project(&x)
-                .is_some_and(|pr| view.intrinsics.inside(pr.pixel, view.margin_px))
+            view.intrinsics.sees(&x, field, view.margin_px).is_some()
         })
         .collect();
     (Point3::from(cam.translation.vector), pts, inside)

@@ -28,6 +28,8 @@ mod live_erd;
 #[cfg(feature = "live")]
 mod live_export;
 #[cfg(feature = "live")]
+mod live_fisheye;
+#[cfg(feature = "live")]
 mod live_gravity;
 #[cfg(feature = "live")]
 mod live_idjac;

@@ -8,7 +8,7 @@
 use activecal::kinematics::EndFrame;
 use activecal::measure::Sensor;
 use activecal::measure::camera::{CameraSensor, Mounting};
-use activecal::measure::pinhole::Intrinsics;
+use activecal::measure::pinhole::{Distortion, Intrinsics};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use pyo3::prelude::*;
 use pyo3::types::PyModule;
@@ -40,7 +40,7 @@ fn opencv(
         let r = m
             .getattr("project")
             .unwrap()
-            .call1((pts, rvec, tvec, k, c.distortion))
+            .call1((pts, rvec, tvec, k, c.distortion.coefficients().to_vec()))
             .unwrap();
         let (img, jac, version): (Vec<Vec<f64>>, Vec<Vec<f64>>, String) = r.extract().unwrap();
         assert!(
@@ -59,7 +59,7 @@ fn intrinsics() -> Intrinsics {
         fy: 1009.25,
         cx: 641.3,
         cy: 479.6,
-        distortion: [-0.21, 0.13, 8e-4, -6e-4, -0.04],
+        distortion: Distortion::PlumbBob([-0.21, 0.13, 8e-4, -6e-4, -0.04]),
     }
 }
 

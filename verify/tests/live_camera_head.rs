@@ -81,6 +81,7 @@ fn head_camera_calibration_matches_a_true_tiago() {
     let view = CameraView {
         intrinsics: read_camera_info(&info).unwrap(),
         mounting: Mounting::EyeToHand,
+        face: [0.0, 0.0, 1.0],
         points: read_target(&board)
             .unwrap()
             .points

@@ -142,6 +142,7 @@ fn panda_line_of_sight_agrees_with_coal() {
     let view = CameraView {
         intrinsics: read_camera_info(&r.join("fixtures/camera/camera_info.yaml")).unwrap(),
         mounting: Mounting::EyeToHand,
+        face: [0.0, 0.0, 1.0],
         points: read_target(&r.join("fixtures/camera/board.yaml"))
             .unwrap()
             .points

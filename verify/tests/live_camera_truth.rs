@@ -185,6 +185,7 @@ fn truth_gate(
     let view = CameraView {
         intrinsics: intrinsics.clone(),
         mounting,
+        face: [0.0, 0.0, 1.0],
         points: tgt.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
         camera: six(&camera)
             .split(',')

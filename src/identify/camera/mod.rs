@@ -31,7 +31,6 @@ use crate::identify::undetermined::{
     FixedParameter, GENERIC_REASON, PIVOT_TOL, undetermined_columns,
 };
 use crate::measure::camera::{CameraSensor, OWN_PARAMS};
-use crate::measure::pinhole::INTRINSIC_NAMES;
 use crate::model::{ParamTable, Robot};
 use nalgebra::Isometry3;
 
@@ -339,16 +338,17 @@ fn free_intrinsics(
     if out.is_empty() {
         return (sensor, own1, Vec::new());
     }
-    let free: Vec<usize> = (0..9).filter(|&j| sensor.free_intrinsics()[j]).collect();
+    let mut mask = sensor.free_intrinsics().to_vec();
+    let free: Vec<usize> = (0..mask.len()).filter(|&j| mask[j]).collect();
     let given = sensor.intrinsics().values();
-    let mut mask = sensor.free_intrinsics();
+    let names = sensor.intrinsics().names();
     let fixed = out
         .iter()
         .map(|&c| {
             let j = free[c - first];
             mask[j] = false;
             FixedParameter {
-                name: format!("camera_{}", INTRINSIC_NAMES[j]),
+                name: format!("camera_{}", names[j]),
                 value: given[j],
                 reason: GENERIC_REASON.to_string(),
             }

@@ -1,4 +1,5 @@
 use super::*;
+use crate::measure::pinhole::Distortion;
 use nalgebra::Rotation3;
 
 fn intrinsics() -> Intrinsics {
@@ -9,7 +10,7 @@ fn intrinsics() -> Intrinsics {
         fy: 905.0,
         cx: 640.0,
         cy: 480.0,
-        distortion: [-0.1, 0.05, 1e-3, -5e-4, -0.01],
+        distortion: Distortion::PlumbBob([-0.1, 0.05, 1e-3, -5e-4, -0.01]),
     }
 }
 
@@ -44,6 +45,11 @@ fn iso(t: [f64; 3], rpy: [f64; 3]) -> Isometry3<f64> {
 /// 0.7 m straight ahead at end frame [`end`], and own unknowns with
 /// rotations off their charts' centres (so that `J_r` is exercised).
 fn setup(mounting: Mounting) -> (CameraSensor, Vec<f64>) {
+    setup_with(mounting, intrinsics())
+}
+
+/// [`setup`] with the camera `c`.
+fn setup_with(mounting: Mounting, c: Intrinsics) -> (CameraSensor, Vec<f64>) {
     let e = end();
     let ahead = Vector3::new(0.04, -0.03, 0.7);
     let (camera, target) = match mounting {
@@ -65,7 +71,7 @@ fn setup(mounting: Mounting) -> (CameraSensor, Vec<f64>) {
             (camera, target)
         }
     };
-    let s = CameraSensor::new(intrinsics(), mounting, grid(), &camera, &target);
+    let s = CameraSensor::new(c, mounting, grid(), &camera, &target);
     let mut own = CameraSensor::start_own(&camera, &target);
     for (k, d) in [
         (3, 0.02),
@@ -219,4 +225,64 @@ fn recentring_keeps_the_placements() {
         ("camera_x", "camera_rz", "target_x")
     );
     assert_eq!(s.rows(), 24);
+}
+
+/// A fisheye whose 8 intrinsics are unknowns: its own rows (placements and
+/// fx … k4) are derivatives of the predicted pixels, central differences
+/// with step 1e-6 as in [`rows_are_derivatives_of_the_prediction`] (the
+/// k's columns run to ~1e2 px per unit), both mountings.
+#[test]
+fn fisheye_own_rows_are_derivatives_of_the_prediction() {
+    let fish = Intrinsics {
+        fx: 400.0,
+        fy: 401.0,
+        distortion: Distortion::Equidistant([-0.01, 0.002, -0.001, 0.0001]),
+        ..intrinsics()
+    };
+    for mounting in [Mounting::EyeToHand, Mounting::EyeInHand] {
+        let (s, mut own) = setup_with(mounting, fish.clone());
+        let s = s.with_intrinsics_refined(true);
+        own.extend(s.free_intrinsic_values());
+        let n = s.n_own_params();
+        assert_eq!(n, OWN_PARAMS + 8);
+        assert_eq!(s.own_param_names()[n - 1], "camera_k4");
+        let mut jac = vec![0.0; s.rows() * n];
+        s.own_rows(&end(), &own, &mut jac, n);
+        let pixels = |c: usize, h: f64| {
+            let mut o = own.clone();
+            o[c] += h;
+            let mut out = vec![0.0; s.value_len()];
+            s.predict(&end(), &o, &mut out);
+            out
+        };
+        for c in 0..n {
+            let (a, b) = (pixels(c, 1e-6), pixels(c, -1e-6));
+            for row in 0..s.rows() {
+                let (k, r) = (row / 2, row % 2);
+                let fd = (a[3 * k + r] - b[3 * k + r]) / 2e-6;
+                let j = jac[row * n + c];
+                assert!(
+                    (j - fd).abs() < 1e-4,
+                    "{mounting:?} row {row} col {c}: {j} vs {fd}"
+                );
+            }
+        }
+    }
+}
+
+/// The viewing angle is measured from the target's face direction: a
+/// target seen from its −z side (Kalibr's aprilgrid, `with_face(−z)`)
+/// has the supplement of the angle it has seen from +z.
+#[test]
+fn the_face_direction_turns_the_viewing_angle() {
+    let (s, own) = setup(Mounting::EyeToHand);
+    let a = s.view(&end(), &own, 0.0);
+    let b = s.clone().with_face(-Vector3::z()).view(&end(), &own, 0.0);
+    // (The setup's board is seen 81° off its face: the two differ.)
+    assert!((a.angle - b.angle).abs() > 0.1, "{a:?} {b:?}");
+    assert!(
+        (a.angle + b.angle - std::f64::consts::PI).abs() < 1e-12,
+        "{a:?} {b:?}"
+    );
+    assert_eq!((a.seen, a.distance), (b.seen, b.distance));
 }

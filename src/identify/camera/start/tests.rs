@@ -28,7 +28,9 @@ fn intrinsics() -> Intrinsics {
         fy: 1000.0,
         cx: 640.0,
         cy: 480.0,
-        distortion: [-0.08, 0.04, 5e-4, -3e-4, -0.01],
+        distortion: crate::measure::pinhole::Distortion::PlumbBob([
+            -0.08, 0.04, 5e-4, -3e-4, -0.01,
+        ]),
     }
 }
 

@@ -558,6 +558,20 @@ class CameraDesign:
         """A pandas DataFrame with the columns of ``select --out
         design.csv``: candidate, the joints, points_seen."""
     @property
+    def how_many(
+        self,
+        pixel_noise: Optional[float] = None,
+        target_error: Optional[float] = None,
+        progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
+    ) -> dict[str, Any]:
+        """How many poses: the curve on the design's visible pool: the dict
+        ``activecal select --camera-info ... --report DIR`` writes as
+        ``how_many_poses`` in report.json (``n_min`` = ⌈p / 6⌉, ``points``
+        with ``n``, ``d_efficiency``, the ``predicted`` true errors in mm,
+        ``noise_px``, ``recommended``) for the pixel noise σ ``pixel_noise``
+        (px; the design's ``pixel_noise``, else 0.3) and, with
+        ``target_error`` (mm), the fewest poses predicted to reach it."""
+    @property
     def report(self) -> dict[str, Any]:
         """The dict ``activecal select --camera-info ... --json`` prints
         (``out`` empty)."""
@@ -580,6 +594,7 @@ def select_camera(
     max_view_angle: float = 60.0,
     distance: Tuple[float, float] = (0.2, 3.0),
     gap: bool = False,
+    pixel_noise: Optional[float] = None,
     progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
 ) -> CameraDesign:
     """Chooses n poses for a camera, as ``activecal select --camera-info
@@ -592,5 +607,8 @@ def select_camera(
     and lies within distance (lo, hi) metres; n of them are chosen
     D-optimally on the pixel Jacobian (seed: the search's; 1 as the
     command line's). gap: score the design against its visible pool's
-    certified bound (``report["gap"]``, ``report["d_efficiency"]``; a
-    minute or two on large pools)."""
+    certified bound (``report["gap"]``, ``report["d_efficiency"]``; about
+    a second: a pose's pixel rows are cut to their rank, 6). pixel_noise:
+    the detected points' σ (px); the report then also predicts the true
+    error at it (``predicted_error_mm``), and `CameraDesign.how_many`
+    uses it."""

@@ -3,7 +3,7 @@
 //! line of sight), and the `CameraDesign` it returns.
 
 use crate::camera::{chain_of, mounting_of, read_intrinsics, read_target, six, yaml_source};
-use crate::convert::{Fail, detached, json_to_py, ndarray, non_negative};
+use crate::convert::{Fail, arg_err, detached, json_to_py, ndarray, non_negative};
 use crate::robot::Robot;
 use activecal::model::robot_ref::RobotRef;
 use activecal::pool::camera_view::CameraView;
@@ -15,6 +15,10 @@ use pyo3::types::PyDict;
 /// see, and the report.
 #[pyclass(module = "activecal", name = "CameraDesign", frozen)]
 pub struct CameraDesign {
+    /// The library's design (its visible pool's blocks, for `how_many`).
+    design: std::sync::Arc<activecal::select::camera::CameraDesign>,
+    /// The selection's settings, which the curve's selections reuse.
+    settings: activecal::select::Settings,
     joint_names: Vec<String>,
     report: serde_json::Value,
     qs: Vec<Vec<f64>>,
@@ -45,10 +49,12 @@ fn reference(
 /// faces the camera within max_view_angle degrees and lies within
 /// distance (lo, hi) metres. n of them are chosen D-optimally on the pixel
 /// Jacobian (seed: the search's, default 1 as the command line's). gap:
-/// score the design against its visible pool's certified bound (slow: a
-/// minute or two on large pools). progress as `select` takes it.
+/// score the design against its visible pool's certified bound (about a
+/// second: a pose's pixel rows are cut to their rank, 6). pixel_noise: the
+/// detected points' σ (px): the report then also predicts the true error
+/// at it (`predicted_error_mm`). progress as `select` takes it.
 #[pyfunction]
-#[pyo3(signature = (robot, camera_info, target, *, n, camera_pose, target_pose, mounting=None, camera_link=None, count=20000, pool_seed=0, seed=1, min_visible=1.0, image_margin=10.0, max_view_angle=60.0, distance=(0.2, 3.0), gap=false, progress=None))]
+#[pyo3(signature = (robot, camera_info, target, *, n, camera_pose, target_pose, mounting=None, camera_link=None, count=20000, pool_seed=0, seed=1, min_visible=1.0, image_margin=10.0, max_view_angle=60.0, distance=(0.2, 3.0), gap=false, pixel_noise=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn select_camera(
     py: Python<'_>,
@@ -68,8 +74,10 @@ pub fn select_camera(
     max_view_angle: f64,
     distance: (f64, f64),
     gap: bool,
+    pixel_noise: Option<f64>,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<CameraDesign> {
+    check_pixel_noise(pixel_noise)?;
     let m = mounting_of(mounting, camera_link.as_deref())?;
     let n = crate::convert::count("n", n, 1)?;
     let samples = crate::convert::count("count", count, 1)?;
@@ -82,7 +90,7 @@ pub fn select_camera(
     let info_src = yaml_source(py, camera_info, "camera_info")?;
     let target_src = yaml_source(py, target, "target")?;
     let inner = robot.inner.clone();
-    let (d, report, joint_names) = crate::progress::with_callback(progress, || {
+    let (d, report, joint_names, settings) = crate::progress::with_callback(progress, || {
         detached(py, move || {
             let branch = chain_of(&inner, camera_link.as_deref())?;
             let r = branch.as_ref().unwrap_or(&inner);
@@ -108,6 +116,7 @@ pub fn select_camera(
                 .seed(seed)
                 .build()?;
             let d = activecal::select::camera::camera_design(r, &view, &candidates, &settings)?;
+            let settings_kept = settings.clone();
             let g = if gap {
                 Some(d.gap(&activecal::bound::BoundSettings::default())?)
             } else {
@@ -121,22 +130,40 @@ pub fn select_camera(
                 candidates: candidates.len(),
                 pool_seed,
                 collision_removed: None,
-                pixel_noise: None,
+                pixel_noise,
             };
             let names = activecal::units::joint_names(r);
             let report = CameraDesignReport::new(&d, pool, m, names.clone(), g);
             let mut v = serde_json::to_value(&report)?;
             v["out"] = serde_json::json!([]);
-            Ok((d, v, names))
+            Ok((d, v, names, settings_kept))
         })
     })?;
+    let (qs, candidates, seen) = (d.qs.clone(), d.candidates.clone(), d.seen.clone());
     Ok(CameraDesign {
+        design: std::sync::Arc::new(d),
+        settings,
         joint_names,
         report,
-        qs: d.qs,
-        candidates: d.candidates,
-        seen: d.seen,
+        qs,
+        candidates,
+        seen,
     })
+}
+
+/// The σ of `--pixel-noise` when `how_many` is not given one, px: a
+/// corner detector's typical sub-pixel error, as the command line's.
+const DEFAULT_PIXEL_NOISE: f64 = 0.3;
+
+/// Refuses a pixel noise that is not a finite number > 0.
+fn check_pixel_noise(pixel_noise: Option<f64>) -> PyResult<()> {
+    match pixel_noise {
+        Some(px) if !(px.is_finite() && px > 0.0) => Err(arg_err(
+            "pixel_noise",
+            format!("{px}: the pixel noise σ must be a finite number > 0 (px)"),
+        )),
+        _ => Ok(()),
+    }
 }
 
 #[pymethods]
@@ -180,6 +207,46 @@ impl CameraDesign {
         }
         data.set_item("points_seen", self.seen.clone())?;
         pd.call_method1("DataFrame", (data,))
+    }
+
+    /// "How many poses" on this design's visible pool: the dict `activecal
+    /// select --camera-info ... --report DIR` writes as `how_many_poses` in
+    /// report.json (`n_min` = ⌈p / 6⌉, `points` with `n`, `d_efficiency`,
+    /// `predicted` true errors in mm, `noise_px`, `recommended`), for a
+    /// pixel noise σ `pixel_noise` (px; the design's, else 0.3) and, with
+    /// `target_error` (mm), the fewest poses predicted to reach it.
+    #[pyo3(signature = (pixel_noise=None, target_error=None, progress=None))]
+    fn how_many<'py>(
+        &self,
+        py: Python<'py>,
+        pixel_noise: Option<f64>,
+        target_error: Option<f64>,
+        progress: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        check_pixel_noise(pixel_noise)?;
+        if let Some(t) = target_error.filter(|t| !(t.is_finite() && *t > 0.0)) {
+            return Err(arg_err(
+                "target_error",
+                format!("{t}: the position error to reach must be a finite number > 0 (mm)"),
+            ));
+        }
+        let noise = pixel_noise
+            .or(self.report["pixel_noise_px"].as_f64())
+            .unwrap_or(DEFAULT_PIXEL_NOISE);
+        let mut cs = activecal::how_many::CurveSettings::new(self.settings.clone(), noise);
+        cs.also = vec![self.qs.len()];
+        cs.target_mm = target_error;
+        let d = self.design.clone();
+        let v = crate::progress::with_callback(progress, || {
+            detached(py, move || {
+                let curve = d.how_many(&cs).map_err(|e| match e {
+                    activecal::how_many::HowManyError::Input(e) => Fail::from(e),
+                    activecal::how_many::HowManyError::Bound(e) => e.into(),
+                })?;
+                Ok(serde_json::to_value(&curve)?)
+            })
+        })?;
+        json_to_py(py, &v)
     }
 
     /// The whole report: the dict `activecal select --camera-info ...

@@ -4,6 +4,9 @@ calibrate --observations FILE --json` and `activecal select --camera-info
 the same written files, DataFrame input equal to CSV input, and the
 refusals."""
 
+import json
+import math
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -226,6 +229,34 @@ def test_select_camera_gap_equals_the_cli():
         k: v for k, v in want["gap"].items() if k not in volatile
     }
     assert 0 < d.report["d_efficiency"] <= 1
+
+
+def test_select_camera_how_many_equals_the_clis_report(tmp_path):
+    """design.how_many() is the curve `select --report` writes (the same
+    library code on the same pool: bit for bit); it starts at ⌈p / 6⌉
+    poses (a pose's pixels move with the target's 6-DOF placement alone)
+    and at the design's own size predicts what the report's
+    `predicted_error_mm` says at the same pixel noise."""
+    args = select_args()
+    args[args.index("--count") + 1] = 600
+    report = tmp_path / "report"
+    want = cli(*args, "--gap", "--pixel-noise", 0.25, "--target-error", 0.3, "--report", report)
+    curve = json.loads((report / "report.json").read_text())["how_many_poses"]
+    r = activecal.Robot.from_urdf(UR5)
+    d = activecal.select_camera(
+        r, INFO, BOARD, n=14, mounting="eye-to-hand", camera_pose=CAMERA_POSE,
+        target_pose=TARGET_POSE, count=600, image_margin=20, distance=(0.3, 2.0), gap=True,
+        pixel_noise=0.25,
+    )
+    same(d.report, want, skip=("out", "gap"))
+    got = d.how_many(target_error=0.3)
+    assert got == curve
+    assert got["noise_px"] == 0.25 and "noise_m" not in got
+    assert got["n_min"] == math.ceil(len(want["unknowns"]) / 6)
+    at = next(p for p in got["points"] if p["n"] == 14)
+    assert at["predicted"]["position_rms_mm"] == pytest.approx(want["predicted_error_mm"], rel=1e-9)
+    refused(lambda: d.how_many(pixel_noise=-1.0), "^pixel_noise: -1")
+    refused(lambda: d.how_many(target_error=0.0), "^target_error: 0")
 
 
 def test_select_camera_on_the_head_equals_the_cli():

@@ -14,6 +14,7 @@
 //! The curve reports the RMS over the configurations of that error and the
 //! 95th percentile of its per-configuration root.
 
+mod camera;
 mod curve;
 mod predict;
 mod recommend;

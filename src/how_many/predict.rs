@@ -4,8 +4,7 @@
 use crate::blocks::Blocks;
 use crate::measure::{RowKind, sensor_for};
 use crate::model::Robot;
-use faer::linalg::solvers::DenseSolveCore;
-use faer::{Mat, MatRef, Side};
+use faer::MatRef;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
@@ -46,20 +45,6 @@ pub fn random_configurations(robot: &Robot, count: usize, seed: u64) -> Vec<Vec<
                 .collect()
         })
         .collect()
-}
-
-/// `M⁻¹` of a symmetric positive definite `M`, through the Cholesky factor
-/// of its unit-diagonal equilibration; `None` when it is not positive
-/// definite.
-fn spd_inverse(m: MatRef<'_, f64>) -> Option<Mat<f64>> {
-    let p = m.nrows();
-    let d: Vec<f64> = (0..p).map(|i| m[(i, i)].max(0.0).sqrt()).collect();
-    if d.iter().any(|&v| !(v > 0.0 && v.is_finite())) {
-        return None;
-    }
-    let e = Mat::from_fn(p, p, |i, j| m[(i, j)] / (d[i] * d[j]));
-    let inv = e.llt(Side::Lower).ok()?.inverse();
-    Some(Mat::from_fn(p, p, |i, j| inv[(i, j)] / (d[i] * d[j])))
 }
 
 /// Draws of each configuration's position error for
@@ -192,7 +177,7 @@ fn errors_of_rows(
     info: MatRef<'_, f64>,
     noise: f64,
 ) -> Option<PredictedErrors> {
-    let inv = spd_inverse(info)?;
+    let inv = crate::linalg::chol::spd_inverse(info)?;
     let points = kinds.iter().filter(|&&k| k == RowKind::Position).count() as f64 / 3.0;
     let full = kinds.contains(&RowKind::Orientation);
     let s2 = noise * noise;

@@ -5,6 +5,7 @@
 use super::simd::clear_upper_simd_state;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt;
+use faer::linalg::solvers::DenseSolveCore;
 use faer::{Mat, MatMut, MatRef, Par, Side};
 
 /// `ln det M` of a symmetric positive definite matrix from its Cholesky
@@ -151,4 +152,19 @@ mod tests {
         let indefinite = Mat::from_fn(2, 2, |i, j| if i == j { 1.0 } else { 2.0 });
         assert!(ln_det_spd_equilibrated(indefinite.as_ref()).is_none());
     }
+}
+
+/// `M⁻¹` of a symmetric positive definite `M`, through the Cholesky factor
+/// of its unit-diagonal equilibration; `None` when it is not positive
+/// definite. Equilibrated first, so that graded columns (metres against
+/// radians, pixels per metre) do not decide it.
+pub fn spd_inverse(m: MatRef<'_, f64>) -> Option<Mat<f64>> {
+    let p = m.nrows();
+    let d: Vec<f64> = (0..p).map(|i| m[(i, i)].max(0.0).sqrt()).collect();
+    if d.iter().any(|&v| !(v > 0.0 && v.is_finite())) {
+        return None;
+    }
+    let e = faer::Mat::from_fn(p, p, |i, j| m[(i, j)] / (d[i] * d[j]));
+    let inv = e.llt(faer::Side::Lower).ok()?.inverse();
+    Some(faer::Mat::from_fn(p, p, |i, j| inv[(i, j)] / (d[i] * d[j])))
 }

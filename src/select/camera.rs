@@ -9,14 +9,9 @@
 use super::{Algorithm, CriterionKind, Selection, Settings, select};
 use crate::blocks::Blocks;
 use crate::error::{Error, Result};
-use crate::how_many::{
-    CurveSettings, ErrorRows, HowManyError, NoiseUnit, PoseCountCurve, fewest_poses,
-    pose_count_curve_on,
-};
 use crate::identify::camera::camera_robot;
-use crate::identify::camera::predict::probe_jacobians;
+use crate::identify::camera::predict::predicted_error_of_information;
 use crate::kinematics::{Evaluator, Motion};
-use crate::measure::RowKind;
 use crate::measure::Sensor;
 use crate::measure::camera::CameraSensor;
 use crate::measure::camera::OWN_PARAMS;
@@ -96,46 +91,6 @@ impl CameraDesign {
     ) -> std::result::Result<crate::bound::DesignGap, crate::bound::BoundError> {
         let bound = crate::bound::relaxation_bound(&self.blocks, None, self.qs.len(), settings)?;
         crate::bound::design_gap(&self.blocks, None, &self.selection.poses, &bound)
-    }
-
-    /// The rows a camera design's errors are predicted from: the
-    /// derivative of the moving one's origin in the fixed one's frame
-    /// ([`crate::identify::camera::predict::probe_jacobians`]) at
-    /// `configurations` generic configurations of seed `seed`.
-    #[must_use]
-    pub fn error_rows(&self, configurations: usize, seed: u64) -> ErrorRows {
-        let mut theta = self.robot.unknown_values(&self.robot.nominal);
-        theta.extend_from_slice(&self.own);
-        let qs = crate::observability::generic_configurations(&self.robot, configurations, seed);
-        ErrorRows {
-            eval: probe_jacobians(&self.robot, &self.sensor, &theta, &qs),
-            kinds: vec![RowKind::Position; 3],
-            orientation_weight: 1.0,
-        }
-    }
-
-    /// "How many poses" for this camera's visible pool: for each size, the
-    /// best design, its D-efficiency against the certified bound and the
-    /// true error it predicts for pixel noise `settings.noise` (px) at
-    /// `settings.configurations` generic configurations (seed
-    /// `settings.seed`), from `⌈p / 6⌉` poses (a pose's pixel information
-    /// has rank 6, [`Self::rank_per_pose`]). The curve's point at this
-    /// design's size predicts what [`Self::predicted_error_per_px`] does
-    /// (same configurations by default: 1,000, seed 0).
-    pub fn how_many(
-        &self,
-        settings: &CurveSettings,
-    ) -> std::result::Result<PoseCountCurve, HowManyError> {
-        let rows = self.error_rows(settings.configurations, settings.seed);
-        let n_min = fewest_poses(&self.blocks, settings);
-        pose_count_curve_on(
-            &self.blocks,
-            &self.pool,
-            settings,
-            &rows,
-            n_min,
-            NoiseUnit::Pixels,
-        )
     }
 }
 
@@ -248,9 +203,15 @@ pub fn camera_design_in_sight(
         rank_per_pose,
         blocks,
     };
-    d.predicted_error_per_px = d
-        .error_rows(PREDICTION_CONFIGURATIONS, 0)
-        .errors(d.blocks.information(&d.selection.poses).as_ref(), 1.0)
-        .map(|e| e.position_rms_mm * 1e-3);
+    let mut theta = d.robot.unknown_values(&d.robot.nominal);
+    theta.extend_from_slice(&d.own);
+    let qs = crate::observability::generic_configurations(&d.robot, PREDICTION_CONFIGURATIONS, 0);
+    d.predicted_error_per_px = predicted_error_of_information(
+        &d.robot,
+        &d.sensor,
+        &theta,
+        d.blocks.information(&d.selection.poses).as_ref(),
+        &qs,
+    );
     Ok(d)
 }

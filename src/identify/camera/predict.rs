@@ -80,6 +80,26 @@ pub fn predicted_error_of(
     (sum / qs.len().max(1) as f64).sqrt()
 }
 
+/// The true error per unit of noise σ that a design whose information
+/// (at σ = 1) is `info` predicts: [`predicted_error_of`] with the
+/// covariance `info⁻¹` (inverted on its equilibrated form,
+/// [`crate::linalg::chol::spd_inverse`]), metres per unit of σ; `None`
+/// for a singular `info`.
+#[must_use]
+pub fn predicted_error_of_information(
+    robot: &Robot,
+    sensor: &CameraSensor,
+    theta: &[f64],
+    info: faer::MatRef<'_, f64>,
+    qs: &[Vec<f64>],
+) -> Option<f64> {
+    let inv = crate::linalg::chol::spd_inverse(info)?;
+    let cov: Vec<Vec<f64>> = (0..inv.nrows())
+        .map(|i| (0..inv.ncols()).map(|j| inv[(i, j)]).collect())
+        .collect();
+    Some(predicted_error_of(robot, sensor, theta, &cov, qs))
+}
+
 /// The derivative of [`probe_of`] in the parameters `theta` at each of
 /// `qs`: one 3-row block a configuration (metres per metre or radian), by
 /// central differences (step 1e-7 m or rad: the probe is smooth and O(1);

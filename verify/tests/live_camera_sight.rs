@@ -295,6 +295,7 @@ fn head_camera_line_of_sight_agrees_with_coal() {
             .iter()
             .map(|p| [p.x, p.y, p.z])
             .collect(),
+        face: [0.0, 0.0, 1.0],
         camera: six(camera),
         target: six(target),
         min_fraction: 1.0,

@@ -121,6 +121,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         intrinsics: intrinsics.clone(),
         mounting: Mounting::EyeToHand,
         points: target.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
+        face: target.face.into(),
         camera: six(&camera),
         target: six(&board),
         min_fraction: 1.0,

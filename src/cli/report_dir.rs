@@ -499,19 +499,8 @@ pub fn selection(
             }
         );
     }
-    for (n, why) in &curve.skipped {
-        let _ = writeln!(md, "\nN = {n}: no identifying design ({why}).");
-    }
-    md += &figure_section(&figs);
-    put(&staged, "report.md", &md)?;
-    let json = serde_json::json!({ "selection": report, "how_many_poses": curve });
-    put(
-        &staged,
-        "report.json",
-        &(serde_json::to_string_pretty(&json)? + "\n"),
-    )?;
-    staged.commit()?;
-    Ok(())
+    let report = serde_json::to_value(report)?;
+    finish_selection(staged, md, &figs, &report, curve)
 }
 
 /// Writes `select --camera-info … --report DIR`: report.md (the text
@@ -547,12 +536,25 @@ pub fn camera_selection(
         text
     );
     md += &how_many_text(curve, noise_is_default);
+    finish_selection(staged, md, &figs, json, curve)
+}
+
+/// The end of a selection report: the sizes the curve skipped and the
+/// figures appended to `md`, report.md and report.json (`{"selection":
+/// selection, "how_many_poses": curve}`) written, the directory swapped in.
+fn finish_selection(
+    staged: StagedDir,
+    mut md: String,
+    figs: &[(String, String)],
+    selection: &serde_json::Value,
+    curve: &PoseCountCurve,
+) -> Result<()> {
     for (n, why) in &curve.skipped {
         let _ = writeln!(md, "\nN = {n}: no identifying design ({why}).");
     }
-    md += &figure_section(&figs);
+    md += &figure_section(figs);
     put(&staged, "report.md", &md)?;
-    let json = serde_json::json!({ "selection": json, "how_many_poses": curve });
+    let json = serde_json::json!({ "selection": selection, "how_many_poses": curve });
     put(
         &staged,
         "report.json",

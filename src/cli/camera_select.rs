@@ -14,16 +14,17 @@
 
 use super::camera_opts::CameraOpts;
 use super::select::SelectArgs;
-use activecal::collision::{CollisionSpec, Obstacle};
+use activecal::collision::Obstacle;
 use activecal::io::UrdfChain;
 use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_target::read_target;
+use activecal::io::collision_choice::CollisionChoice;
 use activecal::model::Robot;
 use activecal::pool::PoolFilter;
 use activecal::pool::camera_view::CameraView;
 use activecal::pool::line_of_sight::LineOfSight;
 use activecal::report::{CameraDesignReport, CameraPoolInfo};
-use activecal::select::camera::{CameraDesign, camera_design_in_sight};
+use activecal::select::camera::{CameraDesign, camera_design_filtered};
 use anyhow::{Context, Result, bail};
 use serde_json::json;
 use std::fmt::Write as _;
@@ -92,9 +93,13 @@ fn sight(a: &SelectArgs, robot: &Robot) -> Result<(Vec<PoolFilter>, Option<LineO
     if !(collision || a.camera.line_of_sight) {
         return Ok((Vec::new(), None));
     }
+    let root = match &a.camera.camera_link {
+        Some(link) => Some((link.as_str(), activecal::io::urdf_branch::tree_root(robot)?)),
+        None => None,
+    };
     let mut chain = UrdfChain::of(robot);
-    if let (Some(_), Some(c)) = (&a.camera.camera_link, chain.as_mut()) {
-        c.base = activecal::io::urdf_branch::tree_root(robot)?;
+    if let (Some((_, r)), Some(c)) = (&root, chain.as_mut()) {
+        c.base.clone_from(r);
     }
     let filters = if collision {
         p.collision_filters_on(chain.clone())?
@@ -114,31 +119,21 @@ fn sight(a: &SelectArgs, robot: &Robot) -> Result<(Vec<PoolFilter>, Option<LineO
             bail!("--package-dir {}: no such directory", d.display());
         }
     }
-    let obstacles = p
-        .obstacles
-        .iter()
-        .map(|o| Obstacle::parse(o).map_err(anyhow::Error::msg))
-        .collect::<Result<Vec<_>>>()?;
-    let spec = CollisionSpec {
-        urdf: chain.file,
-        text: Some(chain.text),
-        joints: chain.joints,
-        lock: chain.lock,
-        base: Some(chain.base),
+    let choice = CollisionChoice {
         package_dirs: p
             .package_dirs
             .iter()
             .map(|d| d.display().to_string())
             .collect(),
-        obstacles,
+        obstacles: p
+            .obstacles
+            .iter()
+            .map(|o| Obstacle::parse(o).map_err(anyhow::Error::msg))
+            .collect::<Result<Vec<_>>>()?,
         floor: p.floor,
-        ..CollisionSpec::default()
+        ..CollisionChoice::default()
     };
-    let los = match &a.camera.camera_link {
-        Some(link) => LineOfSight::from_link(spec, link),
-        None => LineOfSight::new(spec),
-    };
-    Ok((filters, Some(los)))
+    Ok((filters, Some(choice.line_of_sight(chain, root))))
 }
 
 /// Options of `select` a camera design does not take (yet), refused
@@ -214,24 +209,12 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         a.pool.count.unwrap_or(DEFAULT_SAMPLES),
         a.pool.pool_seed.unwrap_or(0),
     );
-    // Candidates the collision filters keep, by their index in the samples.
-    let free: Vec<usize> = (0..candidates.len())
-        .filter(|&i| {
-            filters
-                .iter()
-                .all(|f| f.keeps(&robot, &robot.nominal, &candidates[i]))
-        })
-        .collect();
-    let collision_removed = (!filters.is_empty()).then(|| candidates.len() - free.len());
-    let free_qs: Vec<Vec<f64>> = free.iter().map(|&i| candidates[i].clone()).collect();
     let settings = activecal::select::Settings::builder()
         .n(a.n)
         .seed(a.seed)
         .build()?;
-    let mut d = camera_design_in_sight(&robot, &v, los.as_ref(), &free_qs, &settings)?;
-    for c in &mut d.candidates {
-        *c = free[*c];
-    }
+    let (d, collision_removed) =
+        camera_design_filtered(&robot, &v, &filters, los.as_ref(), &candidates, &settings)?;
     let gap = if a.gap {
         let bs = activecal::bound::BoundSettings::builder()
             .solver(a.gap_solver)
@@ -241,7 +224,7 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         None
     };
     let curve = match &a.report {
-        Some(_) => Some(curve(a, &settings, &d, &free)?),
+        Some(_) => Some(curve(a, &settings, &d)?),
         None => None,
     };
     let names = activecal::units::joint_names(&robot);
@@ -312,7 +295,6 @@ fn curve(
     a: &SelectArgs,
     settings: &activecal::select::Settings,
     d: &CameraDesign,
-    free: &[usize],
 ) -> Result<activecal::how_many::PoseCountCurve> {
     let mut cs = activecal::how_many::CurveSettings::new(
         settings.clone(),
@@ -323,13 +305,7 @@ fn curve(
         .build()?;
     cs.also = vec![a.n];
     cs.target_mm = a.target_error;
-    let mut curve = d.how_many(&cs)?;
-    for p in &mut curve.points {
-        for c in &mut p.poses {
-            *c = free[*c];
-        }
-    }
-    Ok(curve)
+    Ok(d.how_many(&cs)?)
 }
 
 /// The human-readable report of a camera design.

@@ -7,6 +7,7 @@
 use super::UrdfChain;
 use crate::collision::{AlwaysTouching, CollisionFilter, CollisionSpec, Obstacle};
 use crate::pool::PoolFilter;
+use crate::pool::line_of_sight::LineOfSight;
 
 /// What the user asked the collision check to do; the defaults check nothing.
 #[derive(Clone, Debug, Default)]
@@ -68,5 +69,37 @@ impl CollisionChoice {
             })));
         }
         out
+    }
+
+    /// The line of sight of a camera pool for the robot of `chain`
+    /// ([`LineOfSight`]): rays against its collision geometry (meshes
+    /// found in this choice's package directories) and this choice's
+    /// obstacles and floor; for a camera on the robot's own link
+    /// `camera_link` (the chain from it, [`super::urdf_branch`]), cast
+    /// from that link, obstacles and the floor in the tree's root `root`.
+    #[must_use]
+    pub fn line_of_sight(
+        &self,
+        chain: UrdfChain,
+        camera_link: Option<(&str, String)>,
+    ) -> LineOfSight {
+        let base = camera_link
+            .as_ref()
+            .map_or(chain.base, |(_, root)| root.clone());
+        let spec = CollisionSpec {
+            urdf: chain.file,
+            text: Some(chain.text),
+            joints: chain.joints,
+            lock: chain.lock,
+            base: Some(base),
+            package_dirs: self.package_dirs.clone(),
+            obstacles: self.obstacles.clone(),
+            floor: self.floor,
+            ..CollisionSpec::default()
+        };
+        match camera_link {
+            Some((link, _)) => LineOfSight::from_link(spec, link),
+            None => LineOfSight::new(spec),
+        }
     }
 }

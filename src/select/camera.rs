@@ -16,6 +16,7 @@ use crate::measure::Sensor;
 use crate::measure::camera::CameraSensor;
 use crate::measure::camera::OWN_PARAMS;
 use crate::model::Robot;
+use crate::pool::PoolFilter;
 use crate::pool::camera_view::CameraView;
 use crate::pool::line_of_sight::LineOfSight;
 use rayon::prelude::*;
@@ -127,6 +128,34 @@ pub fn camera_design(
     settings: &Settings,
 ) -> Result<CameraDesign> {
     camera_design_in_sight(robot, view, None, candidates, settings)
+}
+
+/// As [`camera_design_in_sight`], the candidates first filtered by
+/// `filters` (collision filters, [`PoolFilter`]), the design's candidate
+/// indices (`candidates`, `pool`) those of `candidates` as given; with how
+/// many the filters removed (`None` without filters).
+pub fn camera_design_filtered(
+    robot: &Robot,
+    view: &CameraView,
+    filters: &[PoolFilter],
+    sight: Option<&LineOfSight>,
+    candidates: &[Vec<f64>],
+    settings: &Settings,
+) -> Result<(CameraDesign, Option<usize>)> {
+    let free: Vec<usize> = (0..candidates.len())
+        .filter(|&i| {
+            filters
+                .iter()
+                .all(|f| f.keeps(robot, &robot.nominal, &candidates[i]))
+        })
+        .collect();
+    let removed = (!filters.is_empty()).then(|| candidates.len() - free.len());
+    let free_qs: Vec<Vec<f64>> = free.iter().map(|&i| candidates[i].clone()).collect();
+    let mut d = camera_design_in_sight(robot, view, sight, &free_qs, settings)?;
+    for c in d.candidates.iter_mut().chain(d.pool.iter_mut()) {
+        *c = free[*c];
+    }
+    Ok((d, removed))
 }
 
 /// As [`camera_design`], the pool also filtered by a line of sight

@@ -595,11 +595,16 @@ def select_camera(
     distance: Tuple[float, float] = (0.2, 3.0),
     gap: bool = False,
     pixel_noise: Optional[float] = None,
+    line_of_sight: bool = False,
+    self_collision: bool = False,
+    srdf: Optional[_Path] = None,
+    package_dirs: Optional[Sequence[_Path]] = None,
+    floor: Optional[float] = None,
+    obstacles: Optional[Sequence[str]] = None,
     progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
 ) -> CameraDesign:
     """Chooses n poses for a camera, as ``activecal select --camera-info
-    ... --json`` does with the same files and options (no collision
-    filters or line of sight yet). camera_info, target, mounting,
+    ... --json`` does with the same files and options. camera_info, target, mounting,
     camera_link, camera_pose and target_pose as `calibrate_camera` takes
     them. count joint-space samples (seed pool_seed) are kept where at
     least min_visible of the target's points lie image_margin px inside
@@ -611,4 +616,9 @@ def select_camera(
     a second: a pose's pixel rows are cut to their rank, 6). pixel_noise:
     the detected points' σ (px); the report then also predicts the true
     error at it (``predicted_error_mm``), and `CameraDesign.how_many`
-    uses it."""
+    uses it. line_of_sight: keep only configurations whose rays from the
+    camera to the points are not blocked by the robot's collision
+    geometry (meshes found beside the URDF or in package_dirs), on with
+    any of self_collision (srdf), floor or obstacles (``"box:…"`` in the
+    base frame, or the tree's root with camera_link), which also remove
+    the colliding samples (``report["collision_removed"]``)."""

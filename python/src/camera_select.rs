@@ -1,8 +1,8 @@
 //! `activecal.select_camera`: poses chosen for a camera, as `activecal
-//! select --camera-info ...` chooses them (without collision filters or a
+//! select --camera-info ...` chooses them (with its collision filters and
 //! line of sight), and the `CameraDesign` it returns.
 
-use crate::camera::{chain_of, mounting_of, read_intrinsics, read_target, six, yaml_source};
+use crate::camera::{chain_of, mounting_of, named, read_intrinsics, read_target, six, yaml_source};
 use crate::convert::{Fail, arg_err, detached, json_to_py, ndarray, non_negative};
 use crate::robot::Robot;
 use activecal::model::robot_ref::RobotRef;
@@ -38,8 +38,7 @@ fn reference(
 }
 
 /// Chooses `n` poses for a camera that sees a target, as `activecal select
-/// --camera-info ... --json` does with the same files and options
-/// (without collision filters or a line of sight).
+/// --camera-info ... --json` does with the same files and options.
 ///
 /// camera_info, target, mounting, camera_link, camera_pose, target_pose
 /// as `calibrate_camera` takes them (the placements are where the camera
@@ -52,9 +51,13 @@ fn reference(
 /// score the design against its visible pool's certified bound (about a
 /// second: a pose's pixel rows are cut to their rank, 6). pixel_noise: the
 /// detected points' σ (px): the report then also predicts the true error
-/// at it (`predicted_error_mm`). progress as `select` takes it.
+/// at it (`predicted_error_mm`). line_of_sight: keep the configurations
+/// whose rays to the points the robot's collision geometry does not block
+/// (on with any of self_collision, srdf, floor, obstacles, which also
+/// remove colliding samples; meshes in package_dirs). progress as
+/// `select` takes it.
 #[pyfunction]
-#[pyo3(signature = (robot, camera_info, target, *, n, camera_pose, target_pose, mounting=None, camera_link=None, count=20000, pool_seed=0, seed=1, min_visible=1.0, image_margin=10.0, max_view_angle=60.0, distance=(0.2, 3.0), gap=false, pixel_noise=None, progress=None))]
+#[pyo3(signature = (robot, camera_info, target, *, n, camera_pose, target_pose, mounting=None, camera_link=None, count=20000, pool_seed=0, seed=1, min_visible=1.0, image_margin=10.0, max_view_angle=60.0, distance=(0.2, 3.0), gap=false, pixel_noise=None, line_of_sight=false, self_collision=false, srdf=None, package_dirs=None, floor=None, obstacles=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn select_camera(
     py: Python<'_>,
@@ -75,9 +78,27 @@ pub fn select_camera(
     distance: (f64, f64),
     gap: bool,
     pixel_noise: Option<f64>,
+    line_of_sight: bool,
+    self_collision: bool,
+    srdf: Option<std::path::PathBuf>,
+    package_dirs: Option<Vec<std::path::PathBuf>>,
+    floor: Option<f64>,
+    obstacles: Option<Vec<String>>,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<CameraDesign> {
     check_pixel_noise(pixel_noise)?;
+    let choice = crate::pool::collision_choice(
+        self_collision,
+        srdf.map(|p| p.display().to_string()),
+        package_dirs
+            .unwrap_or_default()
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect(),
+        floor,
+        obstacles.unwrap_or_default(),
+        0.0,
+    )?;
     let m = mounting_of(mounting, camera_link.as_deref())?;
     let n = crate::convert::count("n", n, 1)?;
     let samples = crate::convert::count("count", count, 1)?;
@@ -90,9 +111,15 @@ pub fn select_camera(
     let info_src = yaml_source(py, camera_info, "camera_info")?;
     let target_src = yaml_source(py, target, "target")?;
     let inner = robot.inner.clone();
+    let branch = chain_of(&inner, camera_link.as_deref()).map_err(Fail::into_py)?;
+    let (filters, sight) = sight_of(
+        &choice,
+        line_of_sight,
+        branch.as_ref().unwrap_or(&inner),
+        camera_link.as_deref(),
+    )?;
     let (d, report, joint_names, settings) = crate::progress::with_callback(progress, || {
         detached(py, move || {
-            let branch = chain_of(&inner, camera_link.as_deref())?;
             let r = branch.as_ref().unwrap_or(&inner);
             let board = read_target(&target_src)?;
             let view = CameraView {
@@ -115,7 +142,14 @@ pub fn select_camera(
                 .n(n)
                 .seed(seed)
                 .build()?;
-            let d = activecal::select::camera::camera_design(r, &view, &candidates, &settings)?;
+            let (d, collision_removed) = activecal::select::camera::camera_design_filtered(
+                r,
+                &view,
+                &filters,
+                sight.as_ref(),
+                &candidates,
+                &settings,
+            )?;
             let settings_kept = settings.clone();
             let g = if gap {
                 Some(d.gap(&activecal::bound::BoundSettings::default())?)
@@ -129,7 +163,7 @@ pub fn select_camera(
                 camera_link,
                 candidates: candidates.len(),
                 pool_seed,
-                collision_removed: None,
+                collision_removed,
                 pixel_noise,
             };
             let names = activecal::units::joint_names(r);
@@ -149,6 +183,47 @@ pub fn select_camera(
         candidates,
         seen,
     })
+}
+
+/// The collision filters of `choice` and the line of sight (asked for, or
+/// on with any collision check) of a camera pool for `robot` (the chain
+/// from the camera's link with `camera_link`: its joints drive the whole
+/// tree by name, obstacles and the floor in the tree's root), as
+/// `activecal select --camera-info` builds them.
+fn sight_of(
+    choice: &activecal::io::collision_choice::CollisionChoice,
+    line_of_sight: bool,
+    robot: &activecal::model::Robot,
+    camera_link: Option<&str>,
+) -> PyResult<(
+    Vec<activecal::pool::PoolFilter>,
+    Option<activecal::pool::line_of_sight::LineOfSight>,
+)> {
+    if !(choice.any() || line_of_sight) {
+        return Ok((Vec::new(), None));
+    }
+    let root = camera_link
+        .map(|l| {
+            activecal::io::urdf_branch::tree_root(robot)
+                .map(|r| (l, r))
+                .map_err(|e| named("camera_link", Fail::Input(e.to_string())).into_py())
+        })
+        .transpose()?;
+    let mut chain = activecal::io::UrdfChain::of(robot);
+    if let (Some((_, r)), Some(c)) = (&root, chain.as_mut()) {
+        c.base.clone_from(r);
+    }
+    let filters = crate::pool::choice_filters(choice, chain.clone(), &robot.name)?;
+    let Some(chain) = chain else {
+        return Err(arg_err(
+            "line_of_sight",
+            format!(
+                "needs a robot imported from a URDF with collision geometry; {} has none",
+                robot.name
+            ),
+        ));
+    };
+    Ok((filters, Some(choice.line_of_sight(chain, root))))
 }
 
 /// The σ of `--pixel-noise` when `how_many` is not given one, px: a

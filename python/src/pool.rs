@@ -82,6 +82,29 @@ fn collision_filters(
     obstacles: Vec<String>,
     clearance: f64,
 ) -> PyResult<Vec<PoolFilter>> {
+    let chain = activecal::io::UrdfChain::of(robot);
+    let choice = collision_choice(
+        self_collision,
+        srdf,
+        package_dirs,
+        floor,
+        obstacles,
+        clearance,
+    )?;
+    choice_filters(&choice, chain, &robot.name)
+}
+
+/// The collision options checked, argument names in the messages (the
+/// files named exist; an SRDF or a clearance only with something to
+/// check).
+pub(crate) fn collision_choice(
+    self_collision: bool,
+    srdf: Option<String>,
+    package_dirs: Vec<String>,
+    floor: Option<f64>,
+    obstacles: Vec<String>,
+    clearance: f64,
+) -> PyResult<CollisionChoice> {
     let obstacles = obstacles
         .iter()
         .map(|o| activecal::collision::Obstacle::parse(o).map_err(|e| arg_err("obstacles", e)))
@@ -120,7 +143,8 @@ fn collision_filters(
                 "applies with self_collision, obstacles or floor",
             ));
         }
-        return Ok(Vec::new());
+        files_exist(&choice)?;
+        return Ok(choice);
     }
     if choice.srdf.is_some() && !self_collision {
         return Err(arg_err(
@@ -128,6 +152,12 @@ fn collision_filters(
             "lists pairs of links for self_collision=True, which is not set",
         ));
     }
+    files_exist(&choice)?;
+    Ok(choice)
+}
+
+/// Refuses an SRDF or a package directory that does not exist.
+fn files_exist(choice: &CollisionChoice) -> PyResult<()> {
     for (name, p) in choice
         .srdf
         .iter()
@@ -140,12 +170,24 @@ fn collision_filters(
             )));
         }
     }
-    let Some(chain) = activecal::io::UrdfChain::of(robot) else {
+    Ok(())
+}
+
+/// The pool filters of a checked `choice` for the URDF chain `chain` (of
+/// the robot named `robot`; `None`: not imported from a URDF).
+pub(crate) fn choice_filters(
+    choice: &CollisionChoice,
+    chain: Option<activecal::io::UrdfChain>,
+    robot: &str,
+) -> PyResult<Vec<PoolFilter>> {
+    if !choice.any() {
+        return Ok(Vec::new());
+    }
+    let Some(chain) = chain else {
         return Err(arg_err(
             "self_collision",
             format!(
-                "collision checks need a robot imported from a URDF with collision geometry; {} has none",
-                robot.name
+                "collision checks need a robot imported from a URDF with collision geometry; {robot} has none"
             ),
         ));
     };

@@ -259,6 +259,35 @@ def test_select_camera_how_many_equals_the_clis_report(tmp_path):
     refused(lambda: d.how_many(target_error=0.0), "^target_error: 0")
 
 
+def test_select_camera_with_line_of_sight_equals_the_cli():
+    """line_of_sight=True is `select --line-of-sight`: the Panda's own
+    links hide the board from some configurations the view keeps
+    (`out_of_sight` > 0), and the design is the command's, value for
+    value; floor= adds the collision filter (`collision_removed`)."""
+    panda = FIXTURES / "example-robot-data" / "panda.urdf"
+    cp = [1.2, 0.6, 0.9, -2.0985, 0.0, 2.0779]
+    tp = [-0.0853, 0.0568, 0.02, 3.141592653589793, 0.0, 0.03]
+    args = [
+        "select", "--robot", f"{panda}#tip=panda_hand_tcp", "--camera-info", INFO,
+        "--target", BOARD, "--mounting", "eye-to-hand", f"--camera-pose={csv6(cp)}",
+        f"--target-pose={csv6(tp)}", "--image-margin", 20, "--distance", "0.3,2.0",
+        "--n", 14, "--count", 1500, "--line-of-sight", "--floor", 0.0,
+    ]
+    want = cli(*args)
+    assert want["out_of_sight"] > 0 and want["collision_removed"] is not None
+    r = activecal.Robot.from_urdf(panda, tip="panda_hand_tcp")
+    d = activecal.select_camera(
+        r, INFO, BOARD, n=14, mounting="eye-to-hand", camera_pose=cp, target_pose=tp,
+        count=1500, image_margin=20, distance=(0.3, 2.0), line_of_sight=True, floor=0.0,
+    )
+    same(d.report, want)
+    with pytest.raises(activecal.FileError, match="^package_dirs: /no/such/dir"):
+        activecal.select_camera(
+            r, INFO, BOARD, n=14, mounting="eye-to-hand", camera_pose=cp, target_pose=tp,
+            line_of_sight=True, package_dirs=["/no/such/dir"],
+        )
+
+
 def test_select_camera_on_the_head_equals_the_cli():
     cp = [0.0908, 0.0800, -0.0220, -3.1416, -1.5708, 0.0]
     tp = [0.0800, -0.0400, 0.0600, 0.0, 1.5708, 0.0]

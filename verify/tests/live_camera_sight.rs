@@ -122,6 +122,28 @@ fn assert_agree(scene: &Scene<'_>, cases: Vec<Value>, ours: &[Vec<bool>], dir: &
     );
 }
 
+/// The design `select --line-of-sight` wrote to `design` (its run's
+/// output `out`, which must have succeeded), checked to have had rays to
+/// block: the line of sight removed some configurations the view keeps.
+fn design_in_sight(out: &std::process::Output, design: &Path, label: &str) -> Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let d: Value = serde_json::from_str(&std::fs::read_to_string(design).unwrap()).unwrap();
+    let removed = d["out_of_sight"].as_u64().unwrap();
+    eprintln!(
+        "{label}: {} in sight, {removed} more seen but out of sight",
+        d["visible"]
+    );
+    assert!(
+        removed > 0,
+        "the line of sight removed nothing: the check would be vacuous"
+    );
+    d
+}
+
 #[test]
 fn panda_line_of_sight_agrees_with_coal() {
     let dir = std::env::temp_dir().join(format!("activecal-live-sight-{}", std::process::id()));
@@ -195,21 +217,7 @@ fn panda_line_of_sight_agrees_with_coal() {
         .arg(&design)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let d: Value = serde_json::from_str(&std::fs::read_to_string(&design).unwrap()).unwrap();
-    let removed = d["out_of_sight"].as_u64().unwrap();
-    eprintln!(
-        "Panda eye-to-hand: {} in sight, {removed} more seen but out of sight",
-        d["visible"]
-    );
-    assert!(
-        removed > 0,
-        "the line of sight removed nothing: the check would be vacuous"
-    );
+    let d = design_in_sight(&out, &design, "Panda eye-to-hand");
     let chosen: Vec<Vec<f64>> = serde_json::from_value(d["poses"].clone()).unwrap();
     assert_eq!(chosen.len(), 20);
     assert_all_free(&scene, chosen.iter().map(|q| case(q)).collect(), &dir);
@@ -336,21 +344,7 @@ fn head_camera_line_of_sight_agrees_with_coal() {
         .arg(&design)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let d: Value = serde_json::from_str(&std::fs::read_to_string(&design).unwrap()).unwrap();
-    let removed = d["out_of_sight"].as_u64().unwrap();
-    eprintln!(
-        "TIAGo head camera: {} in sight, {removed} more seen but out of sight",
-        d["visible"]
-    );
-    assert!(
-        removed > 0,
-        "the line of sight removed nothing: the check would be vacuous"
-    );
+    let d = design_in_sight(&out, &design, "TIAGo head camera");
     assert_eq!(
         d["joint_names"].as_array().unwrap().len(),
         chain.joints.len()

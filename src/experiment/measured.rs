@@ -15,6 +15,7 @@ use crate::identify::{
 };
 use crate::model::gravity::GravityModel;
 use crate::model::{ParamTable, Robot};
+use nalgebra::Vector3;
 use serde::Serialize;
 use std::path::Path;
 use std::sync::Arc;
@@ -243,11 +244,11 @@ fn holdout_report(settings: HoldoutSettings, splits: Vec<SplitResult>) -> Holdou
 const MOUNT_GAIN: f64 = 200.0;
 
 /// A URDF robot mounted in the data's frame when the nominal model is far
-/// from it ([`crate::frames::align`]), or, for a single measured point whose
-/// nominal lies on the last joint's axis, with the tool point the data imply
-/// when they see it off that axis (the unknowns are then chosen where the
-/// data's point is: the slide along the last axis among them); with a note
-/// saying so; and when far, the rigid fit's RMS position error (mm).
+/// from it ([`crate::frames::align`]); and, for single measured points with
+/// no tool point given (a point sensor, no marker), measured as a
+/// one-marker sensor whose offset is an unknown from the start, started at
+/// the point the data imply ([`tool_point_unknown`]); with a note saying so,
+/// and when far, the rigid fit's RMS position error (mm).
 fn mounted_start(
     robot: &Robot,
     meas: &Measurements,
@@ -259,79 +260,106 @@ fn mounted_start(
         return Ok(None);
     };
     let far = a.rms_after * MOUNT_GAIN < a.rms_before;
-    let on_axis = single_point(robot, meas) && off_last_axis(robot, &robot.nominal) < AXIS_TOL;
-    if !far && !on_axis {
+    let tool_unknown = single_point(robot, meas);
+    if !far && !tool_unknown {
         return Ok(None);
     }
-    let mount = a.motion * src.mount;
-    let r = crate::io::urdf::remount(robot, mount, src.tool * a.tool)?;
-    if !far {
-        // The point starts on the last axis: the start the data imply puts
-        // it where they see it, and the unknowns are chosen there.
-        let rho = off_last_axis(&r, &r.nominal);
-        if !(rho > AXIS_SEEN * a.rms_after) {
-            return Ok(None);
-        }
-        let note = format!(
-            "the nominal measured point lies on the last joint's axis, the data's {:.1} mm off it: identification starts from the tool point the data imply (RMS {:.3} mm), with the unknowns identifiable there ({}, the nominal point's {})",
-            rho * 1e3,
+    let tool: [f64; 3] = a.tool.translation.vector.into();
+    let mut r = if far {
+        let mount = a.motion * src.mount;
+        let after = if tool_unknown {
+            src.tool
+        } else {
+            src.tool * a.tool
+        };
+        crate::io::urdf::remount(robot, mount, after)?
+    } else {
+        robot.clone()
+    };
+    let mut notes = Vec::new();
+    if far {
+        let mount = a.motion * src.mount;
+        let t = mount.translation.vector;
+        notes.push(format!(
+            "the data are far from the nominal model (RMS {:.1} mm): identification starts from the measurement frame that fits them best (RMS {:.1} mm), {:.3} m away and turned {:.1}°",
+            a.rms_before * 1e3,
             a.rms_after * 1e3,
-            r.n_params(),
-            robot.n_params()
-        );
-        return Ok(Some((r, note, None)));
+            t.norm(),
+            mount.rotation.angle().to_degrees()
+        ));
     }
-    let t = mount.translation.vector;
-    let note = format!(
-        "the data are far from the nominal model (RMS {:.1} mm): identification starts from the measurement frame that fits them best (RMS {:.1} mm), {:.3} m away and turned {:.1}°",
-        a.rms_before * 1e3,
-        a.rms_after * 1e3,
-        t.norm(),
-        mount.rotation.angle().to_degrees()
-    );
-    Ok(Some((r, note, Some(a.rms_after * 1e3))))
+    if tool_unknown {
+        r = tool_point_unknown(&r, tool)?;
+        notes.push(format!(
+            "single points and no tool point given (--marker): the measured point on '{}' is an unknown (3 coordinates, chosen before the joint origins), started where the data put it, [{:.1}, {:.1}, {:.1}] mm (rigid fit RMS {:.3} mm); {} unknowns",
+            src.tip,
+            tool[0] * 1e3,
+            tool[1] * 1e3,
+            tool[2] * 1e3,
+            a.rms_after * 1e3,
+            r.n_params()
+        ));
+    }
+    Ok(Some((
+        r,
+        notes.join("; "),
+        far.then_some(a.rms_after * 1e3),
+    )))
 }
 
-/// A measured point closer than this to the last joint's axis (metres) lies
-/// on it: the distance is exactly 0 up to rounding (1e-16 m) for a tip on
-/// the axis, millimetres and more for a real tool.
-const AXIS_TOL: f64 = 1e-9;
+/// `robot` (a point sensor) measured as one marker at `offset` in its last
+/// frame: the offset's three coordinates are unknowns chosen before the
+/// joint origins ([`Robot::with_markers`]), so no joint origin absorbs a
+/// tool point off the last axis (the polar `a`, `γ` of the last frames are
+/// singular for a point near the axis). Nominal and start alike hold the
+/// offset the data imply: no other was given.
+fn tool_point_unknown(robot: &Robot, offset: [f64; 3]) -> Result<Robot, crate::Error> {
+    robot.with_markers(&[offset])
+}
 
-/// The data see a tool point off the last axis when its distance from the
-/// axis is this many times the rigid start's RMS residual.
-const AXIS_SEEN: f64 = 3.0;
+/// For a one-marker robot and single-point data whose given offset is far
+/// from where the data put it (more than [`MARKER_FAR`] times the rigid
+/// fit's RMS, and over a millimetre): the data's offset, to start from,
+/// with a note; `None` otherwise (the given offset is the start). The
+/// nominal (the user's offset) is kept for the report.
+fn marker_start(robot: &Robot, meas: &Measurements) -> Option<([f64; 3], String)> {
+    let one = robot.measurement == crate::model::MeasurementKind::Markers(1)
+        && meas.markers() == 1
+        && meas.orientations().is_empty();
+    if !one {
+        return None;
+    }
+    let a = crate::frames::align::measurement_frame(robot, meas)?;
+    let given = Vector3::from(*robot.nominal.markers.first()?);
+    let implied = a.tool.translation.vector;
+    let off = (implied - given).norm();
+    if !(off > MARKER_FAR * a.rms_after && off > 1e-3) {
+        return None;
+    }
+    let note = format!(
+        "the marker given, [{:.1}, {:.1}, {:.1}] mm, is {:.1} mm from where the data put it: identification starts from [{:.1}, {:.1}, {:.1}] mm (rigid fit RMS {:.3} mm)",
+        given[0] * 1e3,
+        given[1] * 1e3,
+        given[2] * 1e3,
+        off * 1e3,
+        implied[0] * 1e3,
+        implied[1] * 1e3,
+        implied[2] * 1e3,
+        a.rms_after * 1e3
+    );
+    Some((implied.into(), note))
+}
+
+/// A given marker is far from the data's when it is this many times the
+/// rigid fit's RMS residual away.
+const MARKER_FAR: f64 = 10.0;
 
 /// Whether the robot measures one point per pose and the data hold only
-/// that (no orientation, one marker).
+/// that (no orientation, one marker): the tool point was not given.
 fn single_point(robot: &Robot, meas: &Measurements) -> bool {
     robot.measurement == crate::model::MeasurementKind::Point
         && meas.markers() == 1
         && meas.orientations().is_empty()
-}
-
-/// The distance (m) of the measured point from the last joint's axis at
-/// `table`: a quarter turn of a revolute last joint moves a point at
-/// distance ρ from its axis by ρ√2 (∞ for a prismatic last joint, which
-/// has no axis to lie on).
-fn off_last_axis(robot: &Robot, table: &crate::model::ParamTable) -> f64 {
-    let Some(last) = robot.dof().checked_sub(1) else {
-        return f64::INFINITY;
-    };
-    if robot
-        .frames
-        .iter()
-        .any(|f| f.joint == Some(last) && f.is_prismatic())
-    {
-        return f64::INFINITY;
-    }
-    let q = crate::observability::generic_configurations(robot, 1, 0x0ff_a815)
-        .pop()
-        .unwrap_or_default();
-    let mut turned = q.clone();
-    turned[last] += std::f64::consts::FRAC_PI_2;
-    let (_, p0) = crate::kinematics::pose(robot, table, &q);
-    let (_, p1) = crate::kinematics::pose(robot, table, &turned);
-    (p1 - p0).norm() / std::f64::consts::SQRT_2
 }
 
 /// Identification from the measurement file `path`: each note is passed
@@ -403,8 +431,12 @@ fn calibrate_read(
         }
         None => robot,
     };
-    let start = for_measurements(robot, meas, &s.lm).map_err(in_file)?;
+    let mut start = for_measurements(robot, meas, &s.lm).map_err(in_file)?;
     start.notes.iter().for_each(|n| note(n));
+    if let Some((offset, n)) = marker_start(&start.robot, meas) {
+        note(&n);
+        start.table.markers = vec![offset];
+    }
 
     let (fitted_robot, without) = match (&s.gravity, s.fit_compliance) {
         (Some(g), true) => {

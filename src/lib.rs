@@ -29,6 +29,7 @@ pub mod report;
 pub mod resources;
 pub mod select;
 mod settings;
+pub mod stats;
 pub mod units;
 
 pub use error::{Error, Result};

@@ -244,10 +244,13 @@ fn names(v: Option<Vec<String>>) -> Vec<String> {
 /// compliance: also estimate a torsional compliance per joint (rad/(N·m)),
 /// the joints deflected by the gravity torques of the robot's URDF
 /// <inertial> elements (`report["compliances"]`), as `--compliance` does.
+/// outliers: "drop" (default: poses with a gross error, found by Baarda's
+/// data snooping at the family-wise rate outlier_rate, are left out one at
+/// a time and listed in `report["outliers"]`) or "keep", as `--outliers`.
 /// progress: a callable `progress(task, done, total, note)`, as `select`
 /// takes it.
 #[pyfunction]
-#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, compliance=false, progress=None))]
+#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, compliance=false, outliers="drop", outlier_rate=0.01, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
@@ -266,9 +269,12 @@ pub fn calibrate(
     splits: i64,
     seed: i128,
     compliance: bool,
+    outliers: &str,
+    outlier_rate: f64,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Calibration> {
     let weights = weights_of(weights, orientation_scale)?;
+    let outliers = outliers_of(outliers, outlier_rate)?;
     let gravity = compliance
         .then(|| {
             let opts = activecal::io::inertia::InertiaOptions {
@@ -304,6 +310,8 @@ pub fn calibrate(
         fit_compliance: compliance,
         compare_compliance: false,
         weights,
+        outliers,
+        stated_noise: None,
     };
     let r = inner.clone();
     let (fitted, id, frames, report) = crate::progress::with_callback(progress, || {
@@ -508,4 +516,23 @@ pub fn evaluate<'py>(
         Ok(serde_json::to_value(&res)?)
     })?;
     json_to_py(py, &v)
+}
+
+/// The outlier choice of `outliers=` ("drop" or "keep") and
+/// `outlier_rate=`.
+fn outliers_of(kind: &str, rate: f64) -> PyResult<activecal::identify::outliers::OutlierChoice> {
+    use activecal::identify::outliers::{OutlierChoice, check_choice};
+    let c = match kind {
+        "drop" => OutlierChoice::Drop { alpha: rate },
+        "keep" => OutlierChoice::Keep,
+        other => {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "outliers={other:?}: give \"drop\" or \"keep\""
+            )));
+        }
+    };
+    check_choice(c).map_err(|e| {
+        pyo3::exceptions::PyValueError::new_err(format!("outlier_rate={rate}: {e}"))
+    })?;
+    Ok(c)
 }

@@ -24,10 +24,17 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
             "--seed {seed}: with --measurements the seed only draws the --holdout splits, and --holdout is not given (the fit of measured data has no randomness)"
         );
     }
-    if !(a.noise.is_finite() && a.noise >= 0.0) {
+    if !(a.noise().is_finite() && a.noise() >= 0.0) {
         bail!(
             "--noise {}: the noise σ must be a finite number >= 0 (metres)",
-            a.noise
+            a.noise()
+        );
+    }
+    if let (Some(n), Some(_)) = (a.noise, &a.measurements)
+        && !(n > 0.0)
+    {
+        bail!(
+            "--noise {n}: with --measurements it is the sensor's stated σ per coordinate, tested against the residuals: give a number > 0 (metres)"
         );
     }
     if a.design.is_some() && a.validation == 0 {
@@ -125,6 +132,9 @@ fn refuse_for_contacts(a: &CalibrateArgs, m: &Path) -> Result<()> {
         (a.compare_compliance, "--compare-compliance"),
         (a.inertia.is_some(), "--inertia"),
         (a.payload.is_some(), "--payload"),
+        (a.noise.is_some(), "--noise"),
+        (a.outliers.is_some(), "--outliers"),
+        (a.outlier_rate.is_some(), "--outlier-rate"),
     ];
     if let Some((_, name)) = given.iter().find(|(g, _)| *g) {
         bail!(
@@ -172,6 +182,8 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
             })
             .transpose()?,
         weights: weights_of(a),
+        outliers: a.outlier_choice()?,
+        stated_noise: a.noise,
         units: a.units.units(),
         gravity: if a.compliance || a.compare_compliance {
             Some(super::compliance::gravity_for(
@@ -199,6 +211,9 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         mut report,
     } = activecal::experiment::measured::calibrate_measured(robot, path, &o, &mut print_note)?;
     report.base.elapsed_seconds = t0.elapsed().as_secs_f64();
+    for w in &report.warnings {
+        super::diag(&format!("warning: {w}"));
+    }
     let id = &f.id;
     let fit = FitBlock {
         poses: report.base.poses,

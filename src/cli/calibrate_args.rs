@@ -24,11 +24,13 @@ pub struct CalibrateArgs {
     /// and radians) or JSON (`qs`, `points`, optional `orientations` or
     /// `quaternions`, `markers`). Several markers per pose calibrate a
     /// marker sensor with one offset per marker; orientations a full pose.
-    /// The simulation's options (`--noise`, `--validation`, `--trials`,
+    /// The simulation's options (`--validation`, `--trials`,
     /// `--save-measurements`) do not apply to measured data: refused.
+    /// `--noise` is then the sensor's stated σ, tested against the
+    /// residuals' σ̂.
     #[arg(
         long,
-        conflicts_with_all = ["design", "trials", "save_measurements", "noise", "validation"]
+        conflicts_with_all = ["design", "trials", "save_measurements", "validation"]
     )]
     pub measurements: Option<PathBuf>,
     /// Write the simulated measurements (trial 0 of the seed) to this file,
@@ -48,11 +50,14 @@ pub struct CalibrateArgs {
     /// Replace existing output files.
     #[arg(long)]
     pub force: bool,
-    /// Measurement noise σ per coordinate, metres (the default, 0.01, is
-    /// 1 cm). A full-pose robot's orientation noise is σ / orientation_scale
-    /// radians per axis.
-    #[arg(long, default_value_t = DEFAULT_NOISE, allow_negative_numbers = true)]
-    pub noise: f64,
+    /// Measurement noise σ per coordinate, metres. With --design, the
+    /// simulated noise (default 0.01, 1 cm; a full-pose robot's orientation
+    /// noise is σ / orientation_scale radians per axis); with
+    /// --measurements, the sensor's stated σ: the residuals' σ̂ is tested
+    /// against it (χ²) and a warning names the likely causes when they
+    /// disagree.
+    #[arg(long, allow_negative_numbers = true)]
+    pub noise: Option<f64>,
     /// Seed of the noise and of the validation poses (default 0); with
     /// --measurements, of the --holdout splits only.
     #[arg(long, value_parser = super::parse_seed, allow_negative_numbers = true)]
@@ -77,6 +82,16 @@ pub struct CalibrateArgs {
     /// turns robust.
     #[arg(long, conflicts_with = "design")]
     pub loss_scale: Option<f64>,
+    /// Poses with a gross error (a tracker glitch), found by Baarda's data
+    /// snooping on each pose's residuals at the least-squares fit: `drop`
+    /// leaves the flagged pose out and refits, one at a time, and lists each
+    /// with its test value; `keep` keeps every pose.
+    #[arg(long, value_enum, requires = "measurements")]
+    pub outliers: Option<OutliersKind>,
+    /// The gross-error test's family-wise false-alarm rate: clean data have
+    /// a pose flagged this often (in (0, 1); default 0.01).
+    #[arg(long, requires = "measurements")]
+    pub outlier_rate: Option<f64>,
     /// Unknowns to fix at their nominal values (comma-separated names, as
     /// in the estimate), with --measurements.
     #[arg(long, value_delimiter = ',', conflicts_with = "design")]
@@ -282,5 +297,51 @@ impl From<MountingArg> for activecal::measure::camera::Mounting {
             MountingArg::EyeToHand => Mounting::EyeToHand,
             MountingArg::EyeInHand => Mounting::EyeInHand,
         }
+    }
+}
+
+/// What `calibrate --outliers` does with the poses the gross-error test
+/// flags.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OutliersKind {
+    /// Leave each flagged pose out and refit.
+    Drop,
+    /// Keep every pose.
+    Keep,
+}
+
+impl CalibrateArgs {
+    /// The simulated noise σ (metres): `--noise`, or [`DEFAULT_NOISE`].
+    #[must_use]
+    pub fn noise(&self) -> f64 {
+        self.noise.unwrap_or(DEFAULT_NOISE)
+    }
+
+    /// The outlier choice of `--outliers` and `--outlier-rate`; the rate
+    /// with `--outliers keep`, or either with a robust `--loss` (which keeps
+    /// every pose), is refused.
+    pub fn outlier_choice(&self) -> anyhow::Result<activecal::identify::outliers::OutlierChoice> {
+        use activecal::identify::outliers::OutlierChoice;
+        if let (Some(OutliersKind::Keep), Some(r)) = (self.outliers, self.outlier_rate) {
+            anyhow::bail!(
+                "--outlier-rate {r}: is the rate of the test that drops poses; with --outliers keep no pose is dropped"
+            );
+        }
+        if self.loss != super::measured::LossKind::L2
+            && (self.outliers.is_some() || self.outlier_rate.is_some())
+        {
+            anyhow::bail!(
+                "--outliers and --outlier-rate test the least-squares fit; --loss {:?} down-weights poses instead and keeps them all",
+                self.loss
+            );
+        }
+        Ok(match self.outliers.unwrap_or(OutliersKind::Drop) {
+            OutliersKind::Drop => OutlierChoice::Drop {
+                alpha: self
+                    .outlier_rate
+                    .unwrap_or(activecal::identify::outliers::ALPHA),
+            },
+            OutliersKind::Keep => OutlierChoice::Keep,
+        })
     }
 }

@@ -4,7 +4,7 @@
 //! (Monte-Carlo); the work is in `activecal::experiment::simulated`, this
 //! file renders it (text, JSON, report directory).
 
-use super::calibrate_args::{CalibrateArgs, DEFAULT_NOISE};
+use super::calibrate_args::CalibrateArgs;
 use super::calibrated::{
     exit_status, frames_of, refuse_unconverged, status_text, write_calibrated,
 };
@@ -45,7 +45,7 @@ pub fn from_design(
         .build()?;
     let settings = MonteCarloSettings::builder()
         .trials(a.trials)
-        .sigma(a.noise)
+        .sigma(a.noise())
         .seed(a.seed())
         .validation_poses(a.validation)
         .lm(lm)
@@ -90,8 +90,8 @@ pub fn from_design(
         pool_size: pool.len(),
         poses: qs.len(),
         measurement: robot.measurement,
-        noise: a.noise,
-        orientation_noise: full.then(|| a.noise / robot.orientation_scale),
+        noise: a.noise(),
+        orientation_noise: full.then(|| a.noise() / robot.orientation_scale),
         seed: a.seed(),
         residual: id
             .names
@@ -141,8 +141,8 @@ fn simulated_report_dir(
     let mut notes = vec![format!(
         "Simulated measurements at the design's {} poses with noise σ = {} mm per coordinate{} (seed {}); errors at {} held-out poses of the design's pool.",
         qs.len(),
-        a.noise * 1e3,
-        if a.noise == 0.01 {
+        a.noise() * 1e3,
+        if a.noise.is_none() {
             " (the default of --noise)"
         } else {
             ""
@@ -210,13 +210,13 @@ fn simulated_text(
     let noise = if full {
         format!(
             "σ = {} m and {:.3e} rad (full poses)",
-            a.noise,
-            a.noise / robot.orientation_scale
+            a.noise(),
+            a.noise() / robot.orientation_scale
         )
     } else {
-        format!("σ = {} m", a.noise)
+        format!("σ = {} m", a.noise())
     };
-    let noise = if a.noise == DEFAULT_NOISE {
+    let noise = if a.noise.is_none() {
         format!("{noise}, the default of --noise")
     } else {
         noise

@@ -9,6 +9,7 @@
 use super::paper::ExperimentError;
 use crate::identify::compliance::{ComplianceComparison, compare, with_compliance};
 use crate::identify::evaluation::ModelErrors;
+use crate::identify::outliers::{Outlier, OutlierChoice};
 use crate::identify::{
     Fit, FixedParameter, HoldoutSettings, LmSettings, LossChoice, Measurements, ParameterTrust,
     SplitResult, for_measurements, holdout, prepare_for_data, residuals, trust,
@@ -43,6 +44,12 @@ pub struct MeasuredSettings {
     pub compare_compliance: bool,
     /// How the fit weighs its residual blocks.
     pub weights: crate::identify::Weights,
+    /// What happens to poses the gross-error test flags (with least
+    /// squares; a robust loss keeps every pose).
+    pub outliers: OutlierChoice,
+    /// The sensor's stated σ per position coordinate (metres), tested
+    /// against the fit's σ̂ ([`crate::identify::variance::NoiseTest`]).
+    pub stated_noise: Option<f64>,
 }
 
 /// A calibration from measurements: the robot as fitted, the fit, and its
@@ -113,6 +120,9 @@ pub struct MeasuredReport {
     pub fixed: Vec<FixedParameter>,
     /// Poses the robust loss down-weighted: `[pose, weight]`.
     pub downweighted: Vec<(usize, f64)>,
+    /// The gross-error test ([`crate::identify::outliers`]): its choice and
+    /// the poses it left out, in the order it found them.
+    pub outliers: OutlierReport,
     /// Held-out validation, if asked.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub holdout: Option<HoldoutReport>,
@@ -130,6 +140,46 @@ pub struct MeasuredReport {
     pub compliance_comparison: Option<ComplianceComparison>,
     /// Each residual block's σ at the fit and the weights it ended with.
     pub noise: NoiseReport,
+    /// The calibrated model's own predicted error at random configurations
+    /// ([`PREDICTION_CONFIGURATIONS`] within the joint limits, seed 0),
+    /// from the fit's covariance at σ̂; `None` when it has none (rank
+    /// deficient, no degree of freedom).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub predicted: Option<crate::how_many::PredictedErrors>,
+    /// σ̂ tested against the stated noise, when one was given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise_test: Option<crate::identify::variance::NoiseTest>,
+    /// What the user should look at: the fit is written, but something in
+    /// the data or the model is not as stated.
+    pub warnings: Vec<String>,
+}
+
+/// Random configurations the calibrated model's predicted error is averaged
+/// over (as `select`'s prediction).
+pub const PREDICTION_CONFIGURATIONS: usize = 1000;
+
+/// The calibrated model's predicted error at random configurations, from
+/// the covariance `σ̂² (XᵀX)⁻¹` of the fit `id` of `robot` to `meas`: the
+/// same propagation as `select`'s prediction
+/// ([`crate::how_many::predicted_errors`]) with the information of the
+/// poses measured, at the estimate, and σ̂ for σ.
+fn predicted_after_fit(
+    robot: &Robot,
+    id: &crate::identify::Identification,
+    meas: &Measurements,
+) -> Option<crate::how_many::PredictedErrors> {
+    let sigma = id.sigma_hat.filter(|s| s.is_finite() && *s > 0.0)?;
+    id.covariance.as_ref()?;
+    let qs = meas.qs();
+    let x = crate::blocks::jacobian_of(robot, &id.table, qs.len(), |k, q| {
+        q.copy_from_slice(&qs[k]);
+    });
+    let info = x.information(&(0..qs.len()).collect::<Vec<_>>());
+    let eval_qs = crate::how_many::random_configurations(robot, PREDICTION_CONFIGURATIONS, 0);
+    let eval = crate::blocks::jacobian_of(robot, &id.table, eval_qs.len(), |k, q| {
+        q.copy_from_slice(&eval_qs[k]);
+    });
+    crate::how_many::predicted_errors(robot, &eval, info.as_ref(), sigma)
 }
 
 /// Each residual block's estimated noise and how the blocks were weighed.
@@ -447,9 +497,11 @@ fn calibrate_read(
     };
     let det =
         prepare_for_data(&fitted_robot, &start.table, meas, &s.fix, &s.free).map_err(in_file)?;
-    let weighted =
-        crate::identify::fit_weighted(&det.robot, &start.table, meas, &s.lm, s.loss, s.weights)
-            .map_err(in_file)?;
+    let screened = screen(&det.robot, &start.table, meas, s).map_err(in_file)?;
+    screened.notes.iter().for_each(|n| note(n));
+    let weighted = screened.fit;
+    let kept_meas = meas.subset(&screened.kept);
+    let meas = &kept_meas;
     let noise = NoiseReport {
         weights: s.weights,
         orientation_scale_m_per_rad: weighted.robot.orientation_scale,
@@ -472,6 +524,11 @@ fn calibrate_read(
         (Some(h), true) => Some(splits.compliance_comparison(h)?),
         _ => None,
     };
+    let predicted = predicted_after_fit(&r, &f.id, meas);
+    let noise_test = s.stated_noise.and_then(|sigma| {
+        crate::identify::variance::NoiseTest::new(sigma, f.id.sigma_hat?, f.id.dof)
+    });
+    let warnings: Vec<String> = noise_test.iter().filter_map(|t| t.warning()).collect();
     let base =
         crate::report::MeasuredCalibrationReport::new(&r, &f.id, source.to_string(), meas.len());
     let report = MeasuredReport {
@@ -482,13 +539,24 @@ fn calibrate_read(
         nominal_placed_position_rms_mm: mounted.as_ref().and_then(|m| m.2),
         parameters: params,
         fixed: det.fixed,
-        downweighted: f.downweighted(),
+        downweighted: f
+            .downweighted()
+            .into_iter()
+            .map(|(i, w)| (screened.kept[i], w))
+            .collect(),
+        outliers: OutlierReport {
+            choice: s.outliers,
+            left_out: screened.outliers,
+        },
         holdout: ho,
         notes,
         frames: None,
         compliance,
         compliance_comparison: comparison,
         noise,
+        predicted,
+        noise_test,
+        warnings,
     };
     Ok(MeasuredCalibration {
         robot: r,
@@ -583,4 +651,123 @@ impl Splits<'_> {
         let com = self.run(&plain, self.s.gravity.clone())?;
         Ok(compare(&geo, &com))
     }
+}
+
+/// The gross-error test's part of a report.
+#[derive(Clone, Debug, Serialize)]
+pub struct OutlierReport {
+    /// Drop (at a rate) or keep.
+    pub choice: OutlierChoice,
+    /// The poses left out, in the order the test found them.
+    pub left_out: Vec<Outlier>,
+}
+
+/// A fit with the poses the gross-error test left out.
+struct Screened {
+    /// The fit of the poses kept.
+    fit: crate::identify::WeightedFit,
+    /// The poses kept (indices into the measurements given).
+    kept: Vec<usize>,
+    /// The poses left out.
+    outliers: Vec<Outlier>,
+    /// What the test did, for the report.
+    notes: Vec<String>,
+}
+
+/// At most this fraction of the poses is left out as gross errors: beyond
+/// it the data are not a few glitches but a noise or a model other than
+/// assumed, which leaving poses out would hide.
+const MOST_OUTLIERS: f64 = 0.2;
+
+/// The fit of `meas` ([`crate::identify::fit_weighted`]), and with least
+/// squares and [`OutlierChoice::Drop`], Baarda's data snooping
+/// ([`crate::identify::outliers`]): the pose the test flags left out and
+/// the fit repeated from the last estimate, until none is flagged or
+/// [`MOST_OUTLIERS`] of the poses are out.
+fn screen(
+    robot: &Robot,
+    start: &ParamTable,
+    meas: &Measurements,
+    s: &MeasuredSettings,
+) -> crate::identify::Result<Screened> {
+    crate::identify::outliers::check_choice(s.outliers)?;
+    let fit = |m: &Measurements, from: &ParamTable| {
+        crate::identify::fit_weighted(robot, from, m, &s.lm, s.loss, s.weights)
+    };
+    let mut kept: Vec<usize> = (0..meas.len()).collect();
+    let mut wf = fit(meas, start)?;
+    let mut found: Vec<(usize, crate::identify::outliers::PoseTest, f64)> = Vec::new();
+    let mut notes = Vec::new();
+    let alpha = match (s.outliers, s.loss) {
+        (OutlierChoice::Drop { alpha }, LossChoice::L2) => alpha,
+        _ => {
+            return Ok(Screened {
+                fit: wf,
+                kept,
+                outliers: Vec::new(),
+                notes,
+            });
+        }
+    };
+    let most = (MOST_OUTLIERS * meas.len() as f64).floor() as usize;
+    loop {
+        let sub = meas.subset(&kept);
+        let mut prob = crate::identify::Calibration::new(&wf.robot, &wf.start, &sub)?;
+        let Some(tests) =
+            crate::identify::outliers::pose_tests(&mut prob, &wf.fit.id.estimate, sub.len())
+        else {
+            break;
+        };
+        let Some(worst) = crate::identify::outliers::flagged(&tests, alpha) else {
+            break;
+        };
+        if found.len() >= most {
+            notes.push(format!(
+                "the gross-error test flags more poses than {} ({:.0} % of {}): these are not isolated glitches but a noise larger than the sensor's or a model that misses something; the poses are kept",
+                most,
+                MOST_OUTLIERS * 100.0,
+                meas.len()
+            ));
+            break;
+        }
+        let threshold = alpha / tests.len() as f64;
+        found.push((kept[worst.pose], worst.clone(), threshold));
+        kept.remove(worst.pose);
+        let next = fit(&meas.subset(&kept), &wf.fit.id.table.clone())?;
+        wf = next;
+    }
+    let outliers = found
+        .into_iter()
+        .map(|(pose, mut test, threshold)| {
+            test.pose = pose;
+            let residual_mm = residuals(&wf.robot, &wf.fit.id.table, &meas.subset(&[pose]))
+                .map_or(f64::NAN, |e| e.position_rms_mm);
+            Outlier {
+                pose,
+                test,
+                threshold,
+                residual_mm,
+            }
+        })
+        .collect::<Vec<_>>();
+    for o in &outliers {
+        notes.push(format!(
+            "pose {} of the data left out as a gross error: residual {:.3} mm, test F = {:.1} on ({}, {}) degrees of freedom, P = {:.1e} < {:.1e} (α {} over {} poses; --outliers keep keeps it)",
+            o.pose + 1,
+            o.residual_mm,
+            o.test.statistic,
+            o.test.dof.0,
+            o.test.dof.1,
+            o.test.p_value,
+            o.threshold,
+            alpha,
+            (alpha / o.threshold).round()
+        ));
+    }
+    Ok(Screened {
+        fit: wf,
+        kept,
+        outliers,
+        notes,
+    })
 }

@@ -122,6 +122,82 @@ pub fn block_sigmas(
         .collect())
 }
 
+/// σ̂ of a fit tested against the sensor's stated σ: `f σ̂² / σ² ~ χ²(f)`
+/// when the stated σ is right, the model complete and the data free of
+/// gross errors.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NoiseTest {
+    /// The stated σ per coordinate (metres).
+    pub stated_m: f64,
+    /// The fit's σ̂ per coordinate (metres).
+    pub estimated_m: f64,
+    /// `σ̂ / σ`.
+    pub ratio: f64,
+    /// Residual degrees of freedom `f`.
+    pub dof: usize,
+    /// `P(χ²(f) ≥ f σ̂²/σ²)`: small when σ̂ is too large.
+    pub p_larger: f64,
+    /// `P(χ²(f) ≤ f σ̂²/σ²)`: small when σ̂ is too small.
+    pub p_smaller: f64,
+    /// Whether the test rejects the stated σ at [`NOISE_TEST_ALPHA`] (two
+    /// sided).
+    pub rejected: bool,
+}
+
+/// The two-sided rate at which [`NoiseTest`] rejects a stated σ that is
+/// right: 1 in 1,000 (a warning, not a verdict, so it errs on silence).
+pub const NOISE_TEST_ALPHA: f64 = 1e-3;
+
+impl NoiseTest {
+    /// The test of `sigma_hat` on `dof` degrees of freedom against `stated`
+    /// (both metres); `None` without degrees of freedom or a σ.
+    #[must_use]
+    pub fn new(stated: f64, sigma_hat: f64, dof: usize) -> Option<NoiseTest> {
+        if dof == 0 || !(stated > 0.0) || !sigma_hat.is_finite() {
+            return None;
+        }
+        let ratio = sigma_hat / stated;
+        let x = dof as f64 * ratio * ratio;
+        let p_larger = crate::stats::chi2_upper_tail(x, dof as f64);
+        let p_smaller = crate::stats::chi2_cdf(x, dof as f64);
+        Some(NoiseTest {
+            stated_m: stated,
+            estimated_m: sigma_hat,
+            ratio,
+            dof,
+            p_larger,
+            p_smaller,
+            rejected: p_larger.min(p_smaller) < 0.5 * NOISE_TEST_ALPHA,
+        })
+    }
+
+    /// The warning a rejected test gives, naming the likely causes; `None`
+    /// when the stated σ stands.
+    #[must_use]
+    pub fn warning(&self) -> Option<String> {
+        if !self.rejected {
+            return None;
+        }
+        let head = format!(
+            "the residuals' σ̂ {:.4} mm per coordinate is {:.2}× the stated noise {:.4} mm (χ² test on {} degrees of freedom, P = {:.1e})",
+            self.estimated_m * 1e3,
+            self.ratio,
+            self.stated_m * 1e3,
+            self.dof,
+            self.p_larger.min(self.p_smaller)
+        );
+        Some(if self.ratio > 1.0 {
+            format!(
+                "{head}: the sensor is noisier than stated, a gross error is left in the data (--outliers), or the model misses something (joint sag under gravity: --compliance; a flexing tool or mount); the σ's and the predicted error use σ̂"
+            )
+        } else {
+            format!(
+                "{head}: the sensor is better than stated, or the data were averaged or smoothed; the σ's and the predicted error use σ̂"
+            )
+        })
+    }
+}
+
 /// The diagonal of the hat matrix `X (XᵀX)⁻¹ Xᵀ` (NaN when `XᵀX` is
 /// singular): the leverage of each row.
 fn hat_diagonal(x: &faer::Mat<f64>) -> Vec<f64> {

@@ -1,0 +1,257 @@
+//! Gross errors found as metrology software finds them: Baarda's data
+//! snooping with each pose's residual block tested as one (Pope's τ test in
+//! its externally studentised form).
+//!
+//! At a least-squares fit with weighted Jacobian `X` (`m` rows, `p`
+//! unknowns, `f = m − p` residual degrees of freedom), pose `i`'s residual
+//! block `r_i` (`t` rows) has the covariance `σ² Q_i`, `Q_i = I − X_i
+//! (XᵀX)⁻¹ X_iᵀ`: the pose's share of the redundancy (`tr Q_i` is its
+//! redundancy number). Its test value
+//!
+//! `T_i = r_iᵀ Q_i⁺ r_i`  (`k_i = rank Q_i` degrees of freedom)
+//!
+//! is the drop in the residual sum of squares when the pose is left out, so
+//! `s_(i)² = (RSS − T_i) / (f − k_i)` estimates σ² without it, and
+//!
+//! `F_i = (T_i / k_i) / s_(i)²  ~  F(k_i, f − k_i)`
+//!
+//! for a pose without a gross error (exactly for a linear model with normal
+//! noise; the stated σ is not needed). A pose is flagged when its tail
+//! probability is below `α / n` (Bonferroni over the `n` poses tested, so
+//! that clean data are flagged at most a fraction `α` of the time), the
+//! largest `F_i` first; the fit is then repeated without it and the test
+//! repeated ([`super::fit`] callers iterate).
+
+use super::{Residuals, Result};
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+
+/// The default family-wise false-alarm rate of the test: on clean data, one
+/// data set in a hundred has a pose flagged.
+pub const ALPHA: f64 = 0.01;
+
+/// One pose's test.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PoseTest {
+    /// The pose (0-based, in the measurements tested).
+    pub pose: usize,
+    /// `F_i` (see the module documentation).
+    pub statistic: f64,
+    /// Its degrees of freedom `k_i` and `f − k_i`.
+    pub dof: (usize, usize),
+    /// `P(F > F_i)`.
+    pub p_value: f64,
+    /// The pose's redundancy number `tr Q_i` (0: the unknowns fit it
+    /// exactly, nothing can be tested).
+    pub redundancy: f64,
+}
+
+/// An eigenvalue of `Q_i` below this is taken as 0: the pose's rows the
+/// unknowns fit exactly (its scale is 1, `Q_i`'s eigenvalues lie in [0, 1]).
+const REDUNDANCY_TOL: f64 = 1e-8;
+
+/// The test of each of the first `poses` blocks of `block_rows` rows of
+/// `prob` at `theta` (see the module documentation); `None` when `XᵀX` is
+/// singular (no fit to test) or no degree of freedom is left.
+pub fn pose_tests<R: Residuals>(
+    prob: &mut R,
+    theta: &[f64],
+    poses: usize,
+) -> Option<Vec<PoseTest>> {
+    let (m, n, t) = (prob.n_residuals(), prob.n_params(), prob.block_rows());
+    let mut r = vec![0.0; m];
+    let mut jac = faer::Mat::<f64>::zeros(m, n);
+    if !prob.eval(theta, &mut r, Some(&mut jac)) || m <= n {
+        return None;
+    }
+    let x = DMatrix::from_fn(m, n, |i, j| jac[(i, j)]);
+    let chol = (x.transpose() * &x).cholesky()?;
+    let rss: f64 = r.iter().map(|v| v * v).sum();
+    let f = m - n;
+    let tests = (0..poses.min(m / t.max(1)))
+        .filter_map(|i| {
+            let rows = i * t..(i + 1) * t;
+            let xi = x.rows(rows.start, t).into_owned();
+            let ri = DVector::from_column_slice(&r[rows]);
+            let q = DMatrix::<f64>::identity(t, t) - &xi * chol.solve(&xi.transpose());
+            block_test(i, &q, &ri, rss, f)
+        })
+        .collect();
+    Some(tests)
+}
+
+/// The test of one block with residual covariance factor `q` and
+/// residuals `ri` (see [`pose_tests`]).
+fn block_test(
+    pose: usize,
+    q: &DMatrix<f64>,
+    ri: &DVector<f64>,
+    rss: f64,
+    f: usize,
+) -> Option<PoseTest> {
+    let eig = q.clone().symmetric_eigen();
+    let mut stat = 0.0;
+    let mut k = 0;
+    for (j, &lambda) in eig.eigenvalues.iter().enumerate() {
+        if lambda > REDUNDANCY_TOL {
+            let u = eig.eigenvectors.column(j);
+            stat += u.dot(ri).powi(2) / lambda;
+            k += 1;
+        }
+    }
+    let redundancy = q.trace();
+    if k == 0 || f <= k {
+        return None;
+    }
+    let d2 = f - k;
+    let s2 = ((rss - stat) / d2 as f64).max(f64::MIN_POSITIVE);
+    let statistic = (stat / k as f64) / s2;
+    Some(PoseTest {
+        pose,
+        statistic,
+        dof: (k, d2),
+        p_value: crate::stats::f_upper_tail(statistic, k as f64, d2 as f64),
+        redundancy,
+    })
+}
+
+/// The pose the test flags at family-wise rate `alpha`: the largest `F_i`
+/// whose tail is below `alpha / n` (`n` the poses tested), or `None`.
+#[must_use]
+pub fn flagged(tests: &[PoseTest], alpha: f64) -> Option<&PoseTest> {
+    let n = tests.len().max(1) as f64;
+    tests
+        .iter()
+        .filter(|t| t.p_value < alpha / n)
+        .max_by(|a, b| a.statistic.total_cmp(&b.statistic))
+}
+
+/// How a calibration treats poses the test flags.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum OutlierChoice {
+    /// Flag, leave out and refit, one pose at a time, at this family-wise
+    /// false-alarm rate.
+    Drop {
+        /// The rate (default [`ALPHA`]).
+        alpha: f64,
+    },
+    /// Keep every pose (the test is still reported).
+    Keep,
+}
+
+impl Default for OutlierChoice {
+    fn default() -> Self {
+        OutlierChoice::Drop { alpha: ALPHA }
+    }
+}
+
+/// A pose left out as a gross error.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Outlier {
+    /// The pose: its row among the measurements given (0-based).
+    pub pose: usize,
+    /// Its test when flagged.
+    pub test: PoseTest,
+    /// The bound its tail fell below (`α / n`).
+    pub threshold: f64,
+    /// Its position residual at the final fit (mm, RMS over its points).
+    pub residual_mm: f64,
+}
+
+/// Checks an [`OutlierChoice`]'s rate: in (0, 1).
+pub fn check_choice(c: OutlierChoice) -> Result<()> {
+    match c {
+        OutlierChoice::Drop { alpha } if !(alpha > 0.0 && alpha < 1.0) => {
+            Err(super::IdentifyError::Model(crate::Error::Invalid(format!(
+                "outlier test rate {alpha}: must be in (0, 1)"
+            ))))
+        }
+        _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A straight line fitted to points, one of them off: `Residuals` with
+    /// blocks of one row.
+    struct Line {
+        x: Vec<f64>,
+        y: Vec<f64>,
+    }
+
+    impl Residuals for Line {
+        fn n_residuals(&self) -> usize {
+            self.x.len()
+        }
+        fn n_params(&self) -> usize {
+            2
+        }
+        fn eval(&mut self, th: &[f64], r: &mut [f64], jac: Option<&mut faer::Mat<f64>>) -> bool {
+            for (i, (x, y)) in self.x.iter().zip(&self.y).enumerate() {
+                r[i] = th[0] + th[1] * x - y;
+            }
+            if let Some(j) = jac {
+                for (i, x) in self.x.iter().enumerate() {
+                    j[(i, 0)] = 1.0;
+                    j[(i, 1)] = *x;
+                }
+            }
+            true
+        }
+    }
+
+    /// The least-squares line through the points.
+    fn fit(l: &Line) -> [f64; 2] {
+        let n = l.x.len() as f64;
+        let (sx, sy) = (l.x.iter().sum::<f64>(), l.y.iter().sum::<f64>());
+        let sxx: f64 = l.x.iter().map(|x| x * x).sum();
+        let sxy: f64 = l.x.iter().zip(&l.y).map(|(x, y)| x * y).sum();
+        let b = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+        [(sy - b * sx) / n, b]
+    }
+
+    #[test]
+    fn the_deletion_test_equals_the_refit_without_the_pose() {
+        // Deterministic scatter and one gross error at x = 7.
+        let x: Vec<f64> = (0..20).map(f64::from).collect();
+        let mut y: Vec<f64> = x
+            .iter()
+            .map(|x| 1.0 + 0.5 * x + 0.01 * (3.7 * x).sin())
+            .collect();
+        y[7] += 0.5;
+        let mut l = Line { x, y };
+        let th = fit(&l);
+        let tests = pose_tests(&mut l, &th, 20).unwrap();
+        let worst = flagged(&tests, ALPHA).expect("the gross error is flagged");
+        assert_eq!(worst.pose, 7);
+        // T_7 is the drop in RSS when pose 7 is left out: refit and compare.
+        let rss = |l: &Line, th: [f64; 2]| -> f64 {
+            l.x.iter()
+                .zip(&l.y)
+                .map(|(x, y)| (th[0] + th[1] * x - y).powi(2))
+                .sum()
+        };
+        let full = rss(&l, th);
+        let mut w = Line {
+            x: l.x.clone(),
+            y: l.y.clone(),
+        };
+        w.x.remove(7);
+        w.y.remove(7);
+        let without = rss(&w, fit(&w));
+        let s2 = without / 17.0;
+        let expected = (full - without) / s2;
+        assert!(
+            (worst.statistic - expected).abs() < 1e-8 * expected,
+            "{} vs {expected}",
+            worst.statistic
+        );
+        // Without it, nothing is flagged.
+        let th = fit(&w);
+        let tests = pose_tests(&mut w, &th, 19).unwrap();
+        assert!(flagged(&tests, ALPHA).is_none(), "{tests:?}");
+    }
+}

@@ -621,9 +621,9 @@ const CASES: &[Case] = &[
         &["visibility filter", "inverted on x"],
     ),
     case(
-        &["calibrate", "--measurements", "m.json", "--noise", "0.5"],
-        2,
-        &["'--measurements <MEASUREMENTS>' cannot be used with '--noise <NOISE>'"],
+        &["calibrate", "--measurements", "m.json", "--noise", "0"],
+        1,
+        &["--noise 0: with --measurements it is the sensor's stated σ"],
     ),
     case(
         &[

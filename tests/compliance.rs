@@ -430,6 +430,9 @@ fn the_frames_file_carries_the_compliances_and_reading_it_back_applies_them() {
         "--measurements",
         UR10_CSV,
         "--compliance",
+        // Every pose kept: `evaluate` below judges the written model on all.
+        "--outliers",
+        "keep",
         "--out",
         yaml.to_str().unwrap(),
         "--out",
@@ -490,4 +493,74 @@ fn the_frames_file_carries_the_compliances_and_reading_it_back_applies_them() {
         ],
         "compliance.elbow_jiont: not a revolute joint of the chain",
     );
+}
+
+#[test]
+fn an_unmodelled_sag_is_warned_of_when_the_noise_is_stated() {
+    use activecal::experiment::measured::{MeasuredSettings, calibrate_measurements};
+    let base = panda(MeasurementKind::Point);
+    let train = random_qs(&base, 60, 21);
+    let (r, real) = compliant(&base, &train);
+    let sigma = 5e-5;
+    let meas = simulate(&r, &real, &train, sigma, &mut ChaCha8Rng::seed_from_u64(22)).unwrap();
+    let settings = |stated: Option<f64>| MeasuredSettings {
+        lm: LmSettings::default(),
+        loss: activecal::identify::LossChoice::L2,
+        fix: Vec::new(),
+        free: Vec::new(),
+        holdout: None,
+        units: activecal::units::Units::default(),
+        gravity: None,
+        fit_compliance: false,
+        compare_compliance: false,
+        weights: activecal::identify::Weights::default(),
+        outliers: activecal::identify::outliers::OutlierChoice::default(),
+        stated_noise: stated,
+    };
+    // The geometric model only, the tracker's σ stated.
+    let c = calibrate_measurements(
+        &base,
+        &meas,
+        "sag",
+        Vec::new(),
+        &settings(Some(sigma)),
+        &mut |_| {},
+    )
+    .unwrap();
+    let t = c.report.noise_test.as_ref().expect("a noise test");
+    eprintln!(
+        "sag: σ̂ {:.4} mm against the stated {:.4} mm, {:?}",
+        t.estimated_m * 1e3,
+        sigma * 1e3,
+        c.report.outliers.left_out.len()
+    );
+    assert!(t.rejected && t.ratio > 1.5, "{t:?}");
+    let w = c.report.warnings.join(" ");
+    assert!(w.contains("--compliance"), "{w}");
+    // The sag is a misfit of every pose, not a glitch: no pose left out.
+    assert!(
+        c.report.outliers.left_out.is_empty(),
+        "{:?}",
+        c.report.outliers.left_out
+    );
+    // The same data from the compliant robot's geometry without sag: no
+    // warning (the control: the warning is about the data, not the test).
+    let clean = simulate(
+        &base,
+        &base.real,
+        &train,
+        sigma,
+        &mut ChaCha8Rng::seed_from_u64(22),
+    )
+    .unwrap();
+    let c = calibrate_measurements(
+        &base,
+        &clean,
+        "clean",
+        Vec::new(),
+        &settings(Some(sigma)),
+        &mut |_| {},
+    )
+    .unwrap();
+    assert!(c.report.warnings.is_empty(), "{:?}", c.report.warnings);
 }

@@ -38,6 +38,9 @@ fn tiago_four_markers_calibrate_from_the_csv_in_one_command() {
         TIAGO,
         "--measurements",
         TIAGO_CSV,
+        // Every pose kept: `evaluate` below judges the written model on all.
+        "--outliers",
+        "keep",
         "--holdout",
         "0.25",
         "--splits",
@@ -169,7 +172,11 @@ fn ur10_full_pose_calibrates_within_the_data_sheet_figures() {
         .as_f64()
         .unwrap();
     assert!(nominal_ori > 20.0, "{nominal_ori}");
-    assert_eq!(r["per_sample"].as_array().unwrap().len(), 23);
+    // Every pose is fitted or left out as a gross error (two of the 23, at
+    // 7–9 mm against a 2.3 mm fit, are found by the default test).
+    let out = v["outliers"]["left_out"].as_array().unwrap().len();
+    assert_eq!(r["per_sample"].as_array().unwrap().len() + out, 23);
+    assert!(out <= 2, "{out} poses left out");
     let h = &v["holdout"];
     assert!(h["orientation_rms_deg"]["mean"].as_f64().unwrap() > 0.0);
     let pruned = h["pruned"]["n_params"].as_array().unwrap();

@@ -20,6 +20,8 @@ pub struct Calibration {
     id: Identification,
     frames: Option<(CalibratedFrames, FramesReport)>,
     report: serde_json::Value,
+    /// The library's verdict: whether the calibrated robot may be written.
+    verdict: activecal::experiment::measured::verdict::Verdict,
 }
 
 /// What `calibrate` reads from its array arguments.
@@ -314,54 +316,54 @@ pub fn calibrate(
         stated_noise: None,
     };
     let r = inner.clone();
-    let (fitted, id, frames, report) = crate::progress::with_callback(progress, || {
-        detached(py, move || {
-            let t0 = std::time::Instant::now();
-            let meas = Measurements::with_orientations(&r, d.qs, d.points, d.orientations)?;
-            let c = calibrate_measurements(
-                &r,
-                &meas,
-                "the arrays given",
-                Vec::new(),
-                &settings,
-                &mut |_| {},
-            )?;
-            let mut report = c.report;
-            report.base.elapsed_seconds = t0.elapsed().as_secs_f64();
-            let id = c.fit.id;
-            let fit = FitBlock {
-                poses: report.base.poses,
-                position_rms_mm: report.residuals.position_rms_mm,
-                orientation_rms_deg: report.residuals.orientation_rms_deg,
-            };
-            let cov = id.covariance.as_ref().map(|c| c.matrix.as_slice());
-            let frames = activecal::frames::calibrated(&c.robot, &id.table, cov, Some(fit))
-                .map_err(crate::convert::Fail::compute)?;
-            report.frames = frames.as_ref().map(|(_, r)| r.clone());
-            let v = serde_json::to_value(&report)?;
-            Ok((c.robot, id, frames, v))
-        })
-    })?;
+    let (fitted, id, frames, report, verdict, warnings) =
+        crate::progress::with_callback(progress, || {
+            detached(py, move || {
+                let t0 = std::time::Instant::now();
+                let meas = Measurements::with_orientations(&r, d.qs, d.points, d.orientations)?;
+                let c = calibrate_measurements(
+                    &r,
+                    &meas,
+                    "the arrays given",
+                    Vec::new(),
+                    &settings,
+                    &mut |_| {},
+                )?;
+                let mut report = c.report;
+                report.base.elapsed_seconds = t0.elapsed().as_secs_f64();
+                let mut v = serde_json::to_value(&report)?;
+                v["exit_status"] = c.verdict.exit_status().into();
+                Ok((c.robot, c.fit.id, c.frames, v, c.verdict, report.warnings))
+            })
+        })?;
+    // What the command line prints as a warning reaches Python as one.
+    for w in &warnings {
+        let cat = py.get_type::<pyo3::exceptions::PyUserWarning>();
+        pyo3::PyErr::warn(
+            py,
+            cat.as_any(),
+            &std::ffi::CString::new(w.as_str()).unwrap_or_default(),
+            1,
+        )?;
+    }
     Ok(Calibration {
         robot: Arc::new(fitted),
         id,
         frames,
         report,
+        verdict,
     })
 }
 
 impl Calibration {
     /// Writes the calibrated robot in `format` to `path`, refused when the
-    /// fit did not converge.
+    /// library's verdict refuses it (a fit that did not converge, or that
+    /// made another robot of this one), as the command line does.
     fn write_as(&self, format: Format, path: &std::path::Path, overwrite: bool) -> PyResult<()> {
-        if !self.id.converged() {
-            return Err(err(format!(
-                "{}: not written: the identification ended {:?} ({:?}) after {} iterations; a calibrated robot is written only from a converged fit",
-                path.display(),
-                self.id.status,
-                self.id.stop,
-                self.id.iterations
-            )));
+        // The command line's verdict, from the library: the same refusals
+        // with the same message.
+        if let Some(why) = self.verdict.refusal() {
+            return Err(err(format!("{}: not written: {why}", path.display())));
         }
         write_robot(
             format,

@@ -6,10 +6,7 @@
 
 pub use super::calibrate_args::{CalibrateArgs, DEFAULT_NOISE};
 pub use super::calibrated::{EXIT_NOT_CONVERGED, NotConverged};
-use super::calibrated::{
-    exit_status, frames_of, not_written, refuse_unconverged, status_text, write_calibrated,
-};
-use activecal::frames::report::FitBlock;
+use super::calibrated::{not_written, status_text, write_calibrated};
 use activecal::identify::{Identification, LmSettings};
 use activecal::io::calibrated::Format;
 use activecal::model::Robot;
@@ -208,39 +205,23 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     let activecal::experiment::measured::MeasuredCalibration {
         robot: fitted,
         fit: f,
+        frames,
         mut report,
+        verdict,
     } = activecal::experiment::measured::calibrate_measured(robot, path, &o, &mut print_note)?;
     report.base.elapsed_seconds = t0.elapsed().as_secs_f64();
     for w in &report.warnings {
         super::diag(&format!("warning: {w}"));
     }
     let id = &f.id;
-    let fit = FitBlock {
-        poses: report.base.poses,
-        position_rms_mm: report.residuals.position_rms_mm,
-        orientation_rms_deg: report.residuals.orientation_rms_deg,
-    };
-    let frames = frames_of(&fitted, id, Some(fit))?;
-    report.frames = frames.as_ref().map(|(_, r)| r.clone());
-    // A converged fit that made another robot of this one is not written.
-    let implausible = id
-        .converged()
-        .then(|| {
-            let f = frames.as_ref().map(|(f, _)| f);
-            activecal::frames::plausible::implausible(&fitted, &id.table, f)
-        })
-        .flatten();
-    if implausible.is_none() {
+    // The library's verdict: a fit that did not converge, or converged to
+    // another robot, is not written.
+    if verdict.refusal().is_none() {
         report.base.out =
             write_calibrated(a, &fitted, id, &path.display().to_string(), frames.as_ref())?;
     }
     let mut v = serde_json::to_value(&report)?;
-    v["exit_status"] = if implausible.is_some() {
-        EXIT_NOT_CONVERGED
-    } else {
-        exit_status(id)
-    }
-    .into();
+    v["exit_status"] = verdict.exit_status().into();
     if let Some(dir) = &a.report {
         super::report_dir::calibration(dir, &measured_summary(&fitted, id, path, &report, &v))?;
     }
@@ -251,37 +232,10 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         }
         s
     })?;
-    // Too few poses for the unknowns: the cause, ahead of what it led to.
-    let few = too_few_rows(&fitted, &report);
-    let cause = |why: String| match &few {
-        Some(f) => format!("{f}\n  {why}"),
-        None => why,
-    };
-    if let Some(why) = implausible {
-        return Err(NotConverged(cause(why) + &not_written(a)).into());
+    match verdict.refusal() {
+        Some(why) => Err(NotConverged(why.to_string() + &not_written(a)).into()),
+        None => Ok(()),
     }
-    refuse_unconverged(a, id).map_err(|e| match e.downcast::<NotConverged>() {
-        Ok(NotConverged(why)) => NotConverged(cause(why)).into(),
-        Err(e) => e,
-    })
-}
-
-/// `N poses give R measurement rows for U unknowns: too few …` when the
-/// data have fewer rows than the fit had unknowns (estimated and fixed).
-fn too_few_rows(
-    fitted: &Robot,
-    r: &activecal::experiment::measured::MeasuredReport,
-) -> Option<String> {
-    let per_pose = fitted.rows_per_pose().max(1);
-    let rows = r.base.poses * per_pose;
-    let unknowns = r.parameters.len() + r.fixed.len();
-    (rows < unknowns).then(|| {
-        format!(
-            "{} poses give {rows} measurement rows for {unknowns} unknowns: too few to determine the model (at least {} poses)",
-            r.base.poses,
-            unknowns.div_ceil(per_pose)
-        )
-    })
 }
 
 /// What `--report` shows of a calibration from measurements.

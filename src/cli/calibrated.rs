@@ -96,16 +96,7 @@ pub fn refuse_unconverged(a: &CalibrateArgs, id: &Identification) -> Result<()> 
     if id.converged() {
         return Ok(());
     }
-    let mut why = format!(
-        "identification ended {:?} ({:?}) after {} iterations",
-        id.status, id.stop, id.iterations
-    );
-    if !id.unidentifiable.is_empty() {
-        why += &format!(
-            "; not determined by the data: {}",
-            id.unidentifiable.join(", ")
-        );
-    }
+    let mut why = activecal::experiment::measured::verdict::unconverged(id);
     why += &not_written(a);
     Err(NotConverged(why).into())
 }

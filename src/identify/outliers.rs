@@ -16,7 +16,11 @@
 //! `F_i = (T_i / k_i) / s_(i)²  ~  F(k_i, f − k_i)`
 //!
 //! for a pose without a gross error (exactly for a linear model with normal
-//! noise; the stated σ is not needed). A pose is flagged when its tail
+//! noise; the stated σ is not needed). When the sensor's σ is stated,
+//! Baarda's own form uses it instead: `T_i / σ² ~ χ²(k_i)` (reported as
+//! `F_i = T_i / (k_i σ²)` on `(k_i, ∞)` degrees of freedom, `dof.1 = 0`):
+//! then a misfit of every pose (a stated σ too small, a model that misses
+//! something) flags every pose, which the callers refuse to call glitches. A pose is flagged when its tail
 //! probability is below `α / n` (Bonferroni over the `n` poses tested, so
 //! that clean data are flagged at most a fraction `α` of the time), the
 //! largest `F_i` first; the fit is then repeated without it and the test
@@ -37,7 +41,8 @@ pub struct PoseTest {
     pub pose: usize,
     /// `F_i` (see the module documentation).
     pub statistic: f64,
-    /// Its degrees of freedom `k_i` and `f − k_i`.
+    /// Its degrees of freedom `k_i` and `f − k_i` (0 for the test with the
+    /// stated σ: the χ² form).
     pub dof: (usize, usize),
     /// `P(F > F_i)`.
     pub p_value: f64,
@@ -51,12 +56,14 @@ pub struct PoseTest {
 const REDUNDANCY_TOL: f64 = 1e-8;
 
 /// The test of each of the first `poses` blocks of `block_rows` rows of
-/// `prob` at `theta` (see the module documentation); `None` when `XᵀX` is
-/// singular (no fit to test) or no degree of freedom is left.
+/// `prob` at `theta` (see the module documentation), with the stated `sigma`
+/// (in the residuals' unit) when given; `None` when `XᵀX` is singular (no
+/// fit to test) or no degree of freedom is left.
 pub fn pose_tests<R: Residuals>(
     prob: &mut R,
     theta: &[f64],
     poses: usize,
+    sigma: Option<f64>,
 ) -> Option<Vec<PoseTest>> {
     let (m, n, t) = (prob.n_residuals(), prob.n_params(), prob.block_rows());
     let mut r = vec![0.0; m];
@@ -74,7 +81,7 @@ pub fn pose_tests<R: Residuals>(
             let xi = x.rows(rows.start, t).into_owned();
             let ri = DVector::from_column_slice(&r[rows]);
             let q = DMatrix::<f64>::identity(t, t) - &xi * chol.solve(&xi.transpose());
-            block_test(i, &q, &ri, rss, f)
+            block_test(i, &q, &ri, rss, f, sigma)
         })
         .collect();
     Some(tests)
@@ -88,6 +95,7 @@ fn block_test(
     ri: &DVector<f64>,
     rss: f64,
     f: usize,
+    sigma: Option<f64>,
 ) -> Option<PoseTest> {
     let eig = q.clone().symmetric_eigen();
     let mut stat = 0.0;
@@ -102,6 +110,16 @@ fn block_test(
     let redundancy = q.trace();
     if k == 0 || f <= k {
         return None;
+    }
+    if let Some(s) = sigma.filter(|s| *s > 0.0) {
+        let x = stat / (s * s);
+        return Some(PoseTest {
+            pose,
+            statistic: x / k as f64,
+            dof: (k, 0),
+            p_value: crate::stats::chi2_upper_tail(x, k as f64),
+            redundancy,
+        });
     }
     let d2 = f - k;
     let s2 = ((rss - stat) / d2 as f64).max(f64::MIN_POSITIVE);
@@ -224,7 +242,7 @@ mod tests {
         y[7] += 0.5;
         let mut l = Line { x, y };
         let th = fit(&l);
-        let tests = pose_tests(&mut l, &th, 20).unwrap();
+        let tests = pose_tests(&mut l, &th, 20, None).unwrap();
         let worst = flagged(&tests, ALPHA).expect("the gross error is flagged");
         assert_eq!(worst.pose, 7);
         // T_7 is the drop in RSS when pose 7 is left out: refit and compare.
@@ -251,7 +269,7 @@ mod tests {
         );
         // Without it, nothing is flagged.
         let th = fit(&w);
-        let tests = pose_tests(&mut w, &th, 19).unwrap();
+        let tests = pose_tests(&mut w, &th, 19, None).unwrap();
         assert!(flagged(&tests, ALPHA).is_none(), "{tests:?}");
     }
 }

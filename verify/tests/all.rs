@@ -34,6 +34,8 @@ mod live_gravity;
 #[cfg(feature = "live")]
 mod live_idjac;
 #[cfg(feature = "live")]
+mod live_messy;
+#[cfg(feature = "live")]
 mod live_tour;
 #[cfg(feature = "live")]
 mod live_truth;

@@ -38,14 +38,14 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-fn root() -> PathBuf {
+pub(super) fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
         .unwrap()
         .to_path_buf()
 }
 
-fn bin() -> PathBuf {
+pub(super) fn bin() -> PathBuf {
     let b = root().join("target/debug/activecal");
     if b.exists() {
         b
@@ -246,7 +246,7 @@ fn robot(a: &Arm) -> OsString {
 }
 
 /// Runs `cmd`; its stdout, or the error with its stderr.
-fn run(cmd: &mut Command) -> Result<String, String> {
+pub(super) fn run(cmd: &mut Command) -> Result<String, String> {
     let out = cmd.output().map_err(|e| format!("{cmd:?}: {e}"))?;
     if out.status.success() {
         Ok(String::from_utf8_lossy(&out.stdout).into_owned())
@@ -260,7 +260,7 @@ fn run(cmd: &mut Command) -> Result<String, String> {
 }
 
 /// `truth.py` with `args`, in `dir`: its JSON.
-fn truth_py<I, S>(dir: &Path, args: I) -> Value
+pub(super) fn truth_py<I, S>(dir: &Path, args: I) -> Value
 where
     I: IntoIterator<Item = S>,
     S: AsRef<std::ffi::OsStr>,
@@ -275,7 +275,7 @@ where
 }
 
 /// `activecal ARGS` in `dir`.
-fn activecal<I, S>(dir: &Path, args: I) -> Result<String, String>
+pub(super) fn activecal<I, S>(dir: &Path, args: I) -> Result<String, String>
 where
     I: IntoIterator<Item = S>,
     S: AsRef<std::ffi::OsStr>,

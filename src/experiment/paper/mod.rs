@@ -57,6 +57,9 @@ pub enum ExperimentError {
     /// Identification or Monte-Carlo.
     #[error(transparent)]
     Identify(#[from] IdentifyError),
+    /// The calibrated frames of a fit.
+    #[error(transparent)]
+    Frames(#[from] crate::frames::FramesError),
     /// Identification from a data file that the file's data make fail.
     #[error("{path}: {error}")]
     InFile {

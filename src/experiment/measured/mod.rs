@@ -9,7 +9,7 @@
 use super::paper::ExperimentError;
 use crate::identify::compliance::{ComplianceComparison, compare, with_compliance};
 use crate::identify::evaluation::ModelErrors;
-use crate::identify::outliers::{Outlier, OutlierChoice};
+use crate::identify::outliers::OutlierChoice;
 use crate::identify::{
     Fit, FixedParameter, HoldoutSettings, LmSettings, LossChoice, Measurements, ParameterTrust,
     SplitResult, for_measurements, holdout, prepare_for_data, residuals, trust,
@@ -17,7 +17,12 @@ use crate::identify::{
 use crate::model::gravity::GravityModel;
 use crate::model::{ParamTable, Robot};
 use nalgebra::Vector3;
+pub use screen::OutlierReport;
+use screen::screen;
 use serde::Serialize;
+
+mod screen;
+pub mod verdict;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -52,16 +57,23 @@ pub struct MeasuredSettings {
     pub stated_noise: Option<f64>,
 }
 
-/// A calibration from measurements: the robot as fitted, the fit, and its
-/// report.
+/// A calibration from measurements: the robot as fitted, the fit, its
+/// calibrated frames (URDF robots), its report and the verdict on it.
 pub struct MeasuredCalibration {
     /// The robot the data were fitted as (mounted, with fixed and freed
     /// unknowns).
     pub robot: Robot,
     /// The fit.
     pub fit: Fit,
+    /// The calibrated frames of a URDF robot at the estimate, with σ.
+    pub frames: Option<(
+        crate::frames::CalibratedFrames,
+        crate::frames::report::FramesReport,
+    )>,
     /// The report.
     pub report: MeasuredReport,
+    /// Whether the calibrated robot may be written.
+    pub verdict: verdict::Verdict,
 }
 
 /// Reads a measurement file (CSV or JSON) for `robot` in `units`; positions
@@ -315,20 +327,17 @@ fn mounted_start(
         return Ok(None);
     }
     let tool: [f64; 3] = a.tool.translation.vector.into();
-    let mut r = if far {
-        let mount = a.motion * src.mount;
-        let after = if tool_unknown {
-            src.tool
-        } else {
-            src.tool * a.tool
-        };
-        crate::io::urdf::remount(robot, mount, after)?
+    // The tool point the data imply is that of the rigid placement: start
+    // from both (a placement near the nominal one changes little).
+    let mount = a.motion * src.mount;
+    let after = if tool_unknown {
+        src.tool
     } else {
-        robot.clone()
+        src.tool * a.tool
     };
+    let mut r = crate::io::urdf::remount(robot, mount, after)?;
     let mut notes = Vec::new();
     if far {
-        let mount = a.motion * src.mount;
         let t = mount.translation.vector;
         notes.push(format!(
             "the data are far from the nominal model (RMS {:.1} mm): identification starts from the measurement frame that fits them best (RMS {:.1} mm), {:.3} m away and turned {:.1}°",
@@ -531,7 +540,7 @@ fn calibrate_read(
     let warnings: Vec<String> = noise_test.iter().filter_map(|t| t.warning()).collect();
     let base =
         crate::report::MeasuredCalibrationReport::new(&r, &f.id, source.to_string(), meas.len());
-    let report = MeasuredReport {
+    let mut report = MeasuredReport {
         base,
         loss: s.loss,
         residuals: res,
@@ -558,10 +567,27 @@ fn calibrate_read(
         noise_test,
         warnings,
     };
+    let fit_block = crate::frames::report::FitBlock {
+        poses: report.base.poses,
+        position_rms_mm: report.residuals.position_rms_mm,
+        orientation_rms_deg: report.residuals.orientation_rms_deg,
+    };
+    let cov = f.id.covariance.as_ref().map(|c| c.matrix.as_slice());
+    let frames = crate::frames::calibrated(&r, &f.id.table, cov, Some(fit_block))?;
+    report.frames = frames.as_ref().map(|(_, fr)| fr.clone());
+    let verdict = verdict::verdict(
+        &r,
+        &f.id,
+        frames.as_ref().map(|(c, _)| c),
+        report.base.poses,
+        report.parameters.len() + report.fixed.len(),
+    );
     Ok(MeasuredCalibration {
         robot: r,
         fit: f,
+        frames,
         report,
+        verdict,
     })
 }
 
@@ -651,123 +677,4 @@ impl Splits<'_> {
         let com = self.run(&plain, self.s.gravity.clone())?;
         Ok(compare(&geo, &com))
     }
-}
-
-/// The gross-error test's part of a report.
-#[derive(Clone, Debug, Serialize)]
-pub struct OutlierReport {
-    /// Drop (at a rate) or keep.
-    pub choice: OutlierChoice,
-    /// The poses left out, in the order the test found them.
-    pub left_out: Vec<Outlier>,
-}
-
-/// A fit with the poses the gross-error test left out.
-struct Screened {
-    /// The fit of the poses kept.
-    fit: crate::identify::WeightedFit,
-    /// The poses kept (indices into the measurements given).
-    kept: Vec<usize>,
-    /// The poses left out.
-    outliers: Vec<Outlier>,
-    /// What the test did, for the report.
-    notes: Vec<String>,
-}
-
-/// At most this fraction of the poses is left out as gross errors: beyond
-/// it the data are not a few glitches but a noise or a model other than
-/// assumed, which leaving poses out would hide.
-const MOST_OUTLIERS: f64 = 0.2;
-
-/// The fit of `meas` ([`crate::identify::fit_weighted`]), and with least
-/// squares and [`OutlierChoice::Drop`], Baarda's data snooping
-/// ([`crate::identify::outliers`]): the pose the test flags left out and
-/// the fit repeated from the last estimate, until none is flagged or
-/// [`MOST_OUTLIERS`] of the poses are out.
-fn screen(
-    robot: &Robot,
-    start: &ParamTable,
-    meas: &Measurements,
-    s: &MeasuredSettings,
-) -> crate::identify::Result<Screened> {
-    crate::identify::outliers::check_choice(s.outliers)?;
-    let fit = |m: &Measurements, from: &ParamTable| {
-        crate::identify::fit_weighted(robot, from, m, &s.lm, s.loss, s.weights)
-    };
-    let mut kept: Vec<usize> = (0..meas.len()).collect();
-    let mut wf = fit(meas, start)?;
-    let mut found: Vec<(usize, crate::identify::outliers::PoseTest, f64)> = Vec::new();
-    let mut notes = Vec::new();
-    let alpha = match (s.outliers, s.loss) {
-        (OutlierChoice::Drop { alpha }, LossChoice::L2) => alpha,
-        _ => {
-            return Ok(Screened {
-                fit: wf,
-                kept,
-                outliers: Vec::new(),
-                notes,
-            });
-        }
-    };
-    let most = (MOST_OUTLIERS * meas.len() as f64).floor() as usize;
-    loop {
-        let sub = meas.subset(&kept);
-        let mut prob = crate::identify::Calibration::new(&wf.robot, &wf.start, &sub)?;
-        let Some(tests) =
-            crate::identify::outliers::pose_tests(&mut prob, &wf.fit.id.estimate, sub.len())
-        else {
-            break;
-        };
-        let Some(worst) = crate::identify::outliers::flagged(&tests, alpha) else {
-            break;
-        };
-        if found.len() >= most {
-            notes.push(format!(
-                "the gross-error test flags more poses than {} ({:.0} % of {}): these are not isolated glitches but a noise larger than the sensor's or a model that misses something; the poses are kept",
-                most,
-                MOST_OUTLIERS * 100.0,
-                meas.len()
-            ));
-            break;
-        }
-        let threshold = alpha / tests.len() as f64;
-        found.push((kept[worst.pose], worst.clone(), threshold));
-        kept.remove(worst.pose);
-        let next = fit(&meas.subset(&kept), &wf.fit.id.table.clone())?;
-        wf = next;
-    }
-    let outliers = found
-        .into_iter()
-        .map(|(pose, mut test, threshold)| {
-            test.pose = pose;
-            let residual_mm = residuals(&wf.robot, &wf.fit.id.table, &meas.subset(&[pose]))
-                .map_or(f64::NAN, |e| e.position_rms_mm);
-            Outlier {
-                pose,
-                test,
-                threshold,
-                residual_mm,
-            }
-        })
-        .collect::<Vec<_>>();
-    for o in &outliers {
-        notes.push(format!(
-            "pose {} of the data left out as a gross error: residual {:.3} mm, test F = {:.1} on ({}, {}) degrees of freedom, P = {:.1e} < {:.1e} (α {} over {} poses; --outliers keep keeps it)",
-            o.pose + 1,
-            o.residual_mm,
-            o.test.statistic,
-            o.test.dof.0,
-            o.test.dof.1,
-            o.test.p_value,
-            o.threshold,
-            alpha,
-            (alpha / o.threshold).round()
-        ));
-    }
-    Ok(Screened {
-        fit: wf,
-        kept,
-        outliers,
-        notes,
-    })
 }

@@ -183,19 +183,14 @@ fn outputs(a: &SelectArgs) -> Result<(Option<&PathBuf>, Option<&PathBuf>)> {
             bail!("--out {}: one file of each kind (.csv, .json)", o.display());
         }
     }
-    for o in csv.iter().chain(json.iter()) {
-        super::refuse_overwrite(o, a.force)?;
-    }
     Ok((csv, json))
 }
 
 /// Runs `select` for a camera.
 pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
     refuse_unused(a)?;
+    super::select::select_files(a).check(a.force)?;
     let (csv_out, json_out) = outputs(a)?;
-    if let Some(dir) = &a.report {
-        super::report_dir::check(dir, a.force)?;
-    }
     let robot = super::load_robot(&a.pool.robot)?;
     let robot = match &a.camera.camera_link {
         Some(link) => activecal::io::urdf_branch::camera_branch(&robot, link)

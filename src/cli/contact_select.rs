@@ -102,7 +102,8 @@ pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
         .map(|s| parse_socket(s))
         .collect::<Result<_>>()?;
     refuse_pool_options(a)?;
-    super::select::check_outs(&a.out, a.force)?;
+    super::select::select_files(a).check(a.force)?;
+    super::select::check_out_formats(&a.out)?;
     let margin_deg = a
         .pool
         .margin

@@ -4,6 +4,7 @@
 //! `activecal::identify::contact::socket_design`.
 
 use super::select::SelectArgs;
+use activecal::identify::contact::lengths::check_distance_reach;
 use activecal::identify::contact::select::Socket;
 use activecal::identify::contact::socket_design::{
     Judged, SocketDesign, SocketDesignSettings, design_for_sockets,
@@ -13,7 +14,7 @@ use activecal::io::design_formats::DesignFormat;
 use activecal::measure::contact::KnownDistance;
 use activecal::model::MeasurementKind;
 use activecal::select::{Algorithm, CriterionKind};
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use std::fmt::Write as _;
 
 /// Joint-space samples projected onto each socket when `--count` is not
@@ -34,7 +35,14 @@ fn parse_socket(s: &str) -> Result<Socket> {
 
 /// The `--point-distance A,B=METRES` between sockets, as indices into
 /// `sockets`; a name that is no socket's is refused, naming the sockets.
-fn known_distances(sockets: &[Socket], given: &[String]) -> Result<Vec<KnownDistance>> {
+/// A distance beyond twice the robot's reach is refused as `calibrate`
+/// refuses it ([`check_distance_reach`], a length in millimetres named as
+/// such).
+fn known_distances(
+    robot: &activecal::model::Robot,
+    sockets: &[Socket],
+    given: &[String],
+) -> Result<Vec<KnownDistance>> {
     let names: Vec<&str> = sockets.iter().map(|s| s.name.as_str()).collect();
     given
         .iter()
@@ -54,6 +62,7 @@ fn known_distances(sockets: &[Socket], given: &[String]) -> Result<Vec<KnownDist
                     "--point-distance {s}: a distance needs two different points and a finite length > 0 (metres)"
                 );
             }
+            check_distance_reach(robot, &d.a, &d.b, d.metres).context("--point-distance")?;
             Ok(KnownDistance {
                 a: ia,
                 b: ib,
@@ -119,7 +128,7 @@ pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
             robot.name
         );
     }
-    let distances = known_distances(&sockets, &a.point_distance)?;
+    let distances = known_distances(&robot, &sockets, &a.point_distance)?;
     let filters = a.pool.collision_filters(&robot)?;
     let settings = SocketDesignSettings {
         n: a.n,

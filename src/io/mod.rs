@@ -220,7 +220,38 @@ fn chosen_markers(
             m.link
         )));
     }
+    let reach = crate::units::reach(robot);
+    for m in &chain.markers {
+        marker_within_reach(m, reach)?;
+    }
     Ok(chain.markers.iter().map(|m| m.offset).collect())
+}
+
+/// Refuses a marker whose offset from its link is beyond the robot's
+/// `reach` (metres, [`crate::units::reach`] of the robot without markers):
+/// an offset in millimetres given as metres (named as such) makes a
+/// different robot, for `select` and `calibrate` alike.
+fn marker_within_reach(m: &MarkerChoice, reach: f64) -> Result<()> {
+    let [x, y, z] = m.offset;
+    let norm = (x * x + y * y + z * z).sqrt();
+    if norm.is_finite() && norm <= reach {
+        return Ok(());
+    }
+    let mm = if norm * 1e-3 <= reach {
+        let c = |v: f64| crate::error::Compact(v * 1e-3);
+        format!(
+            "; it looks like millimetres ({}@{},{},{} in metres)",
+            m.link,
+            c(x),
+            c(y),
+            c(z)
+        )
+    } else {
+        String::new()
+    };
+    Err(Error::Invalid(format!(
+        "marker {m}: {norm:.3} m from its link, beyond the robot's reach ({reach:.3} m){mm}"
+    )))
 }
 
 /// The robot deflecting under gravity with the frames file's compliances

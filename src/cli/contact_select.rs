@@ -4,7 +4,7 @@
 //! `activecal::identify::contact::socket_design`.
 
 use super::select::SelectArgs;
-use activecal::identify::contact::lengths::check_distance_reach;
+use activecal::identify::contact::lengths::distance_beyond_reach;
 use activecal::identify::contact::select::Socket;
 use activecal::identify::contact::socket_design::{
     Judged, SocketDesign, SocketDesignSettings, design_for_sockets,
@@ -14,7 +14,7 @@ use activecal::io::design_formats::DesignFormat;
 use activecal::measure::contact::KnownDistance;
 use activecal::model::MeasurementKind;
 use activecal::select::{Algorithm, CriterionKind};
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use std::fmt::Write as _;
 
 /// Joint-space samples projected onto each socket when `--count` is not
@@ -36,7 +36,7 @@ fn parse_socket(s: &str) -> Result<Socket> {
 /// The `--point-distance A,B=METRES` between sockets, as indices into
 /// `sockets`; a name that is no socket's is refused, naming the sockets.
 /// A distance beyond twice the robot's reach is refused as `calibrate`
-/// refuses it ([`check_distance_reach`], a length in millimetres named as
+/// refuses it ([`distance_beyond_reach`], a length in millimetres named as
 /// such).
 fn known_distances(
     robot: &activecal::model::Robot,
@@ -62,7 +62,9 @@ fn known_distances(
                     "--point-distance {s}: a distance needs two different points and a finite length > 0 (metres)"
                 );
             }
-            check_distance_reach(robot, &d.a, &d.b, d.metres).context("--point-distance")?;
+            if let Some(why) = distance_beyond_reach(robot, &d.a, &d.b, d.metres) {
+                bail!("--point-distance: {why}");
+            }
             Ok(KnownDistance {
                 a: ia,
                 b: ib,

@@ -3,7 +3,7 @@
 //! together, once, before any work ([`RunFiles::check`]). Paths are
 //! compared by their canonical identity
 //! ([`activecal::io::atomic::check_outputs`],
-//! [`activecal::io::atomic::check_output_dirs`]): `--force` never replaces
+//! [`activecal::io::atomic::output_dir_conflict`]): `--force` never replaces
 //! an input of the same run, two outputs never name one file, and a
 //! directory replaced whole (`--report DIR`) holds no input and no other
 //! output.
@@ -111,7 +111,9 @@ impl RunFiles {
             .iter()
             .map(|(label, path)| Output { label, path })
             .collect();
-        activecal::io::atomic::check_output_dirs(&dirs, &files, &inputs)?;
+        if let Some(why) = activecal::io::atomic::output_dir_conflict(&dirs, &files, &inputs) {
+            bail!(why);
+        }
         let pairs: Vec<(&str, &Path)> = files.iter().map(|o| (o.label, o.path)).collect();
         super::check_outputs(&pairs, &inputs, force)?;
         for (label, dir) in &self.dirs {

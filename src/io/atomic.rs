@@ -9,7 +9,7 @@
 //! [`check_outputs`] refuses, before any work is done, an output that exists
 //! (without `force`), that is a directory, whose directory does not exist,
 //! that is one of the command's inputs, or that two outputs share;
-//! [`check_output_dirs`] refuses an output directory (replaced whole) that
+//! [`output_dir_conflict`] finds an output directory (replaced whole) that
 //! holds an input or another output.
 
 use crate::error::{Error, Result};
@@ -59,58 +59,60 @@ fn identity(path: &Path) -> PathBuf {
     }
 }
 
-/// Checks a command's output directories (each replaced whole, as a
-/// report directory is) against its output files and its inputs, by
-/// canonical identity, before any work: a directory that is or holds an
-/// input (replacing it would delete the input), that names the same path as
-/// an output file or another output directory, or that holds an output
-/// file, is refused. The error names both options and the paths.
-pub fn check_output_dirs(
+/// Why a command's output directories (each replaced whole, as a report
+/// directory is) conflict with its output files or its inputs, by
+/// canonical identity, or `None`; checked before any work: a directory
+/// that is or holds an input (replacing it would delete the input), that
+/// names the same path as an output file or another output directory, or
+/// that holds an output file or another output directory. The reason
+/// names both options and the paths.
+#[must_use]
+pub fn output_dir_conflict(
     dirs: &[Output<'_>],
     files: &[Output<'_>],
     inputs: &[&Path],
-) -> Result<()> {
+) -> Option<String> {
     for (k, d) in dirs.iter().enumerate() {
         let shown = d.path.display();
         let id = identity(d.path);
         if let Some(i) = inputs.iter().find(|i| identity(i).starts_with(&id)) {
-            return Err(invalid(format!(
+            return Some(format!(
                 "{} {shown}: is or holds an input of this command ({}), and the directory is replaced whole; choose another directory",
                 d.label,
                 i.display()
-            )));
+            ));
         }
         if let Some(other) = dirs[..k]
             .iter()
             .chain(files)
             .find(|o| identity(o.path) == id)
         {
-            return Err(invalid(format!(
+            return Some(format!(
                 "{} and {} name the same file {shown}",
                 other.label, d.label
-            )));
+            ));
         }
         if let Some(o) = files.iter().find(|o| identity(o.path).starts_with(&id)) {
-            return Err(invalid(format!(
+            return Some(format!(
                 "{} {}: is inside the {} directory {shown}, which is replaced whole; write it outside that directory",
                 o.label,
                 o.path.display(),
                 d.label
-            )));
+            ));
         }
         if let Some(other) = dirs[..k]
             .iter()
             .find(|o| identity(o.path).starts_with(&id) || id.starts_with(identity(o.path)))
         {
-            return Err(invalid(format!(
+            return Some(format!(
                 "{} {shown} and {} {}: one directory inside the other; choose separate directories",
                 d.label,
                 other.label,
                 other.path.display()
-            )));
+            ));
         }
     }
-    Ok(())
+    None
 }
 
 /// Checks a command's output files before it does any work: each must name
@@ -435,9 +437,7 @@ mod tests {
         let report = d.join("report");
         let o = |label, path| Output { label, path };
         let e = |dirs: &[Output<'_>], files: &[Output<'_>]| {
-            check_output_dirs(dirs, files, &[&input])
-                .unwrap_err()
-                .to_string()
+            output_dir_conflict(dirs, files, &[&input]).expect("a conflict")
         };
         // The directory holding the input, by another spelling.
         let here = d.join(".");
@@ -447,12 +447,11 @@ mod tests {
         assert!(e(&[o("--report", &report)], &[o("--out", &report)]).contains("name the same"));
         assert!(e(&[o("--report", &report)], &[o("--out", &inside)]).contains("is inside"));
         let elsewhere = d.join("x.json");
-        check_output_dirs(
-            &[o("--report", &report)],
-            &[o("--out", &elsewhere)],
-            &[&input],
-        )
-        .unwrap();
+        let apart = [o("--report", &report)];
+        assert_eq!(
+            output_dir_conflict(&apart, &[o("--out", &elsewhere)], &[&input]),
+            None
+        );
         std::fs::remove_dir_all(&d).unwrap();
     }
 

@@ -350,17 +350,14 @@ fn within_memory<T>(
     points: usize,
 ) -> std::result::Result<(), String> {
     let bytes = crate::resources::bytes_of(points, BYTES_PER_POINT);
-    crate::resources::MemoryBudget::from_env()
-        .and_then(|m| {
-            m.check(
-                &format!(
-                    "{} ('{kind}'): {rows} × {cols} {what}, {points} target points,",
-                    at(b)
-                ),
-                bytes,
-            )
-        })
-        .map_err(|e| e.to_string())
+    let what = format!(
+        "{} ('{kind}'): {rows} × {cols} {what}, {points} target points,",
+        at(b)
+    );
+    match crate::resources::MemoryBudget::from_env() {
+        Ok(m) => m.check(&what, bytes).map_err(|e| e.to_string()),
+        Err(e) => Err(e.to_string()),
+    }
 }
 
 fn board(b: &Spanned<Board>) -> std::result::Result<Target, String> {

@@ -221,21 +221,25 @@ fn chosen_markers(
         )));
     }
     let reach = crate::units::reach(robot);
-    for m in &chain.markers {
-        marker_within_reach(m, reach)?;
+    if let Some(why) = chain
+        .markers
+        .iter()
+        .find_map(|m| marker_beyond_reach(m, reach))
+    {
+        return Err(Error::Invalid(why));
     }
     Ok(chain.markers.iter().map(|m| m.offset).collect())
 }
 
-/// Refuses a marker whose offset from its link is beyond the robot's
-/// `reach` (metres, [`crate::units::reach`] of the robot without markers):
-/// an offset in millimetres given as metres (named as such) makes a
-/// different robot, for `select` and `calibrate` alike.
-fn marker_within_reach(m: &MarkerChoice, reach: f64) -> Result<()> {
+/// Why a marker cannot be, or `None`: its offset from its link is beyond
+/// the robot's `reach` (metres, [`crate::units::reach`] of the robot
+/// without markers). An offset in millimetres given as metres (named as
+/// such) makes a different robot, for `select` and `calibrate` alike.
+fn marker_beyond_reach(m: &MarkerChoice, reach: f64) -> Option<String> {
     let [x, y, z] = m.offset;
     let norm = (x * x + y * y + z * z).sqrt();
     if norm.is_finite() && norm <= reach {
-        return Ok(());
+        return None;
     }
     let mm = if norm * 1e-3 <= reach {
         let c = |v: f64| crate::error::Compact(v * 1e-3);
@@ -249,9 +253,9 @@ fn marker_within_reach(m: &MarkerChoice, reach: f64) -> Result<()> {
     } else {
         String::new()
     };
-    Err(Error::Invalid(format!(
+    Some(format!(
         "marker {m}: {norm:.3} m from its link, beyond the robot's reach ({reach:.3} m){mm}"
-    )))
+    ))
 }
 
 /// The robot deflecting under gravity with the frames file's compliances

@@ -117,24 +117,6 @@ pub fn camera_blocks(robot: &Robot, view: &CameraView, qs: &[Vec<f64>]) -> Block
     Blocks::from_row_major(&rows, t, p)
 }
 
-/// Refuses, with the figure, the pixel Jacobian of `poses` configurations
-/// ([`camera_blocks`], then its compressed copy) when its memory would
-/// exceed the budget ([`crate::resources::MemoryBudget`]): an error, not
-/// an abort.
-pub fn camera_blocks_within_memory(robot: &Robot, view: &CameraView, poses: usize) -> Result<()> {
-    let (sensor, _) = view.sensor();
-    let (t, p) = (sensor.rows(), robot.n_unknowns() + OWN_PARAMS);
-    // The rows, the blocks made of them, and the compressed blocks.
-    let bytes =
-        crate::resources::bytes_of(poses.saturating_mul(t).saturating_mul(p), 8).saturating_mul(3);
-    crate::resources::MemoryBudget::from_env()?.check(
-        &format!(
-            "the pixel Jacobian of the {poses} candidate configurations the camera sees ({t} rows × {p} unknowns each)"
-        ),
-        bytes,
-    )
-}
-
 /// Chooses `settings.n` of the `candidates` (joint vectors of `robot`)
 /// for `view` by exchange-add-exchange on the D criterion: the candidates
 /// the view keeps (at the nominal parameters) form the pool. Errors when
@@ -216,7 +198,18 @@ pub fn camera_design_in_sight(
         )));
     }
     let qs: Vec<Vec<f64>> = kept.iter().map(|&i| candidates[i].clone()).collect();
-    camera_blocks_within_memory(&robot, view, qs.len())?;
+    // The pixel Jacobian (its rows, the blocks made of them, and the
+    // compressed blocks) refused with the figure when it would exceed the
+    // memory budget: an error, not an abort.
+    let (t, p) = (view.sensor().0.rows(), robot.n_unknowns() + OWN_PARAMS);
+    crate::resources::MemoryBudget::from_env()?.check(
+        &format!(
+            "the pixel Jacobian of the {} candidate configurations the camera sees ({t} rows × {p} unknowns each)",
+            qs.len()
+        ),
+        crate::resources::bytes_of(qs.len().saturating_mul(t).saturating_mul(p), 8)
+            .saturating_mul(3),
+    )?;
     let (blocks, rank_per_pose) = camera_blocks(&robot, view, &qs).compressed();
     let sel = select(&blocks, CriterionKind::Det, Algorithm::Eae, settings)?;
     let seen = sel

@@ -36,24 +36,24 @@ fn distance_label(a: &str, b: &str, metres: f64) -> String {
     format!("distance {a},{b}={}", Compact(metres))
 }
 
-/// Refuses a known distance `metres` between points `a` and `b` beyond
-/// [`LENGTH_REACH_FACTOR`] × the robot's reach ([`crate::units::reach`]):
-/// no two points the tool touches are so far apart (a length in
-/// millimetres given as metres is named as such). The check of a contact
-/// fit's distances ([`check_distances`]) and of a socket design's
-/// (`select --point-distance`) alike.
-pub fn check_distance_reach(robot: &Robot, a: &str, b: &str, metres: f64) -> Result<()> {
+/// Why a known distance `metres` between points `a` and `b` cannot be,
+/// or `None`: beyond [`LENGTH_REACH_FACTOR`] × the robot's reach
+/// ([`crate::units::reach`]), no two points the tool touches are so far
+/// apart (a length in millimetres given as metres is named as such). The
+/// check of a contact fit's distances ([`check_distances`]) and of a
+/// socket design's (`select --point-distance`) alike.
+#[must_use]
+pub fn distance_beyond_reach(robot: &Robot, a: &str, b: &str, metres: f64) -> Option<String> {
     let reach = crate::units::reach(robot);
     let limit = LENGTH_REACH_FACTOR * reach;
-    if metres > limit {
-        return Err(Error::Invalid(format!(
+    (metres > limit).then(|| {
+        format!(
             "{}: {} m is more than {LENGTH_REACH_FACTOR} × the robot's reach ({reach:.3} m){}",
             distance_label(a, b, metres),
             Compact(metres),
             as_mm(metres, limit)
-        )));
-    }
-    Ok(())
+        )
+    })
 }
 
 /// Refuses a known distance beyond [`LENGTH_REACH_FACTOR`] × the reach, or
@@ -67,7 +67,11 @@ pub fn check_distances(robot: &Robot, file: &ContactFile, known: &[KnownDistance
     );
     for d in known {
         let label = distance_label(&file.points[d.a], &file.points[d.b], d.metres);
-        check_distance_reach(robot, &file.points[d.a], &file.points[d.b], d.metres)?;
+        if let Some(why) =
+            distance_beyond_reach(robot, &file.points[d.a], &file.points[d.b], d.metres)
+        {
+            return Err(Error::Invalid(why));
+        }
         let nominal = (means[d.a] - means[d.b]).norm();
         if d.metres * SHORT_FACTOR < nominal {
             return Err(Error::Invalid(format!(

@@ -109,11 +109,12 @@ fn an_output_over_an_input_is_refused_even_with_force() {
         t,
         "--force",
     ]);
+    // Each run, the input it would overwrite, and the option that gave it.
     let cases: Vec<(Vec<&str>, &Path, &str)> = vec![
         (
             vec!["select", "--pool", &pool_spec, "--out", dp, "--force"],
             &poses,
-            "--out",
+            "--pool file:",
         ),
         (
             vec![
@@ -127,34 +128,38 @@ fn an_output_over_an_input_is_refused_even_with_force() {
                 "--force",
             ],
             &poses,
-            "--out",
+            "--existing",
         ),
         (
             vec!["select", "--robot", u, "--frames", f, "--out", f, "--force"],
             &frames,
-            "--out",
+            "--frames",
         ),
         (
             vec!["select", "--robot", u, "--out", u, "--force"],
             &urdf,
-            "--out",
+            "--robot",
         ),
-        (camera, &target, "--out"),
+        (camera, &target, "--target"),
         (
             vec!["pool", "--pool", &pool_spec, "--out", p, "--force"],
             &poses,
-            "--out",
+            "--pool file:",
         ),
         (
             vec!["robots", "--export", u, "--out", u, "--force"],
             &urdf,
-            "--out",
+            "--export",
         ),
     ];
     for (args, input, option) in cases {
         let before = bytes(input);
-        let shown = args[args.iter().rposition(|a| *a == option).unwrap() + 1];
-        refused(&args, &[option, shown, "is an input of this command"]);
+        let shown = args[args.iter().rposition(|a| *a == "--out").unwrap() + 1];
+        let named = format!("({option} {})", input.display());
+        refused(
+            &args,
+            &["--out", shown, "is an input of this command", &named],
+        );
         assert_eq!(bytes(input), before, "{args:?} changed {}", input.display());
     }
     std::fs::remove_dir_all(&d).unwrap();
@@ -197,7 +202,11 @@ fn two_outputs_naming_one_file_are_refused_before_work() {
         ),
         (
             vec!["--report", ds, "--force"],
-            vec!["--report", ds, "holds an input of this command"],
+            vec![
+                "--report",
+                ds,
+                "holds an input of this command (--pool file:",
+            ],
         ),
     ];
     for (more, needles) in cases {

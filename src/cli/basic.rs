@@ -106,7 +106,7 @@ pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
             Some(p) => {
                 let mut files = super::run_files::RunFiles::new();
                 files
-                    .robot(name)
+                    .robot_as("--export", name)
                     .output("--out", Some(p.as_path()))
                     .check(a.force)?;
                 Format::of(p).map_err(|e| anyhow::anyhow!("--out {e}"))?

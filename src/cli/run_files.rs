@@ -2,14 +2,15 @@
 //! every file or directory it writes, collected by the command and checked
 //! together, once, before any work ([`RunFiles::check`]). Paths are
 //! compared by their canonical identity
-//! ([`activecal::io::atomic::check_outputs`],
-//! [`activecal::io::atomic::output_dir_conflict`]): `--force` never replaces
+//! ([`activecal::io::atomic::output_over_input`],
+//! [`activecal::io::atomic::output_dir_conflict`],
+//! [`activecal::io::atomic::check_outputs`]): `--force` never replaces
 //! an input of the same run, two outputs never name one file, and a
 //! directory replaced whole (`--report DIR`) holds no input and no other
 //! output.
 
 use activecal::io::RobotRef;
-use activecal::io::atomic::Output;
+use activecal::io::atomic::{Output, output_dir_conflict, output_over_input};
 use anyhow::{Result, bail};
 use std::path::{Path, PathBuf};
 
@@ -73,8 +74,14 @@ impl RunFiles {
     /// The robot's files: its description (when `--robot` names a file,
     /// not a built-in robot) and the chain's frames file (`--frames`).
     pub fn robot(&mut self, r: &RobotRef) -> &mut Self {
+        self.robot_as("--robot", r)
+    }
+
+    /// As [`Self::robot`], the robot given by option `label` (`robots
+    /// --export`).
+    pub fn robot_as(&mut self, label: &str, r: &RobotRef) -> &mut Self {
         if r.path().is_file() {
-            self.input("--robot", Some(r.path()));
+            self.input(label, Some(r.path()));
         }
         let frames = r.chain.frames.as_deref().map(Path::new);
         self.input("--frames", frames)
@@ -100,27 +107,26 @@ impl RunFiles {
     /// needs `force`, its directory must exist) and each output directory
     /// ([`check_dir`]).
     pub fn check(&self, force: bool) -> Result<()> {
-        let inputs: Vec<&Path> = self.inputs.iter().map(|(_, p)| p.as_path()).collect();
-        let files: Vec<Output<'_>> = self
-            .outputs
-            .iter()
-            .map(|(label, path)| Output { label, path })
-            .collect();
-        let dirs: Vec<Output<'_>> = self
-            .dirs
-            .iter()
-            .map(|(label, path)| Output { label, path })
-            .collect();
-        if let Some(why) = activecal::io::atomic::output_dir_conflict(&dirs, &files, &inputs) {
+        let (inputs, files, dirs) = (view(&self.inputs), view(&self.outputs), view(&self.dirs));
+        let over_input = files.iter().find_map(|o| output_over_input(o, &inputs));
+        if let Some(why) = over_input.or_else(|| output_dir_conflict(&dirs, &files, &inputs)) {
             bail!(why);
         }
+        let paths: Vec<&Path> = inputs.iter().map(|i| i.path).collect();
         let pairs: Vec<(&str, &Path)> = files.iter().map(|o| (o.label, o.path)).collect();
-        super::check_outputs(&pairs, &inputs, force)?;
-        for (label, dir) in &self.dirs {
-            check_dir(label, dir, force)?;
+        super::check_outputs(&pairs, &paths, force)?;
+        for d in &dirs {
+            check_dir(d.label, d.path, force)?;
         }
         Ok(())
     }
+}
+
+/// Labelled paths as the library's [`Output`]s.
+fn view(v: &[(String, PathBuf)]) -> Vec<Output<'_>> {
+    v.iter()
+        .map(|(label, path)| Output { label, path })
+        .collect()
 }
 
 /// Refuses an output directory `dir` (named by option `label`) that is a

@@ -70,16 +70,17 @@ fn identity(path: &Path) -> PathBuf {
 pub fn output_dir_conflict(
     dirs: &[Output<'_>],
     files: &[Output<'_>],
-    inputs: &[&Path],
+    inputs: &[Output<'_>],
 ) -> Option<String> {
     for (k, d) in dirs.iter().enumerate() {
         let shown = d.path.display();
         let id = identity(d.path);
-        if let Some(i) = inputs.iter().find(|i| identity(i).starts_with(&id)) {
+        if let Some(i) = inputs.iter().find(|i| identity(i.path).starts_with(&id)) {
             return Some(format!(
-                "{} {shown}: is or holds an input of this command ({}), and the directory is replaced whole; choose another directory",
+                "{} {shown}: is or holds an input of this command ({} {}), and the directory is replaced whole; choose another directory",
                 d.label,
-                i.display()
+                i.label,
+                i.path.display()
             ));
         }
         if let Some(other) = dirs[..k]
@@ -113,6 +114,24 @@ pub fn output_dir_conflict(
         }
     }
     None
+}
+
+/// Why output `output` (one of a command's) cannot be written, or `None`:
+/// it is one of the command's `inputs` by canonical identity (another
+/// spelling, a symbolic link), which `--force` never replaces. The reason
+/// names the output's option and path and the input's.
+#[must_use]
+pub fn output_over_input(output: &Output<'_>, inputs: &[Output<'_>]) -> Option<String> {
+    let id = identity(output.path);
+    inputs.iter().find(|i| identity(i.path) == id).map(|i| {
+        format!(
+            "{} {}: is an input of this command ({} {}); an input is never overwritten, even with --force: choose another file",
+            output.label,
+            output.path.display(),
+            i.label,
+            i.path.display()
+        )
+    })
 }
 
 /// Checks a command's output files before it does any work: each must name
@@ -436,12 +455,21 @@ mod tests {
         std::fs::write(&input, "{}").unwrap();
         let report = d.join("report");
         let o = |label, path| Output { label, path };
+        let inputs = [o("--pool file:", &input)];
         let e = |dirs: &[Output<'_>], files: &[Output<'_>]| {
-            output_dir_conflict(dirs, files, &[&input]).expect("a conflict")
+            output_dir_conflict(dirs, files, &inputs).expect("a conflict")
         };
         // The directory holding the input, by another spelling.
         let here = d.join(".");
-        assert!(e(&[o("--report", &here)], &[]).contains("holds an input"));
+        assert!(
+            e(&[o("--report", &here)], &[])
+                .contains("holds an input of this command (--pool file:")
+        );
+        // An output over an input, by another spelling, names both.
+        let dotted = d.join(".").join("in.json");
+        let over = output_over_input(&o("--out", &dotted), &inputs);
+        assert!(over.is_some_and(|w| w.contains("--out") && w.contains("(--pool file:")));
+        assert_eq!(output_over_input(&o("--out", &report), &inputs), None);
         // A file named like the directory, a file inside it (not yet made).
         let inside = report.join("x.json");
         assert!(e(&[o("--report", &report)], &[o("--out", &report)]).contains("name the same"));
@@ -449,7 +477,7 @@ mod tests {
         let elsewhere = d.join("x.json");
         let apart = [o("--report", &report)];
         assert_eq!(
-            output_dir_conflict(&apart, &[o("--out", &elsewhere)], &[&input]),
+            output_dir_conflict(&apart, &[o("--out", &elsewhere)], &inputs),
             None
         );
         std::fs::remove_dir_all(&d).unwrap();

@@ -360,7 +360,8 @@ fn select_predicts_the_calibrated_error_for_a_noise() {
 }
 
 /// `select --out` is repeatable: one run writes each format, the same
-/// design in each; a path given twice is refused before any work.
+/// design in each; a path given twice (two outputs naming one file) is
+/// refused before any work.
 #[test]
 fn select_writes_several_formats_in_one_run() {
     let dir = super::common::scratch_dir("select", "outs");
@@ -401,7 +402,7 @@ fn select_writes_several_formats_in_one_run() {
             json.to_str().unwrap(),
             "--force",
         ],
-        "given twice",
+        "--out and --out name the same file",
     );
 }
 

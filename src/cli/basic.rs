@@ -104,7 +104,11 @@ pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
         use activecal::io::calibrated::{Format, render};
         let format = match &a.out {
             Some(p) => {
-                super::refuse_overwrite(p, a.force)?;
+                let mut files = super::run_files::RunFiles::new();
+                files
+                    .robot_as("--export", name)
+                    .output("--out", Some(p.as_path()))
+                    .check(a.force)?;
                 Format::of(p).map_err(|e| anyhow::anyhow!("--out {e}"))?
             }
             None => Format::Toml,
@@ -319,7 +323,11 @@ fn pool_out_format(path: &std::path::Path) -> Result<&'static str> {
 /// with `--out`.
 pub fn cmd_pool(a: PoolArgs) -> Result<()> {
     if let Some(out) = &a.out {
-        super::refuse_overwrite(out, a.force)?;
+        let mut files = super::run_files::RunFiles::new();
+        files
+            .pool(&a.pool)
+            .output("--out", Some(out))
+            .check(a.force)?;
         pool_out_format(out)?;
     }
     if let Some(d) = a.digits.as_deref() {

@@ -39,32 +39,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
             "--validation 0: the validation RMS needs at least 1 held-out pose (the RMS error of no poses would read 0)"
         );
     }
-    let outputs: Vec<(&str, &std::path::Path)> = a
-        .out
-        .iter()
-        .map(|p| ("--out", p.as_path()))
-        .chain(
-            a.save_measurements
-                .as_deref()
-                .map(|p| ("--save-measurements", p)),
-        )
-        .collect();
-    let robot_path = std::path::Path::new(&a.robot.name);
-    let inputs: Vec<&std::path::Path> = [
-        a.design.as_deref(),
-        a.measurements.as_deref(),
-        a.observations.as_deref(),
-        a.camera_info.as_deref(),
-        a.target.as_deref(),
-        Some(robot_path),
-    ]
-    .into_iter()
-    .flatten()
-    .collect();
-    super::check_outputs(&outputs, &inputs, a.force)?;
-    if let Some(dir) = &a.report {
-        super::report_dir::check(dir, a.force)?;
-    }
+    calibrate_files(&a).check(a.force)?;
     for out in &a.out {
         Format::of(out).map_err(|e| anyhow::anyhow!("--out {e}"))?;
     }
@@ -118,6 +93,27 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
         (Some(d), None) => super::simulated::from_design(&a, robot, desc.visibility.as_ref(), d),
         (None, None) => bail!("give --design (simulate) or --measurements (real data)"),
     }
+}
+
+/// Every file of a `calibrate` run: the robot's (description, frames
+/// file), `--design`, `--measurements`, `--observations`, `--camera-info`,
+/// `--target`, `--inertia`; the `--out` files, `--save-measurements`,
+/// `--out-camera-info` and the `--report` directory. Checked once, before
+/// any work ([`super::run_files::RunFiles::check`]).
+fn calibrate_files(a: &CalibrateArgs) -> super::run_files::RunFiles {
+    let mut f = super::run_files::RunFiles::new();
+    f.robot(&a.robot)
+        .input("--design", a.design.as_deref())
+        .input("--measurements", a.measurements.as_deref())
+        .input("--observations", a.observations.as_deref())
+        .input("--camera-info", a.camera_info.as_deref())
+        .input("--target", a.target.as_deref())
+        .input("--inertia", a.inertia.as_deref())
+        .outputs("--out", &a.out)
+        .output("--save-measurements", a.save_measurements.as_deref())
+        .output("--out-camera-info", a.out_camera_info.as_deref())
+        .dir("--report", a.report.as_deref());
+    f
 }
 
 /// The options of a fit of measured poses that a contact fit does not

@@ -69,7 +69,7 @@ pub fn calibrate_camera(
     obs_path: &Path,
 ) -> Result<Option<String>> {
     check_out(a, robot)?;
-    check_camera_info_out(a, obs_path)?;
+    check_camera_info_out(a)?;
     let (Some(info), Some(target)) = (&a.camera_info, &a.target) else {
         bail!("--observations needs --camera-info and --target");
     };
@@ -156,9 +156,10 @@ pub fn calibrate_camera(
     }))
 }
 
-/// Refuses an `--out-camera-info` that is not a `.yaml` or exists (without
-/// `--force`), before any work.
-fn check_camera_info_out(a: &CalibrateArgs, obs_path: &Path) -> Result<()> {
+/// Refuses an `--out-camera-info` that is not a `.yaml`, before any work
+/// (it is checked against the inputs and other outputs with the command's
+/// files).
+fn check_camera_info_out(a: &CalibrateArgs) -> Result<()> {
     if let Some(o) = &a.out_camera_info {
         let yaml = o
             .extension()
@@ -169,17 +170,6 @@ fn check_camera_info_out(a: &CalibrateArgs, obs_path: &Path) -> Result<()> {
                 o.display()
             );
         }
-        let mut outs: Vec<(&str, &Path)> = vec![("--out-camera-info", o.as_path())];
-        outs.extend(a.out.iter().map(|p| ("--out", p.as_path())));
-        let ins: Vec<&Path> = [
-            a.camera_info.as_deref(),
-            a.target.as_deref(),
-            Some(obs_path),
-        ]
-        .into_iter()
-        .flatten()
-        .collect();
-        super::check_outputs(&outs, &ins, a.force)?;
     }
     Ok(())
 }

@@ -183,19 +183,14 @@ fn outputs(a: &SelectArgs) -> Result<(Option<&PathBuf>, Option<&PathBuf>)> {
             bail!("--out {}: one file of each kind (.csv, .json)", o.display());
         }
     }
-    for o in csv.iter().chain(json.iter()) {
-        super::refuse_overwrite(o, a.force)?;
-    }
     Ok((csv, json))
 }
 
 /// Runs `select` for a camera.
 pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
     refuse_unused(a)?;
+    super::select::select_files(a).check(a.force)?;
     let (csv_out, json_out) = outputs(a)?;
-    if let Some(dir) = &a.report {
-        super::report_dir::check(dir, a.force)?;
-    }
     let robot = super::load_robot(&a.pool.robot)?;
     let robot = match &a.camera.camera_link {
         Some(link) => activecal::io::urdf_branch::camera_branch(&robot, link)
@@ -204,9 +199,14 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
     };
     let v = view(&a.camera)?;
     let (filters, los) = sight(a, &robot)?;
+    let count = a.pool.count.unwrap_or(DEFAULT_SAMPLES);
+    activecal::resources::check_alloc::<f64>(
+        &format!("--count {count}: the candidate configurations"),
+        count.saturating_mul(robot.dof() + 3),
+    )?;
     let candidates = activecal::observability::generic_configurations(
         &robot,
-        a.pool.count.unwrap_or(DEFAULT_SAMPLES),
+        count,
         a.pool.pool_seed.unwrap_or(0),
     );
     let settings = activecal::select::Settings::builder()
@@ -214,7 +214,13 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         .seed(a.seed)
         .build()?;
     let (d, collision_removed) =
-        camera_design_filtered(&robot, &v, &filters, los.as_ref(), &candidates, &settings)?;
+        camera_design_filtered(&robot, &v, &filters, los.as_ref(), &candidates, &settings)
+            .map_err(|e| match e {
+                e @ activecal::Error::TooLarge { .. } => {
+                    anyhow::Error::from(e).context(format!("--count {count}"))
+                }
+                e => e.into(),
+            })?;
     let gap = if a.gap {
         let bs = activecal::bound::BoundSettings::builder()
             .solver(a.gap_solver)

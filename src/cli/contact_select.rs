@@ -4,6 +4,7 @@
 //! `activecal::identify::contact::socket_design`.
 
 use super::select::SelectArgs;
+use activecal::identify::contact::lengths::distance_beyond_reach;
 use activecal::identify::contact::select::Socket;
 use activecal::identify::contact::socket_design::{
     Judged, SocketDesign, SocketDesignSettings, design_for_sockets,
@@ -34,7 +35,14 @@ fn parse_socket(s: &str) -> Result<Socket> {
 
 /// The `--point-distance A,B=METRES` between sockets, as indices into
 /// `sockets`; a name that is no socket's is refused, naming the sockets.
-fn known_distances(sockets: &[Socket], given: &[String]) -> Result<Vec<KnownDistance>> {
+/// A distance beyond twice the robot's reach is refused as `calibrate`
+/// refuses it ([`distance_beyond_reach`], a length in millimetres named as
+/// such).
+fn known_distances(
+    robot: &activecal::model::Robot,
+    sockets: &[Socket],
+    given: &[String],
+) -> Result<Vec<KnownDistance>> {
     let names: Vec<&str> = sockets.iter().map(|s| s.name.as_str()).collect();
     given
         .iter()
@@ -53,6 +61,9 @@ fn known_distances(sockets: &[Socket], given: &[String]) -> Result<Vec<KnownDist
                 bail!(
                     "--point-distance {s}: a distance needs two different points and a finite length > 0 (metres)"
                 );
+            }
+            if let Some(why) = distance_beyond_reach(robot, &d.a, &d.b, d.metres) {
+                bail!("--point-distance: {why}");
             }
             Ok(KnownDistance {
                 a: ia,
@@ -102,7 +113,8 @@ pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
         .map(|s| parse_socket(s))
         .collect::<Result<_>>()?;
     refuse_pool_options(a)?;
-    super::select::check_outs(&a.out, a.force)?;
+    super::select::select_files(a).check(a.force)?;
+    super::select::check_out_formats(&a.out)?;
     let margin_deg = a
         .pool
         .margin
@@ -118,7 +130,7 @@ pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
             robot.name
         );
     }
-    let distances = known_distances(&sockets, &a.point_distance)?;
+    let distances = known_distances(&robot, &sockets, &a.point_distance)?;
     let filters = a.pool.collision_filters(&robot)?;
     let settings = SocketDesignSettings {
         n: a.n,

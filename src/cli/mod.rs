@@ -25,6 +25,7 @@ pub mod progress;
 pub mod report_dir;
 pub mod report_plots;
 pub mod reproduce;
+pub mod run_files;
 pub mod score;
 pub mod select;
 pub mod simulated;

@@ -1,7 +1,8 @@
 //! `--report DIR` of `calibrate` and `select`: a directory with report.md,
 //! report.json and the figures (PNG and SVG, [`super::report_plots`]). The
-//! directory is checked before any work (an existing non-empty one needs
-//! `--force`), built aside and swapped in whole.
+//! directory is checked before any work with the command's files
+//! ([`super::run_files`]: an existing non-empty one needs `--force`), built
+//! aside and swapped in whole.
 
 use super::report_plots::{self as plots, CurveRow, JointRow, ParamBar};
 use activecal::how_many::PoseCountCurve;
@@ -9,39 +10,9 @@ use activecal::identify::Identification;
 use activecal::io::atomic::{StagedDir, write_atomic};
 use activecal::model::{JointKind, Robot, Symbol};
 use activecal::report::SelectReport;
-use anyhow::{Result, bail};
+use anyhow::Result;
 use std::fmt::Write as _;
 use std::path::Path;
-
-/// Refuses `--report DIR` when DIR is a file, is a non-empty directory
-/// (without `force`), or its parent does not exist.
-pub fn check(dir: &Path, force: bool) -> Result<()> {
-    if dir.exists() {
-        if !dir.is_dir() {
-            bail!("--report {}: exists and is not a directory", dir.display());
-        }
-        let non_empty = std::fs::read_dir(dir)
-            .map(|mut d| d.next().is_some())
-            .unwrap_or(true);
-        if non_empty && !force {
-            bail!(
-                "--report {}: exists and is not empty; pass --force to replace it",
-                dir.display()
-            );
-        }
-    }
-    if let Some(parent) = dir
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty() && !p.is_dir())
-    {
-        bail!(
-            "--report {}: the directory {} does not exist",
-            dir.display(),
-            parent.display()
-        );
-    }
-    Ok(())
-}
 
 /// Writes `text` into the staged directory as `name`.
 fn put(staged: &StagedDir, name: &str, text: &str) -> Result<()> {

@@ -8,7 +8,7 @@
 use super::figures;
 use activecal::experiment::paper::{self, PaperReport, PaperSettings};
 use activecal::progress::Task;
-use anyhow::{Result, bail};
+use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -94,31 +94,9 @@ pub fn cmd_reproduce(a: ReproduceArgs) -> Result<()> {
     // Every input is checked before any work or any file is made.
     let settings = a.settings();
     settings.validate()?;
-    if a.out.exists() {
-        if !a.out.is_dir() {
-            bail!("--out {}: exists and is not a directory", a.out.display());
-        }
-        let non_empty = std::fs::read_dir(&a.out)
-            .map(|mut d| d.next().is_some())
-            .unwrap_or(true);
-        if non_empty && !a.force {
-            bail!(
-                "--out {}: exists and is not empty; pass --force to replace it",
-                a.out.display()
-            );
-        }
-    }
-    if let Some(parent) = a
-        .out
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty() && !p.is_dir())
-    {
-        bail!(
-            "--out {}: the directory {} does not exist",
-            a.out.display(),
-            parent.display()
-        );
-    }
+    super::run_files::RunFiles::new()
+        .dir("--out", Some(a.out.as_path()))
+        .check(a.force)?;
     // Built aside and swapped in whole: an interrupted run leaves the old
     // report as it was, never new figures beside an old report.
     let staged = activecal::io::atomic::StagedDir::new(&a.out)?;

@@ -346,29 +346,37 @@ fn predicted_after(
     activecal::report::PredictedAfter::of_design(robot, robot.params(params), &ctx.x, poses, noise)
 }
 
-/// `--out` files, checked before any work: each one's format, an existing
-/// file without `--force`, a missing directory, and no path given twice.
-pub fn check_outs(outs: &[PathBuf], force: bool) -> Result<()> {
-    for (k, out) in outs.iter().enumerate() {
-        if outs[..k].contains(out) {
-            bail!("--out {}: given twice", out.display());
-        }
-        super::refuse_overwrite(out, force)?;
+/// Every file of a `select` run, whichever kind (pool, camera, sockets):
+/// the pool's inputs (robot, frames, `--pool file:`, SRDF, mesh
+/// directories), `--existing`, the camera's `--camera-info` and
+/// `--target`, the `--out` files and the `--report` directory; checked
+/// once, before any work ([`super::run_files::RunFiles::check`]).
+pub fn select_files(a: &SelectArgs) -> super::run_files::RunFiles {
+    let mut f = super::run_files::RunFiles::new();
+    f.pool(&a.pool)
+        .input("--existing", a.existing.as_deref())
+        .input("--camera-info", a.camera.camera_info.as_deref())
+        .input("--target", a.camera.target.as_deref())
+        .outputs("--out", &a.out)
+        .dir("--report", a.report.as_deref());
+    f
+}
+
+/// `--out` files' formats (by extension), checked before any work.
+pub fn check_out_formats(outs: &[PathBuf]) -> Result<()> {
+    for out in outs {
         activecal::io::design_formats::DesignFormat::of(out)
             .map_err(|e| anyhow::anyhow!("--out {e}"))?;
     }
     Ok(())
 }
 
-/// The outputs and report options of `select`, checked before any work:
-/// the format, an existing file, a missing directory, the noise.
+/// The files and report options of `select`, checked before any work:
+/// every output against every input and every other output, an existing
+/// file, a missing directory, the format, the noise.
 fn check_select_outputs(a: &SelectArgs) -> Result<()> {
-    // Checked before the search: the format, an existing file, a missing
-    // directory, a path given twice.
-    check_outs(&a.out, a.force)?;
-    if let Some(dir) = &a.report {
-        super::report_dir::check(dir, a.force)?;
-    }
+    select_files(a).check(a.force)?;
+    check_out_formats(&a.out)?;
     if let Some(n) = a.noise.filter(|v| !(v.is_finite() && *v > 0.0)) {
         bail!("--noise {n}: the sensor noise σ must be a finite number > 0 (metres)");
     }

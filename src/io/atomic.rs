@@ -8,7 +8,9 @@
 //!
 //! [`check_outputs`] refuses, before any work is done, an output that exists
 //! (without `force`), that is a directory, whose directory does not exist,
-//! that is one of the command's inputs, or that two outputs share.
+//! that is one of the command's inputs, or that two outputs share;
+//! [`output_dir_conflict`] finds an output directory (replaced whole) that
+//! holds an input or another output.
 
 use crate::error::{Error, Result};
 use std::io::Write;
@@ -30,19 +32,106 @@ fn invalid(msg: String) -> Error {
 }
 
 /// A path's identity for comparisons: canonical when it exists, else its
-/// canonical parent joined with the file name, else as given.
+/// nearest existing ancestor made canonical and joined with the rest (so
+/// `./x/new.json`, `x/new.json` and a symbolic link to `x` agree, and a
+/// file inside a directory yet to be made is still inside it), else as
+/// given.
 fn identity(path: &Path) -> PathBuf {
     if let Ok(c) = path.canonicalize() {
         return c;
     }
-    let parent = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    match (parent.canonicalize(), path.file_name()) {
-        (Ok(p), Some(f)) => p.join(f),
-        _ => path.to_path_buf(),
+    let mut rest = Vec::new();
+    let mut at = path;
+    loop {
+        let (Some(name), Some(parent)) = (at.file_name(), at.parent()) else {
+            return path.to_path_buf();
+        };
+        rest.push(name);
+        at = parent;
+        let base = if at.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            at
+        };
+        if let Ok(c) = base.canonicalize() {
+            return rest.iter().rev().fold(c, |p, n| p.join(n));
+        }
     }
+}
+
+/// Why a command's output directories (each replaced whole, as a report
+/// directory is) conflict with its output files or its inputs, by
+/// canonical identity, or `None`; checked before any work: a directory
+/// that is or holds an input (replacing it would delete the input), that
+/// names the same path as an output file or another output directory, or
+/// that holds an output file or another output directory. The reason
+/// names both options and the paths.
+#[must_use]
+pub fn output_dir_conflict(
+    dirs: &[Output<'_>],
+    files: &[Output<'_>],
+    inputs: &[Output<'_>],
+) -> Option<String> {
+    for (k, d) in dirs.iter().enumerate() {
+        let shown = d.path.display();
+        let id = identity(d.path);
+        if let Some(i) = inputs.iter().find(|i| identity(i.path).starts_with(&id)) {
+            return Some(format!(
+                "{} {shown}: is or holds an input of this command ({} {}), and the directory is replaced whole; choose another directory",
+                d.label,
+                i.label,
+                i.path.display()
+            ));
+        }
+        if let Some(other) = dirs[..k]
+            .iter()
+            .chain(files)
+            .find(|o| identity(o.path) == id)
+        {
+            return Some(format!(
+                "{} and {} name the same file {shown}",
+                other.label, d.label
+            ));
+        }
+        if let Some(o) = files.iter().find(|o| identity(o.path).starts_with(&id)) {
+            return Some(format!(
+                "{} {}: is inside the {} directory {shown}, which is replaced whole; write it outside that directory",
+                o.label,
+                o.path.display(),
+                d.label
+            ));
+        }
+        if let Some(other) = dirs[..k]
+            .iter()
+            .find(|o| identity(o.path).starts_with(&id) || id.starts_with(identity(o.path)))
+        {
+            return Some(format!(
+                "{} {shown} and {} {}: one directory inside the other; choose separate directories",
+                d.label,
+                other.label,
+                other.path.display()
+            ));
+        }
+    }
+    None
+}
+
+/// Why output `output` (one of a command's) cannot be written, or `None`:
+/// it is one of the command's `inputs` by canonical identity (another
+/// spelling, a symbolic link), which `--force` never replaces. The reason
+/// names the output's option and path and the input's.
+#[must_use]
+pub fn output_over_input(output: &Output<'_>, inputs: &[Output<'_>]) -> Option<String> {
+    let id = identity(output.path);
+    inputs.iter().find(|i| identity(i.path) == id).map(|i| {
+        format!(
+            "{} {}: is an input of this command ({} {}); an input is never overwritten, even with --force: choose another file",
+            output.label,
+            output.path.display(),
+            i.label,
+            i.path.display()
+        )
+    })
 }
 
 /// Checks a command's output files before it does any work: each must name
@@ -356,6 +445,41 @@ mod tests {
         assert!(e(&[out(&new)], false).contains("overwriting it was not asked for"));
         check_outputs(&[out(&new)], &[&input], true).unwrap();
         check_outputs(&[out(&d.join("fresh.json"))], &[&input], false).unwrap();
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn output_directories_hold_no_input_and_no_other_output() {
+        let d = scratch("dirs");
+        let input = d.join("in.json");
+        std::fs::write(&input, "{}").unwrap();
+        let report = d.join("report");
+        let o = |label, path| Output { label, path };
+        let inputs = [o("--pool file:", &input)];
+        let e = |dirs: &[Output<'_>], files: &[Output<'_>]| {
+            output_dir_conflict(dirs, files, &inputs).expect("a conflict")
+        };
+        // The directory holding the input, by another spelling.
+        let here = d.join(".");
+        assert!(
+            e(&[o("--report", &here)], &[])
+                .contains("holds an input of this command (--pool file:")
+        );
+        // An output over an input, by another spelling, names both.
+        let dotted = d.join(".").join("in.json");
+        let over = output_over_input(&o("--out", &dotted), &inputs);
+        assert!(over.is_some_and(|w| w.contains("--out") && w.contains("(--pool file:")));
+        assert_eq!(output_over_input(&o("--out", &report), &inputs), None);
+        // A file named like the directory, a file inside it (not yet made).
+        let inside = report.join("x.json");
+        assert!(e(&[o("--report", &report)], &[o("--out", &report)]).contains("name the same"));
+        assert!(e(&[o("--report", &report)], &[o("--out", &inside)]).contains("is inside"));
+        let elsewhere = d.join("x.json");
+        let apart = [o("--report", &report)];
+        assert_eq!(
+            output_dir_conflict(&apart, &[o("--out", &elsewhere)], &inputs),
+            None
+        );
         std::fs::remove_dir_all(&d).unwrap();
     }
 

@@ -334,12 +334,40 @@ fn length(v: &Spanned<Num>, kind: &str, key: &str) -> std::result::Result<f64, S
     Ok(l)
 }
 
+/// Bytes a target point takes while the target is made and checked: its
+/// id, its position, and its row of the spread check's matrix.
+const BYTES_PER_POINT: usize = 8 + 2 * 3 * 8;
+
+/// Refuses a grid of `points` points (`rows × cols` `what` of `kind`, at
+/// `b`'s place in the file) whose memory would exceed the budget
+/// ([`crate::resources::MemoryBudget`]), with the figure, before it is
+/// made.
+fn within_memory<T>(
+    b: &Spanned<T>,
+    kind: &str,
+    (rows, cols): (usize, usize),
+    what: &str,
+    points: usize,
+) -> std::result::Result<(), String> {
+    let bytes = crate::resources::bytes_of(points, BYTES_PER_POINT);
+    let what = format!(
+        "{} ('{kind}'): {rows} × {cols} {what}, {points} target points,",
+        at(b)
+    );
+    match crate::resources::MemoryBudget::from_env() {
+        Ok(m) => m.check(&what, bytes).map_err(|e| e.to_string()),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
 fn board(b: &Spanned<Board>) -> std::result::Result<Target, String> {
     let (rows, cols) = (
         count(&b.value.rows, "checkerboard", "rows", "inner corners", 2)?,
         count(&b.value.cols, "checkerboard", "cols", "inner corners", 2)?,
     );
     let sq = length(&b.value.square, "checkerboard", "square")?;
+    let points = rows.saturating_mul(cols);
+    within_memory(b, "checkerboard", (rows, cols), "inner corners", points)?;
     Ok(Target::checkerboard(rows, cols, sq))
 }
 
@@ -351,6 +379,8 @@ fn charuco(b: &Spanned<Charuco>) -> std::result::Result<Target, String> {
     );
     let square = length(&c.square, "charuco", "square")?;
     let marker = length(&c.marker, "charuco", "marker")?;
+    let points = (rows - 1).saturating_mul(cols - 1);
+    within_memory(b, "charuco", (rows, cols), "squares", points)?;
     if marker >= square {
         return Err(format!(
             "{} ('charuco.marker'): a {marker} m marker in a {square} m square; the marker must be smaller",
@@ -367,6 +397,8 @@ fn aprilgrid(b: &Spanned<Aprilgrid>) -> std::result::Result<Target, String> {
         count(&g.cols, "aprilgrid", "cols", "tags", 1)?,
     );
     let size = length(&g.tag_size, "aprilgrid", "tag_size")?;
+    let points = rows.saturating_mul(cols).saturating_mul(4);
+    within_memory(b, "aprilgrid", (rows, cols), "tags", points)?;
     let spacing = positive(
         &g.tag_spacing,
         "aprilgrid",

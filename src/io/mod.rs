@@ -220,7 +220,42 @@ fn chosen_markers(
             m.link
         )));
     }
+    let reach = crate::units::reach(robot);
+    if let Some(why) = chain
+        .markers
+        .iter()
+        .find_map(|m| marker_beyond_reach(m, reach))
+    {
+        return Err(Error::Invalid(why));
+    }
     Ok(chain.markers.iter().map(|m| m.offset).collect())
+}
+
+/// Why a marker cannot be, or `None`: its offset from its link is beyond
+/// the robot's `reach` (metres, [`crate::units::reach`] of the robot
+/// without markers). An offset in millimetres given as metres (named as
+/// such) makes a different robot, for `select` and `calibrate` alike.
+fn marker_beyond_reach(m: &MarkerChoice, reach: f64) -> Option<String> {
+    let [x, y, z] = m.offset;
+    let norm = (x * x + y * y + z * z).sqrt();
+    if norm.is_finite() && norm <= reach {
+        return None;
+    }
+    let mm = if norm * 1e-3 <= reach {
+        let c = |v: f64| crate::error::Compact(v * 1e-3);
+        format!(
+            "; it looks like millimetres ({}@{},{},{} in metres)",
+            m.link,
+            c(x),
+            c(y),
+            c(z)
+        )
+    } else {
+        String::new()
+    };
+    Some(format!(
+        "marker {m}: {norm:.3} m from its link, beyond the robot's reach ({reach:.3} m){mm}"
+    ))
 }
 
 /// The robot deflecting under gravity with the frames file's compliances

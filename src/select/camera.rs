@@ -198,6 +198,18 @@ pub fn camera_design_in_sight(
         )));
     }
     let qs: Vec<Vec<f64>> = kept.iter().map(|&i| candidates[i].clone()).collect();
+    // The pixel Jacobian (its rows, the blocks made of them, and the
+    // compressed blocks) refused with the figure when it would exceed the
+    // memory budget: an error, not an abort.
+    let (t, p) = (view.sensor().0.rows(), robot.n_unknowns() + OWN_PARAMS);
+    crate::resources::MemoryBudget::from_env()?.check(
+        &format!(
+            "the pixel Jacobian of the {} candidate configurations the camera sees ({t} rows × {p} unknowns each)",
+            qs.len()
+        ),
+        crate::resources::bytes_of(qs.len().saturating_mul(t).saturating_mul(p), 8)
+            .saturating_mul(3),
+    )?;
     let (blocks, rank_per_pose) = camera_blocks(&robot, view, &qs).compressed();
     let sel = select(&blocks, CriterionKind::Det, Algorithm::Eae, settings)?;
     let seen = sel

@@ -31,30 +31,46 @@ fn as_mm(metres: f64, limit: f64) -> String {
     }
 }
 
+/// How a known distance is named in messages: `distance A,B=METRES`.
+fn distance_label(a: &str, b: &str, metres: f64) -> String {
+    format!("distance {a},{b}={}", Compact(metres))
+}
+
+/// Why a known distance `metres` between points `a` and `b` cannot be,
+/// or `None`: beyond [`LENGTH_REACH_FACTOR`] × the robot's reach
+/// ([`crate::units::reach`]), no two points the tool touches are so far
+/// apart (a length in millimetres given as metres is named as such). The
+/// check of a contact fit's distances ([`check_distances`]) and of a
+/// socket design's (`select --point-distance`) alike.
+#[must_use]
+pub fn distance_beyond_reach(robot: &Robot, a: &str, b: &str, metres: f64) -> Option<String> {
+    let reach = crate::units::reach(robot);
+    let limit = LENGTH_REACH_FACTOR * reach;
+    (metres > limit).then(|| {
+        format!(
+            "{}: {} m is more than {LENGTH_REACH_FACTOR} × the robot's reach ({reach:.3} m){}",
+            distance_label(a, b, metres),
+            Compact(metres),
+            as_mm(metres, limit)
+        )
+    })
+}
+
 /// Refuses a known distance beyond [`LENGTH_REACH_FACTOR`] × the reach, or
 /// [`SHORT_FACTOR`] times shorter than the nominal model's distance between
 /// the two points' mean contacts (with no tool offset), naming it.
 pub fn check_distances(robot: &Robot, file: &ContactFile, known: &[KnownDistance]) -> Result<()> {
-    let reach = crate::units::reach(robot);
-    let limit = LENGTH_REACH_FACTOR * reach;
     let means = group_means(
         &tool_points(robot, &robot.nominal, &[0.0; 3], &file.qs),
         &file.groups,
         file.points.len() + file.planes.len(),
     );
     for d in known {
-        let label = format!(
-            "distance {},{}={}",
-            file.points[d.a],
-            file.points[d.b],
-            Compact(d.metres)
-        );
-        if d.metres > limit {
-            return Err(Error::Invalid(format!(
-                "{label}: {} m is more than {LENGTH_REACH_FACTOR} × the robot's reach ({reach:.3} m){}",
-                Compact(d.metres),
-                as_mm(d.metres, limit)
-            )));
+        let label = distance_label(&file.points[d.a], &file.points[d.b], d.metres);
+        if let Some(why) =
+            distance_beyond_reach(robot, &file.points[d.a], &file.points[d.b], d.metres)
+        {
+            return Err(Error::Invalid(why));
         }
         let nominal = (means[d.a] - means[d.b]).norm();
         if d.metres * SHORT_FACTOR < nominal {

@@ -6,7 +6,7 @@ use crate::convert::{arg_err, count, detached, err, float_array, json_to_py, nam
 use crate::robot::Robot;
 use activecal::experiment::measured::{MeasuredSettings, calibrate_measurements};
 use activecal::frames::CalibratedFrames;
-use activecal::frames::report::{FitBlock, FramesReport};
+use activecal::frames::report::FramesReport;
 use activecal::identify::{Identification, LmSettings, LossChoice, Measurements};
 use activecal::io::calibrated::Format;
 use pyo3::prelude::*;

@@ -87,6 +87,7 @@ impl From<activecal::experiment::paper::ExperimentError> for Fail {
             E::Input(e) => e.into(),
             E::Bound(e) => e.into(),
             E::Identify(_) | E::InFile { .. } => Fail::Input(e.to_string()),
+            E::Frames(_) => Fail::Compute(e.to_string()),
         }
     }
 }

@@ -136,30 +136,13 @@ fn sight(a: &SelectArgs, robot: &Robot) -> Result<(Vec<PoolFilter>, Option<LineO
     Ok((filters, Some(choice.line_of_sight(chain, root))))
 }
 
-/// Options of `select` a camera design does not take (yet), refused
-/// rather than ignored.
-fn refuse_unused(a: &SelectArgs) -> Result<()> {
-    if a.noise.is_some() {
-        bail!(
-            "--noise is a point's noise in metres; a camera's is --pixel-noise PX (the detected points' σ in pixels)"
-        );
-    }
+/// A `--pixel-noise` that is no σ, refused (the options a camera design
+/// does not take are refused by `acts_on::SELECT`).
+fn check_pixel_noise(a: &SelectArgs) -> Result<()> {
     if let Some(px) = a.camera.pixel_noise
         && !(px.is_finite() && px > 0.0)
     {
         bail!("--pixel-noise {px}: the pixel noise σ must be a finite number > 0 (px)");
-    }
-    let unused = [
-        ("--existing", a.existing.is_some()),
-        ("--refine", a.refine),
-        ("--order", a.order.is_some()),
-        ("--home", a.home.is_some()),
-        ("--fixed", a.fixed.is_some()),
-    ];
-    if let Some((flag, _)) = unused.iter().find(|(_, used)| *used) {
-        bail!(
-            "{flag} is not available with --camera-info: a camera design is chosen on the pixel Jacobian of its visible pool, with --gap, --report, --out .csv/.json and --json"
-        );
     }
     Ok(())
 }
@@ -191,7 +174,7 @@ fn outputs(a: &SelectArgs) -> Result<(Option<&PathBuf>, Option<&PathBuf>)> {
 
 /// Runs `select` for a camera.
 pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
-    refuse_unused(a)?;
+    check_pixel_noise(a)?;
     let (csv_out, json_out) = outputs(a)?;
     if let Some(dir) = &a.report {
         super::report_dir::check(dir, a.force)?;

@@ -45,6 +45,9 @@ pub fn for_measurements(robot: &Robot, meas: &Measurements, lm: &LmSettings) -> 
     }
     let k = meas.markers();
     let has_orientation = !meas.orientations().is_empty();
+    if has_orientation {
+        refuse_constant_orientation(robot, meas)?;
+    }
     let have = crate::measure::sensor_for(robot);
     if k == have.points_per_pose() && has_orientation == have.measures_orientation() && k == 1
         || (k > 1 && robot.measurement == MeasurementKind::Markers(k))
@@ -79,6 +82,51 @@ pub fn for_measurements(robot: &Robot, meas: &Measurements, lm: &LmSettings) -> 
             })
         }
     }
+}
+
+/// The largest turn, degrees, of the nominal model's orientation (a
+/// point robot's end frame) between the first pose of `meas` and another.
+fn nominal_turn_deg(robot: &Robot, meas: &Measurements) -> f64 {
+    let mut ev = Evaluator::new(robot, &robot.nominal);
+    let mut qs = meas.qs().iter();
+    let Some(first) = qs.next() else {
+        return 0.0;
+    };
+    let r0 = ev.end_frame(first).rotation;
+    qs.map(|q| {
+        let c = ((r0.transpose() * ev.end_frame(q).rotation).trace() - 1.0) / 2.0;
+        c.clamp(-1.0, 1.0).acos().to_degrees()
+    })
+    .fold(0.0, f64::max)
+}
+
+/// Refuses orientations that are one rotation (within 1e-9) at every pose
+/// while the nominal model's orientation turns by more than a degree over
+/// the poses ([`IdentifyError::ConstantOrientation`]): fitted, they would
+/// make the robot's orientation still, with an orientation σ of tens of
+/// degrees. A robot whose orientation does not turn (a gantry) keeps them.
+fn refuse_constant_orientation(robot: &Robot, meas: &Measurements) -> Result<()> {
+    let o = meas.orientations();
+    let same = |a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]| {
+        (0..3).all(|i| (0..3).all(|j| (a[i][j] - b[i][j]).abs() <= 1e-9))
+    };
+    if o.len() < 2 || !o.iter().all(|r| same(r, &o[0])) {
+        return Ok(());
+    }
+    let turn_deg = nominal_turn_deg(robot, meas);
+    if turn_deg <= 1.0 {
+        return Ok(());
+    }
+    let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    Err(IdentifyError::ConstantOrientation {
+        what: if same(&o[0], &identity) {
+            "the identity"
+        } else {
+            "one rotation"
+        },
+        poses: o.len(),
+        turn_deg,
+    })
 }
 
 /// Each marker's least-squares offset for a chain: the mean over poses of

@@ -78,7 +78,6 @@ fn a_cameras_pixels_refuse_the_options_of_a_point_fit() {
 fn a_camera_design_refuses_the_options_of_a_pool() {
     for extra in [
         &["--algorithm", "fedorov"][..],
-        &["--pool", "file:poses.csv"],
         &[
             "--visibility",
             r#"{"kind":"box","min":[-9,-9,-9],"max":[9,9,9]}"#,
@@ -91,6 +90,43 @@ fn a_camera_design_refuses_the_options_of_a_pool() {
         let named = format!("{}: not used with --camera-info", extra[0]);
         common::fails_with(&with(&CAMERA_SELECT, extra), &named);
     }
+}
+
+/// `--pool file:` gives a camera design its candidates (the rows of a
+/// design written before: all 20 chosen, in the file's row numbers);
+/// `--pool lattice`, `--count` with a file and a unit without one are
+/// refused.
+#[test]
+fn a_camera_design_takes_its_candidates_from_a_pool_file() {
+    let d = common::scratch_dir("options", "camera_pool");
+    let first = d.join("first.csv");
+    let first = first.to_str().unwrap();
+    let base = &CAMERA_SELECT[..CAMERA_SELECT.len() - 1];
+    let v = common::json_of(&with(&CAMERA_SELECT, &["--out", first, "--json"]));
+    assert_eq!(v["candidates"], 2000, "{v}");
+    let file = format!("file:{first}");
+    let v = common::json_of(&with(base, &["--pool", &file, "--json"]));
+    assert_eq!(v["candidates"], 20, "{v}");
+    let mut chosen: Vec<u64> = v["chosen_candidates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_u64().unwrap())
+        .collect();
+    chosen.sort_unstable();
+    assert_eq!(chosen, (0..20).collect::<Vec<u64>>());
+    common::fails_with(
+        &with(base, &["--pool", "lattice"]),
+        "--pool lattice: a camera design",
+    );
+    common::fails_with(
+        &with(base, &["--pool", &file, "--count", "5"]),
+        "--count: not used with --pool file:",
+    );
+    common::fails_with(
+        &with(base, &["--angle-unit", "deg"]),
+        "--angle-unit: the unit of a --pool file:'s joint values",
+    );
 }
 
 /// With `--point` the sockets decide: every camera option is refused, no

@@ -172,11 +172,7 @@ pub const SELECT: &[Rule] = &[
     ),
     r("progress", SEL_ALL, ""),
     r("robot", SEL_ALL, ""),
-    r(
-        "pool",
-        &[Pool],
-        "the candidates are --count joint-space samples (--pool-seed)",
-    ),
+    r("pool", &[Pool, Camera], SOCKET),
     r("levels", &[Pool], "there is no lattice"),
     r("count", SEL_ALL, ""),
     r("pool_seed", SEL_ALL, ""),
@@ -196,8 +192,16 @@ pub const SELECT: &[Rule] = &[
     r("package_dirs", SEL_ALL, ""),
     r("obstacles", SEL_ALL, ""),
     r("floor", SEL_ALL, ""),
-    r("angle_unit", &[Pool], "no file of joint values is read"),
-    r("length_unit", &[Pool], "no file of joint values is read"),
+    r(
+        "angle_unit",
+        &[Pool, Camera],
+        "no file of joint values is read",
+    ),
+    r(
+        "length_unit",
+        &[Pool, Camera],
+        "no file of joint values is read",
+    ),
     r("compliance", &[Pool], ""),
     r(
         "margin",

@@ -1,6 +1,6 @@
 //! `select --camera-info cam.yaml --target board.yaml --mounting …`: poses
 //! chosen for a camera. Joint-space samples (`--count`, default 20,000;
-//! `--pool-seed`) are kept where the camera sees the target well
+//! `--pool-seed`), or the rows of `--pool file:PATH`, are kept where the camera sees the target well
 //! (`activecal::pool::camera_view`: `--min-visible`, `--image-margin`,
 //! `--max-view-angle`, `--distance`, at the placements `--camera-pose` and
 //! `--target-pose`), and `--n` of them are chosen D-optimally on the pixel
@@ -13,6 +13,7 @@
 //! (the chain from LINK to the tip, `activecal::io::urdf_branch`).
 
 use super::camera_opts::CameraOpts;
+use super::pool_opts::PoolKind;
 use super::select::SelectArgs;
 use activecal::collision::Obstacle;
 use activecal::io::UrdfChain;
@@ -136,15 +137,63 @@ fn sight(a: &SelectArgs, robot: &Robot) -> Result<(Vec<PoolFilter>, Option<LineO
     Ok((filters, Some(choice.line_of_sight(chain, root))))
 }
 
-/// A `--pixel-noise` that is no σ, refused (the options a camera design
+/// A `--pixel-noise` that is no σ, and a `--pool` a camera design does
+/// not sample from, refused before any work (the options a camera design
 /// does not take are refused by `acts_on::SELECT`).
-fn check_pixel_noise(a: &SelectArgs) -> Result<()> {
+fn check_options(a: &SelectArgs) -> Result<()> {
     if let Some(px) = a.camera.pixel_noise
         && !(px.is_finite() && px > 0.0)
     {
         bail!("--pixel-noise {px}: the pixel noise σ must be a finite number > 0 (px)");
     }
+    let given = |id: &str| a.given.0.iter().find(|(i, _)| i == id).map(|(_, f)| f);
+    match &a.pool.pool {
+        PoolKind::File(p) => {
+            if let Some(f) = given("count").or_else(|| given("pool_seed")) {
+                bail!(
+                    "{f}: not used with --pool file:{} (its rows are the candidates; --count and --pool-seed draw joint-space samples)",
+                    p.display()
+                );
+            }
+        }
+        PoolKind::Lattice | PoolKind::Sobol if given("pool").is_some() => bail!(
+            "--pool {}: a camera design's candidates are --count uniform joint-space samples (--pool random, the default) or the rows of --pool file:PATH",
+            if a.pool.pool == PoolKind::Sobol {
+                "sobol"
+            } else {
+                "lattice"
+            }
+        ),
+        _ => {
+            if let Some(f) = given("angle_unit").or_else(|| given("length_unit")) {
+                bail!(
+                    "{f}: the unit of a --pool file:'s joint values; a camera design without one reads none"
+                );
+            }
+        }
+    }
     Ok(())
+}
+
+/// The candidate configurations: the rows of `--pool file:` (in its
+/// units), else `--count` uniform samples within the joint limits
+/// (`--pool-seed`).
+fn candidates(a: &SelectArgs, robot: &Robot) -> Result<Vec<Vec<f64>>> {
+    Ok(match &a.pool.pool {
+        PoolKind::File(p) => {
+            let c = activecal::pool::file::read_configurations_in(p, robot, a.pool.units.units())
+                .with_context(|| format!("--pool file:{}", p.display()))?;
+            for n in &c.notes {
+                super::diag(&format!("note: {n}"));
+            }
+            c.qs
+        }
+        _ => activecal::observability::generic_configurations(
+            robot,
+            a.pool.count.unwrap_or(DEFAULT_SAMPLES),
+            a.pool.pool_seed.unwrap_or(0),
+        ),
+    })
 }
 
 /// The `--out` files: at most one `.csv` and one `.json`.
@@ -174,7 +223,7 @@ fn outputs(a: &SelectArgs) -> Result<(Option<&PathBuf>, Option<&PathBuf>)> {
 
 /// Runs `select` for a camera.
 pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
-    check_pixel_noise(a)?;
+    check_options(a)?;
     let (csv_out, json_out) = outputs(a)?;
     if let Some(dir) = &a.report {
         super::report_dir::check(dir, a.force)?;
@@ -187,11 +236,7 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
     };
     let v = view(&a.camera)?;
     let (filters, los) = sight(a, &robot)?;
-    let candidates = activecal::observability::generic_configurations(
-        &robot,
-        a.pool.count.unwrap_or(DEFAULT_SAMPLES),
-        a.pool.pool_seed.unwrap_or(0),
-    );
+    let candidates = candidates(a, &robot)?;
     let settings = activecal::select::Settings::builder()
         .n(a.n)
         .seed(a.seed)

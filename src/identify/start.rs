@@ -45,8 +45,11 @@ pub fn for_measurements(robot: &Robot, meas: &Measurements, lm: &LmSettings) -> 
     }
     let k = meas.markers();
     let has_orientation = !meas.orientations().is_empty();
-    if has_orientation {
-        refuse_constant_orientation(robot, meas)?;
+    if let Some(e) = has_orientation
+        .then(|| constant_orientation(robot, meas))
+        .flatten()
+    {
+        return Err(e);
     }
     let have = crate::measure::sensor_for(robot);
     if k == have.points_per_pose() && has_orientation == have.measures_orientation() && k == 1
@@ -100,25 +103,26 @@ fn nominal_turn_deg(robot: &Robot, meas: &Measurements) -> f64 {
     .fold(0.0, f64::max)
 }
 
-/// Refuses orientations that are one rotation (within 1e-9) at every pose
-/// while the nominal model's orientation turns by more than a degree over
-/// the poses ([`IdentifyError::ConstantOrientation`]): fitted, they would
-/// make the robot's orientation still, with an orientation σ of tens of
-/// degrees. A robot whose orientation does not turn (a gantry) keeps them.
-fn refuse_constant_orientation(robot: &Robot, meas: &Measurements) -> Result<()> {
+/// The error of orientations that are one rotation (within 1e-9) at every
+/// pose while the nominal model's orientation turns by more than a degree
+/// over the poses ([`IdentifyError::ConstantOrientation`]): fitted, they
+/// would make the robot's orientation still, with an orientation σ of tens
+/// of degrees. `None` for orientations that change, or a robot whose
+/// orientation does not turn (a gantry).
+fn constant_orientation(robot: &Robot, meas: &Measurements) -> Option<IdentifyError> {
     let o = meas.orientations();
     let same = |a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]| {
         (0..3).all(|i| (0..3).all(|j| (a[i][j] - b[i][j]).abs() <= 1e-9))
     };
     if o.len() < 2 || !o.iter().all(|r| same(r, &o[0])) {
-        return Ok(());
+        return None;
     }
     let turn_deg = nominal_turn_deg(robot, meas);
     if turn_deg <= 1.0 {
-        return Ok(());
+        return None;
     }
     let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    Err(IdentifyError::ConstantOrientation {
+    Some(IdentifyError::ConstantOrientation {
         what: if same(&o[0], &identity) {
             "the identity"
         } else {

@@ -110,7 +110,7 @@ enum Command {
 }
 
 impl Command {
-    /// Records on `calibrate` and `select` the options typed on the
+    /// Records on `calibrate`, `select` and `evaluate` the options typed on the
     /// command line (`matches`: the whole line's).
     fn record_given(&mut self, matches: &ArgMatches) {
         let Some((name, sub)) = matches.subcommand() else {
@@ -125,6 +125,7 @@ impl Command {
         match self {
             Command::Calibrate(a) => a.given = given,
             Command::Select(a) => a.given = given,
+            Command::Evaluate(a) => a.given = given,
             _ => {}
         }
     }
@@ -132,10 +133,13 @@ impl Command {
     /// Refuses, before any work, each option typed with a sensor it does
     /// not act on ([`cli::acts_on`]'s table of the command).
     fn refuse_unused_options(&self) -> anyhow::Result<()> {
-        use cli::acts_on::{CALIBRATE, SELECT, calibrate_sensors, check, select_sensor};
+        use cli::acts_on::{
+            CALIBRATE, EVALUATE, SELECT, calibrate_sensors, check, evaluate_sensors, select_sensor,
+        };
         match self {
             Command::Calibrate(a) => check(CALIBRATE, &a.given, calibrate_sensors(a)),
             Command::Select(a) => check(SELECT, &a.given, &[select_sensor(a)]),
+            Command::Evaluate(a) => check(EVALUATE, &a.given, evaluate_sensors(a)),
             _ => Ok(()),
         }
     }

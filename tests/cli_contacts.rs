@@ -302,7 +302,7 @@ fn evaluate_a_contact_file() {
             "--point-distance",
             "a,b=0.05",
         ],
-        "are for contact files",
+        "--point-distance: not used with --measurements (points or full poses)",
     );
 }
 

@@ -1,5 +1,6 @@
-//! Which sensors each option of `calibrate` and `select` acts on: one
-//! table per command ([`CALIBRATE`], [`SELECT`]), checked against the
+//! Which sensors each option of `calibrate`, `select` and `evaluate` acts
+//! on: one table per command ([`CALIBRATE`], [`SELECT`], [`EVALUATE`]),
+//! checked against the
 //! options typed on the command line before any work. An option typed with
 //! a sensor it does not act on is refused, naming the option and the
 //! sensor: no option is accepted and ignored.
@@ -254,6 +255,26 @@ pub const SELECT: &[Rule] = &[
     r("json", SEL_ALL, ""),
 ];
 
+const EVAL_ALL: &[Sensor] = &[Points, Poses, Contacts];
+
+/// The options of `evaluate` (and the global ones) and the sensors each
+/// acts on.
+pub const EVALUATE: &[Rule] = &[
+    r("base", EVAL_ALL, ""),
+    r("tip", EVAL_ALL, ""),
+    r("lock", EVAL_ALL, ""),
+    r("frames", EVAL_ALL, ""),
+    r("markers", EVAL_ALL, ""),
+    r("progress", EVAL_ALL, ""),
+    r("robot", EVAL_ALL, ""),
+    r("measurements", EVAL_ALL, ""),
+    r("angle_unit", EVAL_ALL, ""),
+    r("length_unit", EVAL_ALL, ""),
+    r("point_distance", &[Contacts], ""),
+    r("plane", &[Contacts], ""),
+    r("json", EVAL_ALL, ""),
+];
+
 /// The options typed on a command's line (not defaulted): each as its
 /// clap id and its flag (`--loss`).
 #[derive(Clone, Debug, Default)]
@@ -332,6 +353,16 @@ pub fn calibrate_sensors(a: &super::calibrate::CalibrateArgs) -> &'static [Senso
         (None, Some(m)) if super::contact::is_contact_file(m) => &[Contacts],
         (None, Some(_)) => MEASURED,
         (None, None) => &[Simulated],
+    }
+}
+
+/// The sensors an `evaluate` command line may be for: contacts, or
+/// points and full poses (which its table does not tell apart).
+pub fn evaluate_sensors(a: &super::measured::EvaluateArgs) -> &'static [Sensor] {
+    if super::contact::is_contact_file(&a.measurements) {
+        &[Contacts]
+    } else {
+        MEASURED
     }
 }
 

@@ -1,9 +1,9 @@
-//! Every option of `calibrate` and `select`, as clap defines it, with every
+//! Every option of `calibrate`, `evaluate` and `select`, as clap defines it, with every
 //! sensor: the table decides it, and an option the table says does not act
 //! on a sensor is refused before any work, naming the option (by clap, or
 //! by the same check `main` runs). A new option without a row fails here.
 
-use super::{CALIBRATE, Rule, SELECT, Sensor, check};
+use super::{CALIBRATE, EVALUATE, Rule, SELECT, Sensor, check};
 use crate::{Cli, Command};
 use clap::{ArgAction, CommandFactory, FromArgMatches};
 
@@ -32,6 +32,16 @@ fn bases(contacts: &str) -> Vec<(&'static str, Sensor, Vec<String>)> {
                 "--target",
                 "t.yaml",
             ]),
+        ),
+        (
+            "evaluate",
+            Sensor::Points,
+            v(&["--robot", "puma560", "--measurements", "m.csv"]),
+        ),
+        (
+            "evaluate",
+            Sensor::Contacts,
+            v(&["--robot", "puma560", "--measurements", contacts]),
         ),
         ("select", Sensor::Pool, v(&[])),
         ("select", Sensor::Sockets, v(&["--point", "a=0.4,0,0.3"])),
@@ -80,7 +90,7 @@ fn sample(command: &str, id: &str) -> Option<(&'static [&'static str], &'static 
         ("calibrate", "holdout") => (&[], "0.2"),
         ("calibrate", "splits") => (&["--holdout", "0.2"], "3"),
         ("calibrate", "orientation_scale") => (&[], "0.5"),
-        ("calibrate", "plane") => (&[], "p=0,0,1,0"),
+        (_, "plane") => (&[], "p=0,0,1,0"),
         ("calibrate", "train_on") => (&[], "left"),
         ("calibrate", "inertia") => (&[], "i.urdf"),
         ("calibrate", "payload") => (&[], "1.5"),
@@ -151,18 +161,18 @@ fn argv_of(command: &str, arg: &clap::Arg) -> Vec<String> {
 }
 
 fn table(command: &str) -> &'static [Rule] {
-    if command == "calibrate" {
-        CALIBRATE
-    } else {
-        SELECT
+    match command {
+        "calibrate" => CALIBRATE,
+        "evaluate" => EVALUATE,
+        _ => SELECT,
     }
 }
 
 #[test]
-fn every_option_of_calibrate_and_select_has_a_row_and_every_row_an_option() {
+fn every_option_of_calibrate_evaluate_and_select_has_a_row_and_every_row_an_option() {
     let mut root = Cli::command();
     root.build();
-    for command in ["calibrate", "select"] {
+    for command in ["calibrate", "evaluate", "select"] {
         let args = options(&root, command);
         for a in &args {
             let id = a.get_id().as_str();

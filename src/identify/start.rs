@@ -174,3 +174,56 @@ fn markers_start(point: &Robot, meas: &Measurements, lm: &LmSettings) -> Result<
         table,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The PUMA's joints at pose `i` of twelve, every joint turning.
+    fn q(i: usize) -> Vec<f64> {
+        (0..6).map(|j| 0.1 * (i * (j + 1)) as f64).collect()
+    }
+
+    /// Twelve PUMA poses, their end points measured and each orientation
+    /// given by `rotation(i)` (row-major).
+    fn measured(rotation: impl FnMut(usize) -> [[f64; 3]; 3]) -> (Robot, Measurements) {
+        let robot = Robot::puma560();
+        let qs: Vec<Vec<f64>> = (0..12).map(q).collect();
+        let mut ev = Evaluator::new(&robot, &robot.nominal);
+        let points = qs.iter().map(|q| ev.end_frame(q).position.into()).collect();
+        let orientations = (0..qs.len()).map(rotation).collect();
+        (robot, Measurements::unchecked(qs, 1, points, orientations))
+    }
+
+    #[test]
+    fn orientations_that_never_change_while_the_robot_turns_are_refused() {
+        let lm = LmSettings::default();
+        let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let (robot, meas) = measured(|_| identity);
+        match for_measurements(&robot, &meas, &lm) {
+            Err(IdentifyError::ConstantOrientation {
+                what,
+                poses,
+                turn_deg,
+            }) => {
+                assert_eq!((what, poses), ("the identity", 12));
+                assert!(turn_deg > 30.0, "{turn_deg}");
+            }
+            other => panic!("{:?}", other.map(|s| s.notes)),
+        }
+        let turned = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+        let (robot, meas) = measured(|_| turned);
+        let e = for_measurements(&robot, &meas, &lm).err().unwrap();
+        assert!(
+            e.to_string()
+                .contains("is one rotation at every one of the 12 poses"),
+            "{e}"
+        );
+        // The orientations the robot has: fitted as full poses.
+        let puma = Robot::puma560();
+        let mut ev = Evaluator::new(&puma, &puma.nominal);
+        let (robot, meas) = measured(|i| ev.end_frame(&q(i)).rotation.transpose().into());
+        let start = for_measurements(&robot, &meas, &lm).unwrap();
+        assert_eq!(start.robot.measurement, MeasurementKind::Pose);
+    }
+}

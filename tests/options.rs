@@ -53,7 +53,7 @@ fn a_cameras_pixels_refuse_the_options_of_a_point_fit() {
         (&["--holdout", "0.2"], "held-out"),
         (
             &["--fix", "d_shoulder_lift_joint"],
-            "estimates every joint origin",
+            "it acts on --measurements of points",
         ),
         (&["--report", report], "report"),
         (&["--compliance"], "--measurements of points"),

@@ -101,11 +101,7 @@ pub const CALIBRATE: &[Rule] = &[
     r("no_geodesic", CAL_ALL, ""),
     r("loss", FITTED, LS),
     r("loss_scale", FITTED, LS),
-    r(
-        "fix",
-        MEASURED,
-        "the camera fit estimates every joint origin of the chain with the camera's and target's placements",
-    ),
+    r("fix", MEASURED, ""),
     r(
         "free",
         FITTED,
@@ -156,7 +152,7 @@ pub const CALIBRATE: &[Rule] = &[
 ];
 
 const SEL_ALL: &[Sensor] = &[Pool, Sockets, Camera];
-const EAE: &str = "a camera design is chosen by exchange-add-exchange (EAE) on the determinant";
+const EAE: &str = "a camera design is chosen by exchange-add-exchange (EAE) on the determinant, a socket design D-optimally then exchanged for the predicted true error";
 const SOCKET: &str = "the pool is configurations projected onto each socket from --count joint-space samples, chosen D-optimally then exchanged for the predicted true error";
 
 /// The options of `select` (and the global ones) and the sensors each acts

@@ -4,7 +4,7 @@
 mod cli;
 
 use clap::parser::ValueSource;
-use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
+use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 use cli::basic::{FkArgs, PoolArgs, RobotsArgs};
 use cli::bench::BenchArgs;
 use cli::bound::{BoundArgs, GapArgs};
@@ -110,6 +110,40 @@ enum Command {
 }
 
 impl Command {
+    /// Records on `calibrate`, `select` and `evaluate` the options typed on the
+    /// command line (`matches`: the whole line's).
+    fn record_given(&mut self, matches: &ArgMatches) {
+        let Some((name, sub)) = matches.subcommand() else {
+            return;
+        };
+        let mut root = Cli::command();
+        root.build();
+        let Some(cmd) = root.find_subcommand(name) else {
+            return;
+        };
+        let given = cli::acts_on::Given::of(cmd, sub);
+        match self {
+            Command::Calibrate(a) => a.given = given,
+            Command::Select(a) => a.given = given,
+            Command::Evaluate(a) => a.given = given,
+            _ => {}
+        }
+    }
+
+    /// Refuses, before any work, each option typed with a sensor it does
+    /// not act on ([`cli::acts_on`]'s table of the command).
+    fn refuse_unused_options(&self) -> anyhow::Result<()> {
+        use cli::acts_on::{
+            CALIBRATE, EVALUATE, SELECT, calibrate_sensors, check, evaluate_sensors, select_sensor,
+        };
+        match self {
+            Command::Calibrate(a) => check(CALIBRATE, &a.given, calibrate_sensors(a)),
+            Command::Select(a) => check(SELECT, &a.given, &[select_sensor(a)]),
+            Command::Evaluate(a) => check(EVALUATE, &a.given, evaluate_sensors(a)),
+            _ => Ok(()),
+        }
+    }
+
     /// Gives the chain options to the command's robot, resolved once; a
     /// command without a `--robot` refuses them.
     fn take_chain(&mut self, c: &activecal::io::ChainChoice) -> anyhow::Result<()> {
@@ -142,7 +176,8 @@ fn main() {
     // count. Parallelism is ours to choose (rayon, over starts and pools).
     faer::set_global_parallelism(faer::Par::Seq);
     let matches = Cli::command().get_matches();
-    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    let mut cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    cli.command.record_given(&matches);
     // Pool options typed on the command line (not defaulted): `score`
     // refuses those that conflict with a `--design`.
     let given = |sub: &str| -> Vec<&'static str> {
@@ -173,6 +208,10 @@ fn main() {
     cli::progress::install_for(cli.progress, json);
     cap_threads();
     let mut command = cli.command;
+    if let Err(e) = command.refuse_unused_options() {
+        report_error(&e);
+        std::process::exit(1);
+    }
     let chain = cli::chain_choice(
         cli.base,
         cli.tip,

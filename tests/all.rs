@@ -43,6 +43,7 @@ mod jacobian;
 mod json_shape;
 mod licences;
 mod mesh_formats;
+mod options;
 mod output_overlap;
 mod paper_golden;
 mod plane_contacts;

@@ -207,7 +207,7 @@ fn cli_selects_a_camera_design_with_its_bound() {
     let mut existing = args.to_vec();
     existing.truncate(15);
     existing.extend(["--existing", "somewhere.csv"]);
-    common::fails_with(&existing, "--existing is not available with --camera-info");
+    common::fails_with(&existing, "--existing: not used with --camera-info");
     let mut noise = args.to_vec();
     noise.truncate(15);
     noise.extend(["--noise", "0.0003"]);

@@ -90,7 +90,7 @@ fn contact_bad_inputs() {
             "--holdout-by",
             "placement",
         ],
-        "are for contact files",
+        "--holdout-by: not used with --measurements (points or full poses)",
     );
 }
 
@@ -225,11 +225,11 @@ fn select_for_a_socket_bad_inputs() {
     );
     fails_with(
         &with(&base, &["--point", FRONT_LEFT_0, "--gap"]),
-        "--gap: not available with --point",
+        "--gap: not used with --point",
     );
     fails_with(
         &with(&base, &["--point", FRONT_LEFT_0, "--algorithm", "fedorov"]),
-        "--algorithm: not available with --point",
+        "--algorithm: not used with --point",
     );
 }
 
@@ -302,7 +302,7 @@ fn evaluate_a_contact_file() {
             "--point-distance",
             "a,b=0.05",
         ],
-        "are for contact files",
+        "--point-distance: not used with --measurements (points or full poses)",
     );
 }
 

@@ -417,7 +417,7 @@ fn conflicting_options_are_refused() {
                 "d_panda_joint1",
             ],
             1,
-            &["--fix is for measured poses", "contact file"],
+            &["--fix: not used with --measurements of contacts"],
         ),
     ];
     for (args, status, needs) in cases {

@@ -53,7 +53,6 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     }
     match (&a.design, &a.measurements) {
         (_, Some(m)) if super::contact::is_contact_file(m) => {
-            refuse_for_contacts(&a, m)?;
             let c = super::contact::ContactArgs {
                 holdout: a.holdout.is_some(),
                 out: &a.out,
@@ -77,19 +76,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
                 None => Ok(()),
             }
         }
-        (_, Some(m)) => {
-            if !a.point_distance.is_empty()
-                || !a.plane.is_empty()
-                || a.holdout_by.is_some()
-                || a.train_on.is_some()
-            {
-                bail!(
-                    "--point-distance, --plane, --holdout-by and --train-on are for contact files (a CSV with a 'point' or 'plane' column); {} has none",
-                    m.display()
-                );
-            }
-            from_measurements(&a, robot, m)
-        }
+        (_, Some(m)) => from_measurements(&a, robot, m),
         (Some(d), None) => super::simulated::from_design(&a, robot, desc.visibility.as_ref(), d),
         (None, None) => bail!("give --design (simulate) or --measurements (real data)"),
     }
@@ -114,28 +101,6 @@ fn calibrate_files(a: &CalibrateArgs) -> super::run_files::RunFiles {
         .output("--out-camera-info", a.out_camera_info.as_deref())
         .dir("--report", a.report.as_deref());
     f
-}
-
-/// The options of a fit of measured poses that a contact fit does not
-/// take: refused rather than silently ignored.
-fn refuse_for_contacts(a: &CalibrateArgs, m: &Path) -> Result<()> {
-    let given = [
-        (!a.fix.is_empty(), "--fix"),
-        (a.compliance, "--compliance"),
-        (a.compare_compliance, "--compare-compliance"),
-        (a.inertia.is_some(), "--inertia"),
-        (a.payload.is_some(), "--payload"),
-        (a.noise.is_some(), "--noise"),
-        (a.outliers.is_some(), "--outliers"),
-        (a.outlier_rate.is_some(), "--outlier-rate"),
-    ];
-    if let Some((_, name)) = given.iter().find(|(g, _)| *g) {
-        bail!(
-            "{name} is for measured poses; {} is a contact file (a 'point' or 'plane' column), whose fit does not take it",
-            m.display()
-        );
-    }
-    Ok(())
 }
 
 /// Identification from a measurement file.
@@ -198,13 +163,29 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
             super::diag(&format!("note: {n}"));
         }
     };
+    let (meas, read_notes) =
+        activecal::experiment::measured::read_measurement_file(path, robot, o.units)?;
+    // Points and full poses told apart: the options of the other refused.
+    let sensor = if meas.orientations().is_empty() {
+        super::acts_on::Sensor::Points
+    } else {
+        super::acts_on::Sensor::Poses
+    };
+    super::acts_on::check(super::acts_on::CALIBRATE, &a.given, &[sensor])?;
     let activecal::experiment::measured::MeasuredCalibration {
         robot: fitted,
         fit: f,
         frames,
         mut report,
         verdict,
-    } = activecal::experiment::measured::calibrate_measured(robot, path, &o, &mut print_note)?;
+    } = activecal::experiment::measured::calibrate_read(
+        robot,
+        &meas,
+        &path.display().to_string(),
+        read_notes,
+        &o,
+        &mut print_note,
+    )?;
     report.base.elapsed_seconds = t0.elapsed().as_secs_f64();
     for w in &report.warnings {
         super::diag(&format!("warning: {w}"));

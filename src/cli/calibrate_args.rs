@@ -260,6 +260,9 @@ pub struct CalibrateArgs {
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
+    /// The options typed on the command line (set after parsing).
+    #[arg(skip)]
+    pub given: super::acts_on::Given,
 }
 
 /// The simulated measurement noise σ when `--noise` is not given, metres.

@@ -1,6 +1,6 @@
 //! `select --camera-info cam.yaml --target board.yaml --mounting …`: poses
 //! chosen for a camera. Joint-space samples (`--count`, default 20,000;
-//! `--pool-seed`) are kept where the camera sees the target well
+//! `--pool-seed`), or the rows of `--pool file:PATH`, are kept where the camera sees the target well
 //! (`activecal::pool::camera_view`: `--min-visible`, `--image-margin`,
 //! `--max-view-angle`, `--distance`, at the placements `--camera-pose` and
 //! `--target-pose`), and `--n` of them are chosen D-optimally on the pixel
@@ -13,6 +13,7 @@
 //! (the chain from LINK to the tip, `activecal::io::urdf_branch`).
 
 use super::camera_opts::CameraOpts;
+use super::pool_opts::PoolKind;
 use super::select::SelectArgs;
 use activecal::collision::Obstacle;
 use activecal::io::UrdfChain;
@@ -136,32 +137,70 @@ fn sight(a: &SelectArgs, robot: &Robot) -> Result<(Vec<PoolFilter>, Option<LineO
     Ok((filters, Some(choice.line_of_sight(chain, root))))
 }
 
-/// Options of `select` a camera design does not take (yet), refused
-/// rather than ignored.
-fn refuse_unused(a: &SelectArgs) -> Result<()> {
-    if a.noise.is_some() {
-        bail!(
-            "--noise is a point's noise in metres; a camera's is --pixel-noise PX (the detected points' σ in pixels)"
-        );
-    }
+/// A `--pixel-noise` that is no σ, and a `--pool` a camera design does
+/// not sample from, refused before any work (the options a camera design
+/// does not take are refused by `acts_on::SELECT`).
+fn check_options(a: &SelectArgs) -> Result<()> {
     if let Some(px) = a.camera.pixel_noise
         && !(px.is_finite() && px > 0.0)
     {
         bail!("--pixel-noise {px}: the pixel noise σ must be a finite number > 0 (px)");
     }
-    let unused = [
-        ("--existing", a.existing.is_some()),
-        ("--refine", a.refine),
-        ("--order", a.order.is_some()),
-        ("--home", a.home.is_some()),
-        ("--fixed", a.fixed.is_some()),
-    ];
-    if let Some((flag, _)) = unused.iter().find(|(_, used)| *used) {
-        bail!(
-            "{flag} is not available with --camera-info: a camera design is chosen on the pixel Jacobian of its visible pool, with --gap, --report, --out .csv/.json and --json"
-        );
+    let given = |id: &str| a.given.0.iter().find(|(i, _)| i == id).map(|(_, f)| f);
+    match &a.pool.pool {
+        PoolKind::File(p) => {
+            if let Some(f) = given("count").or_else(|| given("pool_seed")) {
+                bail!(
+                    "{f}: not used with --pool file:{} (its rows are the candidates; --count and --pool-seed draw joint-space samples)",
+                    p.display()
+                );
+            }
+        }
+        PoolKind::Lattice | PoolKind::Sobol if given("pool").is_some() => bail!(
+            "--pool {}: a camera design's candidates are --count uniform joint-space samples (--pool random, the default) or the rows of --pool file:PATH",
+            if a.pool.pool == PoolKind::Sobol {
+                "sobol"
+            } else {
+                "lattice"
+            }
+        ),
+        _ => {
+            if let Some(f) = given("angle_unit").or_else(|| given("length_unit")) {
+                bail!(
+                    "{f}: the unit of a --pool file:'s joint values; a camera design without one reads none"
+                );
+            }
+        }
     }
     Ok(())
+}
+
+/// The candidate configurations: the rows of `--pool file:` (in its
+/// units), else `--count` uniform samples within the joint limits
+/// (`--pool-seed`).
+fn candidates(a: &SelectArgs, robot: &Robot) -> Result<Vec<Vec<f64>>> {
+    Ok(match &a.pool.pool {
+        PoolKind::File(p) => {
+            let c = activecal::pool::file::read_configurations_in(p, robot, a.pool.units.units())
+                .with_context(|| format!("--pool file:{}", p.display()))?;
+            for n in &c.notes {
+                super::diag(&format!("note: {n}"));
+            }
+            c.qs
+        }
+        _ => {
+            let count = a.pool.count.unwrap_or(DEFAULT_SAMPLES);
+            activecal::resources::check_alloc::<f64>(
+                &format!("--count {count}: the candidate configurations"),
+                count.saturating_mul(robot.dof() + 3),
+            )?;
+            activecal::observability::generic_configurations(
+                robot,
+                count,
+                a.pool.pool_seed.unwrap_or(0),
+            )
+        }
+    })
 }
 
 /// The `--out` files: at most one `.csv` and one `.json`.
@@ -188,7 +227,7 @@ fn outputs(a: &SelectArgs) -> Result<(Option<&PathBuf>, Option<&PathBuf>)> {
 
 /// Runs `select` for a camera.
 pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
-    refuse_unused(a)?;
+    check_options(a)?;
     super::select::select_files(a).check(a.force)?;
     let (csv_out, json_out) = outputs(a)?;
     let robot = super::load_robot(&a.pool.robot)?;
@@ -199,16 +238,7 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
     };
     let v = view(&a.camera)?;
     let (filters, los) = sight(a, &robot)?;
-    let count = a.pool.count.unwrap_or(DEFAULT_SAMPLES);
-    activecal::resources::check_alloc::<f64>(
-        &format!("--count {count}: the candidate configurations"),
-        count.saturating_mul(robot.dof() + 3),
-    )?;
-    let candidates = activecal::observability::generic_configurations(
-        &robot,
-        count,
-        a.pool.pool_seed.unwrap_or(0),
-    );
+    let candidates = candidates(a, &robot)?;
     let settings = activecal::select::Settings::builder()
         .n(a.n)
         .seed(a.seed)
@@ -217,7 +247,7 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         camera_design_filtered(&robot, &v, &filters, los.as_ref(), &candidates, &settings)
             .map_err(|e| match e {
                 e @ activecal::Error::TooLarge { .. } => {
-                    anyhow::Error::from(e).context(format!("--count {count}"))
+                    anyhow::Error::from(e).context(format!("{} candidates", candidates.len()))
                 }
                 e => e.into(),
             })?;

@@ -13,7 +13,6 @@ use activecal::io::contact_design;
 use activecal::io::design_formats::DesignFormat;
 use activecal::measure::contact::KnownDistance;
 use activecal::model::MeasurementKind;
-use activecal::select::{Algorithm, CriterionKind};
 use anyhow::{Result, bail};
 use std::fmt::Write as _;
 
@@ -74,37 +73,6 @@ fn known_distances(
         .collect()
 }
 
-/// The options of `select` that have no meaning for sockets, refused
-/// rather than ignored.
-fn refuse_pool_options(a: &SelectArgs) -> Result<()> {
-    let p = &a.pool;
-    let given = [
-        (a.algorithm != Algorithm::Eae, "--algorithm"),
-        (a.criterion != CriterionKind::Det, "--criterion"),
-        (a.initial.is_some(), "--initial"),
-        (a.designs.is_some(), "--designs"),
-        (a.ils.is_some(), "--ils"),
-        (a.polish, "--polish"),
-        (a.order.is_some(), "--order"),
-        (a.home.is_some(), "--home"),
-        (a.existing.is_some(), "--existing"),
-        (a.refine, "--refine"),
-        (a.report.is_some(), "--report"),
-        (a.gap, "--gap"),
-        (a.fixed.is_some(), "--fixed"),
-        (p.pool != super::PoolKind::Lattice, "--pool"),
-        (p.levels.is_some(), "--levels"),
-        (p.visibility.is_some(), "--visibility"),
-        (p.compliance, "--compliance"),
-    ];
-    if let Some((_, name)) = given.iter().find(|(g, _)| *g) {
-        bail!(
-            "{name}: not available with --point (the pool is configurations projected onto each socket from --count joint-space samples, chosen D-optimally then exchanged for the predicted true error, in selection order)"
-        );
-    }
-    Ok(())
-}
-
 /// Runs `select --point ...`.
 pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
     let sockets: Vec<Socket> = a
@@ -112,7 +80,6 @@ pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
         .iter()
         .map(|s| parse_socket(s))
         .collect::<Result<_>>()?;
-    refuse_pool_options(a)?;
     super::select::select_files(a).check(a.force)?;
     super::select::check_out_formats(&a.out)?;
     let margin_deg = a

@@ -258,6 +258,9 @@ pub struct EvaluateArgs {
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
+    /// The options typed on the command line (set after parsing).
+    #[arg(skip)]
+    pub given: super::acts_on::Given,
 }
 
 /// `evaluate`'s report.
@@ -273,12 +276,6 @@ struct EvaluateReport {
 
 /// Runs `evaluate`: the model's errors on the data, no fitting.
 pub fn cmd_evaluate(a: EvaluateArgs) -> Result<()> {
-    if !(a.point_distance.is_empty() && a.plane.is_empty()) {
-        anyhow::bail!(
-            "--point-distance and --plane are for contact files (a CSV with a point or plane column); {} is not one",
-            a.measurements.display()
-        );
-    }
     let robot = super::load_robot(&a.robot)?;
     let (meas, notes) = read_measurements(&a.measurements, &robot, a.units.units(), a.json)?;
     let res = residuals(&robot, &robot.nominal, &meas).map_err(|e| {

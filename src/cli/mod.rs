@@ -1,5 +1,6 @@
 //! Shared helpers of the command-line subcommands; one file per command group.
 
+pub mod acts_on;
 pub mod basic;
 pub mod bench;
 pub mod bound;

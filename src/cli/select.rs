@@ -160,6 +160,9 @@ pub struct SelectArgs {
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
+    /// The options typed on the command line (set after parsing).
+    #[arg(skip)]
+    pub given: super::acts_on::Given,
 }
 
 /// The weight of a full-pose sensor's orientation rows (metres per

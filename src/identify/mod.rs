@@ -115,6 +115,21 @@ pub enum IdentifyError {
         /// Points per pose of the robot's sensor.
         expected: usize,
     },
+    /// Orientations that are one rotation at every pose while the robot's
+    /// own orientation turns over the poses: not a measurement (a tracker
+    /// that measures none writes the identity).
+    #[error(
+        "the orientation is {what} at every one of the {poses} poses while the robot's nominal orientation turns by up to {turn_deg:.1}° over them: orientations that never change while the joints move are not a measurement; remove the orientation columns (phix1, phiy1, phiz1 or qw1, qx1, qy1, qz1) to calibrate from the points"
+    )]
+    ConstantOrientation {
+        /// "the identity" or "one rotation".
+        what: &'static str,
+        /// Number of poses.
+        poses: usize,
+        /// The largest angle, degrees, between the nominal model's
+        /// orientation at the first pose and at another.
+        turn_deg: f64,
+    },
     /// A measured coordinate that is NaN or infinite.
     #[error(
         "measurement {pose}, coordinate {coordinate}: not a finite number ({value}); missing or corrupt"

@@ -45,6 +45,12 @@ pub fn for_measurements(robot: &Robot, meas: &Measurements, lm: &LmSettings) -> 
     }
     let k = meas.markers();
     let has_orientation = !meas.orientations().is_empty();
+    if let Some(e) = has_orientation
+        .then(|| constant_orientation(robot, meas))
+        .flatten()
+    {
+        return Err(e);
+    }
     let have = crate::measure::sensor_for(robot);
     if k == have.points_per_pose() && has_orientation == have.measures_orientation() && k == 1
         || (k > 1 && robot.measurement == MeasurementKind::Markers(k))
@@ -79,6 +85,52 @@ pub fn for_measurements(robot: &Robot, meas: &Measurements, lm: &LmSettings) -> 
             })
         }
     }
+}
+
+/// The largest turn, degrees, of the nominal model's orientation (a
+/// point robot's end frame) between the first pose of `meas` and another.
+fn nominal_turn_deg(robot: &Robot, meas: &Measurements) -> f64 {
+    let mut ev = Evaluator::new(robot, &robot.nominal);
+    let mut qs = meas.qs().iter();
+    let Some(first) = qs.next() else {
+        return 0.0;
+    };
+    let r0 = ev.end_frame(first).rotation;
+    qs.map(|q| {
+        let c = ((r0.transpose() * ev.end_frame(q).rotation).trace() - 1.0) / 2.0;
+        c.clamp(-1.0, 1.0).acos().to_degrees()
+    })
+    .fold(0.0, f64::max)
+}
+
+/// The error of orientations that are one rotation (within 1e-9) at every
+/// pose while the nominal model's orientation turns by more than a degree
+/// over the poses ([`IdentifyError::ConstantOrientation`]): fitted, they
+/// would make the robot's orientation still, with an orientation σ of tens
+/// of degrees. `None` for orientations that change, or a robot whose
+/// orientation does not turn (a gantry).
+fn constant_orientation(robot: &Robot, meas: &Measurements) -> Option<IdentifyError> {
+    let o = meas.orientations();
+    let same = |a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]| {
+        (0..3).all(|i| (0..3).all(|j| (a[i][j] - b[i][j]).abs() <= 1e-9))
+    };
+    if o.len() < 2 || !o.iter().all(|r| same(r, &o[0])) {
+        return None;
+    }
+    let turn_deg = nominal_turn_deg(robot, meas);
+    if turn_deg <= 1.0 {
+        return None;
+    }
+    let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    Some(IdentifyError::ConstantOrientation {
+        what: if same(&o[0], &identity) {
+            "the identity"
+        } else {
+            "one rotation"
+        },
+        poses: o.len(),
+        turn_deg,
+    })
 }
 
 /// Each marker's least-squares offset for a chain: the mean over poses of
@@ -121,4 +173,57 @@ fn markers_start(point: &Robot, meas: &Measurements, lm: &LmSettings) -> Result<
         robot,
         table,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The PUMA's joints at pose `i` of twelve, every joint turning.
+    fn q(i: usize) -> Vec<f64> {
+        (0..6).map(|j| 0.1 * (i * (j + 1)) as f64).collect()
+    }
+
+    /// Twelve PUMA poses, their end points measured and each orientation
+    /// given by `rotation(i)` (row-major).
+    fn measured(rotation: impl FnMut(usize) -> [[f64; 3]; 3]) -> (Robot, Measurements) {
+        let robot = Robot::puma560();
+        let qs: Vec<Vec<f64>> = (0..12).map(q).collect();
+        let mut ev = Evaluator::new(&robot, &robot.nominal);
+        let points = qs.iter().map(|q| ev.end_frame(q).position.into()).collect();
+        let orientations = (0..qs.len()).map(rotation).collect();
+        (robot, Measurements::unchecked(qs, 1, points, orientations))
+    }
+
+    #[test]
+    fn orientations_that_never_change_while_the_robot_turns_are_refused() {
+        let lm = LmSettings::default();
+        let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let (robot, meas) = measured(|_| identity);
+        match for_measurements(&robot, &meas, &lm) {
+            Err(IdentifyError::ConstantOrientation {
+                what,
+                poses,
+                turn_deg,
+            }) => {
+                assert_eq!((what, poses), ("the identity", 12));
+                assert!(turn_deg > 30.0, "{turn_deg}");
+            }
+            other => panic!("{:?}", other.map(|s| s.notes)),
+        }
+        let turned = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+        let (robot, meas) = measured(|_| turned);
+        let e = for_measurements(&robot, &meas, &lm).err().unwrap();
+        assert!(
+            e.to_string()
+                .contains("is one rotation at every one of the 12 poses"),
+            "{e}"
+        );
+        // The orientations the robot has: fitted as full poses.
+        let puma = Robot::puma560();
+        let mut ev = Evaluator::new(&puma, &puma.nominal);
+        let (robot, meas) = measured(|i| ev.end_frame(&q(i)).rotation.transpose().into());
+        let start = for_measurements(&robot, &meas, &lm).unwrap();
+        assert_eq!(start.robot.measurement, MeasurementKind::Pose);
+    }
 }

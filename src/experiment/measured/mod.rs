@@ -465,8 +465,13 @@ fn in_source(
     }
 }
 
-/// The calibration of measurements read and checked.
-fn calibrate_read(
+/// The calibration of measurements read by [`read_measurement_file`] (and
+/// not checked against `robot`'s sensor: a point robot's data with
+/// orientations are fitted as full poses, several markers as markers), as
+/// [`calibrate_measured`] does after reading: for a caller that looks at
+/// the data before fitting them. `source` names them in errors and in the
+/// report, `notes` are what their reading found.
+pub fn calibrate_read(
     robot: &Robot,
     meas: &Measurements,
     source: &str,

@@ -86,6 +86,7 @@ fn sample(command: &str, id: &str) -> Option<(&'static [&'static str], &'static 
         ("calibrate", "save_measurements") => (&[], "s.json"),
         ("calibrate", "trials" | "validation" | "max_iterations") => (&[], "3"),
         ("calibrate", "loss_scale") => (&[], "0.01"),
+        ("calibrate", "outlier_rate") => (&[], "0.05"),
         ("calibrate", "fix" | "free") => (&[], "d_2"),
         ("calibrate", "holdout") => (&[], "0.2"),
         ("calibrate", "splits") => (&["--holdout", "0.2"], "3"),

@@ -53,7 +53,7 @@ fn a_cameras_pixels_refuse_the_options_of_a_point_fit() {
         (&["--holdout", "0.2"], "held-out"),
         (
             &["--fix", "d_shoulder_lift_joint"],
-            "it acts on --measurements of points",
+            "it acts on point measurements",
         ),
         (&["--report", report], "report"),
         (&["--compliance"], "--measurements of points"),

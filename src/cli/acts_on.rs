@@ -31,6 +31,21 @@ pub enum Sensor {
 }
 
 impl Sensor {
+    /// The sensor in a few words, for the list of those an option acts on.
+    #[must_use]
+    pub fn short(self) -> &'static str {
+        match self {
+            Sensor::Simulated => "--design",
+            Sensor::Points => "point measurements",
+            Sensor::Poses => "full-pose measurements",
+            Sensor::Contacts => "contacts",
+            Sensor::Pixels => "--observations",
+            Sensor::Pool => "a pose pool",
+            Sensor::Sockets => "--point",
+            Sensor::Camera => "--camera-info",
+        }
+    }
+
     /// The sensor as the command line gives it, for messages.
     #[must_use]
     pub fn given_as(self) -> &'static str {
@@ -327,7 +342,7 @@ pub fn check(table: &[Rule], given: &Given, sensors: &[Sensor]) -> Result<()> {
                 return None;
             }
             let why = if rule.why.is_empty() {
-                let sens: Vec<&str> = rule.acts_on.iter().map(|s| s.given_as()).collect();
+                let sens: Vec<&str> = rule.acts_on.iter().map(|s| s.short()).collect();
                 format!("it acts on {}", sens.join(" or "))
             } else {
                 rule.why.to_string()

@@ -203,6 +203,15 @@ fn candidates(a: &SelectArgs, robot: &Robot) -> Result<Vec<Vec<f64>>> {
     })
 }
 
+/// The option that made the candidates, for messages: `--pool file:F` or
+/// `--count N`.
+fn pool_label(a: &SelectArgs) -> String {
+    match &a.pool.pool {
+        PoolKind::File(p) => format!("--pool file:{}", p.display()),
+        _ => format!("--count {}", a.pool.count.unwrap_or(DEFAULT_SAMPLES)),
+    }
+}
+
 /// The `--out` files: at most one `.csv` and one `.json`.
 fn outputs(a: &SelectArgs) -> Result<(Option<&PathBuf>, Option<&PathBuf>)> {
     let ext = |o: &PathBuf, e: &str| o.extension().is_some_and(|x| x.eq_ignore_ascii_case(e));
@@ -247,7 +256,7 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         camera_design_filtered(&robot, &v, &filters, los.as_ref(), &candidates, &settings)
             .map_err(|e| match e {
                 e @ activecal::Error::TooLarge { .. } => {
-                    anyhow::Error::from(e).context(format!("{} candidates", candidates.len()))
+                    anyhow::Error::from(e).context(pool_label(a))
                 }
                 e => e.into(),
             })?;

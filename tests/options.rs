@@ -56,7 +56,7 @@ fn a_cameras_pixels_refuse_the_options_of_a_point_fit() {
             "it acts on point measurements",
         ),
         (&["--report", report], "report"),
-        (&["--compliance"], "--measurements of points"),
+        (&["--compliance"], "point measurements"),
         (&["--weights", "fixed"], "no orientations"),
     ] {
         let out = common::run(&with(&CAMERA, extra));

@@ -87,7 +87,8 @@ fn marker_arg(a: &Arm, m: [f64; 3]) -> String {
 /// (mm) for 0.05 mm of noise.
 fn setup(dir: &Path, a: &Arm, marker: [f64; 3], seed: u64) -> f64 {
     std::fs::create_dir_all(dir).unwrap();
-    let m = format!("{},{},{}", marker[0], marker[1], marker[2]);
+    // `--marker=` keeps a negative first coordinate from reading as an option.
+    let m = format!("--marker={},{},{}", marker[0], marker[1], marker[2]);
     let u = urdf(a).display().to_string();
     let s = seed.to_string();
     let args = [
@@ -98,7 +99,6 @@ fn setup(dir: &Path, a: &Arm, marker: [f64; 3], seed: u64) -> f64 {
         a.tip,
         "--seed",
         &s,
-        "--marker",
         &m,
         "--out",
         "truth.json",

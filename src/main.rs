@@ -133,9 +133,7 @@ impl Command {
     /// Refuses, before any work, each option typed with a sensor it does
     /// not act on ([`cli::acts_on`]'s table of the command).
     fn refuse_unused_options(&self) -> anyhow::Result<()> {
-        use cli::acts_on::{
-            CALIBRATE, EVALUATE, SELECT, calibrate_sensors, check, evaluate_sensors, select_sensor,
-        };
+        use cli::acts_on::{CALIBRATE, EVALUATE, SELECT, check};
         match self {
             Command::Calibrate(a) => check(CALIBRATE, &a.given, calibrate_sensors(a)),
             Command::Select(a) => check(SELECT, &a.given, &[select_sensor(a)]),
@@ -298,5 +296,43 @@ fn report_error(e: &anyhow::Error) {
         .chain(cli::hints::option_hints(e))
     {
         cli::diag(&format!("hint: {h}"));
+    }
+}
+
+// Which sensors a command line is for (the tables of `cli::acts_on` say
+// which options act on each); here, above the command's argument types.
+use cli::acts_on::{self, Sensor};
+
+/// The sensors a `calibrate` command line may be for, before its data are
+/// read: points and full poses are told apart once the file is read
+/// (`calibrate::from_measurements` checks again).
+fn calibrate_sensors(a: &cli::calibrate::CalibrateArgs) -> &'static [acts_on::Sensor] {
+    match (&a.observations, &a.measurements) {
+        (Some(_), _) => &[Sensor::Pixels],
+        (None, Some(m)) if cli::contact::is_contact_file(m) => &[Sensor::Contacts],
+        (None, Some(_)) => acts_on::MEASURED,
+        (None, None) => &[Sensor::Simulated],
+    }
+}
+
+/// The sensors an `evaluate` command line may be for: contacts, or
+/// points and full poses (which its table does not tell apart).
+fn evaluate_sensors(a: &cli::measured::EvaluateArgs) -> &'static [acts_on::Sensor] {
+    if cli::contact::is_contact_file(&a.measurements) {
+        &[Sensor::Contacts]
+    } else {
+        acts_on::MEASURED
+    }
+}
+
+/// The sensor of a `select` command line: `--point` (sockets), else
+/// `--camera-info` (a camera), else a pool of poses.
+fn select_sensor(a: &cli::select::SelectArgs) -> acts_on::Sensor {
+    if !a.points.is_empty() {
+        Sensor::Sockets
+    } else if a.camera.camera_info.is_some() {
+        Sensor::Camera
+    } else {
+        Sensor::Pool
     }
 }

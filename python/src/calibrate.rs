@@ -60,6 +60,11 @@ fn data(
     let robot: &activecal::model::Robot = &wrapper.inner;
     let dof = robot.dof();
     let joints = activecal::units::joint_names(robot);
+    let points = &aligned(q, points, "points")?;
+    let orientations = orientations
+        .map(|o| aligned(q, o, "orientations"))
+        .transpose()?;
+    let orientations = orientations.as_ref();
     let q = &named_columns(q, "q", &joints, "joint")?;
     let (qv, qshape) = float_array(
         py,
@@ -249,10 +254,14 @@ fn names(v: Option<Vec<String>>) -> Vec<String> {
 /// outliers: "drop" (default: poses with a gross error, found by Baarda's
 /// data snooping at the family-wise rate outlier_rate, are left out one at
 /// a time and listed in `report["outliers"]`) or "keep", as `--outliers`.
+/// noise: the sensor's stated σ per coordinate (metres), as `--noise`: σ̂
+/// is tested against it (`report["noise_test"]`), a rejection warns
+/// (`UserWarning`, as the command line's warning), and the outlier test
+/// uses it.
 /// progress: a callable `progress(task, done, total, note)`, as `select`
 /// takes it.
 #[pyfunction]
-#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, compliance=false, outliers="drop", outlier_rate=0.01, progress=None))]
+#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, compliance=false, outliers="drop", outlier_rate=0.01, noise=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
@@ -273,6 +282,7 @@ pub fn calibrate(
     compliance: bool,
     outliers: &str,
     outlier_rate: f64,
+    noise: Option<f64>,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Calibration> {
     let weights = weights_of(weights, orientation_scale)?;
@@ -313,7 +323,14 @@ pub fn calibrate(
         compare_compliance: false,
         weights,
         outliers,
-        stated_noise: None,
+        stated_noise: match noise {
+            Some(s) if !(s.is_finite() && s > 0.0) => {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "noise={s}: the sensor's stated σ per coordinate must be a number > 0 (metres)"
+                )));
+            }
+            s => s,
+        },
     };
     let r = inner.clone();
     let (fitted, id, frames, report, verdict, warnings) =
@@ -537,4 +554,36 @@ fn outliers_of(kind: &str, rate: f64) -> PyResult<activecal::identify::outliers:
         pyo3::exceptions::PyValueError::new_err(format!("outlier_rate={rate}: {e}"))
     })?;
     Ok(c)
+}
+
+/// `other` in the row order of `q` when both are pandas objects with an
+/// index: as given when the indexes are equal, reordered by `q`'s index
+/// when they hold the same unique labels in another order, and refused when
+/// their labels differ (rows are never matched by position behind the
+/// user's back). Anything without an index (NumPy arrays, lists) is taken
+/// as given, row for row.
+fn aligned<'py>(
+    q: &Bound<'py, PyAny>,
+    other: &Bound<'py, PyAny>,
+    name: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (Ok(qi), Ok(oi)) = (q.getattr("index"), other.getattr("index")) else {
+        return Ok(other.clone());
+    };
+    if qi.call_method1("equals", (&oi,))?.is_truthy()? {
+        return Ok(other.clone());
+    }
+    let sorted = |i: &Bound<'py, PyAny>| i.call_method0("sort_values");
+    let same = sorted(&qi)?
+        .call_method1("equals", (sorted(&oi)?,))?
+        .is_truthy()?;
+    let unique = qi.getattr("is_unique")?.is_truthy()? && oi.getattr("is_unique")?.is_truthy()?;
+    if same && unique {
+        return other.getattr("loc")?.get_item(&qi);
+    }
+    Err(pyo3::exceptions::PyValueError::new_err(format!(
+        "{name}: its index does not hold q's row labels (q {}, {name} {}): give both with the same labels, or plain arrays matched row by row",
+        qi.repr()?,
+        oi.repr()?
+    )))
 }

@@ -231,3 +231,60 @@ def test_evaluate_on_poses_the_fit_did_not_see_equals_the_cli(tmp_path):
     assert nominal["position_rms_mm"] > 10 * got["position_rms_mm"]
     with pytest.raises(activecal.InputError, match="^model"):
         activecal.evaluate("ur5", q, p)
+
+
+def test_glitches_are_left_out_as_the_cli_leaves_them_out(tmp_path):
+    """Two tracker glitches of 4 mm: the library's test leaves both out in
+    Python as on the command line, and `outliers="keep"` keeps them."""
+    args = ["--robot", UR5_URDF, "--tip", "tool0", "--marker", MARKER]
+    meas, m = simulated(tmp_path, args)
+    pts = np.array(m["points"])
+    pts[4, 0] += 4e-3
+    pts[17, 2] -= 4e-3
+    m["points"] = pts.tolist()
+    glitched = tmp_path / "g.json"
+    glitched.write_text(json.dumps(m))
+    want = cli("calibrate", *args, "--measurements", glitched)
+    r = activecal.Robot.from_urdf(UR5_URDF, tip="tool0", marker=MARKER)
+    cal = activecal.calibrate(r, m["qs"], pts)
+    assert sorted(o["pose"] for o in cal.report["outliers"]["left_out"]) == [4, 17]
+    assert cal.report["outliers"] == want["outliers"]
+    assert_same_fit(cal, want)
+    kept = activecal.calibrate(r, m["qs"], pts, outliers="keep")
+    assert kept.report["outliers"]["left_out"] == []
+    # The glitches pull the kept fit: its residual is far above the other's.
+    assert kept.residuals["position_rms_mm"] > 5 * cal.residuals["position_rms_mm"]
+    with pytest.raises(ValueError, match="outliers"):
+        activecal.calibrate(r, m["qs"], pts, outliers="maybe")
+
+
+def test_a_shuffled_points_frame_is_aligned_on_its_index(tmp_path):
+    pd = pytest.importorskip("pandas")
+    args = ["--robot", UR5_URDF, "--tip", "tool0", "--marker", MARKER]
+    meas, m = simulated(tmp_path, args)
+    r = activecal.Robot.from_urdf(UR5_URDF, tip="tool0", marker=MARKER)
+    q = pd.DataFrame(m["qs"], columns=r.joint_names)
+    pts = pd.DataFrame(m["points"], columns=["x", "y", "z"])
+    ref = activecal.calibrate(r, q, pts.to_numpy())
+    shuffled = pts.sample(frac=1.0, random_state=1)
+    assert not shuffled.index.equals(q.index)
+    cal = activecal.calibrate(r, q, shuffled)
+    assert cal.residuals["position_rms_mm"] == pytest.approx(ref.residuals["position_rms_mm"], rel=1e-12)
+    # Labels that are not q's are refused, naming the argument.
+    other = pts.set_axis(pts.index + 1000)
+    with pytest.raises(ValueError, match="points: its index"):
+        activecal.calibrate(r, q, other)
+
+
+def test_a_stated_noise_the_data_reject_warns_in_python(tmp_path):
+    """The simulated σ is 0.1 mm; stated as 0.02 mm, the χ² test rejects it
+    and Python gets the command line's warning as a UserWarning."""
+    args = ["--robot", UR5_URDF, "--tip", "tool0", "--marker", MARKER]
+    meas, m = simulated(tmp_path, args)
+    r = activecal.Robot.from_urdf(UR5_URDF, tip="tool0", marker=MARKER)
+    with pytest.warns(UserWarning, match="noisier than stated"):
+        cal = activecal.calibrate(r, m["qs"], m["points"], noise=2e-5)
+    want = cli("calibrate", *args, "--measurements", meas, "--noise", 2e-5)
+    assert cal.report["warnings"] == want["warnings"]
+    assert cal.report["noise_test"]["rejected"]
+    assert cal.report["predicted"] == want["predicted"]

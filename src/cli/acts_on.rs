@@ -80,7 +80,8 @@ const fn r(id: &'static str, acts_on: &'static [Sensor], why: &'static str) -> R
 }
 
 const CAL_ALL: &[Sensor] = &[Simulated, Points, Poses, Contacts, Pixels];
-const MEASURED: &[Sensor] = &[Points, Poses];
+/// Measured points or full poses: told apart once the file is read.
+pub const MEASURED: &[Sensor] = &[Points, Poses];
 const FITTED: &[Sensor] = &[Points, Poses, Contacts];
 const READ: &[Sensor] = &[Points, Poses, Contacts, Pixels];
 const LS: &str = "the camera fit is least squares on the pixels";
@@ -366,40 +367,6 @@ fn given_as(sensors: &[Sensor]) -> &'static str {
     match sensors {
         [s] => s.given_as(),
         _ => "--measurements (points or full poses)",
-    }
-}
-
-/// The sensors a `calibrate` command line may be for, before its data are
-/// read: points and full poses are told apart once the file is read
-/// (`calibrate::from_measurements` checks again).
-pub fn calibrate_sensors(a: &super::calibrate::CalibrateArgs) -> &'static [Sensor] {
-    match (&a.observations, &a.measurements) {
-        (Some(_), _) => &[Pixels],
-        (None, Some(m)) if super::contact::is_contact_file(m) => &[Contacts],
-        (None, Some(_)) => MEASURED,
-        (None, None) => &[Simulated],
-    }
-}
-
-/// The sensors an `evaluate` command line may be for: contacts, or
-/// points and full poses (which its table does not tell apart).
-pub fn evaluate_sensors(a: &super::measured::EvaluateArgs) -> &'static [Sensor] {
-    if super::contact::is_contact_file(&a.measurements) {
-        &[Contacts]
-    } else {
-        MEASURED
-    }
-}
-
-/// The sensor of a `select` command line: `--point` (sockets), else
-/// `--camera-info` (a camera), else a pool of poses.
-pub fn select_sensor(a: &super::select::SelectArgs) -> Sensor {
-    if !a.points.is_empty() {
-        Sockets
-    } else if a.camera.camera_info.is_some() {
-        Camera
-    } else {
-        Pool
     }
 }
 

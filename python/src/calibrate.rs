@@ -567,7 +567,13 @@ fn aligned<'py>(
     other: &Bound<'py, PyAny>,
     name: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let (Ok(qi), Ok(oi)) = (q.getattr("index"), other.getattr("index")) else {
+    // A pandas index (a list's `index` is a method: not one).
+    let index = |x: &Bound<'py, PyAny>| {
+        x.getattr("index")
+            .ok()
+            .filter(|i| i.hasattr("equals").unwrap_or(false))
+    };
+    let (Some(qi), Some(oi)) = (index(q), index(other)) else {
         return Ok(other.clone());
     };
     if qi.call_method1("equals", (&oi,))?.is_truthy()? {

@@ -33,11 +33,6 @@ pub enum Fail {
 }
 
 impl Fail {
-    /// A computation's failure (any error type) with its message.
-    pub fn compute(e: impl Display) -> Self {
-        Fail::Compute(e.to_string())
-    }
-
     /// Wrong input (any error type) with its message.
     pub fn input(e: impl Display) -> Self {
         Fail::Input(e.to_string())

@@ -63,6 +63,17 @@ Usage (run with /work/main/.venv/bin/python; every output is JSON or CSV):
       uniformly at random (numpy default_rng(S)), written in the same CSV
       form (several --out: one design each).
 
+  truth.py optimum --urdf U --tip LINK [--base LINK] --measurements M.csv
+      An independent least-squares fit of single measured points (x1,y1,z1
+      and a column per chain joint): every chain joint's <origin> composed
+      with a free rigid motion (6 unknowns each, more than the minimal
+      parameters: the optimum is the same), the measurement frame (6) and
+      the point on the tip link (3), by SciPy's Levenberg-Marquardt on
+      Pinocchio's kinematics from the rigid start (Kabsch and the point's
+      least squares, alternated). Prints the optimum's RMS position error
+      (mm) over the samples: what any calibration of the same model class
+      can reach on the data.
+
 One arm end to end, printing predicted vs true:
   verify/python/truth_run.sh ur5 [SEED] [RANDOM_DESIGNS]
 The live gate on 9 arms: verify/tests/live_truth.rs.
@@ -605,6 +616,62 @@ def cmd_random_design(a):
     print(json.dumps(done[0] if len(done) == 1 else done))
 
 
+def rigid(p, y):
+    """The least-squares rigid motion (R, t) with y_i = R p_i + t (Kabsch)."""
+    cp, cy = p.mean(axis=0), y.mean(axis=0)
+    u, _, vt = np.linalg.svd((p - cp).T @ (y - cy))
+    d = np.sign(np.linalg.det(vt.T @ u.T))
+    r = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
+    return r, cy - r @ cp
+
+
+def read_points(path, names):
+    """Joint values (in the chain's order) and the points x1,y1,z1 of a CSV."""
+    with open(path) as f:
+        lines = [l.strip() for l in f if l.strip() and not l.startswith("#")]
+    head = lines[0].split(",")
+    rows = np.array([[float(v) for v in l.split(",")] for l in lines[1:]])
+    qs = rows[:, [head.index(n) for n in names]]
+    ys = rows[:, [head.index(c) for c in ("x1", "y1", "z1")]]
+    return qs, ys
+
+
+def cmd_optimum(a):
+    from scipy.optimize import least_squares
+
+    p = pin()
+    chain = Chain(a.urdf, a.base, a.tip)
+    qs, ys = read_points(a.measurements, chain.names)
+    nominal = [chain.model.jointPlacements[j].copy() for j in chain.ids]
+    ends = [chain.relative(q) for q in qs]
+    # The rigid start: the measurement frame and the tip point, alternated.
+    t = np.zeros(3)
+    for _ in range(100):
+        r, c = rigid(np.array([e.act(t) for e in ends]), ys)
+        inv = np.array([r.T @ (y - c) for y in ys])
+        t = np.mean([e.rotation.T @ (x - e.translation) for e, x in zip(ends, inv)], axis=0)
+    m0 = p.SE3(r, c)
+    nj = len(chain.ids)
+
+    def residuals(x):
+        for k, j in enumerate(chain.ids):
+            chain.model.jointPlacements[j] = nominal[k] * p.exp6(p.Motion(x[6 * k:6 * k + 6]))
+        m = p.exp6(p.Motion(x[6 * nj:6 * nj + 6])) * m0
+        tool = t + x[6 * nj + 6:]
+        pred = np.array([(m * chain.relative(q)).act(tool) for q in qs])
+        return (pred - ys).ravel()
+
+    x0 = np.zeros(6 * nj + 9)
+    start = residuals(x0)
+    sol = least_squares(residuals, x0, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                        max_nfev=200 * len(x0))
+    e = sol.fun.reshape(-1, 3)
+    rms = float(np.sqrt(np.mean(np.sum(e ** 2, axis=1)))) * 1e3
+    rms0 = float(np.sqrt(np.mean(np.sum(start.reshape(-1, 3) ** 2, axis=1)))) * 1e3
+    print(json.dumps({"rms_mm": rms, "start_rms_mm": rms0, "poses": len(qs),
+                      "unknowns": len(x0), "evaluations": int(sol.nfev), "status": int(sol.status)}))
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -643,11 +710,16 @@ def main(argv=None):
     p.add_argument("--n", type=int, default=30)
     p.add_argument("--seed", type=int, required=True)
     p.add_argument("--out", required=True, nargs="+")
+    p = sub.add_parser("optimum")
+    p.add_argument("--urdf", required=True)
+    p.add_argument("--tip", required=True)
+    p.add_argument("--base")
+    p.add_argument("--measurements", required=True)
     a = ap.parse_args(argv)
     if a.cmd == "compare" and not a.nominal and not (a.urdf and a.frames):
         ap.error("compare needs --urdf and --frames (or --nominal)")
     {"make": cmd_make, "measure": cmd_measure, "compare": cmd_compare,
-     "sensor-frames": cmd_sensor_frames, "rank": cmd_rank, "random-design": cmd_random_design}[a.cmd](a)
+     "sensor-frames": cmd_sensor_frames, "rank": cmd_rank, "random-design": cmd_random_design, "optimum": cmd_optimum}[a.cmd](a)
 
 
 if __name__ == "__main__":

@@ -86,6 +86,11 @@ fn marker_arg(a: &Arm, m: [f64; 3]) -> String {
 /// `select` chooses from it (`design.csv`): `select`'s predicted true RMS
 /// (mm) for 0.05 mm of noise.
 fn setup(dir: &Path, a: &Arm, marker: [f64; 3], seed: u64) -> f64 {
+    setup_n(dir, a, marker, seed, N)
+}
+
+/// As [`setup`], `n` poses.
+fn setup_n(dir: &Path, a: &Arm, marker: [f64; 3], seed: u64, n: usize) -> f64 {
     std::fs::create_dir_all(dir).unwrap();
     // `--marker=` keeps a negative first coordinate from reading as an option.
     let m = format!("--marker={},{},{}", marker[0], marker[1], marker[2]);
@@ -105,6 +110,7 @@ fn setup(dir: &Path, a: &Arm, marker: [f64; 3], seed: u64) -> f64 {
     ];
     truth_py(dir, args);
     let mk = marker_arg(a, marker);
+    let count = n.to_string();
     let sel = activecal(
         dir,
         [
@@ -122,7 +128,7 @@ fn setup(dir: &Path, a: &Arm, marker: [f64; 3], seed: u64) -> f64 {
             "--pool-seed",
             &s,
             "--n",
-            "30",
+            &count,
             "--noise",
             "5e-5",
             "--seed",
@@ -405,6 +411,117 @@ fn a_stated_noise_three_times_too_small_is_caught() {
     assert!(
         truth <= RATIO * pred && pred <= RATIO * truth,
         "true {truth} mm against the calibrated model's prediction {pred} mm"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `truth.py optimum`'s RMS (mm) of the point data `meas`: an independent
+/// least-squares fit (Pinocchio, SciPy) over every chain joint origin, the
+/// measurement frame and the tool point.
+fn independent_optimum(dir: &Path, urdf: &Path, base: Option<&str>, tip: &str, meas: &str) -> f64 {
+    let u = urdf.display().to_string();
+    let mut args = vec![
+        "optimum",
+        "--urdf",
+        &u,
+        "--tip",
+        tip,
+        "--measurements",
+        meas,
+    ];
+    if let Some(b) = base {
+        args.extend(["--base", b]);
+    }
+    truth_py(dir, args)["rms_mm"].as_f64().unwrap()
+}
+
+/// Equal optima: the two fits' RMS agree to this fraction (the issue's
+/// 0.5 %; a fit stuck elsewhere, or one unknown short, is off by more).
+const SAME_OPTIMUM: f64 = 0.005;
+
+#[test]
+fn positions_without_a_tool_reach_the_independent_optimum() {
+    let dir = base("optimum");
+    std::fs::create_dir_all(&dir).unwrap();
+    // FIGAROH's TIAGo reduced to its first marker's positions, no tool.
+    let csv =
+        std::fs::read_to_string(root().join("fixtures/figaroh/tiago_mocap_4markers.csv")).unwrap();
+    let mut lines = csv.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let keep: Vec<usize> = (0..head.len())
+        .filter(|&k| !["x2", "y2", "z2", "x3", "y3", "z3", "x4", "y4", "z4"].contains(&head[k]))
+        .collect();
+    let pick = |l: &str| -> String {
+        let c: Vec<&str> = l.split(',').collect();
+        keep.iter().map(|&k| c[k]).collect::<Vec<_>>().join(",")
+    };
+    let mut out = vec![keep.iter().map(|&k| head[k]).collect::<Vec<_>>().join(",")];
+    out.extend(lines.filter(|l| !l.trim().is_empty()).map(pick));
+    std::fs::write(dir.join("tiago_p1.csv"), out.join("\n") + "\n").unwrap();
+    let tiago = root().join("fixtures/figaroh/tiago.urdf");
+    let t = tiago.display().to_string();
+    let v: Value = serde_json::from_str(
+        &activecal(
+            &dir,
+            [
+                "calibrate",
+                "--robot",
+                &t,
+                "--base",
+                "base_footprint",
+                "--tip",
+                "arm_7_link",
+                "--measurements",
+                "tiago_p1.csv",
+                "--outliers",
+                "keep",
+                "--out",
+                "tiago.urdf",
+                "--out",
+                "tiago.yaml",
+                "--json",
+            ],
+        )
+        .unwrap_or_else(|e| panic!("TIAGo positions without a tool: {e}")),
+    )
+    .unwrap();
+    let ours = v["residuals"]["position_rms_mm"].as_f64().unwrap();
+    let theirs = independent_optimum(
+        &dir,
+        &tiago,
+        Some("base_footprint"),
+        "arm_7_link",
+        "tiago_p1.csv",
+    );
+    eprintln!(
+        "TIAGo positions, no tool: {ours:.6} mm fitted, independent optimum {theirs:.6} mm, {} unknowns, rank {}",
+        v["parameters"].as_array().unwrap().len(),
+        v["rank"]
+    );
+    assert_eq!(v["exit_status"], 0);
+    assert!(dir.join("tiago.urdf").exists());
+    assert!(
+        (ours - theirs).abs() <= SAME_OPTIMUM * theirs,
+        "{ours} mm against {theirs} mm"
+    );
+    // A true Panda (7 joints), the tool 138 mm off the last axis, 48 poses
+    // of positions with 0.05 mm of noise, no tool given.
+    let a = &ARMS[3];
+    let marker = [0.1, 0.095, 0.04];
+    let pdir = dir.join("panda");
+    setup_n(&pdir, a, marker, 5, 48);
+    measure(&pdir, &["m.csv".into()], NOISE, 5);
+    let v = calibrate(&pdir, a, "m.csv", "cal", &["--outliers", "keep"])
+        .unwrap_or_else(|e| panic!("{e}"));
+    let ours = v["residuals"]["position_rms_mm"].as_f64().unwrap();
+    let theirs = independent_optimum(&pdir, &urdf(a), None, a.tip, "m.csv");
+    eprintln!(
+        "Panda, tool 138 mm off the last axis, 48 poses: {ours:.6} mm fitted, independent optimum {theirs:.6} mm"
+    );
+    assert_eq!(v["exit_status"], 0);
+    assert!(
+        (ours - theirs).abs() <= SAME_OPTIMUM * theirs,
+        "{ours} mm against {theirs} mm"
     );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -39,32 +39,34 @@ const ITERATIONS: usize = 10_000;
 const EPS: f64 = 1e-15;
 const TINY: f64 = 1e-300;
 
+/// `x`, or [`TINY`] when `|x|` is below it: Lentz's guard against a zero
+/// denominator.
+fn nonzero(x: f64) -> f64 {
+    if x.abs() < TINY { TINY } else { x }
+}
+
 /// Lentz's evaluation of the continued fraction of the incomplete beta
 /// function (Numerical Recipes' `betacf`).
 fn beta_fraction(a: f64, b: f64, x: f64) -> f64 {
     let (qab, qap, qam) = (a + b, a + 1.0, a - 1.0);
     let mut c = 1.0;
-    let mut d = 1.0 - qab * x / qap;
-    if d.abs() < TINY {
-        d = TINY;
-    }
-    d = 1.0 / d;
+    let mut d = 1.0 / nonzero(1.0 - qab * x / qap);
     let mut h = d;
     for m in 1..ITERATIONS {
         let m = m as f64;
         let m2 = 2.0 * m;
         let aa = m * (b - m) * x / ((qam + m2) * (a + m2));
         d = 1.0 + aa * d;
-        d = if d.abs() < TINY { TINY } else { d };
+        d = nonzero(d);
         c = 1.0 + aa / c;
-        c = if c.abs() < TINY { TINY } else { c };
+        c = nonzero(c);
         d = 1.0 / d;
         h *= d * c;
         let aa = -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2));
         d = 1.0 + aa * d;
-        d = if d.abs() < TINY { TINY } else { d };
+        d = nonzero(d);
         c = 1.0 + aa / c;
-        c = if c.abs() < TINY { TINY } else { c };
+        c = nonzero(c);
         d = 1.0 / d;
         let del = d * c;
         h *= del;
@@ -141,9 +143,9 @@ fn gamma_regularized(a: f64, x: f64) -> (f64, f64) {
         let an = -(i as f64) * (i as f64 - a);
         b += 2.0;
         d = an * d + b;
-        d = if d.abs() < TINY { TINY } else { d };
+        d = nonzero(d);
         c = b + an / c;
-        c = if c.abs() < TINY { TINY } else { c };
+        c = nonzero(c);
         d = 1.0 / d;
         let del = d * c;
         h *= del;

@@ -19,7 +19,7 @@
 //!   calibrated model's own predicted error (at σ̂) is within [`RATIO`] of
 //!   its true error.
 
-use super::live_truth::{activecal, root, truth_py};
+use super::live_truth::{activecal, compare, root, truth_py};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -182,23 +182,10 @@ fn calibrate(dir: &Path, a: &Arm, meas: &str, stem: &str, extra: &[&str]) -> Res
     Ok(serde_json::from_str(&out).unwrap())
 }
 
-/// The true RMS (mm) at 1,000 random configurations of each calibration
-/// `stems` wrote.
+/// The true RMS (mm) at 1,000 random configurations (seed 0) of each
+/// calibration `stems` wrote (`truth.py compare`).
 fn true_rms(dir: &Path, stems: &[String]) -> Vec<f64> {
-    let mut args: Vec<String> = ["compare", "--truth", "truth.json", "--urdf"]
-        .map(String::from)
-        .to_vec();
-    args.extend(stems.iter().map(|s| format!("{s}.urdf")));
-    args.push("--frames".into());
-    args.extend(stems.iter().map(|s| format!("{s}.yaml")));
-    let v = truth_py(dir, &args);
-    let list = match v {
-        Value::Array(a) => a,
-        one => vec![one],
-    };
-    list.iter()
-        .map(|c| c["random"]["rms_mm"].as_f64().unwrap())
-        .collect()
+    compare(dir, 0, stems)
 }
 
 fn rms(v: &[f64]) -> f64 {

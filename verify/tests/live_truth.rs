@@ -320,7 +320,7 @@ fn calibrate_with(
 }
 
 /// The 3-D RMS (mm) at the random configurations of each `(urdf, yaml)`.
-fn compare(dir: &Path, seed: u64, cals: &[String]) -> Vec<f64> {
+pub(super) fn compare(dir: &Path, seed: u64, cals: &[String]) -> Vec<f64> {
     let mut args: Vec<String> = vec![
         "compare".into(),
         "--truth".into(),

@@ -288,3 +288,29 @@ def test_a_stated_noise_the_data_reject_warns_in_python(tmp_path):
     assert cal.report["warnings"] == want["warnings"]
     assert cal.report["noise_test"]["rejected"]
     assert cal.report["predicted"] == want["predicted"]
+
+
+def test_too_few_poses_are_refused_as_the_cli_refuses_them(tmp_path):
+    """3 poses (9 rows) for 27 unknowns converge on the 9 the rows determine:
+    the library's verdict refuses to write it, in Python as on the command
+    line (exit 3, the same reason)."""
+    import subprocess
+
+    from conftest import cli_path
+
+    args = ["--robot", UR5_URDF, "--tip", "tool0", "--marker", MARKER]
+    meas, m = simulated(tmp_path, args)
+    m["qs"], m["points"] = m["qs"][:3], m["points"][:3]
+    few = tmp_path / "few.json"
+    few.write_text(json.dumps(m))
+    r = activecal.Robot.from_urdf(UR5_URDF, tip="tool0", marker=MARKER)
+    cal = activecal.calibrate(r, m["qs"], m["points"])
+    assert cal.report["exit_status"] == 3
+    with pytest.raises(activecal.Error, match="3 poses give 9 measurement rows for 27 unknowns"):
+        cal.write_urdf(tmp_path / "x.urdf")
+    assert not (tmp_path / "x.urdf").exists()
+    out = subprocess.run([str(cli_path()), "calibrate", *args, "--measurements", str(few), "--out", str(tmp_path / "y.urdf")],
+                         capture_output=True, text=True)
+    assert out.returncode == 3
+    assert "3 poses give 9 measurement rows for 27 unknowns" in out.stderr
+    assert not (tmp_path / "y.urdf").exists()

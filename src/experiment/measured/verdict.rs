@@ -2,8 +2,10 @@
 //! the library so that every front end refuses the same fits with the same
 //! message: a fit that did not converge, or that converged to another robot
 //! ([`crate::frames::plausible::implausible`]: a joint origin moved by more
-//! than a fraction of its link, a tool beyond the reach), is refused, with
-//! too few measurement rows for the unknowns named first as its cause.
+//! than a fraction of its link, a tool beyond the reach), or that had fewer
+//! measurement rows than the robot has unknowns (it converged only by
+//! holding most of them at nominal), is refused, with too few rows named
+//! first as the cause.
 
 use crate::frames::CalibratedFrames;
 use crate::identify::Identification;
@@ -57,15 +59,23 @@ pub fn verdict(
     poses: usize,
     unknowns: usize,
 ) -> Verdict {
-    let why = if id.converged() {
-        crate::frames::plausible::implausible(robot, &id.table, frames)
-    } else {
+    let few = too_few_rows(robot, poses, unknowns);
+    let why = if !id.converged() {
         Some(unconverged(id))
+    } else if few.is_some() {
+        // Converged on the few unknowns the rows determine (the others held
+        // at nominal): a fit of the data, not a calibration of the robot.
+        Some(format!(
+            "the fit converged on {} of the {unknowns} unknowns, the rest held at nominal: not a calibration of the robot",
+            id.names.len()
+        ))
+    } else {
+        crate::frames::plausible::implausible(robot, &id.table, frames)
     };
     match why {
         None => Verdict::Calibrated,
         Some(why) => Verdict::Refused {
-            reason: match too_few_rows(robot, poses, unknowns) {
+            reason: match few {
                 Some(cause) => format!("{cause}\n  {why}"),
                 None => why,
             },

@@ -32,8 +32,25 @@ pub enum LossChoice {
     },
 }
 
-/// A weight below this marks a sample as down-weighted in reports.
+/// A weight below this marks a sample as down-weighted in reports (Huber:
+/// its residual beyond the scale).
 pub const DOWNWEIGHTED: f64 = 0.999;
+
+impl LossChoice {
+    /// The loss weight below which a pose counts as down-weighted: its
+    /// residual norm beyond the loss's scale (Huber's weight `c/r` is below
+    /// 1 there, Cauchy's `1/(1 + r²/c²)` below ½); `None` for least squares.
+    /// Cauchy weighs every pose below 1, so `DOWNWEIGHTED` would list them
+    /// all.
+    #[must_use]
+    pub fn downweighted_below(self) -> Option<f64> {
+        match self {
+            LossChoice::L2 => None,
+            LossChoice::Huber { .. } => Some(DOWNWEIGHTED),
+            LossChoice::Cauchy { .. } => Some(0.5),
+        }
+    }
+}
 
 /// A fit: the identification and each pose's final loss weight (all 1 for
 /// least squares).
@@ -43,16 +60,20 @@ pub struct Fit {
     pub id: Identification,
     /// The loss weight `ρ'(‖r_i‖²)` of each pose at the estimate.
     pub weights: Vec<f64>,
+    /// The loss.
+    pub loss: LossChoice,
 }
 
 impl Fit {
-    /// Poses (0-based) whose weight is below [`DOWNWEIGHTED`], with it.
+    /// Poses (0-based) the loss really down-weights (their residual beyond
+    /// its scale, [`LossChoice::downweighted_below`]), with their weight.
     #[must_use]
     pub fn downweighted(&self) -> Vec<(usize, f64)> {
+        let below = self.loss.downweighted_below().unwrap_or(0.0);
         self.weights
             .iter()
             .enumerate()
-            .filter(|(_, w)| **w < DOWNWEIGHTED)
+            .filter(|(_, w)| **w < below)
             .map(|(i, &w)| (i, w))
             .collect()
     }
@@ -96,7 +117,11 @@ pub fn fit(
             (id, w)
         }
     };
-    Ok(Fit { id, weights: w })
+    Ok(Fit {
+        id,
+        weights: w,
+        loss,
+    })
 }
 
 /// How a fit weighs its residual blocks (positions, orientations) against
@@ -149,7 +174,7 @@ pub fn fit_weighted(
     let mut r = robot.clone();
     let mut from = start.clone();
     let mut f = fit(&r, &from, meas, lm, loss)?;
-    let mut sigmas = super::variance::block_sigmas(&r, &from, meas, &f.id)?;
+    let mut sigmas = super::variance::block_sigmas(&r, &from, meas, &f.id, &f.weights)?;
     let mut rounds = 0;
     let reweigh = weights == Weights::Estimated && !meas.orientations().is_empty();
     while reweigh && rounds < VCE_ROUNDS {
@@ -162,7 +187,7 @@ pub fn fit_weighted(
         r.orientation_scale = w;
         from = f.id.table.clone();
         f = fit(&r, &from, meas, lm, loss)?;
-        sigmas = super::variance::block_sigmas(&r, &from, meas, &f.id)?;
+        sigmas = super::variance::block_sigmas(&r, &from, meas, &f.id, &f.weights)?;
         rounds += 1;
     }
     Ok(WeightedFit {

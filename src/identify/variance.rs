@@ -76,12 +76,17 @@ pub fn row_blocks(kinds: &[RowKind], points: usize) -> (Vec<usize>, Vec<(String,
 
 /// Each residual block's σ at the fit `id` of `robot` to `meas` from
 /// `start` (see the module documentation). A block without redundancy
-/// (every row fitted exactly by the parameters) has σ `NaN`.
+/// (every row fitted exactly by the parameters) has σ `NaN`. With a robust
+/// loss, `pose_weights` are its weights `w_i` (empty: all 1): each pose's
+/// rows count `w_i` times in the sums, its residuals and Jacobian rows by
+/// `√w_i` in the hat matrix, so that a pose the loss sets aside does not
+/// inflate the σ the fit's σ̂ is computed without.
 pub fn block_sigmas(
     robot: &Robot,
     start: &ParamTable,
     meas: &Measurements,
     id: &Identification,
+    pose_weights: &[f64],
 ) -> Result<Vec<BlockSigma>> {
     let mut cal = Calibration::new(robot, start, meas)?;
     let (t, n) = (cal.block_rows(), cal.n_params());
@@ -92,21 +97,29 @@ pub fn block_sigmas(
     let mut r = vec![0.0; m];
     let mut jac = faer::Mat::<f64>::zeros(m, n);
     cal.eval(&id.estimate, &mut r, Some(&mut jac));
+    let w = |i: usize| pose_weights.get(i / t.max(1)).copied().unwrap_or(1.0);
+    for i in 0..(t * meas.len()).min(m) {
+        let s = w(i).sqrt();
+        for j in 0..n {
+            jac[(i, j)] *= s;
+        }
+    }
     let hat = hat_diagonal(&jac);
-    let mut sum = vec![(0usize, 0.0f64, 0.0f64); names.len()];
+    let mut sum = vec![(0usize, 0.0f64, 0.0f64, 0.0f64); names.len()];
     for i in 0..(t * meas.len()).min(m) {
         let c = i % t;
         let b = of_row[c];
         let unweighted = r[i] / weights[c];
         sum[b].0 += 1;
-        sum[b].1 += unweighted * unweighted;
-        sum[b].2 += hat.get(i).copied().unwrap_or(f64::NAN);
+        sum[b].1 += w(i);
+        sum[b].2 += w(i) * unweighted * unweighted;
+        sum[b].3 += hat.get(i).copied().unwrap_or(f64::NAN);
     }
     Ok(names
         .into_iter()
         .zip(sum)
-        .map(|((block, unit), (rows, ss, h))| {
-            let redundancy = rows as f64 - h;
+        .map(|((block, unit), (rows, counted, ss, h))| {
+            let redundancy = counted - h;
             BlockSigma {
                 block,
                 rows,

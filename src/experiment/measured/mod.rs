@@ -305,12 +305,12 @@ fn holdout_report(settings: HoldoutSettings, splits: Vec<SplitResult>) -> Holdou
 /// and 38× and converge from the nominal model, as before.
 const MOUNT_GAIN: f64 = 200.0;
 
-/// A URDF robot mounted in the data's frame when the nominal model is far
-/// from it ([`crate::frames::align`]); and, for single measured points with
-/// no tool point given (a point sensor, no marker), measured as a
-/// one-marker sensor whose offset is an unknown from the start, started at
-/// the point the data imply ([`tool_point_unknown`]); with a note saying so,
-/// and when far, the rigid fit's RMS position error (mm).
+/// A URDF robot mounted in the data's frame ([`crate::frames::align`]) when
+/// the nominal model is far from it, or when single measured points come
+/// with no tool point given (a point sensor, no marker): then it is measured
+/// as a one-marker sensor whose offset is an unknown from the start, started
+/// at the point the rigid placement implies; with a note saying so, and
+/// when far, the rigid fit's RMS position error (mm).
 fn mounted_start(
     robot: &Robot,
     meas: &Measurements,
@@ -348,7 +348,12 @@ fn mounted_start(
         ));
     }
     if tool_unknown {
-        r = tool_point_unknown(&r, tool)?;
+        // One marker at the data's point: its three coordinates are unknowns
+        // chosen before the joint origins (`Robot::with_markers`), so no
+        // joint origin absorbs a tool off the last axis, where the polar
+        // `a`, `γ` of the last frames are singular. Nominal and start alike
+        // hold the point the data imply: no other was given.
+        r = r.with_markers(&[tool])?;
         notes.push(format!(
             "single points and no tool point given (--marker): the measured point on '{}' is an unknown (3 coordinates, chosen before the joint origins), started where the data put it, [{:.1}, {:.1}, {:.1}] mm (rigid fit RMS {:.3} mm); {} unknowns",
             src.tip,
@@ -364,16 +369,6 @@ fn mounted_start(
         notes.join("; "),
         far.then_some(a.rms_after * 1e3),
     )))
-}
-
-/// `robot` (a point sensor) measured as one marker at `offset` in its last
-/// frame: the offset's three coordinates are unknowns chosen before the
-/// joint origins ([`Robot::with_markers`]), so no joint origin absorbs a
-/// tool point off the last axis (the polar `a`, `γ` of the last frames are
-/// singular for a point near the axis). Nominal and start alike hold the
-/// offset the data imply: no other was given.
-fn tool_point_unknown(robot: &Robot, offset: [f64; 3]) -> Result<Robot, crate::Error> {
-    robot.with_markers(&[offset])
 }
 
 /// For a one-marker robot and single-point data whose given offset is far

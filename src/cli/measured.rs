@@ -106,49 +106,7 @@ pub fn measured_text(r: &MeasuredReport, id: &Identification, status: &str) -> S
         }
         None => s += &format!("nominal: {}\n", r.nominal_residuals.summary()),
     }
-    if let Some(p) = &r.predicted {
-        s += &format!(
-            "predicted for the calibrated model (σ̂ {:.4} mm per coordinate): position RMS {:.4} mm at {} random configurations (95th percentile of the error {:.4} mm){}\n",
-            id.sigma_hat.unwrap_or(f64::NAN) * 1e3,
-            p.position_rms_mm,
-            activecal::experiment::measured::PREDICTION_CONFIGURATIONS,
-            p.position_error_p95_mm,
-            p.orientation_rms_deg
-                .map_or(String::new(), |o| format!(", orientation RMS {o:.4}°"))
-        );
-    }
-    if let Some(t) = &r.noise_test {
-        s += &format!(
-            "stated noise {:.4} mm per coordinate: σ̂ is {:.2}× it (χ² on {} dof: P(larger) {:.2e}, P(smaller) {:.2e}){}\n",
-            t.stated_m * 1e3,
-            t.ratio,
-            t.dof,
-            t.p_larger,
-            t.p_smaller,
-            if t.rejected {
-                ", rejected: see the warning"
-            } else {
-                ", consistent"
-            }
-        );
-    }
-    if !r.outliers.left_out.is_empty() {
-        let v: Vec<String> = r
-            .outliers
-            .left_out
-            .iter()
-            .map(|o| {
-                format!(
-                    "pose {} ({:.3} mm, F {:.1}, P {:.1e})",
-                    o.pose + 1,
-                    o.residual_mm,
-                    o.test.statistic,
-                    o.test.p_value
-                )
-            })
-            .collect();
-        s += &format!("left out as gross errors: {}\n", v.join(", "));
-    }
+    s += &judgement_text(r, id);
     if !r.downweighted.is_empty() {
         let v: Vec<String> = r
             .downweighted
@@ -222,6 +180,57 @@ pub fn measured_text(r: &MeasuredReport, id: &Identification, status: &str) -> S
             "\ncompliance on the same splits:\n{}",
             super::compliance::comparison_text(c)
         );
+    }
+    s
+}
+
+/// What the report says of the fit beyond its residuals: the calibrated
+/// model's own predicted error, σ̂ against the stated noise, the poses left
+/// out as gross errors.
+fn judgement_text(r: &MeasuredReport, id: &Identification) -> String {
+    let mut s = String::new();
+    if let Some(p) = &r.predicted {
+        s += &format!(
+            "predicted for the calibrated model (σ̂ {:.4} mm per coordinate): position RMS {:.4} mm at {} random configurations (95th percentile of the error {:.4} mm){}\n",
+            id.sigma_hat.unwrap_or(f64::NAN) * 1e3,
+            p.position_rms_mm,
+            activecal::experiment::measured::PREDICTION_CONFIGURATIONS,
+            p.position_error_p95_mm,
+            p.orientation_rms_deg
+                .map_or(String::new(), |o| format!(", orientation RMS {o:.4}°"))
+        );
+    }
+    if let Some(t) = &r.noise_test {
+        s += &format!(
+            "stated noise {:.4} mm per coordinate: σ̂ is {:.2}× it (χ² on {} dof: P(larger) {:.2e}, P(smaller) {:.2e}){}\n",
+            t.stated_m * 1e3,
+            t.ratio,
+            t.dof,
+            t.p_larger,
+            t.p_smaller,
+            if t.rejected {
+                ", rejected: see the warning"
+            } else {
+                ", consistent"
+            }
+        );
+    }
+    if !r.outliers.left_out.is_empty() {
+        let v: Vec<String> = r
+            .outliers
+            .left_out
+            .iter()
+            .map(|o| {
+                format!(
+                    "pose {} ({:.3} mm, F {:.1}, P {:.1e})",
+                    o.pose + 1,
+                    o.residual_mm,
+                    o.test.statistic,
+                    o.test.p_value
+                )
+            })
+            .collect();
+        s += &format!("left out as gross errors: {}\n", v.join(", "));
     }
     s
 }

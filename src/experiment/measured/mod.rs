@@ -540,7 +540,7 @@ pub fn calibrate_read(
     let warnings: Vec<String> = noise_test.iter().filter_map(|t| t.warning()).collect();
     let base =
         crate::report::MeasuredCalibrationReport::new(&r, &f.id, source.to_string(), meas.len());
-    let mut report = MeasuredReport {
+    let report = MeasuredReport {
         base,
         loss: s.loss,
         residuals: res,
@@ -567,28 +567,7 @@ pub fn calibrate_read(
         noise_test,
         warnings,
     };
-    let fit_block = crate::frames::report::FitBlock {
-        poses: report.base.poses,
-        position_rms_mm: report.residuals.position_rms_mm,
-        orientation_rms_deg: report.residuals.orientation_rms_deg,
-    };
-    let cov = f.id.covariance.as_ref().map(|c| c.matrix.as_slice());
-    let frames = crate::frames::calibrated(&r, &f.id.table, cov, Some(fit_block))?;
-    report.frames = frames.as_ref().map(|(_, fr)| fr.clone());
-    let verdict = verdict::verdict(
-        &r,
-        &f.id,
-        frames.as_ref().map(|(c, _)| c),
-        report.base.poses,
-        report.parameters.len() + report.fixed.len(),
-    );
-    Ok(MeasuredCalibration {
-        robot: r,
-        fit: f,
-        frames,
-        report,
-        verdict,
-    })
+    finish(r, f, report)
 }
 
 /// The nominal model's errors on the data: with a mounted start, the
@@ -677,4 +656,35 @@ impl Splits<'_> {
         let com = self.run(&plain, self.s.gravity.clone())?;
         Ok(compare(&geo, &com))
     }
+}
+
+/// The calibration of `report`'s fit `f` of `r`: its calibrated frames
+/// (URDF robots, in the report too) and the verdict on it.
+fn finish(
+    r: Robot,
+    f: Fit,
+    mut report: MeasuredReport,
+) -> Result<MeasuredCalibration, ExperimentError> {
+    let fit_block = crate::frames::report::FitBlock {
+        poses: report.base.poses,
+        position_rms_mm: report.residuals.position_rms_mm,
+        orientation_rms_deg: report.residuals.orientation_rms_deg,
+    };
+    let cov = f.id.covariance.as_ref().map(|c| c.matrix.as_slice());
+    let frames = crate::frames::calibrated(&r, &f.id.table, cov, Some(fit_block))?;
+    report.frames = frames.as_ref().map(|(_, fr)| fr.clone());
+    let verdict = verdict::verdict(
+        &r,
+        &f.id,
+        frames.as_ref().map(|(c, _)| c),
+        report.base.poses,
+        report.parameters.len() + report.fixed.len(),
+    );
+    Ok(MeasuredCalibration {
+        robot: r,
+        fit: f,
+        frames,
+        report,
+        verdict,
+    })
 }

@@ -6,6 +6,7 @@
 //! and the Python package both call it; reading the files and writing the
 //! results are theirs.
 
+use crate::experiment::measured::verdict::Verdict;
 use crate::frames::camera::camera_frames;
 use crate::frames::report::FramesReport;
 use crate::frames::{CalibratedFrames, FramesError};
@@ -19,6 +20,8 @@ use crate::model::Robot;
 use crate::report::{CameraCalibrationReport, CameraStartReport};
 use nalgebra::Isometry3;
 
+pub mod verdict;
+
 /// What a camera calibration is given besides the robot and the
 /// observations: the camera, the target, how they are mounted and where
 /// they roughly are.
@@ -28,6 +31,8 @@ pub struct CameraSetup {
     pub intrinsics: Intrinsics,
     /// The target's points.
     pub target: Target,
+    /// Where the target came from (its file), for messages.
+    pub target_origin: String,
     /// Which of the two rides on the tip link.
     pub mounting: Mounting,
     /// The robot's link the camera is on (a head), when the robot given
@@ -88,6 +93,8 @@ pub struct CameraCalibration {
     /// The start computed from the pixels, when a placement was not
     /// given.
     pub start: Option<CameraStart>,
+    /// Whether it may be written ([`verdict::camera_verdict`]).
+    pub verdict: Verdict,
 }
 
 /// Calibrates `robot` (the chain from the camera's link for a camera on
@@ -138,7 +145,7 @@ pub fn calibrate_camera(
     if let Some(c) = frames.as_mut().and_then(|f| f.1.camera.as_mut()) {
         c.camera_link.clone_from(&setup.camera_link);
     }
-    Ok(CameraCalibration {
+    let mut cal = CameraCalibration {
         robot_name: robot.name.clone(),
         observations,
         fit,
@@ -146,7 +153,18 @@ pub fn calibrate_camera(
         camera_link: setup.camera_link.clone(),
         refine_intrinsics: setup.refine_intrinsics,
         start,
-    })
+        verdict: Verdict::Calibrated,
+    };
+    cal.verdict = verdict::camera_verdict(&cal, &setup.target_origin, extent(&setup.target));
+    Ok(cal)
+}
+
+/// The largest distance between two of `target`'s points, metres.
+fn extent(target: &Target) -> f64 {
+    let p = &target.points;
+    p.iter()
+        .flat_map(|a| p.iter().map(move |b| (a - b).norm()))
+        .fold(0.0, f64::max)
 }
 
 impl CameraCalibration {
@@ -175,6 +193,8 @@ impl CameraCalibration {
             stop: format!("{:?}", fit.stop),
             camera: self.frames.as_ref().and_then(|f| f.1.camera.clone()),
             intrinsics: self.refine_intrinsics.then(|| fit.intrinsics()),
+            refused: self.verdict.refusal().map(str::to_string),
+            exit_status: self.verdict.exit_status(),
             out,
         }
     }

@@ -63,6 +63,11 @@ pub struct CameraCalibrationReport {
     pub camera: Option<crate::frames::report::CameraBlock>,
     /// The intrinsics at the estimate, when they were refined.
     pub intrinsics: Option<Intrinsics>,
+    /// Why the calibration may not be written (nothing was), when it
+    /// may not ([`crate::experiment::camera::verdict`]).
+    pub refused: Option<String>,
+    /// 0, or 3 when refused.
+    pub exit_status: i32,
     /// The files written.
     pub out: Vec<String>,
 }

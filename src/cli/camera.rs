@@ -150,7 +150,7 @@ pub fn calibrate_camera(
             &written,
             cal.start.as_ref(),
             cal.verdict.refusal(),
-        )
+        ) + &labels_text(&cal.labels)
     })?;
     Ok(cal.verdict.refusal().map(str::to_string))
 }
@@ -306,6 +306,29 @@ fn text(
     }
     for w in written {
         let _ = writeln!(s, "wrote {w}");
+    }
+    s
+}
+
+/// The poses whose checkerboard corners were relabelled, and those
+/// dropped as ambiguous, one line each kind (empty when none).
+fn labels_text(l: &activecal::identify::camera::start::labels::Labels) -> String {
+    let mut s = String::new();
+    if !l.relabelled.is_empty() {
+        let each: Vec<String> = l
+            .relabelled
+            .iter()
+            .map(|r| format!("pose {} {}", r.pose, r.labelling.name()))
+            .collect();
+        let _ = writeln!(
+            s,
+            "note: the checkerboard's corners were detected in another order at {} poses, relabelled by the robot's motion: {}",
+            each.len(),
+            each.join(", ")
+        );
+    }
+    for d in &l.dropped {
+        let _ = writeln!(s, "note: pose {} left out: {}", d.pose, d.reason);
     }
     s
 }

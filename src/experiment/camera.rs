@@ -11,6 +11,7 @@ use crate::frames::camera::camera_frames;
 use crate::frames::report::FramesReport;
 use crate::frames::{CalibratedFrames, FramesError};
 use crate::identify::LmSettings;
+use crate::identify::camera::start::labels::{Labels, relabel};
 use crate::identify::camera::start::{CameraStart, StartError, start_placements};
 use crate::identify::camera::{CameraFit, CameraFitError, CameraObservations, fit_camera};
 use crate::io::camera_target::Target;
@@ -95,16 +96,27 @@ pub struct CameraCalibration {
     pub start: Option<CameraStart>,
     /// Whether it may be written ([`verdict::camera_verdict`]).
     pub verdict: Verdict,
+    /// The poses of a checkerboard whose corners were relabelled, and
+    /// those dropped as ambiguous
+    /// ([`crate::identify::camera::start::labels`]).
+    pub labels: Labels,
 }
 
 /// Calibrates `robot` (the chain from the camera's link for a camera on
 /// the robot's own link) from `observations` of `setup`'s target.
 pub fn calibrate_camera(
     robot: &Robot,
-    observations: CameraObservations,
+    mut observations: CameraObservations,
     setup: &CameraSetup,
     lm: &LmSettings,
 ) -> Result<CameraCalibration, CameraCalibrationError> {
+    let labels = relabel(
+        robot,
+        &setup.intrinsics,
+        setup.mounting,
+        &setup.target,
+        &mut observations,
+    );
     let start = match (setup.camera, setup.target_pose) {
         (Some(_), Some(_)) => None,
         (cam, tgt) => Some(
@@ -154,6 +166,7 @@ pub fn calibrate_camera(
         refine_intrinsics: setup.refine_intrinsics,
         start,
         verdict: Verdict::Calibrated,
+        labels,
     };
     cal.verdict = verdict::camera_verdict(&cal, &setup.target_origin, extent(&setup.target));
     Ok(cal)
@@ -193,6 +206,8 @@ impl CameraCalibration {
             stop: format!("{:?}", fit.stop),
             camera: self.frames.as_ref().and_then(|f| f.1.camera.clone()),
             intrinsics: self.refine_intrinsics.then(|| fit.intrinsics()),
+            relabelled: self.labels.relabelled.clone(),
+            dropped_poses: self.labels.dropped.clone(),
             refused: self.verdict.refusal().map(str::to_string),
             exit_status: self.verdict.exit_status(),
             out,

@@ -17,6 +17,7 @@
 //! refines both jointly.
 
 pub mod hand_eye;
+pub mod labels;
 pub mod pnp;
 
 use super::CameraObservations;
@@ -71,7 +72,7 @@ pub enum StartError {
 
 /// Each pose's end frame of `robot` at its nominal parameters, as a rigid
 /// motion.
-fn end_frames(robot: &Robot, obs: &CameraObservations) -> Vec<Isometry3<f64>> {
+pub(crate) fn end_frames(robot: &Robot, obs: &CameraObservations) -> Vec<Isometry3<f64>> {
     // The end frame the fit's first step sees: no unknowns, the nominal
     // table.
     let mut r = robot.clone();

@@ -149,8 +149,10 @@ pub fn calibrate_camera(
             frames.as_ref().map(|f| &f.1),
             &written,
             cal.start.as_ref(),
-            cal.verdict.refusal(),
         ) + &labels_text(&cal.labels)
+            + &cal.verdict.refusal().map_or_else(String::new, |why| {
+                format!("REFUSED: {why}: nothing written\n")
+            })
     })?;
     Ok(cal.verdict.refusal().map(str::to_string))
 }
@@ -200,7 +202,6 @@ fn text(
     frames: Option<&activecal::frames::report::FramesReport>,
     written: &[String],
     start: Option<&CameraStart>,
-    refused: Option<&str>,
 ) -> String {
     let mut s = String::new();
     let n_kin = fit.robot.n_unknowns();
@@ -300,9 +301,6 @@ fn text(
             fit.names[k],
             u = unit.1
         );
-    }
-    if let Some(why) = refused {
-        let _ = writeln!(s, "REFUSED: {why}: nothing written");
     }
     for w in written {
         let _ = writeln!(s, "wrote {w}");

@@ -188,6 +188,10 @@ fn placements(
         .collect()
 }
 
+/// A pose's best labelling relative to the reference, its score and the
+/// second best's (`None`: no labelling placed the target).
+type Choice = Option<(Labelling, f64, f64)>;
+
 /// The best labelling of each pose relative to the reference `r`, its
 /// score and the second best's, and the total of the best scores.
 fn relative(
@@ -195,7 +199,7 @@ fn relative(
     b: &[[Option<Isometry3<f64>>; 4]],
     r: usize,
     length: f64,
-) -> Option<(Vec<Option<(Labelling, f64, f64)>>, f64)> {
+) -> Option<(Vec<Choice>, f64)> {
     let br = b[r][0]?;
     let mut total = 0.0;
     let rel = (0..b.len())

@@ -59,6 +59,24 @@ pub enum CameraCalibrationError {
     /// The calibrated robot could not be split into frames.
     #[error(transparent)]
     Frames(#[from] FramesError),
+    /// The start computed from the pixels puts seen points behind the
+    /// camera: the poses' PnP disagree with the robot's motion.
+    #[error(
+        "{origin}: the start computed from the pixels (each pose's PnP and the closed-form hand-eye) puts {behind} seen point(s) behind the camera (first: pose {pose}): the poses' own PnP disagree with the robot's motion; the farthest from the start's prediction: {}; check those poses' joint values and their points' ids",
+        worst(disagree)
+    )]
+    StartDisagrees {
+        /// Where the observations came from.
+        origin: String,
+        /// Seen points behind the camera.
+        behind: usize,
+        /// The first pose with one.
+        pose: i64,
+        /// Each pose's PnP distance from the start's prediction (pose,
+        /// metres, degrees), the worst first
+        /// ([`crate::identify::camera::start::disagreeing_poses`]).
+        disagree: Vec<(i64, f64, f64)>,
+    },
     /// A placement not given could not be computed from the pixels.
     #[error("{origin}: no start computed from the pixels ({error}); give both rough placements")]
     Start {
@@ -67,6 +85,16 @@ pub enum CameraCalibrationError {
         /// Why.
         error: StartError,
     },
+}
+
+/// The worst of `disagree` (pose, metres, degrees) in words.
+fn worst(disagree: &[(i64, f64, f64)]) -> String {
+    disagree
+        .iter()
+        .take(5)
+        .map(|(p, m, d)| format!("pose {p} {:.0} mm, {d:.1}°", m * 1e3))
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 impl From<CameraFitError> for CameraCalibrationError {
@@ -152,7 +180,25 @@ pub fn calibrate_camera(
     .with_face(setup.target.face)
     .with_intrinsics_refined(setup.refine_intrinsics);
     let own0 = CameraSensor::start_own(cam0, tgt0);
-    let fit = fit_camera(robot, &sensor, &own0, &observations, lm)?;
+    let fit = match fit_camera(robot, &sensor, &own0, &observations, lm) {
+        Err(CameraFitError::BehindCamera { behind, pose }) if start.is_some() => {
+            let st = start.as_ref().expect("computed");
+            return Err(CameraCalibrationError::StartDisagrees {
+                origin: observations.origin.clone(),
+                behind,
+                pose,
+                disagree: crate::identify::camera::start::disagreeing_poses(
+                    robot,
+                    &setup.intrinsics,
+                    setup.mounting,
+                    &setup.target.points,
+                    &observations,
+                    st,
+                ),
+            });
+        }
+        r => r?,
+    };
     let mut frames = camera_frames(&fit)?;
     if let Some(c) = frames.as_mut().and_then(|f| f.1.camera.as_mut()) {
         c.camera_link.clone_from(&setup.camera_link);

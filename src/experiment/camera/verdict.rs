@@ -6,7 +6,9 @@
 //! * a target whose size cannot be right: the camera sees it at a
 //!   distance (fixed by the target's size and its pixels) beyond
 //!   [`PLACEMENT_REACHES`] times the robot's reach — its squares or points
-//!   given in millimetres, or 10× too large;
+//!   given in millimetres, or 10× too large — when each pose's PnP fits
+//!   its pixels within [`PNP_LIMIT_PX`] (else the distance says nothing
+//!   of the target: k1 = 1e6 puts the camera a hundred metres away);
 //! * a fit that did not converge;
 //! * a pixel σ̂ above [`SIGMA_LIMIT_PX`];
 //! * a joint origin moved by more than a tenth of its link
@@ -28,6 +30,14 @@ use crate::measure::camera::Mounting;
 /// lies far above it.
 pub const SIGMA_LIMIT_PX: f64 = 5.0;
 
+/// The largest RMS of the start's per-pose PnP with which a distance too
+/// far is blamed on the target's size: PnP of a detector's corners fits
+/// them to the detector's σ (0.1–0.5 px) plus the lens model's error; 2
+/// px is four times the worst of those, while a wrong distortion (k1 =
+/// 1e6 on the example: 4.1 px on the few points left in the image) fits
+/// worse.
+pub const PNP_LIMIT_PX: f64 = 2.0;
+
 /// How many of the robot's reaches the fixed camera (or target) may be
 /// from the base, and the camera from the target: a camera looks at a
 /// robot's workspace from a few metres at most (a ceiling camera over a
@@ -38,7 +48,18 @@ pub const PLACEMENT_REACHES: f64 = 5.0;
 /// The verdict on `cal` (its target read from `target_origin`).
 #[must_use]
 pub fn camera_verdict(cal: &CameraCalibration, target_origin: &str, extent: f64) -> Verdict {
-    let why = scale(cal, target_origin, extent)
+    // The distance tells the target's size only when each pose's PnP
+    // fits its pixels (a wrong distortion also puts the camera far
+    // away, with PnP tens of pixels off): the start's PnP RMS, or the
+    // fit's σ̂ when both placements were given.
+    let fit = &cal.fit;
+    let pnp_px = cal
+        .start
+        .as_ref()
+        .map_or(fit.sigma_px.unwrap_or(fit.rms_px), |st| st.pnp_rms_px);
+    let why = (pnp_px <= PNP_LIMIT_PX)
+        .then(|| scale(cal, target_origin, extent))
+        .flatten()
         .or_else(|| unconverged(cal))
         .or_else(|| sigma(cal))
         .or_else(|| {
@@ -88,7 +109,7 @@ fn scale(cal: &CameraCalibration, origin: &str, extent: f64) -> Option<String> {
             "its squares or points are likely 10× too large (a square of 0.25 for 0.025 m)"
         };
         format!(
-            "{origin}: the target, {extent:.3} m across, is seen {d:.2} m from the camera, {ratio:.0} times the reach of this {reach:.3} m robot (at most {PLACEMENT_REACHES}): {likely}"
+            "{origin}: the target, {extent:.3} m across, is seen {d:.2} m from the camera, {ratio:.0} times the reach of this {reach:.3} m robot (at most {PLACEMENT_REACHES}): {likely} (or the camera's focal lengths as many times too large)"
         )
     })
 }

@@ -116,3 +116,36 @@ fn the_right_board_is_not_refused() {
     assert!(v["refused"].is_null(), "{v}");
     assert!(std::path::Path::new(&u).exists());
 }
+
+/// k1 = 1e6 (issue 49: exit 0 at 76 px before): exit 3, nothing written,
+/// and the reason is not the target's size (the start's PnP, 4.1 px on
+/// the few points left in the image, is above the 2 px with which a
+/// distance is blamed on the target).
+#[test]
+fn an_absurd_distortion_is_refused_without_blaming_the_target() {
+    let dir = common::scratch_dir("camera_refuse", "k1");
+    let info = dir.join("k1.yaml");
+    let text = std::fs::read_to_string("fixtures/camera/camera_info.yaml").unwrap();
+    std::fs::write(
+        &info,
+        text.replace("data: [-0.08, 0.04", "data: [1000000.0, 0.04"),
+    )
+    .unwrap();
+    let (i, u) = (
+        info.display().to_string(),
+        dir.join("cal.urdf").display().to_string(),
+    );
+    let mut a = args("fixtures/camera/board.yaml", &u);
+    a[6] = &i;
+    let out = common::run(&a);
+    assert_eq!(
+        out.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let why = v["refused"].as_str().expect("a reason");
+    assert!(!why.contains("the target,"), "{why}");
+    assert!(!std::path::Path::new(&u).exists());
+}

@@ -299,3 +299,30 @@ fn retain(obs: &mut CameraObservations, keep: &[bool]) {
     let mut k = keep.iter();
     obs.seen.retain(|_| *k.next().unwrap_or(&true));
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On a 3 × 4 grid: each labelling is its own inverse, two of them
+    /// compose to the third (the Klein four-group a rectangle's symmetries
+    /// form), and turned 180° maps corner 0 to the last, rows mirrored
+    /// maps it to the last row's first.
+    #[test]
+    fn labellings_are_the_rectangles_symmetries() {
+        let (rows, cols) = (3, 4);
+        for l in Labelling::ALL {
+            assert_eq!(l.then(l), Labelling::Identity);
+            for k in 0..rows * cols {
+                assert_eq!(l.source(l.source(k, rows, cols), rows, cols), k);
+            }
+        }
+        assert_eq!(
+            Labelling::RowsMirrored.then(Labelling::ColumnsMirrored),
+            Labelling::Turned
+        );
+        assert_eq!(Labelling::Turned.source(0, rows, cols), 11);
+        assert_eq!(Labelling::RowsMirrored.source(0, rows, cols), 8);
+        assert_eq!(Labelling::ColumnsMirrored.source(0, rows, cols), 3);
+    }
+}

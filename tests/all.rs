@@ -15,6 +15,8 @@ mod camera;
 mod camera_cli;
 mod camera_fisheye;
 mod camera_head;
+mod camera_labels;
+mod camera_refuse;
 mod camera_sight;
 mod camera_start;
 mod cli;

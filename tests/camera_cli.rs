@@ -61,7 +61,9 @@ fn cli_calibrates_the_example_files() {
 }
 
 /// Wrong inputs on the command line: an intrinsics file with a negative
-/// focal length, degrees in the joint columns, a missing option.
+/// focal length, one without its distortion model (refused with its
+/// line and the accepted values, not read as plumb_bob), degrees in the
+/// joint columns, a missing option.
 #[test]
 fn cli_refuses_wrong_inputs() {
     let dir = common::scratch_dir("camera", "wrong");
@@ -74,6 +76,15 @@ fn cli_refuses_wrong_inputs() {
     common::fails_with(
         &args,
         "bad.yaml: line 5, column 3 ('camera_matrix'): focal lengths",
+    );
+    let unnamed = dir.join("unnamed.yaml");
+    std::fs::write(&unnamed, text.replace("distortion_model: plumb_bob\n", "")).unwrap();
+    let unnamed = unnamed.display().to_string();
+    let mut args = EXAMPLE.to_vec();
+    args[6] = &unnamed;
+    common::fails_with(
+        &args,
+        "unnamed.yaml: line 9, column 3 ('distortion_coefficients'): no 'distortion_model': name the model of the coefficients, 'distortion_model: plumb_bob' (k1, k2, p1, p2, k3) or 'distortion_model: equidistant'",
     );
     let obs = dir.join("deg.csv");
     let csv = std::fs::read_to_string("fixtures/camera/ur5_eye_to_hand.csv").unwrap();

@@ -418,3 +418,50 @@ fn cli_refuses_a_start_the_pixels_cannot_give() {
     );
     common::fails_with(&args, "turn about one axis or not at all");
 }
+
+/// Four of the example's 40 poses with a wrong joint value (the shoulder
+/// pan 1.2 rad off, as a pose logged with another configuration): the
+/// start's per-pose disagreement
+/// (`activecal::identify::camera::start::disagreeing_poses`, named when
+/// the start computed from the pixels fails) ranks exactly those four
+/// first. The pan is off by 1.2 rad (69°), so a wrong pose's PnP is
+/// turned by about that from the start's prediction: more than half of it
+/// (35°) for the four, less for every right pose (measured: the four 64–72°
+/// and 0.17–0.74 m, the right ones ≤ 4.6° and 63 mm: the start, a
+/// least-squares compromise, is pulled off them by the four).
+#[test]
+fn the_start_names_the_poses_that_disagree() {
+    let robot = activecal::io::load_robot("fixtures/ur5.urdf").unwrap();
+    let cam = read_camera_info(Path::new("fixtures/camera/camera_info.yaml")).unwrap();
+    let target = read_target(Path::new("fixtures/camera/board.yaml")).unwrap();
+    let mut obs = read_observations(
+        Path::new("fixtures/camera/ur5_eye_to_hand.csv"),
+        &robot,
+        &target,
+        &cam,
+        Units::default(),
+    )
+    .unwrap();
+    let bad = [2_i64, 9, 17, 25];
+    for (i, q) in obs.qs.iter_mut().enumerate() {
+        if bad.contains(&obs.pose_ids[i]) {
+            q[0] += if q[0] > 0.0 { -1.2 } else { 1.2 };
+        }
+    }
+    let m = Mounting::EyeToHand;
+    let st = start_placements(&robot, &cam, m, &target.points, &obs, None, None).unwrap();
+    let d = activecal::identify::camera::start::disagreeing_poses(
+        &robot,
+        &cam,
+        m,
+        &target.points,
+        &obs,
+        &st,
+    );
+    assert_eq!(d.len(), obs.qs.len());
+    let mut top: Vec<i64> = d[..4].iter().map(|x| x.0).collect();
+    top.sort_unstable();
+    assert_eq!(top, bad, "{d:?}");
+    assert!(d[..4].iter().all(|x| x.2 > 35.0), "{d:?}");
+    assert!(d[4..].iter().all(|x| x.2 < 35.0), "{d:?}");
+}

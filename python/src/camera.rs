@@ -197,11 +197,16 @@ pub fn calibrate_camera(
             let branch = chain_of(&inner, camera_link.as_deref())?;
             let r = branch.as_ref().unwrap_or(&inner);
             let intrinsics = read_intrinsics(&info_src)?;
+            let target_origin = match &target_src {
+                Source::File(p) => p.display().to_string(),
+                Source::Text(_) => "target".to_string(),
+            };
             let target = read_target(&target_src)?;
             let obs = read_observations(&obs_src, r, &target, &intrinsics)?;
             let setup = CameraSetup {
                 intrinsics,
                 target,
+                target_origin,
                 mounting: m,
                 camera_link,
                 camera: cam0.map(|c| activecal::pool::camera_view::placement(&c)),
@@ -250,19 +255,15 @@ fn write_text(path: &Path, text: &str, overwrite: bool) -> PyResult<()> {
 }
 
 impl CameraCalibration {
-    /// Refuses to write from a fit that did not converge.
+    /// Refuses to write what the library refuses (a fit that did not
+    /// converge or cannot be right), with its reason.
     fn check_converged(&self, path: &Path) -> PyResult<()> {
-        let fit = &self.cal.fit;
-        if fit.converged {
-            return Ok(());
+        match self.cal.verdict.refusal() {
+            None => Ok(()),
+            Some(why) => {
+                Err(Fail::Compute(format!("{}: not written: {why}", path.display())).into_py())
+            }
         }
-        Err(Fail::Compute(format!(
-            "{}: not written: the camera fit did not converge ({:?} after {} iterations)",
-            path.display(),
-            fit.stop,
-            fit.iterations
-        ))
-        .into_py())
     }
 
     /// Writes the calibrated robot as `format`.
@@ -314,10 +315,17 @@ impl CameraCalibration {
 
 #[pymethods]
 impl CameraCalibration {
-    /// Whether the fit converged (only then are files written).
+    /// Whether the fit converged.
     #[getter]
     fn converged(&self) -> bool {
         self.cal.fit.converged
+    }
+
+    /// Why the calibration may not be written (None when it may): the
+    /// same reason the command line refuses it with (exit status 3).
+    #[getter]
+    fn refused(&self) -> Option<String> {
+        self.cal.verdict.refusal().map(str::to_string)
     }
 
     /// The estimate {name: value}: the robot's unknowns (metres, radians),

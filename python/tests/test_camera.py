@@ -337,3 +337,26 @@ def test_the_docs_camera_block_runs_and_says_what_it_prints(tmp_path, monkeypatc
     assert "({:.3f}, {:.3f}, {:.3f}) m".format(*cal.camera[:3, 3]) in after
     for f in ("cal.urdf", "cal.yaml", "refined.yaml"):
         assert (tmp_path / f).is_file()
+
+
+def test_a_board_ten_times_too_large_is_refused_as_by_the_cli(tmp_path):
+    """Squares of 0.25 m for the example's 0.025 m: the library refuses
+    the fit (issue 49, item 4) with the same reason the command line exits
+    3 with, and nothing is written."""
+    board = tmp_path / "board.yaml"
+    board.write_text("checkerboard: {rows: 6, cols: 8, square: 0.25}\n")
+    import subprocess
+    from conftest import cli_path
+    args = ["calibrate", "--robot", UR5, "--mounting", "eye-to-hand", "--camera-info", INFO,
+            "--target", board, "--observations", PIXELS, "--json"]
+    out = subprocess.run([str(cli_path()), *map(str, args)], capture_output=True, text=True)
+    assert out.returncode == 3, out.stderr
+    want = json.loads(out.stdout)["refused"]
+    assert "likely 10× too large" in want
+    c = activecal.calibrate_camera(activecal.Robot.from_urdf(UR5), PIXELS, INFO, board,
+                                   mounting="eye-to-hand")
+    assert c.refused == want
+    urdf = tmp_path / "cal.urdf"
+    with pytest.raises(activecal.ComputationError, match="not written"):
+        c.write_urdf(urdf)
+    assert not urdf.exists()

@@ -61,8 +61,10 @@ fn check_out(a: &CalibrateArgs, robot: &Robot) -> Result<()> {
     Ok(())
 }
 
-/// Calibrates from a camera's observations; `Ok(Some(why))` when the fit
-/// did not converge (the report is printed, nothing written).
+/// Calibrates from a camera's observations; `Ok(Some(why))` when the
+/// library refuses the fit (it did not converge or cannot be right,
+/// `activecal::experiment::camera::verdict`: the report is printed,
+/// nothing written).
 pub fn calibrate_camera(
     a: &CalibrateArgs,
     robot: &Robot,
@@ -87,6 +89,7 @@ pub fn calibrate_camera(
         .as_ref()
         .map_or_else(|| mounting.name().to_string(), |l| format!("camera on {l}"));
     let intrinsics = read_camera_info(info).context("--camera-info")?;
+    let target_origin = target.display().to_string();
     let target = read_target(target).context("--target")?;
     let obs = read_observations(obs_path, robot, &target, &intrinsics, a.units.units())?;
     let parse =
@@ -94,6 +97,7 @@ pub fn calibrate_camera(
     let setup = CameraSetup {
         intrinsics,
         target,
+        target_origin,
         mounting,
         camera_link: a.camera_link.clone(),
         camera: parse("--camera-pose", &a.camera_pose)?,
@@ -114,9 +118,10 @@ pub fn calibrate_camera(
     )?;
     let (fit, frames) = (&cal.fit, &cal.frames);
     let mut written = Vec::new();
-    if fit.converged
-        && let Some(f) = frames
-    {
+    // The library's verdict: a fit that did not converge or cannot be
+    // right is not written.
+    let ok = cal.verdict.refusal().is_none();
+    if ok && let Some(f) = frames {
         for path in &a.out {
             let text = render(
                 Format::of(path)?,
@@ -130,9 +135,7 @@ pub fn calibrate_camera(
             written.push(path.display().to_string());
         }
     }
-    if fit.converged
-        && let Some(o) = &a.out_camera_info
-    {
+    if ok && let Some(o) = &a.out_camera_info {
         write_camera_info(o, &cal, obs_path, a.force)?;
         written.push(o.display().to_string());
     }
@@ -146,14 +149,12 @@ pub fn calibrate_camera(
             frames.as_ref().map(|f| &f.1),
             &written,
             cal.start.as_ref(),
-        )
+        ) + &labels_text(&cal.labels)
+            + &cal.verdict.refusal().map_or_else(String::new, |why| {
+                format!("REFUSED: {why}: nothing written\n")
+            })
     })?;
-    Ok((!fit.converged).then(|| {
-        format!(
-            "the camera fit did not converge ({:?} after {} iterations)",
-            fit.stop, fit.iterations
-        )
-    }))
+    Ok(cal.verdict.refusal().map(str::to_string))
 }
 
 /// Refuses an `--out-camera-info` that is not a `.yaml`, before any work
@@ -301,15 +302,31 @@ fn text(
             u = unit.1
         );
     }
-    if !fit.converged {
-        let _ = writeln!(
-            s,
-            "NOT CONVERGED ({:?} after {} iterations): nothing written",
-            fit.stop, fit.iterations
-        );
-    }
     for w in written {
         let _ = writeln!(s, "wrote {w}");
+    }
+    s
+}
+
+/// The poses whose checkerboard corners were relabelled, and those
+/// dropped as ambiguous, one line each kind (empty when none).
+fn labels_text(l: &activecal::identify::camera::start::labels::Labels) -> String {
+    let mut s = String::new();
+    if !l.relabelled.is_empty() {
+        let each: Vec<String> = l
+            .relabelled
+            .iter()
+            .map(|r| format!("pose {} {}", r.pose, r.labelling.name()))
+            .collect();
+        let _ = writeln!(
+            s,
+            "note: the checkerboard's corners were detected in another order at {} poses, relabelled by the robot's motion: {}",
+            each.len(),
+            each.join(", ")
+        );
+    }
+    for d in &l.dropped {
+        let _ = writeln!(s, "note: pose {} left out: {}", d.pose, d.reason);
     }
     s
 }

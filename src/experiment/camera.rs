@@ -6,10 +6,12 @@
 //! and the Python package both call it; reading the files and writing the
 //! results are theirs.
 
+use crate::experiment::measured::verdict::Verdict;
 use crate::frames::camera::camera_frames;
 use crate::frames::report::FramesReport;
 use crate::frames::{CalibratedFrames, FramesError};
 use crate::identify::LmSettings;
+use crate::identify::camera::start::labels::{Labels, relabel};
 use crate::identify::camera::start::{CameraStart, StartError, start_placements};
 use crate::identify::camera::{CameraFit, CameraFitError, CameraObservations, fit_camera};
 use crate::io::camera_target::Target;
@@ -18,6 +20,8 @@ use crate::measure::pinhole::Intrinsics;
 use crate::model::Robot;
 use crate::report::{CameraCalibrationReport, CameraStartReport};
 use nalgebra::Isometry3;
+
+pub mod verdict;
 
 /// What a camera calibration is given besides the robot and the
 /// observations: the camera, the target, how they are mounted and where
@@ -28,6 +32,8 @@ pub struct CameraSetup {
     pub intrinsics: Intrinsics,
     /// The target's points.
     pub target: Target,
+    /// Where the target came from (its file), for messages.
+    pub target_origin: String,
     /// Which of the two rides on the tip link.
     pub mounting: Mounting,
     /// The robot's link the camera is on (a head), when the robot given
@@ -53,6 +59,24 @@ pub enum CameraCalibrationError {
     /// The calibrated robot could not be split into frames.
     #[error(transparent)]
     Frames(#[from] FramesError),
+    /// The start computed from the pixels puts seen points behind the
+    /// camera: the poses' PnP disagree with the robot's motion.
+    #[error(
+        "{origin}: the start computed from the pixels (each pose's PnP and the closed-form hand-eye) puts {behind} seen point(s) behind the camera (first: pose {pose}): the poses' own PnP disagree with the robot's motion; the farthest from the start's prediction: {}; check those poses' joint values and their points' ids",
+        worst(disagree)
+    )]
+    StartDisagrees {
+        /// Where the observations came from.
+        origin: String,
+        /// Seen points behind the camera.
+        behind: usize,
+        /// The first pose with one.
+        pose: i64,
+        /// Each pose's PnP distance from the start's prediction (pose,
+        /// metres, degrees), the worst first
+        /// ([`crate::identify::camera::start::disagreeing_poses`]).
+        disagree: Vec<(i64, f64, f64)>,
+    },
     /// A placement not given could not be computed from the pixels.
     #[error("{origin}: no start computed from the pixels ({error}); give both rough placements")]
     Start {
@@ -61,6 +85,16 @@ pub enum CameraCalibrationError {
         /// Why.
         error: StartError,
     },
+}
+
+/// The worst of `disagree` (pose, metres, degrees) in words.
+fn worst(disagree: &[(i64, f64, f64)]) -> String {
+    disagree
+        .iter()
+        .take(5)
+        .map(|(p, m, d)| format!("pose {p} {:.0} mm, {d:.1}°", m * 1e3))
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 impl From<CameraFitError> for CameraCalibrationError {
@@ -88,16 +122,29 @@ pub struct CameraCalibration {
     /// The start computed from the pixels, when a placement was not
     /// given.
     pub start: Option<CameraStart>,
+    /// Whether it may be written ([`verdict::camera_verdict`]).
+    pub verdict: Verdict,
+    /// The poses of a checkerboard whose corners were relabelled, and
+    /// those dropped as ambiguous
+    /// ([`crate::identify::camera::start::labels`]).
+    pub labels: Labels,
 }
 
 /// Calibrates `robot` (the chain from the camera's link for a camera on
 /// the robot's own link) from `observations` of `setup`'s target.
 pub fn calibrate_camera(
     robot: &Robot,
-    observations: CameraObservations,
+    mut observations: CameraObservations,
     setup: &CameraSetup,
     lm: &LmSettings,
 ) -> Result<CameraCalibration, CameraCalibrationError> {
+    let labels = relabel(
+        robot,
+        &setup.intrinsics,
+        setup.mounting,
+        &setup.target,
+        &mut observations,
+    );
     let start = match (setup.camera, setup.target_pose) {
         (Some(_), Some(_)) => None,
         (cam, tgt) => Some(
@@ -133,12 +180,30 @@ pub fn calibrate_camera(
     .with_face(setup.target.face)
     .with_intrinsics_refined(setup.refine_intrinsics);
     let own0 = CameraSensor::start_own(cam0, tgt0);
-    let fit = fit_camera(robot, &sensor, &own0, &observations, lm)?;
+    let fit = match fit_camera(robot, &sensor, &own0, &observations, lm) {
+        Err(CameraFitError::BehindCamera { behind, pose }) if start.is_some() => {
+            let st = start.as_ref().expect("computed");
+            return Err(CameraCalibrationError::StartDisagrees {
+                origin: observations.origin.clone(),
+                behind,
+                pose,
+                disagree: crate::identify::camera::start::disagreeing_poses(
+                    robot,
+                    &setup.intrinsics,
+                    setup.mounting,
+                    &setup.target.points,
+                    &observations,
+                    st,
+                ),
+            });
+        }
+        r => r?,
+    };
     let mut frames = camera_frames(&fit)?;
     if let Some(c) = frames.as_mut().and_then(|f| f.1.camera.as_mut()) {
         c.camera_link.clone_from(&setup.camera_link);
     }
-    Ok(CameraCalibration {
+    let mut cal = CameraCalibration {
         robot_name: robot.name.clone(),
         observations,
         fit,
@@ -146,7 +211,19 @@ pub fn calibrate_camera(
         camera_link: setup.camera_link.clone(),
         refine_intrinsics: setup.refine_intrinsics,
         start,
-    })
+        verdict: Verdict::Calibrated,
+        labels,
+    };
+    cal.verdict = verdict::camera_verdict(&cal, &setup.target_origin, extent(&setup.target));
+    Ok(cal)
+}
+
+/// The largest distance between two of `target`'s points, metres.
+fn extent(target: &Target) -> f64 {
+    let p = &target.points;
+    p.iter()
+        .flat_map(|a| p.iter().map(move |b| (a - b).norm()))
+        .fold(0.0, f64::max)
 }
 
 impl CameraCalibration {
@@ -175,6 +252,10 @@ impl CameraCalibration {
             stop: format!("{:?}", fit.stop),
             camera: self.frames.as_ref().and_then(|f| f.1.camera.clone()),
             intrinsics: self.refine_intrinsics.then(|| fit.intrinsics()),
+            relabelled: self.labels.relabelled.clone(),
+            dropped_poses: self.labels.dropped.clone(),
+            refused: self.verdict.refusal().map(str::to_string),
+            exit_status: self.verdict.exit_status(),
             out,
         }
     }

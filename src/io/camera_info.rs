@@ -21,7 +21,9 @@
 //!
 //! Checked: the image size (both > 0 pixels), a 3 × 3 camera matrix with
 //! its zeros and 1 where a pinhole has them, positive focal lengths, a
-//! principal point inside the image, the distortion model named (ROS),
+//! principal point inside the image, the distortion model named (ROS: a
+//! file without `distortion_model` is refused with the line of its
+//! coefficients and the accepted values, never taken as plumb_bob),
 //! known and supported (plumb_bob: 5 coefficients, or 4 with k3 = 0;
 //! OpenCV's 8, 12 or 14 only when the coefficients past the fifth are
 //! zero; equidistant: exactly 4). Every error names the file, the key and
@@ -51,6 +53,12 @@ struct InfoEntry {
     distortion_coefficients: Option<Spanned<MatrixEntry>>,
     /// OpenCV's calibration tutorial's fisheye flag (0 or 1).
     fisheye_model: Option<Spanned<i64>>,
+}
+
+/// Whether `text` is an OpenCV `FileStorage` YAML (its `%YAML:` directive
+/// or a `!!opencv-matrix` tag), whose distortion model may go unnamed.
+fn is_opencv(text: &str) -> bool {
+    text.starts_with("%YAML:") || text.contains("!!opencv-matrix")
 }
 
 /// Reads a camera's intrinsics from a ROS `camera_info` or OpenCV YAML
@@ -91,7 +99,7 @@ pub fn parse_camera_info(text: &str, origin: &str) -> Result<Intrinsics> {
             e.without_snippet()
         ))
     })?;
-    build(&f).map_err(err)
+    build(&f, is_opencv(text)).map_err(err)
 }
 
 fn at<T>(s: &Spanned<T>) -> String {
@@ -157,7 +165,7 @@ fn data(
     Ok(d.value.clone())
 }
 
-fn build(f: &InfoEntry) -> std::result::Result<Intrinsics, String> {
+fn build(f: &InfoEntry, opencv: bool) -> std::result::Result<Intrinsics, String> {
     let width = size("image_width", f.image_width.as_ref())?;
     let height = size("image_height", f.image_height.as_ref())?;
     let km = f
@@ -184,7 +192,7 @@ fn build(f: &InfoEntry) -> std::result::Result<Intrinsics, String> {
             k.iter().map(f64::to_string).collect::<Vec<_>>().join(", ")
         ));
     }
-    let distortion = distortion(f)?;
+    let distortion = distortion(f, opencv)?;
     let c = Intrinsics {
         width,
         height,
@@ -200,8 +208,11 @@ fn build(f: &InfoEntry) -> std::result::Result<Intrinsics, String> {
 }
 
 /// The distortion model a file names: ROS's `distortion_model` or
-/// OpenCV's `fisheye_model` flag, plumb_bob when neither is given.
-fn model(f: &InfoEntry) -> std::result::Result<&'static str, String> {
+/// OpenCV's `fisheye_model` flag. Neither is an error in a ROS file (the
+/// same coefficients mean another camera under each model, and a fisheye
+/// read as plumb_bob fits tens of pixels off); an OpenCV file (`opencv`)
+/// without either is plumb_bob, as `cv::calibrateCamera` reads it.
+fn model(f: &InfoEntry, opencv: bool) -> std::result::Result<&'static str, String> {
     let flag = match &f.fisheye_model {
         None => None,
         Some(v) if v.value == 0 || v.value == 1 => Some(v.value == 1),
@@ -234,13 +245,21 @@ fn model(f: &InfoEntry) -> std::result::Result<&'static str, String> {
         )),
         (Some(n), _) => Ok(n),
         (None, Some(true)) => Ok("equidistant"),
-        (None, _) => Ok("plumb_bob"),
+        (None, Some(false)) => Ok("plumb_bob"),
+        (None, None) if opencv => Ok("plumb_bob"),
+        (None, None) => Err(format!(
+            "{}no 'distortion_model': name the model of the coefficients, 'distortion_model: plumb_bob' (k1, k2, p1, p2, k3) or 'distortion_model: equidistant' (the fisheye model: k1, k2, k3, k4)",
+            f.distortion_coefficients
+                .as_ref()
+                .map(|d| format!("{} ('distortion_coefficients'): ", at(d)))
+                .unwrap_or_default()
+        )),
     }
 }
 
 /// The distortion model and its coefficients.
-fn distortion(f: &InfoEntry) -> std::result::Result<Distortion, String> {
-    let model = model(f)?;
+fn distortion(f: &InfoEntry, opencv: bool) -> std::result::Result<Distortion, String> {
+    let model = model(f, opencv)?;
     let Some(dm) = &f.distortion_coefficients else {
         return Err(format!(
             "no 'distortion_coefficients': give them ({}; all 0 for an undistorted image)",
@@ -504,6 +523,11 @@ distortion_coefficients: {rows: 1, cols: 4, data: [-0.01, 0.002, -0.001, 0.0001]
                 ),
                 "line 8",
                 "3 coefficients; equidistant (fisheye) has 4",
+            ),
+            (
+                ROS.replace("distortion_model: plumb_bob\n", ""),
+                "line 9",
+                "no 'distortion_model': name the model of the coefficients, 'distortion_model: plumb_bob' (k1, k2, p1, p2, k3) or 'distortion_model: equidistant'",
             ),
             (
                 "camera_matrix: [1, 2\n".to_string(),

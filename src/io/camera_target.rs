@@ -54,6 +54,12 @@ pub struct Target {
     /// into the target: `+z` for OpenCV's boards and point lists, `−z` for
     /// Kalibr's aprilgrid (see the module documentation).
     pub face: Vector3<f64>,
+    /// A checkerboard's inner-corner grid (rows, cols), stored row by
+    /// row: its 180° turn and mirrors map it onto itself, so a detector
+    /// may label its corners in any of those orders
+    /// ([`crate::identify::camera::start::labels`]); `None` for targets
+    /// with unique ids.
+    pub grid: Option<(usize, usize)>,
 }
 
 impl Target {
@@ -68,6 +74,7 @@ impl Target {
                 .map(|k| Vector3::new((k % cols) as f64 * square, (k / cols) as f64 * square, 0.0))
                 .collect(),
             face: Vector3::z(),
+            grid: Some((rows, cols)),
         }
     }
 
@@ -78,6 +85,7 @@ impl Target {
     #[must_use]
     pub fn charuco(rows: usize, cols: usize, square: f64) -> Self {
         let mut t = Self::checkerboard(rows - 1, cols - 1, square);
+        t.grid = None;
         for p in &mut t.points {
             *p += Vector3::new(square, square, 0.0);
         }
@@ -97,6 +105,7 @@ impl Target {
             ids: (0..(4 * rows * cols) as i64).collect(),
             points: Vec::with_capacity(4 * rows * cols),
             face: -Vector3::z(),
+            grid: None,
         };
         for k in 0..rows * cols {
             let (r, c) = ((k / cols) as f64, (k % cols) as f64);
@@ -413,6 +422,7 @@ fn list(p: &Spanned<Vec<Spanned<PointEntry>>>) -> std::result::Result<Target, St
         ids: Vec::new(),
         points: Vec::new(),
         face: Vector3::z(),
+        grid: None,
     };
     let mut first_line = std::collections::HashMap::new();
     for e in &p.value {

@@ -63,6 +63,16 @@ pub struct CameraCalibrationReport {
     pub camera: Option<crate::frames::report::CameraBlock>,
     /// The intrinsics at the estimate, when they were refined.
     pub intrinsics: Option<Intrinsics>,
+    /// The poses whose checkerboard corners were relabelled (the detector
+    /// returned them turned or mirrored), with the labelling applied.
+    pub relabelled: Vec<crate::identify::camera::start::labels::Relabelled>,
+    /// The poses left out because their corners' order could not be told.
+    pub dropped_poses: Vec<crate::identify::camera::start::labels::DroppedPose>,
+    /// Why the calibration may not be written (nothing was), when it
+    /// may not ([`crate::experiment::camera::verdict`]).
+    pub refused: Option<String>,
+    /// 0, or 3 when refused.
+    pub exit_status: i32,
     /// The files written.
     pub out: Vec<String>,
 }

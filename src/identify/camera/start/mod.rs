@@ -17,6 +17,7 @@
 //! refines both jointly.
 
 pub mod hand_eye;
+pub mod labels;
 pub mod pnp;
 
 use super::CameraObservations;
@@ -71,7 +72,7 @@ pub enum StartError {
 
 /// Each pose's end frame of `robot` at its nominal parameters, as a rigid
 /// motion.
-fn end_frames(robot: &Robot, obs: &CameraObservations) -> Vec<Isometry3<f64>> {
+pub(crate) fn end_frames(robot: &Robot, obs: &CameraObservations) -> Vec<Isometry3<f64>> {
     // The end frame the fit's first step sees: no unknowns, the nominal
     // table.
     let mut r = robot.clone();
@@ -162,3 +163,46 @@ pub fn start_placements(
 
 #[cfg(test)]
 mod tests;
+
+/// How far each placed pose's own PnP is from the target's pose the
+/// start predicts there (eye-to-hand `C⁻¹ Tᵢ G`, eye-in-hand `(Tᵢ C)⁻¹
+/// G`): `(pose id, metres, degrees)`, the worst first (by metres plus the
+/// degrees' arc at 1 m). The poses at the top are those whose joint
+/// values or points' labels disagree with the others'.
+#[must_use]
+pub fn disagreeing_poses(
+    robot: &Robot,
+    intrinsics: &Intrinsics,
+    mounting: Mounting,
+    points: &[Vector3<f64>],
+    obs: &CameraObservations,
+    start: &CameraStart,
+) -> Vec<(i64, f64, f64)> {
+    let frames = end_frames(robot, obs);
+    let mut out: Vec<(i64, f64, f64)> = obs
+        .seen
+        .iter()
+        .enumerate()
+        .filter_map(|(i, seen)| {
+            let (pts, px): (Vec<Vector3<f64>>, Vec<[f64; 2]>) = seen
+                .iter()
+                .zip(points)
+                .filter_map(|(s, pt)| s.map(|px| (*pt, px)))
+                .unzip();
+            let own = place_target(intrinsics, &pts, &px).ok()?.pose;
+            let predicted = match mounting {
+                Mounting::EyeToHand => start.camera.inverse() * frames[i] * start.target,
+                Mounting::EyeInHand => (frames[i] * start.camera).inverse() * start.target,
+            };
+            let d = predicted.inverse() * own;
+            Some((
+                obs.pose_ids[i],
+                d.translation.vector.norm(),
+                d.rotation.angle().to_degrees(),
+            ))
+        })
+        .collect();
+    let score = |x: &(i64, f64, f64)| x.1 + x.2.to_radians();
+    out.sort_by(|a, b| score(b).total_cmp(&score(a)));
+    out
+}

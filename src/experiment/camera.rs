@@ -142,7 +142,8 @@ pub fn calibrate_camera(
         robot,
         &setup.intrinsics,
         setup.mounting,
-        &setup.target,
+        &setup.target.points,
+        setup.target.grid,
         &mut observations,
     );
     let start = match (setup.camera, setup.target_pose) {

@@ -21,7 +21,6 @@
 
 use super::pnp::place_target;
 use crate::identify::camera::CameraObservations;
-use crate::io::camera_target::Target;
 use crate::measure::camera::Mounting;
 use crate::measure::pinhole::Intrinsics;
 use crate::model::Robot;
@@ -167,7 +166,7 @@ fn mismatch(a: &Isometry3<f64>, b: &Isometry3<f64>, length: f64) -> f64 {
 fn placements(
     intrinsics: &Intrinsics,
     mounting: Mounting,
-    target: &Target,
+    points: &[Vector3<f64>],
     (rows, cols): (usize, usize),
     obs: &CameraObservations,
 ) -> Vec<[Option<Isometry3<f64>>; 4]> {
@@ -175,8 +174,8 @@ fn placements(
         .iter()
         .map(|seen| {
             Labelling::ALL.map(|l| {
-                let (pts, px): (Vec<Vector3<f64>>, Vec<[f64; 2]>) = (0..target.points.len())
-                    .filter_map(|k| seen[l.source(k, rows, cols)].map(|p| (target.points[k], p)))
+                let (pts, px): (Vec<Vector3<f64>>, Vec<[f64; 2]>) = (0..points.len())
+                    .filter_map(|k| seen[l.source(k, rows, cols)].map(|p| (points[k], p)))
                     .unzip();
                 let p = place_target(intrinsics, &pts, &px).ok()?.pose;
                 Some(match mounting {
@@ -224,22 +223,24 @@ fn relative(
     Some((rel, total))
 }
 
-/// Chooses each pose's labelling of a checkerboard `target`'s points by
-/// the robot's motion and relabels `obs` in place; poses whose labelling
-/// cannot be told apart are removed (see the module documentation).
-/// Other targets are left as they are.
+/// Chooses each pose's labelling of a checkerboard's `points` (its
+/// inner-corner `grid`, rows × columns, stored row by row) by the robot's
+/// motion and relabels `obs` in place; poses whose labelling cannot be told
+/// apart are removed (see the module documentation). A target without a
+/// grid (ChArUco, aprilgrid, a point list: unique ids) is left as it is.
 pub fn relabel(
     robot: &Robot,
     intrinsics: &Intrinsics,
     mounting: Mounting,
-    target: &Target,
+    points: &[Vector3<f64>],
+    grid: Option<(usize, usize)>,
     obs: &mut CameraObservations,
 ) -> Labels {
-    let Some(grid) = target.grid else {
+    let Some(grid) = grid else {
         return Labels::default();
     };
     let a = super::end_frames(robot, obs);
-    let b = placements(intrinsics, mounting, target, grid, obs);
+    let b = placements(intrinsics, mounting, points, grid, obs);
     let length = crate::units::reach(robot).max(1e-3);
     let Some((rel, _)) = (0..b.len().min(REFERENCES))
         .filter_map(|r| relative(&a, &b, r, length))

@@ -271,19 +271,7 @@ fn eye_in_hand_converges_to_the_same_fit_without_guesses() {
     );
 }
 
-const EXAMPLE: [&str; 11] = [
-    "calibrate",
-    "--robot",
-    "fixtures/ur5.urdf",
-    "--observations",
-    "fixtures/camera/ur5_eye_to_hand.csv",
-    "--camera-info",
-    "fixtures/camera/camera_info.yaml",
-    "--target",
-    "fixtures/camera/board.yaml",
-    "--mounting",
-    "eye-to-hand",
-];
+const EXAMPLE: [&str; 11] = crate::common::CAMERA_EXAMPLE;
 
 /// From the command line without `--camera-pose` and `--target-pose`:
 /// the text says the start was computed, with its pixel RMS, and the

@@ -7,19 +7,7 @@
 use crate::common;
 
 /// `calibrate --observations` on the camera example (`tests/camera_cli.rs`).
-const CAMERA: [&str; 11] = [
-    "calibrate",
-    "--robot",
-    "fixtures/ur5.urdf",
-    "--observations",
-    "fixtures/camera/ur5_eye_to_hand.csv",
-    "--camera-info",
-    "fixtures/camera/camera_info.yaml",
-    "--target",
-    "fixtures/camera/board.yaml",
-    "--mounting",
-    "eye-to-hand",
-];
+const CAMERA: [&str; 11] = crate::common::CAMERA_EXAMPLE;
 
 /// `select --camera-info` for the UR5's camera (`docs/cameras.md`).
 const CAMERA_SELECT: [&str; 14] = [

@@ -109,3 +109,19 @@ pub fn scratch_dir(suite: &str, name: &str) -> std::path::PathBuf {
     std::fs::create_dir_all(&d).unwrap();
     d
 }
+
+/// `calibrate --observations` on the camera example (UR5 eye-to-hand,
+/// `docs/cameras.md`), without the rough placements: the start is computed.
+pub const CAMERA_EXAMPLE: [&str; 11] = [
+    "calibrate",
+    "--robot",
+    "fixtures/ur5.urdf",
+    "--observations",
+    "fixtures/camera/ur5_eye_to_hand.csv",
+    "--camera-info",
+    "fixtures/camera/camera_info.yaml",
+    "--target",
+    "fixtures/camera/board.yaml",
+    "--mounting",
+    "eye-to-hand",
+];

@@ -25,6 +25,7 @@ pub mod names;
 pub mod observability;
 pub mod pool;
 pub mod progress;
+pub mod render;
 pub mod report;
 pub mod resources;
 pub mod select;

@@ -5,7 +5,7 @@
 //! [`activecal::experiment::paper`]; this file parses the arguments, shows
 //! progress and draws the figures.
 
-use super::figures;
+use activecal::render::paper_figures as figures;
 use activecal::experiment::paper::{self, PaperReport, PaperSettings};
 use activecal::progress::Task;
 use anyhow::Result;

@@ -313,7 +313,7 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         select_text(&a, &ctx, &report, seconds)
             + &predicted_text(report.predicted.as_ref())
             + &recommended.map_or(String::new(), |r| {
-                super::report_dir::recommendation_text(&r)
+                activecal::render::folder::recommendation_text(&r)
             })
     })
 }
@@ -516,7 +516,7 @@ fn report_dir(
         &ctx.pool.ids,
         &cs,
     )?;
-    super::report_dir::selection(dir, &ctx.robot, report, &curve, a.noise.is_none())?;
+    activecal::render::folder::selection(dir, &ctx.robot, report, &curve, a.noise.is_none())?;
     Ok(curve.recommended)
 }
 

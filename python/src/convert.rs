@@ -75,9 +75,9 @@ impl From<activecal::bound::BoundError> for Fail {
     }
 }
 
-impl From<activecal::experiment::paper::ExperimentError> for Fail {
-    fn from(e: activecal::experiment::paper::ExperimentError) -> Self {
-        use activecal::experiment::paper::ExperimentError as E;
+impl From<activecal::experiment::ExperimentError> for Fail {
+    fn from(e: activecal::experiment::ExperimentError) -> Self {
+        use activecal::experiment::ExperimentError as E;
         match e {
             E::Input(e) => e.into(),
             E::Bound(e) => e.into(),

@@ -200,7 +200,10 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     let mut v = serde_json::to_value(&report)?;
     v["exit_status"] = verdict.exit_status().into();
     if let Some(dir) = &a.report {
-        activecal::render::folder::calibration(dir, &measured_summary(&fitted, id, path, &report, &v))?;
+        activecal::render::folder::calibration(
+            dir,
+            &measured_summary(&fitted, id, path, &report, &v),
+        )?;
     }
     super::emit(a.json, &v, || {
         let mut s = super::measured::measured_text(&report, id, &status_text(id));

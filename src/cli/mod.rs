@@ -33,7 +33,7 @@ use activecal::model::Robot;
 use anyhow::Result;
 use serde_json::Value;
 
-pub use existing::{Existing, existing_from, existing_text, load_existing};
+pub use existing::{existing_from, existing_text, load_existing};
 pub use pool_opts::{
     DEFAULT_LEVELS, PoolCtx, PoolKind, PoolOpts, filters, pool_stats_text, with_jacobian,
 };

@@ -1,8 +1,8 @@
 //! One figure drawn twice, on a pixel buffer and on an SVG string, and
 //! written as `<base>.png` and `<base>.svg` atomically ([`both`]).
 
-use crate::io::atomic::write_atomic;
 use crate::error::Error;
+use crate::io::atomic::write_atomic;
 
 /// A result whose error defaults to the library's.
 type Result<T, E = Error> = std::result::Result<T, E>;
@@ -63,4 +63,3 @@ fn png_bytes(rgb: &[u8], (width, height): (u32, u32)) -> Result<Vec<u8>, png::En
     writer.finish()?;
     Ok(out)
 }
-

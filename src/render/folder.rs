@@ -5,12 +5,12 @@
 //! aside and swapped in whole.
 
 use super::plots::{self as plots, CurveRow, JointRow, ParamBar};
+use crate::error::Result;
 use crate::how_many::PoseCountCurve;
 use crate::identify::Identification;
 use crate::io::atomic::{StagedDir, write_atomic};
 use crate::model::{JointKind, Robot, Symbol};
 use crate::report::SelectReport;
-use crate::error::Result;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -254,11 +254,7 @@ pub fn calibration(dir: &Path, s: &CalibrationSummary<'_>) -> Result<()> {
     md += &figure_section(&figs);
     md += &parameter_table(&s.params);
     put(&staged, "report.md", &md)?;
-    put(
-        &staged,
-        "report.json",
-        &(json_text(&s.json)? + "\n"),
-    )?;
+    put(&staged, "report.json", &(json_text(&s.json)? + "\n"))?;
     staged.commit()?;
     Ok(())
 }
@@ -536,11 +532,7 @@ fn finish_selection(
     md += &figure_section(figs);
     put(&staged, "report.md", &md)?;
     let json = serde_json::json!({ "selection": selection, "how_many_poses": curve });
-    put(
-        &staged,
-        "report.json",
-        &(json_text(&json)? + "\n"),
-    )?;
+    put(&staged, "report.json", &(json_text(&json)? + "\n"))?;
     staged.commit()?;
     Ok(())
 }
@@ -577,11 +569,7 @@ pub fn contacts(
         figure_section(&figs)
     );
     put(&staged, "report.md", &md)?;
-    put(
-        &staged,
-        "report.json",
-        &(json_text(json)? + "\n"),
-    )?;
+    put(&staged, "report.json", &(json_text(json)? + "\n"))?;
     staged.commit()?;
     Ok(())
 }

@@ -4,8 +4,8 @@
 //! ("50.0" read "50. 0", a "j" lost its hook); here every glyph is drawn at
 //! its pen position plus its bearing, kerned, on one baseline.
 
-use ab_glyph::{Font, FontRef, Glyph, PxScale, ScaleFont, point};
 use crate::error::Error;
+use ab_glyph::{Font, FontRef, Glyph, PxScale, ScaleFont, point};
 
 /// A result whose error defaults to the library's.
 type Result<T, E = Error> = std::result::Result<T, E>;

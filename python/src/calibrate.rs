@@ -406,15 +406,17 @@ pub(crate) fn write_robot(
     path: &std::path::Path,
     overwrite: bool,
 ) -> PyResult<()> {
-    let text = activecal::io::calibrated::render(format, robot, table, frames, header)
-        .map_err(|e| arg_err("path", format!("{}: {e}", path.display())))?;
-    let out = [activecal::io::atomic::Output {
-        label: "path",
-        path,
-    }];
-    activecal::io::atomic::check_outputs(&out, &[], overwrite)
-        .map_err(|e| crate::convert::Fail::from(e).into_py())?;
-    activecal::io::atomic::write_atomic(path, text.as_bytes())
+    if Format::of(path).ok() != Some(format) {
+        return Err(arg_err(
+            "path",
+            format!(
+                "{}: this writer writes a .{} file; the name must end so",
+                path.display(),
+                format!("{format:?}").to_lowercase()
+            ),
+        ));
+    }
+    activecal::io::calibrated::write(robot, table, frames, header, path, overwrite)
         .map_err(|e| crate::convert::Fail::from(e).into_py())
 }
 

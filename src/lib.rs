@@ -19,6 +19,7 @@ pub mod identify;
 pub mod io;
 pub mod kinematics;
 pub(crate) mod linalg;
+pub mod lsq;
 pub mod measure;
 pub mod model;
 pub mod names;

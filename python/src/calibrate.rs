@@ -541,8 +541,8 @@ pub fn evaluate<'py>(
 
 /// The outlier choice of `outliers=` ("drop" or "keep") and
 /// `outlier_rate=`.
-fn outliers_of(kind: &str, rate: f64) -> PyResult<activecal::identify::outliers::OutlierChoice> {
-    use activecal::identify::outliers::{OutlierChoice, check_choice};
+fn outliers_of(kind: &str, rate: f64) -> PyResult<activecal::lsq::outliers::OutlierChoice> {
+    use activecal::lsq::outliers::{OutlierChoice, check_choice};
     let c = match kind {
         "drop" => OutlierChoice::Drop { alpha: rate },
         "keep" => OutlierChoice::Keep,

@@ -69,6 +69,14 @@ impl From<activecal::identify::IdentifyError> for Fail {
     }
 }
 
+impl From<activecal::lsq::LsqError> for Fail {
+    /// A solver setting out of range (an argument) or a problem it cannot
+    /// take.
+    fn from(e: activecal::lsq::LsqError) -> Self {
+        Fail::Input(e.to_string())
+    }
+}
+
 impl From<activecal::bound::BoundError> for Fail {
     fn from(e: activecal::bound::BoundError) -> Self {
         Fail::Compute(e.to_string())

@@ -4,7 +4,7 @@
 use crate::identify::{
     LmSettings, Measurements, Status, ValidationSet, identify, identify_robust, simulate, trial_rng,
 };
-use crate::lsq::loss::{Cauchy, Huber};
+use crate::lsq::loss::Huber;
 use crate::model::Robot;
 use crate::pool::Pool;
 

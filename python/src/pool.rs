@@ -255,7 +255,7 @@ pub(crate) fn pool_of(
     );
     let (src, listed) = if let Ok(s) = source.cast::<PyString>() {
         (
-            pool_source(arg, s.to_str()?, count_, levels, pool_seed)?,
+            pool_source(arg, &s.to_cow()?, count_, levels, pool_seed)?,
             None,
         )
     } else {

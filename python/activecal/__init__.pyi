@@ -140,7 +140,7 @@ class Design:
         """The dict ``activecal select --json`` prints for the same inputs
         and order (``tour``: the visiting order's figures; ``moves``: the
         moves' collision check, with collision filters)."""
-    def write(self, path: _Path, overwrite: bool = False) -> None:
+    def write(self, path: _Path, overwrite: bool = True) -> None:
         """Writes the design by the extension of path, as ``activecal
         select --out`` does: .json (the design file), .csv (joint values,
         one pose a row, a header of joint names) or .yaml (named joint
@@ -338,11 +338,11 @@ class Calibration:
         """The dict ``activecal calibrate --measurements FILE --json``
         prints for a file holding the same values (``measurements`` names
         the arrays here, not a file)."""
-    def write_urdf(self, path: _Path, overwrite: bool = False) -> None:
+    def write_urdf(self, path: _Path, overwrite: bool = True) -> None:
         """Writes the calibrated URDF: the robot's own file with only the
         chain's joint origins changed (a built-in robot: its chain as a
         URDF). Refused (Error) when the fit did not converge."""
-    def write_frames(self, path: _Path, overwrite: bool = False) -> None:
+    def write_frames(self, path: _Path, overwrite: bool = True) -> None:
         """Writes the frames file (YAML): the measurement frame, the tool
         or markers and the joint-origin changes with their σ, as
         ``activecal calibrate --out cal.yaml`` does. URDF robots only;
@@ -432,9 +432,9 @@ class ContactCalibration:
     def report(self) -> dict[str, Any]:
         """The dict ``activecal calibrate --measurements FILE --json``
         prints for a contact file with the same rows."""
-    def write_urdf(self, path: _Path, overwrite: bool = False) -> None:
+    def write_urdf(self, path: _Path, overwrite: bool = True) -> None:
         """The calibrated URDF (refused unless converged and plausible)."""
-    def write_frames(self, path: _Path, overwrite: bool = False) -> None:
+    def write_frames(self, path: _Path, overwrite: bool = True) -> None:
         """The frames file: the ball centre as ``point``, the fitted points
         under ``contacts``."""
 
@@ -494,13 +494,13 @@ class CameraCalibration:
     def report(self) -> dict[str, Any]:
         """The dict ``activecal calibrate --observations FILE --json``
         prints (``out`` empty)."""
-    def write_urdf(self, path: _Path, overwrite: bool = False) -> None:
+    def write_urdf(self, path: _Path, overwrite: bool = True) -> None:
         """Your URDF with the calibrated joint origins (refused unless
         converged)."""
-    def write_frames(self, path: _Path, overwrite: bool = False) -> None:
+    def write_frames(self, path: _Path, overwrite: bool = True) -> None:
         """The frames file with the ``camera`` block (both placements with
         σ, the pixel σ and RMS)."""
-    def write_camera_info(self, path: _Path, overwrite: bool = False) -> None:
+    def write_camera_info(self, path: _Path, overwrite: bool = True) -> None:
         """The refined intrinsics as a ROS camera_info ``.yaml``, the camera
         named by the file's stem (only with ``refine_intrinsics=True`` and
         a converged fit), as ``--out-camera-info`` writes it."""

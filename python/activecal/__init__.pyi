@@ -11,12 +11,40 @@ starts with the argument's name.
 """
 
 from os import PathLike
-from typing import Any, Callable, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Mapping, Optional, Sequence, Tuple, Union, final
+
+from typing_extensions import disjoint_base
 
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
+
+__all__ = [
+    "Calibration",
+    "CameraCalibration",
+    "CameraDesign",
+    "ContactCalibration",
+    "Design",
+    "ComputationError",
+    "Error",
+    "FileError",
+    "InputError",
+    "InternalError",
+    "Pool",
+    "ResourceError",
+    "Robot",
+    "__version__",
+    "bound",
+    "calibrate",
+    "calibrate_camera",
+    "calibrate_contacts",
+    "evaluate",
+    "gap",
+    "pool",
+    "select",
+    "select_camera",
+]
 
 _Path = Union[str, "PathLike[str]"]
 _Marker = Union[str, Tuple[str, Sequence[float]]]
@@ -26,23 +54,25 @@ class Error(Exception):
     argument's name first when one argument is wrong (``q: expected shape
     (6,) ...``). Every error activecal raises is one of its subclasses."""
 
-class InputError(Error):
+class InputError(Error, ValueError):
     """A wrong argument (its name first) or a wrong value in an input file
     (the file and the place named)."""
 
-class FileError(Error):
+class FileError(Error, OSError):
     """A file that could not be read or written, or an output that exists
-    (pass overwrite=True)."""
+    when a writer is given overwrite=False."""
 
-class ResourceError(Error):
+class ResourceError(Error, RuntimeError):
     """Work too large for the memory or size limits, with the figure."""
 
-class ComputationError(Error):
+class ComputationError(Error, RuntimeError):
     """A computation that cannot be done on these (valid) inputs."""
 
-class InternalError(Error):
+class InternalError(Error, RuntimeError):
     """A defect in activecal: please report it with the message."""
 
+@final
+@disjoint_base
 class Robot:
     """A robot model: a serial chain, its joint limits, the unknowns a
     calibration estimates and the sensor it is measured with. Immutable."""
@@ -109,6 +139,8 @@ class Robot:
         3 rows for a point, 6 for a full pose (orientation rows weighed by
         the robot's orientation scale, metres per radian), 3 per marker."""
 
+@final
+@disjoint_base
 class Design:
     """The poses `select` chose, in visiting order (see `select`'s order)."""
 
@@ -144,8 +176,8 @@ class Design:
         """Writes the design by the extension of path, as ``activecal
         select --out`` does: .json (the design file), .csv (joint values,
         one pose a row, a header of joint names) or .yaml (named joint
-        configurations). An existing file is replaced only with
-        overwrite=True."""
+        configurations). An existing file is replaced, as pandas and NumPy
+        do; overwrite=False refuses it (``FileError``)."""
     def bound(
         self, progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None
     ) -> dict[str, Any]:
@@ -175,6 +207,8 @@ class Design:
         released."""
     def __len__(self) -> int: ...
 
+@final
+@disjoint_base
 class Pool:
     """Candidate poses and their identification Jacobian: what `select`
     chooses from."""
@@ -301,6 +335,8 @@ def gap(
     bound over its own pool, the dict `activecal gap --json` prints."""
     ...
 
+@final
+@disjoint_base
 class Calibration:
     """The result of `calibrate`."""
 
@@ -364,6 +400,9 @@ def calibrate(
     splits: int = 4,
     seed: int = 0,
     compliance: bool = False,
+    outliers: str = "drop",
+    outlier_rate: float = 0.01,
+    noise: Optional[float] = None,
     progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
 ) -> Calibration:
     """Calibrates the robot from measured poses, as ``activecal calibrate
@@ -405,6 +444,8 @@ def evaluate(
     orientations as `calibrate` takes them: poses the fit did not see
     judge it."""
 
+@final
+@disjoint_base
 class ContactCalibration:
     """The result of `calibrate_contacts`."""
 
@@ -458,12 +499,18 @@ def calibrate_contacts(
     parameters never fixed; loss, loss_scale, max_iterations and progress
     as `calibrate` takes them."""
 
+@final
+@disjoint_base
 class CameraCalibration:
     """The result of `calibrate_camera`."""
 
     @property
     def converged(self) -> bool:
         """Whether the fit converged (only then are files written)."""
+    @property
+    def refused(self) -> Optional[str]:
+        """Why the calibration may not be written (None when it may): the
+        reason the command line refuses it with (exit status 3)."""
     @property
     def estimate(self) -> dict[str, float]:
         """{unknown: value}: the robot's unknowns (metres, radians),
@@ -537,6 +584,8 @@ def calibrate_camera(
     intrinsics too. Bad input raises `InputError` naming the argument (and
     the file, line and column)."""
 
+@final
+@disjoint_base
 class CameraDesign:
     """The result of `select_camera`."""
 
@@ -557,7 +606,6 @@ class CameraDesign:
     def poses(self) -> Any:
         """A pandas DataFrame with the columns of ``select --out
         design.csv``: candidate, the joints, points_seen."""
-    @property
     def how_many(
         self,
         pixel_noise: Optional[float] = None,
@@ -592,7 +640,7 @@ def select_camera(
     min_visible: float = 1.0,
     image_margin: float = 10.0,
     max_view_angle: float = 60.0,
-    distance: Tuple[float, float] = (0.2, 3.0),
+    distance: Tuple[float, float] = ...,
     gap: bool = False,
     pixel_noise: Optional[float] = None,
     line_of_sight: bool = False,

@@ -13,8 +13,6 @@ starts with the argument's name.
 from os import PathLike
 from typing import Any, Callable, Mapping, Optional, Sequence, Tuple, Union, final
 
-from typing_extensions import disjoint_base
-
 import numpy as np
 import numpy.typing as npt
 
@@ -72,7 +70,6 @@ class InternalError(Error, RuntimeError):
     """A defect in activecal: please report it with the message."""
 
 @final
-@disjoint_base
 class Robot:
     """A robot model: a serial chain, its joint limits, the unknowns a
     calibration estimates and the sensor it is measured with. Immutable."""
@@ -140,7 +137,6 @@ class Robot:
         the robot's orientation scale, metres per radian), 3 per marker."""
 
 @final
-@disjoint_base
 class Design:
     """The poses `select` chose, in visiting order (see `select`'s order)."""
 
@@ -208,7 +204,6 @@ class Design:
     def __len__(self) -> int: ...
 
 @final
-@disjoint_base
 class Pool:
     """Candidate poses and their identification Jacobian: what `select`
     chooses from."""
@@ -336,7 +331,6 @@ def gap(
     ...
 
 @final
-@disjoint_base
 class Calibration:
     """The result of `calibrate`."""
 
@@ -445,7 +439,6 @@ def evaluate(
     judge it."""
 
 @final
-@disjoint_base
 class ContactCalibration:
     """The result of `calibrate_contacts`."""
 
@@ -500,7 +493,6 @@ def calibrate_contacts(
     as `calibrate` takes them."""
 
 @final
-@disjoint_base
 class CameraCalibration:
     """The result of `calibrate_camera`."""
 
@@ -585,7 +577,6 @@ def calibrate_camera(
     the file, line and column)."""
 
 @final
-@disjoint_base
 class CameraDesign:
     """The result of `select_camera`."""
 

@@ -9,7 +9,10 @@
 //! thread's current one: a task started on that thread belongs to it, a
 //! task started on a worker thread belongs to the call of the task that is
 //! running (the innermost live one), so that nested work reaches the caller
-//! too. The first exception the callback raises stops the work (as a
+//! too. The library also marks checkpoints between the steps of loops that
+//! advance no task for long ([`activecal::progress::checkpoint`]), where a
+//! cancelled call's work stops as well. The first exception the callback
+//! raises stops the work (as a
 //! cancellation does) and is raised by the call. A cancelled call (Ctrl-C: see [`crate::convert::detached`])
 //! unwinds its work from the next advance of any of its tasks, on any
 //! thread, with a [`Cancelled`] payload (no panic message is printed).
@@ -17,7 +20,7 @@
 use pyo3::prelude::*;
 use std::cell::RefCell;
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
@@ -35,10 +38,24 @@ pub struct Call {
     cancelled: AtomicBool,
 }
 
+/// How many cancelled calls are still alive: the library's checkpoints
+/// cost one atomic load while there are none.
+static CANCELLED: AtomicUsize = AtomicUsize::new(0);
+
 impl Call {
-    /// Stops the call's work at its next advance.
+    /// Stops the call's work at its next advance or checkpoint.
     pub fn cancel(&self) {
-        self.cancelled.store(true, Ordering::SeqCst);
+        if !self.cancelled.swap(true, Ordering::SeqCst) {
+            CANCELLED.fetch_add(1, Ordering::SeqCst);
+        }
+    }
+}
+
+impl Drop for Call {
+    fn drop(&mut self) {
+        if self.cancelled.load(Ordering::SeqCst) {
+            CANCELLED.fetch_sub(1, Ordering::SeqCst);
+        }
     }
 }
 
@@ -131,6 +148,22 @@ impl activecal::progress::Sink for PySink {
         drop(map);
         Self::stop_if_cancelled(&call);
         Self::forward(&call, &name, done, total, note);
+    }
+
+    fn checkpoint(&self) {
+        if CANCELLED.load(Ordering::Relaxed) == 0 {
+            return;
+        }
+        // This thread's call, or (a worker thread) the innermost live task's.
+        let call = CURRENT.with(|c| c.borrow().clone()).or_else(|| {
+            let map = live().lock().ok()?;
+            map.iter()
+                .max_by_key(|(k, _)| **k)
+                .map(|(_, l)| l.call.clone())
+        });
+        if let Some(call) = call {
+            Self::stop_if_cancelled(&call);
+        }
     }
 
     fn finish(&self, id: u64) {

@@ -527,6 +527,9 @@ where
         return finish_polish(pool, make, sel, s);
     }
     let one = |k: usize| -> Result<Selection> {
+        // Starts still queued when the work is stopped end here, before
+        // their criterion's set-up (tens of ms each on a large pool).
+        crate::progress::checkpoint();
         let mut rng = design_rng(s.seed, k as u64);
         let mut crit = make();
         match algorithm {

@@ -425,15 +425,17 @@ pub(crate) fn write_robot(
     path: &std::path::Path,
     overwrite: bool,
 ) -> PyResult<()> {
-    let text = activecal::io::calibrated::render(format, robot, table, frames, header)
-        .map_err(|e| arg_err("path", format!("{}: {e}", path.display())))?;
-    let out = [activecal::io::atomic::Output {
-        label: "path",
-        path,
-    }];
-    activecal::io::atomic::check_outputs(&out, &[], overwrite)
-        .map_err(|e| crate::convert::Fail::from(e).into_py())?;
-    activecal::io::atomic::write_atomic(path, text.as_bytes())
+    if Format::of(path).ok() != Some(format) {
+        return Err(arg_err(
+            "path",
+            format!(
+                "{}: this writer writes a .{} file; the name must end so",
+                path.display(),
+                format!("{format:?}").to_lowercase()
+            ),
+        ));
+    }
+    activecal::io::calibrated::write(robot, table, frames, header, path, overwrite)
         .map_err(|e| crate::convert::Fail::from(e).into_py())
 }
 
@@ -564,8 +566,8 @@ pub fn evaluate<'py>(
 
 /// The outlier choice of `outliers=` ("drop" or "keep") and
 /// `outlier_rate=`.
-fn outliers_of(kind: &str, rate: f64) -> PyResult<activecal::identify::outliers::OutlierChoice> {
-    use activecal::identify::outliers::{OutlierChoice, check_choice};
+fn outliers_of(kind: &str, rate: f64) -> PyResult<activecal::lsq::outliers::OutlierChoice> {
+    use activecal::lsq::outliers::{OutlierChoice, check_choice};
     let c = match kind {
         "drop" => OutlierChoice::Drop { alpha: rate },
         "keep" => OutlierChoice::Keep,

@@ -64,15 +64,23 @@ impl From<activecal::identify::IdentifyError> for Fail {
     }
 }
 
+impl From<activecal::lsq::LsqError> for Fail {
+    /// A solver setting out of range (an argument) or a problem it cannot
+    /// take.
+    fn from(e: activecal::lsq::LsqError) -> Self {
+        Fail::Input(e.to_string())
+    }
+}
+
 impl From<activecal::bound::BoundError> for Fail {
     fn from(e: activecal::bound::BoundError) -> Self {
         Fail::Compute(e.to_string())
     }
 }
 
-impl From<activecal::experiment::paper::ExperimentError> for Fail {
-    fn from(e: activecal::experiment::paper::ExperimentError) -> Self {
-        use activecal::experiment::paper::ExperimentError as E;
+impl From<activecal::experiment::ExperimentError> for Fail {
+    fn from(e: activecal::experiment::ExperimentError) -> Self {
+        use activecal::experiment::ExperimentError as E;
         match e {
             E::Input(e) => e.into(),
             E::Bound(e) => e.into(),

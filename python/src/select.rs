@@ -6,10 +6,11 @@ use crate::pool::Pool;
 use crate::robot::Robot;
 use activecal::blocks::Blocks;
 use activecal::criterion::Prior;
-use activecal::experiment::visiting::{Visiting, ordered_design, visit_selection};
+use activecal::experiment::select::{Existing, SelectRun};
+use activecal::experiment::visiting::Visiting;
 use activecal::io::design::DesignFile;
+use activecal::model::ParamSet;
 use activecal::names::Choice;
-use activecal::report::{PredictedAfter, SelectReport};
 use activecal::select::{Algorithm, CriterionKind, Settings};
 use pyo3::prelude::*;
 use std::sync::Arc;
@@ -122,73 +123,61 @@ pub fn select(
         ));
     }
     let candidates = candidates(py, robot, pool, count, levels, pool_seed, margin)?;
-    let (existing_qs, prior) = match existing {
-        Some(e) => {
-            let (qs, p) = existing_poses(py, robot, e)?;
-            (Some(qs), Some(p))
-        }
-        None => (None, None),
-    };
-    let inner = robot.inner.clone();
-    let r = inner.clone();
+    let existing = existing.map(|e| existing_poses(py, robot, e)).transpose()?;
+    let prior = existing.as_ref().map(|e| e.prior.clone());
+    let r = robot.inner.clone();
     let (x, built) = (candidates.x.clone(), candidates.pool.clone());
-    let closure_prior = prior.clone();
-    let (file, report, ids, q, sel, settings) = crate::progress::with_callback(progress, || {
+    let s = Settings::builder()
+        .n(n)
+        .initial(Settings::default().initial.min(n))
+        .starts(starts)
+        .ils(ils.unwrap_or_else(|| activecal::select::default_ils_rounds(x.n_poses(), x.t())))
+        .kick(kick)
+        .seed(seed)
+        .prior(prior.clone())
+        .build()
+        .map_err(|e| crate::convert::Fail::from(e).into_py())?;
+    let run = SelectRun {
+        criterion: CriterionKind::Det,
+        algorithm,
+        settings: s.clone(),
+        visiting: Visiting {
+            reorder,
+            home: None,
+            may_swap: true,
+        },
+        gap: None,
+        refine: None,
+        noise,
+        params: ParamSet::Nominal,
+    };
+    let outcome = crate::progress::with_callback(progress, || {
         detached(py, move || {
-            let table = &r.nominal;
-            let s =
-                Settings::builder()
-                    .n(n)
-                    .initial(Settings::default().initial.min(n))
-                    .starts(starts)
-                    .ils(ils.unwrap_or_else(|| {
-                        activecal::select::default_ils_rounds(x.n_poses(), x.t())
-                    }))
-                    .kick(kick)
-                    .seed(seed)
-                    .prior(closure_prior.clone())
-                    .build()?;
-            let t0 = std::time::Instant::now();
-            let mut sel = activecal::select::select(&x, CriterionKind::Det, algorithm, &s)?;
-            let seconds = t0.elapsed().as_secs_f64();
-            let (mut report, order) = visit(
+            Ok(activecal::experiment::select::run(
                 &r,
                 &built,
                 &x,
-                closure_prior.as_ref(),
-                &mut sel,
-                &s,
-                seconds,
-                reorder,
-            )?;
-            if let (Some(noise), None) = (noise, &closure_prior) {
-                report.predicted = PredictedAfter::of_design(&r, table, &x, &sel.poses, noise);
-            }
-            let file = ordered_design(&r, &built, &sel, None, &order, &report);
-            let q: Vec<Vec<f64>> = report.configurations.iter().map(|c| c.q.clone()).collect();
-            let ids: Vec<usize> = report.configurations.iter().map(|c| c.id).collect();
-            let v = serde_json::to_value(&report)?;
-            Ok((file, v, ids, q, sel, s))
+                existing.as_ref(),
+                &run,
+            )?)
         })
     })?;
-    let mut file = file;
-    file.existing = existing_qs.map(|qs| activecal::io::design::ExistingPoses {
-        path: "existing".into(),
-        q: qs,
-    });
+    let report = serde_json::to_value(&outcome.report)
+        .map_err(|e| crate::convert::Fail::from(e).into_py())?;
+    let c = &outcome.report.configurations;
     Ok(Design {
-        robot: inner,
-        file,
+        robot: robot.inner.clone(),
+        file: outcome.design,
         report,
-        q,
-        ids,
-        ln_oid: sel.ln_oid,
-        positions: sel.poses,
+        q: c.iter().map(|c| c.q.clone()).collect(),
+        ids: c.iter().map(|c| c.id).collect(),
+        ln_oid: outcome.selection.ln_oid,
+        positions: outcome.selection.poses,
         pool_ids: candidates.pool.ids.clone(),
         pool: candidates.pool.clone(),
         x: candidates.x,
         prior,
-        settings,
+        settings: s,
         algorithm,
         noise,
         recipe,
@@ -267,39 +256,6 @@ fn algorithm_of(name: &str) -> PyResult<Algorithm> {
     })
 }
 
-/// The selection's report in visiting order (`reorder`) or selection
-/// order, its moves checked, stuck poses exchanged (as `select` does), and
-/// the order (positions in selection order).
-#[allow(clippy::too_many_arguments)]
-fn visit(
-    r: &activecal::model::Robot,
-    built: &activecal::pool::Pool,
-    x: &Blocks,
-    prior: Option<&Prior>,
-    sel: &mut activecal::select::Selection,
-    s: &Settings,
-    seconds: f64,
-    reorder: bool,
-) -> activecal::Result<(SelectReport, Vec<usize>)> {
-    let how = Visiting {
-        reorder,
-        home: None,
-        may_swap: true,
-    };
-    let (mut report, order, swapped) = visit_selection(r, built, x, prior, sel, &how, |sel| {
-        Ok::<_, activecal::Error>(SelectReport::new(
-            r,
-            built,
-            sel,
-            CriterionKind::Det,
-            s,
-            seconds,
-        ))
-    })?;
-    report.swapped = swapped;
-    Ok((report, order))
-}
-
 /// The candidates a `pool` argument names: a `Pool` as built (no size
 /// option beside it), an array of configurations or a source name.
 pub(crate) fn candidates(
@@ -363,7 +319,7 @@ pub(crate) fn existing_poses(
     py: Python<'_>,
     robot: &Robot,
     e: &Bound<'_, PyAny>,
-) -> PyResult<(Vec<Vec<f64>>, Prior)> {
+) -> PyResult<Existing> {
     let dof = robot.inner.dof();
     let joints = activecal::units::joint_names(&robot.inner);
     let e = &crate::convert::named_columns(e, "existing", &joints, "joint")?;
@@ -377,14 +333,10 @@ pub(crate) fn existing_poses(
     let mut qs = crate::convert::rows(&v, dof);
     robot.check_joint_values("existing", &mut qs)?;
     let r = robot.inner.clone();
-    let qs2 = qs.clone();
-    let prior = detached(py, move || {
-        let x = activecal::blocks::jacobian_of(&r, &r.nominal, qs2.len(), |k, q| {
-            q.copy_from_slice(&qs2[k]);
-        });
-        Prior::from_blocks(&x).map_err(|e| crate::convert::Fail::input(format!("existing: {e}")))
-    })?;
-    Ok((qs, prior))
+    detached(py, move || {
+        Existing::from_poses("existing".into(), qs, Vec::new(), &r, ParamSet::Nominal)
+            .map_err(crate::convert::Fail::from)
+    })
 }
 
 #[pymethods]

@@ -208,15 +208,15 @@ pub fn calibrate_contacts(
         let _ = writeln!(report, "calibrated robot written to {out}");
     }
     if let Some(dir) = a.report {
-        let r = super::contact_report::ContactReport {
+        let r = activecal::render::contact_figures::ContactReport {
             robot,
             file: &file,
             fit: &fit,
             figures: &figures,
             held: held.as_ref(),
         };
-        super::report_dir::contacts(dir, robot, &report, &v, |d| {
-            super::contact_report::draw(d, &r)
+        activecal::render::folder::contacts(dir, robot, &report, &v, |d| {
+            activecal::render::contact_figures::draw(d, &r)
         })?;
     }
     super::emit(a.json, &v, || report)?;

@@ -2,7 +2,11 @@
 
 pub mod camera;
 pub mod contacts;
+pub mod error;
 pub mod measured;
 pub mod paper;
+pub mod select;
 pub mod simulated;
+
+pub use error::ExperimentError;
 pub mod visiting;

@@ -1,10 +1,10 @@
 //! The least-squares fit of measured data with Baarda's data snooping
-//! ([`crate::identify::outliers`]): the poses the test flags left out one at
+//! ([`crate::lsq::outliers`]): the poses the test flags left out one at
 //! a time, the fit repeated.
 
 use super::MeasuredSettings;
-use crate::identify::outliers::{Outlier, OutlierChoice};
 use crate::identify::{LossChoice, Measurements, residuals};
+use crate::lsq::outliers::{Outlier, OutlierChoice};
 use crate::model::{ParamTable, Robot};
 use serde::Serialize;
 
@@ -36,7 +36,7 @@ const MOST_OUTLIERS: f64 = 0.2;
 
 /// The fit of `meas` ([`crate::identify::fit_weighted`]), and with least
 /// squares and [`OutlierChoice::Drop`], Baarda's data snooping
-/// ([`crate::identify::outliers`]): the pose the test flags left out and
+/// ([`crate::lsq::outliers`]): the pose the test flags left out and
 /// the fit repeated from the last estimate, until none is flagged or
 /// [`MOST_OUTLIERS`] of the poses are out.
 pub(super) fn screen(
@@ -45,13 +45,13 @@ pub(super) fn screen(
     meas: &Measurements,
     s: &MeasuredSettings,
 ) -> crate::identify::Result<Screened> {
-    crate::identify::outliers::check_choice(s.outliers)?;
+    crate::lsq::outliers::check_choice(s.outliers)?;
     let fit = |m: &Measurements, from: &ParamTable| {
         crate::identify::fit_weighted(robot, from, m, &s.lm, s.loss, s.weights)
     };
     let mut kept: Vec<usize> = (0..meas.len()).collect();
     let mut wf = fit(meas, start)?;
-    let mut found: Vec<(usize, crate::identify::outliers::PoseTest, f64)> = Vec::new();
+    let mut found: Vec<(usize, crate::lsq::outliers::PoseTest, f64)> = Vec::new();
     let mut notes = Vec::new();
     let alpha = match (s.outliers, s.loss) {
         (OutlierChoice::Drop { alpha }, LossChoice::L2) => alpha,
@@ -69,7 +69,7 @@ pub(super) fn screen(
     loop {
         let sub = meas.subset(&kept);
         let mut prob = crate::identify::Calibration::new(&wf.robot, &wf.start, &sub)?;
-        let Some(tests) = crate::identify::outliers::pose_tests(
+        let Some(tests) = crate::lsq::outliers::pose_tests(
             &mut prob,
             &wf.fit.id.estimate,
             sub.len(),
@@ -77,7 +77,7 @@ pub(super) fn screen(
         ) else {
             break;
         };
-        let Some(worst) = crate::identify::outliers::flagged(&tests, alpha) else {
+        let Some(worst) = crate::lsq::outliers::flagged(&tests, alpha) else {
             break;
         };
         if found.len() >= most {

@@ -16,9 +16,9 @@
 use super::data::ContactFile;
 use super::{start_own, start_planes};
 use crate::identify::lm::{Solution, StopReason, levenberg_marquardt};
-use crate::identify::loss::{Cauchy, Huber, Loss};
 use crate::identify::undetermined::{FixedParameter, fix_undetermined_below};
 use crate::identify::{Calibration, LmSettings, LossChoice, Residuals, Result};
+use crate::lsq::loss::{Cauchy, Huber, Loss};
 use crate::measure::contact::{ContactSensor, KnownDistance, Plane, PlaneKind};
 use crate::model::{ParamTable, Robot};
 use faer::Mat;

@@ -2,7 +2,7 @@
 //! memory, as `activecal calibrate --measurements FILE` does from a file,
 //! and the `Calibration` it returns.
 
-use crate::convert::{arg_err, count, detached, err, float_array, json_to_py, named_columns, rows};
+use crate::convert::{arg_err, count, detached, float_array, json_to_py, named_columns, rows};
 use crate::robot::Robot;
 use activecal::experiment::measured::{MeasuredSettings, calibrate_measurements};
 use activecal::frames::CalibratedFrames;
@@ -22,6 +22,8 @@ pub struct Calibration {
     report: serde_json::Value,
     /// The library's verdict: whether the calibrated robot may be written.
     verdict: activecal::experiment::measured::verdict::Verdict,
+    /// How it was made, for pickling.
+    recipe: crate::pickling::Recipe,
 }
 
 /// What `calibrate` reads from its array arguments.
@@ -265,7 +267,7 @@ fn names(v: Option<Vec<String>>) -> Vec<String> {
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
-    robot: &Robot,
+    robot: &Bound<'_, Robot>,
     q: &Bound<'_, PyAny>,
     points: &Bound<'_, PyAny>,
     orientations: Option<&Bound<'_, PyAny>>,
@@ -285,6 +287,14 @@ pub fn calibrate(
     noise: Option<f64>,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Calibration> {
+    use crate::pickling::kept;
+    let recipe = crate::recipe!(py, "calibrate";
+        robot = robot, q = kept(Some(q))?, points = kept(Some(points))?,
+        orientations = kept(orientations)?, fix = &fix, free = &free,
+        max_iterations = max_iterations, loss = loss, loss_scale = loss_scale, weights = weights,
+        orientation_scale = orientation_scale, holdout = holdout, splits = splits, seed = seed,
+        compliance = compliance, outliers = outliers, outlier_rate = outlier_rate, noise = noise);
+    let robot = robot.get();
     let weights = weights_of(weights, orientation_scale)?;
     let outliers = outliers_of(outliers, outlier_rate)?;
     let gravity = compliance
@@ -325,7 +335,7 @@ pub fn calibrate(
         outliers,
         stated_noise: match noise {
             Some(s) if !(s.is_finite() && s > 0.0) => {
-                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                return Err(crate::errors::new_err(crate::errors::Kind::Input, format!(
                     "noise={s}: the sensor's stated σ per coordinate must be a number > 0 (metres)"
                 )));
             }
@@ -353,8 +363,20 @@ pub fn calibrate(
                 Ok((c.robot, c.fit.id, c.frames, v, c.verdict, report.warnings))
             })
         })?;
-    // What the command line prints as a warning reaches Python as one.
-    for w in &warnings {
+    warn_all(py, &warnings)?;
+    Ok(Calibration {
+        robot: Arc::new(fitted),
+        id,
+        frames,
+        report,
+        verdict,
+        recipe,
+    })
+}
+
+/// What the command line prints as a warning reaches Python as one.
+fn warn_all(py: Python<'_>, warnings: &[String]) -> PyResult<()> {
+    for w in warnings {
         let cat = py.get_type::<pyo3::exceptions::PyUserWarning>();
         pyo3::PyErr::warn(
             py,
@@ -363,13 +385,7 @@ pub fn calibrate(
             1,
         )?;
     }
-    Ok(Calibration {
-        robot: Arc::new(fitted),
-        id,
-        frames,
-        report,
-        verdict,
-    })
+    Ok(())
 }
 
 impl Calibration {
@@ -380,7 +396,10 @@ impl Calibration {
         // The command line's verdict, from the library: the same refusals
         // with the same message.
         if let Some(why) = self.verdict.refusal() {
-            return Err(err(format!("{}: not written: {why}", path.display())));
+            return Err(crate::errors::new_err(
+                crate::errors::Kind::Computation,
+                format!("{}: not written: {why}", path.display()),
+            ));
         }
         write_robot(
             format,
@@ -422,6 +441,11 @@ pub(crate) fn write_robot(
 
 #[pymethods]
 impl Calibration {
+    /// Pickling: made again by the same call with the same arguments
+    /// (deterministic: the same result; the robot's files read again).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        self.recipe.reduce(py)
+    }
     /// Whether the fit converged (only then is the estimate trustworthy and
     /// the robot written).
     #[getter]
@@ -482,7 +506,7 @@ impl Calibration {
     /// Writes the calibrated robot as URDF: the robot's own URDF with only
     /// the chain's joint origins changed (a built-in robot: its chain as
     /// URDF). Refused when the fit did not converge.
-    #[pyo3(signature = (path, overwrite=false))]
+    #[pyo3(signature = (path, overwrite=true))]
     fn write_urdf(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
         self.write_as(Format::Urdf, &path, overwrite)
     }
@@ -490,7 +514,7 @@ impl Calibration {
     /// Writes the frames file (YAML): measurement frame, tool or markers and
     /// joint-origin changes with σ, metres and degrees as the command line
     /// writes it. URDF robots only; refused when the fit did not converge.
-    #[pyo3(signature = (path, overwrite=false))]
+    #[pyo3(signature = (path, overwrite=true))]
     fn write_frames(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
         self.write_as(Format::Yaml, &path, overwrite)
     }
@@ -529,6 +553,7 @@ pub fn evaluate<'py>(
     let wrapper = Robot {
         inner: robot.clone(),
         visibility: None,
+        recipe: None,
     };
     let d = data(py, &wrapper, q, points, orientations)?;
     let v = detached(py, move || {

@@ -36,8 +36,12 @@ pub struct Design {
     algorithm: Algorithm,
     /// The pool's pose ids, by position.
     pool_ids: Vec<usize>,
+    /// The pool (named by the gap's report).
+    pool: Arc<activecal::pool::Pool>,
     /// The sensor noise given to `select`, metres.
     noise: Option<f64>,
+    /// How it was made, for pickling.
+    recipe: crate::pickling::Recipe,
 }
 
 /// The noise of the how-many curve when none is given, metres: the
@@ -80,7 +84,7 @@ const DEFAULT_CURVE_NOISE: f64 = 0.01;
 #[allow(clippy::too_many_arguments)]
 pub fn select(
     py: Python<'_>,
-    robot: &Robot,
+    robot: &Bound<'_, Robot>,
     n: i64,
     pool: Option<&Bound<'_, PyAny>>,
     count: Option<i64>,
@@ -97,6 +101,12 @@ pub fn select(
     order: Option<&str>,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Design> {
+    let recipe = crate::recipe!(py, "select";
+        robot = robot, n = n, pool = crate::pickling::kept(pool)?, count = count, levels = levels,
+        pool_seed = pool_seed, margin = margin, algorithm = algorithm, seed = seed,
+        starts = starts, ils = ils, kick = kick, noise = noise,
+        existing = crate::pickling::kept(existing)?, order = order);
+    let robot = robot.get();
     let reorder = reorder_of(robot, order)?;
     let n = crate::convert::count("n", n, 1)?;
     let algorithm = algorithm_of(algorithm)?;
@@ -164,11 +174,13 @@ pub fn select(
         ln_oid: outcome.selection.ln_oid,
         positions: outcome.selection.poses,
         pool_ids: candidates.pool.ids.clone(),
+        pool: candidates.pool.clone(),
         x: candidates.x,
         prior,
         settings: s,
         algorithm,
         noise,
+        recipe,
     })
 }
 
@@ -181,6 +193,8 @@ impl Design {
         progress: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (x, prior, positions) = (self.x.clone(), self.prior.clone(), self.positions.clone());
+        let (robot, pool, ids) = (self.robot.clone(), self.pool.clone(), self.ids.clone());
+        let existing = self.file.existing.as_ref().map(|e| e.q.clone());
         let v = crate::progress::with_callback(progress, || {
             detached(py, move || {
                 let settings = activecal::bound::BoundSettings::default();
@@ -191,7 +205,25 @@ impl Design {
                     &settings,
                 )?;
                 let g = activecal::bound::gap::design_gap(&x, prior.as_ref(), &positions, &b)?;
-                Ok(serde_json::to_value(&g)?)
+                // The report `activecal gap --json` prints for this design.
+                let params = activecal::model::ParamSet::Nominal;
+                let info = activecal::report::PoolInfo::new(&robot, &pool);
+                let mut report = activecal::report::GapReport::new(info, params, ids, &g, &b);
+                if let (Some(qs), Some(prior)) = (existing, prior.as_ref()) {
+                    let xe = activecal::blocks::jacobian_of(
+                        &robot,
+                        robot.params(params),
+                        qs.len(),
+                        |k, q| q.copy_from_slice(&qs[k]),
+                    );
+                    report.existing = Some(activecal::report::ExistingReport::new(
+                        "existing".into(),
+                        &xe,
+                        prior,
+                        Vec::new(),
+                    ));
+                }
+                Ok(serde_json::to_value(&report)?)
             })
         })?;
         json_to_py(py, &v)
@@ -264,6 +296,7 @@ pub(crate) fn candidates(
             robot: b.robot.clone(),
             pool: b.pool.clone(),
             x: b.x.clone(),
+            recipe: None,
         });
     }
     let default = pyo3::types::PyString::new(py, "random").into_any();
@@ -308,6 +341,11 @@ pub(crate) fn existing_poses(
 
 #[pymethods]
 impl Design {
+    /// Pickling: made again by the same call with the same arguments
+    /// (deterministic: the same result; the robot's files read again).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        self.recipe.reduce(py)
+    }
     /// Joint values of the chosen poses, an (n, dof) float64 array in
     /// visiting order (see `order`; radians or metres, as visited: a joint
     /// may be a whole turn from the pool's value).
@@ -424,8 +462,9 @@ impl Design {
     /// Writes the design by the extension of `path`: .json (the design
     /// file), .csv (joint values, one pose a row) or .yaml (named joint
     /// configurations), as `activecal select --out` does. An existing file
-    /// is replaced only with overwrite=True.
-    #[pyo3(signature = (path, overwrite=false))]
+    /// is replaced (as pandas and NumPy do); overwrite=False refuses it
+    /// with `FileError`.
+    #[pyo3(signature = (path, overwrite=true))]
     fn write(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
         activecal::io::design_formats::write(&self.file, &path, overwrite)
             .map_err(|e| crate::convert::Fail::from(e).into_py())

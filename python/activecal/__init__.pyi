@@ -56,6 +56,7 @@ class Robot:
         lock: Optional[Mapping[str, float]] = None,
         frames: Optional[_Path] = None,
         pose: bool = False,
+        kinematics: Optional[_Path] = None,
     ) -> "Robot":
         """Imports the chain base..tip of a URDF file.
 
@@ -67,6 +68,10 @@ class Robot:
         metres. frames: a frames file (as `Calibration.write_frames`
         writes) mounting the chain in its measurement frame with its tool.
         pose: full-pose measurements (position and orientation).
+        kinematics: a kinematics file whose joint origins replace the
+        URDF's: Universal Robots' ``default_kinematics.yaml`` (a factory
+        file, or `Calibration.write_ur_kinematics`'s) or a per-joint
+        origins file (`Calibration.write_joint_origins`).
         """
     @staticmethod
     def builtin(name: str) -> "Robot":
@@ -347,6 +352,19 @@ class Calibration:
         or markers and the joint-origin changes with their σ, as
         ``activecal calibrate --out cal.yaml`` does. URDF robots only;
         refused when the fit did not converge."""
+    def write_ur_kinematics(self, path: _Path, overwrite: bool = False) -> None:
+        """Writes the calibrated joint origins as Universal Robots'
+        ``default_kinematics.yaml`` (per joint ``x y z`` in metres, ``roll
+        pitch yaw`` in radians, and a ``hash``), which ``ur_description``'s
+        xacro reads; as ``activecal calibrate --out default_kinematics.yaml``.
+        URDF robots with the six UR joints only; refused when the fit did
+        not converge."""
+    def write_joint_origins(self, path: _Path, overwrite: bool = False) -> None:
+        """Writes the calibrated joint origins as the per-joint origins
+        file (``JOINT: {xyz: [m], rpy: [rad]}``), which a xacro description
+        reads with ``xacro.load_yaml``; as ``activecal calibrate --out
+        cal_origins.yaml``. URDF robots only; refused when the fit did not
+        converge."""
 
 def calibrate(
     robot: Robot,

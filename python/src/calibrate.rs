@@ -493,6 +493,25 @@ impl Calibration {
         self.write_as(Format::Yaml, &path, overwrite)
     }
 
+    /// Writes the calibrated joint origins as Universal Robots'
+    /// default_kinematics.yaml (per joint x y z in metres, roll pitch yaw in
+    /// radians, and a hash), which ur_description's xacro reads. URDF
+    /// robots with the six UR joints only; refused when the fit did not
+    /// converge.
+    #[pyo3(signature = (path, overwrite=false))]
+    fn write_ur_kinematics(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
+        self.write_as(Format::UrKinematics, &path, overwrite)
+    }
+
+    /// Writes the calibrated joint origins as the per-joint origins file
+    /// (JOINT: {xyz: [m], rpy: [rad]}), for a xacro description to read
+    /// with xacro.load_yaml. URDF robots only; refused when the fit did not
+    /// converge.
+    #[pyo3(signature = (path, overwrite=false))]
+    fn write_joint_origins(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
+        self.write_as(Format::JointOrigins, &path, overwrite)
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Calibration({:?}, {:?}, {} iterations)",

@@ -134,9 +134,12 @@ impl Robot {
     /// the offset in metres in the link's frame, or a list of them (each
     /// offset is then estimated). lock: {joint: value} joints held fixed
     /// (radians or metres). frames: a frames file (measurement frame, tool).
-    /// pose: full-pose measurements (position and orientation).
+    /// kinematics: a kinematics file (Universal Robots'
+    /// default_kinematics.yaml or per-joint origins) whose joint origins
+    /// replace the URDF's. pose: full-pose measurements (position and
+    /// orientation).
     #[staticmethod]
-    #[pyo3(signature = (path, tip=None, base=None, marker=None, lock=None, frames=None, pose=false))]
+    #[pyo3(signature = (path, tip=None, base=None, marker=None, lock=None, frames=None, pose=false, kinematics=None))]
     #[allow(clippy::too_many_arguments)]
     fn from_urdf(
         py: Python<'_>,
@@ -147,6 +150,7 @@ impl Robot {
         lock: Option<std::collections::BTreeMap<String, f64>>,
         frames: Option<std::path::PathBuf>,
         pose: bool,
+        kinematics: Option<std::path::PathBuf>,
     ) -> PyResult<Self> {
         let markers = marker.map(markers_of).transpose()?.unwrap_or_default();
         let lock: Vec<(String, f64)> = lock.unwrap_or_default().into_iter().collect();
@@ -165,6 +169,12 @@ impl Robot {
                 f.display()
             )));
         }
+        if let Some(f) = kinematics.as_ref().filter(|f| !f.is_file()) {
+            return Err(crate::FileError::new_err(format!(
+                "kinematics: {}: no such file",
+                f.display()
+            )));
+        }
         let r = RobotRef {
             name: path.display().to_string(),
             pose,
@@ -173,6 +183,7 @@ impl Robot {
                 tip,
                 lock,
                 frames: frames.map(|f| f.display().to_string()),
+                kinematics: kinematics.map(|f| f.display().to_string()),
                 markers,
             },
         };

@@ -5,7 +5,11 @@
 //!   for a built-in or TOML robot, its chain as URDF ([`super::urdf::to_urdf`]);
 //! * `.yaml` / `.yml` — the frames file ([`super::frames_file`]);
 //! * `.toml` — the description ([`super::robot_toml`]) whose nominal and
-//!   real tables are the estimate.
+//!   real tables are the estimate;
+//! * a name ending in `kinematics.yaml` (`default_kinematics.yaml`) —
+//!   Universal Robots' kinematics file of the calibrated joint origins, and
+//!   one ending in `origins.yaml` — the per-joint origins file
+//!   ([`super::kinematics_yaml`]), for a robot imported from a URDF.
 //!
 //! Any other extension is refused before any work.
 
@@ -23,12 +27,28 @@ pub enum Format {
     Yaml,
     /// activecal's description.
     Toml,
+    /// Universal Robots' `default_kinematics.yaml` of the joint origins.
+    UrKinematics,
+    /// The per-joint origins file.
+    JointOrigins,
 }
 
 impl Format {
     /// The format a file name asks for: an error naming the three when its
     /// extension is none of them.
     pub fn of(path: &Path) -> Result<Format> {
+        let file = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .map(str::to_ascii_lowercase)
+            .unwrap_or_default();
+        let ends = |stem: &str| file.ends_with(&format!("{stem}.yaml")) || file.ends_with(&format!("{stem}.yml"));
+        if ends("kinematics") {
+            return Ok(Format::UrKinematics);
+        }
+        if ends("origins") {
+            return Ok(Format::JointOrigins);
+        }
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
@@ -38,7 +58,7 @@ impl Format {
             Some("yaml" | "yml") => Ok(Format::Yaml),
             Some("toml") => Ok(Format::Toml),
             _ => Err(Error::Invalid(format!(
-                "{}: a calibrated robot is written as .urdf (the URDF with calibrated joint origins), .yaml (the frames file: measurement frame, tool or markers, joint origins) or .toml (activecal's description); the extension says none of them",
+                "{}: a calibrated robot is written as .urdf (the URDF with calibrated joint origins), .yaml (the frames file: measurement frame, tool or markers, joint origins), .toml (activecal's description), a name ending in kinematics.yaml (Universal Robots' kinematics file of the joint origins) or in origins.yaml (the per-joint origins file); the name says none of them",
                 path.display()
             ))),
         }
@@ -71,23 +91,41 @@ pub fn render(
         }
         Format::Urdf => match (&robot.source, frames) {
             (Some(src), Some((f, _))) => {
-                // A chain's first joint walked against the file's tree has
-                // no origin of the file (the camera's placement holds it).
-                let skip_first = usize::from(src.reversed.iter().any(|r| r.neighbour.is_none()));
-                let origins: Vec<(String, nalgebra::Isometry3<f64>)> = f
-                    .joints
-                    .iter()
-                    .skip(skip_first)
-                    .map(|j| (j.name.clone(), j.calibrated))
-                    .collect();
-                super::urdf_edit::with_origins(&src.text, &src.path, &origins)
+                super::urdf_edit::with_origins(&src.text, &src.path, &file_origins(src, f))
             }
             (Some(_), None) => Err(no_frames()),
             (None, _) => super::urdf::to_urdf(robot, table),
+        },
+        Format::UrKinematics | Format::JointOrigins => match (&robot.source, frames) {
+            (Some(src), Some((f, _))) => {
+                let origins = file_origins(src, f);
+                let name = src.path.as_str();
+                if format == Format::UrKinematics {
+                    super::kinematics_yaml::ur_kinematics(name, &origins)
+                } else {
+                    Ok(super::kinematics_yaml::joint_origins(name, &origins))
+                }
+            }
+            _ => Err(no_frames()),
         },
         Format::Yaml => match frames {
             Some((_, report)) => super::frames_file::to_yaml(report),
             None => Err(no_frames()),
         },
     }
+}
+
+/// The calibrated origins of the file's joints: a chain's first joint
+/// walked against the file's tree has no origin of the file (the camera's
+/// placement holds it).
+fn file_origins(
+    src: &crate::model::source::UrdfSource,
+    f: &CalibratedFrames,
+) -> Vec<(String, nalgebra::Isometry3<f64>)> {
+    let skip_first = usize::from(src.reversed.iter().any(|r| r.neighbour.is_none()));
+    f.joints
+        .iter()
+        .skip(skip_first)
+        .map(|j| (j.name.clone(), j.calibrated))
+        .collect()
 }

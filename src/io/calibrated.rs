@@ -42,7 +42,9 @@ impl Format {
             .and_then(|n| n.to_str())
             .map(str::to_ascii_lowercase)
             .unwrap_or_default();
-        let ends = |stem: &str| file.ends_with(&format!("{stem}.yaml")) || file.ends_with(&format!("{stem}.yml"));
+        let ends = |stem: &str| {
+            file.ends_with(&format!("{stem}.yaml")) || file.ends_with(&format!("{stem}.yml"))
+        };
         if ends("kinematics") {
             return Ok(Format::UrKinematics);
         }

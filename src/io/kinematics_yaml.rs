@@ -294,8 +294,10 @@ pub fn parse(text: &str, origin: &str) -> Result<KinematicsFile> {
             })?
             .into_iter()
             .collect();
-    let origins: Vec<(String, Isometry3<f64>)> =
-        entries.into_iter().map(|(n, e)| (n, iso(e.xyz, e.rpy))).collect();
+    let origins: Vec<(String, Isometry3<f64>)> = entries
+        .into_iter()
+        .map(|(n, e)| (n, iso(e.xyz, e.rpy)))
+        .collect();
     finite(&origins)?;
     Ok(KinematicsFile {
         path: origin.to_string(),

@@ -96,7 +96,9 @@ fn a_prefixed_ur_chain_is_written_under_its_keys_and_read_back_onto_it() {
     // Applied to a URDF whose joints carry the prefix.
     let mut urdf = String::from("<robot name=\"r\">\n");
     for (n, _) in &o {
-        urdf += &format!("  <joint name=\"{n}\" type=\"revolute\">\n    <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\n  </joint>\n");
+        urdf += &format!(
+            "  <joint name=\"{n}\" type=\"revolute\">\n    <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\n  </joint>\n"
+        );
     }
     urdf += "</robot>\n";
     let edited = with_file(&urdf, "r.urdf", &f).unwrap();
@@ -109,7 +111,10 @@ fn a_chain_that_is_not_a_ur_is_refused_naming_the_joint() {
     let mut o = origins("");
     o.remove(2);
     let e = ur_kinematics("r", &o).unwrap_err().to_string();
-    assert!(e.contains("elbow_joint") && e.contains("per-joint origins"), "{e}");
+    assert!(
+        e.contains("elbow_joint") && e.contains("per-joint origins"),
+        "{e}"
+    );
     let mut o = origins("");
     o.push(("rail_joint".into(), Isometry3::identity()));
     let e = ur_kinematics("r", &o).unwrap_err().to_string();
@@ -120,7 +125,8 @@ fn a_chain_that_is_not_a_ur_is_refused_naming_the_joint() {
 fn a_file_for_another_description_is_refused() {
     // fixtures/ur5.urdf follows ROS-Industrial (shoulder_lift_joint turned
     // a quarter turn about y); Universal Robots' file turns it about x.
-    let urdf = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/ur5.urdf")).unwrap();
+    let urdf =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/ur5.urdf")).unwrap();
     let mut o: Vec<(String, Isometry3<f64>)> = urdf_origins(&urdf, "ur5.urdf")
         .unwrap()
         .into_iter()
@@ -131,8 +137,15 @@ fn a_file_for_another_description_is_refused() {
     assert!(with_file(&urdf, "ur5.urdf", &own).is_ok());
     o[1].1 = iso([0.0; 3], [std::f64::consts::FRAC_PI_2, 0.0, 0.0]);
     let other = parse(&ur_kinematics("ur5", &o).unwrap(), "k.yaml").unwrap();
-    let e = with_file(&urdf, "ur5.urdf", &other).unwrap_err().to_string();
-    assert!(e.contains("shoulder_lift_joint") && e.contains("k.yaml") && e.contains("another description"), "{e}");
+    let e = with_file(&urdf, "ur5.urdf", &other)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("shoulder_lift_joint")
+            && e.contains("k.yaml")
+            && e.contains("another description"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -148,6 +161,11 @@ fn bad_files_name_the_file_and_what_is_wrong() {
         assert!(e.contains("bad.yaml") && e.contains(want), "{text:?}: {e}");
     }
     let f = parse("nope_joint: {xyz: [0, 0, 0], rpy: [0, 0, 0]}\n", "o.yaml").unwrap();
-    let e = with_file("<robot name=\"r\"/>", "r.urdf", &f).unwrap_err().to_string();
-    assert!(e.contains("nope_joint") && e.contains("o.yaml") && e.contains("r.urdf"), "{e}");
+    let e = with_file("<robot name=\"r\"/>", "r.urdf", &f)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("nope_joint") && e.contains("o.yaml") && e.contains("r.urdf"),
+        "{e}"
+    );
 }

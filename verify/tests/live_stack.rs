@@ -1,0 +1,161 @@
+//! Calibrations in the user's stack (issue #53; feature `live`, the project
+//! venv with `xacro` from PyPI, and `target/debug/activecal`):
+//!
+//! * **into a xacro description**: a UR5 (`fixtures/ur5.urdf` started from
+//!   the factory-style `fixtures/xacro/ur5_factory_kinematics.yaml`) is
+//!   calibrated from simulated measurements and written as Universal
+//!   Robots' `default_kinematics.yaml` and as per-joint origins; the
+//!   minimal xacro descriptions of `fixtures/xacro/` read them
+//!   (`xacro.load_yaml`), `xacro` expands them, and Pinocchio finds the
+//!   expansion equal to the calibrated URDF activecal wrote to [`EXACT_M`]
+//!   at 1,000 random configurations (`verify/python/stack.py`);
+//! * **a factory file read back**: the robot activecal loads from
+//!   `fixtures/ur5.urdf` with the factory file (`--kinematics`, or
+//!   `#kinematics=` in `--robot`) and exports is the model xacro makes of
+//!   the same file, to [`EXACT_M`].
+//!
+//! Each comparison is checked to be able to fail: the model of the other
+//! file (the factory one against the calibrated, the bare fixture against
+//! the factory one) differs by more than [`DIFFERENT_M`].
+
+use super::live_truth::{activecal, root, run};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The acceptance tolerance of issue #53 (metres, radians): both sides
+/// hold the same decimals, so only the rpy conversion's rounding (1e-15)
+/// separates them.
+const EXACT_M: f64 = 1e-12;
+/// Two different models differ by more than this at some configuration
+/// (metres): the factory file moves origins by 0.1–0.9 mm, a calibration
+/// from it moves them again by its estimate's change.
+const DIFFERENT_M: f64 = 1e-5;
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!(
+        "activecal-live-stack-{name}-{}",
+        std::process::id()
+    ));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn fixture(rel: &str) -> String {
+    root().join("fixtures").join(rel).display().to_string()
+}
+
+/// `stack.py xacro-fk`: the expansion of `xacro` with `arg` against `urdf`
+/// (chain base_link..target, 1,000 configurations): the largest position
+/// and rotation differences.
+fn xacro_fk(dir: &Path, xacro: &str, arg: &str, urdf: &str) -> (f64, f64) {
+    let out = run(Command::new(root().join(".venv/bin/python"))
+        .current_dir(dir)
+        .args(["-W", "ignore"])
+        .arg(root().join("verify/python/stack.py"))
+        .args([
+            "xacro-fk", "--xacro", xacro, "--arg", arg, "--urdf", urdf, "--tip", "target", "--n",
+            "1000", "--seed", "0",
+        ]))
+    .unwrap_or_else(|e| panic!("{e}"));
+    let v: Value = serde_json::from_str(&out).unwrap_or_else(|e| panic!("{out:?}: {e}"));
+    assert_eq!(v["n"], 1000);
+    (
+        v["max_position_m"].as_f64().unwrap(),
+        v["max_rotation_rad"].as_f64().unwrap(),
+    )
+}
+
+#[test]
+fn a_xacro_description_reading_the_written_files_is_the_calibrated_model() {
+    let d = dir("xacro");
+    let (urdf, factory) = (
+        fixture("ur5.urdf"),
+        fixture("xacro/ur5_factory_kinematics.yaml"),
+    );
+    let robot = ["--robot", urdf.as_str(), "--kinematics", factory.as_str()];
+    let mut sel = vec!["select"];
+    sel.extend(robot);
+    sel.extend(["--n", "30", "--seed", "3", "--out", "d.json", "--force"]);
+    activecal(&d, &sel).unwrap();
+    let mut cal = vec!["calibrate"];
+    cal.extend(robot);
+    cal.extend([
+        "--design",
+        "d.json",
+        "--noise",
+        "5e-5",
+        "--seed",
+        "4",
+        "--out",
+        "cal.urdf",
+        "--out",
+        "cal.yaml",
+        "--out",
+        "default_kinematics.yaml",
+        "--out",
+        "cal_origins.yaml",
+        "--force",
+    ]);
+    activecal(&d, &cal).unwrap();
+    let text = std::fs::read_to_string(d.join("default_kinematics.yaml")).unwrap();
+    assert!(text.contains("\nkinematics:\n  shoulder:\n") && text.contains("\n  hash: activecal_"));
+    let at = |f: &str| d.join(f).display().to_string();
+    for (xacro, arg) in [
+        (
+            "xacro/ur5.urdf.xacro",
+            format!("kinematics:={}", at("default_kinematics.yaml")),
+        ),
+        (
+            "xacro/ur5_origins.urdf.xacro",
+            format!("origins:={}", at("cal_origins.yaml")),
+        ),
+    ] {
+        let (p, r) = xacro_fk(&d, &fixture(xacro), &arg, &at("cal.urdf"));
+        eprintln!("{xacro}: {p:.3e} m, {r:.3e} rad from cal.urdf");
+        assert!(p <= EXACT_M && r <= EXACT_M, "{xacro}: {p:e} m, {r:e} rad");
+    }
+    // The comparison can fail: the factory model is not the calibrated one.
+    let (p, _) = xacro_fk(
+        &d,
+        &fixture("xacro/ur5.urdf.xacro"),
+        &format!("kinematics:={factory}"),
+        &at("cal.urdf"),
+    );
+    assert!(p > DIFFERENT_M, "{p:e} m");
+}
+
+#[test]
+fn a_factory_file_read_back_is_the_model_xacro_makes_of_it() {
+    let d = dir("factory");
+    let (urdf, factory) = (
+        fixture("ur5.urdf"),
+        fixture("xacro/ur5_factory_kinematics.yaml"),
+    );
+    let xacro = fixture("xacro/ur5.urdf.xacro");
+    let arg = format!("kinematics:={factory}");
+    let fragment = format!("{urdf}#kinematics={factory}");
+    let runs: [&[&str]; 2] = [
+        &[
+            "robots",
+            "--export",
+            &urdf,
+            "--kinematics",
+            &factory,
+            "--out",
+            "a.urdf",
+        ],
+        &["robots", "--export", &fragment, "--out", "b.urdf"],
+    ];
+    for (args, out) in runs.iter().zip(["a.urdf", "b.urdf"]) {
+        let mut a = args.to_vec();
+        a.push("--force");
+        activecal(&d, &a).unwrap();
+        let (p, r) = xacro_fk(&d, &xacro, &arg, &d.join(out).display().to_string());
+        eprintln!("{out}: {p:.3e} m, {r:.3e} rad from xacro's");
+        assert!(p <= EXACT_M && r <= EXACT_M, "{out}: {p:e} m, {r:e} rad");
+    }
+    // The comparison can fail: the bare fixture is not the factory model.
+    let (p, _) = xacro_fk(&d, &xacro, &arg, &urdf);
+    assert!(p > DIFFERENT_M, "{p:e} m");
+}

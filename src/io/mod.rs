@@ -318,7 +318,7 @@ fn load_head(r: &RobotRef) -> Result<Description> {
     if let Ok(robot) = Robot::builtin(&head) {
         if !r.chain.is_empty() {
             return Err(Error::Invalid(format!(
-                "{head}: a chain choice (base, tip, lock or frames: {}) chooses the chain of a URDF file, not of a built-in robot",
+                "{head}: a chain choice (base, tip, lock, frames or kinematics: {}) chooses the chain of a URDF file, not of a built-in robot",
                 r.chain.fragment()
             )));
         }
@@ -331,7 +331,7 @@ fn load_head(r: &RobotRef) -> Result<Description> {
     let ext = r.extension();
     if !r.chain.is_empty() && !r.is_urdf() {
         return Err(Error::Invalid(format!(
-            "{head}: a chain choice (base, tip, lock or frames: {}) applies to a .urdf file; in a description use its `base`, `tip` and [lock] keys",
+            "{head}: a chain choice (base, tip, lock, frames or kinematics: {}) applies to a .urdf file; in a description use its `base`, `tip` and [lock] keys",
             r.chain.fragment()
         )));
     }

@@ -133,6 +133,7 @@ pub const CALIBRATE: &[Rule] = &[
     r("loss", FITTED, LS),
     r("loss_scale", FITTED, LS),
     r("fix", MEASURED, ""),
+    r("unknowns", MEASURED, ""),
     r(
         "free",
         FITTED,

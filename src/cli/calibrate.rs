@@ -103,6 +103,17 @@ fn calibrate_files(a: &CalibrateArgs) -> super::run_files::RunFiles {
     f
 }
 
+/// `--fix`, and with `--unknowns offsets` the robot's link geometry
+/// ([`activecal::identify::offsets::link_unknowns`]).
+fn fixed_unknowns(a: &CalibrateArgs, robot: &Robot) -> Vec<String> {
+    let mut fix = a.fix.clone();
+    if a.unknowns == Some(super::calibrate_args::UnknownsKind::Offsets) {
+        let links = activecal::identify::offsets::link_unknowns(robot);
+        fix.extend(links.into_iter().filter(|n| !a.fix.contains(n)));
+    }
+    fix
+}
+
 /// Identification from a measurement file.
 fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()> {
     let t0 = Instant::now();
@@ -125,7 +136,7 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     let o = activecal::experiment::measured::MeasuredSettings {
         lm,
         loss: super::measured::loss_choice(a.loss, a.loss_scale)?,
-        fix: a.fix.clone(),
+        fix: fixed_unknowns(a, robot),
         free: a.free.clone(),
         holdout: a
             .holdout

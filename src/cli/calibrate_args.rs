@@ -92,6 +92,13 @@ pub struct CalibrateArgs {
     /// a pose flagged this often (in (0, 1); default 0.01).
     #[arg(long, requires = "measurements")]
     pub outlier_rate: Option<f64>,
+    /// Which unknowns to estimate, with --measurements: `all` (the chain's
+    /// complete, minimal set) or `offsets` (only the joints' zero offsets,
+    /// the measurement frame and the tool; every link length and twist
+    /// held at the model's value: what a driver's joint offsets and the
+    /// frames file can hold).
+    #[arg(long, value_enum, requires = "measurements")]
+    pub unknowns: Option<UnknownsKind>,
     /// Unknowns to fix at their nominal values (comma-separated names, as
     /// in the estimate), with --measurements.
     #[arg(long, value_delimiter = ',', conflicts_with = "design")]
@@ -276,6 +283,15 @@ impl CalibrateArgs {
 }
 
 /// The weights options of `calibrate`.
+/// `--unknowns`: which unknowns a fit estimates.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UnknownsKind {
+    /// The chain's complete, minimal set.
+    All,
+    /// Joint zero offsets, the measurement frame and the tool.
+    Offsets,
+}
+
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum WeightsKind {
     /// Each residual block's σ estimated from the data.

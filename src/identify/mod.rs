@@ -48,6 +48,7 @@ pub mod levmar;
 pub mod lm;
 pub mod loss;
 pub mod montecarlo;
+pub mod offsets;
 pub mod outliers;
 pub mod plausible;
 pub mod residual;

@@ -383,6 +383,7 @@ def calibrate(
     seed: int = 0,
     compliance: bool = False,
     progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
+    unknowns: str = "all",
 ) -> Calibration:
     """Calibrates the robot from measured poses, as ``activecal calibrate
     --measurements FILE`` does from a file holding the same values. The
@@ -406,7 +407,9 @@ def calibrate(
     (``report["compliance"]``), as ``--compliance``. q and points may be
     pandas DataFrames: q with a column per joint (by name, in any order,
     others ignored), points with columns ``x, y, z`` (``x1, y1, z1`` ...
-    for K markers).
+    for K markers). unknowns: ``"all"`` (the chain's complete set) or
+    ``"offsets"`` (only the joints' zero offsets, the measurement frame and
+    the tool; link lengths and twists held), as ``--unknowns``.
     """
 
 def evaluate(

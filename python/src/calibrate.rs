@@ -259,9 +259,11 @@ fn names(v: Option<Vec<String>>) -> Vec<String> {
 /// (`UserWarning`, as the command line's warning), and the outlier test
 /// uses it.
 /// progress: a callable `progress(task, done, total, note)`, as `select`
-/// takes it.
+/// takes it. unknowns: "all" (the chain's complete set) or "offsets" (only
+/// the joints' zero offsets, the measurement frame and the tool), as
+/// `--unknowns`.
 #[pyfunction]
-#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, compliance=false, outliers="drop", outlier_rate=0.01, noise=None, progress=None))]
+#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, compliance=false, outliers="drop", outlier_rate=0.01, noise=None, progress=None, unknowns="all"))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
@@ -284,7 +286,9 @@ pub fn calibrate(
     outlier_rate: f64,
     noise: Option<f64>,
     progress: Option<&Bound<'_, PyAny>>,
+    unknowns: &str,
 ) -> PyResult<Calibration> {
+    let fix = fixed_of(robot, names(fix), unknowns)?;
     let weights = weights_of(weights, orientation_scale)?;
     let outliers = outliers_of(outliers, outlier_rate)?;
     let gravity = compliance
@@ -314,7 +318,7 @@ pub fn calibrate(
             .build()
             .map_err(|e| crate::convert::Fail::from(e).into_py())?,
         loss,
-        fix: names(fix),
+        fix,
         free: names(free),
         holdout,
         units: activecal::units::Units::default(),
@@ -391,6 +395,26 @@ impl Calibration {
             path,
             overwrite,
         )
+    }
+}
+
+/// `fix`, and for `unknowns="offsets"` the robot's link geometry
+/// ([`activecal::identify::offsets::link_unknowns`]).
+fn fixed_of(robot: &Robot, mut fix: Vec<String>, unknowns: &str) -> PyResult<Vec<String>> {
+    match unknowns {
+        "all" => Ok(fix),
+        "offsets" => {
+            for n in activecal::identify::offsets::link_unknowns(&robot.inner) {
+                if !fix.contains(&n) {
+                    fix.push(n);
+                }
+            }
+            Ok(fix)
+        }
+        other => Err(arg_err(
+            "unknowns",
+            format!("'{other}': \"all\" or \"offsets\""),
+        )),
     }
 }
 

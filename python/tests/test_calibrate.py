@@ -351,3 +351,19 @@ def test_kinematics_file_errors_name_the_file(tmp_path):
     bad.write_text("elbow_joint: {xyz: [0, 0], rpy: [0, 0, 0]}\n")
     with pytest.raises(activecal.Error, match="bad_origins.yaml"):
         activecal.Robot.from_urdf(FIXTURES / "ur5.urdf", kinematics=bad)
+
+
+def test_offsets_only_equals_the_cli(tmp_path):
+    """unknowns="offsets" estimates what `--unknowns offsets` does: only
+    offsets, measurement frame and tool (no link length or twist)."""
+    args = ["--robot", FIXTURES / "ur5.urdf"]
+    meas, m = simulated(tmp_path, args)
+    want = cli("calibrate", *args, "--measurements", meas, "--unknowns", "offsets")
+    r = activecal.Robot.from_urdf(FIXTURES / "ur5.urdf")
+    cal = activecal.calibrate(r, m["qs"], m["points"], unknowns="offsets")
+    assert_same_fit(cal, want)
+    full = activecal.calibrate(r, m["qs"], m["points"])
+    links = [k for k in full.estimate if k.startswith(("a_", "alpha_")) and not k.endswith("_base")]
+    assert links and not any(k in cal.estimate for k in links)
+    with pytest.raises(activecal.Error, match="unknowns"):
+        activecal.calibrate(r, m["qs"], m["points"], unknowns="some")

@@ -114,6 +114,41 @@ fn fixed_unknowns(a: &CalibrateArgs, robot: &Robot) -> Vec<String> {
     fix
 }
 
+/// With `--unknowns offsets`: the full fit of the same data beside the
+/// offsets-only one `offsets` ([`activecal::experiment::measured::offsets_gain`]).
+fn offsets_gain(
+    a: &CalibrateArgs,
+    robot: &Robot,
+    meas: &activecal::identify::Measurements,
+    path: &Path,
+    o: &activecal::experiment::measured::MeasuredSettings,
+    offsets: (&Robot, &activecal::model::ParamTable),
+) -> Result<Option<activecal::experiment::measured::offsets_gain::OffsetsGain>> {
+    if a.unknowns != Some(super::calibrate_args::UnknownsKind::Offsets) {
+        return Ok(None);
+    }
+    let mut full = o.clone();
+    full.fix.clone_from(&a.fix);
+    let source = path.display().to_string();
+    let g = activecal::experiment::measured::offsets_gain::offsets_gain(
+        robot, meas, &source, &full, offsets,
+    )?;
+    Ok(Some(g))
+}
+
+/// The offsets-only fit's line beside the full fit.
+fn gain_text(g: &activecal::experiment::measured::offsets_gain::OffsetsGain) -> String {
+    format!(
+        "\noffsets only: predicted position RMS {:.4} mm; the full model ({} unknowns, fitted to the same data) {:.4} mm: it would gain {:.4} mm (the two models are {:.4} mm apart, RMS at {} random configurations)\n",
+        g.offsets_predicted_rms_mm,
+        g.full_unknowns,
+        g.full_predicted_rms_mm,
+        g.gain_mm,
+        g.models_apart_rms_mm,
+        activecal::experiment::measured::PREDICTION_CONFIGURATIONS
+    )
+}
+
 /// Identification from a measurement file.
 fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()> {
     let t0 = Instant::now();
@@ -208,13 +243,20 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         report.base.out =
             write_calibrated(a, &fitted, id, &path.display().to_string(), frames.as_ref())?;
     }
+    let gain = offsets_gain(a, robot, &meas, path, &o, (&fitted, &id.table))?;
     let mut v = serde_json::to_value(&report)?;
     v["exit_status"] = verdict.exit_status().into();
+    if let Some(g) = &gain {
+        v["offsets_gain"] = serde_json::to_value(g)?;
+    }
     if let Some(dir) = &a.report {
         super::report_dir::calibration(dir, &measured_summary(&fitted, id, path, &report, &v))?;
     }
     super::emit(a.json, &v, || {
         let mut s = super::measured::measured_text(&report, id, &status_text(id));
+        if let Some(g) = &gain {
+            s += &gain_text(g);
+        }
         for out in &report.base.out {
             s += &format!("\ncalibrated robot written to {out}\n");
         }

@@ -185,3 +185,123 @@ fn bad_files_and_robots_are_refused_naming_them() {
     );
     assert!(!std::path::Path::new(&kin).exists());
 }
+
+/// The offsets of a `*joint_offsets.yaml` file, in joint order.
+fn offsets_in(path: &std::path::Path) -> Vec<f64> {
+    let text = std::fs::read_to_string(path).unwrap();
+    text.split("offsets:\n")
+        .nth(1)
+        .unwrap()
+        .lines()
+        .map(|l| l.split(':').nth(1).unwrap().trim().parse().unwrap())
+        .collect()
+}
+
+#[test]
+fn the_offsets_written_turn_the_files_model_into_the_calibrated_one() {
+    let d = scratch_dir("kinematics_files", "offsets");
+    let at = |f: &str| d.join(f).display().to_string();
+    let (design, meas) = (at("d.json"), at("m.json"));
+    let ok = |args: &[&str]| {
+        let out = run(args);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    ok(&[
+        "select",
+        "--robot",
+        "fixtures/ur5.urdf",
+        "--n",
+        "30",
+        "--seed",
+        "2",
+        "--out",
+        &design,
+    ]);
+    ok(&[
+        "calibrate",
+        "--robot",
+        "fixtures/ur5.urdf",
+        "--design",
+        &design,
+        "--save-measurements",
+        &meas,
+    ]);
+    let (urdf, add, sub) = (
+        at("off.urdf"),
+        at("add_joint_offsets.yaml"),
+        at("sub_joint_offsets.yaml"),
+    );
+    let fit = |extra: &[&str]| {
+        let mut args = vec![
+            "calibrate",
+            "--robot",
+            "fixtures/ur5.urdf",
+            "--measurements",
+            &meas,
+            "--unknowns",
+            "offsets",
+            "--force",
+        ];
+        args.extend(extra);
+        ok(&args);
+    };
+    fit(&["--out", &urdf, "--out", &add]);
+    fit(&[
+        "--out",
+        &sub,
+        "--offset-unit",
+        "deg",
+        "--offset-sign",
+        "subtract",
+    ]);
+    let plus = offsets_in(std::path::Path::new(&add));
+    let minus = offsets_in(std::path::Path::new(&sub));
+    // The two conventions: the same offsets, negated, in degrees.
+    assert_eq!(plus.len(), 6);
+    for (p, m) in plus.iter().zip(&minus) {
+        assert!((m + p.to_degrees()).abs() < 1e-12, "{p} rad vs {m} deg");
+    }
+    // Middle joints moved (the simulated robot's offsets are off).
+    assert!(plus[1..5].iter().any(|v| v.abs() > 1e-4), "{plus:?}");
+    // The calibrated URDF at the reading q is the file's robot at
+    // q + offset ("add"): the offsets are all the URDF changed.
+    let q = [0.3, -1.2, 1.1, 0.4, -0.8, 0.5];
+    let shifted: Vec<String> = q
+        .iter()
+        .zip(&plus)
+        .map(|(a, b)| (a + b).to_string())
+        .collect();
+    let qs: Vec<String> = q.iter().map(f64::to_string).collect();
+    let fk_at = |robot: &str, q: &[String]| {
+        let out = run(&["fk", "--robot", robot, "--q", &q.join(","), "--json"]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        [0, 1, 2].map(|k| v["position"][k].as_f64().unwrap())
+    };
+    let cal = fk_at(&urdf, &qs);
+    let file = fk_at("fixtures/ur5.urdf", &shifted);
+    // `{}` prints the shortest round-trip decimal: rounding only.
+    assert!(dist(cal, file) < 1e-12, "{} m", dist(cal, file));
+    assert!(dist(cal, fk_at("fixtures/ur5.urdf", &qs)) > 1e-5);
+    // Offset options act on the fits that write offsets, not on a camera's.
+    fails_with(
+        &[
+            "calibrate",
+            "--robot",
+            "fixtures/ur5.urdf",
+            "--observations",
+            "x.csv",
+            "--offset-unit",
+            "deg",
+        ],
+        "offset",
+    );
+}

@@ -135,6 +135,16 @@ pub const CALIBRATE: &[Rule] = &[
     r("fix", MEASURED, ""),
     r("unknowns", MEASURED, ""),
     r(
+        "offset_unit",
+        &[Simulated, Points, Poses],
+        "the camera and contact fits write no joint offsets",
+    ),
+    r(
+        "offset_sign",
+        &[Simulated, Points, Poses],
+        "the camera and contact fits write no joint offsets",
+    ),
+    r(
         "free",
         FITTED,
         "the camera fit estimates every joint origin of the chain",

@@ -48,8 +48,12 @@ pub fn write_calibrated(
     }
     let mut written = Vec::new();
     for out in &a.out {
+        let format = match Format::of(out)? {
+            Format::JointOffsets(_) => Format::JointOffsets(a.offset_convention()),
+            f => f,
+        };
         let text = activecal::io::calibrated::render(
-            Format::of(out)?,
+            format,
             robot,
             &id.table,
             frames.map(|(f, r)| (f, r)),

@@ -9,7 +9,9 @@
 //! * a name ending in `kinematics.yaml` (`default_kinematics.yaml`) —
 //!   Universal Robots' kinematics file of the calibrated joint origins, and
 //!   one ending in `origins.yaml` — the per-joint origins file
-//!   ([`super::kinematics_yaml`]), for a robot imported from a URDF.
+//!   ([`super::kinematics_yaml`]), and one ending in `joint_offsets.yaml`
+//!   — the joints' zero offsets as a driver takes them, for a robot
+//!   imported from a URDF.
 //!
 //! Any other extension is refused before any work.
 
@@ -31,6 +33,8 @@ pub enum Format {
     UrKinematics,
     /// The per-joint origins file.
     JointOrigins,
+    /// The joints' zero offsets, as a driver takes them.
+    JointOffsets(super::kinematics_yaml::OffsetConvention),
 }
 
 impl Format {
@@ -51,6 +55,9 @@ impl Format {
         if ends("origins") {
             return Ok(Format::JointOrigins);
         }
+        if ends("joint_offsets") {
+            return Ok(Format::JointOffsets(Default::default()));
+        }
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
@@ -60,7 +67,7 @@ impl Format {
             Some("yaml" | "yml") => Ok(Format::Yaml),
             Some("toml") => Ok(Format::Toml),
             _ => Err(Error::Invalid(format!(
-                "{}: a calibrated robot is written as .urdf (the URDF with calibrated joint origins), .yaml (the frames file: measurement frame, tool or markers, joint origins), .toml (activecal's description), a name ending in kinematics.yaml (Universal Robots' kinematics file of the joint origins) or in origins.yaml (the per-joint origins file); the name says none of them",
+                "{}: a calibrated robot is written as .urdf (the URDF with calibrated joint origins), .yaml (the frames file: measurement frame, tool or markers, joint origins), .toml (activecal's description), a name ending in kinematics.yaml (Universal Robots' kinematics file of the joint origins) in origins.yaml (the per-joint origins file) or in joint_offsets.yaml (the joints' zero offsets); the name says none of them",
                 path.display()
             ))),
         }
@@ -110,6 +117,14 @@ pub fn render(
             }
             _ => Err(no_frames()),
         },
+        Format::JointOffsets(c) => match (&robot.source, frames) {
+            (Some(src), Some((f, _))) => Ok(super::kinematics_yaml::joint_offsets(
+                &src.path,
+                &offsets_of(f),
+                c,
+            )),
+            _ => Err(no_frames()),
+        },
         Format::Yaml => match frames {
             Some((_, report)) => super::frames_file::to_yaml(report),
             None => Err(no_frames()),
@@ -129,5 +144,21 @@ fn file_origins(
         .iter()
         .skip(skip_first)
         .map(|j| (j.name.clone(), j.calibrated))
+        .collect()
+}
+
+/// Each driven joint's zero offset (radians, or metres for a prismatic
+/// joint: the origin's slide along its axis) and whether it is revolute.
+fn offsets_of(f: &CalibratedFrames) -> Vec<(String, f64, bool)> {
+    f.joints
+        .iter()
+        .map(|j| match j.kind {
+            crate::model::JointKind::Revolute => (j.name.clone(), j.offset(), true),
+            crate::model::JointKind::Prismatic => {
+                let slide = j.nominal.rotation.inverse()
+                    * (j.calibrated.translation.vector - j.nominal.translation.vector);
+                (j.name.clone(), slide.dot(&j.axis), false)
+            }
+        })
         .collect()
 }

@@ -165,6 +165,44 @@ pub fn joint_origins(robot: &str, origins: &[(String, Isometry3<f64>)]) -> Strin
     out
 }
 
+/// How a driver takes joint zero offsets: in degrees or radians, added to
+/// the encoder's reading or subtracted from it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OffsetConvention {
+    /// Revolute offsets in degrees (else radians; prismatic ones are
+    /// always metres).
+    pub degrees: bool,
+    /// The driver subtracts its offset from the reading (`q = q_encoder −
+    /// offset`); else it adds it (`q = q_encoder + offset`).
+    pub subtract: bool,
+}
+
+/// The joint zero offsets of a calibration, `(joint, offset, revolute)` in
+/// radians or metres with the sign `q = q_encoder + offset` (the
+/// calibrated model at reading `q_encoder` is the file's at `q`), as a
+/// driver named by `c` takes them.
+#[must_use]
+pub fn joint_offsets(robot: &str, joints: &[(String, f64, bool)], c: OffsetConvention) -> String {
+    let unit = if c.degrees { "deg" } else { "rad" };
+    let (sign, rule) = if c.subtract {
+        ("subtract", "q = q_encoder - offset")
+    } else {
+        ("add", "q = q_encoder + offset")
+    };
+    let mut out = format!(
+        "# Joint zero offsets of robot '{robot}' written by activecal, for a driver that\n# takes them as {rule} (q: the joint value of the robot's description).\n# Revolute joints in {}, prismatic ones in metres. The first and the last\n# joint's offsets are not told apart from the measurement frame and the tool:\n# they are in the frames file, and read 0 here.\nunit: {unit}\nsign: {sign}\noffsets:\n",
+        if c.degrees { "degrees" } else { "radians" }
+    );
+    for (name, v, revolute) in joints {
+        let mut v = if c.subtract { -v } else { *v };
+        if *revolute && c.degrees {
+            v = v.to_degrees();
+        }
+        let _ = writeln!(out, "  {name}: {}", num(v));
+    }
+    out
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct UrOrigin {

@@ -169,3 +169,33 @@ fn bad_files_name_the_file_and_what_is_wrong() {
         "{e}"
     );
 }
+
+#[test]
+fn joint_offsets_follow_the_named_unit_and_sign() {
+    let j = [
+        ("j1".to_string(), 0.01, true),
+        ("rail".to_string(), 0.002, false),
+    ];
+    let add = joint_offsets("r", &j, OffsetConvention::default());
+    assert!(
+        add.contains("unit: rad\nsign: add\noffsets:\n  j1: 0.01\n  rail: 0.002\n"),
+        "{add}"
+    );
+    let sub = joint_offsets(
+        "r",
+        &j,
+        OffsetConvention {
+            degrees: true,
+            subtract: true,
+        },
+    );
+    let deg = format!("{}", -0.01f64.to_degrees());
+    // Prismatic offsets stay in metres.
+    assert!(
+        sub.contains(&format!(
+            "unit: deg\nsign: subtract\noffsets:\n  j1: {deg}\n  rail: -0.002\n"
+        )),
+        "{sub}"
+    );
+    assert!(sub.contains("q = q_encoder - offset"), "{sub}");
+}

@@ -365,6 +365,15 @@ class Calibration:
         reads with ``xacro.load_yaml``; as ``activecal calibrate --out
         cal_origins.yaml``. URDF robots only; refused when the fit did not
         converge."""
+    def write_joint_offsets(
+        self, path: _Path, unit: str = "rad", sign: str = "add", overwrite: bool = False
+    ) -> None:
+        """Writes the joints' zero offsets as a driver takes them: unit
+        ``"rad"`` or ``"deg"`` (prismatic joints in metres), sign ``"add"``
+        (``q = q_encoder + offset``) or ``"subtract"`` (``q = q_encoder -
+        offset``); as ``activecal calibrate --out x_joint_offsets.yaml
+        --offset-unit --offset-sign``. URDF robots only; refused when the
+        fit did not converge."""
 
 def calibrate(
     robot: Robot,

@@ -536,6 +536,35 @@ impl Calibration {
         self.write_as(Format::JointOrigins, &path, overwrite)
     }
 
+    /// Writes the joints' zero offsets as a driver takes them: unit "rad"
+    /// or "deg" (revolute joints; prismatic ones in metres), sign "add" (q =
+    /// q_encoder + offset) or "subtract" (q = q_encoder − offset), as
+    /// `--out *joint_offsets.yaml --offset-unit --offset-sign`. URDF robots
+    /// only; refused when the fit did not converge.
+    #[pyo3(signature = (path, unit="rad", sign="add", overwrite=false))]
+    fn write_joint_offsets(
+        &self,
+        path: std::path::PathBuf,
+        unit: &str,
+        sign: &str,
+        overwrite: bool,
+    ) -> PyResult<()> {
+        let degrees = match unit {
+            "rad" => false,
+            "deg" => true,
+            other => return Err(arg_err("unit", format!("'{other}': \"rad\" or \"deg\""))),
+        };
+        let subtract = match sign {
+            "add" => false,
+            "subtract" => true,
+            other => {
+                return Err(arg_err("sign", format!("'{other}': \"add\" or \"subtract\"")));
+            }
+        };
+        let c = activecal::io::kinematics_yaml::OffsetConvention { degrees, subtract };
+        self.write_as(Format::JointOffsets(c), &path, overwrite)
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Calibration({:?}, {:?}, {} iterations)",

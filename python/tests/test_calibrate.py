@@ -367,3 +367,11 @@ def test_offsets_only_equals_the_cli(tmp_path):
     assert links and not any(k in cal.estimate for k in links)
     with pytest.raises(activecal.Error, match="unknowns"):
         activecal.calibrate(r, m["qs"], m["points"], unknowns="some")
+    # The offsets as a driver takes them, as the command line writes them.
+    off = tmp_path / "cli_joint_offsets.yaml"
+    cli("calibrate", *args, "--measurements", meas, "--unknowns", "offsets", "--out", off,
+        "--offset-unit", "deg", "--offset-sign", "subtract")
+    cal.write_joint_offsets(tmp_path / "py_joint_offsets.yaml", unit="deg", sign="subtract")
+    assert (tmp_path / "py_joint_offsets.yaml").read_text() == off.read_text()
+    with pytest.raises(activecal.Error, match="sign"):
+        cal.write_joint_offsets(tmp_path / "x_joint_offsets.yaml", sign="plus")

@@ -413,7 +413,7 @@ def cmd_make(a):
     for name in chain.names:
         t = unit(rng) * rng.uniform(0.5e-3, 2e-3)
         w = unit(rng) * math.radians(rng.uniform(0.05, 0.3))
-        if a.offsets_only:
+        if getattr(a, "offsets_only", False):
             # Only a turn about the joint's own axis: a zero-offset error.
             t = np.zeros(3)
             w = axes[name] * math.radians(rng.uniform(0.05, 0.3)) * rng.choice([-1.0, 1.0])

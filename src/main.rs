@@ -45,6 +45,12 @@ struct Cli {
     /// are given).
     #[arg(long, global = true, value_name = "FILE")]
     frames: Option<std::path::PathBuf>,
+    /// A kinematics file whose joint origins replace the .urdf robot's:
+    /// Universal Robots' default_kinematics.yaml (a factory file, or one
+    /// `calibrate --out default_kinematics.yaml` wrote) or a per-joint
+    /// origins file (`--out cal_origins.yaml`).
+    #[arg(long, global = true, value_name = "FILE")]
+    kinematics: Option<std::path::PathBuf>,
     /// A marker (retroreflector, tracked point) on the chain's tip:
     /// LINK@X,Y,Z, its offset in metres in the link's frame (repeatable:
     /// one per marker, in the order the measurement files list them).
@@ -215,6 +221,7 @@ fn main() {
         cli.tip,
         cli.lock.as_deref(),
         cli.frames,
+        cli.kinematics,
         &cli.markers,
     )
     .and_then(|c| command.take_chain(&c));

@@ -43,6 +43,7 @@ mod identification_jacobian_fixtures;
 mod identify;
 mod jacobian;
 mod json_shape;
+mod kinematics_files;
 mod licences;
 mod mesh_formats;
 mod options;

@@ -84,6 +84,7 @@ fn import(f: &Fixture) -> Robot {
         tip: Some(f.tip.clone()),
         lock: f.lock.clone(),
         frames: None,
+        kinematics: None,
         markers: Vec::new(),
     };
     let name = format!("{}{}", root().join(&f.urdf).display(), choice.fragment());

@@ -83,6 +83,7 @@ class Robot:
         lock: Optional[Mapping[str, float]] = None,
         frames: Optional[_Path] = None,
         pose: bool = False,
+        kinematics: Optional[_Path] = None,
     ) -> "Robot":
         """Imports the chain base..tip of a URDF file.
 
@@ -94,6 +95,10 @@ class Robot:
         metres. frames: a frames file (as `Calibration.write_frames`
         writes) mounting the chain in its measurement frame with its tool.
         pose: full-pose measurements (position and orientation).
+        kinematics: a kinematics file whose joint origins replace the
+        URDF's: Universal Robots' ``default_kinematics.yaml`` (a factory
+        file, or `Calibration.write_ur_kinematics`'s) or a per-joint
+        origins file (`Calibration.write_joint_origins`).
         """
     @staticmethod
     def builtin(name: str) -> "Robot":
@@ -377,6 +382,28 @@ class Calibration:
         or markers and the joint-origin changes with their σ, as
         ``activecal calibrate --out cal.yaml`` does. URDF robots only;
         refused when the fit did not converge."""
+    def write_ur_kinematics(self, path: _Path, overwrite: bool = True) -> None:
+        """Writes the calibrated joint origins as Universal Robots'
+        ``default_kinematics.yaml`` (per joint ``x y z`` in metres, ``roll
+        pitch yaw`` in radians, and a ``hash``), which ``ur_description``'s
+        xacro reads; as ``activecal calibrate --out default_kinematics.yaml``.
+        URDF robots with the six UR joints only; refused when the fit did
+        not converge."""
+    def write_joint_origins(self, path: _Path, overwrite: bool = True) -> None:
+        """Writes the calibrated joint origins as the per-joint origins
+        file (``JOINT: {xyz: [m], rpy: [rad]}``), which a xacro description
+        reads with ``xacro.load_yaml``; as ``activecal calibrate --out
+        cal_origins.yaml``. URDF robots only; refused when the fit did not
+        converge."""
+    def write_joint_offsets(
+        self, path: _Path, unit: str = "rad", sign: str = "add", overwrite: bool = True
+    ) -> None:
+        """Writes the joints' zero offsets as a driver takes them: unit
+        ``"rad"`` or ``"deg"`` (prismatic joints in metres), sign ``"add"``
+        (``q = q_encoder + offset``) or ``"subtract"`` (``q = q_encoder -
+        offset``); as ``activecal calibrate --out x_joint_offsets.yaml
+        --offset-unit --offset-sign``. URDF robots only; refused when the
+        fit did not converge."""
 
 def calibrate(
     robot: Robot,
@@ -398,6 +425,7 @@ def calibrate(
     outlier_rate: float = 0.01,
     noise: Optional[float] = None,
     progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
+    unknowns: str = "all",
 ) -> Calibration:
     """Calibrates the robot from measured poses, as ``activecal calibrate
     --measurements FILE`` does from a file holding the same values. The
@@ -421,7 +449,9 @@ def calibrate(
     (``report["compliance"]``), as ``--compliance``. q and points may be
     pandas DataFrames: q with a column per joint (by name, in any order,
     others ignored), points with columns ``x, y, z`` (``x1, y1, z1`` ...
-    for K markers).
+    for K markers). unknowns: ``"all"`` (the chain's complete set) or
+    ``"offsets"`` (only the joints' zero offsets, the measurement frame and
+    the tool; link lengths and twists held), as ``--unknowns``.
     """
 
 def evaluate(

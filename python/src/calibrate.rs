@@ -261,9 +261,11 @@ fn names(v: Option<Vec<String>>) -> Vec<String> {
 /// (`UserWarning`, as the command line's warning), and the outlier test
 /// uses it.
 /// progress: a callable `progress(task, done, total, note)`, as `select`
-/// takes it.
+/// takes it. unknowns: "all" (the chain's complete set) or "offsets" (only
+/// the joints' zero offsets, the measurement frame and the tool), as
+/// `--unknowns`.
 #[pyfunction]
-#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, compliance=false, outliers="drop", outlier_rate=0.01, noise=None, progress=None))]
+#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, compliance=false, outliers="drop", outlier_rate=0.01, noise=None, progress=None, unknowns="all"))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
@@ -286,6 +288,7 @@ pub fn calibrate(
     outlier_rate: f64,
     noise: Option<f64>,
     progress: Option<&Bound<'_, PyAny>>,
+    unknowns: &str,
 ) -> PyResult<Calibration> {
     use crate::pickling::kept;
     let recipe = crate::recipe!(py, "calibrate";
@@ -293,8 +296,10 @@ pub fn calibrate(
         orientations = kept(orientations)?, fix = &fix, free = &free,
         max_iterations = max_iterations, loss = loss, loss_scale = loss_scale, weights = weights,
         orientation_scale = orientation_scale, holdout = holdout, splits = splits, seed = seed,
-        compliance = compliance, outliers = outliers, outlier_rate = outlier_rate, noise = noise);
+        compliance = compliance, outliers = outliers, outlier_rate = outlier_rate, noise = noise,
+        unknowns = unknowns);
     let robot = robot.get();
+    let fix = fixed_of(robot, names(fix), unknowns)?;
     let weights = weights_of(weights, orientation_scale)?;
     let outliers = outliers_of(outliers, outlier_rate)?;
     let gravity = compliance
@@ -324,7 +329,7 @@ pub fn calibrate(
             .build()
             .map_err(|e| crate::convert::Fail::from(e).into_py())?,
         loss,
-        fix: names(fix),
+        fix,
         free: names(free),
         holdout,
         units: activecal::units::Units::default(),
@@ -335,9 +340,12 @@ pub fn calibrate(
         outliers,
         stated_noise: match noise {
             Some(s) if !(s.is_finite() && s > 0.0) => {
-                return Err(crate::errors::new_err(crate::errors::Kind::Input, format!(
-                    "noise={s}: the sensor's stated σ per coordinate must be a number > 0 (metres)"
-                )));
+                return Err(crate::errors::new_err(
+                    crate::errors::Kind::Input,
+                    format!(
+                        "noise={s}: the sensor's stated σ per coordinate must be a number > 0 (metres)"
+                    ),
+                ));
             }
             s => s,
         },
@@ -413,6 +421,26 @@ impl Calibration {
     }
 }
 
+/// `fix`, and for `unknowns="offsets"` the robot's link geometry
+/// ([`activecal::identify::offsets::link_unknowns`]).
+fn fixed_of(robot: &Robot, mut fix: Vec<String>, unknowns: &str) -> PyResult<Vec<String>> {
+    match unknowns {
+        "all" => Ok(fix),
+        "offsets" => {
+            for n in activecal::identify::offsets::link_unknowns(&robot.inner) {
+                if !fix.contains(&n) {
+                    fix.push(n);
+                }
+            }
+            Ok(fix)
+        }
+        other => Err(arg_err(
+            "unknowns",
+            format!("'{other}': \"all\" or \"offsets\""),
+        )),
+    }
+}
+
 /// Writes a calibrated robot (`table`, with its frames when it has them) as
 /// `format` to `path` after `header`, atomically; an existing file only with
 /// `overwrite`.
@@ -425,17 +453,18 @@ pub(crate) fn write_robot(
     path: &std::path::Path,
     overwrite: bool,
 ) -> PyResult<()> {
-    if Format::of(path).ok() != Some(format) {
+    let kind = std::mem::discriminant(&format);
+    if Format::of(path).ok().map(|f| std::mem::discriminant(&f)) != Some(kind) {
         return Err(arg_err(
             "path",
             format!(
-                "{}: this writer writes a .{} file; the name must end so",
+                "{}: this writer writes a file whose name ends in {}",
                 path.display(),
-                format!("{format:?}").to_lowercase()
+                format.name_ending()
             ),
         ));
     }
-    activecal::io::calibrated::write(robot, table, frames, header, path, overwrite)
+    activecal::io::calibrated::write(format, robot, table, frames, header, path, overwrite)
         .map_err(|e| crate::convert::Fail::from(e).into_py())
 }
 
@@ -517,6 +546,57 @@ impl Calibration {
     #[pyo3(signature = (path, overwrite=true))]
     fn write_frames(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
         self.write_as(Format::Yaml, &path, overwrite)
+    }
+
+    /// Writes the calibrated joint origins as Universal Robots'
+    /// default_kinematics.yaml (per joint x y z in metres, roll pitch yaw in
+    /// radians, and a hash), which ur_description's xacro reads. URDF
+    /// robots with the six UR joints only; refused when the fit did not
+    /// converge.
+    #[pyo3(signature = (path, overwrite=true))]
+    fn write_ur_kinematics(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
+        self.write_as(Format::UrKinematics, &path, overwrite)
+    }
+
+    /// Writes the calibrated joint origins as the per-joint origins file
+    /// (JOINT: {xyz: [m], rpy: [rad]}), for a xacro description to read
+    /// with xacro.load_yaml. URDF robots only; refused when the fit did not
+    /// converge.
+    #[pyo3(signature = (path, overwrite=true))]
+    fn write_joint_origins(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
+        self.write_as(Format::JointOrigins, &path, overwrite)
+    }
+
+    /// Writes the joints' zero offsets as a driver takes them: unit "rad"
+    /// or "deg" (revolute joints; prismatic ones in metres), sign "add" (q =
+    /// q_encoder + offset) or "subtract" (q = q_encoder − offset), as
+    /// `--out *joint_offsets.yaml --offset-unit --offset-sign`. URDF robots
+    /// only; refused when the fit did not converge.
+    #[pyo3(signature = (path, unit="rad", sign="add", overwrite=true))]
+    fn write_joint_offsets(
+        &self,
+        path: std::path::PathBuf,
+        unit: &str,
+        sign: &str,
+        overwrite: bool,
+    ) -> PyResult<()> {
+        let degrees = match unit {
+            "rad" => false,
+            "deg" => true,
+            other => return Err(arg_err("unit", format!("'{other}': \"rad\" or \"deg\""))),
+        };
+        let subtract = match sign {
+            "add" => false,
+            "subtract" => true,
+            other => {
+                return Err(arg_err(
+                    "sign",
+                    format!("'{other}': \"add\" or \"subtract\""),
+                ));
+            }
+        };
+        let c = activecal::io::kinematics_yaml::OffsetConvention { degrees, subtract };
+        self.write_as(Format::JointOffsets(c), &path, overwrite)
     }
 
     fn __repr__(&self) -> String {

@@ -139,10 +139,16 @@ pub fn detached<T: Send>(
                 });
             let handle = match spawned {
                 Ok(h) => h,
-                Err(e) => return (Err(Box::new(format!("no thread for the work: {e}")) as _), None),
+                Err(e) => {
+                    return (
+                        Err(Box::new(format!("no thread for the work: {e}")) as _),
+                        None,
+                    );
+                }
             };
             let mut interrupt = None;
-            while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) = rx.recv_timeout(SIGNAL_POLL) {
+            while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) = rx.recv_timeout(SIGNAL_POLL)
+            {
                 if interrupt.is_none()
                     && let Err(e) = Python::attach(|py| py.check_signals())
                 {

@@ -81,7 +81,10 @@ fn classes(py: Python<'_>) -> PyResult<&Vec<Py<PyType>>> {
                 let ns = PyDict::new(py);
                 ns.set_item("__doc__", *doc)?;
                 ns.set_item("__module__", "activecal")?;
-                Ok(make.call1((*name, bases, ns))?.cast_into::<PyType>()?.unbind())
+                Ok(make
+                    .call1((*name, bases, ns))?
+                    .cast_into::<PyType>()?
+                    .unbind())
             })
             .collect()
     })

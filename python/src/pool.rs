@@ -167,9 +167,10 @@ fn files_exist(choice: &CollisionChoice) -> PyResult<()> {
         .chain(choice.package_dirs.iter().map(|p| ("package_dirs", p)))
     {
         if !std::path::Path::new(p).exists() {
-            return Err(crate::errors::new_err(crate::errors::Kind::File, format!(
-                "{name}: {p}: no such file or directory"
-            )));
+            return Err(crate::errors::new_err(
+                crate::errors::Kind::File,
+                format!("{name}: {p}: no such file or directory"),
+            ));
         }
     }
     Ok(())
@@ -397,7 +398,8 @@ impl Pool {
     /// `filters`: each filter's `removed` of `seen`).
     #[getter]
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let v = serde_json::to_value(&self.pool.stats).map_err(|e| crate::convert::Fail::from(e).into_py())?;
+        let v = serde_json::to_value(&self.pool.stats)
+            .map_err(|e| crate::convert::Fail::from(e).into_py())?;
         json_to_py(py, &v)
     }
 

@@ -137,9 +137,12 @@ impl Robot {
     /// the offset in metres in the link's frame, or a list of them (each
     /// offset is then estimated). lock: {joint: value} joints held fixed
     /// (radians or metres). frames: a frames file (measurement frame, tool).
-    /// pose: full-pose measurements (position and orientation).
+    /// kinematics: a kinematics file (Universal Robots'
+    /// default_kinematics.yaml or per-joint origins) whose joint origins
+    /// replace the URDF's. pose: full-pose measurements (position and
+    /// orientation).
     #[staticmethod]
-    #[pyo3(signature = (path, tip=None, base=None, marker=None, lock=None, frames=None, pose=false))]
+    #[pyo3(signature = (path, tip=None, base=None, marker=None, lock=None, frames=None, pose=false, kinematics=None))]
     #[allow(clippy::too_many_arguments)]
     fn from_urdf(
         py: Python<'_>,
@@ -150,26 +153,33 @@ impl Robot {
         lock: Option<std::collections::BTreeMap<String, f64>>,
         frames: Option<std::path::PathBuf>,
         pose: bool,
+        kinematics: Option<std::path::PathBuf>,
     ) -> PyResult<Self> {
         let recipe = crate::recipe!(py, "Robot.from_urdf";
             path = &path, tip = &tip, base = &base, marker = crate::pickling::kept(marker)?,
-            lock = &lock, frames = &frames, pose = pose);
+            lock = &lock, frames = &frames, pose = pose, kinematics = &kinematics);
         let markers = marker.map(markers_of).transpose()?.unwrap_or_default();
         let lock: Vec<(String, f64)> = lock.unwrap_or_default().into_iter().collect();
         if let Some((j, v)) = lock.iter().find(|(_, v)| !v.is_finite()) {
             return Err(arg_err("lock", format!("{j}: {v} is not a finite number")));
         }
         if !path.is_file() {
-            return Err(crate::errors::new_err(crate::errors::Kind::File, format!(
-                "path: {}: no such file",
-                path.display()
-            )));
+            return Err(crate::errors::new_err(
+                crate::errors::Kind::File,
+                format!("path: {}: no such file", path.display()),
+            ));
         }
         if let Some(f) = frames.as_ref().filter(|f| !f.is_file()) {
-            return Err(crate::errors::new_err(crate::errors::Kind::File, format!(
-                "frames: {}: no such file",
-                f.display()
-            )));
+            return Err(crate::errors::new_err(
+                crate::errors::Kind::File,
+                format!("frames: {}: no such file", f.display()),
+            ));
+        }
+        if let Some(f) = kinematics.as_ref().filter(|f| !f.is_file()) {
+            return Err(crate::errors::new_err(
+                crate::errors::Kind::File,
+                format!("kinematics: {}: no such file", f.display()),
+            ));
         }
         let r = RobotRef {
             name: path.display().to_string(),
@@ -179,6 +189,7 @@ impl Robot {
                 tip,
                 lock,
                 frames: frames.map(|f| f.display().to_string()),
+                kinematics: kinematics.map(|f| f.display().to_string()),
                 markers,
             },
         };

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import activecal
-from conftest import UR5_URDF, cli
+from conftest import FIXTURES, UR5_URDF, cli
 
 MARKER = "tool0@0.031,-0.024,0.097"
 
@@ -314,3 +314,64 @@ def test_too_few_poses_are_refused_as_the_cli_refuses_them(tmp_path):
     assert out.returncode == 3
     assert "3 poses give 9 measurement rows for 27 unknowns" in out.stderr
     assert not (tmp_path / "y.urdf").exists()
+
+
+def test_kinematics_files_equal_the_clis_and_read_back(tmp_path):
+    """write_ur_kinematics / write_joint_origins write what `calibrate --out
+    *kinematics.yaml / *origins.yaml` writes, and Robot.from_urdf(...,
+    kinematics=FILE) reads either back to the calibrated URDF's model."""
+    ur5 = FIXTURES / "ur5.urdf"
+    factory = FIXTURES / "xacro" / "ur5_factory_kinematics.yaml"
+    args = ["--robot", ur5, "--kinematics", factory]
+    meas, m = simulated(tmp_path, args)
+    kin, ori, urdf = tmp_path / "cli_kinematics.yaml", tmp_path / "cli_origins.yaml", tmp_path / "cli.urdf"
+    cli("calibrate", *args, "--measurements", meas, "--out", kin, "--out", ori, "--out", urdf)
+    r = activecal.Robot.from_urdf(ur5, kinematics=factory)
+    cal = activecal.calibrate(r, m["qs"], m["points"])
+    assert cal.converged
+    cal.write_ur_kinematics(tmp_path / "py_kinematics.yaml")
+    cal.write_joint_origins(tmp_path / "py_origins.yaml")
+    assert (tmp_path / "py_kinematics.yaml").read_text() == kin.read_text()
+    assert (tmp_path / "py_origins.yaml").read_text() == ori.read_text()
+    q = np.array([0.3, -1.2, 1.1, 0.4, -0.8, 0.5])
+    want = np.asarray(activecal.Robot.from_urdf(urdf).fk(q)[1])
+    bare = np.asarray(activecal.Robot.from_urdf(ur5).fk(q)[1])
+    # The calibration moved the model by more than the comparison's bar.
+    assert np.linalg.norm(want - bare) > 1e-5
+    for f in (kin, ori):
+        got = np.asarray(activecal.Robot.from_urdf(ur5, kinematics=f).fk(q)[1])
+        # The same decimals on both sides: rpy rounding only.
+        assert np.linalg.norm(got - want) < 1e-12, f
+
+
+def test_kinematics_file_errors_name_the_file(tmp_path):
+    with pytest.raises(activecal.FileError, match="kinematics: .*nope.yaml: no such file"):
+        activecal.Robot.from_urdf(FIXTURES / "ur5.urdf", kinematics=tmp_path / "nope.yaml")
+    bad = tmp_path / "bad_origins.yaml"
+    bad.write_text("elbow_joint: {xyz: [0, 0], rpy: [0, 0, 0]}\n")
+    with pytest.raises(activecal.Error, match="bad_origins.yaml"):
+        activecal.Robot.from_urdf(FIXTURES / "ur5.urdf", kinematics=bad)
+
+
+def test_offsets_only_equals_the_cli(tmp_path):
+    """unknowns="offsets" estimates what `--unknowns offsets` does: only
+    offsets, measurement frame and tool (no link length or twist)."""
+    args = ["--robot", FIXTURES / "ur5.urdf"]
+    meas, m = simulated(tmp_path, args)
+    want = cli("calibrate", *args, "--measurements", meas, "--unknowns", "offsets")
+    r = activecal.Robot.from_urdf(FIXTURES / "ur5.urdf")
+    cal = activecal.calibrate(r, m["qs"], m["points"], unknowns="offsets")
+    assert_same_fit(cal, want)
+    full = activecal.calibrate(r, m["qs"], m["points"])
+    links = [k for k in full.estimate if k.startswith(("a_", "alpha_")) and not k.endswith("_base")]
+    assert links and not any(k in cal.estimate for k in links)
+    with pytest.raises(activecal.Error, match="unknowns"):
+        activecal.calibrate(r, m["qs"], m["points"], unknowns="some")
+    # The offsets as a driver takes them, as the command line writes them.
+    off = tmp_path / "cli_joint_offsets.yaml"
+    cli("calibrate", *args, "--measurements", meas, "--unknowns", "offsets", "--out", off,
+        "--offset-unit", "deg", "--offset-sign", "subtract")
+    cal.write_joint_offsets(tmp_path / "py_joint_offsets.yaml", unit="deg", sign="subtract")
+    assert (tmp_path / "py_joint_offsets.yaml").read_text() == off.read_text()
+    with pytest.raises(activecal.Error, match="sign"):
+        cal.write_joint_offsets(tmp_path / "x_joint_offsets.yaml", sign="plus")

@@ -93,6 +93,7 @@ pub const CALIBRATE: &[Rule] = &[
     r("tip", CAL_ALL, ""),
     r("lock", CAL_ALL, ""),
     r("frames", CAL_ALL, ""),
+    r("kinematics", CAL_ALL, ""),
     r(
         "markers",
         &[Simulated, Points, Poses, Contacts],
@@ -132,6 +133,17 @@ pub const CALIBRATE: &[Rule] = &[
     r("loss", FITTED, LS),
     r("loss_scale", FITTED, LS),
     r("fix", MEASURED, ""),
+    r("unknowns", MEASURED, ""),
+    r(
+        "offset_unit",
+        &[Simulated, Points, Poses],
+        "the camera and contact fits write no joint offsets",
+    ),
+    r(
+        "offset_sign",
+        &[Simulated, Points, Poses],
+        "the camera and contact fits write no joint offsets",
+    ),
     r(
         "free",
         FITTED,
@@ -192,6 +204,7 @@ pub const SELECT: &[Rule] = &[
     r("tip", SEL_ALL, ""),
     r("lock", SEL_ALL, ""),
     r("frames", SEL_ALL, ""),
+    r("kinematics", SEL_ALL, ""),
     r(
         "markers",
         &[Pool, Sockets],
@@ -290,6 +303,7 @@ pub const EVALUATE: &[Rule] = &[
     r("tip", EVAL_ALL, ""),
     r("lock", EVAL_ALL, ""),
     r("frames", EVAL_ALL, ""),
+    r("kinematics", EVAL_ALL, ""),
     r("markers", EVAL_ALL, ""),
     r("progress", EVAL_ALL, ""),
     r("robot", EVAL_ALL, ""),

@@ -70,6 +70,7 @@ fn sample(command: &str, id: &str) -> Option<(&'static [&'static str], &'static 
         (_, "tip") => (&[], "tool0"),
         (_, "lock") => (&[], "j=0"),
         (_, "frames") => (&[], "f.yaml"),
+        (_, "kinematics") => (&[], "k.yaml"),
         (_, "markers") => (&[], "tool0@0,0,0.1"),
         (_, "robot") => (&[], "puma560"),
         (_, "out") => (&[], "o.json"),

@@ -103,6 +103,52 @@ fn calibrate_files(a: &CalibrateArgs) -> super::run_files::RunFiles {
     f
 }
 
+/// `--fix`, and with `--unknowns offsets` the robot's link geometry
+/// ([`activecal::identify::offsets::link_unknowns`]).
+fn fixed_unknowns(a: &CalibrateArgs, robot: &Robot) -> Vec<String> {
+    let mut fix = a.fix.clone();
+    if a.unknowns == Some(super::calibrate_args::UnknownsKind::Offsets) {
+        let links = activecal::identify::offsets::link_unknowns(robot);
+        fix.extend(links.into_iter().filter(|n| !a.fix.contains(n)));
+    }
+    fix
+}
+
+/// With `--unknowns offsets`: the full fit of the same data beside the
+/// offsets-only one `offsets` ([`activecal::experiment::measured::offsets_gain`]).
+fn offsets_gain(
+    a: &CalibrateArgs,
+    robot: &Robot,
+    meas: &activecal::identify::Measurements,
+    path: &Path,
+    o: &activecal::experiment::measured::MeasuredSettings,
+    offsets: (&Robot, &activecal::model::ParamTable),
+) -> Result<Option<activecal::experiment::measured::offsets_gain::OffsetsGain>> {
+    if a.unknowns != Some(super::calibrate_args::UnknownsKind::Offsets) {
+        return Ok(None);
+    }
+    let mut full = o.clone();
+    full.fix.clone_from(&a.fix);
+    let source = path.display().to_string();
+    let g = activecal::experiment::measured::offsets_gain::offsets_gain(
+        robot, meas, &source, &full, offsets,
+    )?;
+    Ok(Some(g))
+}
+
+/// The offsets-only fit's line beside the full fit.
+fn gain_text(g: &activecal::experiment::measured::offsets_gain::OffsetsGain) -> String {
+    format!(
+        "\noffsets only: predicted position RMS {:.4} mm; the full model ({} unknowns, fitted to the same data) {:.4} mm: it would gain {:.4} mm (the two models are {:.4} mm apart, RMS at {} random configurations)\n",
+        g.offsets_predicted_rms_mm,
+        g.full_unknowns,
+        g.full_predicted_rms_mm,
+        g.gain_mm,
+        g.models_apart_rms_mm,
+        activecal::experiment::measured::PREDICTION_CONFIGURATIONS
+    )
+}
+
 /// Identification from a measurement file.
 fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()> {
     let t0 = Instant::now();
@@ -125,7 +171,7 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     let o = activecal::experiment::measured::MeasuredSettings {
         lm,
         loss: super::measured::loss_choice(a.loss, a.loss_scale)?,
-        fix: a.fix.clone(),
+        fix: fixed_unknowns(a, robot),
         free: a.free.clone(),
         holdout: a
             .holdout
@@ -197,8 +243,12 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         report.base.out =
             write_calibrated(a, &fitted, id, &path.display().to_string(), frames.as_ref())?;
     }
+    let gain = offsets_gain(a, robot, &meas, path, &o, (&fitted, &id.table))?;
     let mut v = serde_json::to_value(&report)?;
     v["exit_status"] = verdict.exit_status().into();
+    if let Some(g) = &gain {
+        v["offsets_gain"] = serde_json::to_value(g)?;
+    }
     if let Some(dir) = &a.report {
         activecal::render::folder::calibration(
             dir,
@@ -207,6 +257,9 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     }
     super::emit(a.json, &v, || {
         let mut s = super::measured::measured_text(&report, id, &status_text(id));
+        if let Some(g) = &gain {
+            s += &gain_text(g);
+        }
         for out in &report.base.out {
             s += &format!("\ncalibrated robot written to {out}\n");
         }

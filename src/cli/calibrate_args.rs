@@ -92,6 +92,22 @@ pub struct CalibrateArgs {
     /// a pose flagged this often (in (0, 1); default 0.01).
     #[arg(long, requires = "measurements")]
     pub outlier_rate: Option<f64>,
+    /// Which unknowns to estimate, with --measurements: `all` (the chain's
+    /// complete, minimal set) or `offsets` (only the joints' zero offsets,
+    /// the measurement frame and the tool; every link length and twist
+    /// held at the model's value: what a driver's joint offsets and the
+    /// frames file can hold).
+    #[arg(long, value_enum, requires = "measurements")]
+    pub unknowns: Option<UnknownsKind>,
+    /// The unit of the joint offsets written to `--out *joint_offsets.yaml`
+    /// (revolute joints; prismatic ones are in metres).
+    #[arg(long, value_enum)]
+    pub offset_unit: Option<OffsetUnit>,
+    /// How the driver applies the offsets written to `--out
+    /// *joint_offsets.yaml`: `add` (q = q_encoder + offset) or `subtract`
+    /// (q = q_encoder − offset), q being the description's joint value.
+    #[arg(long, value_enum)]
+    pub offset_sign: Option<OffsetSign>,
     /// Unknowns to fix at their nominal values (comma-separated names, as
     /// in the estimate), with --measurements.
     #[arg(long, value_delimiter = ',', conflicts_with = "design")]
@@ -276,6 +292,45 @@ impl CalibrateArgs {
 }
 
 /// The weights options of `calibrate`.
+/// `--offset-unit`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OffsetUnit {
+    /// Radians.
+    Rad,
+    /// Degrees.
+    Deg,
+}
+
+/// `--offset-sign`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OffsetSign {
+    /// q = q_encoder + offset.
+    Add,
+    /// q = q_encoder − offset.
+    Subtract,
+}
+
+impl CalibrateArgs {
+    /// The joint-offset convention `--offset-unit` and `--offset-sign` name
+    /// (radians, added, by default).
+    #[must_use]
+    pub fn offset_convention(&self) -> activecal::io::kinematics_yaml::OffsetConvention {
+        activecal::io::kinematics_yaml::OffsetConvention {
+            degrees: self.offset_unit == Some(OffsetUnit::Deg),
+            subtract: self.offset_sign == Some(OffsetSign::Subtract),
+        }
+    }
+}
+
+/// `--unknowns`: which unknowns a fit estimates.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UnknownsKind {
+    /// The chain's complete, minimal set.
+    All,
+    /// Joint zero offsets, the measurement frame and the tool.
+    Offsets,
+}
+
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum WeightsKind {
     /// Each residual block's σ estimated from the data.

@@ -6,6 +6,7 @@ use super::calibrate_args::CalibrateArgs;
 use activecal::frames::CalibratedFrames;
 use activecal::frames::report::{FitBlock, FramesReport};
 use activecal::identify::Identification;
+use activecal::io::calibrated::Format;
 use activecal::model::Robot;
 use anyhow::Result;
 
@@ -36,7 +37,12 @@ pub fn write_calibrated(
     }
     let mut written = Vec::new();
     for out in &a.out {
+        let format = match Format::of(out)? {
+            Format::JointOffsets(_) => Format::JointOffsets(a.offset_convention()),
+            f => f,
+        };
         activecal::io::calibrated::write(
+            format,
             robot,
             &id.table,
             frames.map(|(f, r)| (f, r)),

@@ -91,6 +91,7 @@ pub fn chain_choice(
     tip: Option<String>,
     lock: Option<&str>,
     frames: Option<std::path::PathBuf>,
+    kinematics: Option<std::path::PathBuf>,
     markers: &[String],
 ) -> Result<ChainChoice> {
     let lock = match lock {
@@ -102,6 +103,11 @@ pub fn chain_choice(
     {
         anyhow::bail!("--frames {}: no such file", f.display());
     }
+    if let Some(f) = &kinematics
+        && !f.is_file()
+    {
+        anyhow::bail!("--kinematics {}: no such file", f.display());
+    }
     let markers = markers
         .iter()
         .map(|m| activecal::io::MarkerChoice::parse(m).map_err(|e| anyhow::anyhow!("--{e}")))
@@ -111,6 +117,7 @@ pub fn chain_choice(
         tip,
         lock,
         frames: frames.map(|f| f.display().to_string()),
+        kinematics: kinematics.map(|f| f.display().to_string()),
         markers,
     })
 }
@@ -148,6 +155,9 @@ pub fn chain_options(c: &ChainChoice) -> String {
     }
     if let Some(f) = &c.frames {
         parts.push(format!("--frames {f}"));
+    }
+    if let Some(k) = &c.kinematics {
+        parts.push(format!("--kinematics {k}"));
     }
     parts.extend(c.markers.iter().map(|m| format!("--marker {m}")));
     parts.join(" ")

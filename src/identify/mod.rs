@@ -46,6 +46,7 @@ pub mod evaluation;
 pub mod fit;
 pub mod lm;
 pub mod montecarlo;
+pub mod offsets;
 pub mod plausible;
 pub mod residual;
 pub mod simulate;

@@ -5,7 +5,13 @@
 //!   for a built-in or TOML robot, its chain as URDF ([`super::urdf::to_urdf`]);
 //! * `.yaml` / `.yml` — the frames file ([`super::frames_file`]);
 //! * `.toml` — the description ([`super::robot_toml`]) whose nominal and
-//!   real tables are the estimate.
+//!   real tables are the estimate;
+//! * a name ending in `kinematics.yaml` (`default_kinematics.yaml`) —
+//!   Universal Robots' kinematics file of the calibrated joint origins, and
+//!   one ending in `origins.yaml` — the per-joint origins file
+//!   ([`super::kinematics_yaml`]), and one ending in `joint_offsets.yaml`
+//!   — the joints' zero offsets as a driver takes them, for a robot
+//!   imported from a URDF.
 //!
 //! Any other extension is refused before any work.
 
@@ -23,12 +29,49 @@ pub enum Format {
     Yaml,
     /// activecal's description.
     Toml,
+    /// Universal Robots' `default_kinematics.yaml` of the joint origins.
+    UrKinematics,
+    /// The per-joint origins file.
+    JointOrigins,
+    /// The joints' zero offsets, as a driver takes them.
+    JointOffsets(super::kinematics_yaml::OffsetConvention),
 }
 
 impl Format {
+    /// How a file name written in this format ends (`.urdf`,
+    /// `kinematics.yaml`, …): [`Format::of`] reads it back.
+    #[must_use]
+    pub fn name_ending(self) -> &'static str {
+        match self {
+            Format::Urdf => ".urdf",
+            Format::Yaml => ".yaml",
+            Format::Toml => ".toml",
+            Format::UrKinematics => "kinematics.yaml",
+            Format::JointOrigins => "origins.yaml",
+            Format::JointOffsets(_) => "joint_offsets.yaml",
+        }
+    }
+
     /// The format a file name asks for: an error naming the three when its
     /// extension is none of them.
     pub fn of(path: &Path) -> Result<Format> {
+        let file = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .map(str::to_ascii_lowercase)
+            .unwrap_or_default();
+        let ends = |stem: &str| {
+            file.ends_with(&format!("{stem}.yaml")) || file.ends_with(&format!("{stem}.yml"))
+        };
+        if ends("kinematics") {
+            return Ok(Format::UrKinematics);
+        }
+        if ends("origins") {
+            return Ok(Format::JointOrigins);
+        }
+        if ends("joint_offsets") {
+            return Ok(Format::JointOffsets(Default::default()));
+        }
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
@@ -38,7 +81,7 @@ impl Format {
             Some("yaml" | "yml") => Ok(Format::Yaml),
             Some("toml") => Ok(Format::Toml),
             _ => Err(Error::Invalid(format!(
-                "{}: a calibrated robot is written as .urdf (the URDF with calibrated joint origins), .yaml (the frames file: measurement frame, tool or markers, joint origins) or .toml (activecal's description); the extension says none of them",
+                "{}: a calibrated robot is written as .urdf (the URDF with calibrated joint origins), .yaml (the frames file: measurement frame, tool or markers, joint origins), .toml (activecal's description), a name ending in kinematics.yaml (Universal Robots' kinematics file of the joint origins) in origins.yaml (the per-joint origins file) or in joint_offsets.yaml (the joints' zero offsets); the name says none of them",
                 path.display()
             ))),
         }
@@ -71,19 +114,30 @@ pub fn render(
         }
         Format::Urdf => match (&robot.source, frames) {
             (Some(src), Some((f, _))) => {
-                // A chain's first joint walked against the file's tree has
-                // no origin of the file (the camera's placement holds it).
-                let skip_first = usize::from(src.reversed.iter().any(|r| r.neighbour.is_none()));
-                let origins: Vec<(String, nalgebra::Isometry3<f64>)> = f
-                    .joints
-                    .iter()
-                    .skip(skip_first)
-                    .map(|j| (j.name.clone(), j.calibrated))
-                    .collect();
-                super::urdf_edit::with_origins(&src.text, &src.path, &origins)
+                super::urdf_edit::with_origins(&src.text, &src.path, &file_origins(src, f))
             }
             (Some(_), None) => Err(no_frames()),
             (None, _) => super::urdf::to_urdf(robot, table),
+        },
+        Format::UrKinematics | Format::JointOrigins => match (&robot.source, frames) {
+            (Some(src), Some((f, _))) => {
+                let origins = file_origins(src, f);
+                let name = src.path.as_str();
+                if format == Format::UrKinematics {
+                    super::kinematics_yaml::ur_kinematics(name, &origins)
+                } else {
+                    Ok(super::kinematics_yaml::joint_origins(name, &origins))
+                }
+            }
+            _ => Err(no_frames()),
+        },
+        Format::JointOffsets(c) => match (&robot.source, frames) {
+            (Some(src), Some((f, _))) => Ok(super::kinematics_yaml::joint_offsets(
+                &src.path,
+                &offsets_of(f),
+                c,
+            )),
+            _ => Err(no_frames()),
         },
         Format::Yaml => match frames {
             Some((_, report)) => super::frames_file::to_yaml(report),
@@ -92,10 +146,42 @@ pub fn render(
     }
 }
 
-/// Writes a calibrated robot ([`render`]) to `path` in the format its
-/// extension names, atomically; an existing file only with `overwrite`.
+/// The calibrated origins of the file's joints: a chain's first joint
+/// walked against the file's tree has no origin of the file (the camera's
+/// placement holds it).
+fn file_origins(
+    src: &crate::model::source::UrdfSource,
+    f: &CalibratedFrames,
+) -> Vec<(String, nalgebra::Isometry3<f64>)> {
+    let skip_first = usize::from(src.reversed.iter().any(|r| r.neighbour.is_none()));
+    f.joints
+        .iter()
+        .skip(skip_first)
+        .map(|j| (j.name.clone(), j.calibrated))
+        .collect()
+}
+
+/// Each driven joint's zero offset (radians, or metres for a prismatic
+/// joint: the origin's slide along its axis) and whether it is revolute.
+fn offsets_of(f: &CalibratedFrames) -> Vec<(String, f64, bool)> {
+    f.joints
+        .iter()
+        .map(|j| match j.kind {
+            crate::model::JointKind::Revolute => (j.name.clone(), j.offset(), true),
+            crate::model::JointKind::Prismatic => {
+                let slide = j.nominal.rotation.inverse()
+                    * (j.calibrated.translation.vector - j.nominal.translation.vector);
+                (j.name.clone(), slide.dot(&j.axis), false)
+            }
+        })
+        .collect()
+}
+
+/// Writes a calibrated robot ([`render`]) as `format` (for a file name,
+/// [`Format::of`]) to `path`, atomically; an existing file only with `overwrite`.
 /// The command line (`--out`, `--force`) and Python's writers call this.
 pub fn write(
+    format: Format,
     robot: &Robot,
     table: &ParamTable,
     frames: Option<(&CalibratedFrames, &FramesReport)>,
@@ -103,7 +189,7 @@ pub fn write(
     path: &Path,
     overwrite: bool,
 ) -> Result<()> {
-    let text = render(Format::of(path)?, robot, table, frames, header)
+    let text = render(format, robot, table, frames, header)
         .map_err(|e| Error::Invalid(format!("{}: {e}", path.display())))?;
     let out = [super::atomic::Output {
         label: "calibrated robot",

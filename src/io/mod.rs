@@ -15,6 +15,7 @@ pub mod design_formats;
 pub mod frames_file;
 pub mod inertia;
 pub mod joint_speeds;
+pub mod kinematics_yaml;
 pub mod measurements;
 pub mod read;
 pub mod robot_toml;
@@ -164,11 +165,22 @@ fn load_urdf(path: &Path, chain: &ChainChoice, pose: bool) -> Result<Robot> {
         // The markers' link is the measured link unless a tip is named.
         opts.tip = Some(m.link.clone());
     }
+    let load = |opts: &urdf::UrdfOptions| match &chain.kinematics {
+        // The kinematics file's origins in place of the URDF's.
+        Some(k) => {
+            let file = kinematics_yaml::read(Path::new(k))?;
+            let text = read::read_text(path)?;
+            let name = path.display().to_string();
+            let text = kinematics_yaml::with_file(&text, &name, &file)?;
+            urdf::parse(&text, &name, opts)
+        }
+        None => urdf::load(path, opts),
+    };
     let robot = match &frames {
-        Some(f) => urdf::load(path, &opts)
+        Some(f) => load(&opts)
             .map_err(|e| f.blame_links(e, chain.base.is_some(), chain.tip.is_some()))
             .and_then(|r| f.check_names(&r).map(|()| r))?,
-        None => urdf::load(path, &opts)?,
+        None => load(&opts)?,
     };
     let robot = match &frames {
         Some(f) if !f.compliance.is_empty() => with_compliance(robot, &f.compliance, chain)?,
@@ -306,7 +318,7 @@ fn load_head(r: &RobotRef) -> Result<Description> {
     if let Ok(robot) = Robot::builtin(&head) {
         if !r.chain.is_empty() {
             return Err(Error::Invalid(format!(
-                "{head}: a chain choice (base, tip, lock or frames: {}) chooses the chain of a URDF file, not of a built-in robot",
+                "{head}: a chain choice (base, tip, lock, frames or kinematics: {}) chooses the chain of a URDF file, not of a built-in robot",
                 r.chain.fragment()
             )));
         }
@@ -319,7 +331,7 @@ fn load_head(r: &RobotRef) -> Result<Description> {
     let ext = r.extension();
     if !r.chain.is_empty() && !r.is_urdf() {
         return Err(Error::Invalid(format!(
-            "{head}: a chain choice (base, tip, lock or frames: {}) applies to a .urdf file; in a description use its `base`, `tip` and [lock] keys",
+            "{head}: a chain choice (base, tip, lock, frames or kinematics: {}) applies to a .urdf file; in a description use its `base`, `tip` and [lock] keys",
             r.chain.fragment()
         )));
     }

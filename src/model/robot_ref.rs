@@ -4,7 +4,7 @@
 //! and the chain options once, [`crate::io`] loads it; design files record one (as a name and a
 //! structured chain) and give it back.
 //!
-//! The text form `NAME[:pose][#base=B;tip=T;lock=J:V,…;frames=F;marker=L@X,Y,Z…]` is this
+//! The text form `NAME[:pose][#base=B;tip=T;lock=J:V,…;frames=F;kinematics=K;marker=L@X,Y,Z…]` is this
 //! value's serialisation, read by [`RobotRef::parse`] and written by its
 //! [`std::fmt::Display`]: a loaded robot's [`crate::model::Robot::name`], and
 //! the `robot` of design files written before the chain was stored apart.
@@ -31,6 +31,11 @@ pub struct ChainChoice {
     /// tool (or markers) to mount the chain with.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub frames: Option<String>,
+    /// A kinematics file ([`crate::io::kinematics_yaml`]: Universal Robots'
+    /// `default_kinematics.yaml` or per-joint origins) whose joint origins
+    /// replace the URDF's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kinematics: Option<String>,
     /// Markers measured on the chain's tip, each a link (the tip's) and an
     /// offset in it (metres): the sensor the poses are chosen and the data
     /// fitted for. One marker makes a one-marker sensor (its offset
@@ -95,6 +100,7 @@ impl ChainChoice {
             && self.tip.is_none()
             && self.lock.is_empty()
             && self.frames.is_none()
+            && self.kinematics.is_none()
             && self.markers.is_empty()
     }
 
@@ -114,6 +120,9 @@ impl ChainChoice {
         }
         if let Some(f) = &self.frames {
             parts.push(format!("frames={f}"));
+        }
+        if let Some(k) = &self.kinematics {
+            parts.push(format!("kinematics={k}"));
         }
         parts.extend(self.markers.iter().map(|m| format!("marker={m}")));
         if parts.is_empty() {
@@ -155,10 +164,11 @@ impl ChainChoice {
                 Some(("tip", v)) => c.tip = Some(v.to_string()),
                 Some(("lock", v)) => c.lock = ChainChoice::parse_lock(v)?,
                 Some(("frames", v)) => c.frames = Some(v.to_string()),
+                Some(("kinematics", v)) => c.kinematics = Some(v.to_string()),
                 Some(("marker", v)) => c.markers.push(MarkerChoice::parse(v)?),
                 _ => {
                     return Err(Error::Invalid(format!(
-                        "robot name: unknown chain choice '{part}' after '#' (expected base=LINK, tip=LINK, lock=JOINT:VALUE,…, frames=FILE or marker=LINK@X,Y,Z)"
+                        "robot name: unknown chain choice '{part}' after '#' (expected base=LINK, tip=LINK, lock=JOINT:VALUE,…, frames=FILE, kinematics=FILE or marker=LINK@X,Y,Z)"
                     )));
                 }
             }

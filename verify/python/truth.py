@@ -5,7 +5,7 @@ Pinocchio compares the calibrated model with the truth.
 Usage (run with /work/main/.venv/bin/python; every output is JSON or CSV):
 
   truth.py make --urdf U --tip LINK --seed S --out truth.json
-               [--marker x,y,z] [--pose] [--base LINK]
+               [--marker x,y,z] [--pose] [--base LINK] [--offsets-only]
       A true robot: every moving joint of the chain base..tip has its
       <origin> composed with a small rigid motion (0.5-2 mm, 0.05-0.3 deg,
       random directions, seeded): origin_true = origin * Delta, Delta =
@@ -16,6 +16,8 @@ Usage (run with /work/main/.venv/bin/python; every output is JSON or CSV):
       nominal offset (default 0.031,-0.024,0.097: about 10 cm off the
       flange, off every axis) plus about 2 mm; with --pose the measured
       frame is also turned by about 0.3 deg from the tip link's axes.
+      --offsets-only: each origin only turned about its joint's own axis
+      (0.05-0.3 deg, either sign, t = 0): zero-offset errors alone.
       truth.json holds everything (perturbations, tracker, marker); a
       true.urdf is written beside it for people (not read back).
 
@@ -407,9 +409,14 @@ def cmd_make(a):
     rng = np.random.default_rng(a.seed)
     chain = Chain(a.urdf, a.base, a.tip)
     joints = []
+    axes = joint_axes(a.urdf)
     for name in chain.names:
         t = unit(rng) * rng.uniform(0.5e-3, 2e-3)
         w = unit(rng) * math.radians(rng.uniform(0.05, 0.3))
+        if getattr(a, "offsets_only", False):
+            # Only a turn about the joint's own axis: a zero-offset error.
+            t = np.zeros(3)
+            w = axes[name] * math.radians(rng.uniform(0.05, 0.3)) * rng.choice([-1.0, 1.0])
         joints.append({"name": name, "t": t.tolist(), "w": w.tolist()})
     # The tracker: 2.6 m from the base, turned 95 degrees about a generic axis.
     tracker = se3(exp3(unit(rng) * math.radians(95.0)), unit(rng) * 2.6)
@@ -441,6 +448,16 @@ def cmd_make(a):
     print(json.dumps({"out": a.out, "true_urdf": true_urdf, "joints": chain.names,
                       "base": chain.base, "tip": a.tip,
                       "marker_nominal": nominal.tolist(), "marker_true": true_marker.tolist()}))
+
+
+def joint_axes(urdf):
+    """Each joint's unit axis in its own frame (URDF <axis>, default x)."""
+    axes = {}
+    for j in ET.parse(urdf).getroot().findall("joint"):
+        e = j.find("axis")
+        v = np.array([float(x) for x in e.get("xyz").split()]) if e is not None else np.array([1.0, 0.0, 0.0])
+        axes[j.get("name")] = v / np.linalg.norm(v)
+    return axes
 
 
 def write_true_urdf(urdf, joints, out):
@@ -683,6 +700,7 @@ def main(argv=None):
     p.add_argument("--out", required=True)
     p.add_argument("--marker")
     p.add_argument("--pose", action="store_true")
+    p.add_argument("--offsets-only", action="store_true")
     p = sub.add_parser("measure")
     p.add_argument("--truth", required=True)
     p.add_argument("--design", required=True, nargs="+")

@@ -124,6 +124,7 @@ pub fn robot_name(arm: &Arm, path: &Path) -> String {
         tip: Some(arm.tip.to_string()),
         lock: arm.lock.iter().map(|&(n, v)| (n.to_string(), v)).collect(),
         frames: None,
+        kinematics: None,
         markers: Vec::new(),
     };
     format!("{}{}", path.display(), choice.fragment())

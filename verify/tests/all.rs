@@ -36,6 +36,8 @@ mod live_idjac;
 #[cfg(feature = "live")]
 mod live_messy;
 #[cfg(feature = "live")]
+mod live_stack;
+#[cfg(feature = "live")]
 mod live_tour;
 #[cfg(feature = "live")]
 mod live_truth;

@@ -21,6 +21,7 @@ pub use screen::OutlierReport;
 use screen::screen;
 use serde::Serialize;
 
+pub mod offsets_gain;
 mod screen;
 pub mod verdict;
 use std::path::Path;

@@ -1,0 +1,93 @@
+//! What the full model would gain over an offsets-only calibration
+//! ([`crate::identify::offsets`]): the same data fitted with every unknown,
+//! and the two fitted models compared at random configurations.
+//!
+//! The full model is the best estimate of the robot there is: the
+//! offsets-only model's predicted error is its distance to it (a bias no
+//! amount of data removes) on top of the full model's own predicted error,
+//! `e_off = √(d² + e_full²)`, where `d` is the RMS distance between the two
+//! models' predicted points and `e_full` the full model's predicted RMS
+//! from its covariance ([`super::MeasuredReport::predicted`]).
+
+use super::{ExperimentError, MeasuredSettings, PREDICTION_CONFIGURATIONS, calibrate_read};
+use crate::identify::Measurements;
+use crate::model::{MeasurementKind, ParamTable, Robot};
+use nalgebra::Vector3;
+use serde::Serialize;
+
+/// The offsets-only fit beside the full one.
+#[derive(Clone, Debug, Serialize)]
+pub struct OffsetsGain {
+    /// Unknowns of the full fit (the robot's, with the sensor's own).
+    pub full_unknowns: usize,
+    /// The full model's predicted position RMS at the random
+    /// configurations (mm), from its covariance at its σ̂.
+    pub full_predicted_rms_mm: f64,
+    /// RMS distance between the two fitted models' predicted points at the
+    /// same configurations (mm).
+    pub models_apart_rms_mm: f64,
+    /// The offsets-only model's predicted position RMS (mm):
+    /// `√(apart² + full²)`.
+    pub offsets_predicted_rms_mm: f64,
+    /// What the full model gains: offsets-only minus full predicted RMS (mm).
+    pub gain_mm: f64,
+}
+
+/// The measured points of `robot` at `table` and `q` (each marker of a
+/// markers sensor, else the end point), metres.
+fn points(robot: &Robot, table: &ParamTable, q: &[f64]) -> Vec<Vector3<f64>> {
+    let end = crate::kinematics::Evaluator::new(robot, table).end_frame(q);
+    match robot.measurement {
+        MeasurementKind::Markers(_) => table
+            .markers
+            .iter()
+            .map(|m| end.position + end.rotation * Vector3::from(*m))
+            .collect(),
+        _ => vec![end.position],
+    }
+}
+
+/// RMS distance (mm) between the points of two fitted models at `qs`.
+#[must_use]
+pub fn models_apart_rms_mm(
+    a: (&Robot, &ParamTable),
+    b: (&Robot, &ParamTable),
+    qs: &[Vec<f64>],
+) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for q in qs {
+        for (x, y) in points(a.0, a.1, q).iter().zip(points(b.0, b.1, q)) {
+            sum += (x - y).norm_squared();
+            n += 1;
+        }
+    }
+    (sum / n.max(1) as f64).sqrt() * 1e3
+}
+
+/// Fits `meas` (named `source`) with `full` settings (every unknown, the
+/// user's own fixed ones held) and compares the result with the
+/// offsets-only fit `offsets` (its robot as fitted and its estimate).
+pub fn offsets_gain(
+    robot: &Robot,
+    meas: &Measurements,
+    source: &str,
+    full: &MeasuredSettings,
+    offsets: (&Robot, &ParamTable),
+) -> Result<OffsetsGain, ExperimentError> {
+    let f = calibrate_read(robot, meas, source, Vec::new(), full, &mut |_| {})?;
+    let qs = crate::how_many::random_configurations(&f.robot, PREDICTION_CONFIGURATIONS, 0);
+    let apart = models_apart_rms_mm((&f.robot, &f.fit.id.table), offsets, &qs);
+    let full_rms = f
+        .report
+        .predicted
+        .as_ref()
+        .map_or(f64::NAN, |p| p.position_rms_mm);
+    let off = apart.hypot(full_rms);
+    Ok(OffsetsGain {
+        full_unknowns: f.fit.id.names.len(),
+        full_predicted_rms_mm: full_rms,
+        models_apart_rms_mm: apart,
+        offsets_predicted_rms_mm: off,
+        gain_mm: off - full_rms,
+    })
+}

@@ -258,10 +258,14 @@ fn names(v: Option<Vec<String>>) -> Vec<String> {
 /// is tested against it (`report["noise_test"]`), a rejection warns
 /// (`UserWarning`, as the command line's warning), and the outlier test
 /// uses it.
+/// orientation_noise: with orientations, the tracker's stated σ per
+/// orientation axis (radians), as `--orientation-noise`: the orientation
+/// block's σ is tested against it (`report["orientation_noise_test"]`), a
+/// rejection warns (`UserWarning`).
 /// progress: a callable `progress(task, done, total, note)`, as `select`
 /// takes it.
 #[pyfunction]
-#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, compliance=false, outliers="drop", outlier_rate=0.01, noise=None, progress=None))]
+#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, compliance=false, outliers="drop", outlier_rate=0.01, noise=None, orientation_noise=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
@@ -283,6 +287,7 @@ pub fn calibrate(
     outliers: &str,
     outlier_rate: f64,
     noise: Option<f64>,
+    orientation_noise: Option<f64>,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Calibration> {
     let weights = weights_of(weights, orientation_scale)?;
@@ -327,6 +332,14 @@ pub fn calibrate(
             Some(s) if !(s.is_finite() && s > 0.0) => {
                 return Err(pyo3::exceptions::PyValueError::new_err(format!(
                     "noise={s}: the sensor's stated σ per coordinate must be a number > 0 (metres)"
+                )));
+            }
+            s => s,
+        },
+        stated_orientation_noise: match orientation_noise {
+            Some(s) if !(s.is_finite() && s > 0.0) => {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "orientation_noise={s}: the tracker's stated σ per orientation axis must be a number > 0 (radians)"
                 )));
             }
             s => s,
@@ -539,7 +552,7 @@ pub fn evaluate<'py>(
 
 /// The outlier choice of `outliers=` ("drop" or "keep") and
 /// `outlier_rate=`.
-fn outliers_of(kind: &str, rate: f64) -> PyResult<activecal::identify::outliers::OutlierChoice> {
+pub(crate) fn outliers_of(kind: &str, rate: f64) -> PyResult<activecal::identify::outliers::OutlierChoice> {
     use activecal::identify::outliers::{OutlierChoice, check_choice};
     let c = match kind {
         "drop" => OutlierChoice::Drop { alpha: rate },

@@ -165,10 +165,17 @@ pub struct CameraCalibration {
 /// link a camera is on (a head). camera_pose, target_pose: the rough
 /// placements X, Y, Z, ROLL, PITCH, YAW (metres, radians), the fit's
 /// start; one left out (None) is computed from the pixels (PnP and the
-/// closed-form hand-eye, the report's `start`). refine_intrinsics: fit the intrinsics too. progress as
-/// `calibrate` takes it.
+/// closed-form hand-eye, the report's `start`). refine_intrinsics: fit the intrinsics too.
+/// outliers: "drop" (default: a pose with a gross error, a shifted board,
+/// or one point of it, a misdetected corner, found by Baarda's data
+/// snooping at family-wise rate outlier_rate, left out one at a time and
+/// listed in `report["outliers"]`) or "keep", as `--outliers`.
+/// pixel_noise: the detector's stated σ per pixel coordinate (px), as
+/// `--pixel-noise`: σ̂ is tested against it (`report["noise_test"]`), a
+/// rejection warns (`UserWarning`), and the outlier test uses it. progress
+/// as `calibrate` takes it.
 #[pyfunction]
-#[pyo3(signature = (robot, observations, camera_info, target, *, camera_pose=None, target_pose=None, mounting=None, camera_link=None, refine_intrinsics=false, progress=None))]
+#[pyo3(signature = (robot, observations, camera_info, target, *, camera_pose=None, target_pose=None, mounting=None, camera_link=None, refine_intrinsics=false, outliers="drop", outlier_rate=0.01, pixel_noise=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate_camera(
     py: Python<'_>,
@@ -181,9 +188,20 @@ pub fn calibrate_camera(
     mounting: Option<&str>,
     camera_link: Option<String>,
     refine_intrinsics: bool,
+    outliers: &str,
+    outlier_rate: f64,
+    pixel_noise: Option<f64>,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<CameraCalibration> {
     let m = mounting_of(mounting, camera_link.as_deref())?;
+    let outliers = crate::calibrate::outliers_of(outliers, outlier_rate)?;
+    if let Some(s) = pixel_noise
+        && !(s.is_finite() && s > 0.0)
+    {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "pixel_noise={s}: the detector's stated σ per pixel coordinate must be a number > 0 (px)"
+        )));
+    }
     let (cam0, tgt0) = (
         camera_pose.map(|c| six(py, c, "camera_pose")).transpose()?,
         target_pose.map(|t| six(py, t, "target_pose")).transpose()?,
@@ -212,6 +230,8 @@ pub fn calibrate_camera(
                 camera: cam0.map(|c| activecal::pool::camera_view::placement(&c)),
                 target_pose: tgt0.map(|t| activecal::pool::camera_view::placement(&t)),
                 refine_intrinsics,
+                outliers,
+                pixel_noise,
             };
             let lm = LmSettings::builder()
                 .max_iterations(MAX_ITERATIONS)
@@ -223,6 +243,12 @@ pub fn calibrate_camera(
             Ok((cal, report))
         })
     })?;
+    // What the command line prints as a note or a warning reaches Python
+    // as one.
+    let warnings = report["warnings"].as_array().cloned().unwrap_or_default();
+    for n in cal.notes.iter().map(String::as_str).chain(warnings.iter().filter_map(|w| w.as_str())) {
+        crate::convert::warn(py, n)?;
+    }
     Ok(CameraCalibration { cal, report })
 }
 

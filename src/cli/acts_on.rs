@@ -110,15 +110,17 @@ pub const CALIBRATE: &[Rule] = &[
         &[Simulated, Points, Poses],
         "a contact fit's σ is estimated from its residuals; a camera's is --pixel-noise",
     ),
+    r("outliers", READ, ""),
+    r("outlier_rate", READ, ""),
     r(
-        "outliers",
-        &[Points, Poses],
-        "the gross-error test is of a tracker's poses",
+        "orientation_noise",
+        &[Poses],
+        "it is a tracker's orientation σ; only full poses carry orientations",
     ),
     r(
-        "outlier_rate",
-        &[Points, Poses],
-        "the gross-error test is of a tracker's poses",
+        "pixel_noise",
+        &[Pixels],
+        "it is a camera's σ in pixels; a tracker's is --noise",
     ),
     r(
         "seed",

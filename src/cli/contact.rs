@@ -129,6 +129,8 @@ pub struct ContactArgs<'a> {
     pub json: bool,
     /// `--report DIR` (checked before the fit).
     pub report: Option<&'a Path>,
+    /// `--outliers`, `--outlier-rate`.
+    pub outliers: activecal::identify::outliers::OutlierChoice,
 }
 
 /// Calibrates from a contact file; `Ok(Some(why))` when the fit did not
@@ -161,6 +163,7 @@ pub fn calibrate_contacts(
         .lm(lm)
         .loss(super::measured::loss_choice(a.loss, a.loss_scale)?)
         .keep(a.free.to_vec())
+        .outliers(a.outliers)
         .build()?;
     let activecal::experiment::contacts::ContactCalibration {
         fit,
@@ -169,10 +172,15 @@ pub fn calibrate_contacts(
         predicted,
         frames: all_frames,
         implausible,
+        file: fitted,
+        outliers,
+        notes,
     } = activecal::experiment::contacts::calibrate_contacts(
         robot, &file, &known, &given, &settings,
     )?;
-    let held = held_out(a, robot, &file, &given, &settings)?;
+    // The rows kept: those left out as gross errors are neither fitted
+    // nor held out.
+    let held = held_out(a, robot, &fitted, &given, &settings)?;
     let frames = if a.out.is_empty() { None } else { all_frames };
     let written = match &frames {
         Some(f) if fit.converged && implausible.is_none() => {
@@ -184,6 +192,8 @@ pub fn calibrate_contacts(
         "robot": robot.name,
         "measurements": path.display().to_string(),
         "rows": file.qs.len(),
+        "outliers": {"choice": settings.outliers, "left_out": outliers},
+        "notes": notes,
         "fit": fit,
         "downweighted": down,
         "in_sample": figures,
@@ -193,7 +203,10 @@ pub fn calibrate_contacts(
         "out": written,
         "exit_status": if fit.converged && implausible.is_none() { 0 } else { 3 },
     });
-    let mut report = text(&file, &fit, &figures, held.as_ref());
+    let mut report = text(&fitted, &fit, &figures, held.as_ref());
+    for n in &notes {
+        let _ = writeln!(report, "note: {n}");
+    }
     if let Some(p) = &predicted {
         let _ = writeln!(
             report,
@@ -210,7 +223,7 @@ pub fn calibrate_contacts(
     if let Some(dir) = a.report {
         let r = super::contact_report::ContactReport {
             robot,
-            file: &file,
+            file: &fitted,
             fit: &fit,
             figures: &figures,
             held: held.as_ref(),

@@ -55,6 +55,10 @@ pub struct MeasuredSettings {
     /// The sensor's stated σ per position coordinate (metres), tested
     /// against the fit's σ̂ ([`crate::identify::variance::NoiseTest`]).
     pub stated_noise: Option<f64>,
+    /// The sensor's stated σ per orientation axis (radians, full poses),
+    /// tested against the orientation block's σ
+    /// ([`crate::identify::variance::BlockNoiseTest`]).
+    pub stated_orientation_noise: Option<f64>,
 }
 
 /// A calibration from measurements: the robot as fitted, the fit, its
@@ -161,6 +165,10 @@ pub struct MeasuredReport {
     /// σ̂ tested against the stated noise, when one was given.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub noise_test: Option<crate::identify::variance::NoiseTest>,
+    /// The orientation block's σ tested against the stated orientation
+    /// noise, when one was given (full poses).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orientation_noise_test: Option<crate::identify::variance::BlockNoiseTest>,
     /// What the user should look at: the fit is written, but something in
     /// the data or the model is not as stated.
     pub warnings: Vec<String>,
@@ -537,7 +545,12 @@ pub fn calibrate_read(
     let noise_test = s.stated_noise.and_then(|sigma| {
         crate::identify::variance::NoiseTest::new(sigma, f.id.sigma_hat?, f.id.dof)
     });
-    let warnings: Vec<String> = noise_test.iter().filter_map(|t| t.warning()).collect();
+    let orientation_noise_test = orientation_test(s, &noise.blocks);
+    let warnings: Vec<String> = noise_test
+        .iter()
+        .filter_map(|t| t.warning())
+        .chain(orientation_noise_test.iter().filter_map(|t| t.warning()))
+        .collect();
     let base =
         crate::report::MeasuredCalibrationReport::new(&r, &f.id, source.to_string(), meas.len());
     let report = MeasuredReport {
@@ -565,9 +578,27 @@ pub fn calibrate_read(
         noise,
         predicted,
         noise_test,
+        orientation_noise_test,
         warnings,
     };
     finish(r, f, report)
+}
+
+/// The orientation block's σ (full poses) tested against the stated
+/// orientation noise, when one was given; its degrees of freedom the
+/// block's redundancy, rounded.
+fn orientation_test(
+    s: &MeasuredSettings,
+    blocks: &[crate::identify::variance::BlockSigma],
+) -> Option<crate::identify::variance::BlockNoiseTest> {
+    let stated = s.stated_orientation_noise?;
+    let b = blocks.iter().find(|b| b.block == "orientation")?;
+    crate::identify::variance::BlockNoiseTest::new(
+        crate::identify::variance::NoiseOf::Orientation,
+        stated,
+        b.sigma,
+        b.redundancy.round() as usize,
+    )
 }
 
 /// The nominal model's errors on the data: with a mounted start, the

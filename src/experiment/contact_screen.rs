@@ -13,7 +13,7 @@ use crate::identify::contact::{
     tool_points,
 };
 use crate::identify::outliers::{
-    Flag, MOST_OUTLIERS, OutlierChoice, PoseTest, Snoop, flagged, kept_of, snoop, too_many_note,
+    Capped, Flag, Flagged, MOST_OUTLIERS, OutlierChoice, PoseTest, Snoop, flagged, kept_of, snoop, too_many_note,
 };
 use crate::identify::LossChoice;
 use crate::measure::contact::KnownDistance;
@@ -81,19 +81,21 @@ impl Snoop for Rows<'_> {
         fit_contacts(self.robot, &self.robot.nominal, &sub, &known, self.settings)
     }
 
-    fn flag(&mut self, fit: &ContactFit, out: &[usize], alpha: f64) -> Option<Flag<usize>> {
-        if !fit.converged {
-            return None;
+    fn flag(&mut self, fit: &ContactFit, out: &[usize], alpha: f64) -> Flagged<usize> {
+        let Some(flag) = self.worst(fit, out, alpha) else {
+            return Flagged::Clean;
+        };
+        let row = flag.unit;
+        let g = self.file.groups[row];
+        let name = self.file.name_of(g);
+        let rows_of_g = self.file.rows_of(g).len();
+        let most = point_most(rows_of_g);
+        if out.iter().filter(|&&i| self.file.groups[i] == g).count() >= most {
+            return Flagged::Systematic(format!(
+                "the gross-error test flags more than {most} of the {rows_of_g} rows of '{name}': not isolated glitches but a point that moved during the capture, or a model that misses something near it (joint sag under gravity, a flexing tool); every row is kept"
+            ));
         }
         let kept = kept_of(self.file.qs.len(), out);
-        let (sub, known) = self.without(out).ok()?;
-        let tester = row_tester(fit, &self.robot.nominal, &sub, &known)?;
-        let tests: Vec<PoseTest> = (0..sub.qs.len())
-            .filter_map(|i| tester.test(i, &[3 * i, 3 * i + 1, 3 * i + 2]))
-            .collect();
-        let worst = flagged(&tests, alpha)?;
-        let row = kept[worst.pose];
-        let g = self.file.groups[row];
         let left = kept
             .iter()
             .filter(|&&i| i != row && self.file.groups[i] == g)
@@ -105,18 +107,40 @@ impl Snoop for Rows<'_> {
             });
         if left.len() < MIN_DISTINCT {
             self.notes.push(format!(
-                "line {} ({}) fails the gross-error test (test value {:.1}, P = {:.1e}) but is kept: without it '{}' would have {} different configuration(s), fewer than the {MIN_DISTINCT} a fit needs",
+                "line {} ({name}) fails the gross-error test (test value {:.1}, P = {:.1e}) but is kept: without it '{name}' would have {} different configuration(s), fewer than the {MIN_DISTINCT} a fit needs",
                 self.file.lines[row],
-                self.file.name_of(g),
-                worst.statistic,
-                worst.p_value,
-                self.file.name_of(g),
+                flag.test.statistic,
+                flag.test.p_value,
                 left.len()
             ));
+            return Flagged::Clean;
+        }
+        Flagged::Unit(flag)
+    }
+}
+
+/// The most rows of one point (or plane) with `n` rows the test may leave
+/// out: a fifth ([`MOST_OUTLIERS`]), at least 2 (two contacts seated wrong
+/// at one socket are still glitches).
+fn point_most(n: usize) -> usize {
+    ((MOST_OUTLIERS * n as f64).floor() as usize).max(2)
+}
+
+impl Rows<'_> {
+    /// The row the test flags at `fit` (with `out` left out), if any.
+    fn worst(&self, fit: &ContactFit, out: &[usize], alpha: f64) -> Option<Flag<usize>> {
+        if !fit.converged {
             return None;
         }
+        let kept = kept_of(self.file.qs.len(), out);
+        let (sub, known) = self.without(out).ok()?;
+        let tester = row_tester(fit, &self.robot.nominal, &sub, &known)?;
+        let tests: Vec<PoseTest> = (0..sub.qs.len())
+            .filter_map(|i| tester.test(i, &[3 * i, 3 * i + 1, 3 * i + 2]))
+            .collect();
+        let worst = flagged(&tests, alpha)?;
         Some(Flag {
-            unit: row,
+            unit: kept[worst.pose],
             test: worst.clone(),
             threshold: alpha / tests.len() as f64,
         })
@@ -158,8 +182,10 @@ pub fn screen_contacts(
     let most = (MOST_OUTLIERS * file.qs.len() as f64).floor() as usize;
     let snooped = snoop(&mut rows, alpha, most)?;
     let mut notes = std::mem::take(&mut rows.notes);
-    if snooped.capped {
-        notes.push(too_many_note(most, file.qs.len(), "rows"));
+    match snooped.capped {
+        Some(Capped::Total) => notes.push(too_many_note(most, file.qs.len(), "rows")),
+        Some(Capped::Systematic(why)) => notes.push(why),
+        None => {}
     }
     let out: Vec<usize> = snooped.out.iter().map(|f| f.unit).collect();
     let (sub, sub_known) = if out.is_empty() {

@@ -271,8 +271,31 @@ pub trait Snoop {
         from: Option<&Self::Fit>,
     ) -> std::result::Result<Self::Fit, Self::Error>;
     /// The unit the test flags at `fit` (made with `out` left out) at
-    /// family-wise rate `alpha` ([`flagged`]), if any.
-    fn flag(&mut self, fit: &Self::Fit, out: &[Self::Unit], alpha: f64) -> Option<Flag<Self::Unit>>;
+    /// family-wise rate `alpha` ([`flagged`]), if any; or why the units
+    /// flagged are not isolated glitches (every unit is then kept).
+    fn flag(&mut self, fit: &Self::Fit, out: &[Self::Unit], alpha: f64) -> Flagged<Self::Unit>;
+}
+
+/// What [`Snoop::flag`] found.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Flagged<U> {
+    /// No unit is flagged.
+    Clean,
+    /// This unit.
+    Unit(Flag<U>),
+    /// Too many units of one kind are flagged (e.g. many rows of one
+    /// contact point): not glitches but a model or a setup other than
+    /// assumed, in these words.
+    Systematic(String),
+}
+
+/// Why [`snoop`] kept every unit.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Capped {
+    /// The test would leave out more than the most allowed.
+    Total,
+    /// [`Flagged::Systematic`], with its words.
+    Systematic(String),
 }
 
 /// The outcome of [`snoop`].
@@ -282,8 +305,8 @@ pub struct Snooped<F, U> {
     pub fit: F,
     /// The units left out, in the order the test found them.
     pub out: Vec<Flag<U>>,
-    /// The test flagged more than the most allowed: every unit is kept.
-    pub capped: bool,
+    /// Why every unit is kept though the test flags some, if it does.
+    pub capped: Option<Capped>,
 }
 
 /// Baarda's data snooping iterated: the unit the test flags at rate
@@ -301,14 +324,22 @@ pub fn snoop<S: Snoop>(
     let mut out: Vec<Flag<S::Unit>> = Vec::new();
     loop {
         let units: Vec<S::Unit> = out.iter().map(|f| f.unit.clone()).collect();
-        let Some(flag) = s.flag(&fit, &units, alpha) else {
-            break;
+        let flag = match s.flag(&fit, &units, alpha) {
+            Flagged::Clean => break,
+            Flagged::Unit(f) => f,
+            Flagged::Systematic(why) => {
+                return Ok(Snooped {
+                    fit: all,
+                    out: Vec::new(),
+                    capped: Some(Capped::Systematic(why)),
+                });
+            }
         };
         if out.len() >= most {
             return Ok(Snooped {
                 fit: all,
                 out: Vec::new(),
-                capped: true,
+                capped: Some(Capped::Total),
             });
         }
         out.push(flag);
@@ -318,7 +349,7 @@ pub fn snoop<S: Snoop>(
     Ok(Snooped {
         fit,
         out,
-        capped: false,
+        capped: None,
     })
 }
 

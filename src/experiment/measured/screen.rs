@@ -4,7 +4,7 @@
 
 use super::MeasuredSettings;
 use crate::identify::outliers::{
-    Flag, MOST_OUTLIERS, Outlier, OutlierChoice, Snoop, flagged, kept_of, pose_tests, snoop,
+    Flag, Flagged, MOST_OUTLIERS, Outlier, OutlierChoice, Snoop, flagged, kept_of, pose_tests, snoop,
     too_many_note,
 };
 use crate::identify::{LossChoice, Measurements, residuals};
@@ -59,13 +59,20 @@ impl Snoop for Poses<'_> {
         )
     }
 
-    fn flag(&mut self, wf: &Self::Fit, out: &[usize], alpha: f64) -> Option<Flag<usize>> {
+    fn flag(&mut self, wf: &Self::Fit, out: &[usize], alpha: f64) -> Flagged<usize> {
         let kept = kept_of(self.meas.len(), out);
         let sub = self.meas.subset(&kept);
-        let mut prob = crate::identify::Calibration::new(&wf.robot, &wf.start, &sub).ok()?;
-        let tests = pose_tests(&mut prob, &wf.fit.id.estimate, sub.len(), self.s.stated_noise)?;
-        let worst = flagged(&tests, alpha)?;
-        Some(Flag {
+        let Ok(mut prob) = crate::identify::Calibration::new(&wf.robot, &wf.start, &sub) else {
+            return Flagged::Clean;
+        };
+        let Some(tests) = pose_tests(&mut prob, &wf.fit.id.estimate, sub.len(), self.s.stated_noise)
+        else {
+            return Flagged::Clean;
+        };
+        let Some(worst) = flagged(&tests, alpha) else {
+            return Flagged::Clean;
+        };
+        Flagged::Unit(Flag {
             unit: kept[worst.pose],
             test: worst.clone(),
             threshold: alpha / tests.len() as f64,
@@ -105,7 +112,7 @@ pub(super) fn screen(
     };
     let most = (MOST_OUTLIERS * meas.len() as f64).floor() as usize;
     let snooped = snoop(&mut poses, alpha, most)?;
-    if snooped.capped {
+    if snooped.capped.is_some() {
         notes.push(too_many_note(most, meas.len(), "poses"));
     }
     let wf = snooped.fit;

@@ -15,7 +15,7 @@
 use super::{CameraFit, CameraFitError, CameraObservations, fit_camera};
 use crate::identify::LmSettings;
 use crate::identify::outliers::{
-    Flag, MOST_OUTLIERS, OutlierChoice, PoseTest, Snoop, Tester, flagged, snoop, tail_of,
+    Flag, Flagged, MOST_OUTLIERS, OutlierChoice, PoseTest, Snoop, Tester, flagged, snoop, tail_of,
     too_many_note,
 };
 use crate::identify::residual::{Calibration, Residuals};
@@ -117,7 +117,14 @@ impl Snoop for Pixels<'_> {
         fit_camera(self.robot, self.sensor, self.own0, &without(self.obs, out), self.lm)
     }
 
-    fn flag(&mut self, fit: &CameraFit, out: &[CameraUnit], alpha: f64) -> Option<Flag<CameraUnit>> {
+    fn flag(&mut self, fit: &CameraFit, out: &[CameraUnit], alpha: f64) -> Flagged<CameraUnit> {
+        self.flag_of(fit, out, alpha).map_or(Flagged::Clean, Flagged::Unit)
+    }
+}
+
+impl Pixels<'_> {
+    /// [`Snoop::flag`], `None` for a clean fit.
+    fn flag_of(&self, fit: &CameraFit, out: &[CameraUnit], alpha: f64) -> Option<Flag<CameraUnit>> {
         if !fit.converged {
             return None;
         }
@@ -254,7 +261,7 @@ pub fn screen_camera(
     let most = (MOST_OUTLIERS * obs.qs.len() as f64).floor() as usize;
     let snooped = snoop(&mut px, alpha, most)?;
     let mut notes = Vec::new();
-    if snooped.capped {
+    if snooped.capped.is_some() {
         notes.push(too_many_note(most, obs.qs.len(), "poses or points"));
     }
     let units: Vec<CameraUnit> = snooped.out.iter().map(|f| f.unit).collect();

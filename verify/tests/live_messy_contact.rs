@@ -1,7 +1,10 @@
 //! A contact seated wrong, against a known true robot (issue #49 items 1
 //! and 3; feature `live`, the project venv and `target/debug/activecal`):
 //! `truth.py make` perturbs a UR5's joint origins (0.5–2 mm, 0.05–0.3°) and
-//! its tool point (a ball 2 mm off the nominal); `contact_truth.py
+//! its tool point (a ball 2 mm from `tool0`'s origin, where the nominal
+//! has it, as MUKCa's ball on its link; a ball 112 mm off the flange left
+//! σ̂ 0.065 mm on noise-free contacts, a model misfit that is not this
+//! test's subject); `contact_truth.py
 //! contacts` seats the true ball in 8 sockets (4 placements of two, 50 mm
 //! apart), 12 configurations each, with a seating error of 0.05 mm per
 //! axis, by Pinocchio's forward kinematics; `activecal calibrate` fits the
@@ -120,7 +123,7 @@ fn a_contact_seated_wrong_is_left_out() {
             s("--seed"),
             s("1"),
             s("--marker"),
-            s("0.0,0.05,0.1"),
+            s("0.0,0.0,0.0"),
             s("--out"),
             s("truth.json"),
         ],
@@ -193,6 +196,11 @@ fn a_contact_seated_wrong_is_left_out() {
     assert!(
         t_with <= RATIO * t_clean,
         "true error {t_with} mm, clean {t_clean} mm"
+    );
+    // The glitches matter: kept, they spoil the fit.
+    assert!(
+        t_kept > RATIO * rms(&true_rms(&dir, &without[..1])),
+        "draw 0 kept: {t_kept} mm"
     );
     let _ = std::fs::remove_dir_all(&dir);
 }

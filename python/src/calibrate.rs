@@ -403,13 +403,16 @@ impl Calibration {
             "# Calibrated by activecal (Python).\n",
             path,
             overwrite,
+            &[],
         )
     }
 }
 
 /// Writes a calibrated robot (`table`, with its frames when it has them) as
 /// `format` to `path` after `header`, atomically; an existing file only with
-/// `overwrite`.
+/// `overwrite`, and never an input of the call that made it (`inputs`, and
+/// the robot's own URDF), even with `overwrite`.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn write_robot(
     format: Format,
     robot: &activecal::model::Robot,
@@ -418,6 +421,7 @@ pub(crate) fn write_robot(
     header: &str,
     path: &std::path::Path,
     overwrite: bool,
+    inputs: &[&std::path::Path],
 ) -> PyResult<()> {
     let text = activecal::io::calibrated::render(format, robot, table, frames, header)
         .map_err(|e| arg_err("path", format!("{}: {e}", path.display())))?;
@@ -425,7 +429,11 @@ pub(crate) fn write_robot(
         label: "path",
         path,
     }];
-    activecal::io::atomic::check_outputs(&out, &[], overwrite)
+    let mut all: Vec<&std::path::Path> = inputs.to_vec();
+    if let Some(src) = robot.source.as_ref() {
+        all.push(std::path::Path::new(&src.path));
+    }
+    activecal::io::atomic::check_outputs(&out, &all, overwrite)
         .map_err(|e| crate::convert::Fail::from(e).into_py())?;
     activecal::io::atomic::write_atomic(path, text.as_bytes())
         .map_err(|e| crate::convert::Fail::from(e).into_py())

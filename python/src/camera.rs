@@ -151,6 +151,8 @@ pub(crate) fn chain_of(
 pub struct CameraCalibration {
     cal: Calibrated,
     report: serde_json::Value,
+    /// The files the call read.
+    inputs: Vec<PathBuf>,
 }
 
 /// Calibrates the robot from a camera's pixels of a target, as `activecal
@@ -209,6 +211,13 @@ pub fn calibrate_camera(
     let obs_src = observations_source(observations)?;
     let info_src = yaml_source(py, camera_info, "camera_info")?;
     let target_src = yaml_source(py, target, "target")?;
+    let inputs: Vec<PathBuf> = [&obs_src, &info_src, &target_src]
+        .into_iter()
+        .filter_map(|s| match s {
+            Source::File(p) => Some(p.clone()),
+            Source::Text(_) => None,
+        })
+        .collect();
     let inner = robot.inner.clone();
     let (cal, report) = crate::progress::with_callback(progress, || {
         detached(py, move || {
@@ -249,7 +258,11 @@ pub fn calibrate_camera(
     for n in cal.notes.iter().map(String::as_str).chain(warnings.iter().filter_map(|w| w.as_str())) {
         crate::convert::warn(py, n)?;
     }
-    Ok(CameraCalibration { cal, report })
+    Ok(CameraCalibration {
+        cal,
+        report,
+        inputs,
+    })
 }
 
 /// Reads the observations for the chain `robot`.
@@ -269,18 +282,24 @@ fn read_observations(
 }
 
 /// Writes `text` to `path` atomically; an existing file only with
-/// `overwrite`.
-fn write_text(path: &Path, text: &str, overwrite: bool) -> PyResult<()> {
+/// `overwrite`, never one of `inputs`.
+fn write_text(path: &Path, text: &str, overwrite: bool, inputs: &[&Path]) -> PyResult<()> {
     let out = [activecal::io::atomic::Output {
         label: "path",
         path,
     }];
-    activecal::io::atomic::check_outputs(&out, &[], overwrite)
+    activecal::io::atomic::check_outputs(&out, inputs, overwrite)
         .map_err(|e| Fail::from(e).into_py())?;
     activecal::io::atomic::write_atomic(path, text.as_bytes()).map_err(|e| Fail::from(e).into_py())
 }
 
 impl CameraCalibration {
+    /// The files the call read (observations, camera_info, target given as
+    /// paths): never written over.
+    fn inputs(&self) -> Vec<&Path> {
+        self.inputs.iter().map(PathBuf::as_path).collect()
+    }
+
     /// Refuses to write what the library refuses (a fit that did not
     /// converge or cannot be right), with its reason.
     fn check_converged(&self, path: &Path) -> PyResult<()> {
@@ -314,6 +333,7 @@ impl CameraCalibration {
             "",
             path,
             overwrite,
+            &self.inputs(),
         )
     }
 
@@ -460,10 +480,15 @@ impl CameraCalibration {
             "intrinsics refined by activecal calibrate --refine-intrinsics from {}",
             self.cal.observations.origin
         );
+        let mut inputs = self.inputs();
+        if let Some(src) = self.cal.fit.robot.source.as_ref() {
+            inputs.push(Path::new(&src.path));
+        }
         write_text(
             &path,
             &self.cal.camera_info_text(&name, &comment),
             overwrite,
+            &inputs,
         )
     }
 

@@ -213,6 +213,7 @@ impl ContactCalibration {
             "",
             path,
             overwrite,
+            &[],
         )
     }
 }

@@ -87,6 +87,8 @@ fn sample(command: &str, id: &str) -> Option<(&'static [&'static str], &'static 
         ("calibrate", "trials" | "validation" | "max_iterations") => (&[], "3"),
         ("calibrate", "loss_scale") => (&[], "0.01"),
         ("calibrate", "outlier_rate") => (&[], "0.05"),
+        ("calibrate", "orientation_noise") => (&[], "0.001"),
+        ("calibrate", "pixel_noise") => (&[], "0.3"),
         ("calibrate", "fix" | "free") => (&[], "d_2"),
         ("calibrate", "holdout") => (&[], "0.2"),
         ("calibrate", "splits") => (&["--holdout", "0.2"], "3"),

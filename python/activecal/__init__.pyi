@@ -364,6 +364,10 @@ def calibrate(
     splits: int = 4,
     seed: int = 0,
     compliance: bool = False,
+    outliers: str = "drop",
+    outlier_rate: float = 0.01,
+    noise: Optional[float] = None,
+    orientation_noise: Optional[float] = None,
     progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
 ) -> Calibration:
     """Calibrates the robot from measured poses, as ``activecal calibrate
@@ -447,6 +451,8 @@ def calibrate_contacts(
     max_iterations: int = 200,
     loss: str = "l2",
     loss_scale: Optional[float] = None,
+    outliers: str = "drop",
+    outlier_rate: float = 0.01,
     progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
 ) -> ContactCalibration:
     """Calibrates the robot from contacts, as ``activecal calibrate
@@ -516,6 +522,9 @@ def calibrate_camera(
     mounting: Optional[str] = None,
     camera_link: Optional[str] = None,
     refine_intrinsics: bool = False,
+    outliers: str = "drop",
+    outlier_rate: float = 0.01,
+    pixel_noise: Optional[float] = None,
     progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
 ) -> CameraCalibration:
     """Calibrates the robot from a camera's pixels of a target, as

@@ -4,6 +4,7 @@
 
 use crate::convert::{arg_err, count, detached, err, float_array, json_to_py, named_columns, rows};
 use crate::robot::Robot;
+use activecal::experiment::acts_on::{self as lib_acts, Sensor};
 use activecal::experiment::measured::{MeasuredSettings, calibrate_measurements};
 use activecal::frames::CalibratedFrames;
 use activecal::frames::report::FramesReport;
@@ -290,6 +291,34 @@ pub fn calibrate(
     orientation_noise: Option<f64>,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Calibration> {
+    // Each keyword argument given acts on the data's sensor or is refused
+    // (the command line's table).
+    let given: Vec<&str> = [
+        ("fix", fix.is_some()),
+        ("free", free.is_some()),
+        ("max_iterations", max_iterations != 200),
+        ("loss", loss != "l2"),
+        ("loss_scale", loss_scale.is_some()),
+        ("weights", weights.is_some()),
+        ("orientation_scale", orientation_scale.is_some()),
+        ("holdout", holdout.is_some()),
+        ("splits", splits != 4),
+        ("seed", seed != 0),
+        ("compliance", compliance),
+        ("outliers", outliers != "drop"),
+        ("outlier_rate", outlier_rate != 0.01),
+        ("noise", noise.is_some()),
+        ("orientation_noise", orientation_noise.is_some()),
+    ]
+    .into_iter()
+    .filter_map(|(k, g)| g.then_some(k))
+    .collect();
+    let sensor = if orientations.is_some() {
+        Sensor::Poses
+    } else {
+        Sensor::Points
+    };
+    refuse_unused(lib_acts::CALIBRATE, &given, sensor)?;
     let weights = weights_of(weights, orientation_scale)?;
     let outliers = outliers_of(outliers, outlier_rate)?;
     let gravity = compliance
@@ -560,7 +589,40 @@ pub fn evaluate<'py>(
 
 /// The outlier choice of `outliers=` ("drop" or "keep") and
 /// `outlier_rate=`.
-pub(crate) fn outliers_of(kind: &str, rate: f64) -> PyResult<activecal::identify::outliers::OutlierChoice> {
+/// Refuses each keyword argument of `given` that does not act on `sensor`
+/// by `table` (the command line's, [`activecal::experiment::acts_on`]),
+/// naming the argument and the sensor.
+pub(crate) fn refuse_unused(
+    table: &[lib_acts::ActsOn],
+    given: &[&str],
+    sensor: Sensor,
+) -> PyResult<()> {
+    let unused = lib_acts::not_acting(table, given, &[sensor]);
+    if unused.is_empty() {
+        return Ok(());
+    }
+    let lines: Vec<String> = unused
+        .iter()
+        .map(|k| {
+            let on: Vec<&str> = lib_acts::sensors_of(table, k)
+                .unwrap_or_default()
+                .iter()
+                .map(|s| s.words())
+                .collect();
+            format!(
+                "{k}: not used with {}; it acts on {}",
+                sensor.words(),
+                on.join(" or ")
+            )
+        })
+        .collect();
+    Err(pyo3::exceptions::PyValueError::new_err(lines.join("\n")))
+}
+
+pub(crate) fn outliers_of(
+    kind: &str,
+    rate: f64,
+) -> PyResult<activecal::identify::outliers::OutlierChoice> {
     use activecal::identify::outliers::{OutlierChoice, check_choice};
     let c = match kind {
         "drop" => OutlierChoice::Drop { alpha: rate },

@@ -196,6 +196,24 @@ pub fn calibrate_camera(
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<CameraCalibration> {
     let m = mounting_of(mounting, camera_link.as_deref())?;
+    let given: Vec<&str> = [
+        ("camera_pose", camera_pose.is_some()),
+        ("target_pose", target_pose.is_some()),
+        ("mounting", mounting.is_some()),
+        ("camera_link", camera_link.is_some()),
+        ("refine_intrinsics", refine_intrinsics),
+        ("outliers", outliers != "drop"),
+        ("outlier_rate", outlier_rate != 0.01),
+        ("pixel_noise", pixel_noise.is_some()),
+    ]
+    .into_iter()
+    .filter_map(|(k, g)| g.then_some(k))
+    .collect();
+    crate::calibrate::refuse_unused(
+        activecal::experiment::acts_on::CALIBRATE,
+        &given,
+        activecal::experiment::acts_on::Sensor::Pixels,
+    )?;
     let outliers = crate::calibrate::outliers_of(outliers, outlier_rate)?;
     if let Some(s) = pixel_noise
         && !(s.is_finite() && s > 0.0)
@@ -255,7 +273,12 @@ pub fn calibrate_camera(
     // What the command line prints as a note or a warning reaches Python
     // as one.
     let warnings = report["warnings"].as_array().cloned().unwrap_or_default();
-    for n in cal.notes.iter().map(String::as_str).chain(warnings.iter().filter_map(|w| w.as_str())) {
+    for n in cal
+        .notes
+        .iter()
+        .map(String::as_str)
+        .chain(warnings.iter().filter_map(|w| w.as_str()))
+    {
         crate::convert::warn(py, n)?;
     }
     Ok(CameraCalibration {

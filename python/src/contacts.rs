@@ -105,6 +105,22 @@ pub fn calibrate_contacts(
     outlier_rate: f64,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<ContactCalibration> {
+    let given: Vec<&str> = [
+        ("free", free.is_some()),
+        ("max_iterations", max_iterations != 200),
+        ("loss", loss != "l2"),
+        ("loss_scale", loss_scale.is_some()),
+        ("outliers", outliers != "drop"),
+        ("outlier_rate", outlier_rate != 0.01),
+    ]
+    .into_iter()
+    .filter_map(|(k, g)| g.then_some(k))
+    .collect();
+    crate::calibrate::refuse_unused(
+        activecal::experiment::acts_on::CALIBRATE,
+        &given,
+        activecal::experiment::acts_on::Sensor::Contacts,
+    )?;
     let outliers = crate::calibrate::outliers_of(outliers, outlier_rate)?;
     let inner = robot.inner.clone();
     let dof = inner.dof();

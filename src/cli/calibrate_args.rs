@@ -337,7 +337,11 @@ impl CalibrateArgs {
     /// a finite number > 0.
     pub fn check_stated_noises(&self) -> anyhow::Result<()> {
         for (flag, v, unit) in [
-            ("--orientation-noise", self.orientation_noise, "radians per axis"),
+            (
+                "--orientation-noise",
+                self.orientation_noise,
+                "radians per axis",
+            ),
             ("--pixel-noise", self.pixel_noise, "px per coordinate"),
         ] {
             if let Some(v) = v

@@ -11,9 +11,9 @@ use crate::frames::camera::camera_frames;
 use crate::frames::report::FramesReport;
 use crate::frames::{CalibratedFrames, FramesError};
 use crate::identify::LmSettings;
+use crate::identify::camera::screen::{CameraOutlier, screen_camera};
 use crate::identify::camera::start::labels::{Labels, relabel};
 use crate::identify::camera::start::{CameraStart, StartError, start_placements};
-use crate::identify::camera::screen::{CameraOutlier, screen_camera};
 use crate::identify::camera::{CameraFit, CameraFitError, CameraObservations};
 use crate::identify::outliers::OutlierChoice;
 use crate::identify::variance::{BlockNoiseTest, NoiseOf};
@@ -228,9 +228,9 @@ pub fn calibrate_camera(
         r => r?,
     };
     let fit = screened.fit;
-    let noise_test = setup.pixel_noise.and_then(|px| {
-        BlockNoiseTest::new(NoiseOf::Pixels, px, fit.sigma_px?, fit.redundancy)
-    });
+    let noise_test = setup
+        .pixel_noise
+        .and_then(|px| BlockNoiseTest::new(NoiseOf::Pixels, px, fit.sigma_px?, fit.redundancy));
     let mut frames = camera_frames(&fit)?;
     if let Some(c) = frames.as_mut().and_then(|f| f.1.camera.as_mut()) {
         c.camera_link.clone_from(&setup.camera_link);

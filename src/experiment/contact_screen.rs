@@ -6,6 +6,7 @@
 //! is not left out (the fit would have nothing to determine it by): the
 //! test stops there with a note.
 
+use crate::identify::LossChoice;
 use crate::identify::contact::data::MIN_DISTINCT;
 use crate::identify::contact::fit::row_tester;
 use crate::identify::contact::{
@@ -13,9 +14,9 @@ use crate::identify::contact::{
     tool_points,
 };
 use crate::identify::outliers::{
-    Capped, Flag, Flagged, MOST_OUTLIERS, OutlierChoice, PoseTest, Snoop, flagged, kept_of, snoop, too_many_note,
+    Capped, Flag, Flagged, MOST_OUTLIERS, OutlierChoice, PoseTest, Snoop, flagged, kept_of, snoop,
+    too_many_note,
 };
-use crate::identify::LossChoice;
 use crate::measure::contact::KnownDistance;
 use crate::model::Robot;
 use nalgebra::Vector3;
@@ -76,7 +77,11 @@ impl Snoop for Rows<'_> {
     type Fit = ContactFit;
     type Error = crate::identify::IdentifyError;
 
-    fn fit(&mut self, out: &[usize], _from: Option<&ContactFit>) -> crate::identify::Result<ContactFit> {
+    fn fit(
+        &mut self,
+        out: &[usize],
+        _from: Option<&ContactFit>,
+    ) -> crate::identify::Result<ContactFit> {
         let (sub, known) = self.without(out)?;
         fit_contacts(self.robot, &self.robot.nominal, &sub, &known, self.settings)
     }
@@ -238,7 +243,12 @@ pub fn screen_contacts(
 /// subset of the rows); NaN when the fit has no such point or plane.
 #[must_use]
 pub fn row_residual(fit: &ContactFit, file: &ContactFile, row: usize) -> f64 {
-    let p = tool_points(&fit.robot, &fit.table, &fit.tool_offset, &file.qs[row..=row])[0];
+    let p = tool_points(
+        &fit.robot,
+        &fit.table,
+        &fit.tool_offset,
+        &file.qs[row..=row],
+    )[0];
     let name = file.name_of(file.groups[row]);
     if let Some(k) = fit.points.iter().position(|n| n == name) {
         return (p - Vector3::from(fit.point_positions[k])).norm();

@@ -6,11 +6,11 @@
 //! The command line and the Python package both call it; held-out
 //! placements are the caller's ([`crate::identify::contact::holdout`]).
 
+use crate::experiment::contact_screen::{ContactOutlier, screen_contacts};
 use crate::frames::CalibratedFrames;
 use crate::frames::report::{FitBlock, FramesReport};
 use crate::identify::contact::holdout::{DownweightedRow, Figures, downweighted_rows, judge};
 use crate::identify::contact::predict::{PREDICTION_CONFIGURATIONS, PredictedTrueError};
-use crate::experiment::contact_screen::{ContactOutlier, screen_contacts};
 use crate::identify::contact::{
     ContactFile, ContactFit, ContactSettings, NamedDistance, resolve_distances, rms, tool_points,
 };

@@ -1,5 +1,6 @@
 //! Experiments: whole pipelines that return typed reports.
 
+pub mod acts_on;
 pub mod camera;
 pub mod contact_screen;
 pub mod contacts;

@@ -78,7 +78,15 @@ fn scene(dir: &Path) -> (Robot, CameraSetup, CameraObservations) {
     let (camera, target) = placements();
     run(python()
         .arg(&script)
-        .args(["make", "--base", "base_link", "--tip", "target", "--seed", "3"])
+        .args([
+            "make",
+            "--base",
+            "base_link",
+            "--tip",
+            "target",
+            "--seed",
+            "3",
+        ])
         .args(["--mounting", "eye-to-hand", "--urdf"])
         .arg(&urdf)
         .arg(format!("--camera={}", six(&camera)))
@@ -189,7 +197,13 @@ fn noisy(obs: &CameraObservations, sigma: f64, seed: u64) -> CameraObservations 
 }
 
 /// Calibrates `obs` and writes `stem.urdf` and `stem.yaml` in `dir`.
-fn calibrate(dir: &Path, robot: &Robot, setup: &CameraSetup, obs: CameraObservations, stem: &str) -> CameraCalibration {
+fn calibrate(
+    dir: &Path,
+    robot: &Robot,
+    setup: &CameraSetup,
+    obs: CameraObservations,
+    stem: &str,
+) -> CameraCalibration {
     let cal = calibrate_camera(robot, obs, setup, &LmSettings::default())
         .unwrap_or_else(|e| panic!("{stem}: {e}"));
     assert!(cal.fit.converged, "{stem}: {:?}", cal.fit.stop);
@@ -228,8 +242,13 @@ fn a_misdetected_corner_and_a_shifted_board_are_left_out() {
     let clean_n = 100;
     let mut flagged = 0;
     for j in 0..clean_n {
-        let cal = calibrate_camera(&robot, noisy(&exact, SIGMA_PX, j), &setup, &LmSettings::default())
-            .unwrap_or_else(|e| panic!("clean {j}: {e}"));
+        let cal = calibrate_camera(
+            &robot,
+            noisy(&exact, SIGMA_PX, j),
+            &setup,
+            &LmSettings::default(),
+        )
+        .unwrap_or_else(|e| panic!("clean {j}: {e}"));
         flagged += usize::from(!cal.outliers.is_empty());
     }
     let bound = false_alarm_bound(0.01, clean_n as usize);
@@ -269,7 +288,10 @@ fn a_misdetected_corner_and_a_shifted_board_are_left_out() {
             .collect();
         both += usize::from(poses.contains(&a) && poses.contains(&b));
         if j == 0 {
-            eprintln!("camera glitches, draw 0 (corner {k} of pose {a}, board of pose {b}): {:?}", cal.notes);
+            eprintln!(
+                "camera glitches, draw 0 (corner {k} of pose {a}, board of pose {b}): {:?}",
+                cal.notes
+            );
             assert!(
                 cal.outliers
                     .iter()
@@ -278,7 +300,9 @@ fn a_misdetected_corner_and_a_shifted_board_are_left_out() {
                 cal.outliers
             );
             assert!(
-                cal.outliers.iter().any(|o| o.unit == CameraUnit::Pose { pose: b }),
+                cal.outliers
+                    .iter()
+                    .any(|o| o.unit == CameraUnit::Pose { pose: b }),
                 "the shifted board's pose is left out: {:?}",
                 cal.outliers
             );
@@ -325,11 +349,19 @@ fn a_stated_pixel_noise_three_times_too_small_is_caught() {
     let (robot, mut setup, exact) = scene(&dir);
     setup.pixel_noise = Some(SIGMA_PX);
     for j in 0..5 {
-        let cal = calibrate_camera(&robot, noisy(&exact, 3.0 * SIGMA_PX, j), &setup, &LmSettings::default())
-            .unwrap_or_else(|e| panic!("draw {j}: {e}"));
+        let cal = calibrate_camera(
+            &robot,
+            noisy(&exact, 3.0 * SIGMA_PX, j),
+            &setup,
+            &LmSettings::default(),
+        )
+        .unwrap_or_else(|e| panic!("draw {j}: {e}"));
         let t = cal.noise_test.as_ref().expect("a noise test");
         let w = cal.report(Vec::new()).warnings.join("; ");
-        eprintln!("stated 0.3 px, true 0.9 px, draw {j}: σ̂ {:.3} px ({:.2}×); {w}", t.estimated, t.ratio);
+        eprintln!(
+            "stated 0.3 px, true 0.9 px, draw {j}: σ̂ {:.3} px ({:.2}×); {w}",
+            t.estimated, t.ratio
+        );
         assert!(t.rejected, "draw {j}: the stated σ is not rejected: {t:?}");
         assert!(
             w.contains("noisier than stated") && w.contains("px"),
@@ -345,7 +377,13 @@ fn a_stated_pixel_noise_three_times_too_small_is_caught() {
         );
     }
     // The stated σ that is right is not rejected.
-    let cal = calibrate_camera(&robot, noisy(&exact, SIGMA_PX, 7), &setup, &LmSettings::default()).unwrap();
+    let cal = calibrate_camera(
+        &robot,
+        noisy(&exact, SIGMA_PX, 7),
+        &setup,
+        &LmSettings::default(),
+    )
+    .unwrap();
     let t = cal.noise_test.as_ref().expect("a noise test");
     assert!(!t.rejected, "{t:?}");
     let _ = std::fs::remove_dir_all(&dir);

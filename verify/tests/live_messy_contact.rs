@@ -78,7 +78,10 @@ fn calibrate(dir: &Path, file: &str, stem: &str, extra: &[&str]) -> Value {
 /// The true errors (mm) of the calibrations `stems`.
 fn true_rms(dir: &Path, stems: &[String]) -> Vec<f64> {
     let mut args = vec![
-        root().join("verify/python/contact_truth.py").display().to_string(),
+        root()
+            .join("verify/python/contact_truth.py")
+            .display()
+            .to_string(),
         "compare".into(),
         "--truth".into(),
         "truth.json".into(),
@@ -131,7 +134,10 @@ fn a_contact_seated_wrong_is_left_out() {
     let made = python(
         &dir,
         &[
-            root().join("verify/python/contact_truth.py").display().to_string(),
+            root()
+                .join("verify/python/contact_truth.py")
+                .display()
+                .to_string(),
             s("contacts"),
             s("--truth"),
             s("truth.json"),
@@ -176,8 +182,17 @@ fn a_contact_seated_wrong_is_left_out() {
             eprintln!("contacts, draw 0: glitched rows {bad:?}; {}", r["notes"]);
             assert!(o["test"]["statistic"].as_f64().unwrap() > 0.0, "{o}");
             assert!(o["residual_mm"].as_f64().unwrap() > 1.0, "{o}");
-            let kept = calibrate(&dir, &format!("{stem}.csv"), "kept", &["--outliers", "keep"]);
-            assert!(left_out(&kept).is_empty(), "--outliers keep: {}", kept["outliers"]);
+            let kept = calibrate(
+                &dir,
+                &format!("{stem}.csv"),
+                "kept",
+                &["--outliers", "keep"],
+            );
+            assert!(
+                left_out(&kept).is_empty(),
+                "--outliers keep: {}",
+                kept["outliers"]
+            );
         }
         with.push(stem);
         without.push(format!("c{d}"));

@@ -4,8 +4,8 @@
 
 use super::MeasuredSettings;
 use crate::identify::outliers::{
-    Flag, Flagged, MOST_OUTLIERS, Outlier, OutlierChoice, Snoop, flagged, kept_of, pose_tests, snoop,
-    too_many_note,
+    Flag, Flagged, MOST_OUTLIERS, Outlier, OutlierChoice, Snoop, flagged, kept_of, pose_tests,
+    snoop, too_many_note,
 };
 use crate::identify::{LossChoice, Measurements, residuals};
 use crate::model::{ParamTable, Robot};
@@ -45,7 +45,11 @@ impl Snoop for Poses<'_> {
     type Fit = crate::identify::WeightedFit;
     type Error = crate::identify::IdentifyError;
 
-    fn fit(&mut self, out: &[usize], from: Option<&Self::Fit>) -> crate::identify::Result<Self::Fit> {
+    fn fit(
+        &mut self,
+        out: &[usize],
+        from: Option<&Self::Fit>,
+    ) -> crate::identify::Result<Self::Fit> {
         let kept = kept_of(self.meas.len(), out);
         let from = from.map_or(self.start, |f| &f.fit.id.table);
         let s = self.s;
@@ -65,8 +69,12 @@ impl Snoop for Poses<'_> {
         let Ok(mut prob) = crate::identify::Calibration::new(&wf.robot, &wf.start, &sub) else {
             return Flagged::Clean;
         };
-        let Some(tests) = pose_tests(&mut prob, &wf.fit.id.estimate, sub.len(), self.s.stated_noise)
-        else {
+        let Some(tests) = pose_tests(
+            &mut prob,
+            &wf.fit.id.estimate,
+            sub.len(),
+            self.s.stated_noise,
+        ) else {
             return Flagged::Clean;
         };
         let Some(worst) = flagged(&tests, alpha) else {
@@ -116,7 +124,10 @@ pub(super) fn screen(
         notes.push(too_many_note(most, meas.len(), "poses"));
     }
     let wf = snooped.fit;
-    let kept = kept_of(meas.len(), &snooped.out.iter().map(|f| f.unit).collect::<Vec<_>>());
+    let kept = kept_of(
+        meas.len(),
+        &snooped.out.iter().map(|f| f.unit).collect::<Vec<_>>(),
+    );
     let found: Vec<(usize, crate::identify::outliers::PoseTest, f64)> = snooped
         .out
         .into_iter()

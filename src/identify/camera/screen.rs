@@ -113,12 +113,23 @@ impl Snoop for Pixels<'_> {
     type Fit = CameraFit;
     type Error = CameraFitError;
 
-    fn fit(&mut self, out: &[CameraUnit], _from: Option<&CameraFit>) -> Result<CameraFit, CameraFitError> {
-        fit_camera(self.robot, self.sensor, self.own0, &without(self.obs, out), self.lm)
+    fn fit(
+        &mut self,
+        out: &[CameraUnit],
+        _from: Option<&CameraFit>,
+    ) -> Result<CameraFit, CameraFitError> {
+        fit_camera(
+            self.robot,
+            self.sensor,
+            self.own0,
+            &without(self.obs, out),
+            self.lm,
+        )
     }
 
     fn flag(&mut self, fit: &CameraFit, out: &[CameraUnit], alpha: f64) -> Flagged<CameraUnit> {
-        self.flag_of(fit, out, alpha).map_or(Flagged::Clean, Flagged::Unit)
+        self.flag_of(fit, out, alpha)
+            .map_or(Flagged::Clean, Flagged::Unit)
     }
 }
 

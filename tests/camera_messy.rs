@@ -82,7 +82,11 @@ fn a_pose_whose_points_all_sit_on_one_pixel_is_left_out() {
     let kept = common::run(&args(&obs, info, &["--outliers", "keep"]));
     let k: serde_json::Value = serde_json::from_slice(&kept.stdout).unwrap();
     assert!(k["outliers"]["left_out"].as_array().unwrap().is_empty());
-    assert!(k["sigma_px"].as_f64().unwrap() > 10.0 * sigma, "{}", k["sigma_px"]);
+    assert!(
+        k["sigma_px"].as_f64().unwrap() > 10.0 * sigma,
+        "{}",
+        k["sigma_px"]
+    );
 }
 
 #[test]
@@ -103,7 +107,10 @@ fn a_fisheye_camera_info_without_its_model_is_refused() {
     let fish = text
         .replace("distortion_model: plumb_bob\n", "")
         .replace("cols: 5", "cols: 4")
-        .replace("[-0.08, 0.04, 0.0005, -0.0003, -0.01]", "[0.1, -0.02, 0.003, -0.001]");
+        .replace(
+            "[-0.08, 0.04, 0.0005, -0.0003, -0.01]",
+            "[0.1, -0.02, 0.003, -0.001]",
+        );
     assert_ne!(fish, text);
     let info = dir.join("fish.yaml");
     std::fs::write(&info, fish).unwrap();

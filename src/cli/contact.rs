@@ -155,16 +155,7 @@ pub fn calibrate_contacts(
     activecal::identify::contact::check_scale(&file, &known).context("--point-distance")?;
     activecal::identify::contact::lengths::check_distances(robot, &file, &known)
         .context("--point-distance")?;
-    let lm = LmSettings::builder()
-        .max_iterations(a.max_iterations)
-        .geodesic(!a.no_geodesic)
-        .build()?;
-    let settings = ContactSettings::builder()
-        .lm(lm)
-        .loss(super::measured::loss_choice(a.loss, a.loss_scale)?)
-        .keep(a.free.to_vec())
-        .outliers(a.outliers)
-        .build()?;
+    let settings = settings_of(a)?;
     let activecal::experiment::contacts::ContactCalibration {
         fit,
         in_sample: figures,
@@ -261,6 +252,20 @@ pub fn calibrate_contacts(
         )));
     }
     Ok(None)
+}
+
+/// The fit's settings from the command line.
+fn settings_of(a: &ContactArgs<'_>) -> Result<ContactSettings> {
+    let lm = LmSettings::builder()
+        .max_iterations(a.max_iterations)
+        .geodesic(!a.no_geodesic)
+        .build()?;
+    Ok(ContactSettings::builder()
+        .lm(lm)
+        .loss(super::measured::loss_choice(a.loss, a.loss_scale)?)
+        .keep(a.free.to_vec())
+        .outliers(a.outliers)
+        .build()?)
 }
 
 /// The placements held out (`--holdout-by placement`, `--train-on NAME`),

@@ -308,6 +308,20 @@ impl BlockNoiseTest {
     }
 }
 
+/// The orientation block's σ among `blocks` (full poses) tested against
+/// the `stated` orientation noise (radians), when one was given; its
+/// degrees of freedom the block's redundancy, rounded.
+#[must_use]
+pub fn orientation_test(stated: Option<f64>, blocks: &[BlockSigma]) -> Option<BlockNoiseTest> {
+    let b = blocks.iter().find(|b| b.block == "orientation")?;
+    BlockNoiseTest::new(
+        NoiseOf::Orientation,
+        stated?,
+        b.sigma,
+        b.redundancy.round() as usize,
+    )
+}
+
 /// The diagonal of the hat matrix `X (XᵀX)⁻¹ Xᵀ` (NaN when `XᵀX` is
 /// singular): the leverage of each row.
 fn hat_diagonal(x: &faer::Mat<f64>) -> Vec<f64> {

@@ -55,9 +55,8 @@ pub struct MeasuredSettings {
     /// The sensor's stated σ per position coordinate (metres), tested
     /// against the fit's σ̂ ([`crate::identify::variance::NoiseTest`]).
     pub stated_noise: Option<f64>,
-    /// The sensor's stated σ per orientation axis (radians, full poses),
-    /// tested against the orientation block's σ
-    /// ([`crate::identify::variance::BlockNoiseTest`]).
+    /// The stated σ per orientation axis (radians, full poses), tested
+    /// against the orientation block's σ.
     pub stated_orientation_noise: Option<f64>,
 }
 
@@ -165,8 +164,7 @@ pub struct MeasuredReport {
     /// σ̂ tested against the stated noise, when one was given.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub noise_test: Option<crate::identify::variance::NoiseTest>,
-    /// The orientation block's σ tested against the stated orientation
-    /// noise, when one was given (full poses).
+    /// The orientation σ tested against the stated one, if given.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub orientation_noise_test: Option<crate::identify::variance::BlockNoiseTest>,
     /// What the user should look at: the fit is written, but something in
@@ -545,12 +543,10 @@ pub fn calibrate_read(
     let noise_test = s.stated_noise.and_then(|sigma| {
         crate::identify::variance::NoiseTest::new(sigma, f.id.sigma_hat?, f.id.dof)
     });
-    let orientation_noise_test = orientation_test(s, &noise.blocks);
-    let warnings: Vec<String> = noise_test
-        .iter()
-        .filter_map(|t| t.warning())
-        .chain(orientation_noise_test.iter().filter_map(|t| t.warning()))
-        .collect();
+    let orientation_noise_test =
+        crate::identify::variance::orientation_test(s.stated_orientation_noise, &noise.blocks);
+    let mut warnings: Vec<String> = noise_test.iter().filter_map(|t| t.warning()).collect();
+    warnings.extend(orientation_noise_test.iter().filter_map(|t| t.warning()));
     let base =
         crate::report::MeasuredCalibrationReport::new(&r, &f.id, source.to_string(), meas.len());
     let report = MeasuredReport {
@@ -582,23 +578,6 @@ pub fn calibrate_read(
         warnings,
     };
     finish(r, f, report)
-}
-
-/// The orientation block's σ (full poses) tested against the stated
-/// orientation noise, when one was given; its degrees of freedom the
-/// block's redundancy, rounded.
-fn orientation_test(
-    s: &MeasuredSettings,
-    blocks: &[crate::identify::variance::BlockSigma],
-) -> Option<crate::identify::variance::BlockNoiseTest> {
-    let stated = s.stated_orientation_noise?;
-    let b = blocks.iter().find(|b| b.block == "orientation")?;
-    crate::identify::variance::BlockNoiseTest::new(
-        crate::identify::variance::NoiseOf::Orientation,
-        stated,
-        b.sigma,
-        b.redundancy.round() as usize,
-    )
 }
 
 /// The nominal model's errors on the data: with a mounted start, the

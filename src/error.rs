@@ -208,6 +208,12 @@ pub enum Error {
     /// Any other invalid argument, with a message saying what and why.
     #[error("{0}")]
     Invalid(String),
+
+    /// Drawing a figure failed (plotters, the PNG encoder or the embedded
+    /// fonts).
+    #[error("drawing a figure: {0}")]
+    Draw(String),
+
     /// File input/output.
     // Not a `#[source]`: the message already includes it, and the CLI prints
     // error chains, which would repeat it.

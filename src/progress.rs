@@ -28,6 +28,10 @@ pub trait Sink: Send + Sync {
     fn update(&self, id: u64, done: u64, note: Option<&str>);
     /// Task `id` ended (normally or not).
     fn finish(&self, id: u64);
+    /// A point between two steps of long work where it may be stopped
+    /// ([`checkpoint`]): a sink that cancels work (Python's Ctrl-C) unwinds
+    /// from here; the default does nothing.
+    fn checkpoint(&self) {}
 }
 
 static SINK: OnceLock<Box<dyn Sink>> = OnceLock::new();
@@ -43,6 +47,16 @@ pub fn install(sink: Box<dyn Sink>) -> bool {
 #[must_use]
 pub fn enabled() -> bool {
     SINK.get().is_some()
+}
+
+/// Marks a point between two steps of long work (a round of an exchange
+/// loop) where the installed sink may stop it, so that work that advances
+/// no task for a long time can still be cancelled at once. Costs an atomic
+/// load without a sink.
+pub fn checkpoint() {
+    if let Some(s) = SINK.get() {
+        s.checkpoint();
+    }
 }
 
 /// One unit of long work: started by [`Task::start`], finished when dropped.

@@ -1,5 +1,5 @@
 //! The distribution functions the tests of a fit need: the F distribution's
-//! upper tail (the per-pose outlier test, [`crate::identify::outliers`]) and
+//! upper tail (the per-pose outlier test, [`crate::lsq::outliers`]) and
 //! the χ² distribution's tails (σ̂ against a stated noise), from the
 //! regularised incomplete beta and gamma functions (Numerical Recipes, 3rd
 //! ed., §6.2 and §6.4: series and Lentz's continued fractions, accurate to

@@ -514,7 +514,7 @@ fn an_unmodelled_sag_is_warned_of_when_the_noise_is_stated() {
         fit_compliance: false,
         compare_compliance: false,
         weights: activecal::identify::Weights::default(),
-        outliers: activecal::identify::outliers::OutlierChoice::default(),
+        outliers: activecal::lsq::outliers::OutlierChoice::default(),
         stated_noise: stated,
         stated_orientation_noise: None,
     };

@@ -8,6 +8,7 @@ use activecal::identify::{
     compare_designs, identify, monte_carlo, paper_tables, simulate, trial_rng,
 };
 use activecal::io::design::DesignFile;
+use activecal::lsq::LsqError;
 use activecal::measure::JacobianEvaluator;
 use activecal::model::Robot;
 use activecal::pool::Pool;
@@ -303,12 +304,15 @@ fn bad_input_is_an_error() {
     assert!(e.to_string().contains("alpha_1"), "{e}");
 
     let e = LmSettings::builder().xtol(-1.0).build().unwrap_err();
-    assert!(matches!(e, IdentifyError::Setting { name: "xtol", .. }));
+    assert!(matches!(e, LsqError::Setting { name: "xtol", .. }));
     // Public fields can still be set out of range: `identify` checks too.
     let mut bad = LmSettings::default();
     bad.xtol = -1.0;
     let e = identify(&robot, &robot.nominal, &good, &bad).unwrap_err();
-    assert!(matches!(e, IdentifyError::Setting { name: "xtol", .. }));
+    assert!(matches!(
+        e,
+        IdentifyError::Lsq(LsqError::Setting { name: "xtol", .. })
+    ));
     assert!(simulate(&robot, &robot.real, &qs, -0.01, &mut trial_rng(0, 0)).is_err());
     assert!(MonteCarloSettings::builder().trials(0).build().is_err());
 }
@@ -353,7 +357,7 @@ fn settings_builders_start_from_the_defaults_and_validate() {
     let e = LmSettings::builder().max_iterations(0).build().unwrap_err();
     assert!(matches!(
         e,
-        IdentifyError::Setting {
+        LsqError::Setting {
             name: "max_iterations",
             ..
         }

@@ -13,10 +13,15 @@ Lengths are metres, angles radians (joint values, limits, estimates), the
 residuals and predicted errors millimetres and degrees (their keys say so).
 Arrays are float64 NumPy arrays; anything NumPy reads as one is accepted.
 Every error is an ``activecal.Error``: ``InputError`` (a wrong argument,
-its name first, or a wrong value in a file, with its place), ``FileError``
-(a file not read or written, or an output that exists), ``ResourceError``
-(too large, with the figure), ``ComputationError`` (cannot be done on these
-inputs) or ``InternalError`` (a defect: please report it).
+its name first, or a wrong value in a file, with its place; also a
+``ValueError``), ``FileError`` (a file not read or written, or an output
+that exists when a writer is given ``overwrite=False``; also an
+``OSError``), ``ResourceError`` (too large, with the figure),
+``ComputationError`` (cannot be done on these inputs) or ``InternalError``
+(a defect: please report it); the last three are also ``RuntimeError``.
+Writers replace an existing file by default. Ctrl-C stops a long call.
+``Robot``, ``Pool``, ``Design`` and ``Calibration`` pickle (as the call
+that made them, made again on loading).
 """
 
 from ._activecal import (

@@ -11,12 +11,38 @@ starts with the argument's name.
 """
 
 from os import PathLike
-from typing import Any, Callable, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Mapping, Optional, Sequence, Tuple, Union, final
 
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
+
+__all__ = [
+    "Calibration",
+    "CameraCalibration",
+    "CameraDesign",
+    "ContactCalibration",
+    "Design",
+    "ComputationError",
+    "Error",
+    "FileError",
+    "InputError",
+    "InternalError",
+    "Pool",
+    "ResourceError",
+    "Robot",
+    "__version__",
+    "bound",
+    "calibrate",
+    "calibrate_camera",
+    "calibrate_contacts",
+    "evaluate",
+    "gap",
+    "pool",
+    "select",
+    "select_camera",
+]
 
 _Path = Union[str, "PathLike[str]"]
 _Marker = Union[str, Tuple[str, Sequence[float]]]
@@ -26,23 +52,24 @@ class Error(Exception):
     argument's name first when one argument is wrong (``q: expected shape
     (6,) ...``). Every error activecal raises is one of its subclasses."""
 
-class InputError(Error):
+class InputError(Error, ValueError):
     """A wrong argument (its name first) or a wrong value in an input file
     (the file and the place named)."""
 
-class FileError(Error):
+class FileError(Error, OSError):
     """A file that could not be read or written, or an output that exists
-    (pass overwrite=True)."""
+    when a writer is given overwrite=False."""
 
-class ResourceError(Error):
+class ResourceError(Error, RuntimeError):
     """Work too large for the memory or size limits, with the figure."""
 
-class ComputationError(Error):
+class ComputationError(Error, RuntimeError):
     """A computation that cannot be done on these (valid) inputs."""
 
-class InternalError(Error):
+class InternalError(Error, RuntimeError):
     """A defect in activecal: please report it with the message."""
 
+@final
 class Robot:
     """A robot model: a serial chain, its joint limits, the unknowns a
     calibration estimates and the sensor it is measured with. Immutable."""
@@ -109,6 +136,7 @@ class Robot:
         3 rows for a point, 6 for a full pose (orientation rows weighed by
         the robot's orientation scale, metres per radian), 3 per marker."""
 
+@final
 class Design:
     """The poses `select` chose, in visiting order (see `select`'s order)."""
 
@@ -140,12 +168,12 @@ class Design:
         """The dict ``activecal select --json`` prints for the same inputs
         and order (``tour``: the visiting order's figures; ``moves``: the
         moves' collision check, with collision filters)."""
-    def write(self, path: _Path, overwrite: bool = False) -> None:
+    def write(self, path: _Path, overwrite: bool = True) -> None:
         """Writes the design by the extension of path, as ``activecal
         select --out`` does: .json (the design file), .csv (joint values,
         one pose a row, a header of joint names) or .yaml (named joint
-        configurations). An existing file is replaced only with
-        overwrite=True."""
+        configurations). An existing file is replaced, as pandas and NumPy
+        do; overwrite=False refuses it (``FileError``)."""
     def bound(
         self, progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None
     ) -> dict[str, Any]:
@@ -175,6 +203,7 @@ class Design:
         released."""
     def __len__(self) -> int: ...
 
+@final
 class Pool:
     """Candidate poses and their identification Jacobian: what `select`
     chooses from."""
@@ -301,6 +330,7 @@ def gap(
     bound over its own pool, the dict `activecal gap --json` prints."""
     ...
 
+@final
 class Calibration:
     """The result of `calibrate`."""
 
@@ -338,11 +368,11 @@ class Calibration:
         """The dict ``activecal calibrate --measurements FILE --json``
         prints for a file holding the same values (``measurements`` names
         the arrays here, not a file)."""
-    def write_urdf(self, path: _Path, overwrite: bool = False) -> None:
+    def write_urdf(self, path: _Path, overwrite: bool = True) -> None:
         """Writes the calibrated URDF: the robot's own file with only the
         chain's joint origins changed (a built-in robot: its chain as a
         URDF). Refused (Error) when the fit did not converge."""
-    def write_frames(self, path: _Path, overwrite: bool = False) -> None:
+    def write_frames(self, path: _Path, overwrite: bool = True) -> None:
         """Writes the frames file (YAML): the measurement frame, the tool
         or markers and the joint-origin changes with their σ, as
         ``activecal calibrate --out cal.yaml`` does. URDF robots only;
@@ -409,6 +439,7 @@ def evaluate(
     orientations as `calibrate` takes them: poses the fit did not see
     judge it."""
 
+@final
 class ContactCalibration:
     """The result of `calibrate_contacts`."""
 
@@ -436,9 +467,9 @@ class ContactCalibration:
     def report(self) -> dict[str, Any]:
         """The dict ``activecal calibrate --measurements FILE --json``
         prints for a contact file with the same rows."""
-    def write_urdf(self, path: _Path, overwrite: bool = False) -> None:
+    def write_urdf(self, path: _Path, overwrite: bool = True) -> None:
         """The calibrated URDF (refused unless converged and plausible)."""
-    def write_frames(self, path: _Path, overwrite: bool = False) -> None:
+    def write_frames(self, path: _Path, overwrite: bool = True) -> None:
         """The frames file: the ball centre as ``point``, the fitted points
         under ``contacts``."""
 
@@ -464,12 +495,17 @@ def calibrate_contacts(
     parameters never fixed; loss, loss_scale, max_iterations and progress
     as `calibrate` takes them."""
 
+@final
 class CameraCalibration:
     """The result of `calibrate_camera`."""
 
     @property
     def converged(self) -> bool:
         """Whether the fit converged (only then are files written)."""
+    @property
+    def refused(self) -> Optional[str]:
+        """Why the calibration may not be written (None when it may): the
+        reason the command line refuses it with (exit status 3)."""
     @property
     def estimate(self) -> dict[str, float]:
         """{unknown: value}: the robot's unknowns (metres, radians),
@@ -500,13 +536,13 @@ class CameraCalibration:
     def report(self) -> dict[str, Any]:
         """The dict ``activecal calibrate --observations FILE --json``
         prints (``out`` empty)."""
-    def write_urdf(self, path: _Path, overwrite: bool = False) -> None:
+    def write_urdf(self, path: _Path, overwrite: bool = True) -> None:
         """Your URDF with the calibrated joint origins (refused unless
         converged)."""
-    def write_frames(self, path: _Path, overwrite: bool = False) -> None:
+    def write_frames(self, path: _Path, overwrite: bool = True) -> None:
         """The frames file with the ``camera`` block (both placements with
         σ, the pixel σ and RMS)."""
-    def write_camera_info(self, path: _Path, overwrite: bool = False) -> None:
+    def write_camera_info(self, path: _Path, overwrite: bool = True) -> None:
         """The refined intrinsics as a ROS camera_info ``.yaml``, the camera
         named by the file's stem (only with ``refine_intrinsics=True`` and
         a converged fit), as ``--out-camera-info`` writes it."""
@@ -546,6 +582,7 @@ def calibrate_camera(
     intrinsics too. Bad input raises `InputError` naming the argument (and
     the file, line and column)."""
 
+@final
 class CameraDesign:
     """The result of `select_camera`."""
 
@@ -566,7 +603,6 @@ class CameraDesign:
     def poses(self) -> Any:
         """A pandas DataFrame with the columns of ``select --out
         design.csv``: candidate, the joints, points_seen."""
-    @property
     def how_many(
         self,
         pixel_noise: Optional[float] = None,
@@ -601,7 +637,7 @@ def select_camera(
     min_visible: float = 1.0,
     image_margin: float = 10.0,
     max_view_angle: float = 60.0,
-    distance: Tuple[float, float] = (0.2, 3.0),
+    distance: Tuple[float, float] = ...,
     gap: bool = False,
     pixel_noise: Optional[float] = None,
     line_of_sight: bool = False,

@@ -39,7 +39,7 @@ pub fn bound<'py>(
     let n = crate::convert::count("n", n, 1)?;
     let c = candidates(py, robot, pool, count, levels, pool_seed, margin)?;
     let prior = existing
-        .map(|e| existing_poses(py, robot, e).map(|(_, p)| p))
+        .map(|e| existing_poses(py, robot, e).map(|e| e.prior))
         .transpose()?;
     let r = robot.inner.clone();
     let v = crate::progress::with_callback(progress, || {

@@ -2,7 +2,7 @@
 //! memory, as `activecal calibrate --measurements FILE` does from a file,
 //! and the `Calibration` it returns.
 
-use crate::convert::{arg_err, count, detached, err, float_array, json_to_py, named_columns, rows};
+use crate::convert::{arg_err, count, detached, float_array, json_to_py, named_columns, rows};
 use crate::robot::Robot;
 use activecal::experiment::acts_on::{self as lib_acts, Sensor};
 use activecal::experiment::measured::{MeasuredSettings, calibrate_measurements};
@@ -23,6 +23,8 @@ pub struct Calibration {
     report: serde_json::Value,
     /// The library's verdict: whether the calibrated robot may be written.
     verdict: activecal::experiment::measured::verdict::Verdict,
+    /// How it was made, for pickling.
+    recipe: crate::pickling::Recipe,
 }
 
 /// What `calibrate` reads from its array arguments.
@@ -270,7 +272,7 @@ fn names(v: Option<Vec<String>>) -> Vec<String> {
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
-    robot: &Robot,
+    robot: &Bound<'_, Robot>,
     q: &Bound<'_, PyAny>,
     points: &Bound<'_, PyAny>,
     orientations: Option<&Bound<'_, PyAny>>,
@@ -319,6 +321,15 @@ pub fn calibrate(
         Sensor::Points
     };
     refuse_unused(lib_acts::CALIBRATE, &given, sensor)?;
+    use crate::pickling::kept;
+    let recipe = crate::recipe!(py, "calibrate";
+        robot = robot, q = kept(Some(q))?, points = kept(Some(points))?,
+        orientations = kept(orientations)?, fix = &fix, free = &free,
+        max_iterations = max_iterations, loss = loss, loss_scale = loss_scale, weights = weights,
+        orientation_scale = orientation_scale, holdout = holdout, splits = splits, seed = seed,
+        compliance = compliance, outliers = outliers, outlier_rate = outlier_rate, noise = noise,
+        orientation_noise = orientation_noise);
+    let robot = robot.get();
     let weights = weights_of(weights, orientation_scale)?;
     let outliers = outliers_of(outliers, outlier_rate)?;
     let gravity = compliance
@@ -359,9 +370,12 @@ pub fn calibrate(
         outliers,
         stated_noise: match noise {
             Some(s) if !(s.is_finite() && s > 0.0) => {
-                return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                    "noise={s}: the sensor's stated σ per coordinate must be a number > 0 (metres)"
-                )));
+                return Err(crate::errors::new_err(
+                    crate::errors::Kind::Input,
+                    format!(
+                        "noise={s}: the sensor's stated σ per coordinate must be a number > 0 (metres)"
+                    ),
+                ));
             }
             s => s,
         },
@@ -395,8 +409,20 @@ pub fn calibrate(
                 Ok((c.robot, c.fit.id, c.frames, v, c.verdict, report.warnings))
             })
         })?;
-    // What the command line prints as a warning reaches Python as one.
-    for w in &warnings {
+    warn_all(py, &warnings)?;
+    Ok(Calibration {
+        robot: Arc::new(fitted),
+        id,
+        frames,
+        report,
+        verdict,
+        recipe,
+    })
+}
+
+/// What the command line prints as a warning reaches Python as one.
+fn warn_all(py: Python<'_>, warnings: &[String]) -> PyResult<()> {
+    for w in warnings {
         let cat = py.get_type::<pyo3::exceptions::PyUserWarning>();
         pyo3::PyErr::warn(
             py,
@@ -405,13 +431,7 @@ pub fn calibrate(
             1,
         )?;
     }
-    Ok(Calibration {
-        robot: Arc::new(fitted),
-        id,
-        frames,
-        report,
-        verdict,
-    })
+    Ok(())
 }
 
 impl Calibration {
@@ -422,7 +442,10 @@ impl Calibration {
         // The command line's verdict, from the library: the same refusals
         // with the same message.
         if let Some(why) = self.verdict.refusal() {
-            return Err(err(format!("{}: not written: {why}", path.display())));
+            return Err(crate::errors::new_err(
+                crate::errors::Kind::Computation,
+                format!("{}: not written: {why}", path.display()),
+            ));
         }
         write_robot(
             format,
@@ -452,8 +475,16 @@ pub(crate) fn write_robot(
     overwrite: bool,
     inputs: &[&std::path::Path],
 ) -> PyResult<()> {
-    let text = activecal::io::calibrated::render(format, robot, table, frames, header)
-        .map_err(|e| arg_err("path", format!("{}: {e}", path.display())))?;
+    if Format::of(path).ok() != Some(format) {
+        return Err(arg_err(
+            "path",
+            format!(
+                "{}: this writer writes a .{} file; the name must end so",
+                path.display(),
+                format!("{format:?}").to_lowercase()
+            ),
+        ));
+    }
     let out = [activecal::io::atomic::Output {
         label: "path",
         path,
@@ -462,14 +493,20 @@ pub(crate) fn write_robot(
     if let Some(src) = robot.source.as_ref() {
         all.push(std::path::Path::new(&src.path));
     }
-    activecal::io::atomic::check_outputs(&out, &all, overwrite)
+    // Never over an input of the call, even when overwriting is asked.
+    activecal::io::atomic::check_outputs(&out, &all, true)
         .map_err(|e| crate::convert::Fail::from(e).into_py())?;
-    activecal::io::atomic::write_atomic(path, text.as_bytes())
+    activecal::io::calibrated::write(robot, table, frames, header, path, overwrite)
         .map_err(|e| crate::convert::Fail::from(e).into_py())
 }
 
 #[pymethods]
 impl Calibration {
+    /// Pickling: made again by the same call with the same arguments
+    /// (deterministic: the same result; the robot's files read again).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        self.recipe.reduce(py)
+    }
     /// Whether the fit converged (only then is the estimate trustworthy and
     /// the robot written).
     #[getter]
@@ -530,7 +567,7 @@ impl Calibration {
     /// Writes the calibrated robot as URDF: the robot's own URDF with only
     /// the chain's joint origins changed (a built-in robot: its chain as
     /// URDF). Refused when the fit did not converge.
-    #[pyo3(signature = (path, overwrite=false))]
+    #[pyo3(signature = (path, overwrite=true))]
     fn write_urdf(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
         self.write_as(Format::Urdf, &path, overwrite)
     }
@@ -538,7 +575,7 @@ impl Calibration {
     /// Writes the frames file (YAML): measurement frame, tool or markers and
     /// joint-origin changes with σ, metres and degrees as the command line
     /// writes it. URDF robots only; refused when the fit did not converge.
-    #[pyo3(signature = (path, overwrite=false))]
+    #[pyo3(signature = (path, overwrite=true))]
     fn write_frames(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
         self.write_as(Format::Yaml, &path, overwrite)
     }
@@ -577,6 +614,7 @@ pub fn evaluate<'py>(
     let wrapper = Robot {
         inner: robot.clone(),
         visibility: None,
+        recipe: None,
     };
     let d = data(py, &wrapper, q, points, orientations)?;
     let v = detached(py, move || {
@@ -622,8 +660,8 @@ pub(crate) fn refuse_unused(
 pub(crate) fn outliers_of(
     kind: &str,
     rate: f64,
-) -> PyResult<activecal::identify::outliers::OutlierChoice> {
-    use activecal::identify::outliers::{OutlierChoice, check_choice};
+) -> PyResult<activecal::lsq::outliers::OutlierChoice> {
+    use activecal::lsq::outliers::{OutlierChoice, check_choice};
     let c = match kind {
         "drop" => OutlierChoice::Drop { alpha: rate },
         "keep" => OutlierChoice::Keep,

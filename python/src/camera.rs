@@ -457,14 +457,14 @@ impl CameraCalibration {
 
     /// Writes your URDF with the calibrated joint origins (URDF robots;
     /// refused when the fit did not converge).
-    #[pyo3(signature = (path, overwrite=false))]
+    #[pyo3(signature = (path, overwrite=true))]
     fn write_urdf(&self, path: PathBuf, overwrite: bool) -> PyResult<()> {
         self.write_as(Format::Urdf, &path, overwrite)
     }
 
     /// Writes the frames file (YAML) with the `camera` block: the
     /// camera's and the target's placements with σ, the pixel σ and RMS.
-    #[pyo3(signature = (path, overwrite=false))]
+    #[pyo3(signature = (path, overwrite=true))]
     fn write_frames(&self, path: PathBuf, overwrite: bool) -> PyResult<()> {
         self.write_as(Format::Yaml, &path, overwrite)
     }
@@ -472,7 +472,7 @@ impl CameraCalibration {
     /// Writes the refined intrinsics as a ROS camera_info YAML (only with
     /// refine_intrinsics=True and a converged fit), as `--out-camera-info`
     /// does: the camera named by the file's stem.
-    #[pyo3(signature = (path, overwrite=false))]
+    #[pyo3(signature = (path, overwrite=true))]
     fn write_camera_info(&self, path: PathBuf, overwrite: bool) -> PyResult<()> {
         if !self.cal.refine_intrinsics {
             return Err(arg_err(

@@ -297,14 +297,14 @@ impl ContactCalibration {
 
     /// Writes the calibrated robot as URDF (URDF robots; refused when the
     /// fit did not converge or is implausible).
-    #[pyo3(signature = (path, overwrite=false))]
+    #[pyo3(signature = (path, overwrite=true))]
     fn write_urdf(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
         self.write_as(Format::Urdf, &path, overwrite)
     }
 
     /// Writes the frames file (YAML) with the ball centre as `point` and
     /// the fitted points under `contacts`.
-    #[pyo3(signature = (path, overwrite=false))]
+    #[pyo3(signature = (path, overwrite=true))]
     fn write_frames(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
         self.write_as(Format::Yaml, &path, overwrite)
     }

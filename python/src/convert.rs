@@ -2,20 +2,15 @@
 //! errors naming the argument), results out (NumPy arrays, dicts), library
 //! errors and panics as `activecal.Error`.
 
-use crate::{ComputationError, Error, FileError, InputError, InternalError, ResourceError};
+use crate::errors::{Kind, new_err};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::fmt::Display;
 
-/// A library error as `activecal.Error`, with its message.
-pub fn err(e: impl Display) -> PyErr {
-    Error::new_err(e.to_string())
-}
-
 /// A wrong argument as `activecal.InputError`, the message starting with
 /// its name.
 pub fn arg_err(name: &str, msg: impl Display) -> PyErr {
-    InputError::new_err(format!("{name}: {msg}"))
+    new_err(Kind::Input, format!("{name}: {msg}"))
 }
 
 /// Why library work failed, as the Python exception it becomes: the
@@ -41,10 +36,10 @@ impl Fail {
     /// The Python exception.
     pub fn into_py(self) -> PyErr {
         match self {
-            Fail::Input(m) => InputError::new_err(m),
-            Fail::File(m) => FileError::new_err(m),
-            Fail::Resource(m) => ResourceError::new_err(m),
-            Fail::Compute(m) => ComputationError::new_err(m),
+            Fail::Input(m) => new_err(Kind::Input, m),
+            Fail::File(m) => new_err(Kind::File, m),
+            Fail::Resource(m) => new_err(Kind::Resource, m),
+            Fail::Compute(m) => new_err(Kind::Computation, m),
         }
     }
 }
@@ -69,15 +64,23 @@ impl From<activecal::identify::IdentifyError> for Fail {
     }
 }
 
+impl From<activecal::lsq::LsqError> for Fail {
+    /// A solver setting out of range (an argument) or a problem it cannot
+    /// take.
+    fn from(e: activecal::lsq::LsqError) -> Self {
+        Fail::Input(e.to_string())
+    }
+}
+
 impl From<activecal::bound::BoundError> for Fail {
     fn from(e: activecal::bound::BoundError) -> Self {
         Fail::Compute(e.to_string())
     }
 }
 
-impl From<activecal::experiment::paper::ExperimentError> for Fail {
-    fn from(e: activecal::experiment::paper::ExperimentError) -> Self {
-        use activecal::experiment::paper::ExperimentError as E;
+impl From<activecal::experiment::ExperimentError> for Fail {
+    fn from(e: activecal::experiment::ExperimentError) -> Self {
+        use activecal::experiment::ExperimentError as E;
         match e {
             E::Input(e) => e.into(),
             E::Bound(e) => e.into(),
@@ -102,26 +105,80 @@ impl From<String> for Fail {
     }
 }
 
-/// Runs library work with the GIL released; its failure becomes the
-/// `activecal.Error` subclass of its [`Fail`], a panic
-/// `activecal.InternalError` (never unwinds into Python).
+/// How often a call waiting for its work checks for Ctrl-C.
+const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(50);
+
+/// Stack of the thread that does a call's work (a process's main thread's).
+const WORK_STACK: usize = 8 << 20;
+
+/// Runs library work with the GIL released, on a thread of its own while
+/// the calling thread waits and checks Python's signals every
+/// [`SIGNAL_POLL`]: a signal whose handler raises (Ctrl-C's
+/// `KeyboardInterrupt`) cancels the work, which stops at its next progress
+/// advance ([`crate::progress`]), and the call raises that exception. The
+/// work's failure becomes the `activecal.Error` subclass of its [`Fail`], a
+/// panic `activecal.InternalError` (never unwinds into Python).
 pub fn detached<T: Send>(
     py: Python<'_>,
     work: impl FnOnce() -> Result<T, Fail> + Send,
 ) -> PyResult<T> {
-    let out = py.detach(|| std::panic::catch_unwind(std::panic::AssertUnwindSafe(work)));
+    let call = crate::progress::current_or_new();
+    let (out, interrupt) = py.detach(|| {
+        std::thread::scope(|s| {
+            let (tx, rx) = std::sync::mpsc::channel::<()>();
+            let worker = call.clone();
+            let spawned = std::thread::Builder::new()
+                .name("activecal".into())
+                .stack_size(WORK_STACK)
+                .spawn_scoped(s, move || {
+                    let out = crate::progress::within(worker, || {
+                        std::panic::catch_unwind(std::panic::AssertUnwindSafe(work))
+                    });
+                    let _ = tx.send(());
+                    out
+                });
+            let handle = match spawned {
+                Ok(h) => h,
+                Err(e) => {
+                    return (
+                        Err(Box::new(format!("no thread for the work: {e}")) as _),
+                        None,
+                    );
+                }
+            };
+            let mut interrupt = None;
+            while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) = rx.recv_timeout(SIGNAL_POLL)
+            {
+                if interrupt.is_none()
+                    && let Err(e) = Python::attach(|py| py.check_signals())
+                {
+                    call.cancel();
+                    interrupt = Some(e);
+                }
+            }
+            (handle.join().unwrap_or_else(Err), interrupt)
+        })
+    });
+    if let Some(e) = interrupt {
+        return Err(e);
+    }
     match out {
         Ok(Ok(v)) => Ok(v),
         Ok(Err(f)) => Err(f.into_py()),
+        Err(p) if p.is::<crate::progress::Cancelled>() => Err(new_err(
+            Kind::Internal,
+            "the work was cancelled by its progress callback",
+        )),
         Err(p) => {
             let what = p
                 .downcast_ref::<String>()
                 .cloned()
                 .or_else(|| p.downcast_ref::<&str>().map(|s| (*s).to_string()))
                 .unwrap_or_else(|| "a panic".into());
-            Err(InternalError::new_err(format!(
-                "internal error in activecal (please report it): {what}"
-            )))
+            Err(new_err(
+                Kind::Internal,
+                format!("internal error in activecal (please report it): {what}"),
+            ))
         }
     }
 }

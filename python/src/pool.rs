@@ -20,6 +20,8 @@ pub struct Pool {
     pub(crate) robot: Arc<activecal::model::Robot>,
     pub(crate) pool: Arc<activecal::pool::Pool>,
     pub(crate) x: Arc<Blocks>,
+    /// How it was made, for pickling (`activecal.pool`'s pools).
+    pub(crate) recipe: Option<crate::pickling::Recipe>,
 }
 
 /// What a pool source string names, with its size options.
@@ -165,9 +167,10 @@ fn files_exist(choice: &CollisionChoice) -> PyResult<()> {
         .chain(choice.package_dirs.iter().map(|p| ("package_dirs", p)))
     {
         if !std::path::Path::new(p).exists() {
-            return Err(crate::FileError::new_err(format!(
-                "{name}: {p}: no such file or directory"
-            )));
+            return Err(crate::errors::new_err(
+                crate::errors::Kind::File,
+                format!("{name}: {p}: no such file or directory"),
+            ));
         }
     }
     Ok(())
@@ -223,6 +226,7 @@ pub(crate) fn build(
         robot: robot.clone(),
         pool: Arc::new(pool),
         x: Arc::new(x),
+        recipe: None,
     })
 }
 
@@ -255,7 +259,7 @@ pub(crate) fn pool_of(
     );
     let (src, listed) = if let Ok(s) = source.cast::<PyString>() {
         (
-            pool_source(arg, s.to_str()?, count_, levels, pool_seed)?,
+            pool_source(arg, &s.to_cow()?, count_, levels, pool_seed)?,
             None,
         )
     } else {
@@ -312,7 +316,7 @@ pub(crate) fn pool_of(
 #[allow(clippy::too_many_arguments)]
 pub fn pool(
     py: Python<'_>,
-    robot: &Robot,
+    robot: &Bound<'_, Robot>,
     source: Option<&Bound<'_, PyAny>>,
     count: Option<i64>,
     levels: Option<i64>,
@@ -326,6 +330,11 @@ pub fn pool(
     clearance: f64,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Pool> {
+    let recipe = crate::recipe!(py, "pool";
+        robot = robot, source = crate::pickling::kept(source)?, count = count, levels = levels,
+        pool_seed = pool_seed, margin = margin, self_collision = self_collision, srdf = &srdf,
+        package_dirs = &package_dirs, floor = floor, obstacles = &obstacles, clearance = clearance);
+    let robot = robot.get();
     let filters = collision_filters(
         &robot.inner,
         self_collision,
@@ -341,15 +350,27 @@ pub fn pool(
     )?;
     let default = PyString::new(py, "random").into_any();
     let source = source.unwrap_or(&default);
-    crate::progress::with_callback(progress, || {
+    let mut built = crate::progress::with_callback(progress, || {
         pool_of(
             py, robot, "source", source, count, levels, pool_seed, margin, filters,
         )
-    })
+    })?;
+    built.recipe = Some(recipe);
+    Ok(built)
 }
 
 #[pymethods]
 impl Pool {
+    /// Pickling: the pool is built again by the same call.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        match &self.recipe {
+            Some(r) => r.reduce(py),
+            None => Err(pyo3::exceptions::PyTypeError::new_err(
+                "this Pool cannot be pickled: only the pools of activecal.pool can",
+            )),
+        }
+    }
+
     /// Joint values of the candidates, an (n, dof) float64 array (radians
     /// or metres), in pool order.
     #[getter]
@@ -377,7 +398,8 @@ impl Pool {
     /// `filters`: each filter's `removed` of `seen`).
     #[getter]
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let v = serde_json::to_value(&self.pool.stats).map_err(crate::convert::err)?;
+        let v = serde_json::to_value(&self.pool.stats)
+            .map_err(|e| crate::convert::Fail::from(e).into_py())?;
         json_to_py(py, &v)
     }
 

@@ -15,12 +15,14 @@ pub struct Robot {
     pub(crate) inner: Arc<activecal::model::Robot>,
     /// The region the description's sensor sees (filters pools).
     pub(crate) visibility: Option<Visibility>,
+    /// How it was made, for pickling (none for a calibrated model).
+    pub(crate) recipe: Option<crate::pickling::Recipe>,
 }
 
 impl Robot {
     /// Loads a robot reference as the command line does (validated, with
     /// at least one joint).
-    fn load(py: Python<'_>, r: RobotRef) -> PyResult<Self> {
+    fn load(py: Python<'_>, r: RobotRef, recipe: crate::pickling::Recipe) -> PyResult<Self> {
         let d = detached(py, move || {
             let d = r.load()?;
             d.robot.validate()?;
@@ -34,6 +36,7 @@ impl Robot {
         Ok(Self {
             inner: Arc::new(d.robot),
             visibility: d.visibility,
+            recipe: Some(recipe),
         })
     }
 
@@ -78,7 +81,7 @@ impl Robot {
             },
             qs,
         )
-        .map_err(crate::convert::err)
+        .map_err(|e| crate::errors::new_err(crate::errors::Kind::Input, e.to_string()))
     }
 }
 
@@ -148,22 +151,25 @@ impl Robot {
         frames: Option<std::path::PathBuf>,
         pose: bool,
     ) -> PyResult<Self> {
+        let recipe = crate::recipe!(py, "Robot.from_urdf";
+            path = &path, tip = &tip, base = &base, marker = crate::pickling::kept(marker)?,
+            lock = &lock, frames = &frames, pose = pose);
         let markers = marker.map(markers_of).transpose()?.unwrap_or_default();
         let lock: Vec<(String, f64)> = lock.unwrap_or_default().into_iter().collect();
         if let Some((j, v)) = lock.iter().find(|(_, v)| !v.is_finite()) {
             return Err(arg_err("lock", format!("{j}: {v} is not a finite number")));
         }
         if !path.is_file() {
-            return Err(crate::FileError::new_err(format!(
-                "path: {}: no such file",
-                path.display()
-            )));
+            return Err(crate::errors::new_err(
+                crate::errors::Kind::File,
+                format!("path: {}: no such file", path.display()),
+            ));
         }
         if let Some(f) = frames.as_ref().filter(|f| !f.is_file()) {
-            return Err(crate::FileError::new_err(format!(
-                "frames: {}: no such file",
-                f.display()
-            )));
+            return Err(crate::errors::new_err(
+                crate::errors::Kind::File,
+                format!("frames: {}: no such file", f.display()),
+            ));
         }
         let r = RobotRef {
             name: path.display().to_string(),
@@ -176,7 +182,7 @@ impl Robot {
                 markers,
             },
         };
-        Self::load(py, r)
+        Self::load(py, r, recipe)
     }
 
     /// A built-in robot: "puma560", "ur5" or "stanford"; append ":pose"
@@ -184,7 +190,23 @@ impl Robot {
     #[staticmethod]
     fn builtin(py: Python<'_>, name: &str) -> PyResult<Self> {
         activecal::model::Robot::builtin(name).map_err(|e| arg_err("name", e))?;
-        Self::load(py, RobotRef::parse(name).map_err(|e| arg_err("name", e))?)
+        let recipe = crate::recipe!(py, "Robot.builtin"; name = name);
+        Self::load(
+            py,
+            RobotRef::parse(name).map_err(|e| arg_err("name", e))?,
+            recipe,
+        )
+    }
+
+    /// Pickling: the robot is made again from the same call (its files
+    /// read again). A calibrated model (inside `evaluate`) has none.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        match &self.recipe {
+            Some(r) => r.reduce(py),
+            None => Err(pyo3::exceptions::PyTypeError::new_err(
+                "this Robot cannot be pickled: pickle the Calibration it came from",
+            )),
+        }
     }
 
     /// The robot's name, as design files record it.

@@ -6,10 +6,11 @@ use crate::pool::Pool;
 use crate::robot::Robot;
 use activecal::blocks::Blocks;
 use activecal::criterion::Prior;
-use activecal::experiment::visiting::{Visiting, ordered_design, visit_selection};
+use activecal::experiment::select::{Existing, SelectRun};
+use activecal::experiment::visiting::Visiting;
 use activecal::io::design::DesignFile;
+use activecal::model::ParamSet;
 use activecal::names::Choice;
-use activecal::report::{PredictedAfter, SelectReport};
 use activecal::select::{Algorithm, CriterionKind, Settings};
 use pyo3::prelude::*;
 use std::sync::Arc;
@@ -35,8 +36,12 @@ pub struct Design {
     algorithm: Algorithm,
     /// The pool's pose ids, by position.
     pool_ids: Vec<usize>,
+    /// The pool (named by the gap's report).
+    pool: Arc<activecal::pool::Pool>,
     /// The sensor noise given to `select`, metres.
     noise: Option<f64>,
+    /// How it was made, for pickling.
+    recipe: crate::pickling::Recipe,
 }
 
 /// The noise of the how-many curve when none is given, metres: the
@@ -79,7 +84,7 @@ const DEFAULT_CURVE_NOISE: f64 = 0.01;
 #[allow(clippy::too_many_arguments)]
 pub fn select(
     py: Python<'_>,
-    robot: &Robot,
+    robot: &Bound<'_, Robot>,
     n: i64,
     pool: Option<&Bound<'_, PyAny>>,
     count: Option<i64>,
@@ -96,6 +101,12 @@ pub fn select(
     order: Option<&str>,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Design> {
+    let recipe = crate::recipe!(py, "select";
+        robot = robot, n = n, pool = crate::pickling::kept(pool)?, count = count, levels = levels,
+        pool_seed = pool_seed, margin = margin, algorithm = algorithm, seed = seed,
+        starts = starts, ils = ils, kick = kick, noise = noise,
+        existing = crate::pickling::kept(existing)?, order = order);
+    let robot = robot.get();
     let reorder = reorder_of(robot, order)?;
     let n = crate::convert::count("n", n, 1)?;
     let algorithm = algorithm_of(algorithm)?;
@@ -112,74 +123,64 @@ pub fn select(
         ));
     }
     let candidates = candidates(py, robot, pool, count, levels, pool_seed, margin)?;
-    let (existing_qs, prior) = match existing {
-        Some(e) => {
-            let (qs, p) = existing_poses(py, robot, e)?;
-            (Some(qs), Some(p))
-        }
-        None => (None, None),
-    };
-    let inner = robot.inner.clone();
-    let r = inner.clone();
+    let existing = existing.map(|e| existing_poses(py, robot, e)).transpose()?;
+    let prior = existing.as_ref().map(|e| e.prior.clone());
+    let r = robot.inner.clone();
     let (x, built) = (candidates.x.clone(), candidates.pool.clone());
-    let closure_prior = prior.clone();
-    let (file, report, ids, q, sel, settings) = crate::progress::with_callback(progress, || {
+    let s = Settings::builder()
+        .n(n)
+        .initial(Settings::default().initial.min(n))
+        .starts(starts)
+        .ils(ils.unwrap_or_else(|| activecal::select::default_ils_rounds(x.n_poses(), x.t())))
+        .kick(kick)
+        .seed(seed)
+        .prior(prior.clone())
+        .build()
+        .map_err(|e| crate::convert::Fail::from(e).into_py())?;
+    let run = SelectRun {
+        criterion: CriterionKind::Det,
+        algorithm,
+        settings: s.clone(),
+        visiting: Visiting {
+            reorder,
+            home: None,
+            may_swap: true,
+        },
+        gap: None,
+        refine: None,
+        noise,
+        params: ParamSet::Nominal,
+    };
+    let outcome = crate::progress::with_callback(progress, || {
         detached(py, move || {
-            let table = &r.nominal;
-            let s =
-                Settings::builder()
-                    .n(n)
-                    .initial(Settings::default().initial.min(n))
-                    .starts(starts)
-                    .ils(ils.unwrap_or_else(|| {
-                        activecal::select::default_ils_rounds(x.n_poses(), x.t())
-                    }))
-                    .kick(kick)
-                    .seed(seed)
-                    .prior(closure_prior.clone())
-                    .build()?;
-            let t0 = std::time::Instant::now();
-            let mut sel = activecal::select::select(&x, CriterionKind::Det, algorithm, &s)?;
-            let seconds = t0.elapsed().as_secs_f64();
-            let (mut report, order) = visit(
+            Ok(activecal::experiment::select::run(
                 &r,
                 &built,
                 &x,
-                closure_prior.as_ref(),
-                &mut sel,
-                &s,
-                seconds,
-                reorder,
-            )?;
-            if let (Some(noise), None) = (noise, &closure_prior) {
-                report.predicted = PredictedAfter::of_design(&r, table, &x, &sel.poses, noise);
-            }
-            let file = ordered_design(&r, &built, &sel, None, &order, &report);
-            let q: Vec<Vec<f64>> = report.configurations.iter().map(|c| c.q.clone()).collect();
-            let ids: Vec<usize> = report.configurations.iter().map(|c| c.id).collect();
-            let v = serde_json::to_value(&report)?;
-            Ok((file, v, ids, q, sel, s))
+                existing.as_ref(),
+                &run,
+            )?)
         })
     })?;
-    let mut file = file;
-    file.existing = existing_qs.map(|qs| activecal::io::design::ExistingPoses {
-        path: "existing".into(),
-        q: qs,
-    });
+    let report = serde_json::to_value(&outcome.report)
+        .map_err(|e| crate::convert::Fail::from(e).into_py())?;
+    let c = &outcome.report.configurations;
     Ok(Design {
-        robot: inner,
-        file,
+        robot: robot.inner.clone(),
+        file: outcome.design,
         report,
-        q,
-        ids,
-        ln_oid: sel.ln_oid,
-        positions: sel.poses,
+        q: c.iter().map(|c| c.q.clone()).collect(),
+        ids: c.iter().map(|c| c.id).collect(),
+        ln_oid: outcome.selection.ln_oid,
+        positions: outcome.selection.poses,
         pool_ids: candidates.pool.ids.clone(),
+        pool: candidates.pool.clone(),
         x: candidates.x,
         prior,
-        settings,
+        settings: s,
         algorithm,
         noise,
+        recipe,
     })
 }
 
@@ -192,6 +193,8 @@ impl Design {
         progress: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (x, prior, positions) = (self.x.clone(), self.prior.clone(), self.positions.clone());
+        let (robot, pool, ids) = (self.robot.clone(), self.pool.clone(), self.ids.clone());
+        let existing = self.file.existing.as_ref().map(|e| e.q.clone());
         let v = crate::progress::with_callback(progress, || {
             detached(py, move || {
                 let settings = activecal::bound::BoundSettings::default();
@@ -202,7 +205,25 @@ impl Design {
                     &settings,
                 )?;
                 let g = activecal::bound::gap::design_gap(&x, prior.as_ref(), &positions, &b)?;
-                Ok(serde_json::to_value(&g)?)
+                // The report `activecal gap --json` prints for this design.
+                let params = activecal::model::ParamSet::Nominal;
+                let info = activecal::report::PoolInfo::new(&robot, &pool);
+                let mut report = activecal::report::GapReport::new(info, params, ids, &g, &b);
+                if let (Some(qs), Some(prior)) = (existing, prior.as_ref()) {
+                    let xe = activecal::blocks::jacobian_of(
+                        &robot,
+                        robot.params(params),
+                        qs.len(),
+                        |k, q| q.copy_from_slice(&qs[k]),
+                    );
+                    report.existing = Some(activecal::report::ExistingReport::new(
+                        "existing".into(),
+                        &xe,
+                        prior,
+                        Vec::new(),
+                    ));
+                }
+                Ok(serde_json::to_value(&report)?)
             })
         })?;
         json_to_py(py, &v)
@@ -233,39 +254,6 @@ fn algorithm_of(name: &str) -> PyResult<Algorithm> {
             format!("unknown algorithm '{name}': one of {}", names.join(", ")),
         )
     })
-}
-
-/// The selection's report in visiting order (`reorder`) or selection
-/// order, its moves checked, stuck poses exchanged (as `select` does), and
-/// the order (positions in selection order).
-#[allow(clippy::too_many_arguments)]
-fn visit(
-    r: &activecal::model::Robot,
-    built: &activecal::pool::Pool,
-    x: &Blocks,
-    prior: Option<&Prior>,
-    sel: &mut activecal::select::Selection,
-    s: &Settings,
-    seconds: f64,
-    reorder: bool,
-) -> activecal::Result<(SelectReport, Vec<usize>)> {
-    let how = Visiting {
-        reorder,
-        home: None,
-        may_swap: true,
-    };
-    let (mut report, order, swapped) = visit_selection(r, built, x, prior, sel, &how, |sel| {
-        Ok::<_, activecal::Error>(SelectReport::new(
-            r,
-            built,
-            sel,
-            CriterionKind::Det,
-            s,
-            seconds,
-        ))
-    })?;
-    report.swapped = swapped;
-    Ok((report, order))
 }
 
 /// The candidates a `pool` argument names: a `Pool` as built (no size
@@ -308,6 +296,7 @@ pub(crate) fn candidates(
             robot: b.robot.clone(),
             pool: b.pool.clone(),
             x: b.x.clone(),
+            recipe: None,
         });
     }
     let default = pyo3::types::PyString::new(py, "random").into_any();
@@ -330,7 +319,7 @@ pub(crate) fn existing_poses(
     py: Python<'_>,
     robot: &Robot,
     e: &Bound<'_, PyAny>,
-) -> PyResult<(Vec<Vec<f64>>, Prior)> {
+) -> PyResult<Existing> {
     let dof = robot.inner.dof();
     let joints = activecal::units::joint_names(&robot.inner);
     let e = &crate::convert::named_columns(e, "existing", &joints, "joint")?;
@@ -344,18 +333,19 @@ pub(crate) fn existing_poses(
     let mut qs = crate::convert::rows(&v, dof);
     robot.check_joint_values("existing", &mut qs)?;
     let r = robot.inner.clone();
-    let qs2 = qs.clone();
-    let prior = detached(py, move || {
-        let x = activecal::blocks::jacobian_of(&r, &r.nominal, qs2.len(), |k, q| {
-            q.copy_from_slice(&qs2[k]);
-        });
-        Prior::from_blocks(&x).map_err(|e| crate::convert::Fail::input(format!("existing: {e}")))
-    })?;
-    Ok((qs, prior))
+    detached(py, move || {
+        Existing::from_poses("existing".into(), qs, Vec::new(), &r, ParamSet::Nominal)
+            .map_err(crate::convert::Fail::from)
+    })
 }
 
 #[pymethods]
 impl Design {
+    /// Pickling: made again by the same call with the same arguments
+    /// (deterministic: the same result; the robot's files read again).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        self.recipe.reduce(py)
+    }
     /// Joint values of the chosen poses, an (n, dof) float64 array in
     /// visiting order (see `order`; radians or metres, as visited: a joint
     /// may be a whole turn from the pool's value).
@@ -472,8 +462,9 @@ impl Design {
     /// Writes the design by the extension of `path`: .json (the design
     /// file), .csv (joint values, one pose a row) or .yaml (named joint
     /// configurations), as `activecal select --out` does. An existing file
-    /// is replaced only with overwrite=True.
-    #[pyo3(signature = (path, overwrite=false))]
+    /// is replaced (as pandas and NumPy do); overwrite=False refuses it
+    /// with `FileError`.
+    #[pyo3(signature = (path, overwrite=true))]
     fn write(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
         activecal::io::design_formats::write(&self.file, &path, overwrite)
             .map_err(|e| crate::convert::Fail::from(e).into_py())

@@ -78,8 +78,8 @@ def test_ur5_eye_to_hand_equals_the_cli(tmp_path):
     assert (tmp_path / "py.urdf").read_bytes() == urdf.read_bytes()
     assert (tmp_path / "py.yaml").read_bytes() == frames.read_bytes()
     with pytest.raises(activecal.FileError, match="exists"):
-        c.write_urdf(tmp_path / "py.urdf")
-    c.write_urdf(tmp_path / "py.urdf", overwrite=True)
+        c.write_urdf(tmp_path / "py.urdf", overwrite=False)
+    c.write_urdf(tmp_path / "py.urdf")
     with pytest.raises(activecal.InputError, match="^path: .*not refined"):
         c.write_camera_info(tmp_path / "refined.yaml")
 

@@ -77,9 +77,14 @@ def test_the_bound_and_gap_functions_equal_the_cli(tmp_path):
     with_prior = activecal.bound(r, 10, pool="lattice", levels=3, existing=first.q)
     want = cli("bound", "--robot", "puma560", "--levels", 3, "--n", 10, "--existing", f)
     assert abs(with_prior["ln_bound"] - want["ln_bound"]) < 1e-9 * abs(want["ln_bound"])
-    # gap(design) is design.bound().
+    # gap(design) is design.bound(), and the dict `gap --json` prints for
+    # the design's file: the same keys, the same values (to rounding, one
+    # solve each; the solver's timing aside).
     d = activecal.select(r, 30, pool="lattice", levels=3)
-    assert activecal.gap(d) == d.bound()
+    g = activecal.gap(d)
+    assert g == d.bound() or _without_seconds(g) == _without_seconds(d.bound())
+    d.write(tmp_path / "d30.json")
+    _same_report(g, cli("gap", "--design", tmp_path / "d30.json"))
     with pytest.raises(activecal.InputError, match="n"):
         activecal.bound(r, 0, pool="lattice", levels=3)
 
@@ -103,3 +108,30 @@ def test_collision_filters_equal_the_cli():
     puma = activecal.Robot.builtin("puma560")
     with pytest.raises(activecal.Error, match="^self_collision: collision checks need"):
         activecal.pool(puma, "random", count=10, self_collision=True)
+
+
+def _without_seconds(v):
+    """A report without its timings (keys ending in `seconds`)."""
+    if isinstance(v, dict):
+        return {k: _without_seconds(x) for k, x in v.items() if not k.endswith("seconds")}
+    if isinstance(v, list):
+        return [_without_seconds(x) for x in v]
+    return v
+
+
+def _same_report(got, want, where="gap"):
+    """The same keys at every level and the same values, floats to 1e-9
+    relative (two solves of the same problem), timings aside."""
+    if isinstance(want, dict):
+        assert isinstance(got, dict) and set(got) == set(want), (where, set(got) ^ set(want))
+        for k in want:
+            if not k.endswith("seconds"):
+                _same_report(got[k], want[k], f"{where}.{k}")
+    elif isinstance(want, list):
+        assert isinstance(got, list) and len(got) == len(want), where
+        for i, (a, b) in enumerate(zip(got, want)):
+            _same_report(a, b, f"{where}[{i}]")
+    elif isinstance(want, float) and not isinstance(want, bool):
+        assert got == pytest.approx(want, rel=1e-9, abs=1e-12), where
+    else:
+        assert got == want, where

@@ -78,9 +78,9 @@ def test_written_designs_equal_the_clis_and_read_back(tmp_path, ext):
     else:
         score = cli("score", "--design", mine)
     assert score["ln_oid"] == pytest.approx(d.ln_oid, abs=1e-9)
-    with pytest.raises(activecal.Error, match="exists"):
-        d.write(mine)
-    d.write(mine, overwrite=True)
+    with pytest.raises(activecal.FileError, match="exists"):
+        d.write(mine, overwrite=False)
+    d.write(mine)
 
 
 @pytest.mark.parametrize(

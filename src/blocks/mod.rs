@@ -96,9 +96,36 @@ pub fn jacobian_of<F>(robot: &Robot, table: &ParamTable, n: usize, fill_q: F) ->
 where
     F: Fn(usize, &mut [f64]) + Sync,
 {
-    let t = sensor_for(robot).rows();
-    let mut mat = Mat::<f64>::zeros(n * t, robot.n_params());
-    fill_jacobian(robot, table, &mut mat, fill_q);
+    let sensor = sensor_for(robot);
+    jacobian_with(
+        robot,
+        table,
+        sensor.as_ref(),
+        &table.marker_values(),
+        n,
+        fill_q,
+    )
+}
+
+/// Identification Jacobian of `n` poses (joint angles written by
+/// `fill_q(k, q)`) as `sensor` sees them, its own parameters at `own`:
+/// `robot.n_unknowns() + own.len()` columns, the sensor's rows per pose.
+/// Any [`crate::measure::Sensor`] (a camera's, a contact's) goes through
+/// this one loop.
+pub fn jacobian_with<F>(
+    robot: &Robot,
+    table: &ParamTable,
+    sensor: &dyn crate::measure::Sensor,
+    own: &[f64],
+    n: usize,
+    fill_q: F,
+) -> Blocks
+where
+    F: Fn(usize, &mut [f64]) + Sync,
+{
+    let t = sensor.rows();
+    let mut mat = Mat::<f64>::zeros(n * t, robot.n_unknowns() + own.len());
+    fill_jacobian(robot, table, sensor, own, &mut mat, fill_q);
     Blocks::new(mat, t)
 }
 
@@ -116,23 +143,37 @@ pub fn try_jacobian_of<F>(
 where
     F: Fn(usize, &mut [f64]) + Sync,
 {
-    let t = sensor_for(robot).rows();
+    let sensor = sensor_for(robot);
+    let t = sensor.rows();
     let mut mat = crate::resources::try_zeros_mat(what, n.saturating_mul(t), robot.n_params())?;
-    fill_jacobian(robot, table, &mut mat, fill_q);
+    fill_jacobian(
+        robot,
+        table,
+        sensor.as_ref(),
+        &table.marker_values(),
+        &mut mat,
+        fill_q,
+    );
     Ok(Blocks::new(mat, t))
 }
 
-/// Writes the rows of every pose into `mat` (`n·t × p`), straight into the
+/// Writes the rows of every pose as `sensor` sees them (its own
+/// parameters at `own`) into `mat` (`n·t × p`), straight into the
 /// column-major matrix, chunk by chunk of rows (no row-major copy: a
 /// 10⁶-pose pool's Jacobian is 650 MB already).
-fn fill_jacobian<F>(robot: &Robot, table: &ParamTable, mat: &mut Mat<f64>, fill_q: F)
-where
+fn fill_jacobian<F>(
+    robot: &Robot,
+    table: &ParamTable,
+    sensor: &dyn crate::measure::Sensor,
+    own: &[f64],
+    mat: &mut Mat<f64>,
+    fill_q: F,
+) where
     F: Fn(usize, &mut [f64]) + Sync,
 {
     let n_kin = robot.n_unknowns();
-    let p = robot.n_params();
-    let own = table.marker_values();
-    let sensor = sensor_for(robot);
+    let p = n_kin + own.len();
+    debug_assert_eq!(mat.ncols(), p);
     let t = sensor.rows();
     let dof = robot.dof();
     let n = mat.nrows() / t;
@@ -149,9 +190,9 @@ where
             for k in 0..chunk.nrows() / t {
                 fill_q(c * CHUNK + k, &mut q);
                 let end = ev.motions(&q, &mut motions);
-                sensor.motion_rows(&end, &own, &motions, &mut jac, p);
+                sensor.motion_rows(&end, own, &motions, &mut jac, p);
                 if p > n_kin {
-                    sensor.own_rows(&end, &own, &mut jac[n_kin..], p);
+                    sensor.own_rows(&end, own, &mut jac[n_kin..], p);
                 }
                 for r in 0..t {
                     for col in 0..p {

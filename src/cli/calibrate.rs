@@ -203,7 +203,10 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     let mut v = serde_json::to_value(&report)?;
     v["exit_status"] = verdict.exit_status().into();
     if let Some(dir) = &a.report {
-        super::report_dir::calibration(dir, &measured_summary(&fitted, id, path, &report, &v))?;
+        activecal::render::folder::calibration(
+            dir,
+            &measured_summary(&fitted, id, path, &report, &v),
+        )?;
     }
     super::emit(a.json, &v, || {
         let mut s = super::measured::measured_text(&report, id, &status_text(id));
@@ -225,7 +228,7 @@ fn measured_summary<'a>(
     path: &Path,
     r: &activecal::experiment::measured::MeasuredReport,
     json: &serde_json::Value,
-) -> super::report_dir::CalibrationSummary<'a> {
+) -> activecal::render::folder::CalibrationSummary<'a> {
     let pos = |e: &activecal::identify::ModelErrors| -> Vec<f64> {
         e.per_sample
             .iter()
@@ -253,7 +256,7 @@ fn measured_summary<'a>(
             h.nominal_position_rms_mm
         ));
     }
-    super::report_dir::CalibrationSummary {
+    activecal::render::folder::CalibrationSummary {
         robot,
         id,
         source: format!("measurements `{}`, {} poses", path.display(), r.base.poses),

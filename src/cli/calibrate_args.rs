@@ -358,8 +358,8 @@ impl CalibrateArgs {
     /// The outlier choice of `--outliers` and `--outlier-rate`; the rate
     /// with `--outliers keep`, or either with a robust `--loss` (which keeps
     /// every pose), is refused.
-    pub fn outlier_choice(&self) -> anyhow::Result<activecal::identify::outliers::OutlierChoice> {
-        use activecal::identify::outliers::OutlierChoice;
+    pub fn outlier_choice(&self) -> anyhow::Result<activecal::lsq::outliers::OutlierChoice> {
+        use activecal::lsq::outliers::OutlierChoice;
         if let (Some(OutliersKind::Keep), Some(r)) = (self.outliers, self.outlier_rate) {
             anyhow::bail!(
                 "--outlier-rate {r}: is the rate of the test that drops poses; with --outliers keep no pose is dropped"
@@ -375,9 +375,7 @@ impl CalibrateArgs {
         }
         Ok(match self.outliers.unwrap_or(OutliersKind::Drop) {
             OutliersKind::Drop => OutlierChoice::Drop {
-                alpha: self
-                    .outlier_rate
-                    .unwrap_or(activecal::identify::outliers::ALPHA),
+                alpha: self.outlier_rate.unwrap_or(activecal::lsq::outliers::ALPHA),
             },
             OutliersKind::Keep => OutlierChoice::Keep,
         })

@@ -3,23 +3,11 @@
 //! of an unconverged fit, and the status line.
 
 use super::calibrate_args::CalibrateArgs;
-use super::write_new;
 use activecal::frames::CalibratedFrames;
 use activecal::frames::report::{FitBlock, FramesReport};
 use activecal::identify::Identification;
-use activecal::io::calibrated::Format;
 use activecal::model::Robot;
 use anyhow::Result;
-
-/// The header of a calibrated TOML description.
-fn toml_header(id: &Identification, source: &str) -> String {
-    format!(
-        "# Calibrated by activecal from {source}: nominal = real = the estimate\n# ({:?}, {} iterations, σ̂ = {}).\n",
-        id.status,
-        id.iterations,
-        id.sigma_hat.map_or("-".into(), |v| format!("{v:.6e}"))
-    )
-}
 
 /// The calibrated frames of a URDF robot at the estimate (`None` for other
 /// robots), with σ from the fit's covariance.
@@ -48,15 +36,15 @@ pub fn write_calibrated(
     }
     let mut written = Vec::new();
     for out in &a.out {
-        let text = activecal::io::calibrated::render(
-            Format::of(out)?,
+        activecal::io::calibrated::write(
             robot,
             &id.table,
             frames.map(|(f, r)| (f, r)),
-            &toml_header(id, source),
+            &activecal::io::calibrated::header(id, source),
+            out,
+            a.force,
         )
-        .map_err(|e| anyhow::anyhow!("--out {}: {e}", out.display()))?;
-        write_new(out, &text, a.force)?;
+        .map_err(|e| anyhow::anyhow!("--out {e}"))?;
         written.push(out.display().to_string());
     }
     Ok(written)

@@ -299,8 +299,8 @@ fn text(
                 let _ = write!(
                     s,
                     ", σ {} mm, {} deg",
-                    super::frames_text::s3(t, 3),
-                    super::frames_text::s3(r, 4)
+                    activecal::render::frames_text::s3(t, 3),
+                    activecal::render::frames_text::s3(r, 4)
                 );
             }
             s.push('\n');

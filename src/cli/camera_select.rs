@@ -313,13 +313,13 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
             written,
         );
         if let Some(r) = curve.as_ref().and_then(|c| c.recommended.as_ref()) {
-            s += &super::report_dir::recommendation_text(r);
+            s += &activecal::render::folder::recommendation_text(r);
         }
         s
     };
     if let (Some(dir), Some(c)) = (&a.report, &curve) {
         written.push(dir.display().to_string());
-        super::report_dir::camera_selection(
+        activecal::render::folder::camera_selection(
             dir,
             &robot,
             &names,

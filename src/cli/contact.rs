@@ -130,7 +130,7 @@ pub struct ContactArgs<'a> {
     /// `--report DIR` (checked before the fit).
     pub report: Option<&'a Path>,
     /// `--outliers`, `--outlier-rate`.
-    pub outliers: activecal::identify::outliers::OutlierChoice,
+    pub outliers: activecal::lsq::outliers::OutlierChoice,
 }
 
 /// Calibrates from a contact file; `Ok(Some(why))` when the fit did not
@@ -212,15 +212,15 @@ pub fn calibrate_contacts(
         let _ = writeln!(report, "calibrated robot written to {out}");
     }
     if let Some(dir) = a.report {
-        let r = super::contact_report::ContactReport {
+        let r = activecal::render::contact_figures::ContactReport {
             robot,
             file: &fitted,
             fit: &fit,
             figures: &figures,
             held: held.as_ref(),
         };
-        super::report_dir::contacts(dir, robot, &report, &v, |d| {
-            super::contact_report::draw(d, &r)
+        activecal::render::folder::contacts(dir, robot, &report, &v, |d| {
+            activecal::render::contact_figures::draw(d, &r)
         })?;
     }
     super::emit(a.json, &v, || report)?;

@@ -135,7 +135,7 @@ pub fn measured_text(r: &MeasuredReport, id: &Identification, status: &str) -> S
         s += &super::compliance::compliance_text(c);
     }
     if let Some(f) = &r.frames {
-        s += &super::frames_text::frames_text(f);
+        s += &activecal::render::frames_text::frames_text(f);
     }
     if let Some(h) = &r.holdout {
         s += &format!(

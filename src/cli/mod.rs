@@ -14,24 +14,18 @@ pub mod compliance;
 pub mod contact;
 pub mod contact_evaluate;
 pub mod contact_out;
-pub mod contact_report;
 pub mod contact_select;
 pub mod existing;
-pub mod figures;
-pub mod frames_text;
 pub mod hints;
 pub mod measured;
 pub mod pool_opts;
 pub mod progress;
-pub mod report_dir;
-pub mod report_plots;
 pub mod reproduce;
 pub mod run_files;
 pub mod score;
 pub mod select;
 pub mod simulated;
 pub mod tour;
-pub mod typeset;
 pub mod units;
 
 use activecal::io::{ChainChoice, RobotRef};
@@ -39,7 +33,7 @@ use activecal::model::Robot;
 use anyhow::Result;
 use serde_json::Value;
 
-pub use existing::{Existing, existing_from, existing_text, load_existing};
+pub use existing::{existing_from, existing_text, load_existing};
 pub use pool_opts::{
     DEFAULT_LEVELS, PoolCtx, PoolKind, PoolOpts, filters, pool_stats_text, with_jacobian,
 };

@@ -5,9 +5,9 @@
 //! [`activecal::experiment::paper`]; this file parses the arguments, shows
 //! progress and draws the figures.
 
-use super::figures;
 use activecal::experiment::paper::{self, PaperReport, PaperSettings};
 use activecal::progress::Task;
+use activecal::render::paper_figures as figures;
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;

@@ -1,13 +1,12 @@
 //! `select`: pose selection (for `score`, see [`super::score`]).
 
 use super::{PoolOpts, emit_report, parse_list};
-use activecal::io::design::DesignFile;
+use activecal::experiment::select::SelectRun;
 use activecal::report::SelectReport;
-use activecal::select::{Algorithm, CriterionKind, Settings, default_ils_rounds, select};
+use activecal::select::{Algorithm, CriterionKind, Settings, default_ils_rounds};
 use anyhow::{Result, bail};
 use clap::Args;
 use std::path::PathBuf;
-use std::time::Instant;
 
 /// Arguments of `select`.
 #[derive(Args)]
@@ -257,63 +256,51 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         .map(|p| super::load_existing(p, &ctx.robot, a.pool.params, a.pool.units.units()))
         .transpose()?;
     let prior = existing.as_ref().map(|e| e.prior.clone());
-    let s = selection_settings(&a, &ctx, initial, prior.clone())?;
-    let t0 = Instant::now();
-    let mut sel = select(&ctx.x, a.criterion, a.algorithm, &s)?;
-    let seconds = t0.elapsed().as_secs_f64();
-    let how = activecal::experiment::visiting::Visiting {
-        reorder: a.order.map_or(speeds.is_some(), |o| o == Order::Time),
-        home,
-        // Pool poses under the D criterion: not refined ones.
-        may_swap: a.criterion == CriterionKind::Det && !a.refine,
-    };
-    let mut refined_last = None;
-    let (mut report, order, swapped) = activecal::experiment::visiting::visit_selection(
-        &ctx.robot,
-        &ctx.pool,
-        &ctx.x,
-        prior.as_ref(),
-        &mut sel,
-        &how,
-        |sel| -> Result<SelectReport> {
-            let mut report =
-                SelectReport::new(&ctx.robot, &ctx.pool, sel, a.criterion, &s, seconds);
-            if let Some(e) = &existing {
-                let alone = activecal::criterion::design_ln_det(&ctx.x, None, &sel.poses);
-                report.set_existing(e.report.clone(), alone);
-            }
-            let pool_bound = with_gap(&a, &ctx, prior.as_ref(), sel, &mut report)?;
-            refined_last = refined(&a, &ctx, prior.as_ref(), sel, pool_bound, &mut report)?;
-            Ok(report)
+    let s = selection_settings(&a, &ctx, initial, prior)?;
+    let run = SelectRun {
+        criterion: a.criterion,
+        algorithm: a.algorithm,
+        settings: s.clone(),
+        visiting: activecal::experiment::visiting::Visiting {
+            reorder: a.order.map_or(speeds.is_some(), |o| o == Order::Time),
+            home,
+            // Pool poses under the D criterion: not refined ones.
+            may_swap: a.criterion == CriterionKind::Det && !a.refine,
         },
-    )?;
-    let refined = refined_last;
-    report.swapped = swapped;
-    if !a.out.is_empty() {
-        let design = design_file(
-            &ctx,
-            &sel,
-            refined.as_ref(),
-            existing.as_ref(),
-            &order,
-            &report,
-        )?;
-        for out in &a.out {
-            super::tour::write_design(&design, out, a.force)?;
-        }
-    }
-    if let (Some(noise), None) = (a.noise, &existing) {
-        report.predicted = predicted_after(&ctx, a.pool.params, &sel.poses, noise);
+        gap: a
+            .gap
+            .then(|| {
+                activecal::bound::BoundSettings::builder()
+                    .solver(a.gap_solver)
+                    .build()
+            })
+            .transpose()?,
+        refine: a
+            .refine
+            .then(|| {
+                activecal::select::RefineSettings::builder()
+                    .sweeps(a.refine_sweeps)
+                    .build()
+            })
+            .transpose()?,
+        noise: a.noise,
+        params: a.pool.params,
+    };
+    let outcome =
+        activecal::experiment::select::run(&ctx.robot, &ctx.pool, &ctx.x, existing.as_ref(), &run)?;
+    let (report, seconds) = (&outcome.report, outcome.seconds);
+    for out in &a.out {
+        super::tour::write_design(&outcome.design, out, a.force)?;
     }
     let recommended = match &a.report {
-        Some(dir) => report_dir(&a, &ctx, &s, dir, &report)?,
+        Some(dir) => report_dir(&a, &ctx, &s, dir, report)?,
         None => None,
     };
-    emit_report(a.json, &report, || {
-        select_text(&a, &ctx, &report, seconds)
+    emit_report(a.json, report, || {
+        select_text(&a, &ctx, report, seconds)
             + &predicted_text(report.predicted.as_ref())
             + &recommended.map_or(String::new(), |r| {
-                super::report_dir::recommendation_text(&r)
+                activecal::render::folder::recommendation_text(&r)
             })
     })
 }
@@ -334,19 +321,6 @@ fn predicted_text(p: Option<&activecal::report::PredictedAfter>) -> String {
         s += &format!(", orientation RMS {o:.5}°");
     }
     s + "\n"
-}
-
-/// The errors predicted after calibrating with the pool poses `poses`
-/// with noise `noise` (metres), as `--report`'s curve computes them;
-/// `None` for a singular design.
-fn predicted_after(
-    ctx: &super::PoolCtx,
-    params: activecal::model::ParamSet,
-    poses: &[usize],
-    noise: f64,
-) -> Option<activecal::report::PredictedAfter> {
-    let robot = &ctx.robot;
-    activecal::report::PredictedAfter::of_design(robot, robot.params(params), &ctx.x, poses, noise)
 }
 
 /// Every file of a `select` run, whichever kind (pool, camera, sockets):
@@ -417,83 +391,6 @@ fn selection_settings(
         .build()?)
 }
 
-/// `--gap`: the design against the pool's bound; returns the bound.
-fn with_gap(
-    a: &SelectArgs,
-    ctx: &super::PoolCtx,
-    prior: Option<&activecal::criterion::Prior>,
-    sel: &activecal::select::Selection,
-    report: &mut SelectReport,
-) -> Result<Option<f64>> {
-    let mut pool_bound = None;
-    if a.gap {
-        let settings = activecal::bound::BoundSettings::builder()
-            .solver(a.gap_solver)
-            .build()?;
-        let bound = activecal::bound::relaxation_bound(&ctx.x, prior, a.n, &settings)?;
-        let g = activecal::bound::design_gap(&ctx.x, prior, &sel.poses, &bound)?;
-        report.set_gap(&g);
-        pool_bound = Some(bound.ln_bound);
-    }
-    Ok(pool_bound)
-}
-
-/// `--refine`: the design refined off the pool (its joint values replace
-/// the pool's in the report).
-fn refined(
-    a: &SelectArgs,
-    ctx: &super::PoolCtx,
-    prior: Option<&activecal::criterion::Prior>,
-    sel: &activecal::select::Selection,
-    pool_bound: Option<f64>,
-    report: &mut SelectReport,
-) -> Result<Option<activecal::select::Refinement>> {
-    if !a.refine {
-        return Ok(None);
-    }
-    let qs: Vec<Vec<f64>> = sel.poses.iter().map(|&k| ctx.pool.q(k)).collect();
-    let r = activecal::select::refine(
-        &ctx.robot,
-        ctx.robot.params(a.pool.params),
-        &ctx.robot.nominal,
-        &ctx.pool.spec.filters,
-        prior,
-        &qs,
-        &activecal::select::RefineSettings::builder()
-            .sweeps(a.refine_sweeps)
-            .build()?,
-    )?;
-    let mut rr = activecal::report::RefinementReport::new(&ctx.pool, &sel.poses, &r);
-    if let Some(lb) = pool_bound {
-        rr.set_bound(lb, ctx.x.p());
-    }
-    report.refinement = Some(rr);
-    for (c, p) in report.configurations.iter_mut().zip(&r.poses) {
-        c.q.clone_from(&p.q);
-    }
-    Ok(Some(r))
-}
-
-/// The design file of the selection, in visiting order, with the report's
-/// figures as extra keys.
-fn design_file(
-    ctx: &super::PoolCtx,
-    sel: &activecal::select::Selection,
-    refined: Option<&activecal::select::Refinement>,
-    existing: Option<&super::Existing>,
-    order: &[usize],
-    report: &SelectReport,
-) -> Result<DesignFile> {
-    let mut d = activecal::experiment::visiting::ordered_design(
-        &ctx.robot, &ctx.pool, sel, refined, order, report,
-    );
-    d.existing = existing.map(|e| activecal::io::design::ExistingPoses {
-        path: e.report.file.clone(),
-        q: e.qs.clone(),
-    });
-    Ok(d)
-}
-
 /// `--report DIR`: the "how many poses" curve and the selection's figures;
 /// returns the size the curve recommends.
 fn report_dir(
@@ -516,7 +413,7 @@ fn report_dir(
         &ctx.pool.ids,
         &cs,
     )?;
-    super::report_dir::selection(dir, &ctx.robot, report, &curve, a.noise.is_none())?;
+    activecal::render::folder::selection(dir, &ctx.robot, report, &curve, a.noise.is_none())?;
     Ok(curve.recommended)
 }
 

@@ -158,7 +158,7 @@ fn simulated_report_dir(
             mc.validation_rms_predicted.map_or("-".into(), |p| format!("{:.4}", p * 1e3))
         ));
     }
-    let s = super::report_dir::CalibrationSummary {
+    let s = activecal::render::folder::CalibrationSummary {
         robot,
         id,
         source: format!("simulated, design `{}`", design_path.display()),
@@ -189,7 +189,7 @@ fn simulated_report_dir(
         notes,
         json: v.clone(),
     };
-    super::report_dir::calibration(dir, &s)?;
+    activecal::render::folder::calibration(dir, &s)?;
     Ok(())
 }
 
@@ -247,7 +247,7 @@ fn simulated_text(
         s += &mc_text(mc, mc_seconds);
     }
     if let Some(f) = &report.frames {
-        s += &super::frames_text::frames_text(f);
+        s += &activecal::render::frames_text::frames_text(f);
     }
     s
 }

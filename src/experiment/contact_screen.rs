@@ -1,6 +1,6 @@
 //! Gross errors in contacts: each row (a contact with a point or plane,
 //! three residuals) tested by Baarda's data snooping
-//! ([`crate::identify::outliers::snoop`]) as the tracker's poses are; the
+//! ([`crate::lsq::outliers::snoop`]) as the tracker's poses are; the
 //! row flagged left out and the fit repeated. A row whose point or plane
 //! would be left with fewer than [`MIN_DISTINCT`] different configurations
 //! is not left out (the fit would have nothing to determine it by): the
@@ -13,7 +13,7 @@ use crate::identify::contact::{
     ContactFile, ContactFit, ContactSettings, NamedDistance, fit_contacts, resolve_distances,
     tool_points,
 };
-use crate::identify::outliers::{
+use crate::lsq::outliers::{
     Capped, Flag, Flagged, MOST_OUTLIERS, OutlierChoice, PoseTest, Snoop, flagged, kept_of, snoop,
     too_many_note,
 };

@@ -4,7 +4,11 @@ pub mod acts_on;
 pub mod camera;
 pub mod contact_screen;
 pub mod contacts;
+pub mod error;
 pub mod measured;
 pub mod paper;
+pub mod select;
 pub mod simulated;
+
+pub use error::ExperimentError;
 pub mod visiting;

@@ -84,6 +84,7 @@ pub fn pose_count_curve_on(
         .par_iter()
         .map(|&n| {
             let _size_done = task.tick();
+            crate::progress::checkpoint();
             curve_point(rows, x, ids, settings, n)
         })
         .collect();

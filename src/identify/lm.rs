@@ -1,19 +1,19 @@
-//! Identification by Levenberg–Marquardt ([`super::levmar`]): the
+//! Identification by Levenberg–Marquardt ([`crate::lsq::levmar`]): the
 //! calibration problem posed, solved, and its rank and covariance
 //! `σ̂² (XᵀX)⁻¹` read off the solution.
 //!
 //! The loop ([`levenberg_marquardt`]) sees only a [`Residuals`]: no
 //! kinematics, no sensor. [`identify`] poses the calibration problem
 //! ([`Calibration`]) and reads rank and covariance off the solution;
-//! [`identify_robust`] wraps the problem in a robust loss ([`super::loss`])
+//! [`identify_robust`] wraps the problem in a robust loss ([`crate::lsq::loss`])
 //! and solves it by IRLS ([`irls`]).
 
-pub use super::levmar::{LmSettings, Solution, StopReason, levenberg_marquardt};
-use super::loss::{Loss, Robust};
 use super::residual::{Calibration, Residuals};
 use super::{IdentifyError, Measurements, Result};
 use crate::blocks::Blocks;
 use crate::linalg::qr::inverse_information;
+pub use crate::lsq::levmar::{LmSettings, Solution, StopReason, levenberg_marquardt};
+use crate::lsq::loss::{Loss, Robust};
 use crate::model::{ParamTable, Robot, Symbol};
 use crate::observability::identifiability;
 use faer::Mat;
@@ -183,10 +183,10 @@ pub fn identify(
 }
 
 /// As [`identify`], minimising `½ Σ_i ρ(‖r_i‖²)` over the poses `i` for a
-/// robust `loss` ([`super::loss`]) by iteratively reweighted least squares
+/// robust `loss` ([`crate::lsq::loss`]) by iteratively reweighted least squares
 /// ([`irls`]). Rank and covariance are those of the weighted problem at the
 /// estimate (down-weighted poses count less); the residual sums
-/// (`rss`, `sigma_hat`) are weighted too. With [`super::loss::L2`] the
+/// (`rss`, `sigma_hat`) are weighted too. With [`crate::lsq::loss::L2`] the
 /// result equals [`identify`]'s.
 pub fn identify_robust<L: Loss>(
     robot: &Robot,

@@ -44,11 +44,8 @@ pub mod compliance;
 pub mod contact;
 pub mod evaluation;
 pub mod fit;
-pub mod levmar;
 pub mod lm;
-pub mod loss;
 pub mod montecarlo;
-pub mod outliers;
 pub mod plausible;
 pub mod residual;
 pub mod simulate;
@@ -58,6 +55,10 @@ pub mod tables;
 pub mod undetermined;
 pub mod variance;
 
+#[cfg(test)]
+mod robust_tests;
+
+pub use crate::lsq::loss::{Cauchy, Huber, L2, Loss, Robust};
 pub use evaluation::{ModelErrors, SampleResidual, residuals};
 pub use fit::{
     Fit, HoldoutSettings, LossChoice, ParameterTrust, SplitResult, WeightedFit, Weights, fit,
@@ -67,7 +68,6 @@ pub use lm::{
     Correlation, Covariance, Identification, LmSettings, Solution, Status, StopReason, identify,
     identify_robust, irls, levenberg_marquardt, predicted_covariance,
 };
-pub use loss::{Cauchy, Huber, L2, Loss, Robust};
 pub use montecarlo::{
     Comparison, GeneralizedVariance, MonteCarloSettings, MonteCarloSummary, ParameterStats, Spread,
     ValidationSet, compare_designs, monte_carlo,
@@ -193,6 +193,9 @@ pub enum IdentifyError {
     /// Invalid robot, parameter table or pool.
     #[error(transparent)]
     Model(#[from] Error),
+    /// A solver's setting out of range, or a problem it cannot take.
+    #[error(transparent)]
+    Lsq(#[from] crate::lsq::LsqError),
 }
 
 /// Result with an [`IdentifyError`].

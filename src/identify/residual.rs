@@ -1,7 +1,7 @@
 //! Identification as a problem apart from its solver (argmin's
 //! `core/problem.rs`): a [`Residuals`] is anything with a residual vector and
 //! its Jacobian at a parameter vector θ; [`super::lm`] minimises `½‖r(θ)‖²`
-//! for any of them, and a robust loss ([`super::loss`]) wraps one without
+//! for any of them, and a robust loss ([`crate::lsq::loss`]) wraps one without
 //! touching the solver.
 //!
 //! [`Calibration`] is the kinematic calibration problem: a robot, its sensor
@@ -9,31 +9,13 @@
 //! `r_i(θ) = pred(θ, q_i) ⊖ y_i` (Sun & Hollerbach §V-E; for full poses the
 //! weighted orientation rows of [`crate::measure::pose`]).
 
+pub use crate::lsq::Residuals;
+
 use super::{Measurements, Result};
 use crate::kinematics::{Evaluator, Motion};
 use crate::measure::{Sensor, sensor_for};
 use crate::model::{ParamTable, Robot};
 use faer::Mat;
-
-/// A least-squares problem: `m` residuals of `n` parameters.
-pub trait Residuals {
-    /// Number of residuals `m`.
-    fn n_residuals(&self) -> usize;
-
-    /// Number of parameters `n`.
-    fn n_params(&self) -> usize;
-
-    /// Residuals come in consecutive blocks of this many rows that a robust
-    /// loss treats as one (the rows of one measured pose). Default 1.
-    fn block_rows(&self) -> usize {
-        1
-    }
-
-    /// Writes `r(θ)` into `r` (`m` entries) and, if `jac` is given, the
-    /// Jacobian `∂r/∂θ` into it (`m × n`). Returns whether every value
-    /// written is finite.
-    fn eval(&mut self, theta: &[f64], r: &mut [f64], jac: Option<&mut Mat<f64>>) -> bool;
-}
 
 /// The calibration problem: residuals of a robot's sensor at measured poses,
 /// as functions of the robot's unknowns (then the sensor's own unknowns, see

@@ -91,3 +91,36 @@ pub fn render(
         },
     }
 }
+
+/// Writes a calibrated robot ([`render`]) to `path` in the format its
+/// extension names, atomically; an existing file only with `overwrite`.
+/// The command line (`--out`, `--force`) and Python's writers call this.
+pub fn write(
+    robot: &Robot,
+    table: &ParamTable,
+    frames: Option<(&CalibratedFrames, &FramesReport)>,
+    header: &str,
+    path: &Path,
+    overwrite: bool,
+) -> Result<()> {
+    let text = render(Format::of(path)?, robot, table, frames, header)
+        .map_err(|e| Error::Invalid(format!("{}: {e}", path.display())))?;
+    let out = [super::atomic::Output {
+        label: "calibrated robot",
+        path,
+    }];
+    super::atomic::check_outputs(&out, &[], overwrite)?;
+    super::atomic::write_atomic(path, text.as_bytes())
+}
+
+/// The first lines of a calibrated robot's TOML description: where it is
+/// from and how the fit ended.
+#[must_use]
+pub fn header(id: &crate::identify::Identification, source: &str) -> String {
+    format!(
+        "# Calibrated by activecal from {source}: nominal = real = the estimate\n# ({:?}, {} iterations, σ̂ = {}).\n",
+        id.status,
+        id.iterations,
+        id.sigma_hat.map_or("-".into(), |v| format!("{v:.6e}"))
+    )
+}

@@ -56,7 +56,6 @@
 use super::pinhole::{Intrinsics, Projection, right_jacobian, skew};
 use super::sensor::{Observation, ObservationBuf, RowKind, Sensor};
 use crate::kinematics::{EndFrame, Motion};
-use crate::model::MeasurementKind;
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
 mod mounting;
@@ -500,11 +499,6 @@ impl CameraSensor {
 }
 
 impl Sensor for CameraSensor {
-    /// The chain places a whole frame (the target's or the camera's).
-    fn kind(&self) -> MeasurementKind {
-        MeasurementKind::Pose
-    }
-
     fn describe(&self) -> &'static str {
         "target points seen by a camera (pixels)"
     }

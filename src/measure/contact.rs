@@ -36,7 +36,6 @@
 
 use super::sensor::{Observation, ObservationBuf, RowKind, Sensor};
 use crate::kinematics::{EndFrame, Motion};
-use crate::model::MeasurementKind;
 use nalgebra::Vector3;
 
 /// The weight of a known-distance row (see the module documentation).
@@ -233,12 +232,6 @@ impl ContactSensor {
 }
 
 impl Sensor for ContactSensor {
-    /// A point of the tool is what the chain places (the contact points are
-    /// the sensor's own).
-    fn kind(&self) -> MeasurementKind {
-        MeasurementKind::Point
-    }
-
     fn describe(&self) -> &'static str {
         "contacts with fixed points"
     }

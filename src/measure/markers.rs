@@ -20,7 +20,6 @@
 
 use super::sensor::{Observation, ObservationBuf, RowKind, Sensor};
 use crate::kinematics::{EndFrame, Motion};
-use crate::model::MeasurementKind;
 use nalgebra::Vector3;
 
 /// Measures `K` marker points per pose, `3K` rows, with `3K` offset
@@ -51,10 +50,6 @@ impl MarkerSensor {
 }
 
 impl Sensor for MarkerSensor {
-    fn kind(&self) -> MeasurementKind {
-        MeasurementKind::Markers(self.k)
-    }
-
     fn describe(&self) -> &'static str {
         "marker points"
     }
@@ -274,7 +269,6 @@ mod tests {
     fn sizes_follow_the_number_of_markers() {
         for k in 1..=4 {
             let s = MarkerSensor::new(k);
-            assert_eq!(s.kind(), MeasurementKind::Markers(k));
             assert_eq!(s.points_per_pose(), k);
             assert_eq!(s.rows(), 3 * k);
             assert_eq!(s.value_len(), 3 * k);

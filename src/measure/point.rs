@@ -3,7 +3,6 @@
 
 use super::sensor::{Observation, ObservationBuf, RowKind, Sensor};
 use crate::kinematics::{EndFrame, Motion};
-use crate::model::MeasurementKind;
 
 /// Measures the end point `p`; residual `p − y`; Jacobian rows the linear
 /// velocity of `p` under each parameter's elementary motion.
@@ -22,10 +21,6 @@ const KINDS: [RowKind; 3] = [RowKind::Position; 3];
 const ONES: [f64; 3] = [1.0; 3];
 
 impl Sensor for PointSensor {
-    fn kind(&self) -> MeasurementKind {
-        MeasurementKind::Point
-    }
-
     fn describe(&self) -> &'static str {
         "points"
     }

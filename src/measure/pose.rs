@@ -5,7 +5,6 @@
 use super::sensor::{Observation, ObservationBuf, RowKind, Sensor};
 use super::so3;
 use crate::kinematics::{EndFrame, Motion};
-use crate::model::MeasurementKind;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 /// Measures `(p, R)`; value layout `x y z` then the unit quaternion `w x y z`
@@ -53,10 +52,6 @@ fn store(q: &UnitQuaternion<f64>, out: &mut [f64]) {
 }
 
 impl Sensor for PoseSensor {
-    fn kind(&self) -> MeasurementKind {
-        MeasurementKind::Pose
-    }
-
     fn describe(&self) -> &'static str {
         "full poses (position and orientation)"
     }

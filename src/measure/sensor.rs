@@ -38,7 +38,6 @@
 //! distance between two contact points), appended after the poses' rows.
 
 use crate::kinematics::{EndFrame, Motion};
-use crate::model::MeasurementKind;
 use std::fmt;
 
 /// What a row of a residual measures, for reports that split errors into
@@ -95,9 +94,6 @@ pub struct ObservationBuf {
 /// [`Sensor::motion_rows`] once per pose; every other method is per pose or
 /// per identification.
 pub trait Sensor: fmt::Debug + Send + Sync {
-    /// The measurement kind this sensor implements.
-    fn kind(&self) -> MeasurementKind;
-
     /// What a pose's measurement is, for messages (`points`, `full poses
     /// (position and orientation)`).
     fn describe(&self) -> &'static str;

@@ -92,7 +92,7 @@ pub struct CameraCalibrationReport {
 #[derive(Clone, Debug, Serialize)]
 pub struct CameraOutliers {
     /// Drop (at a rate) or keep.
-    pub choice: crate::identify::outliers::OutlierChoice,
+    pub choice: crate::lsq::outliers::OutlierChoice,
     /// What was left out, in the order the test found it.
     pub left_out: Vec<crate::identify::camera::screen::CameraOutlier>,
 }

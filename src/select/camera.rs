@@ -11,7 +11,6 @@ use crate::blocks::Blocks;
 use crate::error::{Error, Result};
 use crate::identify::camera::camera_robot;
 use crate::identify::camera::predict::predicted_error_of_information;
-use crate::kinematics::{Evaluator, Motion};
 use crate::measure::Sensor;
 use crate::measure::camera::CameraSensor;
 use crate::measure::camera::OWN_PARAMS;
@@ -104,17 +103,10 @@ pub const PREDICTION_CONFIGURATIONS: usize = 1000;
 #[must_use]
 pub fn camera_blocks(robot: &Robot, view: &CameraView, qs: &[Vec<f64>]) -> Blocks {
     let (sensor, own) = view.sensor();
-    let n = robot.n_unknowns();
-    let (t, p) = (sensor.rows(), n + OWN_PARAMS);
-    let mut ev = Evaluator::new(robot, &robot.nominal);
-    let mut motions = vec![Motion::default(); n];
-    let mut rows = vec![0.0; qs.len() * t * p];
-    for (q, block) in qs.iter().zip(rows.chunks_exact_mut(t * p)) {
-        let end = ev.motions(q, &mut motions);
-        sensor.motion_rows(&end, &own, &motions, block, p);
-        sensor.own_rows(&end, &own, &mut block[n..], p);
-    }
-    Blocks::from_row_major(&rows, t, p)
+    debug_assert_eq!(own.len(), OWN_PARAMS);
+    crate::blocks::jacobian_with(robot, &robot.nominal, &sensor, &own, qs.len(), |k, q| {
+        q.copy_from_slice(&qs[k]);
+    })
 }
 
 /// Chooses `settings.n` of the `candidates` (joint vectors of `robot`)

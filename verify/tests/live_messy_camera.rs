@@ -27,11 +27,11 @@ use activecal::experiment::camera::{CameraCalibration, CameraSetup, calibrate_ca
 use activecal::identify::LmSettings;
 use activecal::identify::camera::CameraObservations;
 use activecal::identify::camera::screen::CameraUnit;
-use activecal::identify::outliers::OutlierChoice;
 use activecal::io::calibrated::{Format, render};
 use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_observations::read_observations;
 use activecal::io::camera_target::read_target;
+use activecal::lsq::outliers::OutlierChoice;
 use activecal::measure::camera::Mounting;
 use activecal::model::Robot;
 use activecal::observability::generic_configurations;

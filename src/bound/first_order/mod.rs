@@ -333,6 +333,7 @@ fn start_point(ev: &mut Evaluator<'_>, start: Option<Vec<f64>>) -> Iterate {
 fn warm_up_and_prune(ev: &mut Evaluator<'_>, it: &mut Iterate, rounds: usize, keep: usize) {
     let (n, pool) = (ev.n, ev.sc.x.n_poses());
     for _ in 0..rounds {
+        crate::progress::checkpoint();
         if !multiplicative_step(&mut it.w, &it.eval.d, n) {
             break;
         }

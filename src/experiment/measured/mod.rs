@@ -9,11 +9,11 @@
 use super::paper::ExperimentError;
 use crate::identify::compliance::{ComplianceComparison, compare, with_compliance};
 use crate::identify::evaluation::ModelErrors;
-use crate::identify::outliers::OutlierChoice;
 use crate::identify::{
     Fit, FixedParameter, HoldoutSettings, LmSettings, LossChoice, Measurements, ParameterTrust,
     SplitResult, for_measurements, holdout, prepare_for_data, residuals, trust,
 };
+use crate::lsq::outliers::OutlierChoice;
 use crate::model::gravity::GravityModel;
 use crate::model::{ParamTable, Robot};
 use nalgebra::Vector3;
@@ -135,7 +135,7 @@ pub struct MeasuredReport {
     pub fixed: Vec<FixedParameter>,
     /// Poses the robust loss down-weighted: `[pose, weight]`.
     pub downweighted: Vec<(usize, f64)>,
-    /// The gross-error test ([`crate::identify::outliers`]): its choice and
+    /// The gross-error test ([`crate::lsq::outliers`]): its choice and
     /// the poses it left out, in the order it found them.
     pub outliers: OutlierReport,
     /// Held-out validation, if asked.

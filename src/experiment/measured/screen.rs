@@ -1,13 +1,13 @@
 //! The least-squares fit of measured data with Baarda's data snooping
-//! ([`crate::identify::outliers`]): the poses the test flags left out one at
+//! ([`crate::lsq::outliers`]): the poses the test flags left out one at
 //! a time, the fit repeated.
 
 use super::MeasuredSettings;
-use crate::identify::outliers::{
+use crate::identify::{LossChoice, Measurements, residuals};
+use crate::lsq::outliers::{
     Flag, Flagged, MOST_OUTLIERS, Outlier, OutlierChoice, Snoop, flagged, kept_of, pose_tests,
     snoop, too_many_note,
 };
-use crate::identify::{LossChoice, Measurements, residuals};
 use crate::model::{ParamTable, Robot};
 use serde::Serialize;
 
@@ -90,7 +90,7 @@ impl Snoop for Poses<'_> {
 
 /// The fit of `meas` ([`crate::identify::fit_weighted`]), and with least
 /// squares and [`OutlierChoice::Drop`], Baarda's data snooping
-/// ([`crate::identify::outliers`]): the pose the test flags left out and
+/// ([`crate::lsq::outliers`]): the pose the test flags left out and
 /// the fit repeated from the last estimate, until none is flagged or
 /// [`MOST_OUTLIERS`] of the poses are out.
 pub(super) fn screen(
@@ -99,7 +99,7 @@ pub(super) fn screen(
     meas: &Measurements,
     s: &MeasuredSettings,
 ) -> crate::identify::Result<Screened> {
-    crate::identify::outliers::check_choice(s.outliers)?;
+    crate::lsq::outliers::check_choice(s.outliers)?;
     let mut poses = Poses {
         robot,
         start,
@@ -128,7 +128,7 @@ pub(super) fn screen(
         meas.len(),
         &snooped.out.iter().map(|f| f.unit).collect::<Vec<_>>(),
     );
-    let found: Vec<(usize, crate::identify::outliers::PoseTest, f64)> = snooped
+    let found: Vec<(usize, crate::lsq::outliers::PoseTest, f64)> = snooped
         .out
         .into_iter()
         .map(|f| (f.unit, f.test, f.threshold))

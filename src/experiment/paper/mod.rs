@@ -17,13 +17,9 @@ pub use report::{
 };
 pub use settings::PaperSettings;
 
-use crate::bound::{
-    BoundError, BoundSettings, DesignGap, RelaxationSolver, design_gap, relaxation_bound,
-};
+use crate::bound::{BoundSettings, DesignGap, RelaxationSolver, design_gap, relaxation_bound};
 use crate::criterion::{DCriterion, OiCriterion};
-use crate::identify::{
-    IdentifyError, LmSettings, MonteCarloSettings, PaperTables, compare_designs, paper_tables,
-};
+use crate::identify::{LmSettings, MonteCarloSettings, PaperTables, compare_designs, paper_tables};
 use crate::model::Robot;
 use crate::pool::PoolSpec;
 use crate::select::{
@@ -31,7 +27,6 @@ use crate::select::{
 };
 use assemble::Parts;
 use std::time::Instant;
-use thiserror::Error;
 
 /// The paper's best random design, OI_D (§V-C).
 pub const PAPER_RANDOM_OID: f64 = 2.5414e22;
@@ -42,33 +37,10 @@ pub const PAPER_EAE_OID: f64 = 1.4818e27;
 /// The paper's EAE design, OI (§V-D).
 pub const PAPER_EAE_OI: f64 = 0.11798;
 
+pub use super::error::ExperimentError;
+
 /// Steps [`run`] reports to its progress callback.
 pub const STEPS: u64 = 7;
-
-/// What can stop the experiment: bad settings, or an error of a stage.
-#[derive(Debug, Error)]
-pub enum ExperimentError {
-    /// Bad input (settings, pool).
-    #[error(transparent)]
-    Input(#[from] crate::Error),
-    /// The relaxation bound.
-    #[error(transparent)]
-    Bound(#[from] BoundError),
-    /// Identification or Monte-Carlo.
-    #[error(transparent)]
-    Identify(#[from] IdentifyError),
-    /// The calibrated frames of a fit.
-    #[error(transparent)]
-    Frames(#[from] crate::frames::FramesError),
-    /// Identification from a data file that the file's data make fail.
-    #[error("{path}: {error}")]
-    InFile {
-        /// The data file.
-        path: String,
-        /// What is wrong.
-        error: IdentifyError,
-    },
-}
 
 /// The random baseline (§V-C): the best of `designs` random designs and
 /// the median one (its design drawn again from its seed).

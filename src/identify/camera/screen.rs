@@ -1,6 +1,6 @@
 //! Gross errors in a camera's pixels: a misdetected corner (one point off
 //! by pixels) or a shifted board (every point of a pose off), found by
-//! Baarda's data snooping ([`crate::identify::outliers::snoop`]) as the
+//! Baarda's data snooping ([`crate::lsq::outliers::snoop`]) as the
 //! tracker's poses are.
 //!
 //! Each pose's pixel rows are tested as one block. For the pose flagged,
@@ -14,11 +14,11 @@
 
 use super::{CameraFit, CameraFitError, CameraObservations, fit_camera};
 use crate::identify::LmSettings;
-use crate::identify::outliers::{
+use crate::identify::residual::{Calibration, Residuals};
+use crate::lsq::outliers::{
     Flag, Flagged, MOST_OUTLIERS, OutlierChoice, PoseTest, Snoop, Tester, flagged, snoop, tail_of,
     too_many_note,
 };
-use crate::identify::residual::{Calibration, Residuals};
 use crate::measure::camera::CameraSensor;
 use crate::model::Robot;
 use serde::Serialize;

@@ -16,10 +16,10 @@
 use super::data::ContactFile;
 use super::{start_own, start_planes};
 use crate::identify::lm::{Solution, StopReason, levenberg_marquardt};
-use crate::identify::loss::{Cauchy, Huber, Loss};
-use crate::identify::outliers::{OutlierChoice, Tester};
 use crate::identify::undetermined::{FixedParameter, fix_undetermined_below};
 use crate::identify::{Calibration, LmSettings, LossChoice, Residuals, Result};
+use crate::lsq::loss::{Cauchy, Huber, Loss};
+use crate::lsq::outliers::{OutlierChoice, Tester};
 use crate::measure::contact::{ContactSensor, KnownDistance, Plane, PlaneKind};
 use crate::model::{ParamTable, Robot};
 use faer::Mat;
@@ -64,7 +64,7 @@ pub struct ContactSettings {
     pub keep: Vec<String>,
     /// What happens to rows the gross-error test flags (with least
     /// squares; a robust loss keeps every row). Default: dropped at
-    /// [`crate::identify::outliers::ALPHA`]. [`fit_contacts`] fits every
+    /// [`crate::lsq::outliers::ALPHA`]. [`fit_contacts`] fits every
     /// row; the pipeline ([`crate::experiment::contacts`]) tests them.
     pub outliers: OutlierChoice,
 }
@@ -90,7 +90,7 @@ crate::settings::settings_builder! {
         /// Parameters never fixed (default none).
         keep: Vec<String>,
         /// What happens to rows the gross-error test flags (default:
-        /// dropped at rate [`crate::identify::outliers::ALPHA`]).
+        /// dropped at rate [`crate::lsq::outliers::ALPHA`]).
         outliers: OutlierChoice,
     }
 }
@@ -100,7 +100,7 @@ impl ContactSettings {
     /// test's rate.
     pub fn validate(&self) -> Result<()> {
         self.lm.validate()?;
-        crate::identify::outliers::check_choice(self.outliers)?;
+        crate::lsq::outliers::check_choice(self.outliers)?;
         loss_of(self.loss).map(|_| ())
     }
 }
@@ -226,7 +226,7 @@ fn problem<'a>(
     Calibration::with_sensor(robot, start, &file.qs, Box::new(sensor), measured)
 }
 
-/// The gross-error test of `fit`'s rows ([`crate::identify::outliers`]):
+/// The gross-error test of `fit`'s rows ([`crate::lsq::outliers`]):
 /// the least-squares problem `fit` solved (`file`'s rows with `distances`,
 /// its robot's unknowns from `start`, the planes started as
 /// [`fit_contacts`] starts them) at its estimate, ready to test each row's

@@ -80,6 +80,6 @@ impl MonteCarloSettings {
                 reason: "at least one held-out pose is needed (the RMS error of no poses is no measurement)",
             });
         }
-        self.lm.validate()
+        Ok(self.lm.validate()?)
     }
 }

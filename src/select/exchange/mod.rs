@@ -199,6 +199,7 @@ impl<'a, C: Criterion> Run<'a, C> {
     /// if the criterion increases; repeat until it does not.
     fn exchange_phase(&mut self, max_iter: usize) {
         for _ in 0..max_iter {
+            crate::progress::checkpoint();
             let cur = self.score();
             let Some((out, _)) = self.best_removal() else {
                 return;
@@ -217,6 +218,7 @@ impl<'a, C: Criterion> Run<'a, C> {
     /// improves.
     fn fedorov_phase(&mut self, max_iter: usize) {
         for _ in 0..max_iter {
+            crate::progress::checkpoint();
             let cur = self.score();
             let outs = self.removable();
             let Some((out, inn, new)) = self.best_exchange(&outs) else {
@@ -247,6 +249,7 @@ impl<'a, C: Criterion> Run<'a, C> {
             let mut improved = false;
             let outs = self.removable();
             for out in outs {
+                crate::progress::checkpoint();
                 let cur = self.score();
                 let Some((_, inn, new)) = self.best_exchange(&[out]) else {
                     continue;
@@ -284,6 +287,7 @@ impl<'a, C: Criterion> Run<'a, C> {
             return; // nothing to kick out, or nothing to kick in
         }
         for _ in 0..rounds {
+            crate::progress::checkpoint();
             for _ in 0..kick {
                 let outs = self.removable();
                 let out = outs[rng.random_range(0..outs.len())];
@@ -312,6 +316,7 @@ impl<'a, C: Criterion> Run<'a, C> {
     /// `n` poses or no addition increases the criterion.
     fn add_phase(&mut self, n: usize) {
         while self.state.design().len() < n {
+            crate::progress::checkpoint();
             let cur = self.score();
             let Some((inn, new)) = self.best_add() else {
                 return;
@@ -334,6 +339,7 @@ impl<'a, C: Criterion> Run<'a, C> {
     /// one; stop when the pose just added is the one removed.
     fn detmax_phase(&mut self, max_iter: usize) {
         for _ in 0..max_iter {
+            crate::progress::checkpoint();
             let Some((inn, _)) = self.best_add() else {
                 return;
             };
@@ -521,6 +527,9 @@ where
         return finish_polish(pool, make, sel, s);
     }
     let one = |k: usize| -> Result<Selection> {
+        // Starts still queued when the work is stopped end here, before
+        // their criterion's set-up (tens of ms each on a large pool).
+        crate::progress::checkpoint();
         let mut rng = design_rng(s.seed, k as u64);
         let mut crit = make();
         match algorithm {

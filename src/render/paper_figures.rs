@@ -2,68 +2,13 @@
 //! (plotters): the paper's Fig. 2 (random designs), Fig. 4–6 (traces), and
 //! the selected poses.
 
-use activecal::io::atomic::write_atomic;
-use anyhow::{Result, anyhow};
+use super::figure::{both, err};
+use crate::error::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 
 type Area<'a, DB> = DrawingArea<DB, Shift>;
-
-/// A drawing error as the commands report it.
-pub(super) fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
-    anyhow!("drawing a figure: {e:?}")
-}
-
-/// Draws `$body` (with `$r` bound to the root area) once on a pixel buffer
-/// and once on an SVG string, then writes `<base>.png` and `<base>.svg`
-/// atomically ([`write_figure`]).
-macro_rules! both {
-    ($base:expr, $size:expr, |$r:ident| $body:expr) => {{
-        $crate::cli::typeset::register_fonts()?;
-        let size: (u32, u32) = $size;
-        let mut rgb = vec![0u8; size.0 as usize * size.1 as usize * 3];
-        {
-            let root = $crate::cli::typeset::Typeset(BitMapBackend::with_buffer(&mut rgb, size))
-                .into_drawing_area();
-            root.fill(&WHITE).map_err(err)?;
-            let $r = &root;
-            $body?;
-            root.present().map_err(err)?;
-        }
-        let mut svg = String::new();
-        {
-            let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-            root.fill(&WHITE).map_err(err)?;
-            let $r = &root;
-            $body?;
-            root.present().map_err(err)?;
-        }
-        $crate::cli::figures::write_figure($base, &rgb, size, &svg)
-    }};
-}
-pub(super) use both;
-
-/// Writes a drawn figure: `<base>.png` from the RGB pixels of `size`
-/// (8 bits a channel) and `<base>.svg`, each atomically.
-pub(super) fn write_figure(base: &Path, rgb: &[u8], size: (u32, u32), svg: &str) -> Result<()> {
-    let png = png_bytes(rgb, size).map_err(err)?;
-    write_atomic(&base.with_extension("png"), &png)?;
-    write_atomic(&base.with_extension("svg"), svg.as_bytes())?;
-    Ok(())
-}
-
-/// Encodes RGB pixels (row by row, 8 bits a channel) as a PNG file's bytes.
-fn png_bytes(rgb: &[u8], (width, height): (u32, u32)) -> Result<Vec<u8>, png::EncodingError> {
-    let mut out = Vec::new();
-    let mut encoder = png::Encoder::new(&mut out, width, height);
-    encoder.set_color(png::ColorType::Rgb);
-    encoder.set_depth(png::BitDepth::Eight);
-    let mut writer = encoder.write_header()?;
-    writer.write_image_data(rgb)?;
-    writer.finish()?;
-    Ok(out)
-}
 
 fn range(v: &[f64]) -> (f64, f64) {
     let lo = v

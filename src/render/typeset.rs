@@ -4,8 +4,11 @@
 //! ("50.0" read "50. 0", a "j" lost its hook); here every glyph is drawn at
 //! its pen position plus its bearing, kerned, on one baseline.
 
+use crate::error::Error;
 use ab_glyph::{Font, FontRef, Glyph, PxScale, ScaleFont, point};
-use anyhow::{Result, anyhow};
+
+/// A result whose error defaults to the library's.
+type Result<T, E = Error> = std::result::Result<T, E>;
 use plotters::style::{FontStyle, register_font};
 use plotters_backend::text_anchor::{HPos, VPos};
 use plotters_backend::{
@@ -31,12 +34,12 @@ fn fonts() -> Result<&'static (FontRef<'static>, FontRef<'static>)> {
             ))
         })
         .as_ref()
-        .ok_or_else(|| anyhow!("drawing a figure: an embedded font does not parse"))
+        .ok_or_else(|| Error::Draw("an embedded font does not parse".into()))
 }
 
 /// Registers the embedded fonts with plotters (once per process): the SVG
 /// backend sizes its label areas with them. Also checks that they parse.
-pub(super) fn register_fonts() -> Result<()> {
+pub(crate) fn register_fonts() -> Result<()> {
     static REGISTERED: OnceLock<bool> = OnceLock::new();
     fonts()?;
     let ok = *REGISTERED.get_or_init(|| {
@@ -45,7 +48,7 @@ pub(super) fn register_fonts() -> Result<()> {
             .all(|(name, bytes)| register_font(name, FontStyle::Normal, bytes).is_ok())
     });
     ok.then_some(())
-        .ok_or_else(|| anyhow!("drawing a figure: plotters refused an embedded font"))
+        .ok_or_else(|| Error::Draw("plotters refused an embedded font".into()))
 }
 
 /// A line of text laid out in one font: its glyphs on the baseline, its
@@ -106,7 +109,7 @@ fn anchor_offset(anchor: plotters_backend::text_anchor::Pos, w: i32, h: i32) -> 
 
 /// A drawing backend that draws everything through `B` but sets text
 /// itself ([`lay_out`]).
-pub(super) struct Typeset<B>(pub B);
+pub(crate) struct Typeset<B>(pub B);
 
 impl<B: DrawingBackend> Typeset<B> {
     /// The covered pixels of `text` drawn at `pos` in `style`, with their
@@ -142,7 +145,7 @@ impl<B: DrawingBackend> Typeset<B> {
 }
 
 /// A font error as the backend reports it.
-fn font_error<E: std::error::Error + Send + Sync>(e: anyhow::Error) -> DrawingErrorKind<E> {
+fn font_error<E: std::error::Error + Send + Sync>(e: Error) -> DrawingErrorKind<E> {
     DrawingErrorKind::FontError(e.into())
 }
 

@@ -14,11 +14,11 @@ pub use calibration::{
 pub use contacts::{BarGroup, RowMark, consistency_bars, row_distances};
 pub use selection::{CurveRow, JointRow, how_many, joints_vs_limits, tour};
 
-use anyhow::Result;
+use crate::error::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::figures::err;
+use super::figure::err;
 
 /// A drawing area of any backend.
 type Area<DB> = DrawingArea<DB, Shift>;

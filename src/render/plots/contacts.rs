@@ -4,8 +4,8 @@
 //! faulty rows of a recording stand out.
 
 use super::{AFTER, Area, BEFORE, FONT, legend};
-use crate::cli::figures::{both, err};
-use anyhow::Result;
+use crate::error::Result;
+use crate::render::figure::{both, err};
 use plotters::prelude::*;
 use std::path::Path;
 

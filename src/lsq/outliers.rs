@@ -24,9 +24,9 @@
 //! probability is below `α / n` (Bonferroni over the `n` poses tested, so
 //! that clean data are flagged at most a fraction `α` of the time), the
 //! largest `F_i` first; the fit is then repeated without it and the test
-//! repeated ([`super::fit`] callers iterate).
+//! repeated ([`crate::identify::fit`] callers iterate).
 
-use super::{Residuals, Result};
+use super::{LsqError, Residuals, Result};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
@@ -410,11 +410,9 @@ pub struct Outlier {
 /// Checks an [`OutlierChoice`]'s rate: in (0, 1).
 pub fn check_choice(c: OutlierChoice) -> Result<()> {
     match c {
-        OutlierChoice::Drop { alpha } if !(alpha > 0.0 && alpha < 1.0) => {
-            Err(super::IdentifyError::Model(crate::Error::Invalid(format!(
-                "outlier test rate {alpha}: must be in (0, 1)"
-            ))))
-        }
+        OutlierChoice::Drop { alpha } if !(alpha > 0.0 && alpha < 1.0) => Err(LsqError::Invalid(
+            format!("outlier test rate {alpha}: must be in (0, 1)"),
+        )),
         _ => Ok(()),
     }
 }

@@ -4,15 +4,25 @@
 //! ([`super::run_files`]: an existing non-empty one needs `--force`), built
 //! aside and swapped in whole.
 
-use super::report_plots::{self as plots, CurveRow, JointRow, ParamBar};
-use activecal::how_many::PoseCountCurve;
-use activecal::identify::Identification;
-use activecal::io::atomic::{StagedDir, write_atomic};
-use activecal::model::{JointKind, Robot, Symbol};
-use activecal::report::SelectReport;
-use anyhow::Result;
+use super::plots::{self as plots, CurveRow, JointRow, ParamBar};
+use crate::error::Result;
+use crate::how_many::PoseCountCurve;
+use crate::identify::Identification;
+use crate::io::atomic::{StagedDir, write_atomic};
+use crate::model::{JointKind, Robot, Symbol};
+use crate::report::SelectReport;
 use std::fmt::Write as _;
 use std::path::Path;
+
+/// report.json's text: `v` pretty-printed.
+fn json_text<T: serde::Serialize + ?Sized>(v: &T) -> Result<String> {
+    serde_json::to_string_pretty(v).map_err(json_error)
+}
+
+/// A report that does not serialise (a non-finite map key, say).
+fn json_error(e: serde_json::Error) -> crate::Error {
+    crate::Error::Invalid(format!("report.json: {e}"))
+}
 
 /// Writes `text` into the staged directory as `name`.
 fn put(staged: &StagedDir, name: &str, text: &str) -> Result<()> {
@@ -214,7 +224,7 @@ pub fn calibration(dir: &Path, s: &CalibrationSummary<'_>) -> Result<()> {
     let mut md = format!(
         "# Calibration report\n\nRobot: `{}` (chain {}). Data: {}.\n\nFit: {:?} ({:?}) after {} iterations, rank {} of {}.\n\n",
         s.robot.name,
-        activecal::report::chain(s.robot).join(" → "),
+        crate::report::chain(s.robot).join(" → "),
         s.source,
         s.id.status,
         s.id.stop,
@@ -244,11 +254,7 @@ pub fn calibration(dir: &Path, s: &CalibrationSummary<'_>) -> Result<()> {
     md += &figure_section(&figs);
     md += &parameter_table(&s.params);
     put(&staged, "report.md", &md)?;
-    put(
-        &staged,
-        "report.json",
-        &(serde_json::to_string_pretty(&s.json)? + "\n"),
-    )?;
+    put(&staged, "report.json", &(json_text(&s.json)? + "\n"))?;
     staged.commit()?;
     Ok(())
 }
@@ -374,8 +380,8 @@ fn how_many_figure(out: &Path, curve: &PoseCountCurve, chosen: usize) -> Result<
 }
 
 /// One line: the size a curve recommends, and why.
-pub fn recommendation_text(r: &activecal::how_many::Recommendation) -> String {
-    use activecal::how_many::{KNEE_GAIN, KNEE_MORE_PERCENT, Recommendation as R};
+pub fn recommendation_text(r: &crate::how_many::Recommendation) -> String {
+    use crate::how_many::{KNEE_GAIN, KNEE_MORE_PERCENT, Recommendation as R};
     match r {
         R::Target {
             n,
@@ -430,7 +436,7 @@ pub fn selection(
         "the selected poses' joint values within each joint's limits".into(),
     ));
     if let Some(t) = report.tour.as_ref().filter(|t| t.reordered) {
-        let times = activecal::select::tour::arrival_times(&t.speeds, t.home.as_deref(), &qs)?;
+        let times = crate::select::tour::arrival_times(&t.speeds, t.home.as_deref(), &qs)?;
         let deg: Vec<Vec<f64>> = qs
             .iter()
             .map(|q| {
@@ -446,7 +452,7 @@ pub fn selection(
     let mut md = format!(
         "# Pose selection report\n\nRobot: `{}` (chain {}), {} unknowns, {} rows per pose; pool of {} poses.\n\nSelected: {} poses, log10 OI_D {:.4} (OI_D = det XᵀX, the information of the design).\n",
         robot.name,
-        activecal::report::chain(robot).join(" → "),
+        crate::report::chain(robot).join(" → "),
         curve.p,
         curve.rows_per_pose,
         report.pool_size,
@@ -470,7 +476,7 @@ pub fn selection(
             }
         );
     }
-    let report = serde_json::to_value(report)?;
+    let report = serde_json::to_value(report).map_err(json_error)?;
     finish_selection(staged, md, &figs, &report, curve)
 }
 
@@ -501,7 +507,7 @@ pub fn camera_selection(
     let mut md = format!(
         "# Pose selection report (camera)\n\nRobot: `{}` (chain {}), {} unknowns; a pose's pixel rows compressed to the {} of their information's rank.\n\n```text\n{}```\n",
         robot.name,
-        activecal::report::chain(robot).join(" → "),
+        crate::report::chain(robot).join(" → "),
         curve.p,
         curve.rows_per_pose,
         text
@@ -526,11 +532,7 @@ fn finish_selection(
     md += &figure_section(figs);
     put(&staged, "report.md", &md)?;
     let json = serde_json::json!({ "selection": selection, "how_many_poses": curve });
-    put(
-        &staged,
-        "report.json",
-        &(serde_json::to_string_pretty(&json)? + "\n"),
-    )?;
+    put(&staged, "report.json", &(json_text(&json)? + "\n"))?;
     staged.commit()?;
     Ok(())
 }
@@ -562,16 +564,12 @@ pub fn contacts(
     let md = format!(
         "# Calibration report (contacts)\n\nRobot: `{}` (chain {}).\n\n```text\n{}```\n{}",
         robot.name,
-        activecal::report::chain(robot).join(" → "),
+        crate::report::chain(robot).join(" → "),
         text,
         figure_section(&figs)
     );
     put(&staged, "report.md", &md)?;
-    put(
-        &staged,
-        "report.json",
-        &(serde_json::to_string_pretty(json)? + "\n"),
-    )?;
+    put(&staged, "report.json", &(json_text(json)? + "\n"))?;
     staged.commit()?;
     Ok(())
 }

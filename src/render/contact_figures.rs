@@ -1,16 +1,16 @@
 //! The figures of `calibrate --report DIR` for a contact file, from the fit
 //! and its held-out folds: each placement's consistency and each known
 //! distance's error (nominal, calibrated, held out), and each row's
-//! distance to its point's mean ([`super::report_plots`] draws them).
+//! distance to its point's mean ([`super::plots`] draws them).
 
-use super::report_plots::{BarGroup, RowMark, consistency_bars, row_distances};
-use activecal::identify::contact::holdout::{Figures, downweighted_rows};
-use activecal::identify::contact::{
+use super::plots::{BarGroup, RowMark, consistency_bars, row_distances};
+use crate::error::Result;
+use crate::identify::contact::holdout::{Figures, downweighted_rows};
+use crate::identify::contact::{
     ContactFile, ContactFit, HoldoutReport, RowDistance, placement_of, placements, rms,
     row_distances as rows_of_fit,
 };
-use activecal::model::Robot;
-use anyhow::Result;
+use crate::model::Robot;
 use std::path::Path;
 
 /// What the contact figures are drawn from.

@@ -2,8 +2,8 @@
 //! selected poses within their joint limits, and the tour.
 
 use super::{AFTER, Area, BEFORE, DOUBLE, FONT, WIDE, legend, range};
-use crate::cli::figures::{both, err};
-use anyhow::Result;
+use crate::error::Result;
+use crate::render::figure::{both, err};
 use plotters::prelude::*;
 use std::path::Path;
 

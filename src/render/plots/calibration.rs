@@ -3,8 +3,8 @@
 //! correlation matrix.
 
 use super::{AFTER, Area, BEFORE, DOUBLE, FONT, TALL, WIDE, legend, range};
-use crate::cli::figures::{both, err};
-use anyhow::Result;
+use crate::error::Result;
+use crate::render::figure::{both, err};
 use plotters::prelude::*;
 use std::path::Path;
 

@@ -18,8 +18,7 @@
 //! the gradient test), `damped_trials` (trial steps at rising damping,
 //! MINPACK's tolerances), `finish`.
 
-use super::residual::Residuals;
-use super::{IdentifyError, Result};
+use super::{LsqError, Residuals, Result};
 use crate::linalg::qr::SeqQr;
 use faer::Mat;
 use serde::{Deserialize, Serialize};
@@ -65,7 +64,7 @@ impl Default for LmSettings {
 crate::settings::settings_builder! {
     /// Validated construction of [`LmSettings`]: `LmSettings::builder()`,
     /// setters, `build()`.
-    LmSettingsBuilder for LmSettings, error IdentifyError {
+    LmSettingsBuilder for LmSettings, error LsqError {
         /// Most outer iterations (default 200).
         max_iterations: usize,
         /// Step tolerance (default 1e-10).
@@ -84,13 +83,13 @@ crate::settings::settings_builder! {
 impl LmSettings {
     /// Checks every setting is in range.
     pub fn validate(&self) -> Result<()> {
-        let bad = |name, value: f64, reason| IdentifyError::Setting {
+        let bad = |name, value: f64, reason| LsqError::Setting {
             name,
             value: value.to_string(),
             reason,
         };
         if self.max_iterations == 0 {
-            return Err(IdentifyError::Setting {
+            return Err(LsqError::Setting {
                 name: "max_iterations",
                 value: "0".into(),
                 reason: "at least one iteration is needed (0 would report the start as the estimate)",

@@ -1,14 +1,14 @@
 //! The text form of a calibrated robot's frames: the measurement frame, the
 //! tool or markers, and each joint's origin in URDF terms.
 
-use activecal::frames::report::{FrameBlock, FramesReport};
+use crate::frames::report::{FrameBlock, FramesReport};
 
 fn v3(v: [f64; 3], d: usize) -> String {
     format!("[{:.d$}, {:.d$}, {:.d$}]", v[0], v[1], v[2])
 }
 
 /// σ's with a not-estimated coordinate shown as `fixed` (never 0).
-pub(super) fn s3(v: [Option<f64>; 3], d: usize) -> String {
+pub fn s3(v: [Option<f64>; 3], d: usize) -> String {
     let one = |x: Option<f64>| x.map_or_else(|| "fixed".to_string(), |x| format!("{x:.d$}"));
     format!("[{}, {}, {}]", one(v[0]), one(v[1]), one(v[2]))
 }

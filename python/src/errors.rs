@@ -1,0 +1,116 @@
+//! activecal's Python exceptions: `activecal.Error`, the base of every
+//! error it raises, and its kinds, each also a subclass of the built-in
+//! exception that fits, so that `except ValueError` or `except OSError`
+//! catches them as it does NumPy's and pandas' errors.
+
+use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyTuple, PyType};
+
+pyo3::create_exception!(
+    activecal,
+    Error,
+    pyo3::exceptions::PyException,
+    "Bad input or a failed computation, with the library's message (naming the argument when one is wrong). Every error activecal raises is one of its subclasses."
+);
+
+/// What failed, naming the exception class raised.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// `InputError(Error, ValueError)`.
+    Input,
+    /// `FileError(Error, OSError)`.
+    File,
+    /// `ResourceError(Error, RuntimeError)`.
+    Resource,
+    /// `ComputationError(Error, RuntimeError)`.
+    Computation,
+    /// `InternalError(Error, RuntimeError)`.
+    Internal,
+}
+
+/// Each kind: its class name, the built-in it also subclasses, its doc.
+const KINDS: [(Kind, &str, &str, &str); 5] = [
+    (
+        Kind::Input,
+        "InputError",
+        "ValueError",
+        "A wrong argument (the message starts with its name) or a wrong value in an input file (the message names the file and the place). Also a ValueError.",
+    ),
+    (
+        Kind::File,
+        "FileError",
+        "OSError",
+        "A file that could not be read or written, or an output that exists when a writer is given overwrite=False. Also an OSError.",
+    ),
+    (
+        Kind::Resource,
+        "ResourceError",
+        "RuntimeError",
+        "Work too large for the memory or size limits, with the figure. Also a RuntimeError.",
+    ),
+    (
+        Kind::Computation,
+        "ComputationError",
+        "RuntimeError",
+        "A computation that cannot be done on these (valid) inputs: a design that cannot identify the robot, a bound that fails. Also a RuntimeError.",
+    ),
+    (
+        Kind::Internal,
+        "InternalError",
+        "RuntimeError",
+        "A defect in activecal (please report it with the message). Also a RuntimeError.",
+    ),
+];
+
+/// The kinds' classes, made once (`type(name, (Error, builtin), ...)`:
+/// pyo3's `create_exception!` takes one base).
+static CLASSES: PyOnceLock<Vec<Py<PyType>>> = PyOnceLock::new();
+
+fn classes(py: Python<'_>) -> PyResult<&Vec<Py<PyType>>> {
+    CLASSES.get_or_try_init(py, || {
+        let builtins = py.import("builtins")?;
+        let make = builtins.getattr("type")?;
+        KINDS
+            .iter()
+            .map(|(_, name, base, doc)| {
+                let bases = PyTuple::new(
+                    py,
+                    [py.get_type::<Error>().into_any(), builtins.getattr(*base)?],
+                )?;
+                let ns = PyDict::new(py);
+                ns.set_item("__doc__", *doc)?;
+                ns.set_item("__module__", "activecal")?;
+                Ok(make
+                    .call1((*name, bases, ns))?
+                    .cast_into::<PyType>()?
+                    .unbind())
+            })
+            .collect()
+    })
+}
+
+/// The class of `kind`.
+pub fn class(py: Python<'_>, kind: Kind) -> PyResult<Bound<'_, PyType>> {
+    let k = KINDS.iter().position(|(k, ..)| *k == kind).unwrap_or(0);
+    Ok(classes(py)?[k].bind(py).clone())
+}
+
+/// The exception of `kind` with `msg`.
+pub fn new_err(kind: Kind, msg: impl Into<String>) -> PyErr {
+    let msg = msg.into();
+    Python::attach(|py| match class(py, kind) {
+        Ok(ty) => PyErr::from_type(ty, msg),
+        Err(e) => e,
+    })
+}
+
+/// Adds `Error` and its kinds to the module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("Error", py.get_type::<Error>())?;
+    for (kind, name, ..) in KINDS {
+        m.add(name, class(py, kind)?)?;
+    }
+    Ok(())
+}

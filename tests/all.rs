@@ -16,6 +16,7 @@ mod camera_cli;
 mod camera_fisheye;
 mod camera_head;
 mod camera_labels;
+mod camera_messy;
 mod camera_refuse;
 mod camera_sight;
 mod camera_start;

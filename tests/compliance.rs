@@ -516,6 +516,7 @@ fn an_unmodelled_sag_is_warned_of_when_the_noise_is_stated() {
         weights: activecal::identify::Weights::default(),
         outliers: activecal::lsq::outliers::OutlierChoice::default(),
         stated_noise: stated,
+        stated_orientation_noise: None,
     };
     // The geometric model only, the tracker's σ stated.
     let c = calibrate_measurements(

@@ -424,6 +424,7 @@ def calibrate(
     outliers: str = "drop",
     outlier_rate: float = 0.01,
     noise: Optional[float] = None,
+    orientation_noise: Optional[float] = None,
     progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
     unknowns: str = "all",
 ) -> Calibration:
@@ -511,6 +512,8 @@ def calibrate_contacts(
     max_iterations: int = 200,
     loss: str = "l2",
     loss_scale: Optional[float] = None,
+    outliers: str = "drop",
+    outlier_rate: float = 0.01,
     progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
 ) -> ContactCalibration:
     """Calibrates the robot from contacts, as ``activecal calibrate
@@ -585,6 +588,9 @@ def calibrate_camera(
     mounting: Optional[str] = None,
     camera_link: Optional[str] = None,
     refine_intrinsics: bool = False,
+    outliers: str = "drop",
+    outlier_rate: float = 0.01,
+    pixel_noise: Optional[float] = None,
     progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
 ) -> CameraCalibration:
     """Calibrates the robot from a camera's pixels of a target, as

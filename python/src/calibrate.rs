@@ -4,6 +4,7 @@
 
 use crate::convert::{arg_err, count, detached, float_array, json_to_py, named_columns, rows};
 use crate::robot::Robot;
+use activecal::experiment::acts_on::{self as lib_acts, Sensor};
 use activecal::experiment::measured::{MeasuredSettings, calibrate_measurements};
 use activecal::frames::CalibratedFrames;
 use activecal::frames::report::FramesReport;
@@ -260,12 +261,16 @@ fn names(v: Option<Vec<String>>) -> Vec<String> {
 /// is tested against it (`report["noise_test"]`), a rejection warns
 /// (`UserWarning`, as the command line's warning), and the outlier test
 /// uses it.
+/// orientation_noise: with orientations, the tracker's stated σ per
+/// orientation axis (radians), as `--orientation-noise`: the orientation
+/// block's σ is tested against it (`report["orientation_noise_test"]`), a
+/// rejection warns (`UserWarning`).
 /// progress: a callable `progress(task, done, total, note)`, as `select`
 /// takes it. unknowns: "all" (the chain's complete set) or "offsets" (only
 /// the joints' zero offsets, the measurement frame and the tool), as
 /// `--unknowns`.
 #[pyfunction]
-#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, compliance=false, outliers="drop", outlier_rate=0.01, noise=None, progress=None, unknowns="all"))]
+#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, compliance=false, outliers="drop", outlier_rate=0.01, noise=None, orientation_noise=None, progress=None, unknowns="all"))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
@@ -287,9 +292,39 @@ pub fn calibrate(
     outliers: &str,
     outlier_rate: f64,
     noise: Option<f64>,
+    orientation_noise: Option<f64>,
     progress: Option<&Bound<'_, PyAny>>,
     unknowns: &str,
 ) -> PyResult<Calibration> {
+    // Each keyword argument given acts on the data's sensor or is refused
+    // (the command line's table).
+    let given: Vec<&str> = [
+        ("fix", fix.is_some()),
+        ("free", free.is_some()),
+        ("max_iterations", max_iterations != 200),
+        ("loss", loss != "l2"),
+        ("loss_scale", loss_scale.is_some()),
+        ("weights", weights.is_some()),
+        ("orientation_scale", orientation_scale.is_some()),
+        ("holdout", holdout.is_some()),
+        ("splits", splits != 4),
+        ("seed", seed != 0),
+        ("compliance", compliance),
+        ("outliers", outliers != "drop"),
+        ("outlier_rate", outlier_rate != 0.01),
+        ("noise", noise.is_some()),
+        ("orientation_noise", orientation_noise.is_some()),
+        ("unknowns", unknowns != "all"),
+    ]
+    .into_iter()
+    .filter_map(|(k, g)| g.then_some(k))
+    .collect();
+    let sensor = if orientations.is_some() {
+        Sensor::Poses
+    } else {
+        Sensor::Points
+    };
+    refuse_unused(lib_acts::CALIBRATE, &given, sensor)?;
     use crate::pickling::kept;
     let recipe = crate::recipe!(py, "calibrate";
         robot = robot, q = kept(Some(q))?, points = kept(Some(points))?,
@@ -297,7 +332,7 @@ pub fn calibrate(
         max_iterations = max_iterations, loss = loss, loss_scale = loss_scale, weights = weights,
         orientation_scale = orientation_scale, holdout = holdout, splits = splits, seed = seed,
         compliance = compliance, outliers = outliers, outlier_rate = outlier_rate, noise = noise,
-        unknowns = unknowns);
+        orientation_noise = orientation_noise, unknowns = unknowns);
     let robot = robot.get();
     let fix = fixed_of(robot, names(fix), unknowns)?;
     let weights = weights_of(weights, orientation_scale)?;
@@ -346,6 +381,14 @@ pub fn calibrate(
                         "noise={s}: the sensor's stated σ per coordinate must be a number > 0 (metres)"
                     ),
                 ));
+            }
+            s => s,
+        },
+        stated_orientation_noise: match orientation_noise {
+            Some(s) if !(s.is_finite() && s > 0.0) => {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "orientation_noise={s}: the tracker's stated σ per orientation axis must be a number > 0 (radians)"
+                )));
             }
             s => s,
         },
@@ -417,6 +460,7 @@ impl Calibration {
             "# Calibrated by activecal (Python).\n",
             path,
             overwrite,
+            &[],
         )
     }
 }
@@ -443,7 +487,9 @@ fn fixed_of(robot: &Robot, mut fix: Vec<String>, unknowns: &str) -> PyResult<Vec
 
 /// Writes a calibrated robot (`table`, with its frames when it has them) as
 /// `format` to `path` after `header`, atomically; an existing file only with
-/// `overwrite`.
+/// `overwrite`, and never an input of the call that made it (`inputs`, and
+/// the robot's own URDF), even with `overwrite`.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn write_robot(
     format: Format,
     robot: &activecal::model::Robot,
@@ -452,6 +498,7 @@ pub(crate) fn write_robot(
     header: &str,
     path: &std::path::Path,
     overwrite: bool,
+    inputs: &[&std::path::Path],
 ) -> PyResult<()> {
     let kind = std::mem::discriminant(&format);
     if Format::of(path).ok().map(|f| std::mem::discriminant(&f)) != Some(kind) {
@@ -464,6 +511,17 @@ pub(crate) fn write_robot(
             ),
         ));
     }
+    let out = [activecal::io::atomic::Output {
+        label: "path",
+        path,
+    }];
+    let mut all: Vec<&std::path::Path> = inputs.to_vec();
+    if let Some(src) = robot.source.as_ref() {
+        all.push(std::path::Path::new(&src.path));
+    }
+    // Never over an input of the call, even when overwriting is asked.
+    activecal::io::atomic::check_outputs(&out, &all, true)
+        .map_err(|e| crate::convert::Fail::from(e).into_py())?;
     activecal::io::calibrated::write(format, robot, table, frames, header, path, overwrite)
         .map_err(|e| crate::convert::Fail::from(e).into_py())
 }
@@ -646,7 +704,40 @@ pub fn evaluate<'py>(
 
 /// The outlier choice of `outliers=` ("drop" or "keep") and
 /// `outlier_rate=`.
-fn outliers_of(kind: &str, rate: f64) -> PyResult<activecal::lsq::outliers::OutlierChoice> {
+/// Refuses each keyword argument of `given` that does not act on `sensor`
+/// by `table` (the command line's, [`activecal::experiment::acts_on`]),
+/// naming the argument and the sensor.
+pub(crate) fn refuse_unused(
+    table: &[lib_acts::ActsOn],
+    given: &[&str],
+    sensor: Sensor,
+) -> PyResult<()> {
+    let unused = lib_acts::not_acting(table, given, &[sensor]);
+    if unused.is_empty() {
+        return Ok(());
+    }
+    let lines: Vec<String> = unused
+        .iter()
+        .map(|k| {
+            let on: Vec<&str> = lib_acts::sensors_of(table, k)
+                .unwrap_or_default()
+                .iter()
+                .map(|s| s.words())
+                .collect();
+            format!(
+                "{k}: not used with {}; it acts on {}",
+                sensor.words(),
+                on.join(" or ")
+            )
+        })
+        .collect();
+    Err(pyo3::exceptions::PyValueError::new_err(lines.join("\n")))
+}
+
+pub(crate) fn outliers_of(
+    kind: &str,
+    rate: f64,
+) -> PyResult<activecal::lsq::outliers::OutlierChoice> {
     use activecal::lsq::outliers::{OutlierChoice, check_choice};
     let c = match kind {
         "drop" => OutlierChoice::Drop { alpha: rate },

@@ -151,6 +151,8 @@ pub(crate) fn chain_of(
 pub struct CameraCalibration {
     cal: Calibrated,
     report: serde_json::Value,
+    /// The files the call read.
+    inputs: Vec<PathBuf>,
 }
 
 /// Calibrates the robot from a camera's pixels of a target, as `activecal
@@ -165,10 +167,17 @@ pub struct CameraCalibration {
 /// link a camera is on (a head). camera_pose, target_pose: the rough
 /// placements X, Y, Z, ROLL, PITCH, YAW (metres, radians), the fit's
 /// start; one left out (None) is computed from the pixels (PnP and the
-/// closed-form hand-eye, the report's `start`). refine_intrinsics: fit the intrinsics too. progress as
-/// `calibrate` takes it.
+/// closed-form hand-eye, the report's `start`). refine_intrinsics: fit the intrinsics too.
+/// outliers: "drop" (default: a pose with a gross error, a shifted board,
+/// or one point of it, a misdetected corner, found by Baarda's data
+/// snooping at family-wise rate outlier_rate, left out one at a time and
+/// listed in `report["outliers"]`) or "keep", as `--outliers`.
+/// pixel_noise: the detector's stated σ per pixel coordinate (px), as
+/// `--pixel-noise`: σ̂ is tested against it (`report["noise_test"]`), a
+/// rejection warns (`UserWarning`), and the outlier test uses it. progress
+/// as `calibrate` takes it.
 #[pyfunction]
-#[pyo3(signature = (robot, observations, camera_info, target, *, camera_pose=None, target_pose=None, mounting=None, camera_link=None, refine_intrinsics=false, progress=None))]
+#[pyo3(signature = (robot, observations, camera_info, target, *, camera_pose=None, target_pose=None, mounting=None, camera_link=None, refine_intrinsics=false, outliers="drop", outlier_rate=0.01, pixel_noise=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate_camera(
     py: Python<'_>,
@@ -181,9 +190,38 @@ pub fn calibrate_camera(
     mounting: Option<&str>,
     camera_link: Option<String>,
     refine_intrinsics: bool,
+    outliers: &str,
+    outlier_rate: f64,
+    pixel_noise: Option<f64>,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<CameraCalibration> {
     let m = mounting_of(mounting, camera_link.as_deref())?;
+    let given: Vec<&str> = [
+        ("camera_pose", camera_pose.is_some()),
+        ("target_pose", target_pose.is_some()),
+        ("mounting", mounting.is_some()),
+        ("camera_link", camera_link.is_some()),
+        ("refine_intrinsics", refine_intrinsics),
+        ("outliers", outliers != "drop"),
+        ("outlier_rate", outlier_rate != 0.01),
+        ("pixel_noise", pixel_noise.is_some()),
+    ]
+    .into_iter()
+    .filter_map(|(k, g)| g.then_some(k))
+    .collect();
+    crate::calibrate::refuse_unused(
+        activecal::experiment::acts_on::CALIBRATE,
+        &given,
+        activecal::experiment::acts_on::Sensor::Pixels,
+    )?;
+    let outliers = crate::calibrate::outliers_of(outliers, outlier_rate)?;
+    if let Some(s) = pixel_noise
+        && !(s.is_finite() && s > 0.0)
+    {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "pixel_noise={s}: the detector's stated σ per pixel coordinate must be a number > 0 (px)"
+        )));
+    }
     let (cam0, tgt0) = (
         camera_pose.map(|c| six(py, c, "camera_pose")).transpose()?,
         target_pose.map(|t| six(py, t, "target_pose")).transpose()?,
@@ -191,6 +229,13 @@ pub fn calibrate_camera(
     let obs_src = observations_source(observations)?;
     let info_src = yaml_source(py, camera_info, "camera_info")?;
     let target_src = yaml_source(py, target, "target")?;
+    let inputs: Vec<PathBuf> = [&obs_src, &info_src, &target_src]
+        .into_iter()
+        .filter_map(|s| match s {
+            Source::File(p) => Some(p.clone()),
+            Source::Text(_) => None,
+        })
+        .collect();
     let inner = robot.inner.clone();
     let (cal, report) = crate::progress::with_callback(progress, || {
         detached(py, move || {
@@ -212,6 +257,8 @@ pub fn calibrate_camera(
                 camera: cam0.map(|c| activecal::pool::camera_view::placement(&c)),
                 target_pose: tgt0.map(|t| activecal::pool::camera_view::placement(&t)),
                 refine_intrinsics,
+                outliers,
+                pixel_noise,
             };
             let lm = LmSettings::builder()
                 .max_iterations(MAX_ITERATIONS)
@@ -223,7 +270,22 @@ pub fn calibrate_camera(
             Ok((cal, report))
         })
     })?;
-    Ok(CameraCalibration { cal, report })
+    // What the command line prints as a note or a warning reaches Python
+    // as one.
+    let warnings = report["warnings"].as_array().cloned().unwrap_or_default();
+    for n in cal
+        .notes
+        .iter()
+        .map(String::as_str)
+        .chain(warnings.iter().filter_map(|w| w.as_str()))
+    {
+        crate::convert::warn(py, n)?;
+    }
+    Ok(CameraCalibration {
+        cal,
+        report,
+        inputs,
+    })
 }
 
 /// Reads the observations for the chain `robot`.
@@ -243,18 +305,24 @@ fn read_observations(
 }
 
 /// Writes `text` to `path` atomically; an existing file only with
-/// `overwrite`.
-fn write_text(path: &Path, text: &str, overwrite: bool) -> PyResult<()> {
+/// `overwrite`, never one of `inputs`.
+fn write_text(path: &Path, text: &str, overwrite: bool, inputs: &[&Path]) -> PyResult<()> {
     let out = [activecal::io::atomic::Output {
         label: "path",
         path,
     }];
-    activecal::io::atomic::check_outputs(&out, &[], overwrite)
+    activecal::io::atomic::check_outputs(&out, inputs, overwrite)
         .map_err(|e| Fail::from(e).into_py())?;
     activecal::io::atomic::write_atomic(path, text.as_bytes()).map_err(|e| Fail::from(e).into_py())
 }
 
 impl CameraCalibration {
+    /// The files the call read (observations, camera_info, target given as
+    /// paths): never written over.
+    fn inputs(&self) -> Vec<&Path> {
+        self.inputs.iter().map(PathBuf::as_path).collect()
+    }
+
     /// Refuses to write what the library refuses (a fit that did not
     /// converge or cannot be right), with its reason.
     fn check_converged(&self, path: &Path) -> PyResult<()> {
@@ -288,6 +356,7 @@ impl CameraCalibration {
             "",
             path,
             overwrite,
+            &self.inputs(),
         )
     }
 
@@ -434,10 +503,15 @@ impl CameraCalibration {
             "intrinsics refined by activecal calibrate --refine-intrinsics from {}",
             self.cal.observations.origin
         );
+        let mut inputs = self.inputs();
+        if let Some(src) = self.cal.fit.robot.source.as_ref() {
+            inputs.push(Path::new(&src.path));
+        }
         write_text(
             &path,
             &self.cal.camera_info_text(&name, &comment),
             overwrite,
+            &inputs,
         )
     }
 

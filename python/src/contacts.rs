@@ -83,9 +83,13 @@ fn contact_file(qs: Vec<Vec<f64>>, touched: Vec<String>) -> ContactFile {
 /// between points (metres), a dict {(a, b): m} or a list of (a, b, m); at
 /// least one, since contacts alone leave the scale free. free: parameters
 /// never fixed. max_iterations, loss and loss_scale as `calibrate` takes
-/// them; progress too.
+/// them; progress too. outliers: "drop" (default: rows with a gross error,
+/// a ball seated off its socket, found by Baarda's data snooping at
+/// family-wise rate outlier_rate, left out one at a time and listed in
+/// `report["outliers"]`) or "keep", as `--outliers`; what the test did is
+/// in `report["notes"]` and emitted as `warnings.warn`.
 #[pyfunction]
-#[pyo3(signature = (robot, q, points, distances, free=None, max_iterations=200, loss="l2", loss_scale=None, progress=None))]
+#[pyo3(signature = (robot, q, points, distances, free=None, max_iterations=200, loss="l2", loss_scale=None, outliers="drop", outlier_rate=0.01, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate_contacts(
     py: Python<'_>,
@@ -97,8 +101,27 @@ pub fn calibrate_contacts(
     max_iterations: i64,
     loss: &str,
     loss_scale: Option<f64>,
+    outliers: &str,
+    outlier_rate: f64,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<ContactCalibration> {
+    let given: Vec<&str> = [
+        ("free", free.is_some()),
+        ("max_iterations", max_iterations != 200),
+        ("loss", loss != "l2"),
+        ("loss_scale", loss_scale.is_some()),
+        ("outliers", outliers != "drop"),
+        ("outlier_rate", outlier_rate != 0.01),
+    ]
+    .into_iter()
+    .filter_map(|(k, g)| g.then_some(k))
+    .collect();
+    crate::calibrate::refuse_unused(
+        activecal::experiment::acts_on::CALIBRATE,
+        &given,
+        activecal::experiment::acts_on::Sensor::Contacts,
+    )?;
+    let outliers = crate::calibrate::outliers_of(outliers, outlier_rate)?;
     let inner = robot.inner.clone();
     let dof = inner.dof();
     let joints = activecal::units::joint_names(&inner);
@@ -132,6 +155,7 @@ pub fn calibrate_contacts(
             .map_err(|e| crate::convert::Fail::from(e).into_py())?)
         .loss(crate::calibrate::loss_of(loss, loss_scale)?)
         .keep(free.unwrap_or_default())
+        .outliers(outliers)
         .build()
         .map_err(|e| crate::convert::Fail::from(e).into_py())?;
     let file = contact_file(qs, points);
@@ -146,6 +170,8 @@ pub fn calibrate_contacts(
                 "robot": r.name,
                 "measurements": file.origin,
                 "rows": file.qs.len(),
+                "outliers": {"choice": outliers, "left_out": c.outliers},
+                "notes": c.notes,
                 "fit": c.fit,
                 "downweighted": c.downweighted,
                 "in_sample": c.in_sample,
@@ -158,6 +184,9 @@ pub fn calibrate_contacts(
             Ok((c, report))
         })
     })?;
+    for n in &c.notes {
+        crate::convert::warn(py, n)?;
+    }
     Ok(ContactCalibration {
         robot: inner,
         c,
@@ -200,6 +229,7 @@ impl ContactCalibration {
             "",
             path,
             overwrite,
+            &[],
         )
     }
 }

@@ -361,3 +361,15 @@ pub fn count(name: &str, v: i64, min: usize) -> PyResult<usize> {
         .filter(|&n| n >= min)
         .ok_or_else(|| arg_err(name, format!("{v}: must be an integer >= {min}")))
 }
+
+/// Emits `text` as a Python `UserWarning` (what the command line prints as
+/// a note or warning reaches Python as one).
+pub fn warn(py: Python<'_>, text: &str) -> PyResult<()> {
+    let cat = py.get_type::<pyo3::exceptions::PyUserWarning>();
+    pyo3::PyErr::warn(
+        py,
+        cat.as_any(),
+        &std::ffi::CString::new(text).unwrap_or_default(),
+        1,
+    )
+}

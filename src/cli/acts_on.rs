@@ -1,39 +1,28 @@
 //! Which sensors each option of `calibrate`, `select` and `evaluate` acts
-//! on: one table per command ([`CALIBRATE`], [`SELECT`], [`EVALUATE`]),
-//! checked against the
-//! options typed on the command line before any work. An option typed with
-//! a sensor it does not act on is refused, naming the option and the
-//! sensor: no option is accepted and ignored.
+//! on: the library's tables ([`activecal::experiment::acts_on`], which the
+//! Python package checks its keyword arguments against too), with what to
+//! say here, naming flags, when an option typed on the command line does
+//! not act on the sensor given ([`CALIBRATE`], [`SELECT`], [`EVALUATE`]).
+//! Checked before any work: an option typed with a sensor it does not act
+//! on is refused, naming the option and the sensor: no option is accepted
+//! and ignored.
 
+use activecal::experiment::acts_on as lib;
+pub use activecal::experiment::acts_on::{MEASURED, Sensor};
 use anyhow::{Result, bail};
 use clap::ArgMatches;
 use clap::parser::ValueSource;
 
-/// What a command works for: the sensor of its data or of its design.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Sensor {
-    /// `calibrate --design`: measurements simulated at a design.
-    Simulated,
-    /// `calibrate --measurements` of points (no orientation columns).
-    Points,
-    /// `calibrate --measurements` of full poses (orientation columns).
-    Poses,
-    /// `calibrate --measurements` of contacts (a `point` or `plane` column).
-    Contacts,
-    /// `calibrate --observations`: a camera's pixels.
-    Pixels,
-    /// `select` from a pool of poses (points, markers or full poses).
-    Pool,
-    /// `select --point`: configurations touching sockets.
-    Sockets,
-    /// `select --camera-info`: poses for a camera.
-    Camera,
+/// How the command line names a sensor.
+pub trait SensorText {
+    /// The sensor in a few words, for the list of those an option acts on.
+    fn short(self) -> &'static str;
+    /// The sensor as the command line gives it, for messages.
+    fn given_as(self) -> &'static str;
 }
 
-impl Sensor {
-    /// The sensor in a few words, for the list of those an option acts on.
-    #[must_use]
-    pub fn short(self) -> &'static str {
+impl SensorText for Sensor {
+    fn short(self) -> &'static str {
         match self {
             Sensor::Simulated => "--design",
             Sensor::Points => "point measurements",
@@ -46,9 +35,7 @@ impl Sensor {
         }
     }
 
-    /// The sensor as the command line gives it, for messages.
-    #[must_use]
-    pub fn given_as(self) -> &'static str {
+    fn given_as(self) -> &'static str {
         match self {
             Sensor::Simulated => "--design (measurements simulated at a design)",
             Sensor::Points => "--measurements of points (a file without orientations)",
@@ -62,8 +49,18 @@ impl Sensor {
     }
 }
 
-/// One option's row: its clap id, the sensors it acts on, and what to say
-/// when it is given with another (empty: the sensors it is for are named).
+/// A command's table: the library's sensors per option, and what to say
+/// when one is given with another sensor.
+pub struct Table {
+    /// The options and the sensors each acts on.
+    pub rows: &'static [lib::ActsOn],
+    /// Why an option acts on no other sensor, or what to use instead
+    /// (an option not listed: the sensors it is for are named).
+    pub why: &'static [(&'static str, &'static str)],
+}
+
+/// One option's row: its id, the sensors it acts on, and what to say when
+/// it is given with another (empty: the sensors it is for are named).
 pub struct Rule {
     /// The option's clap id (its field's name).
     pub id: &'static str,
@@ -73,247 +70,146 @@ pub struct Rule {
     pub why: &'static str,
 }
 
-use Sensor::{Camera, Contacts, Pixels, Points, Pool, Poses, Simulated, Sockets};
-
-const fn r(id: &'static str, acts_on: &'static [Sensor], why: &'static str) -> Rule {
-    Rule { id, acts_on, why }
+impl Table {
+    /// Every option's row.
+    pub fn iter(&self) -> impl Iterator<Item = Rule> + '_ {
+        self.rows.iter().map(|r| Rule {
+            id: r.id,
+            acts_on: r.sensors,
+            why: self
+                .why
+                .iter()
+                .find(|(id, _)| *id == r.id)
+                .map_or("", |(_, w)| w),
+        })
+    }
 }
 
-const CAL_ALL: &[Sensor] = &[Simulated, Points, Poses, Contacts, Pixels];
-/// Measured points or full poses: told apart once the file is read.
-pub const MEASURED: &[Sensor] = &[Points, Poses];
-const FITTED: &[Sensor] = &[Points, Poses, Contacts];
-const READ: &[Sensor] = &[Points, Poses, Contacts, Pixels];
 const LS: &str = "the camera fit is least squares on the pixels";
 
-/// The options of `calibrate` (and the global ones) and the sensors each
-/// acts on.
-pub const CALIBRATE: &[Rule] = &[
-    r("base", CAL_ALL, ""),
-    r("tip", CAL_ALL, ""),
-    r("lock", CAL_ALL, ""),
-    r("frames", CAL_ALL, ""),
-    r("kinematics", CAL_ALL, ""),
-    r(
+/// What to say when an option of `calibrate` is given with a sensor it does
+/// not act on (the sensors are the library's table,
+/// [`lib::CALIBRATE`]); an option not listed names the sensors it is for.
+const CALIBRATE_WHY: &[(&str, &str)] = &[
+    (
+        "offset_unit",
+        "the camera and contact fits write no joint offsets",
+    ),
+    (
+        "offset_sign",
+        "the camera and contact fits write no joint offsets",
+    ),
+    (
         "markers",
-        &[Simulated, Points, Poses, Contacts],
         "a camera sees the points of its --target, not markers",
     ),
-    r("progress", CAL_ALL, ""),
-    r("robot", CAL_ALL, ""),
-    r("design", &[Simulated], ""),
-    r("measurements", FITTED, ""),
-    r("save_measurements", &[Simulated], ""),
-    r("out", CAL_ALL, ""),
-    r("force", CAL_ALL, ""),
-    r(
+    (
         "noise",
-        &[Simulated, Points, Poses],
         "a contact fit's σ is estimated from its residuals; a camera's is --pixel-noise",
     ),
-    r(
-        "outliers",
-        &[Points, Poses],
-        "the gross-error test is of a tracker's poses",
+    (
+        "orientation_noise",
+        "it is a tracker's orientation σ; only full poses carry orientations",
     ),
-    r(
-        "outlier_rate",
-        &[Points, Poses],
-        "the gross-error test is of a tracker's poses",
+    (
+        "pixel_noise",
+        "it is a camera's σ in pixels; a tracker's is --noise",
     ),
-    r(
-        "seed",
-        &[Simulated, Points, Poses],
-        "the fit has no randomness",
-    ),
-    r("trials", &[Simulated], ""),
-    r("validation", &[Simulated], ""),
-    r("max_iterations", CAL_ALL, ""),
-    r("no_geodesic", CAL_ALL, ""),
-    r("loss", FITTED, LS),
-    r("loss_scale", FITTED, LS),
-    r("fix", MEASURED, ""),
-    r("unknowns", MEASURED, ""),
-    r(
-        "offset_unit",
-        &[Simulated, Points, Poses],
-        "the camera and contact fits write no joint offsets",
-    ),
-    r(
-        "offset_sign",
-        &[Simulated, Points, Poses],
-        "the camera and contact fits write no joint offsets",
-    ),
-    r(
+    ("seed", "the fit has no randomness"),
+    ("loss", LS),
+    ("loss_scale", LS),
+    (
         "free",
-        FITTED,
         "the camera fit estimates every joint origin of the chain",
     ),
-    r(
+    (
         "holdout",
-        MEASURED,
         "contacts are held out by placement (--holdout-by, --train-on); a camera fit has no held-out validation",
     ),
-    r("splits", MEASURED, "--holdout's splits"),
-    r("compare_pruned", MEASURED, "--holdout's comparison"),
-    r(
+    ("splits", "--holdout's splits"),
+    ("compare_pruned", "--holdout's comparison"),
+    (
         "weights",
-        &[Poses],
         "there are no orientations to weigh against positions",
     ),
-    r(
+    (
         "orientation_scale",
-        &[Poses],
         "there are no orientations to weigh against positions",
     ),
-    r("point_distance", &[Contacts], ""),
-    r("plane", &[Contacts], ""),
-    r("holdout_by", &[Contacts], ""),
-    r("train_on", &[Contacts], ""),
-    r("compliance", MEASURED, ""),
-    r("compare_compliance", MEASURED, ""),
-    r("inertia", MEASURED, "it is for --compliance"),
-    r("payload", MEASURED, "it is for --compliance"),
-    r(
-        "report",
-        &[Simulated, Points, Poses, Contacts],
-        "a camera fit's report is its text or --json",
-    ),
-    r("observations", &[Pixels], ""),
-    r("camera_info", &[Pixels], ""),
-    r("target", &[Pixels], ""),
-    r("mounting", &[Pixels], ""),
-    r("camera_link", &[Pixels], ""),
-    r("camera_pose", &[Pixels], ""),
-    r("target_pose", &[Pixels], ""),
-    r("refine_intrinsics", &[Pixels], ""),
-    r("out_camera_info", &[Pixels], ""),
-    r("angle_unit", READ, "no file of joint values is read"),
-    r("length_unit", READ, "no file of joint values is read"),
-    r("json", CAL_ALL, ""),
+    ("inertia", "it is for --compliance"),
+    ("payload", "it is for --compliance"),
+    ("report", "a camera fit's report is its text or --json"),
+    ("angle_unit", "no file of joint values is read"),
+    ("length_unit", "no file of joint values is read"),
 ];
 
-const SEL_ALL: &[Sensor] = &[Pool, Sockets, Camera];
+/// The options of `calibrate` (and the global ones): the sensors each acts on
+/// and what to say otherwise.
+pub const CALIBRATE: &Table = &Table {
+    rows: lib::CALIBRATE,
+    why: CALIBRATE_WHY,
+};
+
 const EAE: &str = "a camera design is chosen by exchange-add-exchange (EAE) on the determinant, a socket design D-optimally then exchanged for the predicted true error";
 const SOCKET: &str = "the pool is configurations projected onto each socket from --count joint-space samples, chosen D-optimally then exchanged for the predicted true error";
 
-/// The options of `select` (and the global ones) and the sensors each acts
-/// on.
-pub const SELECT: &[Rule] = &[
-    r("base", SEL_ALL, ""),
-    r("tip", SEL_ALL, ""),
-    r("lock", SEL_ALL, ""),
-    r("frames", SEL_ALL, ""),
-    r("kinematics", SEL_ALL, ""),
-    r(
+/// What to say when an option of `select` is given with a sensor it does
+/// not act on (the sensors are the library's table,
+/// [`lib::SELECT`]); an option not listed names the sensors it is for.
+const SELECT_WHY: &[(&str, &str)] = &[
+    (
         "markers",
-        &[Pool, Sockets],
         "a camera sees the points of its --target, not markers",
     ),
-    r("progress", SEL_ALL, ""),
-    r("robot", SEL_ALL, ""),
-    r("pool", &[Pool, Camera], SOCKET),
-    r("levels", &[Pool], "there is no lattice"),
-    r("count", SEL_ALL, ""),
-    r("pool_seed", SEL_ALL, ""),
-    r(
+    ("pool", SOCKET),
+    ("levels", "there is no lattice"),
+    (
         "params",
-        &[Pool, Sockets],
         "the camera's Jacobian is at the nominal parameters",
     ),
-    r(
+    (
         "visibility",
-        &[Pool],
         "the camera's view is --min-visible, --image-margin, --max-view-angle and --distance",
     ),
-    r("self_collision", SEL_ALL, ""),
-    r("srdf", SEL_ALL, ""),
-    r("skip_always_touching", SEL_ALL, ""),
-    r("package_dirs", SEL_ALL, ""),
-    r("obstacles", SEL_ALL, ""),
-    r("floor", SEL_ALL, ""),
-    r(
-        "angle_unit",
-        &[Pool, Camera],
-        "no file of joint values is read",
-    ),
-    r(
-        "length_unit",
-        &[Pool, Camera],
-        "no file of joint values is read",
-    ),
-    r("compliance", &[Pool], ""),
-    r(
-        "margin",
-        &[Pool, Sockets],
-        "the samples are drawn within the joint limits",
-    ),
-    r("clearance", SEL_ALL, ""),
-    r("n", SEL_ALL, ""),
-    r("algorithm", &[Pool], EAE),
-    r("initial", &[Pool], EAE),
-    r("starts", &[Pool], EAE),
-    r("ils", &[Pool], EAE),
-    r("kick", &[Pool], EAE),
-    r("designs", &[Pool], EAE),
-    r("polish", &[Pool], EAE),
-    r("seed", SEL_ALL, ""),
-    r("fixed", &[Pool], ""),
-    r("criterion", &[Pool], EAE),
-    r("out", SEL_ALL, ""),
-    r("force", SEL_ALL, ""),
-    r("gap", &[Pool, Camera], SOCKET),
-    r("gap_solver", &[Pool, Camera], SOCKET),
-    r("existing", &[Pool], ""),
-    r("refine", &[Pool], ""),
-    r("refine_sweeps", &[Pool], ""),
-    r("order", &[Pool], ""),
-    r("home", &[Pool], ""),
-    r("report", &[Pool, Camera], SOCKET),
-    r("target_error", &[Pool, Camera], SOCKET),
-    r(
+    ("angle_unit", "no file of joint values is read"),
+    ("length_unit", "no file of joint values is read"),
+    ("margin", "the samples are drawn within the joint limits"),
+    ("algorithm", EAE),
+    ("initial", EAE),
+    ("starts", EAE),
+    ("ils", EAE),
+    ("kick", EAE),
+    ("designs", EAE),
+    ("polish", EAE),
+    ("criterion", EAE),
+    ("gap", SOCKET),
+    ("gap_solver", SOCKET),
+    ("report", SOCKET),
+    ("target_error", SOCKET),
+    (
         "noise",
-        &[Pool],
         "it is a point's noise in metres; a camera's is --pixel-noise PX (the detected points' σ in pixels), a socket design predicts its errors per unit noise",
     ),
-    r("orientation_noise", &[Pool], ""),
-    r("points", &[Sockets], ""),
-    r("point_distance", &[Sockets], ""),
-    r("camera_info", &[Camera], ""),
-    r("target", &[Camera], ""),
-    r("mounting", &[Camera], ""),
-    r("camera_link", &[Camera], ""),
-    r("camera_pose", &[Camera], ""),
-    r("target_pose", &[Camera], ""),
-    r("min_visible", &[Camera], ""),
-    r("image_margin", &[Camera], ""),
-    r("max_view_angle", &[Camera], ""),
-    r("distance", &[Camera], ""),
-    r("line_of_sight", &[Camera], ""),
-    r("pixel_noise", &[Camera], ""),
-    r("json", SEL_ALL, ""),
 ];
 
-const EVAL_ALL: &[Sensor] = &[Points, Poses, Contacts];
+/// The options of `select` (and the global ones): the sensors each acts on
+/// and what to say otherwise.
+pub const SELECT: &Table = &Table {
+    rows: lib::SELECT,
+    why: SELECT_WHY,
+};
 
-/// The options of `evaluate` (and the global ones) and the sensors each
-/// acts on.
-pub const EVALUATE: &[Rule] = &[
-    r("base", EVAL_ALL, ""),
-    r("tip", EVAL_ALL, ""),
-    r("lock", EVAL_ALL, ""),
-    r("frames", EVAL_ALL, ""),
-    r("kinematics", EVAL_ALL, ""),
-    r("markers", EVAL_ALL, ""),
-    r("progress", EVAL_ALL, ""),
-    r("robot", EVAL_ALL, ""),
-    r("measurements", EVAL_ALL, ""),
-    r("angle_unit", EVAL_ALL, ""),
-    r("length_unit", EVAL_ALL, ""),
-    r("point_distance", &[Contacts], ""),
-    r("plane", &[Contacts], ""),
-    r("json", EVAL_ALL, ""),
-];
+/// What to say when an option of `evaluate` is given with a sensor it does
+/// not act on (the sensors are the library's table,
+/// [`lib::EVALUATE`]); an option not listed names the sensors it is for.
+const EVALUATE_WHY: &[(&str, &str)] = &[];
+
+/// The options of `evaluate` (and the global ones): the sensors each acts on
+/// and what to say otherwise.
+pub const EVALUATE: &Table = &Table {
+    rows: lib::EVALUATE,
+    why: EVALUATE_WHY,
+};
 
 /// The options typed on a command's line (not defaulted): each as its
 /// clap id and its flag (`--loss`).
@@ -345,7 +241,7 @@ impl Given {
 /// Refuses each option of `given` that acts on none of `sensors` (by
 /// `table`), naming the option and the sensor: one line each. An option
 /// without a row in `table` is refused too (every option must be decided).
-pub fn check(table: &[Rule], given: &Given, sensors: &[Sensor]) -> Result<()> {
+pub fn check(table: &Table, given: &Given, sensors: &[Sensor]) -> Result<()> {
     let refused: Vec<String> = given
         .0
         .iter()

@@ -3,7 +3,7 @@
 //! on a sensor is refused before any work, naming the option (by clap, or
 //! by the same check `main` runs). A new option without a row fails here.
 
-use super::{CALIBRATE, EVALUATE, Rule, SELECT, Sensor, check};
+use super::{CALIBRATE, EVALUATE, SELECT, Sensor, Table, check};
 use crate::{Cli, Command};
 use clap::{ArgAction, CommandFactory, FromArgMatches};
 
@@ -88,6 +88,8 @@ fn sample(command: &str, id: &str) -> Option<(&'static [&'static str], &'static 
         ("calibrate", "trials" | "validation" | "max_iterations") => (&[], "3"),
         ("calibrate", "loss_scale") => (&[], "0.01"),
         ("calibrate", "outlier_rate") => (&[], "0.05"),
+        ("calibrate", "orientation_noise") => (&[], "0.001"),
+        ("calibrate", "pixel_noise") => (&[], "0.3"),
         ("calibrate", "fix" | "free") => (&[], "d_2"),
         ("calibrate", "holdout") => (&[], "0.2"),
         ("calibrate", "splits") => (&["--holdout", "0.2"], "3"),
@@ -162,7 +164,7 @@ fn argv_of(command: &str, arg: &clap::Arg) -> Vec<String> {
     argv
 }
 
-fn table(command: &str) -> &'static [Rule] {
+fn table(command: &str) -> &'static Table {
     match command {
         "calibrate" => CALIBRATE,
         "evaluate" => EVALUATE,
@@ -184,7 +186,7 @@ fn every_option_of_calibrate_evaluate_and_select_has_a_row_and_every_row_an_opti
                 a.get_long().unwrap_or(id)
             );
         }
-        for r in table(command) {
+        for r in table(command).iter() {
             assert!(
                 args.iter().any(|a| a.get_id() == r.id),
                 "{command}: the row '{}' names no option",

@@ -34,6 +34,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
             "--noise {n}: with --measurements it is the sensor's stated σ per coordinate, tested against the residuals: give a number > 0 (metres)"
         );
     }
+    a.check_stated_noises()?;
     if a.design.is_some() && a.validation == 0 {
         bail!(
             "--validation 0: the validation RMS needs at least 1 held-out pose (the RMS error of no poses would read 0)"
@@ -70,6 +71,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
                 units: a.units.units(),
                 json: a.json,
                 report: a.report.as_deref(),
+                outliers: a.outlier_choice()?,
             };
             match super::contact::calibrate_contacts(&c, robot, m)? {
                 Some(why) => Err(NotConverged(why).into()),
@@ -188,6 +190,7 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         weights: weights_of(a),
         outliers: a.outlier_choice()?,
         stated_noise: a.noise,
+        stated_orientation_noise: a.orientation_noise,
         units: a.units.units(),
         gravity: if a.compliance || a.compare_compliance {
             Some(super::compliance::gravity_for(

@@ -58,6 +58,17 @@ pub struct CalibrateArgs {
     /// disagree.
     #[arg(long, allow_negative_numbers = true)]
     pub noise: Option<f64>,
+    /// With --measurements of full poses, the tracker's stated orientation
+    /// σ per axis, radians: the orientation residuals' σ̂ is tested against
+    /// it (χ²) and a warning names the likely causes when they disagree.
+    #[arg(long, allow_negative_numbers = true)]
+    pub orientation_noise: Option<f64>,
+    /// With --observations, the detector's stated σ per pixel coordinate,
+    /// px: the pixels' σ̂ is tested against it (χ²), with a warning naming
+    /// the likely causes when they disagree, and the gross-error test
+    /// is against it.
+    #[arg(long, allow_negative_numbers = true)]
+    pub pixel_noise: Option<f64>,
     /// Seed of the noise and of the validation poses (default 0); with
     /// --measurements, of the --holdout splits only.
     #[arg(long, value_parser = super::parse_seed, allow_negative_numbers = true)]
@@ -82,15 +93,17 @@ pub struct CalibrateArgs {
     /// turns robust.
     #[arg(long, conflicts_with = "design")]
     pub loss_scale: Option<f64>,
-    /// Poses with a gross error (a tracker glitch), found by Baarda's data
-    /// snooping on each pose's residuals at the least-squares fit: `drop`
-    /// leaves the flagged pose out and refits, one at a time, and lists each
-    /// with its test value; `keep` keeps every pose.
-    #[arg(long, value_enum, requires = "measurements")]
+    /// Poses with a gross error (a tracker glitch, a contact seated off its
+    /// socket, a misdetected corner or shifted board), found by Baarda's
+    /// data snooping on each pose's (contact row's, camera pose's or
+    /// point's) residuals at the least-squares fit: `drop` leaves the
+    /// flagged one out and refits, one at a time, and lists each with its
+    /// test value; `keep` keeps every one.
+    #[arg(long, value_enum)]
     pub outliers: Option<OutliersKind>,
     /// The gross-error test's family-wise false-alarm rate: clean data have
     /// a pose flagged this often (in (0, 1); default 0.01).
-    #[arg(long, requires = "measurements")]
+    #[arg(long)]
     pub outlier_rate: Option<f64>,
     /// Which unknowns to estimate, with --measurements: `all` (the chain's
     /// complete, minimal set) or `offsets` (only the joints' zero offsets,
@@ -373,6 +386,28 @@ impl CalibrateArgs {
     #[must_use]
     pub fn noise(&self) -> f64 {
         self.noise.unwrap_or(DEFAULT_NOISE)
+    }
+
+    /// Refuses a stated `--orientation-noise` or `--pixel-noise` that is not
+    /// a finite number > 0.
+    pub fn check_stated_noises(&self) -> anyhow::Result<()> {
+        for (flag, v, unit) in [
+            (
+                "--orientation-noise",
+                self.orientation_noise,
+                "radians per axis",
+            ),
+            ("--pixel-noise", self.pixel_noise, "px per coordinate"),
+        ] {
+            if let Some(v) = v
+                && !(v.is_finite() && v > 0.0)
+            {
+                anyhow::bail!(
+                    "{flag} {v}: it is the sensor's stated σ, tested against the residuals: give a finite number > 0 ({unit})"
+                );
+            }
+        }
+        Ok(())
     }
 
     /// The outlier choice of `--outliers` and `--outlier-rate`; the rate

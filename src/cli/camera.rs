@@ -103,6 +103,8 @@ pub fn calibrate_camera(
         camera: parse("--camera-pose", &a.camera_pose)?,
         target_pose: parse("--target-pose", &a.target_pose)?,
         refine_intrinsics: a.refine_intrinsics,
+        outliers: a.outlier_choice()?,
+        pixel_noise: a.pixel_noise,
     };
     let lm = LmSettings::builder()
         .max_iterations(a.max_iterations)
@@ -150,11 +152,32 @@ pub fn calibrate_camera(
             &written,
             cal.start.as_ref(),
         ) + &labels_text(&cal.labels)
+            + &notes_text(&cal)
             + &cal.verdict.refusal().map_or_else(String::new, |why| {
                 format!("REFUSED: {why}: nothing written\n")
             })
     })?;
     Ok(cal.verdict.refusal().map(str::to_string))
+}
+
+/// The gross-error test's notes and the stated noise's warning, one line
+/// each.
+fn notes_text(cal: &CameraCalibration) -> String {
+    let mut s = String::new();
+    for n in &cal.notes {
+        let _ = writeln!(s, "note: {n}");
+    }
+    if let Some(t) = &cal.noise_test {
+        let _ = writeln!(
+            s,
+            "pixel noise: σ̂ {:.3} px per coordinate against the stated {:.3} px ({:.2}×, χ² on {} degrees of freedom)",
+            t.estimated, t.stated, t.ratio, t.dof
+        );
+        if let Some(w) = t.warning() {
+            let _ = writeln!(s, "WARNING: {w}");
+        }
+    }
+    s
 }
 
 /// Refuses an `--out-camera-info` that is not a `.yaml`, before any work

@@ -129,6 +129,8 @@ pub struct ContactArgs<'a> {
     pub json: bool,
     /// `--report DIR` (checked before the fit).
     pub report: Option<&'a Path>,
+    /// `--outliers`, `--outlier-rate`.
+    pub outliers: activecal::lsq::outliers::OutlierChoice,
 }
 
 /// Calibrates from a contact file; `Ok(Some(why))` when the fit did not
@@ -153,15 +155,7 @@ pub fn calibrate_contacts(
     activecal::identify::contact::check_scale(&file, &known).context("--point-distance")?;
     activecal::identify::contact::lengths::check_distances(robot, &file, &known)
         .context("--point-distance")?;
-    let lm = LmSettings::builder()
-        .max_iterations(a.max_iterations)
-        .geodesic(!a.no_geodesic)
-        .build()?;
-    let settings = ContactSettings::builder()
-        .lm(lm)
-        .loss(super::measured::loss_choice(a.loss, a.loss_scale)?)
-        .keep(a.free.to_vec())
-        .build()?;
+    let settings = settings_of(a)?;
     let activecal::experiment::contacts::ContactCalibration {
         fit,
         in_sample: figures,
@@ -169,10 +163,15 @@ pub fn calibrate_contacts(
         predicted,
         frames: all_frames,
         implausible,
+        file: fitted,
+        outliers,
+        notes,
     } = activecal::experiment::contacts::calibrate_contacts(
         robot, &file, &known, &given, &settings,
     )?;
-    let held = held_out(a, robot, &file, &given, &settings)?;
+    // The rows kept: those left out as gross errors are neither fitted
+    // nor held out.
+    let held = held_out(a, robot, &fitted, &given, &settings)?;
     let frames = if a.out.is_empty() { None } else { all_frames };
     let written = match &frames {
         Some(f) if fit.converged && implausible.is_none() => {
@@ -184,6 +183,8 @@ pub fn calibrate_contacts(
         "robot": robot.name,
         "measurements": path.display().to_string(),
         "rows": file.qs.len(),
+        "outliers": {"choice": settings.outliers, "left_out": outliers},
+        "notes": notes,
         "fit": fit,
         "downweighted": down,
         "in_sample": figures,
@@ -193,7 +194,10 @@ pub fn calibrate_contacts(
         "out": written,
         "exit_status": if fit.converged && implausible.is_none() { 0 } else { 3 },
     });
-    let mut report = text(&file, &fit, &figures, held.as_ref());
+    let mut report = text(&fitted, &fit, &figures, held.as_ref());
+    for n in &notes {
+        let _ = writeln!(report, "note: {n}");
+    }
     if let Some(p) = &predicted {
         let _ = writeln!(
             report,
@@ -210,7 +214,7 @@ pub fn calibrate_contacts(
     if let Some(dir) = a.report {
         let r = activecal::render::contact_figures::ContactReport {
             robot,
-            file: &file,
+            file: &fitted,
             fit: &fit,
             figures: &figures,
             held: held.as_ref(),
@@ -248,6 +252,20 @@ pub fn calibrate_contacts(
         )));
     }
     Ok(None)
+}
+
+/// The fit's settings from the command line.
+fn settings_of(a: &ContactArgs<'_>) -> Result<ContactSettings> {
+    let lm = LmSettings::builder()
+        .max_iterations(a.max_iterations)
+        .geodesic(!a.no_geodesic)
+        .build()?;
+    Ok(ContactSettings::builder()
+        .lm(lm)
+        .loss(super::measured::loss_choice(a.loss, a.loss_scale)?)
+        .keep(a.free.to_vec())
+        .outliers(a.outliers)
+        .build()?)
 }
 
 /// The placements held out (`--holdout-by placement`, `--train-on NAME`),

@@ -11,10 +11,13 @@ use crate::frames::camera::camera_frames;
 use crate::frames::report::FramesReport;
 use crate::frames::{CalibratedFrames, FramesError};
 use crate::identify::LmSettings;
+use crate::identify::camera::screen::{CameraOutlier, screen_camera};
 use crate::identify::camera::start::labels::{Labels, relabel};
 use crate::identify::camera::start::{CameraStart, StartError, start_placements};
-use crate::identify::camera::{CameraFit, CameraFitError, CameraObservations, fit_camera};
+use crate::identify::camera::{CameraFit, CameraFitError, CameraObservations};
+use crate::identify::variance::{BlockNoiseTest, NoiseOf};
 use crate::io::camera_target::Target;
+use crate::lsq::outliers::OutlierChoice;
 use crate::measure::camera::{CameraSensor, Mounting};
 use crate::measure::pinhole::Intrinsics;
 use crate::model::Robot;
@@ -47,6 +50,12 @@ pub struct CameraSetup {
     pub target_pose: Option<Isometry3<f64>>,
     /// Whether the intrinsics are unknowns of the fit too.
     pub refine_intrinsics: bool,
+    /// What happens to poses and points the gross-error test flags
+    /// ([`crate::identify::camera::screen`]).
+    pub outliers: OutlierChoice,
+    /// The detector's stated σ per pixel coordinate (px): σ̂ is tested
+    /// against it and the gross-error test uses it; `None`: σ̂ alone.
+    pub pixel_noise: Option<f64>,
 }
 
 /// Why a camera calibration could not be made.
@@ -128,6 +137,15 @@ pub struct CameraCalibration {
     /// those dropped as ambiguous
     /// ([`crate::identify::camera::start::labels`]).
     pub labels: Labels,
+    /// The poses and points the gross-error test left out, in the order it
+    /// found them ([`crate::identify::camera::screen`]).
+    pub outliers: Vec<CameraOutlier>,
+    /// The gross-error test's choice.
+    pub outlier_choice: OutlierChoice,
+    /// What the gross-error test did, in words.
+    pub notes: Vec<String>,
+    /// σ̂ tested against the stated pixel noise, when one was given.
+    pub noise_test: Option<BlockNoiseTest>,
 }
 
 /// Calibrates `robot` (the chain from the camera's link for a camera on
@@ -181,7 +199,16 @@ pub fn calibrate_camera(
     .with_face(setup.target.face)
     .with_intrinsics_refined(setup.refine_intrinsics);
     let own0 = CameraSensor::start_own(cam0, tgt0);
-    let fit = match fit_camera(robot, &sensor, &own0, &observations, lm) {
+    let screened = screen_camera(
+        robot,
+        &sensor,
+        &own0,
+        &observations,
+        lm,
+        setup.outliers,
+        setup.pixel_noise,
+    );
+    let screened = match screened {
         Err(CameraFitError::BehindCamera { behind, pose }) if start.is_some() => {
             let st = start.as_ref().expect("computed");
             return Err(CameraCalibrationError::StartDisagrees {
@@ -200,6 +227,10 @@ pub fn calibrate_camera(
         }
         r => r?,
     };
+    let fit = screened.fit;
+    let noise_test = setup
+        .pixel_noise
+        .and_then(|px| BlockNoiseTest::new(NoiseOf::Pixels, px, fit.sigma_px?, fit.redundancy));
     let mut frames = camera_frames(&fit)?;
     if let Some(c) = frames.as_mut().and_then(|f| f.1.camera.as_mut()) {
         c.camera_link.clone_from(&setup.camera_link);
@@ -214,6 +245,10 @@ pub fn calibrate_camera(
         start,
         verdict: Verdict::Calibrated,
         labels,
+        outliers: screened.outliers,
+        outlier_choice: setup.outliers,
+        notes: screened.notes,
+        noise_test,
     };
     cal.verdict = verdict::camera_verdict(&cal, &setup.target_origin, extent(&setup.target));
     Ok(cal)
@@ -255,6 +290,17 @@ impl CameraCalibration {
             intrinsics: self.refine_intrinsics.then(|| fit.intrinsics()),
             relabelled: self.labels.relabelled.clone(),
             dropped_poses: self.labels.dropped.clone(),
+            outliers: crate::report::CameraOutliers {
+                choice: self.outlier_choice,
+                left_out: self.outliers.clone(),
+            },
+            notes: self.notes.clone(),
+            noise_test: self.noise_test.clone(),
+            warnings: self
+                .noise_test
+                .iter()
+                .filter_map(BlockNoiseTest::warning)
+                .collect(),
             refused: self.verdict.refusal().map(str::to_string),
             exit_status: self.verdict.exit_status(),
             out,

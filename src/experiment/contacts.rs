@@ -6,13 +6,13 @@
 //! The command line and the Python package both call it; held-out
 //! placements are the caller's ([`crate::identify::contact::holdout`]).
 
+use crate::experiment::contact_screen::{ContactOutlier, screen_contacts};
 use crate::frames::CalibratedFrames;
 use crate::frames::report::{FitBlock, FramesReport};
 use crate::identify::contact::holdout::{DownweightedRow, Figures, downweighted_rows, judge};
 use crate::identify::contact::predict::{PREDICTION_CONFIGURATIONS, PredictedTrueError};
 use crate::identify::contact::{
-    ContactFile, ContactFit, ContactSettings, NamedDistance, fit_contacts, resolve_distances, rms,
-    tool_points,
+    ContactFile, ContactFit, ContactSettings, NamedDistance, resolve_distances, rms, tool_points,
 };
 use crate::measure::contact::KnownDistance;
 use crate::model::Robot;
@@ -34,6 +34,13 @@ pub struct ContactCalibration {
     /// by more than a tenth of its link, a tool beyond reach); `None` when
     /// it is.
     pub implausible: Option<String>,
+    /// The rows fitted: the file's, less those left out as gross errors.
+    pub file: ContactFile,
+    /// The rows the gross-error test left out
+    /// ([`crate::experiment::contact_screen`]), in the order it found them.
+    pub outliers: Vec<ContactOutlier>,
+    /// What the gross-error test did, in words.
+    pub notes: Vec<String>,
 }
 
 /// The known distances of `file`'s points (`given` by name) after the
@@ -55,8 +62,10 @@ pub fn checked_distances(
 }
 
 /// Fits `file` with the `known` distances (as [`checked_distances`] gives
-/// them; `given` by name for the frames file) and judges the fit (see the
-/// module documentation).
+/// them; `given` by name for the frames file), the rows the gross-error
+/// test flags left out ([`ContactSettings::outliers`],
+/// [`crate::experiment::contact_screen`]), and judges the fit (see the
+/// module documentation) on the rows kept.
 pub fn calibrate_contacts(
     robot: &Robot,
     file: &ContactFile,
@@ -64,7 +73,8 @@ pub fn calibrate_contacts(
     given: &[NamedDistance],
     settings: &ContactSettings,
 ) -> crate::identify::Result<ContactCalibration> {
-    let fit = fit_contacts(robot, &robot.nominal, file, known, settings)?;
+    let screened = screen_contacts(robot, file, known, given, settings)?;
+    let (fit, file) = (screened.fit, &screened.file);
     let in_sample = judge(robot, &robot.nominal, &fit, file, given);
     let predicted =
         crate::identify::contact::predict::predicted_true_error(&fit, PREDICTION_CONFIGURATIONS, 0);
@@ -82,6 +92,9 @@ pub fn calibrate_contacts(
         predicted,
         frames,
         implausible,
+        file: screened.file,
+        outliers: screened.outliers,
+        notes: screened.notes,
     })
 }
 

@@ -1,6 +1,8 @@
 //! Experiments: whole pipelines that return typed reports.
 
+pub mod acts_on;
 pub mod camera;
+pub mod contact_screen;
 pub mod contacts;
 pub mod error;
 pub mod measured;

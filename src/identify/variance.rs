@@ -211,6 +211,117 @@ impl NoiseTest {
     }
 }
 
+/// What a stated noise other than a position's is of: the words and the
+/// unit of its warning.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum NoiseOf {
+    /// A tracker's orientations (radians; printed in degrees).
+    Orientation,
+    /// A camera's detected points (pixels).
+    Pixels,
+}
+
+/// σ̂ of a block other than positions tested against the sensor's stated
+/// σ, as [`NoiseTest`] (the same χ² test), in the block's own unit.
+#[derive(Clone, Debug, Serialize)]
+pub struct BlockNoiseTest {
+    /// The block.
+    pub of: NoiseOf,
+    /// The unit of `stated` and `estimated`: `rad` or `px`.
+    pub unit: &'static str,
+    /// The stated σ per coordinate.
+    pub stated: f64,
+    /// σ̂ per coordinate.
+    pub estimated: f64,
+    /// `σ̂ / σ`.
+    pub ratio: f64,
+    /// Degrees of freedom of σ̂.
+    pub dof: usize,
+    /// `P(χ²(f) ≥ f σ̂²/σ²)`: small when σ̂ is too large.
+    pub p_larger: f64,
+    /// `P(χ²(f) ≤ f σ̂²/σ²)`: small when σ̂ is too small.
+    pub p_smaller: f64,
+    /// Whether the test rejects the stated σ at [`NOISE_TEST_ALPHA`].
+    pub rejected: bool,
+}
+
+impl BlockNoiseTest {
+    /// The test of `sigma_hat` on `dof` degrees of freedom against `stated`
+    /// (both in `of`'s unit: radians, pixels); `None` without degrees of
+    /// freedom or a σ.
+    #[must_use]
+    pub fn new(of: NoiseOf, stated: f64, sigma_hat: f64, dof: usize) -> Option<Self> {
+        let t = NoiseTest::new(stated, sigma_hat, dof)?;
+        Some(Self {
+            of,
+            unit: match of {
+                NoiseOf::Orientation => "rad",
+                NoiseOf::Pixels => "px",
+            },
+            stated,
+            estimated: sigma_hat,
+            ratio: t.ratio,
+            dof,
+            p_larger: t.p_larger,
+            p_smaller: t.p_smaller,
+            rejected: t.rejected,
+        })
+    }
+
+    /// The warning a rejected test gives, naming the likely causes; `None`
+    /// when the stated σ stands.
+    #[must_use]
+    pub fn warning(&self) -> Option<String> {
+        if !self.rejected {
+            return None;
+        }
+        let (what, value, stated, per, worse) = match self.of {
+            NoiseOf::Orientation => (
+                "the orientations' σ̂",
+                format!("{:.4}°", self.estimated.to_degrees()),
+                format!("{:.4}°", self.stated.to_degrees()),
+                "axis",
+                "the tracker's orientations are noisier than stated, a gross error is left in the data (--outliers), or the model misses something (joint sag under gravity: --compliance; a flexing tool or mount)",
+            ),
+            NoiseOf::Pixels => (
+                "the pixels' σ̂",
+                format!("{:.3} px", self.estimated),
+                format!("{:.3} px", self.stated),
+                "coordinate",
+                "the detector is noisier than stated, a gross error is left in the pixels (--outliers), the intrinsics are off (--refine-intrinsics), or the model misses something (joint sag under gravity; a flexing mount)",
+            ),
+        };
+        let head = format!(
+            "{what} {value} per {per} is {:.2}× the stated noise {stated} (χ² test on {} degrees of freedom, P = {:.1e})",
+            self.ratio,
+            self.dof,
+            self.p_larger.min(self.p_smaller)
+        );
+        Some(if self.ratio > 1.0 {
+            format!("{head}: {worse}; the σ's and the predicted error use σ̂")
+        } else {
+            format!(
+                "{head}: the sensor is better than stated, or the data were averaged or smoothed; the σ's and the predicted error use σ̂"
+            )
+        })
+    }
+}
+
+/// The orientation block's σ among `blocks` (full poses) tested against
+/// the `stated` orientation noise (radians), when one was given; its
+/// degrees of freedom the block's redundancy, rounded.
+#[must_use]
+pub fn orientation_test(stated: Option<f64>, blocks: &[BlockSigma]) -> Option<BlockNoiseTest> {
+    let b = blocks.iter().find(|b| b.block == "orientation")?;
+    BlockNoiseTest::new(
+        NoiseOf::Orientation,
+        stated?,
+        b.sigma,
+        b.redundancy.round() as usize,
+    )
+}
+
 /// The diagonal of the hat matrix `X (XᵀX)⁻¹ Xᵀ` (NaN when `XᵀX` is
 /// singular): the leverage of each row.
 fn hat_diagonal(x: &faer::Mat<f64>) -> Vec<f64> {

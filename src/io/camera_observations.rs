@@ -98,6 +98,7 @@ pub fn parse_observations(
     };
     let t = parse_csv(text, origin)?;
     let c = columns(&t, robot).map_err(err)?;
+    check_locked(&t, robot, units).map_err(err)?;
     let mut obs = CameraObservations {
         origin: origin.to_string(),
         pose_ids: Vec::new(),
@@ -190,6 +191,42 @@ pub fn parse_observations(
     };
     joint_values_to_model_units(robot, units, &source, &mut obs.qs)?;
     Ok(obs)
+}
+
+/// A locked joint moves less than this between the value it is locked at
+/// and the file's (radians or metres): a value printed with six decimals
+/// is within 5e-7 of what was meant, a joint that moved by a tenth of a
+/// degree is 1.7e-3 off.
+const LOCKED_TOL: f64 = 1e-3;
+
+/// Refuses a column of a joint `robot` holds locked whose values the file
+/// says moved: the camera saw the robot in another configuration than the
+/// model would place it in (issue 49: a UR5 fitted so misplaced its
+/// pixels by 145 px). Names the line, the column and both values.
+fn check_locked(t: &Table, robot: &Robot, units: Units) -> std::result::Result<(), String> {
+    let Some(src) = robot.source.as_ref() else {
+        return Ok(());
+    };
+    for j in &src.joints {
+        let (Some(at), Some(k)) = (j.locked, t.column(&j.name)) else {
+            continue;
+        };
+        let scale = match j.kind {
+            Some(crate::model::JointKind::Prismatic) => units.length.to_m(),
+            _ => units.angle.to_rad(),
+        };
+        for (row, line) in t.rows.iter().zip(&t.lines) {
+            let v = row[k] * scale;
+            if v.is_finite() && (v - at).abs() > LOCKED_TOL {
+                return Err(format!(
+                    "line {line}, column {} ('{}'): the joint is locked at {at} but this row has it at {v}: the data say it moved; unlock it (or give its column the locked value)",
+                    k + 1,
+                    j.name
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Refuses a file without rows and a pose that sees fewer than

@@ -65,26 +65,148 @@ pub fn pose_tests<R: Residuals>(
     poses: usize,
     sigma: Option<f64>,
 ) -> Option<Vec<PoseTest>> {
-    let (m, n, t) = (prob.n_residuals(), prob.n_params(), prob.block_rows());
-    let mut r = vec![0.0; m];
-    let mut jac = faer::Mat::<f64>::zeros(m, n);
-    if !prob.eval(theta, &mut r, Some(&mut jac)) || m <= n {
+    let t = prob.block_rows().max(1);
+    let tester = Tester::new(prob, theta, sigma)?;
+    let n = poses.min(tester.r.len() / t);
+    Some(
+        (0..n)
+            .filter_map(|i| tester.test(i, &(i * t..(i + 1) * t).collect::<Vec<_>>()))
+            .collect(),
+    )
+}
+
+/// A least-squares fit's residuals and Jacobian, ready to test any set of
+/// its rows as one block (the module documentation's `T_i` and `F_i`).
+pub struct Tester {
+    x: DMatrix<f64>,
+    r: DVector<f64>,
+    chol: nalgebra::Cholesky<f64, nalgebra::Dyn>,
+    rss: f64,
+    f: usize,
+    sigma: Option<f64>,
+}
+
+impl Tester {
+    /// The residuals and Jacobian of `prob` at `theta`, with the stated
+    /// `sigma` when given; `None` when `XᵀX` is singular or no degree of
+    /// freedom is left.
+    pub fn new<R: Residuals>(prob: &mut R, theta: &[f64], sigma: Option<f64>) -> Option<Tester> {
+        let (m, n) = (prob.n_residuals(), prob.n_params());
+        let mut r = vec![0.0; m];
+        let mut jac = faer::Mat::<f64>::zeros(m, n);
+        if !prob.eval(theta, &mut r, Some(&mut jac)) || m <= n {
+            return None;
+        }
+        let x = DMatrix::from_fn(m, n, |i, j| jac[(i, j)]);
+        let chol = (x.transpose() * &x).cholesky()?;
+        let rss: f64 = r.iter().map(|v| v * v).sum();
+        // Rows that measure nothing (a camera's point not seen: residual
+        // and Jacobian row zero) are no degrees of freedom.
+        let empty = (0..m)
+            .filter(|&i| r[i] == 0.0 && x.row(i).iter().all(|v| *v == 0.0))
+            .count();
+        Some(Tester {
+            x,
+            r: DVector::from_vec(r),
+            chol,
+            rss,
+            f: (m - empty).saturating_sub(n),
+            sigma,
+        })
+    }
+
+    /// The test of the block of `rows` as unit `pose`; `None` when the
+    /// unknowns fit it exactly or too few degrees of freedom are left.
+    #[must_use]
+    pub fn test(&self, pose: usize, rows: &[usize]) -> Option<PoseTest> {
+        let (q, ri) = self.block(rows)?;
+        block_test(pose, &q, &ri, self.rss, self.f, self.sigma)
+    }
+
+    /// `T` and `k` of the block of `rows` (the drop in the residual sum of
+    /// squares when they are left out, and its degrees of freedom; see the
+    /// module documentation); `None` when nothing of it can be tested.
+    #[must_use]
+    pub fn drop_in_rss(&self, rows: &[usize]) -> Option<(f64, usize)> {
+        let (q, ri) = self.block(rows)?;
+        let (t, k) = t_and_k(&q, &ri);
+        (k > 0).then_some((t, k))
+    }
+
+    /// The residual sum of squares, its degrees of freedom and the stated
+    /// σ the tests use.
+    #[must_use]
+    pub fn rss(&self) -> (f64, usize, Option<f64>) {
+        (self.rss, self.f, self.sigma)
+    }
+
+    /// `Q` of the block of `rows` and its residuals, the rows that measure
+    /// nothing left out.
+    fn block(&self, rows: &[usize]) -> Option<(DMatrix<f64>, DVector<f64>)> {
+        // Rows that measure nothing leave `Q`'s eigenvalue 1 with no
+        // residual: not a degree of freedom of the block.
+        let rows: Vec<usize> = rows
+            .iter()
+            .copied()
+            .filter(|&i| !(self.r[i] == 0.0 && self.x.row(i).iter().all(|v| *v == 0.0)))
+            .collect();
+        let t = rows.len();
+        if t == 0 {
+            return None;
+        }
+        let xi = self.x.select_rows(&rows);
+        let ri = self.r.select_rows(&rows);
+        let q = DMatrix::<f64>::identity(t, t) - &xi * self.chol.solve(&xi.transpose());
+        Some((q, ri))
+    }
+}
+
+/// `T = rᵀ Q⁺ r` and `k = rank Q` of a block.
+fn t_and_k(q: &DMatrix<f64>, ri: &DVector<f64>) -> (f64, usize) {
+    let eig = q.clone().symmetric_eigen();
+    let mut stat = 0.0;
+    let mut k = 0;
+    for (j, &lambda) in eig.eigenvalues.iter().enumerate() {
+        if lambda > REDUNDANCY_TOL {
+            let u = eig.eigenvectors.column(j);
+            stat += u.dot(ri).powi(2) / lambda;
+            k += 1;
+        }
+    }
+    (stat, k)
+}
+
+/// The test of `t` (a block's `T`) on `k` rows, against the stated `sigma`
+/// (χ²) or, without one, against the σ estimated without the block from
+/// `rss` on `f` degrees of freedom (F): the statistic, its degrees of
+/// freedom and its tail; `None` when no degree of freedom is left.
+#[must_use]
+pub fn tail_of(
+    t: f64,
+    k: usize,
+    rss: f64,
+    f: usize,
+    sigma: Option<f64>,
+) -> Option<(f64, (usize, usize), f64)> {
+    if k == 0 || f <= k {
         return None;
     }
-    let x = DMatrix::from_fn(m, n, |i, j| jac[(i, j)]);
-    let chol = (x.transpose() * &x).cholesky()?;
-    let rss: f64 = r.iter().map(|v| v * v).sum();
-    let f = m - n;
-    let tests = (0..poses.min(m / t.max(1)))
-        .filter_map(|i| {
-            let rows = i * t..(i + 1) * t;
-            let xi = x.rows(rows.start, t).into_owned();
-            let ri = DVector::from_column_slice(&r[rows]);
-            let q = DMatrix::<f64>::identity(t, t) - &xi * chol.solve(&xi.transpose());
-            block_test(i, &q, &ri, rss, f, sigma)
-        })
-        .collect();
-    Some(tests)
+    if let Some(s) = sigma.filter(|s| *s > 0.0) {
+        let x = t / (s * s);
+        return Some((
+            x / k as f64,
+            (k, 0),
+            crate::stats::chi2_upper_tail(x, k as f64),
+        ));
+    }
+    let d2 = f - k;
+    let s2 = ((rss - t) / d2 as f64).max(f64::MIN_POSITIVE);
+    let statistic = (t / k as f64) / s2;
+    Some((
+        statistic,
+        (k, d2),
+        crate::stats::f_upper_tail(statistic, k as f64, d2 as f64),
+    ))
 }
 
 /// The test of one block with residual covariance factor `q` and
@@ -97,39 +219,14 @@ fn block_test(
     f: usize,
     sigma: Option<f64>,
 ) -> Option<PoseTest> {
-    let eig = q.clone().symmetric_eigen();
-    let mut stat = 0.0;
-    let mut k = 0;
-    for (j, &lambda) in eig.eigenvalues.iter().enumerate() {
-        if lambda > REDUNDANCY_TOL {
-            let u = eig.eigenvectors.column(j);
-            stat += u.dot(ri).powi(2) / lambda;
-            k += 1;
-        }
-    }
-    let redundancy = q.trace();
-    if k == 0 || f <= k {
-        return None;
-    }
-    if let Some(s) = sigma.filter(|s| *s > 0.0) {
-        let x = stat / (s * s);
-        return Some(PoseTest {
-            pose,
-            statistic: x / k as f64,
-            dof: (k, 0),
-            p_value: crate::stats::chi2_upper_tail(x, k as f64),
-            redundancy,
-        });
-    }
-    let d2 = f - k;
-    let s2 = ((rss - stat) / d2 as f64).max(f64::MIN_POSITIVE);
-    let statistic = (stat / k as f64) / s2;
+    let (stat, k) = t_and_k(q, ri);
+    let (statistic, dof, p_value) = tail_of(stat, k, rss, f, sigma)?;
     Some(PoseTest {
         pose,
         statistic,
-        dof: (k, d2),
-        p_value: crate::stats::f_upper_tail(statistic, k as f64, d2 as f64),
-        redundancy,
+        dof,
+        p_value,
+        redundancy: q.trace(),
     })
 }
 
@@ -142,6 +239,139 @@ pub fn flagged(tests: &[PoseTest], alpha: f64) -> Option<&PoseTest> {
         .iter()
         .filter(|t| t.p_value < alpha / n)
         .max_by(|a, b| a.statistic.total_cmp(&b.statistic))
+}
+
+/// A unit of the data (a pose, a contact row, a camera's point) the test
+/// flagged: its test (the unit's index in the data given) and the bound
+/// its tail fell below.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Flag<U> {
+    /// The unit, in the data given.
+    pub unit: U,
+    /// Its test when flagged.
+    pub test: PoseTest,
+    /// `α / n`, `n` the units tested.
+    pub threshold: f64,
+}
+
+/// What data snooping needs of a calibration: a fit with some units left
+/// out, and the unit the test flags at a fit.
+pub trait Snoop {
+    /// What is left out: a pose, a row, a point of a pose.
+    type Unit: Clone;
+    /// The fit.
+    type Fit: Clone;
+    /// Why a fit could not be made.
+    type Error;
+    /// The fit with the units `out` left out, from the last fit `from`
+    /// when given.
+    fn fit(
+        &mut self,
+        out: &[Self::Unit],
+        from: Option<&Self::Fit>,
+    ) -> std::result::Result<Self::Fit, Self::Error>;
+    /// The unit the test flags at `fit` (made with `out` left out) at
+    /// family-wise rate `alpha` ([`flagged`]), if any; or why the units
+    /// flagged are not isolated glitches (every unit is then kept).
+    fn flag(&mut self, fit: &Self::Fit, out: &[Self::Unit], alpha: f64) -> Flagged<Self::Unit>;
+}
+
+/// What [`Snoop::flag`] found.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Flagged<U> {
+    /// No unit is flagged.
+    Clean,
+    /// This unit.
+    Unit(Flag<U>),
+    /// Too many units of one kind are flagged (e.g. many rows of one
+    /// contact point): not glitches but a model or a setup other than
+    /// assumed, in these words.
+    Systematic(String),
+}
+
+/// Why [`snoop`] kept every unit.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Capped {
+    /// The test would leave out more than the most allowed.
+    Total,
+    /// [`Flagged::Systematic`], with its words.
+    Systematic(String),
+}
+
+/// The outcome of [`snoop`].
+#[derive(Clone, Debug)]
+pub struct Snooped<F, U> {
+    /// The fit of the units kept (of every unit when `capped`).
+    pub fit: F,
+    /// The units left out, in the order the test found them.
+    pub out: Vec<Flag<U>>,
+    /// Why every unit is kept though the test flags some, if it does.
+    pub capped: Option<Capped>,
+}
+
+/// Baarda's data snooping iterated: the unit the test flags at rate
+/// `alpha` left out and the fit repeated, until none is flagged; when the
+/// test would leave out more than `most` units, every unit is kept (the
+/// data are then not a few glitches but a noise or a model other than
+/// assumed, which leaving units out would hide).
+pub fn snoop<S: Snoop>(
+    s: &mut S,
+    alpha: f64,
+    most: usize,
+) -> std::result::Result<Snooped<S::Fit, S::Unit>, S::Error> {
+    let all = s.fit(&[], None)?;
+    let mut fit = all.clone();
+    let mut out: Vec<Flag<S::Unit>> = Vec::new();
+    loop {
+        let units: Vec<S::Unit> = out.iter().map(|f| f.unit.clone()).collect();
+        let flag = match s.flag(&fit, &units, alpha) {
+            Flagged::Clean => break,
+            Flagged::Unit(f) => f,
+            Flagged::Systematic(why) => {
+                return Ok(Snooped {
+                    fit: all,
+                    out: Vec::new(),
+                    capped: Some(Capped::Systematic(why)),
+                });
+            }
+        };
+        if out.len() >= most {
+            return Ok(Snooped {
+                fit: all,
+                out: Vec::new(),
+                capped: Some(Capped::Total),
+            });
+        }
+        out.push(flag);
+        let units: Vec<S::Unit> = out.iter().map(|f| f.unit.clone()).collect();
+        fit = s.fit(&units, Some(&fit))?;
+    }
+    Ok(Snooped {
+        fit,
+        out,
+        capped: None,
+    })
+}
+
+/// At most this fraction of the poses is left out as gross errors: beyond
+/// it the data are not a few glitches but a noise or a model other than
+/// assumed, which leaving poses out would hide.
+pub const MOST_OUTLIERS: f64 = 0.2;
+
+/// The note when the test flags more than `most` of `n` `units`: every
+/// unit is kept.
+#[must_use]
+pub fn too_many_note(most: usize, n: usize, units: &str) -> String {
+    format!(
+        "the gross-error test flags more than {most} {units} ({:.0} % of {n}): not isolated glitches but a noise larger than the sensor's or a model that misses something (joint sag under gravity: --compliance); every one is kept",
+        MOST_OUTLIERS * 100.0
+    )
+}
+
+/// `0..n` without `out`, in order.
+#[must_use]
+pub fn kept_of(n: usize, out: &[usize]) -> Vec<usize> {
+    (0..n).filter(|i| !out.contains(i)).collect()
 }
 
 /// How a calibration treats poses the test flags.

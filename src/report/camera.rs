@@ -71,10 +71,30 @@ pub struct CameraCalibrationReport {
     /// Why the calibration may not be written (nothing was), when it
     /// may not ([`crate::experiment::camera::verdict`]).
     pub refused: Option<String>,
+    /// The gross-error test: its choice and the poses and points it left
+    /// out ([`crate::identify::camera::screen`]).
+    pub outliers: CameraOutliers,
+    /// What the gross-error test did, in words.
+    pub notes: Vec<String>,
+    /// σ̂ tested against the stated pixel noise, when one was given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise_test: Option<crate::identify::variance::BlockNoiseTest>,
+    /// What the user should look at: the fit is written, but the pixels
+    /// are not as stated.
+    pub warnings: Vec<String>,
     /// 0, or 3 when refused.
     pub exit_status: i32,
     /// The files written.
     pub out: Vec<String>,
+}
+
+/// The camera's gross-error test in a report.
+#[derive(Clone, Debug, Serialize)]
+pub struct CameraOutliers {
+    /// Drop (at a rate) or keep.
+    pub choice: crate::lsq::outliers::OutlierChoice,
+    /// What was left out, in the order the test found it.
+    pub left_out: Vec<crate::identify::camera::screen::CameraOutlier>,
 }
 
 /// Where a camera fit started: each placement `given` or `computed` from

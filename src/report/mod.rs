@@ -17,7 +17,8 @@ mod select;
 pub use bound::{BoundCommandReport, WeightedPose};
 pub use calibrate::{MeasuredCalibrationReport, SimulatedCalibrationReport};
 pub use camera::{
-    CameraCalibrationReport, CameraDesignReport, CameraPoolInfo, CameraStartReport, xyz_rpy,
+    CameraCalibrationReport, CameraDesignReport, CameraOutliers, CameraPoolInfo, CameraStartReport,
+    xyz_rpy,
 };
 pub use existing::ExistingReport;
 pub use fk::{FkReport, Orientation};

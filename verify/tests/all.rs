@@ -36,6 +36,10 @@ mod live_idjac;
 #[cfg(feature = "live")]
 mod live_messy;
 #[cfg(feature = "live")]
+mod live_messy_camera;
+#[cfg(feature = "live")]
+mod live_messy_contact;
+#[cfg(feature = "live")]
 mod live_stack;
 #[cfg(feature = "live")]
 mod live_tour;

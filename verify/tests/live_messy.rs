@@ -261,7 +261,7 @@ fn tool_point_not_given_is_recovered_on_four_arms() {
 /// `alpha` over `draws` draws: the binomial's quantile at 1 − 1e-3 (so the
 /// assertion itself fails wrongly once in a thousand runs), by summing its
 /// terms.
-fn false_alarm_bound(alpha: f64, draws: usize) -> usize {
+pub(super) fn false_alarm_bound(alpha: f64, draws: usize) -> usize {
     let mut cdf = 0.0;
     let mut term = (1.0 - alpha).powi(draws as i32);
     for k in 0..=draws {

@@ -56,6 +56,9 @@ pub struct MeasuredSettings {
     /// The sensor's stated σ per position coordinate (metres), tested
     /// against the fit's σ̂ ([`crate::identify::variance::NoiseTest`]).
     pub stated_noise: Option<f64>,
+    /// The stated σ per orientation axis (radians, full poses), tested
+    /// against the orientation block's σ.
+    pub stated_orientation_noise: Option<f64>,
 }
 
 /// A calibration from measurements: the robot as fitted, the fit, its
@@ -162,6 +165,9 @@ pub struct MeasuredReport {
     /// σ̂ tested against the stated noise, when one was given.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub noise_test: Option<crate::identify::variance::NoiseTest>,
+    /// The orientation σ tested against the stated one, if given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orientation_noise_test: Option<crate::identify::variance::BlockNoiseTest>,
     /// What the user should look at: the fit is written, but something in
     /// the data or the model is not as stated.
     pub warnings: Vec<String>,
@@ -538,7 +544,10 @@ pub fn calibrate_read(
     let noise_test = s.stated_noise.and_then(|sigma| {
         crate::identify::variance::NoiseTest::new(sigma, f.id.sigma_hat?, f.id.dof)
     });
-    let warnings: Vec<String> = noise_test.iter().filter_map(|t| t.warning()).collect();
+    let orientation_noise_test =
+        crate::identify::variance::orientation_test(s.stated_orientation_noise, &noise.blocks);
+    let mut warnings: Vec<String> = noise_test.iter().filter_map(|t| t.warning()).collect();
+    warnings.extend(orientation_noise_test.iter().filter_map(|t| t.warning()));
     let base =
         crate::report::MeasuredCalibrationReport::new(&r, &f.id, source.to_string(), meas.len());
     let report = MeasuredReport {
@@ -566,6 +575,7 @@ pub fn calibrate_read(
         noise,
         predicted,
         noise_test,
+        orientation_noise_test,
         warnings,
     };
     finish(r, f, report)

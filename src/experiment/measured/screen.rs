@@ -4,7 +4,10 @@
 
 use super::MeasuredSettings;
 use crate::identify::{LossChoice, Measurements, residuals};
-use crate::lsq::outliers::{Outlier, OutlierChoice};
+use crate::lsq::outliers::{
+    Flag, Flagged, MOST_OUTLIERS, Outlier, OutlierChoice, Snoop, flagged, kept_of, pose_tests,
+    snoop, too_many_note,
+};
 use crate::model::{ParamTable, Robot};
 use serde::Serialize;
 
@@ -29,10 +32,61 @@ pub(super) struct Screened {
     pub(super) notes: Vec<String>,
 }
 
-/// At most this fraction of the poses is left out as gross errors: beyond
-/// it the data are not a few glitches but a noise or a model other than
-/// assumed, which leaving poses out would hide.
-const MOST_OUTLIERS: f64 = 0.2;
+/// The tracker's poses as units of [`snoop`].
+struct Poses<'a> {
+    robot: &'a Robot,
+    start: &'a ParamTable,
+    meas: &'a Measurements,
+    s: &'a MeasuredSettings,
+}
+
+impl Snoop for Poses<'_> {
+    type Unit = usize;
+    type Fit = crate::identify::WeightedFit;
+    type Error = crate::identify::IdentifyError;
+
+    fn fit(
+        &mut self,
+        out: &[usize],
+        from: Option<&Self::Fit>,
+    ) -> crate::identify::Result<Self::Fit> {
+        let kept = kept_of(self.meas.len(), out);
+        let from = from.map_or(self.start, |f| &f.fit.id.table);
+        let s = self.s;
+        crate::identify::fit_weighted(
+            self.robot,
+            from,
+            &self.meas.subset(&kept),
+            &s.lm,
+            s.loss,
+            s.weights,
+        )
+    }
+
+    fn flag(&mut self, wf: &Self::Fit, out: &[usize], alpha: f64) -> Flagged<usize> {
+        let kept = kept_of(self.meas.len(), out);
+        let sub = self.meas.subset(&kept);
+        let Ok(mut prob) = crate::identify::Calibration::new(&wf.robot, &wf.start, &sub) else {
+            return Flagged::Clean;
+        };
+        let Some(tests) = pose_tests(
+            &mut prob,
+            &wf.fit.id.estimate,
+            sub.len(),
+            self.s.stated_noise,
+        ) else {
+            return Flagged::Clean;
+        };
+        let Some(worst) = flagged(&tests, alpha) else {
+            return Flagged::Clean;
+        };
+        Flagged::Unit(Flag {
+            unit: kept[worst.pose],
+            test: worst.clone(),
+            threshold: alpha / tests.len() as f64,
+        })
+    }
+}
 
 /// The fit of `meas` ([`crate::identify::fit_weighted`]), and with least
 /// squares and [`OutlierChoice::Drop`], Baarda's data snooping
@@ -46,61 +100,39 @@ pub(super) fn screen(
     s: &MeasuredSettings,
 ) -> crate::identify::Result<Screened> {
     crate::lsq::outliers::check_choice(s.outliers)?;
-    let fit = |m: &Measurements, from: &ParamTable| {
-        crate::identify::fit_weighted(robot, from, m, &s.lm, s.loss, s.weights)
+    let mut poses = Poses {
+        robot,
+        start,
+        meas,
+        s,
     };
-    let mut kept: Vec<usize> = (0..meas.len()).collect();
-    let mut wf = fit(meas, start)?;
-    let mut found: Vec<(usize, crate::lsq::outliers::PoseTest, f64)> = Vec::new();
     let mut notes = Vec::new();
     let alpha = match (s.outliers, s.loss) {
         (OutlierChoice::Drop { alpha }, LossChoice::L2) => alpha,
         _ => {
             return Ok(Screened {
-                fit: wf,
-                kept,
+                fit: poses.fit(&[], None)?,
+                kept: (0..meas.len()).collect(),
                 outliers: Vec::new(),
                 notes,
             });
         }
     };
     let most = (MOST_OUTLIERS * meas.len() as f64).floor() as usize;
-    let all = wf.clone();
-    loop {
-        let sub = meas.subset(&kept);
-        let mut prob = crate::identify::Calibration::new(&wf.robot, &wf.start, &sub)?;
-        let Some(tests) = crate::lsq::outliers::pose_tests(
-            &mut prob,
-            &wf.fit.id.estimate,
-            sub.len(),
-            s.stated_noise,
-        ) else {
-            break;
-        };
-        let Some(worst) = crate::lsq::outliers::flagged(&tests, alpha) else {
-            break;
-        };
-        if found.len() >= most {
-            notes.push(format!(
-                "the gross-error test flags more than {} poses ({:.0} % of {}): not isolated glitches but a noise larger than the sensor's or a model that misses something (joint sag under gravity: --compliance); every pose is kept",
-                most,
-                MOST_OUTLIERS * 100.0,
-                meas.len()
-            ));
-            let kept = (0..meas.len()).collect();
-            return Ok(Screened {
-                fit: all,
-                kept,
-                outliers: Vec::new(),
-                notes,
-            });
-        }
-        let threshold = alpha / tests.len() as f64;
-        found.push((kept[worst.pose], worst.clone(), threshold));
-        kept.remove(worst.pose);
-        let next = fit(&meas.subset(&kept), &wf.fit.id.table.clone())?;
-        wf = next;
+    let snooped = snoop(&mut poses, alpha, most)?;
+    if snooped.capped.is_some() {
+        notes.push(too_many_note(most, meas.len(), "poses"));
     }
+    let wf = snooped.fit;
+    let kept = kept_of(
+        meas.len(),
+        &snooped.out.iter().map(|f| f.unit).collect::<Vec<_>>(),
+    );
+    let found: Vec<(usize, crate::lsq::outliers::PoseTest, f64)> = snooped
+        .out
+        .into_iter()
+        .map(|f| (f.unit, f.test, f.threshold))
+        .collect();
     let outliers = found
         .into_iter()
         .map(|(pose, mut test, threshold)| {

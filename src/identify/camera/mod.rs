@@ -19,6 +19,7 @@
 //! `σ̂² (XᵀX)⁻¹`.
 
 pub mod predict;
+pub mod screen;
 pub mod simulate;
 pub mod start;
 pub mod unknowns;

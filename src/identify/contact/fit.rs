@@ -19,6 +19,7 @@ use crate::identify::lm::{Solution, StopReason, levenberg_marquardt};
 use crate::identify::undetermined::{FixedParameter, fix_undetermined_below};
 use crate::identify::{Calibration, LmSettings, LossChoice, Residuals, Result};
 use crate::lsq::loss::{Cauchy, Huber, Loss};
+use crate::lsq::outliers::{OutlierChoice, Tester};
 use crate::measure::contact::{ContactSensor, KnownDistance, Plane, PlaneKind};
 use crate::model::{ParamTable, Robot};
 use faer::Mat;
@@ -61,6 +62,11 @@ pub struct ContactSettings {
     pub loss: LossChoice,
     /// Parameters never fixed (nor counted as the gauge). Default none.
     pub keep: Vec<String>,
+    /// What happens to rows the gross-error test flags (with least
+    /// squares; a robust loss keeps every row). Default: dropped at
+    /// [`crate::lsq::outliers::ALPHA`]. [`fit_contacts`] fits every
+    /// row; the pipeline ([`crate::experiment::contacts`]) tests them.
+    pub outliers: OutlierChoice,
 }
 
 impl Default for ContactSettings {
@@ -69,6 +75,7 @@ impl Default for ContactSettings {
             lm: LmSettings::default(),
             loss: LossChoice::L2,
             keep: Vec::new(),
+            outliers: OutlierChoice::default(),
         }
     }
 }
@@ -82,13 +89,18 @@ crate::settings::settings_builder! {
         loss: LossChoice,
         /// Parameters never fixed (default none).
         keep: Vec<String>,
+        /// What happens to rows the gross-error test flags (default:
+        /// dropped at rate [`crate::lsq::outliers::ALPHA`]).
+        outliers: OutlierChoice,
     }
 }
 
 impl ContactSettings {
-    /// Checks the solver's settings and the loss's scale.
+    /// Checks the solver's settings, the loss's scale and the outlier
+    /// test's rate.
     pub fn validate(&self) -> Result<()> {
         self.lm.validate()?;
+        crate::lsq::outliers::check_choice(self.outliers)?;
         loss_of(self.loss).map(|_| ())
     }
 }
@@ -212,6 +224,24 @@ fn problem<'a>(
         .flat_map(|&g| ContactSensor::value_of(g))
         .collect();
     Calibration::with_sensor(robot, start, &file.qs, Box::new(sensor), measured)
+}
+
+/// The gross-error test of `fit`'s rows ([`crate::lsq::outliers`]):
+/// the least-squares problem `fit` solved (`file`'s rows with `distances`,
+/// its robot's unknowns from `start`, the planes started as
+/// [`fit_contacts`] starts them) at its estimate, ready to test each row's
+/// three residuals (the distance rows are never tested); `None` when its
+/// information is singular or nothing is left to test against.
+#[must_use]
+pub fn row_tester(
+    fit: &ContactFit,
+    start: &ParamTable,
+    file: &ContactFile,
+    distances: &[KnownDistance],
+) -> Option<Tester> {
+    let planes = start_planes(&fit.robot, start, file);
+    let mut prob = problem(&fit.robot, start, file, distances, &planes);
+    Tester::new(&mut prob, &fit.estimate, None)
 }
 
 /// The Jacobian of `prob` at `theta`.

@@ -1,0 +1,144 @@
+"""Python refuses what the command line refuses: every keyword argument of
+the calibrate functions acts on the sensor of the data given, or is refused
+with a ValueError naming the argument and the sensor (the library's table,
+`activecal::experiment::acts_on`, which the command line's `acts_on.rs`
+uses too); and the writers never write over an input of the call."""
+
+import inspect
+import shutil
+
+import pytest
+
+import activecal
+from conftest import FIXTURES, UR5_URDF
+from test_calibrate import simulated
+
+# A value of each keyword argument that is not its default, and the sensors
+# it acts on (the command line's table, restated here so that a change of
+# the library's is a change of this test).
+CALIBRATE = {
+    "fix": (["d_shoulder_lift_joint"], {"points", "poses"}),
+    "free": (["d_shoulder_lift_joint"], {"points", "poses"}),
+    "max_iterations": (150, {"points", "poses"}),
+    "loss": ("huber", {"points", "poses"}),
+    "loss_scale": (1e-3, {"points", "poses"}),
+    "weights": ("fixed", {"poses"}),
+    "orientation_scale": (0.2, {"poses"}),
+    "holdout": (0.25, {"points", "poses"}),
+    "splits": (3, {"points", "poses"}),
+    "seed": (5, {"points", "poses"}),
+    "compliance": (True, {"points", "poses"}),
+    "outliers": ("keep", {"points", "poses"}),
+    "outlier_rate": (0.05, {"points", "poses"}),
+    "noise": (1e-4, {"points", "poses"}),
+    "orientation_noise": (1e-3, {"poses"}),
+}
+# Arguments a keyword needs beside it (the command line's `requires`).
+NEEDS = {"loss_scale": {"loss": "huber"}, "loss": {"loss_scale": 1e-3}, "splits": {"holdout": 0.25}, "seed": {"holdout": 0.25}}
+WORDS = {"points": "measured points", "poses": "measured full poses"}
+DATA = {"robot", "q", "points", "orientations", "progress"}
+
+
+def keywords(f):
+    return [p for p in inspect.signature(f).parameters if p not in DATA]
+
+
+def test_every_keyword_of_calibrate_is_decided():
+    assert sorted(keywords(activecal.calibrate)) == sorted(CALIBRATE)
+
+
+@pytest.mark.parametrize("sensor", ["points", "poses"])
+def test_every_keyword_of_calibrate_acts_or_is_refused_naming_it(tmp_path, sensor):
+    pose = sensor == "poses"
+    args = ["--robot", f"{UR5_URDF}:pose" if pose else UR5_URDF, "--tip", "tool0"]
+    if not pose:
+        args += ["--marker", "tool0@0.031,-0.024,0.097"]
+    _, m = simulated(tmp_path, args)
+    r = (activecal.Robot.from_urdf(UR5_URDF, tip="tool0", pose=True) if pose
+         else activecal.Robot.from_urdf(UR5_URDF, tip="tool0", marker="tool0@0.031,-0.024,0.097"))
+    extra = {"orientations": m["orientations"]} if pose else {}
+    base = activecal.calibrate(r, m["qs"], m["points"], **extra)
+    # Names of this robot's: an unknown to fix, a fixed parameter to free.
+    names = {"fix": [list(base.estimate)[2]],
+             "free": [f["name"] for f in base.report["fixed"]][:1] or None}
+    acting = refused = 0
+    for k, (value, on) in CALIBRATE.items():
+        value = names.get(k, value)
+        if value is None:
+            continue
+        kw = {k: value, **NEEDS.get(k, {})}
+        if sensor in on:
+            cal = activecal.calibrate(r, m["qs"], m["points"], **extra, **kw)
+            assert cal.report is not None, k
+            acting += 1
+        else:
+            with pytest.raises(ValueError) as e:
+                activecal.calibrate(r, m["qs"], m["points"], **extra, **kw)
+            msg = str(e.value)
+            assert msg.startswith(f"{k}: not used with {WORDS[sensor]}"), msg
+            refused += 1
+    assert acting > 5 and (refused > 0 or pose)
+
+
+def test_contact_and_camera_keywords_act_on_their_sensor():
+    """Every keyword of calibrate_contacts and calibrate_camera is one the
+    table has acting on contacts or pixels: the refusal is never raised by
+    a keyword of their own signatures (checked through the table's words:
+    a keyword the table does not decide would be refused)."""
+    for f in (activecal.calibrate_contacts, activecal.calibrate_camera):
+        ks = keywords(f)
+        assert "outliers" in ks and "outlier_rate" in ks, ks
+    assert "pixel_noise" in keywords(activecal.calibrate_camera)
+
+
+CAM = FIXTURES / "camera"
+CAMERA_POSE = [1.1761, 0.6096, 0.9079, -2.0681, 0.0317, 2.0826]
+TARGET_POSE = [-0.1047, 0.0411, 0.0301, 3.1111, -0.0192, 0.0556]
+
+
+def camera_fit(pixels, **kw):
+    r = activecal.Robot.from_urdf(FIXTURES / "ur5.urdf")
+    return activecal.calibrate_camera(
+        r, pixels, CAM / "camera_info.yaml", CAM / "board.yaml", mounting="eye-to-hand",
+        camera_pose=CAMERA_POSE, target_pose=TARGET_POSE, **kw,
+    )
+
+
+def test_camera_keywords_act(tmp_path):
+    pixels = CAM / "ur5_eye_to_hand.csv"
+    kept = camera_fit(pixels, outliers="keep")
+    assert kept.report["outliers"] == {"choice": {"kind": "keep"}, "left_out": []}
+    # A stated pixel noise far below the fit's σ̂ is rejected, with the
+    # command line's warning.
+    with pytest.warns(UserWarning, match="noisier than stated"):
+        c = camera_fit(pixels, pixel_noise=0.01)
+    assert c.report["noise_test"]["rejected"] and c.report["noise_test"]["unit"] == "px"
+    for kw, words in [
+        (dict(pixel_noise=-1.0), "pixel_noise=-1"),
+        (dict(outliers="maybe"), "outliers"),
+        (dict(outlier_rate=2.0), "outlier_rate=2"),
+    ]:
+        with pytest.raises(ValueError, match=words):
+            camera_fit(pixels, **kw)
+
+
+def test_writers_refuse_to_write_over_an_input(tmp_path):
+    pixels = tmp_path / "pixels.csv"
+    shutil.copy(CAM / "ur5_eye_to_hand.csv", pixels)
+    before = pixels.read_bytes()
+    c = camera_fit(pixels)
+    for write in (c.write_urdf, c.write_frames):
+        with pytest.raises(activecal.Error, match="pixels.csv"):
+            write(pixels, overwrite=True)
+    assert pixels.read_bytes() == before
+    # The robot's own URDF, for a tracker's calibration too.
+    urdf = tmp_path / "ur5.urdf"
+    shutil.copy(UR5_URDF, urdf)
+    marker = "tool0@0.031,-0.024,0.097"
+    _, m = simulated(tmp_path, ["--robot", urdf, "--tip", "tool0", "--marker", marker])
+    r = activecal.Robot.from_urdf(urdf, tip="tool0", marker=marker)
+    cal = activecal.calibrate(r, m["qs"], m["points"])
+    text = urdf.read_bytes()
+    with pytest.raises(activecal.Error, match="ur5.urdf"):
+        cal.write_urdf(urdf, overwrite=True)
+    assert urdf.read_bytes() == text

@@ -1,0 +1,238 @@
+//! Which sensors each option of a command acts on (`calibrate`, `select`,
+//! `evaluate`): one table per command, by the option's name (the command
+//! line's option id, the Python keyword argument's name). An option given
+//! with a sensor it does not act on is refused — by the command line naming
+//! its flag, by the Python package naming the keyword — so no option is
+//! accepted and ignored. The tables name no flag; what to say instead is
+//! the caller's.
+
+use serde::Serialize;
+
+/// What a command works for: the sensor of its data or of its design.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Sensor {
+    /// Calibration from measurements simulated at a design.
+    Simulated,
+    /// Calibration from measured points (no orientations).
+    Points,
+    /// Calibration from measured full poses (with orientations).
+    Poses,
+    /// Calibration from contacts (a point or plane per row).
+    Contacts,
+    /// Calibration from a camera's pixels.
+    Pixels,
+    /// Selection from a pool of poses (points, markers or full poses).
+    Pool,
+    /// Selection of configurations touching sockets.
+    Sockets,
+    /// Selection of poses for a camera.
+    Camera,
+}
+
+impl Sensor {
+    /// The sensor in a few words (no flag), for messages.
+    #[must_use]
+    pub fn words(self) -> &'static str {
+        match self {
+            Sensor::Simulated => "simulated measurements",
+            Sensor::Points => "measured points (no orientations)",
+            Sensor::Poses => "measured full poses (with orientations)",
+            Sensor::Contacts => "contacts",
+            Sensor::Pixels => "a camera's pixels",
+            Sensor::Pool => "a pool of poses",
+            Sensor::Sockets => "configurations touching sockets",
+            Sensor::Camera => "poses chosen for a camera",
+        }
+    }
+}
+
+/// One option's row: its name and the sensors it acts on.
+#[derive(Clone, Copy, Debug)]
+pub struct ActsOn {
+    /// The option's name (the command line's id, the Python keyword's).
+    pub id: &'static str,
+    /// The sensors it acts on.
+    pub sensors: &'static [Sensor],
+}
+
+use Sensor::{Camera, Contacts, Pixels, Points, Pool, Poses, Simulated, Sockets};
+
+const fn a(id: &'static str, sensors: &'static [Sensor]) -> ActsOn {
+    ActsOn { id, sensors }
+}
+
+const CAL_ALL: &[Sensor] = &[Simulated, Points, Poses, Contacts, Pixels];
+/// Measured points or full poses: told apart once the data are read.
+pub const MEASURED: &[Sensor] = &[Points, Poses];
+const FITTED: &[Sensor] = &[Points, Poses, Contacts];
+const READ: &[Sensor] = &[Points, Poses, Contacts, Pixels];
+const SEL_ALL: &[Sensor] = &[Pool, Sockets, Camera];
+const EVAL_ALL: &[Sensor] = &[Points, Poses, Contacts];
+
+/// The options of `calibrate` (and the global ones) and the sensors each acts
+/// on.
+pub const CALIBRATE: &[ActsOn] = &[
+    a("base", CAL_ALL),
+    a("tip", CAL_ALL),
+    a("lock", CAL_ALL),
+    a("frames", CAL_ALL),
+    a("kinematics", CAL_ALL),
+    a("markers", &[Simulated, Points, Poses, Contacts]),
+    a("progress", CAL_ALL),
+    a("robot", CAL_ALL),
+    a("design", &[Simulated]),
+    a("measurements", FITTED),
+    a("save_measurements", &[Simulated]),
+    a("out", CAL_ALL),
+    a("force", CAL_ALL),
+    a("noise", &[Simulated, Points, Poses]),
+    a("outliers", READ),
+    a("outlier_rate", READ),
+    a("orientation_noise", &[Poses]),
+    a("pixel_noise", &[Pixels]),
+    a("seed", &[Simulated, Points, Poses]),
+    a("trials", &[Simulated]),
+    a("validation", &[Simulated]),
+    a("max_iterations", CAL_ALL),
+    a("no_geodesic", CAL_ALL),
+    a("loss", FITTED),
+    a("loss_scale", FITTED),
+    a("fix", MEASURED),
+    a("unknowns", MEASURED),
+    a("offset_unit", &[Simulated, Points, Poses]),
+    a("offset_sign", &[Simulated, Points, Poses]),
+    a("free", FITTED),
+    a("holdout", MEASURED),
+    a("splits", MEASURED),
+    a("compare_pruned", MEASURED),
+    a("weights", &[Poses]),
+    a("orientation_scale", &[Poses]),
+    a("point_distance", &[Contacts]),
+    a("plane", &[Contacts]),
+    a("holdout_by", &[Contacts]),
+    a("train_on", &[Contacts]),
+    a("compliance", MEASURED),
+    a("compare_compliance", MEASURED),
+    a("inertia", MEASURED),
+    a("payload", MEASURED),
+    a("report", &[Simulated, Points, Poses, Contacts]),
+    a("observations", &[Pixels]),
+    a("camera_info", &[Pixels]),
+    a("target", &[Pixels]),
+    a("mounting", &[Pixels]),
+    a("camera_link", &[Pixels]),
+    a("camera_pose", &[Pixels]),
+    a("target_pose", &[Pixels]),
+    a("refine_intrinsics", &[Pixels]),
+    a("out_camera_info", &[Pixels]),
+    a("angle_unit", READ),
+    a("length_unit", READ),
+    a("json", CAL_ALL),
+];
+
+/// The options of `select` (and the global ones) and the sensors each acts
+/// on.
+pub const SELECT: &[ActsOn] = &[
+    a("base", SEL_ALL),
+    a("tip", SEL_ALL),
+    a("lock", SEL_ALL),
+    a("frames", SEL_ALL),
+    a("kinematics", SEL_ALL),
+    a("markers", &[Pool, Sockets]),
+    a("progress", SEL_ALL),
+    a("robot", SEL_ALL),
+    a("pool", &[Pool, Camera]),
+    a("levels", &[Pool]),
+    a("count", SEL_ALL),
+    a("pool_seed", SEL_ALL),
+    a("params", &[Pool, Sockets]),
+    a("visibility", &[Pool]),
+    a("self_collision", SEL_ALL),
+    a("srdf", SEL_ALL),
+    a("skip_always_touching", SEL_ALL),
+    a("package_dirs", SEL_ALL),
+    a("obstacles", SEL_ALL),
+    a("floor", SEL_ALL),
+    a("angle_unit", &[Pool, Camera]),
+    a("length_unit", &[Pool, Camera]),
+    a("compliance", &[Pool]),
+    a("margin", &[Pool, Sockets]),
+    a("clearance", SEL_ALL),
+    a("n", SEL_ALL),
+    a("algorithm", &[Pool]),
+    a("initial", &[Pool]),
+    a("starts", &[Pool]),
+    a("ils", &[Pool]),
+    a("kick", &[Pool]),
+    a("designs", &[Pool]),
+    a("polish", &[Pool]),
+    a("seed", SEL_ALL),
+    a("fixed", &[Pool]),
+    a("criterion", &[Pool]),
+    a("out", SEL_ALL),
+    a("force", SEL_ALL),
+    a("gap", &[Pool, Camera]),
+    a("gap_solver", &[Pool, Camera]),
+    a("existing", &[Pool]),
+    a("refine", &[Pool]),
+    a("refine_sweeps", &[Pool]),
+    a("order", &[Pool]),
+    a("home", &[Pool]),
+    a("report", &[Pool, Camera]),
+    a("target_error", &[Pool, Camera]),
+    a("noise", &[Pool]),
+    a("orientation_noise", &[Pool]),
+    a("points", &[Sockets]),
+    a("point_distance", &[Sockets]),
+    a("camera_info", &[Camera]),
+    a("target", &[Camera]),
+    a("mounting", &[Camera]),
+    a("camera_link", &[Camera]),
+    a("camera_pose", &[Camera]),
+    a("target_pose", &[Camera]),
+    a("min_visible", &[Camera]),
+    a("image_margin", &[Camera]),
+    a("max_view_angle", &[Camera]),
+    a("distance", &[Camera]),
+    a("line_of_sight", &[Camera]),
+    a("pixel_noise", &[Camera]),
+    a("json", SEL_ALL),
+];
+
+/// The options of `evaluate` (and the global ones) and the sensors each acts
+/// on.
+pub const EVALUATE: &[ActsOn] = &[
+    a("base", EVAL_ALL),
+    a("tip", EVAL_ALL),
+    a("lock", EVAL_ALL),
+    a("frames", EVAL_ALL),
+    a("kinematics", EVAL_ALL),
+    a("markers", EVAL_ALL),
+    a("progress", EVAL_ALL),
+    a("robot", EVAL_ALL),
+    a("measurements", EVAL_ALL),
+    a("angle_unit", EVAL_ALL),
+    a("length_unit", EVAL_ALL),
+    a("point_distance", &[Contacts]),
+    a("plane", &[Contacts]),
+    a("json", EVAL_ALL),
+];
+
+/// The sensors option `id` of `table` acts on; `None` for an option the
+/// table does not decide.
+#[must_use]
+pub fn sensors_of(table: &[ActsOn], id: &str) -> Option<&'static [Sensor]> {
+    table.iter().find(|r| r.id == id).map(|r| r.sensors)
+}
+
+/// The options of `given` that act on none of `sensors` by `table` (an
+/// option without a row too), in order.
+#[must_use]
+pub fn not_acting<'a>(table: &[ActsOn], given: &[&'a str], sensors: &[Sensor]) -> Vec<&'a str> {
+    given
+        .iter()
+        .copied()
+        .filter(|id| sensors_of(table, id).is_none_or(|s| !s.iter().any(|x| sensors.contains(x))))
+        .collect()
+}

@@ -32,6 +32,7 @@ CALIBRATE = {
     "outlier_rate": (0.05, {"points", "poses"}),
     "noise": (1e-4, {"points", "poses"}),
     "orientation_noise": (1e-3, {"poses"}),
+    "unknowns": ("offsets", {"points", "poses"}),
 }
 # Arguments a keyword needs beside it (the command line's `requires`).
 NEEDS = {"loss_scale": {"loss": "huber"}, "loss": {"loss_scale": 1e-3}, "splits": {"holdout": 0.25}, "seed": {"holdout": 0.25}}

@@ -166,21 +166,15 @@ pub fn calibrate_contacts(
     let (c, report) = crate::progress::with_callback(progress, || {
         detached(py, move || {
             let c = fit(&r, &file, &known, &given, &settings).map_err(Fail::input)?;
-            let report = serde_json::json!({
-                "robot": r.name,
-                "measurements": file.origin,
-                "rows": file.qs.len(),
-                "outliers": {"choice": outliers, "left_out": c.outliers},
-                "notes": c.notes,
-                "fit": c.fit,
-                "downweighted": c.downweighted,
-                "in_sample": c.in_sample,
-                "holdout": null,
-                "predicted_true_error": c.predicted,
-                "frames": c.frames.as_ref().map(|(_, f)| f),
-                "out": [],
-                "exit_status": if c.fit.converged && c.implausible.is_none() { 0 } else { 3 },
-            });
+            let report = serde_json::to_value(c.report(
+                &r.name,
+                &file.origin,
+                file.qs.len(),
+                outliers,
+                None,
+                true,
+                &[],
+            ))?;
             Ok((c, report))
         })
     })?;

@@ -13,7 +13,6 @@ use activecal::identify::contact::{
 use activecal::io::contacts::{ContactFile, read_contacts};
 use activecal::model::Robot;
 use anyhow::{Context, Result, bail};
-use serde_json::json;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -156,49 +155,34 @@ pub fn calibrate_contacts(
     activecal::identify::contact::lengths::check_distances(robot, &file, &known)
         .context("--point-distance")?;
     let settings = settings_of(a)?;
-    let activecal::experiment::contacts::ContactCalibration {
-        fit,
-        in_sample: figures,
-        downweighted: down,
-        predicted,
-        frames: all_frames,
-        implausible,
-        file: fitted,
-        outliers,
-        notes,
-    } = activecal::experiment::contacts::calibrate_contacts(
+    let cal = activecal::experiment::contacts::calibrate_contacts(
         robot, &file, &known, &given, &settings,
     )?;
+    let (fit, figures, fitted) = (&cal.fit, &cal.in_sample, &cal.file);
     // The rows kept: those left out as gross errors are neither fitted
     // nor held out.
-    let held = held_out(a, robot, &fitted, &given, &settings)?;
-    let frames = if a.out.is_empty() { None } else { all_frames };
-    let written = match &frames {
-        Some(f) if fit.converged && implausible.is_none() => {
-            super::contact_out::write(a.out, a.force, &fit.robot, &fit, f)?
+    let held = held_out(a, robot, fitted, &given, &settings)?;
+    let written = match &cal.frames {
+        Some(f) if !a.out.is_empty() && cal.exit_status() == 0 => {
+            super::contact_out::write(a.out, a.force, &fit.robot, fit, f)?
         }
         _ => Vec::new(),
     };
-    let v = json!({
-        "robot": robot.name,
-        "measurements": path.display().to_string(),
-        "rows": file.qs.len(),
-        "outliers": {"choice": settings.outliers, "left_out": outliers},
-        "notes": notes,
-        "fit": fit,
-        "downweighted": down,
-        "in_sample": figures,
-        "holdout": held,
-        "predicted_true_error": predicted,
-        "frames": frames.as_ref().map(|(_, r)| r),
-        "out": written,
-        "exit_status": if fit.converged && implausible.is_none() { 0 } else { 3 },
-    });
-    let mut report = text(&fitted, &fit, &figures, held.as_ref());
-    for n in &notes {
+    let source = path.display().to_string();
+    let v = serde_json::to_value(cal.report(
+        &robot.name,
+        &source,
+        file.qs.len(),
+        settings.outliers,
+        held.as_ref(),
+        !a.out.is_empty(),
+        &written,
+    ))?;
+    let mut report = text(fitted, fit, figures, held.as_ref());
+    for n in &cal.notes {
         let _ = writeln!(report, "note: {n}");
     }
-    if let Some(p) = &predicted {
+    if let Some(p) = &cal.predicted {
         let _ = writeln!(
             report,
             "predicted true error of the calibrated tool point (the fit's covariance at {} random configurations): {:.4} mm RMS; it includes what held-out placements cannot see (an error common to a placement's rows)",
@@ -214,9 +198,9 @@ pub fn calibrate_contacts(
     if let Some(dir) = a.report {
         let r = activecal::render::contact_figures::ContactReport {
             robot,
-            file: &fitted,
-            fit: &fit,
-            figures: &figures,
+            file: fitted,
+            fit,
+            figures,
             held: held.as_ref(),
         };
         activecal::render::folder::contacts(dir, robot, &report, &v, |d| {
@@ -224,7 +208,7 @@ pub fn calibrate_contacts(
         })?;
     }
     super::emit(a.json, &v, || report)?;
-    if let Some(why) = implausible {
+    if let Some(why) = cal.implausible.clone() {
         let names: Vec<String> = a.out.iter().map(|p| p.display().to_string()).collect();
         let lost = if names.is_empty() {
             String::new()

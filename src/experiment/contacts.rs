@@ -125,3 +125,98 @@ pub fn implausible(fit: &ContactFit, frames: Option<&CalibratedFrames>) -> Optio
         check_offsets("the tool offset", &[fit.tool_offset], reach)
     })
 }
+
+/// The outlier test's choice and the rows it left out, as reported.
+#[derive(Debug, serde::Serialize)]
+pub struct ContactOutliersReport<'a> {
+    /// The test asked for (drop, keep; its rate).
+    pub choice: crate::lsq::outliers::OutlierChoice,
+    /// The rows it left out, in the order it found them.
+    pub left_out: &'a [ContactOutlier],
+}
+
+/// A contact calibration's report: what `calibrate --json` prints for a
+/// contact file and Python's `ContactCalibration.report` holds (one
+/// construction for both).
+#[derive(Debug, serde::Serialize)]
+pub struct ContactCalibrationReport<'a> {
+    /// The robot's name.
+    pub robot: &'a str,
+    /// The contact file.
+    pub measurements: &'a str,
+    /// Rows in the file (before any was left out).
+    pub rows: usize,
+    /// The gross-error test.
+    pub outliers: ContactOutliersReport<'a>,
+    /// What the test did, in words.
+    pub notes: &'a [String],
+    /// The fit.
+    pub fit: &'a ContactFit,
+    /// Rows a robust loss weighed down.
+    pub downweighted: &'a [DownweightedRow],
+    /// In-sample consistency, nominal and calibrated.
+    pub in_sample: &'a Figures,
+    /// Held-out placements, when asked for.
+    pub holdout: Option<&'a crate::identify::contact::HoldoutReport>,
+    /// The tool point's predicted true error.
+    pub predicted_true_error: Option<&'a PredictedTrueError>,
+    /// The calibrated frames (when written).
+    pub frames: Option<&'a FramesReport>,
+    /// The files written.
+    pub out: &'a [String],
+    /// 0, or 3 when the fit did not converge or is not plausible.
+    pub exit_status: i32,
+}
+
+impl ContactCalibration {
+    /// The exit status the calibration implies: 0 when the fit converged
+    /// to a plausible robot, else [`super::measured::verdict::EXIT_REFUSED`].
+    #[must_use]
+    pub fn exit_status(&self) -> i32 {
+        if self.fit.converged && self.implausible.is_none() {
+            0
+        } else {
+            super::measured::verdict::EXIT_REFUSED
+        }
+    }
+
+    /// The report of this calibration of `robot` from `measurements`
+    /// (`rows` rows before screening), with the outlier test's `choice`,
+    /// the held-out placements, the frames when `with_frames`, and the
+    /// files written.
+    #[allow(clippy::too_many_arguments)]
+    #[must_use]
+    pub fn report<'a>(
+        &'a self,
+        robot: &'a str,
+        measurements: &'a str,
+        rows: usize,
+        choice: crate::lsq::outliers::OutlierChoice,
+        holdout: Option<&'a crate::identify::contact::HoldoutReport>,
+        with_frames: bool,
+        out: &'a [String],
+    ) -> ContactCalibrationReport<'a> {
+        ContactCalibrationReport {
+            robot,
+            measurements,
+            rows,
+            outliers: ContactOutliersReport {
+                choice,
+                left_out: &self.outliers,
+            },
+            notes: &self.notes,
+            fit: &self.fit,
+            downweighted: &self.downweighted,
+            in_sample: &self.in_sample,
+            holdout,
+            predicted_true_error: self.predicted.as_ref(),
+            frames: if with_frames {
+                self.frames.as_ref().map(|(_, r)| r)
+            } else {
+                None
+            },
+            out,
+            exit_status: self.exit_status(),
+        }
+    }
+}

@@ -93,3 +93,28 @@ macro_rules! choice {
         }
     };
 }
+
+/// Phrases the library's messages use for a setting that each front end
+/// spells its own way: the command line's hint table (`cli/hints.rs`) and
+/// the Python bindings' (`python/src/convert.rs`) map each to their
+/// option, so the library never names a flag.
+pub mod phrase {
+    /// The gross-error screen (data snooping), which drops flagged poses.
+    pub const OUTLIER_SCREEN: &str = "the gross-error screen";
+    /// Switching the gross-error screen to keep every pose.
+    pub const KEEP_GROSS_ERRORS: &str = "keeping gross errors keeps it";
+    /// Joint compliance (sag under gravity) as unknowns of the fit.
+    pub const COMPLIANCE: &str = "the joints' compliance as unknowns";
+    /// The camera's intrinsics refined with the fit.
+    pub const REFINE_INTRINSICS: &str = "refining the intrinsics";
+    /// Position data with no tool point or marker given.
+    pub const NO_TOOL_POINT: &str = "no tool point given";
+    /// The stated position noise when none is given.
+    pub const DEFAULT_NOISE: &str = "the default stated noise";
+    /// The stated pixel noise when none is given.
+    pub const DEFAULT_PIXEL_NOISE: &str = "the default stated pixel noise";
+    /// A target error for the how-many curve: the fewest poses reaching it.
+    pub const TARGET_ERROR: &str = "a target error gives the fewest poses reaching it";
+    /// Overwriting an existing output, when asked for.
+    pub const OVERWRITE_ASKED: &str = "even when overwriting is asked for";
+}

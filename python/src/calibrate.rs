@@ -432,7 +432,7 @@ fn warn_all(py: Python<'_>, warnings: &[String]) -> PyResult<()> {
         pyo3::PyErr::warn(
             py,
             cat.as_any(),
-            &std::ffi::CString::new(w.as_str()).unwrap_or_default(),
+            &std::ffi::CString::new(crate::errors::spell(w)).unwrap_or_default(),
             1,
         )?;
     }

@@ -369,7 +369,7 @@ pub fn warn(py: Python<'_>, text: &str) -> PyResult<()> {
     pyo3::PyErr::warn(
         py,
         cat.as_any(),
-        &std::ffi::CString::new(text).unwrap_or_default(),
+        &std::ffi::CString::new(crate::errors::spell(text)).unwrap_or_default(),
         1,
     )
 }

@@ -3,6 +3,7 @@
 //! exception that fits, so that `except ValueError` or `except OSError`
 //! catches them as it does NumPy's and pandas' errors.
 
+use activecal::names::phrase;
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyTuple, PyType};
@@ -96,9 +97,35 @@ pub fn class(py: Python<'_>, kind: Kind) -> PyResult<Bound<'_, PyType>> {
     Ok(classes(py)?[k].bind(py).clone())
 }
 
+/// How Python spells the library's phrases for a setting
+/// (`activecal::names::phrase`): as the keyword argument that sets it.
+const SPELLING: &[(&str, &str)] = &[
+    (phrase::KEEP_GROSS_ERRORS, "outliers=\"keep\" keeps it"),
+    (phrase::OUTLIER_SCREEN, "outliers="),
+    (phrase::COMPLIANCE, "compliance=True"),
+    (phrase::REFINE_INTRINSICS, "refine_intrinsics=True"),
+    (phrase::NO_TOOL_POINT, "no tool point given (marker=)"),
+    (phrase::DEFAULT_PIXEL_NOISE, "the default of pixel_noise="),
+    (phrase::DEFAULT_NOISE, "the default of noise="),
+    (
+        phrase::TARGET_ERROR,
+        "target_error=: the fewest reaching an error",
+    ),
+    (phrase::OVERWRITE_ASKED, "even with overwrite=True"),
+];
+
+/// `text` with the library's phrases for settings spelled as this
+/// package's keyword arguments (every message and warning goes through it).
+#[must_use]
+pub fn spell(text: &str) -> String {
+    SPELLING
+        .iter()
+        .fold(text.to_string(), |t, (phrase, kw)| t.replace(phrase, kw))
+}
+
 /// The exception of `kind` with `msg`.
 pub fn new_err(kind: Kind, msg: impl Into<String>) -> PyErr {
-    let msg = msg.into();
+    let msg = spell(&msg.into());
     Python::attach(|py| match class(py, kind) {
         Ok(ty) => PyErr::from_type(ty, msg),
         Err(e) => e,

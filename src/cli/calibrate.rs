@@ -7,6 +7,7 @@
 pub use super::calibrate_args::{CalibrateArgs, DEFAULT_NOISE};
 pub use super::calibrated::{EXIT_NOT_CONVERGED, NotConverged};
 use super::calibrated::{not_written, status_text, write_calibrated};
+use activecal::experiment::measured::full_model::FullModelGain;
 use activecal::identify::{Identification, LmSettings};
 use activecal::io::calibrated::Format;
 use activecal::model::Robot;
@@ -105,50 +106,63 @@ fn calibrate_files(a: &CalibrateArgs) -> super::run_files::RunFiles {
     f
 }
 
-/// `--fix`, and with `--unknowns offsets` the robot's link geometry
-/// ([`activecal::identify::offsets::link_unknowns`]).
-fn fixed_unknowns(a: &CalibrateArgs, robot: &Robot) -> Vec<String> {
-    let mut fix = a.fix.clone();
-    if a.unknowns == Some(super::calibrate_args::UnknownsKind::Offsets) {
-        let links = activecal::identify::offsets::link_unknowns(robot);
-        fix.extend(links.into_iter().filter(|n| !a.fix.contains(n)));
-    }
-    fix
-}
-
-/// With `--unknowns offsets`: the full fit of the same data beside the
-/// offsets-only one `offsets` ([`activecal::experiment::measured::offsets_gain`]).
-fn offsets_gain(
+/// With `--unknowns offsets` or `--keep-axis-relations`: the full fit of
+/// the same data beside the restricted one
+/// ([`activecal::experiment::measured::full_model`]).
+fn full_model_gain(
     a: &CalibrateArgs,
     robot: &Robot,
     meas: &activecal::identify::Measurements,
     path: &Path,
     o: &activecal::experiment::measured::MeasuredSettings,
-    offsets: (&Robot, &activecal::model::ParamTable),
-) -> Result<Option<activecal::experiment::measured::offsets_gain::OffsetsGain>> {
-    if a.unknowns != Some(super::calibrate_args::UnknownsKind::Offsets) {
+    restricted: (&Robot, &activecal::model::ParamTable),
+) -> Result<Option<FullModelGain>> {
+    let restriction = a.restriction();
+    if restriction == activecal::identify::restriction::Restriction::All {
         return Ok(None);
     }
     let mut full = o.clone();
     full.fix.clone_from(&a.fix);
     let source = path.display().to_string();
-    let g = activecal::experiment::measured::offsets_gain::offsets_gain(
-        robot, meas, &source, &full, offsets,
+    let g = activecal::experiment::measured::full_model::full_model_gain(
+        robot,
+        meas,
+        &source,
+        &full,
+        (restriction, restricted.0, restricted.1),
     )?;
     Ok(Some(g))
 }
 
-/// The offsets-only fit's line beside the full fit.
-fn gain_text(g: &activecal::experiment::measured::offsets_gain::OffsetsGain) -> String {
-    format!(
-        "\noffsets only: predicted position RMS {:.4} mm; the full model ({} unknowns, fitted to the same data) {:.4} mm: it would gain {:.4} mm (the two models are {:.4} mm apart, RMS at {} random configurations)\n",
-        g.offsets_predicted_rms_mm,
+/// The restricted fit's lines beside the full fit, and the relations held.
+fn gain_text(g: &FullModelGain, robot: &Robot, held_out: Option<f64>) -> String {
+    use activecal::identify::restriction::Restriction;
+    let mut s = String::from("\n");
+    if g.restricted == Restriction::KeepAxisRelations {
+        s += "axis relations kept (closed-form inverse kinematics stay valid):\n";
+        for h in activecal::identify::axis_relations::held_relations(robot) {
+            let held = if h.held.is_empty() {
+                "no unknown to hold".to_string()
+            } else {
+                h.held.join(", ")
+            };
+            s += &format!("  {} – {}: {} (held: {held})\n", h.from, h.to, h.relation);
+        }
+    }
+    let ho = |v: Option<f64>| v.map_or(String::new(), |v| format!(", held out {v:.4} mm"));
+    s += &format!(
+        "{}: predicted position RMS {:.4} mm{}; the full model ({} unknowns, fitted to the same data) {:.4} mm{}: it would gain {:.4} mm (the two models are {:.4} mm apart, RMS at {} random configurations)\n",
+        g.restricted.describe(),
+        g.restricted_predicted_rms_mm,
+        ho(held_out),
         g.full_unknowns,
         g.full_predicted_rms_mm,
+        ho(g.full_held_out_rms_mm),
         g.gain_mm,
         g.models_apart_rms_mm,
         activecal::experiment::measured::PREDICTION_CONFIGURATIONS
-    )
+    );
+    s
 }
 
 /// Identification from a measurement file.
@@ -173,7 +187,7 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     let o = activecal::experiment::measured::MeasuredSettings {
         lm,
         loss: super::measured::loss_choice(a.loss, a.loss_scale)?,
-        fix: fixed_unknowns(a, robot),
+        fix: activecal::identify::restriction::with_held(&a.fix, a.restriction(), robot),
         free: a.free.clone(),
         holdout: a
             .holdout
@@ -246,11 +260,15 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         report.base.out =
             write_calibrated(a, &fitted, id, &path.display().to_string(), frames.as_ref())?;
     }
-    let gain = offsets_gain(a, robot, &meas, path, &o, (&fitted, &id.table))?;
+    let gain = full_model_gain(a, robot, &meas, path, &o, (&fitted, &id.table))?;
     let mut v = serde_json::to_value(&report)?;
     v["exit_status"] = verdict.exit_status().into();
     if let Some(g) = &gain {
-        v["offsets_gain"] = serde_json::to_value(g)?;
+        v["full_model_gain"] = serde_json::to_value(g)?;
+        if g.restricted == activecal::identify::restriction::Restriction::KeepAxisRelations {
+            v["axis_relations_held"] =
+                serde_json::to_value(activecal::identify::axis_relations::held_relations(robot))?;
+        }
     }
     if let Some(dir) = &a.report {
         activecal::render::folder::calibration(
@@ -261,7 +279,8 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     super::emit(a.json, &v, || {
         let mut s = super::measured::measured_text(&report, id, &status_text(id));
         if let Some(g) = &gain {
-            s += &gain_text(g);
+            let held_out = report.holdout.as_ref().map(|h| h.position_rms_mm.mean);
+            s += &gain_text(g, robot, held_out);
         }
         for out in &report.base.out {
             s += &format!("\ncalibrated robot written to {out}\n");

@@ -1,5 +1,6 @@
 //! The arguments of `calibrate`, parsed once.
 
+use activecal::identify::restriction::Restriction;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -112,6 +113,13 @@ pub struct CalibrateArgs {
     /// frames file can hold).
     #[arg(long, value_enum, requires = "measurements")]
     pub unknowns: Option<UnknownsKind>,
+    /// Keep closed-form inverse kinematics working on the calibrated model
+    /// (with --measurements): hold the parameters that would change the
+    /// nominal model's parallel, perpendicular or intersecting joint axes
+    /// (listed in the report), fit the rest, and report the full model's
+    /// fit of the same data beside it.
+    #[arg(long, requires = "measurements", conflicts_with = "unknowns")]
+    pub keep_axis_relations: bool,
     /// The unit of the joint offsets written to `--out *joint_offsets.yaml`
     /// (revolute joints; prismatic ones are in metres).
     #[arg(long, value_enum)]
@@ -324,6 +332,17 @@ pub enum OffsetSign {
 }
 
 impl CalibrateArgs {
+    /// The unknowns `--unknowns` and `--keep-axis-relations` restrict the
+    /// fit to (every unknown by default).
+    #[must_use]
+    pub fn restriction(&self) -> Restriction {
+        match (self.unknowns, self.keep_axis_relations) {
+            (_, true) => Restriction::KeepAxisRelations,
+            (Some(UnknownsKind::Offsets), false) => Restriction::Offsets,
+            _ => Restriction::All,
+        }
+    }
+
     /// The joint-offset convention `--offset-unit` and `--offset-sign` name
     /// (radians, added, by default).
     #[must_use]

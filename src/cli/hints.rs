@@ -5,6 +5,8 @@
 //! the one place that maps those names to this command line's options, so
 //! that an error ends with the option to change.
 
+use activecal::names::phrase;
+
 /// A phrase the library uses for an input, and the option that gives it.
 const OPTIONS: &[(&str, &str)] = &[
     ("the chain's tip", "--tip LINK names the chain's tip"),
@@ -67,6 +69,34 @@ const IN_DESCRIPTION: &[(&str, &str)] = &[
     ),
 ];
 
+/// How this command line spells the library's phrases for a setting
+/// ([`activecal::names::phrase`]): the phrase is replaced where a message
+/// is printed, so the library's text reads with this command line's flags.
+const SPELLING: &[(&str, &str)] = &[
+    (phrase::KEEP_GROSS_ERRORS, "--outliers keep keeps it"),
+    (phrase::OUTLIER_SCREEN, "--outliers"),
+    (phrase::COMPLIANCE, "--compliance"),
+    (phrase::REFINE_INTRINSICS, "--refine-intrinsics"),
+    (phrase::NO_TOOL_POINT, "no tool point given (--marker)"),
+    (phrase::DEFAULT_PIXEL_NOISE, "the default of --pixel-noise"),
+    (phrase::DEFAULT_NOISE, "the default of --noise"),
+    (
+        phrase::TARGET_ERROR,
+        "--target-error MM: the fewest reaching an error",
+    ),
+    (phrase::OVERWRITE_ASKED, "even with --force"),
+];
+
+/// `text` with the library's phrases for settings spelled as this command
+/// line's flags (applied to everything printed, JSON included: no
+/// spelling holds a quote or a backslash).
+#[must_use]
+pub fn spell(text: &str) -> String {
+    SPELLING.iter().fold(text.to_string(), |t, (phrase, flag)| {
+        t.replace(phrase, flag)
+    })
+}
+
 /// The options an error's message (its whole chain) calls for, in the
 /// table's order, each once: the description's keys instead of the chain
 /// options when the robot came from a description file, and the package
@@ -105,6 +135,18 @@ fn package_hint(text: &str, hint: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_setting_phrase_is_spelled_as_a_flag_and_json_stays_json() {
+        for (p, flag) in SPELLING {
+            let s = spell(&format!("a message naming {p}."));
+            assert!(s.contains("--") && s.contains(flag), "{p}: {s}");
+            assert!(!flag.contains('"') && !flag.contains('\\'), "{flag}");
+        }
+        let j = serde_json::json!({"note": format!("left out ({})", phrase::KEEP_GROSS_ERRORS)});
+        let back: serde_json::Value = serde_json::from_str(&spell(&j.to_string())).unwrap();
+        assert_eq!(back["note"], "left out (--outliers keep keeps it)");
+    }
 
     #[test]
     fn a_library_phrase_gets_its_option_and_others_get_none() {

@@ -230,6 +230,7 @@ pub fn emit(json_out: bool, value: &Value, text: impl FnOnce() -> String) -> Res
 /// panic.
 pub fn print_out(text: &str) -> Result<()> {
     use std::io::Write;
+    let text = hints::spell(text);
     let mut out = std::io::stdout().lock();
     out.write_all(text.as_bytes())
         .and_then(|()| out.flush())
@@ -240,7 +241,7 @@ pub fn print_out(text: &str) -> Result<()> {
 /// diagnostic is never worth a panic or a failed command).
 pub fn diag(line: &str) {
     use std::io::Write;
-    let _ = writeln!(std::io::stderr().lock(), "{line}");
+    let _ = writeln!(std::io::stderr().lock(), "{}", hints::spell(line));
 }
 
 /// Prints a typed report as one JSON line, or the human-readable `text`.

@@ -2,6 +2,7 @@
 
 use super::{PoolOpts, emit_report, parse_list};
 use activecal::experiment::select::SelectRun;
+use activecal::identify::restriction::Restriction;
 use activecal::report::SelectReport;
 use activecal::select::{Algorithm, CriterionKind, Settings, default_ils_rounds};
 use anyhow::{Result, bail};
@@ -41,6 +42,12 @@ pub struct SelectArgs {
     /// Design poses exchanged at random per round of --ils.
     #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
     pub kick: usize,
+    /// Choose the poses for a calibration that keeps closed-form inverse
+    /// kinematics (`calibrate --keep-axis-relations`): the unknowns that
+    /// would change the nominal model's parallel, perpendicular or
+    /// intersecting joint axes are left out of the criterion.
+    #[arg(long)]
+    pub keep_axis_relations: bool,
     /// Random designs drawn by --algorithm random [default: 5000].
     #[arg(long, allow_negative_numbers = true)]
     pub designs: Option<usize>,
@@ -234,6 +241,9 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     check_select_outputs(&a)?;
     // Cheap checks of the ordering's inputs before the pool is built.
     let mut described = super::load_description(&a.pool.robot)?;
+    if a.keep_axis_relations {
+        described.robot = Restriction::KeepAxisRelations.apply(&described.robot);
+    }
     if let Some(so) = a.orientation_noise {
         described.robot.orientation_scale = orientation_scale(&described.robot, a.noise, so)?;
     }

@@ -217,7 +217,7 @@ pub fn screen_contacts(
         .collect();
     for o in &outliers {
         notes.push(format!(
-            "line {} ({}) left out as a gross error: {:.3} mm off at the fit, test value {:.1} on {} rows against σ̂ on {} degrees of freedom, P = {:.1e} < {:.1e} (α {alpha} over {} rows; --outliers keep keeps it)",
+            "line {} ({}) left out as a gross error: {:.3} mm off at the fit, test value {:.1} on {} rows against σ̂ on {} degrees of freedom, P = {:.1e} < {:.1e} (α {alpha} over {} rows; {keep})",
             o.line,
             o.point,
             o.residual_mm,
@@ -226,7 +226,8 @@ pub fn screen_contacts(
             o.test.dof.1,
             o.test.p_value,
             o.threshold,
-            (alpha / o.threshold).round()
+            (alpha / o.threshold).round(),
+            keep = crate::names::phrase::KEEP_GROSS_ERRORS
         ));
     }
     Ok(ScreenedContacts {

@@ -39,6 +39,7 @@
 //! [`IdentifyError`]; a numerical outcome (no convergence, divergence, a rank
 //! deficient design) is the [`Status`] of the result.
 
+pub mod axis_relations;
 pub mod camera;
 pub mod compliance;
 pub mod contact;
@@ -49,6 +50,7 @@ pub mod montecarlo;
 pub mod offsets;
 pub mod plausible;
 pub mod residual;
+pub mod restriction;
 pub mod simulate;
 pub mod start;
 

@@ -20,6 +20,7 @@
 use super::{Calibration, Identification, Measurements, Residuals, Result};
 use crate::measure::RowKind;
 use crate::model::{ParamTable, Robot};
+use crate::names::phrase;
 use nalgebra::DMatrix;
 use serde::Serialize;
 
@@ -201,7 +202,9 @@ impl NoiseTest {
         );
         Some(if self.ratio > 1.0 {
             format!(
-                "{head}: the sensor is noisier than stated, a gross error is left in the data (--outliers), or the model misses something (joint sag under gravity: --compliance; a flexing tool or mount); the σ's and the predicted error use σ̂"
+                "{head}: the sensor is noisier than stated, a gross error is left in the data ({}), or the model misses something (joint sag under gravity: {}; a flexing tool or mount); the σ's and the predicted error use σ̂",
+                phrase::OUTLIER_SCREEN,
+                phrase::COMPLIANCE
             )
         } else {
             format!(
@@ -282,14 +285,22 @@ impl BlockNoiseTest {
                 format!("{:.4}°", self.estimated.to_degrees()),
                 format!("{:.4}°", self.stated.to_degrees()),
                 "axis",
-                "the tracker's orientations are noisier than stated, a gross error is left in the data (--outliers), or the model misses something (joint sag under gravity: --compliance; a flexing tool or mount)",
+                format!(
+                    "the tracker's orientations are noisier than stated, a gross error is left in the data ({}), or the model misses something (joint sag under gravity: {}; a flexing tool or mount)",
+                    phrase::OUTLIER_SCREEN,
+                    phrase::COMPLIANCE
+                ),
             ),
             NoiseOf::Pixels => (
                 "the pixels' σ̂",
                 format!("{:.3} px", self.estimated),
                 format!("{:.3} px", self.stated),
                 "coordinate",
-                "the detector is noisier than stated, a gross error is left in the pixels (--outliers), the intrinsics are off (--refine-intrinsics), or the model misses something (joint sag under gravity; a flexing mount)",
+                format!(
+                    "the detector is noisier than stated, a gross error is left in the pixels ({}), the intrinsics are off ({}), or the model misses something (joint sag under gravity; a flexing mount)",
+                    phrase::OUTLIER_SCREEN,
+                    phrase::REFINE_INTRINSICS
+                ),
             ),
         };
         let head = format!(

@@ -125,11 +125,12 @@ pub fn output_over_input(output: &Output<'_>, inputs: &[Output<'_>]) -> Option<S
     let id = identity(output.path);
     inputs.iter().find(|i| identity(i.path) == id).map(|i| {
         format!(
-            "{} {}: is an input of this command ({} {}); an input is never overwritten, even with --force: choose another file",
+            "{} {}: is an input of this command ({} {}); an input is never overwritten, {}: choose another file",
             output.label,
             output.path.display(),
             i.label,
-            i.path.display()
+            i.path.display(),
+            crate::names::phrase::OVERWRITE_ASKED
         )
     })
 }

@@ -228,7 +228,7 @@ fn chosen_markers(
         .unwrap_or_default();
     if let Some(m) = chain.markers.iter().find(|m| m.link != tip) {
         return Err(Error::Invalid(format!(
-            "marker {m}: markers are placed in the chain's tip link '{tip}', not in '{}'; name the tip as the marker's link (or its tip as --tip)",
+            "marker {m}: markers are placed in the chain's tip link '{tip}', not in '{}'; name the tip as the marker's link (or the marker's link as the chain's tip)",
             m.link
         )));
     }

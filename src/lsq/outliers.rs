@@ -363,8 +363,9 @@ pub const MOST_OUTLIERS: f64 = 0.2;
 #[must_use]
 pub fn too_many_note(most: usize, n: usize, units: &str) -> String {
     format!(
-        "the gross-error test flags more than {most} {units} ({:.0} % of {n}): not isolated glitches but a noise larger than the sensor's or a model that misses something (joint sag under gravity: --compliance); every one is kept",
-        MOST_OUTLIERS * 100.0
+        "the gross-error test flags more than {most} {units} ({:.0} % of {n}): not isolated glitches but a noise larger than the sensor's or a model that misses something (joint sag under gravity: {}); every one is kept",
+        MOST_OUTLIERS * 100.0,
+        crate::names::phrase::COMPLIANCE
     )
 }
 

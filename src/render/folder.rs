@@ -322,11 +322,11 @@ fn how_many_text(curve: &PoseCountCurve, noise_is_default: bool) -> String {
         },
         noise_text(curve),
         if noise_is_default && curve.noise_px.is_some() {
-            " (the default of --pixel-noise)"
+            format!(" ({})", crate::names::phrase::DEFAULT_PIXEL_NOISE)
         } else if noise_is_default {
-            " (the default of --noise)"
+            format!(" ({})", crate::names::phrase::DEFAULT_NOISE)
         } else {
-            ""
+            String::new()
         }
     );
     md += "| N | D-efficiency | predicted RMS (mm) | 95th percentile of the error (mm) | 95th percentile of a configuration's RMS (mm) |\n|---|---|---|---|---|\n";
@@ -395,7 +395,7 @@ pub fn recommendation_text(r: &crate::how_many::Recommendation) -> String {
             target_mm,
             predicted_mm,
         } => format!(
-            "how many poses: no N of the curve is predicted to reach {target_mm} mm; the closest is N = {n} (position RMS {predicted_mm:.4} mm): a less noisy sensor, or more poses than the curve's range (--n)\n"
+            "how many poses: no N of the curve is predicted to reach {target_mm} mm; the closest is N = {n} (position RMS {predicted_mm:.4} mm): a less noisy sensor, or more poses than the curve's range\n"
         ),
         R::Knee {
             n,
@@ -403,13 +403,15 @@ pub fn recommendation_text(r: &crate::how_many::Recommendation) -> String {
             predicted_mm,
             gain,
         } => format!(
-            "how many poses: N = {n} recommended (position RMS {predicted_mm:.4} mm), the knee of the curve: {KNEE_MORE_PERCENT} % more poses (N = {next_n}) gain {:.1} %, under {:.0} % (--target-error MM: the fewest reaching an error)\n",
+            "how many poses: N = {n} recommended (position RMS {predicted_mm:.4} mm), the knee of the curve: {KNEE_MORE_PERCENT} % more poses (N = {next_n}) gain {:.1} %, under {:.0} % ({TARGET_ERROR})\n",
             gain * 100.0,
-            KNEE_GAIN * 100.0
+            KNEE_GAIN * 100.0,
+            TARGET_ERROR = crate::names::phrase::TARGET_ERROR
         ),
         R::NoKnee { n, predicted_mm } => format!(
-            "how many poses: N = {n} recommended (position RMS {predicted_mm:.4} mm), the curve's largest: {KNEE_MORE_PERCENT} % more poses still gain {:.0} % or more up to its end (--target-error MM: the fewest reaching an error)\n",
-            KNEE_GAIN * 100.0
+            "how many poses: N = {n} recommended (position RMS {predicted_mm:.4} mm), the curve's largest: {KNEE_MORE_PERCENT} % more poses still gain {:.0} % or more up to its end ({TARGET_ERROR})\n",
+            KNEE_GAIN * 100.0,
+            TARGET_ERROR = crate::names::phrase::TARGET_ERROR
         ),
     }
 }

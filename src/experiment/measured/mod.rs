@@ -21,7 +21,7 @@ pub use screen::OutlierReport;
 use screen::screen;
 use serde::Serialize;
 
-pub mod offsets_gain;
+pub mod full_model;
 mod screen;
 pub mod verdict;
 use std::path::Path;
@@ -362,7 +362,8 @@ fn mounted_start(
         // hold the point the data imply: no other was given.
         r = r.with_markers(&[tool])?;
         notes.push(format!(
-            "single points and no tool point given (--marker): the measured point on '{}' is an unknown (3 coordinates, chosen before the joint origins), started where the data put it, [{:.1}, {:.1}, {:.1}] mm (rigid fit RMS {:.3} mm); {} unknowns",
+            "single points and {}: the measured point on '{}' is an unknown (3 coordinates, chosen before the joint origins), started where the data put it, [{:.1}, {:.1}, {:.1}] mm (rigid fit RMS {:.3} mm); {} unknowns",
+            crate::names::phrase::NO_TOOL_POINT,
             src.tip,
             tool[0] * 1e3,
             tool[1] * 1e3,

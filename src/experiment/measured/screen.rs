@@ -153,7 +153,7 @@ pub(super) fn screen(
             d => format!("σ̂ on {d} degrees of freedom"),
         };
         notes.push(format!(
-            "pose {} of the data left out as a gross error: residual {:.3} mm, test value {:.1} on {} rows against {against}, P = {:.1e} < {:.1e} (α {} over {} poses; --outliers keep keeps it)",
+            "pose {} of the data left out as a gross error: residual {:.3} mm, test value {:.1} on {} rows against {against}, P = {:.1e} < {:.1e} (α {} over {} poses; {keep})",
             o.pose + 1,
             o.residual_mm,
             o.test.statistic,
@@ -161,7 +161,8 @@ pub(super) fn screen(
             o.test.p_value,
             o.threshold,
             alpha,
-            (alpha / o.threshold).round()
+            (alpha / o.threshold).round(),
+            keep = crate::names::phrase::KEEP_GROSS_ERRORS
         ));
     }
     Ok(Screened {

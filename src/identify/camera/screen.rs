@@ -314,12 +314,13 @@ fn note(o: &CameraOutlier, alpha: f64) -> String {
         d => format!("σ̂ on {d} degrees of freedom"),
     };
     format!(
-        "{what} left out as a gross error: {:.2} px RMS off at the fit, test value {:.1} on {} rows against {against}, P = {:.1e} < {:.1e} (α {alpha} over {}; --outliers keep keeps it)",
+        "{what} left out as a gross error: {:.2} px RMS off at the fit, test value {:.1} on {} rows against {against}, P = {:.1e} < {:.1e} (α {alpha} over {}; {keep})",
         o.residual_px,
         o.test.statistic,
         o.test.dof.0,
         o.test.p_value,
         o.threshold,
-        (alpha / o.threshold).round()
+        (alpha / o.threshold).round(),
+        keep = crate::names::phrase::KEEP_GROSS_ERRORS
     )
 }

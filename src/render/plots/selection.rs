@@ -114,7 +114,7 @@ pub fn how_many(base: &Path, rows: &[CurveRow], chosen: usize, noise: &str) -> R
                 BLACK.stroke_width(1),
             )))
             .map_err(err)?
-            .label(format!("N = {chosen} (--n)"))
+            .label(format!("N = {chosen} (the design)"))
             .legend(|(x, y)| PathElement::new([(x + 10, y - 7), (x + 10, y + 7)], BLACK));
         }
         legend(&mut e, SeriesLabelPosition::UpperRight)

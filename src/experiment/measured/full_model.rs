@@ -1,35 +1,44 @@
-//! What the full model would gain over an offsets-only calibration
-//! ([`crate::identify::offsets`]): the same data fitted with every unknown,
-//! and the two fitted models compared at random configurations.
+//! What the full model would gain over a restricted calibration
+//! ([`crate::identify::restriction`]: offsets only, or the axis relations
+//! kept): the same data fitted with every unknown, and the two fitted
+//! models compared at random configurations.
 //!
 //! The full model is the best estimate of the robot there is: the
-//! offsets-only model's predicted error is its distance to it (a bias no
+//! restricted model's predicted error is its distance to it (a bias no
 //! amount of data removes) on top of the full model's own predicted error,
-//! `e_off = √(d² + e_full²)`, where `d` is the RMS distance between the two
-//! models' predicted points and `e_full` the full model's predicted RMS
-//! from its covariance ([`super::MeasuredReport::predicted`]).
+//! `e_restricted = √(d² + e_full²)`, where `d` is the RMS distance between
+//! the two models' predicted points and `e_full` the full model's predicted
+//! RMS from its covariance ([`super::MeasuredReport::predicted`]).
 
 use super::{ExperimentError, MeasuredSettings, PREDICTION_CONFIGURATIONS, calibrate_read};
 use crate::identify::Measurements;
+use crate::identify::restriction::Restriction;
 use crate::model::{MeasurementKind, ParamTable, Robot};
 use nalgebra::Vector3;
 use serde::Serialize;
 
-/// The offsets-only fit beside the full one.
+/// The restricted fit beside the full one.
 #[derive(Clone, Debug, Serialize)]
-pub struct OffsetsGain {
+pub struct FullModelGain {
+    /// The restriction of the fit compared.
+    pub restricted: Restriction,
     /// Unknowns of the full fit (the robot's, with the sensor's own).
     pub full_unknowns: usize,
     /// The full model's predicted position RMS at the random
     /// configurations (mm), from its covariance at its σ̂.
     pub full_predicted_rms_mm: f64,
+    /// The full model's held-out position RMS (mm, mean over splits), when
+    /// held-out validation was asked: on the same splits as the restricted
+    /// fit's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub full_held_out_rms_mm: Option<f64>,
     /// RMS distance between the two fitted models' predicted points at the
     /// same configurations (mm).
     pub models_apart_rms_mm: f64,
-    /// The offsets-only model's predicted position RMS (mm):
+    /// The restricted model's predicted position RMS (mm):
     /// `√(apart² + full²)`.
-    pub offsets_predicted_rms_mm: f64,
-    /// What the full model gains: offsets-only minus full predicted RMS (mm).
+    pub restricted_predicted_rms_mm: f64,
+    /// What the full model gains: restricted minus full predicted RMS (mm).
     pub gain_mm: f64,
 }
 
@@ -65,29 +74,35 @@ pub fn models_apart_rms_mm(
 }
 
 /// Fits `meas` (named `source`) with `full` settings (every unknown, the
-/// user's own fixed ones held) and compares the result with the
-/// offsets-only fit `offsets` (its robot as fitted and its estimate).
-pub fn offsets_gain(
+/// user's own fixed ones held) and compares the result with the fit
+/// restricted by `restricted` (its robot as fitted and its estimate).
+pub fn full_model_gain(
     robot: &Robot,
     meas: &Measurements,
     source: &str,
     full: &MeasuredSettings,
-    offsets: (&Robot, &ParamTable),
-) -> Result<OffsetsGain, ExperimentError> {
+    restricted: (Restriction, &Robot, &ParamTable),
+) -> Result<FullModelGain, ExperimentError> {
     let f = calibrate_read(robot, meas, source, Vec::new(), full, &mut |_| {})?;
     let qs = crate::how_many::random_configurations(&f.robot, PREDICTION_CONFIGURATIONS, 0);
-    let apart = models_apart_rms_mm((&f.robot, &f.fit.id.table), offsets, &qs);
+    let apart = models_apart_rms_mm(
+        (&f.robot, &f.fit.id.table),
+        (restricted.1, restricted.2),
+        &qs,
+    );
     let full_rms = f
         .report
         .predicted
         .as_ref()
         .map_or(f64::NAN, |p| p.position_rms_mm);
-    let off = apart.hypot(full_rms);
-    Ok(OffsetsGain {
+    let own = apart.hypot(full_rms);
+    Ok(FullModelGain {
+        restricted: restricted.0,
         full_unknowns: f.fit.id.names.len(),
         full_predicted_rms_mm: full_rms,
+        full_held_out_rms_mm: f.report.holdout.as_ref().map(|h| h.position_rms_mm.mean),
         models_apart_rms_mm: apart,
-        offsets_predicted_rms_mm: off,
-        gain_mm: off - full_rms,
+        restricted_predicted_rms_mm: own,
+        gain_mm: own - full_rms,
     })
 }

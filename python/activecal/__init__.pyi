@@ -427,6 +427,7 @@ def calibrate(
     orientation_noise: Optional[float] = None,
     progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
     unknowns: str = "all",
+    keep_axis_relations: bool = False,
 ) -> Calibration:
     """Calibrates the robot from measured poses, as ``activecal calibrate
     --measurements FILE`` does from a file holding the same values. The
@@ -453,6 +454,13 @@ def calibrate(
     for K markers). unknowns: ``"all"`` (the chain's complete set) or
     ``"offsets"`` (only the joints' zero offsets, the measurement frame and
     the tool; link lengths and twists held), as ``--unknowns``.
+    keep_axis_relations: hold the unknowns that would change the nominal
+    model's parallel, perpendicular or intersecting joint axes, so
+    closed-form inverse kinematics still apply, as
+    ``--keep-axis-relations``. With either restriction the same data are
+    also fitted with every unknown: ``report["full_model_gain"]`` gives
+    both models' predicted (and held-out) errors, what the full model
+    gains and the relations held.
     """
 
 def evaluate(

@@ -8,6 +8,7 @@ use activecal::experiment::acts_on::{self as lib_acts, Sensor};
 use activecal::experiment::measured::{MeasuredSettings, calibrate_measurements};
 use activecal::frames::CalibratedFrames;
 use activecal::frames::report::FramesReport;
+use activecal::identify::restriction::Restriction;
 use activecal::identify::{Identification, LmSettings, LossChoice, Measurements};
 use activecal::io::calibrated::Format;
 use pyo3::prelude::*;
@@ -268,9 +269,14 @@ fn names(v: Option<Vec<String>>) -> Vec<String> {
 /// progress: a callable `progress(task, done, total, note)`, as `select`
 /// takes it. unknowns: "all" (the chain's complete set) or "offsets" (only
 /// the joints' zero offsets, the measurement frame and the tool), as
-/// `--unknowns`.
+/// `--unknowns`. keep_axis_relations: hold the unknowns that would change
+/// the nominal model's parallel, perpendicular or intersecting joint axes,
+/// so closed-form inverse kinematics still apply, as
+/// `--keep-axis-relations`. With either restriction the same data are
+/// also fitted with every unknown: `report["full_model_gain"]` gives both
+/// models' predicted (and held-out) errors and the relations held.
 #[pyfunction]
-#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, compliance=false, outliers="drop", outlier_rate=0.01, noise=None, orientation_noise=None, progress=None, unknowns="all"))]
+#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, compliance=false, outliers="drop", outlier_rate=0.01, noise=None, orientation_noise=None, progress=None, unknowns="all", keep_axis_relations=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
@@ -295,6 +301,7 @@ pub fn calibrate(
     orientation_noise: Option<f64>,
     progress: Option<&Bound<'_, PyAny>>,
     unknowns: &str,
+    keep_axis_relations: bool,
 ) -> PyResult<Calibration> {
     // Each keyword argument given acts on the data's sensor or is refused
     // (the command line's table).
@@ -315,6 +322,7 @@ pub fn calibrate(
         ("noise", noise.is_some()),
         ("orientation_noise", orientation_noise.is_some()),
         ("unknowns", unknowns != "all"),
+        ("keep_axis_relations", keep_axis_relations),
     ]
     .into_iter()
     .filter_map(|(k, g)| g.then_some(k))
@@ -332,9 +340,13 @@ pub fn calibrate(
         max_iterations = max_iterations, loss = loss, loss_scale = loss_scale, weights = weights,
         orientation_scale = orientation_scale, holdout = holdout, splits = splits, seed = seed,
         compliance = compliance, outliers = outliers, outlier_rate = outlier_rate, noise = noise,
-        orientation_noise = orientation_noise, unknowns = unknowns);
+        orientation_noise = orientation_noise, unknowns = unknowns,
+        keep_axis_relations = keep_axis_relations);
     let robot = robot.get();
-    let fix = fixed_of(robot, names(fix), unknowns)?;
+    let restriction = restriction_of(unknowns, keep_axis_relations)?;
+    let user_fix = names(fix);
+    let fix = activecal::identify::restriction::with_held(&user_fix, restriction, &robot.inner)
+        .map_err(|e| crate::convert::Fail::from(e).into_py())?;
     let weights = weights_of(weights, orientation_scale)?;
     let outliers = outliers_of(outliers, outlier_rate)?;
     let gravity = compliance
@@ -407,10 +419,22 @@ pub fn calibrate(
                     &settings,
                     &mut |_| {},
                 )?;
+                let gain = activecal::experiment::measured::full_model::beside_full_model(
+                    &r,
+                    &meas,
+                    "the arrays given",
+                    &settings,
+                    &user_fix,
+                    restriction,
+                    (&c.robot, &c.fit.id.table),
+                )?;
                 let mut report = c.report;
                 report.base.elapsed_seconds = t0.elapsed().as_secs_f64();
                 let mut v = serde_json::to_value(&report)?;
                 v["exit_status"] = c.verdict.exit_status().into();
+                if let Some(g) = gain {
+                    v["full_model_gain"] = serde_json::to_value(g)?;
+                }
                 Ok((c.robot, c.fit.id, c.frames, v, c.verdict, report.warnings))
             })
         })?;
@@ -465,20 +489,17 @@ impl Calibration {
     }
 }
 
-/// `fix`, and for `unknowns="offsets"` the robot's link geometry
-/// ([`activecal::identify::offsets::link_unknowns`]).
-fn fixed_of(robot: &Robot, mut fix: Vec<String>, unknowns: &str) -> PyResult<Vec<String>> {
-    match unknowns {
-        "all" => Ok(fix),
-        "offsets" => {
-            for n in activecal::identify::offsets::link_unknowns(&robot.inner) {
-                if !fix.contains(&n) {
-                    fix.push(n);
-                }
-            }
-            Ok(fix)
-        }
-        other => Err(arg_err(
+/// The unknowns `unknowns` and `keep_axis_relations` restrict a fit to.
+fn restriction_of(unknowns: &str, keep_axis_relations: bool) -> PyResult<Restriction> {
+    match (unknowns, keep_axis_relations) {
+        ("all", false) => Ok(Restriction::All),
+        ("all", true) => Ok(Restriction::KeepAxisRelations),
+        ("offsets", false) => Ok(Restriction::Offsets),
+        ("offsets", true) => Err(arg_err(
+            "keep_axis_relations",
+            "with unknowns=\"offsets\": an offsets-only fit keeps every axis relation already",
+        )),
+        (other, _) => Err(arg_err(
             "unknowns",
             format!("'{other}': \"all\" or \"offsets\""),
         )),

@@ -375,3 +375,27 @@ def test_offsets_only_equals_the_cli(tmp_path):
     assert (tmp_path / "py_joint_offsets.yaml").read_text() == off.read_text()
     with pytest.raises(activecal.Error, match="sign"):
         cal.write_joint_offsets(tmp_path / "x_joint_offsets.yaml", sign="plus")
+    # The full model's fit of the same data beside it, as the CLI reports it.
+    assert cal.report["full_model_gain"] == want["full_model_gain"]
+    assert cal.report["full_model_gain"]["restricted"] == "offsets"
+
+
+def test_keeping_axis_relations_equals_the_cli(tmp_path):
+    """keep_axis_relations=True holds what `--keep-axis-relations` holds
+    (the UR5's five relations: 10 unknowns) and reports the same cost
+    against the full model."""
+    args = ["--robot", FIXTURES / "ur5.urdf"]
+    meas, m = simulated(tmp_path, args)
+    want = cli("calibrate", *args, "--measurements", meas, "--keep-axis-relations")
+    r = activecal.Robot.from_urdf(FIXTURES / "ur5.urdf")
+    cal = activecal.calibrate(r, m["qs"], m["points"], keep_axis_relations=True)
+    assert_same_fit(cal, want)
+    g = cal.report["full_model_gain"]
+    assert g == want["full_model_gain"]
+    held = [n for h in g["relations_held"] for n in h["held"]]
+    assert len(g["relations_held"]) == 5 and len(held) == 10
+    assert not any(n in cal.estimate for n in held)
+    # The restricted model is never better than the full one it is compared with.
+    assert g["restricted_predicted_rms_mm"] >= g["full_predicted_rms_mm"]
+    with pytest.raises(activecal.Error, match="keep_axis_relations"):
+        activecal.calibrate(r, m["qs"], m["points"], unknowns="offsets", keep_axis_relations=True)

@@ -106,41 +106,12 @@ fn calibrate_files(a: &CalibrateArgs) -> super::run_files::RunFiles {
     f
 }
 
-/// With `--unknowns offsets` or `--keep-axis-relations`: the full fit of
-/// the same data beside the restricted one
-/// ([`activecal::experiment::measured::full_model`]).
-fn full_model_gain(
-    a: &CalibrateArgs,
-    robot: &Robot,
-    meas: &activecal::identify::Measurements,
-    path: &Path,
-    o: &activecal::experiment::measured::MeasuredSettings,
-    restricted: (&Robot, &activecal::model::ParamTable),
-) -> Result<Option<FullModelGain>> {
-    let restriction = a.restriction();
-    if restriction == activecal::identify::restriction::Restriction::All {
-        return Ok(None);
-    }
-    let mut full = o.clone();
-    full.fix.clone_from(&a.fix);
-    let source = path.display().to_string();
-    let g = activecal::experiment::measured::full_model::full_model_gain(
-        robot,
-        meas,
-        &source,
-        &full,
-        (restriction, restricted.0, restricted.1),
-    )?;
-    Ok(Some(g))
-}
-
 /// The restricted fit's lines beside the full fit, and the relations held.
-fn gain_text(g: &FullModelGain, robot: &Robot, held_out: Option<f64>) -> String {
-    use activecal::identify::restriction::Restriction;
+fn gain_text(g: &FullModelGain, held_out: Option<f64>) -> String {
     let mut s = String::from("\n");
-    if g.restricted == Restriction::KeepAxisRelations {
+    if !g.relations_held.is_empty() {
         s += "axis relations kept (closed-form inverse kinematics stay valid):\n";
-        for h in activecal::identify::axis_relations::held_relations(robot) {
+        for h in &g.relations_held {
             let held = if h.held.is_empty() {
                 "no unknown to hold".to_string()
             } else {
@@ -187,7 +158,7 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     let o = activecal::experiment::measured::MeasuredSettings {
         lm,
         loss: super::measured::loss_choice(a.loss, a.loss_scale)?,
-        fix: activecal::identify::restriction::with_held(&a.fix, a.restriction(), robot),
+        fix: activecal::identify::restriction::with_held(&a.fix, a.restriction(), robot)?,
         free: a.free.clone(),
         holdout: a
             .holdout
@@ -260,15 +231,19 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         report.base.out =
             write_calibrated(a, &fitted, id, &path.display().to_string(), frames.as_ref())?;
     }
-    let gain = full_model_gain(a, robot, &meas, path, &o, (&fitted, &id.table))?;
+    let gain = activecal::experiment::measured::full_model::beside_full_model(
+        robot,
+        &meas,
+        &path.display().to_string(),
+        &o,
+        &a.fix,
+        a.restriction(),
+        (&fitted, &id.table),
+    )?;
     let mut v = serde_json::to_value(&report)?;
     v["exit_status"] = verdict.exit_status().into();
     if let Some(g) = &gain {
         v["full_model_gain"] = serde_json::to_value(g)?;
-        if g.restricted == activecal::identify::restriction::Restriction::KeepAxisRelations {
-            v["axis_relations_held"] =
-                serde_json::to_value(activecal::identify::axis_relations::held_relations(robot))?;
-        }
     }
     if let Some(dir) = &a.report {
         activecal::render::folder::calibration(
@@ -280,7 +255,7 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         let mut s = super::measured::measured_text(&report, id, &status_text(id));
         if let Some(g) = &gain {
             let held_out = report.holdout.as_ref().map(|h| h.position_rms_mm.mean);
-            s += &gain_text(g, robot, held_out);
+            s += &gain_text(g, held_out);
         }
         for out in &report.base.out {
             s += &format!("\ncalibrated robot written to {out}\n");

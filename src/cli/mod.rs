@@ -214,13 +214,17 @@ pub fn write_new(path: &std::path::Path, text: &str, force: bool) -> Result<()> 
     Ok(())
 }
 
-/// Prints `value` as one JSON line, or the human-readable `text`; a stdout
+/// Prints `value` as one JSON line (the library's words), or the
+/// human-readable `text` with the library's phrases for settings spelled as
+/// this command line's flags ([`hints::spell`]); a stdout
 /// that cannot be written (a closed pipe) is an error naming stdout.
 pub fn emit(json_out: bool, value: &Value, text: impl FnOnce() -> String) -> Result<()> {
+    // JSON carries the library's own words; text is spelled with this
+    // command line's flags ([`hints::spell`]).
     let s = if json_out {
         format!("{value}\n")
     } else {
-        text()
+        hints::spell(&text())
     };
     print_out(&s)
 }
@@ -230,7 +234,6 @@ pub fn emit(json_out: bool, value: &Value, text: impl FnOnce() -> String) -> Res
 /// panic.
 pub fn print_out(text: &str) -> Result<()> {
     use std::io::Write;
-    let text = hints::spell(text);
     let mut out = std::io::stdout().lock();
     out.write_all(text.as_bytes())
         .and_then(|()| out.flush())

@@ -242,7 +242,7 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
     // Cheap checks of the ordering's inputs before the pool is built.
     let mut described = super::load_description(&a.pool.robot)?;
     if a.keep_axis_relations {
-        described.robot = Restriction::KeepAxisRelations.apply(&described.robot);
+        described.robot = Restriction::KeepAxisRelations.apply(&described.robot)?;
     }
     if let Some(so) = a.orientation_noise {
         described.robot.orientation_scale = orientation_scale(&described.robot, a.noise, so)?;

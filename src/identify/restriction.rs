@@ -22,13 +22,26 @@ pub enum Restriction {
 
 impl Restriction {
     /// The names of `robot`'s unknowns held at their nominal values.
-    #[must_use]
-    pub fn held(self, robot: &Robot) -> Vec<String> {
-        match self {
+    ///
+    /// # Errors
+    /// Keeping the axis relations of a nominal model that has none (no
+    /// consecutive axes exactly parallel, perpendicular or intersecting:
+    /// a model whose origins a factory calibration already moved) is
+    /// refused: it would hold nothing and keep nothing.
+    pub fn held(self, robot: &Robot) -> crate::Result<Vec<String>> {
+        Ok(match self {
             Restriction::All => Vec::new(),
             Restriction::Offsets => super::offsets::link_unknowns(robot),
-            Restriction::KeepAxisRelations => super::axis_relations::held_unknowns(robot),
-        }
+            Restriction::KeepAxisRelations => {
+                if super::axis_relations::held_relations(robot).is_empty() {
+                    return Err(crate::Error::Invalid(format!(
+                        "keeping the axis relations of '{}': its nominal model has no consecutive joint axes exactly parallel, perpendicular or intersecting (to 1e-9 rad and 1e-9 of its reach), so there is nothing to keep; a kinematics file from a factory calibration moves every origin: start from the design description",
+                        robot.name
+                    )));
+                }
+                super::axis_relations::held_unknowns(robot)
+            }
+        })
     }
 
     /// What the restricted model is, for a report's line ("offsets only").
@@ -43,24 +56,32 @@ impl Restriction {
 
     /// `robot` with the held unknowns removed from its unknowns: the model a
     /// design for the restricted fit is chosen for.
-    #[must_use]
-    pub fn apply(self, robot: &Robot) -> Robot {
-        let held = self.held(robot);
+    ///
+    /// # Errors
+    /// As [`Restriction::held`].
+    pub fn apply(self, robot: &Robot) -> crate::Result<Robot> {
+        let held = self.held(robot)?;
         let mut r = robot.clone();
         r.unknowns.retain(|&u| !held.contains(&robot.param_name(u)));
-        r
+        Ok(r)
     }
 }
 
 /// `fix` with the unknowns `restriction` holds added (each once, the
 /// user's first, in order).
-#[must_use]
-pub fn with_held(fix: &[String], restriction: Restriction, robot: &Robot) -> Vec<String> {
+///
+/// # Errors
+/// As [`Restriction::held`].
+pub fn with_held(
+    fix: &[String],
+    restriction: Restriction,
+    robot: &Robot,
+) -> crate::Result<Vec<String>> {
     let mut out = fix.to_vec();
-    for n in restriction.held(robot) {
+    for n in restriction.held(robot)? {
         if !out.contains(&n) {
             out.push(n);
         }
     }
-    out
+    Ok(out)
 }

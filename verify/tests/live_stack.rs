@@ -410,7 +410,7 @@ fn keeping_axis_relations_keeps_the_ur_closed_form_ik_and_reports_its_cost() {
                 "tool0",
             ],
         );
-        let held = r["axis_relations_held"].as_array().unwrap();
+        let held = r["full_model_gain"]["relations_held"].as_array().unwrap();
         assert_eq!(held.len(), 5, "{held:?}");
         for (k, (got, nom)) in rel["calibrated"]
             .as_array()

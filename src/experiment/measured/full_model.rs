@@ -40,6 +40,10 @@ pub struct FullModelGain {
     pub restricted_predicted_rms_mm: f64,
     /// What the full model gains: restricted minus full predicted RMS (mm).
     pub gain_mm: f64,
+    /// With the axis relations kept: each relation and the unknowns held
+    /// for it ([`crate::identify::axis_relations`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub relations_held: Vec<crate::identify::axis_relations::HeldRelation>,
 }
 
 /// The measured points of `robot` at `table` and `q` (each marker of a
@@ -73,9 +77,43 @@ pub fn models_apart_rms_mm(
     (sum / n.max(1) as f64).sqrt() * 1e3
 }
 
+/// After a fit with `settings` restricted by `restriction` (the user's own
+/// fixed unknowns `user_fix` plus those it holds), which made `fitted`:
+/// the full model's fit of the same data beside it, or `None` when the fit
+/// was not restricted.
+///
+/// # Errors
+/// The full fit's errors.
+pub fn beside_full_model(
+    robot: &Robot,
+    meas: &Measurements,
+    source: &str,
+    settings: &MeasuredSettings,
+    user_fix: &[String],
+    restriction: Restriction,
+    fitted: (&Robot, &ParamTable),
+) -> Result<Option<FullModelGain>, ExperimentError> {
+    if restriction == Restriction::All {
+        return Ok(None);
+    }
+    let mut full = settings.clone();
+    full.fix = user_fix.to_vec();
+    full_model_gain(
+        robot,
+        meas,
+        source,
+        &full,
+        (restriction, fitted.0, fitted.1),
+    )
+    .map(Some)
+}
+
 /// Fits `meas` (named `source`) with `full` settings (every unknown, the
 /// user's own fixed ones held) and compares the result with the fit
 /// restricted by `restricted` (its robot as fitted and its estimate).
+///
+/// # Errors
+/// The full fit's errors.
 pub fn full_model_gain(
     robot: &Robot,
     meas: &Measurements,
@@ -104,5 +142,10 @@ pub fn full_model_gain(
         models_apart_rms_mm: apart,
         restricted_predicted_rms_mm: own,
         gain_mm: own - full_rms,
+        relations_held: if restricted.0 == Restriction::KeepAxisRelations {
+            crate::identify::axis_relations::held_relations(robot)
+        } else {
+            Vec::new()
+        },
     })
 }

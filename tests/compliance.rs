@@ -537,7 +537,7 @@ fn an_unmodelled_sag_is_warned_of_when_the_noise_is_stated() {
     );
     assert!(t.rejected && t.ratio > 1.5, "{t:?}");
     let w = c.report.warnings.join(" ");
-    assert!(w.contains("--compliance"), "{w}");
+    assert!(w.contains(activecal::names::phrase::COMPLIANCE), "{w}");
     // The sag is a misfit of every pose, not a glitch: no pose left out.
     assert!(
         c.report.outliers.left_out.is_empty(),

@@ -387,7 +387,7 @@ fn a_stated_noise_three_times_too_small_is_caught() {
         .unwrap_or_else(|e| panic!("{s}: {e}"));
         let w = r["warnings"].to_string();
         assert!(
-            w.contains("noisier than stated") && w.contains("--compliance"),
+            w.contains("noisier than stated") && w.contains(activecal::names::phrase::COMPLIANCE),
             "{s}: no warning for σ 3× the stated: {w}"
         );
         predicted.push(r["predicted"]["position_rms_mm"].as_f64().unwrap());

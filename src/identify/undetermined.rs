@@ -240,16 +240,13 @@ fn pivoted_selection(x: &Mat<f64>, group: &[usize], pivot_tol: f64) -> Vec<usize
             .filter(|&c| group[c] == g)
             .filter_map(|c| unit[c].clone().map(|v| (c, v)))
             .collect();
+        // A group's columns orthogonalised against the basis so far, then
+        // (modified Gram–Schmidt) against each vector the group adds: each
+        // projection twice ("twice is enough"), O(p² m) in all.
+        for (_, v) in &mut rest {
+            basis.iter().for_each(|b| project_out_twice(v, b));
+        }
         while !rest.is_empty() {
-            // Orthogonalise what is left against the basis (twice is enough).
-            for (_, v) in &mut rest {
-                for _ in 0..2 {
-                    for b in &basis {
-                        let d: f64 = b.iter().zip(v.iter()).map(|(a, c)| a * c).sum();
-                        v.iter_mut().zip(b).for_each(|(y, a)| *y -= d * a);
-                    }
-                }
-            }
             let norms: Vec<f64> = rest
                 .iter()
                 .map(|(_, v)| v.iter().map(|a| a * a).sum::<f64>().sqrt())
@@ -265,6 +262,7 @@ fn pivoted_selection(x: &Mat<f64>, group: &[usize], pivot_tol: f64) -> Vec<usize
             let (c, mut v) = rest.swap_remove(best);
             if nb > 0.0 {
                 v.iter_mut().for_each(|a| *a /= nb);
+                rest.iter_mut().for_each(|(_, r)| project_out_twice(r, &v));
                 basis.push(v);
             }
             kept.push(c);
@@ -273,11 +271,12 @@ fn pivoted_selection(x: &Mat<f64>, group: &[usize], pivot_tol: f64) -> Vec<usize
     // The rank rule itself on the kept columns: drop the last pivots that
     // are not forced until it passes — unless the forced columns alone fail
     // it (what the caller forces free is the caller's: the fit says).
+    let gram = x.transpose() * x;
     let forced: Vec<usize> = kept.iter().copied().filter(|&c| group[c] == 0).collect();
-    if !forced.is_empty() && !passes_rank_rule(x, &forced) {
+    if !forced.is_empty() && !passes_rank_rule(&gram, &forced) {
         return kept;
     }
-    while kept.len() > 1 && !passes_rank_rule(x, &kept) {
+    while kept.len() > 1 && !passes_rank_rule(&gram, &kept) {
         match kept.iter().rposition(|&c| group[c] > 0) {
             Some(i) => {
                 kept.remove(i);
@@ -288,12 +287,20 @@ fn pivoted_selection(x: &Mat<f64>, group: &[usize], pivot_tol: f64) -> Vec<usize
     kept
 }
 
-/// Whether the columns `cols` of `x` have full rank by the shared rule.
-fn passes_rank_rule(x: &Mat<f64>, cols: &[usize]) -> bool {
-    let m = x.nrows();
-    let g = Mat::<f64>::from_fn(cols.len(), cols.len(), |a, b| {
-        (0..m).map(|i| x[(i, cols[a])] * x[(i, cols[b])]).sum()
-    });
+/// `v` less its component along the unit vector `b`, removed twice (the
+/// second pass takes what rounding left of the first).
+fn project_out_twice(v: &mut [f64], b: &[f64]) {
+    for _ in 0..2 {
+        let d: f64 = b.iter().zip(v.iter()).map(|(a, c)| a * c).sum();
+        v.iter_mut().zip(b).for_each(|(y, a)| *y -= d * a);
+    }
+}
+
+/// Whether the columns `cols` of a matrix `X` have full rank by the shared
+/// rule, from its Gram matrix `gram` = `XᵀX` (formed once for every subset
+/// the caller tries).
+fn passes_rank_rule(gram: &Mat<f64>, cols: &[usize]) -> bool {
+    let g = Mat::<f64>::from_fn(cols.len(), cols.len(), |a, b| gram[(cols[a], cols[b])]);
     equilibrated_rank(g.as_ref(), MAX_CONDITION) == cols.len()
 }
 

@@ -476,6 +476,7 @@ pub fn selection(
             }
         );
     }
+    super::pages::selection(out, robot, report, curve, &figs)?;
     let report = serde_json::to_value(report).map_err(json_error)?;
     finish_selection(staged, md, &figs, &report, curve)
 }

@@ -165,8 +165,10 @@ function drawCamera(s, k) {
 
 function readout() {
   scene.updateMatrixWorld(true);
+  const r = renderer.domElement.getBoundingClientRect();
   el('readout').textContent = JSON.stringify({
     poses: data.poses.length,
+    link_names: data.links,
     links: data.links.length,
     meshes: data.meshes.length,
     triangles: data.meshes.reduce((n, m) => n + m.triangles, 0),
@@ -174,6 +176,8 @@ function readout() {
     shown,
     world: robot.links.map((o) => Array.from(o.matrixWorld.elements)),
     drawn: renderer.info.render.triangles,
+    canvas: [r.left, r.top, r.width, r.height],
+    readyMs: Math.round(performance.now()),
   });
 }
 
@@ -232,7 +236,7 @@ function frameView() {
   if (box.isEmpty()) box.expandByPoint(new THREE.Vector3());
   const c = box.getCenter(new THREE.Vector3());
   const r = Math.max(0.4, box.getSize(new THREE.Vector3()).length());
-  camera.position.set(c.x + 0.9 * r, c.y - 1.1 * r, c.z + 0.6 * r);
+  camera.position.set(c.x + 0.6 * r, c.y - 0.8 * r, c.z + 0.45 * r);
   controls.target.copy(c);
   controls.update();
 }
@@ -260,6 +264,12 @@ const hashPose = () => {
   return m ? Number(m[1]) : 0;
 };
 
+// `#click=k`: clicks the k-th entry of the list, as a user would (tests).
+function hashClick() {
+  const m = /click=(\d+)/.exec(location.hash);
+  if (m) document.querySelectorAll('#poses li')[Number(m[1])]?.click();
+}
+
 buildList();
 frameView();
 controls.addEventListener('change', render);
@@ -272,4 +282,8 @@ window.addEventListener('resize', () => {
 });
 window.activecalPage = { showPose, play };
 if (data.poses.length) showPose(hashPose());
-else render();
+else {
+  render();
+  readout();
+}
+hashClick();

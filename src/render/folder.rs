@@ -32,7 +32,7 @@ fn put(staged: &StagedDir, name: &str, text: &str) -> Result<()> {
 
 /// Whether a parameter name is an angle (γ, α, β: radians) rather than a
 /// length (metres).
-fn is_angle(name: &str) -> bool {
+pub(super) fn is_angle(name: &str) -> bool {
     name.split('_')
         .next()
         .and_then(Symbol::parse)
@@ -195,6 +195,9 @@ pub struct CalibrationSummary<'a> {
     pub notes: Vec<String>,
     /// The command's JSON report.
     pub json: serde_json::Value,
+    /// The poses of the fit, for the 3D page (`None`: the page shows the
+    /// tables and figures alone).
+    pub poses: Option<super::pages::FitPoses>,
 }
 
 /// Writes `calibrate --report DIR`.
@@ -253,6 +256,7 @@ pub fn calibration(dir: &Path, s: &CalibrationSummary<'_>) -> Result<()> {
     }
     md += &figure_section(&figs);
     md += &parameter_table(&s.params);
+    super::pages::calibration(out, s, &figs)?;
     put(&staged, "report.md", &md)?;
     put(&staged, "report.json", &(json_text(&s.json)? + "\n"))?;
     staged.commit()?;

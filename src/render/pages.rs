@@ -29,14 +29,14 @@ pub fn add_scene(page: &mut Page, spec: &CollisionSpec) {
 }
 
 /// A tracker at the measurement frame's origin, for point and pose
-/// measurements (in the base link's frame).
-pub fn add_tracker(page: &mut Page, robot: &Robot) {
+/// measurements (in the base link's frame, the base at `mount` in the
+/// measurement frame).
+pub fn add_tracker(page: &mut Page, robot: &Robot, mount: nalgebra::Isometry3<f64>) {
     if matches!(
         robot.measurement,
         MeasurementKind::Point | MeasurementKind::Pose
     ) {
-        let mount = robot.source.as_ref().filter(|_| page.urdf).map(|s| s.mount);
-        let at = mount.map_or(Point3::origin(), |m| m.inverse() * Point3::origin());
+        let at = mount.inverse() * Point3::origin();
         page.sensor = Some(SensorView::Tracker {
             position: [at.x, at.y, at.z],
         });
@@ -113,7 +113,8 @@ pub fn selection(
     if let Some(s) = spec {
         add_scene(&mut page, s);
     }
-    add_tracker(&mut page, robot);
+    let mount = page.mount();
+    add_tracker(&mut page, robot, mount);
     let mut summary = vec![
         vec!["poses".into(), report.poses.len().to_string()],
         vec![
@@ -142,4 +143,136 @@ pub fn selection(
     page.sections.push(curve_table(curve));
     add_figures(&mut page, out, figs);
     page.write(out)
+}
+
+/// The poses of a fit as the page shows them.
+#[derive(Clone, Debug)]
+pub struct FitPoses {
+    /// Joint values of each pose.
+    pub qs: Vec<Vec<f64>>,
+    /// The point measured at each pose (measurement frame, metres), when
+    /// one point per pose was measured.
+    pub measured: Option<Vec<[f64; 3]>>,
+    /// Poses the gross-error test left out.
+    pub flagged: Vec<usize>,
+}
+
+/// A power of ten that draws the largest of `sizes` (metres) at about
+/// 5 cm: the magnification of residuals and of the calibrated robot's
+/// difference, between 1 and 10⁴.
+#[must_use]
+pub fn magnification(sizes: impl Iterator<Item = f64>) -> f64 {
+    let largest = sizes.filter(|x| x.is_finite()).fold(0.0, f64::max);
+    if largest <= 0.0 {
+        return 1.0;
+    }
+    10f64.powf((0.05 / largest).log10().floor().clamp(0.0, 4.0))
+}
+
+/// The parameter table of a calibration: each parameter's change and σ,
+/// lengths in mm and angles in degrees.
+fn parameter_table(params: &[(String, f64, Option<f64>)]) -> String {
+    let rows: Vec<Vec<String>> = params
+        .iter()
+        .map(|(name, change, sigma)| {
+            let (to, unit) = if super::folder::is_angle(name) {
+                (180.0 / std::f64::consts::PI, "°")
+            } else {
+                (1e3, " mm")
+            };
+            vec![
+                name.clone(),
+                format!("{:.4}{unit}", change * to),
+                sigma.map_or("-".into(), |v| format!("{:.4}{unit}", v * to)),
+            ]
+        })
+        .collect();
+    table(
+        "Parameters: change from nominal and σ (the calibrated robot is drawn orange over the nominal one)",
+        &["parameter", "change", "σ"],
+        &rows,
+    )
+}
+
+/// The page of `calibrate --report`.
+pub fn calibration(
+    out: &Path,
+    s: &super::folder::CalibrationSummary<'_>,
+    figs: &[(String, String)],
+) -> Result<()> {
+    let robot = s.robot;
+    let mut page = Page::new(&format!("Calibration of {}", robot.name), robot, &[]);
+    if let Some(f) = &s.poses {
+        let labels: Vec<(String, Vec<f64>)> =
+            f.qs.iter()
+                .enumerate()
+                .map(|(k, q)| (format!("pose {}", k + 1), q.clone()))
+                .collect();
+        page.add_poses(robot, &robot.nominal, &labels);
+        let mount = add_fit(&mut page, robot, &s.id.table, f);
+        add_tracker(&mut page, robot, mount);
+    }
+    let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt();
+    page.sections.push(table(
+        &format!("Position error per {} (mm)", s.what),
+        &["", "nominal", "calibrated"],
+        &[vec![
+            "RMS".into(),
+            format!("{:.4}", rms(&s.position_mm.0)),
+            format!("{:.4}", rms(&s.position_mm.1)),
+        ]],
+    ));
+    page.sections.push(parameter_table(&s.params));
+    add_figures(&mut page, out, figs);
+    page.write(out)
+}
+
+/// The calibrated robot, the measured and fitted points and the marks of
+/// a fit's poses (already added to `page`, in order); returns the
+/// calibrated measurement frame (the base link's pose in it).
+fn add_fit(
+    page: &mut Page,
+    robot: &Robot,
+    fitted: &crate::model::ParamTable,
+    f: &FitPoses,
+) -> nalgebra::Isometry3<f64> {
+    // The calibrated model in its own measurement frame: its base drawn on
+    // the nominal base, so the difference shown is the robot's.
+    let mount = crate::frames::decompose(robot, fitted)
+        .map(|f| f.measurement)
+        .unwrap_or_else(|_| page.mount());
+    let to_base = mount.inverse();
+    let point = |p: nalgebra::Vector3<f64>| {
+        let b = to_base * Point3::from(p);
+        [b.x, b.y, b.z]
+    };
+    let (mut sizes, mut residuals) = (Vec::new(), Vec::new());
+    for (k, q) in f.qs.iter().enumerate() {
+        let cal: Vec<[f64; 16]> = page
+            .place_mounted(robot, fitted, q, mount)
+            .iter()
+            .map(super::page::column_major)
+            .collect();
+        let fit = crate::kinematics::position(robot, fitted, q);
+        let pose = &mut page.poses[k];
+        for (c, n) in cal.iter().zip(&pose.links) {
+            sizes.push(
+                ((c[12] - n[12]).powi(2) + (c[13] - n[13]).powi(2) + (c[14] - n[14]).powi(2))
+                    .sqrt(),
+            );
+        }
+        pose.calibrated = Some(cal);
+        pose.fitted = Some(point(fit));
+        if let Some(m) = f.measured.as_ref().and_then(|m| m.get(k)) {
+            let m = nalgebra::Vector3::from(*m);
+            pose.measured = Some(point(m));
+            residuals.push((m - fit).norm());
+        }
+        if f.flagged.contains(&k) {
+            pose.mark = Some("flagged".into());
+        }
+    }
+    page.magnify = Some(magnification(residuals.into_iter()));
+    page.magnify_robot = Some(magnification(sizes.into_iter()));
+    mount
 }

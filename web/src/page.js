@@ -90,11 +90,17 @@ const robot = makeRobot(meshes, null);
 const fitted = data.poses.some((p) => p.calibrated)
   ? makeRobot(meshes, [1.0, 0.55, 0.1, 0.35])
   : null;
-const skeleton = new THREE.Line(
-  new THREE.BufferGeometry().setFromPoints(data.links.map(() => new THREE.Vector3())),
-  new THREE.LineBasicMaterial({ color: 0x3355aa }),
-);
-if (!data.urdf) scene.add(skeleton);
+// Each link joined to its parent: the robot where meshes are missing,
+// and the calibrated robot's outline.
+const bones = data.parents.flatMap((p, i) => (p == null ? [] : [[p, i]]));
+function makeSkeleton(color) {
+  const g = new THREE.BufferGeometry().setFromPoints(bones.flatMap(() => [new THREE.Vector3(), new THREE.Vector3()]));
+  const l = new THREE.LineSegments(g, new THREE.LineBasicMaterial({ color }));
+  scene.add(l);
+  return l;
+}
+const skeleton = makeSkeleton(0x3355aa);
+const fittedSkeleton = fitted ? makeSkeleton(0xff8800) : null;
 addScene();
 const marks = new THREE.Group();
 scene.add(marks);
@@ -106,7 +112,7 @@ function setLinks(r, mats) {
 
 // The calibrated robot with its difference from the nominal magnified.
 function magnified(p) {
-  const k = data.magnify ?? 1;
+  const k = data.magnify_robot ?? 1;
   return p.calibrated.map((c, i) => {
     const n = p.links[i];
     const out = c.slice();
@@ -181,18 +187,28 @@ function readout() {
   });
 }
 
-function setSkeleton(mats) {
-  const pos = skeleton.geometry.attributes.position;
-  mats.forEach((m, i) => pos.setXYZ(i, m[12], m[13], m[14]));
+function setSkeleton(line, mats) {
+  const pos = line.geometry.attributes.position;
+  bones.forEach(([a, b], i) => {
+    pos.setXYZ(2 * i, mats[a][12], mats[a][13], mats[a][14]);
+    pos.setXYZ(2 * i + 1, mats[b][12], mats[b][13], mats[b][14]);
+  });
   pos.needsUpdate = true;
+  line.geometry.computeBoundingSphere();
 }
 
 function showPose(k) {
   shown = Math.max(0, Math.min(data.poses.length - 1, k));
   const p = data.poses[shown];
   setLinks(robot, p.links);
-  setSkeleton(p.links);
-  if (fitted) setLinks(fitted, magnified(p));
+  setSkeleton(skeleton, p.links);
+  if (fitted) {
+    fitted.group.visible = true;
+    fittedSkeleton.visible = true;
+    const m = magnified(p);
+    setLinks(fitted, m);
+    setSkeleton(fittedSkeleton, m);
+  }
   drawMarks(shown);
   el('slider').value = String(shown);
   el('shown').textContent = `${p.label} (${shown + 1} of ${data.poses.length})`;
@@ -211,13 +227,17 @@ function play() {
   const n = data.links.length;
   let mv = 0;
   let s = 0;
+  if (fitted) {
+    fitted.group.visible = false;
+    fittedSkeleton.visible = false;
+  }
   const step = () => {
     if (mv >= data.moves.length) return showPose(data.poses.length - 1);
     const m = data.moves[mv];
     const mats = [];
     for (let i = 0; i < n; i++) mats.push(Array.from(frames[mv].subarray((s * n + i) * 16, (s * n + i + 1) * 16)));
     setLinks(robot, mats);
-    setSkeleton(mats);
+    setSkeleton(skeleton, mats);
     marks.clear();
     render();
     s += 1;
@@ -255,7 +275,7 @@ function buildList() {
   el('play').addEventListener('click', play);
   el('play').disabled = data.moves.length === 0;
   if (data.magnify) {
-    el('legend').textContent = `Residuals (red, fitted blue → measured green) and the calibrated robot's difference (orange) magnified ×${data.magnify}: 1 mm is drawn as ${data.magnify} mm.`;
+    el('legend').textContent = `Residuals (red: fitted point, blue → measured point, green) magnified ×${data.magnify}: 1 mm is drawn as ${data.magnify} mm. The calibrated robot (orange) differs from the nominal (blue) by its changes magnified ×${data.magnify_robot}.`;
   }
 }
 

@@ -76,9 +76,44 @@ impl LinkPlacer {
         self.urdf.is_some()
     }
 
+    /// Each link's parent link (index), `None` for the root.
+    pub fn parents(&self) -> Vec<Option<usize>> {
+        match &self.urdf {
+            Some(u) => {
+                let mut p = vec![None; u.tree.links.len()];
+                for j in &u.tree.joints {
+                    p[j.child] = Some(j.parent);
+                }
+                p
+            }
+            None => (0..self.names.len()).map(|k| k.checked_sub(1)).collect(),
+        }
+    }
+
+    /// The base link's pose in the measurement frame the placer was made
+    /// with (identity for a robot without a URDF).
+    pub fn mount(&self) -> Isometry3<f64> {
+        self.urdf
+            .as_ref()
+            .map_or(Isometry3::identity(), |u| u.mount)
+    }
+
     /// Each link's placement at `q` with `table`'s parameters, in the base
     /// link's frame (the measurement frame for a robot without a URDF).
     pub fn place(&self, robot: &Robot, table: &ParamTable, q: &[f64]) -> Vec<Isometry3<f64>> {
+        self.place_mounted(robot, table, q, self.mount())
+    }
+
+    /// As [`LinkPlacer::place`], the base link taken at `mount` in the
+    /// measurement frame (a calibrated model's own measurement frame, so
+    /// that its base coincides with the nominal one's).
+    pub fn place_mounted(
+        &self,
+        robot: &Robot,
+        table: &ParamTable,
+        q: &[f64],
+        mount: Isometry3<f64>,
+    ) -> Vec<Isometry3<f64>> {
         let frames = joint_frames(robot, table, q);
         let Some(u) = &self.urdf else {
             return frames;
@@ -93,7 +128,7 @@ impl LinkPlacer {
             .collect();
         let mut tree = vec![Isometry3::identity(); u.tree.links.len()];
         u.tree.placements(&vals, &mut tree);
-        let to_base = u.mount.inverse();
+        let to_base = mount.inverse();
         let anchored = |l: usize| -> Isometry3<f64> {
             match u.anchor[l] {
                 Some(k) if !u.c.is_empty() => to_base * frames[k] * u.c[k],

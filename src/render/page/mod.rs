@@ -104,6 +104,8 @@ pub struct Page {
     pub robot: String,
     /// Link names.
     pub links: Vec<String>,
+    /// Each link's parent link (index), `None` for the root.
+    pub parents: Vec<Option<usize>>,
     /// Whether the links are a URDF's (else the model's frames).
     pub urdf: bool,
     /// Visual elements.
@@ -120,8 +122,10 @@ pub struct Page {
     pub obstacles: Vec<Obstacle>,
     /// The sensor.
     pub sensor: Option<SensorView>,
-    /// Magnification of residuals and of the calibrated robot's difference.
+    /// Magnification of the residuals (fitted point → measured point).
     pub magnify: Option<f64>,
+    /// Magnification of the calibrated robot's difference from the nominal.
+    pub magnify_robot: Option<f64>,
     /// What was not drawn, or drawn simplified.
     pub notes: Vec<String>,
     /// Figures (caption, PNG bytes).
@@ -179,6 +183,7 @@ impl Page {
             title: title.to_string(),
             robot: robot.name.clone(),
             links: placer.names.clone(),
+            parents: placer.parents(),
             urdf: placer.is_urdf(),
             visuals,
             meshes,
@@ -188,6 +193,7 @@ impl Page {
             obstacles: Vec::new(),
             sensor: None,
             magnify: None,
+            magnify_robot: None,
             notes,
             figures: Vec::new(),
             sections: Vec::new(),
@@ -203,6 +209,25 @@ impl Page {
     #[must_use]
     pub fn place(&self, robot: &Robot, table: &ParamTable, q: &[f64]) -> Vec<Isometry3<f64>> {
         self.placer().place(robot, table, q)
+    }
+
+    /// As [`Page::place`], the base link at `mount` in the measurement frame.
+    #[must_use]
+    pub fn place_mounted(
+        &self,
+        robot: &Robot,
+        table: &ParamTable,
+        q: &[f64],
+        mount: Isometry3<f64>,
+    ) -> Vec<Isometry3<f64>> {
+        self.placer().place_mounted(robot, table, q, mount)
+    }
+
+    /// The base link's pose in the measurement frame (identity without a
+    /// URDF).
+    #[must_use]
+    pub fn mount(&self) -> Isometry3<f64> {
+        self.placer().mount()
     }
 
     /// Adds poses (labels and joint values) at `table`.

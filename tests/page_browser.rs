@@ -241,6 +241,13 @@ fn ur5_page_places_its_links_as_the_urdf_and_moves_between_poses() {
     }
     let compared = frames_match(urdf, "base_link", sel, &ro, last);
     assert!(compared >= 8, "{compared} links compared");
+    // The page alone, away from the report's other files, is the same page.
+    let alone = scratch_dir("page", "ur5-alone").join("index.html");
+    std::fs::copy(&page, &alone).unwrap();
+    assert_eq!(
+        readout(&alone, &format!("pose={last}"))["world"],
+        ro["world"]
+    );
     // A click on the list's third entry shows pose 2.
     let clicked = readout(&page, "click=2");
     assert_eq!(clicked["shown"], 2);
@@ -271,4 +278,102 @@ fn ur5_page_places_its_links_as_the_urdf_and_moves_between_poses() {
         moved > 500,
         "{moved} pixels differ between the first and last pose"
     );
+}
+
+/// The URDF's root link (the link no joint has as its child).
+fn root_of(urdf: &str) -> String {
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(urdf)).unwrap();
+    let u = urdf_rs::read_from_string(&text).unwrap();
+    let children: Vec<&str> = u.joints.iter().map(|j| j.child.link.as_str()).collect();
+    u.links
+        .iter()
+        .find(|l| !children.contains(&l.name.as_str()))
+        .unwrap()
+        .name
+        .clone()
+}
+
+#[test]
+fn panda_and_tiago_pages_place_every_link_as_their_urdfs() {
+    if chromium().is_none() {
+        return;
+    }
+    for (name, urdf, tip, at_least) in [
+        (
+            "panda",
+            "fixtures/example-robot-data/panda.urdf",
+            "panda_hand_tcp",
+            10,
+        ),
+        ("tiago", "fixtures/figaroh/tiago.urdf", "arm_tool_link", 30),
+    ] {
+        let (dir, v) = select(name, &["--robot", urdf, "--tip", tip], &[]);
+        let n = v["configurations"].as_array().unwrap().len();
+        let ro = readout(&dir.join("index.html"), &format!("pose={}", n - 1));
+        assert_eq!(ro["poses"], n, "{name}");
+        assert_eq!(ro["shown"], n - 1, "{name}");
+        let compared = frames_match(urdf, &root_of(urdf), &v, &ro, n - 1);
+        assert!(compared >= at_least, "{name}: {compared} links compared");
+    }
+}
+
+#[test]
+fn calibration_page_shows_every_pose_and_marks_the_flagged_ones() {
+    if chromium().is_none() {
+        return;
+    }
+    let dir = scratch_dir("page", "calibrate").join("report");
+    let r = dir.display().to_string();
+    let out = run(&[
+        "calibrate",
+        "--robot",
+        "fixtures/example-robot-data/ur5_robot.urdf",
+        "--frames",
+        "fixtures/truth/ur5/nominal.yaml",
+        "--measurements",
+        "fixtures/truth/ur5/meas0.csv",
+        "--report",
+        &r,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rep: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+    let flagged = rep["outliers"]["left_out"].as_array().map_or(0, Vec::len);
+    let page = dir.join("index.html");
+    let (dom, console) = browse(&page, "pose=0", &["--dump-dom"]);
+    assert!(console.is_empty(), "console: {console:#?}");
+    assert_eq!(
+        dom.matches("<li class=\"flagged\"").count(),
+        flagged,
+        "flagged poses listed"
+    );
+    let ro = readout(&page, "pose=29");
+    assert_eq!(ro["poses"], 30);
+    assert_eq!(ro["shown"], 29);
+}
+
+#[test]
+fn a_report_folder_written_twice_holds_the_same_page() {
+    let pages: Vec<Vec<u8>> = ["a", "b"]
+        .iter()
+        .map(|n| {
+            let (dir, _) = select(
+                &format!("twice-{n}"),
+                &[
+                    "--robot",
+                    "fixtures/example-robot-data/ur5_robot.urdf",
+                    "--tip",
+                    "tool0",
+                ],
+                &[],
+            );
+            std::fs::read(dir.join("index.html")).unwrap()
+        })
+        .collect();
+    assert!(pages[0].len() > 100_000, "{} bytes", pages[0].len());
+    assert!(pages[0] == pages[1], "the two pages differ");
 }

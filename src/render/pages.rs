@@ -266,7 +266,9 @@ fn add_fit(
         if let Some(m) = f.measured.as_ref().and_then(|m| m.get(k)) {
             let m = nalgebra::Vector3::from(*m);
             pose.measured = Some(point(m));
-            residuals.push((m - fit).norm());
+            if !f.flagged.contains(&k) {
+                residuals.push((m - fit).norm());
+            }
         }
         if f.flagged.contains(&k) {
             pose.mark = Some("flagged".into());

@@ -489,13 +489,14 @@ pub fn selection(
 /// report, the "how many poses" curve on the pixel Jacobian, the figures),
 /// report.json (`{"selection": the --json object, "how_many_poses": the
 /// curve}`), the curve's figure and the chosen poses against the joint
-/// limits (`names` the robot's joints, `qs` the poses).
+/// limits (`names` the robot's joints, `design` the poses), and the 3D
+/// page ([`super::page_camera`]).
 #[allow(clippy::too_many_arguments)]
 pub fn camera_selection(
     dir: &Path,
     robot: &Robot,
     names: &[String],
-    qs: &[Vec<f64>],
+    design: &crate::select::camera::CameraDesign,
     text: &str,
     json: &serde_json::Value,
     curve: &PoseCountCurve,
@@ -503,6 +504,7 @@ pub fn camera_selection(
 ) -> Result<()> {
     let staged = StagedDir::new(dir)?;
     let out = staged.path();
+    let qs = &design.qs;
     let mut figs = vec![how_many_figure(out, curve, qs.len())?];
     plots::joints_vs_limits(&out.join("joints_vs_limits"), &joint_rows(robot, names, qs))?;
     figs.push((
@@ -518,6 +520,7 @@ pub fn camera_selection(
         text
     );
     md += &how_many_text(curve, noise_is_default);
+    super::page_camera::camera_selection(out, design, curve, &figs)?;
     finish_selection(staged, md, &figs, json, curve)
 }
 

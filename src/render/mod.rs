@@ -10,6 +10,7 @@ pub(crate) mod figure;
 pub mod folder;
 pub mod frames_text;
 pub mod page;
+pub mod page_camera;
 pub mod pages;
 pub mod paper_figures;
 pub mod plots;

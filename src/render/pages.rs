@@ -36,7 +36,12 @@ pub fn add_tracker(page: &mut Page, robot: &Robot, mount: nalgebra::Isometry3<f6
         robot.measurement,
         MeasurementKind::Point | MeasurementKind::Pose
     ) {
-        let at = mount.inverse() * Point3::origin();
+        let q0 = page
+            .poses
+            .first()
+            .map(|p| p.q.clone())
+            .unwrap_or_else(|| vec![0.0; robot.dof()]);
+        let at = page.measurement_to_page(&q0, mount) * Point3::origin();
         page.sensor = Some(SensorView::Tracker {
             position: [at.x, at.y, at.z],
         });
@@ -44,7 +49,7 @@ pub fn add_tracker(page: &mut Page, robot: &Robot, mount: nalgebra::Isometry3<f6
 }
 
 /// The "how many poses" table.
-fn curve_table(curve: &PoseCountCurve) -> String {
+pub(super) fn curve_table(curve: &PoseCountCurve) -> String {
     let rows: Vec<Vec<String>> = curve
         .points
         .iter()
@@ -241,13 +246,13 @@ fn add_fit(
     let mount = crate::frames::decompose(robot, fitted)
         .map(|f| f.measurement)
         .unwrap_or_else(|_| page.mount());
-    let to_base = mount.inverse();
-    let point = |p: nalgebra::Vector3<f64>| {
-        let b = to_base * Point3::from(p);
-        [b.x, b.y, b.z]
-    };
     let (mut sizes, mut residuals) = (Vec::new(), Vec::new());
     for (k, q) in f.qs.iter().enumerate() {
+        let to_page = page.measurement_to_page(q, mount);
+        let point = |p: nalgebra::Vector3<f64>| {
+            let b = to_page * Point3::from(p);
+            [b.x, b.y, b.z]
+        };
         let cal: Vec<[f64; 16]> = page
             .place_mounted(robot, fitted, q, mount)
             .iter()

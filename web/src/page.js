@@ -235,7 +235,10 @@ function play() {
     if (mv >= data.moves.length) return showPose(data.poses.length - 1);
     const m = data.moves[mv];
     const mats = [];
-    for (let i = 0; i < n; i++) mats.push(Array.from(frames[mv].subarray((s * n + i) * 16, (s * n + i + 1) * 16)));
+    for (let i = 0; i < n; i++) {
+      const f = frames[mv].subarray((s * n + i) * 12, (s * n + i + 1) * 12);
+      mats.push([f[0], f[1], f[2], 0, f[3], f[4], f[5], 0, f[6], f[7], f[8], 0, f[9], f[10], f[11], 1]);
+    }
     setLinks(robot, mats);
     setSkeleton(skeleton, mats);
     marks.clear();

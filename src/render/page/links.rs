@@ -5,8 +5,9 @@
 //! `C_k` from the model's frame to the URDF's ([`model_to_urdf`]): the URDF
 //! frame of any table, nominal or calibrated, as [`crate::frames`] reads it.
 //! Every other link hangs from its nearest chain ancestor (else from the base
-//! link) by the URDF's own origins ([`Tree`]). Placements are in the base
-//! link's frame (the frame of the floor and obstacles). A robot without a
+//! link) by the URDF's own origins ([`Tree`]). Placements are in the URDF's
+//! root frame (the base link's for a chain from the root, the frame of the
+//! floor and obstacles). A robot without a
 //! URDF (built-in, TOML) is drawn as its model frames: one per joint and the
 //! measured frame.
 
@@ -98,10 +99,35 @@ impl LinkPlacer {
             .map_or(Isometry3::identity(), |u| u.mount)
     }
 
-    /// Each link's placement at `q` with `table`'s parameters, in the base
-    /// link's frame (the measurement frame for a robot without a URDF).
+    /// Each link's placement at `q` with `table`'s parameters, in the
+    /// URDF's root frame (the measurement frame for a robot without a URDF).
     pub fn place(&self, robot: &Robot, table: &ParamTable, q: &[f64]) -> Vec<Isometry3<f64>> {
         self.place_mounted(robot, table, q, self.mount())
+    }
+
+    /// The URDF tree's link placements (root frame) at `q`.
+    fn tree_at(u: &UrdfPart, q: &[f64]) -> Vec<Isometry3<f64>> {
+        let vals: Vec<f64> = u
+            .values
+            .iter()
+            .map(|v| match v {
+                Ok(i) => q[*i],
+                Err(x) => *x,
+            })
+            .collect();
+        let mut tree = vec![Isometry3::identity(); u.tree.links.len()];
+        u.tree.placements(&vals, &mut tree);
+        tree
+    }
+
+    /// From the measurement frame (the base link at `mount` in it) to the
+    /// page's frame at `q`: the URDF's root frame (the chain's base link
+    /// moves in it when the chain is walked against the tree, as a head
+    /// camera's is); identity without a URDF.
+    pub fn measurement_to_page(&self, q: &[f64], mount: Isometry3<f64>) -> Isometry3<f64> {
+        self.urdf.as_ref().map_or(Isometry3::identity(), |u| {
+            Self::tree_at(u, q)[u.base] * mount.inverse()
+        })
     }
 
     /// As [`LinkPlacer::place`], the base link taken at `mount` in the
@@ -118,28 +144,19 @@ impl LinkPlacer {
         let Some(u) = &self.urdf else {
             return frames;
         };
-        let vals: Vec<f64> = u
-            .values
-            .iter()
-            .map(|v| match v {
-                Ok(i) => q[*i],
-                Err(x) => *x,
-            })
-            .collect();
-        let mut tree = vec![Isometry3::identity(); u.tree.links.len()];
-        u.tree.placements(&vals, &mut tree);
-        let to_base = mount.inverse();
+        let tree = Self::tree_at(u, q);
+        let to_root = tree[u.base] * mount.inverse();
         let anchored = |l: usize| -> Isometry3<f64> {
             match u.anchor[l] {
-                Some(k) if !u.c.is_empty() => to_base * frames[k] * u.c[k],
-                _ => tree[u.base].inverse() * tree[l],
+                Some(k) if !u.c.is_empty() => to_root * frames[k] * u.c[k],
+                _ => tree[l],
             }
         };
         (0..tree.len())
             .map(|l| match u.hang[l] {
                 Some(a) if a == l => anchored(l),
                 Some(a) => anchored(a) * (tree[a].inverse() * tree[l]),
-                None => tree[u.base].inverse() * tree[l],
+                None => tree[l],
             })
             .collect()
     }

@@ -31,9 +31,9 @@ use std::path::Path;
 
 /// Largest joint travel between two samples of an animated move (radians,
 /// or metres for a prismatic joint).
-pub const MOVE_STEP: f64 = 0.05;
+pub const MOVE_STEP: f64 = 0.1;
 /// Most samples of one straight move.
-pub const MOVE_SAMPLES_MAX: usize = 40;
+pub const MOVE_SAMPLES_MAX: usize = 16;
 
 /// One pose as the page shows it.
 #[derive(Clone, Debug, Serialize)]
@@ -69,8 +69,9 @@ pub struct MoveView {
     pub via: bool,
     /// Samples along it.
     pub samples: usize,
-    /// Link placements per sample: `samples × links × 16` little-endian
-    /// f32 (column-major 4×4), base64.
+    /// Link placements per sample: `samples × links × 12` little-endian
+    /// f32 (the top three rows of the column-major 4×4, column by
+    /// column), base64.
     pub frames: String,
 }
 
@@ -223,6 +224,13 @@ impl Page {
         self.placer().place_mounted(robot, table, q, mount)
     }
 
+    /// From the measurement frame (the base link at `mount` in it) to the
+    /// page's frame at joint values `q`.
+    #[must_use]
+    pub fn measurement_to_page(&self, q: &[f64], mount: Isometry3<f64>) -> Isometry3<f64> {
+        self.placer().measurement_to_page(q, mount)
+    }
+
     /// The base link's pose in the measurement frame (identity without a
     /// URDF).
     #[must_use]
@@ -295,11 +303,9 @@ impl Page {
                         .map(|(x, y)| x + t * (y - x))
                         .collect();
                     for m in self.place(robot, table, &q) {
-                        bytes.extend(
-                            column_major(&m)
-                                .iter()
-                                .flat_map(|v| (*v as f32).to_le_bytes()),
-                        );
+                        let c = column_major(&m);
+                        let top = c.chunks_exact(4).flat_map(|col| &col[..3]);
+                        bytes.extend(top.flat_map(|v| (*v as f32).to_le_bytes()));
                     }
                     samples += 1;
                 }

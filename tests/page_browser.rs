@@ -377,3 +377,66 @@ fn a_report_folder_written_twice_holds_the_same_page() {
     assert!(pages[0].len() > 100_000, "{} bytes", pages[0].len());
     assert!(pages[0] == pages[1], "the two pages differ");
 }
+
+#[test]
+fn tiago_head_camera_page_shows_the_frustum_at_every_pose() {
+    if chromium().is_none() {
+        return;
+    }
+    let dir = scratch_dir("page", "camera").join("report");
+    let r = dir.display().to_string();
+    let out = run(&[
+        "select",
+        "--robot",
+        "fixtures/figaroh/tiago.urdf#tip=arm_tool_link",
+        "--camera-link",
+        "head_2_link",
+        "--camera-info",
+        "fixtures/camera/tiago_xtion.yaml",
+        "--target",
+        "fixtures/camera/tiago_board.yaml",
+        "--camera-pose=0.0908,0.0800,-0.0220,-3.1416,-1.5708,0.0000",
+        "--target-pose=0.0800,-0.0400,0.0600,0.0000,1.5708,0.0000",
+        "--image-margin",
+        "20",
+        "--distance",
+        "0.25,1.5",
+        "--n",
+        "30",
+        "--count",
+        "3000",
+        "--report",
+        &r,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let page = dir.join("index.html");
+    let html = std::fs::read_to_string(&page).unwrap();
+    let data = &html[html.find("id=\"page-data\">").unwrap() + 15..];
+    let data: Value = serde_json::from_str(&data[..data.find("</script>").unwrap()]).unwrap();
+    let cam = &data["sensor"];
+    assert_eq!(cam["kind"], "camera");
+    assert_eq!(cam["placements"].as_array().unwrap().len(), 30);
+    assert_eq!(cam["boards"][0].as_array().unwrap().len(), 4);
+    let ro = readout(&page, "pose=29");
+    assert_eq!(ro["poses"], 30);
+    assert_eq!(ro["shown"], 29);
+    // The camera rides on the head: its placement differs between poses
+    // exactly when the head link moved.
+    let head = ro["link_names"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|n| n == "head_2_link")
+        .unwrap();
+    let first: Value = serde_json::from_value(data["poses"][0]["links"][head].clone()).unwrap();
+    let last: Value = serde_json::from_value(data["poses"][29]["links"][head].clone()).unwrap();
+    assert_eq!(
+        first == last,
+        cam["placements"][0] == cam["placements"][29],
+        "the camera moves with the head"
+    );
+}

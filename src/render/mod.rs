@@ -14,4 +14,5 @@ pub mod page_camera;
 pub mod pages;
 pub mod paper_figures;
 pub mod plots;
+pub mod summary;
 mod typeset;

@@ -4,6 +4,7 @@
 //! figures just drawn.
 
 use super::page::{Page, SensorView, figure, table};
+pub use super::summary::FitPoses;
 use crate::collision::CollisionSpec;
 use crate::error::Result;
 use crate::how_many::PoseCountCurve;
@@ -150,18 +151,6 @@ pub fn selection(
     page.write(out)
 }
 
-/// The poses of a fit as the page shows them.
-#[derive(Clone, Debug)]
-pub struct FitPoses {
-    /// Joint values of each pose.
-    pub qs: Vec<Vec<f64>>,
-    /// The point measured at each pose (measurement frame, metres), when
-    /// one point per pose was measured.
-    pub measured: Option<Vec<[f64; 3]>>,
-    /// Poses the gross-error test left out.
-    pub flagged: Vec<usize>,
-}
-
 /// A power of ten that draws the largest of `sizes` (metres) at about
 /// 5 cm: the magnification of residuals and of the calibrated robot's
 /// difference, between 1 and 10⁴.
@@ -180,7 +169,7 @@ fn parameter_table(params: &[(String, f64, Option<f64>)]) -> String {
     let rows: Vec<Vec<String>> = params
         .iter()
         .map(|(name, change, sigma)| {
-            let (to, unit) = if super::folder::is_angle(name) {
+            let (to, unit) = if super::summary::is_angle(name) {
                 (180.0 / std::f64::consts::PI, "°")
             } else {
                 (1e3, " mm")
@@ -202,7 +191,7 @@ fn parameter_table(params: &[(String, f64, Option<f64>)]) -> String {
 /// The page of `calibrate --report`.
 pub fn calibration(
     out: &Path,
-    s: &super::folder::CalibrationSummary<'_>,
+    s: &super::summary::CalibrationSummary<'_>,
     figs: &[(String, String)],
 ) -> Result<()> {
     let robot = s.robot;
@@ -282,4 +271,25 @@ fn add_fit(
     page.magnify = Some(magnification(residuals.into_iter()));
     page.magnify_robot = Some(magnification(sizes.into_iter()));
     mount
+}
+
+/// The page of a contact calibration (`calibrate --contacts … --report`):
+/// the robot at each contact's configuration, the text report, the figures.
+pub fn contacts(
+    out: &Path,
+    robot: &Robot,
+    text: &str,
+    poses: &[(String, Vec<f64>)],
+    figs: &[(String, String)],
+) -> Result<()> {
+    let mut page = Page::new(
+        &format!("Contact calibration of {}", robot.name),
+        robot,
+        &[],
+    );
+    page.add_poses(robot, &robot.nominal, poses);
+    page.sections
+        .push(format!("<pre>{}</pre>\n", super::page::encode::html(text)));
+    add_figures(&mut page, out, figs);
+    page.write(out)
 }

@@ -354,6 +354,31 @@ fn calibration_page_shows_every_pose_and_marks_the_flagged_ones() {
     let ro = readout(&page, "pose=29");
     assert_eq!(ro["poses"], 30);
     assert_eq!(ro["shown"], 29);
+    // The residual the page draws (fitted point → measured point) is the
+    // one the gross-error test reported for each pose it left out: the
+    // page's points are the fit's, not another model's. The report rounds
+    // nothing here (f64 through JSON): 1e-9 mm is rounding of the two
+    // frame changes.
+    let html = std::fs::read_to_string(&page).unwrap();
+    let data = &html[html.find("id=\"page-data\">").unwrap() + 15..];
+    let data: Value = serde_json::from_str(&data[..data.find("</script>").unwrap()]).unwrap();
+    for o in rep["outliers"]["left_out"].as_array().into_iter().flatten() {
+        let k = o["pose"].as_u64().unwrap() as usize;
+        let p = &data["poses"][k];
+        assert_eq!(p["mark"], "flagged");
+        let d: f64 = (0..3)
+            .map(|i| {
+                (p["measured"][i].as_f64().unwrap() - p["fitted"][i].as_f64().unwrap()).powi(2)
+            })
+            .sum::<f64>()
+            .sqrt();
+        let want = o["residual_mm"].as_f64().unwrap();
+        assert!(
+            (d * 1e3 - want).abs() < 1e-9,
+            "pose {k}: page {} mm, fit {want} mm",
+            d * 1e3
+        );
+    }
 }
 
 #[test]

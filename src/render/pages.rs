@@ -247,7 +247,12 @@ fn add_fit(
             .iter()
             .map(super::page::column_major)
             .collect();
-        let fit = crate::kinematics::position(robot, fitted, q);
+        // The measured point: the end point, or the first marker on it.
+        let (r, e) = crate::kinematics::pose(robot, fitted, q);
+        let fit = fitted
+            .markers
+            .first()
+            .map_or(e, |o| e + r * nalgebra::Vector3::from(*o));
         let pose = &mut page.poses[k];
         for (c, n) in cal.iter().zip(&pose.links) {
             sizes.push(

@@ -145,6 +145,9 @@ function drawMarks(k) {
     dot(p.fitted, 0x2255dd, 0.008);
     dot(tip, 0x22aa22, 0.008);
     line([p.fitted, tip], 0xdd2222);
+    // The scale bar: 1 mm at the residuals' magnification, beside the point.
+    const [x, y, z] = p.fitted;
+    line([[x, y, z + 0.03], [x + 0.001 * m, y, z + 0.03]], 0x000000);
   }
   if (s && s.kind === 'tracker') {
     dot(s.position, 0x333333, 0.03);
@@ -278,7 +281,7 @@ function buildList() {
   el('play').addEventListener('click', play);
   el('play').disabled = data.moves.length === 0;
   if (data.magnify) {
-    el('legend').textContent = `Residuals (red: fitted point, blue → measured point, green) magnified ×${data.magnify}: 1 mm is drawn as ${data.magnify} mm. The calibrated robot (orange) differs from the nominal (blue) by its changes magnified ×${data.magnify_robot}.`;
+    el('legend').textContent = `Residuals (red: fitted point, blue → measured point, green) magnified ×${data.magnify}: 1 mm is drawn as ${data.magnify} mm (the black bar above the fitted point). The calibrated robot (orange) differs from the nominal (blue) by its changes magnified ×${data.magnify_robot}.`;
   }
 }
 

@@ -30,12 +30,20 @@ pub fn html(text: &str) -> String {
         .replace('"', "&quot;")
 }
 
-/// JavaScript or JSON text that cannot end the `<script>` element holding
-/// it: `</` becomes `<\/` (the same string in JSON and in JS string
-/// literals, regular expressions and comments) and `<!--` becomes `<\!--`.
+/// JavaScript text that cannot end the `<script>` element holding it:
+/// `</` becomes `<\/` and `<!--` becomes `<\!--` (the same characters in
+/// JS string literals, regular expressions and comments, where they occur).
 #[must_use]
 pub fn script(text: &str) -> String {
     text.replace("</", "<\\/").replace("<!--", "<\\!--")
+}
+
+/// JSON text that cannot end the `<script>` element holding it: `</`
+/// becomes `<\/` and `<!--` becomes `<\u0021--`, both JSON escapes of
+/// the same characters.
+#[must_use]
+pub fn json_script(text: &str) -> String {
+    text.replace("</", "<\\/").replace("<!--", "<\\u0021--")
 }
 
 #[cfg(test)]
@@ -60,10 +68,12 @@ mod tests {
 
     #[test]
     fn script_text_cannot_close_its_element() {
-        let s = script(r#"{"a":"</script><!--"}"#);
-        assert!(!s.to_ascii_lowercase().contains("</script"));
-        assert!(!s.contains("<!--"));
-        let v: serde_json::Value = serde_json::from_str(&s).unwrap();
-        assert_eq!(v["a"], "</script><\\!--".replace("<\\!--", "<\\!--"));
+        let raw = r#"{"a":"</script><!--"}"#;
+        for s in [script(raw), json_script(raw)] {
+            assert!(!s.to_ascii_lowercase().contains("</script"), "{s}");
+            assert!(!s.contains("<!--"), "{s}");
+        }
+        let v: serde_json::Value = serde_json::from_str(&json_script(raw)).unwrap();
+        assert_eq!(v["a"], "</script><!--");
     }
 }

@@ -5,7 +5,7 @@
 
 use super::Page;
 use super::assets::{self, has_three};
-use super::encode::{base64, html, script};
+use super::encode::{base64, html, json_script, script};
 use crate::error::Result;
 use std::fmt::Write as _;
 
@@ -97,7 +97,7 @@ pub(super) fn page(p: &Page) -> Result<String> {
     let _ = write!(
         s,
         "<script type=\"application/json\" id=\"page-data\">{}</script>\n",
-        script(&data)
+        json_script(&data)
     );
     if has_three() {
         s += &modules();

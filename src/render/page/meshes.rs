@@ -156,7 +156,7 @@ pub fn visuals(
             });
         }
     }
-    let meshes = fit_budget(welded, &mut notes);
+    let meshes = fit_budget(welded, MESH_BUDGET_BYTES, &mut notes);
     (out, meshes, notes)
 }
 
@@ -213,13 +213,17 @@ fn bytes(w: &Welded) -> usize {
 }
 
 /// The meshes, decimated together (one cell size for all, from 1 mm,
-/// doubled) until they fit [`MESH_BUDGET_BYTES`]; a note says so.
-fn fit_budget(welded: Vec<(String, Welded)>, notes: &mut Vec<String>) -> Vec<MeshData> {
+/// doubled) until they fit `budget` bytes; a note says so.
+fn fit_budget(
+    welded: Vec<(String, Welded)>,
+    budget: usize,
+    notes: &mut Vec<String>,
+) -> Vec<MeshData> {
     let total = |ws: &[(String, Welded)]| ws.iter().map(|(_, w)| bytes(w)).sum::<usize>();
     let mut ws = welded;
     let before = total(&ws);
     let mut cell = 0.001;
-    while total(&ws) > MESH_BUDGET_BYTES && cell < 1.0 {
+    while total(&ws) > budget && cell < 1.0 {
         ws = ws
             .into_iter()
             .map(|(name, w)| {
@@ -262,4 +266,44 @@ fn fit_budget(welded: Vec<(String, Welded)>, notes: &mut Vec<String>) -> Vec<Mes
             triangles_read: w.read,
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A flat square of side 1 m cut into `n × n` cells of two triangles.
+    fn square(n: usize) -> Vec<[f64; 3]> {
+        let h = 1.0 / n as f64;
+        let mut pts = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                let (x, y) = (i as f64 * h, j as f64 * h);
+                pts.extend([[x, y, 0.0], [x + h, y, 0.0], [x + h, y + h, 0.0]]);
+                pts.extend([[x, y, 0.0], [x + h, y + h, 0.0], [x, y + h, 0.0]]);
+            }
+        }
+        pts
+    }
+
+    #[test]
+    fn welding_shares_vertices_and_keeps_every_triangle() {
+        // h = 1/8 is exact in binary: shared corners have equal bits.
+        let w = cluster(&square(8), 0.0, 128);
+        assert_eq!(w.f.len(), 128);
+        assert_eq!(w.v.len(), 81);
+    }
+
+    #[test]
+    fn decimation_fits_the_budget_and_says_so() {
+        let w = cluster(&square(256), 0.0, 131_072);
+        let before = bytes(&w);
+        let mut notes = Vec::new();
+        let out = fit_budget(vec![("sq".into(), w)], before / 10, &mut notes);
+        let kept = out[0].triangles;
+        assert!(12 * kept < before / 10, "{kept} triangles kept");
+        assert!(kept > 100, "{kept} triangles kept");
+        assert_eq!(out[0].triangles_read, 131_072);
+        assert!(notes[0].contains("decimated"), "{notes:?}");
+    }
 }

@@ -25,6 +25,9 @@ fn main() {
     println!("cargo::rustc-check-cfg=cfg(activecal_three)");
     println!("cargo::rerun-if-changed=web/package-lock.json");
     println!("cargo::rerun-if-changed=web/node_modules/three/package.json");
+    // Written afresh by every `npm ci` (scripts/setup): a reinstall is seen
+    // even when three's own files keep their times.
+    println!("cargo::rerun-if-changed=web/node_modules/.package-lock.json");
     let have = FILES.iter().all(|(f, _)| three.join(f).is_file());
     for (from, to) in FILES {
         let text = if have {

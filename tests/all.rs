@@ -49,6 +49,7 @@ mod licences;
 mod mesh_formats;
 mod options;
 mod output_overlap;
+mod page_browser;
 mod paper_golden;
 mod plane_contacts;
 mod point_coincidence;

@@ -248,7 +248,7 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     if let Some(dir) = &a.report {
         activecal::render::folder::calibration(
             dir,
-            &measured_summary(&fitted, id, path, &report, &v),
+            &measured_summary(&fitted, id, path, &report, &v, &meas),
         )?;
     }
     super::emit(a.json, &v, || {
@@ -275,6 +275,7 @@ fn measured_summary<'a>(
     path: &Path,
     r: &activecal::experiment::measured::MeasuredReport,
     json: &serde_json::Value,
+    meas: &activecal::identify::Measurements,
 ) -> activecal::render::folder::CalibrationSummary<'a> {
     let pos = |e: &activecal::identify::ModelErrors| -> Vec<f64> {
         e.per_sample
@@ -326,6 +327,11 @@ fn measured_summary<'a>(
         }),
         notes,
         json: json.clone(),
+        poses: Some(activecal::render::pages::FitPoses {
+            qs: meas.qs().to_vec(),
+            measured: (meas.points().len() == meas.qs().len()).then(|| meas.points().to_vec()),
+            flagged: r.outliers.left_out.iter().map(|o| o.pose).collect(),
+        }),
     }
 }
 

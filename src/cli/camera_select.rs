@@ -323,7 +323,7 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
             dir,
             &robot,
             &names,
-            &d.qs,
+            &d,
             &rendered(&written[..written.len() - 1]),
             &value,
             c,

@@ -203,7 +203,18 @@ pub fn calibrate_contacts(
             figures,
             held: held.as_ref(),
         };
-        activecal::render::folder::contacts(dir, robot, &report, &v, |d| {
+        let touches = |g: usize| match fitted.points.get(g) {
+            Some(p) => format!("point {p}"),
+            None => format!("plane {}", g - fitted.points.len() + 1),
+        };
+        let poses: Vec<(String, Vec<f64>)> = fitted
+            .qs
+            .iter()
+            .zip(&fitted.groups)
+            .zip(&fitted.lines)
+            .map(|((q, g), l)| (format!("line {l}: {}", touches(*g)), q.clone()))
+            .collect();
+        activecal::render::folder::contacts(dir, robot, &report, &v, &poses, |d| {
             activecal::render::contact_figures::draw(d, &r)
         })?;
     }

@@ -188,6 +188,11 @@ fn simulated_report_dir(
         splits: None,
         notes,
         json: v.clone(),
+        poses: Some(activecal::render::pages::FitPoses {
+            qs: qs.clone(),
+            measured: None,
+            flagged: Vec::new(),
+        }),
     };
     activecal::render::folder::calibration(dir, &s)?;
     Ok(())

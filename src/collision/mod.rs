@@ -29,12 +29,12 @@ pub mod mesh;
 mod mesh_tree;
 mod model;
 mod moves;
-mod shapes;
+pub(crate) mod shapes;
 mod sight;
 mod spec;
 pub mod srdf;
 pub mod stl;
-mod tree;
+pub(crate) mod tree;
 
 pub use model::{CollisionModel, ContactPair};
 pub use moves::MoveCheck;

@@ -31,7 +31,7 @@ pub(super) struct Geometry {
 /// Where a `package://PKG/rest` or relative mesh file is: the package
 /// directories given, then the URDF's directory and its ancestors (a
 /// directory named PKG, or one holding PKG).
-fn resolve(file: &str, urdf_dir: &Path, package_dirs: &[String]) -> Option<PathBuf> {
+pub(crate) fn resolve(file: &str, urdf_dir: &Path, package_dirs: &[String]) -> Option<PathBuf> {
     if let Some(rest) = file.strip_prefix("package://") {
         let (pkg, sub) = rest.split_once('/').unwrap_or((rest, ""));
         let mut roots: Vec<PathBuf> = package_dirs.iter().map(PathBuf::from).collect();

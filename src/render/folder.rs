@@ -5,11 +5,13 @@
 //! aside and swapped in whole.
 
 use super::plots::{self as plots, CurveRow, JointRow, ParamBar};
+pub use super::summary::CalibrationSummary;
+use super::summary::is_angle;
 use crate::error::Result;
 use crate::how_many::PoseCountCurve;
 use crate::identify::Identification;
 use crate::io::atomic::{StagedDir, write_atomic};
-use crate::model::{JointKind, Robot, Symbol};
+use crate::model::{JointKind, Robot};
 use crate::report::SelectReport;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -28,15 +30,6 @@ fn json_error(e: serde_json::Error) -> crate::Error {
 fn put(staged: &StagedDir, name: &str, text: &str) -> Result<()> {
     write_atomic(&staged.path().join(name), text.as_bytes())?;
     Ok(())
-}
-
-/// Whether a parameter name is an angle (γ, α, β: radians) rather than a
-/// length (metres).
-fn is_angle(name: &str) -> bool {
-    name.split('_')
-        .next()
-        .and_then(Symbol::parse)
-        .is_some_and(|s| matches!(s, Symbol::Gamma | Symbol::Alpha | Symbol::Beta))
 }
 
 /// Parameter changes and σ (SI units) as bars: lengths in mm, angles in
@@ -173,30 +166,6 @@ fn parameter_table(params: &[(String, f64, Option<f64>)]) -> String {
     s
 }
 
-/// What a calibration report shows beside its figures.
-pub struct CalibrationSummary<'a> {
-    /// The robot.
-    pub robot: &'a Robot,
-    /// The fit.
-    pub id: &'a Identification,
-    /// Where the data came from (a file, or a simulated design).
-    pub source: String,
-    /// What one error is taken at ("pose", "held-out pose").
-    pub what: &'static str,
-    /// Position errors, mm: nominal and calibrated.
-    pub position_mm: (Vec<f64>, Vec<f64>),
-    /// Orientation errors, degrees, for full poses.
-    pub orientation_deg: Option<(Vec<f64>, Vec<f64>)>,
-    /// Each parameter: name, change from nominal and σ (metres or radians).
-    pub params: Vec<(String, f64, Option<f64>)>,
-    /// Held-out position RMS per split (mm): nominal and calibrated.
-    pub splits: Option<(Vec<f64>, Vec<f64>)>,
-    /// Further lines of the summary (markdown).
-    pub notes: Vec<String>,
-    /// The command's JSON report.
-    pub json: serde_json::Value,
-}
-
 /// Writes `calibrate --report DIR`.
 pub fn calibration(dir: &Path, s: &CalibrationSummary<'_>) -> Result<()> {
     let staged = StagedDir::new(dir)?;
@@ -253,6 +222,7 @@ pub fn calibration(dir: &Path, s: &CalibrationSummary<'_>) -> Result<()> {
     }
     md += &figure_section(&figs);
     md += &parameter_table(&s.params);
+    super::pages::calibration(out, s, &figs)?;
     put(&staged, "report.md", &md)?;
     put(&staged, "report.json", &(json_text(&s.json)? + "\n"))?;
     staged.commit()?;
@@ -478,6 +448,7 @@ pub fn selection(
             }
         );
     }
+    super::pages::selection(out, robot, report, curve, &figs)?;
     let report = serde_json::to_value(report).map_err(json_error)?;
     finish_selection(staged, md, &figs, &report, curve)
 }
@@ -486,13 +457,14 @@ pub fn selection(
 /// report, the "how many poses" curve on the pixel Jacobian, the figures),
 /// report.json (`{"selection": the --json object, "how_many_poses": the
 /// curve}`), the curve's figure and the chosen poses against the joint
-/// limits (`names` the robot's joints, `qs` the poses).
+/// limits (`names` the robot's joints, `design` the poses), and the 3D
+/// page ([`super::page_camera`]).
 #[allow(clippy::too_many_arguments)]
 pub fn camera_selection(
     dir: &Path,
     robot: &Robot,
     names: &[String],
-    qs: &[Vec<f64>],
+    design: &crate::select::camera::CameraDesign,
     text: &str,
     json: &serde_json::Value,
     curve: &PoseCountCurve,
@@ -500,6 +472,7 @@ pub fn camera_selection(
 ) -> Result<()> {
     let staged = StagedDir::new(dir)?;
     let out = staged.path();
+    let qs = &design.qs;
     let mut figs = vec![how_many_figure(out, curve, qs.len())?];
     plots::joints_vs_limits(&out.join("joints_vs_limits"), &joint_rows(robot, names, qs))?;
     figs.push((
@@ -515,6 +488,7 @@ pub fn camera_selection(
         text
     );
     md += &how_many_text(curve, noise_is_default);
+    super::page_camera::camera_selection(out, design, curve, &figs)?;
     finish_selection(staged, md, &figs, json, curve)
 }
 
@@ -552,17 +526,21 @@ fn joint_scale(robot: &Robot) -> Vec<f64> {
 
 /// Writes `calibrate --report DIR` for a contact file: report.md (the text
 /// report: the fit, in-sample and held-out consistency, in mm, and the
-/// figures), report.json (the `--json` object) and the figures `draw`
-/// writes into the directory (returning each one's stem and caption).
+/// figures), report.json (the `--json` object), the figures `draw`
+/// writes into the directory (returning each one's stem and caption) and
+/// the 3D page of the robot at each contact's configuration (`poses`,
+/// labelled).
 pub fn contacts(
     dir: &Path,
     robot: &Robot,
     text: &str,
     json: &serde_json::Value,
+    poses: &[(String, Vec<f64>)],
     draw: impl FnOnce(&Path) -> Result<Vec<(String, String)>>,
 ) -> Result<()> {
     let staged = StagedDir::new(dir)?;
     let figs = draw(staged.path())?;
+    super::pages::contacts(staged.path(), robot, text, poses, &figs)?;
     let md = format!(
         "# Calibration report (contacts)\n\nRobot: `{}` (chain {}).\n\n```text\n{}```\n{}",
         robot.name,

@@ -1,6 +1,7 @@
 //! Rendering of typed reports: the figures (PNG and SVG, drawn with
 //! plotters and typeset with the embedded DejaVu fonts), the report folders
-//! of `--report DIR` (report.md, report.json, figures), the frames file's
+//! of `--report DIR` (report.md, report.json, figures, and `index.html`,
+//! the interactive 3D page of [`page`] assembled by [`pages`]), the frames file's
 //! text and the paper's figures. The command line and the Python package
 //! both call these; nothing here prints or names a flag.
 
@@ -8,6 +9,10 @@ pub mod contact_figures;
 pub(crate) mod figure;
 pub mod folder;
 pub mod frames_text;
+pub mod page;
+pub mod page_camera;
+pub mod pages;
 pub mod paper_figures;
 pub mod plots;
+pub mod summary;
 mod typeset;

@@ -269,7 +269,8 @@ def cmd_opencv(a):
 
 
 def cmd_score(a):
-    """Detections (image, feature, u, v) against DIR's truth: per image the
+    """Detections (image, feature, u, v; or an observations CSV whose pose
+    is the image's index in DIR) against DIR's truth: per image the
     error of each detected point against the nearest true corner (so that
     a flipped order does not count as an error), whether the order is the
     truth's, and the summary (detection rate, median, 95th percentile and
@@ -277,9 +278,12 @@ def cmd_score(a):
     t = read_truth(a.dir)
     det = {}
     lines = open(a.detections).read().split()
+    head = lines[0].split(",")
+    names = list(t)  # an observations CSV's pose is the image's index
     for l in lines[1:]:
-        name, f, u, v = l.split(",")
-        det.setdefault(name, {})[int(f)] = (float(u), float(v))
+        row = dict(zip(head, l.split(",")))
+        name = row["image"] if "image" in row else names[int(row["pose"])]
+        det.setdefault(name, {})[int(row["feature"])] = (float(row["u"]), float(row["v"]))
     errs, per, reordered = [], {}, 0
     for name, true in t.items():
         if name not in det:

@@ -156,12 +156,8 @@ pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot) -> Result<Option<Strin
     if let (Some(read), Some(m)) = (&images, v.as_object_mut()) {
         m.insert("images".into(), serde_json::to_value(&read.images)?);
     }
-    let image_text = images.as_ref().map_or_else(String::new, |r| {
-        activecal::experiment::camera::images::image_lines(&r.images).join("\n") + "\n"
-    });
     super::emit(a.json, &v, || {
-        image_text.clone()
-            + &text(
+        text(
             fit,
             &label,
             obs_path,

@@ -15,7 +15,8 @@ use activecal::model::Robot;
 use anyhow::{Context, Result, bail};
 use std::path::Path;
 
-/// Reads the images of `spec` with `--joints`' values; writes
+/// Reads the images of `spec` with `--joints`' values, prints a line per
+/// image (without `--json`: the report has them); writes
 /// `--save-observations` (atomically, never over an existing file without
 /// `--force`; the command's files were checked against each other before).
 pub fn read(
@@ -30,6 +31,12 @@ pub fn read(
     };
     let joints = read_image_joints(joints, robot, a.units.units()).context("--joints")?;
     let read = read_images(spec, &joints, target, intrinsics).context("--images")?;
+    // What became of each image, before the fit (which may refuse them).
+    if !a.json {
+        for line in activecal::experiment::camera::images::image_lines(&read.images) {
+            println!("{line}");
+        }
+    }
     if let Some(path) = &a.save_observations {
         let text = observations_csv(&read.observations, robot, target);
         super::write_new(path, &text, a.force).context("--save-observations")?;

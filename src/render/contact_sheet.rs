@@ -58,7 +58,12 @@ fn arrow_factor(images: &[SheetImage], views: &[View]) -> f64 {
     let largest = images
         .iter()
         .zip(views)
-        .flat_map(|(i, v)| i.residuals.iter().flatten().map(move |r| v.scale * r[0].hypot(r[1])))
+        .flat_map(|(i, v)| {
+            i.residuals
+                .iter()
+                .flatten()
+                .map(move |r| v.scale * r[0].hypot(r[1]))
+        })
         .fold(0.0, f64::max);
     let mut f = 1.0;
     for k in 0..8 {
@@ -95,15 +100,19 @@ pub fn write_contact_sheet(path: &Path, images: &[SheetImage]) -> Result<()> {
     let factor = arrow_factor(images, &views);
     super::typeset::register_fonts()?;
     {
-        let root = super::typeset::Typeset(BitMapBackend::with_buffer(&mut rgb, size))
-            .into_drawing_area();
+        let root =
+            super::typeset::Typeset(BitMapBackend::with_buffer(&mut rgb, size)).into_drawing_area();
         let used = images.iter().filter(|i| i.left_out.is_none()).count();
         let title = format!(
             "{} images, {used} used. Points coloured by board row, ids drawn; red arrows: each point's residual after the fit × {factor} (prediction less detection)",
             images.len()
         );
-        root.draw(&Text::new(title, (PAD as i32, 14), ("sans-serif", 14).into_font()))
-            .map_err(err)?;
+        root.draw(&Text::new(
+            title,
+            (PAD as i32, 14),
+            ("sans-serif", 14).into_font(),
+        ))
+        .map_err(err)?;
         for (k, (im, v)) in images.iter().zip(&views).enumerate() {
             let (x0, y0) = origin(k);
             draw_cell(&root, (x0 as i32, y0 as i32), im, v, thumb_h, factor)?;
@@ -140,7 +149,11 @@ fn view_of(im: &SheetImage, h: u32) -> View {
     // Centre the region in the thumbnail.
     let cx = 0.5 * (x0 + x1) - 0.5 * f64::from(THUMB_W) / scale;
     let cy = 0.5 * (y0 + y1) - 0.5 * f64::from(h) / scale;
-    View { x0: cx, y0: cy, scale }
+    View {
+        x0: cx,
+        y0: cy,
+        scale,
+    }
 }
 
 /// Copies `im`'s thumbnail (box-averaged, greyed when left out; black
@@ -177,11 +190,11 @@ fn paint_thumbnail(rgb: &mut [u8], width: u32, at: (u32, u32), im: &SheetImage, 
     }
 }
 
-/// The colour of board row `r` of `rows` (red to blue, as OpenCV draws a
-/// board's rows).
+/// The colour of board row `r` of `rows`: orange to blue (red is the
+/// arrows').
 fn row_colour(r: usize, rows: usize) -> RGBColor {
     let t = r as f64 / rows.saturating_sub(1).max(1) as f64;
-    let (r, g, b) = HSLColor(0.7 * t, 0.9, 0.45).to_rgba().rgb();
+    let (r, g, b) = HSLColor(0.12 + 0.6 * t, 0.9, 0.4).to_rgba().rgb();
     RGBColor(r, g, b)
 }
 
@@ -209,21 +222,34 @@ fn draw_cell<DB: DrawingBackend>(
     for (k, p) in im.points.iter().enumerate() {
         let Some(p) = p else { continue };
         let c = row_colour(k / cols, rows);
-        root.draw(&Circle::new(at(*p), 2, c.filled())).map_err(err)?;
+        root.draw(&Circle::new(at(*p), 2, c.filled()))
+            .map_err(err)?;
         if all_ids || k == 0 || Some(k) == last {
             let (x, y) = at(*p);
-            root.draw(&Text::new(k.to_string(), (x + 3, y - 10), ("sans-serif", 9).into_font().color(&c)))
-                .map_err(err)?;
+            root.draw(&Text::new(
+                k.to_string(),
+                (x + 3, y - 10),
+                ("sans-serif", 9).into_font().color(&c),
+            ))
+            .map_err(err)?;
         }
     }
     for (p, r) in im.points.iter().zip(&im.residuals) {
         let (Some(p), Some(r)) = (p, r) else { continue };
         let (a, b) = (at(*p), at([p[0] + factor * r[0], p[1] + factor * r[1]]));
-        root.draw(&PathElement::new(vec![a, b], RED.stroke_width(2))).map_err(err)?;
+        root.draw(&PathElement::new(vec![a, b], RED.stroke_width(2)))
+            .map_err(err)?;
     }
-    let frame = if im.left_out.is_some() { RED.stroke_width(3) } else { BLACK.mix(0.3).stroke_width(1) };
-    root.draw(&Rectangle::new([(x0, y0), (x0 + THUMB_W as i32, y0 + thumb_h as i32)], frame))
-        .map_err(err)?;
+    let frame = if im.left_out.is_some() {
+        RED.stroke_width(3)
+    } else {
+        BLACK.mix(0.3).stroke_width(1)
+    };
+    root.draw(&Rectangle::new(
+        [(x0, y0), (x0 + THUMB_W as i32, y0 + thumb_h as i32)],
+        frame,
+    ))
+    .map_err(err)?;
     let font = ("sans-serif", 11).into_font();
     let y = y0 + thumb_h as i32 + 4;
     let mut lines: Vec<(String, RGBColor)> = wrap(&format!("{}: {}", im.name, im.caption), 48)
@@ -231,11 +257,19 @@ fn draw_cell<DB: DrawingBackend>(
         .map(|l| (l, BLACK))
         .collect();
     if let Some(why) = &im.left_out {
-        lines.extend(wrap(&format!("LEFT OUT: {why}"), 48).into_iter().map(|l| (l, RED)));
+        lines.extend(
+            wrap(&format!("LEFT OUT: {why}"), 48)
+                .into_iter()
+                .map(|l| (l, RED)),
+        );
     }
     for (i, (line, c)) in lines.into_iter().take(4).enumerate() {
-        root.draw(&Text::new(line, (x0, y + 13 * i as i32), font.clone().color(&c)))
-            .map_err(err)?;
+        root.draw(&Text::new(
+            line,
+            (x0, y + 13 * i as i32),
+            font.clone().color(&c),
+        ))
+        .map_err(err)?;
     }
     Ok(())
 }

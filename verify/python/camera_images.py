@@ -32,6 +32,10 @@ make's truth.json):
       Gaussian noise of --noise grey levels (default 2.0 of 255) and
       written as 8-bit grayscale PNG.
 
+      --draws D (default 1): the same configurations and renders with D
+      draws of the noise (numpy default_rng((S, 1 + d))), in DIR/draw_d/
+      each (the files below in each).
+
       Written in DIR: img_NNN.png; joints.csv (image, then one column per
       joint: the configuration of each image, the file `activecal
       calibrate --images DIR --joints joints.csv` reads); truth.csv (the
@@ -129,14 +133,24 @@ def smallest_square(px, rows, cols):
     return float(min(a, b))
 
 
-def render(r, tv, rays, box, rows, cols, sq, w, h):
+def rays_of(box, k, dist):
+    """The normalised rays of the sub-pixels of `box` (pixel bounds)."""
+    u0, v0, u1, v1 = box
+    s = SUPERSAMPLE
+    us = (np.arange(u0 * s, u1 * s) + 0.5) / s - 0.5
+    vs = (np.arange(v0 * s, v1 * s) + 0.5) / s - 0.5
+    xd = np.broadcast_to((us - k[0, 2]) / k[0, 0], (len(vs), len(us)))
+    yd = np.broadcast_to(((vs - k[1, 2]) / k[1, 1])[:, None], (len(vs), len(us)))
+    return undistort(np.array(xd), np.array(yd), dist)
+
+
+def render(r, tv, k, dist, box, rows, cols, sq, w, h):
     """The image (floats in [0, 1], linear) of the board at camera <- board
     (r, tv): sub-pixels inside `box` (pixel bounds) cast, the rest background."""
     out = np.full((h, w), BACKGROUND)
     u0, v0, u1, v1 = box
     s = SUPERSAMPLE
-    x, y = rays
-    xs, ys = x[v0 * s:v1 * s, u0 * s:u1 * s], y[v0 * s:v1 * s, u0 * s:u1 * s]
+    xs, ys = rays_of(box, k, dist)
     n = r[:, 2]
     denom = n[0] * xs + n[1] * ys + n[2]
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -154,11 +168,16 @@ def render(r, tv, rays, box, rows, cols, sq, w, h):
     return out
 
 
-def finish(img, blur, gamma, noise, rng):
+def develop(img, blur, gamma):
+    """Blurred and gamma-encoded grey levels (0-255, floats)."""
     import cv2
     if blur > 0:
         img = cv2.GaussianBlur(img, (0, 0), blur)
-    img = 255.0 * np.clip(img, 0, 1) ** (1.0 / gamma)
+    return 255.0 * np.clip(img, 0, 1) ** (1.0 / gamma)
+
+
+def with_noise(img, noise, rng):
+    """8-bit levels of `img` with Gaussian noise of `noise` levels."""
     if noise > 0:
         img = img + rng.normal(scale=noise, size=img.shape)
     return np.clip(np.rint(img), 0, 255).astype(np.uint8)
@@ -198,13 +217,10 @@ def cmd_render(a):
     outline = board_outline(rows, cols, sq)
     rng = np.random.default_rng(a.seed)
     chosen = choose(t, a, pts, outline, k, dist, w, h, rng)
-    s = SUPERSAMPLE
-    us = (np.arange(w * s) + 0.5) / s - 0.5
-    vs = (np.arange(h * s) + 0.5) / s - 0.5
-    xd = np.broadcast_to((us - k[0, 2]) / k[0, 0], (h * s, w * s))
-    yd = np.broadcast_to(((vs - k[1, 2]) / k[1, 1])[:, None], (h * s, w * s))
-    rays = undistort(np.array(xd), np.array(yd), dist)
-    os.makedirs(a.out, exist_ok=True)
+    outs = [a.out] if a.draws == 1 else [os.path.join(a.out, "draw_%d" % d) for d in range(a.draws)]
+    rngs = [np.random.default_rng((a.seed, 1 + d)) for d in range(a.draws)]
+    for o in outs:
+        os.makedirs(o, exist_ok=True)
     names = t.chain.names
     joints = ["image," + ",".join(names)]
     obs = ["pose," + ",".join(names) + ",feature,u,v"]
@@ -213,21 +229,23 @@ def cmd_render(a):
         o = project(outline, r, tv, k, dist)
         box = (max(0, int(o[:, 0].min()) - 3), max(0, int(o[:, 1].min()) - 3),
                min(w, int(o[:, 0].max()) + 4), min(h, int(o[:, 1].max()) + 4))
-        img = finish(render(r, tv, rays, box, rows, cols, sq, w, h), a.blur, a.gamma, a.noise, rng)
+        img = develop(render(r, tv, k, dist, box, rows, cols, sq, w, h), a.blur, a.gamma)
         name = "img_%03d.png" % n
-        cv2.imwrite(os.path.join(a.out, name), img)
+        for o, g in zip(outs, rngs):
+            cv2.imwrite(os.path.join(o, name), with_noise(img, a.noise, g))
         qs = ",".join(repr(float(v)) for v in q)
         joints.append("%s,%s" % (name, qs))
         px = project(pts, r, tv, k, dist)
         obs += ["%d,%s,%d,%r,%r" % (n, qs, i, float(px[i, 0]), float(px[i, 1])) for i in range(len(pts))]
         st = dict(st, image=name, smallest_square_px=smallest_square(px, rows, cols))
         stats.append(st)
-    with open(os.path.join(a.out, "joints.csv"), "w") as f:
-        f.write("\n".join(joints) + "\n")
-    with open(os.path.join(a.out, "truth.csv"), "w") as f:
-        f.write("\n".join(obs) + "\n")
-    with open(os.path.join(a.out, "render.json"), "w") as f:
-        json.dump({"board": [rows, cols, sq], "images": stats}, f, indent=1)
+    for o in outs:
+        with open(os.path.join(o, "joints.csv"), "w") as f:
+            f.write("\n".join(joints) + "\n")
+        with open(os.path.join(o, "truth.csv"), "w") as f:
+            f.write("\n".join(obs) + "\n")
+        with open(os.path.join(o, "render.json"), "w") as f:
+            json.dump({"board": [rows, cols, sq], "images": stats}, f, indent=1)
     print(json.dumps({"out": a.out, "images": len(chosen),
                       "smallest_square_px": min(s["smallest_square_px"] for s in stats)}))
 
@@ -323,6 +341,7 @@ def main(argv=None):
     r.add_argument("--blur", type=float, default=0.6)
     r.add_argument("--noise", type=float, default=2.0)
     r.add_argument("--gamma", type=float, default=2.2)
+    r.add_argument("--draws", type=int, default=1)
     r.add_argument("--out", required=True)
     o = sub.add_parser("opencv")
     o.add_argument("--dir", required=True)

@@ -97,7 +97,13 @@ fn as_fitted(
     im.points.clone_from(&cal.observations.seen[i]);
     im.residuals.clone_from(&res[i]);
     let n = res[i].iter().flatten().count().max(1) as f64;
-    let rms = (res[i].iter().flatten().map(|r| r[0] * r[0] + r[1] * r[1]).sum::<f64>() / n).sqrt();
+    let rms = (res[i]
+        .iter()
+        .flatten()
+        .map(|r| r[0] * r[0] + r[1] * r[1])
+        .sum::<f64>()
+        / n)
+        .sqrt();
     im.caption += &format!(", residual {rms:.2} px RMS");
     if let Some(l) = cal.labels.relabelled.iter().find(|l| l.pose == pose) {
         im.caption += &format!(", relabelled ({})", l.labelling.name());

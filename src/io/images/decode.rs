@@ -96,7 +96,10 @@ mod tests {
     #[test]
     fn grey_and_colour_pngs_decode_to_their_levels() {
         let g = decode_png(&encode(2, 2, png::ColorType::Grayscale, &[0, 10, 200, 255])).unwrap();
-        assert_eq!((g.width, g.height, g.data.clone()), (2, 2, vec![0, 10, 200, 255]));
+        assert_eq!(
+            (g.width, g.height, g.data.clone()),
+            (2, 2, vec![0, 10, 200, 255])
+        );
         // Pure red, green, blue and white: their luma by the weights above.
         let rgb = [255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255];
         let c = decode_png(&encode(2, 2, png::ColorType::Rgb, &rgb)).unwrap();

@@ -6,7 +6,8 @@
 //! (ChESS corners) and labels those that form one grid with integer
 //! coordinates; its three parameter sets (`ChessboardParams::
 //! sweep_default`) are tried in turn on the same corners until one gives
-//! the whole board. A checkerboard's corners carry no ids, so only a
+//! the whole board, then again on the corners of the image upscaled twice
+//! (squares of a few pixels, a far oblique board). A checkerboard's corners carry no ids, so only a
 //! board seen whole (every one of its `rows × cols` inner corners) is
 //! labelled: a part of it could sit anywhere on the board.
 //!
@@ -26,8 +27,10 @@
 
 use super::decode::Gray;
 use calib_targets_chessboard::{
-    ChessboardDetector, ChessboardParams, GrayImageView, default_chess_config, detect_corners,
+    ChessCorner, ChessboardDetector, ChessboardParams, GrayImageView, default_chess_config,
+    detect_corners,
 };
+use chess_corners::UpscaleConfig;
 
 /// A board's inner corners found in an image, by id.
 #[derive(Clone, Debug, PartialEq)]
@@ -48,20 +51,38 @@ pub fn find_checkerboard(img: &Gray, rows: usize, cols: usize) -> Result<Found, 
         height: img.height,
         data: &img.data,
     };
-    let corners = detect_corners(&view, &default_chess_config());
-    if corners.len() < 4 {
-        return Err(format!(
-            "no checkerboard: {} corner-like point(s) in the image",
-            corners.len()
-        ));
-    }
     let want = rows * cols;
+    let (mut best, mut candidates) = (0, 0);
+    for upscale in [1, 2] {
+        let mut config = default_chess_config();
+        if upscale > 1 {
+            config = config.with_upscale(UpscaleConfig::fixed(upscale));
+        }
+        let corners = detect_corners(&view, &config);
+        candidates = candidates.max(corners.len());
+        match grid_of(img, &corners, rows, cols) {
+            Ok(found) => return Ok(found),
+            Err(n) => best = best.max(n),
+        }
+    }
+    Err(if best == 0 {
+        format!("no checkerboard: {candidates} corner-like point(s) but no grid among them")
+    } else {
+        format!(
+            "board not seen whole: a grid of {best} corner(s) found, the board has {want} ({rows} × {cols} inner corners; a checkerboard's corners carry no ids, so a part of it cannot be labelled)"
+        )
+    })
+}
+
+/// The whole board among `corners`, or the size of the largest grid
+/// found.
+fn grid_of(img: &Gray, corners: &[ChessCorner], rows: usize, cols: usize) -> Result<Found, usize> {
     let mut best = 0;
     for params in ChessboardParams::sweep_default() {
         let Ok(detector) = ChessboardDetector::new(params) else {
             continue;
         };
-        let Some(d) = detector.detect(&corners) else {
+        let Some(d) = detector.detect(corners) else {
             continue;
         };
         let grid: Vec<([i64; 2], [f64; 2])> = d
@@ -79,16 +100,7 @@ pub fn find_checkerboard(img: &Gray, rows: usize, cols: usize) -> Result<Found, 
             return Ok(f);
         }
     }
-    Err(if best == 0 {
-        format!(
-            "no checkerboard: {} corner-like points but no grid among them",
-            corners.len()
-        )
-    } else {
-        format!(
-            "board not seen whole: a grid of {best} corner(s) found, the board has {want} ({rows} × {cols} inner corners; a checkerboard's corners carry no ids, so a part of it cannot be labelled)"
-        )
-    })
+    Err(best)
 }
 
 /// One way of reading the grid's `(u, v)` as the board's `(col, row)`.

@@ -35,7 +35,7 @@ pub fn image_files(spec: &Path) -> Result<Vec<PathBuf>> {
         };
         if dir.to_string_lossy().contains(['*', '?']) {
             return Err(err(
-                "a pattern may only match file names, not directories".into(),
+                "a pattern may only match file names, not directories".into()
             ));
         }
         if !dir.is_dir() {
@@ -129,7 +129,10 @@ mod tests {
                 .collect()
         };
         assert_eq!(names(image_files(&d).unwrap()), ["a.png", "b.png", "c.PNG"]);
-        assert_eq!(names(image_files(&d.join("?.png")).unwrap()), ["a.png", "b.png"]);
+        assert_eq!(
+            names(image_files(&d.join("?.png")).unwrap()),
+            ["a.png", "b.png"]
+        );
         assert_eq!(names(image_files(&d.join("a.png")).unwrap()), ["a.png"]);
         let e = image_files(&d.join("z*.png")).unwrap_err().to_string();
         assert!(e.contains("no file in") && e.contains("'z*.png'"), "{e}");

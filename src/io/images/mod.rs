@@ -53,7 +53,8 @@ pub enum ImageOutcome {
         /// The shortest square side over the board, px.
         square_px: f64,
         /// The refinement's half window: the smallest and largest over
-        /// the points, px.
+        /// the points, px (0: a corner kept as the detector placed it,
+        /// [`refine::MIN_HALF_WINDOW`], [`refine::MAX_SHIFT`]).
         window_px: [usize; 2],
         /// How far the refinement moved the detector's corners: median and
         /// largest, px.
@@ -99,7 +100,11 @@ pub fn read_images(
     let files = files::image_files(spec)?;
     let names: Vec<String> = files
         .iter()
-        .map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default())
+        .map(|f| {
+            f.file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        })
         .collect();
     if let Some(n) = names.iter().find(|n| joints.of(n).is_none()) {
         return Err(Error::Parse {
@@ -173,11 +178,16 @@ fn one_image(
     let (mut shifts, mut widths, mut windows) = (Vec::new(), Vec::new(), Vec::new());
     for (k, (p, s)) in found.px.iter().zip(&found.square_px).enumerate() {
         let half = refine::half_window(*s);
-        let Some(r) = refine::refine_corner(&img, *p, half) else {
-            continue;
-        };
-        let inside = (-0.5..w as f64 - 0.5).contains(&r.px[0])
-            && (-0.5..h as f64 - 0.5).contains(&r.px[1]);
+        let refined = (half >= refine::MIN_HALF_WINDOW)
+            .then(|| refine::refine_corner(&img, *p, half))
+            .flatten()
+            .filter(|r| r.shift <= refine::MAX_SHIFT);
+        // Not refined (a window too small, or a move too long to be this
+        // corner's): the detector's corner.
+        let r = refined.unwrap_or(refine::Refined { px: *p, shift: 0.0 });
+        let half = if refined.is_some() { half } else { 0 };
+        let inside =
+            (-0.5..w as f64 - 0.5).contains(&r.px[0]) && (-0.5..h as f64 - 0.5).contains(&r.px[1]);
         if !inside {
             continue;
         }
@@ -197,12 +207,19 @@ fn one_image(
     }
     let outcome = ImageOutcome::Found {
         points: shifts.len(),
-        square_px: found.square_px.iter().copied().fold(f64::INFINITY, f64::min),
+        square_px: found
+            .square_px
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min),
         window_px: [
             windows.iter().copied().min().unwrap_or(0),
             windows.iter().copied().max().unwrap_or(0),
         ],
-        shift_px: [median(&mut shifts.clone()), shifts.iter().copied().fold(0.0, f64::max)],
+        shift_px: [
+            median(&mut shifts.clone()),
+            shifts.iter().copied().fold(0.0, f64::max),
+        ],
         edge_width_px: median(&mut widths),
     };
     Ok((seen, outcome))

@@ -50,19 +50,26 @@ fn corners_found_in_the_committed_images_match_the_truth() {
         root().join("fixtures/ur5.urdf").display()
     ))
     .unwrap();
-    let intrinsics = read_camera_info(&root().join("fixtures/camera/small_camera_info.yaml")).unwrap();
+    let intrinsics =
+        read_camera_info(&root().join("fixtures/camera/small_camera_info.yaml")).unwrap();
     let target = read_target(&root().join("fixtures/camera/board_6x9.yaml")).unwrap();
-    let joints = read_image_joints(&root().join(IMAGES).join("joints.csv"), &robot, Default::default()).unwrap();
+    let joints = read_image_joints(
+        &root().join(IMAGES).join("joints.csv"),
+        &robot,
+        Default::default(),
+    )
+    .unwrap();
     let read = read_images(&root().join(IMAGES), &joints, &target, &intrinsics).unwrap();
-    let truth: BTreeMap<(i64, usize), [f64; 2]> = std::fs::read_to_string(root().join("fixtures/camera/images_truth.csv"))
-        .unwrap()
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let c: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-            ((c[0] as i64, c[1] as usize), [c[2], c[3]])
-        })
-        .collect();
+    let truth: BTreeMap<(i64, usize), [f64; 2]> =
+        std::fs::read_to_string(root().join("fixtures/camera/images_truth.csv"))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| {
+                let c: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+                ((c[0] as i64, c[1] as usize), [c[2], c[3]])
+            })
+            .collect();
     let mut errors = Vec::new();
     for (i, id) in read.observations.pose_ids.iter().enumerate() {
         for (k, p) in read.observations.seen[i].iter().enumerate() {
@@ -73,9 +80,16 @@ fn corners_found_in_the_committed_images_match_the_truth() {
         }
     }
     errors.sort_by(f64::total_cmp);
-    let found = read.images.iter().filter(|r| matches!(r.outcome, ImageOutcome::Found { .. })).count();
+    let found = read
+        .images
+        .iter()
+        .filter(|r| matches!(r.outcome, ImageOutcome::Found { .. }))
+        .count();
     let (median, max) = (errors[errors.len() / 2], errors[errors.len() - 1]);
-    println!("{found} of 12 images, {} corners: {median:.3} px median, {max:.3} px max", errors.len());
+    println!(
+        "{found} of 12 images, {} corners: {median:.3} px median, {max:.3} px max",
+        errors.len()
+    );
     // Every image shows the whole board; a corner labelled with another
     // id would be a square (≥ 6 px) off. The bounds: the detector's own
     // corners were within 0.5 px of the truth on the rendered sets, a
@@ -111,22 +125,36 @@ fn bad_images_are_left_out_with_their_reason() {
         saved.to_str().unwrap().to_string(),
         report.to_str().unwrap().to_string(),
     );
-    let out = common::run(&command(&dir, &jp, &["--save-observations", &sp, "--report", &rp]));
+    let out = common::run(&command(
+        &dir,
+        &jp,
+        &["--save-observations", &sp, "--report", &rp],
+    ));
     let text = String::from_utf8_lossy(&out.stdout);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!err.contains("panicked"), "{err}");
     for (file, why) in [
         ("broken.png", "not a readable PNG image"),
         ("blank.png", "no checkerboard"),
-        ("small.png", "100 × 80 px, the camera_info's images are 320 × 240 px"),
+        (
+            "small.png",
+            "100 × 80 px, the camera_info's images are 320 × 240 px",
+        ),
     ] {
         let line = format!("{file}: left out: ");
         let found = text.lines().find(|l| l.starts_with(&line));
-        assert!(found.is_some_and(|l| l.contains(why)), "{file}: '{why}' not in\n{text}");
+        assert!(
+            found.is_some_and(|l| l.contains(why)),
+            "{file}: '{why}' not in\n{text}"
+        );
     }
     // The pixels used are saved (12 poses), the contact sheet written.
     let pixels = std::fs::read_to_string(&saved).unwrap();
-    let poses: std::collections::BTreeSet<&str> = pixels.lines().skip(1).filter_map(|l| l.split(',').next()).collect();
+    let poses: std::collections::BTreeSet<&str> = pixels
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split(',').next())
+        .collect();
     assert_eq!(poses.len(), 12, "{pixels}");
     assert!(report.join("contact_sheet.png").is_file(), "{err}");
     assert!(out.status.success(), "{err}");
@@ -148,7 +176,10 @@ fn write_grey(path: &Path, w: u32, h: u32) {
 fn an_image_without_joint_values_is_refused_naming_both_files() {
     let d = common::scratch_dir("camera_images", "joints");
     let text = std::fs::read_to_string(root().join(IMAGES).join("joints.csv")).unwrap();
-    let without: Vec<&str> = text.lines().filter(|l| !l.starts_with("img_004.png")).collect();
+    let without: Vec<&str> = text
+        .lines()
+        .filter(|l| !l.starts_with("img_004.png"))
+        .collect();
     let j = d.join("joints.csv");
     std::fs::write(&j, without.join("\n") + "\n").unwrap();
     let jp = j.to_str().unwrap();
@@ -164,7 +195,11 @@ fn no_usable_image_is_refused_with_each_reason() {
     let j = d.join("joints.csv");
     let head = std::fs::read_to_string(root().join(IMAGES).join("joints.csv")).unwrap();
     let head = head.lines().next().unwrap();
-    std::fs::write(&j, format!("{head}\na.png,0,-1.5,1.5,-1.5,-1.5,0\nb.png,0,-1.5,1.5,-1.5,-1.5,0\n")).unwrap();
+    std::fs::write(
+        &j,
+        format!("{head}\na.png,0,-1.5,1.5,-1.5,-1.5,0\nb.png,0,-1.5,1.5,-1.5,-1.5,0\n"),
+    )
+    .unwrap();
     let args = command(d.to_str().unwrap(), j.to_str().unwrap(), &[]);
     common::fails_with(&args, "no image could be used");
     common::fails_with(&args, "a.png: not a readable PNG image");
@@ -192,7 +227,11 @@ fn images_and_their_options_are_refused_where_they_do_not_act() {
     );
     // A pattern that matches nothing.
     common::fails_with(
-        &command("fixtures/camera/images/none_*.png", "fixtures/camera/images/joints.csv", &[]),
+        &command(
+            "fixtures/camera/images/none_*.png",
+            "fixtures/camera/images/joints.csv",
+            &[],
+        ),
         "no file in fixtures/camera/images matches 'none_*.png'",
     );
 }

@@ -184,7 +184,8 @@ fn an_image_without_joint_values_is_refused_naming_both_files() {
     std::fs::write(&j, without.join("\n") + "\n").unwrap();
     let jp = j.to_str().unwrap();
     common::fails_with(&command(IMAGES, jp, &[]), "no row for image 'img_004.png'");
-    common::fails_with(&command(IMAGES, jp, &[]), &format!("--joints: {jp}"));
+    common::fails_with(&command(IMAGES, jp, &[]), &format!("{jp}: no row"));
+    common::fails_with(&command(IMAGES, jp, &[]), "(of fixtures/camera/images)");
 }
 
 #[test]

@@ -100,7 +100,7 @@ fn sample(command: &str, id: &str) -> Option<(&'static [&'static str], &'static 
         ("calibrate", "measurements" | "observations") => (&[], "m.csv"),
         ("calibrate", "images") => (&["--joints", "j.csv"], "shots"),
         ("calibrate", "joints") => (&["--images", "shots"], "j.csv"),
-        ("calibrate", "save_observations") => (&["--images", "shots"], "s.csv"),
+        ("calibrate", "save_observations") => (&[], "s.csv"),
         ("calibrate", "save_measurements") => (&[], "s.json"),
         ("calibrate", "trials" | "validation" | "max_iterations") => (&[], "3"),
         ("calibrate", "loss_scale") => (&[], "0.01"),

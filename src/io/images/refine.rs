@@ -146,7 +146,7 @@ mod tests {
         let mut data = Vec::with_capacity(n * n);
         for y in 0..n {
             for x in 0..n {
-                let mut s = 0.0;
+                let mut s = 0.0f64;
                 for sy in 0..8 {
                     for sx in 0..8 {
                         let u = x as f64 - 0.5 + (sx as f64 + 0.5) / 8.0 - cx;
@@ -230,7 +230,7 @@ mod tests {
         let mut data = Vec::with_capacity(n * n);
         for y in 0..n as i64 {
             for x in 0..n as i64 {
-                let mut s = 0.0;
+                let mut s = 0.0f64;
                 for (dy, wy) in [(-1, 1.0), (0, 2.0), (1, 1.0)] {
                     for (dx, wx) in [(-1, 1.0), (0, 2.0), (1, 1.0)] {
                         s += wx * wy * at(x + dx, y + dy);

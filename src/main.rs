@@ -314,6 +314,9 @@ use cli::acts_on::{self, Sensor};
 /// read: points and full poses are told apart once the file is read
 /// (`calibrate::from_measurements` checks again).
 fn calibrate_sensors(a: &cli::calibrate::CalibrateArgs) -> &'static [acts_on::Sensor] {
+    if a.images.is_some() {
+        return &[Sensor::Images];
+    }
     match (&a.observations, &a.measurements) {
         (Some(_), _) => &[Sensor::Pixels],
         (None, Some(m)) if cli::contact::is_contact_file(m) => &[Sensor::Contacts],

@@ -15,6 +15,7 @@ mod camera;
 mod camera_cli;
 mod camera_fisheye;
 mod camera_head;
+mod camera_images;
 mod camera_labels;
 mod camera_messy;
 mod camera_refuse;

@@ -29,6 +29,7 @@ impl SensorText for Sensor {
             Sensor::Poses => "full-pose measurements",
             Sensor::Contacts => "contacts",
             Sensor::Pixels => "--observations",
+            Sensor::Images => "--images",
             Sensor::Pool => "a pose pool",
             Sensor::Sockets => "--point",
             Sensor::Camera => "--camera-info",
@@ -42,6 +43,7 @@ impl SensorText for Sensor {
             Sensor::Poses => "--measurements of full poses (a file with orientations)",
             Sensor::Contacts => "--measurements of contacts (a 'point' or 'plane' column)",
             Sensor::Pixels => "--observations (a camera's pixels)",
+            Sensor::Images => "--images (a camera's images)",
             Sensor::Pool => "a pool of poses (select without --point or --camera-info)",
             Sensor::Sockets => "--point (configurations touching sockets)",
             Sensor::Camera => "--camera-info (poses chosen for a camera)",
@@ -138,7 +140,18 @@ const CALIBRATE_WHY: &[(&str, &str)] = &[
     ),
     ("inertia", "it is for --compliance"),
     ("payload", "it is for --compliance"),
-    ("report", "a camera fit's report is its text or --json"),
+    (
+        "report",
+        "a camera fit's report is its text or --json (with --images, --report writes the contact sheet)",
+    ),
+    (
+        "joints",
+        "--observations carry their joint values; --joints gives the images'",
+    ),
+    (
+        "save_observations",
+        "it writes the pixels detected in --images",
+    ),
     ("angle_unit", "no file of joint values is read"),
     ("length_unit", "no file of joint values is read"),
 ];

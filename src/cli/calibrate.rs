@@ -47,8 +47,8 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     }
     let desc = super::load_description(&a.robot)?;
     let robot = &desc.robot;
-    if let Some(obs) = &a.observations {
-        return match super::camera::calibrate_camera(&a, robot, obs)? {
+    if a.observations.is_some() || a.images.is_some() {
+        return match super::camera::calibrate_camera(&a, robot)? {
             Some(why) => Err(NotConverged(why).into()),
             None => Ok(()),
         };
@@ -86,8 +86,10 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
 }
 
 /// Every file of a `calibrate` run: the robot's (description, frames
-/// file), `--design`, `--measurements`, `--observations`, `--camera-info`,
+/// file), `--design`, `--measurements`, `--observations`, `--images` (each
+/// image), `--joints`, `--camera-info`,
 /// `--target`, `--inertia`; the `--out` files, `--save-measurements`,
+/// `--save-observations`,
 /// `--out-camera-info` and the `--report` directory. Checked once, before
 /// any work ([`super::run_files::RunFiles::check`]).
 fn calibrate_files(a: &CalibrateArgs) -> super::run_files::RunFiles {
@@ -96,14 +98,26 @@ fn calibrate_files(a: &CalibrateArgs) -> super::run_files::RunFiles {
         .input("--design", a.design.as_deref())
         .input("--measurements", a.measurements.as_deref())
         .input("--observations", a.observations.as_deref())
+        .inputs("--images", &image_inputs(a))
+        .input("--joints", a.joints.as_deref())
         .input("--camera-info", a.camera_info.as_deref())
         .input("--target", a.target.as_deref())
         .input("--inertia", a.inertia.as_deref())
         .outputs("--out", &a.out)
         .output("--save-measurements", a.save_measurements.as_deref())
         .output("--out-camera-info", a.out_camera_info.as_deref())
+        .output("--save-observations", a.save_observations.as_deref())
         .dir("--report", a.report.as_deref());
     f
+}
+
+/// The image files `--images` names (none when it names none: the
+/// reader says why).
+fn image_inputs(a: &CalibrateArgs) -> Vec<std::path::PathBuf> {
+    a.images
+        .as_deref()
+        .and_then(|s| activecal::io::images::files::image_files(s).ok())
+        .unwrap_or_default()
 }
 
 /// The restricted fit's lines beside the full fit, and the relations held.

@@ -9,6 +9,7 @@ use std::path::PathBuf;
 /// argument that conflicts with `--measurements`, such as `--design`, is
 /// given: they were silently ignored).
 #[derive(Args)]
+#[command(group(clap::ArgGroup::new("camera_data").args(["observations", "images"])))]
 pub struct CalibrateArgs {
     /// Robot: a built-in name, or a .toml description or .urdf file; append
     /// `:pose` for full-pose measurements.
@@ -16,7 +17,7 @@ pub struct CalibrateArgs {
     pub robot: activecal::io::RobotRef,
     /// Design file (JSON with robot, levels, poses), as written by `select`:
     /// measurements are simulated there.
-    #[arg(long, required_unless_present_any = ["measurements", "observations"])]
+    #[arg(long, required_unless_present_any = ["measurements", "observations", "images"])]
     pub design: Option<PathBuf>,
     /// Measurement file: identify from these real measurements instead of
     /// simulating a design. CSV (`x1,y1,z1`, `x2,y2,z2`… for several
@@ -230,19 +231,42 @@ pub struct CalibrateArgs {
         requires_all = ["camera_info", "target"]
     )]
     pub observations: Option<PathBuf>,
+    /// Calibrate from a camera's images: a directory of PNG images, a
+    /// pattern (`shots/pose_*.png`) or one image. The target's points are
+    /// detected in each image (a checkerboard's inner corners, seen whole),
+    /// refined with a window under half a square, and fitted as
+    /// --observations' pixels are; an image that cannot be used is listed
+    /// with its reason. Needs --joints, --camera-info, --target and
+    /// --mounting (or --camera-link).
+    #[arg(
+        long,
+        value_name = "DIR|GLOB",
+        conflicts_with_all = ["design", "measurements", "observations", "trials", "save_measurements", "noise", "validation"],
+        requires_all = ["camera_info", "target", "joints"]
+    )]
+    pub images: Option<PathBuf>,
+    /// With --images: the joint values of each image, a CSV `image,<joints
+    /// as in the URDF>` with one row per image (its file name).
+    #[arg(long, value_name = "FILE", requires = "images")]
+    pub joints: Option<PathBuf>,
+    /// With --images: write the pixels detected as an observations CSV
+    /// (what --observations reads; joint values in radians and metres), to
+    /// inspect or edit them. An existing file only with --force.
+    #[arg(long, value_name = "FILE.csv", requires = "images")]
+    pub save_observations: Option<PathBuf>,
     /// The camera's intrinsics: a ROS camera_info YAML or an OpenCV
     /// calibration YAML (plumb_bob or equidistant fisheye distortion).
-    #[arg(long, value_name = "FILE", requires = "observations")]
+    #[arg(long, value_name = "FILE", requires = "camera_data")]
     pub camera_info: Option<PathBuf>,
     /// The target's points: a YAML `checkerboard: {rows, cols, square}`
     /// (inner corners, metres), `charuco: {rows, cols, square, marker}`,
     /// `aprilgrid: {rows, cols, tag_size, tag_spacing}` or `points: [{id,
     /// xyz}, …]`.
-    #[arg(long, value_name = "FILE", requires = "observations")]
+    #[arg(long, value_name = "FILE", requires = "camera_data")]
     pub target: Option<PathBuf>,
     /// Where the camera is: eye-to-hand (fixed camera, target on the
     /// flange) or eye-in-hand (camera on the flange, fixed target).
-    #[arg(long, value_enum, requires = "observations")]
+    #[arg(long, value_enum, requires = "camera_data")]
     pub mounting: Option<MountingArg>,
     /// A camera on the robot's own link LINK (a head camera) seeing a
     /// target on the tip: the chain from LINK down to where the two
@@ -251,7 +275,7 @@ pub struct CalibrateArgs {
     #[arg(
         long,
         value_name = "LINK",
-        requires = "observations",
+        requires = "camera_data",
         conflicts_with = "mounting"
     )]
     pub camera_link: Option<String>,
@@ -267,7 +291,7 @@ pub struct CalibrateArgs {
         long,
         value_name = "X,Y,Z,ROLL,PITCH,YAW",
         allow_hyphen_values = true,
-        requires = "observations"
+        requires = "camera_data"
     )]
     pub camera_pose: Option<String>,
     /// The target's frame (its points' frame), roughly: in the tip link
@@ -277,14 +301,14 @@ pub struct CalibrateArgs {
         long,
         value_name = "X,Y,Z,ROLL,PITCH,YAW",
         allow_hyphen_values = true,
-        requires = "observations"
+        requires = "camera_data"
     )]
     pub target_pose: Option<String>,
     /// With --observations: fit the camera's intrinsics too (fx, fy, cx,
     /// cy and the distortion's coefficients: plumb_bob's k1, k2, p1, p2,
     /// k3 or equidistant's k1 … k4; started from --camera-info),
     /// each reported with its σ.
-    #[arg(long, requires = "observations")]
+    #[arg(long, requires = "camera_data")]
     pub refine_intrinsics: bool,
     /// With --refine-intrinsics: write the refined intrinsics as a ROS
     /// camera_info YAML (written only when the fit converged; an existing

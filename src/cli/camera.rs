@@ -65,11 +65,7 @@ fn check_out(a: &CalibrateArgs, robot: &Robot) -> Result<()> {
 /// library refuses the fit (it did not converge or cannot be right,
 /// `activecal::experiment::camera::verdict`: the report is printed,
 /// nothing written).
-pub fn calibrate_camera(
-    a: &CalibrateArgs,
-    robot: &Robot,
-    obs_path: &Path,
-) -> Result<Option<String>> {
+pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot) -> Result<Option<String>> {
     check_out(a, robot)?;
     check_camera_info_out(a)?;
     let (Some(info), Some(target)) = (&a.camera_info, &a.target) else {
@@ -91,7 +87,18 @@ pub fn calibrate_camera(
     let intrinsics = read_camera_info(info).context("--camera-info")?;
     let target_origin = target.display().to_string();
     let target = read_target(target).context("--target")?;
-    let obs = read_observations(obs_path, robot, &target, &intrinsics, a.units.units())?;
+    let (obs_path, obs, images) = match (&a.observations, &a.images) {
+        (Some(p), _) => (
+            p.as_path(),
+            read_observations(p, robot, &target, &intrinsics, a.units.units())?,
+            None,
+        ),
+        (None, Some(spec)) => {
+            let read = super::camera_images::read(a, robot, spec, &target, &intrinsics)?;
+            (spec.as_path(), read.observations.clone(), Some(read))
+        }
+        (None, None) => bail!("give --observations (pixels) or --images"),
+    };
     let parse =
         |flag: &str, s: &Option<String>| s.as_ref().map(|s| parse_placement(flag, s)).transpose();
     let setup = CameraSetup {
@@ -141,7 +148,14 @@ pub fn calibrate_camera(
         write_camera_info(o, &cal, obs_path, a.force)?;
         written.push(o.display().to_string());
     }
-    let v = serde_json::to_value(cal.report(written.clone()))?;
+    if let (Some(dir), Some(read)) = (&a.report, &images) {
+        super::camera_images::write_sheet(dir, read, &cal, &setup.target, a.force)?;
+        written.push(dir.join("contact_sheet.png").display().to_string());
+    }
+    let mut v = serde_json::to_value(cal.report(written.clone()))?;
+    if let (Some(read), Some(m)) = (&images, v.as_object_mut()) {
+        m.insert("images".into(), serde_json::to_value(&read.images)?);
+    }
     super::emit(a.json, &v, || {
         text(
             fit,

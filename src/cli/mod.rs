@@ -8,6 +8,7 @@ pub mod calibrate;
 pub mod calibrate_args;
 pub mod calibrated;
 pub mod camera;
+pub mod camera_images;
 pub mod camera_opts;
 pub mod camera_select;
 pub mod compliance;

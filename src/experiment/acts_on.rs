@@ -22,6 +22,9 @@ pub enum Sensor {
     Contacts,
     /// Calibration from a camera's pixels.
     Pixels,
+    /// Calibration from a camera's images (its pixels detected by
+    /// activecal).
+    Images,
     /// Selection from a pool of poses (points, markers or full poses).
     Pool,
     /// Selection of configurations touching sockets.
@@ -40,6 +43,7 @@ impl Sensor {
             Sensor::Poses => "measured full poses (with orientations)",
             Sensor::Contacts => "contacts",
             Sensor::Pixels => "a camera's pixels",
+            Sensor::Images => "a camera's images",
             Sensor::Pool => "a pool of poses",
             Sensor::Sockets => "configurations touching sockets",
             Sensor::Camera => "poses chosen for a camera",
@@ -56,17 +60,19 @@ pub struct ActsOn {
     pub sensors: &'static [Sensor],
 }
 
-use Sensor::{Camera, Contacts, Pixels, Points, Pool, Poses, Simulated, Sockets};
+use Sensor::{Camera, Contacts, Images, Pixels, Points, Pool, Poses, Simulated, Sockets};
 
 const fn a(id: &'static str, sensors: &'static [Sensor]) -> ActsOn {
     ActsOn { id, sensors }
 }
 
-const CAL_ALL: &[Sensor] = &[Simulated, Points, Poses, Contacts, Pixels];
+const CAL_ALL: &[Sensor] = &[Simulated, Points, Poses, Contacts, Pixels, Images];
+/// A camera's pixels, given or detected in its images.
+const CAMERA_DATA: &[Sensor] = &[Pixels, Images];
 /// Measured points or full poses: told apart once the data are read.
 pub const MEASURED: &[Sensor] = &[Points, Poses];
 const FITTED: &[Sensor] = &[Points, Poses, Contacts];
-const READ: &[Sensor] = &[Points, Poses, Contacts, Pixels];
+const READ: &[Sensor] = &[Points, Poses, Contacts, Pixels, Images];
 const SEL_ALL: &[Sensor] = &[Pool, Sockets, Camera];
 const EVAL_ALL: &[Sensor] = &[Points, Poses, Contacts];
 
@@ -90,7 +96,7 @@ pub const CALIBRATE: &[ActsOn] = &[
     a("outliers", READ),
     a("outlier_rate", READ),
     a("orientation_noise", &[Poses]),
-    a("pixel_noise", &[Pixels]),
+    a("pixel_noise", CAMERA_DATA),
     a("seed", &[Simulated, Points, Poses]),
     a("trials", &[Simulated]),
     a("validation", &[Simulated]),
@@ -117,16 +123,19 @@ pub const CALIBRATE: &[ActsOn] = &[
     a("compare_compliance", MEASURED),
     a("inertia", MEASURED),
     a("payload", MEASURED),
-    a("report", &[Simulated, Points, Poses, Contacts]),
+    a("report", &[Simulated, Points, Poses, Contacts, Images]),
     a("observations", &[Pixels]),
-    a("camera_info", &[Pixels]),
-    a("target", &[Pixels]),
-    a("mounting", &[Pixels]),
-    a("camera_link", &[Pixels]),
-    a("camera_pose", &[Pixels]),
-    a("target_pose", &[Pixels]),
-    a("refine_intrinsics", &[Pixels]),
-    a("out_camera_info", &[Pixels]),
+    a("images", &[Images]),
+    a("joints", &[Images]),
+    a("save_observations", &[Images]),
+    a("camera_info", CAMERA_DATA),
+    a("target", CAMERA_DATA),
+    a("mounting", CAMERA_DATA),
+    a("camera_link", CAMERA_DATA),
+    a("camera_pose", CAMERA_DATA),
+    a("target_pose", CAMERA_DATA),
+    a("refine_intrinsics", CAMERA_DATA),
+    a("out_camera_info", CAMERA_DATA),
     a("angle_unit", READ),
     a("length_unit", READ),
     a("json", CAL_ALL),

@@ -24,6 +24,7 @@ use crate::model::Robot;
 use crate::report::{CameraCalibrationReport, CameraStartReport};
 use nalgebra::Isometry3;
 
+pub mod images;
 pub mod verdict;
 
 /// What a camera calibration is given besides the robot and the

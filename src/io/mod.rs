@@ -13,6 +13,7 @@ pub mod contacts;
 pub mod design;
 pub mod design_formats;
 pub mod frames_file;
+pub mod images;
 pub mod inertia;
 pub mod joint_speeds;
 pub mod kinematics_yaml;

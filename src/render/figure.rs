@@ -53,7 +53,10 @@ pub(crate) fn write_figure(base: &Path, rgb: &[u8], size: (u32, u32), svg: &str)
 }
 
 /// Encodes RGB pixels (row by row, 8 bits a channel) as a PNG file's bytes.
-fn png_bytes(rgb: &[u8], (width, height): (u32, u32)) -> Result<Vec<u8>, png::EncodingError> {
+pub(crate) fn png_bytes(
+    rgb: &[u8],
+    (width, height): (u32, u32),
+) -> Result<Vec<u8>, png::EncodingError> {
     let mut out = Vec::new();
     let mut encoder = png::Encoder::new(&mut out, width, height);
     encoder.set_color(png::ColorType::Rgb);

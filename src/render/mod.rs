@@ -6,6 +6,7 @@
 //! both call these; nothing here prints or names a flag.
 
 pub mod contact_figures;
+pub mod contact_sheet;
 pub(crate) mod figure;
 pub mod folder;
 pub mod frames_text;

@@ -34,6 +34,8 @@ mod live_gravity;
 #[cfg(feature = "live")]
 mod live_idjac;
 #[cfg(feature = "live")]
+mod live_images;
+#[cfg(feature = "live")]
 mod live_messy;
 #[cfg(feature = "live")]
 mod live_messy_camera;

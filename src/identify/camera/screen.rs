@@ -213,6 +213,27 @@ fn rest_tail(tester: &Tester, i: usize, t: usize, point: usize) -> Option<f64> {
     Some(p)
 }
 
+/// Each point's residual at `fit`'s estimate, px: its prediction less
+/// its pixel, pose by pose of `obs` (as fitted) in target order; `None`
+/// where the point was not seen.
+#[must_use]
+pub fn pixel_residuals(fit: &CameraFit, obs: &CameraObservations) -> Vec<Vec<Option<[f64; 2]>>> {
+    let mut prob = problem(fit, obs);
+    let mut r = vec![0.0; prob.n_residuals()];
+    prob.eval(&fit.estimate, &mut r, None);
+    let t = r.len() / obs.seen.len().max(1);
+    obs.seen
+        .iter()
+        .enumerate()
+        .map(|(i, seen)| {
+            seen.iter()
+                .enumerate()
+                .map(|(k, s)| s.map(|_| [r[i * t + 2 * k], r[i * t + 2 * k + 1]]))
+                .collect()
+        })
+        .collect()
+}
+
 /// The RMS pixel distance of `unit`'s points seen (of `obs`, the
 /// observations given) from their prediction by `fit`.
 fn residual_px(fit: &CameraFit, obs: &CameraObservations, unit: CameraUnit) -> f64 {

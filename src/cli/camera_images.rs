@@ -1,0 +1,68 @@
+//! `calibrate --images DIR|GLOB --joints joints.csv`: the images read into
+//! the camera's observations by the library (`activecal::io::images`),
+//! `--save-observations` written before the fit, and with `--report DIR`
+//! the contact sheet after it.
+
+use super::calibrate_args::CalibrateArgs;
+use activecal::experiment::camera::CameraCalibration;
+use activecal::experiment::camera::images::sheet_images;
+use activecal::io::camera_observations::observations_csv;
+use activecal::io::camera_target::Target;
+use activecal::io::images::joints::read_image_joints;
+use activecal::io::images::{ImageObservations, read_images};
+use activecal::measure::pinhole::Intrinsics;
+use activecal::model::Robot;
+use anyhow::{Context, Result, bail};
+use std::path::Path;
+
+/// Reads the images of `spec` with `--joints`' values, prints a line per
+/// image (without `--json`: the report has them); writes
+/// `--save-observations` (atomically, never over an existing file without
+/// `--force`; the command's files were checked against each other before).
+pub fn read(
+    a: &CalibrateArgs,
+    robot: &Robot,
+    spec: &Path,
+    target: &Target,
+    intrinsics: &Intrinsics,
+) -> Result<ImageObservations> {
+    let Some(joints) = &a.joints else {
+        bail!("--images needs --joints (the joint values of each image)");
+    };
+    let joints = read_image_joints(joints, robot, a.units.units()).context("--joints")?;
+    let read = read_images(spec, &joints, target, intrinsics).context("--images")?;
+    // What became of each image, before the fit (which may refuse them).
+    if !a.json {
+        for line in activecal::experiment::camera::images::image_lines(&read.images) {
+            println!("{line}");
+        }
+    }
+    if let Some(path) = &a.save_observations {
+        let text = observations_csv(&read.observations, robot, target);
+        super::write_new(path, &text, a.force).context("--save-observations")?;
+    }
+    Ok(read)
+}
+
+/// Writes `dir` (replaced whole, atomically) with `contact_sheet.png` and
+/// `images.json` (what became of each image).
+pub fn write_sheet(
+    dir: &Path,
+    read: &ImageObservations,
+    cal: &CameraCalibration,
+    target: &Target,
+    force: bool,
+) -> Result<()> {
+    super::run_files::check_dir("--report", dir, force)?;
+    let cols = target.grid.map_or(1, |g| g.1);
+    let staged = activecal::io::atomic::StagedDir::new(dir)?;
+    let sheet = sheet_images(read, Some(cal), cols);
+    activecal::render::contact_sheet::write_contact_sheet(
+        &staged.path().join("contact_sheet.png"),
+        &sheet,
+    )?;
+    let json = serde_json::to_string_pretty(&read.images)?;
+    activecal::io::atomic::write_atomic(&staged.path().join("images.json"), json.as_bytes())?;
+    staged.commit()?;
+    Ok(())
+}

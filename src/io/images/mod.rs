@@ -1,0 +1,240 @@
+//! A camera's images read into its observations
+//! ([`CameraObservations`], what the observations CSV gives): the target's
+//! points detected in each image ([`detect`]), refined to a fraction of a
+//! pixel with a window under half a square ([`refine`]), and paired with
+//! the joint values at which the image was taken ([`joints`]).
+//!
+//! Each image is one pose, whose id is the image's place in the sorted
+//! list of files ([`files`]). An image that cannot be used is left out
+//! with its reason (unreadable, another size than the camera_info's, no
+//! board, the board not seen whole); one that can is reported with the
+//! points found, the shortest square side, the refinement's window and
+//! shift, and the edges' width (sharpness). An image without a row in the
+//! joints file is refused before any detection: its pose is unknown.
+//!
+//! Only checkerboards are detected (the `checkerboard:` target); ChArUco
+//! boards and AprilGrids are refused with that reason.
+
+pub mod decode;
+pub mod detect;
+pub mod files;
+pub mod joints;
+pub mod refine;
+
+use super::camera_target::Target;
+use crate::error::{Error, Result};
+use crate::identify::camera::CameraObservations;
+use crate::measure::camera::MIN_POINTS_PER_POSE;
+use crate::measure::pinhole::Intrinsics;
+use joints::ImageJoints;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// What became of one image.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ImageReport {
+    /// The image's file name.
+    pub file: String,
+    /// Its pose id in the observations, when it was used.
+    pub pose: Option<i64>,
+    /// Found or left out.
+    #[serde(flatten)]
+    pub outcome: ImageOutcome,
+}
+
+/// An image used, with its figures, or left out, with the reason.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum ImageOutcome {
+    /// The board was found.
+    Found {
+        /// Points found and refined.
+        points: usize,
+        /// The shortest square side over the board, px.
+        square_px: f64,
+        /// The refinement's half window: the smallest and largest over
+        /// the points, px (0: a corner kept as the detector placed it,
+        /// [`refine::MIN_HALF_WINDOW`], [`refine::MAX_SHIFT`]).
+        window_px: [usize; 2],
+        /// How far the refinement moved the detector's corners: median and
+        /// largest, px.
+        shift_px: [f64; 2],
+        /// The edges' width at the corners, median, px
+        /// ([`refine::edge_width`]: 2 px for an edge sharp to the pixel).
+        edge_width_px: f64,
+    },
+    /// The image was left out.
+    LeftOut {
+        /// Why, in words.
+        reason: String,
+    },
+}
+
+/// A camera's images read: the observations of the images used, and the
+/// report of every image.
+#[derive(Clone, Debug)]
+pub struct ImageObservations {
+    /// The observations: one pose per image used.
+    pub observations: CameraObservations,
+    /// Every image, in order, with what became of it.
+    pub images: Vec<ImageReport>,
+    /// Every image's path, in the same order.
+    pub files: Vec<PathBuf>,
+}
+
+/// Reads the images `spec` names ([`files::image_files`]) with the joint
+/// values of `joints`, for the camera `intrinsics` and the `target`.
+pub fn read_images(
+    spec: &Path,
+    joints: &ImageJoints,
+    target: &Target,
+    intrinsics: &Intrinsics,
+) -> Result<ImageObservations> {
+    let origin = spec.display().to_string();
+    let Some((rows, cols)) = target.grid else {
+        return Err(Error::Parse {
+            path: origin,
+            message: "activecal detects checkerboards in images (a 'checkerboard:' target); ChArUco boards, AprilGrids and point lists are not detected yet: detect their points yourself and give them as --observations".into(),
+        });
+    };
+    let files = files::image_files(spec)?;
+    let names: Vec<String> = files
+        .iter()
+        .map(|f| {
+            f.file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        })
+        .collect();
+    if let Some(n) = names.iter().find(|n| joints.of(n).is_none()) {
+        return Err(Error::Parse {
+            path: joints.origin.clone(),
+            message: format!(
+                "no row for image '{n}' (of {origin}): each image needs its joint values, in a row whose 'image' cell is its file name"
+            ),
+        });
+    }
+    let mut obs = CameraObservations {
+        origin: origin.clone(),
+        pose_ids: Vec::new(),
+        qs: Vec::new(),
+        seen: Vec::new(),
+    };
+    let mut images = Vec::new();
+    for (k, (path, name)) in files.iter().zip(&names).enumerate() {
+        let outcome = match one_image(path, rows, cols, intrinsics) {
+            Ok((seen, outcome)) => {
+                obs.pose_ids.push(k as i64);
+                obs.qs.push(joints.of(name).unwrap_or_default().to_vec());
+                obs.seen.push(seen);
+                outcome
+            }
+            Err(reason) => ImageOutcome::LeftOut { reason },
+        };
+        images.push(ImageReport {
+            file: name.clone(),
+            pose: matches!(outcome, ImageOutcome::Found { .. }).then_some(k as i64),
+            outcome,
+        });
+    }
+    if obs.pose_ids.is_empty() {
+        let why: Vec<String> = images
+            .iter()
+            .filter_map(|r| match &r.outcome {
+                ImageOutcome::LeftOut { reason } => Some(format!("{}: {reason}", r.file)),
+                ImageOutcome::Found { .. } => None,
+            })
+            .collect();
+        return Err(Error::Parse {
+            path: origin,
+            message: format!("no image could be used:\n  {}", why.join("\n  ")),
+        });
+    }
+    Ok(ImageObservations {
+        observations: obs,
+        images,
+        files,
+    })
+}
+
+/// One image's points (by target id) and figures, or why it is left out.
+fn one_image(
+    path: &Path,
+    rows: usize,
+    cols: usize,
+    intrinsics: &Intrinsics,
+) -> std::result::Result<(Vec<Option<[f64; 2]>>, ImageOutcome), String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("unreadable ({e})"))?;
+    let img = decode::decode_png(&bytes)?;
+    let (w, h) = (intrinsics.width as usize, intrinsics.height as usize);
+    if (img.width, img.height) != (w, h) {
+        return Err(format!(
+            "{} × {} px, the camera_info's images are {w} × {h} px",
+            img.width, img.height
+        ));
+    }
+    let found = detect::find_checkerboard(&img, rows, cols)?;
+    let mut seen = vec![None; rows * cols];
+    let (mut shifts, mut widths, mut windows) = (Vec::new(), Vec::new(), Vec::new());
+    for (k, (p, s)) in found.px.iter().zip(&found.square_px).enumerate() {
+        let half = refine::half_window(*s);
+        let refined = (half >= refine::MIN_HALF_WINDOW)
+            .then(|| refine::refine_corner(&img, *p, half))
+            .flatten()
+            .filter(|r| r.shift <= refine::MAX_SHIFT);
+        // Not refined (a window too small, or a move too long to be this
+        // corner's): the detector's corner.
+        let r = refined.unwrap_or(refine::Refined { px: *p, shift: 0.0 });
+        let half = if refined.is_some() { half } else { 0 };
+        let inside =
+            (-0.5..w as f64 - 0.5).contains(&r.px[0]) && (-0.5..h as f64 - 0.5).contains(&r.px[1]);
+        if !inside {
+            continue;
+        }
+        seen[k] = Some(r.px);
+        shifts.push(r.shift);
+        windows.push(half);
+        if let Some(e) = refine::edge_width(&img, r.px, half) {
+            widths.push(e);
+        }
+    }
+    if shifts.len() < MIN_POINTS_PER_POSE {
+        return Err(format!(
+            "{} of {} corners refined; a pose needs at least {MIN_POINTS_PER_POSE}",
+            shifts.len(),
+            rows * cols
+        ));
+    }
+    let outcome = ImageOutcome::Found {
+        points: shifts.len(),
+        square_px: found
+            .square_px
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min),
+        window_px: [
+            windows.iter().copied().min().unwrap_or(0),
+            windows.iter().copied().max().unwrap_or(0),
+        ],
+        shift_px: [
+            median(&mut shifts.clone()),
+            shifts.iter().copied().fold(0.0, f64::max),
+        ],
+        edge_width_px: median(&mut widths),
+    };
+    Ok((seen, outcome))
+}
+
+/// The median of `v` (NaN when empty).
+fn median(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}

@@ -1,0 +1,191 @@
+//! `activecal extract BAG`: a ROS 2 bag's rests into the measurement CSV
+//! `calibrate --measurements` reads (the library's `io::bag::extract` does
+//! the work; here the flags are parsed and the report rendered).
+
+use super::emit_report;
+use activecal::io::bag::extract::{ExtractReport, ExtractSettings, extract};
+use activecal::io::bag::series::Source;
+use anyhow::{Result, bail};
+use clap::{ArgGroup, Args};
+use std::path::PathBuf;
+
+/// The options of `extract`.
+#[derive(Args, Debug)]
+#[command(group(ArgGroup::new("measurement").required(true).args(["points", "poses", "tf"])))]
+pub struct ExtractArgs {
+    /// The bag: a rosbag2 folder (with its metadata.yaml), or one .mcap or
+    /// .db3 file.
+    pub bag: PathBuf,
+    /// The robot whose joints /joint_states gives (by name) and whose
+    /// nominal model predicts the moves for the clock offset.
+    #[arg(long, value_parser = super::parse_robot)]
+    pub robot: activecal::io::RobotRef,
+    /// The sensor_msgs/msg/JointState topic.
+    #[arg(long, value_name = "TOPIC", default_value = "/joint_states")]
+    pub joints: String,
+    /// A geometry_msgs/msg/PointStamped topic: a tracker's point.
+    #[arg(long, value_name = "TOPIC")]
+    pub points: Option<String>,
+    /// A geometry_msgs/msg/PoseStamped or TransformStamped topic: a
+    /// motion-capture body's pose.
+    #[arg(long, value_name = "TOPIC")]
+    pub poses: Option<String>,
+    /// The transform PARENT → CHILD of /tf and /tf_static (static
+    /// transforms composed with one moving transform).
+    #[arg(long, value_name = "PARENT:CHILD")]
+    pub tf: Option<String>,
+    /// The measurement CSV to write (what `calibrate --measurements` reads).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Overwrite --out if it exists (never an input).
+    #[arg(long)]
+    pub force: bool,
+    /// The clock offset, seconds: the measurement's stamp minus the joint
+    /// stamp of the same instant. Estimated from the moves when not given.
+    #[arg(long, value_name = "S", allow_hyphen_values = true)]
+    pub time_offset: Option<f64>,
+    /// The largest clock offset searched for, seconds.
+    #[arg(long, value_name = "S", default_value_t = 10.0)]
+    pub max_offset: f64,
+    /// A joint is at rest under this speed (rad/s, m/s for prismatic).
+    #[arg(long, value_name = "SPEED", default_value_t = 0.005)]
+    pub rest_speed: f64,
+    /// The shortest rest period, seconds.
+    #[arg(long, value_name = "S", default_value_t = 0.5)]
+    pub rest_min: f64,
+    /// Seconds left out at the start of each rest while the arm settles.
+    #[arg(long, value_name = "S", default_value_t = 0.2)]
+    pub settle: f64,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl ExtractArgs {
+    fn source(&self) -> Result<Source> {
+        Ok(match (&self.points, &self.poses, &self.tf) {
+            (Some(t), _, _) => Source::Points(t.clone()),
+            (_, Some(t), _) => Source::Poses(t.clone()),
+            (_, _, Some(pc)) => {
+                let Some((parent, child)) = pc.split_once(':') else {
+                    bail!("--tf {pc}: give PARENT:CHILD, two frame names");
+                };
+                if parent.is_empty() || child.is_empty() {
+                    bail!("--tf {pc}: give PARENT:CHILD, two frame names");
+                }
+                Source::Tf {
+                    parent: parent.to_string(),
+                    child: child.to_string(),
+                }
+            }
+            _ => bail!("give the measurement: --points, --poses or --tf"),
+        })
+    }
+
+    /// The library's settings from the flags.
+    pub fn settings(&self) -> Result<ExtractSettings> {
+        let mut s = ExtractSettings::new(&self.joints, self.source()?);
+        s.rest.speed = self.rest_speed;
+        s.rest.min_duration = self.rest_min;
+        s.rest.settle = self.settle;
+        s.time_offset = self.time_offset;
+        if !(self.max_offset.is_finite() && self.max_offset >= 0.0) {
+            bail!("--max-offset {}: give seconds, 0 or more", self.max_offset);
+        }
+        s.max_offset = self.max_offset;
+        if let Some(o) = s.time_offset
+            && !o.is_finite()
+        {
+            bail!("--time-offset {o}: not a number of seconds");
+        }
+        Ok(s)
+    }
+}
+
+/// Runs `extract`.
+pub fn cmd_extract(a: ExtractArgs) -> Result<()> {
+    use activecal::io::atomic::{Output, check_outputs, write_atomic};
+    let settings = a.settings()?;
+    if let Some(out) = &a.out {
+        check_outputs(
+            &[Output {
+                label: "--out",
+                path: out,
+            }],
+            &[a.bag.as_path()],
+            a.force,
+        )?;
+        if out.starts_with(&a.bag) {
+            bail!("--out {}: inside the bag {}; choose another place", out.display(), a.bag.display());
+        }
+    }
+    let robot = super::load_robot(&a.robot)?;
+    let got = extract(&a.bag, &robot, &settings)?;
+    if let Some(out) = &a.out {
+        let csv = activecal::io::measurements::to_csv(&got.measurements, &robot);
+        write_atomic(out, csv.as_bytes())?;
+    }
+    let r = &got.report;
+    emit_report(a.json, r, || text(r, a.out.as_ref()))
+}
+
+fn text(r: &ExtractReport, out: Option<&PathBuf>) -> String {
+    let mut s = format!(
+        "{}: '{}' {} samples at {:.1} Hz; {} {} samples at {:.1} Hz\n",
+        r.bag,
+        r.joints,
+        r.joint_samples,
+        r.joint_rate,
+        r.source,
+        r.measurement_samples,
+        r.measurement_rate
+    );
+    let c = &r.clock;
+    s += &match &c.estimate {
+        Some(e) => format!(
+            "clock offset: estimated {:.4} s ± {:.4} s from {} moves; applied {:.4} s ({})\n",
+            e.seconds, e.uncertainty, e.moves, c.applied, c.note
+        ),
+        None => format!("clock offset: {:.4} s ({})\n", c.applied, c.note),
+    };
+    s += &format!(
+        "rests: {} found (speed under {} rad/s for at least {} s, the first {} s left out), {} kept\n",
+        r.rests.len(),
+        r.settings.speed,
+        r.settings.min_duration,
+        r.settings.settle,
+        r.kept()
+    );
+    s += "rest  start s  length s  samples  scatter mm  left out\n";
+    let t0 = r.rests.first().map_or(0.0, |x| x.rest.start);
+    for (k, x) in r.rests.iter().enumerate() {
+        let (n, sc) = x
+            .averaged
+            .as_ref()
+            .map_or(("-".into(), "-".into()), |a| {
+                (a.samples.to_string(), format!("{:.4}", a.scatter * 1e3))
+            });
+        s += &format!(
+            "{:>4}  {:>7.2}  {:>8.2}  {:>7}  {:>10}  {}\n",
+            k + 1,
+            x.rest.start - t0,
+            x.rest.end - x.rest.start,
+            n,
+            sc,
+            x.left_out.as_deref().unwrap_or("")
+        );
+    }
+    s += &format!(
+        "noise: one sample's scatter {:.4} mm per coordinate (median rest), an averaged pose's {:.5} mm",
+        r.scatter * 1e3,
+        r.averaged_noise * 1e3
+    );
+    if let Some(o) = r.orientation_scatter {
+        s += &format!("; orientation {:.4}° per axis", o.to_degrees());
+    }
+    s += "\n";
+    if let Some(out) = out {
+        s += &format!("wrote {} ({} poses)\n", out.display(), r.kept());
+    }
+    s
+}

@@ -166,24 +166,40 @@ fn refine(pred: &Profile, mt: &[f64], ms: &[Option<f64>], idx: &[usize], s0: f64
     if idx.len() < 10 || peak < 0.01 {
         return None;
     }
-    let mut s = s0;
-    for _ in 0..20 {
-        let (mut jtj, mut jtr) = (0.0, 0.0);
-        for &i in idx {
+    // Slow samples are left out: a measured speed is the magnitude of a
+    // noisy difference, biased up by about σ²/(2v) where v is small.
+    let idx: Vec<usize> = idx
+        .iter()
+        .copied()
+        .filter(|&i| pred.at(mt[i] - s0).is_some_and(|p| p > 0.2 * peak))
+        .collect();
+    // Unknowns: the offset and a scale of the predicted speed (the nominal
+    // model's point is not the true one: millimetres over half a metre).
+    let (mut s, mut k) = (s0, 1.0);
+    for _ in 0..30 {
+        let (mut a, mut b, mut c, mut gk, mut gs) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        for &i in &idx {
             let (Some(v), Some(p), Some(d)) = (ms[i], pred.at(mt[i] - s), pred.slope(mt[i] - s))
             else {
                 continue;
             };
-            // r = v - p(t - s); dr/ds = p'(t - s).
-            jtj += d * d;
-            jtr += d * (v - p);
+            // r = v - k p(t - s); dr/dk = -p, dr/ds = k p'(t - s).
+            let (jk, js, r) = (-p, k * d, v - k * p);
+            a += jk * jk;
+            b += jk * js;
+            c += js * js;
+            gk += jk * r;
+            gs += js * r;
         }
-        if jtj <= 0.0 {
+        let det = a * c - b * b;
+        if det <= 0.0 {
             return None;
         }
-        let step = -jtr / jtj;
-        s += step.clamp(-0.02, 0.02);
-        if step.abs() < 1e-7 {
+        let dk = -(c * gk - b * gs) / det;
+        let ds = -(a * gs - b * gk) / det;
+        k += dk;
+        s += ds.clamp(-0.02, 0.02);
+        if ds.abs() < 1e-7 {
             return ((s - s0).abs() < 0.05).then_some(s);
         }
     }

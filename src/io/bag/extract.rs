@@ -194,7 +194,8 @@ fn judge(st: &Streams, rests: &[rest::Rest], s: &RestSettings, offset: f64) -> V
     let mut out: Vec<RestRecord> = rests
         .iter()
         .map(|r| {
-            let averaged = rest::average(&st.joints, &st.meas, r, s.settle, offset);
+            let averaged =
+                rest::average(&st.joints, &st.meas, r, [s.settle, s.window / 2.0], offset);
             let left_out = match &averaged {
                 None => Some("no measurement during the rest".to_string()),
                 Some(a) if a.longest_gap > s.max_gap_intervals * dt => Some(format!(

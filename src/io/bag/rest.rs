@@ -55,10 +55,15 @@ impl RestSettings {
                 return Err(format!("the {name} must be a positive number, not {v}"));
             }
         }
-        if !(self.settle.is_finite() && self.settle >= 0.0 && self.settle < self.min_duration) {
+        if !(self.settle.is_finite()
+            && self.settle >= 0.0
+            && self.settle + self.window / 2.0 < self.min_duration)
+        {
             return Err(format!(
-                "the settling time ({} s) must be at least 0 and shorter than the shortest rest ({} s)",
-                self.settle, self.min_duration
+                "the settling time ({} s) must be at least 0 and, with the {} s trimmed at a rest's end, shorter than the shortest rest ({} s)",
+                self.settle,
+                self.window / 2.0,
+                self.min_duration
             ));
         }
         Ok(())
@@ -167,17 +172,19 @@ pub struct Averaged {
 }
 
 /// Averages the joints and the measurement over `rest` after the settling
-/// time; measurement stamps are moved by `-offset` onto the joint clock.
-/// `None` when the window holds no measurement sample.
+/// time `settle` and before its last `trim` seconds (half the speed
+/// window: a rest's last samples see the next move starting);
+/// measurement stamps are moved by `-offset` onto the joint clock. `None`
+/// when the window holds no measurement sample.
 #[must_use]
 pub fn average(
     j: &JointSeries,
     m: &MeasSeries,
     rest: &Rest,
-    settle: f64,
+    [settle, trim]: [f64; 2],
     offset: f64,
 ) -> Option<Averaged> {
-    let (t0, t1) = (rest.start + settle, rest.end);
+    let (t0, t1) = (rest.start + settle, rest.end - trim);
     let (a, b) = (lower_bound(&j.t, t0), lower_bound(&j.t, t1 + 1e-12));
     let dof = j.q.first().map_or(0, Vec::len);
     let mut q = vec![0.0; dof];
@@ -291,10 +298,10 @@ mod tests {
             p: (0..300).map(|k| [if k < 150 { 1.0 } else { 2.0 }, 0.0, 0.0]).collect(),
             r: Vec::new(),
         };
-        let a = average(&j, &m, &rests[0], 0.2, 2.0).unwrap();
+        let a = average(&j, &m, &rests[0], [0.2, 0.05], 2.0).unwrap();
         assert_eq!(a.position, [1.0, 0.0, 0.0]);
         assert_eq!(a.scatter, 0.0);
         assert!(a.longest_gap <= 0.011, "{a:?}");
-        assert!(average(&j, &m, &rests[1], 0.2, 10.0).is_none());
+        assert!(average(&j, &m, &rests[1], [0.2, 0.05], 10.0).is_none());
     }
 }

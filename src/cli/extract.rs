@@ -116,7 +116,11 @@ pub fn cmd_extract(a: ExtractArgs) -> Result<()> {
             a.force,
         )?;
         if out.starts_with(&a.bag) {
-            bail!("--out {}: inside the bag {}; choose another place", out.display(), a.bag.display());
+            bail!(
+                "--out {}: inside the bag {}; choose another place",
+                out.display(),
+                a.bag.display()
+            );
         }
     }
     let robot = super::load_robot(&a.robot)?;
@@ -159,12 +163,9 @@ fn text(r: &ExtractReport, out: Option<&PathBuf>) -> String {
     s += "rest  start s  length s  samples  scatter mm  left out\n";
     let t0 = r.rests.first().map_or(0.0, |x| x.rest.start);
     for (k, x) in r.rests.iter().enumerate() {
-        let (n, sc) = x
-            .averaged
-            .as_ref()
-            .map_or(("-".into(), "-".into()), |a| {
-                (a.samples.to_string(), format!("{:.4}", a.scatter * 1e3))
-            });
+        let (n, sc) = x.averaged.as_ref().map_or(("-".into(), "-".into()), |a| {
+            (a.samples.to_string(), format!("{:.4}", a.scatter * 1e3))
+        });
         s += &format!(
             "{:>4}  {:>7.2}  {:>8.2}  {:>7}  {:>10}  {}\n",
             k + 1,

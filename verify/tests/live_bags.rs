@@ -51,10 +51,7 @@ fn ur5() -> String {
 }
 
 fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!(
-        "activecal-live-bags-{name}-{}",
-        std::process::id()
-    ));
+    let d = std::env::temp_dir().join(format!("activecal-live-bags-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
@@ -81,14 +78,42 @@ fn setup(d: &Path, seed: u64, pose: bool) -> String {
     }
     make.extend(["--out", "truth.json"]);
     python(d, "truth.py", &make);
-    python(d, "truth.py", &["sensor-frames", "--truth", "truth.json", "--out", "nominal.yaml"]);
+    python(
+        d,
+        "truth.py",
+        &[
+            "sensor-frames",
+            "--truth",
+            "truth.json",
+            "--out",
+            "nominal.yaml",
+        ],
+    );
     let robot = if pose { format!("{u}:pose") } else { u };
     activecal(
         d,
         [
-            "select", "--robot", &robot, "--frames", "nominal.yaml", "--pool", "random",
-            "--count", "2048", "--pool-seed", &s, "--n", "30", "--noise", "5e-5", "--seed", &s,
-            "--out", "design.csv", "--force", "--json",
+            "select",
+            "--robot",
+            &robot,
+            "--frames",
+            "nominal.yaml",
+            "--pool",
+            "random",
+            "--count",
+            "2048",
+            "--pool-seed",
+            &s,
+            "--n",
+            "30",
+            "--noise",
+            "5e-5",
+            "--seed",
+            &s,
+            "--out",
+            "design.csv",
+            "--force",
+            "--json",
         ],
     )
     .unwrap();
@@ -110,8 +135,19 @@ fn calibrate(d: &Path, robot: &str, meas: &str, stem: &str) -> Value {
     let text = activecal(
         d,
         [
-            "calibrate", "--robot", robot, "--frames", "nominal.yaml", "--measurements", meas,
-            "--out", &u, "--out", &y, "--force", "--json",
+            "calibrate",
+            "--robot",
+            robot,
+            "--frames",
+            "nominal.yaml",
+            "--measurements",
+            meas,
+            "--out",
+            &u,
+            "--out",
+            &y,
+            "--force",
+            "--json",
         ],
     )
     .unwrap_or_else(|e| panic!("{e}"));
@@ -124,7 +160,10 @@ fn rms(v: &[f64]) -> f64 {
 
 fn offset(report: &Value) -> (f64, f64) {
     let e = &report["clock"]["estimate"];
-    (e["seconds"].as_f64().unwrap(), e["uncertainty"].as_f64().unwrap())
+    (
+        e["seconds"].as_f64().unwrap(),
+        e["uncertainty"].as_f64().unwrap(),
+    )
 }
 
 #[test]
@@ -140,13 +179,34 @@ fn live_bag_tracker_points_recover_the_truth() {
             &d,
             "bag_truth.py",
             &[
-                "write", "--truth", "truth.json", "--design", "design.csv", "--out", &bag,
-                "--offset", "3.9", "--latency", "0.015", "--gap-pose", "7", "--glitch-pose",
-                "12", "--seed", &s,
+                "write",
+                "--truth",
+                "truth.json",
+                "--design",
+                "design.csv",
+                "--out",
+                &bag,
+                "--offset",
+                "3.9",
+                "--latency",
+                "0.015",
+                "--gap-pose",
+                "7",
+                "--glitch-pose",
+                "12",
+                "--seed",
+                &s,
             ],
         );
         let true_offset = truth["offset"].as_f64().unwrap();
-        let r = extract(&d, &robot, "nominal.yaml", &bag, &meas, &["--points", "/tracker"]);
+        let r = extract(
+            &d,
+            &robot,
+            "nominal.yaml",
+            &bag,
+            &meas,
+            &["--points", "/tracker"],
+        );
         let rests = r["rests"].as_array().unwrap();
         assert_eq!(rests.len(), 30, "draw {k}: {} rests", rests.len());
         let out: Vec<(usize, &str)> = rests
@@ -208,22 +268,49 @@ fn live_bag_sqlite_poses_with_a_clock_offset() {
             &d,
             "bag_truth.py",
             &[
-                "write", "--truth", "truth.json", "--design", "design.csv", "--out", &bag,
-                "--storage", "sqlite3", "--kind", "poses", "--rate", "120", "--offset", "0.8",
-                "--seed", &s,
+                "write",
+                "--truth",
+                "truth.json",
+                "--design",
+                "design.csv",
+                "--out",
+                &bag,
+                "--storage",
+                "sqlite3",
+                "--kind",
+                "poses",
+                "--rate",
+                "120",
+                "--offset",
+                "0.8",
+                "--seed",
+                &s,
             ],
         );
-        let r = extract(&d, &robot, "nominal.yaml", &bag, &meas, &["--poses", "/mocap"]);
+        let r = extract(
+            &d,
+            &robot,
+            "nominal.yaml",
+            &bag,
+            &meas,
+            &["--poses", "/mocap"],
+        );
         assert_eq!(r["rests"].as_array().unwrap().len(), 30);
         let (o, u) = offset(&r);
-        assert!((o - 0.8).abs() <= OFFSET_TOL, "bag {k}: offset {o} ± {u} s, true 0.8 s");
+        assert!(
+            (o - 0.8).abs() <= OFFSET_TOL,
+            "bag {k}: offset {o} ± {u} s, true 0.8 s"
+        );
         let c = calibrate(&d, &robot, &meas, &stem);
         predicted.push(c["predicted"]["position_rms_mm"].as_f64().unwrap());
         stems.push(stem);
     }
     let truth = compare(&d, 0, &stems);
     let (t, p) = (rms(&truth), rms(&predicted));
-    eprintln!("live_bag poses: true {t:.5} mm, predicted {p:.5} mm (ratio {:.3})", t / p);
+    eprintln!(
+        "live_bag poses: true {t:.5} mm, predicted {p:.5} mm (ratio {:.3})",
+        t / p
+    );
     assert!(t <= RATIO * p, "true {t} mm, predicted {p} mm");
     let _ = std::fs::remove_dir_all(&d);
 }
@@ -244,12 +331,35 @@ fn live_bag_tf_chains_a_static_transform() {
         &d,
         "bag_truth.py",
         &[
-            "write", "--truth", "truth.json", "--design", "design.csv", "--out", "bag",
-            "--kind", "tf", "--seed", "3",
+            "write",
+            "--truth",
+            "truth.json",
+            "--design",
+            "design.csv",
+            "--out",
+            "bag",
+            "--kind",
+            "tf",
+            "--seed",
+            "3",
         ],
     );
-    extract(&d, &robot, "nominal.yaml", "bag", "t.csv", &["--tf", "tracker:marker"]);
-    extract(&d, &robot, "nominal.yaml", "bag", "w.csv", &["--tf", "world:marker"]);
+    extract(
+        &d,
+        &robot,
+        "nominal.yaml",
+        "bag",
+        "t.csv",
+        &["--tf", "tracker:marker"],
+    );
+    extract(
+        &d,
+        &robot,
+        "nominal.yaml",
+        "bag",
+        "w.csv",
+        &["--tf", "world:marker"],
+    );
     let (t, w) = (read_csv(&d.join("t.csv")), read_csv(&d.join("w.csv")));
     assert_eq!(t.len(), 30);
     assert_eq!(t.len(), w.len());

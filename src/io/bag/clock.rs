@@ -12,7 +12,7 @@
 //! (the moves are independent, so no noise model is assumed).
 
 use super::rest::{Rest, lower_bound};
-use super::series::{JointSeries, MeasSeries};
+use super::timeseries::{JointSeries, MeasSeries};
 use crate::model::Robot;
 use serde::Serialize;
 
@@ -62,7 +62,9 @@ fn lerp(t: &[f64], p: &[[f64; 3]], x: f64) -> Option<[f64; 3]> {
         return (k < t.len() && t[k] == x).then(|| p[k]);
     }
     let f = (x - t[k - 1]) / (t[k] - t[k - 1]);
-    Some(std::array::from_fn(|c| p[k - 1][c] * (1.0 - f) + p[k][c] * f))
+    Some(std::array::from_fn(|c| {
+        p[k - 1][c] * (1.0 - f) + p[k][c] * f
+    }))
 }
 
 fn speed(t: &[f64], p: &[[f64; 3]], x: f64) -> Option<f64> {

@@ -15,9 +15,7 @@ pub enum BagError {
         cause: std::io::Error,
     },
     /// A storage format other than MCAP and SQLite 3.
-    #[error(
-        "{bag}: storage plugin '{plugin}' is not read (rosbag2's 'mcap' and 'sqlite3' are)"
-    )]
+    #[error("{bag}: storage plugin '{plugin}' is not read (rosbag2's 'mcap' and 'sqlite3' are)")]
     UnknownStorage {
         /// The bag.
         bag: String,

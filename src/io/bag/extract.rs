@@ -153,7 +153,12 @@ pub fn extract(path: &Path, robot: &Robot, s: &ExtractSettings) -> Result<Extrac
 
 /// The offset: the one given, else the estimate when it is significant
 /// (more than twice its uncertainty and over 1 ms).
-fn settle_clock(robot: &Robot, st: &Streams, rests: &[rest::Rest], s: &ExtractSettings) -> ClockReport {
+fn settle_clock(
+    robot: &Robot,
+    st: &Streams,
+    rests: &[rest::Rest],
+    s: &ExtractSettings,
+) -> ClockReport {
     if let Some(o) = s.time_offset {
         return ClockReport {
             applied: o,
@@ -168,9 +173,10 @@ fn settle_clock(robot: &Robot, st: &Streams, rests: &[rest::Rest], s: &ExtractSe
             0.0,
             "not estimated (fewer than two moves seen by both streams); none applied".to_string(),
         ),
-        Some(e) if e.seconds.abs() > (2.0 * e.uncertainty).max(1e-3) => {
-            (e.seconds, "estimated from the moves and applied".to_string())
-        }
+        Some(e) if e.seconds.abs() > (2.0 * e.uncertainty).max(1e-3) => (
+            e.seconds,
+            "estimated from the moves and applied".to_string(),
+        ),
         Some(_) => (
             0.0,
             "estimated from the moves; not significant, none applied".to_string(),
@@ -284,10 +290,7 @@ fn assemble(
         clock,
         scatter: med(&|a| Some(a.scatter)),
         averaged_noise: med(&|a| Some(a.scatter / (a.samples as f64).sqrt())),
-        orientation_scatter: s
-            .source
-            .is_pose()
-            .then(|| med(&|a| a.orientation_scatter)),
+        orientation_scatter: s.source.is_pose().then(|| med(&|a| a.orientation_scatter)),
         rests,
         settings: s.rest.clone(),
     };

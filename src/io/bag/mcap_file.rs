@@ -78,9 +78,9 @@ pub fn topics(file: &Path) -> Result<Vec<Topic>, BagError> {
         while at + 9 <= buf.len() {
             let op = buf[at];
             let n = u64::from_le_bytes(buf[at + 1..at + 9].try_into().expect("8 bytes")) as usize;
-            let body = buf
-                .get(at + 9..at + 9 + n)
-                .ok_or_else(|| storage(file, "MCAP: a summary record runs past its section".into()))?;
+            let body = buf.get(at + 9..at + 9 + n).ok_or_else(|| {
+                storage(file, "MCAP: a summary record runs past its section".into())
+            })?;
             let r = mcap::parse_record(op, body)
                 .map_err(|e| storage(file, format!("MCAP summary: {e}")))?;
             note_topic(&r, &mut schemas, &mut channels);
@@ -96,7 +96,11 @@ pub fn topics(file: &Path) -> Result<Vec<Topic>, BagError> {
         .collect())
 }
 
-fn note_topic(r: &Record<'_>, schemas: &mut HashMap<u16, String>, channels: &mut Vec<(String, u16)>) {
+fn note_topic(
+    r: &Record<'_>,
+    schemas: &mut HashMap<u16, String>,
+    channels: &mut Vec<(String, u16)>,
+) {
     match r {
         Record::Schema { header, .. } => {
             schemas.insert(header.id, header.name.clone());

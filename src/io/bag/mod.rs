@@ -18,6 +18,7 @@ pub mod series;
 mod sqlite;
 pub mod storage;
 pub mod tf;
+pub mod timeseries;
 
 pub use error::BagError;
 pub use storage::{Format, Topic};
@@ -100,7 +101,11 @@ impl Bag {
             return Err(BagError::MissingTopic {
                 bag: self.name().to_string(),
                 topic: name.to_string(),
-                known: if known.is_empty() { "none".into() } else { known },
+                known: if known.is_empty() {
+                    "none".into()
+                } else {
+                    known
+                },
             });
         };
         if !types.contains(&t.msg_type.as_str()) {
@@ -134,7 +139,11 @@ impl Bag {
 
     /// A decoding error of message `m` at `field` (see [`messages`]).
     #[must_use]
-    pub fn decode_error(&self, m: &RawMessage<'_>, (field, message): messages::FieldError) -> BagError {
+    pub fn decode_error(
+        &self,
+        m: &RawMessage<'_>,
+        (field, message): messages::FieldError,
+    ) -> BagError {
         BagError::Decode {
             bag: self.name().to_string(),
             topic: m.topic.to_string(),

@@ -4,7 +4,7 @@
 //! scatter (a measured noise figure); a rest whose measurement has a gap,
 //! or whose scatter is far above the others', is left out with the reason.
 
-use super::series::{JointSeries, MeasSeries};
+use super::timeseries::{JointSeries, MeasSeries};
 use serde::Serialize;
 
 /// How rests are found and measurements averaged.
@@ -266,7 +266,11 @@ pub fn median(v: &[f64]) -> f64 {
     }
     s.sort_by(f64::total_cmp);
     let n = s.len();
-    if n % 2 == 1 { s[n / 2] } else { 0.5 * (s[n / 2 - 1] + s[n / 2]) }
+    if n % 2 == 1 {
+        s[n / 2]
+    } else {
+        0.5 * (s[n / 2 - 1] + s[n / 2])
+    }
 }
 
 #[cfg(test)]
@@ -281,7 +285,13 @@ mod tests {
         let mut j = JointSeries::default();
         for k in 0..1500 {
             let t = k as f64 / 500.0;
-            let q = if t < 1.0 { 0.0 } else if t < 2.0 { 0.5 * (t - 1.0) } else { 0.5 };
+            let q = if t < 1.0 {
+                0.0
+            } else if t < 2.0 {
+                0.5 * (t - 1.0)
+            } else {
+                0.5
+            };
             j.t.push(t);
             j.q.push(vec![q, 0.1]);
         }
@@ -295,7 +305,9 @@ mod tests {
         // A measurement 2 s ahead of the joints: found with the offset.
         let m = MeasSeries {
             t: (0..300).map(|k| 2.0 + k as f64 / 100.0).collect(),
-            p: (0..300).map(|k| [if k < 150 { 1.0 } else { 2.0 }, 0.0, 0.0]).collect(),
+            p: (0..300)
+                .map(|k| [if k < 150 { 1.0 } else { 2.0 }, 0.0, 0.0])
+                .collect(),
             r: Vec::new(),
         };
         let a = average(&j, &m, &rests[0], [0.2, 0.05], 2.0).unwrap();

@@ -4,6 +4,7 @@
 //! `/tf` tree), each sorted by its header stamp.
 
 use super::messages::{self, Stamped};
+pub use super::timeseries::{JointSeries, MeasSeries};
 use super::{Bag, BagError, RawMessage, tf};
 
 /// Where the measurement is in the bag.
@@ -40,26 +41,6 @@ impl Source {
     pub fn is_pose(&self) -> bool {
         !matches!(self, Source::Points(_))
     }
-}
-
-/// Joint values over time, in the robot's joint order.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct JointSeries {
-    /// Header stamps (s), increasing.
-    pub t: Vec<f64>,
-    /// The joint values at each stamp (radians, metres).
-    pub q: Vec<Vec<f64>>,
-}
-
-/// A measured position (and orientation) over time, in the sensor's frame.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct MeasSeries {
-    /// Header stamps (s), increasing.
-    pub t: Vec<f64>,
-    /// The positions (metres).
-    pub p: Vec<[f64; 3]>,
-    /// The orientations `[w, x, y, z]` (empty for points).
-    pub r: Vec<[f64; 4]>,
 }
 
 /// The two streams of a run.
@@ -188,10 +169,7 @@ fn joint_message(
         };
         let v = js.position[*k];
         if !v.is_finite() {
-            return Err(bag.decode_error(
-                m,
-                ("position", format!("joint '{}' is {v}", names[j])),
-            ));
+            return Err(bag.decode_error(m, ("position", format!("joint '{}' is {v}", names[j]))));
         }
         seen[j] = true;
         q.push(v);

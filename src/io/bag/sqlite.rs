@@ -2,9 +2,9 @@
 //! and a `messages` table (topic id, receive time in ns, CDR bytes), read
 //! row by row.
 
+use super::RawMessage;
 use super::error::BagError;
 use super::storage::Topic;
-use super::RawMessage;
 use rusqlite::{Connection, OpenFlags};
 use std::collections::HashMap;
 use std::path::Path;
@@ -40,7 +40,8 @@ fn topics_with_ids(conn: &Connection, file: &Path) -> Result<Vec<(i64, Topic)>, 
             ))
         })
         .map_err(|e| storage(file, &e))?;
-    rows.collect::<Result<_, _>>().map_err(|e| storage(file, &e))
+    rows.collect::<Result<_, _>>()
+        .map_err(|e| storage(file, &e))
 }
 
 /// The topics of one `.db3` file.

@@ -75,11 +75,10 @@ impl Storage {
                 bag: name.clone(),
                 message: e.to_string(),
             })?;
-            let m: MetadataFile =
-                serde_saphyr::from_str(&text).map_err(|e| BagError::Storage {
-                    bag: name.clone(),
-                    message: format!("metadata.yaml: {e}"),
-                })?;
+            let m: MetadataFile = serde_saphyr::from_str(&text).map_err(|e| BagError::Storage {
+                bag: name.clone(),
+                message: format!("metadata.yaml: {e}"),
+            })?;
             let m = m.rosbag2_bagfile_information;
             let format = match m.storage_identifier.as_str() {
                 "mcap" => Format::Mcap,
@@ -136,9 +135,10 @@ fn sniff(file: &Path, bag: &str) -> Result<Format, BagError> {
     } else if head[..n].starts_with(SQLITE_MAGIC) {
         Ok(Format::Sqlite)
     } else {
-        let ext = file
-            .extension()
-            .map_or_else(|| "(none)".to_string(), |e| e.to_string_lossy().into_owned());
+        let ext = file.extension().map_or_else(
+            || "(none)".to_string(),
+            |e| e.to_string_lossy().into_owned(),
+        );
         Err(BagError::UnknownStorage {
             bag: bag.to_string(),
             plugin: format!("file extension .{ext}, neither MCAP nor SQLite 3 bytes"),

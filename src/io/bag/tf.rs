@@ -5,7 +5,7 @@
 //! need their stamps interpolated, and is refused.
 
 use super::messages::{self, Stamped};
-use super::series::MeasSeries;
+use super::timeseries::MeasSeries;
 use super::{Bag, BagError, RawMessage};
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 use std::collections::HashMap;

@@ -6,12 +6,11 @@ use super::emit_report;
 use activecal::io::bag::extract::{ExtractReport, ExtractSettings, extract};
 use activecal::io::bag::series::Source;
 use anyhow::{Result, bail};
-use clap::{ArgGroup, Args};
+use clap::Args;
 use std::path::PathBuf;
 
 /// The options of `extract`.
 #[derive(Args, Debug)]
-#[command(group(ArgGroup::new("measurement").required(true).args(["points", "poses", "tf"])))]
 pub struct ExtractArgs {
     /// The bag: a rosbag2 folder (with its metadata.yaml), or one .mcap or
     /// .db3 file.
@@ -20,26 +19,38 @@ pub struct ExtractArgs {
     /// nominal model predicts the moves for the clock offset.
     #[arg(long, value_parser = super::parse_robot)]
     pub robot: activecal::io::RobotRef,
-    /// The sensor_msgs/msg/JointState topic.
-    #[arg(long, value_name = "TOPIC", default_value = "/joint_states")]
-    pub joints: String,
-    /// A geometry_msgs/msg/PointStamped topic: a tracker's point.
-    #[arg(long, value_name = "TOPIC")]
-    pub points: Option<String>,
-    /// A geometry_msgs/msg/PoseStamped or TransformStamped topic: a
-    /// motion-capture body's pose.
-    #[arg(long, value_name = "TOPIC")]
-    pub poses: Option<String>,
-    /// The transform PARENT → CHILD of /tf and /tf_static (static
-    /// transforms composed with one moving transform).
-    #[arg(long, value_name = "PARENT:CHILD")]
-    pub tf: Option<String>,
+    /// What to read from the bag and how.
+    #[command(flatten)]
+    pub from: BagOpts,
     /// The measurement CSV to write (what `calibrate --measurements` reads).
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
     /// Overwrite --out if it exists (never an input).
     #[arg(long)]
     pub force: bool,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// What to read from a bag and how: the options `extract` and `calibrate
+/// --bag` share.
+#[derive(Args, Debug, Clone)]
+pub struct BagOpts {
+    /// A bag's sensor_msgs/msg/JointState topic.
+    #[arg(long, value_name = "TOPIC", default_value = "/joint_states")]
+    pub joints: String,
+    /// A bag's geometry_msgs/msg/PointStamped topic: a tracker's point.
+    #[arg(long, value_name = "TOPIC", conflicts_with_all = ["poses", "tf"])]
+    pub points: Option<String>,
+    /// A bag's geometry_msgs/msg/PoseStamped or TransformStamped topic: a
+    /// motion-capture body's pose.
+    #[arg(long, value_name = "TOPIC", conflicts_with = "tf")]
+    pub poses: Option<String>,
+    /// The transform PARENT → CHILD of a bag's /tf and /tf_static (static
+    /// transforms composed with one moving transform).
+    #[arg(long, value_name = "PARENT:CHILD")]
+    pub tf: Option<String>,
     /// The clock offset, seconds: the measurement's stamp minus the joint
     /// stamp of the same instant. Estimated from the moves when not given.
     #[arg(long, value_name = "S", allow_hyphen_values = true)]
@@ -56,12 +67,9 @@ pub struct ExtractArgs {
     /// Seconds left out at the start of each rest while the arm settles.
     #[arg(long, value_name = "S", default_value_t = 0.2)]
     pub settle: f64,
-    /// Print one JSON object.
-    #[arg(long)]
-    pub json: bool,
 }
 
-impl ExtractArgs {
+impl BagOpts {
     fn source(&self) -> Result<Source> {
         Ok(match (&self.points, &self.poses, &self.tf) {
             (Some(t), _, _) => Source::Points(t.clone()),
@@ -78,7 +86,7 @@ impl ExtractArgs {
                     child: child.to_string(),
                 }
             }
-            _ => bail!("give the measurement: --points, --poses or --tf"),
+            _ => bail!("give the bag's measurement: --points TOPIC, --poses TOPIC or --tf PARENT:CHILD"),
         })
     }
 
@@ -105,7 +113,7 @@ impl ExtractArgs {
 /// Runs `extract`.
 pub fn cmd_extract(a: ExtractArgs) -> Result<()> {
     use activecal::io::atomic::{Output, check_outputs, write_atomic};
-    let settings = a.settings()?;
+    let settings = a.from.settings()?;
     if let Some(out) = &a.out {
         check_outputs(
             &[Output {
@@ -133,7 +141,8 @@ pub fn cmd_extract(a: ExtractArgs) -> Result<()> {
     emit_report(a.json, r, || text(r, a.out.as_ref()))
 }
 
-fn text(r: &ExtractReport, out: Option<&PathBuf>) -> String {
+/// The text form of an extraction's report (`out`: the CSV written).
+pub fn text(r: &ExtractReport, out: Option<&PathBuf>) -> String {
     let mut s = format!(
         "{}: '{}' {} samples at {:.1} Hz; {} {} samples at {:.1} Hz\n",
         r.bag,

@@ -23,7 +23,9 @@ Usage (run with the project venv's python):
       /tf_static. Its header stamps are the true time + --offset (the
       tracker's clock ahead of the joints') + --latency. --gap-pose K: the
       measurement drops out for 0.8 s in the middle of rest K (0-based);
-      --glitch-pose K: 15 samples of rest K off by 3-5 mm. Prints JSON:
+      --glitch-pose K: 15 samples of rest K off by 3-5 mm. --image-mb M:
+      also M megabytes of raw images (zeros) on /camera/image_raw at 30 Hz,
+      to check that reading streams. Prints JSON:
       the rests' true times (joint clock), the expected offset (offset +
       latency), the rest count.
 
@@ -215,6 +217,15 @@ def cmd_write(a):
                 static_sent = True
             out.tf("/tf", [out.transform(stamp, "tracker", "marker", p, qq)], log_time)
     out.camera_info(T0, T0)
+    if a.image_mb > 0:
+        # A camera's raw images (zeros, 640x480 rgb8, 30 Hz): bulk that a
+        # reader of the other topics must stream past.
+        frame = np.zeros(480 * 640 * 3, dtype=np.uint8)
+        for k in range(int(a.image_mb * 1e6 / frame.size) + 1):
+            tk = k / 30.0
+            m = out.T["sensor_msgs/msg/Image"](header=out.header(T0 + tk, "camera"), height=480, width=640,
+                                               encoding="rgb8", is_bigendian=0, step=640 * 3, data=frame)
+            out.put("/camera/image_raw", "sensor_msgs/msg/Image", m, T0 + tk)
     out.close()
     print(json.dumps({"rests": [[r0, r1] for r0, r1 in rests], "poses": len(qs),
                       "offset": a.offset + a.latency, "duration": end, "joints": list(t.chain.names)}))
@@ -287,6 +298,7 @@ def main(argv=None):
     p.add_argument("--latency", type=float, default=0.0)
     p.add_argument("--gap-pose", type=int)
     p.add_argument("--glitch-pose", type=int)
+    p.add_argument("--image-mb", type=float, default=0.0)
     p.add_argument("--seed", type=int, default=1)
     p = sub.add_parser("tiny")
     p.add_argument("--out", required=True)

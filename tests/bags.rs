@@ -243,3 +243,65 @@ fn the_output_is_never_an_input() {
     assert!(text.contains("rests: 3 found"), "{text}");
     assert!(text.contains("scatter mm"), "{text}");
 }
+
+#[test]
+fn rests_are_matched_to_the_design_and_the_odd_ones_named() {
+    let d = scratch_dir("bags", "design");
+    // Rests 1 and 3 of the bag, and a pose the run never reached; a `via`
+    // row (a move between poses) is not a pose.
+    let design = d.join("design.csv");
+    let row = |q: &[f64]| q.iter().map(f64::to_string).collect::<Vec<_>>().join(",");
+    std::fs::write(
+        &design,
+        format!(
+            "shoulder_pan_joint,shoulder_lift_joint,elbow_joint,wrist_1_joint,wrist_2_joint,wrist_3_joint,id\n{},7\n{},via\n{},9\n{},12\n",
+            row(&RESTS[0]),
+            row(&RESTS[1]),
+            row(&[1.0, -1.0, 1.0, -1.0, -1.0, 1.0]),
+            row(&RESTS[2]),
+        ),
+    )
+    .unwrap();
+    let out = d.join("m.csv");
+    let r = json_of(&[
+        "extract",
+        "fixtures/bags/tiny.mcap",
+        "--robot",
+        UR5,
+        "--points",
+        "/tracker",
+        "--design",
+        design.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    let rests = r["rests"].as_array().unwrap();
+    assert_eq!(rests[0]["design_pose"], 0);
+    assert_eq!(rests[2]["design_pose"], 2);
+    assert!(rests[1]["design_pose"].is_null());
+    let why = rests[1]["left_out"].as_str().unwrap();
+    assert!(why.starts_with("reached no pose of the design"), "{why}");
+    let missing = r["missing_design_poses"].as_array().unwrap();
+    assert_eq!(missing.len(), 1, "{missing:?}");
+    assert_eq!(missing[0]["pose"], 1);
+    assert_eq!(missing[0]["reason"], "no rest reached it");
+    assert_eq!(read_csv(&out).1.len(), 2);
+    // The design is an input: never the output.
+    fails_with(
+        &[
+            "extract",
+            "fixtures/bags/tiny.mcap",
+            "--robot",
+            UR5,
+            "--points",
+            "/tracker",
+            "--design",
+            design.to_str().unwrap(),
+            "--out",
+            design.to_str().unwrap(),
+            "--force",
+        ],
+        "is an input of this command",
+    );
+}

@@ -67,6 +67,15 @@ pub struct BagOpts {
     /// Seconds left out at the start of each rest while the arm settles.
     #[arg(long, value_name = "S", default_value_t = 0.2)]
     pub settle: f64,
+    /// The design the run followed (`select --out`'s .json, .yaml or .csv):
+    /// each rest is matched to the pose it reached, a rest that reached
+    /// none is left out, a pose no rest gives is named.
+    #[arg(long, value_name = "FILE")]
+    pub design: Option<PathBuf>,
+    /// A rest reached a design pose when no joint is further from it than
+    /// this (rad, m for prismatic joints).
+    #[arg(long, value_name = "RAD", default_value_t = 0.01, requires = "design")]
+    pub design_tolerance: f64,
 }
 
 impl BagOpts {
@@ -86,7 +95,9 @@ impl BagOpts {
                     child: child.to_string(),
                 }
             }
-            _ => bail!("give the bag's measurement: --points TOPIC, --poses TOPIC or --tf PARENT:CHILD"),
+            _ => bail!(
+                "give the bag's measurement: --points TOPIC, --poses TOPIC or --tf PARENT:CHILD"
+            ),
         })
     }
 
@@ -101,6 +112,13 @@ impl BagOpts {
             bail!("--max-offset {}: give seconds, 0 or more", self.max_offset);
         }
         s.max_offset = self.max_offset;
+        if !(self.design_tolerance.is_finite() && self.design_tolerance > 0.0) {
+            bail!(
+                "--design-tolerance {}: give a positive number (rad, m)",
+                self.design_tolerance
+            );
+        }
+        s.design_tolerance = self.design_tolerance;
         if let Some(o) = s.time_offset
             && !o.is_finite()
         {
@@ -113,14 +131,16 @@ impl BagOpts {
 /// Runs `extract`.
 pub fn cmd_extract(a: ExtractArgs) -> Result<()> {
     use activecal::io::atomic::{Output, check_outputs, write_atomic};
-    let settings = a.from.settings()?;
+    let mut settings = a.from.settings()?;
     if let Some(out) = &a.out {
+        let mut inputs = vec![a.bag.as_path()];
+        inputs.extend(a.from.design.as_deref());
         check_outputs(
             &[Output {
                 label: "--out",
                 path: out,
             }],
-            &[a.bag.as_path()],
+            &inputs,
             a.force,
         )?;
         if out.starts_with(&a.bag) {
@@ -132,6 +152,9 @@ pub fn cmd_extract(a: ExtractArgs) -> Result<()> {
         }
     }
     let robot = super::load_robot(&a.robot)?;
+    if let Some(d) = &a.from.design {
+        settings.design = Some(activecal::io::bag::design::read_design(d, &robot)?);
+    }
     let got = extract(&a.bag, &robot, &settings)?;
     if let Some(out) = &a.out {
         let csv = activecal::io::measurements::to_csv(&got.measurements, &robot);
@@ -169,14 +192,28 @@ pub fn text(r: &ExtractReport, out: Option<&PathBuf>) -> String {
         r.settings.settle,
         r.kept()
     );
-    s += "rest  start s  length s  samples  scatter mm  left out\n";
+    let design =
+        r.rests.iter().any(|x| x.design_pose.is_some()) || !r.missing_design_poses.is_empty();
+    s += if design {
+        "rest  start s  length s  samples  scatter mm  design pose  left out\n"
+    } else {
+        "rest  start s  length s  samples  scatter mm  left out\n"
+    };
     let t0 = r.rests.first().map_or(0.0, |x| x.rest.start);
     for (k, x) in r.rests.iter().enumerate() {
         let (n, sc) = x.averaged.as_ref().map_or(("-".into(), "-".into()), |a| {
             (a.samples.to_string(), format!("{:.4}", a.scatter * 1e3))
         });
+        let pose = if design {
+            format!(
+                "  {:>11}",
+                x.design_pose.map_or("-".into(), |p| (p + 1).to_string())
+            )
+        } else {
+            String::new()
+        };
         s += &format!(
-            "{:>4}  {:>7.2}  {:>8.2}  {:>7}  {:>10}  {}\n",
+            "{:>4}  {:>7.2}  {:>8.2}  {:>7}  {:>10}{pose}  {}\n",
             k + 1,
             x.rest.start - t0,
             x.rest.end - x.rest.start,
@@ -184,6 +221,9 @@ pub fn text(r: &ExtractReport, out: Option<&PathBuf>) -> String {
             sc,
             x.left_out.as_deref().unwrap_or("")
         );
+    }
+    for m in &r.missing_design_poses {
+        s += &format!("design pose {} not measured: {}\n", m.pose + 1, m.reason);
     }
     s += &format!(
         "noise: one sample's scatter {:.4} mm per coordinate (median rest), an averaged pose's {:.5} mm",

@@ -28,6 +28,12 @@ pub struct ExtractSettings {
     pub time_offset: Option<f64>,
     /// The largest offset searched for (s).
     pub max_offset: f64,
+    /// The design's joint values, when the run followed one: each rest is
+    /// matched to the pose it reached.
+    pub design: Option<Vec<Vec<f64>>>,
+    /// A rest reached a design pose when no joint is further from it than
+    /// this (rad, m).
+    pub design_tolerance: f64,
 }
 
 impl ExtractSettings {
@@ -41,6 +47,8 @@ impl ExtractSettings {
             rest: RestSettings::default(),
             time_offset: None,
             max_offset: 10.0,
+            design: None,
+            design_tolerance: 0.01,
         }
     }
 }
@@ -67,6 +75,17 @@ pub struct RestRecord {
     pub averaged: Option<Averaged>,
     /// Why it was left out (`None`: kept).
     pub left_out: Option<String>,
+    /// The design pose it reached (0-based), with a design.
+    pub design_pose: Option<usize>,
+}
+
+/// A design pose that no kept rest gives.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MissingPose {
+    /// The design pose (0-based).
+    pub pose: usize,
+    /// Why: no rest reached it, or its rest was left out (and why).
+    pub reason: String,
 }
 
 /// What an extraction found.
@@ -98,6 +117,8 @@ pub struct ExtractReport {
     pub averaged_noise: f64,
     /// Median orientation scatter of one sample, per axis (rad; poses).
     pub orientation_scatter: Option<f64>,
+    /// The design's poses that no kept rest gives (with a design).
+    pub missing_design_poses: Vec<MissingPose>,
     /// The settings used.
     pub settings: RestSettings,
 }
@@ -147,8 +168,55 @@ pub fn extract(path: &Path, robot: &Robot, s: &ExtractSettings) -> Result<Extrac
         .into());
     }
     let clock = settle_clock(robot, &streams, &rests, s);
-    let records = judge(&streams, &rests, &s.rest, clock.applied);
-    assemble(&bag, &streams, records, clock, s, robot)
+    let mut records = judge(&streams, &rests, &s.rest, clock.applied);
+    let missing = match &s.design {
+        Some(d) => match_design(&mut records, d, s.design_tolerance),
+        None => Vec::new(),
+    };
+    let mut got = assemble(&bag, &streams, records, clock, s, robot)?;
+    got.report.missing_design_poses = missing;
+    Ok(got)
+}
+
+/// Matches each rest to the design pose it reached; a kept rest that
+/// reached none is left out. Returns the design poses no kept rest gives.
+fn match_design(records: &mut [RestRecord], design: &[Vec<f64>], tol: f64) -> Vec<MissingPose> {
+    use super::design::nearest;
+    for r in records.iter_mut() {
+        let Some(a) = &r.averaged else { continue };
+        match nearest(&a.q, design) {
+            Some((k, far)) if far <= tol => r.design_pose = Some(k),
+            Some((k, far)) if r.left_out.is_none() => {
+                r.left_out = Some(format!(
+                    "reached no pose of the design (the nearest, pose {}, is {far:.4} rad or m away at one joint)",
+                    k + 1
+                ));
+            }
+            _ => {}
+        }
+    }
+    (0..design.len())
+        .filter(|&k| {
+            !records
+                .iter()
+                .any(|r| r.design_pose == Some(k) && r.left_out.is_none())
+        })
+        .map(|k| {
+            let left = records
+                .iter()
+                .enumerate()
+                .find(|(_, r)| r.design_pose == Some(k));
+            let reason = match left {
+                Some((j, r)) => format!(
+                    "its rest ({}) was left out: {}",
+                    j + 1,
+                    r.left_out.as_deref().unwrap_or("")
+                ),
+                None => "no rest reached it".to_string(),
+            };
+            MissingPose { pose: k, reason }
+        })
+        .collect()
 }
 
 /// The offset: the one given, else the estimate when it is significant
@@ -216,6 +284,7 @@ fn judge(st: &Streams, rests: &[rest::Rest], s: &RestSettings, offset: f64) -> V
                 rest: *r,
                 averaged,
                 left_out,
+                design_pose: None,
             }
         })
         .collect();
@@ -292,6 +361,7 @@ fn assemble(
         averaged_noise: med(&|a| Some(a.scatter / (a.samples as f64).sqrt())),
         orientation_scatter: s.source.is_pose().then(|| med(&|a| a.orientation_scatter)),
         rests,
+        missing_design_poses: Vec::new(),
         settings: s.rest.clone(),
     };
     Ok(Extracted {

@@ -9,6 +9,7 @@
 
 pub mod cdr;
 pub mod clock;
+pub mod design;
 pub mod error;
 pub mod extract;
 mod mcap_file;

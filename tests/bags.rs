@@ -192,6 +192,17 @@ fn no_rest_period_is_refused_with_the_thresholds() {
         ],
         "no rest period on '/joint_states': no 0.5 s or longer where every joint's speed stays under 0.005 rad/s",
     );
+    fails_with(
+        &[
+            "extract",
+            "fixtures/bags/moving.mcap",
+            "--robot",
+            UR5,
+            "--points",
+            "/tracker",
+        ],
+        "hint: --rest-speed SPEED and --rest-min S set what counts as a rest",
+    );
     // Rests shorter than asked for: none.
     fails_with(
         &[

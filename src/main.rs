@@ -113,6 +113,10 @@ enum Command {
     /// means no N-pose design of the pool is better; a design refined off
     /// the pool may exceed the pool's bound (it is said when it does).
     Gap(GapArgs),
+    /// A ROS 2 bag's rest periods into the measurement CSV `calibrate
+    /// --measurements` reads: each pose a rest of the arm, its measurement
+    /// averaged, the clocks aligned (MCAP or SQLite 3; no ROS needed).
+    Extract(cli::extract::ExtractArgs),
 }
 
 impl Command {
@@ -160,6 +164,7 @@ impl Command {
             Command::Bound(a) => Some(&mut a.pool.robot),
             Command::Calibrate(a) => Some(&mut a.robot),
             Command::Evaluate(a) => Some(&mut a.robot),
+            Command::Extract(a) => Some(&mut a.robot),
             Command::Bench(_) | Command::Reproduce(_) | Command::Gap(_) => None,
         };
         match robot {
@@ -248,6 +253,7 @@ fn main() {
         Command::Evaluate(a) => cli::measured::cmd_evaluate(a),
         Command::Bound(a) => cli::bound::cmd_bound(a),
         Command::Gap(a) => cli::bound::cmd_gap(a),
+        Command::Extract(a) => cli::extract::cmd_extract(a),
     };
     if std::env::var_os("ACTIVECAL_DEBUG_READS").is_some() {
         // Each input file and how often it was read (once is the rule).

@@ -10,6 +10,7 @@ mod common;
 
 mod atomic_writes;
 mod bad_inputs;
+mod bags;
 mod bound;
 mod camera;
 mod camera_cli;

@@ -26,6 +26,18 @@ const OPTIONS: &[(&str, &str)] = &[
     ),
     ("SRDF file", "--srdf FILE names the SRDF"),
     (
+        "no rest period on",
+        "--rest-speed SPEED and --rest-min S set what counts as a rest",
+    ),
+    (
+        "of the robot is in no message of",
+        "--joints TOPIC names the JointState topic; --base, --tip and --lock choose the chain",
+    ),
+    (
+        "reached no pose of the design",
+        "--design-tolerance RAD sets how near a rest must be to a design pose",
+    ),
+    (
         "fixed parameter",
         "--fix NAME holds an unknown at its nominal value",
     ),

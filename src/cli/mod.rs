@@ -17,6 +17,7 @@ pub mod contact_evaluate;
 pub mod contact_out;
 pub mod contact_select;
 pub mod existing;
+pub mod extract;
 pub mod hints;
 pub mod measured;
 pub mod pool_opts;

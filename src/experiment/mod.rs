@@ -1,6 +1,7 @@
 //! Experiments: whole pipelines that return typed reports.
 
 pub mod acts_on;
+pub mod bag;
 pub mod camera;
 pub mod contact_screen;
 pub mod contacts;

@@ -3,6 +3,7 @@
 //! model never imports them.
 
 pub mod atomic;
+pub mod bag;
 pub mod calibrated;
 pub mod camera_info;
 pub mod camera_observations;

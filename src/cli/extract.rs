@@ -1,0 +1,241 @@
+//! `activecal extract BAG`: a ROS 2 bag's rests into the measurement CSV
+//! `calibrate --measurements` reads (the library's `io::bag::extract` does
+//! the work; here the flags are parsed and the report rendered).
+
+use super::emit_report;
+use activecal::io::bag::extract::{ExtractReport, ExtractSettings, extract};
+use activecal::io::bag::series::Source;
+use anyhow::{Result, bail};
+use clap::Args;
+use std::path::PathBuf;
+
+/// The options of `extract`.
+#[derive(Args, Debug)]
+pub struct ExtractArgs {
+    /// The bag: a rosbag2 folder (with its metadata.yaml), or one .mcap or
+    /// .db3 file.
+    pub bag: PathBuf,
+    /// The robot whose joints /joint_states gives (by name) and whose
+    /// nominal model predicts the moves for the clock offset.
+    #[arg(long, value_parser = super::parse_robot)]
+    pub robot: activecal::io::RobotRef,
+    /// What to read from the bag and how.
+    #[command(flatten)]
+    pub from: BagOpts,
+    /// The measurement CSV to write (what `calibrate --measurements` reads).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Overwrite --out if it exists (never an input).
+    #[arg(long)]
+    pub force: bool,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// What to read from a bag and how: the options `extract` and `calibrate
+/// --bag` share.
+#[derive(Args, Debug, Clone)]
+pub struct BagOpts {
+    /// A bag's sensor_msgs/msg/JointState topic.
+    #[arg(long, value_name = "TOPIC", default_value = "/joint_states")]
+    pub joints: String,
+    /// A bag's geometry_msgs/msg/PointStamped topic: a tracker's point.
+    #[arg(long, value_name = "TOPIC", conflicts_with_all = ["poses", "tf"])]
+    pub points: Option<String>,
+    /// A bag's geometry_msgs/msg/PoseStamped or TransformStamped topic: a
+    /// motion-capture body's pose.
+    #[arg(long, value_name = "TOPIC", conflicts_with = "tf")]
+    pub poses: Option<String>,
+    /// The transform PARENT → CHILD of a bag's /tf and /tf_static (static
+    /// transforms composed with one moving transform).
+    #[arg(long, value_name = "PARENT:CHILD")]
+    pub tf: Option<String>,
+    /// The clock offset, seconds: the measurement's stamp minus the joint
+    /// stamp of the same instant. Estimated from the moves when not given.
+    #[arg(long, value_name = "S", allow_hyphen_values = true)]
+    pub time_offset: Option<f64>,
+    /// The largest clock offset searched for, seconds.
+    #[arg(long, value_name = "S", default_value_t = 10.0)]
+    pub max_offset: f64,
+    /// A joint is at rest under this speed (rad/s, m/s for prismatic).
+    #[arg(long, value_name = "SPEED", default_value_t = 0.005)]
+    pub rest_speed: f64,
+    /// The shortest rest period, seconds.
+    #[arg(long, value_name = "S", default_value_t = 0.5)]
+    pub rest_min: f64,
+    /// Seconds left out at the start of each rest while the arm settles.
+    #[arg(long, value_name = "S", default_value_t = 0.2)]
+    pub settle: f64,
+    /// The design the run followed (`select --out`'s .json, .yaml or .csv):
+    /// each rest is matched to the pose it reached, a rest that reached
+    /// none is left out, a pose no rest gives is named.
+    #[arg(long, value_name = "FILE")]
+    pub design: Option<PathBuf>,
+    /// A rest reached a design pose when no joint is further from it than
+    /// this (rad, m for prismatic joints).
+    #[arg(long, value_name = "RAD", default_value_t = 0.01, requires = "design")]
+    pub design_tolerance: f64,
+}
+
+impl BagOpts {
+    fn source(&self) -> Result<Source> {
+        Ok(match (&self.points, &self.poses, &self.tf) {
+            (Some(t), _, _) => Source::Points(t.clone()),
+            (_, Some(t), _) => Source::Poses(t.clone()),
+            (_, _, Some(pc)) => {
+                let Some((parent, child)) = pc.split_once(':') else {
+                    bail!("--tf {pc}: give PARENT:CHILD, two frame names");
+                };
+                if parent.is_empty() || child.is_empty() {
+                    bail!("--tf {pc}: give PARENT:CHILD, two frame names");
+                }
+                Source::Tf {
+                    parent: parent.to_string(),
+                    child: child.to_string(),
+                }
+            }
+            _ => bail!(
+                "give the bag's measurement: --points TOPIC, --poses TOPIC or --tf PARENT:CHILD"
+            ),
+        })
+    }
+
+    /// The library's settings from the flags.
+    pub fn settings(&self) -> Result<ExtractSettings> {
+        let mut s = ExtractSettings::new(&self.joints, self.source()?);
+        s.rest.speed = self.rest_speed;
+        s.rest.min_duration = self.rest_min;
+        s.rest.settle = self.settle;
+        s.time_offset = self.time_offset;
+        if !(self.max_offset.is_finite() && self.max_offset >= 0.0) {
+            bail!("--max-offset {}: give seconds, 0 or more", self.max_offset);
+        }
+        s.max_offset = self.max_offset;
+        if !(self.design_tolerance.is_finite() && self.design_tolerance > 0.0) {
+            bail!(
+                "--design-tolerance {}: give a positive number (rad, m)",
+                self.design_tolerance
+            );
+        }
+        s.design_tolerance = self.design_tolerance;
+        if let Some(o) = s.time_offset
+            && !o.is_finite()
+        {
+            bail!("--time-offset {o}: not a number of seconds");
+        }
+        Ok(s)
+    }
+}
+
+/// Runs `extract`.
+pub fn cmd_extract(a: ExtractArgs) -> Result<()> {
+    use activecal::io::atomic::{Output, check_outputs, write_atomic};
+    let mut settings = a.from.settings()?;
+    if let Some(out) = &a.out {
+        let mut inputs = vec![a.bag.as_path()];
+        inputs.extend(a.from.design.as_deref());
+        check_outputs(
+            &[Output {
+                label: "--out",
+                path: out,
+            }],
+            &inputs,
+            a.force,
+        )?;
+        if out.starts_with(&a.bag) {
+            bail!(
+                "--out {}: inside the bag {}; choose another place",
+                out.display(),
+                a.bag.display()
+            );
+        }
+    }
+    let robot = super::load_robot(&a.robot)?;
+    if let Some(d) = &a.from.design {
+        settings.design = Some(activecal::io::bag::design::read_design(d, &robot)?);
+    }
+    let got = extract(&a.bag, &robot, &settings)?;
+    if let Some(out) = &a.out {
+        let csv = activecal::io::measurements::to_csv(&got.measurements, &robot);
+        write_atomic(out, csv.as_bytes())?;
+    }
+    let r = &got.report;
+    emit_report(a.json, r, || text(r, a.out.as_ref()))
+}
+
+/// The text form of an extraction's report (`out`: the CSV written).
+pub fn text(r: &ExtractReport, out: Option<&PathBuf>) -> String {
+    let mut s = format!(
+        "{}: '{}' {} samples at {:.1} Hz; {} {} samples at {:.1} Hz\n",
+        r.bag,
+        r.joints,
+        r.joint_samples,
+        r.joint_rate,
+        r.source,
+        r.measurement_samples,
+        r.measurement_rate
+    );
+    let c = &r.clock;
+    s += &match &c.estimate {
+        Some(e) => format!(
+            "clock offset: estimated {:.4} s ± {:.4} s from {} moves; applied {:.4} s ({})\n",
+            e.seconds, e.uncertainty, e.moves, c.applied, c.note
+        ),
+        None => format!("clock offset: {:.4} s ({})\n", c.applied, c.note),
+    };
+    s += &format!(
+        "rests: {} found (speed under {} rad/s for at least {} s, the first {} s left out), {} kept\n",
+        r.rests.len(),
+        r.settings.speed,
+        r.settings.min_duration,
+        r.settings.settle,
+        r.kept()
+    );
+    let design =
+        r.rests.iter().any(|x| x.design_pose.is_some()) || !r.missing_design_poses.is_empty();
+    s += if design {
+        "rest  start s  length s  samples  scatter mm  design pose  left out\n"
+    } else {
+        "rest  start s  length s  samples  scatter mm  left out\n"
+    };
+    let t0 = r.rests.first().map_or(0.0, |x| x.rest.start);
+    for (k, x) in r.rests.iter().enumerate() {
+        let (n, sc) = x.averaged.as_ref().map_or(("-".into(), "-".into()), |a| {
+            (a.samples.to_string(), format!("{:.4}", a.scatter * 1e3))
+        });
+        let pose = if design {
+            format!(
+                "  {:>11}",
+                x.design_pose.map_or("-".into(), |p| (p + 1).to_string())
+            )
+        } else {
+            String::new()
+        };
+        s += &format!(
+            "{:>4}  {:>7.2}  {:>8.2}  {:>7}  {:>10}{pose}  {}\n",
+            k + 1,
+            x.rest.start - t0,
+            x.rest.end - x.rest.start,
+            n,
+            sc,
+            x.left_out.as_deref().unwrap_or("")
+        );
+    }
+    for m in &r.missing_design_poses {
+        s += &format!("design pose {} not measured: {}\n", m.pose + 1, m.reason);
+    }
+    s += &format!(
+        "noise: one sample's scatter {:.4} mm per coordinate (median rest), an averaged pose's {:.5} mm",
+        r.scatter * 1e3,
+        r.averaged_noise * 1e3
+    );
+    if let Some(o) = r.orientation_scatter {
+        s += &format!("; orientation {:.4}° per axis", o.to_degrees());
+    }
+    s += "\n";
+    if let Some(out) = out {
+        s += &format!("wrote {} ({} poses)\n", out.display(), r.kept());
+    }
+    s
+}

@@ -1,0 +1,318 @@
+//! ROS 2 bags (issue #52): the small committed bags of `fixtures/bags/`
+//! (written by `rosbags`, `verify/python/bag_truth.py tiny`) read in both
+//! storage formats, and bad bags refused with the reason, never a panic.
+//! The truth tests (a simulated run, the clock offset, calibration) are
+//! `verify/tests/live_bags.rs`.
+
+use crate::common::{fails_with, json_of, run, scratch_dir};
+use std::path::Path;
+
+const UR5: &str = "fixtures/ur5.urdf";
+
+/// The three rests `bag_truth.py tiny` drives the arm to (its `qs`).
+const RESTS: [[f64; 6]; 3] = [
+    [0.0, -1.2, 1.4, -1.7, -1.57, 0.0],
+    [0.4, -1.0, 1.2, -1.5, -1.4, 0.3],
+    [-0.3, -1.4, 1.6, -1.9, -1.7, -0.4],
+];
+
+fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let head = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|c| c.parse().unwrap()).collect())
+        .collect();
+    (head, rows)
+}
+
+#[test]
+fn mcap_and_sqlite_bags_give_the_rests_joint_values() {
+    let d = scratch_dir("bags", "formats");
+    for bag in ["fixtures/bags/tiny.mcap", "fixtures/bags/tiny_db3"] {
+        let out = d.join("m.csv");
+        let o = out.to_str().unwrap();
+        let r = json_of(&[
+            "extract", bag, "--robot", UR5, "--points", "/tracker", "--out", o, "--force", "--json",
+        ]);
+        assert_eq!(r["rests"].as_array().unwrap().len(), 3, "{bag}: {r}");
+        let (head, rows) = read_csv(&out);
+        assert_eq!(head[0], "shoulder_pan_joint", "{bag}");
+        assert_eq!(&head[6..9], ["x1", "y1", "z1"], "{bag}");
+        assert_eq!(rows.len(), 3, "{bag}");
+        for (row, want) in rows.iter().zip(RESTS) {
+            // The arm stands exactly still at each rest: the average is the
+            // pose the generator drove it to.
+            for (got, want) in row[..6].iter().zip(want) {
+                assert!((got - want).abs() < 1e-12, "{bag}: {row:?} vs {want:?}");
+            }
+            // The made-up point of the generator: 0.5 + 0.1 q1, 0.2 q2,
+            // 0.3 + 0.1 q3 with 0.01 mm of noise, averaged over 5–7 samples.
+            let p = [0.5 + 0.1 * want[0], 0.2 * want[1], 0.3 + 0.1 * want[2]];
+            for k in 0..3 {
+                assert!((row[6 + k] - p[k]).abs() < 5e-5, "{bag}: {row:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_cut_short_mcap_or_db3_is_refused() {
+    let d = scratch_dir("bags", "truncated");
+    let bytes = std::fs::read("fixtures/bags/tiny.mcap").unwrap();
+    let cut = d.join("cut.mcap");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let c = cut.to_str().unwrap();
+    fails_with(
+        &["extract", c, "--robot", UR5, "--points", "/tracker"],
+        "cut short",
+    );
+    let db = std::fs::read("fixtures/bags/tiny_db3/tiny_db3.db3").unwrap();
+    let cut = d.join("cut.db3");
+    std::fs::write(&cut, &db[..db.len() / 3]).unwrap();
+    let c = cut.to_str().unwrap();
+    fails_with(
+        &["extract", c, "--robot", UR5, "--points", "/tracker"],
+        "SQLite 3",
+    );
+    let empty = d.join("empty.mcap");
+    std::fs::write(&empty, b"").unwrap();
+    let e = empty.to_str().unwrap();
+    fails_with(
+        &["extract", e, "--robot", UR5, "--points", "/tracker"],
+        "neither MCAP nor SQLite",
+    );
+}
+
+#[test]
+fn an_unknown_storage_plugin_is_named() {
+    let d = scratch_dir("bags", "plugin");
+    std::fs::write(
+        d.join("metadata.yaml"),
+        "rosbag2_bagfile_information:\n  version: 9\n  storage_identifier: rosbag_v1\n  relative_file_paths: [a.bag]\n",
+    )
+    .unwrap();
+    let b = d.to_str().unwrap();
+    fails_with(
+        &["extract", b, "--robot", UR5, "--points", "/tracker"],
+        "storage plugin 'rosbag_v1' is not read",
+    );
+}
+
+#[test]
+fn a_missing_topic_lists_the_bags_topics() {
+    fails_with(
+        &[
+            "extract",
+            "fixtures/bags/tiny.mcap",
+            "--robot",
+            UR5,
+            "--points",
+            "/nope",
+        ],
+        "no topic '/nope' (the bag's topics: /joint_states (sensor_msgs/msg/JointState), /tracker (geometry_msgs/msg/PointStamped), /camera_info (sensor_msgs/msg/CameraInfo))",
+    );
+    fails_with(
+        &[
+            "extract",
+            "fixtures/bags/tiny_db3",
+            "--robot",
+            UR5,
+            "--joints",
+            "/js",
+            "--points",
+            "/tracker",
+        ],
+        "no topic '/js'",
+    );
+}
+
+#[test]
+fn a_topic_of_another_type_is_named_with_its_type() {
+    fails_with(
+        &[
+            "extract",
+            "fixtures/bags/tiny.mcap",
+            "--robot",
+            UR5,
+            "--points",
+            "/camera_info",
+        ],
+        "topic '/camera_info' is of type sensor_msgs/msg/CameraInfo, not geometry_msgs/msg/PointStamped",
+    );
+    fails_with(
+        &[
+            "extract",
+            "fixtures/bags/tiny.mcap",
+            "--robot",
+            UR5,
+            "--poses",
+            "/tracker",
+        ],
+        "not geometry_msgs/msg/PoseStamped or geometry_msgs/msg/TransformStamped",
+    );
+    fails_with(
+        &[
+            "extract",
+            "fixtures/bags/tiny.mcap",
+            "--robot",
+            UR5,
+            "--tf",
+            "world:tool",
+        ],
+        "no topic '/tf'",
+    );
+}
+
+#[test]
+fn a_joint_of_the_robot_absent_from_the_joint_states_is_named() {
+    fails_with(
+        &[
+            "extract",
+            "fixtures/bags/tiny.mcap",
+            "--robot",
+            "fixtures/stanford.urdf",
+            "--points",
+            "/tracker",
+        ],
+        "of the robot is in no message of '/joint_states'",
+    );
+}
+
+#[test]
+fn no_rest_period_is_refused_with_the_thresholds() {
+    fails_with(
+        &[
+            "extract",
+            "fixtures/bags/moving.mcap",
+            "--robot",
+            UR5,
+            "--points",
+            "/tracker",
+        ],
+        "no rest period on '/joint_states': no 0.5 s or longer where every joint's speed stays under 0.005 rad/s",
+    );
+    fails_with(
+        &[
+            "extract",
+            "fixtures/bags/moving.mcap",
+            "--robot",
+            UR5,
+            "--points",
+            "/tracker",
+        ],
+        "hint: --rest-speed SPEED and --rest-min S set what counts as a rest",
+    );
+    // Rests shorter than asked for: none.
+    fails_with(
+        &[
+            "extract",
+            "fixtures/bags/tiny.mcap",
+            "--robot",
+            UR5,
+            "--points",
+            "/tracker",
+            "--rest-min",
+            "5",
+        ],
+        "no rest period",
+    );
+    fails_with(
+        &[
+            "extract",
+            "fixtures/bags/tiny.mcap",
+            "--robot",
+            UR5,
+            "--points",
+            "/tracker",
+            "--settle",
+            "0.6",
+        ],
+        "the settling time (0.6 s)",
+    );
+}
+
+#[test]
+fn the_output_is_never_an_input() {
+    let d = scratch_dir("bags", "over_input");
+    let bag = d.join("b.mcap");
+    std::fs::copy("fixtures/bags/tiny.mcap", &bag).unwrap();
+    let b = bag.to_str().unwrap();
+    fails_with(
+        &[
+            "extract", b, "--robot", UR5, "--points", "/tracker", "--out", b, "--force",
+        ],
+        "is an input of this command",
+    );
+    assert_eq!(
+        std::fs::read(&bag).unwrap(),
+        std::fs::read("fixtures/bags/tiny.mcap").unwrap()
+    );
+    let out = run(&["extract", b, "--robot", UR5, "--points", "/tracker"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("rests: 3 found"), "{text}");
+    assert!(text.contains("scatter mm"), "{text}");
+}
+
+#[test]
+fn rests_are_matched_to_the_design_and_the_odd_ones_named() {
+    let d = scratch_dir("bags", "design");
+    // Rests 1 and 3 of the bag, and a pose the run never reached; a `via`
+    // row (a move between poses) is not a pose.
+    let design = d.join("design.csv");
+    let row = |q: &[f64]| q.iter().map(f64::to_string).collect::<Vec<_>>().join(",");
+    std::fs::write(
+        &design,
+        format!(
+            "shoulder_pan_joint,shoulder_lift_joint,elbow_joint,wrist_1_joint,wrist_2_joint,wrist_3_joint,id\n{},7\n{},via\n{},9\n{},12\n",
+            row(&RESTS[0]),
+            row(&RESTS[1]),
+            row(&[1.0, -1.0, 1.0, -1.0, -1.0, 1.0]),
+            row(&RESTS[2]),
+        ),
+    )
+    .unwrap();
+    let out = d.join("m.csv");
+    let r = json_of(&[
+        "extract",
+        "fixtures/bags/tiny.mcap",
+        "--robot",
+        UR5,
+        "--points",
+        "/tracker",
+        "--design",
+        design.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    let rests = r["rests"].as_array().unwrap();
+    assert_eq!(rests[0]["design_pose"], 0);
+    assert_eq!(rests[2]["design_pose"], 2);
+    assert!(rests[1]["design_pose"].is_null());
+    let why = rests[1]["left_out"].as_str().unwrap();
+    assert!(why.starts_with("reached no pose of the design"), "{why}");
+    let missing = r["missing_design_poses"].as_array().unwrap();
+    assert_eq!(missing.len(), 1, "{missing:?}");
+    assert_eq!(missing[0]["pose"], 1);
+    assert_eq!(missing[0]["reason"], "no rest reached it");
+    assert_eq!(read_csv(&out).1.len(), 2);
+    // The design is an input: never the output.
+    fails_with(
+        &[
+            "extract",
+            "fixtures/bags/tiny.mcap",
+            "--robot",
+            UR5,
+            "--points",
+            "/tracker",
+            "--design",
+            design.to_str().unwrap(),
+            "--out",
+            design.to_str().unwrap(),
+            "--force",
+        ],
+        "is an input of this command",
+    );
+}

@@ -467,7 +467,10 @@ fn live_images_eye_in_hand_checkerboard() {
     // placements absorb): the prediction is conservative for detected
     // corners, a limit stated in docs/cameras.md.
     assert!(t < RATIO * p, "true {t} mm against predicted {p} mm");
-    assert!(t < RATIO * r, "true {t} mm against {r} mm from the true pixels");
+    assert!(
+        t < RATIO * r,
+        "true {t} mm against {r} mm from the true pixels"
+    );
 }
 
 /// A board whose labelling the detector cannot tell (see the module

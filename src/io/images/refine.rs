@@ -182,7 +182,11 @@ mod tests {
         let r = refine_corner(&img, start, half_window(12.0)).unwrap();
         let e = (r.px[0] - cx).hypot(r.px[1] - cy);
         let e0 = (start[0] - cx).hypot(start[1] - cy);
-        assert!(e < 0.1 && e < e0 / 10.0, "{:?} is {e} px off (start {e0} px)", r.px);
+        assert!(
+            e < 0.1 && e < e0 / 10.0,
+            "{:?} is {e} px off (start {e0} px)",
+            r.px
+        );
         let moved = (r.px[0] - start[0]).hypot(r.px[1] - start[1]);
         assert!((r.shift - moved).abs() < 1e-12);
     }

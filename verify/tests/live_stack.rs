@@ -305,6 +305,41 @@ fn offsets_only_recovers_a_ur5_whose_only_errors_are_offsets() {
 /// The reported gain of the full model against the true difference.
 const GAIN_RATIO: f64 = 1.3;
 
+/// A true arm of `example-robot-data/FILE` with full origin errors,
+/// measured with the truth gate's noise (0.05 mm per axis), fitted
+/// restricted by `extra` into `stem.*` and with every unknown into
+/// `all.*`: the URDF, the restricted fit's JSON report and the two fits'
+/// true RMS errors (mm, restricted first).
+fn restricted_and_full(
+    d: &Path,
+    file: &str,
+    seed: u64,
+    stem: &str,
+    extra: &[&str],
+) -> (String, Value, Vec<f64>) {
+    let urdf = arm_truth(d, file, seed, false);
+    truth_py(
+        d,
+        [
+            "measure",
+            "--truth",
+            "truth.json",
+            "--design",
+            "design.csv",
+            "--noise",
+            "5e-5",
+            "--seed",
+            "2",
+            "--out",
+            "m.csv",
+        ],
+    );
+    let r = fit(d, &urdf, stem, extra);
+    fit(d, &urdf, "all", &[]);
+    let e = compare(d, 0, &[stem.to_string(), "all".to_string()]);
+    (urdf, r, e)
+}
+
 #[test]
 fn with_full_origin_errors_the_reported_gain_is_the_true_one() {
     for (file, seed) in [
@@ -313,29 +348,9 @@ fn with_full_origin_errors_the_reported_gain_is_the_true_one() {
         ("ur10_robot.urdf", 24),
     ] {
         let d = dir(&format!("offsets-full-{seed}"));
-        let urdf = arm_truth(&d, file, seed, false);
-        // Measured with the truth gate's noise, 0.05 mm per axis.
-        truth_py(
-            &d,
-            [
-                "measure",
-                "--truth",
-                "truth.json",
-                "--design",
-                "design.csv",
-                "--noise",
-                "5e-5",
-                "--seed",
-                "2",
-                "--out",
-                "m.csv",
-            ],
-        );
-        let r = fit(&d, &urdf, "off", &["--unknowns", "offsets"]);
-        fit(&d, &urdf, "all", &[]);
+        let (_, r, e) = restricted_and_full(&d, file, seed, "off", &["--unknowns", "offsets"]);
         let g = &r["full_model_gain"];
         let reported = g["gain_mm"].as_f64().unwrap();
-        let e = compare(&d, 0, &["off".to_string(), "all".to_string()]);
         let truly = e[0] - e[1];
         eprintln!(
             "{file} (seed {seed}), origins off 0.5-2 mm, 0.05 mm noise: true RMS offsets only {:.4} mm, full {:.4} mm \
@@ -377,25 +392,7 @@ const IK_SOLVED_M: f64 = 1e-9;
 fn keeping_axis_relations_keeps_the_ur_closed_form_ik_and_reports_its_cost() {
     for (file, seed) in [("ur5_robot.urdf", 22), ("ur10_robot.urdf", 24)] {
         let d = dir(&format!("relations-{seed}"));
-        let urdf = arm_truth(&d, file, seed, false);
-        truth_py(
-            &d,
-            [
-                "measure",
-                "--truth",
-                "truth.json",
-                "--design",
-                "design.csv",
-                "--noise",
-                "5e-5",
-                "--seed",
-                "2",
-                "--out",
-                "m.csv",
-            ],
-        );
-        let r = fit(&d, &urdf, "kar", &["--keep-axis-relations"]);
-        fit(&d, &urdf, "all", &[]);
+        let (urdf, r, e) = restricted_and_full(&d, file, seed, "kar", &["--keep-axis-relations"]);
         // Every nominal relation the report lists as held is kept, to
         // RELATION_KEPT, in the written URDF (Pinocchio's axis lines).
         let rel = ur_ik(
@@ -459,7 +456,6 @@ fn keeping_axis_relations_keeps_the_ur_closed_form_ik_and_reports_its_cost() {
         );
         // The cost, reported and true.
         let g = &r["full_model_gain"];
-        let e = compare(&d, 0, &["kar".to_string(), "all".to_string()]);
         eprintln!(
             "{file} (seed {seed}), origins off 0.5-2 mm, 0.05 mm noise: closed-form IK on the kept model {solved:.1e} m, \
              on the full one {broken:.3} m; true RMS kept {:.4} mm, full {:.4} mm; reported kept {:.4} mm, full {:.4} mm",

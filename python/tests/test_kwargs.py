@@ -33,6 +33,7 @@ CALIBRATE = {
     "noise": (1e-4, {"points", "poses"}),
     "orientation_noise": (1e-3, {"poses"}),
     "unknowns": ("offsets", {"points", "poses"}),
+    "keep_axis_relations": (True, {"points", "poses"}),
 }
 # Arguments a keyword needs beside it (the command line's `requires`).
 NEEDS = {"loss_scale": {"loss": "huber"}, "loss": {"loss_scale": 1e-3}, "splits": {"holdout": 0.25}, "seed": {"holdout": 0.25}}

@@ -27,6 +27,23 @@ impl Table {
     }
 }
 
+/// The lines of CSV `text` that hold data, with their 1-based numbers:
+/// blank lines and `#` comments skipped, a Windows line end dropped.
+pub(crate) fn csv_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    text.lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim_end_matches('\r')))
+        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
+}
+
+/// A CSV header's column names, trimmed and unquoted.
+pub(crate) fn header_cells(header: &str) -> Vec<String> {
+    header
+        .split(',')
+        .map(|c| c.trim().trim_matches('"').trim().to_string())
+        .collect()
+}
+
 /// Parses CSV `text` (from `origin`, for messages). Errors on an empty file,
 /// a duplicate or empty column name, a row with another number of cells than
 /// the header, and a cell that is not a number (NaN and infinities are read
@@ -36,18 +53,11 @@ pub fn parse_csv(text: &str, origin: &str) -> Result<Table> {
         path: origin.to_string(),
         message,
     };
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim_end_matches('\r')))
-        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+    let mut lines = csv_lines(text);
     let (hline, header) = lines
         .next()
         .ok_or_else(|| err("empty file: expected a header line of column names".into()))?;
-    let columns: Vec<String> = header
-        .split(',')
-        .map(|c| c.trim().trim_matches('"').trim().to_string())
-        .collect();
+    let columns = header_cells(header);
     for (i, c) in columns.iter().enumerate() {
         if c.is_empty() {
             return Err(err(format!(

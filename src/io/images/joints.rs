@@ -60,18 +60,11 @@ pub fn parse_image_joints(
         path: origin.to_string(),
         message,
     };
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim_end_matches('\r')))
-        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+    let mut lines = crate::io::table::csv_lines(text);
     let (hline, header) = lines
         .next()
         .ok_or_else(|| err("empty file: expected a header 'image,<joints>'".into()))?;
-    let columns: Vec<String> = header
-        .split(',')
-        .map(|c| c.trim().trim_matches('"').trim().to_string())
-        .collect();
+    let columns = crate::io::table::header_cells(header);
     let names = joint_names(robot);
     let find = |name: &str, what: &str| {
         columns.iter().position(|c| c == name).ok_or_else(|| {

@@ -2,12 +2,14 @@
 //! select --camera-info ...` chooses them (with its collision filters and
 //! line of sight), and the `CameraDesign` it returns.
 
-use crate::camera::{chain_of, mounting_of, named, read_intrinsics, read_target, six, yaml_source};
+use crate::camera::{chain_of, mounting_of, read_intrinsics, read_target, six, yaml_source};
 use crate::convert::{Fail, arg_err, detached, json_to_py, ndarray, non_negative};
 use crate::robot::Robot;
-use activecal::model::robot_ref::RobotRef;
+use activecal::experiment::camera_select::{
+    CameraSelectPlan, CameraSelection, Candidates, DEFAULT_PIXEL_NOISE,
+};
+use activecal::model::robot_ref::{ChainChoice, RobotRef};
 use activecal::pool::camera_view::CameraView;
-use activecal::report::{CameraDesignReport, CameraPoolInfo};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -15,24 +17,18 @@ use pyo3::types::PyDict;
 /// see, and the report.
 #[pyclass(module = "activecal", name = "CameraDesign", frozen)]
 pub struct CameraDesign {
-    /// The library's design (its visible pool's blocks, for `how_many`).
-    design: std::sync::Arc<activecal::select::camera::CameraDesign>,
-    /// The selection's settings, which the curve's selections reuse.
-    settings: activecal::select::Settings,
-    joint_names: Vec<String>,
+    /// The library's design with its report (its visible pool's blocks,
+    /// for `how_many`).
+    sel: std::sync::Arc<CameraSelection>,
+    /// The report as `select --camera-info ... --json` prints it.
     report: serde_json::Value,
-    qs: Vec<Vec<f64>>,
-    candidates: Vec<usize>,
-    seen: Vec<usize>,
 }
 
 /// The robot as its reference names it (`robot`, `chain` of the report):
 /// the name a robot is loaded under is its reference's text form.
-fn reference(
-    robot: &activecal::model::Robot,
-) -> (String, activecal::model::robot_ref::ChainChoice) {
+fn reference(robot: &activecal::model::Robot) -> (String, ChainChoice) {
     RobotRef::parse(&robot.name).map_or_else(
-        |_| (robot.name.clone(), Default::default()),
+        |_| (robot.name.clone(), ChainChoice::default()),
         |r| (r.head(), r.chain),
     )
 }
@@ -111,16 +107,11 @@ pub fn select_camera(
     let info_src = yaml_source(py, camera_info, "camera_info")?;
     let target_src = yaml_source(py, target, "target")?;
     let inner = robot.inner.clone();
-    let branch = chain_of(&inner, camera_link.as_deref()).map_err(Fail::into_py)?;
-    let (filters, sight) = sight_of(
-        &choice,
-        line_of_sight,
-        branch.as_ref().unwrap_or(&inner),
-        camera_link.as_deref(),
-    )?;
-    let (d, report, joint_names, settings) = crate::progress::with_callback(progress, || {
+    if let Some(l) = camera_link.as_deref() {
+        chain_of(&inner, Some(l)).map_err(Fail::into_py)?;
+    }
+    let sel = crate::progress::with_callback(progress, || {
         detached(py, move || {
-            let r = branch.as_ref().unwrap_or(&inner);
             let board = read_target(&target_src)?;
             let view = CameraView {
                 intrinsics: read_intrinsics(&info_src)?,
@@ -134,101 +125,38 @@ pub fn select_camera(
                 max_view_angle: max_view_angle.to_radians(),
                 distance: [distance.0, distance.1],
             };
-            view.validate()
-                .map_err(|e| Fail::Input(format!("camera view: {e}")))?;
-            let candidates =
-                activecal::observability::generic_configurations(r, samples, pool_seed);
-            let settings = activecal::select::Settings::builder()
-                .n(n)
-                .seed(seed)
-                .build()?;
-            let (d, collision_removed) = activecal::select::camera::camera_design_filtered(
-                r,
-                &view,
-                &filters,
-                sight.as_ref(),
-                &candidates,
-                &settings,
-            )?;
-            let settings_kept = settings.clone();
-            let g = if gap {
-                Some(d.gap(&activecal::bound::BoundSettings::default())?)
-            } else {
-                None
-            };
-            let (name, chain) = reference(&inner);
-            let pool = CameraPoolInfo {
-                robot: name,
-                chain,
+            let (robot_name, chain) = reference(&inner);
+            let plan = CameraSelectPlan {
+                view,
                 camera_link,
-                candidates: candidates.len(),
-                pool_seed,
-                collision_removed,
+                collision: choice,
+                line_of_sight,
+                candidates: Candidates::Sampled {
+                    count: samples,
+                    seed: pool_seed,
+                },
+                settings: activecal::select::Settings::builder()
+                    .n(n)
+                    .seed(seed)
+                    .build()?,
+                gap: gap.then(activecal::bound::BoundSettings::default),
                 pixel_noise,
+                robot_name,
+                chain,
             };
-            let names = activecal::units::joint_names(r);
-            let report = CameraDesignReport::new(&d, pool, m, names.clone(), g);
-            let mut v = serde_json::to_value(&report)?;
-            v["out"] = serde_json::json!([]);
-            Ok((d, v, names, settings_kept))
+            Ok(activecal::experiment::camera_select::select_camera(
+                &inner, plan,
+            )?)
         })
     })?;
-    let (qs, candidates, seen) = (d.qs.clone(), d.candidates.clone(), d.seen.clone());
+    let mut report = sel.report.clone();
+    report.out = Some(Vec::new());
+    let report = serde_json::to_value(&report).map_err(|e| Fail::from(e).into_py())?;
     Ok(CameraDesign {
-        design: std::sync::Arc::new(d),
-        settings,
-        joint_names,
+        sel: std::sync::Arc::new(sel),
         report,
-        qs,
-        candidates,
-        seen,
     })
 }
-
-/// The collision filters of `choice` and the line of sight (asked for, or
-/// on with any collision check) of a camera pool for `robot` (the chain
-/// from the camera's link with `camera_link`: its joints drive the whole
-/// tree by name, obstacles and the floor in the tree's root), as
-/// `activecal select --camera-info` builds them.
-fn sight_of(
-    choice: &activecal::io::collision_choice::CollisionChoice,
-    line_of_sight: bool,
-    robot: &activecal::model::Robot,
-    camera_link: Option<&str>,
-) -> PyResult<(
-    Vec<activecal::pool::PoolFilter>,
-    Option<activecal::pool::line_of_sight::LineOfSight>,
-)> {
-    if !(choice.any() || line_of_sight) {
-        return Ok((Vec::new(), None));
-    }
-    let root = camera_link
-        .map(|l| {
-            activecal::io::urdf_branch::tree_root(robot)
-                .map(|r| (l, r))
-                .map_err(|e| named("camera_link", Fail::Input(e.to_string())).into_py())
-        })
-        .transpose()?;
-    let mut chain = activecal::io::UrdfChain::of(robot);
-    if let (Some((_, r)), Some(c)) = (&root, chain.as_mut()) {
-        c.base.clone_from(r);
-    }
-    let filters = crate::pool::choice_filters(choice, chain.clone(), &robot.name)?;
-    let Some(chain) = chain else {
-        return Err(arg_err(
-            "line_of_sight",
-            format!(
-                "needs a robot imported from a URDF with collision geometry; {} has none",
-                robot.name
-            ),
-        ));
-    };
-    Ok((filters, Some(choice.line_of_sight(chain, root))))
-}
-
-/// The σ of `--pixel-noise` when `how_many` is not given one, px: a
-/// corner detector's typical sub-pixel error, as the command line's.
-const DEFAULT_PIXEL_NOISE: f64 = 0.3;
 
 /// Refuses a pixel noise that is not a finite number > 0.
 fn check_pixel_noise(pixel_noise: Option<f64>) -> PyResult<()> {
@@ -247,26 +175,27 @@ impl CameraDesign {
     /// the order chosen.
     #[getter]
     fn q<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let v: Vec<f64> = self.qs.iter().flatten().copied().collect();
-        ndarray(py, &v, &[self.qs.len(), self.joint_names.len()])
+        let qs = &self.sel.design.qs;
+        let v: Vec<f64> = qs.iter().flatten().copied().collect();
+        ndarray(py, &v, &[qs.len(), self.sel.joint_names.len()])
     }
 
     /// Each chosen configuration's index in the samples.
     #[getter]
     fn candidates(&self) -> Vec<usize> {
-        self.candidates.clone()
+        self.sel.design.candidates.clone()
     }
 
     /// The target points each chosen configuration will see.
     #[getter]
     fn points_seen(&self) -> Vec<usize> {
-        self.seen.clone()
+        self.sel.design.seen.clone()
     }
 
     /// The joints' names, the columns of `q`.
     #[getter]
     fn joint_names(&self) -> Vec<String> {
-        self.joint_names.clone()
+        self.sel.joint_names.clone()
     }
 
     /// The chosen poses as a pandas DataFrame, the columns of `select
@@ -275,12 +204,13 @@ impl CameraDesign {
     fn poses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let pd = py.import("pandas")?;
         let data = PyDict::new(py);
-        data.set_item("candidate", self.candidates.clone())?;
-        for (j, name) in self.joint_names.iter().enumerate() {
-            let col: Vec<f64> = self.qs.iter().map(|q| q[j]).collect();
+        let d = &self.sel.design;
+        data.set_item("candidate", d.candidates.clone())?;
+        for (j, name) in self.sel.joint_names.iter().enumerate() {
+            let col: Vec<f64> = d.qs.iter().map(|q| q[j]).collect();
             data.set_item(name, col)?;
         }
-        data.set_item("points_seen", self.seen.clone())?;
+        data.set_item("points_seen", d.seen.clone())?;
         pd.call_method1("DataFrame", (data,))
     }
 
@@ -306,15 +236,13 @@ impl CameraDesign {
             ));
         }
         let noise = pixel_noise
-            .or(self.report["pixel_noise_px"].as_f64())
+            .or(self.sel.pixel_noise)
             .unwrap_or(DEFAULT_PIXEL_NOISE);
-        let mut cs = activecal::how_many::CurveSettings::new(self.settings.clone(), noise);
-        cs.also = vec![self.qs.len()];
-        cs.target_mm = target_error;
-        let d = self.design.clone();
+        let sel = self.sel.clone();
         let v = crate::progress::with_callback(progress, || {
             detached(py, move || {
-                let curve = d.how_many(&cs).map_err(|e| match e {
+                let bound = activecal::bound::BoundSettings::default();
+                let curve = sel.curve(bound, noise, target_error).map_err(|e| match e {
                     activecal::how_many::HowManyError::Input(e) => Fail::from(e),
                     activecal::how_many::HowManyError::Bound(e) => e.into(),
                 })?;
@@ -334,7 +262,7 @@ impl CameraDesign {
     fn __repr__(&self) -> String {
         format!(
             "CameraDesign({} poses, ln det {})",
-            self.qs.len(),
+            self.sel.design.qs.len(),
             self.report["ln_det"]
         )
     }

@@ -312,6 +312,24 @@ impl PoolOpts {
     /// from its own link, whose joints drive the whole tree by name with
     /// the tree's root as the frame of obstacles.
     pub fn collision_filters_on(&self, chain: Option<UrdfChain>) -> Result<Vec<PoolFilter>> {
+        let choice = self.collision_choice()?;
+        if !choice.any() {
+            return Ok(Vec::new());
+        }
+        let Some(chain) = chain else {
+            anyhow::bail!(
+                "--self-collision, --obstacle and --floor need a URDF robot with collision geometry (--robot FILE.urdf); {} has none",
+                self.robot
+            );
+        };
+        Ok(choice.filters(chain))
+    }
+
+    /// What `--self-collision`, `--srdf`, `--package-dir`, `--clearance`,
+    /// `--obstacle` and `--floor` ask the collision check to do, checked
+    /// (`--srdf` and `--package-dir` without a check are errors; the files
+    /// must exist).
+    pub fn collision_choice(&self) -> Result<activecal::io::collision_choice::CollisionChoice> {
         use activecal::collision::Obstacle;
         let obstacles = self
             .obstacles
@@ -336,7 +354,7 @@ impl PoolOpts {
                     "--srdf and --package-dir apply with --self-collision, --obstacle or --floor"
                 );
             }
-            return Ok(Vec::new());
+            return Ok(Default::default());
         }
         if self.skip_always_touching && !self.self_collision {
             anyhow::bail!(
@@ -346,12 +364,6 @@ impl PoolOpts {
         if self.srdf.is_some() && !self.self_collision {
             anyhow::bail!("--srdf lists pairs of links for --self-collision, which is not given");
         }
-        let Some(chain) = chain else {
-            anyhow::bail!(
-                "--self-collision, --obstacle and --floor need a URDF robot with collision geometry (--robot FILE.urdf); {} has none",
-                self.robot
-            );
-        };
         for (opt, p) in self
             .srdf
             .iter()
@@ -375,8 +387,7 @@ impl PoolOpts {
             obstacles,
             floor: self.floor,
         };
-        let out = choice.filters(chain);
-        Ok(out)
+        Ok(choice)
     }
 
     /// Loads the robot, builds the pool and its Jacobian. A pool file is

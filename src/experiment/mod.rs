@@ -3,6 +3,7 @@
 pub mod acts_on;
 pub mod bag;
 pub mod camera;
+pub mod camera_select;
 pub mod contact_screen;
 pub mod contacts;
 pub mod error;

@@ -238,6 +238,10 @@ pub struct CameraDesignReport {
     pub poses: Vec<Vec<f64>>,
     /// The gap to the visible pool's certified bound, when asked for.
     pub gap: Option<DesignGap>,
+    /// The files written from the design (the caller's: set in what it
+    /// prints, absent from the files it writes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub out: Option<Vec<String>>,
 }
 
 impl CameraDesignReport {
@@ -278,6 +282,7 @@ impl CameraDesignReport {
             chosen_candidates: d.candidates.clone(),
             poses: d.qs.clone(),
             gap,
+            out: None,
         }
     }
 }

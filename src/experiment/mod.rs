@@ -2,6 +2,7 @@
 
 pub mod acts_on;
 pub mod bag;
+pub mod bench;
 pub mod camera;
 pub mod camera_select;
 pub mod contact_screen;

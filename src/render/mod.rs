@@ -5,6 +5,7 @@
 //! text and the paper's figures. The command line and the Python package
 //! both call these; nothing here prints or names a flag.
 
+pub mod bench_text;
 pub mod camera_design;
 pub mod contact_figures;
 pub mod contact_sheet;

@@ -5,7 +5,6 @@ use crate::convert::{arg_err, detached, json_to_py, ndarray, non_negative};
 use crate::pool::Pool;
 use crate::robot::Robot;
 use activecal::blocks::Blocks;
-use activecal::criterion::Prior;
 use activecal::experiment::select::{Existing, SelectRun};
 use activecal::experiment::visiting::Visiting;
 use activecal::io::design::DesignFile;
@@ -29,8 +28,6 @@ pub struct Design {
     positions: Vec<usize>,
     /// The pool's Jacobian (for the bound).
     x: Arc<Blocks>,
-    /// The existing poses' information, when given.
-    prior: Option<Prior>,
     /// The selection's settings and algorithm (for the how-many curve).
     settings: Settings,
     algorithm: Algorithm,
@@ -176,7 +173,6 @@ pub fn select(
         pool_ids: candidates.pool.ids.clone(),
         pool: candidates.pool.clone(),
         x: candidates.x,
-        prior,
         settings: s,
         algorithm,
         noise,
@@ -192,38 +188,32 @@ impl Design {
         py: Python<'py>,
         progress: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (x, prior, positions) = (self.x.clone(), self.prior.clone(), self.positions.clone());
+        let (x, positions) = (self.x.clone(), self.positions.clone());
         let (robot, pool, ids) = (self.robot.clone(), self.pool.clone(), self.ids.clone());
         let existing = self.file.existing.as_ref().map(|e| e.q.clone());
         let v = crate::progress::with_callback(progress, || {
             detached(py, move || {
-                let settings = activecal::bound::BoundSettings::default();
-                let b = activecal::bound::relaxation_bound(
-                    &x,
-                    prior.as_ref(),
-                    positions.len(),
-                    &settings,
-                )?;
-                let g = activecal::bound::gap::design_gap(&x, prior.as_ref(), &positions, &b)?;
                 // The report `activecal gap --json` prints for this design.
                 let params = activecal::model::ParamSet::Nominal;
-                let info = activecal::report::PoolInfo::new(&robot, &pool);
-                let mut report = activecal::report::GapReport::new(info, params, ids, &g, &b);
-                if let (Some(qs), Some(prior)) = (existing, prior.as_ref()) {
-                    let xe = activecal::blocks::jacobian_of(
-                        &robot,
-                        robot.params(params),
-                        qs.len(),
-                        |k, q| q.copy_from_slice(&qs[k]),
-                    );
-                    report.existing = Some(activecal::report::ExistingReport::new(
-                        "existing".into(),
-                        &xe,
-                        prior,
-                        Vec::new(),
-                    ));
-                }
-                Ok(serde_json::to_value(&report)?)
+                let existing = existing
+                    .map(|qs| {
+                        Existing::from_poses("existing".into(), qs, Vec::new(), &robot, params)
+                    })
+                    .transpose()?;
+                let on = activecal::experiment::gap::ScoringPool {
+                    robot: &robot,
+                    pool: &pool,
+                    x: &x,
+                    params,
+                };
+                let scored = activecal::experiment::gap::score_design(
+                    on,
+                    ids,
+                    activecal::experiment::gap::DesignPoses::InPool(&positions),
+                    existing,
+                    &activecal::bound::BoundSettings::default(),
+                )?;
+                Ok(serde_json::to_value(&scored.report)?)
             })
         })?;
         json_to_py(py, &v)

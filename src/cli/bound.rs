@@ -2,10 +2,11 @@
 //! design's D-efficiency against it.
 
 use super::{PoolOpts, emit_report, filters, load_description};
-use activecal::bound::{Bound, BoundSettings, RelaxationSolver, design_gap, relaxation_bound};
+use activecal::bound::{Bound, BoundSettings, RelaxationSolver, relaxation_bound};
+use activecal::experiment::gap::{DesignPoses, ScoredDesign, ScoringPool, score_design};
 use activecal::io::design::DesignFile;
 use activecal::model::ParamSet;
-use activecal::report::{BoundCommandReport, GapReport, PoolInfo};
+use activecal::report::BoundCommandReport;
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
@@ -209,50 +210,28 @@ pub fn cmd_gap(a: GapArgs) -> Result<()> {
             )
         })
         .transpose()?;
-    let prior = existing.as_ref().map(|e| &e.prior);
-    let b = relaxation_bound(&ctx.x, prior, d.poses.len(), &settings)?;
-    let g = if d.refined {
-        let qs = d
-            .joint_values(&ctx.robot)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?;
-        let xd = activecal::blocks::jacobian_of(
-            &ctx.robot,
-            ctx.robot.params(a.params),
-            qs.len(),
-            |k, q| q.copy_from_slice(&qs[k]),
-        );
-        let all: Vec<usize> = (0..qs.len()).collect();
-        // The pool's bound is for the pool's Jacobian; the design's own
-        // Jacobian is scored against its value.
-        let ln = activecal::criterion::design_ln_det(&xd, prior, &all);
-        activecal::bound::DesignGap {
-            n: qs.len(),
-            p: b.p,
-            ln_oid: ln,
-            log10_oid: ln.map(|l| l / std::f64::consts::LN_10),
-            ln_bound: b.ln_bound,
-            log10_bound: b.log10_bound(),
-            d_efficiency: activecal::bound::gap::d_efficiency(ln, b.ln_bound, b.p),
-            bound_status: b.status,
-            certificate_gap: b.certificate_gap,
-            weighted: Vec::new(),
-            weights: Vec::new(),
-        }
+    let qs = if d.refined {
+        d.joint_values(&ctx.robot)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?
     } else {
-        design_gap(&ctx.x, prior, &positions, &b)?
+        Vec::new()
     };
-    let mut report = GapReport::new(
-        PoolInfo::new(&ctx.robot, &ctx.pool),
-        a.params,
-        d.poses.clone(),
-        &g,
-        &b,
-    );
-    report.existing = existing.map(|e| e.report);
-    if d.refined {
-        report.refined = true;
-        report.exceeds_bound = g.ln_oid.map(|l| l > b.ln_bound);
-    }
+    let poses = if d.refined {
+        DesignPoses::Refined(&qs)
+    } else {
+        DesignPoses::InPool(&positions)
+    };
+    let on = ScoringPool {
+        robot: &ctx.robot,
+        pool: &ctx.pool,
+        x: &ctx.x,
+        params: a.params,
+    };
+    let ScoredDesign {
+        report,
+        bound: b,
+        gap: g,
+    } = score_design(on, d.poses.clone(), poses, existing, &settings)?;
     emit_report(a.json, &report, || {
         let oid = g
             .log10_oid

@@ -8,6 +8,7 @@ pub mod camera_select;
 pub mod contact_screen;
 pub mod contacts;
 pub mod error;
+pub mod gap;
 pub mod measured;
 pub mod paper;
 pub mod select;

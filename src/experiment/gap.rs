@@ -1,0 +1,116 @@
+//! The `gap` pipeline, owned by the library: a design's certified
+//! D-efficiency against the relaxation bound of its pool (eq. (C)), with
+//! the information of poses measured before it, for a design whose poses
+//! are in the pool or one refined off it (scored from its own joint
+//! values against the bound of the pool it started from). The command
+//! line and the Python package both call [`score_design`].
+
+use super::ExperimentError;
+use super::select::Existing;
+use crate::blocks::Blocks;
+use crate::bound::gap::{d_efficiency, design_gap};
+use crate::bound::{Bound, BoundSettings, DesignGap, relaxation_bound};
+use crate::model::{ParamSet, Robot};
+use crate::pool::Pool;
+use crate::report::{GapReport, PoolInfo};
+
+/// A design's poses.
+#[derive(Clone, Copy, Debug)]
+pub enum DesignPoses<'a> {
+    /// Positions in the pool.
+    InPool(&'a [usize]),
+    /// Joint values off the pool (a refined design; radians, metres).
+    Refined(&'a [Vec<f64>]),
+}
+
+/// A design scored: the report, the bound and the gap.
+#[derive(Clone, Debug)]
+pub struct ScoredDesign {
+    /// The report (`gap --json`'s).
+    pub report: GapReport,
+    /// The pool's certified bound.
+    pub bound: Bound,
+    /// The design against it.
+    pub gap: DesignGap,
+}
+
+/// The pool a design is scored on: the robot, the pool and its Jacobian at
+/// `params`.
+#[derive(Clone, Copy, Debug)]
+pub struct ScoringPool<'a> {
+    /// The robot.
+    pub robot: &'a Robot,
+    /// The pool.
+    pub pool: &'a Pool,
+    /// Its Jacobian.
+    pub x: &'a Blocks,
+    /// The parameters it was evaluated at.
+    pub params: ParamSet,
+}
+
+/// Scores a design of `ids` (its poses' pool ids, for the report) against
+/// the bound of pool `on` for as many poses, with the prior information of
+/// `existing` poses when given.
+///
+/// # Errors
+/// A failing bound, or a design not of the pool.
+pub fn score_design(
+    on: ScoringPool<'_>,
+    ids: Vec<usize>,
+    poses: DesignPoses<'_>,
+    existing: Option<Existing>,
+    settings: &BoundSettings,
+) -> Result<ScoredDesign, ExperimentError> {
+    let prior = existing.as_ref().map(|e| &e.prior);
+    let n = match poses {
+        DesignPoses::InPool(p) => p.len(),
+        DesignPoses::Refined(q) => q.len(),
+    };
+    let bound = relaxation_bound(on.x, prior, n, settings)?;
+    let gap = match poses {
+        DesignPoses::InPool(positions) => design_gap(on.x, prior, positions, &bound)?,
+        DesignPoses::Refined(qs) => refined_gap(on, qs, prior, &bound),
+    };
+    let mut report = GapReport::new(
+        PoolInfo::new(on.robot, on.pool),
+        on.params,
+        ids,
+        &gap,
+        &bound,
+    );
+    report.existing = existing.map(|e| e.report);
+    if matches!(poses, DesignPoses::Refined(_)) {
+        report.refined = true;
+        report.exceeds_bound = gap.ln_oid.map(|l| l > bound.ln_bound);
+    }
+    Ok(ScoredDesign { report, bound, gap })
+}
+
+/// A refined design's gap: its own Jacobian's `ln det` against the value
+/// of the pool's bound (which is for the pool's Jacobian, and so may not
+/// bound it).
+fn refined_gap(
+    on: ScoringPool<'_>,
+    qs: &[Vec<f64>],
+    prior: Option<&crate::criterion::Prior>,
+    b: &Bound,
+) -> DesignGap {
+    let xd = crate::blocks::jacobian_of(on.robot, on.robot.params(on.params), qs.len(), |k, q| {
+        q.copy_from_slice(&qs[k]);
+    });
+    let all: Vec<usize> = (0..qs.len()).collect();
+    let ln = crate::criterion::design_ln_det(&xd, prior, &all);
+    DesignGap {
+        n: qs.len(),
+        p: b.p,
+        ln_oid: ln,
+        log10_oid: ln.map(|l| l / std::f64::consts::LN_10),
+        ln_bound: b.ln_bound,
+        log10_bound: b.log10_bound(),
+        d_efficiency: d_efficiency(ln, b.ln_bound, b.p),
+        bound_status: b.status,
+        certificate_gap: b.certificate_gap,
+        weighted: Vec::new(),
+        weights: Vec::new(),
+    }
+}

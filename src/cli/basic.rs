@@ -1,11 +1,10 @@
 //! `robots`, `fk`, `pool`: the kinematic core on the command line.
 
-use super::{emit, emit_report, load_robot, parse_list};
+use super::{emit_report, load_robot, parse_list};
 use activecal::model::{ParamSet, Robot};
 use activecal::report::{FkReport, LatticeReport};
 use anyhow::Result;
 use clap::Args;
-use serde_json::{Value, json};
 
 /// Arguments of the command.
 #[derive(Args)]
@@ -87,17 +86,6 @@ pub struct PoolArgs {
     pub json: bool,
 }
 
-/// Kind of each joint, by joint number.
-fn joint_kinds(r: &Robot) -> Vec<activecal::model::JointKind> {
-    let mut k = vec![activecal::model::JointKind::Revolute; r.dof()];
-    for f in &r.frames {
-        if let Some(j) = f.joint {
-            k[j] = f.joint_kind;
-        }
-    }
-    k
-}
-
 /// Runs `robots`.
 pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
     if let Some(name) = &a.export {
@@ -148,98 +136,18 @@ pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
             .map(|n| Robot::builtin(n).expect("built-in"))
             .collect(),
     };
-    let described: Vec<Value> = robots.iter().map(robot_json).collect();
-    let v = json!({ "robots": described });
-    emit(a.json, &v, || robots.iter().map(robot_text).collect())
-}
-
-/// One robot of `robots --json`.
-fn robot_json(r: &Robot) -> Value {
-    json!({
-        "name": r.name,
-        "chain": activecal::report::chain(r),
-        "joint_names": activecal::units::joint_names(r),
-        "dof": r.dof(),
-        "frames": r.frames,
-        "real": r.real.rows,
-        "nominal": r.nominal.rows,
-        "unknowns": r.parameter_names(),
-        // Revolute joints in degrees; prismatic ones have none (null): see `limits`.
-        "limits_deg": joint_kinds(r).iter().zip(&r.limits).map(|(k, l)| match k {
-            activecal::model::JointKind::Revolute => Some([l[0].to_degrees(), l[1].to_degrees()]),
-            activecal::model::JointKind::Prismatic => None,
-        }).collect::<Vec<_>>(),
-        "limits": r.limits,
-        "joint_kinds": joint_kinds(r),
-        "measurement": r.measurement,
+    let report = activecal::report::RobotsReport {
+        robots: robots
+            .iter()
+            .map(activecal::report::RobotReport::of)
+            .collect(),
+    };
+    super::emit_report(a.json, &report, || {
+        robots
+            .iter()
+            .map(activecal::render::robot_text::text)
+            .collect()
     })
-}
-
-/// The largest made-up error of a URDF robot's "real" parameters (metres
-/// or radians, [`activecal::model::catalogue::perturbation`]).
-const URDF_REAL_MAX: f64 = 5e-3;
-
-/// One robot of `robots`' text: chain, joints with limits, parameter
-/// tables (lengths in metres, angles in radians), unknowns.
-fn robot_text(r: &Robot) -> String {
-    let mut s = format!(
-        "{} ({} joints, {} unknowns)\nchain: {}\n",
-        r.name,
-        r.dof(),
-        r.n_unknowns(),
-        activecal::report::chain(r).join(" -> ")
-    );
-    s += "joint                            kind        lower       upper\n";
-    for ((name, k), l) in activecal::units::joint_names(r)
-        .iter()
-        .zip(joint_kinds(r))
-        .zip(&r.limits)
-    {
-        let (lo, hi, unit) = match k {
-            activecal::model::JointKind::Revolute => (l[0].to_degrees(), l[1].to_degrees(), "deg"),
-            activecal::model::JointKind::Prismatic => (l[0], l[1], "m"),
-        };
-        s += &format!(
-            "{name:<32} {:<10} {lo:>9.3} {hi:>9.3} {unit}\n",
-            format!("{k:?}").to_lowercase()
-        );
-    }
-    let w = r
-        .frames
-        .iter()
-        .map(|f| f.label.chars().count())
-        .max()
-        .unwrap_or(5)
-        .max(5);
-    if r.source.is_some() {
-        // A URDF has no measured values: say what the "real" rows are.
-        s += &format!(
-            "real: not your robot — the URDF's values with a made-up error of at most {:.0} mm or {:.0} mrad on each unknown: the robot `calibrate --design` simulates measuring (--params real)\n",
-            URDF_REAL_MAX * 1e3,
-            URDF_REAL_MAX * 1e3
-        );
-    }
-    s += &format!(
-        "{:>w$}  conv    joint   gamma(rad)  alpha(rad)        a(m)        d(m)   beta(rad)   (real | nominal)\n",
-        "frame"
-    );
-    for (i, f) in r.frames.iter().enumerate() {
-        for (tag, t) in [("real", &r.real), ("nom ", &r.nominal)] {
-            let row = t.rows[i];
-            s += &format!(
-                "{:>w$}  {:<6}  {:>5} {tag} {:>10.4}  {:>10.4}  {:>10.4}  {:>10.4}  {:>10.4}\n",
-                f.label,
-                format!("{:?}", f.convention),
-                f.joint.map_or("-".into(), |j| format!("q{}", j + 1)),
-                row[0],
-                row[1],
-                row[2],
-                row[3],
-                row[4]
-            );
-        }
-    }
-    s + &format!("unknowns: {}\n", r.parameter_names().join(" "))
 }
 
 /// Runs `fk`.

@@ -9,7 +9,6 @@ use activecal::identify::contact::evaluate::{ContactEvaluation, evaluate_contact
 use activecal::identify::contact::resolve_distances;
 use activecal::io::contacts::read_contacts;
 use anyhow::{Context, Result};
-use serde_json::json;
 use std::fmt::Write as _;
 
 /// Runs `evaluate` on a contact file.
@@ -24,15 +23,15 @@ pub fn cmd_evaluate_contacts(a: &EvaluateArgs) -> Result<()> {
     activecal::identify::contact::lengths::check_distances(&robot, &file, &known)
         .context("--point-distance")?;
     let e = evaluate_contacts(&robot, &robot.nominal, &[0.0; 3], &file, &given);
-    let v = json!({
-        "robot": robot.name,
-        "chain": activecal::report::chain(&robot),
-        "measurements": a.measurements.display().to_string(),
-        "rows": file.qs.len(),
-        "contacts": e,
-    });
-    super::emit(a.json, &v, || {
-        text(&robot.name, &file.origin, file.qs.len(), &e)
+    let report = activecal::report::ContactEvaluationReport {
+        robot: robot.name.clone(),
+        chain: activecal::report::chain(&robot),
+        measurements: a.measurements.display().to_string(),
+        rows: file.qs.len(),
+        contacts: e,
+    };
+    super::emit_report(a.json, &report, || {
+        text(&robot.name, &file.origin, file.qs.len(), &report.contacts)
     })
 }
 

@@ -17,5 +17,6 @@ pub mod page_camera;
 pub mod pages;
 pub mod paper_figures;
 pub mod plots;
+pub mod robot_text;
 pub mod summary;
 mod typeset;

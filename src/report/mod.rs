@@ -11,6 +11,7 @@ mod existing;
 mod fk;
 mod gap;
 mod lattice;
+mod robot;
 mod score;
 mod select;
 
@@ -24,6 +25,7 @@ pub use existing::ExistingReport;
 pub use fk::{FkReport, Orientation};
 pub use gap::GapReport;
 pub use lattice::LatticeReport;
+pub use robot::{ContactEvaluationReport, RobotReport, RobotsReport, joint_kinds};
 pub use score::ScoreReport;
 pub use select::{
     PoseConfig, PredictedAfter, RefinedPoseReport, RefinementReport, SelectReport, TraceStep,

@@ -291,7 +291,7 @@ const NOT_YET_OWNED: &[(&str, &[&str])] = &[
         ],
     ),
     ("src/cli/simulated.rs", &["identify", "measure"]),
-    ("src/cli/tour.rs", &["collision", "pool", "select"]),
+    ("src/cli/tour.rs", &["pool"]),
     ("src/cli/units.rs", &["identify"]),
     ("src/main.rs", &["resources"]),
     ("python/src/bound.rs", &["bound"]),

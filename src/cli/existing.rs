@@ -27,19 +27,3 @@ pub fn existing_from(
 ) -> Result<Existing> {
     Ok(Existing::from_poses(file, qs, notes, robot, params)?)
 }
-
-/// Text lines about the existing poses of a report.
-pub fn existing_text(e: &activecal::report::ExistingReport) -> String {
-    let mut s = format!(
-        "existing: {} poses from {} (rank {}), log10 det M0 {}\n",
-        e.poses,
-        e.file,
-        e.rank,
-        e.log10_det
-            .map_or("singular (-inf)".to_string(), |v| format!("{v:.4}"))
-    );
-    for n in &e.notes {
-        s += &format!("note: {n}\n");
-    }
-    s
-}

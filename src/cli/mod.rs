@@ -35,7 +35,8 @@ use activecal::model::Robot;
 use anyhow::Result;
 use serde_json::Value;
 
-pub use existing::{existing_from, existing_text, load_existing};
+pub use activecal::render::select_text::existing_text;
+pub use existing::{existing_from, load_existing};
 pub use pool_opts::{
     DEFAULT_LEVELS, PoolCtx, PoolKind, PoolOpts, filters, pool_stats_text, with_jacobian,
 };

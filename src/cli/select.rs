@@ -307,30 +307,12 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         None => None,
     };
     emit_report(a.json, report, || {
-        select_text(&a, &ctx, report, seconds)
-            + &predicted_text(report.predicted.as_ref())
+        super::pool_stats_text(&ctx.pool.stats)
+            + &activecal::render::select_text::text(report, &s, seconds)
             + &recommended.map_or(String::new(), |r| {
                 activecal::render::folder::recommendation_text(&r)
             })
     })
-}
-
-/// The predicted errors' line of the text output (empty without them).
-fn predicted_text(p: Option<&activecal::report::PredictedAfter>) -> String {
-    let Some(p) = p else {
-        return String::new();
-    };
-    let mut s = format!(
-        "predicted after calibrating with these poses (σ {} mm per coordinate): position RMS {:.4} mm at {} random configurations (95th percentile of the error {:.4} mm)",
-        p.noise_m * 1e3,
-        p.errors.position_rms_mm,
-        p.configurations,
-        p.errors.position_error_p95_mm
-    );
-    if let Some(o) = p.errors.orientation_rms_deg {
-        s += &format!(", orientation RMS {o:.5}°");
-    }
-    s + "\n"
 }
 
 /// Every file of a `select` run, whichever kind (pool, camera, sockets):
@@ -425,92 +407,4 @@ fn report_dir(
     )?;
     activecal::render::folder::selection(dir, &ctx.robot, report, &curve, a.noise.is_none())?;
     Ok(curve.recommended)
-}
-
-/// The text report of `select`.
-fn select_text(
-    a: &SelectArgs,
-    ctx: &super::PoolCtx,
-    report: &SelectReport,
-    seconds: f64,
-) -> String {
-    let mut s = super::pool_stats_text(&ctx.pool.stats);
-    if let Some(e) = &report.existing {
-        s += &super::existing_text(e);
-    }
-    s += &format!(
-        "{:?} ({:?} criterion, seed {}, {} start(s){}{}): {} poses in {:.3} s\nlog10 OI_D {:.4}{}  OI {:.6}\nposes: {}\n",
-        report.algorithm,
-        report.criterion,
-        a.seed,
-        a.starts,
-        if report.ils > 0 {
-            format!(", {} ILS rounds of {} kicks", report.ils, report.kick)
-        } else {
-            String::new()
-        },
-        if a.polish { ", Fedorov polish" } else { "" },
-        report.poses.len(),
-        seconds,
-        report.log10_oid,
-        if report.existing.is_some() {
-            " (existing + new poses)"
-        } else {
-            ""
-        },
-        report.oi,
-        report
-            .poses
-            .iter()
-            .map(|p| p.to_string())
-            .collect::<Vec<_>>()
-            .join(",")
-    );
-    if let Some(Some(g)) = report.ln_gain {
-        s += &format!(
-            "the new poses add {:.4} to log10 det M0\n",
-            g / std::f64::consts::LN_10
-        );
-    }
-    if let (Some(b), Some(eff)) = (report.log10_bound, report.d_efficiency) {
-        s += &format!(
-            "log10 bound {b:.4}{}  D-efficiency >= {eff:.6}\n",
-            if report.existing.is_some() {
-                " (with the existing poses' information)"
-            } else {
-                ""
-            }
-        );
-    }
-    if let Some(r) = &report.refinement {
-        s += &format!(
-            "refined off the pool: log10 OI_D {:.4} -> {:.4} (+{:.4}), {} pass(es)\n",
-            r.ln_oid_before / std::f64::consts::LN_10,
-            r.log10_oid,
-            r.ln_gain / std::f64::consts::LN_10,
-            r.sweeps
-        );
-        s += "pose    log10 gain  largest joint move\n";
-        for p in &r.poses {
-            s += &format!(
-                "{:>6}  {:>10.4}  {:.4}\n",
-                p.pose,
-                p.ln_gain / std::f64::consts::LN_10,
-                p.max_move
-            );
-        }
-        if let (Some(true), Some(b)) = (r.exceeds_pool_bound, report.log10_bound) {
-            s += &format!(
-                "the refined design EXCEEDS the pool's certified bound (log10 {:.4} > {b:.4}): no design of the pool can reach it\n",
-                r.log10_oid
-            );
-        } else if let (Some(false), Some(b)) = (r.exceeds_pool_bound, report.log10_bound) {
-            s += &format!(
-                "the refined design stays below the pool's certified bound (log10 {:.4} <= {b:.4})\n",
-                r.log10_oid
-            );
-        }
-    }
-    s += &super::tour::configurations_text(report);
-    s
 }

@@ -18,5 +18,6 @@ pub mod pages;
 pub mod paper_figures;
 pub mod plots;
 pub mod robot_text;
+pub mod select_text;
 pub mod summary;
 mod typeset;

@@ -278,7 +278,6 @@ const NOT_YET_OWNED: &[(&str, &[&str])] = &[
         "src/cli/pool_opts.rs",
         &["blocks", "collision", "identify", "measure", "pool"],
     ),
-    ("src/cli/score.rs", &["blocks"]),
     (
         "src/cli/select.rs",
         &[

@@ -150,12 +150,6 @@ pub fn cmd_score(a: ScoreArgs, given: &[&str]) -> Result<()> {
             let qs = d
                 .joint_values(&robot)
                 .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-            let x = activecal::blocks::jacobian_of(
-                &robot,
-                robot.params(a.pool.params),
-                qs.len(),
-                |k, q| q.copy_from_slice(&qs[k]),
-            );
             let info = PoolInfo {
                 robot: robot.name.clone(),
                 chain: activecal::report::chain(&robot),
@@ -163,7 +157,13 @@ pub fn cmd_score(a: ScoreArgs, given: &[&str]) -> Result<()> {
                 pool: d.spec()?,
                 pool_stats: None,
             };
-            ScoreReport::new(info, d.poses.clone(), &x)
+            activecal::experiment::gap::score_joint_values(
+                &robot,
+                a.pool.params,
+                &qs,
+                d.poses.clone(),
+                info,
+            )
         }
         (None, None) if matches!(a.pool.pool, super::PoolKind::File(_)) => {
             // Every pose of the file: a design written as .csv or .json.

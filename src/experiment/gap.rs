@@ -114,3 +114,20 @@ fn refined_gap(
         weights: Vec::new(),
     }
 }
+
+/// The indices of a design given by its joint values `qs` (radians,
+/// metres; `ids` its poses' ids, for the report) at `params`, from its own
+/// Jacobian: a design read from a file, scored off any pool.
+#[must_use]
+pub fn score_joint_values(
+    robot: &Robot,
+    params: ParamSet,
+    qs: &[Vec<f64>],
+    ids: Vec<usize>,
+    info: PoolInfo,
+) -> crate::report::ScoreReport {
+    let x = crate::blocks::jacobian_of(robot, robot.params(params), qs.len(), |k, q| {
+        q.copy_from_slice(&qs[k]);
+    });
+    crate::report::ScoreReport::new(info, ids, &x)
+}

@@ -447,7 +447,14 @@ pub fn calibrate(
                         &meas,
                     ),
                 );
-                Ok((c.robot, c.fit.id, c.frames, (v, summary), c.verdict, report.warnings))
+                Ok((
+                    c.robot,
+                    c.fit.id,
+                    c.frames,
+                    (v, summary),
+                    c.verdict,
+                    report.warnings,
+                ))
             })
         })?;
     warn_all(py, &warnings)?;
@@ -699,8 +706,14 @@ impl Calibration {
     /// flagged poses marked). An existing directory is replaced whole;
     /// overwrite=False refuses a non-empty one with `FileError`.
     #[pyo3(signature = (path, overwrite=true))]
-    fn write_report(&self, py: Python<'_>, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
-        crate::page::write_folder(py, &path, overwrite, |dir| {
+    fn write_report(
+        &self,
+        py: Python<'_>,
+        path: std::path::PathBuf,
+        overwrite: bool,
+    ) -> PyResult<()> {
+        let inputs = crate::page::robot_inputs(&self.robot);
+        crate::page::write_folder(py, &path, overwrite, &inputs, |dir| {
             self.summary.folder(dir, &self.robot, &self.id)
         })
     }

@@ -56,19 +56,28 @@ impl Page {
             .map_err(|e| Fail::from(e).into_py())
     }
 
-    fn __len__(&self) -> usize {
-        self.html.len()
-    }
-
     fn __repr__(&self) -> String {
         format!("Page({} bytes of HTML)", self.html.len())
     }
 }
 
-/// Refuses `dir` (argument `path`) when it is not a directory, or is a
-/// non-empty one and `overwrite` is false; its parent must exist.
-fn check_dir(dir: &Path, overwrite: bool) -> PyResult<()> {
+/// Refuses `dir` (argument `path`) when it is or holds one of `inputs`
+/// (labelled: it is replaced whole, even with `overwrite`), is not a
+/// directory, or is a non-empty one and `overwrite` is false; its parent
+/// must exist.
+fn check_dir(dir: &Path, overwrite: bool, inputs: &[(&str, PathBuf)]) -> PyResult<()> {
     let file_err = |m: String| Fail::File(m).into_py();
+    let ins: Vec<activecal::io::atomic::Output<'_>> = inputs
+        .iter()
+        .map(|(label, path)| activecal::io::atomic::Output { label, path })
+        .collect();
+    let out = [activecal::io::atomic::Output {
+        label: "path",
+        path: dir,
+    }];
+    if let Some(why) = activecal::io::atomic::output_dir_conflict(&out, &[], &ins) {
+        return Err(file_err(why));
+    }
     if dir.exists() {
         if !dir.is_dir() {
             return Err(file_err(format!(
@@ -98,14 +107,25 @@ fn check_dir(dir: &Path, overwrite: bool) -> PyResult<()> {
     Ok(())
 }
 
-/// Writes a report folder into `dir` (checked as [`check_dir`] says).
+/// The files a report folder reads of `robot`: its description.
+pub(crate) fn robot_inputs(robot: &Robot) -> Vec<(&'static str, PathBuf)> {
+    robot
+        .source
+        .iter()
+        .map(|s| ("the robot's description", PathBuf::from(&s.path)))
+        .collect()
+}
+
+/// Writes a report folder into `dir` (checked as [`check_dir`] says,
+/// against the files it reads, `inputs`).
 pub(crate) fn write_folder(
     py: Python<'_>,
     dir: &Path,
     overwrite: bool,
+    inputs: &[(&str, PathBuf)],
     write: impl FnOnce(&Path) -> Result<(), Fail> + Send,
 ) -> PyResult<()> {
-    check_dir(dir, overwrite)?;
+    check_dir(dir, overwrite, inputs)?;
     detached(py, || write(dir))
 }
 
@@ -170,16 +190,26 @@ pub(crate) fn check_curve_args(noise: f64, target_error: Option<f64>) -> PyResul
 
 impl CurveInputs {
     /// The "how many poses" curve, as `select --report` computes it.
-    pub(crate) fn curve(&self, noise: f64, target_error: Option<f64>) -> Result<PoseCountCurve, Fail> {
+    pub(crate) fn curve(
+        &self,
+        noise: f64,
+        target_error: Option<f64>,
+    ) -> Result<PoseCountCurve, Fail> {
         let mut cs = CurveSettings::new(self.settings.clone(), noise);
         cs.algorithm = self.algorithm;
         cs.also = vec![self.n];
         cs.target_mm = target_error;
-        activecal::how_many::pose_count_curve(&self.robot, &self.robot.nominal, &self.x, &self.ids, &cs)
-            .map_err(|e| match e {
-                HowManyError::Input(e) => Fail::from(e),
-                HowManyError::Bound(e) => e.into(),
-            })
+        activecal::how_many::pose_count_curve(
+            &self.robot,
+            &self.robot.nominal,
+            &self.x,
+            &self.ids,
+            &cs,
+        )
+        .map_err(|e| match e {
+            HowManyError::Input(e) => Fail::from(e),
+            HowManyError::Bound(e) => e.into(),
+        })
     }
 
     /// Writes `select --report`'s folder for `report` into `dir`.
@@ -229,7 +259,12 @@ impl KeptSummary {
     }
 
     /// Writes `calibrate --report`'s folder into `dir`.
-    pub(crate) fn folder(&self, dir: &Path, robot: &Robot, id: &Identification) -> Result<(), Fail> {
+    pub(crate) fn folder(
+        &self,
+        dir: &Path,
+        robot: &Robot,
+        id: &Identification,
+    ) -> Result<(), Fail> {
         let s = CalibrationSummary {
             robot,
             id,

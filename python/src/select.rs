@@ -200,6 +200,23 @@ impl Design {
         }
     }
 
+    /// The files its report folder reads: the robot's description and the
+    /// collision filter's mesh directories.
+    fn inputs(&self) -> Vec<(&'static str, std::path::PathBuf)> {
+        let mut inputs = crate::page::robot_inputs(&self.robot);
+        for f in &self.typed.pool.pool.filters {
+            if let activecal::pool::PoolFilter::Collision(c) = f {
+                inputs.extend(
+                    c.spec
+                        .package_dirs
+                        .iter()
+                        .map(|d| ("a mesh directory", d.into())),
+                );
+            }
+        }
+        inputs
+    }
+
     /// Writes the report folder into `dir` (see `write_report`).
     fn folder(
         &self,
@@ -455,7 +472,9 @@ impl Design {
         crate::page::check_curve_args(noise, target_error)?;
         let inputs = self.curve_inputs();
         let v = crate::progress::with_callback(progress, || {
-            detached(py, move || Ok(serde_json::to_value(&inputs.curve(noise, target_error)?)?))
+            detached(py, move || {
+                Ok(serde_json::to_value(&inputs.curve(noise, target_error)?)?)
+            })
         })?;
         json_to_py(py, &v)
     }
@@ -478,9 +497,12 @@ impl Design {
         target_error: Option<f64>,
         progress: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        crate::page::check_curve_args(noise.or(self.noise).unwrap_or(DEFAULT_CURVE_NOISE), target_error)?;
+        crate::page::check_curve_args(
+            noise.or(self.noise).unwrap_or(DEFAULT_CURVE_NOISE),
+            target_error,
+        )?;
         crate::progress::with_callback(progress, || {
-            crate::page::write_folder(py, &path, overwrite, |dir| {
+            crate::page::write_folder(py, &path, overwrite, &self.inputs(), |dir| {
                 self.folder(dir, noise, target_error)
             })
         })
@@ -488,18 +510,19 @@ impl Design {
 
     /// The 3D page of `write_report`'s folder (`index.html`), shown inline
     /// by Jupyter (a `Page`; its `html` is the page's text, byte for byte
-    /// the command line's). Arguments as `write_report`'s.
-    #[pyo3(signature = (noise=None, target_error=None, progress=None))]
+    /// the command line's). noise and progress as `write_report` takes
+    /// them (the page does not show the curve's recommendation, so no
+    /// target_error).
+    #[pyo3(signature = (noise=None, progress=None))]
     fn show(
         &self,
         py: Python<'_>,
         noise: Option<f64>,
-        target_error: Option<f64>,
         progress: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<crate::page::Page> {
-        crate::page::check_curve_args(noise.or(self.noise).unwrap_or(DEFAULT_CURVE_NOISE), target_error)?;
+        crate::page::check_curve_args(noise.or(self.noise).unwrap_or(DEFAULT_CURVE_NOISE), None)?;
         crate::progress::with_callback(progress, || {
-            crate::page::page_of(py, |dir| self.folder(dir, noise, target_error))
+            crate::page::page_of(py, |dir| self.folder(dir, noise, None))
         })
     }
 

@@ -265,7 +265,11 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
             &activecal::experiment::measured::summary::measured(
                 &fitted,
                 id,
-                format!("measurements `{}`, {} poses", path.display(), report.base.poses),
+                format!(
+                    "measurements `{}`, {} poses",
+                    path.display(),
+                    report.base.poses
+                ),
                 &report,
                 &v,
                 &meas,

@@ -4,7 +4,11 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 
+// Milliseconds since navigation at each step of opening (the read-out's
+// `timings`): where the time to interactive goes.
+const timings = { boot: window.activecalBoot ?? null, module: performance.now() };
 const data = JSON.parse(document.getElementById('page-data').textContent);
+timings.parsed = performance.now();
 const el = (id) => document.getElementById(id);
 const host = el('canvas');
 const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
@@ -21,7 +25,15 @@ const sun = new THREE.DirectionalLight(0xffffff, 1.5);
 sun.position.set(2, -3, 4);
 scene.add(sun);
 
-const bytes = (b64) => Uint8Array.from(atob(b64), (c) => c.charCodeAt(0)).buffer;
+// Base64 to bytes in one pass over a preallocated array (a callback per
+// character, as Uint8Array.from takes, is several times slower on meshes
+// of megabytes).
+function bytes(b64) {
+  const s = atob(b64);
+  const out = new Uint8Array(s.length);
+  for (let i = 0; i < s.length; i++) out[i] = s.charCodeAt(i);
+  return out.buffer;
+}
 const matrix = (m) => new THREE.Matrix4().fromArray(m);
 
 function meshGeometry(m) {
@@ -86,6 +98,7 @@ function addScene() {
 }
 
 const meshes = data.meshes.map(meshGeometry);
+timings.meshes = performance.now();
 const robot = makeRobot(meshes, null);
 const fitted = data.poses.some((p) => p.calibrated)
   ? makeRobot(meshes, [1.0, 0.55, 0.1, 0.35])
@@ -187,6 +200,7 @@ function readout() {
     drawn: renderer.info.render.triangles,
     canvas: [r.left, r.top, r.width, r.height],
     readyMs: Math.round(performance.now()),
+    timings,
   });
 }
 
@@ -222,6 +236,7 @@ function showPose(k) {
 
 function render() {
   renderer.render(scene, camera);
+  timings.rendered ??= performance.now();
 }
 
 // Plays the moves of the tour from pose `from`, sample by sample.
@@ -296,6 +311,7 @@ function hashClick() {
   if (m) document.querySelectorAll('#poses li')[Number(m[1])]?.click();
 }
 
+timings.scene = performance.now();
 buildList();
 frameView();
 controls.addEventListener('change', render);

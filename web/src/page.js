@@ -123,6 +123,16 @@ function setLinks(r, mats) {
   mats.forEach((m, i) => r.links[i].matrix.fromArray(m));
 }
 
+// The least clearance (a pose's or a move's): its links drawn red.
+function highlight(c) {
+  const near = new Set(c ? c.links : []);
+  robot.links.forEach((o, i) => {
+    for (const m of o.children) if (m.material.emissive) m.material.emissive.setHex(near.has(i) ? 0xcc0000 : 0);
+  });
+}
+
+const clearanceText = (c) => (c ? `least clearance ${(1000 * c.distance).toFixed(1)} mm (${c.between[0]} – ${c.between[1]})` : '');
+
 // The calibrated robot with its difference from the nominal magnified.
 function magnified(p) {
   const k = data.magnify_robot ?? 1;
@@ -227,8 +237,10 @@ function showPose(k) {
     setSkeleton(fittedSkeleton, m);
   }
   drawMarks(shown);
+  highlight(p.clearance);
   el('slider').value = String(shown);
-  el('shown').textContent = `${p.label} (${shown + 1} of ${data.poses.length})`;
+  const c = clearanceText(p.clearance);
+  el('shown').textContent = `${p.label} (${shown + 1} of ${data.poses.length})${c ? `, ${c}` : ''}`;
   document.querySelectorAll('#poses li').forEach((li, i) => li.classList.toggle('on', i === shown));
   render();
   readout();
@@ -259,6 +271,8 @@ function play() {
     }
     setLinks(robot, mats);
     setSkeleton(skeleton, mats);
+    highlight(m.clearance);
+    if (s === 0) el('shown').textContent = `move to ${data.poses[m.to].label}${m.clearance ? `, ${clearanceText(m.clearance)}` : ''}`;
     marks.clear();
     render();
     s += 1;
@@ -287,6 +301,7 @@ function buildList() {
   data.poses.forEach((p, i) => {
     const li = document.createElement('li');
     li.textContent = p.mark ? `${p.label} (${p.mark})` : p.label;
+    if (p.clearance) li.title = clearanceText(p.clearance);
     if (p.mark) li.classList.add(p.mark === 'held out' ? 'held' : 'flagged');
     li.addEventListener('click', () => showPose(i));
     list.appendChild(li);

@@ -260,21 +260,15 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         v["full_model_gain"] = serde_json::to_value(g)?;
     }
     if let Some(dir) = &a.report {
-        activecal::render::folder::calibration(
-            dir,
-            &activecal::experiment::measured::summary::measured(
-                &fitted,
-                id,
-                format!(
-                    "measurements `{}`, {} poses",
-                    path.display(),
-                    report.base.poses
-                ),
-                &report,
-                &v,
-                &meas,
-            ),
-        )?;
+        let source = format!(
+            "measurements `{}`, {} poses",
+            path.display(),
+            report.base.poses
+        );
+        let s = activecal::experiment::measured::summary::measured(
+            &fitted, id, source, &report, &v, &meas,
+        );
+        activecal::render::folder::calibration(dir, &s)?;
     }
     super::emit(a.json, &v, || {
         let mut s = super::measured::measured_text(&report, id, &status_text(id));

@@ -211,6 +211,8 @@ function readout() {
     canvas: [r.left, r.top, r.width, r.height],
     readyMs: Math.round(performance.now()),
     timings,
+    clearance: data.poses[shown]?.clearance ?? null,
+    red: robot.links.flatMap((o, i) => (o.children.some((m) => m.material.emissive?.getHex()) ? [i] : [])),
   });
 }
 

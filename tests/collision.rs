@@ -84,6 +84,61 @@ fn panda_self_collision_agrees_with_coal_within_a_millimetre_of_contact() {
     );
 }
 
+/// The least distance (`CollisionModel::closest`) against Coal's verdicts
+/// on the same 2,000 Panda configurations: where Coal finds no pair within
+/// 1 mm, activecal's least distance is at least 1 mm; where Coal finds the
+/// links crossing deeper than 1 mm, it is 0. Between the two (grazing) the
+/// libraries may round differently, as the contact test allows. The
+/// 1e-9 m slack: both take distances between the same triangles in f64,
+/// which round at ~1e-15 m on a metre-sized robot. And the branch and
+/// bound returns the least of every item's exact distance, with its pair.
+#[test]
+fn panda_least_distance_agrees_with_coal_and_with_every_pairs_distance() {
+    let (f, model) = panda(true, true);
+    let (mut far, mut deep) = (0, 0);
+    for (k, q) in f.configs.iter().enumerate() {
+        let c = model.closest(q).expect("the Panda has checked pairs");
+        if !f.collides_1mm[k] {
+            far += 1;
+            assert!(
+                c.distance >= 1e-3 - 1e-9,
+                "configuration {k}: Coal finds nothing within 1 mm, activecal {} m ({:?})",
+                c.distance,
+                c.pair
+            );
+        }
+        if f.collides[k] && f.depth[k] > 1e-3 {
+            deep += 1;
+            assert_eq!(c.distance, 0.0, "configuration {k}: Coal finds a crossing");
+            assert!(model.contact(q).is_some());
+        }
+        if k < 150 {
+            let all = model.distances(q);
+            let (pair, least) = all
+                .iter()
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .expect("pairs");
+            assert!(
+                (c.distance - least).abs() <= 1e-12,
+                "configuration {k}: {} against {least}",
+                c.distance
+            );
+            if all
+                .iter()
+                .filter(|(_, d)| (d - least).abs() <= 1e-12)
+                .count()
+                == 1
+            {
+                assert_eq!(&c.pair, pair, "configuration {k}");
+            }
+        }
+    }
+    assert!(
+        far >= 100 && deep >= 10,
+        "both kinds in the sample: {far} far, {deep} deep"
+    );
+}
+
 #[test]
 fn without_the_srdf_more_pairs_are_checked_and_no_collision_is_lost() {
     let (f, with) = panda(true, true);

@@ -241,6 +241,16 @@ fn ur5_page_places_its_links_as_the_urdf_and_moves_between_poses() {
     }
     let compared = frames_match(urdf, "base_link", sel, &ro, last);
     assert!(compared >= 8, "{compared} links compared");
+    // The least clearance of the pose shown (the pool's collision filter):
+    // a pose the filter kept is free, and the page draws red exactly the
+    // links of its closest pair.
+    let c = &ro["clearance"];
+    let d = c["distance"]
+        .as_f64()
+        .expect("a clearance with a collision filter");
+    assert!(d > 0.0 && d < 2.0, "clearance {d} m");
+    assert!(!c["links"].as_array().unwrap().is_empty(), "{c}");
+    assert_eq!(ro["red"], c["links"], "the links drawn red");
     // The page alone, away from the report's other files, is the same page.
     let alone = scratch_dir("page", "ur5-alone").join("index.html");
     std::fs::copy(&page, &alone).unwrap();

@@ -21,4 +21,13 @@ export default [
     files: ['src/boot.js'],
     languageOptions: { sourceType: 'script' },
   },
+  {
+    // Measurement scripts run by Node (web/tools/page-timing.mjs).
+    files: ['tools/**/*.mjs'],
+    languageOptions: {
+      ecmaVersion: 2022,
+      globals: { ...globals.node, WebSocket: 'readonly' },
+    },
+    rules: { 'no-unused-vars': 'error', 'prefer-const': 'error' },
+  },
 ];

@@ -29,6 +29,7 @@ __all__ = [
     "FileError",
     "InputError",
     "InternalError",
+    "Page",
     "Pool",
     "ResourceError",
     "Robot",
@@ -142,6 +143,21 @@ class Robot:
         the robot's orientation scale, metres per radian), 3 per marker."""
 
 @final
+class Page:
+    """A report's 3D page (``index.html`` of its report folder): one
+    self-contained HTML page, shown inline by Jupyter (``_repr_html_``:
+    the page in an iframe's ``srcdoc``)."""
+
+    @property
+    def html(self) -> str:
+        """The page's HTML text, byte for byte ``index.html`` of the
+        command line's report folder."""
+    def _repr_html_(self) -> str: ...
+    def write(self, path: _Path, overwrite: bool = True) -> None:
+        """Writes the page alone to `path` (an existing file is replaced;
+        overwrite=False refuses it with `FileError`)."""
+
+@final
 class Design:
     """The poses `select` chose, in visiting order (see `select`'s order)."""
 
@@ -206,6 +222,29 @@ class Design:
         command line). target_error: the position RMS to reach, mm.
         A selection and a bound per size: seconds to minutes; the GIL is
         released."""
+    def write_report(
+        self,
+        path: _Path,
+        overwrite: bool = True,
+        noise: Optional[float] = None,
+        target_error: Optional[float] = None,
+        progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
+    ) -> None:
+        """Writes the report folder ``activecal select --report DIR``
+        writes: report.md, report.json, the figures (PNG and SVG) and
+        ``index.html``, the 3D page of the poses in visiting order. Computes
+        the "how many poses" curve (`how_many`'s noise, target_error and
+        progress; seconds to minutes). An existing directory is replaced
+        whole (never one holding the robot's files); overwrite=False
+        refuses a non-empty one with `FileError`."""
+    def show(
+        self,
+        noise: Optional[float] = None,
+        progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
+    ) -> Page:
+        """The 3D page of `write_report`'s folder, shown inline by
+        Jupyter (noise and progress as `write_report` takes them; the page
+        does not show the curve's recommendation)."""
     def __len__(self) -> int: ...
 
 @final
@@ -404,6 +443,17 @@ class Calibration:
         offset``); as ``activecal calibrate --out x_joint_offsets.yaml
         --offset-unit --offset-sign``. URDF robots only; refused when the
         fit did not converge."""
+    def write_report(self, path: _Path, overwrite: bool = True) -> None:
+        """Writes the report folder ``activecal calibrate --measurements
+        FILE --report DIR`` writes: report.md, report.json, the figures and
+        ``index.html``, the 3D page of the measured poses (nominal and
+        calibrated robot overlaid, measured and fitted points, residuals
+        magnified, flagged poses marked). An existing directory is replaced
+        whole (never one holding the robot's files); overwrite=False
+        refuses a non-empty one with `FileError`."""
+    def show(self) -> Page:
+        """The 3D page of `write_report`'s folder, shown inline by
+        Jupyter."""
 
 def calibrate(
     robot: Robot,

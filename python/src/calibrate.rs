@@ -24,6 +24,8 @@ pub struct Calibration {
     report: serde_json::Value,
     /// The library's verdict: whether the calibrated robot may be written.
     verdict: activecal::experiment::measured::verdict::Verdict,
+    /// What its report folder shows.
+    summary: crate::page::KeptSummary,
     /// How it was made, for pickling.
     recipe: crate::pickling::Recipe,
 }
@@ -406,7 +408,7 @@ pub fn calibrate(
         },
     };
     let r = inner.clone();
-    let (fitted, id, frames, report, verdict, warnings) =
+    let (fitted, id, frames, (report, summary), verdict, warnings) =
         crate::progress::with_callback(progress, || {
             detached(py, move || {
                 let t0 = std::time::Instant::now();
@@ -435,7 +437,24 @@ pub fn calibrate(
                 if let Some(g) = gain {
                     v["full_model_gain"] = serde_json::to_value(g)?;
                 }
-                Ok((c.robot, c.fit.id, c.frames, v, c.verdict, report.warnings))
+                let summary = crate::page::KeptSummary::keep(
+                    activecal::experiment::measured::summary::measured(
+                        &c.robot,
+                        &c.fit.id,
+                        format!("the arrays given, {} poses", report.base.poses),
+                        &report,
+                        &v,
+                        &meas,
+                    ),
+                );
+                Ok((
+                    c.robot,
+                    c.fit.id,
+                    c.frames,
+                    (v, summary),
+                    c.verdict,
+                    report.warnings,
+                ))
             })
         })?;
     warn_all(py, &warnings)?;
@@ -445,6 +464,7 @@ pub fn calibrate(
         frames,
         report,
         verdict,
+        summary,
         recipe,
     })
 }
@@ -676,6 +696,33 @@ impl Calibration {
         };
         let c = activecal::io::kinematics_yaml::OffsetConvention { degrees, subtract };
         self.write_as(Format::JointOffsets(c), &path, overwrite)
+    }
+
+    /// The report folder `activecal calibrate --measurements FILE --report
+    /// DIR` writes for this fit, written into `path`: report.md,
+    /// report.json, the figures (PNG and SVG) and `index.html`, the 3D
+    /// page of the measured poses (the nominal and the calibrated robot
+    /// overlaid, the measured and fitted points, the residuals magnified,
+    /// flagged poses marked). An existing directory is replaced whole;
+    /// overwrite=False refuses a non-empty one with `FileError`.
+    #[pyo3(signature = (path, overwrite=true))]
+    fn write_report(
+        &self,
+        py: Python<'_>,
+        path: std::path::PathBuf,
+        overwrite: bool,
+    ) -> PyResult<()> {
+        let inputs = crate::page::robot_inputs(&self.robot);
+        crate::page::write_folder(py, &path, overwrite, &inputs, |dir| {
+            self.summary.folder(dir, &self.robot, &self.id)
+        })
+    }
+
+    /// The 3D page of `write_report`'s folder (`index.html`), shown inline
+    /// by Jupyter (a `Page`; its `html` is the page's text, byte for byte
+    /// the command line's for the same data).
+    fn show(&self, py: Python<'_>) -> PyResult<crate::page::Page> {
+        crate::page::page_of(py, |dir| self.summary.folder(dir, &self.robot, &self.id))
     }
 
     fn __repr__(&self) -> String {

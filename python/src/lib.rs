@@ -13,6 +13,7 @@ mod camera_select;
 mod contacts;
 mod convert;
 mod errors;
+mod page;
 mod pickling;
 mod pool;
 mod progress;
@@ -27,6 +28,7 @@ fn _activecal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(pickling::_replay, m)?)?;
     m.add_class::<robot::Robot>()?;
     m.add_class::<select::Design>()?;
+    m.add_class::<page::Page>()?;
     m.add_class::<pool::Pool>()?;
     m.add_function(wrap_pyfunction!(pool::pool, m)?)?;
     m.add_class::<calibrate::Calibration>()?;

@@ -37,6 +37,8 @@ pub struct Design {
     pool: Arc<activecal::pool::Pool>,
     /// The sensor noise given to `select`, metres.
     noise: Option<f64>,
+    /// The selection's report (for the report folder).
+    typed: Arc<activecal::report::SelectReport>,
     /// How it was made, for pickling.
     recipe: crate::pickling::Recipe,
 }
@@ -176,11 +178,57 @@ pub fn select(
         settings: s,
         algorithm,
         noise,
+        typed: Arc::new(outcome.report),
         recipe,
     })
 }
 
 impl Design {
+    /// What its how-many curve is computed from.
+    fn curve_inputs(&self) -> crate::page::CurveInputs {
+        crate::page::CurveInputs {
+            robot: self.robot.clone(),
+            x: self.x.clone(),
+            ids: self.pool_ids.clone(),
+            settings: self.settings.clone(),
+            algorithm: self.algorithm,
+            n: self.q.len(),
+        }
+    }
+
+    /// The files its report folder reads: the robot's description and the
+    /// collision filter's mesh directories.
+    fn inputs(&self) -> Vec<(&'static str, std::path::PathBuf)> {
+        let mut inputs = crate::page::robot_inputs(&self.robot);
+        for f in &self.typed.pool.pool.filters {
+            if let activecal::pool::PoolFilter::Collision(c) = f {
+                inputs.extend(
+                    c.spec
+                        .package_dirs
+                        .iter()
+                        .map(|d| ("a mesh directory", d.into())),
+                );
+            }
+        }
+        inputs
+    }
+
+    /// Writes the report folder into `dir` (see `write_report`).
+    fn folder(
+        &self,
+        dir: &std::path::Path,
+        noise: Option<f64>,
+        target_error: Option<f64>,
+    ) -> Result<(), crate::convert::Fail> {
+        self.curve_inputs().selection_folder(
+            dir,
+            &self.typed,
+            noise.or(self.noise),
+            DEFAULT_CURVE_NOISE,
+            target_error,
+        )
+    }
+
     /// The design against the certified bound over its own pool: the dict
     /// `activecal gap --json` prints.
     pub(crate) fn gap_dict<'py>(
@@ -411,36 +459,61 @@ impl Design {
         progress: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let noise = noise.or(self.noise).unwrap_or(DEFAULT_CURVE_NOISE);
-        if !(noise.is_finite() && noise > 0.0) {
-            return Err(arg_err(
-                "noise",
-                format!("{noise}: the sensor noise σ must be a finite number > 0 (metres)"),
-            ));
-        }
-        if let Some(t) = target_error.filter(|t| !(t.is_finite() && *t > 0.0)) {
-            return Err(arg_err(
-                "target_error",
-                format!("{t}: the position error to reach must be a finite number > 0 (mm)"),
-            ));
-        }
-        let mut cs = activecal::how_many::CurveSettings::new(self.settings.clone(), noise);
-        cs.algorithm = self.algorithm;
-        cs.also = vec![self.q.len()];
-        cs.target_mm = target_error;
-        let (r, x, ids) = (self.robot.clone(), self.x.clone(), self.pool_ids.clone());
+        crate::page::check_curve_args(noise, target_error)?;
+        let inputs = self.curve_inputs();
         let v = crate::progress::with_callback(progress, || {
             detached(py, move || {
-                let curve = activecal::how_many::pose_count_curve(&r, &r.nominal, &x, &ids, &cs)
-                    .map_err(|e| match e {
-                        activecal::how_many::HowManyError::Input(e) => {
-                            crate::convert::Fail::from(e)
-                        }
-                        activecal::how_many::HowManyError::Bound(e) => e.into(),
-                    })?;
-                Ok(serde_json::to_value(&curve)?)
+                Ok(serde_json::to_value(&inputs.curve(noise, target_error)?)?)
             })
         })?;
         json_to_py(py, &v)
+    }
+
+    /// The report folder `activecal select --report DIR` writes for this
+    /// design, written into `path`: report.md, report.json, the figures
+    /// (PNG and SVG) and `index.html`, the 3D page of the poses in
+    /// visiting order (with the moves between them and the pool's
+    /// obstacles). Computes the "how many poses" curve (see `how_many`:
+    /// noise, target_error and progress as it takes them; seconds to
+    /// minutes). An existing directory is replaced whole; overwrite=False
+    /// refuses a non-empty one with `FileError`.
+    #[pyo3(signature = (path, overwrite=true, noise=None, target_error=None, progress=None))]
+    fn write_report(
+        &self,
+        py: Python<'_>,
+        path: std::path::PathBuf,
+        overwrite: bool,
+        noise: Option<f64>,
+        target_error: Option<f64>,
+        progress: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        crate::page::check_curve_args(
+            noise.or(self.noise).unwrap_or(DEFAULT_CURVE_NOISE),
+            target_error,
+        )?;
+        crate::progress::with_callback(progress, || {
+            crate::page::write_folder(py, &path, overwrite, &self.inputs(), |dir| {
+                self.folder(dir, noise, target_error)
+            })
+        })
+    }
+
+    /// The 3D page of `write_report`'s folder (`index.html`), shown inline
+    /// by Jupyter (a `Page`; its `html` is the page's text, byte for byte
+    /// the command line's). noise and progress as `write_report` takes
+    /// them (the page does not show the curve's recommendation, so no
+    /// target_error).
+    #[pyo3(signature = (noise=None, progress=None))]
+    fn show(
+        &self,
+        py: Python<'_>,
+        noise: Option<f64>,
+        progress: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<crate::page::Page> {
+        crate::page::check_curve_args(noise.or(self.noise).unwrap_or(DEFAULT_CURVE_NOISE), None)?;
+        crate::progress::with_callback(progress, || {
+            crate::page::page_of(py, |dir| self.folder(dir, noise, None))
+        })
     }
 
     /// The selection's report: the dict `activecal select --json` prints.

@@ -144,3 +144,29 @@ def test_writers_refuse_to_write_over_an_input(tmp_path):
     with pytest.raises(activecal.Error, match="ur5.urdf"):
         cal.write_urdf(urdf, overwrite=True)
     assert urdf.read_bytes() == text
+    # A report folder is replaced whole: never one holding the robot's
+    # description, even with overwrite.
+    with pytest.raises(activecal.FileError, match="holds an input"):
+        cal.write_report(tmp_path, overwrite=True)
+    assert urdf.read_bytes() == text
+
+
+def test_every_keyword_of_the_report_folder_acts(tmp_path):
+    """Design.show and write_report: noise changes the "how many poses"
+    curve the folder and its page show, target_error the size report.md
+    recommends (progress is called)."""
+    d = activecal.select(activecal.Robot.builtin("puma560"), 12, count=400, order="none")
+    assert keywords(d.show) == ["noise"]
+    assert keywords(d.write_report) == ["path", "overwrite", "noise", "target_error"]
+    calls = []
+    base = d.show(progress=lambda *a: calls.append(a)).html
+    assert calls
+    assert d.show(noise=3e-3).html != base
+    # target_error: the size the folder's report.md recommends.
+    target = d.how_many()["points"][0]["predicted"]["position_rms_mm"]
+    d.write_report(tmp_path / "a")
+    d.write_report(tmp_path / "b", target_error=target * 1.5)
+    a, b = ((tmp_path / x / "report.md").read_text() for x in "ab")
+    assert "recommended, the fewest predicted to reach" in b and a != b
+    assert keywords(activecal.Calibration.show) == ["self"]
+    assert keywords(activecal.Calibration.write_report) == ["self", "path", "overwrite"]

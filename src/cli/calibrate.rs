@@ -8,7 +8,7 @@ pub use super::calibrate_args::{CalibrateArgs, DEFAULT_NOISE};
 pub use super::calibrated::{EXIT_NOT_CONVERGED, NotConverged};
 use super::calibrated::{not_written, status_text, write_calibrated};
 use activecal::experiment::measured::full_model::FullModelGain;
-use activecal::identify::{Identification, LmSettings};
+use activecal::identify::LmSettings;
 use activecal::io::calibrated::Format;
 use activecal::model::Robot;
 use anyhow::{Result, bail};
@@ -260,10 +260,15 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         v["full_model_gain"] = serde_json::to_value(g)?;
     }
     if let Some(dir) = &a.report {
-        activecal::render::folder::calibration(
-            dir,
-            &measured_summary(&fitted, id, path, &report, &v, &meas),
-        )?;
+        let source = format!(
+            "measurements `{}`, {} poses",
+            path.display(),
+            report.base.poses
+        );
+        let s = activecal::experiment::measured::summary::measured(
+            &fitted, id, source, &report, &v, &meas,
+        );
+        activecal::render::folder::calibration(dir, &s)?;
     }
     super::emit(a.json, &v, || {
         let mut s = super::measured::measured_text(&report, id, &status_text(id));
@@ -279,73 +284,6 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     match verdict.refusal() {
         Some(why) => Err(NotConverged(why.to_string() + &not_written(a)).into()),
         None => Ok(()),
-    }
-}
-
-/// What `--report` shows of a calibration from measurements.
-fn measured_summary<'a>(
-    robot: &'a Robot,
-    id: &'a Identification,
-    path: &Path,
-    r: &activecal::experiment::measured::MeasuredReport,
-    json: &serde_json::Value,
-    meas: &activecal::identify::Measurements,
-) -> activecal::render::folder::CalibrationSummary<'a> {
-    let pos = |e: &activecal::identify::ModelErrors| -> Vec<f64> {
-        e.per_sample
-            .iter()
-            .flat_map(|s| s.position_mm.iter().copied())
-            .collect()
-    };
-    let ori = |e: &activecal::identify::ModelErrors| -> Option<Vec<f64>> {
-        e.per_sample.iter().map(|s| s.orientation_deg).collect()
-    };
-    let mut notes: Vec<String> = r
-        .fixed
-        .iter()
-        .map(|f| {
-            format!(
-                "Fixed at nominal: {}",
-                serde_json::to_string(f).unwrap_or_default()
-            )
-        })
-        .collect();
-    if let Some(h) = &r.holdout {
-        notes.push(format!(
-            "Held-out position RMS over {} splits: {:.3} mm calibrated, {:.3} mm nominal (mean).",
-            h.splits.len(),
-            h.position_rms_mm.mean,
-            h.nominal_position_rms_mm
-        ));
-    }
-    activecal::render::folder::CalibrationSummary {
-        robot,
-        id,
-        source: format!("measurements `{}`, {} poses", path.display(), r.base.poses),
-        what: "pose",
-        position_mm: (pos(&r.nominal_residuals), pos(&r.residuals)),
-        orientation_deg: ori(&r.nominal_residuals).zip(ori(&r.residuals)),
-        params: r
-            .parameters
-            .iter()
-            .map(|p| (p.name.clone(), p.change, p.std))
-            .collect(),
-        splits: r.holdout.as_ref().map(|h| {
-            (
-                h.splits.iter().map(|s| s.nominal.position_rms_mm).collect(),
-                h.splits
-                    .iter()
-                    .map(|s| s.held_out.position_rms_mm)
-                    .collect(),
-            )
-        }),
-        notes,
-        json: json.clone(),
-        poses: Some(activecal::render::pages::FitPoses {
-            qs: meas.qs().to_vec(),
-            measured: (meas.points().len() == meas.qs().len()).then(|| meas.points().to_vec()),
-            flagged: r.outliers.left_out.iter().map(|o| o.pose).collect(),
-        }),
     }
 }
 

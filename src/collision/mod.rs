@@ -25,6 +25,7 @@
 
 mod always;
 mod build;
+mod closest;
 pub mod mesh;
 mod mesh_tree;
 mod model;
@@ -36,6 +37,7 @@ pub mod srdf;
 pub mod stl;
 pub(crate) mod tree;
 
+pub use closest::Closest;
 pub use model::{CollisionModel, ContactPair};
 pub use moves::MoveCheck;
 pub use spec::{AlwaysTouching, CollisionSpec, Obstacle, TouchingPair};

@@ -76,11 +76,23 @@ pub(super) fn curve_table(curve: &PoseCountCurve) -> String {
 }
 
 /// The collision filter of a pool, if it has one.
-fn collision_spec(report: &SelectReport) -> Option<&CollisionSpec> {
+fn collision_filter(report: &SelectReport) -> Option<&crate::collision::CollisionFilter> {
     report.pool.pool.filters.iter().find_map(|f| match f {
-        PoolFilter::Collision(c) => Some(&c.spec),
+        PoolFilter::Collision(c) => Some(c),
         _ => None,
     })
+}
+
+/// The least clearance of each pose and move, by the pool's collision
+/// filter (a note when its model does not load).
+fn add_clearances(page: &mut Page, filter: &crate::collision::CollisionFilter) {
+    match filter.load() {
+        Ok(model) => {
+            page.add_clearances(&model);
+            page.notes.push("Clearance: the least distance between the links (and obstacles) the collision filter checks, at each pose and over each move's drawn samples; the two closest are drawn red.".into());
+        }
+        Err(e) => page.notes.push(format!("clearances are not shown: {e}")),
+    }
 }
 
 /// The page of `select --report`.
@@ -91,7 +103,8 @@ pub fn selection(
     curve: &PoseCountCurve,
     figs: &[(String, String)],
 ) -> Result<()> {
-    let spec = collision_spec(report);
+    let filter = collision_filter(report);
+    let spec = filter.map(|f| &f.spec);
     let dirs = spec.map(|s| s.package_dirs.clone()).unwrap_or_default();
     let mut page = Page::new(
         &format!(
@@ -116,8 +129,9 @@ pub fn selection(
         .collect();
     let home = report.tour.as_ref().and_then(|t| t.home.as_deref());
     page.add_moves(robot, &robot.nominal, home, &vias);
-    if let Some(s) = spec {
-        add_scene(&mut page, s);
+    if let Some(f) = filter {
+        add_scene(&mut page, &f.spec);
+        add_clearances(&mut page, f);
     }
     let mount = page.mount();
     add_tracker(&mut page, robot, mount);

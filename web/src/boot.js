@@ -2,6 +2,7 @@
 // can import no file, so the embedded three.js modules and the page's own
 // become blob URLs, each module's imports rewritten to its dependency's URL.
 (function boot() {
+  window.activecalBoot = performance.now();
   const text = (id) => document.getElementById(id).textContent;
   const url = (t) => URL.createObjectURL(new Blob([t], { type: 'text/javascript' }));
   const swap = (t, from, to) => t.split(from).join(JSON.stringify(to));

@@ -4,7 +4,11 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 
+// Milliseconds since navigation at each step of opening (the read-out's
+// `timings`): where the time to interactive goes.
+const timings = { boot: window.activecalBoot ?? null, module: performance.now() };
 const data = JSON.parse(document.getElementById('page-data').textContent);
+timings.parsed = performance.now();
 const el = (id) => document.getElementById(id);
 const host = el('canvas');
 const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
@@ -21,7 +25,15 @@ const sun = new THREE.DirectionalLight(0xffffff, 1.5);
 sun.position.set(2, -3, 4);
 scene.add(sun);
 
-const bytes = (b64) => Uint8Array.from(atob(b64), (c) => c.charCodeAt(0)).buffer;
+// Base64 to bytes in one pass over a preallocated array (a callback per
+// character, as Uint8Array.from takes, is several times slower on meshes
+// of megabytes).
+function bytes(b64) {
+  const s = atob(b64);
+  const out = new Uint8Array(s.length);
+  for (let i = 0; i < s.length; i++) out[i] = s.charCodeAt(i);
+  return out.buffer;
+}
 const matrix = (m) => new THREE.Matrix4().fromArray(m);
 
 function meshGeometry(m) {
@@ -86,6 +98,7 @@ function addScene() {
 }
 
 const meshes = data.meshes.map(meshGeometry);
+timings.meshes = performance.now();
 const robot = makeRobot(meshes, null);
 const fitted = data.poses.some((p) => p.calibrated)
   ? makeRobot(meshes, [1.0, 0.55, 0.1, 0.35])
@@ -109,6 +122,16 @@ let shown = 0;
 function setLinks(r, mats) {
   mats.forEach((m, i) => r.links[i].matrix.fromArray(m));
 }
+
+// The least clearance (a pose's or a move's): its links drawn red.
+function highlight(c) {
+  const near = new Set(c ? c.links : []);
+  robot.links.forEach((o, i) => {
+    for (const m of o.children) if (m.material.emissive) m.material.emissive.setHex(near.has(i) ? 0xcc0000 : 0);
+  });
+}
+
+const clearanceText = (c) => (c ? `least clearance ${(1000 * c.distance).toFixed(1)} mm (${c.between[0]} – ${c.between[1]})` : '');
 
 // The calibrated robot with its difference from the nominal magnified.
 function magnified(p) {
@@ -187,6 +210,9 @@ function readout() {
     drawn: renderer.info.render.triangles,
     canvas: [r.left, r.top, r.width, r.height],
     readyMs: Math.round(performance.now()),
+    timings,
+    clearance: data.poses[shown]?.clearance ?? null,
+    red: robot.links.flatMap((o, i) => (o.children.some((m) => m.material.emissive?.getHex()) ? [i] : [])),
   });
 }
 
@@ -213,8 +239,10 @@ function showPose(k) {
     setSkeleton(fittedSkeleton, m);
   }
   drawMarks(shown);
+  highlight(p.clearance);
   el('slider').value = String(shown);
-  el('shown').textContent = `${p.label} (${shown + 1} of ${data.poses.length})`;
+  const c = clearanceText(p.clearance);
+  el('shown').textContent = `${p.label} (${shown + 1} of ${data.poses.length})${c ? `, ${c}` : ''}`;
   document.querySelectorAll('#poses li').forEach((li, i) => li.classList.toggle('on', i === shown));
   render();
   readout();
@@ -222,6 +250,7 @@ function showPose(k) {
 
 function render() {
   renderer.render(scene, camera);
+  timings.rendered ??= performance.now();
 }
 
 // Plays the moves of the tour from pose `from`, sample by sample.
@@ -244,6 +273,8 @@ function play() {
     }
     setLinks(robot, mats);
     setSkeleton(skeleton, mats);
+    highlight(m.clearance);
+    if (s === 0) el('shown').textContent = `move to ${data.poses[m.to].label}${m.clearance ? `, ${clearanceText(m.clearance)}` : ''}`;
     marks.clear();
     render();
     s += 1;
@@ -272,6 +303,7 @@ function buildList() {
   data.poses.forEach((p, i) => {
     const li = document.createElement('li');
     li.textContent = p.mark ? `${p.label} (${p.mark})` : p.label;
+    if (p.clearance) li.title = clearanceText(p.clearance);
     if (p.mark) li.classList.add(p.mark === 'held out' ? 'held' : 'flagged');
     li.addEventListener('click', () => showPose(i));
     list.appendChild(li);
@@ -296,6 +328,7 @@ function hashClick() {
   if (m) document.querySelectorAll('#poses li')[Number(m[1])]?.click();
 }
 
+timings.scene = performance.now();
 buildList();
 frameView();
 controls.addEventListener('change', render);

@@ -23,6 +23,7 @@ use serde::Serialize;
 
 pub mod full_model;
 mod screen;
+pub mod summary;
 pub mod verdict;
 use std::path::Path;
 use std::sync::Arc;

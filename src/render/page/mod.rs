@@ -19,7 +19,7 @@ pub mod meshes;
 
 pub use html::{figure, table};
 
-use crate::collision::Obstacle;
+use crate::collision::{Closest, CollisionModel, Obstacle};
 use crate::error::Result;
 use crate::io::atomic::write_atomic;
 use crate::model::{ParamTable, Robot};
@@ -56,6 +56,21 @@ pub struct PoseView {
     /// A mark ("flagged", "held out"), if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mark: Option<String>,
+    /// With a collision filter: the least clearance.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub clearance: Option<ClearanceView>,
+}
+
+/// The least clearance of a pose or a move: the closest pair of the
+/// collision filter's checked pairs.
+#[derive(Clone, Debug, Serialize)]
+pub struct ClearanceView {
+    /// The two links, or the link and the obstacle (`box 1`, `floor`).
+    pub between: [String; 2],
+    /// The page's links among them (indices into [`Page::links`]).
+    pub links: Vec<usize>,
+    /// Their least distance, metres (0: touching).
+    pub distance: f64,
 }
 
 /// A planned move, sampled.
@@ -73,6 +88,12 @@ pub struct MoveView {
     /// f32 (the top three rows of the column-major 4×4, column by
     /// column), base64.
     pub frames: String,
+    /// With a collision filter: the least clearance over the samples.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub clearance: Option<ClearanceView>,
+    /// Joint values of the samples.
+    #[serde(skip)]
+    pub qs: Vec<Vec<f64>>,
 }
 
 /// The sensor's placement.
@@ -254,6 +275,7 @@ impl Page {
                 measured: None,
                 fitted: None,
                 mark: None,
+                clearance: None,
             });
         }
     }
@@ -288,6 +310,7 @@ impl Page {
             path.push(qs[to].clone());
             let mut bytes = Vec::new();
             let mut samples = 0;
+            let mut sampled = Vec::new();
             for (k, w) in path.windows(2).enumerate() {
                 let travel = w[0]
                     .iter()
@@ -307,6 +330,7 @@ impl Page {
                         let top = c.chunks_exact(4).flat_map(|col| &col[..3]);
                         bytes.extend(top.flat_map(|v| (*v as f32).to_le_bytes()));
                     }
+                    sampled.push(q);
                     samples += 1;
                 }
             }
@@ -316,9 +340,39 @@ impl Page {
                 via: via.is_some(),
                 samples,
                 frames: encode::base64(&bytes),
+                clearance: None,
+                qs: sampled,
             });
         }
         self.moves = moves;
+    }
+
+    /// The least clearance of each pose and of each move (over the move's
+    /// samples, [`MOVE_STEP`] apart in every joint) by `model`
+    /// ([`CollisionModel::closest`]).
+    pub fn add_clearances(&mut self, model: &CollisionModel) {
+        let view = |c: Closest, names: &[String]| {
+            let between = [c.pair.link, c.pair.other];
+            let links = between
+                .iter()
+                .filter_map(|n| names.iter().position(|m| m == n))
+                .collect();
+            ClearanceView {
+                between,
+                links,
+                distance: c.distance,
+            }
+        };
+        for p in &mut self.poses {
+            p.clearance = model.closest(&p.q).map(|c| view(c, &self.links));
+        }
+        for m in &mut self.moves {
+            let least =
+                m.qs.iter()
+                    .filter_map(|q| model.closest(q))
+                    .min_by(|a, b| a.distance.total_cmp(&b.distance));
+            m.clearance = least.map(|c| view(c, &self.links));
+        }
     }
 
     /// The page's HTML text (deterministic: no time, no random).

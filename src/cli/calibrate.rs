@@ -17,7 +17,7 @@ use std::time::Instant;
 
 /// Runs `calibrate`.
 pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
-    if let (Some(seed), Some(_), None) = (a.seed, &a.measurements, a.holdout) {
+    if let (Some(seed), true, None) = (a.seed, a.measurements.is_some() || a.bag.is_some(), a.holdout) {
         bail!(
             "--seed {seed}: with --measurements the seed only draws the --holdout splits, and --holdout is not given (the fit of measured data has no randomness)"
         );
@@ -28,7 +28,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
             a.noise()
         );
     }
-    if let (Some(n), Some(_)) = (a.noise, &a.measurements)
+    if let (Some(n), true) = (a.noise, a.measurements.is_some() || a.bag.is_some())
         && !(n > 0.0)
     {
         bail!(
@@ -80,8 +80,11 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
             }
         }
         (_, Some(m)) => from_measurements(&a, robot, m),
+        (_, None) if a.bag.is_some() => super::calibrate_bag::from_bag(&a, robot),
         (Some(d), None) => super::simulated::from_design(&a, robot, desc.visibility.as_ref(), d),
-        (None, None) => bail!("give --design (simulate) or --measurements (real data)"),
+        (None, None) => {
+            bail!("give --design (simulate), --measurements or --bag (real data)")
+        }
     }
 }
 
@@ -97,6 +100,8 @@ fn calibrate_files(a: &CalibrateArgs) -> super::run_files::RunFiles {
     f.robot(&a.robot)
         .input("--design", a.design.as_deref())
         .input("--measurements", a.measurements.as_deref())
+        .input("--bag", a.bag.as_deref())
+        .input("--bag-design", a.bag_design.as_deref())
         .input("--observations", a.observations.as_deref())
         .inputs("--images", &image_inputs(a))
         .input("--joints", a.joints.as_deref())
@@ -150,21 +155,72 @@ fn gain_text(g: &FullModelGain, held_out: Option<f64>) -> String {
     s
 }
 
-/// Identification from a measurement file.
-fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()> {
-    let t0 = Instant::now();
-    let mut scaled;
-    let robot = match a.orientation_scale {
+/// `robot` with `--orientation-scale` applied.
+pub(super) fn scaled_robot(a: &CalibrateArgs, robot: &Robot) -> Result<Robot> {
+    let mut scaled = robot.clone();
+    match a.orientation_scale {
         Some(w) if !(w.is_finite() && w > 0.0) => {
             bail!("--orientation-scale {w}: must be a finite number > 0 (metres per radian)")
         }
-        Some(w) => {
-            scaled = robot.clone();
-            scaled.orientation_scale = w;
-            &scaled
+        Some(w) => scaled.orientation_scale = w,
+        None => {}
+    }
+    Ok(scaled)
+}
+
+/// Identification from a measurement file.
+fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()> {
+    let t0 = Instant::now();
+    let robot = &scaled_robot(a, robot)?;
+    let o = measured_settings(a, robot)?;
+    let mut print_note = |n: &str| {
+        if !a.json {
+            super::diag(&format!("note: {n}"));
         }
-        None => robot,
     };
+    let (meas, read_notes) =
+        activecal::experiment::measured::read_measurement_file(path, robot, o.units)?;
+    // Points and full poses told apart: the options of the other refused.
+    let sensor = if meas.orientations().is_empty() {
+        super::acts_on::Sensor::Points
+    } else {
+        super::acts_on::Sensor::Poses
+    };
+    super::acts_on::check(super::acts_on::CALIBRATE, &a.given, &[sensor])?;
+    let c = activecal::experiment::measured::calibrate_read(
+        robot,
+        &meas,
+        &path.display().to_string(),
+        read_notes,
+        &o,
+        &mut print_note,
+    )?;
+    let source = Source {
+        name: path.display().to_string(),
+        described: format!("measurements `{}`", path.display()),
+        json: None,
+        text: String::new(),
+    };
+    render_measured(a, robot, &meas, c, &o, &source, t0)
+}
+
+/// Where the measurements of a fit came from, as the output shows it.
+pub(super) struct Source {
+    /// Its name in the calibrated files' header (a path).
+    pub name: String,
+    /// In the report folder's summary.
+    pub described: String,
+    /// A JSON object added to the output (`key`, value).
+    pub json: Option<(&'static str, serde_json::Value)>,
+    /// Text printed before the fit's.
+    pub text: String,
+}
+
+/// The settings of a fit of measured data from the options.
+pub(super) fn measured_settings(
+    a: &CalibrateArgs,
+    robot: &Robot,
+) -> Result<activecal::experiment::measured::MeasuredSettings> {
     let lm = LmSettings::builder()
         .max_iterations(a.max_iterations)
         .geodesic(!a.no_geodesic)
@@ -206,34 +262,29 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         fit_compliance: a.compliance,
         compare_compliance: a.compare_compliance,
     };
-    let mut print_note = |n: &str| {
-        if !a.json {
-            super::diag(&format!("note: {n}"));
-        }
-    };
-    let (meas, read_notes) =
-        activecal::experiment::measured::read_measurement_file(path, robot, o.units)?;
-    // Points and full poses told apart: the options of the other refused.
-    let sensor = if meas.orientations().is_empty() {
-        super::acts_on::Sensor::Points
-    } else {
-        super::acts_on::Sensor::Poses
-    };
-    super::acts_on::check(super::acts_on::CALIBRATE, &a.given, &[sensor])?;
+    Ok(o)
+}
+
+/// Writes and prints a fit of measured data (`c`, of `meas` from `source`
+/// with the settings `o`), started at `t0`: the calibrated robot when the
+/// library's verdict allows, the report folder, the text or JSON, and the
+/// exit status.
+pub(super) fn render_measured(
+    a: &CalibrateArgs,
+    robot: &Robot,
+    meas: &activecal::identify::Measurements,
+    c: activecal::experiment::measured::MeasuredCalibration,
+    o: &activecal::experiment::measured::MeasuredSettings,
+    source: &Source,
+    t0: Instant,
+) -> Result<()> {
     let activecal::experiment::measured::MeasuredCalibration {
         robot: fitted,
         fit: f,
         frames,
         mut report,
         verdict,
-    } = activecal::experiment::measured::calibrate_read(
-        robot,
-        &meas,
-        &path.display().to_string(),
-        read_notes,
-        &o,
-        &mut print_note,
-    )?;
+    } = c;
     report.base.elapsed_seconds = t0.elapsed().as_secs_f64();
     for w in &report.warnings {
         super::diag(&format!("warning: {w}"));
@@ -242,14 +293,13 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     // The library's verdict: a fit that did not converge, or converged to
     // another robot, is not written.
     if verdict.refusal().is_none() {
-        report.base.out =
-            write_calibrated(a, &fitted, id, &path.display().to_string(), frames.as_ref())?;
+        report.base.out = write_calibrated(a, &fitted, id, &source.name, frames.as_ref())?;
     }
     let gain = activecal::experiment::measured::full_model::beside_full_model(
         robot,
-        &meas,
-        &path.display().to_string(),
-        &o,
+        meas,
+        &source.name,
+        o,
         &a.fix,
         a.restriction(),
         (&fitted, &id.table),
@@ -259,14 +309,18 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     if let Some(g) = &gain {
         v["full_model_gain"] = serde_json::to_value(g)?;
     }
+    if let Some((key, value)) = &source.json {
+        v[*key] = value.clone();
+    }
     if let Some(dir) = &a.report {
         activecal::render::folder::calibration(
             dir,
-            &measured_summary(&fitted, id, path, &report, &v, &meas),
+            &measured_summary(&fitted, id, &source.described, &report, &v, meas),
         )?;
     }
     super::emit(a.json, &v, || {
-        let mut s = super::measured::measured_text(&report, id, &status_text(id));
+        let mut s = source.text.clone();
+        s += &super::measured::measured_text(&report, id, &status_text(id));
         if let Some(g) = &gain {
             let held_out = report.holdout.as_ref().map(|h| h.position_rms_mm.mean);
             s += &gain_text(g, held_out);
@@ -286,7 +340,7 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
 fn measured_summary<'a>(
     robot: &'a Robot,
     id: &'a Identification,
-    path: &Path,
+    described: &str,
     r: &activecal::experiment::measured::MeasuredReport,
     json: &serde_json::Value,
     meas: &activecal::identify::Measurements,
@@ -321,7 +375,7 @@ fn measured_summary<'a>(
     activecal::render::folder::CalibrationSummary {
         robot,
         id,
-        source: format!("measurements `{}`, {} poses", path.display(), r.base.poses),
+        source: format!("{described}, {} poses", r.base.poses),
         what: "pose",
         position_mm: (pos(&r.nominal_residuals), pos(&r.residuals)),
         orientation_deg: ori(&r.nominal_residuals).zip(ori(&r.residuals)),

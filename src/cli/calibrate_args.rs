@@ -5,11 +5,13 @@ use clap::Args;
 use std::path::PathBuf;
 
 /// Arguments of the command. The options of measured data conflict with
-/// `--design` (clap's `requires = "measurements"` is not checked when an
+/// `--design` (clap's `requires = "measured"` is not checked when an
 /// argument that conflicts with `--measurements`, such as `--design`, is
 /// given: they were silently ignored).
 #[derive(Args)]
 #[command(group(clap::ArgGroup::new("camera_data").args(["observations", "images"])))]
+#[command(group(clap::ArgGroup::new("measured").args(["measurements", "bag"])))]
+#[command(group(clap::ArgGroup::new("with_joints").args(["images", "bag"])))]
 pub struct CalibrateArgs {
     /// Robot: a built-in name, or a .toml description or .urdf file; append
     /// `:pose` for full-pose measurements.
@@ -17,7 +19,7 @@ pub struct CalibrateArgs {
     pub robot: activecal::io::RobotRef,
     /// Design file (JSON with robot, levels, poses), as written by `select`:
     /// measurements are simulated there.
-    #[arg(long, required_unless_present_any = ["measurements", "observations", "images"])]
+    #[arg(long, required_unless_present_any = ["measurements", "observations", "images", "bag"])]
     pub design: Option<PathBuf>,
     /// Measurement file: identify from these real measurements instead of
     /// simulating a design. CSV (`x1,y1,z1`, `x2,y2,z2`… for several
@@ -112,14 +114,14 @@ pub struct CalibrateArgs {
     /// the measurement frame and the tool; every link length and twist
     /// held at the model's value: what a driver's joint offsets and the
     /// frames file can hold).
-    #[arg(long, value_enum, requires = "measurements")]
+    #[arg(long, value_enum, requires = "measured")]
     pub unknowns: Option<UnknownsKind>,
     /// Keep closed-form inverse kinematics working on the calibrated model
     /// (with --measurements): hold the parameters that would change the
     /// nominal model's parallel, perpendicular or intersecting joint axes
     /// (listed in the report), fit the rest, and report the full model's
     /// fit of the same data beside it.
-    #[arg(long, requires = "measurements", conflicts_with = "unknowns")]
+    #[arg(long, requires = "measured", conflicts_with = "unknowns")]
     pub keep_axis_relations: bool,
     /// The unit of the joint offsets written to `--out *joint_offsets.yaml`
     /// (revolute joints; prismatic ones are in metres).
@@ -159,7 +161,7 @@ pub struct CalibrateArgs {
         long,
         value_enum,
         default_value = "estimated",
-        requires = "measurements"
+        requires = "measured"
     )]
     pub weights: WeightsKind,
     /// Metres of position error a radian of orientation error counts as
@@ -167,7 +169,7 @@ pub struct CalibrateArgs {
     #[arg(
         long,
         value_name = "M_PER_RAD",
-        requires = "measurements",
+        requires = "measured",
         conflicts_with = "weights"
     )]
     pub orientation_scale: Option<f64>,
@@ -246,9 +248,36 @@ pub struct CalibrateArgs {
     )]
     pub images: Option<PathBuf>,
     /// With --images: the joint values of each image, a CSV `image,<joints
-    /// as in the URDF>` with one row per image (its file name).
-    #[arg(long, value_name = "FILE", requires = "images")]
+    /// as in the URDF>` with one row per image (its file name). With
+    /// --bag: the bag's sensor_msgs/msg/JointState topic (default
+    /// /joint_states).
+    #[arg(long, value_name = "FILE|TOPIC", requires = "with_joints")]
     pub joints: Option<PathBuf>,
+    /// Calibrate from a ROS 2 bag (a rosbag2 folder, or one .mcap or .db3
+    /// file): the joints of --joints' topic, the measurement of --points,
+    /// --poses or --tf, one pose per rest period (as `extract` finds and
+    /// averages them), the clock offset estimated from the moves unless
+    /// --time-offset gives it, and estimated again with the calibrated
+    /// model (the fit repeated once when it moved by more than its
+    /// uncertainty).
+    #[arg(
+        long,
+        value_name = "BAG",
+        conflicts_with_all = ["design", "measurements", "observations", "images", "trials", "save_measurements", "validation"],
+    )]
+    pub bag: Option<PathBuf>,
+    /// What to read from --bag and how.
+    #[command(flatten)]
+    pub from_bag: super::extract::BagOpts,
+    /// With --bag: the design the run followed (`select --out`'s file):
+    /// each rest is matched to the pose it reached, a rest that reached
+    /// none is left out, a pose no rest gives is named.
+    #[arg(long, value_name = "FILE", requires = "bag")]
+    pub bag_design: Option<PathBuf>,
+    /// With --bag-design: a rest reached a design pose when no joint is
+    /// further from it than this (rad, m for prismatic joints).
+    #[arg(long, value_name = "RAD", default_value_t = 0.01, requires = "bag_design")]
+    pub design_tolerance: f64,
     /// With --images: write the pixels detected as an observations CSV
     /// (what --observations reads; joint values in radians and metres), to
     /// inspect or edit them. An existing file only with --force.

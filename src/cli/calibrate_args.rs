@@ -5,12 +5,13 @@ use clap::Args;
 use std::path::PathBuf;
 
 /// Arguments of the command. The options of measured data conflict with
-/// `--design` (clap's `requires = "measured"` is not checked when an
+/// `--design` (clap's `requires = "measurements"` is not checked when an
 /// argument that conflicts with `--measurements`, such as `--design`, is
-/// given: they were silently ignored).
+/// given: they were silently ignored); those of measured data from a file
+/// or a bag are refused with other data by the acts-on tables
+/// (`acts_on.rs`), naming the data given.
 #[derive(Args)]
 #[command(group(clap::ArgGroup::new("camera_data").args(["observations", "images"])))]
-#[command(group(clap::ArgGroup::new("measured").args(["measurements", "bag"])))]
 #[command(group(clap::ArgGroup::new("with_joints").args(["images", "bag"])))]
 pub struct CalibrateArgs {
     /// Robot: a built-in name, or a .toml description or .urdf file; append
@@ -114,14 +115,14 @@ pub struct CalibrateArgs {
     /// the measurement frame and the tool; every link length and twist
     /// held at the model's value: what a driver's joint offsets and the
     /// frames file can hold).
-    #[arg(long, value_enum, requires = "measured")]
+    #[arg(long, value_enum)]
     pub unknowns: Option<UnknownsKind>,
     /// Keep closed-form inverse kinematics working on the calibrated model
     /// (with --measurements): hold the parameters that would change the
     /// nominal model's parallel, perpendicular or intersecting joint axes
     /// (listed in the report), fit the rest, and report the full model's
     /// fit of the same data beside it.
-    #[arg(long, requires = "measured", conflicts_with = "unknowns")]
+    #[arg(long, conflicts_with = "unknowns")]
     pub keep_axis_relations: bool,
     /// The unit of the joint offsets written to `--out *joint_offsets.yaml`
     /// (revolute joints; prismatic ones are in metres).
@@ -160,8 +161,7 @@ pub struct CalibrateArgs {
     #[arg(
         long,
         value_enum,
-        default_value = "estimated",
-        requires = "measured"
+        default_value = "estimated"
     )]
     pub weights: WeightsKind,
     /// Metres of position error a radian of orientation error counts as
@@ -169,7 +169,6 @@ pub struct CalibrateArgs {
     #[arg(
         long,
         value_name = "M_PER_RAD",
-        requires = "measured",
         conflicts_with = "weights"
     )]
     pub orientation_scale: Option<f64>,

@@ -144,3 +144,31 @@ def test_writers_refuse_to_write_over_an_input(tmp_path):
     with pytest.raises(activecal.Error, match="ur5.urdf"):
         cal.write_urdf(urdf, overwrite=True)
     assert urdf.read_bytes() == text
+
+
+# activecal.extract's keywords and the flags of `activecal extract` they are
+# (a bag's options, the same on `calibrate --bag`).
+EXTRACT = {
+    "joints": "--joints",
+    "points": "--points",
+    "poses": "--poses",
+    "tf": "--tf",
+    "time_offset": "--time-offset",
+    "max_offset": "--max-offset",
+    "rest_speed": "--rest-speed",
+    "rest_min": "--rest-min",
+    "settle": "--settle",
+    "design": "--design",
+    "design_tolerance": "--design-tolerance",
+}
+
+
+def test_every_keyword_of_extract_is_a_flag_of_the_command_line():
+    import subprocess
+
+    from conftest import cli_path
+
+    assert sorted(p for p in keywords(activecal.extract) if p != "bag") == sorted(EXTRACT)
+    help_text = subprocess.run([str(cli_path()), "extract", "--help"], capture_output=True, text=True).stdout
+    for flag in EXTRACT.values():
+        assert flag + " " in help_text, flag

@@ -111,7 +111,7 @@ pub const CALIBRATE: &[ActsOn] = &[
     a("progress", CAL_ALL),
     a("robot", CAL_ALL),
     a("design", &[Simulated]),
-    a("measurements", FITTED),
+    a("measurements", &[Points, Poses, Contacts]),
     a("save_measurements", &[Simulated]),
     a("out", CAL_ALL),
     a("force", CAL_ALL),

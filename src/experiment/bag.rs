@@ -21,7 +21,16 @@ pub fn read_bag(
     robot: &Robot,
     s: &ExtractSettings,
 ) -> Result<(Measurements, Vec<String>, ExtractReport), ExperimentError> {
-    let got = extract(path, robot, s)?;
+    checked(path, robot, extract(path, robot, s)?)
+}
+
+/// An extraction's measurements checked against `robot` and its reach,
+/// with the notes of its report.
+fn checked(
+    path: &Path,
+    robot: &Robot,
+    got: crate::io::bag::extract::Extracted,
+) -> Result<(Measurements, Vec<String>, ExtractReport), ExperimentError> {
     let source = path.display().to_string();
     let in_file = |error| ExperimentError::InFile {
         path: source.clone(),
@@ -133,21 +142,19 @@ pub fn calibrate_bag(
         return Ok(done(meas, first, report, Some(clock)));
     };
     let moved = (e2.seconds - estimated.seconds).abs() > estimated.uncertainty;
-    let mut clock = ClockRefit {
+    let clock = ClockRefit {
         nominal: estimated,
         calibrated: Some(e2.clone()),
         refitted: moved,
     };
-    on_note(&clock_note(&clock));
     if !moved {
+        on_note(&clock_note(&clock));
         return Ok(done(meas, first, report, Some(clock)));
     }
-    let (meas2, mut notes2, mut report2) = read_bag(path, &calibrated, x)?;
-    // The calibrated model's estimate stands, whatever the first rule said.
-    report2.clock = again.report.clock;
+    // The extraction with the calibrated model applied its estimate.
+    let (meas2, mut notes2, report2) = checked(path, robot, again)?;
     notes2.push(clock_note(&clock));
     let second = calibrate_read(robot, &meas2, &source, notes2, s, on_note)?;
-    clock.refitted = true;
     Ok(done(meas2, second, report2, Some(clock)))
 }
 

@@ -343,8 +343,8 @@ fn calibrate_from_a_bag_is_the_fit_of_the_extracted_csv() {
         let out = run(&args);
         let err = String::from_utf8_lossy(&out.stderr).to_string();
         assert!(!err.contains("panicked"), "{err}");
-        let v: serde_json::Value = serde_json::from_slice(&out.stdout)
-            .unwrap_or_else(|e| panic!("{args:?}: {e}: {err}"));
+        let v: serde_json::Value =
+            serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{args:?}: {e}: {err}"));
         (out.status.code(), v)
     };
     let (s_csv, v_csv) = fit(&["--measurements", c]);
@@ -358,7 +358,10 @@ fn calibrate_from_a_bag_is_the_fit_of_the_extracted_csv() {
     assert!(!p_bag.is_empty());
     for (a, b) in p_csv.iter().zip(p_bag) {
         assert_eq!(a["name"], b["name"]);
-        let (x, y) = (a["estimate"].as_f64().unwrap(), b["estimate"].as_f64().unwrap());
+        let (x, y) = (
+            a["estimate"].as_f64().unwrap(),
+            b["estimate"].as_f64().unwrap(),
+        );
         assert!((x - y).abs() <= 1e-9 * (1.0 + x.abs()), "{a} vs {b}");
     }
     let rests = v_bag["bag"]["extraction"]["rests"].as_array().unwrap();
@@ -376,8 +379,14 @@ fn a_bags_options_need_a_bag_and_a_files_need_a_file() {
     };
     let bag = ["--bag", "fixtures/bags/tiny.mcap", "--points", "/tracker"];
     for (extra, needle) in [
-        (&["--measurements", "m.csv", "--rest-speed", "0.01"][..], "--bag"),
-        (&["--measurements", "m.csv", "--time-offset", "0.1"], "--bag"),
+        (
+            &["--measurements", "m.csv", "--rest-speed", "0.01"][..],
+            "--bag",
+        ),
+        (
+            &["--measurements", "m.csv", "--time-offset", "0.1"],
+            "--bag",
+        ),
         (&["--design", "d.json", "--points", "/tracker"], "--bag"),
     ] {
         fails_with(&with(extra), needle);

@@ -156,9 +156,18 @@ const CALIBRATE_WHY: &[(&str, &str)] = &[
         "save_observations",
         "it writes the pixels detected in --images",
     ),
-    ("angle_unit", "no file of joint values is read (a bag's are in radians)"),
-    ("length_unit", "no file of joint values is read (a bag's are in metres)"),
-    ("bag_design", "it matches a bag's rests to the design the run followed"),
+    (
+        "angle_unit",
+        "no file of joint values is read (a bag's are in radians)",
+    ),
+    (
+        "length_unit",
+        "no file of joint values is read (a bag's are in metres)",
+    ),
+    (
+        "bag_design",
+        "it matches a bag's rests to the design the run followed",
+    ),
     (
         "design_tolerance",
         "it matches a bag's rests to the design the run followed",

@@ -1,5 +1,6 @@
 //! `calibrate`: the choice between simulated (`--design`, rendered in
-//! `simulated.rs`), measured (`--measurements`, here), contact
+//! `simulated.rs`), measured (`--measurements` or a ROS 2 bag's `--bag`,
+//! here; the bag's pipeline is the library's `experiment::bag`), contact
 //! (`contact.rs`) and camera (`--observations`, `camera.rs`) calibration. Its arguments are in `calibrate_args.rs`,
 //! what the three share on the way out (the calibrated robot, exit
 //! statuses) in `calibrated.rs`.
@@ -11,13 +12,17 @@ use activecal::experiment::measured::full_model::FullModelGain;
 use activecal::identify::{Identification, LmSettings};
 use activecal::io::calibrated::Format;
 use activecal::model::Robot;
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use std::path::Path;
 use std::time::Instant;
 
 /// Runs `calibrate`.
 pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
-    if let (Some(seed), true, None) = (a.seed, a.measurements.is_some() || a.bag.is_some(), a.holdout) {
+    if let (Some(seed), true, None) = (
+        a.seed,
+        a.measurements.is_some() || a.bag.is_some(),
+        a.holdout,
+    ) {
         bail!(
             "--seed {seed}: with --measurements the seed only draws the --holdout splits, and --holdout is not given (the fit of measured data has no randomness)"
         );
@@ -80,7 +85,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
             }
         }
         (_, Some(m)) => from_measurements(&a, robot, m),
-        (_, None) if a.bag.is_some() => super::calibrate_bag::from_bag(&a, robot),
+        (_, None) if a.bag.is_some() => from_bag(&a, robot),
         (Some(d), None) => super::simulated::from_design(&a, robot, desc.visibility.as_ref(), d),
         (None, None) => {
             bail!("give --design (simulate), --measurements or --bag (real data)")
@@ -156,7 +161,7 @@ fn gain_text(g: &FullModelGain, held_out: Option<f64>) -> String {
 }
 
 /// `robot` with `--orientation-scale` applied.
-pub(super) fn scaled_robot(a: &CalibrateArgs, robot: &Robot) -> Result<Robot> {
+fn scaled_robot(a: &CalibrateArgs, robot: &Robot) -> Result<Robot> {
     let mut scaled = robot.clone();
     match a.orientation_scale {
         Some(w) if !(w.is_finite() && w > 0.0) => {
@@ -204,20 +209,69 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     render_measured(a, robot, &meas, c, &o, &source, t0)
 }
 
+/// The joint topic when `--joints` is not given.
+const DEFAULT_JOINTS: &str = "/joint_states";
+
+/// Calibrates `robot` from `--bag`.
+fn from_bag(a: &CalibrateArgs, robot: &Robot) -> Result<()> {
+    let t0 = Instant::now();
+    let bag = a.bag.as_deref().context("--bag: not given")?;
+    let robot = &scaled_robot(a, robot)?;
+    let o = measured_settings(a, robot)?;
+    let joints = a
+        .joints
+        .as_deref()
+        .map_or(DEFAULT_JOINTS.into(), |j| j.to_string_lossy());
+    let mut x = a.from_bag.settings(&joints, a.design_tolerance)?;
+    if let Some(d) = &a.bag_design {
+        x.design = Some(activecal::io::bag::design::read_design(d, robot)?);
+    }
+    let mut print_note = |n: &str| {
+        if !a.json {
+            super::diag(&format!("note: {n}"));
+        }
+    };
+    let got = activecal::experiment::bag::calibrate_bag(bag, robot, &x, &o, &mut print_note)?;
+    let mut json = serde_json::json!({ "extraction": got.extraction });
+    if let Some(c) = &got.clock {
+        json["clock_refit"] = serde_json::to_value(c)?;
+    }
+    let mut text = super::extract::text(&got.extraction, None);
+    if let Some(c) = &got.clock {
+        text += &format!("{}\n", activecal::experiment::bag::clock_note(c));
+    }
+    text += "\n";
+    let source = Source {
+        name: bag.display().to_string(),
+        described: format!("ROS 2 bag `{}`", bag.display()),
+        json: Some(("bag", json)),
+        text,
+    };
+    render_measured(
+        a,
+        robot,
+        &got.measurements,
+        got.calibration,
+        &o,
+        &source,
+        t0,
+    )
+}
+
 /// Where the measurements of a fit came from, as the output shows it.
-pub(super) struct Source {
+struct Source {
     /// Its name in the calibrated files' header (a path).
-    pub name: String,
+    name: String,
     /// In the report folder's summary.
-    pub described: String,
+    described: String,
     /// A JSON object added to the output (`key`, value).
-    pub json: Option<(&'static str, serde_json::Value)>,
+    json: Option<(&'static str, serde_json::Value)>,
     /// Text printed before the fit's.
-    pub text: String,
+    text: String,
 }
 
 /// The settings of a fit of measured data from the options.
-pub(super) fn measured_settings(
+fn measured_settings(
     a: &CalibrateArgs,
     robot: &Robot,
 ) -> Result<activecal::experiment::measured::MeasuredSettings> {
@@ -269,7 +323,7 @@ pub(super) fn measured_settings(
 /// with the settings `o`), started at `t0`: the calibrated robot when the
 /// library's verdict allows, the report folder, the text or JSON, and the
 /// exit status.
-pub(super) fn render_measured(
+fn render_measured(
     a: &CalibrateArgs,
     robot: &Robot,
     meas: &activecal::identify::Measurements,

@@ -158,19 +158,11 @@ pub struct CalibrateArgs {
     /// components; the σ's are printed with their degrees of freedom);
     /// `fixed` keeps the robot's orientation scale (1 m per rad unless
     /// --orientation-scale).
-    #[arg(
-        long,
-        value_enum,
-        default_value = "estimated"
-    )]
+    #[arg(long, value_enum, default_value = "estimated")]
     pub weights: WeightsKind,
     /// Metres of position error a radian of orientation error counts as
     /// (a full-pose fit's fixed weight); implies --weights fixed.
-    #[arg(
-        long,
-        value_name = "M_PER_RAD",
-        conflicts_with = "weights"
-    )]
+    #[arg(long, value_name = "M_PER_RAD", conflicts_with = "weights")]
     pub orientation_scale: Option<f64>,
     /// A distance known between two contact points (a file with a `point`
     /// column): `A,B=METRES`, repeatable.
@@ -275,7 +267,12 @@ pub struct CalibrateArgs {
     pub bag_design: Option<PathBuf>,
     /// With --bag-design: a rest reached a design pose when no joint is
     /// further from it than this (rad, m for prismatic joints).
-    #[arg(long, value_name = "RAD", default_value_t = 0.01, requires = "bag_design")]
+    #[arg(
+        long,
+        value_name = "RAD",
+        default_value_t = 0.01,
+        requires = "bag_design"
+    )]
     pub design_tolerance: f64,
     /// With --images: write the pixels detected as an observations CSV
     /// (what --observations reads; joint values in radians and metres), to

@@ -5,7 +5,6 @@ pub mod basic;
 pub mod bench;
 pub mod bound;
 pub mod calibrate;
-pub mod calibrate_bag;
 pub mod calibrate_args;
 pub mod calibrated;
 pub mod camera;

@@ -146,7 +146,12 @@ pub const CALIBRATE: &[ActsOn] = &[
     a("compare_compliance", MEASURED_ANY),
     a("inertia", MEASURED_ANY),
     a("payload", MEASURED_ANY),
-    a("report", &[Simulated, Points, Poses, Contacts, Images, BagPoints, BagPoses]),
+    a(
+        "report",
+        &[
+            Simulated, Points, Poses, Contacts, Images, BagPoints, BagPoses,
+        ],
+    ),
     a("observations", &[Pixels]),
     a("images", &[Images]),
     a("joints", &[Images, BagPoints, BagPoses]),

@@ -80,7 +80,9 @@ fn calibrate_csv(d: &Path, robot: &str, meas: &str, stem: &str) {
 /// `kept`, written to `out`.
 fn kept_design(d: &Path, kept: &[usize], out: &str) {
     let text = std::fs::read_to_string(d.join("design.csv")).unwrap();
-    let mut lines = text.lines().filter(|l| !l.trim().is_empty() && !l.starts_with('#'));
+    let mut lines = text
+        .lines()
+        .filter(|l| !l.trim().is_empty() && !l.starts_with('#'));
     let head = lines.next().unwrap();
     let id = head.split(',').position(|c| c.trim() == "id");
     let mut s = format!("{head}\n");
@@ -115,13 +117,28 @@ fn kept(report: &Value) -> (Vec<usize>, f64) {
 /// One case: `draws` bags written with `write` (bag_truth.py's options
 /// after the bag's name and seed), calibrated with `extra`; returns the
 /// bag's and the clean CSVs' true error RMS.
-fn case(d: &Path, robot: &str, draws: u64, write: &[&str], extra: &[&str], pose: bool) -> (f64, f64) {
+fn case(
+    d: &Path,
+    robot: &str,
+    draws: u64,
+    write: &[&str],
+    extra: &[&str],
+    pose: bool,
+) -> (f64, f64) {
     let (mut bags, mut cleans, mut table) = (Vec::new(), Vec::new(), Vec::new());
     for k in 1..=draws {
         let (bag, stem, clean) = (format!("bag{k}"), format!("cal{k}"), format!("clean{k}"));
         let s = k.to_string();
         let mut args = vec![
-            "write", "--truth", "truth.json", "--design", "design.csv", "--out", &bag, "--seed", &s,
+            "write",
+            "--truth",
+            "truth.json",
+            "--design",
+            "design.csv",
+            "--out",
+            &bag,
+            "--seed",
+            &s,
         ];
         args.extend(write);
         let truth = python(d, "bag_truth.py", &args);
@@ -142,8 +159,17 @@ fn case(d: &Path, robot: &str, draws: u64, write: &[&str], extra: &[&str], pose:
         let on = (ORIENTATION_NOISE / samples.sqrt()).to_string();
         let seed = (100 + k).to_string();
         let mut m = vec![
-            "measure", "--truth", "truth.json", "--design", &format!("kept{k}.csv"), "--noise",
-            &noise, "--seed", &seed, "--out", &format!("{clean}.csv"),
+            "measure",
+            "--truth",
+            "truth.json",
+            "--design",
+            &format!("kept{k}.csv"),
+            "--noise",
+            &noise,
+            "--seed",
+            &seed,
+            "--out",
+            &format!("{clean}.csv"),
         ]
         .into_iter()
         .map(String::from)
@@ -151,7 +177,11 @@ fn case(d: &Path, robot: &str, draws: u64, write: &[&str], extra: &[&str], pose:
         if pose {
             m.extend(["--orientation-noise".into(), on]);
         }
-        python(d, "truth.py", &m.iter().map(String::as_str).collect::<Vec<_>>());
+        python(
+            d,
+            "truth.py",
+            &m.iter().map(String::as_str).collect::<Vec<_>>(),
+        );
         calibrate_csv(d, robot, &format!("{clean}.csv"), &clean);
         table.push((
             true_offset,
@@ -199,7 +229,14 @@ fn live_bag_calibrate_sqlite_poses_with_a_clock_offset() {
     let d = dir("calibrate-poses");
     let robot = setup(&d, 2, true);
     let write = [
-        "--storage", "sqlite3", "--kind", "poses", "--rate", "120", "--offset", "0.8",
+        "--storage",
+        "sqlite3",
+        "--kind",
+        "poses",
+        "--rate",
+        "120",
+        "--offset",
+        "0.8",
     ];
     let (t_bag, t_clean) = case(&d, &robot, 4, &write, &["--poses", "/mocap"], true);
     assert!(

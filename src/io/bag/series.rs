@@ -61,7 +61,9 @@ impl Source {
                 }),
                 _ => Err(format!("tf {pc}: give PARENT:CHILD, two frame names")),
             },
-            (None, None, None) => Err("give the bag's measurement: points TOPIC, poses TOPIC or tf PARENT:CHILD".into()),
+            (None, None, None) => Err(
+                "give the bag's measurement: points TOPIC, poses TOPIC or tf PARENT:CHILD".into(),
+            ),
             _ => Err("give one measurement of points, poses and tf".into()),
         }
     }

@@ -38,6 +38,7 @@ __all__ = [
     "calibrate_camera",
     "calibrate_contacts",
     "evaluate",
+    "extract",
     "gap",
     "pool",
     "select",

@@ -323,6 +323,14 @@ fn calibrate_sensors(a: &cli::calibrate::CalibrateArgs) -> &'static [acts_on::Se
     if a.images.is_some() {
         return &[Sensor::Images];
     }
+    if a.bag.is_some() {
+        // A bag's measurement is known by its option before it is read.
+        return if a.from_bag.gives_poses() {
+            &[Sensor::BagPoses]
+        } else {
+            &[Sensor::BagPoints]
+        };
+    }
     match (&a.observations, &a.measurements) {
         (Some(_), _) => &[Sensor::Pixels],
         (None, Some(m)) if cli::contact::is_contact_file(m) => &[Sensor::Contacts],

@@ -316,3 +316,95 @@ fn rests_are_matched_to_the_design_and_the_odd_ones_named() {
         "is an input of this command",
     );
 }
+
+/// `calibrate --bag` reads the bag directly: the same fit as `extract
+/// --out` then `calibrate --measurements` of the CSV it wrote (the CSV
+/// holds every digit), and the extraction's report beside it.
+#[test]
+fn calibrate_from_a_bag_is_the_fit_of_the_extracted_csv() {
+    let d = scratch_dir("bags", "calibrate");
+    let csv = d.join("m.csv");
+    let c = csv.to_str().unwrap();
+    json_of(&[
+        "extract",
+        "fixtures/bags/tiny.mcap",
+        "--robot",
+        UR5,
+        "--points",
+        "/tracker",
+        "--out",
+        c,
+        "--force",
+        "--json",
+    ]);
+    let fit = |extra: &[&str]| {
+        let mut args = vec!["calibrate", "--robot", UR5, "--json"];
+        args.extend(extra);
+        let out = run(&args);
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(!err.contains("panicked"), "{err}");
+        let v: serde_json::Value =
+            serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{args:?}: {e}: {err}"));
+        (out.status.code(), v)
+    };
+    let (s_csv, v_csv) = fit(&["--measurements", c]);
+    let (s_bag, v_bag) = fit(&["--bag", "fixtures/bags/tiny.mcap", "--points", "/tracker"]);
+    assert_eq!(s_csv, s_bag);
+    let (p_csv, p_bag) = (
+        v_csv["parameters"].as_array().unwrap(),
+        v_bag["parameters"].as_array().unwrap(),
+    );
+    assert_eq!(p_csv.len(), p_bag.len());
+    assert!(!p_bag.is_empty());
+    for (a, b) in p_csv.iter().zip(p_bag) {
+        assert_eq!(a["name"], b["name"]);
+        let (x, y) = (
+            a["estimate"].as_f64().unwrap(),
+            b["estimate"].as_f64().unwrap(),
+        );
+        assert!((x - y).abs() <= 1e-9 * (1.0 + x.abs()), "{a} vs {b}");
+    }
+    let rests = v_bag["bag"]["extraction"]["rests"].as_array().unwrap();
+    assert_eq!(rests.len(), 3, "{}", v_bag["bag"]);
+    assert_eq!(v_bag["poses"], v_csv["poses"]);
+}
+
+/// A bag's options are refused without `--bag`, and a file's with it,
+/// naming the option; `--joints` is a bag's topic or the images' file.
+#[test]
+fn a_bags_options_need_a_bag_and_a_files_need_a_file() {
+    let base = ["calibrate", "--robot", UR5];
+    let with = |extra: &[&'static str]| -> Vec<&'static str> {
+        base.iter().chain(extra).copied().collect()
+    };
+    let bag = ["--bag", "fixtures/bags/tiny.mcap", "--points", "/tracker"];
+    for (extra, needle) in [
+        (
+            &["--measurements", "m.csv", "--rest-speed", "0.01"][..],
+            "--bag",
+        ),
+        (
+            &["--measurements", "m.csv", "--time-offset", "0.1"],
+            "--bag",
+        ),
+        (&["--design", "d.json", "--points", "/tracker"], "--bag"),
+    ] {
+        fails_with(&with(extra), needle);
+    }
+    let mut args = with(&bag);
+    args.extend(["--angle-unit", "deg"]);
+    fails_with(
+        &args,
+        "--angle-unit: not used with --bag --points (a tracker's points from a ROS 2 bag)",
+    );
+    let mut args = with(&bag);
+    args.extend(["--orientation-noise", "0.001"]);
+    fails_with(&args, "--orientation-noise: not used with --bag --points");
+    let mut args = with(&bag);
+    args.extend(["--joints", "/no_such_topic"]);
+    fails_with(&args, "/no_such_topic");
+    fails_with(
+        &with(&["--bag", "fixtures/bags/tiny.mcap"]),
+        "give the bag's measurement: --points TOPIC, --poses TOPIC or --tf PARENT:CHILD",
+    );
+}

@@ -39,6 +39,7 @@ __all__ = [
     "calibrate_camera",
     "calibrate_contacts",
     "evaluate",
+    "extract",
     "gap",
     "pool",
     "select",
@@ -755,3 +756,36 @@ def select_camera(
     any of self_collision (srdf), floor or obstacles (``"box:…"`` in the
     base frame, or the tree's root with camera_link), which also remove
     the colliding samples (``report["collision_removed"]``)."""
+
+def extract(
+    bag: _Path,
+    robot: Robot,
+    *,
+    joints: str = "/joint_states",
+    points: Optional[str] = None,
+    poses: Optional[str] = None,
+    tf: Optional[str] = None,
+    time_offset: Optional[float] = None,
+    max_offset: float = 10.0,
+    rest_speed: float = 0.005,
+    rest_min: float = 0.5,
+    settle: float = 0.2,
+    design: Optional[_Path] = None,
+    design_tolerance: float = 0.01,
+    progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
+) -> Any:
+    """Reads a ROS 2 bag (a rosbag2 folder, or one ``.mcap`` or ``.db3``
+    file) as ``activecal extract BAG --out FILE`` does: one row per rest of
+    the joints of ``joints`` (every joint slower than ``rest_speed`` rad/s
+    for ``rest_min`` s or longer), its joint values and measurement averaged
+    after ``settle`` s. The measurement is one of ``points`` (a
+    ``PointStamped`` topic), ``poses`` (``PoseStamped`` or
+    ``TransformStamped``) or ``tf`` (``"PARENT:CHILD"`` of ``/tf``).
+    ``time_offset``: the clock offset (s, the measurement's stamp minus the
+    joints'), estimated from the moves within ``±max_offset`` s when None.
+    ``design``: the design file the run followed (each rest matched to its
+    pose within ``design_tolerance`` rad or m). Returns a pandas DataFrame
+    with the CSV's columns (the joints, ``x1, y1, z1``, for poses ``qw1,
+    qx1, qy1, qz1``; radians, metres), the extraction's report (rests and
+    the reasons some were left out, the clock offset, the scatter) in
+    ``attrs["report"]``."""

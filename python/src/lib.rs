@@ -6,6 +6,7 @@
 
 use pyo3::prelude::*;
 
+mod bag;
 mod bound;
 mod calibrate;
 mod camera;
@@ -43,5 +44,6 @@ fn _activecal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(camera_select::select_camera, m)?)?;
     m.add_class::<contacts::ContactCalibration>()?;
     m.add_function(wrap_pyfunction!(contacts::calibrate_contacts, m)?)?;
+    m.add_function(wrap_pyfunction!(bag::extract, m)?)?;
     Ok(())
 }

@@ -170,3 +170,32 @@ def test_every_keyword_of_the_report_folder_acts(tmp_path):
     assert "recommended, the fewest predicted to reach" in b and a != b
     assert keywords(activecal.Calibration.show) == ["self"]
     assert keywords(activecal.Calibration.write_report) == ["self", "path", "overwrite"]
+
+
+# activecal.extract's keywords and the flags of `activecal extract` they are
+# (a bag's options, the same on `calibrate --bag`).
+EXTRACT = {
+    "joints": "--joints",
+    "points": "--points",
+    "poses": "--poses",
+    "tf": "--tf",
+    "time_offset": "--time-offset",
+    "max_offset": "--max-offset",
+    "rest_speed": "--rest-speed",
+    "rest_min": "--rest-min",
+    "settle": "--settle",
+    "design": "--design",
+    "design_tolerance": "--design-tolerance",
+}
+
+
+def test_every_keyword_of_extract_is_a_flag_of_the_command_line():
+    import subprocess
+
+    from conftest import cli_path
+
+    given = inspect.signature(activecal.extract).parameters
+    assert sorted(p for p in given if p not in {"bag", "robot", "progress"}) == sorted(EXTRACT)
+    help_text = subprocess.run([str(cli_path()), "extract", "--help"], capture_output=True, text=True).stdout
+    for flag in EXTRACT.values():
+        assert flag + " " in help_text, flag

@@ -33,6 +33,8 @@ impl SensorText for Sensor {
             Sensor::Pool => "a pose pool",
             Sensor::Sockets => "--point",
             Sensor::Camera => "--camera-info",
+            Sensor::BagPoints => "--bag --points",
+            Sensor::BagPoses => "--bag --poses or --tf",
         }
     }
 
@@ -47,6 +49,8 @@ impl SensorText for Sensor {
             Sensor::Pool => "a pool of poses (select without --point or --camera-info)",
             Sensor::Sockets => "--point (configurations touching sockets)",
             Sensor::Camera => "--camera-info (poses chosen for a camera)",
+            Sensor::BagPoints => "--bag --points (a tracker's points from a ROS 2 bag)",
+            Sensor::BagPoses => "--bag --poses or --tf (full poses from a ROS 2 bag)",
         }
     }
 }
@@ -103,7 +107,7 @@ const CALIBRATE_WHY: &[(&str, &str)] = &[
     ),
     (
         "markers",
-        "a camera sees the points of its --target, not markers",
+        "a camera sees the points of its --target, not markers; a bag's --points topic is one point",
     ),
     (
         "noise",
@@ -146,14 +150,28 @@ const CALIBRATE_WHY: &[(&str, &str)] = &[
     ),
     (
         "joints",
-        "--observations carry their joint values; --joints gives the images'",
+        "--observations carry their joint values; --joints gives the images' (a file) or a bag's joint topic",
     ),
     (
         "save_observations",
         "it writes the pixels detected in --images",
     ),
-    ("angle_unit", "no file of joint values is read"),
-    ("length_unit", "no file of joint values is read"),
+    (
+        "angle_unit",
+        "no file of joint values is read (a bag's are in radians)",
+    ),
+    (
+        "length_unit",
+        "no file of joint values is read (a bag's are in metres)",
+    ),
+    (
+        "bag_design",
+        "it matches a bag's rests to the design the run followed",
+    ),
+    (
+        "design_tolerance",
+        "it matches a bag's rests to the design the run followed",
+    ),
 ];
 
 /// The options of `calibrate` (and the global ones): the sensors each acts on

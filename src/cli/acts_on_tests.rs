@@ -48,6 +48,16 @@ fn bases(contacts: &str) -> Vec<(&'static str, Sensor, Vec<String>)> {
             ]),
         ),
         (
+            "calibrate",
+            Sensor::BagPoints,
+            v(&["--bag", "b.mcap", "--points", "/tracker"]),
+        ),
+        (
+            "calibrate",
+            Sensor::BagPoses,
+            v(&["--bag", "b.mcap", "--poses", "/mocap"]),
+        ),
+        (
             "evaluate",
             Sensor::Points,
             v(&["--robot", "puma560", "--measurements", "m.csv"]),
@@ -99,7 +109,19 @@ fn sample(command: &str, id: &str) -> Option<(&'static [&'static str], &'static 
         ("calibrate", "design") => (&[], "d.json"),
         ("calibrate", "measurements" | "observations") => (&[], "m.csv"),
         ("calibrate", "images") => (&["--joints", "j.csv"], "shots"),
-        ("calibrate", "joints") => (&["--images", "shots"], "j.csv"),
+        // --images needs --joints, --bag not: given alone, it is refused
+        // by clap for the sensors other than these two.
+        ("calibrate", "joints") => (&[], "j.csv"),
+        ("calibrate", "bag") => (&["--points", "/tracker"], "b.mcap"),
+        ("calibrate", "points" | "poses") => (&["--bag", "b.mcap"], "/t"),
+        ("calibrate", "tf") => (&["--bag", "b.mcap"], "world:marker"),
+        ("calibrate", "time_offset" | "max_offset" | "rest_speed" | "rest_min" | "settle") => {
+            (&["--bag", "b.mcap"], "0.1")
+        }
+        ("calibrate", "bag_design") => (&["--bag", "b.mcap"], "d.csv"),
+        ("calibrate", "design_tolerance") => {
+            (&["--bag", "b.mcap", "--bag-design", "d.csv"], "0.02")
+        }
         ("calibrate", "save_observations") => (&[], "s.csv"),
         ("calibrate", "save_measurements") => (&[], "s.json"),
         ("calibrate", "trials" | "validation" | "max_iterations") => (&[], "3"),
@@ -181,6 +203,23 @@ fn argv_of(command: &str, arg: &clap::Arg) -> Vec<String> {
     argv
 }
 
+/// `extra` without the options (and their values) `base` gives already
+/// (an option's needs that the base line holds).
+fn without_given(base: &[String], extra: Vec<String>) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut it = extra.into_iter().peekable();
+    while let Some(w) = it.next() {
+        if w.starts_with("--") && base.contains(&w) {
+            if it.peek().is_some_and(|v| !v.starts_with("--")) {
+                it.next();
+            }
+            continue;
+        }
+        out.push(w);
+    }
+    out
+}
+
 fn table(command: &str) -> &'static Table {
     match command {
         "calibrate" => CALIBRATE,
@@ -258,10 +297,14 @@ fn every_option_acts_on_a_sensor_or_is_refused_naming_it() {
             // The option that gives the sensor; on a pool's line, one that
             // gives another (the line is then that sensor's).
             let defines = matches!(arg.get_id().as_str(), "points" | "camera_info");
-            if base.contains(&long) || (defines && sensor == Sensor::Pool) {
+            // A bag's measurement options give its sensor (their conflicts
+            // are clap's).
+            let bag_defines = matches!(arg.get_id().as_str(), "points" | "poses" | "tf")
+                && matches!(sensor, Sensor::BagPoints | Sensor::BagPoses);
+            if base.contains(&long) || (defines && sensor == Sensor::Pool) || bag_defines {
                 continue;
             }
-            let extra = argv_of(command, &arg);
+            let extra = without_given(&base, argv_of(command, &arg));
             let rule = table(command)
                 .iter()
                 .find(|r| r.id == arg.get_id().as_str())

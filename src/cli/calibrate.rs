@@ -1,5 +1,6 @@
 //! `calibrate`: the choice between simulated (`--design`, rendered in
-//! `simulated.rs`), measured (`--measurements`, here), contact
+//! `simulated.rs`), measured (`--measurements` or a ROS 2 bag's `--bag`,
+//! here; the bag's pipeline is the library's `experiment::bag`), contact
 //! (`contact.rs`) and camera (`--observations`, `camera.rs`) calibration. Its arguments are in `calibrate_args.rs`,
 //! what the three share on the way out (the calibrated robot, exit
 //! statuses) in `calibrated.rs`.
@@ -11,13 +12,17 @@ use activecal::experiment::measured::full_model::FullModelGain;
 use activecal::identify::LmSettings;
 use activecal::io::calibrated::Format;
 use activecal::model::Robot;
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use std::path::Path;
 use std::time::Instant;
 
 /// Runs `calibrate`.
 pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
-    if let (Some(seed), Some(_), None) = (a.seed, &a.measurements, a.holdout) {
+    if let (Some(seed), true, None) = (
+        a.seed,
+        a.measurements.is_some() || a.bag.is_some(),
+        a.holdout,
+    ) {
         bail!(
             "--seed {seed}: with --measurements the seed only draws the --holdout splits, and --holdout is not given (the fit of measured data has no randomness)"
         );
@@ -28,7 +33,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
             a.noise()
         );
     }
-    if let (Some(n), Some(_)) = (a.noise, &a.measurements)
+    if let (Some(n), true) = (a.noise, a.measurements.is_some() || a.bag.is_some())
         && !(n > 0.0)
     {
         bail!(
@@ -80,8 +85,11 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
             }
         }
         (_, Some(m)) => from_measurements(&a, robot, m),
+        (_, None) if a.bag.is_some() => from_bag(&a, robot),
         (Some(d), None) => super::simulated::from_design(&a, robot, desc.visibility.as_ref(), d),
-        (None, None) => bail!("give --design (simulate) or --measurements (real data)"),
+        (None, None) => {
+            bail!("give --design (simulate), --measurements or --bag (real data)")
+        }
     }
 }
 
@@ -97,6 +105,8 @@ fn calibrate_files(a: &CalibrateArgs) -> super::run_files::RunFiles {
     f.robot(&a.robot)
         .input("--design", a.design.as_deref())
         .input("--measurements", a.measurements.as_deref())
+        .input("--bag", a.bag.as_deref())
+        .input("--bag-design", a.bag_design.as_deref())
         .input("--observations", a.observations.as_deref())
         .inputs("--images", &image_inputs(a))
         .input("--joints", a.joints.as_deref())
@@ -150,21 +160,121 @@ fn gain_text(g: &FullModelGain, held_out: Option<f64>) -> String {
     s
 }
 
-/// Identification from a measurement file.
-fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()> {
-    let t0 = Instant::now();
-    let mut scaled;
-    let robot = match a.orientation_scale {
+/// `robot` with `--orientation-scale` applied.
+fn scaled_robot(a: &CalibrateArgs, robot: &Robot) -> Result<Robot> {
+    let mut scaled = robot.clone();
+    match a.orientation_scale {
         Some(w) if !(w.is_finite() && w > 0.0) => {
             bail!("--orientation-scale {w}: must be a finite number > 0 (metres per radian)")
         }
-        Some(w) => {
-            scaled = robot.clone();
-            scaled.orientation_scale = w;
-            &scaled
+        Some(w) => scaled.orientation_scale = w,
+        None => {}
+    }
+    Ok(scaled)
+}
+
+/// Identification from a measurement file.
+fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()> {
+    let t0 = Instant::now();
+    let robot = &scaled_robot(a, robot)?;
+    let o = measured_settings(a, robot)?;
+    let mut print_note = |n: &str| {
+        if !a.json {
+            super::diag(&format!("note: {n}"));
         }
-        None => robot,
     };
+    let (meas, read_notes) =
+        activecal::experiment::measured::read_measurement_file(path, robot, o.units)?;
+    // Points and full poses told apart: the options of the other refused.
+    let sensor = if meas.orientations().is_empty() {
+        super::acts_on::Sensor::Points
+    } else {
+        super::acts_on::Sensor::Poses
+    };
+    super::acts_on::check(super::acts_on::CALIBRATE, &a.given, &[sensor])?;
+    let c = activecal::experiment::measured::calibrate_read(
+        robot,
+        &meas,
+        &path.display().to_string(),
+        read_notes,
+        &o,
+        &mut print_note,
+    )?;
+    let source = Source {
+        name: path.display().to_string(),
+        described: format!("measurements `{}`", path.display()),
+        json: None,
+        text: String::new(),
+    };
+    render_measured(a, robot, &meas, c, &o, &source, t0)
+}
+
+/// The joint topic when `--joints` is not given.
+const DEFAULT_JOINTS: &str = "/joint_states";
+
+/// Calibrates `robot` from `--bag`.
+fn from_bag(a: &CalibrateArgs, robot: &Robot) -> Result<()> {
+    let t0 = Instant::now();
+    let bag = a.bag.as_deref().context("--bag: not given")?;
+    let robot = &scaled_robot(a, robot)?;
+    let o = measured_settings(a, robot)?;
+    let joints = a
+        .joints
+        .as_deref()
+        .map_or(DEFAULT_JOINTS.into(), |j| j.to_string_lossy());
+    let mut x = a.from_bag.settings(&joints, a.design_tolerance)?;
+    if let Some(d) = &a.bag_design {
+        x.design = Some(activecal::io::bag::design::read_design(d, robot)?);
+    }
+    let mut print_note = |n: &str| {
+        if !a.json {
+            super::diag(&format!("note: {n}"));
+        }
+    };
+    let got = activecal::experiment::bag::calibrate_bag(bag, robot, &x, &o, &mut print_note)?;
+    let mut json = serde_json::json!({ "extraction": got.extraction });
+    if let Some(c) = &got.clock {
+        json["clock_refit"] = serde_json::to_value(c)?;
+    }
+    let mut text = super::extract::text(&got.extraction, None);
+    if let Some(c) = &got.clock {
+        text += &format!("{}\n", activecal::experiment::bag::clock_note(c));
+    }
+    text += "\n";
+    let source = Source {
+        name: bag.display().to_string(),
+        described: format!("ROS 2 bag `{}`", bag.display()),
+        json: Some(("bag", json)),
+        text,
+    };
+    render_measured(
+        a,
+        robot,
+        &got.measurements,
+        got.calibration,
+        &o,
+        &source,
+        t0,
+    )
+}
+
+/// Where the measurements of a fit came from, as the output shows it.
+struct Source {
+    /// Its name in the calibrated files' header (a path).
+    name: String,
+    /// In the report folder's summary.
+    described: String,
+    /// A JSON object added to the output (`key`, value).
+    json: Option<(&'static str, serde_json::Value)>,
+    /// Text printed before the fit's.
+    text: String,
+}
+
+/// The settings of a fit of measured data from the options.
+fn measured_settings(
+    a: &CalibrateArgs,
+    robot: &Robot,
+) -> Result<activecal::experiment::measured::MeasuredSettings> {
     let lm = LmSettings::builder()
         .max_iterations(a.max_iterations)
         .geodesic(!a.no_geodesic)
@@ -206,34 +316,29 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         fit_compliance: a.compliance,
         compare_compliance: a.compare_compliance,
     };
-    let mut print_note = |n: &str| {
-        if !a.json {
-            super::diag(&format!("note: {n}"));
-        }
-    };
-    let (meas, read_notes) =
-        activecal::experiment::measured::read_measurement_file(path, robot, o.units)?;
-    // Points and full poses told apart: the options of the other refused.
-    let sensor = if meas.orientations().is_empty() {
-        super::acts_on::Sensor::Points
-    } else {
-        super::acts_on::Sensor::Poses
-    };
-    super::acts_on::check(super::acts_on::CALIBRATE, &a.given, &[sensor])?;
+    Ok(o)
+}
+
+/// Writes and prints a fit of measured data (`c`, of `meas` from `source`
+/// with the settings `o`), started at `t0`: the calibrated robot when the
+/// library's verdict allows, the report folder, the text or JSON, and the
+/// exit status.
+fn render_measured(
+    a: &CalibrateArgs,
+    robot: &Robot,
+    meas: &activecal::identify::Measurements,
+    c: activecal::experiment::measured::MeasuredCalibration,
+    o: &activecal::experiment::measured::MeasuredSettings,
+    source: &Source,
+    t0: Instant,
+) -> Result<()> {
     let activecal::experiment::measured::MeasuredCalibration {
         robot: fitted,
         fit: f,
         frames,
         mut report,
         verdict,
-    } = activecal::experiment::measured::calibrate_read(
-        robot,
-        &meas,
-        &path.display().to_string(),
-        read_notes,
-        &o,
-        &mut print_note,
-    )?;
+    } = c;
     report.base.elapsed_seconds = t0.elapsed().as_secs_f64();
     for w in &report.warnings {
         super::diag(&format!("warning: {w}"));
@@ -242,14 +347,13 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     // The library's verdict: a fit that did not converge, or converged to
     // another robot, is not written.
     if verdict.refusal().is_none() {
-        report.base.out =
-            write_calibrated(a, &fitted, id, &path.display().to_string(), frames.as_ref())?;
+        report.base.out = write_calibrated(a, &fitted, id, &source.name, frames.as_ref())?;
     }
     let gain = activecal::experiment::measured::full_model::beside_full_model(
         robot,
-        &meas,
-        &path.display().to_string(),
-        &o,
+        meas,
+        &source.name,
+        o,
         &a.fix,
         a.restriction(),
         (&fitted, &id.table),
@@ -259,19 +363,19 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     if let Some(g) = &gain {
         v["full_model_gain"] = serde_json::to_value(g)?;
     }
+    if let Some((key, value)) = &source.json {
+        v[*key] = value.clone();
+    }
     if let Some(dir) = &a.report {
-        let source = format!(
-            "measurements `{}`, {} poses",
-            path.display(),
-            report.base.poses
-        );
+        let described = format!("{}, {} poses", source.described, report.base.poses);
         let s = activecal::experiment::measured::summary::measured(
-            &fitted, id, source, &report, &v, &meas,
+            &fitted, id, described, &report, &v, meas,
         );
         activecal::render::folder::calibration(dir, &s)?;
     }
     super::emit(a.json, &v, || {
-        let mut s = super::measured::measured_text(&report, id, &status_text(id));
+        let mut s = source.text.clone();
+        s += &super::measured::measured_text(&report, id, &status_text(id));
         if let Some(g) = &gain {
             let held_out = report.holdout.as_ref().map(|h| h.position_rms_mm.mean);
             s += &gain_text(g, held_out);

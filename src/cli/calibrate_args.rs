@@ -7,9 +7,12 @@ use std::path::PathBuf;
 /// Arguments of the command. The options of measured data conflict with
 /// `--design` (clap's `requires = "measurements"` is not checked when an
 /// argument that conflicts with `--measurements`, such as `--design`, is
-/// given: they were silently ignored).
+/// given: they were silently ignored); those of measured data from a file
+/// or a bag are refused with other data by the acts-on tables
+/// (`acts_on.rs`), naming the data given.
 #[derive(Args)]
 #[command(group(clap::ArgGroup::new("camera_data").args(["observations", "images"])))]
+#[command(group(clap::ArgGroup::new("with_joints").args(["images", "bag"])))]
 pub struct CalibrateArgs {
     /// Robot: a built-in name, or a .toml description or .urdf file; append
     /// `:pose` for full-pose measurements.
@@ -17,7 +20,7 @@ pub struct CalibrateArgs {
     pub robot: activecal::io::RobotRef,
     /// Design file (JSON with robot, levels, poses), as written by `select`:
     /// measurements are simulated there.
-    #[arg(long, required_unless_present_any = ["measurements", "observations", "images"])]
+    #[arg(long, required_unless_present_any = ["measurements", "observations", "images", "bag"])]
     pub design: Option<PathBuf>,
     /// Measurement file: identify from these real measurements instead of
     /// simulating a design. CSV (`x1,y1,z1`, `x2,y2,z2`… for several
@@ -112,14 +115,14 @@ pub struct CalibrateArgs {
     /// the measurement frame and the tool; every link length and twist
     /// held at the model's value: what a driver's joint offsets and the
     /// frames file can hold).
-    #[arg(long, value_enum, requires = "measurements")]
+    #[arg(long, value_enum)]
     pub unknowns: Option<UnknownsKind>,
     /// Keep closed-form inverse kinematics working on the calibrated model
     /// (with --measurements): hold the parameters that would change the
     /// nominal model's parallel, perpendicular or intersecting joint axes
     /// (listed in the report), fit the rest, and report the full model's
     /// fit of the same data beside it.
-    #[arg(long, requires = "measurements", conflicts_with = "unknowns")]
+    #[arg(long, conflicts_with = "unknowns")]
     pub keep_axis_relations: bool,
     /// The unit of the joint offsets written to `--out *joint_offsets.yaml`
     /// (revolute joints; prismatic ones are in metres).
@@ -155,21 +158,11 @@ pub struct CalibrateArgs {
     /// components; the σ's are printed with their degrees of freedom);
     /// `fixed` keeps the robot's orientation scale (1 m per rad unless
     /// --orientation-scale).
-    #[arg(
-        long,
-        value_enum,
-        default_value = "estimated",
-        requires = "measurements"
-    )]
+    #[arg(long, value_enum, default_value = "estimated")]
     pub weights: WeightsKind,
     /// Metres of position error a radian of orientation error counts as
     /// (a full-pose fit's fixed weight); implies --weights fixed.
-    #[arg(
-        long,
-        value_name = "M_PER_RAD",
-        requires = "measurements",
-        conflicts_with = "weights"
-    )]
+    #[arg(long, value_name = "M_PER_RAD", conflicts_with = "weights")]
     pub orientation_scale: Option<f64>,
     /// A distance known between two contact points (a file with a `point`
     /// column): `A,B=METRES`, repeatable.
@@ -246,9 +239,41 @@ pub struct CalibrateArgs {
     )]
     pub images: Option<PathBuf>,
     /// With --images: the joint values of each image, a CSV `image,<joints
-    /// as in the URDF>` with one row per image (its file name).
-    #[arg(long, value_name = "FILE", requires = "images")]
+    /// as in the URDF>` with one row per image (its file name). With
+    /// --bag: the bag's sensor_msgs/msg/JointState topic (default
+    /// /joint_states).
+    #[arg(long, value_name = "FILE|TOPIC", requires = "with_joints")]
     pub joints: Option<PathBuf>,
+    /// Calibrate from a ROS 2 bag (a rosbag2 folder, or one .mcap or .db3
+    /// file): the joints of --joints' topic, the measurement of --points,
+    /// --poses or --tf, one pose per rest period (as `extract` finds and
+    /// averages them), the clock offset estimated from the moves unless
+    /// --time-offset gives it, and estimated again with the calibrated
+    /// model (the fit repeated once when it moved by more than its
+    /// uncertainty).
+    #[arg(
+        long,
+        value_name = "BAG",
+        conflicts_with_all = ["design", "measurements", "observations", "images", "trials", "save_measurements", "validation"],
+    )]
+    pub bag: Option<PathBuf>,
+    /// What to read from --bag and how.
+    #[command(flatten)]
+    pub from_bag: super::extract::BagOpts,
+    /// With --bag: the design the run followed (`select --out`'s file):
+    /// each rest is matched to the pose it reached, a rest that reached
+    /// none is left out, a pose no rest gives is named.
+    #[arg(long, value_name = "FILE", requires = "bag")]
+    pub bag_design: Option<PathBuf>,
+    /// With --bag-design: a rest reached a design pose when no joint is
+    /// further from it than this (rad, m for prismatic joints).
+    #[arg(
+        long,
+        value_name = "RAD",
+        default_value_t = 0.01,
+        requires = "bag_design"
+    )]
+    pub design_tolerance: f64,
     /// With --images: write the pixels detected as an observations CSV
     /// (what --observations reads; joint values in radians and metres), to
     /// inspect or edit them. An existing file only with --force.

@@ -19,9 +19,21 @@ pub struct ExtractArgs {
     /// nominal model predicts the moves for the clock offset.
     #[arg(long, value_parser = super::parse_robot)]
     pub robot: activecal::io::RobotRef,
+    /// The bag's sensor_msgs/msg/JointState topic.
+    #[arg(long, value_name = "TOPIC", default_value = "/joint_states")]
+    pub joints: String,
     /// What to read from the bag and how.
     #[command(flatten)]
     pub from: BagOpts,
+    /// The design the run followed (`select --out`'s .json, .yaml or .csv):
+    /// each rest is matched to the pose it reached, a rest that reached
+    /// none is left out, a pose no rest gives is named.
+    #[arg(long, value_name = "FILE")]
+    pub design: Option<PathBuf>,
+    /// A rest reached a design pose when no joint is further from it than
+    /// this (rad, m for prismatic joints).
+    #[arg(long, value_name = "RAD", default_value_t = 0.01, requires = "design")]
+    pub design_tolerance: f64,
     /// The measurement CSV to write (what `calibrate --measurements` reads).
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
@@ -34,48 +46,37 @@ pub struct ExtractArgs {
 }
 
 /// What to read from a bag and how: the options `extract` and `calibrate
-/// --bag` share.
+/// --bag` share (each command names the joint topic and the design its
+/// own way: `calibrate --design` is the simulation's).
 #[derive(Args, Debug, Clone)]
 pub struct BagOpts {
-    /// A bag's sensor_msgs/msg/JointState topic.
-    #[arg(long, value_name = "TOPIC", default_value = "/joint_states")]
-    pub joints: String,
     /// A bag's geometry_msgs/msg/PointStamped topic: a tracker's point.
-    #[arg(long, value_name = "TOPIC", conflicts_with_all = ["poses", "tf"])]
+    #[arg(long, value_name = "TOPIC", conflicts_with_all = ["poses", "tf"], requires = "bag")]
     pub points: Option<String>,
     /// A bag's geometry_msgs/msg/PoseStamped or TransformStamped topic: a
     /// motion-capture body's pose.
-    #[arg(long, value_name = "TOPIC", conflicts_with = "tf")]
+    #[arg(long, value_name = "TOPIC", conflicts_with = "tf", requires = "bag")]
     pub poses: Option<String>,
     /// The transform PARENT → CHILD of a bag's /tf and /tf_static (static
     /// transforms composed with one moving transform).
-    #[arg(long, value_name = "PARENT:CHILD")]
+    #[arg(long, value_name = "PARENT:CHILD", requires = "bag")]
     pub tf: Option<String>,
     /// The clock offset, seconds: the measurement's stamp minus the joint
     /// stamp of the same instant. Estimated from the moves when not given.
-    #[arg(long, value_name = "S", allow_hyphen_values = true)]
+    #[arg(long, value_name = "S", allow_hyphen_values = true, requires = "bag")]
     pub time_offset: Option<f64>,
     /// The largest clock offset searched for, seconds.
-    #[arg(long, value_name = "S", default_value_t = 10.0)]
+    #[arg(long, value_name = "S", default_value_t = 10.0, requires = "bag")]
     pub max_offset: f64,
     /// A joint is at rest under this speed (rad/s, m/s for prismatic).
-    #[arg(long, value_name = "SPEED", default_value_t = 0.005)]
+    #[arg(long, value_name = "SPEED", default_value_t = 0.005, requires = "bag")]
     pub rest_speed: f64,
     /// The shortest rest period, seconds.
-    #[arg(long, value_name = "S", default_value_t = 0.5)]
+    #[arg(long, value_name = "S", default_value_t = 0.5, requires = "bag")]
     pub rest_min: f64,
     /// Seconds left out at the start of each rest while the arm settles.
-    #[arg(long, value_name = "S", default_value_t = 0.2)]
+    #[arg(long, value_name = "S", default_value_t = 0.2, requires = "bag")]
     pub settle: f64,
-    /// The design the run followed (`select --out`'s .json, .yaml or .csv):
-    /// each rest is matched to the pose it reached, a rest that reached
-    /// none is left out, a pose no rest gives is named.
-    #[arg(long, value_name = "FILE")]
-    pub design: Option<PathBuf>,
-    /// A rest reached a design pose when no joint is further from it than
-    /// this (rad, m for prismatic joints).
-    #[arg(long, value_name = "RAD", default_value_t = 0.01, requires = "design")]
-    pub design_tolerance: f64,
 }
 
 impl BagOpts {
@@ -101,9 +102,17 @@ impl BagOpts {
         })
     }
 
-    /// The library's settings from the flags.
-    pub fn settings(&self) -> Result<ExtractSettings> {
-        let mut s = ExtractSettings::new(&self.joints, self.source()?);
+    /// Whether the measurement is a full pose (`--poses`, `--tf`) rather
+    /// than a point (`--points`).
+    #[must_use]
+    pub fn gives_poses(&self) -> bool {
+        self.points.is_none()
+    }
+
+    /// The library's settings from the flags, with the joint topic and
+    /// the design's tolerance (rad, m) as the command gives them.
+    pub fn settings(&self, joints: &str, design_tolerance: f64) -> Result<ExtractSettings> {
+        let mut s = ExtractSettings::new(joints, self.source()?);
         s.rest.speed = self.rest_speed;
         s.rest.min_duration = self.rest_min;
         s.rest.settle = self.settle;
@@ -112,13 +121,10 @@ impl BagOpts {
             bail!("--max-offset {}: give seconds, 0 or more", self.max_offset);
         }
         s.max_offset = self.max_offset;
-        if !(self.design_tolerance.is_finite() && self.design_tolerance > 0.0) {
-            bail!(
-                "--design-tolerance {}: give a positive number (rad, m)",
-                self.design_tolerance
-            );
+        if !(design_tolerance.is_finite() && design_tolerance > 0.0) {
+            bail!("--design-tolerance {design_tolerance}: give a positive number (rad, m)");
         }
-        s.design_tolerance = self.design_tolerance;
+        s.design_tolerance = design_tolerance;
         if let Some(o) = s.time_offset
             && !o.is_finite()
         {
@@ -131,10 +137,10 @@ impl BagOpts {
 /// Runs `extract`.
 pub fn cmd_extract(a: ExtractArgs) -> Result<()> {
     use activecal::io::atomic::{Output, check_outputs, write_atomic};
-    let mut settings = a.from.settings()?;
+    let mut settings = a.from.settings(&a.joints, a.design_tolerance)?;
     if let Some(out) = &a.out {
         let mut inputs = vec![a.bag.as_path()];
-        inputs.extend(a.from.design.as_deref());
+        inputs.extend(a.design.as_deref());
         check_outputs(
             &[Output {
                 label: "--out",
@@ -152,7 +158,7 @@ pub fn cmd_extract(a: ExtractArgs) -> Result<()> {
         }
     }
     let robot = super::load_robot(&a.robot)?;
-    if let Some(d) = &a.from.design {
+    if let Some(d) = &a.design {
         settings.design = Some(activecal::io::bag::design::read_design(d, &robot)?);
     }
     let got = extract(&a.bag, &robot, &settings)?;

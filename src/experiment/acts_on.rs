@@ -25,6 +25,12 @@ pub enum Sensor {
     /// Calibration from a camera's images (its pixels detected by
     /// activecal).
     Images,
+    /// Calibration from points read from a ROS 2 bag (a tracker's
+    /// topic): measured points whose source is a bag, not a file.
+    BagPoints,
+    /// Calibration from full poses read from a ROS 2 bag (a
+    /// motion-capture topic or a transform of /tf).
+    BagPoses,
     /// Selection from a pool of poses (points, markers or full poses).
     Pool,
     /// Selection of configurations touching sockets.
@@ -44,6 +50,8 @@ impl Sensor {
             Sensor::Contacts => "contacts",
             Sensor::Pixels => "a camera's pixels",
             Sensor::Images => "a camera's images",
+            Sensor::BagPoints => "points read from a ROS 2 bag",
+            Sensor::BagPoses => "full poses read from a ROS 2 bag",
             Sensor::Pool => "a pool of poses",
             Sensor::Sockets => "configurations touching sockets",
             Sensor::Camera => "poses chosen for a camera",
@@ -60,19 +68,34 @@ pub struct ActsOn {
     pub sensors: &'static [Sensor],
 }
 
-use Sensor::{Camera, Contacts, Images, Pixels, Points, Pool, Poses, Simulated, Sockets};
+use Sensor::{
+    BagPoints, BagPoses, Camera, Contacts, Images, Pixels, Points, Pool, Poses, Simulated, Sockets,
+};
 
 const fn a(id: &'static str, sensors: &'static [Sensor]) -> ActsOn {
     ActsOn { id, sensors }
 }
 
-const CAL_ALL: &[Sensor] = &[Simulated, Points, Poses, Contacts, Pixels, Images];
+const CAL_ALL: &[Sensor] = &[
+    Simulated, Points, Poses, Contacts, Pixels, Images, BagPoints, BagPoses,
+];
 /// A camera's pixels, given or detected in its images.
 const CAMERA_DATA: &[Sensor] = &[Pixels, Images];
 /// Measured points or full poses: told apart once the data are read.
 pub const MEASURED: &[Sensor] = &[Points, Poses];
-const FITTED: &[Sensor] = &[Points, Poses, Contacts];
+/// Points or full poses read from a ROS 2 bag.
+pub const BAG: &[Sensor] = &[BagPoints, BagPoses];
+/// Points or full poses, from a file or a bag.
+const MEASURED_ANY: &[Sensor] = &[Points, Poses, BagPoints, BagPoses];
+/// Full poses, from a file or a bag.
+const POSES_ANY: &[Sensor] = &[Poses, BagPoses];
+/// Points or full poses (from a file or a bag) and simulated ones.
+const POINTS_FITS: &[Sensor] = &[Simulated, Points, Poses, BagPoints, BagPoses];
+const FITTED: &[Sensor] = &[Points, Poses, Contacts, BagPoints, BagPoses];
 const READ: &[Sensor] = &[Points, Poses, Contacts, Pixels, Images];
+/// Data read and fitted with a robust loss or screened for gross errors:
+/// files, images and bags.
+const FITTED_READ: &[Sensor] = &[Points, Poses, Contacts, Pixels, Images, BagPoints, BagPoses];
 const SEL_ALL: &[Sensor] = &[Pool, Sockets, Camera];
 const EVAL_ALL: &[Sensor] = &[Points, Poses, Contacts];
 
@@ -88,45 +111,50 @@ pub const CALIBRATE: &[ActsOn] = &[
     a("progress", CAL_ALL),
     a("robot", CAL_ALL),
     a("design", &[Simulated]),
-    a("measurements", FITTED),
+    a("measurements", &[Points, Poses, Contacts]),
     a("save_measurements", &[Simulated]),
     a("out", CAL_ALL),
     a("force", CAL_ALL),
-    a("noise", &[Simulated, Points, Poses]),
-    a("outliers", READ),
-    a("outlier_rate", READ),
-    a("orientation_noise", &[Poses]),
+    a("noise", POINTS_FITS),
+    a("outliers", FITTED_READ),
+    a("outlier_rate", FITTED_READ),
+    a("orientation_noise", POSES_ANY),
     a("pixel_noise", CAMERA_DATA),
-    a("seed", &[Simulated, Points, Poses]),
+    a("seed", POINTS_FITS),
     a("trials", &[Simulated]),
     a("validation", &[Simulated]),
     a("max_iterations", CAL_ALL),
     a("no_geodesic", CAL_ALL),
     a("loss", FITTED),
     a("loss_scale", FITTED),
-    a("fix", MEASURED),
-    a("unknowns", MEASURED),
-    a("keep_axis_relations", MEASURED),
-    a("offset_unit", &[Simulated, Points, Poses]),
-    a("offset_sign", &[Simulated, Points, Poses]),
+    a("fix", MEASURED_ANY),
+    a("unknowns", MEASURED_ANY),
+    a("keep_axis_relations", MEASURED_ANY),
+    a("offset_unit", POINTS_FITS),
+    a("offset_sign", POINTS_FITS),
     a("free", FITTED),
-    a("holdout", MEASURED),
-    a("splits", MEASURED),
-    a("compare_pruned", MEASURED),
-    a("weights", &[Poses]),
-    a("orientation_scale", &[Poses]),
+    a("holdout", MEASURED_ANY),
+    a("splits", MEASURED_ANY),
+    a("compare_pruned", MEASURED_ANY),
+    a("weights", POSES_ANY),
+    a("orientation_scale", POSES_ANY),
     a("point_distance", &[Contacts]),
     a("plane", &[Contacts]),
     a("holdout_by", &[Contacts]),
     a("train_on", &[Contacts]),
-    a("compliance", MEASURED),
-    a("compare_compliance", MEASURED),
-    a("inertia", MEASURED),
-    a("payload", MEASURED),
-    a("report", &[Simulated, Points, Poses, Contacts, Images]),
+    a("compliance", MEASURED_ANY),
+    a("compare_compliance", MEASURED_ANY),
+    a("inertia", MEASURED_ANY),
+    a("payload", MEASURED_ANY),
+    a(
+        "report",
+        &[
+            Simulated, Points, Poses, Contacts, Images, BagPoints, BagPoses,
+        ],
+    ),
     a("observations", &[Pixels]),
     a("images", &[Images]),
-    a("joints", &[Images]),
+    a("joints", &[Images, BagPoints, BagPoses]),
     a("save_observations", &[Images]),
     a("camera_info", CAMERA_DATA),
     a("target", CAMERA_DATA),
@@ -138,6 +166,17 @@ pub const CALIBRATE: &[ActsOn] = &[
     a("out_camera_info", CAMERA_DATA),
     a("angle_unit", READ),
     a("length_unit", READ),
+    a("bag", BAG),
+    a("points", &[BagPoints]),
+    a("poses", &[BagPoses]),
+    a("tf", &[BagPoses]),
+    a("time_offset", BAG),
+    a("max_offset", BAG),
+    a("rest_speed", BAG),
+    a("rest_min", BAG),
+    a("settle", BAG),
+    a("bag_design", BAG),
+    a("design_tolerance", BAG),
     a("json", CAL_ALL),
 ];
 

@@ -1,10 +1,15 @@
 //! Measurements from a ROS 2 bag ([`crate::io::bag::extract`]), checked as
-//! a measurement file's are: the calibration pipeline's other reader.
+//! a measurement file's are: the calibration pipeline's other reader; and
+//! the calibration from a bag ([`calibrate_bag`]), whose clock offset is
+//! estimated again with the calibrated model.
 
 use super::error::ExperimentError;
+use super::measured::{MeasuredCalibration, MeasuredSettings, calibrate_read};
 use crate::identify::Measurements;
+use crate::io::bag::clock::Offset;
 use crate::io::bag::extract::{ExtractReport, ExtractSettings, extract};
 use crate::model::Robot;
+use serde::Serialize;
 use std::path::Path;
 
 /// The measurements of the bag at `path` (one pose per kept rest), checked
@@ -16,7 +21,16 @@ pub fn read_bag(
     robot: &Robot,
     s: &ExtractSettings,
 ) -> Result<(Measurements, Vec<String>, ExtractReport), ExperimentError> {
-    let got = extract(path, robot, s)?;
+    checked(path, robot, extract(path, robot, s)?)
+}
+
+/// An extraction's measurements checked against `robot` and its reach,
+/// with the notes of its report.
+fn checked(
+    path: &Path,
+    robot: &Robot,
+    got: crate::io::bag::extract::Extracted,
+) -> Result<(Measurements, Vec<String>, ExtractReport), ExperimentError> {
     let source = path.display().to_string();
     let in_file = |error| ExperimentError::InFile {
         path: source.clone(),
@@ -65,4 +79,119 @@ pub fn notes(r: &ExtractReport) -> Vec<String> {
         r.averaged_noise * 1e3
     ));
     out
+}
+
+/// How a calibration from a bag settled the clock offset: the estimate from
+/// the nominal model's predicted moves, the calibrated model's, and
+/// whether the data were extracted and fitted again with the latter.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ClockRefit {
+    /// The estimate with the nominal model (s, with its uncertainty).
+    pub nominal: Offset,
+    /// The estimate with the calibrated model, when made (the first fit
+    /// converged and enough moves were seen).
+    pub calibrated: Option<Offset>,
+    /// Whether the calibrated model's estimate moved by more than the
+    /// nominal one's uncertainty, so that the bag was extracted and the
+    /// robot fitted once more with it.
+    pub refitted: bool,
+}
+
+/// A calibration from a ROS 2 bag: the measurements extracted (those of
+/// the final fit), the fit, the extraction's report and the clock.
+pub struct BagCalibration {
+    /// The measurements fitted, one pose per kept rest.
+    pub measurements: Measurements,
+    /// The calibration of those measurements.
+    pub calibration: MeasuredCalibration,
+    /// The extraction that gave them.
+    pub extraction: ExtractReport,
+    /// The clock offset estimated twice (`None`: given, or not estimated).
+    pub clock: Option<ClockRefit>,
+}
+
+/// Calibrates `robot` from the bag at `path`: extracts one pose per rest
+/// ([`read_bag`]), fits it as a measurement file's data
+/// ([`calibrate_read`]) and, when the clock offset was estimated, estimates
+/// it again with the calibrated model (the nominal model's predicted moves
+/// bias it); when it moved by more than its uncertainty, the bag is
+/// extracted with the new offset and fitted once more.
+pub fn calibrate_bag(
+    path: &Path,
+    robot: &Robot,
+    x: &ExtractSettings,
+    s: &MeasuredSettings,
+    on_note: &mut dyn FnMut(&str),
+) -> Result<BagCalibration, ExperimentError> {
+    let source = path.display().to_string();
+    let (meas, notes, report) = read_bag(path, robot, x)?;
+    let first = calibrate_read(robot, &meas, &source, notes, s, on_note)?;
+    let estimated = match (&report.clock.estimate, x.time_offset) {
+        (Some(e), None) if first.fit.id.converged() => e.clone(),
+        _ => return Ok(done(meas, first, report, None)),
+    };
+    let mut calibrated = first.robot.clone();
+    calibrated.nominal = first.fit.id.table.clone();
+    let again = extract(path, &calibrated, x)?;
+    let Some(e2) = again.report.clock.estimate.clone() else {
+        let clock = ClockRefit {
+            nominal: estimated,
+            calibrated: None,
+            refitted: false,
+        };
+        return Ok(done(meas, first, report, Some(clock)));
+    };
+    let moved = (e2.seconds - estimated.seconds).abs() > estimated.uncertainty;
+    let clock = ClockRefit {
+        nominal: estimated,
+        calibrated: Some(e2.clone()),
+        refitted: moved,
+    };
+    if !moved {
+        on_note(&clock_note(&clock));
+        return Ok(done(meas, first, report, Some(clock)));
+    }
+    // The extraction with the calibrated model applied its estimate.
+    let (meas2, mut notes2, report2) = checked(path, robot, again)?;
+    notes2.push(clock_note(&clock));
+    let second = calibrate_read(robot, &meas2, &source, notes2, s, on_note)?;
+    Ok(done(meas2, second, report2, Some(clock)))
+}
+
+fn done(
+    measurements: Measurements,
+    calibration: MeasuredCalibration,
+    extraction: ExtractReport,
+    clock: Option<ClockRefit>,
+) -> BagCalibration {
+    BagCalibration {
+        measurements,
+        calibration,
+        extraction,
+        clock,
+    }
+}
+
+/// The two estimates of the clock offset, as a note.
+#[must_use]
+pub fn clock_note(c: &ClockRefit) -> String {
+    let n = &c.nominal;
+    match &c.calibrated {
+        Some(k) => format!(
+            "clock offset with the calibrated model {:.4} s ± {:.4} s (nominal model {:.4} s ± {:.4} s): {}",
+            k.seconds,
+            k.uncertainty,
+            n.seconds,
+            n.uncertainty,
+            if c.refitted {
+                "moved by more than its uncertainty, extracted and fitted again"
+            } else {
+                "within the nominal estimate's uncertainty, kept"
+            }
+        ),
+        None => format!(
+            "clock offset {:.4} s ± {:.4} s with the nominal model, not estimated again",
+            n.seconds, n.uncertainty
+        ),
+    }
 }

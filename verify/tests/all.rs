@@ -10,6 +10,8 @@ mod model;
 #[cfg(feature = "live")]
 mod live;
 #[cfg(feature = "live")]
+mod live_bag_calibrate;
+#[cfg(feature = "live")]
 mod live_bags;
 #[cfg(feature = "live")]
 mod live_bound;

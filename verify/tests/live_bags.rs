@@ -43,21 +43,21 @@ const SIGMA_RATIO: f64 = 1.35;
 /// Bags (noise draws) per case.
 const DRAWS: u64 = 4;
 
-fn ur5() -> String {
+pub(super) fn ur5() -> String {
     root()
         .join("fixtures/example-robot-data/ur5_robot.urdf")
         .display()
         .to_string()
 }
 
-fn dir(name: &str) -> PathBuf {
+pub(super) fn dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("activecal-live-bags-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
 }
 
-fn python(dir: &Path, script: &str, args: &[&str]) -> Value {
+pub(super) fn python(dir: &Path, script: &str, args: &[&str]) -> Value {
     let out = run(Command::new(root().join(".venv/bin/python"))
         .current_dir(dir)
         .args(["-W", "ignore"])
@@ -69,7 +69,7 @@ fn python(dir: &Path, script: &str, args: &[&str]) -> Value {
 
 /// A true UR5 (seed `seed`, `pose` for a full pose) and the 30 poses
 /// `select` chooses for it (`design.csv`).
-fn setup(d: &Path, seed: u64, pose: bool) -> String {
+pub(super) fn setup(d: &Path, seed: u64, pose: bool) -> String {
     let s = seed.to_string();
     let u = ur5();
     let mut make = vec!["make", "--urdf", &u, "--tip", "tool0", "--seed", &s];
@@ -154,7 +154,7 @@ fn calibrate(d: &Path, robot: &str, meas: &str, stem: &str) -> Value {
     serde_json::from_str(&text).unwrap()
 }
 
-fn rms(v: &[f64]) -> f64 {
+pub(super) fn rms(v: &[f64]) -> f64 {
     (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
 }
 

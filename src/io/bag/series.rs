@@ -41,6 +41,32 @@ impl Source {
     pub fn is_pose(&self) -> bool {
         !matches!(self, Source::Points(_))
     }
+
+    /// The source of one of a points topic, a poses topic or a transform
+    /// `PARENT:CHILD` of /tf (the one given; an error, without the
+    /// option's name, when none or two are given or the transform is not
+    /// two frame names).
+    pub fn one_of(
+        points: Option<&str>,
+        poses: Option<&str>,
+        tf: Option<&str>,
+    ) -> Result<Self, String> {
+        match (points, poses, tf) {
+            (Some(t), None, None) => Ok(Source::Points(t.to_string())),
+            (None, Some(t), None) => Ok(Source::Poses(t.to_string())),
+            (None, None, Some(pc)) => match pc.split_once(':') {
+                Some((p, c)) if !p.is_empty() && !c.is_empty() => Ok(Source::Tf {
+                    parent: p.to_string(),
+                    child: c.to_string(),
+                }),
+                _ => Err(format!("tf {pc}: give PARENT:CHILD, two frame names")),
+            },
+            (None, None, None) => Err(
+                "give the bag's measurement: points TOPIC, poses TOPIC or tf PARENT:CHILD".into(),
+            ),
+            _ => Err("give one measurement of points, poses and tf".into()),
+        }
+    }
 }
 
 /// The two streams of a run.

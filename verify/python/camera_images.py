@@ -9,13 +9,17 @@ make's truth.json):
                           --board ROWS,COLS,SQUARE --count N --seed S
                           --out DIR [--far K] [--behind]
                           [--blur PX] [--noise DN] [--gamma G]
+                          [--near-range A,B] [--far-range A,B]
       N configurations drawn uniformly within the joint limits (numpy
       default_rng(S)) at which the TRUE robot shows the whole printed board
       (its inner corners and the quiet zone of one square around the
-      outer squares, 10 px inside the image) from 0.3-0.9 m with the
-      board's normal within 60 deg of the line of sight; the last K of
-      them (--far) from 0.9-1.4 m and 60-75 deg (squares foreshortened
-      to a few pixels). The board's printed face is seen when its z axis
+      outer squares, 10 px inside the image) from 0.3-0.9 m (--near-range)
+      with the board's normal within 60 deg of the line of sight; the last
+      K of them (--far) from 0.9-1.4 m (--far-range) and 60-75 deg
+      (squares foreshortened to a few pixels). Eye-to-hand (the truth's
+      mounting: the camera fixed, the board on the flange) is rendered
+      the same way, the camera <- board transform being then the truth's
+      measured frame itself. The board's printed face is seen when its z axis
       points away from the camera; --behind keeps only configurations
       that see it from behind (a see-through or back-lit board: the same
       pattern, mirrored).
@@ -198,8 +202,8 @@ def choose(t, a, pts, outline, k, dist, w, h, rng):
             if v is None or not v[3] or v[2] != a.behind:
                 continue
             d, ang = v[0], v[1]
-            kind = "near" if 0.3 <= d <= 0.9 and ang <= 60 else (
-                "far" if 0.9 < d <= 1.4 and 60 < ang <= 75 else None)
+            kind = "near" if a.near_range[0] <= d <= a.near_range[1] and ang <= 60 else (
+                "far" if a.far_range[0] < d <= a.far_range[1] and 60 < ang <= 75 else None)
             want = near_n if kind == "near" else a.far
             if kind and len(found[kind]) < want:
                 found[kind].append((q, r, tv, {"distance_m": d, "view_angle_deg": ang,
@@ -342,6 +346,10 @@ def main(argv=None):
     r.add_argument("--noise", type=float, default=2.0)
     r.add_argument("--gamma", type=float, default=2.2)
     r.add_argument("--draws", type=int, default=1)
+    r.add_argument("--near-range", type=lambda v: camera_truth.numbers(v, 2, "--near-range"),
+                   default=(0.3, 0.9), help="A,B: the near images' distance, m")
+    r.add_argument("--far-range", type=lambda v: camera_truth.numbers(v, 2, "--far-range"),
+                   default=(0.9, 1.4), help="A,B: the far images' distance, m")
     r.add_argument("--out", required=True)
     o = sub.add_parser("opencv")
     o.add_argument("--dir", required=True)

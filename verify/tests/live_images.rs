@@ -116,6 +116,8 @@ pub(crate) struct Board {
     pub yaml: String,
     /// `camera_images.py render`'s arguments for it.
     pub render: Vec<String>,
+    /// Whether its points carry ids (a part of it is labelled).
+    pub ids: bool,
 }
 
 /// A checkerboard of `rows × cols` inner corners, [`SQUARE`] squares.
@@ -123,6 +125,7 @@ pub(crate) fn checkerboard(rows: usize, cols: usize) -> Board {
     Board {
         yaml: format!("checkerboard: {{rows: {rows}, cols: {cols}, square: {SQUARE}}}\n"),
         render: vec![format!("--board={rows},{cols},{SQUARE}")],
+        ids: false,
     }
 }
 
@@ -134,6 +137,9 @@ pub(crate) struct Scene {
     pub truth: PathBuf,
     pub board: PathBuf,
     pub draws: Vec<PathBuf>,
+    /// Whether the board's points carry ids (ChArUco), compared with
+    /// OpenCV's on the corners both found.
+    pub board_has_ids: bool,
 }
 
 /// `rig`'s truth and `draws` renders of `count` images (the last 3 far
@@ -197,6 +203,7 @@ pub(crate) fn scene(
         truth,
         board: path,
         draws,
+        board_has_ids: board.ids,
     }
 }
 

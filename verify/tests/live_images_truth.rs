@@ -31,11 +31,15 @@
 //!   (to `panda_hand_tcp`), the camera fixed 1.3 m away as the pixels'
 //!   gate has it (`live_camera_truth.rs`), a 6 × 9 board on the hand, 20
 //!   images from 0.3–2 m (squares of 7–28 px); the same OpenCV routes.
+//! * [`live_images_eye_in_hand_charuco`]: the UR5 eye-in-hand as the
+//!   first, an OpenCV ChArUco board of 7 × 10 squares of 25 mm, markers of
+//!   15 mm (`DICT_4X4_50`), its ids found in the markers; against OpenCV's
+//!   `CharucoDetector` with its defaults.
 
 use super::live_images::{
-    Board, RATIO, Rig, Scene, calibrate, checkerboard, corner_errors, from_images, noisy_truth,
-    opencv, predicted, quantile, read_pixels, rms, scene, truth_labelled, ur5_eye_in_hand,
-    write_pixels,
+    Board, Pixels, RATIO, Rig, SQUARE, Scene, calibrate, checkerboard, corner_errors, from_images,
+    noisy_truth, opencv, predicted, quantile, read_pixels, rms, scene, truth_labelled,
+    ur5_eye_in_hand, write_pixels,
 };
 use activecal::measure::camera::Mounting;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
@@ -110,10 +114,14 @@ fn gate(s: &Scene, routes: &[(&str, Vec<String>)]) {
                     "  OpenCV {label}: {n} of {} images, {m:.3} px median, {p:.3} px p95",
                     truth.poses.len()
                 );
-                assert!(
-                    median <= m && p95 <= p,
-                    "{label}: {m} / {p} px against activecal's {median} / {p95} px"
-                );
+                if s.board_has_ids {
+                    same_corners(s, draw, &detected, &truth, label);
+                } else {
+                    assert!(
+                        median <= m && p95 <= p,
+                        "{label}: {m} / {p} px against activecal's {median} / {p95} px"
+                    );
+                }
             }
         }
         t2 += true_mm * true_mm;
@@ -179,4 +187,83 @@ fn live_images_eye_to_hand_checkerboard() {
         DRAWS,
     );
     gate(&s, &checkerboard_routes(6, 9));
+}
+
+/// The ChArUco board of [`live_images_eye_in_hand_charuco`]: rows × cols
+/// squares, the markers' side.
+const CHARUCO: (usize, usize, f64) = (7, 10, 0.015);
+
+#[test]
+fn live_images_eye_in_hand_charuco() {
+    let (rows, cols, marker) = CHARUCO;
+    let spec = format!("{rows},{cols},{SQUARE},{marker}");
+    let board = Board {
+        yaml: format!(
+            "charuco: {{rows: {rows}, cols: {cols}, square: {SQUARE}, marker: {marker}, dictionary: DICT_4X4_50}}\n"
+        ),
+        render: vec![
+            format!("--charuco={spec}"),
+            "--dictionary=DICT_4X4_50".into(),
+        ],
+        ids: true,
+    };
+    // The rig's board is centred on its inner corners, as a checkerboard
+    // of (rows − 1) × (cols − 1) inner corners; the ChArUco target's frame
+    // is one square further out.
+    let mut rig = ur5_eye_in_hand("eye-in-hand-charuco", rows - 1, cols - 1, false);
+    rig.target *= nalgebra::Translation3::new(-SQUARE, -SQUARE, 0.0);
+    let s = scene(rig, &board, false, (20, true), DRAWS);
+    let route = vec![
+        "--method=charuco".to_string(),
+        format!("--charuco={spec}"),
+        "--dictionary=DICT_4X4_50".into(),
+    ];
+    gate(&s, &[("CharucoDetector", route)]);
+}
+
+/// A board with ids (ChArUco): OpenCV keeps fewer of its corners (those
+/// its marker-based interpolation vouches for), so the corners are
+/// compared on those both found (`opencv.csv`: image, feature, u, v):
+/// activecal finds at least as many, with a 95th percentile at least as
+/// small; the medians are printed (see docs/cameras.md for the measured
+/// limit).
+fn same_corners(s: &Scene, draw: &std::path::Path, ours: &Pixels, truth: &Pixels, label: &str) {
+    let names: Vec<String> = std::fs::read_to_string(draw.join("joints.csv"))
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap().to_string())
+        .collect();
+    let text = std::fs::read_to_string(s.dir.join("opencv.csv")).unwrap();
+    let (mut a, mut b, mut theirs) = (Vec::new(), Vec::new(), 0usize);
+    for l in text.lines().skip(1) {
+        let c: Vec<&str> = l.split(',').collect();
+        let pose = names.iter().position(|n| n == c[0]).unwrap() as i64;
+        let f: i64 = c[1].parse().unwrap();
+        let q = [c[2].parse::<f64>().unwrap(), c[3].parse::<f64>().unwrap()];
+        theirs += 1;
+        let t = truth.poses[&pose].1[&f];
+        if let Some(p) = ours.poses.get(&pose).and_then(|(_, pts)| pts.get(&f)) {
+            a.push((p[0] - t[0]).hypot(p[1] - t[1]));
+            b.push((q[0] - t[0]).hypot(q[1] - t[1]));
+        }
+    }
+    let found: usize = ours.poses.values().map(|(_, p)| p.len()).sum();
+    a.sort_by(f64::total_cmp);
+    b.sort_by(f64::total_cmp);
+    let (ma, pa, mb, pb) = (
+        quantile(&a, 0.5),
+        quantile(&a, 0.95),
+        quantile(&b, 0.5),
+        quantile(&b, 0.95),
+    );
+    println!(
+        "  on the {} corners both found (activecal {found}, OpenCV {theirs}): activecal {ma:.4} px median, {pa:.4} px p95; OpenCV {label} {mb:.4} px median, {pb:.4} px p95",
+        a.len()
+    );
+    assert!(
+        found >= theirs,
+        "activecal found {found} corners, OpenCV {theirs}"
+    );
+    assert!(pa <= pb, "{label}: p95 {pb} px against activecal's {pa} px");
 }

@@ -548,6 +548,19 @@ mod tests {
         assert!(near(t.points[0], [0.04, 0.04, 0.0]));
         assert!(near(t.points[6], [0.12, 0.08, 0.0]), "{:?}", t.points[6]);
         assert_eq!(t.face, Vector3::z());
+        let p = t.charuco.as_ref().unwrap();
+        assert_eq!(p.dictionary.as_deref(), Some("DICT_4X4_50"));
+        assert!(!p.legacy_pattern);
+        let e = parse_target(
+            "charuco: {rows: 4, cols: 5, square: 0.04, marker: 0.03,\n  dictionary: DICT_9X9_1}\n",
+            "c.yaml",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("c.yaml") && e.contains("line 2") && e.contains("DICT_9X9_1"),
+            "{e}"
+        );
         let g = parse_target(
             "aprilgrid: {rows: 1, cols: 2, tag_size: 0.05, tag_spacing: 0.3}\n",
             "g.yaml",

@@ -145,3 +145,51 @@ fn shortest_side(id: usize, px: [f64; 2], corners: &[(usize, [f64; 2])], cols: u
         })
         .fold(f64::INFINITY, f64::min)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pattern(rows: usize, dictionary: Option<&str>, legacy_pattern: bool) -> CharucoPattern {
+        CharucoPattern {
+            rows,
+            cols: 5,
+            square: 0.04,
+            marker: 0.03,
+            dictionary: dictionary.map(str::to_string),
+            legacy_pattern,
+        }
+    }
+
+    #[test]
+    fn a_board_without_its_dictionary_or_in_the_legacy_layout_is_refused_in_words() {
+        let e = check_pattern(&pattern(4, None, false)).unwrap_err();
+        assert!(e.contains("'charuco.dictionary'"), "{e}");
+        let e = check_pattern(&pattern(4, Some("DICT_4X4_50"), true)).unwrap_err();
+        assert!(e.contains("legacy pattern") && e.contains("4 rows"), "{e}");
+        // An odd number of rows: both layouts are the same board.
+        assert!(check_pattern(&pattern(5, Some("DICT_4X4_50"), true)).is_ok());
+        assert!(check_pattern(&pattern(4, Some("DICT_5X5_100"), false)).is_ok());
+    }
+
+    /// Two corners one square apart along a row and one two squares down:
+    /// each corner's shortest side is the one-square distance (10 px), or
+    /// the two-square one halved.
+    #[test]
+    fn a_corners_shortest_side_is_its_nearest_neighbours_distance_over_their_grid_distance() {
+        let corners = [(0, [0.0, 0.0]), (1, [10.0, 0.0]), (8, [0.0, 24.0])];
+        assert!((shortest_side(0, [0.0, 0.0], &corners, 4) - 10.0).abs() < 1e-12);
+        assert!((shortest_side(8, [0.0, 24.0], &corners, 4) - 12.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_blank_image_has_no_board() {
+        let img = Gray {
+            width: 64,
+            height: 48,
+            data: vec![128; 64 * 48],
+        };
+        let e = find_charuco(&img, &pattern(5, Some("DICT_4X4_50"), false)).unwrap_err();
+        assert!(e.starts_with("no ChArUco board"), "{e}");
+    }
+}

@@ -207,7 +207,14 @@ fn one_image(
             .flatten()
             .filter(|r| r.shift <= refine::MAX_SHIFT);
         // Not refined (a window too small, or a move too long to be this
-        // corner's): the detector's corner.
+        // corner's): the detector's corner on a checkerboard (only a whole
+        // board is labelled); left out on a ChArUco board, whose corners
+        // carry ids (its detector placed one 1.6 px off on the rendered
+        // images of `verify/tests/live_images_truth.rs`, a move the
+        // refinement refused).
+        if refined.is_none() && matches!(board, Board::Charuco(_)) {
+            continue;
+        }
         let r = refined.unwrap_or(refine::Refined {
             px: c.px,
             shift: 0.0,

@@ -172,14 +172,16 @@ mod tests {
         assert!(check_pattern(&pattern(4, Some("DICT_5X5_100"), false)).is_ok());
     }
 
-    /// Two corners one square apart along a row and one two squares down:
-    /// each corner's shortest side is the one-square distance (10 px), or
-    /// the two-square one halved.
+    /// Corners 0 and 1 one square apart along a row (10 px), corner 8 two
+    /// rows below corner 0 (24 px): corner 0's shortest side is 10 px;
+    /// corner 8's the least of 24 px over 2 squares (to corner 0) and 26
+    /// px over √5 squares (to corner 1, one across and two down).
     #[test]
     fn a_corners_shortest_side_is_its_nearest_neighbours_distance_over_their_grid_distance() {
         let corners = [(0, [0.0, 0.0]), (1, [10.0, 0.0]), (8, [0.0, 24.0])];
         assert!((shortest_side(0, [0.0, 0.0], &corners, 4) - 10.0).abs() < 1e-12);
-        assert!((shortest_side(8, [0.0, 24.0], &corners, 4) - 12.0).abs() < 1e-12);
+        let want = 26.0 / 5f64.sqrt();
+        assert!((shortest_side(8, [0.0, 24.0], &corners, 4) - want).abs() < 1e-12);
     }
 
     #[test]

@@ -236,3 +236,38 @@ fn images_and_their_options_are_refused_where_they_do_not_act() {
         "no file in fixtures/camera/images matches 'none_*.png'",
     );
 }
+
+/// A ChArUco target without its dictionary, or in OpenCV's legacy layout
+/// on an even number of rows (which the detector does not read), is
+/// refused before any image is read, saying why; with the dictionary, the
+/// checkerboard images hold no ChArUco board and each says so.
+#[test]
+fn charuco_targets_the_detector_cannot_read_are_refused_in_words() {
+    let d = common::scratch_dir("camera_images", "charuco");
+    let board = "charuco: {rows: 6, cols: 9, square: 0.025, marker: 0.015";
+    let cases = [
+        ("nodict.yaml", "}", "'charuco.dictionary' must name"),
+        (
+            "legacy.yaml",
+            ", dictionary: DICT_4X4_50, legacy_pattern: true}",
+            "6 rows printed with OpenCV's legacy pattern",
+        ),
+        (
+            "ok.yaml",
+            ", dictionary: DICT_4X4_50}",
+            "img_000.png: no ChArUco board",
+        ),
+    ];
+    let joints = root().join(IMAGES).join("joints.csv");
+    for (file, tail, says) in cases {
+        let t = d.join(file);
+        std::fs::write(&t, format!("{board}{tail}\n")).unwrap();
+        let mut args = command(IMAGES, joints.to_str().unwrap(), &[]);
+        let k = args
+            .iter()
+            .position(|a| *a == "fixtures/camera/board_6x9.yaml")
+            .unwrap();
+        args[k] = t.to_str().unwrap();
+        common::fails_with(&args, says);
+    }
+}

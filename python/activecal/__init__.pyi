@@ -38,6 +38,7 @@ __all__ = [
     "calibrate",
     "calibrate_camera",
     "calibrate_contacts",
+    "detect",
     "evaluate",
     "extract",
     "gap",
@@ -635,6 +636,28 @@ class CameraCalibration:
         """The refined intrinsics as a ROS camera_info ``.yaml``, the camera
         named by the file's stem (only with ``refine_intrinsics=True`` and
         a converged fit), as ``--out-camera-info`` writes it."""
+
+def detect(
+    images: _Path,
+    target: Union[_Path, Mapping[str, Any]],
+    camera_info: Union[_Path, Mapping[str, Any]],
+    *,
+    robot: Robot,
+    joints: _Path,
+) -> Any:
+    """Detects the target's points in a camera's images, as ``activecal
+    calibrate --images IMAGES --joints JOINTS --save-observations F``
+    does. images: a folder of PNG images, a glob pattern or one file.
+    target: a target YAML path or a dict (a ``checkerboard`` or a
+    ``charuco`` board with its ``dictionary``). camera_info: a ROS
+    camera_info or OpenCV YAML path, or a dict. robot: the robot whose
+    joint values ``joints`` holds; joints: a CSV with an ``image`` column
+    (each image's file name) and a column per joint. Returns a pandas
+    DataFrame with the observations CSV's columns ``pose, <joint names>,
+    feature, u, v`` (pixels), which `calibrate_camera` takes;
+    ``df.attrs["images"]`` lists every image with what became of it
+    (``status`` ``"found"`` with its figures, or ``"left_out"`` with its
+    ``reason``)."""
 
 def calibrate_camera(
     robot: Robot,

@@ -14,6 +14,7 @@ mod camera_select;
 mod contacts;
 mod convert;
 mod errors;
+mod images;
 mod page;
 mod pickling;
 mod pool;
@@ -40,6 +41,7 @@ fn _activecal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(calibrate::evaluate, m)?)?;
     m.add_class::<camera::CameraCalibration>()?;
     m.add_function(wrap_pyfunction!(camera::calibrate_camera, m)?)?;
+    m.add_function(wrap_pyfunction!(images::detect, m)?)?;
     m.add_class::<camera_select::CameraDesign>()?;
     m.add_function(wrap_pyfunction!(camera_select::select_camera, m)?)?;
     m.add_class::<contacts::ContactCalibration>()?;

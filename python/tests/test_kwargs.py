@@ -93,6 +93,14 @@ def test_contact_and_camera_keywords_act_on_their_sensor():
     assert "pixel_noise" in keywords(activecal.calibrate_camera)
 
 
+def test_detect_takes_the_robot_and_the_joints_by_keyword():
+    """detect's keywords: the robot and the joints file its observations
+    need (the command line's --robot and --joints), nothing else."""
+    sig = inspect.signature(activecal.detect)
+    kw = [n for n, p in sig.parameters.items() if p.kind == p.KEYWORD_ONLY]
+    assert kw == ["robot", "joints"], kw
+
+
 CAM = FIXTURES / "camera"
 CAMERA_POSE = [1.1761, 0.6096, 0.9079, -2.0681, 0.0317, 2.0826]
 TARGET_POSE = [-0.1047, 0.0411, 0.0301, 3.1111, -0.0192, 0.0556]

@@ -54,7 +54,11 @@ pub fn write_sheet(
     force: bool,
 ) -> Result<()> {
     super::run_files::check_dir("--report", dir, force)?;
-    let cols = target.grid.map_or(1, |g| g.1);
+    let cols = match (target.grid, &target.charuco) {
+        (Some((_, cols)), _) => cols,
+        (None, Some(p)) => p.cols - 1,
+        (None, None) => 1,
+    };
     let staged = activecal::io::atomic::StagedDir::new(dir)?;
     let sheet = sheet_images(read, Some(cal), cols);
     activecal::render::contact_sheet::write_contact_sheet(

@@ -10,8 +10,10 @@
 //!   0)`;
 //! * a ChArUco board's chessboard corners, `charuco: {rows: 5, cols: 7,
 //!   square: 0.04, marker: 0.03}` (`rows × cols` squares, the markers'
-//!   side `marker` < `square`; an optional `dictionary` is not read, the
-//!   corners do not depend on it): the `(rows − 1) × (cols − 1)` inner
+//!   side `marker` < `square`; `dictionary` (OpenCV's name, `DICT_4X4_50`
+//!   …) and `legacy_pattern` (OpenCV's `setLegacyPattern`, default
+//!   false) say how it is printed, which detecting it in images needs and
+//!   the corners do not depend on): the `(rows − 1) × (cols − 1)` inner
 //!   corners with OpenCV's ids and positions (`cv2.aruco.CharucoBoard((cols,
 //!   rows), square, marker, dictionary).getChessboardCorners()`: id
 //!   `i·(cols − 1) + j` at `((j + 1)·square, (i + 1)·square, 0)`), the ids
@@ -60,6 +62,28 @@ pub struct Target {
     /// ([`crate::identify::camera::start::labels`]); `None` for targets
     /// with unique ids.
     pub grid: Option<(usize, usize)>,
+    /// A ChArUco board's printed pattern (`charuco:` targets), which a
+    /// detector needs; `None` for other targets.
+    pub charuco: Option<CharucoPattern>,
+}
+
+/// A ChArUco board as printed (see the module documentation).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CharucoPattern {
+    /// Squares down.
+    pub rows: usize,
+    /// Squares across.
+    pub cols: usize,
+    /// A square's side, m.
+    pub square: f64,
+    /// A marker's side, m.
+    pub marker: f64,
+    /// The markers' ArUco dictionary (OpenCV's name), when the file gives it.
+    pub dictionary: Option<String>,
+    /// OpenCV's legacy pattern (`setLegacyPattern(true)`, the layout before
+    /// OpenCV 4.6: on a board with an even number of rows, marker 0 in the
+    /// top-left square).
+    pub legacy_pattern: bool,
 }
 
 impl Target {
@@ -75,6 +99,7 @@ impl Target {
                 .collect(),
             face: Vector3::z(),
             grid: Some((rows, cols)),
+            charuco: None,
         }
     }
 
@@ -106,6 +131,7 @@ impl Target {
             points: Vec::with_capacity(4 * rows * cols),
             face: -Vector3::z(),
             grid: None,
+            charuco: None,
         };
         for k in 0..rows * cols {
             let (r, c) = ((k / cols) as f64, (k % cols) as f64);
@@ -203,9 +229,8 @@ struct Charuco {
     cols: Spanned<Num>,
     square: Spanned<Num>,
     marker: Spanned<Num>,
-    /// Not read: the corners do not depend on the markers' dictionary.
-    #[allow(dead_code)]
-    dictionary: Option<serde::de::IgnoredAny>,
+    dictionary: Option<Spanned<String>>,
+    legacy_pattern: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -233,7 +258,7 @@ struct TargetEntry {
 }
 
 /// The four kinds a target file may give, for messages.
-const KINDS: &str = "a 'checkerboard: {rows, cols, square}', a 'charuco: {rows, cols, square, marker}', an 'aprilgrid: {rows, cols, tag_size, tag_spacing}' or a 'points' list of {id, xyz}";
+const KINDS: &str = "a 'checkerboard: {rows, cols, square}', a 'charuco: {rows, cols, square, marker, dictionary, legacy_pattern}', an 'aprilgrid: {rows, cols, tag_size, tag_spacing}' or a 'points' list of {id, xyz}";
 
 /// Reads a target file (see the module documentation).
 pub fn read_target(path: &Path) -> Result<Target> {
@@ -396,7 +421,26 @@ fn charuco(b: &Spanned<Charuco>) -> std::result::Result<Target, String> {
             at(&c.marker)
         ));
     }
-    Ok(Target::charuco(rows, cols, square))
+    let dictionary = match &c.dictionary {
+        Some(d) if calib_targets_charuco::resolve_dictionary(&d.value).is_none() => {
+            return Err(format!(
+                "{} ('charuco.dictionary'): '{}' is not an ArUco dictionary activecal knows (OpenCV's names: DICT_4X4_50 … DICT_7X7_1000, DICT_ARUCO_ORIGINAL, DICT_APRILTAG_36h11 …)",
+                at(d),
+                d.value
+            ));
+        }
+        d => d.as_ref().map(|d| d.value.clone()),
+    };
+    let mut t = Target::charuco(rows, cols, square);
+    t.charuco = Some(CharucoPattern {
+        rows,
+        cols,
+        square,
+        marker,
+        dictionary,
+        legacy_pattern: c.legacy_pattern.unwrap_or(false),
+    });
+    Ok(t)
 }
 
 fn aprilgrid(b: &Spanned<Aprilgrid>) -> std::result::Result<Target, String> {
@@ -423,6 +467,7 @@ fn list(p: &Spanned<Vec<Spanned<PointEntry>>>) -> std::result::Result<Target, St
         points: Vec::new(),
         face: Vector3::z(),
         grid: None,
+        charuco: None,
     };
     let mut first_line = std::collections::HashMap::new();
     for e in &p.value {
@@ -503,6 +548,19 @@ mod tests {
         assert!(near(t.points[0], [0.04, 0.04, 0.0]));
         assert!(near(t.points[6], [0.12, 0.08, 0.0]), "{:?}", t.points[6]);
         assert_eq!(t.face, Vector3::z());
+        let p = t.charuco.as_ref().unwrap();
+        assert_eq!(p.dictionary.as_deref(), Some("DICT_4X4_50"));
+        assert!(!p.legacy_pattern);
+        let e = parse_target(
+            "charuco: {rows: 4, cols: 5, square: 0.04, marker: 0.03,\n  dictionary: DICT_9X9_1}\n",
+            "c.yaml",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("c.yaml") && e.contains("line 2") && e.contains("DICT_9X9_1"),
+            "{e}"
+        );
         let g = parse_target(
             "aprilgrid: {rows: 1, cols: 2, tag_size: 0.05, tag_spacing: 0.3}\n",
             "g.yaml",

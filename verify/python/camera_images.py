@@ -9,13 +9,17 @@ make's truth.json):
                           --board ROWS,COLS,SQUARE --count N --seed S
                           --out DIR [--far K] [--behind]
                           [--blur PX] [--noise DN] [--gamma G]
+                          [--near-range A,B] [--far-range A,B]
       N configurations drawn uniformly within the joint limits (numpy
       default_rng(S)) at which the TRUE robot shows the whole printed board
       (its inner corners and the quiet zone of one square around the
-      outer squares, 10 px inside the image) from 0.3-0.9 m with the
-      board's normal within 60 deg of the line of sight; the last K of
-      them (--far) from 0.9-1.4 m and 60-75 deg (squares foreshortened
-      to a few pixels). The board's printed face is seen when its z axis
+      outer squares, 10 px inside the image) from 0.3-0.9 m (--near-range)
+      with the board's normal within 60 deg of the line of sight; the last
+      K of them (--far) from 0.9-1.4 m (--far-range) and 60-75 deg
+      (squares foreshortened to a few pixels). Eye-to-hand (the truth's
+      mounting: the camera fixed, the board on the flange) is rendered
+      the same way, the camera <- board transform being then the truth's
+      measured frame itself. The board's printed face is seen when its z axis
       points away from the camera; --behind keeps only configurations
       that see it from behind (a see-through or back-lit board: the same
       pattern, mirrored).
@@ -31,6 +35,16 @@ make's truth.json):
       default 0.6), encoded with the gamma 1/G (default 2.2), given
       Gaussian noise of --noise grey levels (default 2.0 of 255) and
       written as 8-bit grayscale PNG.
+
+      --charuco ROWS,COLS,SQUARE,MARKER --dictionary NAME [--legacy]
+      (instead of --board): an OpenCV ChArUco board of ROWS x COLS
+      squares (cv2.aruco.CharucoBoard((COLS, ROWS), SQUARE, MARKER,
+      getPredefinedDictionary(NAME)), setLegacyPattern with --legacy)
+      and half a square of white paper around it, its texture
+      generateImage's at 100 px per square (its squares' edges on whole
+      texture pixels), each sub-pixel taking the texel it hits; the truth
+      is its inner corners with OpenCV's ids (i*(COLS-1)+j at
+      ((j+1)*SQUARE, (i+1)*SQUARE, 0)).
 
       --draws D (default 1): the same configurations and renders with D
       draws of the noise (numpy default_rng((S, 1 + d))), in DIR/draw_d/
@@ -95,10 +109,14 @@ def camera_from_board(t, q):
     return np.asarray(m.rotation), np.asarray(m.translation)
 
 
-def board_outline(rows, cols, sq, n=40):
+def board_outline(rows, cols, sq):
     """Points along the edge of the printed board's quiet zone (one square
     around the outer squares), board frame."""
-    x0, x1, y0, y1 = -2 * sq, (cols + 1) * sq, -2 * sq, (rows + 1) * sq
+    return rect_outline(-2 * sq, (cols + 1) * sq, -2 * sq, (rows + 1) * sq)
+
+
+def rect_outline(x0, x1, y0, y1, n=40):
+    """Points along the rectangle [x0, x1] x [y0, y1] of the board's plane."""
     s = np.linspace(0, 1, n)
     xs = np.concatenate([x0 + (x1 - x0) * s, np.full(n, x1), x1 - (x1 - x0) * s, np.full(n, x0)])
     ys = np.concatenate([np.full(n, y0), y0 + (y1 - y0) * s, np.full(n, y1), y1 - (y1 - y0) * s])
@@ -144,8 +162,57 @@ def rays_of(box, k, dist):
     return undistort(np.array(xd), np.array(yd), dist)
 
 
-def render(r, tv, k, dist, box, rows, cols, sq, w, h):
-    """The image (floats in [0, 1], linear) of the board at camera <- board
+class Checkerboard:
+    """A checkerboard of rows x cols inner corners (OpenCV's ids), a quiet
+    zone of one square around its outer squares."""
+
+    def __init__(self, rows, cols, sq):
+        self.rows, self.cols, self.sq = rows, cols, sq
+        self.pts = np.array([[(i % cols) * sq, (i // cols) * sq, 0.0] for i in range(rows * cols)])
+        self.grid = (rows, cols)
+        self.outline = board_outline(rows, cols, sq)
+
+    def colour(self, bx, by):
+        rows, cols, sq = self.rows, self.cols, self.sq
+        cx, cy = np.floor(bx / sq), np.floor(by / sq)
+        square = (cx >= -1) & (cx <= cols - 1) & (cy >= -1) & (cy <= rows - 1)
+        quiet = (bx >= -2 * sq) & (bx <= (cols + 1) * sq) & (by >= -2 * sq) & (by <= (rows + 1) * sq)
+        sub = np.where(quiet, WHITE, BACKGROUND)
+        return np.where(square & ((cx + cy) % 2 == 0), BLACK, sub)
+
+
+TEXEL = 100  # texture pixels per ChArUco square
+
+
+class Charuco:
+    """OpenCV's ChArUco board of rows x cols squares (its inner corners with
+    OpenCV's ids), half a square of white paper around it."""
+
+    def __init__(self, rows, cols, sq, marker, dictionary, legacy):
+        import cv2
+        b = cv2.aruco.CharucoBoard((cols, rows), sq, marker,
+                                   cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, dictionary)))
+        b.setLegacyPattern(legacy)
+        self.board = b
+        self.rows, self.cols, self.sq = rows, cols, sq
+        self.tex = b.generateImage((cols * TEXEL, rows * TEXEL), marginSize=0, borderBits=1)
+        self.pts = np.asarray(b.getChessboardCorners(), dtype=float).reshape(-1, 3)
+        self.grid = (rows - 1, cols - 1)
+        self.outline = rect_outline(-0.5 * sq, (cols + 0.5) * sq, -0.5 * sq, (rows + 0.5) * sq)
+
+    def colour(self, bx, by):
+        rows, cols, sq = self.rows, self.cols, self.sq
+        tx, ty = np.floor(bx / sq * TEXEL), np.floor(by / sq * TEXEL)
+        on = (tx >= 0) & (tx < cols * TEXEL) & (ty >= 0) & (ty < rows * TEXEL)
+        texel = self.tex[np.clip(ty, 0, rows * TEXEL - 1).astype(int),
+                         np.clip(tx, 0, cols * TEXEL - 1).astype(int)]
+        level = np.where(texel > 127, WHITE, BLACK)
+        paper = (bx >= -0.5 * sq) & (bx <= (cols + 0.5) * sq) & (by >= -0.5 * sq) & (by <= (rows + 0.5) * sq)
+        return np.where(on, level, np.where(paper, WHITE, BACKGROUND))
+
+
+def render(r, tv, k, dist, box, board, w, h):
+    """The image (floats in [0, 1], linear) of `board` at camera <- board
     (r, tv): sub-pixels inside `box` (pixel bounds) cast, the rest background."""
     out = np.full((h, w), BACKGROUND)
     u0, v0, u1, v1 = box
@@ -158,11 +225,7 @@ def render(r, tv, k, dist, box, rows, cols, sq, w, h):
     px, py, pz = depth * xs - tv[0], depth * ys - tv[1], depth - tv[2]
     bx = r[0, 0] * px + r[1, 0] * py + r[2, 0] * pz
     by = r[0, 1] * px + r[1, 1] * py + r[2, 1] * pz
-    cx, cy = np.floor(bx / sq), np.floor(by / sq)
-    square = (cx >= -1) & (cx <= cols - 1) & (cy >= -1) & (cy <= rows - 1)
-    quiet = (bx >= -2 * sq) & (bx <= (cols + 1) * sq) & (by >= -2 * sq) & (by <= (rows + 1) * sq)
-    sub = np.where(quiet, WHITE, BACKGROUND)
-    sub = np.where(square & ((cx + cy) % 2 == 0), BLACK, sub)
+    sub = board.colour(bx, by)
     sub = np.where(np.isfinite(depth) & (depth > 0), sub, BACKGROUND)
     out[v0:v1, u0:u1] = sub.reshape(v1 - v0, s, u1 - u0, s).mean(axis=(1, 3))
     return out
@@ -198,8 +261,8 @@ def choose(t, a, pts, outline, k, dist, w, h, rng):
             if v is None or not v[3] or v[2] != a.behind:
                 continue
             d, ang = v[0], v[1]
-            kind = "near" if 0.3 <= d <= 0.9 and ang <= 60 else (
-                "far" if 0.9 < d <= 1.4 and 60 < ang <= 75 else None)
+            kind = "near" if a.near_range[0] <= d <= a.near_range[1] and ang <= 60 else (
+                "far" if a.far_range[0] < d <= a.far_range[1] and 60 < ang <= 75 else None)
             want = near_n if kind == "near" else a.far
             if kind and len(found[kind]) < want:
                 found[kind].append((q, r, tv, {"distance_m": d, "view_angle_deg": ang,
@@ -211,10 +274,15 @@ def cmd_render(a):
     import cv2
     t = truth.Truth(a.truth)
     k, dist, w, h = camera_truth.camera_info(a.camera_info)
-    rows, cols, sq = camera_truth.numbers(a.board, 3, "--board")
-    rows, cols = int(rows), int(cols)
-    pts = np.array([[(i % cols) * sq, (i // cols) * sq, 0.0] for i in range(rows * cols)])
-    outline = board_outline(rows, cols, sq)
+    if (a.board is None) == (a.charuco is None):
+        raise SystemExit("give one of --board and --charuco")
+    if a.board is not None:
+        rows, cols, sq = camera_truth.numbers(a.board, 3, "--board")
+        board = Checkerboard(int(rows), int(cols), sq)
+    else:
+        rows, cols, sq, marker = camera_truth.numbers(a.charuco, 4, "--charuco")
+        board = Charuco(int(rows), int(cols), sq, marker, a.dictionary, a.legacy)
+    pts, outline = board.pts, board.outline
     rng = np.random.default_rng(a.seed)
     chosen = choose(t, a, pts, outline, k, dist, w, h, rng)
     outs = [a.out] if a.draws == 1 else [os.path.join(a.out, "draw_%d" % d) for d in range(a.draws)]
@@ -229,7 +297,7 @@ def cmd_render(a):
         o = project(outline, r, tv, k, dist)
         box = (max(0, int(o[:, 0].min()) - 3), max(0, int(o[:, 1].min()) - 3),
                min(w, int(o[:, 0].max()) + 4), min(h, int(o[:, 1].max()) + 4))
-        img = develop(render(r, tv, k, dist, box, rows, cols, sq, w, h), a.blur, a.gamma)
+        img = develop(render(r, tv, k, dist, box, board, w, h), a.blur, a.gamma)
         name = "img_%03d.png" % n
         for o, g in zip(outs, rngs):
             cv2.imwrite(os.path.join(o, name), with_noise(img, a.noise, g))
@@ -237,7 +305,7 @@ def cmd_render(a):
         joints.append("%s,%s" % (name, qs))
         px = project(pts, r, tv, k, dist)
         obs += ["%d,%s,%d,%r,%r" % (n, qs, i, float(px[i, 0]), float(px[i, 1])) for i in range(len(pts))]
-        st = dict(st, image=name, smallest_square_px=smallest_square(px, rows, cols))
+        st = dict(st, image=name, smallest_square_px=smallest_square(px, *board.grid))
         stats.append(st)
     for o in outs:
         with open(os.path.join(o, "joints.csv"), "w") as f:
@@ -245,7 +313,7 @@ def cmd_render(a):
         with open(os.path.join(o, "truth.csv"), "w") as f:
             f.write("\n".join(obs) + "\n")
         with open(os.path.join(o, "render.json"), "w") as f:
-            json.dump({"board": [rows, cols, sq], "images": stats}, f, indent=1)
+            json.dump({"board": [board.rows, board.cols, sq], "images": stats}, f, indent=1)
     print(json.dumps({"out": a.out, "images": len(chosen),
                       "smallest_square_px": min(s["smallest_square_px"] for s in stats)}))
 
@@ -265,14 +333,28 @@ def read_truth(d):
 def cmd_opencv(a):
     """OpenCV's detectors on DIR's images, as a user would run them:
     findChessboardCorners + cornerSubPix with a fixed (W, W) window (the
-    tutorial's 11), or findChessboardCornersSB with its defaults. Written
-    as detections CSV: image, feature (OpenCV's order), u, v."""
+    tutorial's 11), or findChessboardCornersSB with its defaults; or, for
+    a ChArUco board (--method charuco), cv2.aruco.CharucoDetector with its
+    default parameters (its corners' ids). Written as detections CSV:
+    image, feature (OpenCV's order or id), u, v."""
     import cv2
-    rows, cols = (int(v) for v in a.pattern.split(","))
     lines = ["image,feature,u,v"]
     crit = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 30, 0.001)
+    if a.method == "charuco":
+        rows, cols, sq, marker = camera_truth.numbers(a.charuco, 4, "--charuco")
+        detector = cv2.aruco.CharucoDetector(
+            Charuco(int(rows), int(cols), sq, marker, a.dictionary, a.legacy).board)
+    else:
+        rows, cols = (int(v) for v in a.pattern.split(","))
     for name in sorted(read_truth(a.dir)):
         img = cv2.imread(os.path.join(a.dir, name), cv2.IMREAD_GRAYSCALE)
+        if a.method == "charuco":
+            c, ids, _, _ = detector.detectBoard(img)
+            if ids is None or len(ids) == 0:
+                continue
+            lines += ["%s,%d,%r,%r" % (name, int(i), float(p[0][0]), float(p[0][1]))
+                      for i, p in zip(ids.ravel(), c)]
+            continue
         if a.method == "sb":
             ok, c = cv2.findChessboardCornersSB(img, (cols, rows))
         else:
@@ -333,7 +415,10 @@ def main(argv=None):
     r = sub.add_parser("render")
     r.add_argument("--truth", required=True)
     r.add_argument("--camera-info", required=True)
-    r.add_argument("--board", required=True)
+    r.add_argument("--board")
+    r.add_argument("--charuco", help="ROWS,COLS,SQUARE,MARKER: a ChArUco board's squares")
+    r.add_argument("--dictionary", default="DICT_4X4_50")
+    r.add_argument("--legacy", action="store_true")
     r.add_argument("--count", type=int, default=25)
     r.add_argument("--far", type=int, default=4)
     r.add_argument("--behind", action="store_true")
@@ -342,11 +427,18 @@ def main(argv=None):
     r.add_argument("--noise", type=float, default=2.0)
     r.add_argument("--gamma", type=float, default=2.2)
     r.add_argument("--draws", type=int, default=1)
+    r.add_argument("--near-range", type=lambda v: camera_truth.numbers(v, 2, "--near-range"),
+                   default=(0.3, 0.9), help="A,B: the near images' distance, m")
+    r.add_argument("--far-range", type=lambda v: camera_truth.numbers(v, 2, "--far-range"),
+                   default=(0.9, 1.4), help="A,B: the far images' distance, m")
     r.add_argument("--out", required=True)
     o = sub.add_parser("opencv")
     o.add_argument("--dir", required=True)
-    o.add_argument("--pattern", required=True, help="ROWS,COLS of inner corners")
-    o.add_argument("--method", choices=["classic", "sb"], default="classic")
+    o.add_argument("--pattern", help="ROWS,COLS of inner corners")
+    o.add_argument("--method", choices=["classic", "sb", "charuco"], default="classic")
+    o.add_argument("--charuco", help="ROWS,COLS,SQUARE,MARKER: a ChArUco board's squares")
+    o.add_argument("--dictionary", default="DICT_4X4_50")
+    o.add_argument("--legacy", action="store_true")
     o.add_argument("--window", type=int, default=11)
     o.add_argument("--out", required=True)
     c = sub.add_parser("score")

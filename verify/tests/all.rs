@@ -40,6 +40,8 @@ mod live_idjac;
 #[cfg(feature = "live")]
 mod live_images;
 #[cfg(feature = "live")]
+mod live_images_truth;
+#[cfg(feature = "live")]
 mod live_messy;
 #[cfg(feature = "live")]
 mod live_messy_camera;

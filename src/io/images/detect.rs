@@ -43,6 +43,45 @@ pub struct Found {
     pub square_px: Vec<f64>,
 }
 
+/// A target point found in an image, ready for refinement.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Located {
+    /// The point's id in the target (its index: the targets activecal
+    /// detects number their points 0, 1, …).
+    pub id: usize,
+    /// Its pixel, as the detector placed it.
+    pub px: [f64; 2],
+    /// The shortest square side at it, px.
+    pub square_px: f64,
+    /// How far around it the image holds only the four squares' edges
+    /// that meet there, px: half a square on a checkerboard, less on a
+    /// ChArUco board (its markers' edges), the refinement's window bound
+    /// ([`super::refine::half_window_within`]).
+    pub clear_px: f64,
+    /// Whether `clear_px` is a disc's radius (a ChArUco corner) rather
+    /// than a square window's half width.
+    pub round: bool,
+}
+
+impl Found {
+    /// The corners as [`Located`] points (clear for half a square).
+    #[must_use]
+    pub fn located(&self) -> Vec<Located> {
+        self.px
+            .iter()
+            .zip(&self.square_px)
+            .enumerate()
+            .map(|(id, (px, s))| Located {
+                id,
+                px: *px,
+                square_px: *s,
+                clear_px: 0.5 * s,
+                round: false,
+            })
+            .collect()
+    }
+}
+
 /// Finds the `rows × cols` inner corners of a checkerboard in `img`; the
 /// error says why none were found, in words.
 pub fn find_checkerboard(img: &Gray, rows: usize, cols: usize) -> Result<Found, String> {

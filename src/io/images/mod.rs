@@ -12,16 +12,18 @@
 //! shift, and the edges' width (sharpness). An image without a row in the
 //! joints file is refused before any detection: its pose is unknown.
 //!
-//! Only checkerboards are detected (the `checkerboard:` target); ChArUco
-//! boards and AprilGrids are refused with that reason.
+//! Checkerboards (the `checkerboard:` target, [`detect`]) and ChArUco
+//! boards (the `charuco:` target, [`charuco`]) are detected; AprilGrids
+//! and point lists are refused with that reason.
 
+pub mod charuco;
 pub mod decode;
 pub mod detect;
 pub mod files;
 pub mod joints;
 pub mod refine;
 
-use super::camera_target::Target;
+use super::camera_target::{CharucoPattern, Target};
 use crate::error::{Error, Result};
 use crate::identify::camera::CameraObservations;
 use crate::measure::camera::MIN_POINTS_PER_POSE;
@@ -91,11 +93,19 @@ pub fn read_images(
     intrinsics: &Intrinsics,
 ) -> Result<ImageObservations> {
     let origin = spec.display().to_string();
-    let Some((rows, cols)) = target.grid else {
-        return Err(Error::Parse {
+    let board = match (&target.charuco, target.grid) {
+        (Some(p), _) => {
+            charuco::check_pattern(p).map_err(|message| Error::Parse {
+                path: origin.clone(),
+                message: format!("the target: {message}"),
+            })?;
+            Board::Charuco(p)
+        }
+        (None, Some(grid)) => Board::Checkerboard(grid),
+        (None, None) => return Err(Error::Parse {
             path: origin,
-            message: "activecal detects checkerboards in images (a 'checkerboard:' target); ChArUco boards, AprilGrids and point lists are not detected yet: detect their points yourself and give them as --observations".into(),
-        });
+            message: "activecal detects checkerboards and ChArUco boards in images (a 'checkerboard:' or 'charuco:' target); AprilGrids and point lists are not detected yet: detect their points yourself and give them as --observations".into(),
+        }),
     };
     let files = files::image_files(spec)?;
     let names: Vec<String> = files
@@ -122,7 +132,7 @@ pub fn read_images(
     };
     let mut images = Vec::new();
     for (k, (path, name)) in files.iter().zip(&names).enumerate() {
-        let outcome = match one_image(path, rows, cols, intrinsics) {
+        let outcome = match one_image(path, &board, target.ids.len(), intrinsics) {
             Ok((seen, outcome)) => {
                 obs.pose_ids.push(k as i64);
                 obs.qs.push(joints.of(name).unwrap_or_default().to_vec());
@@ -157,11 +167,20 @@ pub fn read_images(
     })
 }
 
-/// One image's points (by target id) and figures, or why it is left out.
+/// A board activecal detects.
+enum Board<'a> {
+    /// A checkerboard's inner corners (rows, cols).
+    Checkerboard((usize, usize)),
+    /// A ChArUco board.
+    Charuco(&'a CharucoPattern),
+}
+
+/// One image's points (by target id; `n` of them) and figures, or why it
+/// is left out.
 fn one_image(
     path: &Path,
-    rows: usize,
-    cols: usize,
+    board: &Board,
+    n: usize,
     intrinsics: &Intrinsics,
 ) -> std::result::Result<(Vec<Option<[f64; 2]>>, ImageOutcome), String> {
     let bytes = std::fs::read(path).map_err(|e| format!("unreadable ({e})"))?;
@@ -173,25 +192,40 @@ fn one_image(
             img.width, img.height
         ));
     }
-    let found = detect::find_checkerboard(&img, rows, cols)?;
-    let mut seen = vec![None; rows * cols];
+    let found = match board {
+        Board::Checkerboard((rows, cols)) => {
+            detect::find_checkerboard(&img, *rows, *cols)?.located()
+        }
+        Board::Charuco(p) => charuco::find_charuco(&img, p)?,
+    };
+    let mut seen = vec![None; n];
     let (mut shifts, mut widths, mut windows) = (Vec::new(), Vec::new(), Vec::new());
-    for (k, (p, s)) in found.px.iter().zip(&found.square_px).enumerate() {
-        let half = refine::half_window(*s);
+    for c in found.iter().filter(|c| c.id < n) {
+        let half = refine::half_window_within(c.clear_px);
         let refined = (half >= refine::MIN_HALF_WINDOW)
-            .then(|| refine::refine_corner(&img, *p, half))
+            .then(|| refine::refine_corner_in(&img, c.px, half, c.round))
             .flatten()
             .filter(|r| r.shift <= refine::MAX_SHIFT);
         // Not refined (a window too small, or a move too long to be this
-        // corner's): the detector's corner.
-        let r = refined.unwrap_or(refine::Refined { px: *p, shift: 0.0 });
+        // corner's): the detector's corner on a checkerboard (only a whole
+        // board is labelled); left out on a ChArUco board, whose corners
+        // carry ids (its detector placed one 1.6 px off on the rendered
+        // images of `verify/tests/live_images_truth.rs`, a move the
+        // refinement refused).
+        if refined.is_none() && matches!(board, Board::Charuco(_)) {
+            continue;
+        }
+        let r = refined.unwrap_or(refine::Refined {
+            px: c.px,
+            shift: 0.0,
+        });
         let half = if refined.is_some() { half } else { 0 };
         let inside =
             (-0.5..w as f64 - 0.5).contains(&r.px[0]) && (-0.5..h as f64 - 0.5).contains(&r.px[1]);
         if !inside {
             continue;
         }
-        seen[k] = Some(r.px);
+        seen[c.id] = Some(r.px);
         shifts.push(r.shift);
         windows.push(half);
         if let Some(e) = refine::edge_width(&img, r.px, half) {
@@ -200,17 +234,15 @@ fn one_image(
     }
     if shifts.len() < MIN_POINTS_PER_POSE {
         return Err(format!(
-            "{} of {} corners refined; a pose needs at least {MIN_POINTS_PER_POSE}",
+            "{} of {n} corners found in the image; a pose needs at least {MIN_POINTS_PER_POSE}",
             shifts.len(),
-            rows * cols
         ));
     }
     let outcome = ImageOutcome::Found {
         points: shifts.len(),
         square_px: found
-            .square_px
             .iter()
-            .copied()
+            .map(|c| c.square_px)
             .fold(f64::INFINITY, f64::min),
         window_px: [
             windows.iter().copied().min().unwrap_or(0),

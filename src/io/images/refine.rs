@@ -49,7 +49,17 @@ pub const MAX_SHIFT: f64 = 0.75;
 /// [`MAX_HALF_WINDOW`].
 #[must_use]
 pub fn half_window(square_px: f64) -> usize {
-    let h = (0.5 * square_px - 1.0).floor();
+    half_window_within(0.5 * square_px)
+}
+
+/// The half width `h = ⌊clear_px − 1⌋` of a window that stays, with its
+/// gradients' one-pixel margin, within `clear_px` of the corner (half a
+/// square on a checkerboard, [`half_window`]; the distance to the nearest
+/// marker's edge on a ChArUco board); at least 1 and at most
+/// [`MAX_HALF_WINDOW`].
+#[must_use]
+pub fn half_window_within(clear_px: f64) -> usize {
+    let h = (clear_px - 1.0).floor();
     if h.is_finite() && h > 1.0 {
         (h as usize).min(MAX_HALF_WINDOW)
     } else {
@@ -71,6 +81,15 @@ pub struct Refined {
 /// gradients all parallel or none) or the estimate leaves the window.
 #[must_use]
 pub fn refine_corner(img: &Gray, start: [f64; 2], h: usize) -> Option<Refined> {
+    refine_corner_in(img, start, h, false)
+}
+
+/// [`refine_corner`] with the window `[−h, h]²`, or with `round` the disc
+/// of radius `h` in it (a ChArUco corner: the markers' edges nearest the
+/// corner are diagonal to it, at `√2` times their distance along the
+/// board's axes, so a disc reaches farther than a square clear of them).
+#[must_use]
+pub fn refine_corner_in(img: &Gray, start: [f64; 2], h: usize, round: bool) -> Option<Refined> {
     let hi = h as i64;
     let hf = h as f64;
     let mut q = start;
@@ -78,6 +97,9 @@ pub fn refine_corner(img: &Gray, start: [f64; 2], h: usize) -> Option<Refined> {
         let (mut a, mut b, mut c, mut r0, mut r1) = (0.0, 0.0, 0.0, 0.0, 0.0);
         for j in -hi..=hi {
             for i in -hi..=hi {
+                if round && i * i + j * j > hi * hi {
+                    continue;
+                }
                 let (x, y) = (q[0] + i as f64, q[1] + j as f64);
                 let gx = 0.5 * (img.bilinear(x + 1.0, y) - img.bilinear(x - 1.0, y));
                 let gy = 0.5 * (img.bilinear(x, y + 1.0) - img.bilinear(x, y - 1.0));

@@ -1,0 +1,62 @@
+"""activecal.detect on the committed images (fixtures/camera/images/: a
+camera on a true UR5's flange looking at a 6 x 9 checkerboard, rendered by
+verify/python/camera_images.py with --noise 0; their true corners in
+fixtures/camera/images_truth.csv), and the observations it returns
+calibrated by calibrate_camera."""
+
+import csv
+import math
+
+import pytest
+
+import activecal
+from conftest import FIXTURES
+
+CAM = FIXTURES / "camera"
+IMAGES = CAM / "images"
+
+
+def ur5():
+    return activecal.Robot.from_urdf(FIXTURES / "ur5.urdf", tip="target")
+
+
+def detected():
+    return activecal.detect(IMAGES, CAM / "board_6x9.yaml", CAM / "small_camera_info.yaml",
+                            robot=ur5(), joints=IMAGES / "joints.csv")
+
+
+def test_detect_returns_the_observations_of_every_image_with_the_true_corners():
+    df = detected()
+    r = ur5()
+    assert list(df.columns) == ["pose", *r.joint_names, "feature", "u", "v"]
+    images = df.attrs["images"]
+    assert len(images) == 12 and all(i["status"] == "found" for i in images), images
+    assert sorted(set(df["pose"])) == list(range(12))
+    truth = {(int(row["pose"]), int(row["feature"])): (float(row["u"]), float(row["v"]))
+             for row in csv.DictReader(open(CAM / "images_truth.csv"))}
+    errors = sorted(math.hypot(u - truth[(p, f)][0], v - truth[(p, f)][1])
+                    for p, f, u, v in zip(df["pose"], df["feature"], df["u"], df["v"]))
+    # Every corner labelled as the truth (another id is a square, >= 6 px,
+    # away) and refined (the bounds of tests/camera_images.rs: the
+    # detector's corners within 0.5 px, refined ones 0.1 px in the median).
+    assert len(errors) == 12 * 54
+    assert errors[len(errors) // 2] < 0.1 and errors[-1] < 0.5, errors[-5:]
+
+
+def test_the_detected_observations_calibrate_as_the_command_line_does():
+    cal = activecal.calibrate_camera(ur5(), detected(), CAM / "small_camera_info.yaml",
+                                     CAM / "board_6x9.yaml", mounting="eye-in-hand")
+    assert cal.converged
+    # Noise-free renders: the corners' errors are the refinement's
+    # (under 0.1 px in the median), the fit's pixel σ of the same order.
+    assert cal.report["sigma_px"] < 0.2, cal.report["sigma_px"]
+
+
+def test_a_missing_folder_and_a_target_without_a_detector_are_refused_naming_them(tmp_path):
+    with pytest.raises(activecal.InputError, match="^images: "):
+        activecal.detect(tmp_path / "nowhere", CAM / "board_6x9.yaml",
+                         CAM / "small_camera_info.yaml", robot=ur5(), joints=IMAGES / "joints.csv")
+    grid = {"aprilgrid": {"rows": 2, "cols": 2, "tag_size": 0.05, "tag_spacing": 0.3}}
+    with pytest.raises(activecal.InputError, match="^images: .*AprilGrids"):
+        activecal.detect(IMAGES, grid, CAM / "small_camera_info.yaml", robot=ur5(),
+                         joints=IMAGES / "joints.csv")

@@ -1,0 +1,269 @@
+//! The images' truth gates (issue #51; feature `live`, the project venv
+//! with Pinocchio and OpenCV, and `target/debug/activecal`): a true robot
+//! (Pinocchio, every chain joint's origin off by 0.5–2 mm and 0.05–0.3°,
+//! `camera_truth.py make`), rendered images of its target
+//! (`camera_images.py render`, exactly: rays cast through the true
+//! distortion, 4 × 4 anti-aliasing, blur 0.6 px, gamma 2.2, noise 2 grey
+//! levels, 4 draws of the noise on the same renders), `activecal
+//! calibrate --images` → URDF + frames, `truth.py compare` → the true
+//! error of the target's origin in the camera's frame at 1,000 random
+//! configurations (the scene's helpers: [`super::live_images`]).
+//!
+//! Each gate asserts: every corner labelled as the truth; the corners at
+//! least as accurate (median and 95th percentile against the true pixels)
+//! as each of OpenCV's routes on the same images; the true error's RMS
+//! over the draws at most 1.3× the fit's prediction
+//! (`identify::camera::predict`) and at most 1.3× the true error of the
+//! same images' true pixels given Gaussian noise of the detected corners'
+//! own σ. One-sided: on the UR5 eye-in-hand it came out about half of
+//! either (the detected corners' errors are partly common to
+//! neighbouring corners, which the fit's residual σ̂ counts but the
+//! placements absorb): the prediction is conservative for detected
+//! corners, a limit stated in docs/cameras.md.
+//!
+//! * [`live_images_eye_in_hand_checkerboard`]: the UR5, the camera on its
+//!   flange, a 6 × 9 board (its corner order fixed by its colours) fixed
+//!   0.45 m out, 20 images (the last 3 far and oblique: squares of
+//!   6–15 px); against `findChessboardCorners` + `cornerSubPix` with the
+//!   tutorial's (11, 11) window and with (5, 5), and
+//!   `findChessboardCornersSB`.
+//! * [`live_images_eye_to_hand_checkerboard`]: example-robot-data's Panda
+//!   (to `panda_hand_tcp`), the camera fixed 1.3 m away as the pixels'
+//!   gate has it (`live_camera_truth.rs`), a 6 × 9 board on the hand, 20
+//!   images from 0.3–2 m (squares of 7–28 px); the same OpenCV routes.
+//! * [`live_images_eye_in_hand_charuco`]: the UR5 eye-in-hand as the
+//!   first, an OpenCV ChArUco board of 7 × 10 squares of 25 mm, markers of
+//!   15 mm (`DICT_4X4_50`), its ids found in the markers; against OpenCV's
+//!   `CharucoDetector` with its defaults.
+
+use super::live_images::{
+    Board, Pixels, RATIO, Rig, SQUARE, Scene, calibrate, checkerboard, corner_errors, from_images,
+    noisy_truth, opencv, predicted, quantile, read_pixels, rms, scene, truth_labelled,
+    ur5_eye_in_hand, write_pixels,
+};
+use activecal::measure::camera::Mounting;
+use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+
+/// Draws of the noise on the same renders.
+const DRAWS: usize = 4;
+
+/// OpenCV's checkerboard routes (label, `camera_images.py opencv`'s
+/// arguments) for a `rows × cols` board.
+fn checkerboard_routes(rows: usize, cols: usize) -> Vec<(&'static str, Vec<String>)> {
+    let p = format!("--pattern={rows},{cols}");
+    let args = |v: &[&str]| -> Vec<String> {
+        std::iter::once(p.clone())
+            .chain(v.iter().map(|s| (*s).to_string()))
+            .collect()
+    };
+    vec![
+        (
+            "findChessboardCorners + cornerSubPix (11, 11)",
+            args(&["--method", "classic", "--window", "11"]),
+        ),
+        (
+            "findChessboardCorners + cornerSubPix (5, 5)",
+            args(&["--method", "classic", "--window", "5"]),
+        ),
+        ("findChessboardCornersSB", args(&["--method", "sb"])),
+    ]
+}
+
+/// The gate on a rendered scene (see the module documentation), with
+/// OpenCV's `routes` compared on the first draw.
+fn gate(s: &Scene, routes: &[(&str, Vec<String>)]) {
+    let (mut t2, mut p2, mut r2) = (0.0, 0.0, 0.0);
+    for (d, draw) in s.draws.iter().enumerate() {
+        let (report, true_mm, saved) = from_images(s, draw, &format!("images{d}"));
+        let detected = read_pixels(&saved);
+        let truth = read_pixels(&draw.join("truth.csv"));
+        let (_, misordered) = truth_labelled(&detected, &truth);
+        assert!(
+            misordered.is_empty(),
+            "draw {d}: poses {misordered:?} labelled otherwise than the truth"
+        );
+        assert!(
+            report["relabelled"].as_array().unwrap().is_empty(),
+            "draw {d}"
+        );
+        let e = corner_errors(&detected, &truth);
+        let (median, p95) = (quantile(&e, 0.5), quantile(&e, 0.95));
+        let predicted_mm = predicted(s, &saved);
+        // The same poses' true pixels with the detected corners' own σ.
+        let sigma = rms(&e) / 2f64.sqrt();
+        let reference = s.dir.join(format!("truth{d}.csv"));
+        write_pixels(
+            &noisy_truth(&detected, &truth, sigma, d as u64 + 1),
+            &reference,
+        );
+        let (_, ref_mm) = calibrate(
+            s,
+            &["--observations".as_ref(), reference.as_os_str()],
+            &format!("truth{d}"),
+        );
+        println!(
+            "{} draw {d}: {} of {} images, corners {median:.3} px median, {p95:.3} px p95 (σ {sigma:.3} px); true error {true_mm:.4} mm, predicted {predicted_mm:.4} mm, true pixels + σ {ref_mm:.4} mm",
+            s.rig.name,
+            detected.poses.len(),
+            truth.poses.len()
+        );
+        if d == 0 {
+            for (label, args) in routes {
+                let (n, m, p) = opencv(s, draw, args, "opencv");
+                println!(
+                    "  OpenCV {label}: {n} of {} images, {m:.3} px median, {p:.3} px p95",
+                    truth.poses.len()
+                );
+                if s.board_has_ids {
+                    same_corners(s, draw, &detected, &truth, label);
+                } else {
+                    assert!(
+                        median <= m && p95 <= p,
+                        "{label}: {m} / {p} px against activecal's {median} / {p95} px"
+                    );
+                }
+            }
+        }
+        t2 += true_mm * true_mm;
+        p2 += predicted_mm * predicted_mm;
+        r2 += ref_mm * ref_mm;
+    }
+    let n = s.draws.len() as f64;
+    let (t, p, r) = ((t2 / n).sqrt(), (p2 / n).sqrt(), (r2 / n).sqrt());
+    println!(
+        "{}: RMS over {n} draws: true {t:.4} mm, predicted {p:.4} mm ({:.2}×), true pixels + σ {r:.4} mm ({:.2}×)",
+        s.rig.name,
+        t / p,
+        t / r
+    );
+    assert!(t < RATIO * p, "true {t} mm against predicted {p} mm");
+    assert!(
+        t < RATIO * r,
+        "true {t} mm against {r} mm from the true pixels"
+    );
+}
+
+#[test]
+fn live_images_eye_in_hand_checkerboard() {
+    let board: Board = checkerboard(6, 9);
+    let s = scene(
+        ur5_eye_in_hand("eye-in-hand", 6, 9, false),
+        &board,
+        false,
+        (20, true),
+        DRAWS,
+    );
+    gate(&s, &checkerboard_routes(6, 9));
+}
+
+/// The Panda eye-to-hand (see the module documentation): the camera and
+/// the board's placement on the hand as in the pixels' gate.
+fn panda_eye_to_hand(name: &'static str) -> Rig {
+    Rig {
+        name,
+        urdf: "fixtures/example-robot-data/panda.urdf",
+        base: "panda_link0",
+        tip: "panda_hand_tcp",
+        mounting: Mounting::EyeToHand,
+        camera: Isometry3::from_parts(
+            Translation3::new(1.2, 0.6, 0.9),
+            UnitQuaternion::from_euler_angles(-2.0985, 0.0, 2.0779),
+        ),
+        target: Isometry3::from_parts(
+            Translation3::new(-0.0853, 0.0568, 0.02),
+            UnitQuaternion::from_euler_angles(std::f64::consts::PI, 0.0, 0.03),
+        ),
+        near: [0.3, 2.0],
+    }
+}
+
+#[test]
+fn live_images_eye_to_hand_checkerboard() {
+    let s = scene(
+        panda_eye_to_hand("eye-to-hand"),
+        &checkerboard(6, 9),
+        false,
+        (20, false),
+        DRAWS,
+    );
+    gate(&s, &checkerboard_routes(6, 9));
+}
+
+/// The ChArUco board of [`live_images_eye_in_hand_charuco`]: rows × cols
+/// squares, the markers' side.
+const CHARUCO: (usize, usize, f64) = (7, 10, 0.015);
+
+#[test]
+fn live_images_eye_in_hand_charuco() {
+    let (rows, cols, marker) = CHARUCO;
+    let spec = format!("{rows},{cols},{SQUARE},{marker}");
+    let board = Board {
+        yaml: format!(
+            "charuco: {{rows: {rows}, cols: {cols}, square: {SQUARE}, marker: {marker}, dictionary: DICT_4X4_50}}\n"
+        ),
+        render: vec![
+            format!("--charuco={spec}"),
+            "--dictionary=DICT_4X4_50".into(),
+        ],
+        ids: true,
+    };
+    // The rig's board is centred on its inner corners, as a checkerboard
+    // of (rows − 1) × (cols − 1) inner corners; the ChArUco target's frame
+    // is one square further out.
+    let mut rig = ur5_eye_in_hand("eye-in-hand-charuco", rows - 1, cols - 1, false);
+    rig.target *= nalgebra::Translation3::new(-SQUARE, -SQUARE, 0.0);
+    let s = scene(rig, &board, false, (20, true), DRAWS);
+    let route = vec![
+        "--method=charuco".to_string(),
+        format!("--charuco={spec}"),
+        "--dictionary=DICT_4X4_50".into(),
+    ];
+    gate(&s, &[("CharucoDetector", route)]);
+}
+
+/// A board with ids (ChArUco): OpenCV keeps fewer of its corners (those
+/// its marker-based interpolation vouches for), so the corners are
+/// compared on those both found (`opencv.csv`: image, feature, u, v):
+/// activecal finds at least as many, with a 95th percentile at least as
+/// small; the medians are printed (see docs/cameras.md for the measured
+/// limit).
+fn same_corners(s: &Scene, draw: &std::path::Path, ours: &Pixels, truth: &Pixels, label: &str) {
+    let names: Vec<String> = std::fs::read_to_string(draw.join("joints.csv"))
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap().to_string())
+        .collect();
+    let text = std::fs::read_to_string(s.dir.join("opencv.csv")).unwrap();
+    let (mut a, mut b, mut theirs) = (Vec::new(), Vec::new(), 0usize);
+    for l in text.lines().skip(1) {
+        let c: Vec<&str> = l.split(',').collect();
+        let pose = names.iter().position(|n| n == c[0]).unwrap() as i64;
+        let f: i64 = c[1].parse().unwrap();
+        let q = [c[2].parse::<f64>().unwrap(), c[3].parse::<f64>().unwrap()];
+        theirs += 1;
+        let t = truth.poses[&pose].1[&f];
+        if let Some(p) = ours.poses.get(&pose).and_then(|(_, pts)| pts.get(&f)) {
+            a.push((p[0] - t[0]).hypot(p[1] - t[1]));
+            b.push((q[0] - t[0]).hypot(q[1] - t[1]));
+        }
+    }
+    let found: usize = ours.poses.values().map(|(_, p)| p.len()).sum();
+    a.sort_by(f64::total_cmp);
+    b.sort_by(f64::total_cmp);
+    let (ma, pa, mb, pb) = (
+        quantile(&a, 0.5),
+        quantile(&a, 0.95),
+        quantile(&b, 0.5),
+        quantile(&b, 0.95),
+    );
+    println!(
+        "  on the {} corners both found (activecal {found}, OpenCV {theirs}): activecal {ma:.4} px median, {pa:.4} px p95; OpenCV {label} {mb:.4} px median, {pb:.4} px p95",
+        a.len()
+    );
+    assert!(
+        found >= theirs,
+        "activecal found {found} corners, OpenCV {theirs}"
+    );
+    assert!(pa <= pb, "{label}: p95 {pb} px against activecal's {pa} px");
+}

@@ -305,11 +305,15 @@ const NOT_YET_OWNED: &[(&str, &[&str])] = &[
     ),
     ("python/src/contacts.rs", &["identify"]),
     ("python/src/convert.rs", &["bound", "identify", "lsq"]),
+    (
+        "python/src/page.rs",
+        &["blocks", "how_many", "identify", "select"],
+    ),
     ("python/src/pool.rs", &["blocks", "collision", "pool"]),
     ("python/src/robot.rs", &["kinematics", "measure"]),
     (
         "python/src/select.rs",
-        &["blocks", "bound", "how_many", "pool", "select"],
+        &["blocks", "bound", "pool", "select"],
     ),
 ];
 

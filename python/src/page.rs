@@ -5,12 +5,14 @@
 //! inline in Jupyter by a `Page`. Nothing of the page is assembled here.
 
 use crate::convert::{Fail, arg_err, detached};
-use activecal::how_many::{CurveSettings, HowManyError, PoseCountCurve};
+use activecal::experiment::select::{CurveOf, how_many_curve};
+use activecal::how_many::{HowManyError, PoseCountCurve};
 use activecal::identify::Identification;
+use activecal::model::ParamSet;
 use activecal::model::Robot;
 use activecal::render::summary::{CalibrationSummary, FitPoses};
 use activecal::report::SelectReport;
-use activecal::select::{Algorithm, Settings};
+use activecal::select::{Algorithm, CriterionKind, Settings};
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -195,18 +197,17 @@ impl CurveInputs {
         noise: f64,
         target_error: Option<f64>,
     ) -> Result<PoseCountCurve, Fail> {
-        let mut cs = CurveSettings::new(self.settings.clone(), noise);
-        cs.algorithm = self.algorithm;
-        cs.also = vec![self.n];
-        cs.target_mm = target_error;
-        activecal::how_many::pose_count_curve(
-            &self.robot,
-            &self.robot.nominal,
-            &self.x,
-            &self.ids,
-            &cs,
-        )
-        .map_err(|e| match e {
+        let on = CurveOf {
+            robot: &self.robot,
+            params: ParamSet::Nominal,
+            x: &self.x,
+            ids: &self.ids,
+            settings: &self.settings,
+            criterion: CriterionKind::Det,
+            algorithm: self.algorithm,
+            n: self.n,
+        };
+        how_many_curve(on, noise, target_error).map_err(|e| match e {
             HowManyError::Input(e) => Fail::from(e),
             HowManyError::Bound(e) => e.into(),
         })

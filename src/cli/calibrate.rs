@@ -232,10 +232,7 @@ fn from_bag(a: &CalibrateArgs, robot: &Robot) -> Result<()> {
         }
     };
     let got = activecal::experiment::bag::calibrate_bag(bag, robot, &x, &o, &mut print_note)?;
-    let mut json = serde_json::json!({ "extraction": got.extraction });
-    if let Some(c) = &got.clock {
-        json["clock_refit"] = serde_json::to_value(c)?;
-    }
+    let json = serde_json::to_value(got.section())?;
     let mut text = super::extract::text(&got.extraction, None);
     if let Some(c) = &got.clock {
         text += &format!("{}\n", activecal::experiment::bag::clock_note(c));

@@ -392,18 +392,20 @@ fn report_dir(
     dir: &std::path::Path,
     report: &SelectReport,
 ) -> Result<Option<activecal::how_many::Recommendation>> {
-    let mut cs =
-        activecal::how_many::CurveSettings::new(s.clone(), a.noise.unwrap_or(DEFAULT_REPORT_NOISE));
-    cs.criterion = a.criterion;
-    cs.algorithm = a.algorithm;
-    cs.also = vec![a.n];
-    cs.target_mm = a.target_error;
-    let curve = activecal::how_many::pose_count_curve(
-        &ctx.robot,
-        ctx.robot.params(a.pool.params),
-        &ctx.x,
-        &ctx.pool.ids,
-        &cs,
+    let on = activecal::experiment::select::CurveOf {
+        robot: &ctx.robot,
+        params: a.pool.params,
+        x: &ctx.x,
+        ids: &ctx.pool.ids,
+        settings: s,
+        criterion: a.criterion,
+        algorithm: a.algorithm,
+        n: a.n,
+    };
+    let curve = activecal::experiment::select::how_many_curve(
+        on,
+        a.noise.unwrap_or(DEFAULT_REPORT_NOISE),
+        a.target_error,
     )?;
     activecal::render::folder::selection(dir, &ctx.robot, report, &curve, a.noise.is_none())?;
     Ok(curve.recommended)

@@ -110,6 +110,28 @@ pub struct BagCalibration {
     pub clock: Option<ClockRefit>,
 }
 
+/// What a calibration's report says of its bag: the extraction and, when
+/// the clock offset was estimated, both estimates.
+#[derive(Clone, Debug, Serialize)]
+pub struct BagSection<'a> {
+    /// The extraction that gave the measurements.
+    pub extraction: &'a ExtractReport,
+    /// The clock offset estimated twice, when it was estimated.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub clock_refit: Option<&'a ClockRefit>,
+}
+
+impl BagCalibration {
+    /// What the calibration's report says of its bag.
+    #[must_use]
+    pub fn section(&self) -> BagSection<'_> {
+        BagSection {
+            extraction: &self.extraction,
+            clock_refit: self.clock.as_ref(),
+        }
+    }
+}
+
 /// Calibrates `robot` from the bag at `path`: extracts one pose per rest
 /// ([`read_bag`]), fits it as a measurement file's data
 /// ([`calibrate_read`]) and, when the clock offset was estimated, estimates

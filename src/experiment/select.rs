@@ -222,3 +222,46 @@ fn refine(
     }
     Ok(Some(r))
 }
+
+/// What a selection's "how many poses" curve is computed from: its pool
+/// (robot at `params`, Jacobian, ids by position) and search.
+#[derive(Clone, Copy, Debug)]
+pub struct CurveOf<'a> {
+    /// The robot.
+    pub robot: &'a Robot,
+    /// The parameters the pool's Jacobian is at.
+    pub params: ParamSet,
+    /// The pool's Jacobian.
+    pub x: &'a Blocks,
+    /// The pool's ids, by position.
+    pub ids: &'a [usize],
+    /// The selection's settings.
+    pub settings: &'a Settings,
+    /// Its criterion.
+    pub criterion: CriterionKind,
+    /// Its algorithm.
+    pub algorithm: Algorithm,
+    /// The design's own size (always among the curve's sizes).
+    pub n: usize,
+}
+
+/// The "how many poses" curve of a selection ([`crate::how_many`]) at
+/// sensor noise σ `noise` (metres per coordinate), recommending the
+/// fewest poses predicted to reach `target_mm` when given, else the knee:
+/// what `select --report` draws and Python's `Design.how_many` returns.
+///
+/// # Errors
+/// A noise or target that is not a finite number > 0, or a failing
+/// selection or bound.
+pub fn how_many_curve(
+    c: CurveOf<'_>,
+    noise: f64,
+    target_mm: Option<f64>,
+) -> std::result::Result<crate::how_many::PoseCountCurve, crate::how_many::HowManyError> {
+    let mut cs = crate::how_many::CurveSettings::new(c.settings.clone(), noise);
+    cs.criterion = c.criterion;
+    cs.algorithm = c.algorithm;
+    cs.also = vec![c.n];
+    cs.target_mm = target_mm;
+    crate::how_many::pose_count_curve(c.robot, c.robot.params(c.params), c.x, c.ids, &cs)
+}

@@ -18,9 +18,7 @@ use crate::select::swap::SwappedPose;
 use crate::select::{Refinement, Selection};
 use std::sync::Arc;
 
-/// Speed assumed for a joint whose limit the robot does not state, rad/s
-/// (or m/s).
-pub const FALLBACK_SPEED: f64 = 1.0;
+pub use crate::select::tour::FALLBACK_SPEED;
 
 /// Replacements of a stuck pose tried, best first by the `ln OI_D` kept.
 pub const SWAP_TRIES: usize = 32;

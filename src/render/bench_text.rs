@@ -1,7 +1,7 @@
-//! The text of the project's benchmark ([`crate::experiment::bench`]): the
+//! The text of the project's benchmark ([`crate::report::bench`]): the
 //! timing table, peak memory and the robots side by side.
 
-use crate::experiment::bench::BenchReport;
+use crate::report::bench::BenchReport;
 use std::fmt::Write as _;
 
 /// The benchmark's report as text (milliseconds, seconds, MiB).

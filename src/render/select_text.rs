@@ -3,9 +3,9 @@
 //! check, the poses in visiting order and the predicted errors (units on
 //! every figure).
 
-use crate::experiment::visiting::FALLBACK_SPEED;
 use crate::report::SelectReport;
 use crate::select::Settings;
+use crate::select::tour::FALLBACK_SPEED;
 
 /// The text of a selection: the poses already measured, the search
 /// with its settings `a` and time (`seconds`), the figures, the

@@ -15,6 +15,10 @@ use crate::select::turns::{choose_turns, turned};
 use serde::Serialize;
 use std::f64::consts::TAU;
 
+/// Speed assumed for a joint whose limit the robot does not state, rad/s
+/// (or m/s).
+pub const FALLBACK_SPEED: f64 = 1.0;
+
 /// Gains below this, seconds, are not taken (rounding would otherwise let
 /// two equal orders swap forever).
 const GAIN_TOL: f64 = 1e-12;

@@ -18,7 +18,7 @@
 //! [`OFFSET_TOL`] of the truth, and estimated twice (the nominal model's
 //! estimate, the calibrated model's).
 
-use super::live_bags::{dir, python, rms, setup};
+use super::live_bags::{calibrate, dir, python, rms, setup};
 use super::live_truth::{activecal, compare};
 use serde_json::Value;
 use std::path::Path;
@@ -50,30 +50,6 @@ fn calibrate_bag(d: &Path, robot: &str, bag: &str, stem: &str, extra: &[&str]) -
     args.extend(["--out", &u, "--out", &y, "--force", "--json"]);
     let text = activecal(d, &args).unwrap_or_else(|e| panic!("{e}"));
     serde_json::from_str(&text).unwrap()
-}
-
-/// `calibrate --measurements meas` into `stem.urdf` and `stem.yaml`.
-fn calibrate_csv(d: &Path, robot: &str, meas: &str, stem: &str) {
-    let (u, y) = (format!("{stem}.urdf"), format!("{stem}.yaml"));
-    activecal(
-        d,
-        [
-            "calibrate",
-            "--robot",
-            robot,
-            "--frames",
-            "nominal.yaml",
-            "--measurements",
-            meas,
-            "--out",
-            &u,
-            "--out",
-            &y,
-            "--force",
-            "--json",
-        ],
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
 }
 
 /// `design.csv` with only the poses (0-based, `via` rows not counted) in
@@ -182,7 +158,7 @@ fn case(
             "truth.py",
             &m.iter().map(String::as_str).collect::<Vec<_>>(),
         );
-        calibrate_csv(d, robot, &format!("{clean}.csv"), &clean);
+        calibrate(d, robot, &format!("{clean}.csv"), &clean);
         table.push((
             true_offset,
             nominal - true_offset,

@@ -130,7 +130,7 @@ fn extract(d: &Path, robot: &str, frames: &str, bag: &str, out: &str, extra: &[&
 }
 
 /// `calibrate` of `meas` into `stem.urdf` and `stem.yaml`: its report.
-fn calibrate(d: &Path, robot: &str, meas: &str, stem: &str) -> Value {
+pub(super) fn calibrate(d: &Path, robot: &str, meas: &str, stem: &str) -> Value {
     let (u, y) = (format!("{stem}.urdf"), format!("{stem}.yaml"));
     let text = activecal(
         d,

@@ -296,7 +296,7 @@ const NOT_YET_OWNED: &[(&str, &[&str])] = &[
     ("python/src/bound.rs", &["bound"]),
     (
         "python/src/calibrate.rs",
-        &["frames", "identify", "lsq", "measure"],
+        &["frames", "identify", "measure"],
     ),
     ("python/src/camera.rs", &["identify", "measure", "pool"]),
     (
@@ -305,6 +305,7 @@ const NOT_YET_OWNED: &[(&str, &[&str])] = &[
     ),
     ("python/src/contacts.rs", &["identify"]),
     ("python/src/convert.rs", &["bound", "identify", "lsq"]),
+    ("python/src/fit_args.rs", &["identify", "lsq"]),
     (
         "python/src/page.rs",
         &["blocks", "how_many", "identify", "select"],

@@ -373,3 +373,41 @@ pub fn warn(py: Python<'_>, text: &str) -> PyResult<()> {
         1,
     )
 }
+
+/// `other` in the row order of `q` when both are pandas objects with an
+/// index: as given when the indexes are equal, reordered by `q`'s index
+/// when they hold the same unique labels in another order, and refused when
+/// their labels differ (rows are never matched by position behind the
+/// user's back). Anything without an index (NumPy arrays, lists) is taken
+/// as given, row for row.
+pub(crate) fn aligned<'py>(
+    q: &Bound<'py, PyAny>,
+    other: &Bound<'py, PyAny>,
+    name: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    // A pandas index (a list's `index` is a method: not one).
+    let index = |x: &Bound<'py, PyAny>| {
+        x.getattr("index")
+            .ok()
+            .filter(|i| i.hasattr("equals").unwrap_or(false))
+    };
+    let (Some(qi), Some(oi)) = (index(q), index(other)) else {
+        return Ok(other.clone());
+    };
+    if qi.call_method1("equals", (&oi,))?.is_truthy()? {
+        return Ok(other.clone());
+    }
+    let sorted = |i: &Bound<'py, PyAny>| i.call_method0("sort_values");
+    let same = sorted(&qi)?
+        .call_method1("equals", (sorted(&oi)?,))?
+        .is_truthy()?;
+    let unique = qi.getattr("is_unique")?.is_truthy()? && oi.getattr("is_unique")?.is_truthy()?;
+    if same && unique {
+        return other.getattr("loc")?.get_item(&qi);
+    }
+    Err(pyo3::exceptions::PyValueError::new_err(format!(
+        "{name}: its index does not hold q's row labels (q {}, {name} {}): give both with the same labels, or plain arrays matched row by row",
+        qi.repr()?,
+        oi.repr()?
+    )))
+}

@@ -14,6 +14,7 @@ mod camera_select;
 mod contacts;
 mod convert;
 mod errors;
+mod fit_args;
 mod images;
 mod page;
 mod pickling;

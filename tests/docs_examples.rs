@@ -30,6 +30,14 @@
 //! right after a line `<!-- not run: REASON -->`: every shell example is
 //! either run or says why not. `DOCS_EXAMPLES_ONLY=docs/x.md` runs one
 //! page; `DOCS_EXAMPLES_SHOW=1` prints every command's whole output.
+//!
+//! Beyond the lines a page promises, every command's *whole* output is
+//! kept in `tests/golden/docs/<page>.txt` and must stay the same (a
+//! refactoring of the front ends changes no output): text byte for byte,
+//! a number within one unit of its last printed digit (another CPU's BLAS
+//! kernels may round the last digit the other way), a duration (a number
+//! followed by ` s` or ` ms`) free. `DOCS_GOLDEN_UPDATE=1` rewrites the
+//! files after an intended change of output (review the diff).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -288,6 +296,125 @@ fn run_example(dir: &Path, command: &str) -> String {
     text
 }
 
+/// The whole outputs of one page's commands, as kept in its golden file:
+/// each command after a `$ ` line, its output after it.
+fn transcript(runs: &[(String, String)]) -> String {
+    let mut t = String::new();
+    for (command, output) in runs {
+        t.push_str("$ ");
+        t.push_str(command);
+        t.push('\n');
+        t.push_str(output);
+        if !output.ends_with('\n') {
+            t.push('\n');
+        }
+    }
+    t
+}
+
+/// Whether a printed number `actual` is `expected` within one unit of the
+/// last digit `expected` prints (the same text always agrees).
+fn same_number(expected: &str, actual: &str) -> bool {
+    if expected == actual {
+        return true;
+    }
+    match (number_at(expected), number_at(actual)) {
+        (Some((e, _, Some(d))), Some((a, _, Some(da)))) if d == da => {
+            (a - e).abs() <= 10f64.powi(-(d as i32)) * (1.0 + 1e-9) * scale_of(expected)
+        }
+        _ => false,
+    }
+}
+
+/// The power of ten a number in exponent notation carries (1 otherwise):
+/// `1.25e-7`'s last digit is a unit of 1e-9.
+fn scale_of(s: &str) -> f64 {
+    s.find(['e', 'E'])
+        .and_then(|k| s[k + 1..].parse::<i32>().ok())
+        .map_or(1.0, |x| 10f64.powi(x))
+}
+
+/// The tokens of a line: runs of a number (as [`number_at`] reads it),
+/// and single other characters.
+fn tokens(line: &str) -> Vec<&str> {
+    let mut out = Vec::new();
+    let mut k = 0;
+    while k < line.len() {
+        let at_boundary = k == 0 || !line.as_bytes()[k - 1].is_ascii_alphanumeric();
+        let n = if at_boundary {
+            number_at(&line[k..]).map(|(_, n, _)| n)
+        } else {
+            None
+        };
+        let len = n.unwrap_or_else(|| line[k..].chars().next().map_or(1, char::len_utf8));
+        out.push(&line[k..k + len]);
+        k += len;
+    }
+    out
+}
+
+/// Whether an output line equals its golden line (see the module
+/// documentation: numbers to one unit of the last digit, durations free).
+pub fn golden_line_matches(golden: &str, actual: &str) -> bool {
+    let (g, a) = (tokens(golden), tokens(actual));
+    if g.len() != a.len() {
+        return false;
+    }
+    let duration = |t: &[&str], i: usize| {
+        let rest: String = t[i + 1..].iter().take(3).copied().collect();
+        rest.starts_with(" s") && !rest[2..].starts_with(|c: char| c.is_alphanumeric())
+            || rest.starts_with(" ms")
+            || rest.starts_with("s)")
+    };
+    g.iter().zip(&a).enumerate().all(|(i, (x, y))| {
+        x == y
+            || number_at(x).is_some()
+                && number_at(y).is_some()
+                && (duration(&g, i) || same_number(x, y))
+    })
+}
+
+/// Where a page's whole output first differs from its golden file, if it
+/// does (or why the file cannot be read).
+fn golden_difference(root: &Path, page: &Path, transcript: &str) -> Option<String> {
+    let stem = page
+        .file_stem()
+        .expect("a page has a name")
+        .to_string_lossy();
+    let file = root.join("tests/golden/docs").join(format!("{stem}.txt"));
+    if std::env::var_os("DOCS_GOLDEN_UPDATE").is_some() {
+        std::fs::create_dir_all(file.parent().expect("a folder")).expect("the golden folder");
+        std::fs::write(&file, transcript).expect("the golden file written");
+        return None;
+    }
+    let Ok(golden) = std::fs::read_to_string(&file) else {
+        return Some(format!(
+            "{}: no golden output {} (DOCS_GOLDEN_UPDATE=1 writes it)",
+            page.display(),
+            file.display()
+        ));
+    };
+    let (g, a): (Vec<&str>, Vec<&str>) = (golden.lines().collect(), transcript.lines().collect());
+    let at = (0..g.len().max(a.len())).find(
+        |&k| !matches!((g.get(k), a.get(k)), (Some(x), Some(y)) if golden_line_matches(x, y)),
+    )?;
+    let command = g[..at.min(g.len())]
+        .iter()
+        .rev()
+        .find(|l| l.starts_with("$ "))
+        .copied()
+        .unwrap_or("");
+    Some(format!(
+        "{}: the whole output differs from {} at its line {} (in `{}`):\n  golden: {}\n  now:    {}\n  (an intended change: DOCS_GOLDEN_UPDATE=1, then review the diff)",
+        page.display(),
+        file.display(),
+        at + 1,
+        command.trim_start_matches("$ "),
+        g.get(at).copied().unwrap_or("<end of file>"),
+        a.get(at).copied().unwrap_or("<end of output>")
+    ))
+}
+
 /// Why an example's output is not what its page says, if it is not.
 fn check(page: &Path, ex: &Example, output: &str) -> Option<String> {
     let (i, from) = first_unmatched(&ex.expected, output)?;
@@ -325,6 +452,7 @@ fn every_shell_example_in_the_readme_and_docs_runs_and_prints_what_it_says() {
             ));
         }
         let dir = scratch(root, &page);
+        let mut runs = Vec::new();
         for ex in &parsed.examples {
             let t = Instant::now();
             let output = run_example(&dir, &ex.command);
@@ -340,6 +468,13 @@ fn every_shell_example_in_the_readme_and_docs_runs_and_prints_what_it_says() {
                 eprintln!("{output}");
             }
             failures.extend(check(&page, ex, &output));
+            runs.push((
+                ex.command.clone(),
+                output.replace(&dir.display().to_string(), "SCRATCH"),
+            ));
+        }
+        if !parsed.examples.is_empty() && std::env::var_os("DOCS_EXAMPLES_ONLY").is_none() {
+            failures.extend(golden_difference(root, &page, &transcript(&runs)));
         }
         let _ = std::fs::remove_dir_all(&dir);
     }
@@ -380,6 +515,27 @@ fn a_figure_outside_its_tolerance_fails_and_elisions_match_anything() {
         first_unmatched(&["two 2.0".into(), "one 1.0".into()], out),
         Some((1, 2))
     );
+}
+
+#[test]
+fn golden_lines_allow_the_last_digit_and_durations_only() {
+    assert!(golden_line_matches(
+        "RMS 0.085 mm in 0.32 s",
+        "RMS 0.085 mm in 1.70 s"
+    ));
+    assert!(golden_line_matches("RMS 0.085 mm", "RMS 0.086 mm"));
+    assert!(!golden_line_matches("RMS 0.085 mm", "RMS 0.087 mm"));
+    assert!(!golden_line_matches("RMS 0.085 mm", "RMS 0.0850 mm"));
+    assert!(!golden_line_matches("RMS 0.085 mm", "RMS  0.085 mm"));
+    assert!(golden_line_matches("rss 2.18e-7 m", "rss 2.19e-7 m"));
+    assert!(!golden_line_matches("rss 2.18e-7 m", "rss 2.20e-7 m"));
+    assert!(!golden_line_matches("30 poses", "31 poses"));
+    assert!(!golden_line_matches("0.5 mm", "0.5 m"));
+    assert!(golden_line_matches("took 12 ms", "took 80 ms"));
+    assert!(golden_line_matches("a (0.21 s)", "a (1.30 s)"));
+    assert!(!golden_line_matches("0.21 sigma", "0.31 sigma"));
+    assert!(golden_line_matches("joint_2 x", "joint_2 x"));
+    assert!(!golden_line_matches("joint_2 x", "joint_3 x"));
 }
 
 #[test]

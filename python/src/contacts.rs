@@ -158,10 +158,18 @@ pub fn calibrate_contacts(
         .outliers(outliers)
         .build()
         .map_err(|e| crate::convert::Fail::from(e).into_py())?;
-    let file = contact_file(qs, points);
-    file.check_distinct().map_err(|e| arg_err("q", e))?;
-    let known = activecal::experiment::contacts::checked_distances(&inner, &file, &given)
-        .map_err(|e| arg_err("distances", e))?;
+    let mut file = contact_file(qs, points);
+    let known = activecal::experiment::contacts::checked_inputs(
+        &inner,
+        &mut file,
+        &[],
+        &given,
+        activecal::experiment::contacts::ContactUse::Fit,
+    )
+    .map_err(|e| match e.input {
+        activecal::experiment::contacts::ContactInput::Rows => arg_err("q", e.source),
+        _ => arg_err("distances", e.source),
+    })?;
     let r = inner.clone();
     let (c, report) = crate::progress::with_callback(progress, || {
         detached(py, move || {
@@ -193,16 +201,7 @@ impl ContactCalibration {
     /// not converge or is not a plausible robot.
     fn write_as(&self, format: Format, path: &std::path::Path, overwrite: bool) -> PyResult<()> {
         let fit = &self.c.fit;
-        if !fit.converged {
-            return Err(Fail::Compute(format!(
-                "{}: not written: the contact fit ended {:?} after {} iterations",
-                path.display(),
-                fit.stop,
-                fit.iterations
-            ))
-            .into_py());
-        }
-        if let Some(why) = &self.c.implausible {
+        if let Some(why) = self.c.verdict().refusal() {
             return Err(Fail::Compute(format!("{}: not written: {why}", path.display())).into_py());
         }
         let Some((f, r)) = &self.c.frames else {

@@ -4,16 +4,18 @@
 //! rendering of the fit and of `--holdout-by
 //! placement` / `--train-on`. The work is in `activecal::identify::contact`.
 
+use activecal::experiment::contacts::{
+    ContactInput, ContactInputError, ContactUse, checked_inputs,
+};
 use activecal::identify::LmSettings;
 use activecal::identify::contact::{
-    ContactFit, ContactSettings, HoldoutMode, HoldoutReport, NamedDistance, NamedPlane,
-    holdout::{Figures, downweighted_rows},
-    holdout_by_placement, resolve_distances,
+    ContactSettings, HoldoutMode, HoldoutReport, NamedDistance, NamedPlane, holdout_by_placement,
 };
 use activecal::io::contacts::{ContactFile, read_contacts};
 use activecal::model::Robot;
-use anyhow::{Context, Result, bail};
-use std::fmt::Write as _;
+use activecal::render::contact_figures::ContactReport;
+use activecal::render::contact_text;
+use anyhow::{Result, bail};
 use std::path::Path;
 
 /// How to hold contacts out.
@@ -147,106 +149,68 @@ pub fn calibrate_contacts(
     super::contact_out::check(a.out, robot)?;
     let (given, planes) = contact_setup(a.setup, a.point_distance, a.plane)?;
     let mut file = read_contacts(path, robot, a.units)?;
-    file.check_distinct()?;
-    file.set_known_planes(&planes).context("--plane")?;
-    activecal::identify::contact::lengths::check_planes(robot, &file).context("--plane")?;
-    let known = resolve_distances(&file, &given, true).context("--point-distance")?;
-    activecal::identify::contact::check_scale(&file, &known).context("--point-distance")?;
-    activecal::identify::contact::lengths::check_distances(robot, &file, &known)
-        .context("--point-distance")?;
+    let known =
+        checked_inputs(robot, &mut file, &planes, &given, ContactUse::Fit).map_err(named)?;
     let settings = settings_of(a)?;
     let cal = activecal::experiment::contacts::calibrate_contacts(
         robot, &file, &known, &given, &settings,
     )?;
-    let (fit, figures, fitted) = (&cal.fit, &cal.in_sample, &cal.file);
     // The rows kept: those left out as gross errors are neither fitted
     // nor held out.
-    let held = held_out(a, robot, fitted, &given, &settings)?;
+    let held = held_out(a, robot, &cal.file, &given, &settings)?;
+    let verdict = cal.verdict();
     let written = match &cal.frames {
-        Some(f) if !a.out.is_empty() && cal.exit_status() == 0 => {
-            super::contact_out::write(a.out, a.force, &fit.robot, fit, f)?
+        Some(f) if !a.out.is_empty() && verdict.exit_status() == 0 => {
+            super::contact_out::write(a.out, a.force, &cal.fit.robot, &cal.fit, f)?
         }
         _ => Vec::new(),
     };
-    let source = path.display().to_string();
     let v = serde_json::to_value(cal.report(
         &robot.name,
-        &source,
+        &path.display().to_string(),
         file.qs.len(),
         settings.outliers,
         held.as_ref(),
         !a.out.is_empty(),
         &written,
     ))?;
-    let mut report = text(fitted, fit, figures, held.as_ref());
-    for n in &cal.notes {
-        let _ = writeln!(report, "note: {n}");
-    }
-    if let Some(p) = &cal.predicted {
-        let _ = writeln!(
-            report,
-            "predicted true error of the calibrated tool point (the fit's covariance at {} random configurations): {:.4} mm RMS; it includes what held-out placements cannot see (an error common to a placement's rows)",
-            p.configurations, p.rms_mm
-        );
-    }
-    if !written.is_empty() {
-        report.push('\n');
-    }
-    for out in &written {
-        let _ = writeln!(report, "calibrated robot written to {out}");
-    }
+    let r = ContactReport {
+        robot,
+        file: &cal.file,
+        fit: &cal.fit,
+        figures: &cal.in_sample,
+        held: held.as_ref(),
+    };
+    let extras = contact_text::Extras {
+        notes: &cal.notes,
+        predicted: cal.predicted.as_ref(),
+        written: &written,
+    };
+    let report = contact_text::text(&r, extras);
     if let Some(dir) = a.report {
-        let r = activecal::render::contact_figures::ContactReport {
-            robot,
-            file: fitted,
-            fit,
-            figures,
-            held: held.as_ref(),
-        };
-        let touches = |g: usize| match fitted.points.get(g) {
-            Some(p) => format!("point {p}"),
-            None => format!("plane {}", g - fitted.points.len() + 1),
-        };
-        let poses: Vec<(String, Vec<f64>)> = fitted
-            .qs
-            .iter()
-            .zip(&fitted.groups)
-            .zip(&fitted.lines)
-            .map(|((q, g), l)| (format!("line {l}: {}", touches(*g)), q.clone()))
-            .collect();
-        activecal::render::folder::contacts(dir, robot, &report, &v, &poses, |d| {
-            activecal::render::contact_figures::draw(d, &r)
-        })?;
+        contact_text::write_report(dir, &r, &report, &v)?;
     }
     super::emit(a.json, &v, || report)?;
-    if let Some(why) = cal.implausible.clone() {
+    Ok(verdict.refusal().map(|why| {
         let names: Vec<String> = a.out.iter().map(|p| p.display().to_string()).collect();
-        let lost = if names.is_empty() {
-            String::new()
+        if names.is_empty() {
+            why.to_string()
         } else {
-            format!("; {} not written", names.join(", "))
-        };
-        return Ok(Some(why + &lost));
+            format!("{why}; {} not written", names.join(", "))
+        }
+    }))
+}
+
+/// A refused input of a contact calibration, named as the command line
+/// gives it: `--plane` or `--point-distance` (a refused row names its file
+/// and line itself).
+pub fn named(e: ContactInputError) -> anyhow::Error {
+    let source = anyhow::Error::new(e.source);
+    match e.input {
+        ContactInput::Rows => source,
+        ContactInput::Planes => source.context("--plane"),
+        ContactInput::Distances => source.context("--point-distance"),
     }
-    if !fit.converged {
-        let names: Vec<String> = a.out.iter().map(|p| p.display().to_string()).collect();
-        return Ok(Some(format!(
-            "the contact fit ended {:?} after {} iterations{}{}",
-            fit.stop,
-            fit.iterations,
-            if fit.std.is_none() {
-                " without a full-rank Jacobian"
-            } else {
-                ""
-            },
-            if names.is_empty() {
-                String::new()
-            } else {
-                format!("; {} not written", names.join(", "))
-            }
-        )));
-    }
-    Ok(None)
 }
 
 /// The fit's settings from the command line.
@@ -279,139 +243,4 @@ fn held_out(
     };
     let h = holdout_by_placement(robot, &robot.nominal, file, given, settings, &mode)?;
     Ok(Some(h))
-}
-
-/// The report as text.
-fn text(
-    file: &ContactFile,
-    fit: &ContactFit,
-    fig: &Figures,
-    held: Option<&HoldoutReport>,
-) -> String {
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "{}: {} contacts with {} points and {} planes; {} unknowns estimated ({} robot unknowns fixed), {:?} after {} iterations, σ̂ = {}",
-        file.origin,
-        file.qs.len(),
-        file.points.len(),
-        file.planes.len(),
-        fit.estimate.len(),
-        fit.fixed.len(),
-        fit.stop,
-        fit.iterations,
-        fit.sigma_hat
-            .map_or("-".into(), |v| format!("{:.4} mm", 1e3 * v))
-    );
-    for f in &fit.fixed {
-        let _ = writeln!(s, "  fixed {} = {:.6}: {}", f.name, f.value, f.reason);
-    }
-    let t = fit.tool_offset;
-    let _ = writeln!(
-        s,
-        "tool offset (end frame): {:.3} {:.3} {:.3} mm",
-        1e3 * t[0],
-        1e3 * t[1],
-        1e3 * t[2]
-    );
-    for p in &fit.planes {
-        let n = p.normal;
-        let _ = writeln!(
-            s,
-            "plane {} ({}): normal {:.5} {:.5} {:.5}, offset {:.3} mm",
-            p.name,
-            if p.known { "given" } else { "estimated" },
-            n[0],
-            n[1],
-            n[2],
-            1e3 * p.offset_m
-        );
-    }
-    let _ = writeln!(
-        s,
-        "in-sample consistency (RMS distance to the point's mean; a plane's: RMS signed distance to it):"
-    );
-    s += &figures_text(fig);
-    let down = downweighted_rows(fit, file);
-    if !down.is_empty() {
-        let _ = writeln!(s, "down-weighted rows ({}):", down.len());
-        for d in &down {
-            let _ = writeln!(s, "  line {} ({}): weight {:.3}", d.line, d.point, d.weight);
-        }
-    }
-    if let Some(h) = held {
-        s += &holdout_text(h);
-    }
-    s
-}
-
-fn figures_text(f: &Figures) -> String {
-    let mut s = String::new();
-    for p in &f.points {
-        let _ = writeln!(
-            s,
-            "  {:<20} {:>3} rows  nominal {:7.3} mm  calibrated {:7.3} mm",
-            p.point, p.rows, p.nominal_mm, p.calibrated_mm
-        );
-    }
-    let _ = writeln!(
-        s,
-        "  pooled                        nominal {:7.3} mm  calibrated {:7.3} mm",
-        f.nominal_mm, f.calibrated_mm
-    );
-    for p in &f.planes {
-        let _ = writeln!(
-            s,
-            "  plane {:<14} {:>3} rows  nominal {:7.3} mm  calibrated {:7.3} mm{}",
-            p.plane,
-            p.rows,
-            p.nominal_mm,
-            p.calibrated_mm,
-            if p.known { " (given plane)" } else { "" }
-        );
-    }
-    for d in &f.distances {
-        let _ = writeln!(
-            s,
-            "  distance {} – {} ({:.3} mm): error nominal {:.3} mm, calibrated {:.3} mm",
-            d.a, d.b, d.known_mm, d.nominal_error_mm, d.calibrated_error_mm
-        );
-    }
-    s
-}
-
-fn holdout_text(h: &HoldoutReport) -> String {
-    let mut s = format!("\nheld out ({}):\n", h.mode);
-    for f in &h.folds {
-        let _ = writeln!(
-            s,
-            "held out {} (trained on {}; {} unknowns, {} fixed{}):",
-            f.held_out,
-            f.trained_on.join(", "),
-            f.estimated,
-            f.fixed,
-            if f.converged { "" } else { "; NOT converged" }
-        );
-        s += &figures_text(&f.figures);
-        if !f.downweighted.is_empty() {
-            let rows: Vec<String> = f
-                .downweighted
-                .iter()
-                .map(|d| format!("line {} ({}, w {:.2})", d.line, d.point, d.weight))
-                .collect();
-            let _ = writeln!(s, "  down-weighted training rows: {}", rows.join("; "));
-        }
-    }
-    let _ = writeln!(
-        s,
-        "pooled over every held-out row: nominal {:.3} mm, calibrated {:.3} mm; mean over folds {:.3} mm",
-        h.pooled_nominal_mm, h.pooled_calibrated_mm, h.mean_calibrated_mm
-    );
-    if let (Some(m), Some(x)) = (h.mean_distance_error_mm, h.max_distance_error_mm) {
-        let _ = writeln!(
-            s,
-            "distance error, calibrated: mean {m:.3} mm, largest {x:.3} mm"
-        );
-    }
-    s
 }

@@ -6,9 +6,8 @@
 use super::contact::contact_setup;
 use super::measured::EvaluateArgs;
 use activecal::identify::contact::evaluate::{ContactEvaluation, evaluate_contacts};
-use activecal::identify::contact::resolve_distances;
 use activecal::io::contacts::read_contacts;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use std::fmt::Write as _;
 
 /// Runs `evaluate` on a contact file.
@@ -17,11 +16,14 @@ pub fn cmd_evaluate_contacts(a: &EvaluateArgs) -> Result<()> {
     let (given, planes) = contact_setup(&desc.contacts, &a.point_distance, &a.plane)?;
     let robot = desc.robot;
     let mut file = read_contacts(&a.measurements, &robot, a.units.units())?;
-    file.set_known_planes(&planes).context("--plane")?;
-    activecal::identify::contact::lengths::check_planes(&robot, &file).context("--plane")?;
-    let known = resolve_distances(&file, &given, true).context("--point-distance")?;
-    activecal::identify::contact::lengths::check_distances(&robot, &file, &known)
-        .context("--point-distance")?;
+    activecal::experiment::contacts::checked_inputs(
+        &robot,
+        &mut file,
+        &planes,
+        &given,
+        activecal::experiment::contacts::ContactUse::Evaluate,
+    )
+    .map_err(super::contact::named)?;
     let e = evaluate_contacts(&robot, &robot.nominal, &[0.0; 3], &file, &given);
     let report = activecal::report::ContactEvaluationReport {
         robot: robot.name.clone(),

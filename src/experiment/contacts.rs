@@ -43,25 +43,74 @@ pub struct ContactCalibration {
     pub notes: Vec<String>,
 }
 
+/// The input of a contact calibration a check refused, for the front end
+/// to name (its flag or argument): the rows, the known planes, the known
+/// distances.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContactInput {
+    /// The contact rows (configurations too close to tell apart).
+    Rows,
+    /// The known planes (beyond the robot's reach, normals not unit).
+    Planes,
+    /// The known distances (a point not in the file, none given, out of
+    /// scale with the robot).
+    Distances,
+}
+
+/// A check of a contact calibration's inputs that failed, with the input
+/// it concerns.
+#[derive(Debug, thiserror::Error)]
+#[error("{source}")]
+pub struct ContactInputError {
+    /// The input the check concerns.
+    pub input: ContactInput,
+    /// What is wrong with it.
+    #[source]
+    pub source: crate::Error,
+}
+
+/// What the inputs are checked for: a fit (which needs distinct
+/// configurations and a known distance to fix the scale) or an evaluation
+/// of a model (which needs neither).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContactUse {
+    /// A calibration: every check.
+    Fit,
+    /// An evaluation of a given model: the planes and the distances named.
+    Evaluate,
+}
+
 /// The known distances of `file`'s points (`given` by name) after the
-/// checks a contact fit needs (the library's messages; callers add the
-/// input's name): configurations distinct enough, known planes within
-/// reach, every distance naming two of the file's points, at least one
-/// distance (contacts alone leave the scale free), distances in scale.
-pub fn checked_distances(
+/// checks a contact calibration needs, the `planes` given by name made
+/// known first: configurations distinct enough (a fit), known planes
+/// within reach, every distance naming two of the file's points, at least
+/// one distance (a fit: contacts alone leave the scale free), distances in
+/// scale. The error names the input it concerns.
+pub fn checked_inputs(
     robot: &Robot,
-    file: &ContactFile,
+    file: &mut ContactFile,
+    planes: &[crate::identify::contact::NamedPlane],
     given: &[NamedDistance],
-) -> crate::identify::Result<Vec<KnownDistance>> {
-    file.check_distinct()?;
-    crate::identify::contact::lengths::check_planes(robot, file)?;
-    let known = resolve_distances(file, given, true)?;
-    crate::identify::contact::check_scale(file, &known)?;
-    crate::identify::contact::lengths::check_distances(robot, file, &known)?;
+    use_: ContactUse,
+) -> Result<Vec<KnownDistance>, ContactInputError> {
+    let on = |input| move |source| ContactInputError { input, source };
+    if use_ == ContactUse::Fit {
+        file.check_distinct().map_err(on(ContactInput::Rows))?;
+    }
+    file.set_known_planes(planes)
+        .map_err(on(ContactInput::Planes))?;
+    crate::identify::contact::lengths::check_planes(robot, file)
+        .map_err(on(ContactInput::Planes))?;
+    let distances = on(ContactInput::Distances);
+    let known = resolve_distances(file, given, true).map_err(distances)?;
+    if use_ == ContactUse::Fit {
+        crate::identify::contact::check_scale(file, &known).map_err(distances)?;
+    }
+    crate::identify::contact::lengths::check_distances(robot, file, &known).map_err(distances)?;
     Ok(known)
 }
 
-/// Fits `file` with the `known` distances (as [`checked_distances`] gives
+/// Fits `file` with the `known` distances (as [`checked_inputs`] gives
 /// them; `given` by name for the frames file), the rows the gross-error
 /// test flags left out ([`ContactSettings::outliers`],
 /// [`crate::experiment::contact_screen`]), and judges the fit (see the
@@ -173,11 +222,32 @@ impl ContactCalibration {
     /// to a plausible robot, else [`super::measured::verdict::EXIT_REFUSED`].
     #[must_use]
     pub fn exit_status(&self) -> i32 {
-        if self.fit.converged && self.implausible.is_none() {
-            0
+        self.verdict().exit_status()
+    }
+
+    /// Whether the calibrated robot may be written: refused when the fit
+    /// did not converge or converged to an implausible robot, with why.
+    #[must_use]
+    pub fn verdict(&self) -> super::measured::verdict::Verdict {
+        use super::measured::verdict::Verdict;
+        let fit = &self.fit;
+        let reason = if let Some(why) = &self.implausible {
+            why.clone()
+        } else if !fit.converged {
+            format!(
+                "the contact fit ended {:?} after {} iterations{}",
+                fit.stop,
+                fit.iterations,
+                if fit.std.is_none() {
+                    " without a full-rank Jacobian"
+                } else {
+                    ""
+                }
+            )
         } else {
-            super::measured::verdict::EXIT_REFUSED
-        }
+            return Verdict::Calibrated;
+        };
+        Verdict::Refused { reason }
     }
 
     /// The report of this calibration of `robot` from `measurements`

@@ -9,6 +9,7 @@ pub mod bench_text;
 pub mod camera_design;
 pub mod contact_figures;
 pub mod contact_sheet;
+pub mod contact_text;
 pub(crate) mod figure;
 pub mod folder;
 pub mod frames_text;

@@ -7,11 +7,12 @@
 
 pub use super::calibrate_args::{CalibrateArgs, DEFAULT_NOISE};
 pub use super::calibrated::{EXIT_NOT_CONVERGED, NotConverged};
-use super::calibrated::{not_written, status_text, write_calibrated};
+use super::calibrated::{not_written, write_calibrated};
 use activecal::experiment::measured::full_model::FullModelGain;
 use activecal::identify::LmSettings;
 use activecal::io::calibrated::Format;
 use activecal::model::Robot;
+use activecal::render::measured_text::{measured_text, status_text};
 use anyhow::{Context, Result, bail};
 use std::path::Path;
 use std::time::Instant;
@@ -372,7 +373,7 @@ fn render_measured(
     }
     super::emit(a.json, &v, || {
         let mut s = source.text.clone();
-        s += &super::measured::measured_text(&report, id, &status_text(id));
+        s += &measured_text(&report, id, &status_text(id));
         if let Some(g) = &gain {
             let held_out = report.holdout.as_ref().map(|h| h.position_rms_mm.mean);
             s += &gain_text(g, held_out);

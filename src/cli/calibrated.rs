@@ -107,22 +107,3 @@ pub fn not_written(a: &CalibrateArgs) -> String {
         if names.len() == 1 { "was" } else { "were" }
     )
 }
-
-pub fn status_text(id: &Identification) -> String {
-    let mut s = format!(
-        "status: {:?} ({:?}) after {} iterations, {} evaluations\n",
-        id.status, id.stop, id.iterations, id.evaluations
-    );
-    s += &format!(
-        "rss {:.6e} (start {:.6e}), σ̂ = {}, rank {}/{}\n",
-        id.rss,
-        id.initial_rss,
-        id.sigma_hat.map_or("-".into(), |v| format!("{v:.6}")),
-        id.rank,
-        id.names.len()
-    );
-    if !id.unidentifiable.is_empty() {
-        s += &format!("unidentifiable: {}\n", id.unidentifiable.join(" "));
-    }
-    s
-}

@@ -5,9 +5,7 @@
 //! file renders it (text, JSON, report directory).
 
 use super::calibrate_args::CalibrateArgs;
-use super::calibrated::{
-    exit_status, frames_of, refuse_unconverged, status_text, write_calibrated,
-};
+use super::calibrated::{exit_status, frames_of, refuse_unconverged, write_calibrated};
 use super::{emit, write_new};
 use activecal::identify::{LmSettings, MonteCarloSettings, MonteCarloSummary};
 use activecal::io::design::DesignFile;
@@ -231,7 +229,7 @@ fn simulated_text(
         design_path.display(),
         qs.len(),
         a.seed(),
-        status_text(id)
+        activecal::render::measured_text::status_text(id)
     );
     s += "\nestimate (Table III)\n";
     s += &tables.estimate.to_text(6);

@@ -7,12 +7,14 @@
 
 pub mod bench_text;
 pub mod camera_design;
+pub mod camera_text;
 pub mod contact_figures;
 pub mod contact_sheet;
 pub mod contact_text;
 pub(crate) mod figure;
 pub mod folder;
 pub mod frames_text;
+pub mod measured_text;
 pub mod page;
 pub mod page_camera;
 pub mod pages;

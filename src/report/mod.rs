@@ -12,6 +12,7 @@ mod existing;
 mod fk;
 mod gap;
 mod lattice;
+pub mod measured;
 mod robot;
 mod score;
 mod select;

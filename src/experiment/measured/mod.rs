@@ -10,18 +10,19 @@ use super::paper::ExperimentError;
 use crate::identify::compliance::{ComplianceComparison, compare, with_compliance};
 use crate::identify::evaluation::ModelErrors;
 use crate::identify::{
-    Fit, FixedParameter, HoldoutSettings, LmSettings, LossChoice, Measurements, ParameterTrust,
-    SplitResult, for_measurements, holdout, prepare_for_data, residuals, trust,
+    Fit, HoldoutSettings, LmSettings, LossChoice, Measurements, SplitResult, for_measurements,
+    holdout, prepare_for_data, residuals, trust,
 };
 use crate::lsq::outliers::OutlierChoice;
 use crate::model::gravity::GravityModel;
 use crate::model::{ParamTable, Robot};
+pub use crate::report::measured::{
+    HoldoutReport, MeasuredReport, NoiseReport, OutlierReport, PREDICTION_CONFIGURATIONS,
+    PrunedReport, Stat,
+};
 use holdout::holdout_report;
-pub use holdout::{HoldoutReport, PrunedReport, Stat};
 use nalgebra::Vector3;
-pub use screen::OutlierReport;
 use screen::screen;
-use serde::Serialize;
 
 pub mod full_model;
 mod holdout;
@@ -114,73 +115,6 @@ pub fn read_measurement_file(
     Ok((meas, notes))
 }
 
-/// The report of a calibration from measurements.
-#[derive(Serialize)]
-pub struct MeasuredReport {
-    /// The plain identification report (status, estimate, covariance, …).
-    #[serde(flatten)]
-    pub base: crate::report::MeasuredCalibrationReport,
-    /// The loss.
-    pub loss: LossChoice,
-    /// Errors of the fitted model on the data, mm and degrees.
-    pub residuals: ModelErrors,
-    /// Errors of the nominal model on the data, as given (with the best
-    /// marker offsets for it).
-    pub nominal_residuals: ModelErrors,
-    /// When the data are far from the nominal model (a tracker metres away
-    /// and turned): the RMS position error, mm, of the nominal geometry
-    /// placed by the rigid motion of the measurement frame (and the
-    /// measured point on the tip) that fits the data best — what the
-    /// robot's own geometry is off by.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub nominal_placed_position_rms_mm: Option<f64>,
-    /// Each parameter's estimate, change, σ, t and verdict.
-    pub parameters: Vec<ParameterTrust>,
-    /// Unknowns the data do not determine, fixed at nominal, with why.
-    pub fixed: Vec<FixedParameter>,
-    /// Poses the robust loss down-weighted: `[pose, weight]`.
-    pub downweighted: Vec<(usize, f64)>,
-    /// The gross-error test ([`crate::lsq::outliers`]): its choice and
-    /// the poses it left out, in the order it found them.
-    pub outliers: OutlierReport,
-    /// Held-out validation, if asked.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub holdout: Option<HoldoutReport>,
-    /// What was adapted to the data (sensor, markers, ignored columns).
-    pub notes: Vec<String>,
-    /// The calibrated robot's measurement frame, tool or markers and joint
-    /// origins (URDF robots).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub frames: Option<crate::frames::report::FramesReport>,
-    /// The fitted joint compliances.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub compliance: Option<crate::identify::compliance::ComplianceReport>,
-    /// Held-out errors with and without compliances on the same splits.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub compliance_comparison: Option<ComplianceComparison>,
-    /// Each residual block's σ at the fit and the weights it ended with.
-    pub noise: NoiseReport,
-    /// The calibrated model's own predicted error at random configurations
-    /// ([`PREDICTION_CONFIGURATIONS`] within the joint limits, seed 0),
-    /// from the fit's covariance at σ̂; `None` when it has none (rank
-    /// deficient, no degree of freedom).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub predicted: Option<crate::how_many::PredictedErrors>,
-    /// σ̂ tested against the stated noise, when one was given.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub noise_test: Option<crate::identify::variance::NoiseTest>,
-    /// The orientation σ tested against the stated one, if given.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub orientation_noise_test: Option<crate::identify::variance::BlockNoiseTest>,
-    /// What the user should look at: the fit is written, but something in
-    /// the data or the model is not as stated.
-    pub warnings: Vec<String>,
-}
-
-/// Random configurations the calibrated model's predicted error is averaged
-/// over (as `select`'s prediction).
-pub const PREDICTION_CONFIGURATIONS: usize = 1000;
-
 /// The calibrated model's predicted error at random configurations, from
 /// the covariance `σ̂² (XᵀX)⁻¹` of the fit `id` of `robot` to `meas`: the
 /// same propagation as `select`'s prediction
@@ -203,20 +137,6 @@ fn predicted_after_fit(
         q.copy_from_slice(&eval_qs[k]);
     });
     crate::how_many::predicted_errors(robot, &eval, info.as_ref(), sigma)
-}
-
-/// Each residual block's estimated noise and how the blocks were weighed.
-#[derive(Clone, Debug, Serialize)]
-pub struct NoiseReport {
-    /// Estimated from the residuals, or fixed.
-    pub weights: crate::identify::Weights,
-    /// Metres of position a radian of orientation counted as in the final
-    /// fit (full poses).
-    pub orientation_scale_m_per_rad: f64,
-    /// Reweighting rounds.
-    pub rounds: usize,
-    /// Each block's σ (its unit beside it) and redundancy.
-    pub blocks: Vec<crate::identify::variance::BlockSigma>,
 }
 
 /// How much better the rigid fit of the nominal points must fit the data

@@ -9,16 +9,6 @@ use crate::lsq::outliers::{
     snoop, too_many_note,
 };
 use crate::model::{ParamTable, Robot};
-use serde::Serialize;
-
-/// The gross-error test's part of a report.
-#[derive(Clone, Debug, Serialize)]
-pub struct OutlierReport {
-    /// Drop (at a rate) or keep.
-    pub choice: OutlierChoice,
-    /// The poses left out, in the order the test found them.
-    pub left_out: Vec<Outlier>,
-}
 
 /// A fit with the poses the gross-error test left out.
 pub(super) struct Screened {

@@ -257,10 +257,7 @@ const NOT_YET_OWNED: &[(&str, &[&str])] = &[
     ("src/cli/calibrate.rs", &["identify"]),
     ("src/cli/calibrate_args.rs", &["identify", "lsq", "measure"]),
     ("src/cli/calibrated.rs", &["frames", "identify"]),
-    (
-        "src/cli/camera.rs",
-        &["frames", "identify", "measure", "pool"],
-    ),
+    ("src/cli/camera.rs", &["identify", "measure", "pool"]),
     ("src/cli/camera_images.rs", &["measure"]),
     ("src/cli/camera_opts.rs", &["pool"]),
     (

@@ -2,7 +2,7 @@
 //! design's D-efficiency against it.
 
 use super::{PoolOpts, emit_report, filters, load_description};
-use activecal::bound::{Bound, BoundSettings, RelaxationSolver, relaxation_bound};
+use activecal::bound::{BoundSettings, RelaxationSolver, relaxation_bound};
 use activecal::experiment::gap::{DesignPoses, ScoredDesign, ScoringPool, score_design};
 use activecal::io::design::DesignFile;
 use activecal::model::ParamSet;
@@ -92,50 +92,6 @@ pub struct GapArgs {
     pub json: bool,
 }
 
-fn bound_text(b: &Bound) -> String {
-    let mut s = format!(
-        "relaxation bound, N = {} of {} poses, p = {}: {:?}\n\
-         ln bound   {:.9}  (log10 OI_D <= {:.6})\n\
-         ln primal  {:.9}\n\
-         gap        {:.3e}\n\
-         support    {} poses with weight\n",
-        b.n,
-        b.pool_size,
-        b.p,
-        b.status,
-        b.ln_bound,
-        b.log10_bound(),
-        b.ln_primal,
-        b.certificate_gap,
-        b.support_size,
-    );
-    match b.conic.status {
-        Some(st) => {
-            s += &format!(
-                "{:<10} {st:?}, {} iterations, {} round(s), {} candidates, {:.2} s\n",
-                solver_name(b),
-                b.conic.iterations,
-                b.conic.rounds,
-                b.conic.candidates,
-                b.conic.seconds
-            )
-        }
-        None => s += &format!("{:<10} not run\n", solver_name(b)),
-    }
-    s += &format!(
-        "first order {} rounds, {} steps, {:.2} s\ntotal      {:.2} s\n",
-        b.first_order.rounds, b.first_order.steps, b.first_order.seconds, b.seconds
-    );
-    s
-}
-
-fn solver_name(b: &Bound) -> &'static str {
-    match b.conic.solver {
-        RelaxationSolver::Clarabel => "clarabel",
-        RelaxationSolver::Newton => "newton",
-    }
-}
-
 /// Runs `bound`.
 pub fn cmd_bound(a: BoundArgs) -> Result<()> {
     let settings = a.solve.settings()?;
@@ -161,7 +117,7 @@ pub fn cmd_bound(a: BoundArgs) -> Result<()> {
         if let Some(e) = &report.existing {
             s += &super::existing_text(e);
         }
-        s += &bound_text(&b);
+        s += &activecal::render::bound_text::bound_text(&b);
         if let Some(support) = &report.support {
             s += "pose      weight\n";
             for w in support {

@@ -13,6 +13,7 @@ use crate::identify::tables::{PaperTables, paper_tables};
 use crate::io::design::DesignFile;
 use crate::model::Robot;
 use crate::pool::{Pool, PoolSpec};
+use crate::report::SimulatedCalibrationReport;
 use std::time::Instant;
 
 /// What a simulated calibration at a design found.
@@ -91,4 +92,132 @@ pub fn calibrate_design(
         tables,
         validation,
     })
+}
+
+impl SimulatedCalibration {
+    /// The report of this calibration of `robot` at the design `design`,
+    /// simulated with noise σ `noise` (metres) and `seed`, with the
+    /// calibrated frames (URDF robots) and the seconds it took.
+    #[must_use]
+    pub fn report(
+        &self,
+        robot: &Robot,
+        design: &str,
+        noise: f64,
+        seed: u64,
+        frames: Option<crate::frames::report::FramesReport>,
+        elapsed_seconds: f64,
+    ) -> SimulatedCalibrationReport {
+        let id = &self.tables.identification;
+        let truth = robot.unknown_values(&robot.real);
+        let full = crate::measure::sensor_for(robot).observes_orientation();
+        SimulatedCalibrationReport {
+            identification: id.clone(),
+            robot: robot.name.clone(),
+            chain: crate::report::chain(robot),
+            design: design.to_string(),
+            pool: self.pool.spec.clone(),
+            pool_size: self.pool.len(),
+            poses: self.qs.len(),
+            measurement: robot.measurement,
+            noise,
+            orientation_noise: full.then(|| noise / robot.orientation_scale),
+            seed,
+            residual: id
+                .names
+                .iter()
+                .cloned()
+                .zip(truth.iter().zip(&id.estimate).map(|(t, e)| t - e))
+                .collect(),
+            validation_poses: self.validation.len(),
+            validation_rms_before: self.rms_before,
+            validation_rms_after: self.rms_after,
+            validation_orientation_rms_before: self.orientation_rms_before,
+            validation_orientation_rms_after: self.orientation_rms_after,
+            monte_carlo_seconds: self.monte_carlo.as_ref().map(|_| self.monte_carlo_seconds),
+            monte_carlo: self.monte_carlo.clone(),
+            frames,
+            elapsed_seconds,
+        }
+    }
+}
+
+/// What the report folder shows of a simulated calibration of `robot` at
+/// `design`: the errors at the held-out poses before and after, the
+/// parameter changes, notes on the simulation (noise σ in metres with a
+/// note on where it came from, `seed`); `json` is the command's report.
+#[must_use]
+pub fn summary<'a>(
+    robot: &'a Robot,
+    sim: &'a SimulatedCalibration,
+    design: &str,
+    (noise, noise_note): (f64, &str),
+    seed: u64,
+    json: &serde_json::Value,
+) -> crate::render::summary::CalibrationSummary<'a> {
+    let (qs, tables, validation) = (&sim.qs, &sim.tables, &sim.validation);
+    let id = &tables.identification;
+    let full = crate::measure::sensor_for(robot).observes_orientation();
+    let mc = &sim.monte_carlo;
+    let to_mm = |v: Vec<f64>| v.into_iter().map(|x| x * 1e3).collect::<Vec<_>>();
+    let to_deg = |v: Vec<f64>| v.into_iter().map(f64::to_degrees).collect::<Vec<_>>();
+    let nominal = robot.unknown_values(&robot.nominal);
+    let std = id.covariance.as_ref().map(|c| c.std.clone());
+    let mut notes = vec![format!(
+        "Simulated measurements at the design's {} poses with noise σ = {} mm per coordinate{} (seed {}); errors at {} held-out poses of the design's pool.",
+        qs.len(),
+        noise * 1e3,
+        if noise_note.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", noise_note.trim_start_matches(", "))
+        },
+        seed,
+        validation.len()
+    )];
+    if let Some(mc) = &mc {
+        notes.push(format!(
+            "Monte-Carlo over {} trials: validation RMS after calibration median {} mm, predicted {} mm.",
+            mc.trials,
+            mc.validation_rms_after.as_ref().map_or("-".into(), |v| format!("{:.4}", v.median * 1e3)),
+            mc.validation_rms_predicted.map_or("-".into(), |p| format!("{:.4}", p * 1e3))
+        ));
+    }
+    let s = crate::render::summary::CalibrationSummary {
+        robot,
+        id,
+        source: format!("simulated, design `{design}`"),
+        what: "held-out pose",
+        position_mm: (
+            to_mm(validation.position_errors(robot, &robot.nominal)),
+            to_mm(validation.position_errors(robot, &id.table)),
+        ),
+        orientation_deg: full.then(|| {
+            (
+                to_deg(validation.orientation_errors(robot, &robot.nominal)),
+                to_deg(validation.orientation_errors(robot, &id.table)),
+            )
+        }),
+        params: id
+            .names
+            .iter()
+            .enumerate()
+            .map(|(k, n)| {
+                (
+                    n.clone(),
+                    id.estimate[k] - nominal[k],
+                    std.as_ref().map(|s| s[k]),
+                )
+            })
+            .collect(),
+        splits: None,
+        notes,
+        json: json.clone(),
+        poses: Some(crate::render::pages::FitPoses {
+            qs: qs.clone(),
+            measured: None,
+            flagged: Vec::new(),
+        }),
+    };
+    s
 }

@@ -6,6 +6,7 @@
 //! both call these; nothing here prints or names a flag.
 
 pub mod bench_text;
+pub mod bound_text;
 pub mod camera_design;
 pub mod camera_text;
 pub mod contact_figures;
@@ -22,5 +23,6 @@ pub mod paper_figures;
 pub mod plots;
 pub mod robot_text;
 pub mod select_text;
+pub mod simulated_text;
 pub mod summary;
 mod typeset;

@@ -444,7 +444,12 @@ fn a_refused_bag_writes_nothing() {
     let cases: [(&str, &str, &[&str], &str); 7] = [
         (&cut_mcap, UR5, &["--points", "/tracker"], "cut short"),
         (&cut_db3, UR5, &["--points", "/tracker"], "SQLite 3"),
-        (&plugin, UR5, &["--points", "/tracker"], "storage plugin 'rosbag_v1' is not read"),
+        (
+            &plugin,
+            UR5,
+            &["--points", "/tracker"],
+            "storage plugin 'rosbag_v1' is not read",
+        ),
         (tiny, UR5, &["--points", "/nope"], "no topic '/nope'"),
         (
             tiny,

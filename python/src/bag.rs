@@ -5,6 +5,7 @@
 
 use crate::convert::{Fail, arg_err, detached, json_to_py};
 use crate::robot::Robot;
+use activecal::experiment::bag::BagCalibration;
 use activecal::io::bag::extract::{ExtractSettings, extract as extract_bag};
 use activecal::io::bag::series::Source;
 use pyo3::prelude::*;
@@ -179,7 +180,7 @@ pub(crate) fn calibrate_from(
     b: BagInput,
     robot: &activecal::model::Robot,
     s: &activecal::experiment::measured::MeasuredSettings,
-) -> Result<(activecal::experiment::bag::BagCalibration, serde_json::Value), Fail> {
+) -> Result<(BagCalibration, serde_json::Value), Fail> {
     let mut x = b.settings;
     if let Some(d) = &b.design {
         x.design = Some(activecal::io::bag::design::read_design(d, robot)?);

@@ -420,8 +420,8 @@ fn fitted_input(
         Input::Bag(b) => {
             let name = b.path.display().to_string();
             let described = format!("ROS 2 bag `{name}`");
-            let (got, section) = crate::bag::calibrate_from(b, robot, s)?;
-            Ok((got.measurements, got.calibration, (name, described), Some(section)))
+            let (g, bag) = crate::bag::calibrate_from(b, robot, s)?;
+            Ok((g.measurements, g.calibration, (name, described), Some(bag)))
         }
     }
 }

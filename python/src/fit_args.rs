@@ -178,7 +178,9 @@ pub(crate) fn stated_noises(
     if let Some(s) = noise.filter(|s| !(s.is_finite() && *s > 0.0)) {
         return Err(crate::errors::new_err(
             crate::errors::Kind::Input,
-            format!("noise={s}: the sensor's stated σ per coordinate must be a number > 0 (metres)"),
+            format!(
+                "noise={s}: the sensor's stated σ per coordinate must be a number > 0 (metres)"
+            ),
         ));
     }
     if let Some(s) = orientation_noise.filter(|s| !(s.is_finite() && *s > 0.0)) {

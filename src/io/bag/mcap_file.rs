@@ -186,29 +186,48 @@ mod tests {
     /// 2 GB figure (peak memory) is benches/bag_memory.sh's.
     #[test]
     fn a_bag_is_read_a_chunk_at_a_time() {
-        let path = std::env::temp_dir().join(format!("activecal-stream-{}.mcap", std::process::id()));
+        let path =
+            std::env::temp_dir().join(format!("activecal-stream-{}.mcap", std::process::id()));
         let out = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
         let mut w = mcap::WriteOptions::new()
             .compression(None)
             .chunk_size(Some(1 << 20))
             .create(out)
             .unwrap();
-        let schema = w.add_schema("sensor_msgs/msg/JointState", "ros2msg", b"").unwrap();
-        let joints = w.add_channel(schema, "/joint_states", "cdr", &Default::default()).unwrap();
-        let image = w.add_schema("sensor_msgs/msg/Image", "ros2msg", b"").unwrap();
-        let camera = w.add_channel(image, "/camera", "cdr", &Default::default()).unwrap();
+        let schema = w
+            .add_schema("sensor_msgs/msg/JointState", "ros2msg", b"")
+            .unwrap();
+        let joints = w
+            .add_channel(schema, "/joint_states", "cdr", &Default::default())
+            .unwrap();
+        let image = w
+            .add_schema("sensor_msgs/msg/Image", "ros2msg", b"")
+            .unwrap();
+        let camera = w
+            .add_channel(image, "/camera", "cdr", &Default::default())
+            .unwrap();
         let frame = vec![7u8; 100_000];
         let (mut sent, mut k) = (0u64, 0u32);
         for i in 0..240u64 {
             for j in 0..33u64 {
                 let t = i * 33_000_000 + j * 1_000_000;
-                let header = mcap::records::MessageHeader { channel_id: joints, sequence: k, log_time: t, publish_time: t };
+                let header = mcap::records::MessageHeader {
+                    channel_id: joints,
+                    sequence: k,
+                    log_time: t,
+                    publish_time: t,
+                };
                 w.write_to_known_channel(&header, &t.to_le_bytes()).unwrap();
                 sent += 1;
                 k += 1;
             }
             let t = i * 33_000_000;
-            let header = mcap::records::MessageHeader { channel_id: camera, sequence: k, log_time: t, publish_time: t };
+            let header = mcap::records::MessageHeader {
+                channel_id: camera,
+                sequence: k,
+                log_time: t,
+                publish_time: t,
+            };
             w.write_to_known_channel(&header, &frame).unwrap();
             k += 1;
         }
@@ -234,6 +253,9 @@ mod tests {
         std::fs::remove_file(&path).unwrap();
         assert!(size > 24_000_000, "{size} bytes");
         assert_eq!((seen, got, counts["/joint_states"]), (sent, sent, sent));
-        assert!(largest <= 2 << 20, "the reader asked for {largest} bytes at once of {size}");
+        assert!(
+            largest <= 2 << 20,
+            "the reader asked for {largest} bytes at once of {size}"
+        );
     }
 }

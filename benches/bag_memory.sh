@@ -37,7 +37,7 @@ for storage in ${BAG_STORAGES:-mcap sqlite3}; do
   start=$(date +%s)
   "$py" -W ignore "$root/verify/python/bag_truth.py" write --truth truth.json --design design.csv \
     --out "$bag" --storage "$storage" --joint-rate 1000 --image-mb "$image_mb" >/dev/null
-  size=$(du -sm "$bag" | cut -f1)
+  size=$(($(du -sb "$bag" | cut -f1) / 1000000))
   echo "bag_memory: $storage bag written by rosbags in $(($(date +%s) - start)) s: $size MB"
   /usr/bin/time -v -o time.txt "$bin" extract "$bag" --robot "$urdf" --frames nominal.yaml \
     --points /tracker --out "m_$storage.csv" --force --json >"extract_$storage.json"

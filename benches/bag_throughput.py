@@ -2,7 +2,7 @@
 at least as fast as `rosbags` reading the same bag in Python). Writes the
 bag of a simulated calibration run with rosbags (verify/python/bag_truth.py:
 the true UR5 through a 30-pose design, /joint_states at 1 kHz, a tracker at
-100 Hz, 170 MB of raw images on a camera topic: about 215 MB) in MCAP and in
+100 Hz, 170 MB of raw images on a camera topic: about 226 MB) in MCAP and in
 SQLite 3, then times, in turn A B A B ..., `activecal extract BAG --points
 /tracker --time-offset 0` (read, rests, averages; the clock offset given, as
 the Python side does not estimate it) against benches/bag_rosbags_read.py

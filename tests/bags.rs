@@ -408,3 +408,78 @@ fn a_bags_options_need_a_bag_and_a_files_need_a_file() {
         "give the bag's measurement: --points TOPIC, --poses TOPIC or --tf PARENT:CHILD",
     );
 }
+
+/// Each bad bag of the acceptance (cut short in MCAP and SQLite 3, an
+/// unknown storage plugin, a topic missing or of another type, a joint of
+/// the robot absent from the joint states, no rest) is refused by `extract
+/// --out` and by `calibrate --bag --out` with its reason and a non-zero
+/// status, and nothing is written: the folder holds the inputs only (no
+/// output, no temporary file beside it).
+#[test]
+fn a_refused_bag_writes_nothing() {
+    let d = scratch_dir("bags", "nothing_written");
+    let mcap = std::fs::read("fixtures/bags/tiny.mcap").unwrap();
+    std::fs::write(d.join("cut.mcap"), &mcap[..mcap.len() / 2]).unwrap();
+    let db = std::fs::read("fixtures/bags/tiny_db3/tiny_db3.db3").unwrap();
+    std::fs::write(d.join("cut.db3"), &db[..db.len() / 3]).unwrap();
+    let plugin = d.join("plugin");
+    std::fs::create_dir_all(&plugin).unwrap();
+    std::fs::write(
+        plugin.join("metadata.yaml"),
+        "rosbag2_bagfile_information:\n  version: 9\n  storage_identifier: rosbag_v1\n  relative_file_paths: [a.bag]\n",
+    )
+    .unwrap();
+    let inputs = |d: &Path| {
+        let mut v: Vec<String> = std::fs::read_dir(d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    };
+    let before = inputs(&d);
+    let at = |f: &str| d.join(f).to_str().unwrap().to_string();
+    let (cut_mcap, cut_db3, plugin) = (at("cut.mcap"), at("cut.db3"), at("plugin"));
+    let tiny = "fixtures/bags/tiny.mcap";
+    let cases: [(&str, &str, &[&str], &str); 7] = [
+        (&cut_mcap, UR5, &["--points", "/tracker"], "cut short"),
+        (&cut_db3, UR5, &["--points", "/tracker"], "SQLite 3"),
+        (
+            &plugin,
+            UR5,
+            &["--points", "/tracker"],
+            "storage plugin 'rosbag_v1' is not read",
+        ),
+        (tiny, UR5, &["--points", "/nope"], "no topic '/nope'"),
+        (
+            tiny,
+            UR5,
+            &["--points", "/camera_info"],
+            "is of type sensor_msgs/msg/CameraInfo",
+        ),
+        (
+            tiny,
+            "fixtures/stanford.urdf",
+            &["--points", "/tracker"],
+            "is in no message of '/joint_states'",
+        ),
+        (
+            "fixtures/bags/moving.mcap",
+            UR5,
+            &["--points", "/tracker"],
+            "no rest period",
+        ),
+    ];
+    let (csv, urdf) = (at("m.csv"), at("cal.urdf"));
+    for (bag, robot, extra, needle) in cases {
+        let mut args = vec!["extract", bag, "--robot", robot];
+        args.extend(extra);
+        args.extend(["--out", &csv]);
+        fails_with(&args, needle);
+        let mut args = vec!["calibrate", "--robot", robot, "--bag", bag];
+        args.extend(extra);
+        args.extend(["--out", &urdf]);
+        fails_with(&args, needle);
+        assert_eq!(inputs(&d), before, "{bag} {extra:?}: something was written");
+    }
+}

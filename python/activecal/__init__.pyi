@@ -459,8 +459,8 @@ class Calibration:
 
 def calibrate(
     robot: Robot,
-    q: npt.ArrayLike,
-    points: npt.ArrayLike,
+    q: Optional[npt.ArrayLike] = None,
+    points: Union[npt.ArrayLike, str, None] = None,
     orientations: Optional[npt.ArrayLike] = None,
     fix: Optional[Sequence[str]] = None,
     free: Optional[Sequence[str]] = None,
@@ -480,10 +480,33 @@ def calibrate(
     progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
     unknowns: str = "all",
     keep_axis_relations: bool = False,
+    bag: Optional[_Path] = None,
+    joints: str = "/joint_states",
+    poses: Optional[str] = None,
+    tf: Optional[str] = None,
+    time_offset: Optional[float] = None,
+    max_offset: float = 10.0,
+    rest_speed: float = 0.005,
+    rest_min: float = 0.5,
+    settle: float = 0.2,
+    design: Optional[_Path] = None,
+    design_tolerance: float = 0.01,
 ) -> Calibration:
     """Calibrates the robot from measured poses, as ``activecal calibrate
-    --measurements FILE`` does from a file holding the same values. The
-    GIL is released while it runs.
+    --measurements FILE`` does from a file holding the same values, or
+    from a ROS 2 bag (``bag=``) as ``activecal calibrate --bag BAG`` does.
+    The GIL is released while it runs.
+
+    bag: a rosbag2 folder, or one ``.mcap`` or ``.db3`` file, instead of q
+    and points: one pose per rest of the joints, read as `extract` reads
+    it, with ``points`` the bag's ``PointStamped`` topic (a str), or
+    ``poses`` (``PoseStamped``/``TransformStamped``) or ``tf``
+    (``"PARENT:CHILD"``); joints, time_offset, max_offset, rest_speed,
+    rest_min, settle, design (the design file the run followed) and
+    design_tolerance as `extract` takes them. The clock offset, when
+    estimated, is estimated again with the calibrated model (and the bag
+    fitted once more when it moved), as the command line does; the
+    extraction and both estimates are in ``report["bag"]``.
 
     q: shape (n, dof), joint values in radians or metres. points: shape
     (n, 3), the measured positions in the sensor's frame, metres (shape

@@ -147,11 +147,6 @@ fn data(
     })
 }
 
-/// Names given to a wrapper as an iterable of str.
-fn names(v: Option<Vec<String>>) -> Vec<String> {
-    v.unwrap_or_default()
-}
-
 /// Calibrates the robot from measured poses, as `activecal calibrate
 /// --measurements FILE --json` does with a file holding the same values.
 ///
@@ -191,14 +186,18 @@ fn names(v: Option<Vec<String>>) -> Vec<String> {
 /// `--keep-axis-relations`. With either restriction the same data are
 /// also fitted with every unknown: `report["full_model_gain"]` gives both
 /// models' predicted (and held-out) errors and the relations held.
+/// bag: a ROS 2 bag instead of q and points, as `--bag` (`points` its
+/// PointStamped topic; poses, tf, joints, time_offset, max_offset,
+/// rest_speed, rest_min, settle, design, design_tolerance as `extract`
+/// takes them): the same pipeline, the extraction in `report["bag"]`.
 #[pyfunction]
-#[pyo3(signature = (robot, q, points, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, compliance=false, outliers="drop", outlier_rate=0.01, noise=None, orientation_noise=None, progress=None, unknowns="all", keep_axis_relations=false))]
+#[pyo3(signature = (robot, q=None, points=None, orientations=None, fix=None, free=None, max_iterations=200, loss="l2", loss_scale=None, weights=None, orientation_scale=None, holdout=None, splits=4, seed=0, compliance=false, outliers="drop", outlier_rate=0.01, noise=None, orientation_noise=None, progress=None, unknowns="all", keep_axis_relations=false, bag=None, joints="/joint_states", poses=None, tf=None, time_offset=None, max_offset=10.0, rest_speed=0.005, rest_min=0.5, settle=0.2, design=None, design_tolerance=0.01))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
     robot: &Bound<'_, Robot>,
-    q: &Bound<'_, PyAny>,
-    points: &Bound<'_, PyAny>,
+    q: Option<&Bound<'_, PyAny>>,
+    points: Option<&Bound<'_, PyAny>>,
     orientations: Option<&Bound<'_, PyAny>>,
     fix: Option<Vec<String>>,
     free: Option<Vec<String>>,
@@ -218,7 +217,31 @@ pub fn calibrate(
     progress: Option<&Bound<'_, PyAny>>,
     unknowns: &str,
     keep_axis_relations: bool,
+    bag: Option<std::path::PathBuf>,
+    joints: &str,
+    poses: Option<&str>,
+    tf: Option<&str>,
+    time_offset: Option<f64>,
+    max_offset: f64,
+    rest_speed: f64,
+    rest_min: f64,
+    settle: f64,
+    design: Option<std::path::PathBuf>,
+    design_tolerance: f64,
 ) -> PyResult<Calibration> {
+    let topic = crate::bag::points_topic(bag.is_some(), q, points, orientations)?;
+    let bag_args = crate::bag::BagArgs {
+        joints,
+        points: topic.as_deref(),
+        poses,
+        tf,
+        time_offset,
+        max_offset,
+        rest_speed,
+        rest_min,
+        settle,
+        design_tolerance,
+    };
     // Each keyword argument given acts on the data's sensor or is refused
     // (the command line's table).
     let given: Vec<&str> = [
@@ -242,47 +265,49 @@ pub fn calibrate(
     ]
     .into_iter()
     .filter_map(|(k, g)| g.then_some(k))
+    .chain(bag_args.given(bag.is_some(), design.is_some()))
     .collect();
-    let sensor = if orientations.is_some() {
-        Sensor::Poses
-    } else {
-        Sensor::Points
+    let sensor = match (&bag, orientations) {
+        (Some(_), _) if poses.is_some() || tf.is_some() => Sensor::BagPoses,
+        (Some(_), _) => Sensor::BagPoints,
+        (None, Some(_)) => Sensor::Poses,
+        (None, None) => Sensor::Points,
     };
     refuse_unused(lib_acts::CALIBRATE, &given, sensor)?;
     use crate::pickling::kept;
     let recipe = crate::recipe!(py, "calibrate";
-        robot = robot, q = kept(Some(q))?, points = kept(Some(points))?,
+        robot = robot, q = kept(q)?, points = kept(points)?,
         orientations = kept(orientations)?, fix = &fix, free = &free,
         max_iterations = max_iterations, loss = loss, loss_scale = loss_scale, weights = weights,
         orientation_scale = orientation_scale, holdout = holdout, splits = splits, seed = seed,
         compliance = compliance, outliers = outliers, outlier_rate = outlier_rate, noise = noise,
         orientation_noise = orientation_noise, unknowns = unknowns,
-        keep_axis_relations = keep_axis_relations);
+        keep_axis_relations = keep_axis_relations, bag = &bag, joints = joints, poses = poses,
+        tf = tf, time_offset = time_offset, max_offset = max_offset, rest_speed = rest_speed,
+        rest_min = rest_min, settle = settle, design = &design,
+        design_tolerance = design_tolerance);
     let robot = robot.get();
     let restriction = restriction_of(unknowns, keep_axis_relations)?;
-    let user_fix = names(fix);
+    let user_fix = fix.unwrap_or_default();
     let fix = activecal::identify::restriction::with_held(&user_fix, restriction, &robot.inner)
         .map_err(|e| crate::convert::Fail::from(e).into_py())?;
     let weights = weights_of(weights, orientation_scale)?;
     let outliers = outliers_of(outliers, outlier_rate)?;
-    let gravity = compliance
-        .then(|| {
-            let opts = activecal::io::inertia::InertiaOptions {
-                inertials: None,
-                payload: None,
-            };
-            activecal::io::inertia::gravity_model(&robot.inner, &opts)
-                .map(Arc::new)
-                .map_err(|e| arg_err("compliance", e))
-        })
-        .transpose()?;
+    let gravity = crate::fit_args::gravity_of(compliance, &robot.inner)?;
+    let (stated_noise, stated_orientation_noise) =
+        crate::fit_args::stated_noises(noise, orientation_noise)?;
     let mut scaled = (*robot.inner).clone();
     if let Some(w) = orientation_scale {
         scaled.orientation_scale = w;
     }
     let inner = Arc::new(scaled);
     let holdout = holdout_of(holdout, splits, seed, weights)?;
-    let d = data(py, robot, q, points, orientations)?;
+    let input = match (crate::bag::input(bag, &bag_args, design)?, q, points) {
+        (Some(b), _, _) => Input::Bag(b),
+        (None, Some(q), Some(p)) => Input::Arrays(data(py, robot, q, p, orientations)?),
+        // Refused by `points_topic`.
+        (None, _, _) => return Err(arg_err("q", "give q and points, or bag")),
+    };
     let max_iterations = count("max_iterations", max_iterations, 1)?;
     let loss = loss_of(loss, loss_scale)?;
     let settings = MeasuredSettings {
@@ -293,7 +318,7 @@ pub fn calibrate(
             .map_err(|e| crate::convert::Fail::from(e).into_py())?,
         loss,
         fix,
-        free: names(free),
+        free: free.unwrap_or_default(),
         holdout,
         units: activecal::units::Units::default(),
         gravity,
@@ -301,44 +326,19 @@ pub fn calibrate(
         compare_compliance: false,
         weights,
         outliers,
-        stated_noise: match noise {
-            Some(s) if !(s.is_finite() && s > 0.0) => {
-                return Err(crate::errors::new_err(
-                    crate::errors::Kind::Input,
-                    format!(
-                        "noise={s}: the sensor's stated σ per coordinate must be a number > 0 (metres)"
-                    ),
-                ));
-            }
-            s => s,
-        },
-        stated_orientation_noise: match orientation_noise {
-            Some(s) if !(s.is_finite() && s > 0.0) => {
-                return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                    "orientation_noise={s}: the tracker's stated σ per orientation axis must be a number > 0 (radians)"
-                )));
-            }
-            s => s,
-        },
+        stated_noise,
+        stated_orientation_noise,
     };
     let r = inner.clone();
     let (fitted, id, frames, (report, summary), verdict, warnings) =
         crate::progress::with_callback(progress, || {
             detached(py, move || {
                 let t0 = std::time::Instant::now();
-                let meas = Measurements::with_orientations(&r, d.qs, d.points, d.orientations)?;
-                let c = calibrate_measurements(
-                    &r,
-                    &meas,
-                    "the arrays given",
-                    Vec::new(),
-                    &settings,
-                    &mut |_| {},
-                )?;
+                let (meas, c, source, bag) = fitted_input(input, &r, &settings)?;
                 let gain = activecal::experiment::measured::full_model::beside_full_model(
                     &r,
                     &meas,
-                    "the arrays given",
+                    &source.0,
                     &settings,
                     &user_fix,
                     restriction,
@@ -351,11 +351,14 @@ pub fn calibrate(
                 if let Some(g) = gain {
                     v["full_model_gain"] = serde_json::to_value(g)?;
                 }
+                if let Some(b) = bag {
+                    v["bag"] = b;
+                }
                 let summary = crate::page::KeptSummary::keep(
                     activecal::experiment::measured::summary::measured(
                         &c.robot,
                         &c.fit.id,
-                        format!("the arrays given, {} poses", report.base.poses),
+                        format!("{}, {} poses", source.1, report.base.poses),
                         &report,
                         &v,
                         &meas,
@@ -371,7 +374,7 @@ pub fn calibrate(
                 ))
             })
         })?;
-    warn_all(py, &warnings)?;
+    crate::errors::warn_all(py, &warnings)?;
     Ok(Calibration {
         robot: Arc::new(fitted),
         id,
@@ -383,18 +386,44 @@ pub fn calibrate(
     })
 }
 
-/// What the command line prints as a warning reaches Python as one.
-fn warn_all(py: Python<'_>, warnings: &[String]) -> PyResult<()> {
-    for w in warnings {
-        let cat = py.get_type::<pyo3::exceptions::PyUserWarning>();
-        pyo3::PyErr::warn(
-            py,
-            cat.as_any(),
-            &std::ffi::CString::new(crate::errors::spell(w)).unwrap_or_default(),
-            1,
-        )?;
+/// Where `calibrate`'s measurements come from: arrays, or a ROS 2 bag.
+enum Input {
+    /// The arrays q, points (and orientations), checked.
+    Arrays(Data),
+    /// A bag, its measurement and how to read it.
+    Bag(crate::bag::BagInput),
+}
+
+/// What `calibrate` fitted.
+type Fitted = (
+    Measurements,
+    activecal::experiment::measured::MeasuredCalibration,
+    (String, String),
+    Option<serde_json::Value>,
+);
+
+/// The fit of `input` with `s`: the measurements fitted, the calibration,
+/// their source (its name, as the report folder describes it) and, for a
+/// bag, what the report says of it.
+fn fitted_input(
+    input: Input,
+    robot: &activecal::model::Robot,
+    s: &MeasuredSettings,
+) -> Result<Fitted, crate::convert::Fail> {
+    const ARRAYS: &str = "the arrays given";
+    match input {
+        Input::Arrays(d) => {
+            let meas = Measurements::with_orientations(robot, d.qs, d.points, d.orientations)?;
+            let c = calibrate_measurements(robot, &meas, ARRAYS, Vec::new(), s, &mut |_| {})?;
+            Ok((meas, c, (ARRAYS.into(), ARRAYS.into()), None))
+        }
+        Input::Bag(b) => {
+            let name = b.path.display().to_string();
+            let described = format!("ROS 2 bag `{name}`");
+            let (g, bag) = crate::bag::calibrate_from(b, robot, s)?;
+            Ok((g.measurements, g.calibration, (name, described), Some(bag)))
+        }
     }
-    Ok(())
 }
 
 impl Calibration {

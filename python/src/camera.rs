@@ -153,6 +153,8 @@ pub struct CameraCalibration {
     report: serde_json::Value,
     /// The files the call read.
     inputs: Vec<PathBuf>,
+    /// How it was made, for pickling.
+    recipe: crate::pickling::Recipe,
 }
 
 /// Calibrates the robot from a camera's pixels of a target, as `activecal
@@ -181,7 +183,7 @@ pub struct CameraCalibration {
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate_camera(
     py: Python<'_>,
-    robot: &Robot,
+    robot: &Bound<'_, Robot>,
     observations: &Bound<'_, PyAny>,
     camera_info: &Bound<'_, PyAny>,
     target: &Bound<'_, PyAny>,
@@ -195,6 +197,14 @@ pub fn calibrate_camera(
     pixel_noise: Option<f64>,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<CameraCalibration> {
+    use crate::pickling::kept;
+    let recipe = crate::recipe!(py, "calibrate_camera";
+        robot = robot, observations = kept(Some(observations))?,
+        camera_info = kept(Some(camera_info))?, target = kept(Some(target))?,
+        camera_pose = kept(camera_pose)?, target_pose = kept(target_pose)?, mounting = mounting,
+        camera_link = &camera_link, refine_intrinsics = refine_intrinsics, outliers = outliers,
+        outlier_rate = outlier_rate, pixel_noise = pixel_noise);
+    let robot = robot.get();
     let m = mounting_of(mounting, camera_link.as_deref())?;
     let given: Vec<&str> = [
         ("camera_pose", camera_pose.is_some()),
@@ -285,6 +295,7 @@ pub fn calibrate_camera(
         cal,
         report,
         inputs,
+        recipe,
     })
 }
 
@@ -384,6 +395,11 @@ impl CameraCalibration {
 
 #[pymethods]
 impl CameraCalibration {
+    /// Pickling: the call that made it, made again on loading.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        self.recipe.reduce(py)
+    }
+
     /// Whether the fit converged.
     #[getter]
     fn converged(&self) -> bool {

@@ -23,6 +23,8 @@ pub struct ContactCalibration {
     robot: Arc<activecal::model::Robot>,
     c: Calibrated,
     report: serde_json::Value,
+    /// How it was made, for pickling.
+    recipe: crate::pickling::Recipe,
 }
 
 /// The distances argument: a dict {(a, b): metres} or pairs (a, b, metres).
@@ -93,7 +95,7 @@ fn contact_file(qs: Vec<Vec<f64>>, touched: Vec<String>) -> ContactFile {
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate_contacts(
     py: Python<'_>,
-    robot: &Robot,
+    robot: &Bound<'_, Robot>,
     q: &Bound<'_, PyAny>,
     points: Vec<String>,
     distances: &Bound<'_, PyAny>,
@@ -105,6 +107,12 @@ pub fn calibrate_contacts(
     outlier_rate: f64,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<ContactCalibration> {
+    use crate::pickling::kept;
+    let recipe = crate::recipe!(py, "calibrate_contacts";
+        robot = robot, q = kept(Some(q))?, points = &points,
+        distances = kept(Some(distances))?, free = &free, max_iterations = max_iterations,
+        loss = loss, loss_scale = loss_scale, outliers = outliers, outlier_rate = outlier_rate);
+    let robot = robot.get();
     let given: Vec<&str> = [
         ("free", free.is_some()),
         ("max_iterations", max_iterations != 200),
@@ -193,6 +201,7 @@ pub fn calibrate_contacts(
         robot: inner,
         c,
         report,
+        recipe,
     })
 }
 
@@ -229,6 +238,11 @@ impl ContactCalibration {
 
 #[pymethods]
 impl ContactCalibration {
+    /// Pickling: the call that made it, made again on loading.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        self.recipe.reduce(py)
+    }
+
     /// Whether the fit converged.
     #[getter]
     fn converged(&self) -> bool {

@@ -141,3 +141,17 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     }
     Ok(())
 }
+
+/// What the command line prints as a warning reaches Python as one.
+pub(crate) fn warn_all(py: Python<'_>, warnings: &[String]) -> PyResult<()> {
+    for w in warnings {
+        let cat = py.get_type::<pyo3::exceptions::PyUserWarning>();
+        pyo3::PyErr::warn(
+            py,
+            cat.as_any(),
+            &std::ffi::CString::new(spell(w)).unwrap_or_default(),
+            1,
+        )?;
+    }
+    Ok(())
+}

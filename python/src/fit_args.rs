@@ -135,6 +135,8 @@ pub(crate) fn refuse_unused(
                 .iter()
                 .map(|s| s.words())
                 .collect();
+            // The table's `bag_design` is `calibrate`'s `design`.
+            let k = if *k == "bag_design" { "design" } else { k };
             format!(
                 "{k}: not used with {}; it acts on {}",
                 sensor.words(),
@@ -165,4 +167,45 @@ pub(crate) fn outliers_of(
         pyo3::exceptions::PyValueError::new_err(format!("outlier_rate={rate}: {e}"))
     })?;
     Ok(c)
+}
+
+/// The `noise` (metres per coordinate) and `orientation_noise` (radians per
+/// axis) arguments, the sensor's stated σ, checked.
+pub(crate) fn stated_noises(
+    noise: Option<f64>,
+    orientation_noise: Option<f64>,
+) -> PyResult<(Option<f64>, Option<f64>)> {
+    if let Some(s) = noise.filter(|s| !(s.is_finite() && *s > 0.0)) {
+        return Err(crate::errors::new_err(
+            crate::errors::Kind::Input,
+            format!(
+                "noise={s}: the sensor's stated σ per coordinate must be a number > 0 (metres)"
+            ),
+        ));
+    }
+    if let Some(s) = orientation_noise.filter(|s| !(s.is_finite() && *s > 0.0)) {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "orientation_noise={s}: the tracker's stated σ per orientation axis must be a number > 0 (radians)"
+        )));
+    }
+    Ok((noise, orientation_noise))
+}
+
+/// The gravity model `compliance=True` fits the joints' compliances with
+/// (the torques of the robot's URDF <inertial> elements), or None.
+pub(crate) fn gravity_of(
+    compliance: bool,
+    robot: &activecal::model::Robot,
+) -> PyResult<Option<std::sync::Arc<activecal::model::gravity::GravityModel>>> {
+    compliance
+        .then(|| {
+            let opts = activecal::io::inertia::InertiaOptions {
+                inertials: None,
+                payload: None,
+            };
+            activecal::io::inertia::gravity_model(robot, &opts)
+                .map(std::sync::Arc::new)
+                .map_err(|e| crate::convert::arg_err("compliance", e))
+        })
+        .transpose()
 }

@@ -1,5 +1,6 @@
 //! Pickling (`pickle`, `multiprocessing`, `joblib`) of `Robot`, `Pool`,
-//! `Design` and `Calibration` by their recipe: the call that made the
+//! `Design`, `Calibration`, `CameraCalibration` and `ContactCalibration`
+//! by their recipe: the call that made the
 //! object and its arguments. Unpickling makes the call again; every one of
 //! them is deterministic (seeded), so the copy has the same poses, ids and
 //! estimates, at the cost of the call's time, and the files the call read

@@ -16,28 +16,44 @@ from test_calibrate import simulated
 # A value of each keyword argument that is not its default, and the sensors
 # it acts on (the command line's table, restated here so that a change of
 # the library's is a change of this test).
+MEASURED = {"points", "poses", "bag_points", "bag_poses"}
+POSES = {"poses", "bag_poses"}
+BAG = {"bag_points", "bag_poses"}
 CALIBRATE = {
-    "fix": (["d_shoulder_lift_joint"], {"points", "poses"}),
-    "free": (["d_shoulder_lift_joint"], {"points", "poses"}),
-    "max_iterations": (150, {"points", "poses"}),
-    "loss": ("huber", {"points", "poses"}),
-    "loss_scale": (1e-3, {"points", "poses"}),
-    "weights": ("fixed", {"poses"}),
-    "orientation_scale": (0.2, {"poses"}),
-    "holdout": (0.25, {"points", "poses"}),
-    "splits": (3, {"points", "poses"}),
-    "seed": (5, {"points", "poses"}),
-    "compliance": (True, {"points", "poses"}),
-    "outliers": ("keep", {"points", "poses"}),
-    "outlier_rate": (0.05, {"points", "poses"}),
-    "noise": (1e-4, {"points", "poses"}),
-    "orientation_noise": (1e-3, {"poses"}),
-    "unknowns": ("offsets", {"points", "poses"}),
-    "keep_axis_relations": (True, {"points", "poses"}),
+    "fix": (["d_shoulder_lift_joint"], MEASURED),
+    "free": (["d_shoulder_lift_joint"], MEASURED),
+    "max_iterations": (150, MEASURED),
+    "loss": ("huber", MEASURED),
+    "loss_scale": (1e-3, MEASURED),
+    "weights": ("fixed", POSES),
+    "orientation_scale": (0.2, POSES),
+    "holdout": (0.25, MEASURED),
+    "splits": (3, MEASURED),
+    "seed": (5, MEASURED),
+    "compliance": (True, MEASURED),
+    "outliers": ("keep", MEASURED),
+    "outlier_rate": (0.05, MEASURED),
+    "noise": (1e-4, MEASURED),
+    "orientation_noise": (1e-3, POSES),
+    "unknowns": ("offsets", MEASURED),
+    "keep_axis_relations": (True, MEASURED),
+    # A ROS 2 bag's (`bag` itself chooses the sensor: see below).
+    "bag": (None, BAG),
+    "joints": ("/js", BAG),
+    "poses": ("/mocap", {"bag_poses"}),
+    "tf": ("world:tool0", {"bag_poses"}),
+    "time_offset": (0.01, BAG),
+    "max_offset": (2.0, BAG),
+    "rest_speed": (0.01, BAG),
+    "rest_min": (0.4, BAG),
+    "settle": (0.1, BAG),
+    "design": ("d.json", BAG),
+    "design_tolerance": (0.02, BAG),
 }
 # Arguments a keyword needs beside it (the command line's `requires`).
 NEEDS = {"loss_scale": {"loss": "huber"}, "loss": {"loss_scale": 1e-3}, "splits": {"holdout": 0.25}, "seed": {"holdout": 0.25}}
-WORDS = {"points": "measured points", "poses": "measured full poses"}
+WORDS = {"points": "measured points", "poses": "measured full poses",
+         "bag_points": "points read from a ROS 2 bag", "bag_poses": "full poses read from a ROS 2 bag"}
 DATA = {"robot", "q", "points", "orientations", "progress"}
 
 
@@ -80,6 +96,49 @@ def test_every_keyword_of_calibrate_acts_or_is_refused_naming_it(tmp_path, senso
             assert msg.startswith(f"{k}: not used with {WORDS[sensor]}"), msg
             refused += 1
     assert acting > 5 and (refused > 0 or pose)
+
+
+TINY = FIXTURES / "bags" / "tiny.mcap"
+
+
+@pytest.mark.parametrize("sensor", ["bag_points", "bag_poses"])
+def test_every_keyword_of_calibrate_from_a_bag_acts_or_is_refused_naming_it(sensor):
+    """With bag=, the same table: each keyword that acts on a bag's sensor
+    is not refused (the call may still fail for another reason: the tiny
+    bag's three rests, or for bag_poses its point topic read as poses), and
+    each other one is refused naming it and the bag's sensor."""
+    pose = sensor == "bag_poses"
+    ur5 = FIXTURES / "ur5.urdf"
+    r = activecal.Robot.from_urdf(ur5, pose=pose)
+    source = {"poses": "/tracker"} if pose else {"points": "/tracker"}
+    base = activecal.calibrate(activecal.Robot.from_urdf(ur5), bag=TINY, points="/tracker")
+    names = {"fix": [list(base.estimate)[2]],
+             "free": [f["name"] for f in base.report["fixed"]][:1] or None}
+    acting = refused = 0
+    for k, (value, on) in CALIBRATE.items():
+        value = names.get(k, value)
+        if value is None or k in source:
+            continue
+        kw = {k: value, **NEEDS.get(k, {})}
+        if k in ("poses", "tf") and not pose:
+            # A pose topic with a point topic: the bag's sensor is poses,
+            # and the point topic is the one refused.
+            with pytest.raises(ValueError, match=f"^points: not used with {WORDS['bag_poses']}"):
+                activecal.calibrate(r, bag=TINY, **source, **kw)
+            continue
+        if sensor in on:
+            try:
+                activecal.calibrate(r, bag=TINY, **source, **kw)
+            except (activecal.Error, ValueError) as e:
+                assert not str(e).startswith(f"{k}: not used"), (k, str(e))
+            acting += 1
+        else:
+            with pytest.raises(ValueError) as e:
+                activecal.calibrate(r, bag=TINY, **source, **kw)
+            msg = str(e.value)
+            assert msg.startswith(f"{k}: not used with {WORDS[sensor]}"), msg
+            refused += 1
+    assert acting > 15 and (refused > 0 or pose), (acting, refused)
 
 
 def test_contact_and_camera_keywords_act_on_their_sensor():

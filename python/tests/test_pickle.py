@@ -1,13 +1,14 @@
-"""Robot, Pool, Design and Calibration pickle (by the call that made
-them, made again on loading): the copy gives the same poses, ids and
-estimates, through pickle and through a multiprocessing worker."""
+"""Robot, Pool, Design, Calibration, CameraCalibration and
+ContactCalibration pickle (by the call that made them, made again on
+loading): the copy gives the same poses, ids, estimates and reports,
+through pickle and through a multiprocessing worker."""
 
 import multiprocessing
 import pickle
 
 import numpy as np
 import activecal
-from conftest import UR5_URDF
+from conftest import FIXTURES, UR5_URDF
 
 
 def ur5():
@@ -62,3 +63,38 @@ def test_a_design_crosses_to_a_multiprocessing_worker():
         back = workers.apply(activecal.select, (r, 30), {"pool": "lattice", "levels": 3})
     assert (ids, ln_oid) == (d.ids, d.ln_oid)
     assert back.ids == d.ids
+
+
+def test_camera_and_contact_calibrations_round_trip():
+    """The camera's and the contacts' results pickle equal (estimate, σ,
+    report), with their inputs given as files, dicts and DataFrames: the
+    copy is the same call made again, and every fit is deterministic."""
+    import csv
+
+    import pandas as pd
+
+    cam = FIXTURES / "camera"
+    pixels = pd.read_csv(cam / "ur5_eye_to_hand.csv")
+    c = activecal.calibrate_camera(
+        activecal.Robot.from_urdf(FIXTURES / "ur5.urdf"), pixels, cam / "camera_info.yaml", cam / "board.yaml",
+        mounting="eye-to-hand", camera_pose=[1.1761, 0.6096, 0.9079, -2.0681, 0.0317, 2.0826],
+        target_pose=[-0.1047, 0.0411, 0.0301, 3.1111, -0.0192, 0.0556], outliers="keep",
+    )
+    blob = pickle.dumps(c)
+    pixels.loc[:, "u"] = 0.0  # a later change to the caller's DataFrame changes no copy
+    c2 = pickle.loads(blob)
+    assert type(c2) is activecal.CameraCalibration
+    assert c2.estimate == c.estimate and c2.sigma == c.sigma
+    assert c2.report == c.report
+
+    with open(FIXTURES / "mukca" / "panda_2.csv") as f:
+        body = list(csv.reader(f))[1:]
+    q = np.array([[float(x) for x in row[:-1]] for row in body])
+    touched = [row[-1] for row in body]
+    distances = {(f"{b}/0", f"{b}/1"): 0.05 for b in sorted({t.split("/")[0] for t in touched})}
+    r = activecal.Robot.from_urdf(FIXTURES / "mukca" / "panda.urdf", tip="ball_link")
+    k = activecal.calibrate_contacts(r, q, touched, distances, max_iterations=150)
+    k2 = pickle.loads(pickle.dumps(k))
+    assert type(k2) is activecal.ContactCalibration
+    assert k2.estimate == k.estimate and k2.sigma == k.sigma
+    assert k2.report == k.report

@@ -9,11 +9,12 @@ Usage (run with the project venv's python):
                      [--noise M] [--orientation-noise RAD] [--joint-noise RAD]
                      [--rate HZ] [--offset S] [--latency S]
                      [--gap-pose K] [--glitch-pose K] [--seed S]
+                     [--joint-rate HZ] [--image-mb M]
       The true robot of truth.json (verify/python/truth.py: Pinocchio,
       perturbed joint origins, a tracker 2.6 m away) driven through the
       design's poses in order: at each pose a rest of 1.6-2.4 s, then a
       move to the next with a quintic (smooth) profile, at most 1 rad/s.
-      /joint_states (sensor_msgs/JointState) at 500 Hz with Gaussian encoder
+      /joint_states (sensor_msgs/JointState) at 500 Hz (--joint-rate) with Gaussian encoder
       noise (--joint-noise, default 2e-6 rad) and one joint that is not the
       robot's (a gripper's, always 0). The measurement at --rate Hz with
       --noise metres per axis (default 5e-5): --kind points on /tracker
@@ -177,8 +178,8 @@ def cmd_write(a):
     segs, rests, end = timeline(qs, rng)
     out = Out(a.out, a.storage)
     names = list(t.chain.names) + ["gripper_finger_joint"]
-    for k in range(int(end * 500) + 1):
-        tk = k / 500.0
+    for k in range(int(end * a.joint_rate) + 1):
+        tk = k / a.joint_rate
         q = q_at(segs, tk) + rng.normal(scale=a.joint_noise, size=len(t.chain.names))
         out.joints(T0 + tk, names, list(q) + [0.0], T0 + tk + 0.001)
     glitch, gap = set(), None
@@ -299,6 +300,7 @@ def main(argv=None):
     p.add_argument("--gap-pose", type=int)
     p.add_argument("--glitch-pose", type=int)
     p.add_argument("--image-mb", type=float, default=0.0)
+    p.add_argument("--joint-rate", type=float, default=500.0)
     p.add_argument("--seed", type=int, default=1)
     p = sub.add_parser("tiny")
     p.add_argument("--out", required=True)

@@ -112,16 +112,19 @@ fn note_topic(
     }
 }
 
-/// Calls `f` with every record of the file, in order.
+/// Calls `f` with every record of the file, in order; returns the largest
+/// read the reader asked for at once (bytes): a chunk's, never the file's.
 fn stream(
     file: &Path,
     f: &mut dyn FnMut(Record<'_>) -> Result<(), BagError>,
-) -> Result<(), BagError> {
+) -> Result<usize, BagError> {
     let mut input = std::fs::File::open(file).map_err(io(file))?;
     let mut reader = LinearReader::new();
+    let mut largest = 0;
     while let Some(event) = reader.next_event() {
         match event.map_err(|e| storage(file, format!("MCAP: {e}")))? {
             LinearReadEvent::ReadRequest(need) => {
+                largest = largest.max(need);
                 let n = input.read(reader.insert(need)).map_err(io(file))?;
                 reader.notify_read(n);
             }
@@ -132,7 +135,7 @@ fn stream(
             }
         }
     }
-    Ok(())
+    Ok(largest)
 }
 
 /// Calls `f` with each message of the `wanted` topics, in the file's order;
@@ -169,4 +172,90 @@ pub fn for_each(
         }
         _ => Ok(()),
     })
+    .map(|_| ())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A bag of 24 MB, 1 MB chunks of a camera's 100 kB messages beside
+    /// 1 kHz joint states, is read as a stream: every joint message
+    /// reaches the caller, and the reader never asks for more than a
+    /// chunk and a message at once (2 MB), an eighth of the file; the
+    /// 2 GB figure (peak memory) is benches/bag_memory.sh's.
+    #[test]
+    fn a_bag_is_read_a_chunk_at_a_time() {
+        let path =
+            std::env::temp_dir().join(format!("activecal-stream-{}.mcap", std::process::id()));
+        let out = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
+        let mut w = mcap::WriteOptions::new()
+            .compression(None)
+            .chunk_size(Some(1 << 20))
+            .create(out)
+            .unwrap();
+        let schema = w
+            .add_schema("sensor_msgs/msg/JointState", "ros2msg", b"")
+            .unwrap();
+        let joints = w
+            .add_channel(schema, "/joint_states", "cdr", &Default::default())
+            .unwrap();
+        let image = w
+            .add_schema("sensor_msgs/msg/Image", "ros2msg", b"")
+            .unwrap();
+        let camera = w
+            .add_channel(image, "/camera", "cdr", &Default::default())
+            .unwrap();
+        let frame = vec![7u8; 100_000];
+        let (mut sent, mut k) = (0u64, 0u32);
+        for i in 0..240u64 {
+            for j in 0..33u64 {
+                let t = i * 33_000_000 + j * 1_000_000;
+                let header = mcap::records::MessageHeader {
+                    channel_id: joints,
+                    sequence: k,
+                    log_time: t,
+                    publish_time: t,
+                };
+                w.write_to_known_channel(&header, &t.to_le_bytes()).unwrap();
+                sent += 1;
+                k += 1;
+            }
+            let t = i * 33_000_000;
+            let header = mcap::records::MessageHeader {
+                channel_id: camera,
+                sequence: k,
+                log_time: t,
+                publish_time: t,
+            };
+            w.write_to_known_channel(&header, &frame).unwrap();
+            k += 1;
+        }
+        w.finish().unwrap();
+        drop(w);
+        let size = std::fs::metadata(&path).unwrap().len() as usize;
+        let mut seen = 0u64;
+        let largest = stream(&path, &mut |r| {
+            if matches!(r, Record::Message { ref header, .. } if header.channel_id == joints) {
+                seen += 1;
+            }
+            Ok(())
+        })
+        .unwrap();
+        let mut counts = HashMap::new();
+        let mut got = 0u64;
+        for_each(&path, &["/joint_states"], &mut counts, &mut |m| {
+            assert_eq!(m.data.len(), 8, "a joint message's bytes");
+            got += 1;
+            Ok(())
+        })
+        .unwrap();
+        std::fs::remove_file(&path).unwrap();
+        assert!(size > 24_000_000, "{size} bytes");
+        assert_eq!((seen, got, counts["/joint_states"]), (sent, sent, sent));
+        assert!(
+            largest <= 2 << 20,
+            "the reader asked for {largest} bytes at once of {size}"
+        );
+    }
 }

@@ -6,14 +6,12 @@
 
 use activecal::identify::LmSettings;
 use activecal::identify::contact::{
-    ContactFit, ContactSettings, HoldoutMode, HoldoutReport, NamedDistance, NamedPlane,
-    holdout::{Figures, downweighted_rows},
-    holdout_by_placement, resolve_distances,
+    ContactSettings, HoldoutMode, HoldoutReport, NamedDistance, NamedPlane, holdout_by_placement,
+    resolve_distances,
 };
 use activecal::io::contacts::{ContactFile, read_contacts};
 use activecal::model::Robot;
 use anyhow::{Context, Result, bail};
-use std::fmt::Write as _;
 use std::path::Path;
 
 /// How to hold contacts out.
@@ -158,7 +156,7 @@ pub fn calibrate_contacts(
     let cal = activecal::experiment::contacts::calibrate_contacts(
         robot, &file, &known, &given, &settings,
     )?;
-    let (fit, figures, fitted) = (&cal.fit, &cal.in_sample, &cal.file);
+    let (fit, fitted) = (&cal.fit, &cal.file);
     // The rows kept: those left out as gross errors are neither fitted
     // nor held out.
     let held = held_out(a, robot, fitted, &given, &settings)?;
@@ -178,45 +176,9 @@ pub fn calibrate_contacts(
         !a.out.is_empty(),
         &written,
     ))?;
-    let mut report = text(fitted, fit, figures, held.as_ref());
-    for n in &cal.notes {
-        let _ = writeln!(report, "note: {n}");
-    }
-    if let Some(p) = &cal.predicted {
-        let _ = writeln!(
-            report,
-            "predicted true error of the calibrated tool point (the fit's covariance at {} random configurations): {:.4} mm RMS; it includes what held-out placements cannot see (an error common to a placement's rows)",
-            p.configurations, p.rms_mm
-        );
-    }
-    if !written.is_empty() {
-        report.push('\n');
-    }
-    for out in &written {
-        let _ = writeln!(report, "calibrated robot written to {out}");
-    }
+    let report = cal.text(held.as_ref(), &written);
     if let Some(dir) = a.report {
-        let r = activecal::render::contact_figures::ContactReport {
-            robot,
-            file: fitted,
-            fit,
-            figures,
-            held: held.as_ref(),
-        };
-        let touches = |g: usize| match fitted.points.get(g) {
-            Some(p) => format!("point {p}"),
-            None => format!("plane {}", g - fitted.points.len() + 1),
-        };
-        let poses: Vec<(String, Vec<f64>)> = fitted
-            .qs
-            .iter()
-            .zip(&fitted.groups)
-            .zip(&fitted.lines)
-            .map(|((q, g), l)| (format!("line {l}: {}", touches(*g)), q.clone()))
-            .collect();
-        activecal::render::folder::contacts(dir, robot, &report, &v, &poses, |d| {
-            activecal::render::contact_figures::draw(d, &r)
-        })?;
+        cal.write_report(dir, robot, &v, held.as_ref(), &report)?;
     }
     super::emit(a.json, &v, || report)?;
     if let Some(why) = cal.implausible.clone() {
@@ -279,139 +241,4 @@ fn held_out(
     };
     let h = holdout_by_placement(robot, &robot.nominal, file, given, settings, &mode)?;
     Ok(Some(h))
-}
-
-/// The report as text.
-fn text(
-    file: &ContactFile,
-    fit: &ContactFit,
-    fig: &Figures,
-    held: Option<&HoldoutReport>,
-) -> String {
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "{}: {} contacts with {} points and {} planes; {} unknowns estimated ({} robot unknowns fixed), {:?} after {} iterations, σ̂ = {}",
-        file.origin,
-        file.qs.len(),
-        file.points.len(),
-        file.planes.len(),
-        fit.estimate.len(),
-        fit.fixed.len(),
-        fit.stop,
-        fit.iterations,
-        fit.sigma_hat
-            .map_or("-".into(), |v| format!("{:.4} mm", 1e3 * v))
-    );
-    for f in &fit.fixed {
-        let _ = writeln!(s, "  fixed {} = {:.6}: {}", f.name, f.value, f.reason);
-    }
-    let t = fit.tool_offset;
-    let _ = writeln!(
-        s,
-        "tool offset (end frame): {:.3} {:.3} {:.3} mm",
-        1e3 * t[0],
-        1e3 * t[1],
-        1e3 * t[2]
-    );
-    for p in &fit.planes {
-        let n = p.normal;
-        let _ = writeln!(
-            s,
-            "plane {} ({}): normal {:.5} {:.5} {:.5}, offset {:.3} mm",
-            p.name,
-            if p.known { "given" } else { "estimated" },
-            n[0],
-            n[1],
-            n[2],
-            1e3 * p.offset_m
-        );
-    }
-    let _ = writeln!(
-        s,
-        "in-sample consistency (RMS distance to the point's mean; a plane's: RMS signed distance to it):"
-    );
-    s += &figures_text(fig);
-    let down = downweighted_rows(fit, file);
-    if !down.is_empty() {
-        let _ = writeln!(s, "down-weighted rows ({}):", down.len());
-        for d in &down {
-            let _ = writeln!(s, "  line {} ({}): weight {:.3}", d.line, d.point, d.weight);
-        }
-    }
-    if let Some(h) = held {
-        s += &holdout_text(h);
-    }
-    s
-}
-
-fn figures_text(f: &Figures) -> String {
-    let mut s = String::new();
-    for p in &f.points {
-        let _ = writeln!(
-            s,
-            "  {:<20} {:>3} rows  nominal {:7.3} mm  calibrated {:7.3} mm",
-            p.point, p.rows, p.nominal_mm, p.calibrated_mm
-        );
-    }
-    let _ = writeln!(
-        s,
-        "  pooled                        nominal {:7.3} mm  calibrated {:7.3} mm",
-        f.nominal_mm, f.calibrated_mm
-    );
-    for p in &f.planes {
-        let _ = writeln!(
-            s,
-            "  plane {:<14} {:>3} rows  nominal {:7.3} mm  calibrated {:7.3} mm{}",
-            p.plane,
-            p.rows,
-            p.nominal_mm,
-            p.calibrated_mm,
-            if p.known { " (given plane)" } else { "" }
-        );
-    }
-    for d in &f.distances {
-        let _ = writeln!(
-            s,
-            "  distance {} – {} ({:.3} mm): error nominal {:.3} mm, calibrated {:.3} mm",
-            d.a, d.b, d.known_mm, d.nominal_error_mm, d.calibrated_error_mm
-        );
-    }
-    s
-}
-
-fn holdout_text(h: &HoldoutReport) -> String {
-    let mut s = format!("\nheld out ({}):\n", h.mode);
-    for f in &h.folds {
-        let _ = writeln!(
-            s,
-            "held out {} (trained on {}; {} unknowns, {} fixed{}):",
-            f.held_out,
-            f.trained_on.join(", "),
-            f.estimated,
-            f.fixed,
-            if f.converged { "" } else { "; NOT converged" }
-        );
-        s += &figures_text(&f.figures);
-        if !f.downweighted.is_empty() {
-            let rows: Vec<String> = f
-                .downweighted
-                .iter()
-                .map(|d| format!("line {} ({}, w {:.2})", d.line, d.point, d.weight))
-                .collect();
-            let _ = writeln!(s, "  down-weighted training rows: {}", rows.join("; "));
-        }
-    }
-    let _ = writeln!(
-        s,
-        "pooled over every held-out row: nominal {:.3} mm, calibrated {:.3} mm; mean over folds {:.3} mm",
-        h.pooled_nominal_mm, h.pooled_calibrated_mm, h.mean_calibrated_mm
-    );
-    if let (Some(m), Some(x)) = (h.mean_distance_error_mm, h.max_distance_error_mm) {
-        let _ = writeln!(
-            s,
-            "distance error, calibrated: mean {m:.3} mm, largest {x:.3} mm"
-        );
-    }
-    s
 }

@@ -284,9 +284,13 @@ impl CameraSelection {
             dir,
             &self.robot,
             &self.joint_names,
-            &crate::render::folder::CameraPage {
+            &crate::render::page_camera::CameraPage {
                 design: &self.design,
                 lines: &lines,
+                package_dirs: self
+                    .sight
+                    .as_ref()
+                    .map_or(&[], |s| s.collision.spec.package_dirs.as_slice()),
             },
             &self.text(written, Some(curve)),
             &json,

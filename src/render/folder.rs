@@ -453,16 +453,6 @@ pub fn selection(
     finish_selection(staged, md, &figs, &report, curve)
 }
 
-/// What the 3D page of a camera design shows: the design, and the lines
-/// of sight checked at each of its poses (empty without a check).
-#[derive(Clone, Copy, Debug)]
-pub struct CameraPage<'a> {
-    /// The design.
-    pub design: &'a crate::select::camera::CameraDesign,
-    /// The lines of sight at each pose, in order.
-    pub lines: &'a [crate::pool::line_of_sight::SightLines],
-}
-
 /// Writes `select --camera-info … --report DIR`: report.md (the text
 /// report, the "how many poses" curve on the pixel Jacobian, the figures),
 /// report.json (`{"selection": the --json object, "how_many_poses": the
@@ -474,7 +464,7 @@ pub fn camera_selection(
     dir: &Path,
     robot: &Robot,
     names: &[String],
-    page: &CameraPage<'_>,
+    page: &super::page_camera::CameraPage<'_>,
     text: &str,
     json: &serde_json::Value,
     curve: &PoseCountCurve,
@@ -498,7 +488,7 @@ pub fn camera_selection(
         text
     );
     md += &how_many_text(curve, noise_is_default);
-    super::page_camera::camera_selection(out, page.design, page.lines, curve, &figs)?;
+    super::page_camera::camera_selection(out, page, curve, &figs)?;
     finish_selection(staged, md, &figs, json, curve)
 }
 

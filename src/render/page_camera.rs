@@ -12,6 +12,18 @@ use crate::select::camera::CameraDesign;
 use nalgebra::{Isometry3, Point3};
 use std::path::Path;
 
+/// What the 3D page of a camera design shows: the design, and the lines
+/// of sight checked at each of its poses (empty without a check).
+#[derive(Clone, Copy, Debug)]
+pub struct CameraPage<'a> {
+    /// The design.
+    pub design: &'a CameraDesign,
+    /// The lines of sight at each pose, in order.
+    pub lines: &'a [SightLines],
+    /// Where `package://` meshes are looked for first.
+    pub package_dirs: &'a [String],
+}
+
 /// The camera's placement, the board's outline and the lines of sight
 /// checked (`lines`, one per pose or none) at each pose of `d`, in the
 /// page's frame.
@@ -90,14 +102,14 @@ fn ray_views(l: &SightLines, to_page: &Isometry3<f64>) -> Vec<RayView> {
 }
 
 /// Writes the page of a camera design into `out`, with the lines of sight
-/// checked at its poses (`lines`: one per pose, or none).
+/// checked at its poses (`c.lines`: one per pose, or none).
 pub fn camera_selection(
     out: &Path,
-    d: &CameraDesign,
-    lines: &[SightLines],
+    c: &CameraPage<'_>,
     curve: &PoseCountCurve,
     figs: &[(String, String)],
 ) -> Result<()> {
+    let (d, lines) = (c.design, c.lines);
     let robot = &d.robot;
     let mut page = Page::new(
         &format!(
@@ -106,7 +118,7 @@ pub fn camera_selection(
             robot.name
         ),
         robot,
-        &[],
+        c.package_dirs,
     );
     let poses: Vec<(String, Vec<f64>)> =
         d.qs.iter()

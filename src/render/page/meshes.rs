@@ -211,7 +211,7 @@ fn missing_note(missing: &[(String, String)]) -> String {
     let files: std::collections::BTreeSet<&str> = missing.iter().map(|m| m.1.as_str()).collect();
     let first = files.iter().next().copied().unwrap_or_default();
     format!(
-        "{} visual mesh file(s) of {} link(s) not found (such as {first}): a package://PKG/… file is looked for in the package directories given, then in the URDF's folder and its ancestors (a folder named PKG, one holding it, or one whose package.xml names PKG); those links are drawn by their collision boxes, cylinders and spheres where they have them, else as the grey lines joining the link frames",
+        "{} visual mesh file(s) of {} link(s) not found (such as {first}): a relative file is looked for beside the URDF, a package://PKG/… file in the package directories given, then in the URDF's folder and its ancestors (a folder named PKG, one holding it, or one whose package.xml names PKG); those links are drawn by their collision boxes, cylinders and spheres where they have them, and every link by the blue lines joining the link frames",
         files.len(),
         links.len()
     )

@@ -506,9 +506,9 @@ fn camera_page_draws_the_lines_of_sight_the_design_counted() {
         "--distance",
         "0.3,2.0",
         "--n",
-        "10",
+        "14",
         "--count",
-        "600",
+        "1500",
         "--line-of-sight",
         "--json",
         "--report",
@@ -525,8 +525,8 @@ fn camera_page_draws_the_lines_of_sight_the_design_counted() {
     let data = &html[html.find("id=\"page-data\">").unwrap() + 15..];
     let data: Value = serde_json::from_str(&data[..data.find("</script>").unwrap()]).unwrap();
     let cam = &data["sensor"];
-    assert_eq!(cam["rays"].as_array().unwrap().len(), 10);
-    for k in [0, 9] {
+    assert_eq!(cam["rays"].as_array().unwrap().len(), 14);
+    for k in [0, 13] {
         let ro = readout(&page, &format!("pose={k}"));
         assert_eq!(ro["shown"], k);
         let rays = cam["rays"][k].as_array().unwrap();

@@ -475,3 +475,131 @@ fn tiago_head_camera_page_shows_the_frustum_at_every_pose() {
         "the camera moves with the head"
     );
 }
+
+/// The Panda eye-to-hand camera design with a line of sight (its own links
+/// hide the board from some configurations): at the first and last pose,
+/// the page draws one ray per board point inside the image, and the clear
+/// ones are the points `select` says the pose sees (`points_seen`, counted
+/// by the same check when the design was chosen); the rays leave from the
+/// camera the page draws.
+#[test]
+fn camera_page_draws_the_lines_of_sight_the_design_counted() {
+    if chromium().is_none() {
+        return;
+    }
+    let dir = scratch_dir("page", "sight").join("report");
+    let r = dir.display().to_string();
+    let out = run(&[
+        "select",
+        "--robot",
+        "fixtures/example-robot-data/panda.urdf#tip=panda_hand_tcp",
+        "--camera-info",
+        "fixtures/camera/camera_info.yaml",
+        "--target",
+        "fixtures/camera/board.yaml",
+        "--mounting",
+        "eye-to-hand",
+        "--camera-pose=1.2,0.6,0.9,-2.0985,0.0,2.0779",
+        "--target-pose=-0.0853,0.0568,0.02,3.141592653589793,0.0,0.03",
+        "--image-margin",
+        "20",
+        "--distance",
+        "0.3,2.0",
+        "--n",
+        "14",
+        "--count",
+        "1500",
+        "--line-of-sight",
+        "--json",
+        "--report",
+        &r,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let page = dir.join("index.html");
+    let html = std::fs::read_to_string(&page).unwrap();
+    let data = &html[html.find("id=\"page-data\">").unwrap() + 15..];
+    let data: Value = serde_json::from_str(&data[..data.find("</script>").unwrap()]).unwrap();
+    let cam = &data["sensor"];
+    assert_eq!(cam["rays"].as_array().unwrap().len(), 14);
+    for k in [0, 13] {
+        let ro = readout(&page, &format!("pose={k}"));
+        assert_eq!(ro["shown"], k);
+        let rays = cam["rays"][k].as_array().unwrap();
+        let m = &ro["marks"];
+        assert_eq!(m["rays_clear"], v["points_seen"][k], "pose {k}");
+        assert_eq!(
+            m["rays_clear"].as_u64().unwrap() + m["rays_blocked"].as_u64().unwrap(),
+            rays.len() as u64,
+            "pose {k}"
+        );
+        for ray in rays {
+            for i in 0..3 {
+                let eye = cam["placements"][k][12 + i].as_f64().unwrap();
+                assert!((ray["from"][i].as_f64().unwrap() - eye).abs() < 1e-9);
+            }
+        }
+    }
+}
+
+/// A contact calibration's page (MUKCa's Panda, `calibrate --report`)
+/// draws one sphere per socket the fit reports, and no plane (the file has
+/// none).
+#[test]
+fn contact_page_draws_every_socket() {
+    if chromium().is_none() {
+        return;
+    }
+    let dir = scratch_dir("page", "contacts").join("report");
+    let r = dir.display().to_string();
+    let mut args = vec![
+        "calibrate",
+        "--robot",
+        "fixtures/mukca/panda.urdf",
+        "--tip",
+        "ball_link",
+        "--measurements",
+        "fixtures/mukca/panda_2.csv",
+        "--json",
+        "--report",
+        &r,
+    ];
+    let blocks = [
+        "back_left",
+        "back_right",
+        "front_center",
+        "front_left",
+        "front_right",
+        "high",
+        "mid-high",
+        "mid_left",
+        "mid_right",
+    ];
+    let distances: Vec<String> = blocks
+        .iter()
+        .map(|b| format!("--point-distance={b}/0,{b}/1=0.05"))
+        .collect();
+    args.extend(distances.iter().map(String::as_str));
+    let out = run(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let points = v["fit"]["points"].as_array().unwrap().len();
+    assert!(points >= 2);
+    let ro = readout(&dir.join("index.html"), "pose=0");
+    assert_eq!(ro["marks"]["sockets"], points);
+    assert_eq!(ro["marks"]["planes"], 0);
+    // A pose per row fitted: the file's less those left out as gross errors.
+    let left_out = v["outliers"]["left_out"].as_array().unwrap().len() as u64;
+    assert_eq!(
+        ro["poses"].as_u64().unwrap(),
+        v["rows"].as_u64().unwrap() - left_out
+    );
+}

@@ -408,3 +408,79 @@ fn bad_plane_files_name_the_row() {
     );
     assert!(activecal::io::contacts::has_point_column(&planes_only));
 }
+
+/// The report folder of a fit with sockets and planes: its page draws
+/// every fitted socket where the fit puts it and every plane as a square
+/// lying in the fitted plane (n · x = d to 1e-9 m: four corners built in
+/// the plane by unit vectors, rounding ~1e-16 m) that holds every contact
+/// on it (each row's calibrated tool point projected into the plane lies
+/// within the square's half-width along both of its edges). MUKCa's
+/// Panda's base link is its URDF's root, so the page's frame is the fit's.
+#[test]
+fn the_report_page_draws_the_sockets_and_each_plane_about_its_contacts() {
+    let robot = panda();
+    let (sim, given, _) = simulated(&robot);
+    let known = resolve_distances(&sim, &given, true).unwrap();
+    let cal = activecal::experiment::contacts::calibrate_contacts(
+        &robot,
+        &sim,
+        &known,
+        &given,
+        &settings(),
+    )
+    .unwrap();
+    let dir = scratch_dir("plane_contacts", "page").join("report");
+    let text = cal.text(None, &[]);
+    cal.write_report(&dir, &robot, &serde_json::json!({}), None, &text)
+        .unwrap();
+    let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    let start = html.find("id=\"page-data\">").unwrap() + 15;
+    let data: serde_json::Value =
+        serde_json::from_str(&html[start..start + html[start..].find("</script>").unwrap()])
+            .unwrap();
+    let s = &data["sensor"];
+    assert_eq!(s["kind"], "contacts");
+    let v3 = |v: &serde_json::Value| {
+        Vector3::new(
+            v[0].as_f64().unwrap(),
+            v[1].as_f64().unwrap(),
+            v[2].as_f64().unwrap(),
+        )
+    };
+    let fit = &cal.fit;
+    let sockets = s["sockets"].as_array().unwrap();
+    assert_eq!(sockets.len(), fit.points.len());
+    for (drawn, (name, p)) in sockets
+        .iter()
+        .zip(fit.points.iter().zip(&fit.point_positions))
+    {
+        assert_eq!(drawn["name"], name.as_str());
+        assert!((v3(&drawn["position"]) - Vector3::from(*p)).norm() < 1e-12);
+    }
+    let planes = s["planes"].as_array().unwrap();
+    assert_eq!(planes.len(), 3);
+    let tips = tool_points(&fit.robot, &fit.table, &fit.tool_offset, &cal.file.qs);
+    for (k, (drawn, est)) in planes.iter().zip(&fit.planes).enumerate() {
+        assert_eq!(drawn["name"], est.name.as_str());
+        let n = Vector3::from(est.normal);
+        let c: Vec<Vector3<f64>> = (0..4).map(|i| v3(&drawn["corners"][i])).collect();
+        for x in &c {
+            assert!((n.dot(x) - est.offset_m).abs() < 1e-9, "{}", est.name);
+        }
+        let centre = c.iter().sum::<Vector3<f64>>() / 4.0;
+        let (e1, e2) = (c[1] - c[0], c[3] - c[0]);
+        let on: Vec<&Vector3<f64>> = tips
+            .iter()
+            .zip(&cal.file.groups)
+            .filter(|(_, g)| **g == cal.file.points.len() + k)
+            .map(|(p, _)| p)
+            .collect();
+        assert_eq!(on.len(), PLANE_ROWS);
+        for p in on {
+            let d = p - centre;
+            for e in [e1, e2] {
+                assert!(d.dot(&e).abs() <= 0.5 * e.norm_squared(), "{}", est.name);
+            }
+        }
+    }
+}

@@ -585,6 +585,17 @@ class ContactCalibration:
     def write_frames(self, path: _Path, overwrite: bool = True) -> None:
         """The frames file: the ball centre as ``point``, the fitted points
         under ``contacts``."""
+    def write_report(self, path: _Path, overwrite: bool = True) -> None:
+        """Writes the report folder ``activecal calibrate --measurements
+        FILE --report DIR`` writes for a contact file with the same rows:
+        report.md, report.json, the figures and ``index.html``, the 3D page
+        of the robot at each contact with the fitted sockets (spheres) and
+        planes (translucent squares). An existing directory is replaced
+        whole (never one holding the robot's files); overwrite=False
+        refuses a non-empty one with `FileError`."""
+    def show(self) -> Page:
+        """The 3D page of `write_report`'s folder, shown inline by
+        Jupyter."""
 
 def calibrate_contacts(
     robot: Robot,
@@ -751,6 +762,29 @@ class CameraDesign:
         ``noise_px``, ``recommended``) for the pixel noise σ ``pixel_noise``
         (px; the design's ``pixel_noise``, else 0.3) and, with
         ``target_error`` (mm), the fewest poses predicted to reach it."""
+    def write_report(
+        self,
+        path: _Path,
+        overwrite: bool = True,
+        pixel_noise: Optional[float] = None,
+        target_error: Optional[float] = None,
+        progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
+    ) -> None:
+        """Writes the report folder ``activecal select --camera-info ...
+        --report DIR`` writes: report.md, report.json, the figures (PNG and
+        SVG) and ``index.html``, the 3D page of the poses with the camera's
+        field of view, the board and the lines of sight checked. Computes
+        the "how many poses" curve (`how_many`'s pixel_noise, target_error
+        and progress; seconds to minutes). An existing directory is
+        replaced whole (never one holding the robot's files);
+        overwrite=False refuses a non-empty one with `FileError`."""
+    def show(
+        self,
+        pixel_noise: Optional[float] = None,
+        progress: Optional[Callable[[str, int, Optional[int], Optional[str]], Any]] = None,
+    ) -> Page:
+        """The 3D page of `write_report`'s folder, shown inline by
+        Jupyter (pixel_noise and progress as `write_report` takes them)."""
     @property
     def report(self) -> dict[str, Any]:
         """The dict ``activecal select --camera-info ... --json`` prints

@@ -169,6 +169,53 @@ fn check_pixel_noise(pixel_noise: Option<f64>) -> PyResult<()> {
     }
 }
 
+/// Refuses a pixel noise that is not a finite number > 0 and a
+/// `target_error` that is not a finite number > 0 (mm).
+fn check_curve_args(pixel_noise: Option<f64>, target_error: Option<f64>) -> PyResult<()> {
+    check_pixel_noise(pixel_noise)?;
+    match target_error {
+        Some(t) if !(t.is_finite() && t > 0.0) => Err(arg_err(
+            "target_error",
+            format!("{t}: the position error to reach must be a finite number > 0 (mm)"),
+        )),
+        _ => Ok(()),
+    }
+}
+
+impl CameraDesign {
+    /// The "how many poses" curve at `pixel_noise` (the design's, else the
+    /// default) and `target_error`, as `select --report` computes it.
+    fn curve(
+        &self,
+        pixel_noise: Option<f64>,
+        target_error: Option<f64>,
+    ) -> Result<activecal::how_many::PoseCountCurve, Fail> {
+        let noise = pixel_noise
+            .or(self.sel.pixel_noise)
+            .unwrap_or(DEFAULT_PIXEL_NOISE);
+        let bound = activecal::bound::BoundSettings::default();
+        self.sel
+            .curve(bound, noise, target_error)
+            .map_err(|e| match e {
+                activecal::how_many::HowManyError::Input(e) => Fail::from(e),
+                activecal::how_many::HowManyError::Bound(e) => e.into(),
+            })
+    }
+
+    /// Writes `select --camera-info ... --report`'s folder into `dir`.
+    fn folder(
+        &self,
+        dir: &std::path::Path,
+        pixel_noise: Option<f64>,
+        target_error: Option<f64>,
+    ) -> Result<(), Fail> {
+        let curve = self.curve(pixel_noise, target_error)?;
+        let noise_is_default = pixel_noise.or(self.sel.pixel_noise).is_none();
+        self.sel.write_report(dir, &curve, &[], noise_is_default)?;
+        Ok(())
+    }
+}
+
 #[pymethods]
 impl CameraDesign {
     /// The chosen configurations, an (n, dof) array (radians, metres), in
@@ -228,28 +275,58 @@ impl CameraDesign {
         target_error: Option<f64>,
         progress: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        check_pixel_noise(pixel_noise)?;
-        if let Some(t) = target_error.filter(|t| !(t.is_finite() && *t > 0.0)) {
-            return Err(arg_err(
-                "target_error",
-                format!("{t}: the position error to reach must be a finite number > 0 (mm)"),
-            ));
-        }
-        let noise = pixel_noise
-            .or(self.sel.pixel_noise)
-            .unwrap_or(DEFAULT_PIXEL_NOISE);
-        let sel = self.sel.clone();
+        check_curve_args(pixel_noise, target_error)?;
         let v = crate::progress::with_callback(progress, || {
-            detached(py, move || {
-                let bound = activecal::bound::BoundSettings::default();
-                let curve = sel.curve(bound, noise, target_error).map_err(|e| match e {
-                    activecal::how_many::HowManyError::Input(e) => Fail::from(e),
-                    activecal::how_many::HowManyError::Bound(e) => e.into(),
-                })?;
+            detached(py, || {
+                let curve = self.curve(pixel_noise, target_error)?;
                 Ok(serde_json::to_value(&curve)?)
             })
         })?;
         json_to_py(py, &v)
+    }
+
+    /// The report folder `activecal select --camera-info ... --report DIR`
+    /// writes for this design, written into `path`: report.md,
+    /// report.json, the figures (PNG and SVG) and `index.html`, the 3D page
+    /// of the poses with the camera's field of view, the board and the
+    /// lines of sight checked. Computes the "how many poses" curve (see
+    /// `how_many`: pixel_noise, target_error and progress as it takes
+    /// them; seconds to minutes). An existing directory is replaced whole;
+    /// overwrite=False refuses a non-empty one with `FileError`.
+    #[pyo3(signature = (path, overwrite=true, pixel_noise=None, target_error=None, progress=None))]
+    fn write_report(
+        &self,
+        py: Python<'_>,
+        path: std::path::PathBuf,
+        overwrite: bool,
+        pixel_noise: Option<f64>,
+        target_error: Option<f64>,
+        progress: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        check_curve_args(pixel_noise, target_error)?;
+        let inputs = crate::page::robot_inputs(&self.sel.robot);
+        crate::progress::with_callback(progress, || {
+            crate::page::write_folder(py, &path, overwrite, &inputs, |dir| {
+                self.folder(dir, pixel_noise, target_error)
+            })
+        })
+    }
+
+    /// The 3D page of `write_report`'s folder (`index.html`), shown inline
+    /// by Jupyter (a `Page`; its `html` is the page's text, byte for byte
+    /// the command line's). pixel_noise and progress as `write_report`
+    /// takes them.
+    #[pyo3(signature = (pixel_noise=None, progress=None))]
+    fn show(
+        &self,
+        py: Python<'_>,
+        pixel_noise: Option<f64>,
+        progress: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<crate::page::Page> {
+        check_curve_args(pixel_noise, None)?;
+        crate::progress::with_callback(progress, || {
+            crate::page::page_of(py, |dir| self.folder(dir, pixel_noise, None))
+        })
     }
 
     /// The whole report: the dict `activecal select --camera-info ...

@@ -206,6 +206,15 @@ pub fn calibrate_contacts(
 }
 
 impl ContactCalibration {
+    /// Writes the report folder into `dir` (no held-out placements, no
+    /// file written beside it).
+    fn folder(&self, dir: &std::path::Path) -> Result<(), Fail> {
+        let text = self.c.text(None, &[]);
+        self.c
+            .write_report(dir, &self.robot, &self.report, None, &text)?;
+        Ok(())
+    }
+
     /// Writes the calibrated robot as `format`, refused when the fit did
     /// not converge or is not a plausible robot.
     fn write_as(&self, format: Format, path: &std::path::Path, overwrite: bool) -> PyResult<()> {
@@ -314,6 +323,30 @@ impl ContactCalibration {
     #[pyo3(signature = (path, overwrite=true))]
     fn write_frames(&self, path: std::path::PathBuf, overwrite: bool) -> PyResult<()> {
         self.write_as(Format::Yaml, &path, overwrite)
+    }
+
+    /// The report folder `activecal calibrate --measurements FILE
+    /// --report DIR` writes for a contact file with the same rows, written
+    /// into `path`: report.md, report.json, the figures (PNG and SVG) and
+    /// `index.html`, the 3D page of the robot at each contact with the
+    /// fitted sockets and planes. An existing directory is replaced whole;
+    /// overwrite=False refuses a non-empty one with `FileError`.
+    #[pyo3(signature = (path, overwrite=true))]
+    fn write_report(
+        &self,
+        py: Python<'_>,
+        path: std::path::PathBuf,
+        overwrite: bool,
+    ) -> PyResult<()> {
+        let inputs = crate::page::robot_inputs(&self.robot);
+        crate::page::write_folder(py, &path, overwrite, &inputs, |dir| self.folder(dir))
+    }
+
+    /// The 3D page of `write_report`'s folder (`index.html`), shown inline
+    /// by Jupyter (a `Page`; its `html` is the page's text, the command
+    /// line's for the same rows but for the data's source it names).
+    fn show(&self, py: Python<'_>) -> PyResult<crate::page::Page> {
+        crate::page::page_of(py, |dir| self.folder(dir))
     }
 
     fn __repr__(&self) -> String {

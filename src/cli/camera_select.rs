@@ -16,14 +16,13 @@ use super::camera_opts::CameraOpts;
 use super::pool_opts::PoolKind;
 use super::select::SelectArgs;
 use activecal::experiment::camera_select::{
-    CameraSelectPlan, CameraSelection, Candidates, DEFAULT_SAMPLES, select_camera,
+    CameraSelectPlan, Candidates, DEFAULT_SAMPLES, select_camera,
 };
 use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_target::read_target;
 use activecal::io::collision_choice::CollisionChoice;
 use activecal::model::Robot;
 use activecal::pool::camera_view::CameraView;
-use activecal::render::camera_design::{CameraDesignFacts, text};
 use anyhow::{Context, Result, bail};
 use std::path::PathBuf;
 
@@ -239,29 +238,13 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         .chain(json_out.iter())
         .map(|p| p.display().to_string())
         .collect();
-    let rendered = |written: &[String]| {
-        let mut s = text(&sel.design, &facts(&sel, &csv), written);
-        if let Some(r) = curve.as_ref().and_then(|c| c.recommended.as_ref()) {
-            s += &activecal::render::folder::recommendation_text(r);
-        }
-        s
-    };
     if let (Some(dir), Some(c)) = (&a.report, &curve) {
-        activecal::render::folder::camera_selection(
-            dir,
-            &sel.robot,
-            &sel.joint_names,
-            &sel.design,
-            &rendered(&written),
-            &serde_json::to_value(report)?,
-            c,
-            a.camera.pixel_noise.is_none(),
-        )?;
+        sel.write_report(dir, c, &written, a.camera.pixel_noise.is_none())?;
         written.push(dir.display().to_string());
     }
     let mut report = sel.report.clone();
     report.out = Some(written.clone());
-    super::emit_report(a.json, &report, || rendered(&written))
+    super::emit_report(a.json, &report, || sel.text(&written, curve.as_ref()))
 }
 
 /// The certified bound's settings of `--gap` and `--report`'s curve
@@ -270,15 +253,4 @@ fn bound(a: &SelectArgs) -> Result<activecal::bound::BoundSettings> {
     Ok(activecal::bound::BoundSettings::builder()
         .solver(a.gap_solver)
         .build()?)
-}
-
-/// What the design's text says beside the design.
-fn facts<'a>(sel: &'a CameraSelection, csv: &'a str) -> CameraDesignFacts<'a> {
-    CameraDesignFacts {
-        candidates: sel.candidates,
-        collision_removed: sel.collision_removed,
-        gap: sel.gap.as_ref(),
-        pixel_noise: sel.pixel_noise,
-        csv,
-    }
 }

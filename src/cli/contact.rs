@@ -13,8 +13,6 @@ use activecal::identify::contact::{
 };
 use activecal::io::contacts::{ContactFile, read_contacts};
 use activecal::model::Robot;
-use activecal::render::contact_figures::ContactReport;
-use activecal::render::contact_text;
 use anyhow::{Result, bail};
 use std::path::Path;
 
@@ -174,21 +172,9 @@ pub fn calibrate_contacts(
         !a.out.is_empty(),
         &written,
     ))?;
-    let r = ContactReport {
-        robot,
-        file: &cal.file,
-        fit: &cal.fit,
-        figures: &cal.in_sample,
-        held: held.as_ref(),
-    };
-    let extras = contact_text::Extras {
-        notes: &cal.notes,
-        predicted: cal.predicted.as_ref(),
-        written: &written,
-    };
-    let report = contact_text::text(&r, extras);
+    let report = cal.text(held.as_ref(), &written);
     if let Some(dir) = a.report {
-        contact_text::write_report(dir, &r, &report, &v)?;
+        cal.write_report(dir, robot, &v, held.as_ref(), &report)?;
     }
     super::emit(a.json, &v, || report)?;
     Ok(verdict.refusal().map(|why| {

@@ -30,13 +30,14 @@ pub(super) struct Geometry {
 
 /// Where a `package://PKG/rest` or relative mesh file is: the package
 /// directories given, then the URDF's directory and its ancestors (a
-/// directory named PKG, or one holding PKG).
+/// directory named PKG, one holding PKG, or one whose `package.xml` names
+/// PKG: a package checked out under another folder name).
 pub(crate) fn resolve(file: &str, urdf_dir: &Path, package_dirs: &[String]) -> Option<PathBuf> {
     if let Some(rest) = file.strip_prefix("package://") {
         let (pkg, sub) = rest.split_once('/').unwrap_or((rest, ""));
         let mut roots: Vec<PathBuf> = package_dirs.iter().map(PathBuf::from).collect();
         roots.extend(urdf_dir.ancestors().map(Path::to_path_buf));
-        for r in roots {
+        for r in &roots {
             for cand in [r.join(pkg).join(sub), r.join(sub)] {
                 let named = r.file_name().is_some_and(|n| n == pkg);
                 if (named || cand.starts_with(r.join(pkg))) && cand.is_file() {
@@ -44,7 +45,11 @@ pub(crate) fn resolve(file: &str, urdf_dir: &Path, package_dirs: &[String]) -> O
                 }
             }
         }
-        return None;
+        return urdf_dir
+            .ancestors()
+            .find(|r| package_name(r).as_deref() == Some(pkg))
+            .map(|r| r.join(sub))
+            .filter(|p| p.is_file());
     }
     let p = file.strip_prefix("file://").unwrap_or(file);
     let p = if Path::new(p).is_absolute() {
@@ -53,6 +58,17 @@ pub(crate) fn resolve(file: &str, urdf_dir: &Path, package_dirs: &[String]) -> O
         urdf_dir.join(p)
     };
     p.is_file().then_some(p)
+}
+
+/// The `<name>` of the ROS package whose `package.xml` is in `dir`, if any.
+fn package_name(dir: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(dir.join("package.xml")).ok()?;
+    let doc = roxmltree::Document::parse(&text).ok()?;
+    doc.root_element()
+        .children()
+        .find(|n| n.has_tag_name("name"))
+        .and_then(|n| n.text())
+        .map(|t| t.trim().to_string())
 }
 
 /// The shape of a URDF collision element of `link`: a box, sphere,
@@ -175,4 +191,63 @@ pub(super) fn geometries(
         }
     }
     Ok(geoms)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::resolve;
+
+    /// A scratch tree: `root/checkout/{package.xml, urdf/, meshes/a.stl}`,
+    /// the package named `name` in its package.xml.
+    fn tree(tag: &str, name: &str) -> std::path::PathBuf {
+        let root =
+            std::env::temp_dir().join(format!("activecal-resolve-{tag}-{}", std::process::id()));
+        let pkg = root.join("checkout");
+        std::fs::create_dir_all(pkg.join("urdf")).unwrap();
+        std::fs::create_dir_all(pkg.join("meshes")).unwrap();
+        std::fs::write(
+            pkg.join("package.xml"),
+            format!("<?xml version=\"1.0\"?>\n<package format=\"3\">\n  <name> {name} </name>\n  <version>1.0.0</version>\n</package>\n"),
+        )
+        .unwrap();
+        std::fs::write(pkg.join("meshes/a.stl"), "solid a\nendsolid a\n").unwrap();
+        root
+    }
+
+    #[test]
+    fn a_package_is_found_by_the_name_its_package_xml_gives() {
+        let root = tree("named", "my_robot_description");
+        let urdf_dir = root.join("checkout/urdf");
+        let found = resolve(
+            "package://my_robot_description/meshes/a.stl",
+            &urdf_dir,
+            &[],
+        );
+        assert_eq!(found, Some(root.join("checkout/meshes/a.stl")));
+        // Another package's name, or a file the package lacks: not found.
+        assert_eq!(
+            resolve("package://other/meshes/a.stl", &urdf_dir, &[]),
+            None
+        );
+        assert_eq!(
+            resolve(
+                "package://my_robot_description/meshes/b.stl",
+                &urdf_dir,
+                &[]
+            ),
+            None
+        );
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn a_folder_named_as_the_package_is_found_without_a_package_xml() {
+        let root = tree("folder", "unrelated");
+        let urdf_dir = root.join("checkout/urdf");
+        assert_eq!(
+            resolve("package://checkout/meshes/a.stl", &urdf_dir, &[]),
+            Some(root.join("checkout/meshes/a.stl"))
+        );
+        std::fs::remove_dir_all(&root).unwrap();
+    }
 }

@@ -16,7 +16,7 @@ use crate::model::Robot;
 use crate::model::robot_ref::ChainChoice;
 use crate::pool::PoolFilter;
 use crate::pool::camera_view::CameraView;
-use crate::pool::line_of_sight::LineOfSight;
+use crate::pool::line_of_sight::{LineOfSight, SightLines};
 use crate::report::{CameraDesignReport, CameraPoolInfo};
 use crate::select::Settings;
 use crate::select::camera::{CameraDesign, camera_design_filtered};
@@ -94,6 +94,10 @@ pub struct CameraSelection {
     pub settings: Settings,
     /// The pixel noise σ the user gave, px.
     pub pixel_noise: Option<f64>,
+    /// What the camera sees (its intrinsics, placements and target).
+    pub view: CameraView,
+    /// The line-of-sight check, when asked for.
+    pub sight: Option<LineOfSight>,
 }
 
 /// Chooses a camera design: the chain, the candidates, the filters and line
@@ -162,6 +166,8 @@ pub fn select_camera(
         joint_names,
         settings: plan.settings,
         pixel_noise: plan.pixel_noise,
+        view: plan.view,
+        sight,
     })
 }
 
@@ -227,6 +233,70 @@ impl CameraSelection {
             let _ = writeln!(csv, "{c},{},{s}", joints.join(","));
         }
         csv
+    }
+
+    /// The design as text (what `select --camera-info` prints): the
+    /// candidates, the design's figures, the files `written` (the CSV table
+    /// when none was) and, with a `curve`, the size it recommends.
+    #[must_use]
+    pub fn text(&self, written: &[String], curve: Option<&PoseCountCurve>) -> String {
+        let csv = self.design_csv();
+        let facts = crate::render::camera_design::CameraDesignFacts {
+            candidates: self.candidates,
+            collision_removed: self.collision_removed,
+            gap: self.gap.as_ref(),
+            pixel_noise: self.pixel_noise,
+            csv: &csv,
+        };
+        let mut s = crate::render::camera_design::text(&self.design, &facts, written);
+        if let Some(r) = curve.and_then(|c| c.recommended.as_ref()) {
+            s += &crate::render::folder::recommendation_text(r);
+        }
+        s
+    }
+
+    /// Writes the report folder of this design into `dir` (`select
+    /// --camera-info … --report DIR`): its text with the files `written`
+    /// beside it, the report, the `curve` (`noise_is_default`: its noise
+    /// was not given), the figures and the 3D page.
+    ///
+    /// # Errors
+    /// The folder cannot be written.
+    pub fn write_report(
+        &self,
+        dir: &std::path::Path,
+        curve: &PoseCountCurve,
+        written: &[String],
+        noise_is_default: bool,
+    ) -> Result<(), Error> {
+        let json = serde_json::to_value(&self.report)
+            .map_err(|e| Error::Invalid(format!("report.json: {e}")))?;
+        let lines: Vec<SightLines> = match &self.sight {
+            Some(s) => self
+                .design
+                .qs
+                .iter()
+                .filter_map(|q| s.sight_lines(&self.view, &self.robot, &self.robot.nominal, q))
+                .collect(),
+            None => Vec::new(),
+        };
+        crate::render::folder::camera_selection(
+            dir,
+            &self.robot,
+            &self.joint_names,
+            &crate::render::page_camera::CameraPage {
+                design: &self.design,
+                lines: &lines,
+                package_dirs: self
+                    .sight
+                    .as_ref()
+                    .map_or(&[], |s| s.collision.spec.package_dirs.as_slice()),
+            },
+            &self.text(written, Some(curve)),
+            &json,
+            curve,
+            noise_is_default,
+        )
     }
 
     /// The "how many poses" curve of this design's visible pool at pixel

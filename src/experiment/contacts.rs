@@ -290,3 +290,71 @@ impl ContactCalibration {
         }
     }
 }
+
+impl ContactCalibration {
+    /// The calibration as text (what `calibrate` prints for a contact
+    /// file): the fit and its figures ([`crate::render::contact_text`]),
+    /// the held-out placements, the gross-error test's notes, the tool
+    /// point's predicted true error and the files `written`.
+    #[must_use]
+    pub fn text(
+        &self,
+        held: Option<&crate::identify::contact::HoldoutReport>,
+        written: &[String],
+    ) -> String {
+        use std::fmt::Write as _;
+        let mut s = crate::render::contact_text::text(&self.file, &self.fit, &self.in_sample, held);
+        for n in &self.notes {
+            let _ = writeln!(s, "note: {n}");
+        }
+        if let Some(p) = &self.predicted {
+            let _ = writeln!(
+                s,
+                "predicted true error of the calibrated tool point (the fit's covariance at {} random configurations): {:.4} mm RMS; it includes what held-out placements cannot see (an error common to a placement's rows)",
+                p.configurations, p.rms_mm
+            );
+        }
+        if !written.is_empty() {
+            s.push('\n');
+        }
+        for out in written {
+            let _ = writeln!(s, "calibrated robot written to {out}");
+        }
+        s
+    }
+
+    /// Writes the report folder of this calibration of `robot` into `dir`
+    /// (`calibrate --report DIR` for a contact file): `text` (as
+    /// [`ContactCalibration::text`] gives it), `json` the report
+    /// ([`ContactCalibration::report`]), the figures and the 3D page with
+    /// the robot at each contact, the fitted sockets and planes.
+    pub fn write_report(
+        &self,
+        dir: &std::path::Path,
+        robot: &Robot,
+        json: &serde_json::Value,
+        held: Option<&crate::identify::contact::HoldoutReport>,
+        text: &str,
+    ) -> crate::error::Result<()> {
+        let file = &self.file;
+        let r = crate::render::contact_figures::ContactReport {
+            robot,
+            file,
+            fit: &self.fit,
+            figures: &self.in_sample,
+            held,
+        };
+        let touches = |g: usize| match file.points.get(g) {
+            Some(p) => format!("point {p}"),
+            None => format!("plane {}", g - file.points.len() + 1),
+        };
+        let poses: Vec<(String, Vec<f64>)> = file
+            .qs
+            .iter()
+            .zip(&file.groups)
+            .zip(&file.lines)
+            .map(|((q, g), l)| (format!("line {l}: {}", touches(*g)), q.clone()))
+            .collect();
+        crate::render::folder::contacts(dir, &r, text, json, &poses)
+    }
+}

@@ -40,6 +40,31 @@ pub struct LineOfSight {
     pub camera_link: Option<String>,
 }
 
+/// The lines of sight a [`LineOfSight`] checked at one configuration.
+#[derive(Clone, Debug)]
+pub struct SightLines {
+    /// The camera's centre (base frame).
+    pub eye: Point3<f64>,
+    /// The target's points (base frame).
+    pub points: Vec<Point3<f64>>,
+    /// Per point: inside the image (with the view's margin).
+    pub inside: Vec<bool>,
+    /// Per point: the ray from the camera is blocked.
+    pub blocked: Vec<bool>,
+}
+
+impl SightLines {
+    /// Per point: seen inside the image and in sight.
+    #[must_use]
+    pub fn seen(&self) -> Vec<bool> {
+        self.inside
+            .iter()
+            .zip(&self.blocked)
+            .map(|(i, b)| *i && !*b)
+            .collect()
+    }
+}
+
 /// The points of the target and the camera's centre in the base frame at
 /// `q`, and which points the camera sees (in front, inside its model's
 /// field and the image with the margin).
@@ -113,6 +138,34 @@ impl LineOfSight {
         }
     }
 
+    /// The lines of sight at `q`: the camera's centre, the target's
+    /// points, which of them are inside the image and which rays the
+    /// robot or an obstacle blocks (base frame of `robot`). `None` when the
+    /// model cannot be loaded ([`LineOfSight::load`] says why).
+    #[must_use]
+    pub fn sight_lines(
+        &self,
+        view: &CameraView,
+        robot: &Robot,
+        table: &ParamTable,
+        q: &[f64],
+    ) -> Option<SightLines> {
+        let model = self.load().ok()?;
+        let (eye, points, inside) = rays(view, robot, table, q);
+        let blocked = match &self.camera_link {
+            Some(l) => model
+                .blocked_rays_from_link(q, l, &eye, &points, self.stop)
+                .unwrap_or_else(|| vec![true; points.len()]),
+            None => model.blocked_rays(q, &eye, &points, self.stop, true),
+        };
+        Some(SightLines {
+            eye,
+            points,
+            inside,
+            blocked,
+        })
+    }
+
     /// For each target point at `q`: seen inside the image and in sight.
     /// Empty when the model cannot be loaded ([`LineOfSight::load`] says why).
     #[must_use]
@@ -123,21 +176,9 @@ impl LineOfSight {
         table: &ParamTable,
         q: &[f64],
     ) -> Vec<bool> {
-        let Ok(model) = self.load() else {
-            return Vec::new();
-        };
-        let (eye, pts, inside) = rays(view, robot, table, q);
-        let blocked = match &self.camera_link {
-            Some(l) => model
-                .blocked_rays_from_link(q, l, &eye, &pts, self.stop)
-                .unwrap_or_else(|| vec![true; pts.len()]),
-            None => model.blocked_rays(q, &eye, &pts, self.stop, true),
-        };
-        inside
-            .iter()
-            .zip(&blocked)
-            .map(|(i, b)| *i && !*b)
-            .collect()
+        self.sight_lines(view, robot, table, q)
+            .map(|s| s.seen())
+            .unwrap_or_default()
     }
 
     /// Whether at least the view's fraction of the target's points are seen

@@ -1,80 +1,16 @@
-//! A contact calibration as text: the fit (unknowns estimated and fixed,
-//! the tool offset, the planes), the in-sample and held-out consistency per
-//! point, plane and known distance (mm), the rows a robust loss weighed
-//! down, the notes of the gross-error test, the tool point's predicted true
-//! error and the files written. The same text is printed by `calibrate`
-//! and kept in the report folder ([`write_report`]).
+//! The text of a contact calibration (what `calibrate --measurements
+//! contacts.csv` prints, and its report folder holds): the fit, the
+//! in-sample consistency and the held-out placements, lengths in mm.
 
-use super::contact_figures::ContactReport;
 use crate::identify::contact::holdout::{Figures, downweighted_rows};
-use crate::identify::contact::predict::PredictedTrueError;
 use crate::identify::contact::{ContactFile, ContactFit, HoldoutReport};
 use std::fmt::Write as _;
-use std::path::Path;
 
-/// What a contact calibration adds to its report beyond the fit: the
-/// gross-error test's notes, the predicted true error, the files written.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Extras<'a> {
-    /// What the gross-error test did, in words.
-    pub notes: &'a [String],
-    /// The tool point's predicted true error.
-    pub predicted: Option<&'a PredictedTrueError>,
-    /// The files written.
-    pub written: &'a [String],
-}
-
-/// The whole text report of a contact calibration.
+/// The report of a contact fit as text: the fit, the fixed unknowns, the
+/// tool offset and planes, the in-sample consistency (mm), the rows a
+/// robust loss weighed down and the held-out placements, if any.
 #[must_use]
-pub fn text(r: &ContactReport<'_>, extras: Extras<'_>) -> String {
-    let mut report = fit_text(r.file, r.fit, r.figures, r.held);
-    for n in extras.notes {
-        let _ = writeln!(report, "note: {n}");
-    }
-    if let Some(p) = extras.predicted {
-        let _ = writeln!(
-            report,
-            "predicted true error of the calibrated tool point (the fit's covariance at {} random configurations): {:.4} mm RMS; it includes what held-out placements cannot see (an error common to a placement's rows)",
-            p.configurations, p.rms_mm
-        );
-    }
-    if !extras.written.is_empty() {
-        report.push('\n');
-    }
-    for out in extras.written {
-        let _ = writeln!(report, "calibrated robot written to {out}");
-    }
-    report
-}
-
-/// Writes the report folder of a contact calibration: its `text`, its
-/// `json` object, the figures and the 3D page of the robot at each row's
-/// configuration, labelled by its file line and what it touched.
-pub fn write_report(
-    dir: &Path,
-    r: &ContactReport<'_>,
-    text: &str,
-    json: &serde_json::Value,
-) -> crate::error::Result<()> {
-    let file = r.file;
-    let touches = |g: usize| match file.points.get(g) {
-        Some(p) => format!("point {p}"),
-        None => format!("plane {}", g - file.points.len() + 1),
-    };
-    let poses: Vec<(String, Vec<f64>)> = file
-        .qs
-        .iter()
-        .zip(&file.groups)
-        .zip(&file.lines)
-        .map(|((q, g), l)| (format!("line {l}: {}", touches(*g)), q.clone()))
-        .collect();
-    super::folder::contacts(dir, r.robot, text, json, &poses, |d| {
-        super::contact_figures::draw(d, r)
-    })
-}
-
-/// The fit as text (the first part of [`text`]).
-fn fit_text(
+pub fn text(
     file: &ContactFile,
     fit: &ContactFit,
     fig: &Figures,
@@ -137,8 +73,7 @@ fn fit_text(
     s
 }
 
-/// Per point, pooled, per plane and per known distance: nominal and
-/// calibrated consistency, mm.
+/// The consistency figures, one line per point, plane and distance (mm).
 fn figures_text(f: &Figures) -> String {
     let mut s = String::new();
     for p in &f.points {
@@ -174,7 +109,7 @@ fn figures_text(f: &Figures) -> String {
     s
 }
 
-/// The held-out folds' figures, pooled and averaged, mm.
+/// The held-out placements' figures (mm).
 fn holdout_text(h: &HoldoutReport) -> String {
     let mut s = format!("\nheld out ({}):\n", h.mode);
     for f in &h.folds {

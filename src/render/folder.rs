@@ -457,14 +457,14 @@ pub fn selection(
 /// report, the "how many poses" curve on the pixel Jacobian, the figures),
 /// report.json (`{"selection": the --json object, "how_many_poses": the
 /// curve}`), the curve's figure and the chosen poses against the joint
-/// limits (`names` the robot's joints, `design` the poses), and the 3D
-/// page ([`super::page_camera`]).
+/// limits (`names` the robot's joints, `page`'s design the poses), and the
+/// 3D page ([`super::page_camera`]).
 #[allow(clippy::too_many_arguments)]
 pub fn camera_selection(
     dir: &Path,
     robot: &Robot,
     names: &[String],
-    design: &crate::select::camera::CameraDesign,
+    page: &super::page_camera::CameraPage<'_>,
     text: &str,
     json: &serde_json::Value,
     curve: &PoseCountCurve,
@@ -472,7 +472,7 @@ pub fn camera_selection(
 ) -> Result<()> {
     let staged = StagedDir::new(dir)?;
     let out = staged.path();
-    let qs = &design.qs;
+    let qs = &page.design.qs;
     let mut figs = vec![how_many_figure(out, curve, qs.len())?];
     plots::joints_vs_limits(&out.join("joints_vs_limits"), &joint_rows(robot, names, qs))?;
     figs.push((
@@ -488,7 +488,7 @@ pub fn camera_selection(
         text
     );
     md += &how_many_text(curve, noise_is_default);
-    super::page_camera::camera_selection(out, design, curve, &figs)?;
+    super::page_camera::camera_selection(out, page, curve, &figs)?;
     finish_selection(staged, md, &figs, json, curve)
 }
 
@@ -526,21 +526,21 @@ fn joint_scale(robot: &Robot) -> Vec<f64> {
 
 /// Writes `calibrate --report DIR` for a contact file: report.md (the text
 /// report: the fit, in-sample and held-out consistency, in mm, and the
-/// figures), report.json (the `--json` object), the figures `draw`
-/// writes into the directory (returning each one's stem and caption) and
-/// the 3D page of the robot at each contact's configuration (`poses`,
-/// labelled).
+/// figures), report.json (the `--json` object), the figures of `r`
+/// ([`super::contact_figures::draw`]) and the 3D page of the robot at each
+/// contact's configuration (`poses`, labelled) with the fit's sockets and
+/// planes ([`super::page_contacts`]).
 pub fn contacts(
     dir: &Path,
-    robot: &Robot,
+    r: &super::contact_figures::ContactReport<'_>,
     text: &str,
     json: &serde_json::Value,
     poses: &[(String, Vec<f64>)],
-    draw: impl FnOnce(&Path) -> Result<Vec<(String, String)>>,
 ) -> Result<()> {
+    let robot = r.robot;
     let staged = StagedDir::new(dir)?;
-    let figs = draw(staged.path())?;
-    super::pages::contacts(staged.path(), robot, text, poses, &figs)?;
+    let figs = super::contact_figures::draw(staged.path(), r)?;
+    super::page_contacts::contacts(staged.path(), r, text, poses, &figs)?;
     let md = format!(
         "# Calibration report (contacts)\n\nRobot: `{}` (chain {}).\n\n```text\n{}```\n{}",
         robot.name,

@@ -18,6 +18,7 @@ pub mod frames_text;
 pub mod measured_text;
 pub mod page;
 pub mod page_camera;
+pub mod page_contacts;
 pub mod pages;
 pub mod paper_figures;
 pub mod plots;

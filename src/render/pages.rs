@@ -291,24 +291,3 @@ fn add_fit(
     page.magnify_robot = Some(magnification(sizes.into_iter()));
     mount
 }
-
-/// The page of a contact calibration (`calibrate --contacts … --report`):
-/// the robot at each contact's configuration, the text report, the figures.
-pub fn contacts(
-    out: &Path,
-    robot: &Robot,
-    text: &str,
-    poses: &[(String, Vec<f64>)],
-    figs: &[(String, String)],
-) -> Result<()> {
-    let mut page = Page::new(
-        &format!("Contact calibration of {}", robot.name),
-        robot,
-        &[],
-    );
-    page.add_poses(robot, &robot.nominal, poses);
-    page.sections
-        .push(format!("<pre>{}</pre>\n", super::page::encode::html(text)));
-    add_figures(&mut page, out, figs);
-    page.write(out)
-}

@@ -178,6 +178,53 @@ function drawMarks(k) {
     line([s.position, [end[12], end[13], end[14]]], 0x999999);
   }
   if (s && s.kind === 'camera') drawCamera(s, k);
+  if (s && s.kind === 'contacts') drawContacts(s);
+}
+
+// The lines of sight the library checked at pose k: green where it held,
+// red where the robot or an obstacle blocks it (one draw call each).
+function drawRays(rays) {
+  for (const [clear, color] of [[true, 0x22aa44], [false, 0xdd2222]]) {
+    const pts = rays.filter((r) => r.clear === clear).flatMap((r) => [r.from, r.to]);
+    if (!pts.length) continue;
+    const g = new THREE.BufferGeometry().setFromPoints(pts.map((p) => new THREE.Vector3(...p)));
+    const l = new THREE.LineSegments(g, new THREE.LineBasicMaterial({ color }));
+    l.userData.rays = pts.length / 2;
+    l.userData.clear = clear;
+    marks.add(l);
+  }
+}
+
+// The sockets of a contact design as spheres, its planes as translucent
+// squares.
+function drawContacts(s) {
+  for (const p of s.sockets) {
+    dot(p.position, 0xcc7700, 0.012);
+    marks.children[marks.children.length - 1].userData.socket = p.name;
+  }
+  for (const p of s.planes) {
+    const g = new THREE.BufferGeometry().setFromPoints(p.corners.map((c) => new THREE.Vector3(...c)));
+    g.setIndex([0, 1, 2, 0, 2, 3]);
+    const m = new THREE.Mesh(
+      g,
+      new THREE.MeshBasicMaterial({ color: 0x3377cc, transparent: true, opacity: 0.3, side: THREE.DoubleSide }),
+    );
+    m.userData.plane = p.name;
+    marks.add(m);
+    line([...p.corners, p.corners[0]], 0x3377cc);
+  }
+}
+
+// What the marks of the shown pose hold: rays (clear, blocked), sockets,
+// planes.
+function drawn() {
+  const count = (f) => marks.children.reduce((n, o) => n + f(o.userData), 0);
+  return {
+    rays_clear: count((u) => (u.clear === true ? u.rays : 0)),
+    rays_blocked: count((u) => (u.clear === false ? u.rays : 0)),
+    sockets: count((u) => (u.socket === undefined ? 0 : 1)),
+    planes: count((u) => (u.plane === undefined ? 0 : 1)),
+  };
 }
 
 function drawCamera(s, k) {
@@ -193,6 +240,7 @@ function drawCamera(s, k) {
   line([...corners, corners[0]].map((v) => v.toArray()), 0x8844aa);
   const b = s.boards[k];
   if (b && b.length) line([...b, b[0]], 0x111111);
+  if (s.rays && s.rays[k]) drawRays(s.rays[k]);
 }
 
 function readout() {
@@ -213,6 +261,7 @@ function readout() {
     timings,
     clearance: data.poses[shown]?.clearance ?? null,
     red: robot.links.flatMap((o, i) => (o.children.some((m) => m.material.emissive?.getHex()) ? [i] : [])),
+    marks: drawn(),
   });
 }
 

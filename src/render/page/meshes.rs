@@ -101,22 +101,19 @@ pub fn visuals(
     let mut files: BTreeMap<String, usize> = BTreeMap::new();
     let mut welded: Vec<(String, Welded)> = Vec::new();
     let mut notes = Vec::new();
+    let mut missing: Vec<(String, String)> = Vec::new();
     for link in &urdf.links {
         let Some(&li) = index.get(link.name.as_str()) else {
             continue;
         };
+        let before = missing.len();
         for v in &link.visual {
-            let shape = match &v.geometry {
-                urdf_rs::Geometry::Box { size } => Shape::Box {
-                    size: [size[0], size[1], size[2]],
-                },
-                urdf_rs::Geometry::Cylinder { radius, length }
-                | urdf_rs::Geometry::Capsule { radius, length } => Shape::Cylinder {
-                    radius: *radius,
-                    length: *length,
-                },
-                urdf_rs::Geometry::Sphere { radius } => Shape::Sphere { radius: *radius },
-                urdf_rs::Geometry::Mesh { filename, scale } => {
+            let shape = match primitive(&v.geometry) {
+                Some(s) => s,
+                None => {
+                    let urdf_rs::Geometry::Mesh { filename, scale } = &v.geometry else {
+                        continue;
+                    };
                     let k = match files.get(filename) {
                         Some(k) => *k,
                         None => match load(filename, urdf_dir, package_dirs) {
@@ -125,7 +122,11 @@ pub fn visuals(
                                 welded.push((filename.clone(), w));
                                 welded.len() - 1
                             }
-                            Err(e) => {
+                            Err(Missing::NotFound) => {
+                                missing.push((link.name.clone(), filename.clone()));
+                                continue;
+                            }
+                            Err(Missing::Unreadable(e)) => {
                                 notes.push(format!("link '{}': {e}; not drawn", link.name));
                                 continue;
                             }
@@ -155,16 +156,79 @@ pub fn visuals(
                 rgba,
             });
         }
+        if missing.len() > before {
+            out.extend(stand_ins(link, li));
+        }
+    }
+    if !missing.is_empty() {
+        notes.push(missing_note(&missing));
     }
     let meshes = fit_budget(welded, MESH_BUDGET_BYTES, &mut notes);
     (out, meshes, notes)
 }
 
+/// A URDF geometry that is a primitive shape (a capsule drawn as its
+/// cylinder); `None` for a mesh.
+fn primitive(g: &urdf_rs::Geometry) -> Option<Shape> {
+    Some(match g {
+        urdf_rs::Geometry::Box { size } => Shape::Box {
+            size: [size[0], size[1], size[2]],
+        },
+        urdf_rs::Geometry::Cylinder { radius, length }
+        | urdf_rs::Geometry::Capsule { radius, length } => Shape::Cylinder {
+            radius: *radius,
+            length: *length,
+        },
+        urdf_rs::Geometry::Sphere { radius } => Shape::Sphere { radius: *radius },
+        urdf_rs::Geometry::Mesh { .. } => return None,
+    })
+}
+
+/// Grey, for a link's collision shapes drawn in place of its missing
+/// visual meshes.
+const STAND_IN_RGBA: [f64; 4] = [0.6, 0.6, 0.62, 1.0];
+
+/// The collision boxes, cylinders and spheres of `link`, drawn in place of
+/// its visual meshes when none of them was found.
+fn stand_ins(link: &urdf_rs::Link, li: usize) -> Vec<Visual> {
+    link.collision
+        .iter()
+        .filter_map(|c| {
+            primitive(&c.geometry).map(|shape| Visual {
+                link: li,
+                origin: super::column_major(&pose(&c.origin)),
+                shape,
+                rgba: Some(STAND_IN_RGBA),
+            })
+        })
+        .collect()
+}
+
+/// The page's note on the visual meshes not found (`(link, file)`): how
+/// many, where they were looked for, and what is drawn instead.
+fn missing_note(missing: &[(String, String)]) -> String {
+    let links: std::collections::BTreeSet<&str> = missing.iter().map(|m| m.0.as_str()).collect();
+    let files: std::collections::BTreeSet<&str> = missing.iter().map(|m| m.1.as_str()).collect();
+    let first = files.iter().next().copied().unwrap_or_default();
+    format!(
+        "{} visual mesh file(s) of {} link(s) not found (such as {first}): a relative file is looked for beside the URDF, a package://PKG/… file in the package directories given, then in the URDF's folder and its ancestors (a folder named PKG, one holding it, or one whose package.xml names PKG); those links are drawn by their collision boxes, cylinders and spheres where they have them, and every link by the blue lines joining the link frames",
+        files.len(),
+        links.len()
+    )
+}
+
+/// Why a mesh was not drawn.
+enum Missing {
+    /// Its file was not found.
+    NotFound,
+    /// Its file did not read.
+    Unreadable(String),
+}
+
 /// Reads and welds a mesh file.
-fn load(filename: &str, urdf_dir: &Path, package_dirs: &[String]) -> Result<Welded, String> {
-    let path = resolve(filename, urdf_dir, package_dirs)
-        .ok_or_else(|| format!("mesh '{filename}' not found"))?;
-    let tris = mesh::load(&path)?;
+fn load(filename: &str, urdf_dir: &Path, package_dirs: &[String]) -> Result<Welded, Missing> {
+    let path = resolve(filename, urdf_dir, package_dirs).ok_or(Missing::NotFound)?;
+    let tris = mesh::load(&path).map_err(Missing::Unreadable)?;
     let read = tris.len();
     let pts: Vec<[f64; 3]> = tris.iter().flatten().copied().collect();
     Ok(cluster(&pts, 0.0, read))

@@ -114,7 +114,48 @@ pub enum SensorView {
         boards: Vec<Vec<[f64; 3]>>,
         /// Horizontal and vertical field of view (radians).
         fov: [f64; 2],
+        /// The lines of sight checked per pose (empty when none was).
+        #[serde(skip_serializing_if = "Vec::is_empty")]
+        rays: Vec<Vec<RayView>>,
     },
+    /// A contact design or fit: the sockets the tool touches and the
+    /// planes it touches.
+    Contacts {
+        /// The sockets (points), in the page's frame.
+        sockets: Vec<SocketView>,
+        /// The planes, each as a square about its contacts.
+        planes: Vec<PlaneView>,
+    },
+}
+
+/// A line of sight the library checked: from the camera to one of the
+/// board's points (page frame, metres), and whether it held.
+#[derive(Clone, Debug, Serialize)]
+pub struct RayView {
+    /// The camera's centre.
+    pub from: [f64; 3],
+    /// The board's point.
+    pub to: [f64; 3],
+    /// Whether nothing of the robot blocks it.
+    pub clear: bool,
+}
+
+/// A socket of a contact design: its name and place (page frame, metres).
+#[derive(Clone, Debug, Serialize)]
+pub struct SocketView {
+    /// Its name.
+    pub name: String,
+    /// Its centre.
+    pub position: [f64; 3],
+}
+
+/// A plane of a contact design, drawn as a translucent square.
+#[derive(Clone, Debug, Serialize)]
+pub struct PlaneView {
+    /// Its name.
+    pub name: String,
+    /// The square's corners in order (page frame, metres).
+    pub corners: [[f64; 3]; 4],
 }
 
 /// Everything the page shows.

@@ -8,10 +8,12 @@
 //! [`crate::identify::Measurements`] with a report of what was kept and why.
 
 pub mod cdr;
+pub mod camera;
 pub mod clock;
 pub mod design;
 pub mod error;
 pub mod extract;
+pub mod image;
 mod mcap_file;
 pub mod messages;
 pub mod rest;

@@ -84,20 +84,25 @@ pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot) -> Result<Option<Strin
         .camera_link
         .as_ref()
         .map_or_else(|| mounting.name().to_string(), |l| format!("camera on {l}"));
-    let intrinsics = read_camera_info(info).context("--camera-info")?;
     let target_origin = target.display().to_string();
     let target = read_target(target).context("--target")?;
-    let (obs_path, obs, images) = match (&a.observations, &a.images) {
-        (Some(p), _) => (
-            p.as_path(),
-            read_observations(p, robot, &target, &intrinsics, a.units.units())?,
-            None,
-        ),
-        (None, Some(spec)) => {
-            let read = super::camera_images::read(a, robot, spec, &target, &intrinsics)?;
-            (spec.as_path(), read.observations.clone(), Some(read))
+    let (intrinsics, obs_path, obs, images, bag) = match (&a.observations, &a.images, &a.bag) {
+        (Some(p), _, _) => {
+            let intrinsics = read_camera_info(info).context("--camera-info")?;
+            let obs = read_observations(p, robot, &target, &intrinsics, a.units.units())?;
+            (intrinsics, p.as_path(), obs, None, None)
         }
-        (None, None) => bail!("give --observations (pixels) or --images"),
+        (None, Some(topic), Some(bag)) => {
+            let got = super::camera_images::read_bag(a, robot, bag, topic, info, &target)?;
+            (got.intrinsics, bag.as_path(), got.observations, None, Some(got.report))
+        }
+        (None, Some(spec), None) => {
+            let intrinsics = read_camera_info(info).context("--camera-info")?;
+            let read = super::camera_images::read(a, robot, spec, &target, &intrinsics)?;
+            let obs = read.observations.clone();
+            (intrinsics, spec.as_path(), obs, Some(read), None)
+        }
+        (None, None, _) => bail!("give --observations (pixels) or --images"),
     };
     let parse =
         |flag: &str, s: &Option<String>| s.as_ref().map(|s| parse_placement(flag, s)).transpose();
@@ -155,6 +160,10 @@ pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot) -> Result<Option<Strin
     let mut v = serde_json::to_value(cal.report(written.clone()))?;
     if let (Some(read), Some(m)) = (&images, v.as_object_mut()) {
         m.insert("images".into(), serde_json::to_value(&read.images)?);
+    }
+    if let (Some(r), Some(m)) = (&bag, v.as_object_mut()) {
+        m.insert("images".into(), serde_json::to_value(r.images())?);
+        m.insert("bag".into(), serde_json::to_value(r)?);
     }
     super::emit(a.json, &v, || {
         text(

@@ -61,7 +61,7 @@ pub(crate) fn yaml_source(py: Python<'_>, obj: &Bound<'_, PyAny>, name: &str) ->
 
 /// The observations argument: a CSV path, or a pandas DataFrame with the
 /// file's columns (written as CSV by pandas, floats round-tripping).
-fn observations_source(obj: &Bound<'_, PyAny>) -> PyResult<Source> {
+pub(crate) fn observations_source(obj: &Bound<'_, PyAny>) -> PyResult<Source> {
     if obj.hasattr("to_csv")? && obj.hasattr("columns")? {
         let kw = PyDict::new(obj.py());
         kw.set_item("index", false)?;
@@ -156,10 +156,17 @@ pub struct CameraCalibration {
 }
 
 /// Calibrates the robot from a camera's pixels of a target, as `activecal
-/// calibrate --observations FILE --json` does with the same files.
+/// calibrate --observations FILE --json` does with the same files (or
+/// `--images DIR --joints FILE` with images=, joints=).
 ///
 /// observations: a CSV path or a pandas DataFrame with the file's columns
 /// `pose, <joint names>, feature, u, v` (a row per point seen; pixels).
+/// Or images: a folder of PNG images, a glob pattern, one file or a list
+/// of files (each a pose, in the folder's sorted order or the list's),
+/// with joints: a CSV path or a DataFrame with an `image` column (each
+/// image's file name) and a column per joint; the target's points are
+/// detected by the library (as `detect` does) and `report["images"]` lists
+/// what became of each image.
 /// camera_info: a ROS camera_info or OpenCV YAML path, or a dict of a ROS
 /// camera_info's content. target: a target YAML path, or a dict
 /// ({"checkerboard": {"rows", "cols", "square"}} or {"points": [...]}).
@@ -177,14 +184,16 @@ pub struct CameraCalibration {
 /// rejection warns (`UserWarning`), and the outlier test uses it. progress
 /// as `calibrate` takes it.
 #[pyfunction]
-#[pyo3(signature = (robot, observations, camera_info, target, *, camera_pose=None, target_pose=None, mounting=None, camera_link=None, refine_intrinsics=false, outliers="drop", outlier_rate=0.01, pixel_noise=None, progress=None))]
+#[pyo3(signature = (robot, observations=None, camera_info=None, target=None, *, images=None, joints=None, camera_pose=None, target_pose=None, mounting=None, camera_link=None, refine_intrinsics=false, outliers="drop", outlier_rate=0.01, pixel_noise=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate_camera(
     py: Python<'_>,
     robot: &Robot,
-    observations: &Bound<'_, PyAny>,
-    camera_info: &Bound<'_, PyAny>,
-    target: &Bound<'_, PyAny>,
+    observations: Option<&Bound<'_, PyAny>>,
+    camera_info: Option<&Bound<'_, PyAny>>,
+    target: Option<&Bound<'_, PyAny>>,
+    images: Option<&Bound<'_, PyAny>>,
+    joints: Option<&Bound<'_, PyAny>>,
     camera_pose: Option<&Bound<'_, PyAny>>,
     target_pose: Option<&Bound<'_, PyAny>>,
     mounting: Option<&str>,
@@ -209,11 +218,19 @@ pub fn calibrate_camera(
     .into_iter()
     .filter_map(|(k, g)| g.then_some(k))
     .collect();
-    crate::calibrate::refuse_unused(
-        activecal::experiment::acts_on::CALIBRATE,
-        &given,
-        activecal::experiment::acts_on::Sensor::Pixels,
-    )?;
+    let sensor = if images.is_some() {
+        activecal::experiment::acts_on::Sensor::Images
+    } else {
+        activecal::experiment::acts_on::Sensor::Pixels
+    };
+    crate::calibrate::refuse_unused(activecal::experiment::acts_on::CALIBRATE, &given, sensor)?;
+    let (Some(camera_info), Some(target)) = (camera_info, target) else {
+        return Err(arg_err(
+            if camera_info.is_none() { "camera_info" } else { "target" },
+            "none given: the camera's intrinsics (a camera_info YAML or dict) and the target (a YAML or dict) are needed",
+        ));
+    };
+    let data = crate::images::pixels_source(py, observations, images, joints)?;
     let outliers = crate::calibrate::outliers_of(outliers, outlier_rate)?;
     if let Some(s) = pixel_noise
         && !(s.is_finite() && s > 0.0)
@@ -226,16 +243,16 @@ pub fn calibrate_camera(
         camera_pose.map(|c| six(py, c, "camera_pose")).transpose()?,
         target_pose.map(|t| six(py, t, "target_pose")).transpose()?,
     );
-    let obs_src = observations_source(observations)?;
     let info_src = yaml_source(py, camera_info, "camera_info")?;
     let target_src = yaml_source(py, target, "target")?;
-    let inputs: Vec<PathBuf> = [&obs_src, &info_src, &target_src]
+    let mut inputs: Vec<PathBuf> = [&info_src, &target_src]
         .into_iter()
         .filter_map(|s| match s {
             Source::File(p) => Some(p.clone()),
             Source::Text(_) => None,
         })
         .collect();
+    inputs.extend(data.files());
     let inner = robot.inner.clone();
     let (cal, report) = crate::progress::with_callback(progress, || {
         detached(py, move || {
@@ -247,7 +264,7 @@ pub fn calibrate_camera(
                 Source::Text(_) => "target".to_string(),
             };
             let target = read_target(&target_src)?;
-            let obs = read_observations(&obs_src, r, &target, &intrinsics)?;
+            let (obs, images) = data.read(r, &target, &intrinsics)?;
             let setup = CameraSetup {
                 intrinsics,
                 target,
@@ -266,7 +283,10 @@ pub fn calibrate_camera(
                 .build()?;
             let cal = activecal::experiment::camera::calibrate_camera(r, obs, &setup, &lm)
                 .map_err(Fail::input)?;
-            let report = serde_json::to_value(cal.report(Vec::new()))?;
+            let mut report = serde_json::to_value(cal.report(Vec::new()))?;
+            if let (Some(i), Some(m)) = (images, report.as_object_mut()) {
+                m.insert("images".into(), i);
+            }
             Ok((cal, report))
         })
     })?;
@@ -289,7 +309,7 @@ pub fn calibrate_camera(
 }
 
 /// Reads the observations for the chain `robot`.
-fn read_observations(
+pub(crate) fn read_observations(
     s: &Source,
     robot: &activecal::model::Robot,
     target: &activecal::io::camera_target::Target,

@@ -58,6 +58,20 @@ fn bases(contacts: &str) -> Vec<(&'static str, Sensor, Vec<String>)> {
             v(&["--bag", "b.mcap", "--poses", "/mocap"]),
         ),
         (
+            "calibrate",
+            Sensor::BagImages,
+            v(&[
+                "--bag",
+                "b.mcap",
+                "--images",
+                "/camera/image",
+                "--camera-info",
+                "/camera/camera_info",
+                "--target",
+                "t.yaml",
+            ]),
+        ),
+        (
             "evaluate",
             Sensor::Points,
             v(&["--robot", "puma560", "--measurements", "m.csv"]),

@@ -92,9 +92,23 @@ pub fn read_images(
     target: &Target,
     intrinsics: &Intrinsics,
 ) -> Result<ImageObservations> {
-    let origin = spec.display().to_string();
-    let board = Board::of(target, &origin)?;
     let files = files::image_files(spec)?;
+    read_image_list(&spec.display().to_string(), files, joints, target, intrinsics)
+}
+
+/// Reads the image `files` (given as `origin`, for messages: a folder, a
+/// pattern, a list) with the joint values of `joints`, for the camera
+/// `intrinsics` and the `target`: each image one pose, its id its place in
+/// `files`.
+pub fn read_image_list(
+    origin: &str,
+    files: Vec<PathBuf>,
+    joints: &ImageJoints,
+    target: &Target,
+    intrinsics: &Intrinsics,
+) -> Result<ImageObservations> {
+    let origin = origin.to_string();
+    let board = Board::of(target, &origin)?;
     let names: Vec<String> = files
         .iter()
         .map(|f| {

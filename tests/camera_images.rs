@@ -213,7 +213,7 @@ fn images_and_their_options_are_refused_where_they_do_not_act() {
     let mut args: Vec<&str> = common::CAMERA_EXAMPLE.to_vec();
     args.extend(["--save-observations", "x.csv"]);
     common::fails_with(&args, "--images");
-    // --images without --joints: clap names the missing option.
+    // --images without --joints: refused naming the missing option.
     common::fails_with(
         &[
             "calibrate",

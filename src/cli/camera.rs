@@ -71,6 +71,9 @@ pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot) -> Result<Option<Strin
     let (Some(info), Some(target)) = (&a.camera_info, &a.target) else {
         bail!("--observations needs --camera-info and --target");
     };
+    if a.images.is_some() && a.bag.is_none() && a.joints.is_none() {
+        bail!("--images needs --joints (the joint values of each image)");
+    }
     let (branch, mounting) = match (&a.camera_link, a.mounting) {
         (Some(link), _) => (
             Some(camera_branch(robot, link).with_context(|| format!("--camera-link {link}"))?),

@@ -12,7 +12,7 @@ use std::path::PathBuf;
 /// (`acts_on.rs`), naming the data given.
 #[derive(Args)]
 #[command(group(clap::ArgGroup::new("camera_data").args(["observations", "images"])))]
-#[command(group(clap::ArgGroup::new("with_joints").args(["images", "bag"])))]
+#[command(group(clap::ArgGroup::new("with_joints").args(["images", "bag"]).multiple(true)))]
 pub struct CalibrateArgs {
     /// Robot: a built-in name, or a .toml description or .urdf file; append
     /// `:pose` for full-pose measurements.

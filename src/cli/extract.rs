@@ -246,13 +246,17 @@ fn check_out(a: &ExtractArgs) -> Result<()> {
 pub fn images_text(r: &BagImagesReport, out: Option<&PathBuf>) -> String {
     let c = &r.intrinsics;
     let mut s = format!(
-        "{}: '{}' {} samples; '{}' {} images at {:.1} Hz; camera from '{}': {} × {} px, fx {:.1} px, {}\n",
+        "{}: '{}' {} samples; '{}' {} image(s){}; camera from '{}': {} × {} px, fx {:.1} px, {}\n",
         r.bag,
         r.joints,
         r.joint_samples,
         r.images,
         r.image_count,
-        r.image_rate,
+        if r.image_rate > 0.0 {
+            format!(" at {:.1} Hz", r.image_rate)
+        } else {
+            String::new()
+        },
         r.camera_info,
         c.width,
         c.height,

@@ -420,8 +420,8 @@ fn root() -> &'static Path {
 /// The camera's observations of the bag's `topic`, by the library.
 fn bag_observations(topic: &str) -> activecal::io::bag::camera::BagImages {
     use activecal::io::bag::camera::{BagImageSettings, read_bag_images};
-    let robot = activecal::io::load_robot(&format!("{}#tip=target", root().join(UR5).display()))
-        .unwrap();
+    let robot =
+        activecal::io::load_robot(&format!("{}#tip=target", root().join(UR5).display())).unwrap();
     let target =
         activecal::io::camera_target::read_target(&root().join("fixtures/camera/board_6x9.yaml"))
             .unwrap();
@@ -442,8 +442,8 @@ fn a_bags_camera_topics_give_the_pixels_of_the_same_images_read_as_files() {
         let f = format!("img_{k:03}.png");
         std::fs::copy(src.join(&f), d.join(&f)).unwrap();
     }
-    let robot = activecal::io::load_robot(&format!("{}#tip=target", root().join(UR5).display()))
-        .unwrap();
+    let robot =
+        activecal::io::load_robot(&format!("{}#tip=target", root().join(UR5).display())).unwrap();
     let target =
         activecal::io::camera_target::read_target(&root().join("fixtures/camera/board_6x9.yaml"))
             .unwrap();
@@ -452,7 +452,9 @@ fn a_bags_camera_topics_give_the_pixels_of_the_same_images_read_as_files() {
     )
     .unwrap();
     let j = read_image_joints(&d.join("joints.csv"), &robot, Default::default()).unwrap();
-    let files = read_images(&d, &j, &target, &intrinsics).unwrap().observations;
+    let files = read_images(&d, &j, &target, &intrinsics)
+        .unwrap()
+        .observations;
     // PNG-compressed frames: every rest's image, the same pixels bit for
     // bit (the same bytes decoded), the rest's mean joint values those of
     // joints.csv (the arm stands exactly still: equal to rounding), and
@@ -475,7 +477,10 @@ fn a_bags_camera_topics_give_the_pixels_of_the_same_images_read_as_files() {
     for r in &raw.report.rests[1..] {
         match &r.image.outcome {
             ImageOutcome::LeftOut { reason } => {
-                assert!(reason.contains("no image on '/camera/image_raw'"), "{reason}");
+                assert!(
+                    reason.contains("no image on '/camera/image_raw'"),
+                    "{reason}"
+                );
             }
             ImageOutcome::Found { .. } => panic!("{:?}", r.image),
         }
@@ -506,8 +511,8 @@ fn extract_writes_a_bags_camera_as_the_observations_csv() {
     // The CSV is the observations file the camera route reads: read back,
     // it holds the library's observations (pixels written to 1e-6 px: half
     // a unit of the last digit apart at most).
-    let robot = activecal::io::load_robot(&format!("{}#tip=target", root().join(UR5).display()))
-        .unwrap();
+    let robot =
+        activecal::io::load_robot(&format!("{}#tip=target", root().join(UR5).display())).unwrap();
     let target =
         activecal::io::camera_target::read_target(&root().join("fixtures/camera/board_6x9.yaml"))
             .unwrap();
@@ -521,7 +526,12 @@ fn extract_writes_a_bags_camera_as_the_observations_csv() {
     )
     .unwrap();
     assert_eq!(back.pose_ids, bag.observations.pose_ids);
-    for (a, b) in back.seen.iter().flatten().zip(bag.observations.seen.iter().flatten()) {
+    for (a, b) in back
+        .seen
+        .iter()
+        .flatten()
+        .zip(bag.observations.seen.iter().flatten())
+    {
         match (a, b) {
             (Some(a), Some(b)) => {
                 assert!((a[0] - b[0]).abs() <= 5e-7 + 1e-12 && (a[1] - b[1]).abs() <= 5e-7 + 1e-12);

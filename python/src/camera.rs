@@ -226,7 +226,11 @@ pub fn calibrate_camera(
     crate::calibrate::refuse_unused(activecal::experiment::acts_on::CALIBRATE, &given, sensor)?;
     let (Some(camera_info), Some(target)) = (camera_info, target) else {
         return Err(arg_err(
-            if camera_info.is_none() { "camera_info" } else { "target" },
+            if camera_info.is_none() {
+                "camera_info"
+            } else {
+                "target"
+            },
             "none given: the camera's intrinsics (a camera_info YAML or dict) and the target (a YAML or dict) are needed",
         ));
     };

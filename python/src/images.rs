@@ -153,7 +153,10 @@ fn images_spec(obj: &Bound<'_, PyAny>) -> PyResult<(String, ImagesSpec)> {
     if files.is_empty() {
         return Err(arg_err("images", "an empty list"));
     }
-    Ok((format!("a list of {} images", files.len()), ImagesSpec::Files(files)))
+    Ok((
+        format!("a list of {} images", files.len()),
+        ImagesSpec::Files(files),
+    ))
 }
 
 /// A CSV argument: a path, or a pandas DataFrame written as CSV.
@@ -187,7 +190,9 @@ impl PixelsSource {
                 match spec {
                     ImagesSpec::Files(f) => out.extend(f.iter().cloned()),
                     ImagesSpec::Spec(s) => {
-                        out.extend(activecal::io::images::files::image_files(s).unwrap_or_default());
+                        out.extend(
+                            activecal::io::images::files::image_files(s).unwrap_or_default(),
+                        );
                     }
                 }
             }
@@ -203,8 +208,13 @@ impl PixelsSource {
         robot: &activecal::model::Robot,
         target: &activecal::io::camera_target::Target,
         intrinsics: &activecal::measure::pinhole::Intrinsics,
-    ) -> Result<(activecal::identify::camera::CameraObservations, Option<serde_json::Value>), Fail>
-    {
+    ) -> Result<
+        (
+            activecal::identify::camera::CameraObservations,
+            Option<serde_json::Value>,
+        ),
+        Fail,
+    > {
         let (origin, spec, joints) = match self {
             PixelsSource::Observations(s) => {
                 return crate::camera::read_observations(s, robot, target, intrinsics)
@@ -224,8 +234,9 @@ impl PixelsSource {
         }
         .map_err(|e| named("joints", e))?;
         let files = match spec {
-            ImagesSpec::Spec(s) => activecal::io::images::files::image_files(s)
-                .map_err(|e| named("images", e))?,
+            ImagesSpec::Spec(s) => {
+                activecal::io::images::files::image_files(s).map_err(|e| named("images", e))?
+            }
             ImagesSpec::Files(f) => f.clone(),
         };
         let read = activecal::io::images::read_image_list(origin, files, &j, target, intrinsics)

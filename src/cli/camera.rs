@@ -97,7 +97,13 @@ pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot) -> Result<Option<Strin
         }
         (None, Some(topic), Some(bag)) => {
             let got = super::camera_images::read_bag(a, robot, bag, topic, info, &target)?;
-            (got.intrinsics, bag.as_path(), got.observations, None, Some(got.report))
+            (
+                got.intrinsics,
+                bag.as_path(),
+                got.observations,
+                None,
+                Some(got.report),
+            )
         }
         (None, Some(spec), None) => {
             let intrinsics = read_camera_info(info).context("--camera-info")?;

@@ -6,8 +6,8 @@
 use super::calibrate_args::CalibrateArgs;
 use activecal::experiment::camera::CameraCalibration;
 use activecal::experiment::camera::images::sheet_images;
-use activecal::io::camera_observations::observations_csv;
 use activecal::io::bag::camera::{BagImages, read_bag_images};
+use activecal::io::camera_observations::observations_csv;
 use activecal::io::camera_target::Target;
 use activecal::io::images::joints::read_image_joints;
 use activecal::io::images::{ImageObservations, read_images};
@@ -60,11 +60,9 @@ pub fn read_bag(
         .joints
         .as_deref()
         .map_or("/joint_states".into(), |j| j.to_string_lossy());
-    let s = a.from_bag.image_settings(
-        &joints,
-        &topic.to_string_lossy(),
-        &info.to_string_lossy(),
-    )?;
+    let s =
+        a.from_bag
+            .image_settings(&joints, &topic.to_string_lossy(), &info.to_string_lossy())?;
     let got = read_bag_images(bag, robot, target, &s)?;
     if !a.json {
         print!("{}", super::extract::images_text(&got.report, None));

@@ -208,8 +208,11 @@ fn extract_images(a: &ExtractArgs) -> Result<()> {
     let s = a.from.image_settings(&a.joints, topic, info)?;
     let got = read_bag_images(&a.bag, &robot, &target, &s)?;
     if let Some(out) = &a.out {
-        let csv =
-            activecal::io::camera_observations::observations_csv(&got.observations, &robot, &target);
+        let csv = activecal::io::camera_observations::observations_csv(
+            &got.observations,
+            &robot,
+            &target,
+        );
         activecal::io::atomic::write_atomic(out, csv.as_bytes())?;
     }
     let r = &got.report;

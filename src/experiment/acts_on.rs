@@ -73,7 +73,8 @@ pub struct ActsOn {
 }
 
 use Sensor::{
-    BagImages, BagPoints, BagPoses, Camera, Contacts, Images, Pixels, Points, Pool, Poses, Simulated, Sockets,
+    BagImages, BagPoints, BagPoses, Camera, Contacts, Images, Pixels, Points, Pool, Poses,
+    Simulated, Sockets,
 };
 
 const fn a(id: &'static str, sensors: &'static [Sensor]) -> ActsOn {

@@ -64,7 +64,12 @@ fn from_bag(s: &Scene, d: usize) -> (Value, f64) {
         .arg(s.rig.robot_ref())
         .arg("--bag")
         .arg(&bag)
-        .args(["--images", "/camera/image", "--camera-info", "/camera/camera_info"])
+        .args([
+            "--images",
+            "/camera/image",
+            "--camera-info",
+            "/camera/camera_info",
+        ])
         .arg("--target")
         .arg(&s.board)
         .args(["--mounting", s.rig.mounting.name()])
@@ -140,5 +145,8 @@ fn live_bag_calibrate_camera_images() {
         b / r
     );
     assert!(b < RATIO * f, "bag {b} mm against {f} mm from the files");
-    assert!(b < RATIO * r, "bag {b} mm against {r} mm from the true pixels");
+    assert!(
+        b < RATIO * r,
+        "bag {b} mm against {r} mm from the true pixels"
+    );
 }

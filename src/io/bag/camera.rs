@@ -141,7 +141,9 @@ pub fn intrinsics(info: &CameraInfo) -> std::result::Result<Intrinsics, String> 
     }
     let d = &info.d;
     let distortion = match info.distortion_model.as_str() {
-        "plumb_bob" if matches!(d.len(), 4 | 5 | 8 | 12 | 14) && d.iter().skip(5).all(|v| *v == 0.0) => {
+        "plumb_bob"
+            if matches!(d.len(), 4 | 5 | 8 | 12 | 14) && d.iter().skip(5).all(|v| *v == 0.0) =>
+        {
             Distortion::PlumbBob([d[0], d[1], d[2], d[3], d.get(4).copied().unwrap_or(0.0)])
         }
         "equidistant" if d.len() == 4 => Distortion::Equidistant([d[0], d[1], d[2], d[3]]),
@@ -211,7 +213,8 @@ fn scan(bag: &Bag, s: &BagImageSettings, names: &[String]) -> std::result::Resul
             Ok(())
         } else {
             if out.info.is_none() {
-                out.info = Some(messages::camera_info(m.data).map_err(|e| bag.decode_error(&m, e))?);
+                out.info =
+                    Some(messages::camera_info(m.data).map_err(|e| bag.decode_error(&m, e))?);
             }
             Ok(())
         }
@@ -275,12 +278,14 @@ pub fn read_bag_images(
     };
     let Some(info) = &found.info else {
         return Err(bag
-            .content_error(format!("no message on '{}': the camera's intrinsics are unknown", s.camera_info))
+            .content_error(format!(
+                "no message on '{}': the camera's intrinsics are unknown",
+                s.camera_info
+            ))
             .into());
     };
-    let intrinsics = intrinsics(info).map_err(|e| {
-        bag.content_error(format!("'{}', message 0: {e}", s.camera_info))
-    })?;
+    let intrinsics = intrinsics(info)
+        .map_err(|e| bag.content_error(format!("'{}', message 0: {e}", s.camera_info)))?;
     let rests = rest::find_rests(&found.streams.joints, &s.rest);
     if rests.is_empty() {
         return Err(bag
@@ -367,11 +372,18 @@ fn assemble(
             })
             .collect();
         return Err(bag
-            .content_error(format!("no rest's image could be used:\n  {}", why.join("\n  ")))
+            .content_error(format!(
+                "no rest's image could be used:\n  {}",
+                why.join("\n  ")
+            ))
             .into());
     }
     let t: Vec<f64> = found.stamps.iter().map(|x| x.1).collect();
-    let dt: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).filter(|d| *d > 0.0).collect();
+    let dt: Vec<f64> = t
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|d| *d > 0.0)
+        .collect();
     let m = rest::median(&dt);
     let report = BagImagesReport {
         bag: bag.name().to_string(),

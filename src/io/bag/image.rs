@@ -102,9 +102,15 @@ mod tests {
         assert_eq!(g.data, vec![1, 2, 3, 4]);
         // Pure red in rgb8 and in bgr8: the same luma as the PNG's (76).
         let rgb = [255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0];
-        assert_eq!(decode_message(&raw("rgb8", 2, 2, 6, &rgb)).unwrap().data, vec![76; 4]);
+        assert_eq!(
+            decode_message(&raw("rgb8", 2, 2, 6, &rgb)).unwrap().data,
+            vec![76; 4]
+        );
         let bgr = [0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0, 255];
-        assert_eq!(decode_message(&raw("bgr8", 2, 2, 6, &bgr)).unwrap().data, vec![76; 4]);
+        assert_eq!(
+            decode_message(&raw("bgr8", 2, 2, 6, &bgr)).unwrap().data,
+            vec![76; 4]
+        );
     }
 
     #[test]
@@ -123,5 +129,4 @@ mod tests {
         png.compressed = true;
         assert_eq!(decode_message(&png).unwrap().data, vec![5, 6, 7, 8]);
     }
-
 }

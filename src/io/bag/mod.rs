@@ -7,8 +7,8 @@
 //! two streams' clocks from the moves, and [`extract`] turns a bag into
 //! [`crate::identify::Measurements`] with a report of what was kept and why.
 
-pub mod cdr;
 pub mod camera;
+pub mod cdr;
 pub mod clock;
 pub mod design;
 pub mod error;

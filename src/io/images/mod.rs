@@ -93,7 +93,13 @@ pub fn read_images(
     intrinsics: &Intrinsics,
 ) -> Result<ImageObservations> {
     let files = files::image_files(spec)?;
-    read_image_list(&spec.display().to_string(), files, joints, target, intrinsics)
+    read_image_list(
+        &spec.display().to_string(),
+        files,
+        joints,
+        target,
+        intrinsics,
+    )
 }
 
 /// Reads the image `files` (given as `origin`, for messages: a folder, a

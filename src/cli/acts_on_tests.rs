@@ -323,6 +323,13 @@ fn every_option_acts_on_a_sensor_or_is_refused_naming_it() {
                 .iter()
                 .find(|r| r.id == arg.get_id().as_str())
                 .unwrap();
+            // A bag's option on an --images line brings its --bag: the line
+            // is then a bag's images.
+            let sensor = if sensor == Sensor::Images && extra.iter().any(|w| w == "--bag") {
+                Sensor::BagImages
+            } else {
+                sensor
+            };
             let got = refusal(&line(&extra), sensor);
             if rule.acts_on.contains(&sensor) {
                 acting += 1;

@@ -239,11 +239,7 @@ fn settled(r: &Rest, s: &RestSettings) -> (f64, f64) {
 
 /// Of each rest, the image nearest the middle of its settled part: its
 /// index on the topic and its time on the joint clock.
-fn choose(
-    rests: &[Rest],
-    stamps: &[(u64, f64)],
-    s: &BagImageSettings,
-) -> Vec<Option<(u64, f64)>> {
+fn choose(rests: &[Rest], stamps: &[(u64, f64)], s: &BagImageSettings) -> Vec<Option<(u64, f64)>> {
     rests
         .iter()
         .map(|r| {

@@ -11,6 +11,7 @@ use super::calibrate_args::CalibrateArgs;
 use activecal::experiment::camera::{CameraCalibration, CameraCalibrationError, CameraSetup};
 use activecal::identify::LmSettings;
 use activecal::identify::camera::CameraFit;
+use activecal::identify::camera::CameraObservations;
 use activecal::identify::camera::start::CameraStart;
 use activecal::io::calibrated::{Format, render};
 use activecal::io::camera_info::read_camera_info;
@@ -18,6 +19,7 @@ use activecal::io::camera_observations::read_observations;
 use activecal::io::camera_target::read_target;
 use activecal::io::urdf_branch::camera_branch;
 use activecal::measure::camera::Mounting;
+use activecal::measure::pinhole::Intrinsics;
 use activecal::model::Robot;
 use activecal::pool::camera_view::placement;
 use anyhow::{Context, Result, bail};
@@ -89,30 +91,7 @@ pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot) -> Result<Option<Strin
         .map_or_else(|| mounting.name().to_string(), |l| format!("camera on {l}"));
     let target_origin = target.display().to_string();
     let target = read_target(target).context("--target")?;
-    let (intrinsics, obs_path, obs, images, bag) = match (&a.observations, &a.images, &a.bag) {
-        (Some(p), _, _) => {
-            let intrinsics = read_camera_info(info).context("--camera-info")?;
-            let obs = read_observations(p, robot, &target, &intrinsics, a.units.units())?;
-            (intrinsics, p.as_path(), obs, None, None)
-        }
-        (None, Some(topic), Some(bag)) => {
-            let got = super::camera_images::read_bag(a, robot, bag, topic, info, &target)?;
-            (
-                got.intrinsics,
-                bag.as_path(),
-                got.observations,
-                None,
-                Some(got.report),
-            )
-        }
-        (None, Some(spec), None) => {
-            let intrinsics = read_camera_info(info).context("--camera-info")?;
-            let read = super::camera_images::read(a, robot, spec, &target, &intrinsics)?;
-            let obs = read.observations.clone();
-            (intrinsics, spec.as_path(), obs, Some(read), None)
-        }
-        (None, None, _) => bail!("give --observations (pixels) or --images"),
-    };
+    let (intrinsics, obs_path, obs, images, bag) = camera_data(a, robot, info, &target)?;
     let parse =
         |flag: &str, s: &Option<String>| s.as_ref().map(|s| parse_placement(flag, s)).transpose();
     let setup = CameraSetup {
@@ -190,6 +169,51 @@ pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot) -> Result<Option<Strin
             })
     })?;
     Ok(cal.verdict.refusal().map(str::to_string))
+}
+
+/// The camera's data: the intrinsics, where the pixels are from, the
+/// observations, and the images read (files, or a bag's topic with its
+/// report).
+type CameraData<'a> = (
+    Intrinsics,
+    &'a Path,
+    CameraObservations,
+    Option<activecal::io::images::ImageObservations>,
+    Option<activecal::io::bag::camera::BagImagesReport>,
+);
+
+/// Reads `--observations`, `--images` or a bag's `--images` topic (with
+/// `--camera-info` the file or, with `--bag`, the topic).
+fn camera_data<'a>(
+    a: &'a CalibrateArgs,
+    robot: &Robot,
+    info: &Path,
+    target: &activecal::io::camera_target::Target,
+) -> Result<CameraData<'a>> {
+    Ok(match (&a.observations, &a.images, &a.bag) {
+        (Some(p), _, _) => {
+            let intrinsics = read_camera_info(info).context("--camera-info")?;
+            let obs = read_observations(p, robot, target, &intrinsics, a.units.units())?;
+            (intrinsics, p.as_path(), obs, None, None)
+        }
+        (None, Some(topic), Some(bag)) => {
+            let got = super::camera_images::read_bag(a, robot, bag, topic, info, target)?;
+            (
+                got.intrinsics,
+                bag.as_path(),
+                got.observations,
+                None,
+                Some(got.report),
+            )
+        }
+        (None, Some(spec), None) => {
+            let intrinsics = read_camera_info(info).context("--camera-info")?;
+            let read = super::camera_images::read(a, robot, spec, target, &intrinsics)?;
+            let obs = read.observations.clone();
+            (intrinsics, spec.as_path(), obs, Some(read), None)
+        }
+        (None, None, _) => bail!("give --observations (pixels) or --images"),
+    })
 }
 
 /// The gross-error test's notes and the stated noise's warning, one line

@@ -315,7 +315,14 @@ fn every_option_acts_on_a_sensor_or_is_refused_naming_it() {
             // are clap's).
             let bag_defines = matches!(arg.get_id().as_str(), "points" | "poses" | "tf")
                 && matches!(sensor, Sensor::BagPoints | Sensor::BagPoses);
-            if base.contains(&long) || (defines && sensor == Sensor::Pool) || bag_defines {
+            // --bag on an --images line brings a bag's measurement
+            // (--points): a bag's images line is its own base's.
+            let bag_on_images = arg.get_id() == "bag" && sensor == Sensor::Images;
+            if base.contains(&long)
+                || (defines && sensor == Sensor::Pool)
+                || bag_defines
+                || bag_on_images
+            {
                 continue;
             }
             let extra = without_given(&base, argv_of(command, &arg));

@@ -3,6 +3,7 @@
 //! `CameraCalibration` it returns.
 
 use crate::convert::{Fail, arg_err, detached, float_array, json_to_py, ndarray};
+use crate::images::{ImagesSpec, PixelsSource};
 use crate::robot::Robot;
 use activecal::experiment::camera::{CameraCalibration as Calibrated, CameraSetup};
 use activecal::identify::LmSettings;
@@ -268,7 +269,7 @@ pub fn calibrate_camera(
                 Source::Text(_) => "target".to_string(),
             };
             let target = read_target(&target_src)?;
-            let (obs, images) = data.read(r, &target, &intrinsics)?;
+            let (obs, images) = read_pixels(&data, r, &target, &intrinsics)?;
             let setup = CameraSetup {
                 intrinsics,
                 target,
@@ -326,6 +327,50 @@ pub(crate) fn read_observations(
         Source::Text(t) => parse_observations(t, "observations", robot, target, intrinsics, units),
     }
     .map_err(|e| named("observations", e))
+}
+
+/// The camera's observations for the chain `robot`: read, or detected
+/// in the images by the library (as `calibrate --images` does, with
+/// what became of each image, the report's `images`).
+pub(crate) fn read_pixels(
+    data: &PixelsSource,
+    robot: &activecal::model::Robot,
+    target: &activecal::io::camera_target::Target,
+    intrinsics: &activecal::measure::pinhole::Intrinsics,
+) -> Result<
+    (
+        activecal::identify::camera::CameraObservations,
+        Option<serde_json::Value>,
+    ),
+    Fail,
+> {
+    let (origin, spec, joints) = match data {
+        PixelsSource::Observations(s) => {
+            return read_observations(s, robot, target, intrinsics).map(|o| (o, None));
+        }
+        PixelsSource::Images {
+            origin,
+            spec,
+            joints,
+        } => (origin, spec, joints),
+    };
+    use activecal::io::images::joints::{parse_image_joints, read_image_joints};
+    let units = activecal::units::Units::default();
+    let j = match joints {
+        Source::File(p) => read_image_joints(p, robot, units),
+        Source::Text(t) => parse_image_joints(t, "the DataFrame", robot, units),
+    }
+    .map_err(|e| named("joints", e))?;
+    let files = match spec {
+        ImagesSpec::Spec(s) => {
+            activecal::io::images::files::image_files(s).map_err(|e| named("images", e))?
+        }
+        ImagesSpec::Files(f) => f.clone(),
+    };
+    let read = activecal::io::images::read_image_list(origin, files, &j, target, intrinsics)
+        .map_err(|e| named("images", e))?;
+    let images = serde_json::to_value(&read.images).map_err(Fail::input)?;
+    Ok((read.observations, Some(images)))
 }
 
 /// Writes `text` to `path` atomically; an existing file only with

@@ -199,49 +199,4 @@ impl PixelsSource {
         }
         out
     }
-
-    /// The camera's observations for the chain `robot`: read, or detected
-    /// in the images by the library (as `calibrate --images` does, with
-    /// what became of each image, the report's `images`).
-    pub(crate) fn read(
-        &self,
-        robot: &activecal::model::Robot,
-        target: &activecal::io::camera_target::Target,
-        intrinsics: &activecal::measure::pinhole::Intrinsics,
-    ) -> Result<
-        (
-            activecal::identify::camera::CameraObservations,
-            Option<serde_json::Value>,
-        ),
-        Fail,
-    > {
-        let (origin, spec, joints) = match self {
-            PixelsSource::Observations(s) => {
-                return crate::camera::read_observations(s, robot, target, intrinsics)
-                    .map(|o| (o, None));
-            }
-            PixelsSource::Images {
-                origin,
-                spec,
-                joints,
-            } => (origin, spec, joints),
-        };
-        use activecal::io::images::joints::{parse_image_joints, read_image_joints};
-        let units = activecal::units::Units::default();
-        let j = match joints {
-            Source::File(p) => read_image_joints(p, robot, units),
-            Source::Text(t) => parse_image_joints(t, "the DataFrame", robot, units),
-        }
-        .map_err(|e| named("joints", e))?;
-        let files = match spec {
-            ImagesSpec::Spec(s) => {
-                activecal::io::images::files::image_files(s).map_err(|e| named("images", e))?
-            }
-            ImagesSpec::Files(f) => f.clone(),
-        };
-        let read = activecal::io::images::read_image_list(origin, files, &j, target, intrinsics)
-            .map_err(|e| named("images", e))?;
-        let images = serde_json::to_value(&read.images).map_err(Fail::input)?;
-        Ok((read.observations, Some(images)))
-    }
 }

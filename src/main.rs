@@ -320,6 +320,9 @@ use cli::acts_on::{self, Sensor};
 /// read: points and full poses are told apart once the file is read
 /// (`calibrate::from_measurements` checks again).
 fn calibrate_sensors(a: &cli::calibrate::CalibrateArgs) -> &'static [acts_on::Sensor] {
+    if a.images.is_some() && a.bag.is_some() {
+        return &[Sensor::BagImages];
+    }
     if a.images.is_some() {
         return &[Sensor::Images];
     }

@@ -483,3 +483,177 @@ fn a_refused_bag_writes_nothing() {
         assert_eq!(inputs(&d), before, "{bag} {extra:?}: something was written");
     }
 }
+/// `fixtures/bags/camera.mcap` (`bag_truth.py tiny-images`): the first six
+/// committed renders of `fixtures/camera/images/`, one per rest.
+const CAMERA_BAG: &str = "fixtures/bags/camera.mcap";
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The camera's observations of the bag's `topic`, by the library.
+fn bag_observations(topic: &str) -> activecal::io::bag::camera::BagImages {
+    use activecal::io::bag::camera::{BagImageSettings, read_bag_images};
+    let robot =
+        activecal::io::load_robot(&format!("{}#tip=target", root().join(UR5).display())).unwrap();
+    let target =
+        activecal::io::camera_target::read_target(&root().join("fixtures/camera/board_6x9.yaml"))
+            .unwrap();
+    let s = BagImageSettings::new("/joint_states", topic, "/camera/camera_info");
+    read_bag_images(&root().join(CAMERA_BAG), &robot, &target, &s).unwrap()
+}
+
+#[test]
+fn a_bags_camera_topics_give_the_pixels_of_the_same_images_read_as_files() {
+    use activecal::io::images::{ImageOutcome, joints::read_image_joints, read_images};
+    // The same six images as files, with their joints.csv rows.
+    let d = scratch_dir("bags", "camera_files");
+    let src = root().join("fixtures/camera/images");
+    let joints = std::fs::read_to_string(src.join("joints.csv")).unwrap();
+    let kept: Vec<&str> = joints.lines().take(7).collect();
+    std::fs::write(d.join("joints.csv"), kept.join("\n") + "\n").unwrap();
+    for k in 0..6 {
+        let f = format!("img_{k:03}.png");
+        std::fs::copy(src.join(&f), d.join(&f)).unwrap();
+    }
+    let robot =
+        activecal::io::load_robot(&format!("{}#tip=target", root().join(UR5).display())).unwrap();
+    let target =
+        activecal::io::camera_target::read_target(&root().join("fixtures/camera/board_6x9.yaml"))
+            .unwrap();
+    let intrinsics = activecal::io::camera_info::read_camera_info(
+        &root().join("fixtures/camera/small_camera_info.yaml"),
+    )
+    .unwrap();
+    let j = read_image_joints(&d.join("joints.csv"), &robot, Default::default()).unwrap();
+    let files = read_images(&d, &j, &target, &intrinsics)
+        .unwrap()
+        .observations;
+    // PNG-compressed frames: every rest's image, the same pixels bit for
+    // bit (the same bytes decoded), the rest's mean joint values those of
+    // joints.csv (the arm stands exactly still: equal to rounding), and
+    // the CameraInfo message's camera the YAML's.
+    let bag = bag_observations("/camera/image");
+    assert_eq!(bag.intrinsics, intrinsics);
+    assert_eq!(bag.report.rests.len(), 6, "{:?}", bag.report.rests);
+    assert_eq!(bag.observations.pose_ids, files.pose_ids);
+    assert_eq!(bag.observations.seen, files.seen);
+    for (a, b) in bag.observations.qs.iter().zip(&files.qs) {
+        for (x, y) in a.iter().zip(b) {
+            assert!((x - y).abs() < 1e-12, "{a:?} vs {b:?}");
+        }
+    }
+    // A raw mono8 frame on the first rest only: the same pixels; the other
+    // rests are listed with the reason.
+    let raw = bag_observations("/camera/image_raw");
+    assert_eq!(raw.observations.pose_ids, vec![0]);
+    assert_eq!(raw.observations.seen[0], files.seen[0]);
+    for r in &raw.report.rests[1..] {
+        match &r.image.outcome {
+            ImageOutcome::LeftOut { reason } => {
+                assert!(
+                    reason.contains("no image on '/camera/image_raw'"),
+                    "{reason}"
+                );
+            }
+            ImageOutcome::Found { .. } => panic!("{:?}", r.image),
+        }
+    }
+}
+
+#[test]
+fn extract_writes_a_bags_camera_as_the_observations_csv() {
+    let d = scratch_dir("bags", "camera_extract");
+    let out = d.join("pixels.csv");
+    let r = json_of(&[
+        "extract",
+        CAMERA_BAG,
+        "--robot",
+        "fixtures/ur5.urdf#tip=target",
+        "--images",
+        "/camera/image",
+        "--camera-info",
+        "/camera/camera_info",
+        "--target",
+        "fixtures/camera/board_6x9.yaml",
+        "--out",
+        out.to_str().unwrap(),
+        "--force",
+        "--json",
+    ]);
+    assert_eq!(r["rests"].as_array().unwrap().len(), 6, "{r}");
+    // The CSV is the observations file the camera route reads: read back,
+    // it holds the library's observations (pixels written to 1e-6 px: half
+    // a unit of the last digit apart at most).
+    let robot =
+        activecal::io::load_robot(&format!("{}#tip=target", root().join(UR5).display())).unwrap();
+    let target =
+        activecal::io::camera_target::read_target(&root().join("fixtures/camera/board_6x9.yaml"))
+            .unwrap();
+    let bag = bag_observations("/camera/image");
+    let back = activecal::io::camera_observations::read_observations(
+        &out,
+        &robot,
+        &target,
+        &bag.intrinsics,
+        Default::default(),
+    )
+    .unwrap();
+    assert_eq!(back.pose_ids, bag.observations.pose_ids);
+    for (a, b) in back
+        .seen
+        .iter()
+        .flatten()
+        .zip(bag.observations.seen.iter().flatten())
+    {
+        match (a, b) {
+            (Some(a), Some(b)) => {
+                assert!((a[0] - b[0]).abs() <= 5e-7 + 1e-12 && (a[1] - b[1]).abs() <= 5e-7 + 1e-12);
+            }
+            (None, None) => {}
+            _ => panic!("{a:?} vs {b:?}"),
+        }
+    }
+}
+
+#[test]
+fn a_bags_camera_without_intrinsics_or_decodable_images_is_refused_by_name() {
+    let line = |images: &'static str, info: &'static str| {
+        vec![
+            "extract",
+            CAMERA_BAG,
+            "--robot",
+            "fixtures/ur5.urdf#tip=target",
+            "--images",
+            images,
+            "--camera-info",
+            info,
+            "--target",
+            "fixtures/camera/board_6x9.yaml",
+        ]
+    };
+    fails_with(
+        &line("/camera/image", "/camera/no_info"),
+        "no message on '/camera/no_info': the camera's intrinsics are unknown",
+    );
+    fails_with(
+        &line("/camera/image", "/camera/info"),
+        "no topic '/camera/info'",
+    );
+    fails_with(
+        &line("/camera/image", "/joint_states"),
+        "topic '/joint_states' is of type sensor_msgs/msg/JointState, not sensor_msgs/msg/CameraInfo",
+    );
+    fails_with(
+        &line("/camera/image_yuv", "/camera/camera_info"),
+        "rest 1 (image 0): a raw image in encoding 'yuv422'",
+    );
+    fails_with(
+        &line("/camera/image_jpeg", "/camera/camera_info"),
+        "a compressed image in format 'jpeg'",
+    );
+    // The measurement options of points and poses do not go with --images.
+    let mut both = line("/camera/image", "/camera/camera_info");
+    both.extend(["--points", "/tracker"]);
+    fails_with(&both, "--points");
+}

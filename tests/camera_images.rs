@@ -213,7 +213,7 @@ fn images_and_their_options_are_refused_where_they_do_not_act() {
     let mut args: Vec<&str> = common::CAMERA_EXAMPLE.to_vec();
     args.extend(["--save-observations", "x.csv"]);
     common::fails_with(&args, "--images");
-    // --images without --joints: clap names the missing option.
+    // --images without --joints: refused naming the missing option.
     common::fails_with(
         &[
             "calibrate",
@@ -270,4 +270,61 @@ fn charuco_targets_the_detector_cannot_read_are_refused_in_words() {
         args[k] = t.to_str().unwrap();
         common::fails_with(&args, says);
     }
+}
+
+/// `fixtures/camera/charuco/`: 4 renders, 640 × 480, of an OpenCV ChArUco
+/// board of 4 × 5 squares (`fixtures/camera/charuco_4x5.yaml`) on a true
+/// UR5's flange camera (`camera_images.py render --charuco 4,5,0.025,0.018
+/// --noise 0 --near-range 0.3,0.5`; squares 28–41 px), with the true pixel
+/// of each corner in `fixtures/camera/charuco_truth.csv` (its columns
+/// `pose, <joints>, feature, u, v`).
+#[test]
+fn charuco_corners_found_in_the_committed_renders_carry_the_true_ids() {
+    let robot = activecal::io::load_robot(&format!(
+        "{}#tip=target",
+        root().join("fixtures/ur5.urdf").display()
+    ))
+    .unwrap();
+    let intrinsics =
+        read_camera_info(&root().join("fixtures/camera/charuco_camera_info.yaml")).unwrap();
+    let target = read_target(&root().join("fixtures/camera/charuco_4x5.yaml")).unwrap();
+    let dir = root().join("fixtures/camera/charuco");
+    let joints = read_image_joints(&dir.join("joints.csv"), &robot, Default::default()).unwrap();
+    let read = read_images(&dir, &joints, &target, &intrinsics).unwrap();
+    let text = std::fs::read_to_string(root().join("fixtures/camera/charuco_truth.csv")).unwrap();
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
+    let (pose, feature, u, v) = (col("pose"), col("feature"), col("u"), col("v"));
+    let truth: BTreeMap<(i64, usize), [f64; 2]> = lines
+        .map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            (
+                (c[pose].parse().unwrap(), c[feature].parse().unwrap()),
+                [c[u].parse().unwrap(), c[v].parse().unwrap()],
+            )
+        })
+        .collect();
+    let mut errors = Vec::new();
+    for (i, id) in read.observations.pose_ids.iter().enumerate() {
+        for (k, p) in read.observations.seen[i].iter().enumerate() {
+            if let Some(p) = p {
+                let t = truth[&(*id, k)];
+                errors.push((p[0] - t[0]).hypot(p[1] - t[1]));
+            }
+        }
+    }
+    errors.sort_by(f64::total_cmp);
+    let (median, max) = (errors[errors.len() / 2], errors[errors.len() - 1]);
+    println!(
+        "{} corners of 4 × 12: {median:.3} px median, {max:.3} px max",
+        errors.len()
+    );
+    // Every image shows the whole board: every inner corner found, each
+    // with the id of its true place (another id is a square, ≥ 28 px,
+    // away); refined to the checkerboard's bounds above.
+    assert_eq!(read.observations.pose_ids, vec![0, 1, 2, 3]);
+    assert_eq!(errors.len(), 4 * 12);
+    assert!(median < 0.1, "median {median} px");
+    assert!(max < 0.5, "max {max} px");
 }

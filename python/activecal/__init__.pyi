@@ -695,10 +695,12 @@ def detect(
 
 def calibrate_camera(
     robot: Robot,
-    observations: Union[_Path, Any],
-    camera_info: Union[_Path, Mapping[str, Any]],
-    target: Union[_Path, Mapping[str, Any]],
+    observations: Optional[Union[_Path, Any]] = None,
+    camera_info: Optional[Union[_Path, Mapping[str, Any]]] = None,
+    target: Optional[Union[_Path, Mapping[str, Any]]] = None,
     *,
+    images: Optional[Union[_Path, Sequence[_Path]]] = None,
+    joints: Optional[Union[_Path, Any]] = None,
     camera_pose: Optional[Sequence[float]] = None,
     target_pose: Optional[Sequence[float]] = None,
     mounting: Optional[str] = None,
@@ -714,6 +716,13 @@ def calibrate_camera(
     files. observations: a CSV path or a pandas DataFrame with its columns
     ``pose, <joint names>, feature, u, v`` (one row a point seen, pixels;
     a DataFrame's errors name the line of its CSV, line 2 its first row).
+    Or, instead, images: a folder of PNG images, a glob pattern, one file
+    or a list of files (each a pose), with joints: a CSV path or a pandas
+    DataFrame with an ``image`` column (each image's file name) and a
+    column per joint, as ``activecal calibrate --images DIR --joints FILE``
+    takes them: the target's points are detected by the library (as
+    `detect` does) and ``report["images"]`` lists what became of each
+    image.
     camera_info: a ROS camera_info or OpenCV YAML path, or a dict of a ROS
     camera_info's keys. target: a target YAML path, or a dict
     (``{"checkerboard": {"rows": 6, "cols": 8, "square": 0.025}}`` or

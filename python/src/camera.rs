@@ -3,6 +3,7 @@
 //! `CameraCalibration` it returns.
 
 use crate::convert::{Fail, arg_err, detached, float_array, json_to_py, ndarray};
+use crate::images::{ImagesSpec, PixelsSource};
 use crate::robot::Robot;
 use activecal::experiment::camera::{CameraCalibration as Calibrated, CameraSetup};
 use activecal::identify::LmSettings;
@@ -61,7 +62,7 @@ pub(crate) fn yaml_source(py: Python<'_>, obj: &Bound<'_, PyAny>, name: &str) ->
 
 /// The observations argument: a CSV path, or a pandas DataFrame with the
 /// file's columns (written as CSV by pandas, floats round-tripping).
-fn observations_source(obj: &Bound<'_, PyAny>) -> PyResult<Source> {
+pub(crate) fn observations_source(obj: &Bound<'_, PyAny>) -> PyResult<Source> {
     if obj.hasattr("to_csv")? && obj.hasattr("columns")? {
         let kw = PyDict::new(obj.py());
         kw.set_item("index", false)?;
@@ -158,10 +159,17 @@ pub struct CameraCalibration {
 }
 
 /// Calibrates the robot from a camera's pixels of a target, as `activecal
-/// calibrate --observations FILE --json` does with the same files.
+/// calibrate --observations FILE --json` does with the same files (or
+/// `--images DIR --joints FILE` with images=, joints=).
 ///
 /// observations: a CSV path or a pandas DataFrame with the file's columns
 /// `pose, <joint names>, feature, u, v` (a row per point seen; pixels).
+/// Or images: a folder of PNG images, a glob pattern, one file or a list
+/// of files (each a pose, in the folder's sorted order or the list's),
+/// with joints: a CSV path or a DataFrame with an `image` column (each
+/// image's file name) and a column per joint; the target's points are
+/// detected by the library (as `detect` does) and `report["images"]` lists
+/// what became of each image.
 /// camera_info: a ROS camera_info or OpenCV YAML path, or a dict of a ROS
 /// camera_info's content. target: a target YAML path, or a dict
 /// ({"checkerboard": {"rows", "cols", "square"}} or {"points": [...]}).
@@ -179,14 +187,16 @@ pub struct CameraCalibration {
 /// rejection warns (`UserWarning`), and the outlier test uses it. progress
 /// as `calibrate` takes it.
 #[pyfunction]
-#[pyo3(signature = (robot, observations, camera_info, target, *, camera_pose=None, target_pose=None, mounting=None, camera_link=None, refine_intrinsics=false, outliers="drop", outlier_rate=0.01, pixel_noise=None, progress=None))]
+#[pyo3(signature = (robot, observations=None, camera_info=None, target=None, *, images=None, joints=None, camera_pose=None, target_pose=None, mounting=None, camera_link=None, refine_intrinsics=false, outliers="drop", outlier_rate=0.01, pixel_noise=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate_camera(
     py: Python<'_>,
     robot: &Bound<'_, Robot>,
-    observations: &Bound<'_, PyAny>,
-    camera_info: &Bound<'_, PyAny>,
-    target: &Bound<'_, PyAny>,
+    observations: Option<&Bound<'_, PyAny>>,
+    camera_info: Option<&Bound<'_, PyAny>>,
+    target: Option<&Bound<'_, PyAny>>,
+    images: Option<&Bound<'_, PyAny>>,
+    joints: Option<&Bound<'_, PyAny>>,
     camera_pose: Option<&Bound<'_, PyAny>>,
     target_pose: Option<&Bound<'_, PyAny>>,
     mounting: Option<&str>,
@@ -199,8 +209,9 @@ pub fn calibrate_camera(
 ) -> PyResult<CameraCalibration> {
     use crate::pickling::kept;
     let recipe = crate::recipe!(py, "calibrate_camera";
-        robot = robot, observations = kept(Some(observations))?,
-        camera_info = kept(Some(camera_info))?, target = kept(Some(target))?,
+        robot = robot, observations = kept(observations)?,
+        camera_info = kept(camera_info)?, target = kept(target)?,
+        images = kept(images)?, joints = kept(joints)?,
         camera_pose = kept(camera_pose)?, target_pose = kept(target_pose)?, mounting = mounting,
         camera_link = &camera_link, refine_intrinsics = refine_intrinsics, outliers = outliers,
         outlier_rate = outlier_rate, pixel_noise = pixel_noise);
@@ -219,11 +230,23 @@ pub fn calibrate_camera(
     .into_iter()
     .filter_map(|(k, g)| g.then_some(k))
     .collect();
-    crate::calibrate::refuse_unused(
-        activecal::experiment::acts_on::CALIBRATE,
-        &given,
-        activecal::experiment::acts_on::Sensor::Pixels,
-    )?;
+    let sensor = if images.is_some() {
+        activecal::experiment::acts_on::Sensor::Images
+    } else {
+        activecal::experiment::acts_on::Sensor::Pixels
+    };
+    crate::calibrate::refuse_unused(activecal::experiment::acts_on::CALIBRATE, &given, sensor)?;
+    let (Some(camera_info), Some(target)) = (camera_info, target) else {
+        return Err(arg_err(
+            if camera_info.is_none() {
+                "camera_info"
+            } else {
+                "target"
+            },
+            "none given: the camera's intrinsics (a camera_info YAML or dict) and the target (a YAML or dict) are needed",
+        ));
+    };
+    let data = crate::images::pixels_source(py, observations, images, joints)?;
     let outliers = crate::calibrate::outliers_of(outliers, outlier_rate)?;
     if let Some(s) = pixel_noise
         && !(s.is_finite() && s > 0.0)
@@ -236,16 +259,16 @@ pub fn calibrate_camera(
         camera_pose.map(|c| six(py, c, "camera_pose")).transpose()?,
         target_pose.map(|t| six(py, t, "target_pose")).transpose()?,
     );
-    let obs_src = observations_source(observations)?;
     let info_src = yaml_source(py, camera_info, "camera_info")?;
     let target_src = yaml_source(py, target, "target")?;
-    let inputs: Vec<PathBuf> = [&obs_src, &info_src, &target_src]
+    let mut inputs: Vec<PathBuf> = [&info_src, &target_src]
         .into_iter()
         .filter_map(|s| match s {
             Source::File(p) => Some(p.clone()),
             Source::Text(_) => None,
         })
         .collect();
+    inputs.extend(data.files());
     let inner = robot.inner.clone();
     let (cal, report) = crate::progress::with_callback(progress, || {
         detached(py, move || {
@@ -257,7 +280,7 @@ pub fn calibrate_camera(
                 Source::Text(_) => "target".to_string(),
             };
             let target = read_target(&target_src)?;
-            let obs = read_observations(&obs_src, r, &target, &intrinsics)?;
+            let (obs, images) = read_pixels(&data, r, &target, &intrinsics)?;
             let setup = CameraSetup {
                 intrinsics,
                 target,
@@ -276,7 +299,10 @@ pub fn calibrate_camera(
                 .build()?;
             let cal = activecal::experiment::camera::calibrate_camera(r, obs, &setup, &lm)
                 .map_err(Fail::input)?;
-            let report = serde_json::to_value(cal.report(Vec::new()))?;
+            let mut report = serde_json::to_value(cal.report(Vec::new()))?;
+            if let (Some(i), Some(m)) = (images, report.as_object_mut()) {
+                m.insert("images".into(), i);
+            }
             Ok((cal, report))
         })
     })?;
@@ -300,7 +326,7 @@ pub fn calibrate_camera(
 }
 
 /// Reads the observations for the chain `robot`.
-fn read_observations(
+pub(crate) fn read_observations(
     s: &Source,
     robot: &activecal::model::Robot,
     target: &activecal::io::camera_target::Target,
@@ -313,6 +339,50 @@ fn read_observations(
         Source::Text(t) => parse_observations(t, "observations", robot, target, intrinsics, units),
     }
     .map_err(|e| named("observations", e))
+}
+
+/// The camera's observations for the chain `robot`: read, or detected
+/// in the images by the library (as `calibrate --images` does, with
+/// what became of each image, the report's `images`).
+pub(crate) fn read_pixels(
+    data: &PixelsSource,
+    robot: &activecal::model::Robot,
+    target: &activecal::io::camera_target::Target,
+    intrinsics: &activecal::measure::pinhole::Intrinsics,
+) -> Result<
+    (
+        activecal::identify::camera::CameraObservations,
+        Option<serde_json::Value>,
+    ),
+    Fail,
+> {
+    let (origin, spec, joints) = match data {
+        PixelsSource::Observations(s) => {
+            return read_observations(s, robot, target, intrinsics).map(|o| (o, None));
+        }
+        PixelsSource::Images {
+            origin,
+            spec,
+            joints,
+        } => (origin, spec, joints),
+    };
+    use activecal::io::images::joints::{parse_image_joints, read_image_joints};
+    let units = activecal::units::Units::default();
+    let j = match joints {
+        Source::File(p) => read_image_joints(p, robot, units),
+        Source::Text(t) => parse_image_joints(t, "the DataFrame", robot, units),
+    }
+    .map_err(|e| named("joints", e))?;
+    let files = match spec {
+        ImagesSpec::Spec(s) => {
+            activecal::io::images::files::image_files(s).map_err(|e| named("images", e))?
+        }
+        ImagesSpec::Files(f) => f.clone(),
+    };
+    let read = activecal::io::images::read_image_list(origin, files, &j, target, intrinsics)
+        .map_err(|e| named("images", e))?;
+    let images = serde_json::to_value(&read.images).map_err(Fail::input)?;
+    Ok((read.observations, Some(images)))
 }
 
 /// Writes `text` to `path` atomically; an existing file only with

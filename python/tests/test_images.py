@@ -60,3 +60,41 @@ def test_a_missing_folder_and_a_target_without_a_detector_are_refused_naming_the
     with pytest.raises(activecal.InputError, match="^images: .*AprilGrids"):
         activecal.detect(IMAGES, grid, CAM / "small_camera_info.yaml", robot=ur5(),
                          joints=IMAGES / "joints.csv")
+
+
+def test_calibrate_camera_from_images_equals_the_command_line():
+    from conftest import cli
+    want = cli("calibrate", "--robot", f"{FIXTURES / 'ur5.urdf'}#tip=target", "--images", IMAGES,
+               "--joints", IMAGES / "joints.csv", "--camera-info", CAM / "small_camera_info.yaml",
+               "--target", CAM / "board_6x9.yaml", "--mounting", "eye-in-hand")
+    got = activecal.calibrate_camera(ur5(), camera_info=CAM / "small_camera_info.yaml",
+                                     target=CAM / "board_6x9.yaml", images=IMAGES,
+                                     joints=IMAGES / "joints.csv", mounting="eye-in-hand")
+    # The same library code on the same images: the reports equal bit for
+    # bit, the images' list (found, figures) included.
+    assert set(got.report) == set(want)
+    for k in sorted(set(want) - {"out"}):
+        assert got.report[k] == want[k], k
+    assert len(got.report["images"]) == 12
+    # The images as a list of files and the joints as a DataFrame: the same.
+    import pandas as pd
+    files = sorted(IMAGES.glob("img_*.png"))
+    again = activecal.calibrate_camera(ur5(), camera_info=CAM / "small_camera_info.yaml",
+                                       target=CAM / "board_6x9.yaml", images=[str(f) for f in files],
+                                       joints=pd.read_csv(IMAGES / "joints.csv"),
+                                       mounting="eye-in-hand")
+    assert again.report["estimate"] == want["estimate"]
+    assert again.report["images"] == want["images"]
+
+
+def test_calibrate_camera_refuses_images_without_joints_or_with_observations():
+    info, board = CAM / "small_camera_info.yaml", CAM / "board_6x9.yaml"
+    with pytest.raises(ValueError, match="^joints: none given"):
+        activecal.calibrate_camera(ur5(), camera_info=info, target=board, images=IMAGES,
+                                   mounting="eye-in-hand")
+    with pytest.raises(ValueError, match="^images: give the pixels"):
+        activecal.calibrate_camera(ur5(), detected(), info, board, images=IMAGES,
+                                   joints=IMAGES / "joints.csv", mounting="eye-in-hand")
+    with pytest.raises(ValueError, match="^images: an empty list"):
+        activecal.calibrate_camera(ur5(), camera_info=info, target=board, images=[],
+                                   joints=IMAGES / "joints.csv", mounting="eye-in-hand")

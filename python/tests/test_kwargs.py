@@ -160,6 +160,17 @@ def test_detect_takes_the_robot_and_the_joints_by_keyword():
     assert kw == ["robot", "joints"], kw
 
 
+def test_calibrate_camera_takes_images_and_joints_by_keyword():
+    """calibrate_camera's images and joints (the command line's --images
+    and --joints): keyword-only, None by default (the pixels are then the
+    observations)."""
+    sig = inspect.signature(activecal.calibrate_camera)
+    for k in ("images", "joints"):
+        p = sig.parameters[k]
+        assert p.kind == p.KEYWORD_ONLY and p.default is None, (k, p)
+    assert sig.parameters["observations"].default is None
+
+
 CAM = FIXTURES / "camera"
 CAMERA_POSE = [1.1761, 0.6096, 0.9079, -2.0681, 0.0317, 2.0826]
 TARGET_POSE = [-0.1047, 0.0411, 0.0301, 3.1111, -0.0192, 0.0556]

@@ -35,6 +35,7 @@ impl SensorText for Sensor {
             Sensor::Camera => "--camera-info",
             Sensor::BagPoints => "--bag --points",
             Sensor::BagPoses => "--bag --poses or --tf",
+            Sensor::BagImages => "--bag --images",
         }
     }
 
@@ -51,6 +52,7 @@ impl SensorText for Sensor {
             Sensor::Camera => "--camera-info (poses chosen for a camera)",
             Sensor::BagPoints => "--bag --points (a tracker's points from a ROS 2 bag)",
             Sensor::BagPoses => "--bag --poses or --tf (full poses from a ROS 2 bag)",
+            Sensor::BagImages => "--bag --images (a camera's images from a ROS 2 bag)",
         }
     }
 }
@@ -146,7 +148,7 @@ const CALIBRATE_WHY: &[(&str, &str)] = &[
     ("payload", "it is for --compliance"),
     (
         "report",
-        "a camera fit's report is its text or --json (with --images, --report writes the contact sheet)",
+        "a camera fit's report is its text or --json (with --images DIR, --report writes the contact sheet; not yet with a bag's images)",
     ),
     (
         "joints",
@@ -163,6 +165,10 @@ const CALIBRATE_WHY: &[(&str, &str)] = &[
     (
         "length_unit",
         "no file of joint values is read (a bag's are in metres)",
+    ),
+    (
+        "max_offset",
+        "a camera's clock offset is not estimated from a bag: give --time-offset (0 when not given)",
     ),
     (
         "bag_design",

@@ -58,6 +58,20 @@ fn bases(contacts: &str) -> Vec<(&'static str, Sensor, Vec<String>)> {
             v(&["--bag", "b.mcap", "--poses", "/mocap"]),
         ),
         (
+            "calibrate",
+            Sensor::BagImages,
+            v(&[
+                "--bag",
+                "b.mcap",
+                "--images",
+                "/camera/image",
+                "--camera-info",
+                "/camera/camera_info",
+                "--target",
+                "t.yaml",
+            ]),
+        ),
+        (
             "evaluate",
             Sensor::Points,
             v(&["--robot", "puma560", "--measurements", "m.csv"]),
@@ -301,7 +315,14 @@ fn every_option_acts_on_a_sensor_or_is_refused_naming_it() {
             // are clap's).
             let bag_defines = matches!(arg.get_id().as_str(), "points" | "poses" | "tf")
                 && matches!(sensor, Sensor::BagPoints | Sensor::BagPoses);
-            if base.contains(&long) || (defines && sensor == Sensor::Pool) || bag_defines {
+            // --bag on an --images line brings a bag's measurement
+            // (--points): a bag's images line is its own base's.
+            let bag_on_images = arg.get_id() == "bag" && sensor == Sensor::Images;
+            if base.contains(&long)
+                || (defines && sensor == Sensor::Pool)
+                || bag_defines
+                || bag_on_images
+            {
                 continue;
             }
             let extra = without_given(&base, argv_of(command, &arg));
@@ -309,6 +330,13 @@ fn every_option_acts_on_a_sensor_or_is_refused_naming_it() {
                 .iter()
                 .find(|r| r.id == arg.get_id().as_str())
                 .unwrap();
+            // A bag's option on an --images line brings its --bag: the line
+            // is then a bag's images.
+            let sensor = if sensor == Sensor::Images && extra.iter().any(|w| w == "--bag") {
+                Sensor::BagImages
+            } else {
+                sensor
+            };
             let got = refusal(&line(&extra), sensor);
             if rule.acts_on.contains(&sensor) {
                 acting += 1;

@@ -111,7 +111,10 @@ fn calibrate_files(a: &CalibrateArgs) -> super::run_files::RunFiles {
         .input("--observations", a.observations.as_deref())
         .inputs("--images", &image_inputs(a))
         .input("--joints", a.joints.as_deref())
-        .input("--camera-info", a.camera_info.as_deref())
+        .input(
+            "--camera-info",
+            a.camera_info.as_deref().filter(|_| a.bag.is_none()),
+        )
         .input("--target", a.target.as_deref())
         .input("--inertia", a.inertia.as_deref())
         .outputs("--out", &a.out)
@@ -123,10 +126,11 @@ fn calibrate_files(a: &CalibrateArgs) -> super::run_files::RunFiles {
 }
 
 /// The image files `--images` names (none when it names none: the
-/// reader says why).
+/// reader says why; none with `--bag`, where it is a topic).
 fn image_inputs(a: &CalibrateArgs) -> Vec<std::path::PathBuf> {
     a.images
         .as_deref()
+        .filter(|_| a.bag.is_none())
         .and_then(|s| activecal::io::images::files::image_files(s).ok())
         .unwrap_or_default()
 }

@@ -12,7 +12,7 @@ use std::path::PathBuf;
 /// (`acts_on.rs`), naming the data given.
 #[derive(Args)]
 #[command(group(clap::ArgGroup::new("camera_data").args(["observations", "images"])))]
-#[command(group(clap::ArgGroup::new("with_joints").args(["images", "bag"])))]
+#[command(group(clap::ArgGroup::new("with_joints").args(["images", "bag"]).multiple(true)))]
 pub struct CalibrateArgs {
     /// Robot: a built-in name, or a .toml description or .urdf file; append
     /// `:pose` for full-pose measurements.
@@ -230,12 +230,15 @@ pub struct CalibrateArgs {
     /// refined with a window under half a square, and fitted as
     /// --observations' pixels are; an image that cannot be used is listed
     /// with its reason. Needs --joints, --camera-info, --target and
-    /// --mounting (or --camera-link).
+    /// --mounting (or --camera-link). With --bag: the bag's
+    /// sensor_msgs/msg/Image or CompressedImage topic (raw mono8, rgb8,
+    /// bgr8, rgba8, bgra8 or PNG), of each rest the image nearest its
+    /// middle, and --camera-info the bag's CameraInfo topic.
     #[arg(
         long,
-        value_name = "DIR|GLOB",
+        value_name = "DIR|GLOB|TOPIC",
         conflicts_with_all = ["design", "measurements", "observations", "trials", "save_measurements", "noise", "validation"],
-        requires_all = ["camera_info", "target", "joints"]
+        requires_all = ["camera_info", "target"]
     )]
     pub images: Option<PathBuf>,
     /// With --images: the joint values of each image, a CSV `image,<joints
@@ -254,7 +257,7 @@ pub struct CalibrateArgs {
     #[arg(
         long,
         value_name = "BAG",
-        conflicts_with_all = ["design", "measurements", "observations", "images", "trials", "save_measurements", "validation"],
+        conflicts_with_all = ["design", "measurements", "observations", "trials", "save_measurements", "validation"],
     )]
     pub bag: Option<PathBuf>,
     /// What to read from --bag and how.
@@ -274,14 +277,15 @@ pub struct CalibrateArgs {
         requires = "bag_design"
     )]
     pub design_tolerance: f64,
-    /// With --images: write the pixels detected as an observations CSV
+    /// With --images (files or a bag's topic): write the pixels detected as an observations CSV
     /// (what --observations reads; joint values in radians and metres), to
     /// inspect or edit them. An existing file only with --force.
     #[arg(long, value_name = "FILE.csv", requires = "images")]
     pub save_observations: Option<PathBuf>,
     /// The camera's intrinsics: a ROS camera_info YAML or an OpenCV
     /// calibration YAML (plumb_bob or equidistant fisheye distortion).
-    #[arg(long, value_name = "FILE", requires = "camera_data")]
+    /// With --bag --images: the bag's sensor_msgs/msg/CameraInfo topic.
+    #[arg(long, value_name = "FILE|TOPIC", requires = "camera_data")]
     pub camera_info: Option<PathBuf>,
     /// The target's points: a YAML `checkerboard: {rows, cols, square}`
     /// (inner corners, metres), `charuco: {rows, cols, square, marker}`,

@@ -10,12 +10,14 @@
 use super::calibrate_args::CalibrateArgs;
 use activecal::experiment::camera::{CameraCalibration, CameraCalibrationError, CameraSetup};
 use activecal::identify::LmSettings;
+use activecal::identify::camera::CameraObservations;
 use activecal::io::calibrated::{Format, render};
 use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_observations::read_observations;
 use activecal::io::camera_target::read_target;
 use activecal::io::urdf_branch::camera_branch;
 use activecal::measure::camera::Mounting;
+use activecal::measure::pinhole::Intrinsics;
 use activecal::model::Robot;
 use activecal::pool::camera_view::placement;
 use activecal::render::camera_text::CameraText;
@@ -58,6 +60,9 @@ pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot) -> Result<Option<Strin
     let (Some(info), Some(target)) = (&a.camera_info, &a.target) else {
         bail!("--observations needs --camera-info and --target");
     };
+    if a.images.is_some() && a.bag.is_none() && a.joints.is_none() {
+        bail!("--images needs --joints (the joint values of each image)");
+    }
     let (branch, mounting) = match (&a.camera_link, a.mounting) {
         (Some(link), _) => (
             Some(camera_branch(robot, link).with_context(|| format!("--camera-link {link}"))?),
@@ -71,21 +76,9 @@ pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot) -> Result<Option<Strin
         .camera_link
         .as_ref()
         .map_or_else(|| mounting.name().to_string(), |l| format!("camera on {l}"));
-    let intrinsics = read_camera_info(info).context("--camera-info")?;
     let target_origin = target.display().to_string();
     let target = read_target(target).context("--target")?;
-    let (obs_path, obs, images) = match (&a.observations, &a.images) {
-        (Some(p), _) => (
-            p.as_path(),
-            read_observations(p, robot, &target, &intrinsics, a.units.units())?,
-            None,
-        ),
-        (None, Some(spec)) => {
-            let read = super::camera_images::read(a, robot, spec, &target, &intrinsics)?;
-            (spec.as_path(), read.observations.clone(), Some(read))
-        }
-        (None, None) => bail!("give --observations (pixels) or --images"),
-    };
+    let (intrinsics, obs_path, obs, images, bag) = camera_data(a, robot, info, &target)?;
     let parse =
         |flag: &str, s: &Option<String>| s.as_ref().map(|s| parse_placement(flag, s)).transpose();
     let setup = CameraSetup {
@@ -143,6 +136,10 @@ pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot) -> Result<Option<Strin
     if let (Some(read), Some(m)) = (&images, v.as_object_mut()) {
         m.insert("images".into(), serde_json::to_value(&read.images)?);
     }
+    if let (Some(r), Some(m)) = (&bag, v.as_object_mut()) {
+        m.insert("images".into(), serde_json::to_value(r.images())?);
+        m.insert("bag".into(), serde_json::to_value(r)?);
+    }
     super::emit(a.json, &v, || {
         activecal::render::camera_text::text(&CameraText {
             fit,
@@ -159,6 +156,51 @@ pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot) -> Result<Option<Strin
         })
     })?;
     Ok(cal.verdict.refusal().map(str::to_string))
+}
+
+/// The camera's data: the intrinsics, where the pixels are from, the
+/// observations, and the images read (files, or a bag's topic with its
+/// report).
+type CameraData<'a> = (
+    Intrinsics,
+    &'a Path,
+    CameraObservations,
+    Option<activecal::io::images::ImageObservations>,
+    Option<activecal::io::bag::camera::BagImagesReport>,
+);
+
+/// Reads `--observations`, `--images` or a bag's `--images` topic (with
+/// `--camera-info` the file or, with `--bag`, the topic).
+fn camera_data<'a>(
+    a: &'a CalibrateArgs,
+    robot: &Robot,
+    info: &Path,
+    target: &activecal::io::camera_target::Target,
+) -> Result<CameraData<'a>> {
+    Ok(match (&a.observations, &a.images, &a.bag) {
+        (Some(p), _, _) => {
+            let intrinsics = read_camera_info(info).context("--camera-info")?;
+            let obs = read_observations(p, robot, target, &intrinsics, a.units.units())?;
+            (intrinsics, p.as_path(), obs, None, None)
+        }
+        (None, Some(topic), Some(bag)) => {
+            let got = super::camera_images::read_bag(a, robot, bag, topic, info, target)?;
+            (
+                got.intrinsics,
+                bag.as_path(),
+                got.observations,
+                None,
+                Some(got.report),
+            )
+        }
+        (None, Some(spec), None) => {
+            let intrinsics = read_camera_info(info).context("--camera-info")?;
+            let read = super::camera_images::read(a, robot, spec, target, &intrinsics)?;
+            let obs = read.observations.clone();
+            (intrinsics, spec.as_path(), obs, Some(read), None)
+        }
+        (None, None, _) => bail!("give --observations (pixels) or --images"),
+    })
 }
 
 /// Refuses an `--out-camera-info` that is not a `.yaml`, before any work

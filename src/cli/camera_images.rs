@@ -6,6 +6,7 @@
 use super::calibrate_args::CalibrateArgs;
 use activecal::experiment::camera::CameraCalibration;
 use activecal::experiment::camera::images::sheet_images;
+use activecal::io::bag::camera::{BagImages, read_bag_images};
 use activecal::io::camera_observations::observations_csv;
 use activecal::io::camera_target::Target;
 use activecal::io::images::joints::read_image_joints;
@@ -42,6 +43,35 @@ pub fn read(
         super::write_new(path, &text, a.force).context("--save-observations")?;
     }
     Ok(read)
+}
+
+/// Reads the camera of `--bag` (`topic`: `--images`, `info`:
+/// `--camera-info`, both topics) with the rest options, prints a line per
+/// rest (without `--json`) and writes `--save-observations`.
+pub fn read_bag(
+    a: &CalibrateArgs,
+    robot: &Robot,
+    bag: &Path,
+    topic: &Path,
+    info: &Path,
+    target: &Target,
+) -> Result<BagImages> {
+    let joints = a
+        .joints
+        .as_deref()
+        .map_or("/joint_states".into(), |j| j.to_string_lossy());
+    let s =
+        a.from_bag
+            .image_settings(&joints, &topic.to_string_lossy(), &info.to_string_lossy())?;
+    let got = read_bag_images(bag, robot, target, &s)?;
+    if !a.json {
+        print!("{}", super::extract::images_text(&got.report, None));
+    }
+    if let Some(path) = &a.save_observations {
+        let text = observations_csv(&got.observations, robot, target);
+        super::write_new(path, &text, a.force).context("--save-observations")?;
+    }
+    Ok(got)
 }
 
 /// Writes `dir` (replaced whole, atomically) with `contact_sheet.png` and

@@ -3,9 +3,10 @@
 //! the work; here the flags are parsed and the report rendered).
 
 use super::emit_report;
+use activecal::io::bag::camera::{BagImageSettings, BagImagesReport, read_bag_images};
 use activecal::io::bag::extract::{ExtractReport, ExtractSettings, extract};
 use activecal::io::bag::series::Source;
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -25,6 +26,25 @@ pub struct ExtractArgs {
     /// What to read from the bag and how.
     #[command(flatten)]
     pub from: BagOpts,
+    /// A camera's sensor_msgs/msg/Image or CompressedImage topic (raw
+    /// mono8, rgb8, bgr8, rgba8, bgra8 or PNG): of each rest, the image
+    /// nearest the middle of its settled part is searched for --target,
+    /// and --out is the observations CSV `calibrate --observations` reads.
+    #[arg(
+        long,
+        value_name = "TOPIC",
+        requires_all = ["camera_info", "target"],
+        conflicts_with_all = ["points", "poses", "tf", "max_offset", "design"]
+    )]
+    pub images: Option<String>,
+    /// With --images: the camera's sensor_msgs/msg/CameraInfo topic (its
+    /// first message gives the intrinsics).
+    #[arg(long, value_name = "TOPIC", requires = "images")]
+    pub camera_info: Option<String>,
+    /// With --images: the target (the YAML `calibrate --target` reads; a
+    /// checkerboard or a ChArUco board).
+    #[arg(long, value_name = "FILE", requires = "images")]
+    pub target: Option<PathBuf>,
     /// The design the run followed (`select --out`'s .json, .yaml or .csv):
     /// each rest is matched to the pose it reached, a rest that reached
     /// none is left out, a pose no rest gives is named.
@@ -34,7 +54,9 @@ pub struct ExtractArgs {
     /// this (rad, m for prismatic joints).
     #[arg(long, value_name = "RAD", default_value_t = 0.01, requires = "design")]
     pub design_tolerance: f64,
-    /// The measurement CSV to write (what `calibrate --measurements` reads).
+    /// The measurement CSV to write (what `calibrate --measurements` reads;
+    /// with --images, the observations CSV `calibrate --observations`
+    /// reads).
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
     /// Overwrite --out if it exists (never an input).
@@ -109,6 +131,28 @@ impl BagOpts {
         self.points.is_none()
     }
 
+    /// The settings of a camera's images from the flags, with the joint,
+    /// image and CameraInfo topics (the clock offset 0 unless
+    /// --time-offset gives it: it is not estimated for a camera).
+    pub fn image_settings(
+        &self,
+        joints: &str,
+        images: &str,
+        camera_info: &str,
+    ) -> Result<BagImageSettings> {
+        let mut s = BagImageSettings::new(joints, images, camera_info);
+        s.rest.speed = self.rest_speed;
+        s.rest.min_duration = self.rest_min;
+        s.rest.settle = self.settle;
+        if let Some(o) = self.time_offset {
+            if !o.is_finite() {
+                bail!("--time-offset {o}: not a number of seconds");
+            }
+            s.time_offset = o;
+        }
+        Ok(s)
+    }
+
     /// The library's settings from the flags, with the joint topic and
     /// the design's tolerance (rad, m) as the command gives them.
     pub fn settings(&self, joints: &str, design_tolerance: f64) -> Result<ExtractSettings> {
@@ -136,11 +180,52 @@ impl BagOpts {
 
 /// Runs `extract`.
 pub fn cmd_extract(a: ExtractArgs) -> Result<()> {
-    use activecal::io::atomic::{Output, check_outputs, write_atomic};
+    check_out(&a)?;
+    if a.images.is_some() {
+        return extract_images(&a);
+    }
     let mut settings = a.from.settings(&a.joints, a.design_tolerance)?;
+    let robot = super::load_robot(&a.robot)?;
+    if let Some(d) = &a.design {
+        settings.design = Some(activecal::io::bag::design::read_design(d, &robot)?);
+    }
+    let got = extract(&a.bag, &robot, &settings)?;
+    if let Some(out) = &a.out {
+        let csv = activecal::io::measurements::to_csv(&got.measurements, &robot);
+        activecal::io::atomic::write_atomic(out, csv.as_bytes())?;
+    }
+    let r = &got.report;
+    emit_report(a.json, r, || text(r, a.out.as_ref()))
+}
+
+/// `extract --images`: a camera's observations CSV.
+fn extract_images(a: &ExtractArgs) -> Result<()> {
+    let (Some(topic), Some(info), Some(target)) = (&a.images, &a.camera_info, &a.target) else {
+        bail!("--images needs --camera-info TOPIC and --target FILE");
+    };
+    let robot = super::load_robot(&a.robot)?;
+    let target = activecal::io::camera_target::read_target(target).context("--target")?;
+    let s = a.from.image_settings(&a.joints, topic, info)?;
+    let got = read_bag_images(&a.bag, &robot, &target, &s)?;
+    if let Some(out) = &a.out {
+        let csv = activecal::io::camera_observations::observations_csv(
+            &got.observations,
+            &robot,
+            &target,
+        );
+        activecal::io::atomic::write_atomic(out, csv.as_bytes())?;
+    }
+    let r = &got.report;
+    emit_report(a.json, r, || images_text(r, a.out.as_ref()))
+}
+
+/// Refuses `--out` over an input or inside the bag, before any work.
+fn check_out(a: &ExtractArgs) -> Result<()> {
+    use activecal::io::atomic::{Output, check_outputs};
     if let Some(out) = &a.out {
         let mut inputs = vec![a.bag.as_path()];
         inputs.extend(a.design.as_deref());
+        inputs.extend(a.target.as_deref());
         check_outputs(
             &[Output {
                 label: "--out",
@@ -157,17 +242,47 @@ pub fn cmd_extract(a: ExtractArgs) -> Result<()> {
             );
         }
     }
-    let robot = super::load_robot(&a.robot)?;
-    if let Some(d) = &a.design {
-        settings.design = Some(activecal::io::bag::design::read_design(d, &robot)?);
+    Ok(())
+}
+
+/// The text form of a camera's extraction (`out`: the CSV written).
+pub fn images_text(r: &BagImagesReport, out: Option<&PathBuf>) -> String {
+    let c = &r.intrinsics;
+    let mut s = format!(
+        "{}: '{}' {} samples; '{}' {} image(s){}; camera from '{}': {} × {} px, fx {:.1} px, {}\n",
+        r.bag,
+        r.joints,
+        r.joint_samples,
+        r.images,
+        r.image_count,
+        if r.image_rate > 0.0 {
+            format!(" at {:.1} Hz", r.image_rate)
+        } else {
+            String::new()
+        },
+        r.camera_info,
+        c.width,
+        c.height,
+        c.fx,
+        c.distortion.model()
+    );
+    s += &format!(
+        "rests: {} found (speed under {} rad/s for at least {} s, the first {} s left out, clock offset {} s), {} with the target\n",
+        r.rests.len(),
+        r.settings.speed,
+        r.settings.min_duration,
+        r.settings.settle,
+        r.time_offset,
+        r.kept()
+    );
+    for line in activecal::experiment::camera::images::image_lines(&r.images()) {
+        s += &line;
+        s += "\n";
     }
-    let got = extract(&a.bag, &robot, &settings)?;
-    if let Some(out) = &a.out {
-        let csv = activecal::io::measurements::to_csv(&got.measurements, &robot);
-        write_atomic(out, csv.as_bytes())?;
+    if let Some(out) = out {
+        s += &format!("wrote {} ({} poses)\n", out.display(), r.kept());
     }
-    let r = &got.report;
-    emit_report(a.json, r, || text(r, a.out.as_ref()))
+    s
 }
 
 /// The text form of an extraction's report (`out`: the CSV written).

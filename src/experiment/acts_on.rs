@@ -31,6 +31,9 @@ pub enum Sensor {
     /// Calibration from full poses read from a ROS 2 bag (a
     /// motion-capture topic or a transform of /tf).
     BagPoses,
+    /// Calibration from a camera's images read from a ROS 2 bag (an image
+    /// topic and its CameraInfo; the target detected by activecal).
+    BagImages,
     /// Selection from a pool of poses (points, markers or full poses).
     Pool,
     /// Selection of configurations touching sockets.
@@ -52,6 +55,7 @@ impl Sensor {
             Sensor::Images => "a camera's images",
             Sensor::BagPoints => "points read from a ROS 2 bag",
             Sensor::BagPoses => "full poses read from a ROS 2 bag",
+            Sensor::BagImages => "a camera's images read from a ROS 2 bag",
             Sensor::Pool => "a pool of poses",
             Sensor::Sockets => "configurations touching sockets",
             Sensor::Camera => "poses chosen for a camera",
@@ -69,7 +73,8 @@ pub struct ActsOn {
 }
 
 use Sensor::{
-    BagPoints, BagPoses, Camera, Contacts, Images, Pixels, Points, Pool, Poses, Simulated, Sockets,
+    BagImages, BagPoints, BagPoses, Camera, Contacts, Images, Pixels, Points, Pool, Poses,
+    Simulated, Sockets,
 };
 
 const fn a(id: &'static str, sensors: &'static [Sensor]) -> ActsOn {
@@ -77,10 +82,12 @@ const fn a(id: &'static str, sensors: &'static [Sensor]) -> ActsOn {
 }
 
 const CAL_ALL: &[Sensor] = &[
-    Simulated, Points, Poses, Contacts, Pixels, Images, BagPoints, BagPoses,
+    Simulated, Points, Poses, Contacts, Pixels, Images, BagPoints, BagPoses, BagImages,
 ];
-/// A camera's pixels, given or detected in its images.
-const CAMERA_DATA: &[Sensor] = &[Pixels, Images];
+/// A camera's pixels, given or detected in its images (files or a bag's).
+const CAMERA_DATA: &[Sensor] = &[Pixels, Images, BagImages];
+/// Anything read from a ROS 2 bag.
+const BAG_ANY: &[Sensor] = &[BagPoints, BagPoses, BagImages];
 /// Measured points or full poses: told apart once the data are read.
 pub const MEASURED: &[Sensor] = &[Points, Poses];
 /// Points or full poses read from a ROS 2 bag.
@@ -95,7 +102,9 @@ const FITTED: &[Sensor] = &[Points, Poses, Contacts, BagPoints, BagPoses];
 const READ: &[Sensor] = &[Points, Poses, Contacts, Pixels, Images];
 /// Data read and fitted with a robust loss or screened for gross errors:
 /// files, images and bags.
-const FITTED_READ: &[Sensor] = &[Points, Poses, Contacts, Pixels, Images, BagPoints, BagPoses];
+const FITTED_READ: &[Sensor] = &[
+    Points, Poses, Contacts, Pixels, Images, BagPoints, BagPoses, BagImages,
+];
 const SEL_ALL: &[Sensor] = &[Pool, Sockets, Camera];
 const EVAL_ALL: &[Sensor] = &[Points, Poses, Contacts];
 
@@ -153,9 +162,9 @@ pub const CALIBRATE: &[ActsOn] = &[
         ],
     ),
     a("observations", &[Pixels]),
-    a("images", &[Images]),
-    a("joints", &[Images, BagPoints, BagPoses]),
-    a("save_observations", &[Images]),
+    a("images", &[Images, BagImages]),
+    a("joints", &[Images, BagPoints, BagPoses, BagImages]),
+    a("save_observations", &[Images, BagImages]),
     a("camera_info", CAMERA_DATA),
     a("target", CAMERA_DATA),
     a("mounting", CAMERA_DATA),
@@ -166,15 +175,15 @@ pub const CALIBRATE: &[ActsOn] = &[
     a("out_camera_info", CAMERA_DATA),
     a("angle_unit", READ),
     a("length_unit", READ),
-    a("bag", BAG),
+    a("bag", BAG_ANY),
     a("points", &[BagPoints]),
     a("poses", &[BagPoses]),
     a("tf", &[BagPoses]),
-    a("time_offset", BAG),
+    a("time_offset", BAG_ANY),
     a("max_offset", BAG),
-    a("rest_speed", BAG),
-    a("rest_min", BAG),
-    a("settle", BAG),
+    a("rest_speed", BAG_ANY),
+    a("rest_min", BAG_ANY),
+    a("settle", BAG_ANY),
     a("bag_design", BAG),
     a("design_tolerance", BAG),
     a("json", CAL_ALL),

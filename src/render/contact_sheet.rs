@@ -49,32 +49,38 @@ const TITLE_H: u32 = 46;
 /// The longest residual arrow drawn, thumbnail px.
 const LONGEST_ARROW: f64 = 24.0;
 
-/// The magnification of the residual arrows: the largest of 1, 2, 5, 10,
-/// 20, 50 … whose longest arrow is at most [`LONGEST_ARROW`] thumbnail
-/// pixels (`views`: each image's view, whose scale is thumbnail pixels
-/// per image pixel).
+/// The residual arrows' length per pixel of residual (thumbnail pixels
+/// per image pixel, one for the whole sheet, whatever each thumbnail's
+/// zoom): the largest of 1, 2, 5, 10, 20, 50 … at which the longest arrow
+/// is at most [`LONGEST_ARROW`] thumbnail pixels.
 #[must_use]
-fn arrow_factor(images: &[SheetImage], views: &[View]) -> f64 {
+fn arrow_factor(images: &[SheetImage]) -> f64 {
     let largest = images
         .iter()
-        .zip(views)
-        .flat_map(|(i, v)| {
-            i.residuals
-                .iter()
-                .flatten()
-                .map(move |r| v.scale * r[0].hypot(r[1]))
-        })
+        .flat_map(|i| i.residuals.iter().flatten().map(|r| r[0].hypot(r[1])))
         .fold(0.0, f64::max);
-    let mut f = 1.0;
-    for k in 0..8 {
+    nice_at_most(LONGEST_ARROW / largest.max(1e-12)).max(1.0)
+}
+
+/// The largest of 1, 2, 5 × 10ⁿ (n from −6 to 8) at most `x` (1e-6 when
+/// none is).
+fn nice_at_most(x: f64) -> f64 {
+    let mut f = 1e-6;
+    for k in -6..=8 {
         for m in [1.0, 2.0, 5.0] {
             let c = m * 10f64.powi(k);
-            if largest * c <= LONGEST_ARROW {
+            if c <= x {
                 f = c;
             }
         }
     }
     f
+}
+
+/// The scale bar's residual (px) for arrows of `factor` thumbnail pixels
+/// per pixel: a round value drawn at most [`LONGEST_ARROW`] long.
+fn scale_bar(factor: f64) -> f64 {
+    nice_at_most(LONGEST_ARROW / factor)
 }
 
 /// Draws the sheet of `images` (all of one size) and writes it to `path`
@@ -85,7 +91,7 @@ pub fn write_contact_sheet(path: &Path, images: &[SheetImage]) -> Result<()> {
     };
     let whole = f64::from(THUMB_W) / first.gray.width as f64;
     let thumb_h = (first.gray.height as f64 * whole).round() as u32;
-    let views: Vec<View> = images.iter().map(|i| view_of(i, thumb_h)).collect();
+    let views: Vec<View> = images.iter().map(|i| view_of(i, thumb_h, whole)).collect();
     let rows = (images.len() as u32).div_ceil(PER_ROW);
     let (cell_w, cell_h) = (THUMB_W + 2 * PAD, thumb_h + CAPTION_H + 2 * PAD);
     let size = (PER_ROW * cell_w, TITLE_H + rows * cell_h);
@@ -97,20 +103,35 @@ pub fn write_contact_sheet(path: &Path, images: &[SheetImage]) -> Result<()> {
     for (k, (im, v)) in images.iter().zip(&views).enumerate() {
         paint_thumbnail(&mut rgb, size.0, origin(k), im, v, thumb_h);
     }
-    let factor = arrow_factor(images, &views);
+    let factor = arrow_factor(images);
+    let bar = scale_bar(factor);
     super::typeset::register_fonts()?;
     {
         let root =
             super::typeset::Typeset(BitMapBackend::with_buffer(&mut rgb, size)).into_drawing_area();
         let used = images.iter().filter(|i| i.left_out.is_none()).count();
         let title = format!(
-            "{} images, {used} used. Points coloured by board row, ids drawn; red arrows: each point's residual after the fit × {factor} (prediction less detection)",
+            "{} images, {used} used. Points coloured by board row, ids drawn; red arrows: each point's residual after the fit (prediction less detection), {factor} thumbnail px per px of residual in every image:",
             images.len()
         );
         root.draw(&Text::new(
             title,
-            (PAD as i32, 14),
+            (PAD as i32, 8),
             ("sans-serif", 14).into_font(),
+        ))
+        .map_err(err)?;
+        // The scale bar: `bar` px of residual as an arrow draws it.
+        let (bx, by) = (PAD as i32, 32);
+        let len = (bar * factor).round() as i32;
+        root.draw(&PathElement::new(
+            vec![(bx, by), (bx + len, by)],
+            RED.stroke_width(2),
+        ))
+        .map_err(err)?;
+        root.draw(&Text::new(
+            format!("= {bar} px of residual"),
+            (bx + len + 6, by - 7),
+            ("sans-serif", 12).into_font(),
         ))
         .map_err(err)?;
         for (k, (im, v)) in images.iter().zip(&views).enumerate() {
@@ -132,10 +153,12 @@ struct View {
     scale: f64,
 }
 
-/// The view of `im` in a thumbnail of [`THUMB_W`] × `h`: the detected
-/// points' box grown by a quarter of its size each side, or the whole
-/// image.
-fn view_of(im: &SheetImage, h: u32) -> View {
+/// The view of `im` in a thumbnail of [`THUMB_W`] × `h` (the image's
+/// aspect; `whole` the scale that shows all of it): the detected points'
+/// box grown by a quarter of its size each side, or the whole image;
+/// never zoomed out beyond the whole image and moved inside it, so that no
+/// part of the thumbnail falls outside the image.
+fn view_of(im: &SheetImage, h: u32, whole: f64) -> View {
     let (w, hh) = (im.gray.width as f64, im.gray.height as f64);
     let pts: Vec<[f64; 2]> = im.points.iter().flatten().copied().collect();
     let (mut x0, mut y0, mut x1, mut y1) = (0.0, 0.0, w, hh);
@@ -145,19 +168,23 @@ fn view_of(im: &SheetImage, h: u32) -> View {
         let pad = 0.25 * (hi[0] - lo[0]).max(hi[1] - lo[1]) + 10.0;
         (x0, y0, x1, y1) = (lo[0] - pad, lo[1] - pad, hi[0] + pad, hi[1] + pad);
     }
-    let scale = (f64::from(THUMB_W) / (x1 - x0)).min(f64::from(h) / (y1 - y0));
-    // Centre the region in the thumbnail.
-    let cx = 0.5 * (x0 + x1) - 0.5 * f64::from(THUMB_W) / scale;
-    let cy = 0.5 * (y0 + y1) - 0.5 * f64::from(h) / scale;
+    let scale = (f64::from(THUMB_W) / (x1 - x0))
+        .min(f64::from(h) / (y1 - y0))
+        .max(whole);
+    // Centre the region in the thumbnail, then move the window inside the
+    // image (it is no larger: the scale is at least the whole image's).
+    let (ww, wh) = (f64::from(THUMB_W) / scale, f64::from(h) / scale);
+    let inside = |c: f64, win: f64, size: f64| c.min(size - 0.5 - win).max(-0.5);
     View {
-        x0: cx,
-        y0: cy,
+        x0: inside(0.5 * (x0 + x1) - 0.5 * ww, ww, w),
+        y0: inside(0.5 * (y0 + y1) - 0.5 * wh, wh, hh),
         scale,
     }
 }
 
-/// Copies `im`'s thumbnail (box-averaged, greyed when left out; black
-/// outside the image) into the sheet's pixels at `at`.
+/// Copies `im`'s thumbnail (box-averaged, greyed when left out; the
+/// sheet's white outside the image, which [`view_of`] keeps out of view)
+/// into the sheet's pixels at `at`.
 fn paint_thumbnail(rgb: &mut [u8], width: u32, at: (u32, u32), im: &SheetImage, v: &View, h: u32) {
     let step = 1.0 / v.scale;
     let (gw, gh) = (im.gray.width as f64, im.gray.height as f64);
@@ -165,7 +192,7 @@ fn paint_thumbnail(rgb: &mut [u8], width: u32, at: (u32, u32), im: &SheetImage, 
         for tx in 0..THUMB_W {
             let (fx, fy) = (v.x0 + f64::from(tx) * step, v.y0 + f64::from(ty) * step);
             let mut g = if fx < -0.5 || fy < -0.5 || fx + step > gw + 0.5 || fy + step > gh + 0.5 {
-                0.0
+                255.0
             } else {
                 let (x0, y0) = (fx.max(0.0) as usize, fy.max(0.0) as usize);
                 let (x1, y1) = (
@@ -236,7 +263,11 @@ fn draw_cell<DB: DrawingBackend>(
     }
     for (p, r) in im.points.iter().zip(&im.residuals) {
         let (Some(p), Some(r)) = (p, r) else { continue };
-        let (a, b) = (at(*p), at([p[0] + factor * r[0], p[1] + factor * r[1]]));
+        let a = at(*p);
+        let b = (
+            a.0 + (factor * r[0]).round() as i32,
+            a.1 + (factor * r[1]).round() as i32,
+        );
         root.draw(&PathElement::new(vec![a, b], RED.stroke_width(2)))
             .map_err(err)?;
     }
@@ -300,4 +331,60 @@ fn wrap(text: &str, width: usize) -> Vec<String> {
         }
     }
     lines
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(points: Vec<Option<[f64; 2]>>, residuals: Vec<Option<[f64; 2]>>) -> SheetImage {
+        SheetImage {
+            name: "a.png".into(),
+            gray: Gray {
+                width: 320,
+                height: 240,
+                data: vec![100; 320 * 240],
+            },
+            points,
+            cols: 2,
+            residuals,
+            left_out: None,
+            caption: String::new(),
+        }
+    }
+
+    /// A board at the image's edge (the black bars of the first sheets):
+    /// the view stays inside the image, every thumbnail pixel the image's
+    /// grey level, none the sheet's white.
+    #[test]
+    fn a_board_at_the_edge_is_shown_without_pixels_outside_the_image() {
+        let whole = f64::from(THUMB_W) / 320.0;
+        let h = (240.0 * whole).round() as u32;
+        for pts in [
+            vec![Some([2.0, 100.0]), Some([60.0, 160.0])],
+            vec![Some([300.0, 5.0]), Some([318.0, 230.0])],
+            vec![Some([0.0, 0.0]), Some([319.0, 239.0])],
+        ] {
+            let im = image(pts, vec![None, None]);
+            let v = view_of(&im, h, whole);
+            let mut rgb = vec![0u8; (THUMB_W * h * 3) as usize];
+            paint_thumbnail(&mut rgb, THUMB_W, (0, 0), &im, &v, h);
+            assert!(rgb.iter().all(|&g| g == 100), "{v:?}");
+        }
+    }
+
+    /// One length per pixel of residual for the whole sheet: the longest
+    /// arrow at most LONGEST_ARROW thumbnail px, and within a factor 2.5
+    /// of it (the round values 1, 2, 5 are at most 2.5 apart); the scale
+    /// bar a round residual drawn no longer.
+    #[test]
+    fn arrows_have_one_round_scale_and_a_bar_in_px() {
+        let im = image(vec![Some([10.0, 10.0])], vec![Some([0.3, 0.4])]);
+        let f = arrow_factor(&[im]);
+        assert_eq!(f, 20.0);
+        assert!(0.5 * f <= LONGEST_ARROW && 0.5 * f * 2.5 > LONGEST_ARROW);
+        let bar = scale_bar(f);
+        assert_eq!(bar, 1.0);
+        assert!(bar * f <= LONGEST_ARROW);
+    }
 }

@@ -30,12 +30,42 @@ Usage (run with the project venv's python):
       the rests' true times (joint clock), the expected offset (offset +
       latency), the rest count.
 
+  bag_truth.py images --dir DIR --camera-info YAML --out BAG
+                      [--storage mcap|sqlite3] [--encoding png|mono8|rgb8|bgr8]
+                      [--joint-noise RAD] [--per-rest N] [--seed S]
+      A camera's run (issue #52's camera topics): the images of DIR (as
+      camera_images.py render writes them: img_NNN.png and joints.csv, the
+      true robot's configuration of each) in the order of joints.csv, the
+      arm resting at each image's configuration 1.6-2.4 s and moving to
+      the next with the quintic profile above. /joint_states at 500 Hz
+      (UR5 names from joints.csv's header, Gaussian --joint-noise, default
+      2e-6 rad); the camera on /camera/image at 30 Hz during the rests
+      only (a camera at rest sees the same scene: each frame is the
+      rendered image itself, --per-rest N frames evenly over the rest, all
+      of them by default), as sensor_msgs/CompressedImage (--encoding png:
+      the PNG file's bytes, format 'png') or sensor_msgs/Image (mono8,
+      rgb8, bgr8: the PNG decoded by OpenCV and converted); and one
+      CameraInfo on /camera/camera_info from the YAML (K, D, plumb_bob).
+      Prints JSON: the rests' true times, the image files in order.
+
   bag_truth.py tiny --out DIR
       The small committed bags of fixtures/bags/ (the UR5 of
       fixtures/ur5.urdf; no Pinocchio): tiny.mcap (3 rests of 0.8 s, joints
       at 20 Hz, a point at 10 Hz, a CameraInfo), tiny_db3/ (the same in
       SQLite 3 with its metadata.yaml) and moving.mcap (the arm never
       stops).
+
+  bag_truth.py tiny-images --out DIR
+      fixtures/bags/camera.mcap: the first six committed renders of
+      fixtures/camera/images/ (joints.csv's configurations; joints at
+      20 Hz, no noise, rests of 0.6 s), one frame per rest on
+      /camera/image (CompressedImage, png), the first rest's frame
+      also raw on /camera/image_raw (Image, mono8), a 16 x 8 frame per
+      rest in encoding yuv422 on /camera/image_yuv and in JPEG on
+      /camera/image_jpeg (CompressedImage, format 'jpeg'),
+      /camera/camera_info (the CameraInfo of
+      fixtures/camera/small_camera_info.yaml) and /camera/no_info (a
+      CameraInfo topic without messages).
 """
 
 import argparse
@@ -265,6 +295,111 @@ def cmd_tiny(a):
     finish(tmp, os.path.join(a.out, "moving.mcap"))
 
 
+def camera_info_msg(out, path, stamp, topic):
+    """The CameraInfo of a camera_info YAML, on topic."""
+    from camera_truth import camera_info
+    k, d, w, h = camera_info(path)
+    roi = out.T["sensor_msgs/msg/RegionOfInterest"](x_offset=0, y_offset=0, height=0, width=0,
+                                                     do_rectify=False)
+    p = np.hstack([k, np.zeros((3, 1))]).ravel()
+    m = out.T["sensor_msgs/msg/CameraInfo"](
+        header=out.header(stamp, "camera"), height=h, width=w, distortion_model="plumb_bob",
+        d=np.asarray(d, dtype=float), k=k.ravel().astype(float), r=np.eye(3).ravel(), p=p,
+        binning_x=0, binning_y=0, roi=roi)
+    out.put(topic, "sensor_msgs/msg/CameraInfo", m, stamp)
+
+
+def image_msg(out, topic, stamp, png_bytes, encoding):
+    """One frame: the PNG as a CompressedImage, or decoded as a raw Image."""
+    if encoding == "png":
+        m = out.T["sensor_msgs/msg/CompressedImage"](
+            header=out.header(stamp, "camera"), format="png",
+            data=np.frombuffer(png_bytes, dtype=np.uint8))
+        out.put(topic, "sensor_msgs/msg/CompressedImage", m, stamp)
+        return
+    import cv2
+    g = cv2.imdecode(np.frombuffer(png_bytes, dtype=np.uint8), cv2.IMREAD_UNCHANGED)
+    raw_image(out, topic, stamp, g, encoding)
+
+
+def raw_image(out, topic, stamp, g, encoding):
+    import cv2
+    if encoding in ("rgb8", "bgr8") and g.ndim == 2:
+        g = cv2.cvtColor(g, cv2.COLOR_GRAY2RGB if encoding == "rgb8" else cv2.COLOR_GRAY2BGR)
+    h, w = g.shape[:2]
+    step = g.strides[0]
+    m = out.T["sensor_msgs/msg/Image"](
+        header=out.header(stamp, "camera"), height=h, width=w, encoding=encoding, is_bigendian=0,
+        step=step, data=np.ascontiguousarray(g).ravel().view(np.uint8))
+    out.put(topic, "sensor_msgs/msg/Image", m, stamp)
+
+
+def read_images_dir(d):
+    """The joints.csv of DIR: joint names, [(file, q)]."""
+    lines = open(os.path.join(d, "joints.csv")).read().split()
+    names = lines[0].split(",")[1:]
+    rows = [(l.split(",")[0], np.array([float(v) for v in l.split(",")[1:]])) for l in lines[1:]]
+    return names, rows
+
+
+def cmd_images(a):
+    names, rows = read_images_dir(a.dir)
+    rng = np.random.default_rng(a.seed)
+    qs = [q for _, q in rows]
+    segs, rests, end = timeline(qs, rng)
+    out = Out(a.out, a.storage)
+    for k in range(int(end * 500) + 1):
+        tk = k / 500.0
+        q = q_at(segs, tk) + rng.normal(scale=a.joint_noise, size=len(names))
+        out.joints(T0 + tk, names, list(q), T0 + tk + 0.001)
+    camera_info_msg(out, a.camera_info, T0, "/camera/camera_info")
+    for (f, _), (r0, r1) in zip(rows, rests):
+        data = open(os.path.join(a.dir, f), "rb").read()
+        frames = [r0 + j / 30.0 for j in range(int((r1 - r0) * 30) + 1)]
+        if a.per_rest:
+            frames = list(np.linspace(r0, r1, a.per_rest + 2)[1:-1])
+        for tk in frames:
+            image_msg(out, "/camera/image", T0 + tk, data, a.encoding)
+    out.close()
+    print(json.dumps({"rests": [[r0, r1] for r0, r1 in rests], "images": [f for f, _ in rows]}))
+
+
+def cmd_tiny_images(a):
+    import cv2
+    root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+    d = os.path.join(root, "fixtures", "camera", "images")
+    names, rows = read_images_dir(d)
+    rows = rows[:6]
+    segs, rests, end = timeline([q for _, q in rows], np.random.default_rng(1), vmax=2.0,
+                                rest=(0.6, 0.6), lead=0.1)
+    tmp = os.path.join(a.out, "camera.mcap.d")
+    remove(tmp)
+    out = Out(tmp, "mcap")
+    for k in range(int(end * 20) + 1):
+        tk = k / 20.0
+        out.joints(T0 + tk, names, list(q_at(segs, tk)), T0 + tk)
+    info = os.path.join(root, "fixtures", "camera", "small_camera_info.yaml")
+    camera_info_msg(out, info, T0, "/camera/camera_info")
+    out.conn("/camera/no_info", "sensor_msgs/msg/CameraInfo")
+    small = np.full((8, 16), 128, dtype=np.uint8)
+    jpeg = cv2.imencode(".jpg", small)[1].tobytes()
+    for n, ((f, _), (r0, r1)) in enumerate(zip(rows, rests)):
+        data = open(os.path.join(d, f), "rb").read()
+        tk = T0 + 0.5 * (r0 + r1)
+        image_msg(out, "/camera/image", tk, data, "png")
+        if n == 0:
+            image_msg(out, "/camera/image_raw", tk, data, "mono8")
+        m = out.T["sensor_msgs/msg/Image"](
+            header=out.header(tk, "camera"), height=8, width=8, encoding="yuv422", is_bigendian=0,
+            step=16, data=small.ravel())
+        out.put("/camera/image_yuv", "sensor_msgs/msg/Image", m, tk)
+        m = out.T["sensor_msgs/msg/CompressedImage"](
+            header=out.header(tk, "camera"), format="jpeg", data=np.frombuffer(jpeg, dtype=np.uint8))
+        out.put("/camera/image_jpeg", "sensor_msgs/msg/CompressedImage", m, tk)
+    out.close()
+    finish(tmp, os.path.join(a.out, "camera.mcap"))
+
+
 def remove(path):
     import shutil
     if os.path.isdir(path):
@@ -302,10 +437,21 @@ def main(argv=None):
     p.add_argument("--image-mb", type=float, default=0.0)
     p.add_argument("--joint-rate", type=float, default=500.0)
     p.add_argument("--seed", type=int, default=1)
+    p = sub.add_parser("images")
+    p.add_argument("--dir", required=True)
+    p.add_argument("--camera-info", required=True)
+    p.add_argument("--out", required=True)
+    p.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
+    p.add_argument("--encoding", choices=["png", "mono8", "rgb8", "bgr8"], default="png")
+    p.add_argument("--joint-noise", type=float, default=2e-6)
+    p.add_argument("--per-rest", type=int, default=0)
+    p.add_argument("--seed", type=int, default=1)
+    p = sub.add_parser("tiny-images")
+    p.add_argument("--out", required=True)
     p = sub.add_parser("tiny")
     p.add_argument("--out", required=True)
     a = ap.parse_args(argv)
-    {"write": cmd_write, "tiny": cmd_tiny}[a.cmd](a)
+    {"write": cmd_write, "tiny": cmd_tiny, "images": cmd_images, "tiny-images": cmd_tiny_images}[a.cmd](a)
 
 
 if __name__ == "__main__":

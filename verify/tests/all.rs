@@ -12,6 +12,8 @@ mod live;
 #[cfg(feature = "live")]
 mod live_bag_calibrate;
 #[cfg(feature = "live")]
+mod live_bag_images;
+#[cfg(feature = "live")]
 mod live_bags;
 #[cfg(feature = "live")]
 mod live_bound;

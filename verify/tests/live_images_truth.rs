@@ -35,6 +35,9 @@
 //!   first, an OpenCV ChArUco board of 7 × 10 squares of 25 mm, markers of
 //!   15 mm (`DICT_4X4_50`), its ids found in the markers; against OpenCV's
 //!   `CharucoDetector` with its defaults.
+//! * [`live_images_eye_to_hand_charuco`]: the Panda eye-to-hand with that
+//!   ChArUco board on its hand, 20 images from 0.3–1.2 m; against
+//!   `CharucoDetector`.
 
 use super::live_images::{
     Board, Pixels, RATIO, Rig, SQUARE, Scene, calibrate, checkerboard, corner_errors, from_images,
@@ -193,8 +196,9 @@ fn live_images_eye_to_hand_checkerboard() {
 /// squares, the markers' side.
 const CHARUCO: (usize, usize, f64) = (7, 10, 0.015);
 
-#[test]
-fn live_images_eye_in_hand_charuco() {
+/// The ChArUco board of [`CHARUCO`] as the target file names it and the
+/// renderer draws it, and OpenCV's `CharucoDetector` route for it.
+fn charuco_board() -> (Board, Vec<(&'static str, Vec<String>)>) {
     let (rows, cols, marker) = CHARUCO;
     let spec = format!("{rows},{cols},{SQUARE},{marker}");
     let board = Board {
@@ -207,18 +211,40 @@ fn live_images_eye_in_hand_charuco() {
         ],
         ids: true,
     };
+    let route = vec![
+        "--method=charuco".to_string(),
+        format!("--charuco={spec}"),
+        "--dictionary=DICT_4X4_50".into(),
+    ];
+    (board, vec![("CharucoDetector", route)])
+}
+
+#[test]
+fn live_images_eye_in_hand_charuco() {
+    let (rows, cols, _) = CHARUCO;
+    let (board, routes) = charuco_board();
     // The rig's board is centred on its inner corners, as a checkerboard
     // of (rows − 1) × (cols − 1) inner corners; the ChArUco target's frame
     // is one square further out.
     let mut rig = ur5_eye_in_hand("eye-in-hand-charuco", rows - 1, cols - 1, false);
     rig.target *= nalgebra::Translation3::new(-SQUARE, -SQUARE, 0.0);
     let s = scene(rig, &board, false, (20, true), DRAWS);
-    let route = vec![
-        "--method=charuco".to_string(),
-        format!("--charuco={spec}"),
-        "--dictionary=DICT_4X4_50".into(),
-    ];
-    gate(&s, &[("CharucoDetector", route)]);
+    gate(&s, &routes);
+}
+
+/// The Panda eye-to-hand of [`live_images_eye_to_hand_checkerboard`] with
+/// the ChArUco board on its hand (its inner corners where the
+/// checkerboard's are: the target's frame one square further out), the
+/// images from 0.3–1.2 m (at 2 m a 15 mm marker is 7 px, under the
+/// 1.5 px per bit its decoding needs).
+#[test]
+fn live_images_eye_to_hand_charuco() {
+    let (board, routes) = charuco_board();
+    let mut rig = panda_eye_to_hand("eye-to-hand-charuco");
+    rig.target *= Translation3::new(-SQUARE, -SQUARE, 0.0);
+    rig.near = [0.3, 1.2];
+    let s = scene(rig, &board, false, (20, false), DRAWS);
+    gate(&s, &routes);
 }
 
 /// A board with ids (ChArUco): OpenCV keeps fewer of its corners (those

@@ -131,6 +131,14 @@ impl<'a> Cdr<'a> {
         Ok(n)
     }
 
+    /// A sequence of bytes (an image's pixels), borrowed from the message.
+    pub fn bytes(&mut self) -> CdrResult<&'a [u8]> {
+        let n = self.length(1)?;
+        let b = &self.data[self.pos..self.pos + n];
+        self.pos += n;
+        Ok(b)
+    }
+
     /// The number of elements of a sequence (its length field only).
     pub fn sequence_len(&mut self, min_size: usize) -> CdrResult<usize> {
         self.length(min_size)

@@ -237,3 +237,63 @@ pub fn compressed_image_header(data: &[u8]) -> Decoded<ImageHeader> {
         bytes,
     })
 }
+
+/// An `Image` or a `CompressedImage`: its header, size and bytes, as
+/// stored (decoded into grey levels by
+/// [`crate::io::images::decode::decode_message`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImageData<'a> {
+    /// The header.
+    pub header: Header,
+    /// Width (pixels; 0 for a compressed image).
+    pub width: u32,
+    /// Height (pixels; 0 for a compressed image).
+    pub height: u32,
+    /// The encoding (`mono8`, `rgb8`, …) or the compressed format
+    /// (`png`, `jpeg`, `rgb8; png compressed bgr8`, …).
+    pub encoding: String,
+    /// Bytes per row (0 for a compressed image).
+    pub step: u32,
+    /// Whether the image was compressed (`CompressedImage`).
+    pub compressed: bool,
+    /// The pixels, or the compressed file's bytes.
+    pub data: &'a [u8],
+}
+
+/// Decodes an `Image` with its pixels.
+pub fn image(data: &[u8]) -> Decoded<ImageData<'_>> {
+    let mut c = at("(header)", Cdr::new(data))?;
+    let header = header(&mut c)?;
+    let height = at("height", c.u32())?;
+    let width = at("width", c.u32())?;
+    let encoding = at("encoding", c.string())?;
+    let _big_endian = at("is_bigendian", c.u8())?;
+    let step = at("step", c.u32())?;
+    let data = at("data", c.bytes())?;
+    Ok(ImageData {
+        header,
+        width,
+        height,
+        encoding,
+        step,
+        compressed: false,
+        data,
+    })
+}
+
+/// Decodes a `CompressedImage` with its bytes.
+pub fn compressed_image(data: &[u8]) -> Decoded<ImageData<'_>> {
+    let mut c = at("(header)", Cdr::new(data))?;
+    let header = header(&mut c)?;
+    let encoding = at("format", c.string())?;
+    let data = at("data", c.bytes())?;
+    Ok(ImageData {
+        header,
+        width: 0,
+        height: 0,
+        encoding,
+        step: 0,
+        compressed: true,
+        data,
+    })
+}

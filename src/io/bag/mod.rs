@@ -7,11 +7,13 @@
 //! two streams' clocks from the moves, and [`extract`] turns a bag into
 //! [`crate::identify::Measurements`] with a report of what was kept and why.
 
+pub mod camera;
 pub mod cdr;
 pub mod clock;
 pub mod design;
 pub mod error;
 pub mod extract;
+pub mod image;
 mod mcap_file;
 pub mod messages;
 pub mod rest;

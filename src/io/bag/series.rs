@@ -162,7 +162,7 @@ fn push(meas: &mut MeasSeries, s: &Stamped, pose: bool) {
 
 /// One `JointState`: all the robot's joints, or none (another group's);
 /// a message with some but not all is an error naming the joint missing.
-fn joint_message(
+pub(super) fn joint_message(
     bag: &Bag,
     m: &RawMessage<'_>,
     names: &[String],
@@ -214,7 +214,7 @@ fn order(t: &[f64]) -> Option<Vec<usize>> {
     Some(idx)
 }
 
-fn sort_joints(j: &mut JointSeries) {
+pub(super) fn sort_joints(j: &mut JointSeries) {
     if let Some(idx) = order(&j.t) {
         j.t = idx.iter().map(|&i| j.t[i]).collect();
         j.q = idx.iter().map(|&i| j.q[i].clone()).collect();

@@ -92,22 +92,29 @@ pub fn read_images(
     target: &Target,
     intrinsics: &Intrinsics,
 ) -> Result<ImageObservations> {
-    let origin = spec.display().to_string();
-    let board = match (&target.charuco, target.grid) {
-        (Some(p), _) => {
-            charuco::check_pattern(p).map_err(|message| Error::Parse {
-                path: origin.clone(),
-                message: format!("the target: {message}"),
-            })?;
-            Board::Charuco(p)
-        }
-        (None, Some(grid)) => Board::Checkerboard(grid),
-        (None, None) => return Err(Error::Parse {
-            path: origin,
-            message: "activecal detects checkerboards and ChArUco boards in images (a 'checkerboard:' or 'charuco:' target); AprilGrids and point lists are not detected yet: detect their points yourself and give them as --observations".into(),
-        }),
-    };
     let files = files::image_files(spec)?;
+    read_image_list(
+        &spec.display().to_string(),
+        files,
+        joints,
+        target,
+        intrinsics,
+    )
+}
+
+/// Reads the image `files` (given as `origin`, for messages: a folder, a
+/// pattern, a list) with the joint values of `joints`, for the camera
+/// `intrinsics` and the `target`: each image one pose, its id its place in
+/// `files`.
+pub fn read_image_list(
+    origin: &str,
+    files: Vec<PathBuf>,
+    joints: &ImageJoints,
+    target: &Target,
+    intrinsics: &Intrinsics,
+) -> Result<ImageObservations> {
+    let origin = origin.to_string();
+    let board = Board::of(target, &origin)?;
     let names: Vec<String> = files
         .iter()
         .map(|f| {
@@ -168,15 +175,37 @@ pub fn read_images(
 }
 
 /// A board activecal detects.
-enum Board<'a> {
+#[derive(Clone, Copy, Debug)]
+pub enum Board<'a> {
     /// A checkerboard's inner corners (rows, cols).
     Checkerboard((usize, usize)),
     /// A ChArUco board.
     Charuco(&'a CharucoPattern),
 }
 
-/// One image's points (by target id; `n` of them) and figures, or why it
-/// is left out.
+impl<'a> Board<'a> {
+    /// The board of `target` (read from `origin`, for messages); a target
+    /// that is neither a checkerboard nor a ChArUco board is refused.
+    pub fn of(target: &'a Target, origin: &str) -> Result<Self> {
+        match (&target.charuco, target.grid) {
+            (Some(p), _) => {
+                charuco::check_pattern(p).map_err(|message| Error::Parse {
+                    path: origin.to_string(),
+                    message: format!("the target: {message}"),
+                })?;
+                Ok(Board::Charuco(p))
+            }
+            (None, Some(grid)) => Ok(Board::Checkerboard(grid)),
+            (None, None) => Err(Error::Parse {
+                path: origin.to_string(),
+                message: "activecal detects checkerboards and ChArUco boards in images (a 'checkerboard:' or 'charuco:' target); AprilGrids and point lists are not detected yet: detect their points yourself and give them as --observations".into(),
+            }),
+        }
+    }
+}
+
+/// One image file's points (by target id; `n` of them) and figures, or
+/// why it is left out.
 fn one_image(
     path: &Path,
     board: &Board,
@@ -185,6 +214,18 @@ fn one_image(
 ) -> std::result::Result<(Vec<Option<[f64; 2]>>, ImageOutcome), String> {
     let bytes = std::fs::read(path).map_err(|e| format!("unreadable ({e})"))?;
     let img = decode::decode_png(&bytes)?;
+    detect_in(&img, board, n, intrinsics)
+}
+
+/// One image's points (by target id; `n` of them, the target's point
+/// count) and figures, refined ([`refine`]), or why it is left out (another
+/// size than the camera's, the board not found, too few corners).
+pub fn detect_in(
+    img: &decode::Gray,
+    board: &Board,
+    n: usize,
+    intrinsics: &Intrinsics,
+) -> std::result::Result<(Vec<Option<[f64; 2]>>, ImageOutcome), String> {
     let (w, h) = (intrinsics.width as usize, intrinsics.height as usize);
     if (img.width, img.height) != (w, h) {
         return Err(format!(
@@ -194,16 +235,16 @@ fn one_image(
     }
     let found = match board {
         Board::Checkerboard((rows, cols)) => {
-            detect::find_checkerboard(&img, *rows, *cols)?.located()
+            detect::find_checkerboard(img, *rows, *cols)?.located()
         }
-        Board::Charuco(p) => charuco::find_charuco(&img, p)?,
+        Board::Charuco(p) => charuco::find_charuco(img, p)?,
     };
     let mut seen = vec![None; n];
     let (mut shifts, mut widths, mut windows) = (Vec::new(), Vec::new(), Vec::new());
     for c in found.iter().filter(|c| c.id < n) {
         let half = refine::half_window_within(c.clear_px);
         let refined = (half >= refine::MIN_HALF_WINDOW)
-            .then(|| refine::refine_corner_in(&img, c.px, half, c.round))
+            .then(|| refine::refine_corner_in(img, c.px, half, c.round))
             .flatten()
             .filter(|r| r.shift <= refine::MAX_SHIFT);
         // Not refined (a window too small, or a move too long to be this
@@ -228,7 +269,7 @@ fn one_image(
         seen[c.id] = Some(r.px);
         shifts.push(r.shift);
         windows.push(half);
-        if let Some(e) = refine::edge_width(&img, r.px, half) {
+        if let Some(e) = refine::edge_width(img, r.px, half) {
             widths.push(e);
         }
     }

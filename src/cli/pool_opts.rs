@@ -185,59 +185,10 @@ pub fn with_jacobian(robot: Robot, pool: Pool, params: ParamSet) -> Result<PoolC
 
 /// One line per filter (what it removed) and per note of a pool's build.
 pub fn pool_stats_text(st: &activecal::pool::PoolStats) -> String {
-    let mut s = format!("pool: {} candidates", st.candidates);
-    for f in &st.filters {
-        s += &format!(", {} filter removed {} of {}", f.filter, f.removed, f.seen);
-    }
-    s += &format!(", {} kept\n", st.kept);
-    for f in &st.filters {
-        if let Some(c) = &f.contacts {
-            s += &format!(
-                "  {} filter: {} removed by two links touching, {} by a link touching an obstacle; {} pairs, the largest:\n",
-                f.filter, c.self_collision, c.obstacle, c.distinct_pairs
-            );
-            for p in &c.top {
-                s += &format!(
-                    "    {:>7}  {} – {}{}\n",
-                    p.removed,
-                    p.link,
-                    p.other,
-                    if p.obstacle { " (obstacle)" } else { "" }
-                );
-            }
-            if !c.always_touching.is_empty() {
-                s += &format!(
-                    "  {} filter: {} pairs of links touch in nearly every configuration and are not checked:\n",
-                    f.filter,
-                    c.always_touching.len()
-                );
-                for p in &c.always_touching {
-                    s += &format!(
-                        "    {:>5.1} %  {} – {}\n",
-                        100.0 * p.fraction,
-                        p.link,
-                        p.other
-                    );
-                }
-            }
-        }
-        if let Some(w) = &f.warning {
-            s += &format!("warning: {w}");
-            let own = f
-                .contacts
-                .as_ref()
-                .and_then(|c| c.top.first())
-                .is_some_and(|p| !p.obstacle);
-            if own {
-                s += " (give the SRDF with --srdf FILE, or without one --skip-always-touching)";
-            }
-            s += "\n";
-        }
-    }
-    for n in &st.notes {
-        s += &format!("note: {n}\n");
-    }
-    s
+    activecal::render::pool_text::pool_stats_text(
+        st,
+        " (give the SRDF with --srdf FILE, or without one --skip-always-touching)",
+    )
 }
 
 impl PoolOpts {

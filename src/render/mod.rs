@@ -22,6 +22,7 @@ pub mod page_contacts;
 pub mod pages;
 pub mod paper_figures;
 pub mod plots;
+pub mod pool_text;
 pub mod robot_text;
 pub mod select_text;
 pub mod simulated_text;

@@ -124,13 +124,6 @@ impl<'a> Cdr<'a> {
         Ok(out)
     }
 
-    /// A sequence of bytes, skipped (an image's pixels): its length.
-    pub fn skip_bytes(&mut self) -> CdrResult<usize> {
-        let n = self.length(1)?;
-        self.pos += n;
-        Ok(n)
-    }
-
     /// A sequence of bytes (an image's pixels), borrowed from the message.
     pub fn bytes(&mut self) -> CdrResult<&'a [u8]> {
         let n = self.length(1)?;

@@ -206,36 +206,12 @@ pub struct ImageHeader {
 
 /// Decodes an `Image`'s header and size.
 pub fn image_header(data: &[u8]) -> Decoded<ImageHeader> {
-    let mut c = at("(header)", Cdr::new(data))?;
-    let header = header(&mut c)?;
-    let height = at("height", c.u32())?;
-    let width = at("width", c.u32())?;
-    let encoding = at("encoding", c.string())?;
-    let _big_endian = at("is_bigendian", c.u8())?;
-    let _step = at("step", c.u32())?;
-    let bytes = at("data", c.skip_bytes())?;
-    Ok(ImageHeader {
-        header,
-        width,
-        height,
-        encoding,
-        bytes,
-    })
+    image(data).map(ImageData::header_only)
 }
 
 /// Decodes a `CompressedImage`'s header and format.
 pub fn compressed_image_header(data: &[u8]) -> Decoded<ImageHeader> {
-    let mut c = at("(header)", Cdr::new(data))?;
-    let header = header(&mut c)?;
-    let encoding = at("format", c.string())?;
-    let bytes = at("data", c.skip_bytes())?;
-    Ok(ImageHeader {
-        header,
-        width: 0,
-        height: 0,
-        encoding,
-        bytes,
-    })
+    compressed_image(data).map(ImageData::header_only)
 }
 
 /// An `Image` or a `CompressedImage`: its header, size and bytes, as
@@ -258,6 +234,20 @@ pub struct ImageData<'a> {
     pub compressed: bool,
     /// The pixels, or the compressed file's bytes.
     pub data: &'a [u8],
+}
+
+impl ImageData<'_> {
+    /// The header, size and encoding, with the count of bytes for the
+    /// bytes.
+    fn header_only(self) -> ImageHeader {
+        ImageHeader {
+            header: self.header,
+            width: self.width,
+            height: self.height,
+            encoding: self.encoding,
+            bytes: self.data.len(),
+        }
+    }
 }
 
 /// Decodes an `Image` with its pixels.

@@ -11,6 +11,7 @@ pub mod blocks;
 pub mod bound;
 pub mod collision;
 pub mod criterion;
+pub mod data;
 pub mod error;
 pub mod experiment;
 pub mod frames;

@@ -7,10 +7,11 @@
 //! cannot solve are refused with what to give.
 
 use crate::common;
+use activecal::data::CameraObservations;
 use activecal::identify::LmSettings;
 use activecal::identify::camera::simulate::simulate_observations;
 use activecal::identify::camera::start::start_placements;
-use activecal::identify::camera::{CameraFit, CameraObservations, camera_robot, fit_camera};
+use activecal::identify::camera::{CameraFit, camera_robot, fit_camera};
 use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_observations::read_observations;
 use activecal::io::camera_target::{Target, read_target};

@@ -4,10 +4,10 @@
 //! and geometric errors, simulated with noise — recovered within 3σ, with a
 //! held-out error at the noise floor that the geometric model misses.
 
+use activecal::data::Measurements;
 use activecal::identify::compliance::{report, with_compliance};
 use activecal::identify::{
-    Calibration, LmSettings, Measurements, Residuals, fix_undetermined, identify, residuals,
-    simulate,
+    Calibration, LmSettings, Residuals, fix_undetermined, identify, residuals, simulate,
 };
 use activecal::io::inertia::{InertiaOptions, gravity_model};
 use activecal::io::urdf::{UrdfOptions, load};

@@ -7,9 +7,8 @@
 //! format that has no place for the contact setup.
 
 use crate::common;
-use activecal::identify::contact::{
-    ContactSettings, NamedDistance, fit_contacts, resolve_distances, tool_points,
-};
+use activecal::data::NamedDistance;
+use activecal::identify::contact::{ContactSettings, fit_contacts, resolve_distances, tool_points};
 use activecal::io::contacts::read_contacts;
 use activecal::io::load_robot;
 use common::{fails_with, json_of};

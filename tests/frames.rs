@@ -6,8 +6,9 @@
 //! recovers every frame and origin within 3σ, with no frame leaking into a
 //! robot link.
 
+use activecal::data::Measurements;
 use activecal::frames::{CalibratedFrames, decompose, uncertainty::sigmas};
-use activecal::identify::{LmSettings, Measurements, identify};
+use activecal::identify::{LmSettings, identify};
 use activecal::io::urdf::{UrdfOptions, parse, remount};
 use activecal::io::urdf_edit::with_origins;
 use activecal::kinematics::pose;

@@ -1,6 +1,6 @@
 //! Loader fuzz: 10,000 generated inputs for each file loader — robot
 //! descriptions (`io::robot_toml`), URDF (`io::urdf`), design files
-//! (`io::design`) and measurement files (`identify::Measurements`) — made by
+//! (`io::design`) and measurement files (`data::Measurements`) — made by
 //! mutating valid seeds (the fixtures, and files the library writes): bit
 //! flips, random bytes, truncation, numbers replaced by NaN, infinities,
 //! 1e300, -0, huge or negative integers and values of the wrong type, and
@@ -18,7 +18,8 @@
 //! see both outcomes (some inputs load, most do not), or the mutations
 //! would be testing nothing.
 
-use activecal::identify::{Measurements, simulate, trial_rng};
+use activecal::data::Measurements;
+use activecal::identify::{simulate, trial_rng};
 use activecal::io::design::DesignFile;
 use activecal::io::robot_toml;
 use activecal::io::urdf::{self, UrdfOptions};

@@ -3,8 +3,9 @@
 //! errors for bad input, determinism of the Monte-Carlo, and the command line.
 
 use crate::common;
+use activecal::data::{DataError, Measurements};
 use activecal::identify::{
-    IdentifyError, LmSettings, Measurements, MonteCarloSettings, Status, StopReason, ValidationSet,
+    IdentifyError, LmSettings, MonteCarloSettings, Status, StopReason, ValidationSet,
     compare_designs, identify, monte_carlo, paper_tables, simulate, trial_rng,
 };
 use activecal::io::design::DesignFile;
@@ -250,7 +251,7 @@ fn bad_input_is_an_error() {
     assert!(
         matches!(
             e,
-            IdentifyError::NonFiniteMeasurement {
+            DataError::NonFiniteMeasurement {
                 pose: 4,
                 coordinate: 'y',
                 ..
@@ -263,7 +264,7 @@ fn bad_input_is_an_error() {
     let e = Measurements::new(&robot, qs.clone(), good.points()[..29].to_vec()).unwrap_err();
     assert!(matches!(
         e,
-        IdentifyError::MeasurementCount {
+        DataError::MeasurementCount {
             poses: 30,
             measurements: 29,
             per_pose: 1
@@ -283,11 +284,11 @@ fn bad_input_is_an_error() {
     nan_q[2][0] = f64::INFINITY;
     assert!(matches!(
         Measurements::new(&robot, nan_q, good.points().to_vec()),
-        Err(IdentifyError::Pose { pose: 2, .. })
+        Err(DataError::Pose { pose: 2, .. })
     ));
     assert!(matches!(
         Measurements::new(&robot, vec![], vec![]),
-        Err(IdentifyError::Empty)
+        Err(DataError::Empty)
     ));
 
     // Measurements deserialized without the constructor are checked again.
@@ -295,7 +296,7 @@ fn bad_input_is_an_error() {
     let raw: Measurements = serde_json::from_value(json).unwrap();
     assert!(matches!(
         identify(&robot, &robot.nominal, &raw, &LmSettings::default()),
-        Err(IdentifyError::MeasurementCount { .. })
+        Err(IdentifyError::Data(DataError::MeasurementCount { .. }))
     ));
 
     let mut start = robot.nominal.clone();
@@ -394,7 +395,7 @@ fn pose_measurements_are_checked() {
     assert!(
         matches!(
             e,
-            IdentifyError::OrientationCount {
+            DataError::OrientationCount {
                 given: 0,
                 poses: 30,
                 ..
@@ -421,10 +422,7 @@ fn pose_measurements_are_checked() {
         let mut bad = rots.clone();
         spoil(&mut bad[7]);
         let e = Measurements::with_orientations(&robot, qs.clone(), pts.clone(), bad).unwrap_err();
-        assert!(
-            matches!(e, IdentifyError::NotARotation { pose: 7, .. }),
-            "{e}"
-        );
+        assert!(matches!(e, DataError::NotARotation { pose: 7, .. }), "{e}");
         assert!(e.to_string().contains(needle), "'{e}' lacks '{needle}'");
     }
     // Rounding to 7 significant digits (a sensor's export) is accepted.

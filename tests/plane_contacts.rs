@@ -8,10 +8,10 @@
 use crate::common;
 use common::{fails_with, json_of, scratch_dir};
 
+use activecal::data::{ContactFile, NamedDistance, NamedPlane};
 use activecal::identify::contact::project::{project_to_point, simulate_contacts};
 use activecal::identify::contact::{
-    ContactFile, ContactSettings, NamedDistance, NamedPlane, fit_contacts, placement_of,
-    resolve_distances, tool_points,
+    ContactSettings, fit_contacts, placement_of, resolve_distances, tool_points,
 };
 use activecal::io::contacts::{parse_contacts, read_contacts};
 use activecal::io::load_robot;

@@ -3,9 +3,9 @@
 //! inputs, and the figures of issue 29 on MUKCa's real Panda data
 //! (`fixtures/mukca`).
 
+use activecal::data::NamedDistance;
 use activecal::identify::contact::{
-    ContactFit, ContactSettings, HoldoutMode, NamedDistance, fit_contacts, holdout_by_placement,
-    resolve_distances,
+    ContactFit, ContactSettings, HoldoutMode, fit_contacts, holdout_by_placement, resolve_distances,
 };
 use activecal::identify::{Calibration, LossChoice, Residuals};
 use activecal::io::contacts::{ContactFile, parse_contacts, read_contacts};

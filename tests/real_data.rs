@@ -10,7 +10,8 @@
 
 use crate::common;
 
-use activecal::identify::{LmSettings, Measurements, identify, simulate};
+use activecal::data::Measurements;
+use activecal::identify::{LmSettings, identify, simulate};
 use activecal::model::Robot;
 use common::{fails_with, json_of};
 use rand::SeedableRng;

@@ -8,11 +8,12 @@ use crate::convert::{
 use crate::fit_args::{holdout_of, restriction_of, weights_of};
 pub(crate) use crate::fit_args::{loss_of, outliers_of, refuse_unused};
 use crate::robot::Robot;
+use activecal::data::Measurements;
 use activecal::experiment::acts_on::{self as lib_acts, Sensor};
 use activecal::experiment::measured::{MeasuredSettings, calibrate_measurements};
 use activecal::frames::CalibratedFrames;
 use activecal::frames::report::FramesReport;
-use activecal::identify::{Identification, LmSettings, Measurements};
+use activecal::identify::{Identification, LmSettings};
 use activecal::io::calibrated::Format;
 use pyo3::prelude::*;
 use std::sync::Arc;

@@ -331,7 +331,7 @@ pub(crate) fn read_observations(
     robot: &activecal::model::Robot,
     target: &activecal::io::camera_target::Target,
     intrinsics: &Intrinsics,
-) -> Result<activecal::identify::camera::CameraObservations, Fail> {
+) -> Result<activecal::data::CameraObservations, Fail> {
     use activecal::io::camera_observations::{parse_observations, read_observations};
     let units = activecal::units::Units::default();
     match s {
@@ -351,7 +351,7 @@ pub(crate) fn read_pixels(
     intrinsics: &activecal::measure::pinhole::Intrinsics,
 ) -> Result<
     (
-        activecal::identify::camera::CameraObservations,
+        activecal::data::CameraObservations,
         Option<serde_json::Value>,
     ),
     Fail,

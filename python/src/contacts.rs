@@ -5,11 +5,12 @@
 
 use crate::convert::{Fail, arg_err, count, detached, float_array, json_to_py, rows};
 use crate::robot::Robot;
+use activecal::data::{ContactFile, NamedDistance};
 use activecal::experiment::contacts::{
     ContactCalibration as Calibrated, calibrate_contacts as fit,
 };
 use activecal::identify::LmSettings;
-use activecal::identify::contact::{ContactFile, ContactSettings, NamedDistance};
+use activecal::identify::contact::ContactSettings;
 use activecal::io::calibrated::Format;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;

@@ -64,6 +64,13 @@ impl From<activecal::identify::IdentifyError> for Fail {
     }
 }
 
+impl From<activecal::data::DataError> for Fail {
+    /// Bad measured data (its own description).
+    fn from(e: activecal::data::DataError) -> Self {
+        Fail::Input(e.to_string())
+    }
+}
+
 impl From<activecal::lsq::LsqError> for Fail {
     /// A solver setting out of range (an argument) or a problem it cannot
     /// take.

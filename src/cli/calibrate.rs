@@ -328,7 +328,7 @@ fn measured_settings(
 fn render_measured(
     a: &CalibrateArgs,
     robot: &Robot,
-    meas: &activecal::identify::Measurements,
+    meas: &activecal::data::Measurements,
     c: activecal::experiment::measured::MeasuredCalibration,
     o: &activecal::experiment::measured::MeasuredSettings,
     source: &Source,

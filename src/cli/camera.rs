@@ -8,9 +8,9 @@
 //! `--force`.
 
 use super::calibrate_args::CalibrateArgs;
+use activecal::data::CameraObservations;
 use activecal::experiment::camera::{CameraCalibration, CameraCalibrationError, CameraSetup};
 use activecal::identify::LmSettings;
-use activecal::identify::camera::CameraObservations;
 use activecal::io::calibrated::{Format, render};
 use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_observations::read_observations;

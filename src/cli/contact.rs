@@ -4,12 +4,13 @@
 //! rendering of the fit and of `--holdout-by
 //! placement` / `--train-on`. The work is in `activecal::identify::contact`.
 
+use activecal::data::{NamedDistance, NamedPlane};
 use activecal::experiment::contacts::{
     ContactInput, ContactInputError, ContactUse, checked_inputs,
 };
 use activecal::identify::LmSettings;
 use activecal::identify::contact::{
-    ContactSettings, HoldoutMode, HoldoutReport, NamedDistance, NamedPlane, holdout_by_placement,
+    ContactSettings, HoldoutMode, HoldoutReport, holdout_by_placement,
 };
 use activecal::io::contacts::{ContactFile, read_contacts};
 use activecal::model::Robot;
@@ -219,7 +220,7 @@ fn held_out(
     a: &ContactArgs<'_>,
     robot: &Robot,
     file: &ContactFile,
-    given: &[activecal::identify::contact::NamedDistance],
+    given: &[activecal::data::NamedDistance],
     settings: &ContactSettings,
 ) -> Result<Option<HoldoutReport>> {
     let mode = match (&a.holdout_by, &a.train_on) {

@@ -4,7 +4,8 @@
 //! work is in `activecal::experiment::measured` and `activecal::identify`.
 
 use super::emit_report;
-use activecal::identify::{LossChoice, Measurements, residuals};
+use activecal::data::Measurements;
+use activecal::identify::{LossChoice, residuals};
 use activecal::model::Robot;
 use activecal::report::measured::EvaluationReport;
 use anyhow::{Result, bail};

@@ -5,7 +5,7 @@
 
 use super::error::ExperimentError;
 use super::measured::{MeasuredCalibration, MeasuredSettings, calibrate_read};
-use crate::identify::Measurements;
+use crate::data::Measurements;
 use crate::io::bag::clock::Offset;
 use crate::io::bag::extract::{ExtractReport, ExtractSettings, extract};
 use crate::model::Robot;
@@ -36,7 +36,9 @@ fn checked(
         path: source.clone(),
         error,
     };
-    got.measurements.check(robot).map_err(in_file)?;
+    got.measurements
+        .check(robot)
+        .map_err(|e| in_file(e.into()))?;
     crate::identify::evaluation::check_in_reach(
         robot,
         &got.measurements,

@@ -6,6 +6,7 @@
 //! and the Python package both call it; reading the files and writing the
 //! results are theirs.
 
+use crate::data::CameraObservations;
 use crate::experiment::measured::verdict::Verdict;
 use crate::frames::camera::camera_frames;
 use crate::frames::report::FramesReport;
@@ -14,7 +15,7 @@ use crate::identify::LmSettings;
 use crate::identify::camera::screen::{CameraOutlier, screen_camera};
 use crate::identify::camera::start::labels::{Labels, relabel};
 use crate::identify::camera::start::{CameraStart, StartError, start_placements};
-use crate::identify::camera::{CameraFit, CameraFitError, CameraObservations};
+use crate::identify::camera::{CameraFit, CameraFitError};
 use crate::identify::variance::{BlockNoiseTest, NoiseOf};
 use crate::io::camera_target::Target;
 use crate::lsq::outliers::OutlierChoice;

@@ -6,12 +6,12 @@
 //! is not left out (the fit would have nothing to determine it by): the
 //! test stops there with a note.
 
+use crate::data::MIN_DISTINCT;
+use crate::data::{ContactFile, NamedDistance};
 use crate::identify::LossChoice;
-use crate::identify::contact::data::MIN_DISTINCT;
 use crate::identify::contact::fit::row_tester;
 use crate::identify::contact::{
-    ContactFile, ContactFit, ContactSettings, NamedDistance, fit_contacts, resolve_distances,
-    tool_points,
+    ContactFit, ContactSettings, fit_contacts, resolve_distances, tool_points,
 };
 use crate::lsq::outliers::{
     Capped, Flag, Flagged, MOST_OUTLIERS, OutlierChoice, PoseTest, Snoop, flagged, kept_of, snoop,

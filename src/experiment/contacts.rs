@@ -6,14 +6,13 @@
 //! The command line and the Python package both call it; held-out
 //! placements are the caller's ([`crate::identify::contact::holdout`]).
 
+use crate::data::{ContactFile, NamedDistance};
 use crate::experiment::contact_screen::{ContactOutlier, screen_contacts};
 use crate::frames::CalibratedFrames;
 use crate::frames::report::{FitBlock, FramesReport};
 use crate::identify::contact::holdout::{DownweightedRow, Figures, downweighted_rows, judge};
 use crate::identify::contact::predict::{PREDICTION_CONFIGURATIONS, PredictedTrueError};
-use crate::identify::contact::{
-    ContactFile, ContactFit, ContactSettings, NamedDistance, resolve_distances, rms, tool_points,
-};
+use crate::identify::contact::{ContactFit, ContactSettings, resolve_distances, rms, tool_points};
 use crate::measure::contact::KnownDistance;
 use crate::model::Robot;
 
@@ -89,7 +88,7 @@ pub enum ContactUse {
 pub fn checked_inputs(
     robot: &Robot,
     file: &mut ContactFile,
-    planes: &[crate::identify::contact::NamedPlane],
+    planes: &[crate::data::NamedPlane],
     given: &[NamedDistance],
     use_: ContactUse,
 ) -> Result<Vec<KnownDistance>, ContactInputError> {

@@ -4,7 +4,7 @@
 //! from a frame a few degrees off, not from one 100° and metres away, where
 //! a tracker often stands.
 
-use crate::identify::Measurements;
+use crate::data::Measurements;
 use crate::kinematics::pose;
 use crate::model::Robot;
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};

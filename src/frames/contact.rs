@@ -13,7 +13,8 @@
 use super::report::{ContactPlaneBlock, ContactPointBlock, ContactsBlock, FitBlock, FramesReport};
 use super::uncertainty::sigmas;
 use super::{CalibratedFrames, FramesError, decompose};
-use crate::identify::contact::{ContactFit, NamedDistance};
+use crate::data::NamedDistance;
+use crate::identify::contact::ContactFit;
 use crate::model::{MeasurementKind, ParamTable, Robot};
 use nalgebra::{Point3, Translation3, Vector3};
 

@@ -262,7 +262,7 @@ pub struct ContactsBlock {
     pub planes: Vec<ContactPlaneBlock>,
     /// The known distances the fit used (m).
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub distances: Vec<crate::identify::contact::NamedDistance>,
+    pub distances: Vec<crate::data::NamedDistance>,
 }
 
 fn quaternion(t: &Isometry3<f64>) -> [f64; 4] {

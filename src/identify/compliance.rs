@@ -5,7 +5,8 @@
 //! offset, which the joint's γ already is), and what a fit says of them:
 //! `c` with σ and t, the stiffness `k = −1/c` and the largest deflection.
 
-use super::{Identification, Measurements};
+use super::Identification;
+use crate::data::Measurements;
 use crate::kinematics::{Evaluator, Motion};
 use crate::model::gravity::GravityModel;
 use crate::model::{JointKind, ParamId, ParamTable, Robot, Symbol};

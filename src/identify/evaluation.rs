@@ -8,7 +8,8 @@
 //! per marker). The sensor's weighted residual rows are unweighted here, so
 //! that `orientation_scale` never mixes metres and radians in a figure.
 
-use super::{Measurements, Result};
+use super::Result;
+use crate::data::Measurements;
 use crate::kinematics::Evaluator;
 use crate::measure::{RowKind, sensor_for};
 use crate::model::{ParamTable, Robot};
@@ -156,7 +157,7 @@ mod tests {
         let mut rots = m.orientations().to_vec();
         let turn =
             nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::y_axis(), 0.5f64.to_radians());
-        rots[4] = crate::identify::rows(&(turn.matrix() * crate::identify::matrix(&rots[4])));
+        rots[4] = crate::data::rows(&(turn.matrix() * crate::data::matrix(&rots[4])));
         let moved = Measurements::with_orientations(&robot, qs.clone(), pts, rots).unwrap();
         let r = residuals(&robot, &robot.nominal, &moved).unwrap();
         assert!(

@@ -6,9 +6,10 @@
 use super::evaluation::{ModelErrors, residuals};
 use super::start::for_measurements;
 use super::{
-    Calibration, Cauchy, Huber, Identification, IdentifyError, LmSettings, Loss, Measurements,
-    Result, Robust, identify, identify_robust,
+    Calibration, Cauchy, Huber, Identification, IdentifyError, LmSettings, Loss, Result, Robust,
+    identify, identify_robust,
 };
+use crate::data::Measurements;
 use crate::model::{ParamTable, Robot};
 use rand::SeedableRng;
 use rand::seq::SliceRandom;

@@ -9,8 +9,9 @@
 //! and solves it by IRLS ([`irls`]).
 
 use super::residual::{Calibration, Residuals};
-use super::{IdentifyError, Measurements, Result};
+use super::{IdentifyError, Result};
 use crate::blocks::Blocks;
+use crate::data::Measurements;
 use crate::linalg::qr::inverse_information;
 pub use crate::lsq::levmar::{LmSettings, Solution, StopReason, levenberg_marquardt};
 use crate::lsq::loss::{Loss, Robust};
@@ -362,7 +363,7 @@ pub fn predicted_covariance(
     for (i, q) in qs.iter().enumerate() {
         robot
             .check_q(q)
-            .map_err(|source| IdentifyError::Pose { pose: i, source })?;
+            .map_err(|source| crate::data::DataError::Pose { pose: i, source })?;
     }
     let x = crate::blocks::jacobian_of(robot, table, qs.len(), |k, q| q.copy_from_slice(&qs[k]));
     if identifiability(robot, &x).rank < robot.n_params() {

@@ -11,7 +11,8 @@
 
 pub use crate::lsq::Residuals;
 
-use super::{Measurements, Result};
+use super::Result;
+use crate::data::Measurements;
 use crate::kinematics::{Evaluator, Motion};
 use crate::measure::{Sensor, sensor_for};
 use crate::model::{ParamTable, Robot};

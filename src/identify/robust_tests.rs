@@ -1,8 +1,9 @@
 //! Robust losses on a calibration: Huber against gross outliers, and a
 //! Huber of large scale equal to least squares.
 
+use crate::data::Measurements;
 use crate::identify::{
-    LmSettings, Measurements, Status, ValidationSet, identify, identify_robust, simulate, trial_rng,
+    LmSettings, Status, ValidationSet, identify, identify_robust, simulate, trial_rng,
 };
 use crate::lsq::loss::Huber;
 use crate::model::Robot;

@@ -7,7 +7,8 @@
 //! `rand` 0.9's traits and does not accept a `rand` 0.10 generator, and two
 //! lines of Box–Muller are not worth a second `rand` in the build.
 
-use super::{Measurements, Result};
+use super::Result;
+use crate::data::Measurements;
 use crate::kinematics::Evaluator;
 use crate::measure::sensor_for;
 use crate::model::{ParamTable, Robot};
@@ -78,7 +79,7 @@ pub fn simulate<R: Rng + ?Sized>(
     for (i, q) in qs.iter().enumerate() {
         robot
             .check_q(q)
-            .map_err(|source| super::IdentifyError::Pose { pose: i, source })?;
+            .map_err(|source| crate::data::DataError::Pose { pose: i, source })?;
         sensor.predict(&ev.end_frame(q), &own, &mut value);
         let z = &noise[t * i..t * (i + 1)];
         for ((d, z), w) in delta.iter_mut().zip(z).zip(sensor.weights()) {

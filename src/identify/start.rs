@@ -17,7 +17,8 @@
 //!   fitted chain. The `K`-marker robot's nominal table is the robot's with
 //!   these offsets; identification starts from the fit with these offsets.
 
-use super::{IdentifyError, LmSettings, Measurements, Result, identify};
+use super::{IdentifyError, LmSettings, Result, identify};
+use crate::data::Measurements;
 use crate::kinematics::Evaluator;
 use crate::model::{MeasurementKind, ParamTable, Robot};
 use nalgebra::Vector3;
@@ -78,11 +79,12 @@ pub fn for_measurements(robot: &Robot, meas: &Measurements, lm: &LmSettings) -> 
         _ => {
             // Not a combination we adapt: the check names what differs.
             meas.check(robot)?;
-            Err(IdentifyError::MarkerCount {
+            Err(crate::data::DataError::MarkerCount {
                 robot: robot.name.clone(),
                 given: k,
                 expected: have.points_per_pose(),
-            })
+            }
+            .into())
         }
     }
 }

@@ -1,9 +1,10 @@
 //! The paper's Tables III (estimates) and IV (residuals) for a design: one
 //! simulated calibration, laid out one row per frame and one column per symbol.
 
+use super::Result;
 use super::lm::{Identification, LmSettings, identify};
 use super::simulate::{simulate, trial_rng};
-use super::{Measurements, Result};
+use crate::data::Measurements;
 use crate::model::{ParamId, Robot, Symbol};
 use serde::Serialize;
 

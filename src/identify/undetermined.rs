@@ -21,7 +21,8 @@
 //! determined. The kept set is then checked with the rank rule itself, and
 //! the last kept pivots (outside group 1) are dropped until it passes.
 
-use super::{Calibration, Measurements, Residuals, Result};
+use super::{Calibration, Residuals, Result};
+use crate::data::Measurements;
 use crate::linalg::rank::{MAX_CONDITION, equilibrated_rank};
 use crate::model::{ParamTable, Robot};
 use crate::units::joint_names;

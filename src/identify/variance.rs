@@ -17,7 +17,8 @@
 //! ∝ 1/σ_b` and refitting until the σ's settle gives the weights the data's
 //! own noise implies ([`crate::identify::fit::fit_weighted`]).
 
-use super::{Calibration, Identification, Measurements, Residuals, Result};
+use super::{Calibration, Identification, Residuals, Result};
+use crate::data::Measurements;
 use crate::measure::RowKind;
 use crate::model::{ParamTable, Robot};
 use crate::names::phrase;

@@ -28,8 +28,8 @@
 //! ([`crate::units::joint_values_to_model_units`]).
 
 use super::table::{Table, parse_csv};
+use crate::data::{Measurements, ROTATION_TOLERANCE};
 use crate::error::{Error, Result};
-use crate::identify::{Measurements, ROTATION_TOLERANCE};
 use crate::model::Robot;
 pub use crate::units::joint_names;
 use crate::units::{JointSource, Units, joint_values_to_model_units};
@@ -429,7 +429,7 @@ impl OrientationColumns {
                 }
                 // R = Rz(phiz) Ry(phiy) Rx(phix): nalgebra's roll-pitch-yaw.
                 let r = Rotation3::from_euler_angles(a[0], a[1], a[2]);
-                Ok(Some(crate::identify::rows(r.matrix())))
+                Ok(Some(crate::data::rows(r.matrix())))
             }
             Self::Quaternion(cols) => {
                 let v = [
@@ -446,9 +446,7 @@ impl OrientationColumns {
                     ));
                 }
                 let uq = UnitQuaternion::from_quaternion(Quaternion::new(v[0], v[1], v[2], v[3]));
-                Ok(Some(crate::identify::rows(
-                    uq.to_rotation_matrix().matrix(),
-                )))
+                Ok(Some(crate::data::rows(uq.to_rotation_matrix().matrix())))
             }
         }
     }
@@ -473,7 +471,7 @@ mod tests {
         let rz = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::z_axis(), z);
         let ry = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::y_axis(), y);
         let rx = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::x_axis(), x);
-        let want = crate::identify::rows((rz * ry * rx).matrix());
+        let want = crate::data::rows((rz * ry * rx).matrix());
         for (got, want) in m.orientations()[0].iter().zip(&want) {
             for (g, w) in got.iter().zip(want) {
                 assert!((g - w).abs() < 1e-15);

@@ -54,9 +54,9 @@ pub struct Description {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ContactSetup {
     /// Known distances.
-    pub distances: Vec<crate::identify::contact::NamedDistance>,
+    pub distances: Vec<crate::data::NamedDistance>,
     /// Known planes.
-    pub planes: Vec<crate::identify::contact::NamedPlane>,
+    pub planes: Vec<crate::data::NamedPlane>,
 }
 
 /// A robot by built-in name (see [`Robot::builtin`]) or from a file, in

@@ -4,10 +4,11 @@
 //! distance to its point's mean ([`super::plots`] draws them).
 
 use super::plots::{BarGroup, RowMark, consistency_bars, row_distances};
+use crate::data::ContactFile;
 use crate::error::Result;
 use crate::identify::contact::holdout::{Figures, downweighted_rows};
 use crate::identify::contact::{
-    ContactFile, ContactFit, HoldoutReport, RowDistance, placement_of, placements, rms,
+    ContactFit, HoldoutReport, RowDistance, placement_of, placements, rms,
     row_distances as rows_of_fit,
 };
 use crate::model::Robot;

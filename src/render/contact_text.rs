@@ -2,8 +2,9 @@
 //! contacts.csv` prints, and its report folder holds): the fit, the
 //! in-sample consistency and the held-out placements, lengths in mm.
 
+use crate::data::ContactFile;
 use crate::identify::contact::holdout::{Figures, downweighted_rows};
-use crate::identify::contact::{ContactFile, ContactFit, HoldoutReport};
+use crate::identify::contact::{ContactFit, HoldoutReport};
 use std::fmt::Write as _;
 
 /// The report of a contact fit as text: the fit, the fixed unknowns, the

@@ -16,6 +16,7 @@
 //!   URDF and the frames file), loaded by Pinocchio and the frames reader,
 //!   give the fitted tool point of every row.
 
+use activecal::data::{ContactFile, NamedDistance};
 use activecal::frames::contact::contact_frames;
 use activecal::frames::decompose;
 use activecal::frames::report::FitBlock;
@@ -24,8 +25,8 @@ use activecal::identify::contact::project::project_to_point;
 use activecal::identify::contact::select::Socket;
 use activecal::identify::contact::socket_design::{SocketDesignSettings, design_for_sockets};
 use activecal::identify::contact::{
-    ContactFile, ContactSettings, NamedDistance, best_plane, fit_contacts, group_means,
-    placement_of, resolve_distances, tool_points,
+    ContactSettings, best_plane, fit_contacts, group_means, placement_of, resolve_distances,
+    tool_points,
 };
 use activecal::io::calibrated::{Format, render};
 use activecal::io::contacts::read_contacts;

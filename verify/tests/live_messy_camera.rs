@@ -23,9 +23,9 @@
 
 use super::live_messy::false_alarm_bound;
 use super::live_truth::{compare, root};
+use activecal::data::CameraObservations;
 use activecal::experiment::camera::{CameraCalibration, CameraSetup, calibrate_camera};
 use activecal::identify::LmSettings;
-use activecal::identify::camera::CameraObservations;
 use activecal::identify::camera::screen::CameraUnit;
 use activecal::io::calibrated::{Format, render};
 use activecal::io::camera_info::read_camera_info;

@@ -11,7 +11,7 @@
 //! RMS from its covariance ([`super::MeasuredReport::predicted`]).
 
 use super::{ExperimentError, MeasuredSettings, PREDICTION_CONFIGURATIONS, calibrate_read};
-use crate::identify::Measurements;
+use crate::data::Measurements;
 use crate::identify::restriction::Restriction;
 use crate::model::{MeasurementKind, ParamTable, Robot};
 use nalgebra::Vector3;

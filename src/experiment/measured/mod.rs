@@ -7,11 +7,12 @@
 //! the report.
 
 use super::paper::ExperimentError;
+use crate::data::Measurements;
 use crate::identify::compliance::{ComplianceComparison, compare, with_compliance};
 use crate::identify::evaluation::ModelErrors;
 use crate::identify::{
-    Fit, HoldoutSettings, LmSettings, LossChoice, Measurements, SplitResult, for_measurements,
-    holdout, prepare_for_data, residuals, trust,
+    Fit, HoldoutSettings, LmSettings, LossChoice, SplitResult, for_measurements, holdout,
+    prepare_for_data, residuals, trust,
 };
 use crate::lsq::outliers::OutlierChoice;
 use crate::model::gravity::GravityModel;
@@ -287,7 +288,7 @@ pub fn calibrate_measurements(
     on_note: &mut dyn FnMut(&str),
 ) -> Result<MeasuredCalibration, ExperimentError> {
     let in_file = in_source(source);
-    meas.check(robot).map_err(in_file)?;
+    meas.check(robot).map_err(|e| in_file(e.into()))?;
     crate::identify::evaluation::check_in_reach(robot, meas, source, crate::units::LengthUnit::M)
         .map_err(in_file)?;
     calibrate_read(robot, meas, source, read_notes, s, on_note)

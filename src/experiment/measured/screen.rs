@@ -3,7 +3,8 @@
 //! a time, the fit repeated.
 
 use super::MeasuredSettings;
-use crate::identify::{LossChoice, Measurements, residuals};
+use crate::data::Measurements;
+use crate::identify::{LossChoice, residuals};
 use crate::lsq::outliers::{
     Flag, Flagged, MOST_OUTLIERS, Outlier, OutlierChoice, Snoop, flagged, kept_of, pose_tests,
     snoop, too_many_note,

@@ -1,7 +1,8 @@
 //! What the report folder (`render::folder`) shows of a calibration from
 //! measurements: one summary for the command line and the Python package.
 
-use crate::identify::{Identification, Measurements, ModelErrors};
+use crate::data::Measurements;
+use crate::identify::{Identification, ModelErrors};
 use crate::model::Robot;
 
 /// What the report folder shows of a calibration from measurements

@@ -12,7 +12,8 @@
 //! points seen) and the rest passes (at `α` over the poses), only the
 //! point is left out; otherwise the whole pose. The fit is then repeated.
 
-use super::{CameraFit, CameraFitError, CameraObservations, fit_camera};
+use super::{CameraFit, CameraFitError, fit_camera};
+use crate::data::CameraObservations;
 use crate::identify::LmSettings;
 use crate::identify::residual::{Calibration, Residuals};
 use crate::lsq::outliers::{

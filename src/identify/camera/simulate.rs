@@ -3,7 +3,7 @@
 //! camera sees (in front of it, inside the image with a margin) and the
 //! poses that see at least [`MIN_POINTS_PER_POSE`] of them.
 
-use super::CameraObservations;
+use crate::data::CameraObservations;
 use crate::identify::simulate::fill_standard_normal;
 use crate::kinematics::Evaluator;
 use crate::measure::Sensor;

@@ -3,9 +3,10 @@
 //! known distance's error and each plane's flatness, millimetres — the
 //! figures of [`super::holdout`] for one model.
 
-use super::data::ContactFile;
 use super::holdout::figures_of;
-use super::{NamedDistance, tool_points};
+use super::tool_points;
+use crate::data::ContactFile;
+use crate::data::NamedDistance;
 use crate::model::{ParamTable, Robot};
 use serde::Serialize;
 

@@ -13,8 +13,8 @@
 //! ([`crate::identify::undetermined`]: column-pivoted QR on the
 //! column-scaled Jacobian, the sensor's own unknowns pivoted first).
 
-use super::data::ContactFile;
 use super::{start_own, start_planes};
+use crate::data::ContactFile;
 use crate::identify::lm::{Solution, StopReason, levenberg_marquardt};
 use crate::identify::undetermined::{FixedParameter, fix_undetermined_below};
 use crate::identify::{Calibration, LmSettings, LossChoice, Residuals, Result};

@@ -10,12 +10,10 @@
 //! between two points' means against the known distance. Nominal (the
 //! start table, no tool offset) against calibrated.
 
-use super::data::ContactFile;
 use super::fit::{ContactFit, ContactSettings, fit_contacts};
-use super::{
-    NamedDistance, best_plane, group_means, placement_of, resolve_distances, rms, spreads,
-    tool_points,
-};
+use super::{best_plane, group_means, placement_of, resolve_distances, rms, spreads, tool_points};
+use crate::data::ContactFile;
+use crate::data::NamedDistance;
 use crate::error::Error;
 use crate::identify::Result;
 use crate::measure::contact::PlaneKind;

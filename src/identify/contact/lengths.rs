@@ -3,7 +3,8 @@
 //! millimetres given as metres) is refused, and so is a distance far
 //! shorter than the one the nominal model puts between the two points.
 
-use super::{ContactFile, group_means, tool_points};
+use super::{group_means, tool_points};
+use crate::data::ContactFile;
 use crate::error::{Compact, Error, Result};
 use crate::measure::contact::{KnownDistance, PlaneKind};
 use crate::model::Robot;

@@ -20,7 +20,6 @@
 //! * [`select`], [`socket_design`]: the configurations to record for
 //!   sockets at given positions.
 
-pub mod data;
 pub mod evaluate;
 pub mod fit;
 pub mod holdout;
@@ -31,7 +30,7 @@ pub mod select;
 pub mod socket_design;
 pub mod worth;
 
-pub use data::{ContactFile, NamedPlane};
+pub use crate::data::{ContactFile, NamedDistance, NamedPlane};
 pub use fit::{ContactFit, ContactSettings, PlaneEstimate, fit_contacts};
 pub use holdout::{
     DistanceFigure, DownweightedRow, Figures, HoldoutFold, HoldoutMode, HoldoutReport, PlaneFigure,
@@ -43,18 +42,6 @@ use crate::kinematics::Evaluator;
 use crate::measure::contact::{ContactSensor, KnownDistance, Plane, PlaneKind, TOOL_OFFSET_PARAMS};
 use crate::model::{ParamTable, Robot};
 use nalgebra::Vector3;
-use serde::Serialize;
-
-/// A distance known between two named points.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct NamedDistance {
-    /// The first point's name.
-    pub a: String,
-    /// The second point's name.
-    pub b: String,
-    /// The distance, metres.
-    pub metres: f64,
-}
 
 /// The distances of `given` between points of `file`, as indices. With
 /// `strict`, a distance naming a point the file does not have is an error

@@ -2,8 +2,8 @@
 //! on the tool point's position within the joint limits (less a margin),
 //! and contacts simulated with it (a known robot, points and noise).
 
-use super::data::ContactFile;
 use super::group_means;
+use crate::data::ContactFile;
 use crate::error::Error;
 use crate::identify::simulate::fill_standard_normal;
 use crate::kinematics::{Evaluator, Motion};

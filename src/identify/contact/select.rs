@@ -11,9 +11,9 @@
 //! calibrated model's contacts would scatter about the socket, in units of
 //! σ. A design whose `M` is singular has an infinite error.
 
-use super::data::ContactFile;
 use super::fit::{CONTACT_PIVOT_TOL, gauge_unknowns};
 use super::project::project_to_point;
+use crate::data::ContactFile;
 use crate::identify::Calibration;
 use crate::identify::Residuals;
 use crate::identify::undetermined::fix_undetermined_below;

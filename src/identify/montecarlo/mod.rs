@@ -56,7 +56,7 @@ pub fn monte_carlo(
     settings.validate()?;
     robot.validate()?;
     if qs.is_empty() {
-        return Err(IdentifyError::Empty);
+        return Err(crate::data::DataError::Empty.into());
     }
     let names = robot.parameter_names();
     let p = names.len();

@@ -80,7 +80,7 @@ impl ValidationSet {
         for (i, q) in qs.iter().enumerate() {
             robot
                 .check_q(q)
-                .map_err(|source| IdentifyError::Pose { pose: i, source })?;
+                .map_err(|source| crate::data::DataError::Pose { pose: i, source })?;
         }
         let poses: Vec<_> = qs.iter().map(|q| pose(robot, &robot.real, q)).collect();
         let truth = poses.iter().map(|(_, p)| *p).collect();

@@ -5,7 +5,7 @@
 //! the poses (the periods the arm stands still) and averages each
 //! measurement over its rest, [`clock`] estimates the offset between the
 //! two streams' clocks from the moves, and [`extract`] turns a bag into
-//! [`crate::identify::Measurements`] with a report of what was kept and why.
+//! [`crate::data::Measurements`] with a report of what was kept and why.
 
 pub mod camera;
 pub mod cdr;

@@ -24,8 +24,8 @@ pub mod joints;
 pub mod refine;
 
 use super::camera_target::{CharucoPattern, Target};
+use crate::data::CameraObservations;
 use crate::error::{Error, Result};
-use crate::identify::camera::CameraObservations;
 use crate::measure::camera::MIN_POINTS_PER_POSE;
 use crate::measure::pinhole::Intrinsics;
 use joints::ImageJoints;

@@ -20,13 +20,11 @@ pub(super) fn contact_setup(cx: &Ctx<'_>, spec: &FileSpec) -> Result<crate::io::
                 ),
             ));
         }
-        setup
-            .distances
-            .push(crate::identify::contact::NamedDistance {
-                a: v.a.clone(),
-                b: v.b.clone(),
-                metres: v.metres,
-            });
+        setup.distances.push(crate::data::NamedDistance {
+            a: v.a.clone(),
+            b: v.b.clone(),
+            metres: v.metres,
+        });
     }
     for p in &spec.plane {
         let v = p.get_ref();
@@ -40,7 +38,7 @@ pub(super) fn contact_setup(cx: &Ctx<'_>, spec: &FileSpec) -> Result<crate::io::
                 ),
             ));
         }
-        setup.planes.push(crate::identify::contact::NamedPlane {
+        setup.planes.push(crate::data::NamedPlane {
             name: v.name.clone(),
             normal: v.normal,
             offset: v.offset,

@@ -23,7 +23,7 @@
 //! they are.
 
 use super::pnp::place_target;
-use crate::identify::camera::CameraObservations;
+use crate::data::CameraObservations;
 use crate::measure::camera::Mounting;
 use crate::measure::pinhole::Intrinsics;
 use crate::model::Robot;

@@ -20,7 +20,7 @@ pub mod hand_eye;
 pub mod labels;
 pub mod pnp;
 
-use super::CameraObservations;
+use crate::data::CameraObservations;
 use crate::kinematics::Evaluator;
 use crate::measure::camera::Mounting;
 use crate::measure::pinhole::Intrinsics;

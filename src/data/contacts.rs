@@ -2,6 +2,7 @@
 //! plane it touches and its file line ([`crate::io::contacts`] reads them).
 
 use crate::measure::contact::{Plane, PlaneKind};
+use serde::Serialize;
 
 /// Contacts read from a file.
 #[derive(Clone, Debug, PartialEq)]
@@ -185,4 +186,15 @@ impl ContactFile {
             lines: rows.iter().map(|&i| self.lines[i]).collect(),
         }
     }
+}
+
+/// A distance known between two named points.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NamedDistance {
+    /// The first point's name.
+    pub a: String,
+    /// The second point's name.
+    pub b: String,
+    /// The distance, metres.
+    pub metres: f64,
 }

@@ -34,5 +34,6 @@ pub mod select;
 mod settings;
 pub mod stats;
 pub mod units;
+pub mod write;
 
 pub use error::{Error, Result};

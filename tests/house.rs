@@ -233,13 +233,15 @@ fn library_errors_name_the_input_and_the_binary_names_the_option() {
 }
 
 /// The library's modules a front end may name: its pipelines, their typed
-/// reports and renderings, the readers and writers of files, the robot
-/// description, names, units, progress and errors.
+/// reports and renderings, the measured data, the readers and writers of
+/// files, the robot description, names, units, progress and errors.
 const FRONT_END_MAY_NAME: &[&str] = &[
     "experiment",
     "report",
     "render",
+    "data",
     "io",
+    "write",
     "model",
     "names",
     "units",

@@ -14,7 +14,7 @@ use activecal::experiment::measured::{MeasuredSettings, calibrate_measurements};
 use activecal::frames::CalibratedFrames;
 use activecal::frames::report::FramesReport;
 use activecal::identify::{Identification, LmSettings};
-use activecal::io::calibrated::Format;
+use activecal::write::calibrated::Format;
 use pyo3::prelude::*;
 use std::sync::Arc;
 
@@ -468,29 +468,22 @@ pub(crate) fn write_robot(
     overwrite: bool,
     inputs: &[&std::path::Path],
 ) -> PyResult<()> {
-    let kind = std::mem::discriminant(&format);
-    if Format::of(path).ok().map(|f| std::mem::discriminant(&f)) != Some(kind) {
-        return Err(arg_err(
-            "path",
-            format!(
-                "{}: this writer writes a file whose name ends in {}",
-                path.display(),
-                format.name_ending()
-            ),
-        ));
-    }
-    let out = [activecal::io::atomic::Output {
-        label: "path",
-        path,
-    }];
-    let mut all: Vec<&std::path::Path> = inputs.to_vec();
-    if let Some(src) = robot.source.as_ref() {
-        all.push(std::path::Path::new(&src.path));
-    }
-    // Never over an input of the call, even when overwriting is asked.
-    activecal::io::atomic::check_outputs(&out, &all, true)
-        .map_err(|e| crate::convert::Fail::from(e).into_py())?;
-    activecal::io::calibrated::write(format, robot, table, frames, header, path, overwrite)
+    let calibrated = activecal::write::calibrated::CalibratedRobot {
+        robot,
+        table,
+        frames,
+        header,
+    };
+    calibrated
+        .write(
+            format,
+            activecal::io::atomic::Output {
+                label: "path",
+                path,
+            },
+            overwrite,
+            inputs,
+        )
         .map_err(|e| crate::convert::Fail::from(e).into_py())
 }
 

@@ -11,7 +11,7 @@ use activecal::experiment::contacts::{
 };
 use activecal::identify::LmSettings;
 use activecal::identify::contact::ContactSettings;
-use activecal::io::calibrated::Format;
+use activecal::write::calibrated::Format;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::Arc;

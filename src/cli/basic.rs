@@ -89,7 +89,7 @@ pub struct PoolArgs {
 /// Runs `robots`.
 pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
     if let Some(name) = &a.export {
-        use activecal::io::calibrated::{Format, render};
+        use activecal::write::calibrated::{Format, render};
         let format = match &a.out {
             Some(p) => {
                 let mut files = super::run_files::RunFiles::new();

@@ -6,8 +6,8 @@ use super::calibrate_args::CalibrateArgs;
 use activecal::frames::CalibratedFrames;
 use activecal::frames::report::{FitBlock, FramesReport};
 use activecal::identify::Identification;
-use activecal::io::calibrated::Format;
 use activecal::model::Robot;
+use activecal::write::calibrated::{CalibratedRobot, Format};
 use anyhow::Result;
 
 /// The calibrated frames of a URDF robot at the estimate (`None` for other
@@ -35,25 +35,31 @@ pub fn write_calibrated(
     if !id.converged() {
         return Ok(Vec::new());
     }
+    let header = activecal::write::calibrated::header(id, source);
+    let calibrated = CalibratedRobot {
+        robot,
+        table: &id.table,
+        frames: frames.map(|(f, r)| (f, r)),
+        header: &header,
+    };
     let mut written = Vec::new();
     for out in &a.out {
         let format = match Format::of(out)? {
             Format::JointOffsets(_) => Format::JointOffsets(a.offset_convention()),
             f => f,
         };
-        activecal::io::calibrated::write(
-            format,
-            robot,
-            &id.table,
-            frames.map(|(f, r)| (f, r)),
-            &activecal::io::calibrated::header(id, source),
-            out,
-            a.force,
-        )
-        .map_err(|e| anyhow::anyhow!("--out {e}"))?;
+        calibrated.write(format, out_file(out), a.force, &[])?;
         written.push(out.display().to_string());
     }
     Ok(written)
+}
+
+/// An `--out` file, as the library's writers name it in messages.
+pub fn out_file(path: &std::path::Path) -> activecal::io::atomic::Output<'_> {
+    activecal::io::atomic::Output {
+        label: "--out",
+        path,
+    }
 }
 
 /// The exit status of a calibration whose fit did not converge or is rank

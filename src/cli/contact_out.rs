@@ -6,11 +6,12 @@
 //! when it converged, each file atomically and never over an existing one
 //! without `--force`.
 
+use super::calibrated::out_file;
 use activecal::frames::CalibratedFrames;
 use activecal::frames::report::FramesReport;
 use activecal::identify::contact::ContactFit;
-use activecal::io::calibrated::{Format, render};
 use activecal::model::Robot;
+use activecal::write::calibrated::{CalibratedRobot, Format};
 use anyhow::{Result, bail};
 use std::path::PathBuf;
 
@@ -45,17 +46,15 @@ pub fn write(
     fit: &ContactFit,
     frames: &(CalibratedFrames, FramesReport),
 ) -> Result<Vec<String>> {
+    let calibrated = CalibratedRobot {
+        robot,
+        table: &fit.table,
+        frames: Some((&frames.0, &frames.1)),
+        header: "",
+    };
     let mut written = Vec::new();
     for path in out {
-        let text = render(
-            Format::of(path)?,
-            robot,
-            &fit.table,
-            Some((&frames.0, &frames.1)),
-            "",
-        )
-        .map_err(|e| anyhow::anyhow!("--out {}: {e}", path.display()))?;
-        super::write_new(path, &text, force)?;
+        calibrated.write(Format::of(path)?, out_file(path), force, &[])?;
         written.push(path.display().to_string());
     }
     Ok(written)

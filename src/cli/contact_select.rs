@@ -9,10 +9,10 @@ use activecal::identify::contact::select::Socket;
 use activecal::identify::contact::socket_design::{
     Judged, SocketDesign, SocketDesignSettings, design_for_sockets,
 };
-use activecal::io::contact_design;
 use activecal::io::design_formats::DesignFormat;
 use activecal::measure::contact::KnownDistance;
 use activecal::model::MeasurementKind;
+use activecal::write::contact_design;
 use anyhow::{Result, bail};
 use std::fmt::Write as _;
 

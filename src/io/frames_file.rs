@@ -1,29 +1,18 @@
-//! The frames file (`cal.yaml`): a calibration's measurement frame, tool or
-//! markers and joint origins ([`crate::frames::report::FramesReport`]),
-//! written as YAML, and read back to mount a (calibrated) URDF in the
-//! sensor's frame with its tool.
+//! The frames file (`cal.yaml`) read back: a calibration's measurement
+//! frame, tool or markers and joint origins (written by
+//! [`crate::write::frames`]), to mount a (calibrated) URDF in the sensor's
+//! frame with its tool.
 //!
 //! Written and read with `serde_saphyr` (pure Rust, maintained, panic-free),
 //! the crate design files use too.
 
 use crate::error::{Error, Result};
-use crate::frames::report::FramesReport;
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use serde::Deserialize;
 use serde::de::IgnoredAny;
 use serde_saphyr::Spanned;
 use std::collections::HashMap;
 use std::path::Path;
-
-/// The header of a written frames file.
-const HEADER: &str = "# Calibrated frames written by activecal. Units: metres and radians (xyz, rpy);\n# millimetres and degrees where a name says so (_mm, _deg). rpy as in URDF:\n# R = Rz(yaw) Ry(pitch) Rx(roll); quaternion [w, x, y, z]. measurement_frame is\n# the base link's pose in the sensor's frame; tool the measured frame's pose in\n# the tip link's; markers are positions in the tip link's frame.\n";
-
-/// The frames file's text.
-pub fn to_yaml(report: &FramesReport) -> Result<String> {
-    let body = serde_saphyr::to_string(report)
-        .map_err(|e| Error::Invalid(format!("cannot write the frames as YAML: {e}")))?;
-    Ok(format!("{HEADER}{body}"))
-}
 
 /// Numbers with the place they were read from.
 type Numbers = Spanned<Vec<f64>>;

@@ -4,12 +4,10 @@
 
 pub mod atomic;
 pub mod bag;
-pub mod calibrated;
 pub mod camera_info;
 pub mod camera_observations;
 pub mod camera_target;
 pub mod collision_choice;
-pub mod contact_design;
 pub mod contacts;
 pub mod design;
 pub mod design_formats;

@@ -1,15 +1,15 @@
 //! A calibrated robot written out, in the format its file name asks for:
 //!
 //! * `.urdf` — for a robot imported from a URDF, the user's own file with
-//!   only the chain's joint `<origin>`s changed ([`super::urdf_edit`]);
-//!   for a built-in or TOML robot, its chain as URDF ([`super::urdf::to_urdf`]);
-//! * `.yaml` / `.yml` — the frames file ([`super::frames_file`]);
-//! * `.toml` — the description ([`super::robot_toml`]) whose nominal and
+//!   only the chain's joint `<origin>`s changed ([`crate::io::urdf_edit`]);
+//!   for a built-in or TOML robot, its chain as URDF ([`crate::io::urdf::to_urdf`]);
+//! * `.yaml` / `.yml` — the frames file ([`super::frames`]);
+//! * `.toml` — the description ([`crate::io::robot_toml`]) whose nominal and
 //!   real tables are the estimate;
 //! * a name ending in `kinematics.yaml` (`default_kinematics.yaml`) —
 //!   Universal Robots' kinematics file of the calibrated joint origins, and
 //!   one ending in `origins.yaml` — the per-joint origins file
-//!   ([`super::kinematics_yaml`]), and one ending in `joint_offsets.yaml`
+//!   ([`crate::io::kinematics_yaml`]), and one ending in `joint_offsets.yaml`
 //!   — the joints' zero offsets as a driver takes them, for a robot
 //!   imported from a URDF.
 //!
@@ -34,7 +34,7 @@ pub enum Format {
     /// The per-joint origins file.
     JointOrigins,
     /// The joints' zero offsets, as a driver takes them.
-    JointOffsets(super::kinematics_yaml::OffsetConvention),
+    JointOffsets(crate::io::kinematics_yaml::OffsetConvention),
 }
 
 impl Format {
@@ -110,29 +110,29 @@ pub fn render(
             let mut r = robot.clone();
             r.nominal = table.clone();
             r.real = table.clone();
-            Ok(header.to_string() + &super::robot_toml::to_toml(&r))
+            Ok(header.to_string() + &crate::io::robot_toml::to_toml(&r))
         }
         Format::Urdf => match (&robot.source, frames) {
             (Some(src), Some((f, _))) => {
-                super::urdf_edit::with_origins(&src.text, &src.path, &file_origins(src, f))
+                crate::io::urdf_edit::with_origins(&src.text, &src.path, &file_origins(src, f))
             }
             (Some(_), None) => Err(no_frames()),
-            (None, _) => super::urdf::to_urdf(robot, table),
+            (None, _) => crate::io::urdf::to_urdf(robot, table),
         },
         Format::UrKinematics | Format::JointOrigins => match (&robot.source, frames) {
             (Some(src), Some((f, _))) => {
                 let origins = file_origins(src, f);
                 let name = src.path.as_str();
                 if format == Format::UrKinematics {
-                    super::kinematics_yaml::ur_kinematics(name, &origins)
+                    crate::io::kinematics_yaml::ur_kinematics(name, &origins)
                 } else {
-                    Ok(super::kinematics_yaml::joint_origins(name, &origins))
+                    Ok(crate::io::kinematics_yaml::joint_origins(name, &origins))
                 }
             }
             _ => Err(no_frames()),
         },
         Format::JointOffsets(c) => match (&robot.source, frames) {
-            (Some(src), Some((f, _))) => Ok(super::kinematics_yaml::joint_offsets(
+            (Some(src), Some((f, _))) => Ok(crate::io::kinematics_yaml::joint_offsets(
                 &src.path,
                 &offsets_of(f),
                 c,
@@ -140,7 +140,7 @@ pub fn render(
             _ => Err(no_frames()),
         },
         Format::Yaml => match frames {
-            Some((_, report)) => super::frames_file::to_yaml(report),
+            Some((_, report)) => super::frames::to_yaml(report),
             None => Err(no_frames()),
         },
     }
@@ -177,26 +177,62 @@ fn offsets_of(f: &CalibratedFrames) -> Vec<(String, f64, bool)> {
         .collect()
 }
 
-/// Writes a calibrated robot ([`render`]) as `format` (for a file name,
-/// [`Format::of`]) to `path`, atomically; an existing file only with `overwrite`.
-/// The command line (`--out`, `--force`) and Python's writers call this.
-pub fn write(
-    format: Format,
-    robot: &Robot,
-    table: &ParamTable,
-    frames: Option<(&CalibratedFrames, &FramesReport)>,
-    header: &str,
-    path: &Path,
-    overwrite: bool,
-) -> Result<()> {
-    let text = render(format, robot, table, frames, header)
-        .map_err(|e| Error::Invalid(format!("{}: {e}", path.display())))?;
-    let out = [super::atomic::Output {
-        label: "calibrated robot",
-        path,
-    }];
-    super::atomic::check_outputs(&out, &[], overwrite)?;
-    super::atomic::write_atomic(path, text.as_bytes())
+/// A calibrated robot ready to be written: the robot, its estimate and,
+/// for a robot imported from a URDF, its calibrated frames (the split of
+/// [`crate::frames::decompose`] and the frames file's content); `header`
+/// heads a TOML description ([`header`]).
+#[derive(Clone, Copy, Debug)]
+pub struct CalibratedRobot<'a> {
+    /// The robot calibrated.
+    pub robot: &'a Robot,
+    /// The estimate.
+    pub table: &'a ParamTable,
+    /// Its calibrated frames, for a URDF robot.
+    pub frames: Option<(&'a CalibratedFrames, &'a FramesReport)>,
+    /// The first lines of a TOML description.
+    pub header: &'a str,
+}
+
+impl CalibratedRobot<'_> {
+    /// Its text in `format` ([`render`]).
+    pub fn render(&self, format: Format) -> Result<String> {
+        render(format, self.robot, self.table, self.frames, self.header)
+    }
+
+    /// Writes it as `format` to `out`, atomically. The name of `out.path`
+    /// must say `format` ([`Format::of`]); an existing file is replaced only
+    /// with `overwrite`, and never one of `inputs` or the robot's own file,
+    /// even with `overwrite`. Messages name the file by `out.label` (the
+    /// front end's name for it). The command line (`--out`, `--force`) and
+    /// Python's writers call this.
+    pub fn write(
+        &self,
+        format: Format,
+        out: crate::io::atomic::Output<'_>,
+        overwrite: bool,
+        inputs: &[&Path],
+    ) -> Result<()> {
+        let (label, path) = (out.label, out.path);
+        let said = Format::of(path).ok().map(|f| std::mem::discriminant(&f));
+        if said != Some(std::mem::discriminant(&format)) {
+            return Err(Error::Invalid(format!(
+                "{label} {}: this writer writes a file whose name ends in {}",
+                path.display(),
+                format.name_ending()
+            )));
+        }
+        let text = self
+            .render(format)
+            .map_err(|e| Error::Invalid(format!("{label} {}: {e}", path.display())))?;
+        let out = [out];
+        let mut given: Vec<&Path> = inputs.to_vec();
+        if let Some(src) = self.robot.source.as_ref() {
+            given.push(Path::new(&src.path));
+        }
+        // Never over an input, even when overwriting is asked.
+        crate::io::atomic::check_outputs(&out, &given, overwrite)?;
+        crate::io::atomic::write_atomic(path, text.as_bytes())
+    }
 }
 
 /// The first lines of a calibrated robot's TOML description: where it is

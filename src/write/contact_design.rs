@@ -1,7 +1,7 @@
 //! The configurations chosen for sockets
 //! ([`crate::identify::contact::socket_design::SocketDesign`]) in the
 //! formats a design is written in, told apart by the extension
-//! ([`super::design_formats::DesignFormat`]):
+//! ([`crate::io::design_formats::DesignFormat`]):
 //!
 //! * `.json`: the whole design with its figures;
 //! * `.csv`: a contact file to fill in: a `point` column, the joint names
@@ -11,9 +11,9 @@
 //!   configurations, `configurations: [{name: pose_01, id: 17, point:
 //!   front_left/0, joints: {joint_a: 0.1, ...}}]` (as a design's YAML).
 
-use super::design_formats::Joints;
 use crate::error::{Error, Result};
 use crate::identify::contact::socket_design::SocketDesign;
+use crate::io::design_formats::Joints;
 use serde::Serialize;
 
 /// The design as pretty JSON.

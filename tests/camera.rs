@@ -6,12 +6,11 @@
 //! ones put every unknown within 3σ of it and estimate σ; wrong input
 //! files are refused with their place.
 
+use activecal::data::CameraObservations;
 use activecal::identify::LmSettings;
 use activecal::identify::camera::simulate::simulate_observations;
 use activecal::identify::camera::{CameraFit, camera_robot, fit_camera};
-use activecal::io::camera_observations::{
-    CameraObservations, observations_csv, parse_observations,
-};
+use activecal::io::camera_observations::{observations_csv, parse_observations};
 use activecal::io::camera_target::Target;
 use activecal::kinematics::Evaluator;
 use activecal::measure::camera::{CameraSensor, Mounting};

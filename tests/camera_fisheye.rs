@@ -12,10 +12,10 @@
 //! 3σ.
 
 use super::camera::{looking, truth, ur5};
+use activecal::data::CameraObservations;
 use activecal::identify::LmSettings;
 use activecal::identify::camera::simulate::simulate_observations;
 use activecal::identify::camera::{CameraFit, camera_robot, fit_camera};
-use activecal::io::camera_observations::CameraObservations;
 use activecal::io::camera_target::Target;
 use activecal::kinematics::Evaluator;
 use activecal::measure::camera::{CameraSensor, Mounting};

@@ -249,7 +249,7 @@ struct Head {
     placements: (Isometry3<f64>, Isometry3<f64>),
     start: CameraSensor,
     own_start: Vec<f64>,
-    obs: activecal::io::camera_observations::CameraObservations,
+    obs: activecal::data::CameraObservations,
 }
 
 impl Head {

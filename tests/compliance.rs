@@ -507,6 +507,7 @@ fn an_unmodelled_sag_is_warned_of_when_the_noise_is_stated() {
         lm: LmSettings::default(),
         loss: activecal::identify::LossChoice::L2,
         fix: Vec::new(),
+        restriction: activecal::identify::restriction::Restriction::All,
         free: Vec::new(),
         holdout: None,
         units: activecal::units::Units::default(),

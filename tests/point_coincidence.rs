@@ -3,12 +3,13 @@
 //! inputs, and the figures of issue 29 on MUKCa's real Panda data
 //! (`fixtures/mukca`).
 
+use activecal::data::ContactFile;
 use activecal::data::NamedDistance;
 use activecal::identify::contact::{
     ContactFit, ContactSettings, HoldoutMode, fit_contacts, holdout_by_placement, resolve_distances,
 };
 use activecal::identify::{Calibration, LossChoice, Residuals};
-use activecal::io::contacts::{ContactFile, parse_contacts, read_contacts};
+use activecal::io::contacts::{parse_contacts, read_contacts};
 use activecal::io::load_robot;
 use activecal::measure::contact::{ContactSensor, KnownDistance};
 use activecal::model::Robot;

@@ -289,9 +289,7 @@ pub fn calibrate(
         design_tolerance = design_tolerance);
     let robot = robot.get();
     let restriction = restriction_of(unknowns, keep_axis_relations)?;
-    let user_fix = fix.unwrap_or_default();
-    let fix = activecal::identify::restriction::with_held(&user_fix, restriction, &robot.inner)
-        .map_err(|e| crate::convert::Fail::from(e).into_py())?;
+    let fix = fix.unwrap_or_default();
     let weights = weights_of(weights, orientation_scale)?;
     let outliers = outliers_of(outliers, outlier_rate)?;
     let gravity = crate::fit_args::gravity_of(compliance, &robot.inner)?;
@@ -319,6 +317,7 @@ pub fn calibrate(
             .map_err(|e| crate::convert::Fail::from(e).into_py())?,
         loss,
         fix,
+        restriction,
         free: free.unwrap_or_default(),
         holdout,
         units: activecal::units::Units::default(),
@@ -336,22 +335,9 @@ pub fn calibrate(
             detached(py, move || {
                 let t0 = std::time::Instant::now();
                 let (meas, c, source, bag) = fitted_input(input, &r, &settings)?;
-                let gain = activecal::experiment::measured::full_model::beside_full_model(
-                    &r,
-                    &meas,
-                    &source.0,
-                    &settings,
-                    &user_fix,
-                    restriction,
-                    (&c.robot, &c.fit.id.table),
-                )?;
                 let mut report = c.report;
                 report.base.elapsed_seconds = t0.elapsed().as_secs_f64();
                 let mut v = serde_json::to_value(&report)?;
-                v["exit_status"] = c.verdict.exit_status().into();
-                if let Some(g) = gain {
-                    v["full_model_gain"] = serde_json::to_value(g)?;
-                }
                 if let Some(b) = bag {
                     v["bag"] = b;
                 }

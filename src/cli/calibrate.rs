@@ -8,10 +8,9 @@
 pub use super::calibrate_args::{CalibrateArgs, DEFAULT_NOISE};
 pub use super::calibrated::{EXIT_NOT_CONVERGED, NotConverged};
 use super::calibrated::{not_written, write_calibrated};
-use activecal::experiment::measured::full_model::FullModelGain;
 use activecal::identify::LmSettings;
 use activecal::model::Robot;
-use activecal::render::measured_text::{measured_text, status_text};
+use activecal::render::measured_text::{full_model_gain_text, measured_text, status_text};
 use activecal::write::calibrated::Format;
 use anyhow::{Context, Result, bail};
 use std::path::Path;
@@ -135,36 +134,6 @@ fn image_inputs(a: &CalibrateArgs) -> Vec<std::path::PathBuf> {
         .unwrap_or_default()
 }
 
-/// The restricted fit's lines beside the full fit, and the relations held.
-fn gain_text(g: &FullModelGain, held_out: Option<f64>) -> String {
-    let mut s = String::from("\n");
-    if !g.relations_held.is_empty() {
-        s += "axis relations kept (closed-form inverse kinematics stay valid):\n";
-        for h in &g.relations_held {
-            let held = if h.held.is_empty() {
-                "no unknown to hold".to_string()
-            } else {
-                h.held.join(", ")
-            };
-            s += &format!("  {} – {}: {} (held: {held})\n", h.from, h.to, h.relation);
-        }
-    }
-    let ho = |v: Option<f64>| v.map_or(String::new(), |v| format!(", held out {v:.4} mm"));
-    s += &format!(
-        "{}: predicted position RMS {:.4} mm{}; the full model ({} unknowns, fitted to the same data) {:.4} mm{}: it would gain {:.4} mm (the two models are {:.4} mm apart, RMS at {} random configurations)\n",
-        g.restricted.describe(),
-        g.restricted_predicted_rms_mm,
-        ho(held_out),
-        g.full_unknowns,
-        g.full_predicted_rms_mm,
-        ho(g.full_held_out_rms_mm),
-        g.gain_mm,
-        g.models_apart_rms_mm,
-        activecal::experiment::measured::PREDICTION_CONFIGURATIONS
-    );
-    s
-}
-
 /// `robot` with `--orientation-scale` applied.
 fn scaled_robot(a: &CalibrateArgs, robot: &Robot) -> Result<Robot> {
     let mut scaled = robot.clone();
@@ -211,7 +180,7 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
         json: None,
         text: String::new(),
     };
-    render_measured(a, robot, &meas, c, &o, &source, t0)
+    render_measured(a, &meas, c, &source, t0)
 }
 
 /// The joint topic when `--joints` is not given.
@@ -238,7 +207,7 @@ fn from_bag(a: &CalibrateArgs, robot: &Robot) -> Result<()> {
     };
     let got = activecal::experiment::bag::calibrate_bag(bag, robot, &x, &o, &mut print_note)?;
     let json = serde_json::to_value(got.section())?;
-    let mut text = super::extract::text(&got.extraction, None);
+    let mut text = activecal::render::bag_text::extract_text(&got.extraction, None);
     if let Some(c) = &got.clock {
         text += &format!("{}\n", activecal::experiment::bag::clock_note(c));
     }
@@ -249,15 +218,7 @@ fn from_bag(a: &CalibrateArgs, robot: &Robot) -> Result<()> {
         json: Some(("bag", json)),
         text,
     };
-    render_measured(
-        a,
-        robot,
-        &got.measurements,
-        got.calibration,
-        &o,
-        &source,
-        t0,
-    )
+    render_measured(a, &got.measurements, got.calibration, &source, t0)
 }
 
 /// Where the measurements of a fit came from, as the output shows it.
@@ -284,7 +245,8 @@ fn measured_settings(
     let o = activecal::experiment::measured::MeasuredSettings {
         lm,
         loss: super::measured::loss_choice(a.loss, a.loss_scale)?,
-        fix: activecal::identify::restriction::with_held(&a.fix, a.restriction(), robot)?,
+        fix: a.fix.clone(),
+        restriction: a.restriction(),
         free: a.free.clone(),
         holdout: a
             .holdout
@@ -321,16 +283,14 @@ fn measured_settings(
     Ok(o)
 }
 
-/// Writes and prints a fit of measured data (`c`, of `meas` from `source`
-/// with the settings `o`), started at `t0`: the calibrated robot when the
+/// Writes and prints a fit of measured data (`c`, of `meas` from `source`),
+/// with `t0` its start: the calibrated robot when the
 /// library's verdict allows, the report folder, the text or JSON, and the
 /// exit status.
 fn render_measured(
     a: &CalibrateArgs,
-    robot: &Robot,
     meas: &activecal::data::Measurements,
     c: activecal::experiment::measured::MeasuredCalibration,
-    o: &activecal::experiment::measured::MeasuredSettings,
     source: &Source,
     t0: Instant,
 ) -> Result<()> {
@@ -351,20 +311,7 @@ fn render_measured(
     if verdict.refusal().is_none() {
         report.base.out = write_calibrated(a, &fitted, id, &source.name, frames.as_ref())?;
     }
-    let gain = activecal::experiment::measured::full_model::beside_full_model(
-        robot,
-        meas,
-        &source.name,
-        o,
-        &a.fix,
-        a.restriction(),
-        (&fitted, &id.table),
-    )?;
     let mut v = serde_json::to_value(&report)?;
-    v["exit_status"] = verdict.exit_status().into();
-    if let Some(g) = &gain {
-        v["full_model_gain"] = serde_json::to_value(g)?;
-    }
     if let Some((key, value)) = &source.json {
         v[*key] = value.clone();
     }
@@ -378,9 +325,9 @@ fn render_measured(
     super::emit(a.json, &v, || {
         let mut s = source.text.clone();
         s += &measured_text(&report, id, &status_text(id));
-        if let Some(g) = &gain {
+        if let Some(g) = &report.full_model_gain {
             let held_out = report.holdout.as_ref().map(|h| h.position_rms_mm.mean);
-            s += &gain_text(g, held_out);
+            s += &full_model_gain_text(g, held_out);
         }
         for out in &report.base.out {
             s += &format!("\ncalibrated robot written to {out}\n");

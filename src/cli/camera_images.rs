@@ -65,7 +65,10 @@ pub fn read_bag(
             .image_settings(&joints, &topic.to_string_lossy(), &info.to_string_lossy())?;
     let got = read_bag_images(bag, robot, target, &s)?;
     if !a.json {
-        print!("{}", super::extract::images_text(&got.report, None));
+        print!(
+            "{}",
+            activecal::render::bag_text::bag_images_text(&got.report, None)
+        );
     }
     if let Some(path) = &a.save_observations {
         let text = observations_csv(&got.observations, robot, target);

@@ -4,6 +4,7 @@
 //! rendering of the fit and of `--holdout-by
 //! placement` / `--train-on`. The work is in `activecal::identify::contact`.
 
+use activecal::data::ContactFile;
 use activecal::data::{NamedDistance, NamedPlane};
 use activecal::experiment::contacts::{
     ContactInput, ContactInputError, ContactUse, checked_inputs,
@@ -12,7 +13,7 @@ use activecal::identify::LmSettings;
 use activecal::identify::contact::{
     ContactSettings, HoldoutMode, HoldoutReport, holdout_by_placement,
 };
-use activecal::io::contacts::{ContactFile, read_contacts};
+use activecal::io::contacts::read_contacts;
 use activecal::model::Robot;
 use anyhow::{Result, bail};
 use std::path::Path;

@@ -6,15 +6,12 @@
 use super::select::SelectArgs;
 use activecal::identify::contact::lengths::distance_beyond_reach;
 use activecal::identify::contact::select::Socket;
-use activecal::identify::contact::socket_design::{
-    Judged, SocketDesign, SocketDesignSettings, design_for_sockets,
-};
+use activecal::identify::contact::socket_design::{SocketDesignSettings, design_for_sockets};
 use activecal::io::design_formats::DesignFormat;
 use activecal::measure::contact::KnownDistance;
 use activecal::model::MeasurementKind;
 use activecal::write::contact_design;
 use anyhow::{Result, bail};
-use std::fmt::Write as _;
 
 /// Joint-space samples projected onto each socket when `--count` is not
 /// given.
@@ -118,91 +115,11 @@ pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
         };
         super::write_new(out, &text, a.force)?;
     }
-    super::emit_report(a.json, &d, || text(&d))
-}
-
-/// One criterion's figures: the chosen configurations', the D-optimal
-/// choice's, random draws' and the pool's bound, in units of σ.
-fn judged_lines(s: &mut String, what: &str, j: &Judged) {
-    let r = &j.random;
-    let _ = writeln!(
-        s,
-        "{what}, σ = contact noise per coordinate: chosen {:.4} σ (D-optimal {:.4} σ), median of {} random draws {:.4} σ (quartiles {:.4}–{:.4} σ): {:.3}× lower; no design of this pool can be below {:.4} σ (convex relaxation, certified; {} configurations carry weight)",
-        j.predicted_sigma,
-        j.d_optimal_sigma,
-        r.draws,
-        r.median_sigma,
-        r.q1_sigma,
-        r.q3_sigma,
-        j.ratio_to_random,
-        j.bound.certified_sigma,
-        j.bound.support
-    );
-}
-
-/// The design as text: the figures, then the configurations with their
-/// named joint values.
-fn text(d: &SocketDesign) -> String {
-    let mut s = String::new();
-    for p in &d.points {
-        let x = p.socket.position;
-        let _ = writeln!(
-            s,
-            "point {} at ({:.4}, {:.4}, {:.4}) m: {} of {} samples reach it{}",
-            p.socket.name,
-            x[0],
-            x[1],
-            x[2],
-            p.configurations,
-            d.samples_per_point,
-            if d.pool_stats.is_some() {
-                " and pass the pool filters"
-            } else {
-                ""
-            }
-        );
-    }
-    if let Some(st) = &d.pool_stats {
-        s += &super::pool_opts::pool_stats_text(st);
-    }
-    let _ = writeln!(
-        s,
-        "{} configurations chosen from {}; {} unknowns ({} of the robot, tool offset, points)",
-        d.configurations.len(),
-        d.pool,
-        d.unknowns,
-        d.robot_unknowns
-    );
-    if d.known_distances == 0 {
-        s += "no known distance between the points (--point-distance): contacts alone leave the scale free, and calibrate will need one\n";
-    } else {
-        let _ = writeln!(
-            s,
-            "{} known distance(s) between the points, counted as calibrate will count them",
-            d.known_distances
-        );
-    }
-    judged_lines(
-        &mut s,
-        "predicted true error of the tool point (3-D RMS at 1000 random configurations; the criterion)",
-        &d.true_error,
-    );
-    judged_lines(
-        &mut s,
-        "predicted consistency error (RMS about each point, per coordinate; what held-out contacts see)",
-        &d.consistency,
-    );
-    let _ = write!(s, "{:>4} {:>6} {:<16}", "#", "id", "point");
-    for n in &d.joint_names {
-        let _ = write!(s, " {n:>12}");
-    }
-    s += "  reach (mm)   (rad; m for prismatic joints)\n";
-    for (k, c) in d.configurations.iter().enumerate() {
-        let _ = write!(s, "{:>4} {:>6} {:<16}", k + 1, c.id, c.point);
-        for v in &c.q {
-            let _ = write!(s, " {v:>12.6}");
-        }
-        let _ = writeln!(s, "  {:.2e}", 1e3 * c.reach_m);
-    }
-    s
+    super::emit_report(a.json, &d, || {
+        activecal::render::socket_design_text::socket_design_text(
+            &d,
+            super::pool_opts::SRDF_HINT,
+            " (--point-distance)",
+        )
+    })
 }

@@ -183,12 +183,14 @@ pub fn with_jacobian(robot: Robot, pool: Pool, params: ParamSet) -> Result<PoolC
     Ok(PoolCtx { robot, pool, x })
 }
 
+/// How this command line says where an SRDF is given, ending the pool
+/// filters' note on a robot without one.
+pub const SRDF_HINT: &str =
+    " (give the SRDF with --srdf FILE, or without one --skip-always-touching)";
+
 /// One line per filter (what it removed) and per note of a pool's build.
 pub fn pool_stats_text(st: &activecal::pool::PoolStats) -> String {
-    activecal::render::pool_text::pool_stats_text(
-        st,
-        " (give the SRDF with --srdf FILE, or without one --skip-always-touching)",
-    )
+    activecal::render::pool_text::pool_stats_text(st, SRDF_HINT)
 }
 
 impl PoolOpts {

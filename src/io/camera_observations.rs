@@ -29,7 +29,7 @@ use crate::model::Robot;
 use crate::units::{JointSource, Units, joint_names, joint_values_to_model_units};
 use std::path::Path;
 
-pub use crate::data::CameraObservations;
+use crate::data::CameraObservations;
 pub use crate::measure::camera::MIN_POINTS_PER_POSE;
 
 /// Reads an observation file for `robot`, `target` and the camera

@@ -29,7 +29,7 @@ pub const MIN_ROWS_PER_POINT: usize = 3;
 /// 2 and its offset), and 3 points are the fewest that span a plane.
 pub const MIN_ROWS_PER_PLANE: usize = 3;
 
-pub use crate::data::ContactFile;
+use crate::data::ContactFile;
 
 /// The name of the column that names the plane a row touches.
 pub const PLANE_COLUMN: &str = "plane";

@@ -1,8 +1,10 @@
 //! The text of a contact calibration (what `calibrate --measurements
 //! contacts.csv` prints, and its report folder holds): the fit, the
-//! in-sample consistency and the held-out placements, lengths in mm.
+//! in-sample consistency and the held-out placements, and a model's
+//! evaluation on contacts (`evaluate`), lengths in mm.
 
 use crate::data::ContactFile;
+use crate::identify::contact::evaluate::ContactEvaluation;
 use crate::identify::contact::holdout::{Figures, downweighted_rows};
 use crate::identify::contact::{ContactFit, HoldoutReport};
 use std::fmt::Write as _;
@@ -142,6 +144,51 @@ fn holdout_text(h: &HoldoutReport) -> String {
         let _ = writeln!(
             s,
             "distance error, calibrated: mean {m:.3} mm, largest {x:.3} mm"
+        );
+    }
+    s
+}
+
+/// A contact evaluation of robot `robot` on `origin` (`rows` contacts) as
+/// text: the pooled and per-point consistency, each distance's error and
+/// each plane's flatness, mm.
+#[must_use]
+pub fn contact_evaluation_text(
+    robot: &str,
+    origin: &str,
+    rows: usize,
+    e: &ContactEvaluation,
+) -> String {
+    let mut s = format!(
+        "{robot} on {origin} ({rows} contacts, tool point at the chain's tip): consistency pooled {:.3} mm (RMS distance to the point's mean)\n",
+        e.pooled_mm
+    );
+    for p in &e.points {
+        let _ = writeln!(
+            s,
+            "  {:<20} {:>3} rows  {:8.3} mm",
+            p.point, p.rows, p.consistency_mm
+        );
+    }
+    for d in &e.distances {
+        let _ = writeln!(
+            s,
+            "  distance {} – {} ({:.3} mm): error {:.3} mm",
+            d.a, d.b, d.known_mm, d.error_mm
+        );
+    }
+    for p in &e.planes {
+        let _ = writeln!(
+            s,
+            "  plane {:<14} {:>3} rows  {:8.3} mm RMS signed distance{}",
+            p.plane,
+            p.rows,
+            p.rms_mm,
+            if p.known {
+                " (given plane)"
+            } else {
+                " (best-fit plane)"
+            }
         );
     }
     s

@@ -6,7 +6,7 @@
 
 use crate::identify::Identification;
 use crate::identify::compliance::{ComplianceComparison, ComplianceReport};
-use crate::report::measured::MeasuredReport;
+use crate::report::measured::{FullModelGain, MeasuredReport};
 
 /// The fit's status, residual sum of squares, σ̂ and rank, as text.
 #[must_use]
@@ -323,5 +323,36 @@ pub fn evaluation_text(report: &crate::report::measured::EvaluationReport) -> St
             p.orientation_deg.map_or("-".into(), |v| format!("{v:.4}"))
         );
     }
+    s
+}
+
+/// The restricted fit's lines beside the full fit, and the relations held.
+#[must_use]
+pub fn full_model_gain_text(g: &FullModelGain, held_out: Option<f64>) -> String {
+    let mut s = String::from("\n");
+    if !g.relations_held.is_empty() {
+        s += "axis relations kept (closed-form inverse kinematics stay valid):\n";
+        for h in &g.relations_held {
+            let held = if h.held.is_empty() {
+                "no unknown to hold".to_string()
+            } else {
+                h.held.join(", ")
+            };
+            s += &format!("  {} – {}: {} (held: {held})\n", h.from, h.to, h.relation);
+        }
+    }
+    let ho = |v: Option<f64>| v.map_or(String::new(), |v| format!(", held out {v:.4} mm"));
+    s += &format!(
+        "{}: predicted position RMS {:.4} mm{}; the full model ({} unknowns, fitted to the same data) {:.4} mm{}: it would gain {:.4} mm (the two models are {:.4} mm apart, RMS at {} random configurations)\n",
+        g.restricted.describe(),
+        g.restricted_predicted_rms_mm,
+        ho(held_out),
+        g.full_unknowns,
+        g.full_predicted_rms_mm,
+        ho(g.full_held_out_rms_mm),
+        g.gain_mm,
+        g.models_apart_rms_mm,
+        crate::report::measured::PREDICTION_CONFIGURATIONS
+    );
     s
 }

@@ -5,6 +5,7 @@
 //! text and the paper's figures. The command line and the Python package
 //! both call these; nothing here prints or names a flag.
 
+pub mod bag_text;
 pub mod bench_text;
 pub mod bound_text;
 pub mod camera_design;
@@ -26,5 +27,6 @@ pub mod pool_text;
 pub mod robot_text;
 pub mod select_text;
 pub mod simulated_text;
+pub mod socket_design_text;
 pub mod summary;
 mod typeset;

@@ -71,6 +71,43 @@ pub struct MeasuredReport {
     /// What the user should look at: the fit is written, but something in
     /// the data or the model is not as stated.
     pub warnings: Vec<String>,
+    /// A restricted fit beside the full model fitted to the same data
+    /// (with a restriction only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub full_model_gain: Option<FullModelGain>,
+    /// The exit status the verdict implies (0: written; 3: not converged,
+    /// implausible or too few rows).
+    pub exit_status: i32,
+}
+
+/// A restricted calibration beside the full model fitted to the same data
+/// ([`crate::experiment::measured::full_model`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct FullModelGain {
+    /// The restriction of the fit compared.
+    pub restricted: crate::identify::restriction::Restriction,
+    /// Unknowns of the full fit (the robot's, with the sensor's own).
+    pub full_unknowns: usize,
+    /// The full model's predicted position RMS at the random
+    /// configurations (mm), from its covariance at its σ̂.
+    pub full_predicted_rms_mm: f64,
+    /// The full model's held-out position RMS (mm, mean over splits), when
+    /// held-out validation was asked: on the same splits as the restricted
+    /// fit's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub full_held_out_rms_mm: Option<f64>,
+    /// RMS distance between the two fitted models' predicted points at the
+    /// same configurations (mm).
+    pub models_apart_rms_mm: f64,
+    /// The restricted model's predicted position RMS (mm):
+    /// `√(apart² + full²)`.
+    pub restricted_predicted_rms_mm: f64,
+    /// What the full model gains: restricted minus full predicted RMS (mm).
+    pub gain_mm: f64,
+    /// With the axis relations kept: each relation and the unknowns held
+    /// for it ([`crate::identify::axis_relations`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub relations_held: Vec<crate::identify::axis_relations::HeldRelation>,
 }
 
 /// Random configurations the calibrated model's predicted error is averaged

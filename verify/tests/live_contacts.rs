@@ -28,7 +28,6 @@ use activecal::identify::contact::{
     ContactSettings, best_plane, fit_contacts, group_means, placement_of, resolve_distances,
     tool_points,
 };
-use activecal::io::calibrated::{Format, render};
 use activecal::io::contacts::read_contacts;
 use activecal::io::frames_file;
 use activecal::io::load_robot;
@@ -36,6 +35,7 @@ use activecal::io::urdf_edit::with_origins;
 use activecal::measure::contact::{DISTANCE_WEIGHT, Plane, PlaneKind};
 use activecal::model::Robot;
 use activecal::units::{Units, joint_names};
+use activecal::write::calibrated::{Format, render};
 use nalgebra::{Matrix3, Vector3};
 use std::path::{Path, PathBuf};
 use verify::bridge::Bridge;

@@ -10,41 +10,13 @@
 //! the two models' predicted points and `e_full` the full model's predicted
 //! RMS from its covariance ([`super::MeasuredReport::predicted`]).
 
-use super::{ExperimentError, MeasuredSettings, PREDICTION_CONFIGURATIONS, calibrate_read};
+use super::{ExperimentError, MeasuredSettings, PREDICTION_CONFIGURATIONS, fit_read};
 use crate::data::Measurements;
 use crate::identify::restriction::Restriction;
 use crate::model::{MeasurementKind, ParamTable, Robot};
 use nalgebra::Vector3;
-use serde::Serialize;
 
-/// The restricted fit beside the full one.
-#[derive(Clone, Debug, Serialize)]
-pub struct FullModelGain {
-    /// The restriction of the fit compared.
-    pub restricted: Restriction,
-    /// Unknowns of the full fit (the robot's, with the sensor's own).
-    pub full_unknowns: usize,
-    /// The full model's predicted position RMS at the random
-    /// configurations (mm), from its covariance at its σ̂.
-    pub full_predicted_rms_mm: f64,
-    /// The full model's held-out position RMS (mm, mean over splits), when
-    /// held-out validation was asked: on the same splits as the restricted
-    /// fit's.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub full_held_out_rms_mm: Option<f64>,
-    /// RMS distance between the two fitted models' predicted points at the
-    /// same configurations (mm).
-    pub models_apart_rms_mm: f64,
-    /// The restricted model's predicted position RMS (mm):
-    /// `√(apart² + full²)`.
-    pub restricted_predicted_rms_mm: f64,
-    /// What the full model gains: restricted minus full predicted RMS (mm).
-    pub gain_mm: f64,
-    /// With the axis relations kept: each relation and the unknowns held
-    /// for it ([`crate::identify::axis_relations`]).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub relations_held: Vec<crate::identify::axis_relations::HeldRelation>,
-}
+pub use crate::report::measured::FullModelGain;
 
 /// The measured points of `robot` at `table` and `q` (each marker of a
 /// markers sensor, else the end point), metres.
@@ -98,6 +70,7 @@ pub fn beside_full_model(
     }
     let mut full = settings.clone();
     full.fix = user_fix.to_vec();
+    full.restriction = Restriction::All;
     full_model_gain(
         robot,
         meas,
@@ -121,7 +94,7 @@ pub fn full_model_gain(
     full: &MeasuredSettings,
     restricted: (Restriction, &Robot, &ParamTable),
 ) -> Result<FullModelGain, ExperimentError> {
-    let f = calibrate_read(robot, meas, source, Vec::new(), full, &mut |_| {})?;
+    let f = fit_read(robot, meas, source, Vec::new(), full, &mut |_| {})?;
     let qs = crate::how_many::random_configurations(&f.robot, PREDICTION_CONFIGURATIONS, 0);
     let apart = models_apart_rms_mm(
         (&f.robot, &f.fit.id.table),

@@ -40,8 +40,13 @@ pub struct MeasuredSettings {
     pub lm: LmSettings,
     /// The loss.
     pub loss: LossChoice,
-    /// Unknowns to fix at their nominal values.
+    /// Unknowns to fix at their nominal values (the user's).
     pub fix: Vec<String>,
+    /// Which unknowns are fitted: all, or a model that holds some (the
+    /// links' offsets only, or the axis relations kept); with a restriction
+    /// the full model is fitted to the same data beside it
+    /// ([`full_model::FullModelGain`], in the report).
+    pub restriction: crate::identify::restriction::Restriction,
     /// Parameters to add to the unknowns.
     pub free: Vec<String>,
     /// Held-out validation, if asked.
@@ -318,6 +323,53 @@ pub fn calibrate_read(
     s: &MeasuredSettings,
     on_note: &mut dyn FnMut(&str),
 ) -> Result<MeasuredCalibration, ExperimentError> {
+    let held = s.with_held(robot)?;
+    let fitted = fit_read(robot, meas, source, read_notes, &held, on_note)?;
+    beside_full(robot, meas, source, s, &held, fitted)
+}
+
+/// The full model's fit beside a restricted one ([`MeasuredSettings::restriction`]),
+/// in the report, and the report's exit status.
+fn beside_full(
+    robot: &Robot,
+    meas: &Measurements,
+    source: &str,
+    user: &MeasuredSettings,
+    held: &MeasuredSettings,
+    mut c: MeasuredCalibration,
+) -> Result<MeasuredCalibration, ExperimentError> {
+    c.report.full_model_gain = full_model::beside_full_model(
+        robot,
+        meas,
+        source,
+        held,
+        &user.fix,
+        user.restriction,
+        (&c.robot, &c.fit.id.table),
+    )?;
+    c.report.exit_status = c.verdict.exit_status();
+    Ok(c)
+}
+
+impl MeasuredSettings {
+    /// These settings with the unknowns [`MeasuredSettings::restriction`]
+    /// holds added to those fixed.
+    fn with_held(&self, robot: &Robot) -> Result<Self, ExperimentError> {
+        let mut held = self.clone();
+        held.fix = crate::identify::restriction::with_held(&self.fix, self.restriction, robot)?;
+        Ok(held)
+    }
+}
+
+/// [`calibrate_read`]'s fit with the unknowns held already fixed.
+pub(super) fn fit_read(
+    robot: &Robot,
+    meas: &Measurements,
+    source: &str,
+    read_notes: Vec<String>,
+    s: &MeasuredSettings,
+    on_note: &mut dyn FnMut(&str),
+) -> Result<MeasuredCalibration, ExperimentError> {
     let in_file = in_source(source);
     let mut notes = Vec::new();
     let mut note = |n: &str| {
@@ -414,6 +466,8 @@ pub fn calibrate_read(
         noise_test,
         orientation_noise_test,
         warnings,
+        full_model_gain: None,
+        exit_status: 0,
     };
     finish(r, f, report)
 }

@@ -30,7 +30,7 @@ pub mod select;
 pub mod socket_design;
 pub mod worth;
 
-pub use crate::data::{ContactFile, NamedDistance, NamedPlane};
+use crate::data::{ContactFile, NamedDistance};
 pub use fit::{ContactFit, ContactSettings, PlaneEstimate, fit_contacts};
 pub use holdout::{
     DistanceFigure, DownweightedRow, Figures, HoldoutFold, HoldoutMode, HoldoutReport, PlaneFigure,

@@ -4,22 +4,11 @@
 
 use super::calibrate_args::CalibrateArgs;
 use activecal::frames::CalibratedFrames;
-use activecal::frames::report::{FitBlock, FramesReport};
+use activecal::frames::report::FramesReport;
 use activecal::identify::Identification;
 use activecal::model::Robot;
 use activecal::write::calibrated::{CalibratedRobot, Format};
 use anyhow::Result;
-
-/// The calibrated frames of a URDF robot at the estimate (`None` for other
-/// robots), with σ from the fit's covariance.
-pub fn frames_of(
-    robot: &Robot,
-    id: &Identification,
-    fit: Option<FitBlock>,
-) -> Result<Option<(CalibratedFrames, FramesReport)>> {
-    let cov = id.covariance.as_ref().map(|c| c.matrix.as_slice());
-    Ok(activecal::frames::calibrated(robot, &id.table, cov, fit)?)
-}
 
 /// Writes the calibrated robot to every `--out` when identification
 /// converged (by extension, [`Format`]); returns the files written. A
@@ -78,15 +67,6 @@ impl std::fmt::Display for NotConverged {
 }
 
 impl std::error::Error for NotConverged {}
-
-/// The exit status a calibration ends with: 0 or [`EXIT_NOT_CONVERGED`].
-pub fn exit_status(id: &Identification) -> i32 {
-    if id.converged() {
-        0
-    } else {
-        EXIT_NOT_CONVERGED
-    }
-}
 
 /// After the report is printed: a [`NotConverged`] error (exit status
 /// [`EXIT_NOT_CONVERGED`]) with the reason when the estimate did not

@@ -5,7 +5,7 @@
 //! file renders it (text, JSON, report directory).
 
 use super::calibrate_args::CalibrateArgs;
-use super::calibrated::{exit_status, frames_of, refuse_unconverged, write_calibrated};
+use super::calibrated::{refuse_unconverged, write_calibrated};
 use super::{emit, write_new};
 use activecal::identify::{LmSettings, MonteCarloSettings};
 use activecal::io::design::DesignFile;
@@ -69,8 +69,7 @@ pub fn from_design(
         write_new(path, &text, a.force)?;
     }
     let source = format!("simulated measurements at {}", design_path.display());
-    let frames = frames_of(robot, id, None)?;
-    write_calibrated(a, robot, id, &source, frames.as_ref())?;
+    write_calibrated(a, robot, id, &source, sim.frames.as_ref())?;
     let noise_note = if a.noise.is_none() {
         ", the default of --noise"
     } else {
@@ -81,11 +80,9 @@ pub fn from_design(
         &design_path.display().to_string(),
         a.noise(),
         a.seed(),
-        frames.map(|(_, r)| r),
         t0.elapsed().as_secs_f64(),
     );
-    let mut v = serde_json::to_value(&report)?;
-    v["exit_status"] = exit_status(id).into();
+    let v = serde_json::to_value(&report)?;
     if let Some(dir) = &a.report {
         let s = activecal::experiment::simulated::summary(
             robot,

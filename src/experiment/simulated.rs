@@ -41,6 +41,12 @@ pub struct SimulatedCalibration {
     pub monte_carlo: Option<MonteCarloSummary>,
     /// Seconds the Monte-Carlo took.
     pub monte_carlo_seconds: f64,
+    /// The calibrated frames of a URDF robot at the estimate of trial 0,
+    /// with σ from its covariance (`None` for other robots).
+    pub frames: Option<(
+        crate::frames::CalibratedFrames,
+        crate::frames::report::FramesReport,
+    )>,
 }
 
 /// Simulates the calibration of `robot` at `design` (pool `spec`, named
@@ -73,7 +79,10 @@ pub fn calibrate_design(
         settings.seed,
     )?;
     let tables = paper_tables(robot, &qs, settings.sigma, settings.seed, &settings.lm)?;
-    let table = &tables.identification.table;
+    let id = &tables.identification;
+    let table = &id.table;
+    let cov = id.covariance.as_ref().map(|c| c.matrix.as_slice());
+    let frames = crate::frames::calibrated(robot, table, cov, None)?;
     let t_mc = Instant::now();
     let mc = if settings.trials > 1 {
         Some(monte_carlo(robot, name, &qs, &validation, settings)?)
@@ -87,6 +96,7 @@ pub fn calibrate_design(
         orientation_rms_after: validation.orientation_rms(robot, table),
         monte_carlo_seconds: t_mc.elapsed().as_secs_f64(),
         monte_carlo: mc,
+        frames,
         pool,
         qs,
         tables,
@@ -97,7 +107,8 @@ pub fn calibrate_design(
 impl SimulatedCalibration {
     /// The report of this calibration of `robot` at the design `design`,
     /// simulated with noise σ `noise` (metres) and `seed`, with the
-    /// calibrated frames (URDF robots) and the seconds it took.
+    /// calibrated frames (URDF robots), the seconds it took and the exit
+    /// status its convergence implies.
     #[must_use]
     pub fn report(
         &self,
@@ -105,7 +116,6 @@ impl SimulatedCalibration {
         design: &str,
         noise: f64,
         seed: u64,
-        frames: Option<crate::frames::report::FramesReport>,
         elapsed_seconds: f64,
     ) -> SimulatedCalibrationReport {
         let id = &self.tables.identification;
@@ -136,8 +146,13 @@ impl SimulatedCalibration {
             validation_orientation_rms_after: self.orientation_rms_after,
             monte_carlo_seconds: self.monte_carlo.as_ref().map(|_| self.monte_carlo_seconds),
             monte_carlo: self.monte_carlo.clone(),
-            frames,
+            frames: self.frames.as_ref().map(|(_, r)| r.clone()),
             elapsed_seconds,
+            exit_status: if id.converged() {
+                0
+            } else {
+                super::measured::verdict::EXIT_REFUSED
+            },
         }
     }
 }

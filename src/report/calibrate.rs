@@ -118,4 +118,6 @@ pub struct SimulatedCalibrationReport {
     pub frames: Option<crate::frames::report::FramesReport>,
     /// Wall-clock seconds.
     pub elapsed_seconds: f64,
+    /// The exit status: 0 when the fit converged, else 3 (nothing written).
+    pub exit_status: i32,
 }

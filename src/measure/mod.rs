@@ -17,7 +17,7 @@ pub mod sensor;
 pub mod so3;
 pub mod visibility;
 
-pub use sensor::{Observation, ObservationBuf, RowKind, Sensor};
+pub use sensor::{Observation, ObservationBuf, RowKind, Sensor, ToolRecord};
 pub use visibility::Visibility;
 
 use crate::kinematics::{Evaluator, Motion};

@@ -106,6 +106,11 @@ impl<'r> JacobianEvaluator<'r> {
 // not beside the trait: each sensor file imports the trait, and the trait's
 // file imports none of them.
 /// The sensor of a measurement kind, with the robot's weights.
+///
+/// # Panics
+/// For a [`crate::model::MeasurementKind::Registered`] key that no sensor
+/// registers, or whose rows differ from its sensor's: keys come from the
+/// sensors' folders, so either is a programming error, not input.
 #[must_use]
 pub fn sensor_of(kind: crate::model::MeasurementKind, orientation_scale: f64) -> Box<dyn Sensor> {
     match kind {

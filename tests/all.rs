@@ -64,6 +64,7 @@ mod reproduce;
 mod robots;
 mod robots_describe;
 mod score_design;
+mod seam_sensor;
 mod select;
 mod tour_moves;
 mod truth_fixtures;

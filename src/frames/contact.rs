@@ -15,7 +15,8 @@ use super::uncertainty::sigmas;
 use super::{CalibratedFrames, FramesError, decompose};
 use crate::data::NamedDistance;
 use crate::identify::contact::ContactFit;
-use crate::model::{MeasurementKind, ParamTable, Robot};
+use crate::measure::ToolRecord;
+use crate::model::{ParamTable, Robot};
 use nalgebra::{Point3, Translation3, Vector3};
 
 /// The split of a contact fit's robot with the tool moved to the tool
@@ -46,8 +47,10 @@ pub fn contact_frames(
         }
         None => None,
     };
-    let mut report =
-        FramesReport::new(src, MeasurementKind::Point, &f, sigma.as_ref(), Some(block));
+    // What a contact sensor records of the tool: its tool point
+    // (`ContactSensor::tool_record`, the trait's default for a sensor
+    // without orientation).
+    let mut report = FramesReport::new(src, ToolRecord::Point, &f, sigma.as_ref(), Some(block));
     report.contacts = Some(contacts_block(fit, distances, n_kin));
     Ok(Some((f, report)))
 }

@@ -188,7 +188,13 @@ pub fn calibrated(
     let sigma = cov
         .map(|c| uncertainty::sigmas(robot, table, c))
         .transpose()?;
-    let mut r = report::FramesReport::new(src, robot.measurement, &f, sigma.as_ref(), fit);
+    let mut r = report::FramesReport::new(
+        src,
+        crate::measure::sensor_for(robot).tool_record(),
+        &f,
+        sigma.as_ref(),
+        fit,
+    );
     let names = src.driven_names();
     for (k, u) in robot.unknowns.iter().enumerate() {
         let Some(j) = robot.frames[u.frame]

@@ -7,7 +7,7 @@
 use super::structure::{AxisRelation, relations};
 use super::uncertainty::{FrameSigma, FramesSigma};
 use super::{CalibratedFrames, chain::UrdfFrames};
-use crate::model::MeasurementKind;
+use crate::measure::ToolRecord;
 use crate::model::source::{UrdfSource, rpy};
 use nalgebra::{Isometry3, Vector3};
 use serde::ser::SerializeMap;
@@ -374,12 +374,12 @@ fn joint_block(j: &super::JointOrigin, s: Option<(&FrameSigma, f64)>) -> JointBl
 
 impl FramesReport {
     /// The report of calibrated frames `f` (with standard deviations
-    /// `sigma` when the fit has them) of a robot from `src` measured as
-    /// `measurement`.
+    /// `sigma` when the fit has them) of a robot from `src` whose sensor
+    /// records `record` of the tool ([`crate::measure::Sensor::tool_record`]).
     #[must_use]
     pub fn new(
         src: &UrdfSource,
-        measurement: MeasurementKind,
+        record: ToolRecord,
         f: &CalibratedFrames,
         sigma: Option<&FramesSigma>,
         fit: Option<FitBlock>,
@@ -397,12 +397,12 @@ impl FramesReport {
                 .filter_map(|j| j.locked.map(|v| (j.name.clone(), v)))
                 .collect(),
         };
-        let (tool, markers) = match measurement {
-            MeasurementKind::Pose => (
+        let (tool, markers) = match record {
+            ToolRecord::Frame => (
                 Some(frame_block(&src.tip, None, &f.tool, sigma.map(|s| &s.tool))),
                 Vec::new(),
             ),
-            MeasurementKind::Point => (
+            ToolRecord::Point => (
                 None,
                 vec![MarkerBlock {
                     name: "point".into(),
@@ -413,7 +413,7 @@ impl FramesReport {
                         .map_or_else(Vec::new, |s| fixed_coordinates(&s.tool.xyz, &[], None)),
                 }],
             ),
-            MeasurementKind::Markers(_) => (
+            ToolRecord::Markers => (
                 None,
                 f.markers
                     .iter()

@@ -531,9 +531,14 @@ pub fn remount(robot: &Robot, mount: Isometry3<f64>, tool: Isometry3<f64>) -> Re
         .iter()
         .filter_map(|j| j.locked.map(|v| (j.name.clone(), v)))
         .collect();
-    let kind = match robot.measurement {
-        MeasurementKind::Markers(_) => MeasurementKind::Point,
-        k => k,
+    // Markers are the tool point's chain with their offsets added after
+    // parsing: what the sensor records of the tool says which.
+    let markers =
+        crate::measure::sensor_for(robot).tool_record() == crate::measure::ToolRecord::Markers;
+    let kind = if markers {
+        MeasurementKind::Point
+    } else {
+        robot.measurement
     };
     let opts = UrdfOptions {
         base: Some(src.base.clone()),
@@ -547,7 +552,7 @@ pub fn remount(robot: &Robot, mount: Isometry3<f64>, tool: Isometry3<f64>) -> Re
     let mut r = parse(&src.text, &src.path, &opts)?;
     r.name = robot.name.clone();
     r.orientation_scale = robot.orientation_scale;
-    if let MeasurementKind::Markers(_) = robot.measurement {
+    if markers {
         r = r.with_markers(&robot.nominal.markers)?;
     }
     Ok(r)

@@ -18,7 +18,7 @@
 //! markers per pose is read by this sensor with `K` offsets (see
 //! [`crate::io::measurements`]).
 
-use super::sensor::{Observation, ObservationBuf, RowKind, Sensor};
+use super::sensor::{Observation, ObservationBuf, RowKind, Sensor, ToolRecord};
 use crate::kinematics::{EndFrame, Motion};
 use nalgebra::Vector3;
 
@@ -86,6 +86,17 @@ impl Sensor for MarkerSensor {
 
     fn points_per_pose(&self) -> usize {
         self.k
+    }
+
+    fn tool_record(&self) -> ToolRecord {
+        ToolRecord::Markers
+    }
+
+    /// Each marker `p + R o_k`.
+    fn measured_points(&self, end: &EndFrame, own: &[f64]) -> Vec<Vector3<f64>> {
+        own.chunks_exact(3)
+            .map(|o| end.position + end.rotation * Vector3::new(o[0], o[1], o[2]))
+            .collect()
     }
 
     fn value_len(&self) -> usize {

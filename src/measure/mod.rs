@@ -3,6 +3,12 @@
 //! camera's projection in [`pinhole`]), the region it sees ([`visibility`])
 //! and the rotation maps of full-pose measurements ([`so3`]).
 //!
+//! A sensor beside these is one folder `measure/<name>/` (its [`Sensor`],
+//! its [`crate::model::SensorKey`] and its [`Registration`]) plus one line
+//! in `registered_sensors!` below: a robot measured by it
+//! ([`crate::model::MeasurementKind::Registered`]) is selected, bounded and
+//! fitted by the library's pipelines through the trait alone.
+//!
 //! [`JacobianEvaluator`] joins the kinematics' per-unknown motions and a
 //! sensor's rows into the identification Jacobian of one pose.
 
@@ -17,7 +23,7 @@ pub mod sensor;
 pub mod so3;
 pub mod visibility;
 
-pub use sensor::{Observation, ObservationBuf, RowKind, Sensor};
+pub use sensor::{Observation, ObservationBuf, RowKind, Sensor, ToolRecord};
 pub use visibility::Visibility;
 
 use crate::kinematics::{Evaluator, Motion};
@@ -100,13 +106,58 @@ impl<'r> JacobianEvaluator<'r> {
 // not beside the trait: each sensor file imports the trait, and the trait's
 // file imports none of them.
 /// The sensor of a measurement kind, with the robot's weights.
+///
+/// # Panics
+/// For a [`crate::model::MeasurementKind::Registered`] key that no sensor
+/// registers, or whose rows differ from its sensor's: keys come from the
+/// sensors' folders, so either is a programming error, not input.
 #[must_use]
 pub fn sensor_of(kind: crate::model::MeasurementKind, orientation_scale: f64) -> Box<dyn Sensor> {
     match kind {
         crate::model::MeasurementKind::Point => Box::new(point::PointSensor::new()),
         crate::model::MeasurementKind::Pose => Box::new(pose::PoseSensor::new(orientation_scale)),
         crate::model::MeasurementKind::Markers(k) => Box::new(markers::MarkerSensor::new(k)),
+        crate::model::MeasurementKind::Registered(key) => {
+            let r = registered()
+                .into_iter()
+                .find(|r| r.key == key)
+                .unwrap_or_else(|| panic!("sensor '{}' is not registered", key.name));
+            let sensor = (r.make)(orientation_scale);
+            assert_eq!(sensor.rows(), key.rows, "sensor '{}': rows", key.name);
+            sensor
+        }
     }
+}
+
+/// A sensor registered beside the built-in ones
+/// ([`crate::model::MeasurementKind::Registered`]): the key it is named by
+/// and how it is built.
+#[derive(Clone, Copy, Debug)]
+pub struct Registration {
+    /// Its key.
+    pub key: crate::model::SensorKey,
+    /// Builds the sensor, given the robot's orientation scale.
+    pub make: fn(f64) -> Box<dyn Sensor>,
+}
+
+/// Declares each registered sensor's module (`measure/<name>/`, which
+/// defines its `REGISTRATION`) and lists them in [`registered`].
+macro_rules! registered_sensors {
+    ($($name:ident),* $(,)?) => {
+        $(pub mod $name;)*
+
+        /// Every sensor registered beside the built-in ones.
+        #[must_use]
+        pub fn registered() -> Vec<Registration> {
+            vec![$($name::REGISTRATION),*]
+        }
+    };
+}
+
+// Sensors beside the built-in ones: each is its folder `measure/<name>/`
+// (the sensor, its key and its `REGISTRATION`) and one line here.
+registered_sensors! {
+    height,
 }
 
 /// The sensor a robot is measured with ([`Robot::measurement`], weighted by

@@ -38,7 +38,20 @@
 //! distance between two contact points), appended after the poses' rows.
 
 use crate::kinematics::{EndFrame, Motion};
+use nalgebra::Vector3;
 use std::fmt;
+
+/// What a calibrated robot's description records of what its sensor
+/// measured on the last link, for frames tables and URDF tool frames.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ToolRecord {
+    /// The tool frame, position and orientation (a full pose).
+    Frame,
+    /// One tool point in the last link (its orientation unobserved).
+    Point,
+    /// Each marker's offset in the last link.
+    Markers,
+}
 
 /// What a row of a residual measures, for reports that split errors into
 /// distances and angles.
@@ -128,6 +141,25 @@ pub trait Sensor: fmt::Debug + Send + Sync {
 
     /// Points measured per pose.
     fn points_per_pose(&self) -> usize;
+
+    /// What a calibrated description records of the measured tool (frames
+    /// tables, URDF tool frames, the 3D page's tracker). Default: the tool
+    /// frame when a value holds an orientation, else the tool point.
+    fn tool_record(&self) -> ToolRecord {
+        if self.measures_orientation() {
+            ToolRecord::Frame
+        } else {
+            ToolRecord::Point
+        }
+    }
+
+    /// The points of the last link the sensor follows, in the measurement
+    /// frame (metres), for end frame `end` and own unknowns `own`: the end
+    /// point by default; each marker for a marker sensor.
+    fn measured_points(&self, end: &EndFrame, own: &[f64]) -> Vec<Vector3<f64>> {
+        let _ = own;
+        vec![end.position]
+    }
 
     /// Length of one pose's measured or predicted value.
     fn value_len(&self) -> usize;

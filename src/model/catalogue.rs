@@ -72,7 +72,9 @@ fn assemble(
     let (name, unknowns) = match m {
         MeasurementKind::Point => (name.to_string(), point_unknowns),
         MeasurementKind::Pose => (format!("{name}:pose"), pose_unknowns),
-        MeasurementKind::Markers(_) => unreachable!("built-in robots measure points or poses"),
+        MeasurementKind::Markers(_) | MeasurementKind::Registered(_) => {
+            unreachable!("built-in robots measure points or poses")
+        }
     };
     let r = Robot {
         name,

@@ -1,6 +1,25 @@
-//! What is measured at each pose: a point, a full pose, or several markers.
+//! What is measured at each pose: a point, a full pose, several markers,
+//! or a sensor registered beside them.
 
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Serialize, Serializer};
+
+/// A sensor registered in `crate::measure` beside the built-in ones
+/// ([`MeasurementKind::Registered`]): its name and its rows per pose (the
+/// sensor it names has as many, checked when it is built). Serialized as
+/// its name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SensorKey {
+    /// The sensor's name (`height`), as reports name the measurement.
+    pub name: &'static str,
+    /// Rows of the identification Jacobian per pose.
+    pub rows: usize,
+}
+
+impl Serialize for SensorKey {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name)
+    }
+}
 
 /// What is measured at each pose.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -18,6 +37,13 @@ pub enum MeasurementKind {
     /// `o_k` ([`ParamTable::markers`](super::ParamTable::markers)), three unknowns per marker after the
     /// robot's.
     Markers(usize),
+    /// A sensor registered in `crate::measure` beside these (its own folder
+    /// and one registration line): the library's pipelines reach it
+    /// through the `Sensor` trait alone. No file format names one (they
+    /// are read from none); a robot is given one by
+    /// `Robot::with_measurement`.
+    #[serde(skip_deserializing)]
+    Registered(SensorKey),
 }
 
 impl MeasurementKind {
@@ -28,16 +54,18 @@ impl MeasurementKind {
             MeasurementKind::Point => 3,
             MeasurementKind::Pose => 6,
             MeasurementKind::Markers(k) => 3 * k,
+            MeasurementKind::Registered(key) => key.rows,
         }
     }
 
-    /// `point`, `pose` or `markers`.
+    /// `point`, `pose`, `markers` or a registered sensor's name.
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {
             MeasurementKind::Point => "point",
             MeasurementKind::Pose => "pose",
             MeasurementKind::Markers(_) => "markers",
+            MeasurementKind::Registered(key) => key.name,
         }
     }
 

@@ -29,7 +29,7 @@ mod validate;
 pub use builtin::BUILTIN;
 pub use chain::{Convention, Frame, JointKind};
 pub use frame::{FrameMotion, frame_transform};
-pub use measurement::MeasurementKind;
+pub use measurement::{MeasurementKind, SensorKey};
 pub use params::{ParamId, ParamSet, ParamTable, Symbol};
 
 use crate::error::{Error, Result};

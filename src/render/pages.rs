@@ -8,7 +8,8 @@ pub use super::summary::FitPoses;
 use crate::collision::CollisionSpec;
 use crate::error::Result;
 use crate::how_many::PoseCountCurve;
-use crate::model::{MeasurementKind, Robot};
+use crate::measure::ToolRecord;
+use crate::model::Robot;
 use crate::pool::PoolFilter;
 use crate::report::SelectReport;
 use nalgebra::Point3;
@@ -29,13 +30,14 @@ pub fn add_scene(page: &mut Page, spec: &CollisionSpec) {
     page.obstacles = spec.obstacles.clone();
 }
 
-/// A tracker at the measurement frame's origin, for point and pose
-/// measurements (in the base link's frame, the base at `mount` in the
+/// A tracker at the measurement frame's origin, for sensors that record a
+/// tool point or frame ([`crate::measure::Sensor::tool_record`]; markers
+/// have their own view) (in the base link's frame, the base at `mount` in the
 /// measurement frame).
 pub fn add_tracker(page: &mut Page, robot: &Robot, mount: nalgebra::Isometry3<f64>) {
     if matches!(
-        robot.measurement,
-        MeasurementKind::Point | MeasurementKind::Pose
+        crate::measure::sensor_for(robot).tool_record(),
+        ToolRecord::Point | ToolRecord::Frame
     ) {
         let q0 = page
             .poses

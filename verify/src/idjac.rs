@@ -142,6 +142,7 @@ impl Source {
                     MeasurementKind::Point => stem,
                     MeasurementKind::Pose => format!("{stem}_pose"),
                     MeasurementKind::Markers(k) => format!("{stem}_markers{k}"),
+                    MeasurementKind::Registered(key) => format!("{stem}_{}", key.name),
                 }
             }
         }

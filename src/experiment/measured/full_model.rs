@@ -13,23 +13,16 @@
 use super::{ExperimentError, MeasuredSettings, PREDICTION_CONFIGURATIONS, fit_read};
 use crate::data::Measurements;
 use crate::identify::restriction::Restriction;
-use crate::model::{MeasurementKind, ParamTable, Robot};
+use crate::model::{ParamTable, Robot};
 use nalgebra::Vector3;
 
 pub use crate::report::measured::FullModelGain;
 
-/// The measured points of `robot` at `table` and `q` (each marker of a
-/// markers sensor, else the end point), metres.
+/// The measured points of `robot` at `table` and `q` (those its sensor
+/// follows: [`crate::measure::Sensor::measured_points`]), metres.
 fn points(robot: &Robot, table: &ParamTable, q: &[f64]) -> Vec<Vector3<f64>> {
     let end = crate::kinematics::Evaluator::new(robot, table).end_frame(q);
-    match robot.measurement {
-        MeasurementKind::Markers(_) => table
-            .markers
-            .iter()
-            .map(|m| end.position + end.rotation * Vector3::from(*m))
-            .collect(),
-        _ => vec![end.position],
-    }
+    crate::measure::sensor_for(robot).measured_points(&end, &table.marker_values())
 }
 
 /// RMS distance (mm) between the points of two fitted models at `qs`.

@@ -170,6 +170,9 @@ struct TopLevel {
 }
 
 fn top_level(cx: &Ctx<'_>, spec: &FileSpec) -> Result<TopLevel> {
+    // Parsing: the file's `measurement` key names one of the built-in
+    // sensors, so this maps its spelling onto the enum (the one place a
+    // sensor is chosen by name; the pipelines then ask the sensor).
     let measurement = match spec.measurement {
         None | Some(MeasurementSpec::Point) => MeasurementKind::Point,
         Some(MeasurementSpec::Pose) => MeasurementKind::Pose,

@@ -2,7 +2,7 @@
 //! robot.
 
 use crate::measure::Visibility;
-use crate::model::{Convention, JointKind, MeasurementKind, Robot, Symbol};
+use crate::model::{Convention, JointKind, Robot, Symbol};
 use serde::Serialize;
 
 /// Writes a robot as a description that [`super::parse`] reads back to the same
@@ -26,7 +26,12 @@ pub fn description_to_toml(robot: &Robot, visibility: Option<&Visibility>) -> St
     s += "# activecal robot description (see activecal::io::robot_toml)\n";
     s += &format!("name = {:?}\n", robot.name);
     s += &format!("measurement = \"{}\"\n", robot.measurement.name());
-    if robot.measurement == MeasurementKind::Pose {
+    // The orientation scale weighs orientation rows: written for a sensor
+    // that has them.
+    if crate::measure::sensor_for(robot)
+        .row_kinds()
+        .contains(&crate::measure::RowKind::Orientation)
+    {
         s += &format!("orientation_scale = {}\n", num(robot.orientation_scale));
     }
     for (n, r) in robot.nominal.markers.iter().zip(&robot.real.markers) {

@@ -37,18 +37,10 @@ pub fn write_calibrated(
             Format::JointOffsets(_) => Format::JointOffsets(a.offset_convention()),
             f => f,
         };
-        calibrated.write(format, out_file(out), a.force, &[])?;
+        calibrated.write(format, super::out_file(out), a.force, &[])?;
         written.push(out.display().to_string());
     }
     Ok(written)
-}
-
-/// An `--out` file, as the library's writers name it in messages.
-pub fn out_file(path: &std::path::Path) -> activecal::io::atomic::Output<'_> {
-    activecal::io::atomic::Output {
-        label: "--out",
-        path,
-    }
 }
 
 /// The exit status of a calibration whose fit did not converge or is rank

@@ -34,7 +34,7 @@ pub fn read(
     let read = read_images(spec, &joints, target, intrinsics).context("--images")?;
     // What became of each image, before the fit (which may refuse them).
     if !a.json {
-        for line in activecal::experiment::camera::images::image_lines(&read.images) {
+        for line in activecal::render::camera_text::image_lines(&read.images) {
             println!("{line}");
         }
     }

@@ -6,7 +6,7 @@
 //! when it converged, each file atomically and never over an existing one
 //! without `--force`.
 
-use super::calibrated::out_file;
+use super::out_file;
 use activecal::frames::CalibratedFrames;
 use activecal::frames::report::FramesReport;
 use activecal::identify::contact::ContactFit;

@@ -217,6 +217,14 @@ pub fn write_new(path: &std::path::Path, text: &str, force: bool) -> Result<()> 
     Ok(())
 }
 
+/// An `--out` file, as the library's writers name it in messages.
+pub fn out_file(path: &std::path::Path) -> activecal::io::atomic::Output<'_> {
+    activecal::io::atomic::Output {
+        label: "--out",
+        path,
+    }
+}
+
 /// Prints `value` as one JSON line (the library's words), or the
 /// human-readable `text` with the library's phrases for settings spelled as
 /// this command line's flags ([`hints::spell`]); a stdout

@@ -38,7 +38,7 @@ pub fn bag_images_text(r: &BagImagesReport, out: Option<&Path>) -> String {
         r.time_offset,
         r.kept()
     );
-    for line in crate::experiment::camera::images::image_lines(&r.images()) {
+    for line in super::camera_text::image_lines(&r.images()) {
         s += &line;
         s += "\n";
     }

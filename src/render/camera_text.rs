@@ -2,7 +2,8 @@
 //! pixels fitted, the unknowns, the start computed from the pixels, pixel
 //! error RMS and σ (px), the camera's and target's placements with σ (m,
 //! mm, deg), refined intrinsics, the robot unknowns' changes, the corners
-//! relabelled, the gross-error test's notes and the verdict.
+//! relabelled, the gross-error test's notes and the verdict; and the
+//! images' detection, one line per image.
 
 use crate::frames::report::FramesReport;
 use crate::identify::camera::CameraFit;
@@ -233,4 +234,26 @@ fn intrinsics_text(fit: &CameraFit, s: &mut String) {
     for f in &fit.fixed_intrinsics {
         let _ = writeln!(s, "  {} held at {}: {}", f.name, f.value, f.reason);
     }
+}
+
+/// One line per image: the points found and the detection's figures, or
+/// the reason it was left out.
+#[must_use]
+pub fn image_lines(images: &[crate::io::images::ImageReport]) -> Vec<String> {
+    images
+        .iter()
+        .map(|r| match &r.outcome {
+            crate::io::images::ImageOutcome::Found {
+                points,
+                square_px,
+                window_px,
+                shift_px,
+                edge_width_px,
+            } => format!(
+                "{}: {points} points, squares ≥ {square_px:.1} px, window ±{}–{} px, refinement shift {:.3} px median ({:.3} px max), edge width {edge_width_px:.2} px",
+                r.file, window_px[0], window_px[1], shift_px[0], shift_px[1]
+            ),
+            crate::io::images::ImageOutcome::LeftOut { reason } => format!("{}: left out: {reason}", r.file),
+        })
+        .collect()
 }

@@ -127,25 +127,3 @@ fn caption(r: &ImageReport) -> String {
         ImageOutcome::LeftOut { .. } => "not used".into(),
     }
 }
-
-/// One line per image: the points found and the detection's figures, or
-/// the reason it was left out.
-#[must_use]
-pub fn image_lines(images: &[ImageReport]) -> Vec<String> {
-    images
-        .iter()
-        .map(|r| match &r.outcome {
-            ImageOutcome::Found {
-                points,
-                square_px,
-                window_px,
-                shift_px,
-                edge_width_px,
-            } => format!(
-                "{}: {points} points, squares ≥ {square_px:.1} px, window ±{}–{} px, refinement shift {:.3} px median ({:.3} px max), edge width {edge_width_px:.2} px",
-                r.file, window_px[0], window_px[1], shift_px[0], shift_px[1]
-            ),
-            ImageOutcome::LeftOut { reason } => format!("{}: left out: {reason}", r.file),
-        })
-        .collect()
-}

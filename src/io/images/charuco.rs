@@ -207,19 +207,21 @@ fn check_ids(
         .iter()
         .map(|&(id, px)| ([(id % inner + 1) as i64, (id / inner + 1) as i64], px))
         .collect();
-    let reads = layout::read_markers(
-        img,
-        &by_corner,
-        (p.rows, p.cols),
-        dictionary,
-        p.marker / p.square,
-    );
+    let Some(grid) = layout::Grid::new(&by_corner) else {
+        return Err(format!(
+            "{} corner(s) found, too few to check their ids against the markers",
+            corners.len()
+        ));
+    };
+    let rel = p.marker / p.square;
+    let reads = layout::read_markers(img, &grid, (p.rows, p.cols), dictionary, rel);
     let a = layout::agreement(layout, &reads);
-    if a.disagree == 0 {
+    let white = layout::white_where_black(img, &grid, layout, rel).unwrap_or(0);
+    if a.disagree == 0 && white == 0 {
         return Ok(());
     }
     let counts = format!(
-        "{} of the {} markers read on and around the board are not where its layout puts them",
+        "{} of the {} markers read on and around the board are not where its layout puts them, {white} of its squares without a marker are not black",
         a.disagree,
         reads.len()
     );

@@ -22,7 +22,11 @@
 //! The ring matters: a legacy 4 × 5 board labelled as the current layout
 //! one square to the side has every marker of its labelled squares where
 //! the current layout puts it, and only its last column's markers, in
-//! squares off the labelled board, tell the layouts apart.
+//! squares off the labelled board, tell the layouts apart. When those are
+//! not read (an oblique view, the homography's extrapolation off by
+//! distortion), the paper around the board does: the labelled board's
+//! first column then holds white paper where the layout puts black
+//! squares ([`white_where_black`]).
 
 use super::decode::Gray;
 use calib_targets_aruco::{
@@ -97,15 +101,56 @@ pub struct Read {
     pub id: u32,
 }
 
+/// A board's grid in the image: the corners found (board corner
+/// `(column, row)`, a square's top-left corner being its own `(x, y)`, →
+/// pixel), the others placed by the homography through them.
+pub struct Grid<'a> {
+    corners: &'a HashMap<[i64; 2], [f64; 2]>,
+    h: Matrix3<f64>,
+}
+
+impl<'a> Grid<'a> {
+    /// The grid of `corners`; `None` with fewer than 4, or all on a line.
+    #[must_use]
+    pub fn new(corners: &'a HashMap<[i64; 2], [f64; 2]>) -> Option<Self> {
+        let pairs: Vec<([f64; 2], [f64; 2])> = corners
+            .iter()
+            .map(|(c, p)| ([c[0] as f64, c[1] as f64], *p))
+            .collect();
+        Some(Self {
+            corners,
+            h: homography(&pairs)?,
+        })
+    }
+
+    /// Board corner `c`'s pixel: found, or placed by the homography.
+    #[must_use]
+    pub fn corner(&self, c: [i64; 2]) -> [f64; 2] {
+        self.corners.get(&c).copied().unwrap_or_else(|| {
+            let q = self.h * Vector3::new(c[0] as f64, c[1] as f64, 1.0);
+            [q.x / q.z, q.y / q.z]
+        })
+    }
+
+    /// The pixel at `(u, v)` (fractions of a side) in square `(x, y)`:
+    /// its four corners interpolated bilinearly.
+    #[must_use]
+    pub fn in_square(&self, [x, y]: [i64; 2], [u, v]: [f64; 2]) -> [f64; 2] {
+        let [a, b, c, d] = [[x, y], [x + 1, y], [x + 1, y + 1], [x, y + 1]].map(|k| self.corner(k));
+        let lerp = |k: usize| {
+            (1.0 - v) * ((1.0 - u) * a[k] + u * b[k]) + v * ((1.0 - u) * d[k] + u * c[k])
+        };
+        [lerp(0), lerp(1)]
+    }
+}
+
 /// Reads the marker of `dictionary` (of side `marker_rel` squares) in every
-/// square of a board of `rows × cols` squares and of the ring around it,
-/// from the `corners` found (board corner `(column, row)`, a square's
-/// top-left corner being its own `(x, y)`, → pixel; see the module
-/// documentation).
+/// square of a board of `rows × cols` squares and of the ring around it
+/// (see the module documentation).
 #[must_use]
 pub fn read_markers(
     img: &Gray,
-    corners: &HashMap<[i64; 2], [f64; 2]>,
+    grid: &Grid<'_>,
     (rows, cols): (usize, usize),
     dictionary: Dictionary,
     marker_rel: f64,
@@ -114,19 +159,6 @@ pub fn read_markers(
         width: img.width,
         height: img.height,
         data: &img.data,
-    };
-    let pairs: Vec<([f64; 2], [f64; 2])> = corners
-        .iter()
-        .map(|(c, p)| ([c[0] as f64, c[1] as f64], *p))
-        .collect();
-    let Some(h) = homography(&pairs) else {
-        return Vec::new();
-    };
-    let at = |c: [i64; 2]| {
-        corners.get(&c).copied().unwrap_or_else(|| {
-            let q = h * Vector3::new(c[0] as f64, c[1] as f64, 1.0);
-            [q.x / q.z, q.y / q.z]
-        })
     };
     // The crate's sampling grid: a square rectified to this many pixels
     // and a margin of 6 % of the marker left out of its bits' samples
@@ -140,7 +172,7 @@ pub fn read_markers(
     for y in -1..=rows as i64 {
         for x in -1..=cols as i64 {
             let quad = [[x, y], [x + 1, y], [x + 1, y + 1], [x, y + 1]]
-                .map(|c| at(c))
+                .map(|c| grid.corner(c))
                 .map(|p| Point2::new(p[0] as f32, p[1] as f32));
             let cell = MarkerCell::new(Coord::new(x as i32, y as i32), quad);
             if let Some(m) = decode_marker_in_cell(&view, &cell, px_per_square, &cfg, &matcher) {
@@ -152,6 +184,54 @@ pub fn read_markers(
         }
     }
     reads
+}
+
+/// How many of the board's squares without a marker (black in OpenCV's
+/// layouts), seen whole in the image, are not dark: their centre (the
+/// mean of 9 points over its middle 40 %) brighter than halfway between
+/// the median of those centres and the median of the marker squares'
+/// white margins (the middle of the margin, at the middle of each side).
+/// A board labelled a square to the side has the paper around it where
+/// the layout puts a black square. `None` when fewer than 2 of either
+/// were seen, or black and white are under 20 grey levels apart.
+#[must_use]
+pub fn white_where_black(img: &Gray, grid: &Grid<'_>, layout: &Layout, marker_rel: f64) -> Option<usize> {
+    let inside = |p: [f64; 2]| {
+        (1.0..img.width as f64 - 2.0).contains(&p[0]) && (1.0..img.height as f64 - 2.0).contains(&p[1])
+    };
+    let level = |square: [i64; 2], pts: &[[f64; 2]]| -> Option<f64> {
+        let px: Vec<[f64; 2]> = pts.iter().map(|&q| grid.in_square(square, q)).collect();
+        let all = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]].map(|q| grid.in_square(square, q));
+        (all.iter().all(|p| inside(*p))).then(|| {
+            px.iter().map(|p| img.bilinear(p[0], p[1])).sum::<f64>() / px.len() as f64
+        })
+    };
+    let centre: Vec<[f64; 2]> = (0..9)
+        .map(|k| [0.3 + 0.2 * f64::from(k % 3), 0.3 + 0.2 * f64::from(k / 3)])
+        .collect();
+    let t = 0.25 * (1.0 - marker_rel);
+    let margin = [[t, 0.5], [1.0 - t, 0.5], [0.5, t], [0.5, 1.0 - t]];
+    let (mut black, mut white) = (Vec::new(), Vec::new());
+    for y in 0..layout.rows as i64 {
+        for x in 0..layout.cols as i64 {
+            match layout.at([x, y]) {
+                None => black.extend(level([x, y], &centre)),
+                Some(_) => white.extend(level([x, y], &margin)),
+            }
+        }
+    }
+    if black.len() < 2 || white.len() < 2 {
+        return None;
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let (b, w) = (median(&mut black.clone()), median(&mut white));
+    if w - b < 20.0 {
+        return None;
+    }
+    Some(black.iter().filter(|&&l| l > 0.5 * (b + w)).count())
 }
 
 /// The plane-to-image homography through `pairs` (plane point → pixel),

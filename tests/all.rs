@@ -18,6 +18,7 @@ mod camera_fisheye;
 mod camera_head;
 mod camera_images;
 mod camera_labels;
+mod camera_legacy;
 mod camera_messy;
 mod camera_refuse;
 mod camera_sight;

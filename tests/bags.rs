@@ -649,11 +649,62 @@ fn a_bags_camera_without_intrinsics_or_decodable_images_is_refused_by_name() {
         "rest 1 (image 0): a raw image in encoding 'yuv422'",
     );
     fails_with(
-        &line("/camera/image_jpeg", "/camera/camera_info"),
-        "a compressed image in format 'jpeg'",
+        &line("/camera/image_jpeg", "/camera/no_info"),
+        "no message on '/camera/no_info'",
     );
     // The measurement options of points and poses do not go with --images.
     let mut both = line("/camera/image", "/camera/camera_info");
     both.extend(["--points", "/tracker"]);
     fails_with(&both, "--points");
+}
+
+/// `/camera/image_jpeg` (`CompressedImage`, format `jpeg`): its first two
+/// frames are the bytes of `fixtures/camera/jpeg/img_000.jpg` and
+/// `img_001.jpg` and decode to the files' pixels, level for level; the
+/// camera's observations of the bag are the files' (the first two rests),
+/// and the other rests' 16 × 8 px frames are listed with their size.
+#[test]
+fn a_bags_jpeg_frames_decode_to_the_pixels_of_their_files() {
+    use activecal::io::bag::{Bag, image::decode_message, messages::compressed_image};
+    use activecal::io::images::decode::decode_image;
+    use activecal::io::images::{ImageOutcome, joints::read_image_joints, read_images};
+    let bag = Bag::open(&root().join(CAMERA_BAG)).unwrap();
+    let mut frames = Vec::new();
+    bag.for_each(&["/camera/image_jpeg"], |m| {
+        let msg = compressed_image(m.data).unwrap();
+        assert_eq!(msg.encoding, "jpeg");
+        frames.push(decode_message(&msg));
+        Ok(())
+    })
+    .unwrap();
+    assert_eq!(frames.len(), 6);
+    for k in 0..2 {
+        let file = std::fs::read(root().join(format!("fixtures/camera/jpeg/img_{k:03}.jpg"))).unwrap();
+        let want = decode_image(&file).unwrap();
+        assert_eq!((want.width, want.height), (320, 240));
+        assert_eq!(frames[k].as_ref().unwrap(), &want, "frame {k}");
+    }
+    let robot =
+        activecal::io::load_robot(&format!("{}#tip=target", root().join(UR5).display())).unwrap();
+    let target =
+        activecal::io::camera_target::read_target(&root().join("fixtures/camera/board_6x9.yaml"))
+            .unwrap();
+    let intrinsics = activecal::io::camera_info::read_camera_info(
+        &root().join("fixtures/camera/small_camera_info.yaml"),
+    )
+    .unwrap();
+    let dir = root().join("fixtures/camera/jpeg");
+    let j = read_image_joints(&dir.join("joints.csv"), &robot, Default::default()).unwrap();
+    let files = read_images(&dir, &j, &target, &intrinsics).unwrap().observations;
+    let from_bag = bag_observations("/camera/image_jpeg");
+    assert_eq!(from_bag.observations.pose_ids, vec![0, 1]);
+    assert_eq!(from_bag.observations.seen, files.seen);
+    for r in &from_bag.report.rests[2..] {
+        match &r.image.outcome {
+            ImageOutcome::LeftOut { reason } => {
+                assert!(reason.contains("16 × 8 px"), "{reason}");
+            }
+            ImageOutcome::Found { .. } => panic!("{:?}", r.image),
+        }
+    }
 }

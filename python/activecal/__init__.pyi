@@ -681,7 +681,7 @@ def detect(
 ) -> Any:
     """Detects the target's points in a camera's images, as ``activecal
     calibrate --images IMAGES --joints JOINTS --save-observations F``
-    does. images: a folder of PNG images, a glob pattern or one file.
+    does. images: a folder of PNG or JPEG images, a glob pattern or one file.
     target: a target YAML path or a dict (a ``checkerboard`` or a
     ``charuco`` board with its ``dictionary``). camera_info: a ROS
     camera_info or OpenCV YAML path, or a dict. robot: the robot whose
@@ -716,7 +716,7 @@ def calibrate_camera(
     files. observations: a CSV path or a pandas DataFrame with its columns
     ``pose, <joint names>, feature, u, v`` (one row a point seen, pixels;
     a DataFrame's errors name the line of its CSV, line 2 its first row).
-    Or, instead, images: a folder of PNG images, a glob pattern, one file
+    Or, instead, images: a folder of PNG or JPEG images, a glob pattern, one file
     or a list of files (each a pose), with joints: a CSV path or a pandas
     DataFrame with an ``image`` column (each image's file name) and a
     column per joint, as ``activecal calibrate --images DIR --joints FILE``

@@ -164,7 +164,7 @@ pub struct CameraCalibration {
 ///
 /// observations: a CSV path or a pandas DataFrame with the file's columns
 /// `pose, <joint names>, feature, u, v` (a row per point seen; pixels).
-/// Or images: a folder of PNG images, a glob pattern, one file or a list
+/// Or images: a folder of PNG or JPEG images, a glob pattern, one file or a list
 /// of files (each a pose, in the folder's sorted order or the list's),
 /// with joints: a CSV path or a DataFrame with an `image` column (each
 /// image's file name) and a column per joint; the target's points are

@@ -11,7 +11,7 @@ use std::path::PathBuf;
 /// Detects the target's points in a camera's images, as `activecal
 /// calibrate --images IMAGES --joints JOINTS --save-observations F` does.
 ///
-/// images: a folder of PNG images, a glob pattern (`DIR/*.png`) or one
+/// images: a folder of PNG or JPEG images, a glob pattern (`DIR/*.png`) or one
 /// file. target: a target YAML path or a dict (a `checkerboard` or a
 /// `charuco` board with its `dictionary`). camera_info: a ROS camera_info
 /// or OpenCV YAML path, or a dict (the images must be its size). robot: the

@@ -224,7 +224,7 @@ pub struct CalibrateArgs {
         requires_all = ["camera_info", "target"]
     )]
     pub observations: Option<PathBuf>,
-    /// Calibrate from a camera's images: a directory of PNG images, a
+    /// Calibrate from a camera's images: a directory of PNG or JPEG images, a
     /// pattern (`shots/pose_*.png`) or one image. The target's points are
     /// detected in each image (a checkerboard's inner corners, seen whole),
     /// refined with a window under half a square, and fitted as
@@ -232,7 +232,7 @@ pub struct CalibrateArgs {
     /// with its reason. Needs --joints, --camera-info, --target and
     /// --mounting (or --camera-link). With --bag: the bag's
     /// sensor_msgs/msg/Image or CompressedImage topic (raw mono8, rgb8,
-    /// bgr8, rgba8, bgra8 or PNG), of each rest the image nearest its
+    /// bgr8, rgba8, bgra8, PNG or JPEG), of each rest the image nearest its
     /// middle, and --camera-info the bag's CameraInfo topic.
     #[arg(
         long,

@@ -61,8 +61,10 @@ Usage (run with the project venv's python):
       20 Hz, no noise, rests of 0.6 s), one frame per rest on
       /camera/image (CompressedImage, png), the first rest's frame
       also raw on /camera/image_raw (Image, mono8), a 16 x 8 frame per
-      rest in encoding yuv422 on /camera/image_yuv and in JPEG on
-      /camera/image_jpeg (CompressedImage, format 'jpeg'),
+      rest in encoding yuv422 on /camera/image_yuv; on /camera/image_jpeg
+      (CompressedImage, format 'jpeg') the first two rests' images as the
+      JPEG files fixtures/camera/jpeg/img_000.jpg and img_001.jpg (the
+      renders at quality 90) and a 16 x 8 JPEG frame on the other rests,
       /camera/camera_info (the CameraInfo of
       fixtures/camera/small_camera_info.yaml) and /camera/no_info (a
       CameraInfo topic without messages).
@@ -393,8 +395,11 @@ def cmd_tiny_images(a):
             header=out.header(tk, "camera"), height=8, width=8, encoding="yuv422", is_bigendian=0,
             step=16, data=small.ravel())
         out.put("/camera/image_yuv", "sensor_msgs/msg/Image", m, tk)
+        frame = jpeg
+        if n < 2:
+            frame = open(os.path.join(root, "fixtures", "camera", "jpeg", f"img_{n:03}.jpg"), "rb").read()
         m = out.T["sensor_msgs/msg/CompressedImage"](
-            header=out.header(tk, "camera"), format="jpeg", data=np.frombuffer(jpeg, dtype=np.uint8))
+            header=out.header(tk, "camera"), format="jpeg", data=np.frombuffer(frame, dtype=np.uint8))
         out.put("/camera/image_jpeg", "sensor_msgs/msg/CompressedImage", m, tk)
     out.close()
     finish(tmp, os.path.join(a.out, "camera.mcap"))

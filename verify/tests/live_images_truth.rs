@@ -38,6 +38,10 @@
 //! * [`live_images_eye_to_hand_charuco`]: the Panda eye-to-hand with that
 //!   ChArUco board on its hand, 20 images from 0.3–1.2 m; against
 //!   `CharucoDetector`.
+//! * [`live_images_eye_in_hand_charuco_legacy`]: the UR5 eye-in-hand with
+//!   a board of 6 × 9 squares printed in OpenCV's legacy layout
+//!   (`legacy_pattern: true`), one draw; against `CharucoDetector` with
+//!   `setLegacyPattern(true)`.
 
 use super::live_images::{
     Board, Pixels, RATIO, Rig, SQUARE, Scene, calibrate, checkerboard, corner_errors, from_images,
@@ -245,6 +249,38 @@ fn live_images_eye_to_hand_charuco() {
     rig.near = [0.3, 1.2];
     let s = scene(rig, &board, false, (20, false), DRAWS);
     gate(&s, &routes);
+}
+
+/// OpenCV's legacy layout (`setLegacyPattern(true)`, every board printed
+/// before OpenCV 4.6; markers in the other squares on an even number of
+/// rows): a board of 6 × 9 squares of 25 mm, markers of 15 mm, on the
+/// UR5 eye-in-hand of [`live_images_eye_in_hand_charuco`], one draw of
+/// the noise; against `CharucoDetector` with `setLegacyPattern(true)`.
+#[test]
+fn live_images_eye_in_hand_charuco_legacy() {
+    let (rows, cols, marker) = (6, 9, 0.015);
+    let spec = format!("{rows},{cols},{SQUARE},{marker}");
+    let board = Board {
+        yaml: format!(
+            "charuco: {{rows: {rows}, cols: {cols}, square: {SQUARE}, marker: {marker}, dictionary: DICT_4X4_50, legacy_pattern: true}}\n"
+        ),
+        render: vec![
+            format!("--charuco={spec}"),
+            "--dictionary=DICT_4X4_50".into(),
+            "--legacy".into(),
+        ],
+        ids: true,
+    };
+    let route = vec![
+        "--method=charuco".to_string(),
+        format!("--charuco={spec}"),
+        "--dictionary=DICT_4X4_50".into(),
+        "--legacy".into(),
+    ];
+    let mut rig = ur5_eye_in_hand("eye-in-hand-charuco-legacy", rows - 1, cols - 1, false);
+    rig.target *= nalgebra::Translation3::new(-SQUARE, -SQUARE, 0.0);
+    let s = scene(rig, &board, false, (20, true), 1);
+    gate(&s, &[("CharucoDetector, legacy pattern", route)]);
 }
 
 /// A board with ids (ChArUco): OpenCV keeps fewer of its corners (those

@@ -7,7 +7,7 @@
 
 use super::CameraCalibration;
 use crate::identify::camera::screen::{CameraUnit, pixel_residuals};
-use crate::io::images::decode::{Gray, decode_png};
+use crate::io::images::decode::{Gray, decode_image};
 use crate::io::images::{ImageObservations, ImageOutcome, ImageReport};
 use crate::render::contact_sheet::SheetImage;
 
@@ -23,7 +23,7 @@ pub fn sheet_images(
     let grays: Vec<Option<Gray>> = read
         .files
         .iter()
-        .map(|f| std::fs::read(f).ok().and_then(|b| decode_png(&b).ok()))
+        .map(|f| std::fs::read(f).ok().and_then(|b| decode_image(&b).ok()))
         .collect();
     let (w, h) = grays
         .iter()

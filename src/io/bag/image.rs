@@ -3,22 +3,25 @@
 //! ([`crate::io::images::decode::Gray`]).
 
 use super::messages::ImageData;
-use crate::io::images::decode::{Gray, decode_png};
+use crate::io::images::decode::{Gray, decode_jpeg, decode_png};
 
 /// Decodes a ROS image message's pixels into grey levels: a raw `Image`
 /// in `mono8`, `rgb8`, `bgr8`, `rgba8` or `bgra8` (`width × height`, rows
 /// `step` bytes apart; colour turned grey by its luma as a PNG's is), or a
-/// `CompressedImage` holding a PNG (`format` `png`, or image_transport's
-/// `… png compressed …`). Any other encoding (JPEG, 16-bit, Bayer, YUV) is
-/// an error naming it.
+/// `CompressedImage` holding a PNG or a JPEG (`format` `png` or `jpeg`,
+/// or image_transport's `… png compressed …`, `… jpeg compressed …`).
+/// Any other encoding (16-bit, Bayer, YUV) is an error naming it.
 pub fn decode_message(m: &ImageData<'_>) -> Result<Gray, String> {
     if m.compressed {
         let f = m.encoding.to_ascii_lowercase();
         if f.contains("png") {
             return decode_png(m.data);
         }
+        if f.contains("jpeg") || f.contains("jpg") {
+            return decode_jpeg(m.data);
+        }
         return Err(format!(
-            "a compressed image in format '{}': activecal decodes PNG-compressed images (format 'png') and raw ones (mono8, rgb8, bgr8, rgba8, bgra8); record those (image_transport's 'compressed' with png_level, or 'raw')",
+            "a compressed image in format '{}': activecal decodes PNG- and JPEG-compressed images (format 'png' or 'jpeg') and raw ones (mono8, rgb8, bgr8, rgba8, bgra8)",
             m.encoding
         ));
     }
@@ -119,10 +122,14 @@ mod tests {
         assert!(e.contains("encoding 'yuv422'"), "{e}");
         let e = decode_message(&raw("mono8", 4, 4, 4, &[0; 10])).unwrap_err();
         assert!(e.contains("10 byte(s) of pixels for 4 × 4 px mono8"), "{e}");
+        let mut tiff = raw("tiff", 0, 0, 0, &[0x49, 0x49]);
+        tiff.compressed = true;
+        let e = decode_message(&tiff).unwrap_err();
+        assert!(e.contains("format 'tiff'"), "{e}");
         let mut jpeg = raw("jpeg", 0, 0, 0, &[0xff, 0xd8]);
         jpeg.compressed = true;
         let e = decode_message(&jpeg).unwrap_err();
-        assert!(e.contains("format 'jpeg'"), "{e}");
+        assert!(e.contains("not a readable JPEG image"), "{e}");
         let mut png = raw("png", 0, 0, 0, &[]);
         let bytes = encode(2, 2, &[5, 6, 7, 8]);
         png.data = &bytes;

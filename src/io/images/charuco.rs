@@ -15,38 +15,97 @@
 //!
 //! **Legacy pattern.** OpenCV before 4.6 (and `setLegacyPattern(true)`
 //! since) places the markers in the other squares when the board has an
-//! even number of rows; the crate reads only the current layout, so such a
-//! board is refused before any image is read ([`check_pattern`]). With an
-//! odd number of rows both layouts are the same board.
+//! even number of rows ([`super::layout`]); the crate reads only the
+//! current layout. A legacy board of `rows × cols` squares is the lower
+//! `rows` rows of a current-layout board of `rows + 1` rows whose first
+//! row's `⌊cols / 2⌋` markers are not printed: the crate is given that
+//! board, its markers numbered as the legacy board's after that first
+//! row's (codes of the dictionary the board does not use), and its
+//! corners' ids less `cols − 1` (the first row of inner corners, on the
+//! printed board's edge, is dropped).
+//!
+//! **Ids checked.** Every detection's ids are checked against the image
+//! itself ([`super::layout`]): the markers read in the squares whose four
+//! corners were found must be those the layout puts there. A board
+//! printed in the other layout than the target says is refused with that
+//! reason, never labelled with another corner's ids.
 
 use super::decode::Gray;
 use super::detect::Located;
+use super::layout::{self, Layout};
 use crate::io::camera_target::CharucoPattern;
 use calib_targets_charuco::{
-    CharucoBoardSpec, CharucoDetection, CharucoDetector, CharucoParams, GrayImageView,
-    MarkerLayout, resolve_dictionary,
+    CharucoBoardSpec, CharucoDetector, CharucoParams, Dictionary, GrayImageView, MarkerLayout,
+    resolve_dictionary,
 };
 use chess_corners::UpscaleConfig;
+use std::collections::HashMap;
+use std::sync::{Mutex, PoisonError};
 
 /// Why `p` cannot be detected in images, if it cannot: no dictionary
-/// named, or OpenCV's legacy pattern on an even number of rows (see the
-/// module documentation).
+/// named, or a legacy board whose dictionary holds too few markers for
+/// the crate's board (see the module documentation).
 pub fn check_pattern(p: &CharucoPattern) -> Result<(), String> {
     let Some(name) = &p.dictionary else {
         return Err("a ChArUco board is detected by its markers: the target's 'charuco.dictionary' must name their ArUco dictionary (OpenCV's name, e.g. DICT_4X4_50)".into());
     };
-    if resolve_dictionary(name).is_none() {
+    let Some(dictionary) = resolve_dictionary(name) else {
         return Err(format!(
             "'{name}' is not an ArUco dictionary activecal knows"
         ));
-    }
-    if p.legacy_pattern && p.rows % 2 == 0 {
+    };
+    crate_board(p, dictionary).map(|_| ())
+}
+
+/// The board the crate is given for `p`, and how much to take off its
+/// corners' ids (see the module documentation).
+fn crate_board(p: &CharucoPattern, dictionary: Dictionary) -> Result<(CharucoBoardSpec, usize), String> {
+    let (rows, dictionary, shift) = if p.legacy_pattern && p.rows % 2 == 0 {
+        (p.rows + 1, legacy_dictionary(dictionary, p.rows, p.cols)?, p.cols - 1)
+    } else {
+        (p.rows, dictionary, 0)
+    };
+    let spec = CharucoBoardSpec::new(
+        rows as u32,
+        p.cols as u32,
+        (1e3 * p.square) as f32,
+        (p.marker / p.square) as f32,
+        dictionary,
+    )
+    .with_marker_layout(MarkerLayout::OpenCvCharuco);
+    Ok((spec, shift))
+}
+
+/// The dictionary of the crate's board for a legacy board of `rows` (even)
+/// × `cols` squares: `⌊cols / 2⌋` codes the board does not print (those
+/// after its `rows · cols / 2` markers), then the board's own. Built once
+/// per dictionary and board size (the crate keeps codes for the program's
+/// life).
+fn legacy_dictionary(d: Dictionary, rows: usize, cols: usize) -> Result<Dictionary, String> {
+    static BUILT: Mutex<Vec<((&str, usize, usize), Dictionary)>> = Mutex::new(Vec::new());
+    let (n, pad) = (rows * cols / 2, cols / 2);
+    let codes = d.codes();
+    if codes.len() < n + pad {
         return Err(format!(
-            "a ChArUco board of {} rows printed with OpenCV's legacy pattern (legacy_pattern: true) places its markers in the other squares, which activecal does not detect yet; print the board with OpenCV ≥ 4.6's layout (the default), or one with an odd number of rows (both layouts are then the same)",
-            p.rows
+            "a ChArUco board of {rows} × {cols} squares in OpenCV's legacy layout (legacy_pattern: true) is detected with {pad} more markers than its {n} from its dictionary, and {} has {}",
+            d.name(),
+            codes.len()
         ));
     }
-    Ok(())
+    let mut built = BUILT.lock().unwrap_or_else(PoisonError::into_inner);
+    if let Some((_, b)) = built.iter().find(|(k, _)| *k == (d.name(), rows, cols)) {
+        return Ok(*b);
+    }
+    let v: Vec<u64> = codes[n..n + pad].iter().chain(&codes[..n]).copied().collect();
+    let b = Dictionary::from_static_codes(
+        d.name(),
+        d.marker_size(),
+        d.max_correction_bits(),
+        Box::leak(v.into_boxed_slice()),
+    )
+    .map_err(|e| format!("the legacy board's dictionary ({e:?})"))?;
+    built.push(((d.name(), rows, cols), b));
+    Ok(b)
 }
 
 /// The corners of the ChArUco board `p` found in `img`, by id, with each
@@ -60,20 +119,16 @@ pub fn find_charuco(img: &Gray, p: &CharucoPattern) -> Result<Vec<Located>, Stri
         .as_deref()
         .and_then(resolve_dictionary)
         .ok_or("no dictionary")?;
-    let spec = CharucoBoardSpec::new(
-        p.rows as u32,
-        p.cols as u32,
-        (1e3 * p.square) as f32,
-        (p.marker / p.square) as f32,
-        dictionary,
-    )
-    .with_marker_layout(MarkerLayout::OpenCvCharuco);
+    let (spec, shift) = crate_board(p, dictionary)?;
+    let layout = Layout::opencv(p.rows, p.cols, p.legacy_pattern);
     let view = GrayImageView {
         width: img.width,
         height: img.height,
         data: &img.data,
     };
-    let mut best: Option<CharucoDetection> = None;
+    let n = (p.rows - 1) * (p.cols - 1);
+    let mut best: Option<Vec<(usize, [f64; 2])>> = None;
+    let mut refused: Option<(usize, String)> = None;
     let mut why = String::from("no ChArUco board");
     for upscale in [1, 2] {
         for mut params in CharucoParams::sweep_for_board(&spec) {
@@ -83,35 +138,41 @@ pub fn find_charuco(img: &Gray, p: &CharucoPattern) -> Result<Vec<Located>, Stri
             let Ok(detector) = CharucoDetector::new(params) else {
                 continue;
             };
-            match detector.detect(&view) {
-                Ok(d)
-                    if best
-                        .as_ref()
-                        .is_none_or(|b| d.corners.len() > b.corners.len()) =>
-                {
-                    best = Some(d);
+            let d = match detector.detect(&view) {
+                Ok(d) => d,
+                Err(e) => {
+                    why = format!("no ChArUco board ({e})");
+                    continue;
                 }
-                Ok(_) => {}
-                Err(e) => why = format!("no ChArUco board ({e})"),
+            };
+            let corners: Vec<(usize, [f64; 2])> = d
+                .corners
+                .iter()
+                .filter_map(|c| {
+                    let id = (c.id as usize).checked_sub(shift)?;
+                    (id < n).then(|| (id, [f64::from(c.position.x), f64::from(c.position.y)]))
+                })
+                .collect();
+            match check_ids(img, &corners, p, dictionary, &layout) {
+                Ok(()) if best.as_ref().is_none_or(|b| corners.len() > b.len()) => {
+                    best = Some(corners);
+                }
+                Ok(()) => {}
+                Err(e) if refused.as_ref().is_none_or(|r| corners.len() > r.0) => {
+                    refused = Some((corners.len(), e));
+                }
+                Err(_) => {}
             }
         }
         if best.is_some() {
             break;
         }
     }
-    let d = best.ok_or(why)?;
-    let n = (p.rows - 1) * (p.cols - 1);
-    let corners: Vec<(usize, [f64; 2])> = d
-        .corners
-        .iter()
-        .filter(|c| (c.id as usize) < n)
-        .map(|c| {
-            (
-                c.id as usize,
-                [f64::from(c.position.x), f64::from(c.position.y)],
-            )
-        })
-        .collect();
+    let corners = match (best, refused) {
+        (Some(c), _) => c,
+        (None, Some((_, e))) => return Err(e),
+        (None, None) => return Err(why),
+    };
     // The distance from a corner to the nearest marker corner, in squares
     // (the white square's margin around its marker, diagonally), within
     // half a square.
@@ -129,6 +190,51 @@ pub fn find_charuco(img: &Gray, p: &CharucoPattern) -> Result<Vec<Located>, Stri
             }
         })
         .collect())
+}
+
+/// Whether the markers read in the squares of the `corners` found (by id
+/// on the board `p`) are those `layout` puts there; the error says which
+/// layout they are, in words.
+fn check_ids(
+    img: &Gray,
+    corners: &[(usize, [f64; 2])],
+    p: &CharucoPattern,
+    dictionary: Dictionary,
+    layout: &Layout,
+) -> Result<(), String> {
+    let inner = p.cols - 1;
+    let by_corner: HashMap<[i64; 2], [f64; 2]> = corners
+        .iter()
+        .map(|&(id, px)| ([(id % inner + 1) as i64, (id / inner + 1) as i64], px))
+        .collect();
+    let Some(grid) = layout::Grid::new(&by_corner) else {
+        return Err(format!(
+            "{} corner(s) found, too few to check their ids against the markers",
+            corners.len()
+        ));
+    };
+    let rel = p.marker / p.square;
+    let reads = layout::read_markers(img, &grid, (p.rows, p.cols), dictionary, rel);
+    let a = layout::agreement(layout, &reads);
+    let white = layout::white_where_black(img, &grid, layout, rel).unwrap_or(0);
+    if a.disagree == 0 && white == 0 {
+        return Ok(());
+    }
+    let counts = format!(
+        "{} of the {} markers read on and around the board are not where its layout puts them, {white} of its squares without a marker are not black",
+        a.disagree,
+        reads.len()
+    );
+    let other = Layout::opencv(p.rows, p.cols, !p.legacy_pattern);
+    Err(if other != *layout && layout::explained_by(&other, &reads) {
+        if p.legacy_pattern {
+            format!("{counts}: the markers read are those of OpenCV's current layout (4.6 and later): is the board printed without setLegacyPattern(true)? remove `legacy_pattern: true`")
+        } else {
+            format!("{counts}: the markers read are those of OpenCV's legacy layout: is the board printed with setLegacyPattern(true)? say `legacy_pattern: true`")
+        }
+    } else {
+        format!("markers disagree with the board's layout ({counts})")
+    })
 }
 
 /// The shortest square side at corner `id` (at `px`): the least distance
@@ -162,13 +268,17 @@ mod tests {
     }
 
     #[test]
-    fn a_board_without_its_dictionary_or_in_the_legacy_layout_is_refused_in_words() {
+    fn a_board_without_its_dictionary_or_too_large_for_its_legacy_detection_is_refused_in_words() {
         let e = check_pattern(&pattern(4, None, false)).unwrap_err();
         assert!(e.contains("'charuco.dictionary'"), "{e}");
-        let e = check_pattern(&pattern(4, Some("DICT_4X4_50"), true)).unwrap_err();
-        assert!(e.contains("legacy pattern") && e.contains("4 rows"), "{e}");
-        // An odd number of rows: both layouts are the same board.
+        assert!(check_pattern(&pattern(4, Some("DICT_4X4_50"), true)).is_ok());
         assert!(check_pattern(&pattern(5, Some("DICT_4X4_50"), true)).is_ok());
+        // A legacy board of 20 × 5 squares uses DICT_4X4_50's 50 markers;
+        // the crate's board needs 2 more.
+        let mut big = pattern(20, Some("DICT_4X4_50"), true);
+        big.cols = 5;
+        let e = check_pattern(&big).unwrap_err();
+        assert!(e.contains("2 more markers than its 50") && e.contains("has 50"), "{e}");
         assert!(check_pattern(&pattern(4, Some("DICT_5X5_100"), false)).is_ok());
     }
 

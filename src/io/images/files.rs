@@ -1,4 +1,5 @@
-//! The image files a `DIR|GLOB` names: every `.png` in a directory, or
+//! The image files a `DIR|GLOB` names: every `.png`, `.jpg` or `.jpeg`
+//! (in any case) in a directory, or
 //! the files whose names match a pattern (`*` any run of characters, `?`
 //! one character, in the file name only: `shots/pose_*.png`), or one
 //! file; sorted by name.
@@ -21,10 +22,14 @@ pub fn image_files(spec: &Path) -> Result<Vec<PathBuf>> {
         let files = listed(spec, |n| {
             Path::new(n)
                 .extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+                .is_some_and(|e| {
+                    ["png", "jpg", "jpeg"]
+                        .iter()
+                        .any(|k| e.eq_ignore_ascii_case(k))
+                })
         })?;
         if files.is_empty() {
-            return Err(err("the directory holds no .png image".into()));
+            return Err(err("the directory holds no .png, .jpg or .jpeg image".into()));
         }
         return Ok(files);
     }
@@ -54,7 +59,7 @@ pub fn image_files(spec: &Path) -> Result<Vec<PathBuf>> {
         return Ok(vec![spec.to_path_buf()]);
     }
     Err(err(
-        "no such directory or file (give a directory of .png images, a pattern such as 'dir/*.png', or one image)".into(),
+        "no such directory or file (give a directory of .png or .jpg images, a pattern such as 'dir/*.png', or one image)".into(),
     ))
 }
 
@@ -120,7 +125,7 @@ mod tests {
     fn a_directory_a_pattern_and_a_file_name_their_images() {
         let d = std::env::temp_dir().join(format!("activecal-image-files-{}", std::process::id()));
         std::fs::create_dir_all(&d).unwrap();
-        for f in ["b.png", "a.png", "notes.txt", "c.PNG"] {
+        for f in ["b.png", "a.png", "notes.txt", "c.PNG", "d.jpg", "e.JPEG"] {
             std::fs::write(d.join(f), b"x").unwrap();
         }
         let names = |v: Vec<PathBuf>| -> Vec<String> {
@@ -128,7 +133,7 @@ mod tests {
                 .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
                 .collect()
         };
-        assert_eq!(names(image_files(&d).unwrap()), ["a.png", "b.png", "c.PNG"]);
+        assert_eq!(names(image_files(&d).unwrap()), ["a.png", "b.png", "c.PNG", "d.jpg", "e.JPEG"]);
         assert_eq!(
             names(image_files(&d.join("?.png")).unwrap()),
             ["a.png", "b.png"]

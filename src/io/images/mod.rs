@@ -21,6 +21,7 @@ pub mod decode;
 pub mod detect;
 pub mod files;
 pub mod joints;
+pub mod layout;
 pub mod refine;
 
 use super::camera_target::{CharucoPattern, Target};
@@ -213,7 +214,7 @@ fn one_image(
     intrinsics: &Intrinsics,
 ) -> std::result::Result<(Vec<Option<[f64; 2]>>, ImageOutcome), String> {
     let bytes = std::fs::read(path).map_err(|e| format!("unreadable ({e})"))?;
-    let img = decode::decode_png(&bytes)?;
+    let img = decode::decode_image(&bytes)?;
     detect_in(&img, board, n, intrinsics)
 }
 

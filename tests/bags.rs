@@ -679,7 +679,8 @@ fn a_bags_jpeg_frames_decode_to_the_pixels_of_their_files() {
     .unwrap();
     assert_eq!(frames.len(), 6);
     for k in 0..2 {
-        let file = std::fs::read(root().join(format!("fixtures/camera/jpeg/img_{k:03}.jpg"))).unwrap();
+        let file =
+            std::fs::read(root().join(format!("fixtures/camera/jpeg/img_{k:03}.jpg"))).unwrap();
         let want = decode_image(&file).unwrap();
         assert_eq!((want.width, want.height), (320, 240));
         assert_eq!(frames[k].as_ref().unwrap(), &want, "frame {k}");
@@ -695,7 +696,9 @@ fn a_bags_jpeg_frames_decode_to_the_pixels_of_their_files() {
     .unwrap();
     let dir = root().join("fixtures/camera/jpeg");
     let j = read_image_joints(&dir.join("joints.csv"), &robot, Default::default()).unwrap();
-    let files = read_images(&dir, &j, &target, &intrinsics).unwrap().observations;
+    let files = read_images(&dir, &j, &target, &intrinsics)
+        .unwrap()
+        .observations;
     let from_bag = bag_observations("/camera/image_jpeg");
     assert_eq!(from_bag.observations.pose_ids, vec![0, 1]);
     assert_eq!(from_bag.observations.seen, files.seen);

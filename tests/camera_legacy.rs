@@ -88,7 +88,10 @@ fn legacy_charuco_corners_found_in_the_committed_renders_carry_the_true_ids() {
     .unwrap();
     let e = errors(&r, &truth("fixtures/camera/charuco_legacy_truth.csv"));
     let (median, max) = (e[e.len() / 2], e[e.len() - 1]);
-    println!("{} corners of 4 × 12: {median:.3} px median, {max:.3} px max", e.len());
+    println!(
+        "{} corners of 4 × 12: {median:.3} px median, {max:.3} px max",
+        e.len()
+    );
     assert_eq!(r.observations.pose_ids, vec![0, 1, 2, 3]);
     assert_eq!(e.len(), 4 * 12);
     assert!(median < 0.1, "median {median} px");
@@ -134,15 +137,27 @@ fn a_charuco_board_in_the_other_layout_is_refused_saying_which() {
 #[test]
 fn every_marker_read_on_the_committed_renders_is_where_their_layout_puts_it() {
     for (dir, target) in [
-        ("fixtures/camera/charuco", "fixtures/camera/charuco_4x5.yaml"),
+        (
+            "fixtures/camera/charuco",
+            "fixtures/camera/charuco_4x5.yaml",
+        ),
         (LEGACY, "fixtures/camera/charuco_legacy_4x5.yaml"),
     ] {
-        let counts = marker_counts(&root().join(dir), &root().join(CHARUCO_INFO), &root().join(target));
+        let counts = marker_counts(
+            &root().join(dir),
+            &root().join(CHARUCO_INFO),
+            &root().join(target),
+        );
         assert_eq!(counts.len(), 4);
         for (f, c) in counts {
             let (agree, disagree, white) = c.unwrap_or_else(|e| panic!("{dir}/{f}: {e}"));
-            println!("{dir}/{f}: {agree} markers agree, {disagree} disagree, {white:?} plain squares not black");
-            assert!(agree >= 3 && disagree == 0, "{dir}/{f}: {agree} agree, {disagree} disagree");
+            println!(
+                "{dir}/{f}: {agree} markers agree, {disagree} disagree, {white:?} plain squares not black"
+            );
+            assert!(
+                agree >= 3 && disagree == 0,
+                "{dir}/{f}: {agree} agree, {disagree} disagree"
+            );
             assert_eq!(white, Some(0), "{dir}/{f}");
         }
     }
@@ -193,12 +208,19 @@ fn jpeg_images_give_the_corners_of_their_pngs() {
 /// (the check of `activecal::io::images::layout`), from the corners the
 /// detector labelled: `(file, (agree, disagree, squares without a marker
 /// not black))`, or the reason the image was refused.
-fn marker_counts(dir: &Path, info: &Path, target: &Path) -> Vec<(String, Result<(usize, usize, Option<usize>), String>)> {
-    use activecal::io::images::{charuco::find_charuco, decode::decode_image, files::image_files, layout};
+fn marker_counts(
+    dir: &Path,
+    info: &Path,
+    target: &Path,
+) -> Vec<(String, Result<(usize, usize, Option<usize>), String>)> {
+    use activecal::io::images::{
+        charuco::find_charuco, decode::decode_image, files::image_files, layout,
+    };
     let t = read_target(target).unwrap();
     let p = t.charuco.clone().unwrap();
     let _ = read_camera_info(info).unwrap();
-    let dictionary = calib_targets_aruco::resolve_dictionary(p.dictionary.as_deref().unwrap()).unwrap();
+    let dictionary =
+        calib_targets_aruco::resolve_dictionary(p.dictionary.as_deref().unwrap()).unwrap();
     let lay = layout::Layout::opencv(p.rows, p.cols, p.legacy_pattern);
     image_files(dir)
         .unwrap()

@@ -59,9 +59,16 @@ pub fn check_pattern(p: &CharucoPattern) -> Result<(), String> {
 
 /// The board the crate is given for `p`, and how much to take off its
 /// corners' ids (see the module documentation).
-fn crate_board(p: &CharucoPattern, dictionary: Dictionary) -> Result<(CharucoBoardSpec, usize), String> {
+fn crate_board(
+    p: &CharucoPattern,
+    dictionary: Dictionary,
+) -> Result<(CharucoBoardSpec, usize), String> {
     let (rows, dictionary, shift) = if p.legacy_pattern && p.rows % 2 == 0 {
-        (p.rows + 1, legacy_dictionary(dictionary, p.rows, p.cols)?, p.cols - 1)
+        (
+            p.rows + 1,
+            legacy_dictionary(dictionary, p.rows, p.cols)?,
+            p.cols - 1,
+        )
     } else {
         (p.rows, dictionary, 0)
     };
@@ -96,7 +103,11 @@ fn legacy_dictionary(d: Dictionary, rows: usize, cols: usize) -> Result<Dictiona
     if let Some((_, b)) = built.iter().find(|(k, _)| *k == (d.name(), rows, cols)) {
         return Ok(*b);
     }
-    let v: Vec<u64> = codes[n..n + pad].iter().chain(&codes[..n]).copied().collect();
+    let v: Vec<u64> = codes[n..n + pad]
+        .iter()
+        .chain(&codes[..n])
+        .copied()
+        .collect();
     let b = Dictionary::from_static_codes(
         d.name(),
         d.marker_size(),
@@ -226,15 +237,21 @@ fn check_ids(
         reads.len()
     );
     let other = Layout::opencv(p.rows, p.cols, !p.legacy_pattern);
-    Err(if other != *layout && layout::explained_by(&other, &reads) {
-        if p.legacy_pattern {
-            format!("{counts}: the markers read are those of OpenCV's current layout (4.6 and later): is the board printed without setLegacyPattern(true)? remove `legacy_pattern: true`")
+    Err(
+        if other != *layout && layout::explained_by(&other, &reads) {
+            if p.legacy_pattern {
+                format!(
+                    "{counts}: the markers read are those of OpenCV's current layout (4.6 and later): is the board printed without setLegacyPattern(true)? remove `legacy_pattern: true`"
+                )
+            } else {
+                format!(
+                    "{counts}: the markers read are those of OpenCV's legacy layout: is the board printed with setLegacyPattern(true)? say `legacy_pattern: true`"
+                )
+            }
         } else {
-            format!("{counts}: the markers read are those of OpenCV's legacy layout: is the board printed with setLegacyPattern(true)? say `legacy_pattern: true`")
-        }
-    } else {
-        format!("markers disagree with the board's layout ({counts})")
-    })
+            format!("markers disagree with the board's layout ({counts})")
+        },
+    )
 }
 
 /// The shortest square side at corner `id` (at `px`): the least distance
@@ -278,7 +295,10 @@ mod tests {
         let mut big = pattern(20, Some("DICT_4X4_50"), true);
         big.cols = 5;
         let e = check_pattern(&big).unwrap_err();
-        assert!(e.contains("2 more markers than its 50") && e.contains("has 50"), "{e}");
+        assert!(
+            e.contains("2 more markers than its 50") && e.contains("has 50"),
+            "{e}"
+        );
         assert!(check_pattern(&pattern(4, Some("DICT_5X5_100"), false)).is_ok());
     }
 

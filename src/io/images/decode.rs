@@ -177,8 +177,10 @@ mod tests {
     fn grey_and_colour_jpegs_decode_to_their_levels() {
         let enc = |img: image::DynamicImage| {
             let mut out = std::io::Cursor::new(Vec::new());
-            img.write_with_encoder(image::codecs::jpeg::JpegEncoder::new_with_quality(&mut out, 100))
-                .unwrap();
+            img.write_with_encoder(image::codecs::jpeg::JpegEncoder::new_with_quality(
+                &mut out, 100,
+            ))
+            .unwrap();
             out.into_inner()
         };
         let grey = image::GrayImage::from_pixel(16, 16, image::Luma([90]));
@@ -188,7 +190,11 @@ mod tests {
         for (rgb, want) in [([255, 0, 0], 76u8), ([0, 255, 0], 150), ([0, 0, 255], 29)] {
             let c = image::RgbImage::from_pixel(16, 16, image::Rgb(rgb));
             let g = decode_image(&enc(c.into())).unwrap();
-            assert!(g.data.iter().all(|&v| v.abs_diff(want) <= 2), "{rgb:?}: {:?}", &g.data[..4]);
+            assert!(
+                g.data.iter().all(|&v| v.abs_diff(want) <= 2),
+                "{rgb:?}: {:?}",
+                &g.data[..4]
+            );
         }
     }
 }

@@ -20,16 +20,16 @@ pub fn image_files(spec: &Path) -> Result<Vec<PathBuf>> {
         .unwrap_or_default();
     if spec.is_dir() {
         let files = listed(spec, |n| {
-            Path::new(n)
-                .extension()
-                .is_some_and(|e| {
-                    ["png", "jpg", "jpeg"]
-                        .iter()
-                        .any(|k| e.eq_ignore_ascii_case(k))
-                })
+            Path::new(n).extension().is_some_and(|e| {
+                ["png", "jpg", "jpeg"]
+                    .iter()
+                    .any(|k| e.eq_ignore_ascii_case(k))
+            })
         })?;
         if files.is_empty() {
-            return Err(err("the directory holds no .png, .jpg or .jpeg image".into()));
+            return Err(err(
+                "the directory holds no .png, .jpg or .jpeg image".into()
+            ));
         }
         return Ok(files);
     }
@@ -133,7 +133,10 @@ mod tests {
                 .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
                 .collect()
         };
-        assert_eq!(names(image_files(&d).unwrap()), ["a.png", "b.png", "c.PNG", "d.jpg", "e.JPEG"]);
+        assert_eq!(
+            names(image_files(&d).unwrap()),
+            ["a.png", "b.png", "c.PNG", "d.jpg", "e.JPEG"]
+        );
         assert_eq!(
             names(image_files(&d.join("?.png")).unwrap()),
             ["a.png", "b.png"]

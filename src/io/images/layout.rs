@@ -195,16 +195,22 @@ pub fn read_markers(
 /// the layout puts a black square. `None` when fewer than 2 of either
 /// were seen, or black and white are under 20 grey levels apart.
 #[must_use]
-pub fn white_where_black(img: &Gray, grid: &Grid<'_>, layout: &Layout, marker_rel: f64) -> Option<usize> {
+pub fn white_where_black(
+    img: &Gray,
+    grid: &Grid<'_>,
+    layout: &Layout,
+    marker_rel: f64,
+) -> Option<usize> {
     let inside = |p: [f64; 2]| {
-        (1.0..img.width as f64 - 2.0).contains(&p[0]) && (1.0..img.height as f64 - 2.0).contains(&p[1])
+        (1.0..img.width as f64 - 2.0).contains(&p[0])
+            && (1.0..img.height as f64 - 2.0).contains(&p[1])
     };
     let level = |square: [i64; 2], pts: &[[f64; 2]]| -> Option<f64> {
         let px: Vec<[f64; 2]> = pts.iter().map(|&q| grid.in_square(square, q)).collect();
-        let all = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]].map(|q| grid.in_square(square, q));
-        (all.iter().all(|p| inside(*p))).then(|| {
-            px.iter().map(|p| img.bilinear(p[0], p[1])).sum::<f64>() / px.len() as f64
-        })
+        let all =
+            [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]].map(|q| grid.in_square(square, q));
+        (all.iter().all(|p| inside(*p)))
+            .then(|| px.iter().map(|p| img.bilinear(p[0], p[1])).sum::<f64>() / px.len() as f64)
     };
     let centre: Vec<[f64; 2]> = (0..9)
         .map(|k| [0.3 + 0.2 * f64::from(k % 3), 0.3 + 0.2 * f64::from(k / 3)])
@@ -245,7 +251,9 @@ fn homography(pairs: &[([f64; 2], [f64; 2])]) -> Option<Matrix3<f64>> {
     let normaliser = |pts: &mut dyn Iterator<Item = [f64; 2]>| {
         let v: Vec<[f64; 2]> = pts.collect();
         let n = v.len() as f64;
-        let (cx, cy) = v.iter().fold((0.0, 0.0), |a, p| (a.0 + p[0] / n, a.1 + p[1] / n));
+        let (cx, cy) = v
+            .iter()
+            .fold((0.0, 0.0), |a, p| (a.0 + p[0] / n, a.1 + p[1] / n));
         let d = v.iter().map(|p| (p[0] - cx).hypot(p[1] - cy)).sum::<f64>() / n;
         let s = std::f64::consts::SQRT_2 / d.max(1e-12);
         Matrix3::new(s, 0.0, -s * cx, 0.0, s, -s * cy, 0.0, 0.0, 1.0)
@@ -357,9 +365,34 @@ mod tests {
     /// and after `setLegacyPattern(true)`.
     #[test]
     fn the_layouts_number_their_markers_row_by_row_in_opposite_squares() {
-        let current = [[1, 0], [3, 0], [0, 1], [2, 1], [4, 1], [1, 2], [3, 2], [0, 3], [2, 3], [4, 3]];
-        let legacy = [[0, 0], [2, 0], [4, 0], [1, 1], [3, 1], [0, 2], [2, 2], [4, 2], [1, 3], [3, 3]];
-        for (layout, want) in [(Layout::opencv(4, 5, false), current), (Layout::opencv(4, 5, true), legacy)] {
+        let current = [
+            [1, 0],
+            [3, 0],
+            [0, 1],
+            [2, 1],
+            [4, 1],
+            [1, 2],
+            [3, 2],
+            [0, 3],
+            [2, 3],
+            [4, 3],
+        ];
+        let legacy = [
+            [0, 0],
+            [2, 0],
+            [4, 0],
+            [1, 1],
+            [3, 1],
+            [0, 2],
+            [2, 2],
+            [4, 2],
+            [1, 3],
+            [3, 3],
+        ];
+        for (layout, want) in [
+            (Layout::opencv(4, 5, false), current),
+            (Layout::opencv(4, 5, true), legacy),
+        ] {
             assert_eq!(layout.markers(), 10);
             for (id, square) in want.iter().enumerate() {
                 assert_eq!(layout.square_of(id as u32), Some(*square));
@@ -396,16 +429,37 @@ mod tests {
                 id: current.at(s).unwrap(),
             })
             .collect();
-        assert_eq!(agreement(&current, &own), Agreement { agree: 3, disagree: 0 });
+        assert_eq!(
+            agreement(&current, &own),
+            Agreement {
+                agree: 3,
+                disagree: 0
+            }
+        );
         // A marker also read in the ring beside its own square: neither.
         let mut twice = own.clone();
-        twice.push(Read { square: [5, 2], id: current.at([3, 2]).unwrap() });
-        assert_eq!(agreement(&current, &twice), Agreement { agree: 3, disagree: 0 });
+        twice.push(Read {
+            square: [5, 2],
+            id: current.at([3, 2]).unwrap(),
+        });
+        assert_eq!(
+            agreement(&current, &twice),
+            Agreement {
+                agree: 3,
+                disagree: 0
+            }
+        );
         // Two markers that no single turn and shift place: not explained.
         // (The legacy board's own reads under the shift explain it.)
         let scattered = [
-            Read { square: [0, 0], id: 0 },
-            Read { square: [0, 1], id: 0 },
+            Read {
+                square: [0, 0],
+                id: 0,
+            },
+            Read {
+                square: [0, 1],
+                id: 0,
+            },
         ];
         assert!(!explained_by(&legacy, &scattered));
     }
@@ -431,8 +485,9 @@ mod tests {
         let q = fit * Vector3::new(4.0, -1.0, 1.0);
         let want = map(4.0, -1.0);
         assert!((q.x / q.z - want[0]).abs() < 1e-9 && (q.y / q.z - want[1]).abs() < 1e-9);
-        let line: Vec<([f64; 2], [f64; 2])> =
-            (0..5).map(|k| ([f64::from(k), 0.0], map(f64::from(k), 0.0))).collect();
+        let line: Vec<([f64; 2], [f64; 2])> = (0..5)
+            .map(|k| ([f64::from(k), 0.0], map(f64::from(k), 0.0)))
+            .collect();
         assert!(homography(&line).is_none());
     }
 }

@@ -174,20 +174,24 @@ pub(crate) struct BagInput {
 
 /// The calibration of `robot` from the bag `b` with the fit's settings
 /// `s`: the library's pipeline `calibrate --bag` runs
-/// ([`activecal::experiment::bag::calibrate_bag`]), with what the report
-/// says of the bag (`report["bag"]`, as the command line's JSON).
+/// ([`activecal::experiment::bag::calibrate_bag`]), whose report says
+/// what it found in the bag (`report["bag"]`, as the command line's JSON).
 pub(crate) fn calibrate_from(
     b: BagInput,
     robot: &activecal::model::Robot,
     s: &activecal::experiment::measured::MeasuredSettings,
-) -> Result<(BagCalibration, serde_json::Value), Fail> {
+) -> Result<BagCalibration, Fail> {
     let mut x = b.settings;
     if let Some(d) = &b.design {
         x.design = Some(activecal::io::bag::design::read_design(d, robot)?);
     }
-    let got = activecal::experiment::bag::calibrate_bag(&b.path, robot, &x, s, &mut |_| {})?;
-    let section = serde_json::to_value(got.section())?;
-    Ok((got, section))
+    Ok(activecal::experiment::bag::calibrate_bag(
+        &b.path,
+        robot,
+        &x,
+        s,
+        &mut |_| {},
+    )?)
 }
 
 /// `calibrate`'s `points` as a bag's topic: with `bag` given, `points` is

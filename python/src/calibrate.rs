@@ -334,13 +334,10 @@ pub fn calibrate(
         crate::progress::with_callback(progress, || {
             detached(py, move || {
                 let t0 = std::time::Instant::now();
-                let (meas, c, source, bag) = fitted_input(input, &r, &settings)?;
+                let (meas, c, source) = fitted_input(input, &r, &settings)?;
                 let mut report = c.report;
                 report.base.elapsed_seconds = t0.elapsed().as_secs_f64();
-                let mut v = serde_json::to_value(&report)?;
-                if let Some(b) = bag {
-                    v["bag"] = b;
-                }
+                let v = serde_json::to_value(&report)?;
                 let summary = crate::page::KeptSummary::keep(
                     activecal::experiment::measured::summary::measured(
                         &c.robot,
@@ -386,12 +383,10 @@ type Fitted = (
     Measurements,
     activecal::experiment::measured::MeasuredCalibration,
     (String, String),
-    Option<serde_json::Value>,
 );
 
 /// The fit of `input` with `s`: the measurements fitted, the calibration,
-/// their source (its name, as the report folder describes it) and, for a
-/// bag, what the report says of it.
+/// and their source (its name, as the report folder describes it).
 fn fitted_input(
     input: Input,
     robot: &activecal::model::Robot,
@@ -402,13 +397,13 @@ fn fitted_input(
         Input::Arrays(d) => {
             let meas = Measurements::with_orientations(robot, d.qs, d.points, d.orientations)?;
             let c = calibrate_measurements(robot, &meas, ARRAYS, Vec::new(), s, &mut |_| {})?;
-            Ok((meas, c, (ARRAYS.into(), ARRAYS.into()), None))
+            Ok((meas, c, (ARRAYS.into(), ARRAYS.into())))
         }
         Input::Bag(b) => {
             let name = b.path.display().to_string();
             let described = format!("ROS 2 bag `{name}`");
-            let (g, bag) = crate::bag::calibrate_from(b, robot, s)?;
-            Ok((g.measurements, g.calibration, (name, described), Some(bag)))
+            let g = crate::bag::calibrate_from(b, robot, s)?;
+            Ok((g.measurements, g.calibration, (name, described)))
         }
     }
 }

@@ -177,8 +177,6 @@ fn from_measurements(a: &CalibrateArgs, robot: &Robot, path: &Path) -> Result<()
     let source = Source {
         name: path.display().to_string(),
         described: format!("measurements `{}`", path.display()),
-        json: None,
-        text: String::new(),
     };
     render_measured(a, &meas, c, &source, t0)
 }
@@ -206,17 +204,9 @@ fn from_bag(a: &CalibrateArgs, robot: &Robot) -> Result<()> {
         }
     };
     let got = activecal::experiment::bag::calibrate_bag(bag, robot, &x, &o, &mut print_note)?;
-    let json = serde_json::to_value(got.section())?;
-    let mut text = activecal::render::bag_text::extract_text(&got.extraction, None);
-    if let Some(c) = &got.clock {
-        text += &format!("{}\n", activecal::experiment::bag::clock_note(c));
-    }
-    text += "\n";
     let source = Source {
         name: bag.display().to_string(),
         described: format!("ROS 2 bag `{}`", bag.display()),
-        json: Some(("bag", json)),
-        text,
     };
     render_measured(a, &got.measurements, got.calibration, &source, t0)
 }
@@ -227,10 +217,6 @@ struct Source {
     name: String,
     /// In the report folder's summary.
     described: String,
-    /// A JSON object added to the output (`key`, value).
-    json: Option<(&'static str, serde_json::Value)>,
-    /// Text printed before the fit's.
-    text: String,
 }
 
 /// The settings of a fit of measured data from the options.
@@ -311,10 +297,7 @@ fn render_measured(
     if verdict.refusal().is_none() {
         report.base.out = write_calibrated(a, &fitted, id, &source.name, frames.as_ref())?;
     }
-    let mut v = serde_json::to_value(&report)?;
-    if let Some((key, value)) = &source.json {
-        v[*key] = value.clone();
-    }
+    let v = serde_json::to_value(&report)?;
     if let Some(dir) = &a.report {
         let described = format!("{}, {} poses", source.described, report.base.poses);
         let s = activecal::experiment::measured::summary::measured(
@@ -323,7 +306,10 @@ fn render_measured(
         activecal::render::folder::calibration(dir, &s)?;
     }
     super::emit(a.json, &v, || {
-        let mut s = source.text.clone();
+        let mut s = report
+            .bag
+            .as_ref()
+            .map_or(String::new(), activecal::render::bag_text::bag_section_text);
         s += &measured_text(&report, id, &status_text(id));
         if let Some(g) = &report.full_model_gain {
             let held_out = report.holdout.as_ref().map(|h| h.position_rms_mm.mean);

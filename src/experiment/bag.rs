@@ -6,10 +6,10 @@
 use super::error::ExperimentError;
 use super::measured::{MeasuredCalibration, MeasuredSettings, calibrate_read};
 use crate::data::Measurements;
-use crate::io::bag::clock::Offset;
 use crate::io::bag::extract::{ExtractReport, ExtractSettings, extract};
 use crate::model::Robot;
-use serde::Serialize;
+use crate::render::bag_text::clock_note;
+use crate::report::bag::{BagSection, ClockRefit};
 use std::path::Path;
 
 /// The measurements of the bag at `path` (one pose per kept rest), checked
@@ -83,55 +83,14 @@ pub fn notes(r: &ExtractReport) -> Vec<String> {
     out
 }
 
-/// How a calibration from a bag settled the clock offset: the estimate from
-/// the nominal model's predicted moves, the calibrated model's, and
-/// whether the data were extracted and fitted again with the latter.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct ClockRefit {
-    /// The estimate with the nominal model (s, with its uncertainty).
-    pub nominal: Offset,
-    /// The estimate with the calibrated model, when made (the first fit
-    /// converged and enough moves were seen).
-    pub calibrated: Option<Offset>,
-    /// Whether the calibrated model's estimate moved by more than the
-    /// nominal one's uncertainty, so that the bag was extracted and the
-    /// robot fitted once more with it.
-    pub refitted: bool,
-}
-
 /// A calibration from a ROS 2 bag: the measurements extracted (those of
-/// the final fit), the fit, the extraction's report and the clock.
+/// the final fit) and the fit, whose report says what the extraction found
+/// and how the clock was settled (`report.bag`).
 pub struct BagCalibration {
     /// The measurements fitted, one pose per kept rest.
     pub measurements: Measurements,
     /// The calibration of those measurements.
     pub calibration: MeasuredCalibration,
-    /// The extraction that gave them.
-    pub extraction: ExtractReport,
-    /// The clock offset estimated twice (`None`: given, or not estimated).
-    pub clock: Option<ClockRefit>,
-}
-
-/// What a calibration's report says of its bag: the extraction and, when
-/// the clock offset was estimated, both estimates.
-#[derive(Clone, Debug, Serialize)]
-pub struct BagSection<'a> {
-    /// The extraction that gave the measurements.
-    pub extraction: &'a ExtractReport,
-    /// The clock offset estimated twice, when it was estimated.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub clock_refit: Option<&'a ClockRefit>,
-}
-
-impl BagCalibration {
-    /// What the calibration's report says of its bag.
-    #[must_use]
-    pub fn section(&self) -> BagSection<'_> {
-        BagSection {
-            extraction: &self.extraction,
-            clock_refit: self.clock.as_ref(),
-        }
-    }
 }
 
 /// Calibrates `robot` from the bag at `path`: extracts one pose per rest
@@ -182,40 +141,21 @@ pub fn calibrate_bag(
     Ok(done(meas2, second, report2, Some(clock)))
 }
 
+/// The calibration of `measurements`, its report saying what the
+/// extraction found and how the clock was settled.
 fn done(
     measurements: Measurements,
-    calibration: MeasuredCalibration,
+    mut calibration: MeasuredCalibration,
     extraction: ExtractReport,
-    clock: Option<ClockRefit>,
+    clock_refit: Option<ClockRefit>,
 ) -> BagCalibration {
+    calibration.report.bag = Some(BagSection {
+        extraction,
+        clock_refit,
+    });
     BagCalibration {
         measurements,
         calibration,
-        extraction,
-        clock,
     }
 }
 
-/// The two estimates of the clock offset, as a note.
-#[must_use]
-pub fn clock_note(c: &ClockRefit) -> String {
-    let n = &c.nominal;
-    match &c.calibrated {
-        Some(k) => format!(
-            "clock offset with the calibrated model {:.4} s ± {:.4} s (nominal model {:.4} s ± {:.4} s): {}",
-            k.seconds,
-            k.uncertainty,
-            n.seconds,
-            n.uncertainty,
-            if c.refitted {
-                "moved by more than its uncertainty, extracted and fitted again"
-            } else {
-                "within the nominal estimate's uncertainty, kept"
-            }
-        ),
-        None => format!(
-            "clock offset {:.4} s ± {:.4} s with the nominal model, not estimated again",
-            n.seconds, n.uncertainty
-        ),
-    }
-}

@@ -5,6 +5,7 @@
 
 use crate::io::bag::camera::BagImagesReport;
 use crate::io::bag::extract::ExtractReport;
+use crate::report::bag::{BagSection, ClockRefit};
 use std::path::Path;
 
 /// The text form of a camera's extraction (`out`: the CSV written).
@@ -123,4 +124,39 @@ pub fn extract_text(r: &ExtractReport, out: Option<&Path>) -> String {
         s += &format!("wrote {} ({} poses)\n", out.display(), r.kept());
     }
     s
+}
+
+/// The two estimates of the clock offset, as a note.
+#[must_use]
+pub fn clock_note(c: &ClockRefit) -> String {
+    let n = &c.nominal;
+    match &c.calibrated {
+        Some(k) => format!(
+            "clock offset with the calibrated model {:.4} s ± {:.4} s (nominal model {:.4} s ± {:.4} s): {}",
+            k.seconds,
+            k.uncertainty,
+            n.seconds,
+            n.uncertainty,
+            if c.refitted {
+                "moved by more than its uncertainty, extracted and fitted again"
+            } else {
+                "within the nominal estimate's uncertainty, kept"
+            }
+        ),
+        None => format!(
+            "clock offset {:.4} s ± {:.4} s with the nominal model, not estimated again",
+            n.seconds, n.uncertainty
+        ),
+    }
+}
+
+/// What `calibrate --bag` prints before its fit: the extraction and, when
+/// the clock offset was estimated again, both estimates.
+#[must_use]
+pub fn bag_section_text(b: &BagSection) -> String {
+    let mut text = extract_text(&b.extraction, None);
+    if let Some(c) = &b.clock_refit {
+        text += &format!("{}\n", clock_note(c));
+    }
+    text + "\n"
 }

@@ -78,6 +78,9 @@ pub struct MeasuredReport {
     /// The exit status the verdict implies (0: written; 3: not converged,
     /// implausible or too few rows).
     pub exit_status: i32,
+    /// The ROS 2 bag the measurements were extracted from, when they were.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bag: Option<super::bag::BagSection>,
 }
 
 /// A restricted calibration beside the full model fitted to the same data

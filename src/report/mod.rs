@@ -4,6 +4,7 @@
 //! rebuilds them. (The bound's summary is how [`crate::bound::Bound`] serialises; the paper's
 //! experiment is [`crate::experiment::paper::PaperReport`].)
 
+pub mod bag;
 pub mod bench;
 mod bound;
 mod calibrate;

@@ -468,6 +468,7 @@ pub(super) fn fit_read(
         warnings,
         full_model_gain: None,
         exit_status: 0,
+        bag: None,
     };
     finish(r, f, report)
 }

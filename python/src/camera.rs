@@ -298,11 +298,9 @@ pub fn calibrate_camera(
                 .geodesic(true)
                 .build()?;
             let cal = activecal::experiment::camera::calibrate_camera(r, obs, &setup, &lm)
-                .map_err(Fail::input)?;
-            let mut report = serde_json::to_value(cal.report(Vec::new()))?;
-            if let (Some(i), Some(m)) = (images, report.as_object_mut()) {
-                m.insert("images".into(), i);
-            }
+                .map_err(Fail::input)?
+                .with_source(images);
+            let report = serde_json::to_value(cal.report(Vec::new()))?;
             Ok((cal, report))
         })
     })?;
@@ -342,8 +340,9 @@ pub(crate) fn read_observations(
 }
 
 /// The camera's observations for the chain `robot`: read, or detected
-/// in the images by the library (as `calibrate --images` does, with
-/// what became of each image, the report's `images`).
+/// in the images by the library (as `calibrate --images` does), with
+/// where they came from (for images, what became of each: the report's
+/// `images`).
 pub(crate) fn read_pixels(
     data: &PixelsSource,
     robot: &activecal::model::Robot,
@@ -352,13 +351,14 @@ pub(crate) fn read_pixels(
 ) -> Result<
     (
         activecal::data::CameraObservations,
-        Option<serde_json::Value>,
+        activecal::experiment::camera::CameraSource,
     ),
     Fail,
 > {
     let (origin, spec, joints) = match data {
         PixelsSource::Observations(s) => {
-            return read_observations(s, robot, target, intrinsics).map(|o| (o, None));
+            return read_observations(s, robot, target, intrinsics)
+                .map(|o| (o, activecal::experiment::camera::CameraSource::Pixels));
         }
         PixelsSource::Images {
             origin,
@@ -381,8 +381,10 @@ pub(crate) fn read_pixels(
     };
     let read = activecal::io::images::read_image_list(origin, files, &j, target, intrinsics)
         .map_err(|e| named("images", e))?;
-    let images = serde_json::to_value(&read.images).map_err(Fail::input)?;
-    Ok((read.observations, Some(images)))
+    Ok((
+        read.observations,
+        activecal::experiment::camera::CameraSource::Images(read.images),
+    ))
 }
 
 /// Writes `text` to `path` atomically; an existing file only with

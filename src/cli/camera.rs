@@ -9,7 +9,9 @@
 
 use super::calibrate_args::CalibrateArgs;
 use activecal::data::CameraObservations;
-use activecal::experiment::camera::{CameraCalibration, CameraCalibrationError, CameraSetup};
+use activecal::experiment::camera::{
+    CameraCalibration, CameraCalibrationError, CameraSetup, CameraSource,
+};
 use activecal::identify::LmSettings;
 use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_observations::read_observations;
@@ -97,14 +99,19 @@ pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot) -> Result<Option<Strin
         .max_iterations(a.max_iterations)
         .geodesic(!a.no_geodesic)
         .build()?;
-    let cal = activecal::experiment::camera::calibrate_camera(robot, obs, &setup, &lm).map_err(
-        |e| match e {
+    let source = match (&images, &bag) {
+        (Some(read), _) => CameraSource::Images(read.images.clone()),
+        (None, Some(r)) => CameraSource::Bag(r.clone()),
+        (None, None) => CameraSource::Pixels,
+    };
+    let cal = activecal::experiment::camera::calibrate_camera(robot, obs, &setup, &lm)
+        .map_err(|e| match e {
             CameraCalibrationError::Start { origin, error } => anyhow::Error::new(error).context(
                 format!("{origin}: no start computed from the pixels; give --camera-pose and --target-pose"),
             ),
             e => e.into(),
-        },
-    )?;
+        })?
+        .with_source(source);
     let (fit, frames) = (&cal.fit, &cal.frames);
     let mut written = Vec::new();
     // The library's verdict: a fit that did not converge or cannot be
@@ -129,17 +136,11 @@ pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot) -> Result<Option<Strin
         written.push(o.display().to_string());
     }
     if let (Some(dir), Some(read)) = (&a.report, &images) {
-        super::camera_images::write_sheet(dir, read, &cal, &setup.target, a.force)?;
+        // The directory was checked with the command's files, before any work.
+        activecal::experiment::camera::images::write_sheet_folder(dir, read, &cal, &setup.target)?;
         written.push(dir.join("contact_sheet.png").display().to_string());
     }
-    let mut v = serde_json::to_value(cal.report(written.clone()))?;
-    if let (Some(read), Some(m)) = (&images, v.as_object_mut()) {
-        m.insert("images".into(), serde_json::to_value(&read.images)?);
-    }
-    if let (Some(r), Some(m)) = (&bag, v.as_object_mut()) {
-        m.insert("images".into(), serde_json::to_value(r.images())?);
-        m.insert("bag".into(), serde_json::to_value(r)?);
-    }
+    let v = serde_json::to_value(cal.report(written.clone()))?;
     super::emit(a.json, &v, || {
         activecal::render::camera_text::text(&CameraText {
             fit,

@@ -1,11 +1,10 @@
 //! `calibrate --images DIR|GLOB --joints joints.csv`: the images read into
 //! the camera's observations by the library (`activecal::io::images`),
-//! `--save-observations` written before the fit, and with `--report DIR`
-//! the contact sheet after it.
+//! `--save-observations` written before the fit (with `--report DIR` the
+//! library writes the contact sheet after it,
+//! `activecal::experiment::camera::images::write_sheet_folder`).
 
 use super::calibrate_args::CalibrateArgs;
-use activecal::experiment::camera::CameraCalibration;
-use activecal::experiment::camera::images::sheet_images;
 use activecal::io::bag::camera::{BagImages, read_bag_images};
 use activecal::io::camera_observations::observations_csv;
 use activecal::io::camera_target::Target;
@@ -75,31 +74,4 @@ pub fn read_bag(
         super::write_new(path, &text, a.force).context("--save-observations")?;
     }
     Ok(got)
-}
-
-/// Writes `dir` (replaced whole, atomically) with `contact_sheet.png` and
-/// `images.json` (what became of each image).
-pub fn write_sheet(
-    dir: &Path,
-    read: &ImageObservations,
-    cal: &CameraCalibration,
-    target: &Target,
-    force: bool,
-) -> Result<()> {
-    super::run_files::check_dir("--report", dir, force)?;
-    let cols = match (target.grid, &target.charuco) {
-        (Some((_, cols)), _) => cols,
-        (None, Some(p)) => p.cols - 1,
-        (None, None) => 1,
-    };
-    let staged = activecal::io::atomic::StagedDir::new(dir)?;
-    let sheet = sheet_images(read, Some(cal), cols);
-    activecal::render::contact_sheet::write_contact_sheet(
-        &staged.path().join("contact_sheet.png"),
-        &sheet,
-    )?;
-    let json = serde_json::to_string_pretty(&read.images)?;
-    activecal::io::atomic::write_atomic(&staged.path().join("images.json"), json.as_bytes())?;
-    staged.commit()?;
-    Ok(())
 }

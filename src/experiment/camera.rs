@@ -148,6 +148,21 @@ pub struct CameraCalibration {
     pub notes: Vec<String>,
     /// σ̂ tested against the stated pixel noise, when one was given.
     pub noise_test: Option<BlockNoiseTest>,
+    /// Where the pixels came from, as the report shows it
+    /// ([`Self::with_source`]; a pixels file unless said).
+    pub source: CameraSource,
+}
+
+/// Where a camera calibration's pixels came from, as its report shows it.
+#[derive(Clone, Debug, Default)]
+pub enum CameraSource {
+    /// Pixels given (a file, arrays).
+    #[default]
+    Pixels,
+    /// Detected in image files: what became of each image.
+    Images(Vec<crate::io::images::ImageReport>),
+    /// Detected in a ROS 2 bag's image topic: what was read from it.
+    Bag(crate::io::bag::camera::BagImagesReport),
 }
 
 /// Calibrates `robot` (the chain from the camera's link for a camera on
@@ -251,6 +266,7 @@ pub fn calibrate_camera(
         outlier_choice: setup.outliers,
         notes: screened.notes,
         noise_test,
+        source: CameraSource::Pixels,
     };
     cal.verdict = verdict::camera_verdict(&cal, &setup.target_origin, extent(&setup.target));
     Ok(cal)
@@ -265,6 +281,13 @@ fn extent(target: &Target) -> f64 {
 }
 
 impl CameraCalibration {
+    /// The calibration, its pixels from `source`.
+    #[must_use]
+    pub fn with_source(mut self, source: CameraSource) -> Self {
+        self.source = source;
+        self
+    }
+
     /// The report, with the files `out` written from it.
     #[must_use]
     pub fn report(&self, out: Vec<String>) -> CameraCalibrationReport {
@@ -306,6 +329,15 @@ impl CameraCalibration {
             refused: self.verdict.refusal().map(str::to_string),
             exit_status: self.verdict.exit_status(),
             out,
+            images: match &self.source {
+                CameraSource::Pixels => None,
+                CameraSource::Images(i) => Some(i.clone()),
+                CameraSource::Bag(b) => Some(b.images()),
+            },
+            bag: match &self.source {
+                CameraSource::Bag(b) => Some(b.clone()),
+                _ => None,
+            },
         }
     }
 

@@ -553,3 +553,17 @@ pub fn contacts(
     staged.commit()?;
     Ok(())
 }
+
+/// Writes `calibrate --images … --report DIR` (replaced whole,
+/// atomically): `contact_sheet.png` (the sheet's `images`) and
+/// `images.json` (what became of each image, `reports`).
+pub fn camera_images(
+    dir: &Path,
+    images: &[super::contact_sheet::SheetImage],
+    reports: &[crate::io::images::ImageReport],
+) -> Result<()> {
+    let staged = StagedDir::new(dir)?;
+    super::contact_sheet::write_contact_sheet(&staged.path().join("contact_sheet.png"), images)?;
+    put(&staged, "images.json", &json_text(reports)?)?;
+    staged.commit()
+}

@@ -86,6 +86,13 @@ pub struct CameraCalibrationReport {
     pub exit_status: i32,
     /// The files written.
     pub out: Vec<String>,
+    /// What became of each image, when the pixels were detected in images
+    /// (files or a bag's image topic).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub images: Option<Vec<crate::io::images::ImageReport>>,
+    /// What was read from the ROS 2 bag, when the images came from one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bag: Option<crate::io::bag::camera::BagImagesReport>,
 }
 
 /// The camera's gross-error test in a report.

@@ -9,7 +9,28 @@ use super::CameraCalibration;
 use crate::identify::camera::screen::{CameraUnit, pixel_residuals};
 use crate::io::images::decode::{Gray, decode_image};
 use crate::io::images::{ImageObservations, ImageOutcome, ImageReport};
+use crate::io::camera_target::Target;
 use crate::render::contact_sheet::SheetImage;
+use std::path::Path;
+
+/// Writes the folder `dir` of a calibration from images (replaced whole,
+/// atomically, [`crate::render::folder::camera_images`]): the contact
+/// sheet of `read`'s images as `cal` fitted them, and what became of each
+/// image; `target`'s inner corners per row number the sheet's points.
+pub fn write_sheet_folder(
+    dir: &Path,
+    read: &ImageObservations,
+    cal: &CameraCalibration,
+    target: &Target,
+) -> crate::error::Result<()> {
+    let cols = match (target.grid, &target.charuco) {
+        (Some((_, cols)), _) => cols,
+        (None, Some(p)) => p.cols - 1,
+        (None, None) => 1,
+    };
+    let sheet = sheet_images(read, Some(cal), cols);
+    crate::render::folder::camera_images(dir, &sheet, &read.images)
+}
 
 /// The sheet's images: every image read, in order, with its points
 /// (as fitted when `cal` is given), residuals and reason for being left

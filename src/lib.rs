@@ -25,6 +25,7 @@ pub mod measure;
 pub mod model;
 pub mod names;
 pub mod observability;
+pub mod options;
 pub mod pool;
 pub mod progress;
 pub mod render;

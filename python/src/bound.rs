@@ -4,8 +4,9 @@
 use crate::convert::{detached, json_to_py};
 use crate::robot::Robot;
 use crate::select::{Design, candidates, existing_poses};
-use activecal::bound::{BoundSettings, relaxation_bound};
+use activecal::bound::relaxation_bound;
 use activecal::model::ParamSet;
+use activecal::options::BoundSettings;
 use activecal::report::BoundCommandReport;
 use pyo3::prelude::*;
 

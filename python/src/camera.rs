@@ -6,9 +6,9 @@ use crate::convert::{Fail, arg_err, detached, float_array, json_to_py, ndarray};
 use crate::images::{ImagesSpec, PixelsSource};
 use crate::robot::Robot;
 use activecal::experiment::camera::{CameraCalibration as Calibrated, CameraSetup};
-use activecal::identify::LmSettings;
-use activecal::measure::camera::Mounting;
-use activecal::measure::pinhole::Intrinsics;
+use activecal::options::Intrinsics;
+use activecal::options::LmSettings;
+use activecal::options::Mounting;
 use activecal::write::calibrated::Format;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -287,8 +287,8 @@ pub fn calibrate_camera(
                 target_origin,
                 mounting: m,
                 camera_link,
-                camera: cam0.map(|c| activecal::pool::camera_view::placement(&c)),
-                target_pose: tgt0.map(|t| activecal::pool::camera_view::placement(&t)),
+                camera: cam0.map(|c| activecal::options::placement(&c)),
+                target_pose: tgt0.map(|t| activecal::options::placement(&t)),
                 refine_intrinsics,
                 outliers,
                 pixel_noise,
@@ -347,7 +347,7 @@ pub(crate) fn read_pixels(
     data: &PixelsSource,
     robot: &activecal::model::Robot,
     target: &activecal::io::camera_target::Target,
-    intrinsics: &activecal::measure::pinhole::Intrinsics,
+    intrinsics: &activecal::options::Intrinsics,
 ) -> Result<
     (
         activecal::data::CameraObservations,
@@ -455,8 +455,8 @@ impl CameraCalibration {
             &c.target
         };
         let (t, r) = (b.xyz, b.rpy);
-        let m = activecal::pool::camera_view::placement(&[t[0], t[1], t[2], r[0], r[1], r[2]])
-            .to_homogeneous();
+        let m =
+            activecal::options::placement(&[t[0], t[1], t[2], r[0], r[1], r[2]]).to_homogeneous();
         let rows: Vec<f64> = (0..4)
             .flat_map(|i| (0..4).map(move |j| (i, j)))
             .map(|(i, j)| m[(i, j)])

@@ -9,7 +9,7 @@ use activecal::experiment::camera_select::{
     CameraSelectPlan, CameraSelection, Candidates, DEFAULT_PIXEL_NOISE,
 };
 use activecal::model::robot_ref::{ChainChoice, RobotRef};
-use activecal::pool::camera_view::CameraView;
+use activecal::options::CameraView;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -135,11 +135,11 @@ pub fn select_camera(
                     count: samples,
                     seed: pool_seed,
                 },
-                settings: activecal::select::Settings::builder()
+                settings: activecal::options::SelectSettings::builder()
                     .n(n)
                     .seed(seed)
                     .build()?,
-                gap: gap.then(activecal::bound::BoundSettings::default),
+                gap: gap.then(activecal::options::BoundSettings::default),
                 pixel_noise,
                 robot_name,
                 chain,
@@ -193,7 +193,7 @@ impl CameraDesign {
         let noise = pixel_noise
             .or(self.sel.pixel_noise)
             .unwrap_or(DEFAULT_PIXEL_NOISE);
-        let bound = activecal::bound::BoundSettings::default();
+        let bound = activecal::options::BoundSettings::default();
         self.sel
             .curve(bound, noise, target_error)
             .map_err(|e| match e {

@@ -9,8 +9,8 @@ use activecal::data::{ContactFile, NamedDistance};
 use activecal::experiment::contacts::{
     ContactCalibration as Calibrated, calibrate_contacts as fit,
 };
-use activecal::identify::LmSettings;
-use activecal::identify::contact::ContactSettings;
+use activecal::options::ContactSettings;
+use activecal::options::LmSettings;
 use activecal::write::calibrated::Format;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;

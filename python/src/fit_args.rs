@@ -5,16 +5,16 @@
 
 use crate::convert::{arg_err, count};
 use activecal::experiment::acts_on::{self as lib_acts, Sensor};
-use activecal::identify::LossChoice;
-use activecal::identify::restriction::Restriction;
+use activecal::options::LossChoice;
+use activecal::options::Restriction;
 use pyo3::prelude::*;
 
 /// The `weights` and `orientation_scale` arguments, checked.
 pub(crate) fn weights_of(
     weights: Option<&str>,
     orientation_scale: Option<f64>,
-) -> PyResult<activecal::identify::Weights> {
-    use activecal::identify::Weights;
+) -> PyResult<activecal::options::Weights> {
+    use activecal::options::Weights;
     if let Some(w) = orientation_scale.filter(|w| !(w.is_finite() && *w > 0.0)) {
         return Err(arg_err(
             "orientation_scale",
@@ -40,8 +40,8 @@ pub(crate) fn holdout_of(
     holdout: Option<f64>,
     splits: i64,
     seed: i128,
-    weights: activecal::identify::Weights,
-) -> PyResult<Option<activecal::identify::HoldoutSettings>> {
+    weights: activecal::options::Weights,
+) -> PyResult<Option<activecal::options::HoldoutSettings>> {
     let splits = count("splits", splits, 1)?;
     let seed = crate::convert::non_negative("seed", seed)?;
     holdout
@@ -52,7 +52,7 @@ pub(crate) fn holdout_of(
                     format!("{fraction}: the fraction of poses held out is in (0, 1)"),
                 ));
             }
-            activecal::identify::HoldoutSettings::builder()
+            activecal::options::HoldoutSettings::builder()
                 .fraction(fraction)
                 .splits(splits)
                 .seed(seed)
@@ -149,10 +149,7 @@ pub(crate) fn refuse_unused(
 
 /// The outlier choice of `outliers=` ("drop" or "keep") and
 /// `outlier_rate=`.
-pub(crate) fn outliers_of(
-    kind: &str,
-    rate: f64,
-) -> PyResult<activecal::lsq::outliers::OutlierChoice> {
+pub(crate) fn outliers_of(kind: &str, rate: f64) -> PyResult<activecal::options::OutlierChoice> {
     use activecal::lsq::outliers::{OutlierChoice, check_choice};
     let c = match kind {
         "drop" => OutlierChoice::Drop { alpha: rate },

@@ -8,7 +8,7 @@ use crate::convert::{
 use crate::robot::Robot;
 use activecal::blocks::Blocks;
 use activecal::io::collision_choice::CollisionChoice;
-use activecal::pool::{Configurations, PoolFilter, PoolSource, PoolSpec};
+use activecal::options::{Configurations, PoolFilter, PoolSource, PoolSpec};
 use pyo3::prelude::*;
 use pyo3::types::PyString;
 use std::sync::Arc;
@@ -109,7 +109,7 @@ pub(crate) fn collision_choice(
 ) -> PyResult<CollisionChoice> {
     let obstacles = obstacles
         .iter()
-        .map(|o| activecal::collision::Obstacle::parse(o).map_err(|e| arg_err("obstacles", e)))
+        .map(|o| activecal::options::Obstacle::parse(o).map_err(|e| arg_err("obstacles", e)))
         .collect::<PyResult<Vec<_>>>()?;
     if let Some(z) = floor.filter(|z| !z.is_finite()) {
         return Err(arg_err(
@@ -289,8 +289,8 @@ pub(crate) fn pool_of(
         robot.check_joint_values(arg, &mut qs)?;
         (PoolSource::File { path: arg.into() }, Some(qs))
     };
-    let margin_deg =
-        margin.unwrap_or_else(|| activecal::pool::default_margin_deg(inner.source.is_some(), &src));
+    let margin_deg = margin
+        .unwrap_or_else(|| activecal::options::default_margin_deg(inner.source.is_some(), &src));
     let spec = PoolSpec {
         source: src,
         filters,

@@ -3,7 +3,7 @@
 
 use crate::convert::{arg_err, detached, float_array, ndarray};
 use activecal::io::{ChainChoice, MarkerChoice, RobotRef};
-use activecal::measure::Visibility;
+use activecal::options::Visibility;
 use pyo3::prelude::*;
 use pyo3::types::{PyString, PyTuple};
 use std::sync::Arc;

@@ -10,7 +10,7 @@ use activecal::experiment::visiting::Visiting;
 use activecal::io::design::DesignFile;
 use activecal::model::ParamSet;
 use activecal::names::Choice;
-use activecal::select::{Algorithm, CriterionKind, Settings};
+use activecal::options::{Algorithm, CriterionKind, SelectSettings as Settings};
 use pyo3::prelude::*;
 use std::sync::Arc;
 
@@ -130,7 +130,7 @@ pub fn select(
         .n(n)
         .initial(Settings::default().initial.min(n))
         .starts(starts)
-        .ils(ils.unwrap_or_else(|| activecal::select::default_ils_rounds(x.n_poses(), x.t())))
+        .ils(ils.unwrap_or_else(|| activecal::options::default_ils_rounds(x.n_poses(), x.t())))
         .kick(kick)
         .seed(seed)
         .prior(prior.clone())
@@ -259,7 +259,7 @@ impl Design {
                     ids,
                     activecal::experiment::gap::DesignPoses::InPool(&positions),
                     existing,
-                    &activecal::bound::BoundSettings::default(),
+                    &activecal::options::BoundSettings::default(),
                 )?;
                 Ok(serde_json::to_value(&scored.report)?)
             })

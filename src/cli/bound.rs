@@ -2,10 +2,11 @@
 //! design's D-efficiency against it.
 
 use super::{PoolOpts, emit_report, filters, load_description};
-use activecal::bound::{BoundSettings, RelaxationSolver, relaxation_bound};
+use activecal::bound::relaxation_bound;
 use activecal::experiment::gap::{DesignPoses, ScoredDesign, ScoringPool, score_design};
 use activecal::io::design::DesignFile;
 use activecal::model::ParamSet;
+use activecal::options::{BoundSettings, RelaxationSolver};
 use activecal::report::BoundCommandReport;
 use anyhow::Result;
 use clap::Args;
@@ -212,7 +213,7 @@ pub fn cmd_gap(a: GapArgs) -> Result<()> {
             b.status,
             b.certificate_gap,
             g.d_efficiency,
-            activecal::bound::gap::WEIGHT_TOL,
+            activecal::options::SUPPORT_WEIGHT,
             report.weighted_poses.len(),
             g.n,
             report.weighted_poses

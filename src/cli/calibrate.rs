@@ -8,8 +8,8 @@
 pub use super::calibrate_args::{CalibrateArgs, DEFAULT_NOISE};
 pub use super::calibrated::{EXIT_NOT_CONVERGED, NotConverged};
 use super::calibrated::{not_written, write_calibrated};
-use activecal::identify::LmSettings;
 use activecal::model::Robot;
+use activecal::options::LmSettings;
 use activecal::render::measured_text::{full_model_gain_text, measured_text, status_text};
 use activecal::write::calibrated::Format;
 use anyhow::{Context, Result, bail};
@@ -237,7 +237,7 @@ fn measured_settings(
         holdout: a
             .holdout
             .map(|fraction| {
-                activecal::identify::HoldoutSettings::builder()
+                activecal::options::HoldoutSettings::builder()
                     .fraction(fraction)
                     .splits(a.splits)
                     .seed(a.seed())
@@ -327,10 +327,10 @@ fn render_measured(
 }
 
 /// The weights of `--weights` (fixed whenever `--orientation-scale` is given).
-fn weights_of(a: &CalibrateArgs) -> activecal::identify::Weights {
+fn weights_of(a: &CalibrateArgs) -> activecal::options::Weights {
     use super::calibrate_args::WeightsKind;
     match (a.weights, a.orientation_scale) {
-        (WeightsKind::Fixed, _) | (_, Some(_)) => activecal::identify::Weights::Fixed,
-        (WeightsKind::Estimated, None) => activecal::identify::Weights::Estimated,
+        (WeightsKind::Fixed, _) | (_, Some(_)) => activecal::options::Weights::Fixed,
+        (WeightsKind::Estimated, None) => activecal::options::Weights::Estimated,
     }
 }

@@ -1,6 +1,6 @@
 //! The arguments of `calibrate`, parsed once.
 
-use activecal::identify::restriction::Restriction;
+use activecal::options::Restriction;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -433,9 +433,9 @@ pub enum MountingArg {
     EyeInHand,
 }
 
-impl From<MountingArg> for activecal::measure::camera::Mounting {
+impl From<MountingArg> for activecal::options::Mounting {
     fn from(m: MountingArg) -> Self {
-        use activecal::measure::camera::Mounting;
+        use activecal::options::Mounting;
         match m {
             MountingArg::EyeToHand => Mounting::EyeToHand,
             MountingArg::EyeInHand => Mounting::EyeInHand,
@@ -485,8 +485,8 @@ impl CalibrateArgs {
     /// The outlier choice of `--outliers` and `--outlier-rate`; the rate
     /// with `--outliers keep`, or either with a robust `--loss` (which keeps
     /// every pose), is refused.
-    pub fn outlier_choice(&self) -> anyhow::Result<activecal::lsq::outliers::OutlierChoice> {
-        use activecal::lsq::outliers::OutlierChoice;
+    pub fn outlier_choice(&self) -> anyhow::Result<activecal::options::OutlierChoice> {
+        use activecal::options::OutlierChoice;
         if let (Some(OutliersKind::Keep), Some(r)) = (self.outliers, self.outlier_rate) {
             anyhow::bail!(
                 "--outlier-rate {r}: is the rate of the test that drops poses; with --outliers keep no pose is dropped"
@@ -502,7 +502,9 @@ impl CalibrateArgs {
         }
         Ok(match self.outliers.unwrap_or(OutliersKind::Drop) {
             OutliersKind::Drop => OutlierChoice::Drop {
-                alpha: self.outlier_rate.unwrap_or(activecal::lsq::outliers::ALPHA),
+                alpha: self
+                    .outlier_rate
+                    .unwrap_or(activecal::options::DEFAULT_OUTLIER_ALPHA),
             },
             OutliersKind::Keep => OutlierChoice::Keep,
         })

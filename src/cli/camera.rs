@@ -12,15 +12,15 @@ use activecal::data::CameraObservations;
 use activecal::experiment::camera::{
     CameraCalibration, CameraCalibrationError, CameraSetup, CameraSource,
 };
-use activecal::identify::LmSettings;
 use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_observations::read_observations;
 use activecal::io::camera_target::read_target;
 use activecal::io::urdf_branch::camera_branch;
-use activecal::measure::camera::Mounting;
-use activecal::measure::pinhole::Intrinsics;
 use activecal::model::Robot;
-use activecal::pool::camera_view::placement;
+use activecal::options::Intrinsics;
+use activecal::options::LmSettings;
+use activecal::options::Mounting;
+use activecal::options::placement;
 use activecal::render::camera_text::CameraText;
 use activecal::write::calibrated::{Format, render};
 use anyhow::{Context, Result, bail};

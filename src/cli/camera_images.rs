@@ -10,8 +10,8 @@ use activecal::io::camera_observations::observations_csv;
 use activecal::io::camera_target::Target;
 use activecal::io::images::joints::read_image_joints;
 use activecal::io::images::{ImageObservations, read_images};
-use activecal::measure::pinhole::Intrinsics;
 use activecal::model::Robot;
+use activecal::options::Intrinsics;
 use anyhow::{Context, Result, bail};
 use std::path::Path;
 

@@ -1,6 +1,6 @@
 //! The camera options of `select` (`camera_select.rs` runs them).
 
-use activecal::pool::camera_view::DEFAULT_MAX_VIEW_ANGLE_DEG;
+use activecal::options::DEFAULT_MAX_VIEW_ANGLE_DEG;
 use clap::Args;
 use std::path::PathBuf;
 

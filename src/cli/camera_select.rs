@@ -22,7 +22,7 @@ use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_target::read_target;
 use activecal::io::collision_choice::CollisionChoice;
 use activecal::model::Robot;
-use activecal::pool::camera_view::CameraView;
+use activecal::options::CameraView;
 use anyhow::{Context, Result, bail};
 use std::path::PathBuf;
 
@@ -46,7 +46,7 @@ fn view(c: &CameraOpts) -> Result<CameraView> {
     };
     let m = match (c.mounting, &c.camera_link) {
         (Some(m), None) => m.into(),
-        (None, Some(_)) => activecal::measure::camera::Mounting::EyeToHand,
+        (None, Some(_)) => activecal::options::Mounting::EyeToHand,
         _ => bail!("--camera-info needs --mounting or --camera-link"),
     };
     let d = super::parse_list::<f64>(&c.distance, "--distance")?;
@@ -201,7 +201,7 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         collision: collision(a)?,
         line_of_sight: a.camera.line_of_sight,
         candidates: candidates(a, &listed_robot)?,
-        settings: activecal::select::Settings::builder()
+        settings: activecal::options::SelectSettings::builder()
             .n(a.n)
             .seed(a.seed)
             .build()?,
@@ -249,8 +249,8 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
 
 /// The certified bound's settings of `--gap` and `--report`'s curve
 /// (`--gap-solver`).
-fn bound(a: &SelectArgs) -> Result<activecal::bound::BoundSettings> {
-    Ok(activecal::bound::BoundSettings::builder()
+fn bound(a: &SelectArgs) -> Result<activecal::options::BoundSettings> {
+    Ok(activecal::options::BoundSettings::builder()
         .solver(a.gap_solver)
         .build()?)
 }

@@ -9,12 +9,12 @@ use activecal::data::{NamedDistance, NamedPlane};
 use activecal::experiment::contacts::{
     ContactInput, ContactInputError, ContactUse, checked_inputs,
 };
-use activecal::identify::LmSettings;
 use activecal::identify::contact::{
     ContactSettings, HoldoutMode, HoldoutReport, holdout_by_placement,
 };
 use activecal::io::contacts::read_contacts;
 use activecal::model::Robot;
+use activecal::options::LmSettings;
 use anyhow::{Result, bail};
 use std::path::Path;
 
@@ -131,7 +131,7 @@ pub struct ContactArgs<'a> {
     /// `--report DIR` (checked before the fit).
     pub report: Option<&'a Path>,
     /// `--outliers`, `--outlier-rate`.
-    pub outliers: activecal::lsq::outliers::OutlierChoice,
+    pub outliers: activecal::options::OutlierChoice,
 }
 
 /// Calibrates from a contact file; `Ok(Some(why))` when the fit did not

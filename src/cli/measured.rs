@@ -5,8 +5,9 @@
 
 use super::emit_report;
 use activecal::data::Measurements;
-use activecal::identify::{LossChoice, residuals};
+use activecal::identify::residuals;
 use activecal::model::Robot;
+use activecal::options::LossChoice;
 use activecal::report::measured::EvaluationReport;
 use anyhow::{Result, bail};
 use std::path::Path;

@@ -4,9 +4,10 @@
 
 use super::{choice, compliance, load_description, parse_robot, units};
 use activecal::io::{RobotRef, UrdfChain};
-use activecal::measure::Visibility;
 use activecal::model::{ParamSet, Robot};
-use activecal::pool::{Pool, PoolFilter, PoolSource, PoolSpec};
+use activecal::options::Visibility;
+use activecal::options::{PoolFilter, PoolSource, PoolSpec};
+use activecal::pool::Pool;
 use anyhow::Result;
 
 /// Where the candidate poses come from (`--pool`).
@@ -144,8 +145,8 @@ pub struct PoolOpts {
 }
 
 /// The joint-limit margin of a URDF robot when `--margin` is not given,
-/// degrees ([`activecal::pool::DEFAULT_URDF_MARGIN_DEG`]).
-pub const DEFAULT_MARGIN_DEG: f64 = activecal::pool::DEFAULT_URDF_MARGIN_DEG;
+/// degrees ([`activecal::options::DEFAULT_URDF_MARGIN_DEG`]).
+pub const DEFAULT_MARGIN_DEG: f64 = activecal::options::DEFAULT_URDF_MARGIN_DEG;
 
 /// A robot, its pose pool and the pool's identification Jacobian.
 pub struct PoolCtx {
@@ -247,7 +248,7 @@ impl PoolOpts {
                 anyhow::bail!("--margin {m}: the margin is an angle >= 0 degrees")
             }
             Some(m) => m,
-            None => activecal::pool::default_margin_deg(self.robot.is_urdf(), &self.source()?),
+            None => activecal::options::default_margin_deg(self.robot.is_urdf(), &self.source()?),
         };
         Ok(deg.to_radians())
     }
@@ -283,7 +284,7 @@ impl PoolOpts {
     /// (`--srdf` and `--package-dir` without a check are errors; the files
     /// must exist).
     pub fn collision_choice(&self) -> Result<activecal::io::collision_choice::CollisionChoice> {
-        use activecal::collision::Obstacle;
+        use activecal::options::Obstacle;
         let obstacles = self
             .obstacles
             .iter()

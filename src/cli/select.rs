@@ -2,9 +2,11 @@
 
 use super::{PoolOpts, emit_report, parse_list};
 use activecal::experiment::select::SelectRun;
-use activecal::identify::restriction::Restriction;
+use activecal::options::Restriction;
+use activecal::options::{
+    Algorithm, CriterionKind, SelectSettings as Settings, default_ils_rounds,
+};
 use activecal::report::SelectReport;
-use activecal::select::{Algorithm, CriterionKind, Settings, default_ils_rounds};
 use anyhow::{Result, bail};
 use clap::Args;
 use std::path::PathBuf;
@@ -84,8 +86,8 @@ pub struct SelectArgs {
     #[arg(long)]
     pub gap: bool,
     /// Solver of the bound for `--gap` (see `bound`).
-    #[arg(long, value_parser = super::choice::<activecal::bound::RelaxationSolver>(), default_value_t = activecal::bound::RelaxationSolver::Newton, requires = "gap")]
-    pub gap_solver: activecal::bound::RelaxationSolver,
+    #[arg(long, value_parser = super::choice::<activecal::options::RelaxationSolver>(), default_value_t = activecal::options::RelaxationSolver::Newton, requires = "gap")]
+    pub gap_solver: activecal::options::RelaxationSolver,
     /// Poses already measured: a CSV or JSON of joint configurations (as
     /// --pool file: reads them) or a JSON measurement file. The new poses
     /// maximise ln det(M0 + XᵀX) with M0 the information of these, and
@@ -280,7 +282,7 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         gap: a
             .gap
             .then(|| {
-                activecal::bound::BoundSettings::builder()
+                activecal::options::BoundSettings::builder()
                     .solver(a.gap_solver)
                     .build()
             })
@@ -288,7 +290,7 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         refine: a
             .refine
             .then(|| {
-                activecal::select::RefineSettings::builder()
+                activecal::options::RefineSettings::builder()
                     .sweeps(a.refine_sweeps)
                     .build()
             })
@@ -358,7 +360,7 @@ fn selection_settings(
     a: &SelectArgs,
     ctx: &super::PoolCtx,
     initial: usize,
-    prior: Option<activecal::criterion::Prior>,
+    prior: Option<activecal::options::Prior>,
 ) -> Result<Settings> {
     let fixed_ids: Vec<usize> = match &a.fixed {
         Some(f) => parse_list(f, "--fixed")?,

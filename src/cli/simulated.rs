@@ -7,9 +7,9 @@
 use super::calibrate_args::CalibrateArgs;
 use super::calibrated::{refuse_unconverged, write_calibrated};
 use super::{emit, write_new};
-use activecal::identify::{LmSettings, MonteCarloSettings};
 use activecal::io::design::DesignFile;
 use activecal::model::Robot;
+use activecal::options::{LmSettings, MonteCarloSettings};
 use anyhow::Result;
 use std::path::Path;
 use std::time::Instant;
@@ -23,7 +23,7 @@ use std::time::Instant;
 pub fn from_design(
     a: &CalibrateArgs,
     robot: &Robot,
-    described: Option<&activecal::measure::Visibility>,
+    described: Option<&activecal::options::Visibility>,
     design_path: &Path,
 ) -> Result<()> {
     let t0 = Instant::now();

@@ -7,9 +7,9 @@
 
 use super::CameraCalibration;
 use crate::identify::camera::screen::{CameraUnit, pixel_residuals};
+use crate::io::camera_target::Target;
 use crate::io::images::decode::{Gray, decode_image};
 use crate::io::images::{ImageObservations, ImageOutcome, ImageReport};
-use crate::io::camera_target::Target;
 use crate::render::contact_sheet::SheetImage;
 use std::path::Path;
 

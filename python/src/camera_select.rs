@@ -189,7 +189,7 @@ impl CameraDesign {
         &self,
         pixel_noise: Option<f64>,
         target_error: Option<f64>,
-    ) -> Result<activecal::how_many::PoseCountCurve, Fail> {
+    ) -> Result<activecal::report::PoseCountCurve, Fail> {
         let noise = pixel_noise
             .or(self.sel.pixel_noise)
             .unwrap_or(DEFAULT_PIXEL_NOISE);
@@ -197,8 +197,8 @@ impl CameraDesign {
         self.sel
             .curve(bound, noise, target_error)
             .map_err(|e| match e {
-                activecal::how_many::HowManyError::Input(e) => Fail::from(e),
-                activecal::how_many::HowManyError::Bound(e) => e.into(),
+                activecal::experiment::error::HowManyError::Input(e) => Fail::from(e),
+                activecal::experiment::error::HowManyError::Bound(e) => e.into(),
             })
     }
 

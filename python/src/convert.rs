@@ -57,9 +57,9 @@ impl From<activecal::Error> for Fail {
     }
 }
 
-impl From<activecal::identify::IdentifyError> for Fail {
+impl From<activecal::experiment::error::IdentifyError> for Fail {
     /// Bad input to identification (its own description).
-    fn from(e: activecal::identify::IdentifyError) -> Self {
+    fn from(e: activecal::experiment::error::IdentifyError) -> Self {
         Fail::Input(e.to_string())
     }
 }
@@ -71,16 +71,16 @@ impl From<activecal::data::DataError> for Fail {
     }
 }
 
-impl From<activecal::lsq::LsqError> for Fail {
+impl From<activecal::experiment::error::LsqError> for Fail {
     /// A solver setting out of range (an argument) or a problem it cannot
     /// take.
-    fn from(e: activecal::lsq::LsqError) -> Self {
+    fn from(e: activecal::experiment::error::LsqError) -> Self {
         Fail::Input(e.to_string())
     }
 }
 
-impl From<activecal::bound::BoundError> for Fail {
-    fn from(e: activecal::bound::BoundError) -> Self {
+impl From<activecal::experiment::error::BoundError> for Fail {
+    fn from(e: activecal::experiment::error::BoundError) -> Self {
         Fail::Compute(e.to_string())
     }
 }

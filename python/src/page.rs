@@ -5,13 +5,14 @@
 //! inline in Jupyter by a `Page`. Nothing of the page is assembled here.
 
 use crate::convert::{Fail, arg_err, detached};
+use activecal::experiment::error::HowManyError;
 use activecal::experiment::select::{CurveOf, how_many_curve};
-use activecal::how_many::{HowManyError, PoseCountCurve};
 use activecal::identify::Identification;
 use activecal::model::ParamSet;
 use activecal::model::Robot;
 use activecal::options::{Algorithm, CriterionKind, SelectSettings as Settings};
 use activecal::render::summary::{CalibrationSummary, FitPoses};
+use activecal::report::PoseCountCurve;
 use activecal::report::SelectReport;
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};

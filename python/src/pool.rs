@@ -207,20 +207,19 @@ pub(crate) fn build(
 ) -> PyResult<Pool> {
     let r = robot.clone();
     let (pool, x) = detached(py, move || {
-        let table = &r.nominal;
-        let pool = match listed {
-            Some(qs) => spec.build_listed(
-                &r,
-                table,
-                Configurations {
-                    qs,
-                    notes: Vec::new(),
-                },
-            )?,
-            None => spec.build(&r, table)?,
-        };
-        let x = pool.try_jacobian(&r, table)?;
-        Ok((pool, x))
+        let listed = listed.map(|qs| Configurations {
+            qs,
+            notes: Vec::new(),
+        });
+        let run = activecal::experiment::pool::build_pool(
+            (*r).clone(),
+            &spec,
+            listed,
+            activecal::units::Units::default(),
+            activecal::model::ParamSet::Nominal,
+            false,
+        )?;
+        Ok((run.pool, run.x))
     })?;
     Ok(Pool {
         robot: robot.clone(),

@@ -247,11 +247,7 @@ pub fn cmd_pool(a: PoolArgs) -> Result<()> {
         let levels = a.pool.levels.unwrap_or(super::DEFAULT_LEVELS);
         let r = LatticeReport::new(&robot, levels, Some(digits))?;
         return emit_report(a.json, &r, || {
-            let mut s = format!("lattice: {} levels per joint, {} poses\n", r.levels, r.size);
-            if let (Some(i), Some(q)) = (r.index, &r.q) {
-                s += &format!("index: {i}\nq (rad): {q:?}\n");
-            }
-            s
+            activecal::render::pool_text::lattice_text(&r)
         });
     }
     let d = super::load_description(&a.pool.robot)?;
@@ -267,38 +263,11 @@ pub fn cmd_pool(a: PoolArgs) -> Result<()> {
         super::write_new(out, &text, a.force)?;
     }
     emit_report(a.json, &r, || {
-        let mut s = super::pool_stats_text(&r.pool_stats);
-        if let Some(l) = pool.lattice() {
-            s += &format!(
-                "lattice: {} levels per joint, {} poses, {} distinct\n",
-                l.levels,
-                l.size(),
-                l.distinct_poses()
-            );
-        }
-        if r.pool.margin > 0.0 {
-            s += &format!(
-                "margin: {:.4}° inside every revolute joint's limits\n",
-                r.pool.margin.to_degrees()
-            );
-        }
-        for j in r.lattice.iter().flatten() {
-            s += &format!(
-                "  {}: {} levels{}, {} distinct\n",
-                j.name,
-                j.levels.len(),
-                if j.full_turn {
-                    " on the circle (the joint turns all the way round)"
-                } else {
-                    ""
-                },
-                j.distinct
-            );
-        }
-        s += &format!("{} poses kept, {} distinct\n", r.size, r.distinct);
-        if let Some(out) = &a.out {
-            s += &format!("wrote {}\n", out.display());
-        }
-        s
+        activecal::render::pool_text::pool_summary_text(
+            &r,
+            pool.lattice(),
+            super::pool_opts::SRDF_HINT,
+            a.out.as_deref(),
+        )
     })
 }

@@ -3,7 +3,6 @@
 
 use super::{PoolOpts, emit_report, filters, load_description};
 use activecal::bound::relaxation_bound;
-use activecal::experiment::gap::{DesignPoses, ScoredDesign, ScoringPool, score_design};
 use activecal::io::design::DesignFile;
 use activecal::model::ParamSet;
 use activecal::options::{BoundSettings, RelaxationSolver};
@@ -119,13 +118,10 @@ pub fn cmd_bound(a: BoundArgs) -> Result<()> {
             s += &super::existing_text(e);
         }
         s += &activecal::render::bound_text::bound_text(&b);
-        if let Some(support) = &report.support {
-            s += "pose      weight\n";
-            for w in support {
-                s += &format!("{:>6}  {:.6}\n", w.pose, w.w);
-            }
-        }
-        s
+        s + &report
+            .support
+            .as_deref()
+            .map_or(String::new(), activecal::render::bound_text::support_text)
     })
 }
 
@@ -135,88 +131,17 @@ pub fn cmd_gap(a: GapArgs) -> Result<()> {
     let settings = a.solve.settings()?;
     let d = DesignFile::read(&a.design)?;
     let desc = load_description(&d.robot_ref()?)?;
-    let mut spec = d.spec()?;
-    if d.pool.is_none() || a.visibility.is_some() {
-        spec.filters = filters(a.visibility.as_deref(), desc.visibility.as_ref())?;
-    }
-    let pool = d
-        .build_pool(&spec, &desc.robot, &desc.robot.nominal)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?;
-    let robot = super::design_compliance(desc.robot, &d)?;
-    let ctx = super::with_jacobian(robot, pool, a.params)?;
-    // A refined design's poses are off the pool: it is scored from its
-    // joint values against the bound of the pool it started from.
-    let positions = if d.refined {
-        Vec::new()
-    } else {
-        d.positions_in(&ctx.robot, &ctx.pool)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?
-    };
-    // A design chosen on top of existing poses is scored, and bounded, with
-    // their information (stored in the design file).
-    let existing = d
-        .existing
-        .as_ref()
-        .map(|e| {
-            super::existing_from(
-                e.path.clone(),
-                e.q.clone(),
-                Vec::new(),
-                &ctx.robot,
-                a.params,
-            )
-        })
+    let replaced = (d.pool.is_none() || a.visibility.is_some())
+        .then(|| filters(a.visibility.as_deref(), desc.visibility.as_ref()))
         .transpose()?;
-    let qs = if d.refined {
-        d.joint_values(&ctx.robot)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", a.design.display()))?
-    } else {
-        Vec::new()
-    };
-    let poses = if d.refined {
-        DesignPoses::Refined(&qs)
-    } else {
-        DesignPoses::InPool(&positions)
-    };
-    let on = ScoringPool {
-        robot: &ctx.robot,
-        pool: &ctx.pool,
-        x: &ctx.x,
-        params: a.params,
-    };
-    let ScoredDesign {
-        report,
-        bound: b,
-        gap: g,
-    } = score_design(on, d.poses.clone(), poses, existing, &settings)?;
+    let report = activecal::experiment::gap::gap_of_design_file(
+        &a.design, &d, desc, replaced, a.params, &settings,
+    )?;
     emit_report(a.json, &report, || {
-        let oid = g
-            .log10_oid
-            .map_or("singular (-inf)".to_string(), |l| format!("{l:.6}"));
-        let mut head = report
-            .existing
-            .as_ref()
-            .map_or(String::new(), super::existing_text);
-        if let Some(ex) = report.exceeds_bound {
-            head += &format!(
-                "refined design (poses off the pool): the pool's bound does not bound it; it {} that bound\n",
-                if ex { "EXCEEDS" } else { "stays below" }
-            );
-        }
-        head + &format!(
-            "design {} ({} poses, p = {})\nlog10 OI_D     {oid}\nlog10 bound    {:.6}  ({:?}, gap {:.1e})\nD-efficiency  >= {:.6}\n\
-             poses with relaxation weight > {}: {} of {}: {:?}\n",
-            a.design.display(),
-            g.n,
-            g.p,
-            g.log10_bound,
-            b.status,
-            b.certificate_gap,
-            g.d_efficiency,
+        activecal::render::design_text::gap_text(
+            &a.design.display().to_string(),
+            &report,
             activecal::options::SUPPORT_WEIGHT,
-            report.weighted_poses.len(),
-            g.n,
-            report.weighted_poses
         )
     })
 }

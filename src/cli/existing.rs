@@ -16,14 +16,3 @@ pub fn load_existing(
     use anyhow::Context;
     Existing::read(path, robot, params, units).context("--existing")
 }
-
-/// The prior information of poses `qs` (from `file`) at `params`.
-pub fn existing_from(
-    file: String,
-    qs: Vec<Vec<f64>>,
-    notes: Vec<String>,
-    robot: &Robot,
-    params: ParamSet,
-) -> Result<Existing> {
-    Ok(Existing::from_poses(file, qs, notes, robot, params)?)
-}

@@ -36,10 +36,8 @@ use anyhow::Result;
 use serde_json::Value;
 
 pub use activecal::render::select_text::existing_text;
-pub use existing::{existing_from, load_existing};
-pub use pool_opts::{
-    DEFAULT_LEVELS, PoolCtx, PoolKind, PoolOpts, filters, pool_stats_text, with_jacobian,
-};
+pub use existing::load_existing;
+pub use pool_opts::{DEFAULT_LEVELS, PoolCtx, PoolKind, PoolOpts, filters, pool_stats_text};
 
 /// Parses a comma-separated list, naming the option in the error.
 pub fn parse_list<T: std::str::FromStr>(s: &str, what: &str) -> Result<Vec<T>>
@@ -274,18 +272,4 @@ pub fn load_description(r: &RobotRef) -> Result<activecal::io::Description> {
     d.robot.validate()?;
     has_joints(&r.to_string(), &d.robot)?;
     Ok(d)
-}
-
-/// The robot with the compliance unknowns a design was chosen for
-/// (`select --compliance`), or as it is.
-pub fn design_compliance(robot: Robot, d: &activecal::io::design::DesignFile) -> Result<Robot> {
-    if d.compliance.is_empty() {
-        return Ok(robot);
-    }
-    let g = compliance::gravity_for(&robot, None, None)?;
-    Ok(activecal::identify::compliance::with_compliant_joints(
-        &robot,
-        &g,
-        &d.compliance,
-    )?)
 }

@@ -2,12 +2,11 @@
 //! `--count`, margins, filters), resolved once into a `PoolSpec`, and the
 //! pool with its Jacobian.
 
-use super::{choice, compliance, load_description, parse_robot, units};
+use super::{choice, load_description, parse_robot, units};
 use activecal::io::{RobotRef, UrdfChain};
 use activecal::model::{ParamSet, Robot};
 use activecal::options::Visibility;
 use activecal::options::{PoolFilter, PoolSource, PoolSpec};
-use activecal::pool::Pool;
 use anyhow::Result;
 
 /// Where the candidate poses come from (`--pool`).
@@ -148,15 +147,9 @@ pub struct PoolOpts {
 /// degrees ([`activecal::options::DEFAULT_URDF_MARGIN_DEG`]).
 pub const DEFAULT_MARGIN_DEG: f64 = activecal::options::DEFAULT_URDF_MARGIN_DEG;
 
-/// A robot, its pose pool and the pool's identification Jacobian.
-pub struct PoolCtx {
-    /// The robot.
-    pub robot: Robot,
-    /// The pool.
-    pub pool: Pool,
-    /// Identification Jacobian of every pool pose.
-    pub x: activecal::blocks::Blocks,
-}
+/// A robot, its pose pool and the pool's identification Jacobian
+/// ([`activecal::experiment::pool::build_pool`]).
+pub type PoolCtx = activecal::experiment::pool::PoolRun;
 
 /// The filters of a pool: `--visibility`, else the robot description's
 /// region, else none.
@@ -175,13 +168,6 @@ pub fn filters(
         (None, Some(vis)) => vec![PoolFilter::Visibility(vis.clone())],
         (None, None) => vec![],
     })
-}
-
-/// A built pool with its Jacobian at `params` (reserved fallibly: memory
-/// the system refuses is an error, not an abort).
-pub fn with_jacobian(robot: Robot, pool: Pool, params: ParamSet) -> Result<PoolCtx> {
-    let x = pool.try_jacobian(&robot, robot.params(params))?;
-    Ok(PoolCtx { robot, pool, x })
 }
 
 /// How this command line says where an SRDF is given, ending the pool
@@ -351,32 +337,17 @@ impl PoolOpts {
     }
 
     /// Builds the pool of these options and its Jacobian for a robot
-    /// already loaded (from [`PoolOpts::robot`]).
+    /// already loaded (from [`PoolOpts::robot`]); a pool file is read in
+    /// the options' units.
     pub fn load_for(&self, d: activecal::io::Description) -> Result<PoolCtx> {
         let spec = self.spec(&d)?;
-        if let PoolSource::File { path } = &spec.source {
-            let rows = activecal::pool::read_configurations_in(
-                std::path::Path::new(path),
-                &d.robot,
-                self.units.units(),
-            )?;
-            let pool = spec.build_listed(&d.robot, &d.robot.nominal, rows)?;
-            let robot = self.compliant(d.robot, &pool)?;
-            return with_jacobian(robot, pool, self.params);
-        }
-        let pool = spec.build(&d.robot, &d.robot.nominal)?;
-        let robot = self.compliant(d.robot, &pool)?;
-        with_jacobian(robot, pool, self.params)
-    }
-
-    /// With `--compliance`, the robot with a compliance unknown per joint
-    /// whose gravity torque varies over the pool.
-    fn compliant(&self, robot: Robot, pool: &Pool) -> Result<Robot> {
-        if !self.compliance {
-            return Ok(robot);
-        }
-        let g = compliance::gravity_for(&robot, None, None)?;
-        let qs: Vec<Vec<f64>> = (0..pool.len()).map(|k| pool.q(k)).collect();
-        Ok(activecal::identify::compliance::with_compliance_at(&robot, &g, &qs).0)
+        Ok(activecal::experiment::pool::build_pool(
+            d.robot,
+            &spec,
+            None,
+            self.units.units(),
+            self.params,
+            self.compliance,
+        )?)
     }
 }

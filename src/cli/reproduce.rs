@@ -3,11 +3,10 @@
 //! polish, the relaxation bound, and the calibration simulation — written as
 //! a Markdown report, a JSON summary and figures. The pipeline is
 //! [`activecal::experiment::paper`]; this file parses the arguments, shows
-//! progress and draws the figures.
+//! progress and writes the staged folder.
 
-use activecal::experiment::paper::{self, PaperReport, PaperSettings};
+use activecal::experiment::paper::{self, PaperSettings};
 use activecal::progress::Task;
-use activecal::render::paper_figures as figures;
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
@@ -105,7 +104,7 @@ pub fn cmd_reproduce(a: ReproduceArgs) -> Result<()> {
     let report = paper::run(&settings, |msg| steps.step(msg))?;
     steps.step("figures");
     let out = staged.path();
-    draw_figures(out, &report, a.levels)?;
+    paper::figures::draw_figures(out, &report, a.levels)?;
     steps.step("report");
     std::fs::write(
         out.join("report.json"),
@@ -120,48 +119,4 @@ pub fn cmd_reproduce(a: ReproduceArgs) -> Result<()> {
         out.display(),
         clock.elapsed().as_secs_f64()
     ))
-}
-
-/// Figures 2 to 6 of the paper, from the report.
-fn draw_figures(out: &std::path::Path, r: &PaperReport, levels: usize) -> Result<()> {
-    let f = &r.figures;
-    figures::random_designs(&out.join("fig2_random_designs"), &f.random_oi, f.eae_oi)?;
-    figures::trace(
-        &out.join("fig4_log10_oid"),
-        "log10 OI_D per EAE iteration (Fig. 4)",
-        "log10 OI_D",
-        &[("EAE, det criterion", r.eae.trace_log10_oid.clone())],
-    )?;
-    let mut oi_series = vec![("EAE, det criterion", f.eae_trace_oi.clone())];
-    if let Some(o) = &f.eae_oi_trace_oi {
-        oi_series.push(("EAE, eigenvalue-OI criterion", o.clone()));
-    }
-    figures::trace(
-        &out.join("fig5_oi"),
-        "OI per EAE iteration (Fig. 5)",
-        "OI, eq. (1)",
-        &oi_series,
-    )?;
-    // 1/OI_D spans 20 decades: plotted as its log10 on a linear axis (a log
-    // scale with every decade labelled).
-    let inv: Vec<f64> = r.eae.trace_log10_oid.iter().map(|v| -v).collect();
-    figures::trace(
-        &out.join("fig6_inverse_oid"),
-        "1/OI_D per EAE iteration, log scale (Fig. 6)",
-        "log10 (1/OI_D)",
-        &[("EAE", inv)],
-    )?;
-    figures::poses(
-        &out.join("fig3_initial_poses"),
-        "the initial EAE poses (Fig. 3)",
-        &f.initial_digits,
-        levels,
-    )?;
-    figures::poses(
-        &out.join("fig4a_selected_poses"),
-        "poses selected by EAE (Fig. 4 A)",
-        &f.selected_digits,
-        levels,
-    )?;
-    Ok(())
 }

@@ -146,7 +146,7 @@ pub fn cmd_score(a: ScoreArgs, given: &[&str]) -> Result<()> {
             let d = DesignFile::read(path)?;
             check_design_options(&a, given, &d, path)?;
             let desc = weighted(&a, load_description(&d.robot_ref()?)?)?;
-            let robot = super::design_compliance(desc.robot, &d)?;
+            let robot = activecal::experiment::gap::design_robot(desc.robot, &d)?;
             let qs = d
                 .joint_values(&robot)
                 .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
@@ -182,21 +182,6 @@ pub fn cmd_score(a: ScoreArgs, given: &[&str]) -> Result<()> {
         ),
     };
     emit_report(a.json, &report, || {
-        let ind = &report.indices;
-        format!(
-            "{} poses, rank {} of {}\nln OI_D {:.6}  log10 OI_D {:.6}\nOI {:.6}  O1 {:.6e}  O2 {:.6e}  O3 {:.6e}  O4 {:.6e}  O5 {:.6e}  tr(M^-1) {:.6e}\n",
-            report.poses.len(),
-            ind.rank,
-            report.p,
-            ind.ln_oid,
-            ind.log10_oid,
-            ind.oi,
-            ind.o1,
-            ind.o2,
-            ind.o3,
-            ind.o4,
-            ind.o5,
-            ind.a_trace
-        )
+        activecal::render::design_text::score_text(&report)
     })
 }

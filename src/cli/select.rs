@@ -393,7 +393,7 @@ fn report_dir(
     s: &Settings,
     dir: &std::path::Path,
     report: &SelectReport,
-) -> Result<Option<activecal::how_many::Recommendation>> {
+) -> Result<Option<activecal::report::Recommendation>> {
     let on = activecal::experiment::select::CurveOf {
         robot: &ctx.robot,
         params: a.pool.params,

@@ -4,7 +4,7 @@
 //! [`activecal::units::Units`]; and the option a unit error calls for.
 
 use activecal::error::UnitHint;
-use activecal::identify::IdentifyError;
+use activecal::experiment::error::IdentifyError;
 use activecal::units::{AngleUnit, LengthUnit, Units};
 
 /// The unit of revolute joint values, as typed.

@@ -2,8 +2,10 @@
 //! kept as it is, so that the command line and Python tell input, bound
 //! and identification failures apart.
 
-use crate::bound::BoundError;
-use crate::identify::IdentifyError;
+pub use crate::bound::BoundError;
+pub use crate::how_many::HowManyError;
+pub use crate::identify::IdentifyError;
+pub use crate::lsq::LsqError;
 use thiserror::Error;
 
 /// What can stop a pipeline: bad input, or an error of a stage.

@@ -10,9 +10,11 @@ use super::select::Existing;
 use crate::blocks::Blocks;
 use crate::bound::gap::{d_efficiency, design_gap};
 use crate::bound::{Bound, BoundSettings, DesignGap, relaxation_bound};
+use crate::io::design::DesignFile;
 use crate::model::{ParamSet, Robot};
-use crate::pool::Pool;
+use crate::pool::{Pool, PoolFilter};
 use crate::report::{GapReport, PoolInfo};
+use std::path::Path;
 
 /// A design's poses.
 #[derive(Clone, Copy, Debug)]
@@ -130,4 +132,75 @@ pub fn score_joint_values(
         q.copy_from_slice(&qs[k]);
     });
     crate::report::ScoreReport::new(info, ids, &x)
+}
+
+/// The robot a design was chosen for: with the compliance unknowns of
+/// `select --compliance` (the gravity torques from its URDF's inertials),
+/// or as it is.
+///
+/// # Errors
+/// A design with compliances for a robot without a URDF's inertials.
+pub fn design_robot(robot: Robot, d: &DesignFile) -> Result<Robot, ExperimentError> {
+    if d.compliance.is_empty() {
+        return Ok(robot);
+    }
+    let g = super::pool::urdf_gravity(&robot)?;
+    Ok(crate::identify::compliance::with_compliant_joints(
+        &robot,
+        &g,
+        &d.compliance,
+    )?)
+}
+
+/// The `gap` of the design file `d` (read from `path`): its poses against
+/// the certified bound of its own pool, rebuilt from the file's source and
+/// filters (`filters` replacing the latter when given) for the robot of
+/// `desc` with the compliance unknowns the design was chosen for
+/// ([`design_robot`]), at `params`; a design chosen on top of poses
+/// measured before is scored and bounded with their information (stored
+/// in the file); a refined design, whose poses are off the pool, from its
+/// joint values against the bound of the pool it started from.
+///
+/// # Errors
+/// A pool that cannot be rebuilt, poses not of it, a failing bound.
+pub fn gap_of_design_file(
+    path: &Path,
+    d: &DesignFile,
+    desc: crate::io::Description,
+    filters: Option<Vec<PoolFilter>>,
+    params: ParamSet,
+    settings: &BoundSettings,
+) -> Result<GapReport, ExperimentError> {
+    let in_file = |e: crate::Error| crate::Error::Invalid(format!("{}: {e}", path.display()));
+    let mut spec = d.spec()?;
+    if let Some(f) = filters {
+        spec.filters = f;
+    }
+    let pool = d
+        .build_pool(&spec, &desc.robot, &desc.robot.nominal)
+        .map_err(in_file)?;
+    let robot = design_robot(desc.robot, d)?;
+    let x = pool.try_jacobian(&robot, robot.params(params))?;
+    let (positions, qs) = if d.refined {
+        (Vec::new(), d.joint_values(&robot).map_err(in_file)?)
+    } else {
+        (d.positions_in(&robot, &pool).map_err(in_file)?, Vec::new())
+    };
+    let existing = d
+        .existing
+        .as_ref()
+        .map(|e| Existing::from_poses(e.path.clone(), e.q.clone(), Vec::new(), &robot, params))
+        .transpose()?;
+    let poses = if d.refined {
+        DesignPoses::Refined(&qs)
+    } else {
+        DesignPoses::InPool(&positions)
+    };
+    let on = ScoringPool {
+        robot: &robot,
+        pool: &pool,
+        x: &x,
+        params,
+    };
+    Ok(score_design(on, d.poses.clone(), poses, existing, settings)?.report)
 }

@@ -11,6 +11,7 @@ pub mod error;
 pub mod gap;
 pub mod measured;
 pub mod paper;
+pub mod pool;
 pub mod select;
 pub mod simulated;
 

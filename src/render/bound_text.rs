@@ -50,3 +50,13 @@ fn solver_name(b: &Bound) -> &'static str {
         RelaxationSolver::Newton => "newton",
     }
 }
+
+/// The relaxation's weight per pose of its support (`bound --weights`).
+#[must_use]
+pub fn support_text(support: &[crate::report::WeightedPose]) -> String {
+    let mut s = "pose      weight\n".to_string();
+    for w in support {
+        s += &format!("{:>6}  {:.6}\n", w.pose, w.w);
+    }
+    s
+}

@@ -13,6 +13,7 @@ pub mod camera_text;
 pub mod contact_figures;
 pub mod contact_sheet;
 pub mod contact_text;
+pub mod design_text;
 pub(crate) mod figure;
 pub mod folder;
 pub mod frames_text;

@@ -63,3 +63,61 @@ pub fn pool_stats_text(st: &PoolStats, srdf_hint: &str) -> String {
     }
     s
 }
+
+/// A pool's summary, as `pool` prints it: what each filter removed, the
+/// lattice (`lattice`, when the pool is one: its levels, size and distinct
+/// poses), the joint-limit margin (degrees), each joint's levels, the
+/// poses kept and distinct, and the file written (`out`); `srdf_hint` ends
+/// the filters' note on a robot without an SRDF.
+#[must_use]
+pub fn pool_summary_text(
+    r: &crate::pool::summary::PoolSummary,
+    lattice: Option<&crate::pool::Lattice>,
+    srdf_hint: &str,
+    out: Option<&std::path::Path>,
+) -> String {
+    let mut s = pool_stats_text(&r.pool_stats, srdf_hint);
+    if let Some(l) = lattice {
+        s += &format!(
+            "lattice: {} levels per joint, {} poses, {} distinct\n",
+            l.levels,
+            l.size(),
+            l.distinct_poses()
+        );
+    }
+    if r.pool.margin > 0.0 {
+        s += &format!(
+            "margin: {:.4}° inside every revolute joint's limits\n",
+            r.pool.margin.to_degrees()
+        );
+    }
+    for j in r.lattice.iter().flatten() {
+        s += &format!(
+            "  {}: {} levels{}, {} distinct\n",
+            j.name,
+            j.levels.len(),
+            if j.full_turn {
+                " on the circle (the joint turns all the way round)"
+            } else {
+                ""
+            },
+            j.distinct
+        );
+    }
+    s += &format!("{} poses kept, {} distinct\n", r.size, r.distinct);
+    if let Some(out) = out {
+        s += &format!("wrote {}\n", out.display());
+    }
+    s
+}
+
+/// One pose of a lattice (`pool --digits`): the lattice's levels and size,
+/// the pose's index and joint values (radians).
+#[must_use]
+pub fn lattice_text(r: &crate::report::LatticeReport) -> String {
+    let mut s = format!("lattice: {} levels per joint, {} poses\n", r.levels, r.size);
+    if let (Some(i), Some(q)) = (r.index, &r.q) {
+        s += &format!("index: {i}\nq (rad): {q:?}\n");
+    }
+    s
+}

@@ -18,6 +18,7 @@ mod robot;
 mod score;
 mod select;
 
+pub use crate::how_many::{PoseCountCurve, Recommendation};
 pub use bound::{BoundCommandReport, WeightedPose};
 pub use calibrate::{MeasuredCalibrationReport, SimulatedCalibrationReport};
 pub use camera::{

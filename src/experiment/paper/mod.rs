@@ -7,6 +7,7 @@
 //! renders it. Figures are left to the caller ([`FigureData`]).
 
 mod assemble;
+pub mod figures;
 mod markdown;
 mod report;
 mod settings;

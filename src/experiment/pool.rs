@@ -1,0 +1,85 @@
+//! A pool ready for the criteria: the robot, its pool of poses built from a
+//! spec (generated, or a file's configurations read in the user's units),
+//! the compliance unknowns the pool's gravity torques call for, and the
+//! pool's identification Jacobian at the parameters chosen. What `select`,
+//! `bound` and `score` work on, from the command line and from Python.
+
+use super::ExperimentError;
+use crate::blocks::Blocks;
+use crate::model::gravity::GravityModel;
+use crate::model::{ParamSet, Robot};
+use crate::pool::{Configurations, Pool, PoolSource, PoolSpec};
+use crate::units::Units;
+use std::path::Path;
+use std::sync::Arc;
+
+/// A robot, its pose pool and the pool's identification Jacobian.
+pub struct PoolRun {
+    /// The robot (with compliance unknowns when asked).
+    pub robot: Robot,
+    /// The pool.
+    pub pool: Pool,
+    /// Identification Jacobian of every pool pose.
+    pub x: Blocks,
+}
+
+/// Builds the pool of `spec` for `robot` and its Jacobian at `params`
+/// (reserved fallibly: memory the system refuses is an error, not an
+/// abort). A pool file is read in `units`; `listed` configurations, when
+/// given, are the pool's candidates instead of its source's. With
+/// `compliance`, the robot gains a compliance unknown per joint whose
+/// gravity torque varies over the pool.
+///
+/// # Errors
+/// A pool file that cannot be read, a pool that cannot be built, a robot
+/// without a URDF's inertials for compliance, memory refused.
+pub fn build_pool(
+    robot: Robot,
+    spec: &PoolSpec,
+    listed: Option<Configurations>,
+    units: Units,
+    params: ParamSet,
+    compliance: bool,
+) -> Result<PoolRun, ExperimentError> {
+    let listed = match (&spec.source, listed) {
+        (_, Some(rows)) => Some(rows),
+        (PoolSource::File { path }, None) => Some(crate::pool::read_configurations_in(
+            Path::new(path),
+            &robot,
+            units,
+        )?),
+        _ => None,
+    };
+    let pool = match listed {
+        Some(rows) => spec.build_listed(&robot, &robot.nominal, rows)?,
+        None => spec.build(&robot, &robot.nominal)?,
+    };
+    let robot = if compliance {
+        let g = urdf_gravity(&robot)?;
+        let qs: Vec<Vec<f64>> = (0..pool.len()).map(|k| pool.q(k)).collect();
+        crate::identify::compliance::with_compliance_at(&robot, &g, &qs).0
+    } else {
+        robot
+    };
+    let x = pool.try_jacobian(&robot, robot.params(params))?;
+    Ok(PoolRun { robot, pool, x })
+}
+
+/// The gravity model of a URDF robot from its own `<inertial>` elements.
+///
+/// # Errors
+/// A robot not imported from a URDF, or whose inertials are unusable.
+pub fn urdf_gravity(robot: &Robot) -> Result<Arc<GravityModel>, ExperimentError> {
+    if robot.source.is_none() {
+        return Err(crate::Error::Invalid(format!(
+            "{} needs a URDF robot (gravity torques come from its <inertial> elements); '{}' is not one",
+            crate::names::phrase::COMPLIANCE,
+            robot.name
+        ))
+        .into());
+    }
+    Ok(Arc::new(crate::io::inertia::gravity_model(
+        robot,
+        &crate::io::inertia::InertiaOptions::default(),
+    )?))
+}

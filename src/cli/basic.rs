@@ -2,7 +2,8 @@
 
 use super::{emit_report, load_robot, parse_list};
 use activecal::model::{ParamSet, Robot};
-use activecal::report::{FkReport, LatticeReport};
+use activecal::report::{FkReport, LatticeReport, PoolSummary};
+use activecal::write::poses::{PosesFormat, poses_text};
 use anyhow::Result;
 use clap::Args;
 
@@ -89,7 +90,7 @@ pub struct PoolArgs {
 /// Runs `robots`.
 pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
     if let Some(name) = &a.export {
-        use activecal::write::calibrated::{Format, render};
+        use activecal::write::calibrated::Format;
         let format = match &a.out {
             Some(p) => {
                 let mut files = super::run_files::RunFiles::new();
@@ -102,23 +103,7 @@ pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
             None => Format::Toml,
         };
         let d = super::load_description(name)?;
-        d.robot.validate()?;
-        let r = &d.robot;
-        let text = match format {
-            Format::Toml => {
-                activecal::io::robot_toml::description_to_toml(r, d.visibility.as_ref())
-            }
-            _ => {
-                let frames = activecal::frames::calibrated(r, &r.nominal, None, None)?;
-                render(
-                    format,
-                    r,
-                    &r.nominal,
-                    frames.as_ref().map(|(f, rep)| (f, rep)),
-                    "",
-                )?
-            }
-        };
+        let text = activecal::write::robot::export(&d, format)?;
         match &a.out {
             Some(path) => super::write_new(path, &text, a.force)?,
             None => super::print_out(&text)?,
@@ -209,23 +194,6 @@ pub fn cmd_fk(a: FkArgs) -> Result<()> {
     })
 }
 
-/// The format of `pool --out`, by its extension.
-fn pool_out_format(path: &std::path::Path) -> Result<&'static str> {
-    match path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .as_deref()
-    {
-        Some("csv") => Ok("csv"),
-        Some("json") => Ok("json"),
-        _ => anyhow::bail!(
-            "--out {}: the poses are written as .csv or .json; name the file with one of these extensions",
-            path.display()
-        ),
-    }
-}
-
 /// Runs `pool`: one lattice pose (`--digits`), or the pool every source and
 /// filter makes, with its counts, checked for repeated poses and written
 /// with `--out`.
@@ -236,7 +204,7 @@ pub fn cmd_pool(a: PoolArgs) -> Result<()> {
             .pool(&a.pool)
             .output("--out", Some(out))
             .check(a.force)?;
-        pool_out_format(out)?;
+        PosesFormat::of("--out", out)?;
     }
     if let Some(d) = a.digits.as_deref() {
         let robot = load_robot(&a.pool.robot)?;
@@ -253,13 +221,9 @@ pub fn cmd_pool(a: PoolArgs) -> Result<()> {
     let d = super::load_description(&a.pool.robot)?;
     let spec = a.pool.spec(&d)?;
     let pool = spec.build_poses(&d.robot, &d.robot.nominal)?;
-    let r = activecal::pool::summary::PoolSummary::new(&d.robot, &pool)?;
+    let r = PoolSummary::new(&d.robot, &pool)?;
     if let Some(out) = &a.out {
-        let qs: Vec<Vec<f64>> = (0..pool.len()).map(|k| pool.q(k)).collect();
-        let text = match pool_out_format(out)? {
-            "csv" => activecal::pool::summary::poses_csv(&r.joints, &qs, &pool.ids),
-            _ => activecal::pool::summary::poses_json(&r.robot, &r.joints, &qs, &pool.ids),
-        };
+        let text = poses_text(PosesFormat::of("--out", out)?, &r, &pool);
         super::write_new(out, &text, a.force)?;
     }
     emit_report(a.json, &r, || {

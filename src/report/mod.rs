@@ -19,6 +19,7 @@ mod score;
 mod select;
 
 pub use crate::how_many::{PoseCountCurve, Recommendation};
+pub use crate::pool::summary::PoolSummary;
 pub use bound::{BoundCommandReport, WeightedPose};
 pub use calibrate::{MeasuredCalibrationReport, SimulatedCalibrationReport};
 pub use camera::{

@@ -38,7 +38,7 @@ pub use crate::bound::{BoundSettings, RelaxationSolver};
 /// Pools: where poses come from, the filters, the joint-limit margin.
 pub use crate::collision::Obstacle;
 pub use crate::pool::{
-    Configurations, DEFAULT_URDF_MARGIN_DEG, PoolFilter, PoolSource, PoolSpec, default_margin_deg,
+    DEFAULT_URDF_MARGIN_DEG, PoolFilter, PoolSource, PoolSpec, default_margin_deg,
 };
 
 /// Sensors' set-up: a camera's mounting, intrinsics and view, where a

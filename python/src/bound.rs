@@ -4,10 +4,8 @@
 use crate::convert::{detached, json_to_py};
 use crate::robot::Robot;
 use crate::select::{Design, candidates, existing_poses};
-use activecal::bound::relaxation_bound;
 use activecal::model::ParamSet;
 use activecal::options::BoundSettings;
-use activecal::report::BoundCommandReport;
 use pyo3::prelude::*;
 
 /// The certified upper bound on ln OI_D (= ln det XᵀX) of every design of
@@ -39,16 +37,23 @@ pub fn bound<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let n = crate::convert::count("n", n, 1)?;
     let c = candidates(py, robot, pool, count, levels, pool_seed, margin)?;
-    let prior = existing
-        .map(|e| existing_poses(py, robot, e).map(|e| e.prior))
-        .transpose()?;
+    let existing = existing.map(|e| existing_poses(py, robot, e)).transpose()?;
     let r = robot.inner.clone();
     let v = crate::progress::with_callback(progress, || {
         detached(py, move || {
-            let settings = BoundSettings::default();
-            let b = relaxation_bound(&c.x, prior.as_ref(), n, &settings)?;
-            let report =
-                BoundCommandReport::new(&r, &c.pool, &b, ParamSet::Nominal, settings, weights);
+            let on = activecal::experiment::gap::ScoringPool {
+                robot: &r,
+                pool: &c.pool,
+                x: &c.x,
+                params: ParamSet::Nominal,
+            };
+            let report = activecal::experiment::bound::bound_of_pool(
+                on,
+                existing,
+                n,
+                BoundSettings::default(),
+                weights,
+            )?;
             Ok(serde_json::to_value(&report)?)
         })
     })?;

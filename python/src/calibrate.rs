@@ -9,12 +9,12 @@ use crate::fit_args::{holdout_of, restriction_of, weights_of};
 pub(crate) use crate::fit_args::{loss_of, outliers_of, refuse_unused};
 use crate::robot::Robot;
 use activecal::data::Measurements;
+use activecal::experiment::CalibratedFrames;
+use activecal::experiment::Identification;
 use activecal::experiment::acts_on::{self as lib_acts, Sensor};
 use activecal::experiment::measured::{MeasuredSettings, calibrate_measurements};
-use activecal::frames::CalibratedFrames;
-use activecal::frames::report::FramesReport;
-use activecal::identify::Identification;
 use activecal::options::LmSettings;
+use activecal::report::FramesReport;
 use activecal::write::calibrated::Format;
 use pyo3::prelude::*;
 use std::sync::Arc;
@@ -85,7 +85,7 @@ fn data(
         "one row of joint values per pose, radians or metres",
     )?;
     let n = qshape[0];
-    let k = activecal::measure::sensor_for(robot).points_per_pose();
+    let k = activecal::experiment::sensor_for(robot).points_per_pose();
     let points = &points_frame(points, k)?;
     let (pv, _) = if k == 1 {
         float_array(
@@ -106,7 +106,7 @@ fn data(
     };
     let orientations = match (
         orientations,
-        activecal::measure::sensor_for(robot).measures_orientation(),
+        activecal::experiment::sensor_for(robot).measures_orientation(),
     ) {
         (Some(o), true) => {
             let (ov, _) = float_array(
@@ -666,8 +666,14 @@ pub fn evaluate<'py>(
     let d = data(py, &wrapper, q, points, orientations)?;
     let v = detached(py, move || {
         let meas = Measurements::with_orientations(&robot, d.qs, d.points, d.orientations)?;
-        let res = activecal::identify::residuals(&robot, &table, &meas)?;
-        Ok(serde_json::to_value(&res)?)
+        let e = activecal::experiment::measured::evaluate::evaluate(
+            &robot,
+            &table,
+            &meas,
+            "the arrays given",
+            Vec::new(),
+        )?;
+        Ok(serde_json::to_value(&e.residuals)?)
     })?;
     json_to_py(py, &v)
 }

@@ -150,7 +150,7 @@ pub(crate) fn refuse_unused(
 /// The outlier choice of `outliers=` ("drop" or "keep") and
 /// `outlier_rate=`.
 pub(crate) fn outliers_of(kind: &str, rate: f64) -> PyResult<activecal::options::OutlierChoice> {
-    use activecal::lsq::outliers::{OutlierChoice, check_choice};
+    use activecal::options::OutlierChoice;
     let c = match kind {
         "drop" => OutlierChoice::Drop { alpha: rate },
         "keep" => OutlierChoice::Keep,
@@ -160,7 +160,7 @@ pub(crate) fn outliers_of(kind: &str, rate: f64) -> PyResult<activecal::options:
             )));
         }
     };
-    check_choice(c).map_err(|e| {
+    c.validate().map_err(|e| {
         pyo3::exceptions::PyValueError::new_err(format!("outlier_rate={rate}: {e}"))
     })?;
     Ok(c)

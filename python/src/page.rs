@@ -5,9 +5,9 @@
 //! inline in Jupyter by a `Page`. Nothing of the page is assembled here.
 
 use crate::convert::{Fail, arg_err, detached};
+use activecal::experiment::Identification;
 use activecal::experiment::error::HowManyError;
 use activecal::experiment::select::{CurveOf, how_many_curve};
-use activecal::identify::Identification;
 use activecal::model::ParamSet;
 use activecal::model::Robot;
 use activecal::options::{Algorithm, CriterionKind, SelectSettings as Settings};
@@ -163,7 +163,7 @@ pub(crate) struct CurveInputs {
     /// The robot (nominal parameters).
     pub robot: std::sync::Arc<Robot>,
     /// The pool's Jacobian.
-    pub x: std::sync::Arc<activecal::blocks::Blocks>,
+    pub x: std::sync::Arc<activecal::experiment::Blocks>,
     /// The pool's ids, by position.
     pub ids: Vec<usize>,
     /// The selection's settings.

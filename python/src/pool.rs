@@ -6,9 +6,10 @@ use crate::convert::{
     arg_err, count, detached, float_array, json_to_py, ndarray, non_negative, rows,
 };
 use crate::robot::Robot;
-use activecal::blocks::Blocks;
+use activecal::experiment::Blocks;
 use activecal::io::collision_choice::CollisionChoice;
-use activecal::options::{Configurations, PoolFilter, PoolSource, PoolSpec};
+use activecal::io::configurations::Configurations;
+use activecal::options::{PoolFilter, PoolSource, PoolSpec};
 use pyo3::prelude::*;
 use pyo3::types::PyString;
 use std::sync::Arc;
@@ -18,7 +19,7 @@ use std::sync::Arc;
 #[pyclass(module = "activecal", name = "Pool", frozen)]
 pub struct Pool {
     pub(crate) robot: Arc<activecal::model::Robot>,
-    pub(crate) pool: Arc<activecal::pool::Pool>,
+    pub(crate) pool: Arc<activecal::experiment::Pool>,
     pub(crate) x: Arc<Blocks>,
     /// How it was made, for pickling (`activecal.pool`'s pools).
     pub(crate) recipe: Option<crate::pickling::Recipe>,

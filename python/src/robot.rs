@@ -256,7 +256,7 @@ impl Robot {
     /// Whether orientations are measured too (a full-pose sensor).
     #[getter]
     fn measures_orientation(&self) -> bool {
-        activecal::measure::sensor_for(&self.inner).measures_orientation()
+        activecal::experiment::sensor_for(&self.inner).measures_orientation()
     }
 
     /// Forward kinematics of the nominal model at joint values q (radians or

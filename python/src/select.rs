@@ -4,7 +4,7 @@
 use crate::convert::{arg_err, detached, json_to_py, ndarray, non_negative};
 use crate::pool::Pool;
 use crate::robot::Robot;
-use activecal::blocks::Blocks;
+use activecal::experiment::Blocks;
 use activecal::experiment::select::{Existing, SelectRun};
 use activecal::experiment::visiting::Visiting;
 use activecal::io::design::DesignFile;
@@ -34,7 +34,7 @@ pub struct Design {
     /// The pool's pose ids, by position.
     pool_ids: Vec<usize>,
     /// The pool (named by the gap's report).
-    pool: Arc<activecal::pool::Pool>,
+    pool: Arc<activecal::experiment::Pool>,
     /// The sensor noise given to `select`, metres.
     noise: Option<f64>,
     /// The selection's report (for the report folder).
@@ -201,7 +201,7 @@ impl Design {
     fn inputs(&self) -> Vec<(&'static str, std::path::PathBuf)> {
         let mut inputs = crate::page::robot_inputs(&self.robot);
         for f in &self.typed.pool.pool.filters {
-            if let activecal::pool::PoolFilter::Collision(c) = f {
+            if let activecal::options::PoolFilter::Collision(c) = f {
                 inputs.extend(
                     c.spec
                         .package_dirs

@@ -2,11 +2,9 @@
 //! design's D-efficiency against it.
 
 use super::{PoolOpts, emit_report, filters, load_description};
-use activecal::bound::relaxation_bound;
 use activecal::io::design::DesignFile;
 use activecal::model::ParamSet;
 use activecal::options::{BoundSettings, RelaxationSolver};
-use activecal::report::BoundCommandReport;
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
@@ -101,23 +99,19 @@ pub fn cmd_bound(a: BoundArgs) -> Result<()> {
         .as_deref()
         .map(|p| super::load_existing(p, &ctx.robot, a.pool.params, a.pool.units.units()))
         .transpose()?;
-    let prior = existing.as_ref().map(|e| &e.prior);
-    let b = relaxation_bound(&ctx.x, prior, a.n, &settings)?;
-    let mut report = BoundCommandReport::new(
-        &ctx.robot,
-        &ctx.pool,
-        &b,
-        a.pool.params,
+    let report = activecal::experiment::bound::bound_of_pool(
+        ctx.scoring(a.pool.params),
+        existing,
+        a.n,
         settings,
         a.weights,
-    );
-    report.existing = existing.map(|e| e.report);
+    )?;
     emit_report(a.json, &report, || {
         let mut s = super::pool_stats_text(&ctx.pool.stats);
         if let Some(e) = &report.existing {
             s += &super::existing_text(e);
         }
-        s += &activecal::render::bound_text::bound_text(&b);
+        s += &activecal::render::bound_text::bound_text(&report.bound);
         s + &report
             .support
             .as_deref()

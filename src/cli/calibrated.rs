@@ -3,10 +3,10 @@
 //! of an unconverged fit, and the status line.
 
 use super::calibrate_args::CalibrateArgs;
-use activecal::frames::CalibratedFrames;
-use activecal::frames::report::FramesReport;
-use activecal::identify::Identification;
+use activecal::experiment::CalibratedFrames;
+use activecal::experiment::Identification;
 use activecal::model::Robot;
+use activecal::report::FramesReport;
 use activecal::write::calibrated::{CalibratedRobot, Format};
 use anyhow::Result;
 

@@ -1,10 +1,10 @@
 //! `select --camera-info cam.yaml --target board.yaml --mounting …`: poses
 //! chosen for a camera. Joint-space samples (`--count`, default 20,000;
 //! `--pool-seed`), or the rows of `--pool file:PATH`, are kept where the camera sees the target well
-//! (`activecal::pool::camera_view`: `--min-visible`, `--image-margin`,
+//! (the camera's view, `activecal::options::CameraView`: `--min-visible`, `--image-margin`,
 //! `--max-view-angle`, `--distance`, at the placements `--camera-pose` and
 //! `--target-pose`), and `--n` of them are chosen D-optimally on the pixel
-//! Jacobian (`activecal::select::camera`). `--out design.csv` writes them:
+//! Jacobian (`activecal::experiment::camera_select`). `--out design.csv` writes them:
 //! one row a pose, `candidate`, the joints (radians, metres), and
 //! `points_seen`, the target points the pose will see; `--out
 //! design.json` the design with its figures. `--gap` scores it against
@@ -139,8 +139,12 @@ fn check_options(a: &SelectArgs) -> Result<()> {
 fn candidates(a: &SelectArgs, robot: &Robot) -> Result<Candidates> {
     Ok(match &a.pool.pool {
         PoolKind::File(p) => {
-            let c = activecal::pool::file::read_configurations_in(p, robot, a.pool.units.units())
-                .with_context(|| format!("--pool file:{}", p.display()))?;
+            let c = activecal::io::configurations::read_configurations_in(
+                p,
+                robot,
+                a.pool.units.units(),
+            )
+            .with_context(|| format!("--pool file:{}", p.display()))?;
             for n in &c.notes {
                 super::diag(&format!("note: {n}"));
             }

@@ -1,7 +1,7 @@
 //! `calibrate --compliance`, `--inertia`, `--payload` and
 //! `--compare-compliance`: the options parsed into a gravity model, and the
 //! rendering of compliances and of the side-by-side held-out comparison.
-//! The work is in `activecal::identify::compliance`.
+//! The work is the library's (`activecal::experiment::measured`).
 
 use activecal::io::inertia::{InertiaOptions, Payload, gravity_model};
 use activecal::model::Robot;

@@ -1,14 +1,13 @@
 //! `calibrate --measurements` (identification from real data, with a loss,
 //! fixed or freed unknowns, parameter significance and held-out splits) and
 //! `evaluate` (a model's errors on data, no fitting): rendering only; the
-//! work is in `activecal::experiment::measured` and `activecal::identify`.
+//! work is in `activecal::experiment::measured`.
 
 use super::emit_report;
 use activecal::data::Measurements;
-use activecal::identify::residuals;
+use activecal::experiment::measured::evaluate::evaluate;
 use activecal::model::Robot;
 use activecal::options::LossChoice;
-use activecal::report::measured::EvaluationReport;
 use anyhow::{Result, bail};
 use std::path::Path;
 
@@ -102,10 +101,10 @@ pub struct EvaluateArgs {
 pub fn cmd_evaluate(a: EvaluateArgs) -> Result<()> {
     let robot = super::load_robot(&a.robot)?;
     let (meas, notes) = read_measurements(&a.measurements, &robot, a.units.units(), a.json)?;
-    let res = residuals(&robot, &robot.nominal, &meas).map_err(|e| {
+    let source = a.measurements.display().to_string();
+    let report = evaluate(&robot, &robot.nominal, &meas, &source, notes).map_err(|e| {
         anyhow::anyhow!(
-            "{}: {e}{}",
-            a.measurements.display(),
+            "{source}: {e}{}",
             if meas.markers() > 1 {
                 " (a model for several markers carries their offsets: evaluate the description `calibrate --out` wrote)"
             } else {
@@ -113,14 +112,6 @@ pub fn cmd_evaluate(a: EvaluateArgs) -> Result<()> {
             }
         )
     })?;
-    let report = EvaluationReport {
-        robot: robot.name.clone(),
-        chain: activecal::report::chain(&robot),
-        measurements: a.measurements.display().to_string(),
-        poses: meas.len(),
-        residuals: res,
-        notes,
-    };
     emit_report(a.json, &report, || {
         activecal::render::measured_text::evaluation_text(&report)
     })

@@ -176,7 +176,7 @@ pub const SRDF_HINT: &str =
     " (give the SRDF with --srdf FILE, or without one --skip-always-touching)";
 
 /// One line per filter (what it removed) and per note of a pool's build.
-pub fn pool_stats_text(st: &activecal::pool::PoolStats) -> String {
+pub fn pool_stats_text(st: &activecal::report::PoolStats) -> String {
     activecal::render::pool_text::pool_stats_text(st, SRDF_HINT)
 }
 

@@ -188,11 +188,11 @@ pub(super) fn orientation_scale(
             "--orientation-noise {orientation}: the orientation noise σ must be a finite number > 0 (radians)"
         );
     }
-    if !activecal::measure::sensor_for(robot).observes_orientation() {
+    if !activecal::experiment::sensor_for(robot).observes_orientation() {
         bail!(
             "--orientation-noise: robot '{}' measures {}, no orientation (append ':pose' to --robot for full poses)",
             robot.name,
-            activecal::measure::sensor_for(robot).describe()
+            activecal::experiment::sensor_for(robot).describe()
         );
     }
     Ok(noise.unwrap_or(DEFAULT_REPORT_NOISE) / orientation)

@@ -15,7 +15,7 @@ pub fn parse_home(text: Option<&str>, robot: &Robot) -> Result<Option<Vec<f64>>>
             "--home {t}: {} joint values, the robot has {} joints ({})",
             q.len(),
             robot.dof(),
-            activecal::pool::file::joint_names(robot).join(", ")
+            activecal::io::configurations::joint_names(robot).join(", ")
         );
     }
     if let Some(j) = q.iter().position(|v| !v.is_finite()) {

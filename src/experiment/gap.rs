@@ -7,12 +7,11 @@
 
 use super::ExperimentError;
 use super::select::Existing;
-use crate::blocks::Blocks;
 use crate::bound::gap::{d_efficiency, design_gap};
 use crate::bound::{Bound, BoundSettings, DesignGap, relaxation_bound};
 use crate::io::design::DesignFile;
 use crate::model::{ParamSet, Robot};
-use crate::pool::{Pool, PoolFilter};
+use crate::pool::PoolFilter;
 use crate::report::{GapReport, PoolInfo};
 use std::path::Path;
 
@@ -36,19 +35,7 @@ pub struct ScoredDesign {
     pub gap: DesignGap,
 }
 
-/// The pool a design is scored on: the robot, the pool and its Jacobian at
-/// `params`.
-#[derive(Clone, Copy, Debug)]
-pub struct ScoringPool<'a> {
-    /// The robot.
-    pub robot: &'a Robot,
-    /// The pool.
-    pub pool: &'a Pool,
-    /// Its Jacobian.
-    pub x: &'a Blocks,
-    /// The parameters it was evaluated at.
-    pub params: ParamSet,
-}
+pub use super::pool::ScoringPool;
 
 /// Scores a design of `ids` (its poses' pool ids, for the report) against
 /// the bound of pool `on` for as many poses, with the prior information of

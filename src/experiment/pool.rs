@@ -23,6 +23,34 @@ pub struct PoolRun {
     pub x: Blocks,
 }
 
+/// The pool a design is scored on: the robot, the pool and its Jacobian at
+/// `params`.
+#[derive(Clone, Copy, Debug)]
+pub struct ScoringPool<'a> {
+    /// The robot.
+    pub robot: &'a Robot,
+    /// The pool.
+    pub pool: &'a Pool,
+    /// Its Jacobian.
+    pub x: &'a Blocks,
+    /// The parameters it was evaluated at.
+    pub params: ParamSet,
+}
+
+impl PoolRun {
+    /// The pool to score and bound designs on, its Jacobian at `params`
+    /// (those it was built with).
+    #[must_use]
+    pub fn scoring(&self, params: ParamSet) -> ScoringPool<'_> {
+        ScoringPool {
+            robot: &self.robot,
+            pool: &self.pool,
+            x: &self.x,
+            params,
+        }
+    }
+}
+
 /// Builds the pool of `spec` for `robot` and its Jacobian at `params`
 /// (reserved fallibly: memory the system refuses is an error, not an
 /// abort). A pool file is read in `units`; `listed` configurations, when

@@ -363,3 +363,10 @@ fn load_head(r: &RobotRef) -> Result<Description> {
     };
     Ok(d)
 }
+
+/// Joint configurations read from a file (CSV or JSON: a planner's export,
+/// a measurement campaign), in the user's units and checked against the
+/// joint limits; the chain's joint names they are matched by.
+pub mod configurations {
+    pub use crate::pool::file::{Configurations, joint_names, read_configurations_in};
+}

@@ -408,6 +408,16 @@ pub struct Outlier {
     pub residual_mm: f64,
 }
 
+impl OutlierChoice {
+    /// Checks the choice's rate: in (0, 1) ([`check_choice`]).
+    ///
+    /// # Errors
+    /// A rate outside (0, 1).
+    pub fn validate(self) -> Result<()> {
+        check_choice(self)
+    }
+}
+
 /// Checks an [`OutlierChoice`]'s rate: in (0, 1).
 pub fn check_choice(c: OutlierChoice) -> Result<()> {
     match c {

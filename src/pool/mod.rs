@@ -24,8 +24,8 @@ pub mod stats;
 pub mod summary;
 pub mod turn;
 
+pub use crate::pool::file::{Configurations, read_configurations, read_configurations_in};
 pub use build::memory_estimate;
-pub use file::{Configurations, read_configurations, read_configurations_in};
 pub use lattice::Lattice;
 pub use sampled::{Sobol, Uniform};
 

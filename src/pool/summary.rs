@@ -2,9 +2,10 @@
 //! are distinct (a pool whose poses repeat is refused), the lattice's levels
 //! per joint, and the kept poses written out as a configuration file.
 
-use super::{Pool, PoolStats, file::joint_names, turn};
+use super::{Pool, PoolStats, turn};
 use crate::error::{Error, Result};
 use crate::model::Robot;
+use crate::pool::file::joint_names;
 use serde::Serialize;
 
 /// One joint of a lattice: its levels and how many distinct places they are.

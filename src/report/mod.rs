@@ -18,7 +18,9 @@ mod robot;
 mod score;
 mod select;
 
+pub use crate::frames::report::FramesReport;
 pub use crate::how_many::{PoseCountCurve, Recommendation};
+pub use crate::pool::PoolStats;
 pub use crate::pool::summary::PoolSummary;
 pub use bound::{BoundCommandReport, WeightedPose};
 pub use calibrate::{MeasuredCalibrationReport, SimulatedCalibrationReport};
@@ -37,7 +39,7 @@ pub use select::{
 };
 
 use crate::model::Robot;
-use crate::pool::{Pool, PoolSpec, PoolStats};
+use crate::pool::{Pool, PoolSpec};
 use serde::Serialize;
 
 /// The chain a report used: the label of every frame a joint drives, in

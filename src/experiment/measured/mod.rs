@@ -25,6 +25,7 @@ use holdout::holdout_report;
 use nalgebra::Vector3;
 use screen::screen;
 
+pub mod evaluate;
 pub mod full_model;
 mod holdout;
 mod screen;

@@ -12,10 +12,12 @@
 //! shift, and the edges' width (sharpness). An image without a row in the
 //! joints file is refused before any detection: its pose is unknown.
 //!
-//! Checkerboards (the `checkerboard:` target, [`detect`]) and ChArUco
-//! boards (the `charuco:` target, [`charuco`]) are detected; AprilGrids
-//! and point lists are refused with that reason.
+//! Checkerboards (the `checkerboard:` target, [`detect`]), ChArUco
+//! boards (the `charuco:` target, [`charuco`]) and Kalibr's aprilgrids
+//! (the `aprilgrid:` target, [`aprilgrid`]) are detected; point lists are
+//! refused with that reason.
 
+pub mod aprilgrid;
 pub mod charuco;
 pub mod decode;
 pub mod detect;
@@ -23,7 +25,7 @@ pub mod files;
 pub mod joints;
 pub mod refine;
 
-use super::camera_target::{CharucoPattern, Target};
+use super::camera_target::{AprilgridPattern, CharucoPattern, Target};
 use crate::error::{Error, Result};
 use crate::identify::camera::CameraObservations;
 use crate::measure::camera::MIN_POINTS_PER_POSE;
@@ -181,12 +183,18 @@ pub enum Board<'a> {
     Checkerboard((usize, usize)),
     /// A ChArUco board.
     Charuco(&'a CharucoPattern),
+    /// A Kalibr aprilgrid.
+    Aprilgrid(&'a AprilgridPattern),
 }
 
 impl<'a> Board<'a> {
     /// The board of `target` (read from `origin`, for messages); a target
-    /// that is neither a checkerboard nor a ChArUco board is refused.
+    /// that is not a checkerboard, a ChArUco board or an aprilgrid is
+    /// refused.
     pub fn of(target: &'a Target, origin: &str) -> Result<Self> {
+        if let Some(p) = &target.aprilgrid {
+            return Ok(Board::Aprilgrid(p));
+        }
         match (&target.charuco, target.grid) {
             (Some(p), _) => {
                 charuco::check_pattern(p).map_err(|message| Error::Parse {
@@ -198,7 +206,7 @@ impl<'a> Board<'a> {
             (None, Some(grid)) => Ok(Board::Checkerboard(grid)),
             (None, None) => Err(Error::Parse {
                 path: origin.to_string(),
-                message: "activecal detects checkerboards and ChArUco boards in images (a 'checkerboard:' or 'charuco:' target); AprilGrids and point lists are not detected yet: detect their points yourself and give them as --observations".into(),
+                message: "activecal detects checkerboards, ChArUco boards and aprilgrids in images (a 'checkerboard:', 'charuco:' or 'aprilgrid:' target); a point list is not detected: detect its points yourself and give them as --observations".into(),
             }),
         }
     }
@@ -238,6 +246,7 @@ pub fn detect_in(
             detect::find_checkerboard(img, *rows, *cols)?.located()
         }
         Board::Charuco(p) => charuco::find_charuco(img, p)?,
+        Board::Aprilgrid(p) => aprilgrid::find_aprilgrid(img, p)?,
     };
     let mut seen = vec![None; n];
     let (mut shifts, mut widths, mut windows) = (Vec::new(), Vec::new(), Vec::new());
@@ -253,7 +262,7 @@ pub fn detect_in(
         // carry ids (its detector placed one 1.6 px off on the rendered
         // images of `verify/tests/live_images_truth.rs`, a move the
         // refinement refused).
-        if refined.is_none() && matches!(board, Board::Charuco(_)) {
+        if refined.is_none() && matches!(board, Board::Charuco(_) | Board::Aprilgrid(_)) {
             continue;
         }
         let r = refined.unwrap_or(refine::Refined {

@@ -329,11 +329,11 @@ fn charuco_corners_found_in_the_committed_renders_carry_the_true_ids() {
     assert!(max < 0.5, "max {max} px");
 }
 
-/// `fixtures/camera/aprilgrid/`: 4 renders, 640 × 480, of a Kalibr
+/// `fixtures/camera/aprilgrid/`: 8 renders, 640 × 480, of a Kalibr
 /// aprilgrid of 3 × 4 tags of 30 mm, `tagSpacing` 0.3
 /// (`fixtures/camera/aprilgrid_3x4.yaml`), on a true UR5's flange camera
-/// (`camera_images.py render --aprilgrid 3,4,0.03,0.3 --noise 0
-/// --near-range 0.3,0.5`), with the true pixel of each tag corner in
+/// (`camera_images.py render --aprilgrid 3,4,0.03,0.3 --count 8 --noise 0
+/// --near-range 0.3,0.5`; tags of 23–48 px), with the true pixel of each tag corner in
 /// `fixtures/camera/aprilgrid_truth.csv` (its columns `pose, <joints>,
 /// feature, u, v`, Kalibr's ids).
 #[test]
@@ -375,7 +375,7 @@ fn aprilgrid_corners_found_in_the_committed_renders_carry_kalibrs_ids() {
     errors.sort_by(f64::total_cmp);
     let (median, max) = (errors[errors.len() / 2], errors[errors.len() - 1]);
     println!(
-        "{} corners of 4 × 48: {median:.3} px median, {max:.3} px max",
+        "{} corners of 8 × 48: {median:.3} px median, {max:.3} px max",
         errors.len()
     );
     // Every image shows the whole grid: every tag corner found, each with
@@ -383,8 +383,8 @@ fn aprilgrid_corners_found_in_the_committed_renders_carry_kalibrs_ids() {
     // gap, ≥ 14 px here, so a wrong id is at least that far off);
     // refined to the checkerboard's bounds above (noise-free renders: the
     // refinement's own error, 0.1 px in the median, 0.5 px at most).
-    assert_eq!(read.observations.pose_ids, vec![0, 1, 2, 3]);
-    assert_eq!(errors.len(), 4 * 48);
+    assert_eq!(read.observations.pose_ids, (0..8).collect::<Vec<i64>>());
+    assert_eq!(errors.len(), 8 * 48);
     for r in &read.images {
         assert!(
             matches!(r.outcome, ImageOutcome::Found { points: 48, .. }),

@@ -15,8 +15,12 @@
 //! **Refinement's window.** At a tag's corner the four quadrants are the
 //! tag's black border (2 bits: a fifth of the tag's side, then its data
 //! bits), the black corner square (`tag_spacing` times the side) and two
-//! white gaps as wide as it: a square window stays among the four edges
-//! through the corner within `min(0.2, tag_spacing)` tag sides.
+//! white gaps as wide as it: the refinement's disc stays among the four
+//! edges through the corner within `min(0.2, tag_spacing)` tag sides of
+//! the edges across (measured square to those edges: a tag seen sheared
+//! leaves less room along its diagonal; an axis-aligned square window
+//! of the same half width placed two corners of the committed renders
+//! 0.52 px off, reaching into the data bits).
 
 use super::decode::Gray;
 use super::detect::Located;
@@ -60,19 +64,28 @@ pub fn find_aprilgrid(img: &Gray, p: &AprilgridPattern) -> Result<Vec<Located>, 
             let q = c[CRATE_OF_KALIBR[i]];
             [f64::from(q.0), f64::from(q.1)]
         });
+        let d = |a: [f64; 2], b: [f64; 2]| [b[0] - a[0], b[1] - a[1]];
         let side = (0..4)
-            .map(|i| {
-                let (a, b) = (px[i], px[(i + 1) % 4]);
-                (a[0] - b[0]).hypot(a[1] - b[1])
-            })
+            .map(|i| d(px[i], px[(i + 1) % 4]))
+            .map(|e| e[0].hypot(e[1]))
             .fold(f64::INFINITY, f64::min);
         for (i, q) in px.iter().enumerate() {
+            // The tag's edges at this corner, `a` and `b`: the border's
+            // inner edges run parallel to them `clear` of the other edge
+            // in, at `clear·|a × b| / |a|` and `clear·|a × b| / |b|` from
+            // the corner (the corner square's and the gaps' far edges
+            // likewise), so a disc of `clear·|a × b| / max(|a|, |b|)`
+            // holds only the four edges through the corner, however the
+            // tag is turned or sheared in the image.
+            let (a, b) = (d(*q, px[(i + 1) % 4]), d(*q, px[(i + 3) % 4]));
+            let cross = (a[0] * b[1] - a[1] * b[0]).abs();
+            let longer = a[0].hypot(a[1]).max(b[0].hypot(b[1]));
             out.push(Located {
                 id: 4 * k as usize + i,
                 px: *q,
                 square_px: side,
-                clear_px: clear * side,
-                round: false,
+                clear_px: clear * cross / longer,
+                round: true,
             });
         }
     }

@@ -12,7 +12,12 @@
 //! a misread) are dropped. The corners carry ids: a part of the grid is
 //! labelled as well as the whole of it.
 //!
-//! **Refinement's window.** At a tag's corner the four quadrants are the
+//! **Not refined.** The crate's corners are kept as it places them (its
+//! own saddle-point refinement was more accurate than activecal's
+//! Förstner refinement on rendered images, [`super::detect_in`]); the
+//! disc below is where the edges' width (sharpness) is measured.
+//!
+//! **The disc clear of other edges.** At a tag's corner the four quadrants are the
 //! tag's black border (2 bits: a fifth of the tag's side, then its data
 //! bits), the black corner square (`tag_spacing` times the side) and two
 //! white gaps as wide as it: the refinement's disc stays among the four

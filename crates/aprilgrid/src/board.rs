@@ -1,5 +1,4 @@
 use crate::saddle::{Saddle, is_valid_quad};
-use glam;
 use kdtree::KdTree;
 use kdtree::distance::squared_euclidean;
 use std::collections::HashMap;
@@ -180,18 +179,17 @@ impl<'a, 'b> Board<'a, 'b> {
         s1: &Saddle,
     ) -> ([usize; 3], usize, [usize; 3], usize) {
         let ratio0 = 1.0 + self.spacing_ratio;
-        let radius_sq = 0.5
-            * (glam::Vec2::new(s0.p.0, s0.p.1) - glam::Vec2::new(s1.p.0, s1.p.1)).length_squared();
+        // glam's `Vec2` arithmetic, written out in the same order.
+        let (dx, dy) = (s0.p.0 - s1.p.0, s0.p.1 - s1.p.1);
+        let radius_sq = 0.5 * ((dx * dx) + (dy * dy));
         let angle_thres = 5.0;
-        let v0 = glam::Vec2::new(s0.p.0, s0.p.1);
-        let v1 = glam::Vec2::new(s1.p.0, s1.p.1);
-        let v10 = v1 - v0;
-        let new_v0 = v0 + v10 * ratio0;
-        let new_v1 = v1 + v10 * ratio0;
+        let v10 = (s1.p.0 - s0.p.0, s1.p.1 - s0.p.1);
+        let new_v0 = [s0.p.0 + v10.0 * ratio0, s0.p.1 + v10.1 * ratio0];
+        let new_v1 = [s1.p.0 + v10.0 * ratio0, s1.p.1 + v10.1 * ratio0];
 
         let nv0s = self
             .tree
-            .nearest(&[new_v0.x, new_v0.y], 3, &squared_euclidean)
+            .nearest(&new_v0, 3, &squared_euclidean)
             .unwrap();
 
         let mut out0 = [0usize; 3];
@@ -212,7 +210,7 @@ impl<'a, 'b> Board<'a, 'b> {
 
         let nv1s = self
             .tree
-            .nearest(&[new_v1.x, new_v1.y], 3, &squared_euclidean)
+            .nearest(&new_v1, 3, &squared_euclidean)
             .unwrap();
 
         let mut out1 = [0usize; 3];

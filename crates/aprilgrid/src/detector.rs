@@ -10,7 +10,6 @@ use crate::saddle::Saddle;
 use crate::{image_util, math_util, tag_families};
 use faer::linalg::solvers::SolveLstsqCore;
 use image::{DynamicImage, GenericImageView, GrayImage, ImageBuffer, Luma};
-use itertools::Itertools;
 use kdtree::KdTree;
 use kdtree::distance::squared_euclidean;
 
@@ -475,33 +474,6 @@ impl TagDetector {
         None
     }
 
-    #[cfg(feature = "kornia")]
-    pub fn detect_kornia<const N: usize>(
-        &self,
-        img: &kornia::image::Image<u8, N>,
-    ) -> HashMap<u32, [(f32, f32); 4]> {
-        let dyn_img = match img.num_channels() {
-            1 => DynamicImage::ImageLuma8(
-                GrayImage::from_vec(
-                    img.width() as u32,
-                    img.height() as u32,
-                    img.clone().0.into_vec(),
-                )
-                .unwrap(),
-            ),
-            3 => DynamicImage::ImageRgb8(
-                image::RgbImage::from_vec(
-                    img.width() as u32,
-                    img.height() as u32,
-                    img.clone().0.into_vec(),
-                )
-                .unwrap(),
-            ),
-            _ => panic!("Only support u8c1 and u8c3"),
-        };
-        self.detect(&dyn_img)
-    }
-
     pub fn detect(&self, img: &DynamicImage) -> HashMap<u32, [(f32, f32); 4]> {
         let mut detected_tags = HashMap::new();
         let img_grey = img.to_luma8();
@@ -562,7 +534,10 @@ pub fn init_quads(
     }
     for s1_idx in same_p_idxs {
         let s1 = refined[s1_idx];
-        for dp in diff_p_idxs.iter().combinations(2) {
+        // The pairs of itertools' `combinations(2)`, in its order.
+        let pairs = (0..diff_p_idxs.len())
+            .flat_map(|i| (i + 1..diff_p_idxs.len()).map(move |j| (i, j)));
+        for dp in pairs.map(|(i, j)| [&diff_p_idxs[i], &diff_p_idxs[j]]) {
             let d0 = refined[*dp[0]];
             let d1 = refined[*dp[1]];
             if !crate::saddle::is_valid_quad(&s0, &d0, &s1, &d1) {
@@ -607,10 +582,10 @@ pub fn try_find_best_board(refined: &[Saddle]) -> Option<Vec<[usize; 4]>> {
             hm.get_mut(&angle).unwrap().push(i);
         }
     });
+    // The last of the longest (as itertools' stable `sorted_by(…).next_back()`).
     let mut s0_idxs: Vec<usize> = hm
         .iter()
-        .sorted_by(|a, b| a.1.len().cmp(&b.1.len()))
-        .next_back()
+        .max_by(|a, b| a.1.len().cmp(&b.1.len()))
         .unwrap()
         .1
         .to_owned();

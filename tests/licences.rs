@@ -190,7 +190,14 @@ fn vendored_code_keeps_its_authors_licence_and_says_where_it_came_from() {
         "crates/aprilgrid/LICENSE is not aprilgrid-rs's MIT text"
     );
     let readme = std::fs::read_to_string(dir.join("README.md")).unwrap();
-    for needed in ["aprilgrid-rs 0.8.0", "github.com/powei-lin/aprilgrid-rs", "Changed"] {
-        assert!(readme.contains(needed), "crates/aprilgrid/README.md lacks {needed:?}");
+    for needed in [
+        "aprilgrid-rs 0.8.0",
+        "github.com/powei-lin/aprilgrid-rs",
+        "Changed",
+    ] {
+        assert!(
+            readme.contains(needed),
+            "crates/aprilgrid/README.md lacks {needed:?}"
+        );
     }
 }

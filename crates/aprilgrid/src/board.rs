@@ -187,10 +187,7 @@ impl<'a, 'b> Board<'a, 'b> {
         let new_v0 = [s0.p.0 + v10.0 * ratio0, s0.p.1 + v10.1 * ratio0];
         let new_v1 = [s1.p.0 + v10.0 * ratio0, s1.p.1 + v10.1 * ratio0];
 
-        let nv0s = self
-            .tree
-            .nearest(&new_v0, 3, &squared_euclidean)
-            .unwrap();
+        let nv0s = self.tree.nearest(&new_v0, 3, &squared_euclidean).unwrap();
 
         let mut out0 = [0usize; 3];
         let mut count0 = 0;
@@ -208,10 +205,7 @@ impl<'a, 'b> Board<'a, 'b> {
             }
         }
 
-        let nv1s = self
-            .tree
-            .nearest(&new_v1, 3, &squared_euclidean)
-            .unwrap();
+        let nv1s = self.tree.nearest(&new_v1, 3, &squared_euclidean).unwrap();
 
         let mut out1 = [0usize; 3];
         let mut count1 = 0;

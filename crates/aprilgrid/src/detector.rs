@@ -535,8 +535,8 @@ pub fn init_quads(
     for s1_idx in same_p_idxs {
         let s1 = refined[s1_idx];
         // The pairs of itertools' `combinations(2)`, in its order.
-        let pairs = (0..diff_p_idxs.len())
-            .flat_map(|i| (i + 1..diff_p_idxs.len()).map(move |j| (i, j)));
+        let pairs =
+            (0..diff_p_idxs.len()).flat_map(|i| (i + 1..diff_p_idxs.len()).map(move |j| (i, j)));
         for dp in pairs.map(|(i, j)| [&diff_p_idxs[i], &diff_p_idxs[j]]) {
             let d0 = refined[*dp[0]];
             let d1 = refined[*dp[1]];

@@ -340,6 +340,14 @@ const APRILGRID: (usize, usize, f64, f64) = (6, 6, 0.03, 0.3);
 /// far and oblique: tags of 7–12 px); against OpenCV's `ArucoDetector`
 /// on its tags (`DICT_APRILTAG_36h11`, a 2-bit border,
 /// `CORNER_REFINE_APRILTAG`: OpenCV has no aprilgrid detector).
+///
+/// Fails today (2026-12-06, not in `scripts/test`'s `required`): the
+/// corners pass (0.031–0.032 px median, every id true, OpenCV 0.705 px),
+/// the true error does not: 0.0219 mm RMS over the 4 draws against 0.0144
+/// mm predicted (1.52×). The corners' mean error over each image is
+/// 0.005–0.01 px and the same in every draw (independent errors would
+/// give 0.0023 px): errors common to an image, which the prediction does
+/// not count (docs/cameras.md).
 #[test]
 fn live_images_eye_in_hand_aprilgrid() {
     let (rows, cols, tag, spacing) = APRILGRID;

@@ -167,11 +167,37 @@ fn the_workspace_states_its_licence() {
         let text = std::fs::read_to_string(Path::new(ROOT).join(f)).unwrap();
         assert!(text.len() > 1000, "{f} is not a full licence text");
     }
-    for manifest in ["Cargo.toml", "proptests/Cargo.toml", "verify/Cargo.toml"] {
+    for manifest in [
+        "Cargo.toml",
+        "proptests/Cargo.toml",
+        "verify/Cargo.toml",
+        "crates/aprilgrid/Cargo.toml",
+    ] {
         let text = std::fs::read_to_string(Path::new(ROOT).join(manifest)).unwrap();
         assert!(
             text.contains("license = \"MIT OR Apache-2.0\""),
             "{manifest} lacks the licence"
+        );
+    }
+}
+
+#[test]
+fn vendored_code_keeps_its_authors_licence_and_says_where_it_came_from() {
+    let dir = Path::new(ROOT).join("crates/aprilgrid");
+    let licence = std::fs::read_to_string(dir.join("LICENSE")).unwrap();
+    assert!(
+        licence.starts_with("MIT License") && licence.contains("Copyright (c) 2024 Powei Lin"),
+        "crates/aprilgrid/LICENSE is not aprilgrid-rs's MIT text"
+    );
+    let readme = std::fs::read_to_string(dir.join("README.md")).unwrap();
+    for needed in [
+        "aprilgrid-rs 0.8.0",
+        "github.com/powei-lin/aprilgrid-rs",
+        "Changed",
+    ] {
+        assert!(
+            readme.contains(needed),
+            "crates/aprilgrid/README.md lacks {needed:?}"
         );
     }
 }

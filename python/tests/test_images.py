@@ -56,10 +56,33 @@ def test_a_missing_folder_and_a_target_without_a_detector_are_refused_naming_the
     with pytest.raises(activecal.InputError, match="^images: "):
         activecal.detect(tmp_path / "nowhere", CAM / "board_6x9.yaml",
                          CAM / "small_camera_info.yaml", robot=ur5(), joints=IMAGES / "joints.csv")
-    grid = {"aprilgrid": {"rows": 2, "cols": 2, "tag_size": 0.05, "tag_spacing": 0.3}}
-    with pytest.raises(activecal.InputError, match="^images: .*AprilGrids"):
-        activecal.detect(IMAGES, grid, CAM / "small_camera_info.yaml", robot=ur5(),
+    points = {"points": [{"id": i, "xyz": [0.1 * (i % 2), 0.1 * (i // 2), 0.0]} for i in range(4)]}
+    with pytest.raises(activecal.InputError, match="^images: .*a point list is not detected"):
+        activecal.detect(IMAGES, points, CAM / "small_camera_info.yaml", robot=ur5(),
                          joints=IMAGES / "joints.csv")
+
+
+def test_detect_finds_kalibrs_aprilgrid_with_its_ids():
+    """fixtures/camera/aprilgrid/: 8 noise-free renders (640 x 480) of a
+    Kalibr aprilgrid of 3 x 4 tags of 30 mm (tagSpacing 0.3), the true
+    pixel of each tag corner in fixtures/camera/aprilgrid_truth.csv."""
+    d = CAM / "aprilgrid"
+    df = activecal.detect(d, CAM / "aprilgrid_3x4.yaml", CAM / "charuco_camera_info.yaml",
+                          robot=ur5(), joints=d / "joints.csv")
+    images = df.attrs["images"]
+    assert len(images) == 8 and all(i["status"] == "found" for i in images), images
+    truth = {(int(row["pose"]), int(row["feature"])): (float(row["u"]), float(row["v"]))
+             for row in csv.DictReader(open(CAM / "aprilgrid_truth.csv"))}
+    errors = sorted(math.hypot(u - truth[(p, f)][0], v - truth[(p, f)][1])
+                    for p, f, u, v in zip(df["pose"], df["feature"], df["u"], df["v"]))
+    # Every tag corner found with its true id (another id is at least the
+    # 9 mm gap, >= 14 px, away) within the bounds of tests/camera_images.rs.
+    assert len(errors) == 8 * 48
+    assert errors[len(errors) // 2] < 0.1 and errors[-1] < 0.5, errors[-5:]
+    cal = activecal.calibrate_camera(ur5(), camera_info=CAM / "charuco_camera_info.yaml",
+                                     target=CAM / "aprilgrid_3x4.yaml", images=d,
+                                     joints=d / "joints.csv", mounting="eye-in-hand")
+    assert cal.report["images"] == images
 
 
 def test_calibrate_camera_from_images_equals_the_command_line():

@@ -65,6 +65,22 @@ pub struct Target {
     /// A ChArUco board's printed pattern (`charuco:` targets), which a
     /// detector needs; `None` for other targets.
     pub charuco: Option<CharucoPattern>,
+    /// A Kalibr aprilgrid's layout (`aprilgrid:` targets), which a
+    /// detector needs; `None` for other targets.
+    pub aprilgrid: Option<AprilgridPattern>,
+}
+
+/// A Kalibr aprilgrid as printed (see the module documentation).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AprilgridPattern {
+    /// Tags down (Kalibr's `tagRows`).
+    pub rows: usize,
+    /// Tags across (Kalibr's `tagCols`).
+    pub cols: usize,
+    /// A tag's side, m (Kalibr's `tagSize`).
+    pub tag_size: f64,
+    /// The gap between tags over the tag's side (Kalibr's `tagSpacing`).
+    pub tag_spacing: f64,
 }
 
 /// A ChArUco board as printed (see the module documentation).
@@ -100,6 +116,7 @@ impl Target {
             face: Vector3::z(),
             grid: Some((rows, cols)),
             charuco: None,
+            aprilgrid: None,
         }
     }
 
@@ -132,6 +149,12 @@ impl Target {
             face: -Vector3::z(),
             grid: None,
             charuco: None,
+            aprilgrid: Some(AprilgridPattern {
+                rows,
+                cols,
+                tag_size,
+                tag_spacing,
+            }),
         };
         for k in 0..rows * cols {
             let (r, c) = ((k / cols) as f64, (k % cols) as f64);
@@ -468,6 +491,7 @@ fn list(p: &Spanned<Vec<Spanned<PointEntry>>>) -> std::result::Result<Target, St
         face: Vector3::z(),
         grid: None,
         charuco: None,
+        aprilgrid: None,
     };
     let mut first_line = std::collections::HashMap::new();
     for e in &p.value {

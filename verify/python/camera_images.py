@@ -46,6 +46,16 @@ make's truth.json):
       is its inner corners with OpenCV's ids (i*(COLS-1)+j at
       ((j+1)*SQUARE, (i+1)*SQUARE, 0)).
 
+      --aprilgrid ROWS,COLS,TAG,SPACING (instead of --board): Kalibr's
+      aprilgrid (tagRows, tagCols, tagSize in m, tagSpacing the gap over
+      the tag's side) as kalibr_create_target_pdf draws it (class
+      Aprilgrid: 36h11 tags with a 2-bit border, the black squares at
+      their corners), half a tag of white paper around the corner squares;
+      its face is seen when its z axis points towards the camera (Kalibr's
+      frame), which --behind turns around; the truth is the tags' corners
+      with Kalibr's ids (4k ... 4k+3: lower left, lower right, upper right,
+      upper left of tag k), the smallest square is the shortest tag side.
+
       --draws D (default 1): the same configurations and renders with D
       draws of the noise (numpy default_rng((S, 1 + d))), in DIR/draw_d/
       each (the files below in each).
@@ -129,8 +139,10 @@ def project(pts, r, tv, k, dist):
     return img.reshape(-1, 2)
 
 
-def view(r, tv, pts, outline, k, dist, w, h):
-    """(distance m, view angle deg, behind, smallest square px, in image)."""
+def view(r, tv, pts, outline, k, dist, w, h, face=1.0):
+    """(distance m, view angle deg, behind, in image); `face` is +1 for a
+    board whose printed face is seen when its z axis points away from the
+    camera (OpenCV's), -1 when it points towards it (Kalibr's aprilgrid)."""
     cam = pts @ r.T + tv
     if np.any(cam[:, 2] <= 0.05) or np.any((outline @ r.T + tv)[:, 2] <= 0.05):
         return None
@@ -141,7 +153,7 @@ def view(r, tv, pts, outline, k, dist, w, h):
     angle = math.degrees(math.acos(min(1.0, abs(cosang))))
     o = project(outline, r, tv, k, dist)
     inside = bool(np.all((o[:, 0] >= 10) & (o[:, 0] <= w - 11) & (o[:, 1] >= 10) & (o[:, 1] <= h - 11)))
-    return dist_m, angle, cosang < 0, inside
+    return dist_m, angle, face * cosang < 0, inside
 
 
 def smallest_square(px, rows, cols):
@@ -171,6 +183,10 @@ class Checkerboard:
         self.pts = np.array([[(i % cols) * sq, (i // cols) * sq, 0.0] for i in range(rows * cols)])
         self.grid = (rows, cols)
         self.outline = board_outline(rows, cols, sq)
+        self.face = 1.0
+
+    def smallest(self, px):
+        return smallest_square(px, *self.grid)
 
     def colour(self, bx, by):
         rows, cols, sq = self.rows, self.cols, self.sq
@@ -199,6 +215,10 @@ class Charuco:
         self.pts = np.asarray(b.getChessboardCorners(), dtype=float).reshape(-1, 3)
         self.grid = (rows - 1, cols - 1)
         self.outline = rect_outline(-0.5 * sq, (cols + 0.5) * sq, -0.5 * sq, (rows + 0.5) * sq)
+        self.face = 1.0
+
+    def smallest(self, px):
+        return smallest_square(px, *self.grid)
 
     def colour(self, bx, by):
         rows, cols, sq = self.rows, self.cols, self.sq
@@ -209,6 +229,83 @@ class Charuco:
         level = np.where(texel > 127, WHITE, BLACK)
         paper = (bx >= -0.5 * sq) & (bx <= (cols + 0.5) * sq) & (by >= -0.5 * sq) & (by <= (rows + 0.5) * sq)
         return np.where(on, level, np.where(paper, WHITE, BACKGROUND))
+
+
+# Tag 0 of the AprilTag family 36h11 (AprilTag's tag36h11 table, the code
+# Kalibr's kalibr_create_target_pdf draws): its 36 bits, the most
+# significant first, row by row from the top-left of the printed tag,
+# white = 1 (Kalibr's generateAprilTag: bit 6i+j of the code, turned 180
+# degrees by np.rot90(., 2), drawn with row 0 at the top).
+TAG36H11_0 = 0xD5D628584
+
+
+def kalibr_tag(dictionary, tag_id):
+    """Kalibr's printed tag `tag_id` (36h11, a 2-bit black border) as 10 x 10
+    booleans (True: black), row 0 at the top of the printed face: OpenCV's
+    generateImageMarker(DICT_APRILTAG_36h11, id, borderBits=2) turned 180
+    degrees (OpenCV draws the same code with its first bit at the other
+    corner), checked on tag 0 against the family's code."""
+    import cv2
+    m = cv2.aruco.generateImageMarker(dictionary, tag_id, 10, borderBits=2)
+    black = np.rot90(m < 128, 2)
+    if tag_id == 0:
+        want = [(TAG36H11_0 >> (35 - n)) & 1 == 0 for n in range(36)]
+        if list(black[2:8, 2:8].ravel()) != want:
+            raise SystemExit("OpenCV's DICT_APRILTAG_36h11 tag 0 is not Kalibr's")
+    return black
+
+
+class Aprilgrid:
+    """Kalibr's aprilgrid of rows x cols tags (36h11, ids 0 ... rows*cols - 1
+    row by row from the bottom-left) of side `size` (m), `spacing * size`
+    apart, as kalibr_create_target_pdf draws it: each tag a 10 x 10 bit
+    square with a 2-bit black border, a black square of side spacing*size
+    diagonally outside each of its corners (touching the tag's corner:
+    X-junctions), white paper half a tag around that. The board's frame is
+    Kalibr's: x right, y up on the printed face, z out of it (the face is
+    seen when z points towards the camera). The truth is the tags' corners
+    with Kalibr's ids (4k ... 4k+3: lower left, lower right, upper right,
+    upper left; activecal's aprilgrid target). Not drawn: the PDF's axis
+    arrows and caption below the grid (outside the paper here)."""
+
+    def __init__(self, rows, cols, size, spacing):
+        import cv2
+        d = cv2.aruco.getPredefinedDictionary(cv2.aruco.DICT_APRILTAG_36h11)
+        self.rows, self.cols, self.sq = rows, cols, size
+        self.size, self.spacing = size, spacing
+        self.pitch = (1 + spacing) * size
+        self.tags = np.stack([kalibr_tag(d, i) for i in range(rows * cols)])
+        pts = []
+        for i in range(rows * cols):
+            x0, y0 = (i % cols) * self.pitch, (i // cols) * self.pitch
+            pts += [[x0, y0, 0], [x0 + size, y0, 0], [x0 + size, y0 + size, 0], [x0, y0 + size, 0]]
+        self.pts = np.array(pts, dtype=float)
+        m = spacing * size + 0.5 * size
+        # the corner squares reach spacing*size past the outer tags
+        self.paper = (-m, (cols - 1) * self.pitch + size + m, -m, (rows - 1) * self.pitch + size + m)
+        self.outline = rect_outline(*self.paper)
+        self.face = -1.0
+
+    def smallest(self, px):
+        """The shortest tag side, px."""
+        q = px.reshape(-1, 4, 2)
+        return float(np.linalg.norm(q - np.roll(q, 1, axis=1), axis=2).min())
+
+    def colour(self, bx, by):
+        p, t = self.pitch, self.size
+        cx, cy = np.floor(bx / p), np.floor(by / p)
+        u, v = bx - cx * p, by - cy * p
+        in_tag = (u < t) & (v < t) & (cx >= 0) & (cx < self.cols) & (cy >= 0) & (cy < self.rows)
+        k = np.clip(cy * self.cols + cx, 0, self.rows * self.cols - 1).astype(int)
+        b = t / 10
+        row = np.clip(9 - np.floor(v / b), 0, 9).astype(int)
+        col = np.clip(np.floor(u / b), 0, 9).astype(int)
+        tag_black = self.tags[k, row, col]
+        corner = (u >= t) & (v >= t) & (cx >= -1) & (cx <= self.cols - 1) & (cy >= -1) & (cy <= self.rows - 1)
+        x0, x1, y0, y1 = self.paper
+        paper = (bx >= x0) & (bx <= x1) & (by >= y0) & (by <= y1)
+        black = (in_tag & tag_black) | corner
+        return np.where(black, BLACK, np.where(paper, WHITE, BACKGROUND))
 
 
 def render(r, tv, k, dist, box, board, w, h):
@@ -246,7 +343,7 @@ def with_noise(img, noise, rng):
     return np.clip(np.rint(img), 0, 255).astype(np.uint8)
 
 
-def choose(t, a, pts, outline, k, dist, w, h, rng):
+def choose(t, a, pts, outline, k, dist, w, h, rng, face=1.0):
     """The configurations to render: (q, r, tv, stats) per image."""
     near_n = a.count - a.far
     found = {"near": [], "far": []}
@@ -257,7 +354,7 @@ def choose(t, a, pts, outline, k, dist, w, h, rng):
             raise SystemExit("fewer than %d configurations show the board in 400,000 draws" % a.count)
         for q in t.chain.random_configurations(1000, rng):
             r, tv = camera_from_board(t, q)
-            v = view(r, tv, pts, outline, k, dist, w, h)
+            v = view(r, tv, pts, outline, k, dist, w, h, face)
             if v is None or not v[3] or v[2] != a.behind:
                 continue
             d, ang = v[0], v[1]
@@ -274,17 +371,20 @@ def cmd_render(a):
     import cv2
     t = truth.Truth(a.truth)
     k, dist, w, h = camera_truth.camera_info(a.camera_info)
-    if (a.board is None) == (a.charuco is None):
-        raise SystemExit("give one of --board and --charuco")
+    if sum(x is not None for x in (a.board, a.charuco, a.aprilgrid)) != 1:
+        raise SystemExit("give one of --board, --charuco and --aprilgrid")
     if a.board is not None:
         rows, cols, sq = camera_truth.numbers(a.board, 3, "--board")
         board = Checkerboard(int(rows), int(cols), sq)
+    elif a.aprilgrid is not None:
+        rows, cols, sq, spacing = camera_truth.numbers(a.aprilgrid, 4, "--aprilgrid")
+        board = Aprilgrid(int(rows), int(cols), sq, spacing)
     else:
         rows, cols, sq, marker = camera_truth.numbers(a.charuco, 4, "--charuco")
         board = Charuco(int(rows), int(cols), sq, marker, a.dictionary, a.legacy)
     pts, outline = board.pts, board.outline
     rng = np.random.default_rng(a.seed)
-    chosen = choose(t, a, pts, outline, k, dist, w, h, rng)
+    chosen = choose(t, a, pts, outline, k, dist, w, h, rng, board.face)
     outs = [a.out] if a.draws == 1 else [os.path.join(a.out, "draw_%d" % d) for d in range(a.draws)]
     rngs = [np.random.default_rng((a.seed, 1 + d)) for d in range(a.draws)]
     for o in outs:
@@ -305,7 +405,7 @@ def cmd_render(a):
         joints.append("%s,%s" % (name, qs))
         px = project(pts, r, tv, k, dist)
         obs += ["%d,%s,%d,%r,%r" % (n, qs, i, float(px[i, 0]), float(px[i, 1])) for i in range(len(pts))]
-        st = dict(st, image=name, smallest_square_px=smallest_square(px, *board.grid))
+        st = dict(st, image=name, smallest_square_px=board.smallest(px))
         stats.append(st)
     for o in outs:
         with open(os.path.join(o, "joints.csv"), "w") as f:
@@ -330,12 +430,56 @@ def read_truth(d):
     return out
 
 
+# OpenCV's marker corner c (clockwise from the top-left of its marker
+# image) is Kalibr's corner KALIBR_OF_OPENCV[c] of the same tag: Kalibr
+# prints OpenCV's marker image turned 180 degrees (kalibr_tag), so
+# OpenCV's top-left, top-right, bottom-right, bottom-left are Kalibr's
+# lower right, lower left, upper left, upper right.
+KALIBR_OF_OPENCV = [1, 0, 3, 2]
+
+
+def aprilgrid_detector(method):
+    """OpenCV's ArucoDetector for Kalibr's tags (DICT_APRILTAG_36h11, a
+    2-bit border), its other parameters the defaults but the corner
+    refinement: 'aprilgrid-subpix' (CORNER_REFINE_SUBPIX, cornerSubPix
+    with its documented defaults), 'aprilgrid-apriltag'
+    (CORNER_REFINE_APRILTAG), 'aprilgrid' (none)."""
+    import cv2
+    p = cv2.aruco.DetectorParameters()
+    p.markerBorderBits = 2
+    p.cornerRefinementMethod = {
+        "aprilgrid": cv2.aruco.CORNER_REFINE_NONE,
+        "aprilgrid-subpix": cv2.aruco.CORNER_REFINE_SUBPIX,
+        "aprilgrid-apriltag": cv2.aruco.CORNER_REFINE_APRILTAG}[method]
+    d = cv2.aruco.getPredefinedDictionary(cv2.aruco.DICT_APRILTAG_36h11)
+    return cv2.aruco.ArucoDetector(d, p)
+
+
+def aprilgrid_lines(detector, img, name, ntags):
+    """The detections CSV's rows of the aprilgrid's tags (ids below
+    `ntags`) found by `detector` in `img`, with Kalibr's point ids."""
+    corners, ids, _ = detector.detectMarkers(img)
+    if ids is None:
+        return []
+    out = []
+    for c, i in zip(corners, ids.ravel()):
+        if i >= ntags:
+            continue
+        for k in range(4):
+            f = 4 * int(i) + KALIBR_OF_OPENCV[k]
+            out.append("%s,%d,%r,%r" % (name, f, float(c[0][k][0]), float(c[0][k][1])))
+    return out
+
+
 def cmd_opencv(a):
     """OpenCV's detectors on DIR's images, as a user would run them:
     findChessboardCorners + cornerSubPix with a fixed (W, W) window (the
     tutorial's 11), or findChessboardCornersSB with its defaults; or, for
     a ChArUco board (--method charuco), cv2.aruco.CharucoDetector with its
-    default parameters (its corners' ids). Written as detections CSV:
+    default parameters (its corners' ids); or, for Kalibr's aprilgrid
+    (--method aprilgrid[-subpix|-apriltag] --aprilgrid R,C,T,S; OpenCV has
+    no aprilgrid detector), cv2.aruco.ArucoDetector on its tags
+    (aprilgrid_detector), each tag's corners with Kalibr's ids. Written as detections CSV:
     image, feature (OpenCV's order or id), u, v."""
     import cv2
     lines = ["image,feature,u,v"]
@@ -344,10 +488,16 @@ def cmd_opencv(a):
         rows, cols, sq, marker = camera_truth.numbers(a.charuco, 4, "--charuco")
         detector = cv2.aruco.CharucoDetector(
             Charuco(int(rows), int(cols), sq, marker, a.dictionary, a.legacy).board)
+    elif a.method.startswith("aprilgrid"):
+        detector = aprilgrid_detector(a.method)
+        ntags = int(np.prod(camera_truth.numbers(a.aprilgrid, 4, "--aprilgrid")[:2]))
     else:
         rows, cols = (int(v) for v in a.pattern.split(","))
     for name in sorted(read_truth(a.dir)):
         img = cv2.imread(os.path.join(a.dir, name), cv2.IMREAD_GRAYSCALE)
+        if a.method.startswith("aprilgrid"):
+            lines += aprilgrid_lines(detector, img, name, ntags)
+            continue
         if a.method == "charuco":
             c, ids, _, _ = detector.detectBoard(img)
             if ids is None or len(ids) == 0:
@@ -419,6 +569,7 @@ def main(argv=None):
     r.add_argument("--charuco", help="ROWS,COLS,SQUARE,MARKER: a ChArUco board's squares")
     r.add_argument("--dictionary", default="DICT_4X4_50")
     r.add_argument("--legacy", action="store_true")
+    r.add_argument("--aprilgrid", help="ROWS,COLS,TAG,SPACING: Kalibr's aprilgrid (tagRows, tagCols, tagSize m, tagSpacing)")
     r.add_argument("--count", type=int, default=25)
     r.add_argument("--far", type=int, default=4)
     r.add_argument("--behind", action="store_true")
@@ -435,7 +586,9 @@ def main(argv=None):
     o = sub.add_parser("opencv")
     o.add_argument("--dir", required=True)
     o.add_argument("--pattern", help="ROWS,COLS of inner corners")
-    o.add_argument("--method", choices=["classic", "sb", "charuco"], default="classic")
+    o.add_argument("--method", choices=["classic", "sb", "charuco", "aprilgrid", "aprilgrid-subpix",
+                                        "aprilgrid-apriltag"], default="classic")
+    o.add_argument("--aprilgrid", help="ROWS,COLS,TAG,SPACING: Kalibr's aprilgrid")
     o.add_argument("--charuco", help="ROWS,COLS,SQUARE,MARKER: a ChArUco board's squares")
     o.add_argument("--dictionary", default="DICT_4X4_50")
     o.add_argument("--legacy", action="store_true")

@@ -1,9 +1,9 @@
 use crate::saddle::{Saddle, is_valid_quad};
 use kdtree::KdTree;
 use kdtree::distance::squared_euclidean;
-use std::collections::HashMap;
+use std::collections::BTreeMap;
 
-#[derive(Hash, PartialEq, Eq, Clone, Copy, Debug)]
+#[derive(Hash, PartialEq, Eq, PartialOrd, Ord, Clone, Copy, Debug)]
 struct BoardIdx {
     x: i32,
     y: i32,
@@ -17,7 +17,7 @@ impl BoardIdx {
 pub struct Board<'a, 'b> {
     refined: &'a [Saddle],
     active_idxs: Vec<bool>,
-    found_board_idxs: HashMap<BoardIdx, Option<[usize; 4]>>,
+    found_board_idxs: BTreeMap<BoardIdx, Option<[usize; 4]>>,
     tree: &'b KdTree<f32, usize, [f32; 2]>,
     spacing_ratio: f32,
     pub score: u32,
@@ -37,7 +37,7 @@ impl<'a, 'b> Board<'a, 'b> {
         let mut b = Board {
             refined,
             active_idxs,
-            found_board_idxs: HashMap::from([(BoardIdx::new(0, 0), Some(*quad_idxs))]),
+            found_board_idxs: BTreeMap::from([(BoardIdx::new(0, 0), Some(*quad_idxs))]),
             tree,
             spacing_ratio,
             score: 1,

@@ -573,10 +573,10 @@ pub fn try_find_best_board(refined: &[Saddle]) -> Option<Vec<[usize; 4]>> {
     let active_mask: Vec<bool> = vec![true; refined.len()];
     let (mut best_score, mut best_board_option) = (0, None);
     let mut count = 0;
-    let mut hm = HashMap::<i32, Vec<usize>>::new();
+    let mut hm = std::collections::BTreeMap::<i32, Vec<usize>>::new();
     refined.iter().enumerate().for_each(|(i, s)| {
         let angle = s.theta.round() as i32;
-        if let std::collections::hash_map::Entry::Vacant(e) = hm.entry(angle) {
+        if let std::collections::btree_map::Entry::Vacant(e) = hm.entry(angle) {
             e.insert(vec![i]);
         } else {
             hm.get_mut(&angle).unwrap().push(i);

@@ -65,6 +65,7 @@ mod reproduce;
 mod robots;
 mod robots_describe;
 mod score_design;
+mod seam_commands;
 mod seam_sensor;
 mod select;
 mod tour_moves;

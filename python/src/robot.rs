@@ -184,6 +184,7 @@ impl Robot {
         let r = RobotRef {
             name: path.display().to_string(),
             pose,
+            sensor: None,
             chain: ChainChoice {
                 base,
                 tip,

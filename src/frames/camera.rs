@@ -34,7 +34,8 @@ pub fn camera_frames(
     fit: &CameraFit,
 ) -> Result<Option<(CalibratedFrames, FramesReport)>, FramesError> {
     let mut robot = fit.robot.clone();
-    // As a full pose: the split's tool is the end frame in the tip link.
+    // As a full pose: the split's tool is the end frame in the tip link
+    // (builds a kind for the frames' split, decides nothing).
     robot.measurement = MeasurementKind::Pose;
     let n = robot.n_unknowns();
     let cov: Option<Vec<Vec<f64>>> = fit

@@ -185,6 +185,9 @@ fn errors_of_rows(
     let rows: Vec<usize> = (0..kinds.len())
         .filter(|&r| kinds[r] == RowKind::Position)
         .collect();
+    // Position rows per measured point: three, or one for a sensor that
+    // reads one coordinate of its points (a height).
+    let point_rows = if rows.len() % 3 == 0 { 3 } else { 1 };
     let mut rng = ChaCha8Rng::seed_from_u64(0);
     let (mut pos, mut ori, mut norms) = (Vec::new(), Vec::new(), Vec::new());
     for i in 0..eval.n_poses() {
@@ -197,12 +200,17 @@ fn errors_of_rows(
         }
         pos.push((s2 * tr[0] / points.max(1.0)).sqrt() * 1e3);
         ori.push((s2 * tr[1]).sqrt() / w * 180.0 / std::f64::consts::PI);
-        for t in rows.chunks_exact(3) {
+        for t in rows.chunks_exact(point_rows) {
+            // A point's coordinates the sensor reads; the others' error 0.
             let cov: [[f64; 3]; 3] = std::array::from_fn(|a| {
                 std::array::from_fn(|c| {
-                    s2 * (0..b.ncols())
-                        .map(|k| xc[(t[a], k)] * b[(t[c], k)])
-                        .sum::<f64>()
+                    if a < t.len() && c < t.len() {
+                        s2 * (0..b.ncols())
+                            .map(|k| xc[(t[a], k)] * b[(t[c], k)])
+                            .sum::<f64>()
+                    } else {
+                        0.0
+                    }
                 })
             });
             error_norms(&cov, &mut rng, &mut norms);

@@ -53,8 +53,9 @@ pub fn for_measurements(robot: &Robot, meas: &Measurements, lm: &LmSettings) -> 
         return Err(e);
     }
     let have = crate::measure::sensor_for(robot);
+    let markers = have.tool_record() == crate::measure::ToolRecord::Markers;
     if k == have.points_per_pose() && has_orientation == have.measures_orientation() && k == 1
-        || (k > 1 && robot.measurement == MeasurementKind::Markers(k))
+        || (k > 1 && markers && have.points_per_pose() == k)
     {
         return Ok(Start {
             robot: robot.clone(),
@@ -62,8 +63,10 @@ pub fn for_measurements(robot: &Robot, meas: &Measurements, lm: &LmSettings) -> 
             notes: Vec::new(),
         });
     }
-    match (robot.measurement, k, has_orientation) {
-        (MeasurementKind::Point, 1, true) => {
+    // A robot measured by its whole tool point adapts to the data's shape.
+    match (have.follows_tool_point(), k, has_orientation) {
+        (true, 1, true) => {
+            // Builds the full-pose kind the data hold, decided above.
             let r = robot.with_measurement(MeasurementKind::Pose)?;
             Ok(Start {
                 table: r.nominal.clone(),
@@ -75,7 +78,7 @@ pub fn for_measurements(robot: &Robot, meas: &Measurements, lm: &LmSettings) -> 
                 robot: r,
             })
         }
-        (MeasurementKind::Point, k, false) if k > 1 => markers_start(robot, meas, lm),
+        (true, k, false) if k > 1 => markers_start(robot, meas, lm),
         _ => {
             // Not a combination we adapt: the check names what differs.
             meas.check(robot)?;

@@ -107,7 +107,9 @@ pub fn read_in(path: &Path, robot: &Robot, units: Units) -> Result<MeasurementFi
 
 /// The CSV form of `meas` for `robot`, as [`read`] reads it back: a column
 /// per joint (named as a URDF robot's joints, else `q1`…`qN`; radians,
-/// metres for prismatic joints), `x1,y1,z1` (… one triple per marker; metres) and, for full
+/// metres for prismatic joints), `x1,y1,z1` (… one triple per marker; metres;
+/// of a sensor that reads fewer coordinates, those alone:
+/// [`crate::measure::Sensor::point_coordinates`]) and, for full
 /// poses, the orientation as a unit quaternion `qw1,qx1,qy1,qz1`; one row
 /// a pose, every value at full precision.
 #[must_use]
@@ -119,8 +121,9 @@ pub fn to_csv(meas: &Measurements, robot: &Robot) -> String {
     } else {
         (1..=robot.dof()).map(|j| format!("q{j}")).collect()
     };
+    let coords = crate::measure::sensor_for(robot).point_coordinates();
     for m in 1..=k {
-        head.extend(["x", "y", "z"].iter().map(|c| format!("{c}{m}")));
+        head.extend(coords.iter().map(|&c| format!("{}{m}", AXES[c])));
     }
     if full {
         head.extend(["qw1", "qx1", "qy1", "qz1"].map(String::from));
@@ -129,7 +132,7 @@ pub fn to_csv(meas: &Measurements, robot: &Robot) -> String {
     for (i, q) in meas.qs().iter().enumerate() {
         let mut row: Vec<String> = q.iter().map(f64::to_string).collect();
         for p in &meas.points()[k * i..k * (i + 1)] {
-            row.extend(p.iter().map(f64::to_string));
+            row.extend(coords.iter().map(|&c| p[c].to_string()));
         }
         if let Some(r) = meas.orientations().get(i) {
             let m = nalgebra::Matrix3::from_row_slice(&r.concat());
@@ -181,8 +184,13 @@ pub fn parse_csv_measurements_in(
                 .map_err(err)?,
         );
         for cols in &layout.markers {
-            let [x, y, z] = cols.map(|c| cell.at(c).map(|v| m * v));
-            points.push([x.map_err(err)?, y.map_err(err)?, z.map_err(err)?]);
+            let mut p = [0.0; 3];
+            for (v, c) in p.iter_mut().zip(cols) {
+                if let Some(c) = *c {
+                    *v = m * cell.at(c).map_err(err)?;
+                }
+            }
+            points.push(p);
         }
         if let Some(r) = layout.orientation.read(&cell).map_err(err)? {
             orientations.push(r);
@@ -208,8 +216,9 @@ pub fn parse_csv_measurements_in(
 
 /// Which columns of a measurement CSV hold what.
 struct Layout {
-    /// `x_k, y_k, z_k` of each marker.
-    markers: Vec<[usize; 3]>,
+    /// `x_k, y_k, z_k` of each marker (`None`: a coordinate the sensor
+    /// does not read, 0).
+    markers: Vec<[Option<usize>; 3]>,
     /// The orientation columns of a full pose, if any.
     orientation: OrientationColumns,
     /// One column per joint of the robot, in joint order.
@@ -256,7 +265,8 @@ impl Layout {
     /// Finds the marker, orientation and joint columns of `t`'s header.
     fn of(t: &Table, robot: &Robot) -> std::result::Result<Self, String> {
         let mut used = vec![false; t.columns.len()];
-        let markers = marker_columns(t, &mut used)?;
+        let coords = crate::measure::sensor_for(robot).point_coordinates();
+        let markers = marker_columns(t, &mut used, coords)?;
         let orientation = orientation_columns(t, &mut used, markers.len())?;
         let joints = joint_columns(t, &mut used, robot)?;
         Ok(Self {
@@ -302,45 +312,68 @@ fn take(t: &Table, name: &str, used: &mut [bool]) -> Option<usize> {
     Some(c)
 }
 
-/// Markers: `x1,y1,z1`, `x2,…`; plain `x,y,z` count as marker 1.
-fn marker_columns(t: &Table, used: &mut [bool]) -> std::result::Result<Vec<[usize; 3]>, String> {
-    let mut marker_cols: Vec<[usize; 3]> = Vec::new();
+/// The coordinate names of a measured point, in order.
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// Markers: `x1,y1,z1`, `x2,…`; plain `x,y,z` count as marker 1. Only the
+/// coordinates `coords` (indices into `x y z`) the sensor reads are
+/// columns; the others stay `None`.
+fn marker_columns(
+    t: &Table,
+    used: &mut [bool],
+    coords: &[usize],
+) -> std::result::Result<Vec<[Option<usize>; 3]>, String> {
+    let mut marker_cols: Vec<[Option<usize>; 3]> = Vec::new();
     for k in 1.. {
-        let names = [format!("x{k}"), format!("y{k}"), format!("z{k}")];
+        let names: Vec<String> = coords.iter().map(|&c| format!("{}{k}", AXES[c])).collect();
         let found: Vec<Option<usize>> = names.iter().map(|n| t.column(n)).collect();
         let found = if k == 1 && found.iter().all(Option::is_none) {
-            ["x", "y", "z"].iter().map(|n| t.column(n)).collect()
+            coords.iter().map(|&c| t.column(AXES[c])).collect()
         } else {
             found
         };
-        match found[..] {
-            [None, None, None] => break,
-            [Some(x), Some(y), Some(z)] => {
-                let cols = [x, y, z];
-                cols.iter().for_each(|&c| used[c] = true);
-                marker_cols.push(cols);
-            }
-            _ => {
-                let missing: Vec<&str> = names
-                    .iter()
-                    .zip(&found)
-                    .filter(|(_, f)| f.is_none())
-                    .map(|(n, _)| n.as_str())
-                    .collect();
-                return Err(format!(
-                    "marker {k}: column(s) {} missing (a marker needs x{k}, y{k} and z{k})",
-                    missing.join(", ")
-                ));
-            }
+        if found.iter().all(Option::is_none) {
+            break;
         }
+        if found.iter().any(Option::is_none) {
+            let missing: Vec<&str> = names
+                .iter()
+                .zip(&found)
+                .filter(|(_, f)| f.is_none())
+                .map(|(n, _)| n.as_str())
+                .collect();
+            return Err(format!(
+                "marker {k}: column(s) {} missing (a marker needs {})",
+                missing.join(", "),
+                and_list(&names)
+            ));
+        }
+        let mut cols = [None; 3];
+        for (&c, f) in coords.iter().zip(&found) {
+            cols[c] = *f;
+            f.iter().for_each(|&i| used[i] = true);
+        }
+        marker_cols.push(cols);
     }
     if marker_cols.is_empty() {
+        let names: Vec<String> = coords.iter().map(|&c| format!("{}1", AXES[c])).collect();
         return Err(format!(
-            "no measured point: expected columns x1, y1, z1 (metres); the header has {}",
+            "no measured point: expected column{} {} (metres); the header has {}",
+            if names.len() == 1 { "" } else { "s" },
+            names.join(", "),
             t.columns.join(", ")
         ));
     }
     Ok(marker_cols)
+}
+
+/// `a`, `a and b`, `a, b and c`.
+fn and_list(names: &[String]) -> String {
+    match names {
+        [] => String::new(),
+        [a] => a.clone(),
+        [init @ .., last] => format!("{} and {last}", init.join(", ")),
+    }
 }
 
 /// The orientation columns: all three angles, all four quaternion entries,

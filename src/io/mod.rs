@@ -81,11 +81,41 @@ impl RobotRef {
     /// again. [`RobotRef::pose`] asks for full-pose measurements: a URDF
     /// imports with [`MeasurementKind::Pose`], a point description turns
     /// into its full-pose variant ([`Robot::with_measurement`]).
+    ///
+    /// [`RobotRef::sensor`] (`ur5:NAME`) measures the robot with that
+    /// registered sensor ([`crate::measure::registered_kind`]) in place of
+    /// its tool point; a name no sensor registers is refused, naming those
+    /// that are.
     pub fn load(&self) -> Result<Description> {
         let mut d = load_head(self)?;
+        if let Some(name) = &self.sensor {
+            d.robot = with_sensor(&d.robot, name, self)?;
+        }
         d.robot.name = self.to_string();
         Ok(d)
     }
+}
+
+/// `robot` measured by the registered sensor `name` (the `:NAME` suffix
+/// of `r`): refused when no sensor registers it, or when the robot's own
+/// sensor follows more than its tool point (markers, a full pose).
+fn with_sensor(robot: &Robot, name: &str, r: &RobotRef) -> Result<Robot> {
+    let Some(kind) = crate::measure::registered_kind(name) else {
+        let mut known = vec!["pose"];
+        known.extend(crate::measure::registered_names());
+        return Err(Error::Invalid(format!(
+            "{r}: unknown measurement '{name}' after ':' (known: {})",
+            known.join(", ")
+        )));
+    };
+    let own = crate::measure::sensor_for(robot);
+    if !own.follows_tool_point() {
+        return Err(Error::Invalid(format!(
+            "{r}: the robot is measured by {}; ':{name}' replaces a sensor that follows the tool point alone",
+            own.describe()
+        )));
+    }
+    robot.with_measurement(kind)
 }
 
 /// The URDF behind a robot and the chain chosen in it, as a collision
@@ -339,7 +369,10 @@ fn load_head(r: &RobotRef) -> Result<Description> {
     let d = match ext.as_deref() {
         Some("toml") => {
             let mut d = robot_toml::load_description(path)?;
-            if r.pose && d.robot.measurement == MeasurementKind::Point {
+            // `:pose` turns a description whose sensor follows the tool
+            // point alone into its full-pose variant (a marker, full-pose
+            // or registered sensor's description keeps its own).
+            if r.pose && crate::measure::sensor_for(&d.robot).follows_tool_point() {
                 d.robot = d.robot.with_measurement(MeasurementKind::Pose)?;
             }
             d

@@ -160,6 +160,24 @@ registered_sensors! {
     height,
 }
 
+/// The measurement kind of the registered sensor named `name` (its
+/// [`crate::model::SensorKey::name`]), as robot files and robot names
+/// (`ur5:NAME`) choose it; `None` when no sensor registers that name.
+#[must_use]
+pub fn registered_kind(name: &str) -> Option<crate::model::MeasurementKind> {
+    registered()
+        .into_iter()
+        .find(|r| r.key.name == name)
+        .map(|r| crate::model::MeasurementKind::Registered(r.key))
+}
+
+/// The names of the registered sensors, in registration order, for
+/// messages listing the measurements a file or a name may choose.
+#[must_use]
+pub fn registered_names() -> Vec<&'static str> {
+    registered().into_iter().map(|r| r.key.name).collect()
+}
+
 /// The sensor a robot is measured with ([`Robot::measurement`], weighted by
 /// [`Robot::orientation_scale`]).
 #[must_use]

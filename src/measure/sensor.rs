@@ -153,12 +153,36 @@ pub trait Sensor: fmt::Debug + Send + Sync {
         }
     }
 
+    /// Whether a value is the whole tool point and nothing more (its `x y
+    /// z`, no orientation, no unknowns of the sensor's own): a robot so
+    /// measured turns into its full-pose variant when data hold
+    /// orientations (or `:pose` asks for it), into a `K`-marker one when
+    /// data hold `K` points a pose, and is started from the tool point the
+    /// data imply. Default: from [`Sensor::tool_record`],
+    /// [`Sensor::point_coordinates`], [`Sensor::measures_orientation`] and
+    /// [`Sensor::n_own_params`], so a sensor reading less (a height) is not.
+    fn follows_tool_point(&self) -> bool {
+        self.tool_record() == ToolRecord::Point
+            && self.points_per_pose() == 1
+            && self.point_coordinates().len() == 3
+            && !self.measures_orientation()
+            && self.n_own_params() == 0
+    }
+
     /// The points of the last link the sensor follows, in the measurement
     /// frame (metres), for end frame `end` and own unknowns `own`: the end
     /// point by default; each marker for a marker sensor.
     fn measured_points(&self, end: &EndFrame, own: &[f64]) -> Vec<Vector3<f64>> {
         let _ = own;
         vec![end.position]
+    }
+
+    /// The coordinates of each measured point that a value reads (indices
+    /// into `x y z`, increasing), for measurement files: a CSV holds the
+    /// columns `x1 y1 z1`… of these alone, and the others of a point read
+    /// as 0. Default all three.
+    fn point_coordinates(&self) -> &'static [usize] {
+        &[0, 1, 2]
     }
 
     /// Length of one pose's measured or predicted value.

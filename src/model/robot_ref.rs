@@ -4,7 +4,7 @@
 //! and the chain options once, [`crate::io`] loads it; design files record one (as a name and a
 //! structured chain) and give it back.
 //!
-//! The text form `NAME[:pose][#base=B;tip=T;lock=J:V,…;frames=F;kinematics=K;marker=L@X,Y,Z…]` is this
+//! The text form `NAME[:pose|:SENSOR][#base=B;tip=T;lock=J:V,…;frames=F;kinematics=K;marker=L@X,Y,Z…]` is this
 //! value's serialisation, read by [`RobotRef::parse`] and written by its
 //! [`std::fmt::Display`]: a loaded robot's [`crate::model::Robot::name`], and
 //! the `robot` of design files written before the chain was stored apart.
@@ -185,26 +185,36 @@ pub struct RobotRef {
     pub name: String,
     /// Full poses asked for (the `:pose` suffix).
     pub pose: bool,
+    /// A registered sensor asked for by its name (the `:NAME` suffix, e.g.
+    /// `ur5:gauge`): resolved against `crate::measure::registered` when
+    /// the robot is loaded, which refuses a name no sensor registers.
+    pub sensor: Option<String>,
     /// The chain of a URDF tree.
     pub chain: ChainChoice,
 }
 
 impl RobotRef {
     /// Reads the text form (see the module documentation). A `:pose`
-    /// suffix is taken from the name unless a file of that exact name
-    /// exists.
+    /// suffix, or a `:NAME` suffix that is a lower-case word (a registered
+    /// sensor's name, checked when loaded), is taken from the name unless a
+    /// file of that exact name exists.
     pub fn parse(text: &str) -> Result<Self> {
         let (head, chain) = match text.rsplit_once('#') {
             Some((h, f)) if f.contains('=') => (h, ChainChoice::parse_fragment(f)?),
             _ => (text, ChainChoice::default()),
         };
-        let (name, pose) = match head.strip_suffix(":pose") {
-            Some(f) if !Path::new(head).exists() => (f, true),
-            _ => (head, false),
+        let suffix = head
+            .rsplit_once(':')
+            .filter(|(n, w)| !n.is_empty() && is_word(w) && !Path::new(head).exists());
+        let (name, pose, sensor) = match suffix {
+            Some((n, "pose")) => (n, true, None),
+            Some((n, w)) => (n, false, Some(w.to_string())),
+            None => (head, false, None),
         };
         Ok(Self {
             name: name.to_string(),
             pose,
+            sensor,
             chain,
         })
     }
@@ -242,9 +252,21 @@ impl RobotRef {
     }
 }
 
+/// Whether `w` can name a sensor after `:`: a lower-case ASCII word
+/// (letters, digits, `_`), starting with a letter.
+fn is_word(w: &str) -> bool {
+    w.starts_with(|c: char| c.is_ascii_lowercase())
+        && w.chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
+}
+
 impl fmt::Display for RobotRef {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}{}", self.head(), self.chain.fragment())
+        let sensor = self
+            .sensor
+            .as_ref()
+            .map_or(String::new(), |s| format!(":{s}"));
+        write!(f, "{}{sensor}{}", self.head(), self.chain.fragment())
     }
 }
 
@@ -276,6 +298,14 @@ mod tests {
         );
         assert_eq!(r.to_string(), t);
         assert_eq!(RobotRef::parse("puma560").unwrap().to_string(), "puma560");
+        // Any word: the sensor's name is checked when the robot is loaded.
+        let h = RobotRef::parse("arm.urdf:gauge_2#tip=tool").unwrap();
+        assert_eq!((h.name.as_str(), h.pose), ("arm.urdf", false));
+        assert_eq!(h.sensor.as_deref(), Some("gauge_2"));
+        assert_eq!(h.to_string(), "arm.urdf:gauge_2#tip=tool");
+        // Not a word after ':': part of the name.
+        assert_eq!(RobotRef::parse("a:b/c.toml").unwrap().sensor, None);
+        assert_eq!(RobotRef::parse("ur5:Pose").unwrap().name, "ur5:Pose");
         assert!(RobotRef::parse("a.urdf#colour=red").is_err());
         assert!(ChainChoice::parse_lock("j=abc").is_err());
         assert!(ChainChoice::parse_lock("j=inf").is_err());

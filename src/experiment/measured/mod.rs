@@ -227,7 +227,9 @@ fn mounted_start(
 /// with a note; `None` otherwise (the given offset is the start). The
 /// nominal (the user's offset) is kept for the report.
 fn marker_start(robot: &Robot, meas: &Measurements) -> Option<([f64; 3], String)> {
-    let one = robot.measurement == crate::model::MeasurementKind::Markers(1)
+    let sensor = crate::measure::sensor_for(robot);
+    let one = sensor.tool_record() == crate::measure::ToolRecord::Markers
+        && sensor.points_per_pose() == 1
         && meas.markers() == 1
         && meas.orientations().is_empty();
     if !one {
@@ -261,7 +263,7 @@ const MARKER_FAR: f64 = 10.0;
 /// Whether the robot measures one point per pose and the data hold only
 /// that (no orientation, one marker): the tool point was not given.
 fn single_point(robot: &Robot, meas: &Measurements) -> bool {
-    robot.measurement == crate::model::MeasurementKind::Point
+    crate::measure::sensor_for(robot).follows_tool_point()
         && meas.markers() == 1
         && meas.orientations().is_empty()
 }

@@ -28,6 +28,8 @@ const SEED: u64 = 0x5eed_ca3e_0041;
 /// unknowns preferred.
 pub fn camera_robot(robot: &Robot) -> Result<Robot> {
     let mut r = robot.clone();
+    // Builds a kind, decides nothing: the camera's rows come from its own
+    // sensor; the robot's unknowns are chosen for a point's.
     r.measurement = MeasurementKind::Point;
     r.real.markers.clear();
     r.nominal.markers.clear();

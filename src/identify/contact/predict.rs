@@ -77,7 +77,8 @@ pub fn tool_point_moment(
     seed: u64,
 ) -> (DMatrix<f64>, usize) {
     // The tool point as a one-marker sensor at the offset: columns are the
-    // robot's unknowns, then the offset.
+    // robot's unknowns, then the offset. (Builds a kind, decides nothing:
+    // the contact fit's own sensor is the point with its offset unknown.)
     let mut tool = robot.clone();
     tool.measurement = MeasurementKind::Markers(1);
     let mut table = table.clone();

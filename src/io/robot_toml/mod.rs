@@ -4,7 +4,7 @@
 //!
 //! ```toml
 //! name = "puma560"            # optional; default: the file name
-//! measurement = "point"       # "point" (3 rows per pose), "pose" (6 rows) or "markers" (3 per marker)
+//! measurement = "point"       # "point" (3 rows per pose), "pose" (6 rows), "markers" (3 per marker) or a registered sensor's name
 //! # orientation_scale = 0.29  # pose only: metres per radian, σ_position / σ_orientation
 //! # unknowns = "auto"         # choose identifiable unknowns automatically
 //!
@@ -72,7 +72,7 @@ use crate::error::{Compact, Error, Result};
 use crate::measure::Visibility;
 use crate::model::{MeasurementKind, ParamTable, Robot};
 use frames::frames_of;
-use spec::{Ctx, FileSpec, MarkerSpec, MeasurementSpec};
+use spec::{Ctx, FileSpec, MarkerSpec};
 use std::ops::Range;
 use std::path::Path;
 use toml::Spanned;
@@ -170,14 +170,7 @@ struct TopLevel {
 }
 
 fn top_level(cx: &Ctx<'_>, spec: &FileSpec) -> Result<TopLevel> {
-    // Parsing: the file's `measurement` key names one of the built-in
-    // sensors, so this maps its spelling onto the enum (the one place a
-    // sensor is chosen by name; the pipelines then ask the sensor).
-    let measurement = match spec.measurement {
-        None | Some(MeasurementSpec::Point) => MeasurementKind::Point,
-        Some(MeasurementSpec::Pose) => MeasurementKind::Pose,
-        Some(MeasurementSpec::Markers) => MeasurementKind::Markers(spec.marker.len()),
-    };
+    let measurement = measurement_kind(cx, spec)?;
     let markers = marker_offsets(&cx, &spec.marker, measurement)?;
     let orientation_scale = match &spec.orientation_scale {
         None => crate::model::DEFAULT_ORIENTATION_SCALE,
@@ -230,6 +223,33 @@ fn top_level(cx: &Ctx<'_>, spec: &FileSpec) -> Result<TopLevel> {
         auto,
         visibility,
     })
+}
+
+/// The file's `measurement` key: one of the built-in sensors or a
+/// registered one by its name ([`crate::measure::registered_kind`]); any
+/// other value is refused at its place, naming those known.
+fn measurement_kind(cx: &Ctx<'_>, spec: &FileSpec) -> Result<MeasurementKind> {
+    // Parsing: this maps the key's spelling onto the enum (the one place a
+    // file chooses a sensor by name; the pipelines then ask the sensor).
+    let Some(m) = &spec.measurement else {
+        return Ok(MeasurementKind::Point);
+    };
+    match m.get_ref().as_str() {
+        "point" => Ok(MeasurementKind::Point),
+        "pose" => Ok(MeasurementKind::Pose),
+        "markers" => Ok(MeasurementKind::Markers(spec.marker.len())),
+        name => crate::measure::registered_kind(name).ok_or_else(|| {
+            let mut known = vec!["point", "pose", "markers"];
+            known.extend(crate::measure::registered_names());
+            cx.at(
+                m.span(),
+                format!(
+                    "measurement = \"{name}\": unknown (known: {})",
+                    known.join(", ")
+                ),
+            )
+        }),
+    }
 }
 
 /// A chain imported from a URDF (`urdf = …`, with `base`, `tip`, `lock`),

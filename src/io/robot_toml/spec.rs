@@ -20,7 +20,7 @@ pub const MAX_ABS: f64 = 1e6;
 #[serde(deny_unknown_fields)]
 pub(super) struct FileSpec {
     pub(super) name: Option<String>,
-    pub(super) measurement: Option<MeasurementSpec>,
+    pub(super) measurement: Option<Spanned<String>>,
     #[serde(default)]
     pub(super) marker: Vec<MarkerSpec>,
     pub(super) orientation_scale: Option<Spanned<f64>>,
@@ -54,14 +54,6 @@ pub(super) struct PlaneSpec {
     pub(super) name: String,
     pub(super) normal: [f64; 3],
     pub(super) offset: f64,
-}
-
-#[derive(Deserialize, Clone, Copy, PartialEq, Eq)]
-#[serde(rename_all = "lowercase")]
-pub(super) enum MeasurementSpec {
-    Point,
-    Pose,
-    Markers,
 }
 
 #[derive(Deserialize)]

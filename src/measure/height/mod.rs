@@ -12,7 +12,8 @@
 //! position in `x` and `y` and its turn about `z` are invisible, so
 //! [`crate::model::Robot::with_measurement`] keeps fewer unknowns than for a
 //! point. A measured value is a point whose `z` alone is read (measurement
-//! files hold the tool point; a simulated one has `x = y = 0`).
+//! files hold its `z1` column alone, [`Sensor::point_coordinates`]; a
+//! simulated one has `x = y = 0`).
 
 use super::sensor::{Observation, ObservationBuf, RowKind, Sensor};
 use crate::kinematics::{EndFrame, Motion};
@@ -69,6 +70,10 @@ impl Sensor for HeightSensor {
 
     fn points_per_pose(&self) -> usize {
         1
+    }
+
+    fn point_coordinates(&self) -> &'static [usize] {
+        &[2]
     }
 
     fn value_len(&self) -> usize {

@@ -39,10 +39,11 @@ pub enum MeasurementKind {
     Markers(usize),
     /// A sensor registered in `crate::measure` beside these (its own folder
     /// and one registration line): the library's pipelines reach it
-    /// through the `Sensor` trait alone. No file format names one (they
-    /// are read from none); a robot is given one by
-    /// `Robot::with_measurement`.
-    #[serde(skip_deserializing)]
+    /// through the `Sensor` trait alone. Named by its key: `--robot
+    /// ur5:KEY`, a description's `measurement = "KEY"` (both looked up in
+    /// the registry by the readers), `Robot::with_measurement`; reports
+    /// name it by its key alone (`"measurement": "height"`).
+    #[serde(skip_deserializing, untagged)]
     Registered(SensorKey),
 }
 

@@ -41,7 +41,8 @@ pub struct RobotsArgs {
 #[derive(Args)]
 pub struct FkArgs {
     /// Robot: a built-in name, or a .toml description or .urdf file; append
-    /// `:pose` for full-pose measurements.
+    /// `:pose` for full-pose measurements (`:NAME` for a registered sensor,
+    /// `:height`).
     #[arg(long, default_value = "puma560", value_parser = super::parse_robot)]
     pub robot: activecal::io::RobotRef,
     /// Parameter set.

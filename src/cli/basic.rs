@@ -41,8 +41,8 @@ pub struct RobotsArgs {
 #[derive(Args)]
 pub struct FkArgs {
     /// Robot: a built-in name, or a .toml description or .urdf file; append
-    /// `:pose` for full-pose measurements (`:NAME` for a registered sensor,
-    /// `:height`).
+    /// `:pose` for full-pose measurements (`:NAME` for a sensor registered
+    /// by that name).
     #[arg(long, default_value = "puma560", value_parser = super::parse_robot)]
     pub robot: activecal::io::RobotRef,
     /// Parameter set.

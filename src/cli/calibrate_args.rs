@@ -15,8 +15,8 @@ use std::path::PathBuf;
 #[command(group(clap::ArgGroup::new("with_joints").args(["images", "bag"]).multiple(true)))]
 pub struct CalibrateArgs {
     /// Robot: a built-in name, or a .toml description or .urdf file; append
-    /// `:pose` for full-pose measurements (`:NAME` for a registered sensor,
-    /// `:height`).
+    /// `:pose` for full-pose measurements (`:NAME` for a sensor registered
+    /// by that name).
     #[arg(long, default_value = "puma560", value_parser = super::parse_robot)]
     pub robot: activecal::io::RobotRef,
     /// Design file (JSON with robot, levels, poses), as written by `select`:

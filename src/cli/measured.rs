@@ -72,7 +72,8 @@ pub fn read_measurements(
 pub struct EvaluateArgs {
     /// The model: a built-in name, a .toml description (e.g. what
     /// `calibrate --out` wrote) or a .urdf file; append `:pose` for full
-    /// poses (`:NAME` for a registered sensor, `:height`). Its nominal table is evaluated.
+    /// poses (`:NAME` for a sensor registered by
+    /// that name). Its nominal table is evaluated.
     #[arg(long, value_parser = super::parse_robot)]
     pub robot: activecal::io::RobotRef,
     /// Measurement file: CSV (x1,y1,z1…, optional phix1,phiy1,phiz1 or

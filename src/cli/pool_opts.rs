@@ -59,7 +59,8 @@ pub const DEFAULT_LEVELS: usize = 5;
 pub struct PoolOpts {
     /// Robot: a built-in name (puma560, ur5, stanford), or a .toml
     /// description or .urdf file; append `:pose` for full-pose measurements
-    /// (`:NAME` for a registered sensor, `:height`).
+    /// (`:NAME` for a sensor registered by
+    /// that name).
     #[arg(long, default_value = "puma560", value_parser = parse_robot)]
     pub robot: RobotRef,
     /// Candidate poses: lattice (--levels), random or sobol (--count,

@@ -267,10 +267,6 @@ const NOT_YET_OWNED: &[(&str, &[&str])] = &[
         &["bound", "measure", "pool", "select"],
     ),
     ("src/cli/compliance.rs", &["identify"]),
-    ("src/cli/contact.rs", &["identify", "lsq"]),
-    ("src/cli/contact_evaluate.rs", &["identify"]),
-    ("src/cli/contact_out.rs", &["frames", "identify"]),
-    ("src/cli/contact_select.rs", &["identify", "measure"]),
     ("src/cli/measured.rs", &["identify"]),
     ("src/cli/mod.rs", &["identify"]),
     (
@@ -302,7 +298,6 @@ const NOT_YET_OWNED: &[(&str, &[&str])] = &[
         "python/src/camera_select.rs",
         &["bound", "how_many", "pool", "select"],
     ),
-    ("python/src/contacts.rs", &["identify"]),
     ("python/src/convert.rs", &["bound", "identify", "lsq"]),
     ("python/src/fit_args.rs", &["identify", "lsq"]),
     (

@@ -5,6 +5,7 @@ pub mod bag;
 pub mod bench;
 pub mod camera;
 pub mod camera_select;
+pub mod contact_run;
 pub mod contact_screen;
 pub mod contacts;
 pub mod error;
@@ -13,6 +14,7 @@ pub mod measured;
 pub mod paper;
 pub mod select;
 pub mod simulated;
+pub mod socket_design;
 
 pub use error::ExperimentError;
 pub mod visiting;

@@ -103,5 +103,3 @@ fn start_selection(x: &Blocks, design: &[usize], s: &Settings) -> crate::select:
         start_score: vec![ln_oid],
     }
 }
-#[doc(hidden)]
-pub mod legacy;

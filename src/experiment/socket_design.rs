@@ -146,10 +146,12 @@ mod tests {
     #[test]
     fn only_a_point_sensor_measures_the_tip() {
         use crate::model::MeasurementKind;
-        use crate::model::catalogue::ur5_with;
-        assert!(measures_the_tip(&ur5_with(MeasurementKind::Point)));
+        let point = Robot::ur5();
+        assert!(measures_the_tip(&point));
         for kind in [MeasurementKind::Pose, MeasurementKind::Markers(2)] {
-            assert!(!measures_the_tip(&ur5_with(kind)), "{kind:?}");
+            let mut r = point.clone();
+            r.measurement = kind;
+            assert!(!measures_the_tip(&r), "{kind:?}");
         }
     }
 }

@@ -259,10 +259,6 @@ const NOT_YET_OWNED: &[(&str, &[&str])] = &[
     // The Robot class's own queries: forward kinematics and the
     // identification Jacobian at one configuration.
     ("python/src/robot.rs", &["kinematics", "measure"]),
-    ("src/cli/contact.rs", &["identify"]),
-    ("src/cli/contact_evaluate.rs", &["identify"]),
-    ("src/cli/contact_out.rs", &["frames", "identify"]),
-    ("src/cli/contact_select.rs", &["identify", "measure"]),
     // The process's threads and memory budget.
     ("src/main.rs", &["resources"]),
 ];

@@ -553,11 +553,10 @@ fn contacts_predict_their_true_error() {
 /// the pool's, not the search's).
 #[test]
 fn selected_contacts_beat_random_draws() {
-    use activecal::identify::contact::select::{
-        Socket, predicted_consistency, refine_for_consistency, select_d_optimal, socket_pool,
-    };
-    use activecal::identify::contact::socket_design::consistency_bound;
+    use activecal::identify::contact::select::{Socket, predicted_consistency, socket_pool};
     use activecal::identify::contact::{group_means, tool_points};
+    use activecal::select::contact::socket_design::consistency_bound;
+    use activecal::select::contact::{refine_for_consistency, select_d_optimal};
     use rand::seq::SliceRandom;
     let robot = panda();
     let real = contacts(&robot);
@@ -587,10 +586,11 @@ fn selected_contacts_beat_random_draws() {
     );
     let reach = tool_points(&robot, &robot.nominal, &[0.0; 3], &pool.qs);
     assert!(reach.iter().all(|t| (t - socket).norm() <= 1e-4));
-    let design = select_d_optimal(&pool, 30);
+    let search = Default::default();
+    let design = select_d_optimal(&pool, 30, &search).unwrap();
     assert_eq!(design.len(), 30);
     let d_opt = predicted_consistency(&pool, &design);
-    let design = refine_for_consistency(&pool, design);
+    let design = refine_for_consistency(&pool, &design, &search).unwrap();
     let chosen = predicted_consistency(&pool, &design);
     let ids: Vec<usize> = (0..pool.qs.len()).collect();
     let mut random: Vec<f64> = (0..100)
@@ -605,7 +605,7 @@ fn selected_contacts_beat_random_draws() {
     eprintln!(
         "pool {}, unknowns {}: D-optimal {d_opt:.4} σ, refined {chosen:.4} σ, random median {median:.4} σ",
         pool.qs.len(),
-        pool.blocks[0].ncols()
+        pool.p()
     );
     assert!(
         chosen.is_finite() && median >= 1.2 * chosen,
@@ -722,10 +722,10 @@ fn plane_rows_are_central_differences() {
 #[test]
 fn selected_contacts_judged_at_other_placements() {
     use activecal::identify::contact::select::{
-        Socket, SocketPool, consistency_moment, refine_for_consistency, select_d_optimal,
-        socket_pool, with_unknowns_of,
+        Socket, SocketPool, consistency_moment, socket_pool, with_unknowns_of,
     };
     use activecal::identify::contact::{group_means, placement_of, tool_points};
+    use activecal::select::contact::{refine_for_consistency, select_d_optimal};
     use nalgebra::DMatrix;
     use rand::seq::SliceRandom;
     let robot = panda();
@@ -764,17 +764,18 @@ fn selected_contacts_judged_at_other_placements() {
     let k = pool.robot.n_unknowns() + 3;
     let w = consistency_moment(&eval).view((0, 0), (k, k)).into_owned();
     let score = |pool: &SocketPool, d: &[usize]| -> f64 {
-        let p = pool.blocks[0].ncols();
+        let p = pool.p();
         let mut m = DMatrix::zeros(p, p);
         for &i in d {
-            m += pool.blocks[i].transpose() * &pool.blocks[i];
+            m += pool.block(i).transpose() * pool.block(i);
         }
         m.try_inverse().map_or(f64::INFINITY, |mi| {
             (mi.view((0, 0), (k, k)) * &w).trace().sqrt()
         })
     };
-    let d_opt = select_d_optimal(&pool, 30);
-    let chosen = refine_for_consistency(&pool, d_opt.clone());
+    let search = Default::default();
+    let d_opt = select_d_optimal(&pool, 30, &search).unwrap();
+    let chosen = refine_for_consistency(&pool, &d_opt, &search).unwrap();
     let ids: Vec<usize> = (0..pool.qs.len()).collect();
     let mut random: Vec<f64> = (0..100)
         .map(|_| {
@@ -810,10 +811,11 @@ fn selected_contacts_judged_at_other_placements() {
 fn select_point_predicts_the_true_error_of_its_choice_and_of_random_draws() {
     use activecal::identify::contact::predict::true_error_moment;
     use activecal::identify::contact::select::{
-        Socket, determined_pool, predicted_error, projected, refine_for, select_d_optimal,
+        Socket, determined_pool, predicted_error, projected,
     };
-    use activecal::identify::contact::socket_design::error_bound;
     use activecal::identify::contact::{group_means, tool_points};
+    use activecal::select::contact::socket_design::error_bound;
+    use activecal::select::contact::{refine_for, select_d_optimal};
     use rand::seq::SliceRandom;
     let robot = panda();
     let real = contacts(&robot);
@@ -852,7 +854,14 @@ fn select_point_predicts_the_true_error_of_its_choice_and_of_random_draws() {
         "a known distance determines the scale"
     );
     let w = true_error_moment(&pool, &robot.nominal, 3);
-    let chosen = refine_for(&pool, select_d_optimal(&pool, 30), &w);
+    let search = Default::default();
+    let chosen = refine_for(
+        &pool,
+        &select_d_optimal(&pool, 30, &search).unwrap(),
+        &w,
+        &search,
+    )
+    .unwrap();
     let estimated = pool.robot.parameter_names();
     let truth = perturbed(
         &robot,

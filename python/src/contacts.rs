@@ -6,11 +6,7 @@
 use crate::convert::{Fail, arg_err, count, detached, float_array, json_to_py, rows};
 use crate::robot::Robot;
 use activecal::data::{ContactFile, NamedDistance};
-use activecal::experiment::contacts::{
-    ContactCalibration as Calibrated, calibrate_contacts as fit,
-};
-use activecal::options::ContactSettings;
-use activecal::options::LmSettings;
+use activecal::experiment::contact_run::{ContactOutError, ContactRequest, ContactRun, run};
 use activecal::write::calibrated::Format;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -22,7 +18,7 @@ use std::sync::Arc;
 #[pyclass(module = "activecal", name = "ContactCalibration", frozen)]
 pub struct ContactCalibration {
     robot: Arc<activecal::model::Robot>,
-    c: Calibrated,
+    c: ContactRun,
     report: serde_json::Value,
     /// How it was made, for pickling.
     recipe: crate::pickling::Recipe,
@@ -155,17 +151,17 @@ pub fn calibrate_contacts(
     let mut qs = rows(&v, dof);
     robot.check_joint_values("q", &mut qs)?;
     let given = distances_of(distances)?;
-    let lm = LmSettings::builder()
-        .max_iterations(count("max_iterations", max_iterations, 1)?)
-        .geodesic(true);
-    let settings = ContactSettings::builder()
-        .lm(lm
-            .build()
-            .map_err(|e| crate::convert::Fail::from(e).into_py())?)
-        .loss(crate::calibrate::loss_of(loss, loss_scale)?)
-        .keep(free.unwrap_or_default())
-        .outliers(outliers)
-        .build()
+    let request = ContactRequest {
+        max_iterations: count("max_iterations", max_iterations, 1)?,
+        geodesic: true,
+        loss: crate::calibrate::loss_of(loss, loss_scale)?,
+        keep: free.unwrap_or_default(),
+        outliers,
+        holdout: None,
+    };
+    // The settings checked before the data, as every call checks them.
+    request
+        .settings()
         .map_err(|e| crate::convert::Fail::from(e).into_py())?;
     let mut file = contact_file(qs, points);
     let known = activecal::experiment::contacts::checked_inputs(
@@ -182,20 +178,12 @@ pub fn calibrate_contacts(
     let r = inner.clone();
     let (c, report) = crate::progress::with_callback(progress, || {
         detached(py, move || {
-            let c = fit(&r, &file, &known, &given, &settings).map_err(Fail::input)?;
-            let report = serde_json::to_value(c.report(
-                &r.name,
-                &file.origin,
-                file.qs.len(),
-                outliers,
-                None,
-                true,
-                &[],
-            ))?;
+            let c = run(&r, &file, &known, &given, &request).map_err(Fail::input)?;
+            let report = serde_json::to_value(c.report(&r.name, &file.origin, true, &[]))?;
             Ok((c, report))
         })
     })?;
-    for n in &c.notes {
+    for n in &c.calibration.notes {
         crate::convert::warn(py, n)?;
     }
     Ok(ContactCalibration {
@@ -210,39 +198,28 @@ impl ContactCalibration {
     /// Writes the report folder into `dir` (no held-out placements, no
     /// file written beside it).
     fn folder(&self, dir: &std::path::Path) -> Result<(), Fail> {
-        let text = self.c.text(None, &[]);
-        self.c
-            .write_report(dir, &self.robot, &self.report, None, &text)?;
+        let text = self.c.text(&[]);
+        self.c.write_report(dir, &self.robot, &self.report, &text)?;
         Ok(())
     }
 
-    /// Writes the calibrated robot as `format`, refused when the fit did
-    /// not converge or is not a plausible robot.
     fn write_as(&self, format: Format, path: &std::path::Path, overwrite: bool) -> PyResult<()> {
-        let fit = &self.c.fit;
-        if let Some(why) = self.c.verdict().refusal() {
-            return Err(Fail::Compute(format!("{}: not written: {why}", path.display())).into_py());
-        }
-        let Some((f, r)) = &self.c.frames else {
-            return Err(arg_err(
+        let out = activecal::io::atomic::Output {
+            label: "path",
+            path,
+        };
+        self.c.write_robot(format, out, overwrite).map_err(|e| match e {
+            ContactOutError::Refused { .. } => Fail::Compute(e.to_string()).into_py(),
+            ContactOutError::NotUrdf { .. } | ContactOutError::Toml { .. } => arg_err(
                 "path",
                 format!(
                     "{}: robot '{}' was not imported from a URDF: there is no URDF or frames file to write",
                     path.display(),
                     self.robot.name
                 ),
-            ));
-        };
-        crate::calibrate::write_robot(
-            format,
-            &fit.robot,
-            &fit.table,
-            Some((f, r)),
-            "",
-            path,
-            overwrite,
-            &[],
-        )
+            ),
+            ContactOutError::Write(e) => Fail::from(e).into_py(),
+        })
     }
 }
 
@@ -256,14 +233,14 @@ impl ContactCalibration {
     /// Whether the fit converged.
     #[getter]
     fn converged(&self) -> bool {
-        self.c.fit.converged
+        self.c.calibration.fit.converged
     }
 
     /// The estimate: {parameter name: value}, metres and radians (the
     /// robot's unknowns, the tool offset and each point's coordinates).
     #[getter]
     fn estimate(&self) -> std::collections::BTreeMap<String, f64> {
-        let f = &self.c.fit;
+        let f = &self.c.calibration.fit;
         f.names
             .iter()
             .cloned()
@@ -275,7 +252,7 @@ impl ContactCalibration {
     /// full-rank Jacobian.
     #[getter]
     fn sigma(&self) -> Option<std::collections::BTreeMap<String, f64>> {
-        let f = &self.c.fit;
+        let f = &self.c.calibration.fit;
         f.std
             .as_ref()
             .map(|s| f.names.iter().cloned().zip(s.iter().copied()).collect())
@@ -284,7 +261,7 @@ impl ContactCalibration {
     /// The fitted points {name: (x, y, z)} in the base frame, metres.
     #[getter]
     fn points(&self) -> std::collections::BTreeMap<String, [f64; 3]> {
-        let f = &self.c.fit;
+        let f = &self.c.calibration.fit;
         f.points
             .iter()
             .cloned()
@@ -295,7 +272,7 @@ impl ContactCalibration {
     /// The tool point (ball centre) on the tip link, metres.
     #[getter]
     fn tool_offset(&self) -> [f64; 3] {
-        self.c.fit.tool_offset
+        self.c.calibration.fit.tool_offset
     }
 
     /// The tool point's predicted true error at 1000 random configurations
@@ -353,7 +330,7 @@ impl ContactCalibration {
     fn __repr__(&self) -> String {
         format!(
             "ContactCalibration({:?}, {} rows, converged={})",
-            self.robot.name, self.report["rows"], self.c.fit.converged
+            self.robot.name, self.report["rows"], self.c.calibration.fit.converged
         )
     }
 }

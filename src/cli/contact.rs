@@ -2,19 +2,19 @@
 //! or a `plane` column (calibration from contacts with fixed points and
 //! planes, no instrument): parsing of `--point-distance` and `--plane`,
 //! rendering of the fit and of `--holdout-by
-//! placement` / `--train-on`. The work is in `activecal::identify::contact`.
+//! placement` / `--train-on`. The work is in
+//! `activecal::experiment::contact_run`.
 
-use activecal::data::ContactFile;
 use activecal::data::{NamedDistance, NamedPlane};
+use activecal::experiment::contact_run::{
+    ContactOutError, ContactRequest, HoldoutMode, OutlierChoice, check_out, run,
+};
 use activecal::experiment::contacts::{
     ContactInput, ContactInputError, ContactUse, checked_inputs,
 };
-use activecal::identify::contact::{
-    ContactSettings, HoldoutMode, HoldoutReport, holdout_by_placement,
-};
 use activecal::io::contacts::read_contacts;
 use activecal::model::Robot;
-use activecal::options::LmSettings;
+use activecal::write::calibrated::Format;
 use anyhow::{Result, bail};
 use std::path::Path;
 
@@ -131,7 +131,7 @@ pub struct ContactArgs<'a> {
     /// `--report DIR` (checked before the fit).
     pub report: Option<&'a Path>,
     /// `--outliers`, `--outlier-rate`.
-    pub outliers: activecal::options::OutlierChoice,
+    pub outliers: OutlierChoice,
 }
 
 /// Calibrates from a contact file; `Ok(Some(why))` when the fit did not
@@ -146,47 +146,46 @@ pub fn calibrate_contacts(
             "--holdout: contacts are held out by placement (--holdout-by placement or --train-on NAME), not by random rows"
         );
     }
-    super::contact_out::check(a.out, robot)?;
+    for out in a.out {
+        check_out(out, robot).map_err(out_err)?;
+    }
     let (given, planes) = contact_setup(a.setup, a.point_distance, a.plane)?;
     let mut file = read_contacts(path, robot, a.units)?;
     let known =
         checked_inputs(robot, &mut file, &planes, &given, ContactUse::Fit).map_err(named)?;
-    let settings = settings_of(a)?;
-    let cal = activecal::experiment::contacts::calibrate_contacts(
-        robot, &file, &known, &given, &settings,
-    )?;
-    // The rows kept: those left out as gross errors are neither fitted
-    // nor held out.
-    let held = held_out(a, robot, &cal.file, &given, &settings)?;
-    let verdict = cal.verdict();
-    let written = match &cal.frames {
-        Some(f) if !a.out.is_empty() && verdict.exit_status() == 0 => {
-            super::contact_out::write(a.out, a.force, &cal.fit.robot, &cal.fit, f)?
+    let r = run(robot, &file, &known, &given, &request_of(a)?)?;
+    let mut written = Vec::new();
+    if r.exit_status() == 0 && r.calibration.frames.is_some() {
+        for out in a.out {
+            r.write_robot(Format::of(out)?, super::out_file(out), a.force)
+                .map_err(out_err)?;
+            written.push(out.display().to_string());
         }
-        _ => Vec::new(),
-    };
-    let v = serde_json::to_value(cal.report(
-        &robot.name,
-        &path.display().to_string(),
-        file.qs.len(),
-        settings.outliers,
-        held.as_ref(),
-        !a.out.is_empty(),
-        &written,
-    ))?;
-    let report = cal.text(held.as_ref(), &written);
+    }
+    let measurements = path.display().to_string();
+    let v =
+        serde_json::to_value(r.report(&robot.name, &measurements, !a.out.is_empty(), &written))?;
+    let report = r.text(&written);
     if let Some(dir) = a.report {
-        cal.write_report(dir, robot, &v, held.as_ref(), &report)?;
+        r.write_report(dir, robot, &v, &report)?;
     }
     super::emit(a.json, &v, || report)?;
-    Ok(verdict.refusal().map(|why| {
+    Ok(r.refusal().map(|why| {
         let names: Vec<String> = a.out.iter().map(|p| p.display().to_string()).collect();
         if names.is_empty() {
-            why.to_string()
+            why
         } else {
             format!("{why}; {} not written", names.join(", "))
         }
     }))
+}
+
+/// A refused or failed `--out`, named as the command line gives it.
+fn out_err(e: ContactOutError) -> anyhow::Error {
+    match e {
+        ContactOutError::Write(e) => e.into(),
+        e => anyhow::anyhow!("--out {e}"),
+    }
 }
 
 /// A refused input of a contact calibration, named as the command line
@@ -201,34 +200,19 @@ pub fn named(e: ContactInputError) -> anyhow::Error {
     }
 }
 
-/// The fit's settings from the command line.
-fn settings_of(a: &ContactArgs<'_>) -> Result<ContactSettings> {
-    let lm = LmSettings::builder()
-        .max_iterations(a.max_iterations)
-        .geodesic(!a.no_geodesic)
-        .build()?;
-    Ok(ContactSettings::builder()
-        .lm(lm)
-        .loss(super::measured::loss_choice(a.loss, a.loss_scale)?)
-        .keep(a.free.to_vec())
-        .outliers(a.outliers)
-        .build()?)
-}
-
-/// The placements held out (`--holdout-by placement`, `--train-on NAME`),
-/// if asked.
-fn held_out(
-    a: &ContactArgs<'_>,
-    robot: &Robot,
-    file: &ContactFile,
-    given: &[activecal::data::NamedDistance],
-    settings: &ContactSettings,
-) -> Result<Option<HoldoutReport>> {
-    let mode = match (&a.holdout_by, &a.train_on) {
-        (_, Some(t)) => HoldoutMode::TrainOn((*t).to_string()),
-        (Some(HoldoutBy::Placement), None) => HoldoutMode::LeaveOneOut,
-        (None, None) => return Ok(None),
+/// The calibration's request from the command line.
+fn request_of(a: &ContactArgs<'_>) -> Result<ContactRequest> {
+    let holdout = match (&a.holdout_by, &a.train_on) {
+        (_, Some(t)) => Some(HoldoutMode::TrainOn((*t).to_string())),
+        (Some(HoldoutBy::Placement), None) => Some(HoldoutMode::LeaveOneOut),
+        (None, None) => None,
     };
-    let h = holdout_by_placement(robot, &robot.nominal, file, given, settings, &mode)?;
-    Ok(Some(h))
+    Ok(ContactRequest {
+        max_iterations: a.max_iterations,
+        geodesic: !a.no_geodesic,
+        loss: super::measured::loss_choice(a.loss, a.loss_scale)?,
+        keep: a.free.to_vec(),
+        outliers: a.outliers,
+        holdout,
+    })
 }

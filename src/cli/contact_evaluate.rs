@@ -1,11 +1,10 @@
 //! `evaluate --measurements contacts.csv`: a model's consistency on a
 //! contact file (no fit): per point, pooled, each `--point-distance`'s error
 //! and each plane's flatness, mm. The work is in
-//! `activecal::identify::contact::evaluate`.
+//! `activecal::experiment::contacts::evaluate`.
 
 use super::contact::contact_setup;
 use super::measured::EvaluateArgs;
-use activecal::identify::contact::evaluate::evaluate_contacts;
 use activecal::io::contacts::read_contacts;
 use anyhow::Result;
 
@@ -15,22 +14,15 @@ pub fn cmd_evaluate_contacts(a: &EvaluateArgs) -> Result<()> {
     let (given, planes) = contact_setup(&desc.contacts, &a.point_distance, &a.plane)?;
     let robot = desc.robot;
     let mut file = read_contacts(&a.measurements, &robot, a.units.units())?;
-    activecal::experiment::contacts::checked_inputs(
+    let measurements = a.measurements.display().to_string();
+    let report = activecal::experiment::contacts::evaluate(
         &robot,
         &mut file,
         &planes,
         &given,
-        activecal::experiment::contacts::ContactUse::Evaluate,
+        &measurements,
     )
     .map_err(super::contact::named)?;
-    let e = evaluate_contacts(&robot, &robot.nominal, &[0.0; 3], &file, &given);
-    let report = activecal::report::ContactEvaluationReport {
-        robot: robot.name.clone(),
-        chain: activecal::report::chain(&robot),
-        measurements: a.measurements.display().to_string(),
-        rows: file.qs.len(),
-        contacts: e,
-    };
     super::emit_report(a.json, &report, || {
         activecal::render::contact_text::contact_evaluation_text(
             &robot.name,

@@ -1,21 +1,15 @@
 //! `select --point NAME=x,y,z`: the configurations to record for sockets
 //! (calibration from contacts, no instrument). Parses the sockets and the
 //! options that apply, renders the design; the work is in
-//! `activecal::identify::contact::socket_design`.
+//! `activecal::experiment::socket_design`.
 
 use super::select::SelectArgs;
-use activecal::identify::contact::lengths::distance_beyond_reach;
-use activecal::identify::contact::select::Socket;
-use activecal::identify::contact::socket_design::{SocketDesignSettings, design_for_sockets};
+use activecal::experiment::socket_design::{
+    DEFAULT_SAMPLES, Socket, SocketDesignError, SocketDesignSettings, design,
+};
 use activecal::io::design_formats::DesignFormat;
-use activecal::measure::contact::KnownDistance;
-use activecal::model::MeasurementKind;
 use activecal::write::contact_design;
 use anyhow::{Result, bail};
-
-/// Joint-space samples projected onto each socket when `--count` is not
-/// given.
-pub const DEFAULT_SAMPLES: usize = 1000;
 
 /// Parses one `--point NAME=x,y,z` (base frame, metres).
 fn parse_socket(s: &str) -> Result<Socket> {
@@ -29,45 +23,28 @@ fn parse_socket(s: &str) -> Result<Socket> {
     }
 }
 
-/// The `--point-distance A,B=METRES` between sockets, as indices into
-/// `sockets`; a name that is no socket's is refused, naming the sockets.
-/// A distance beyond twice the robot's reach is refused as `calibrate`
-/// refuses it ([`distance_beyond_reach`], a length in millimetres named as
-/// such).
-fn known_distances(
-    robot: &activecal::model::Robot,
-    sockets: &[Socket],
-    given: &[String],
-) -> Result<Vec<KnownDistance>> {
-    let names: Vec<&str> = sockets.iter().map(|s| s.name.as_str()).collect();
-    given
-        .iter()
-        .map(|s| {
-            let d = super::contact::parse_distance(s)?;
-            let index = |n: &str| {
-                names.iter().position(|m| *m == n).ok_or_else(|| {
-                    anyhow::anyhow!(
-                        "--point-distance {s}: no --point is named '{n}' (the points: {})",
-                        names.join(", ")
-                    )
-                })
-            };
-            let (ia, ib) = (index(&d.a)?, index(&d.b)?);
-            if ia == ib || !(d.metres.is_finite() && d.metres > 0.0) {
-                bail!(
-                    "--point-distance {s}: a distance needs two different points and a finite length > 0 (metres)"
-                );
-            }
-            if let Some(why) = distance_beyond_reach(robot, &d.a, &d.b, d.metres) {
-                bail!("--point-distance: {why}");
-            }
-            Ok(KnownDistance {
-                a: ia,
-                b: ib,
-                metres: d.metres,
-            })
-        })
-        .collect()
+/// A refused input of the design, named as the command line gives it
+/// (`given` the `--point-distance` arguments).
+fn named(e: SocketDesignError, given: &[String]) -> anyhow::Error {
+    match e {
+        SocketDesignError::ToolNotAPoint { robot } => anyhow::anyhow!(
+            "--point: the tool point of {robot} is a measured point; use the robot without :pose"
+        ),
+        SocketDesignError::UnknownPoint {
+            distance,
+            name,
+            points,
+        } => anyhow::anyhow!(
+            "--point-distance {}: no --point is named '{name}' (the points: {})",
+            given[distance],
+            points.join(", ")
+        ),
+        SocketDesignError::BadDistance { distance } => {
+            anyhow::anyhow!("--point-distance {}: {e}", given[distance])
+        }
+        SocketDesignError::BeyondReach { .. } => anyhow::anyhow!("--point-distance: {e}"),
+        SocketDesignError::Design(e) => e.into(),
+    }
 }
 
 /// Runs `select --point ...`.
@@ -88,13 +65,11 @@ pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
     }
     let described = super::load_description(&a.pool.robot)?;
     let robot = described.robot;
-    if !matches!(robot.measurement, MeasurementKind::Point) {
-        bail!(
-            "--point: the tool point of {} is a measured point; use the robot without :pose",
-            robot.name
-        );
-    }
-    let distances = known_distances(&robot, &sockets, &a.point_distance)?;
+    let given = a
+        .point_distance
+        .iter()
+        .map(|s| super::contact::parse_distance(s))
+        .collect::<Result<Vec<_>>>()?;
     let filters = a.pool.collision_filters(&robot)?;
     let settings = SocketDesignSettings {
         n: a.n,
@@ -103,10 +78,16 @@ pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
         sample_seed: a.pool.pool_seed.unwrap_or(0),
         draw_seed: a.seed,
         filters,
-        distances,
         ..SocketDesignSettings::default()
     };
-    let d = design_for_sockets(&robot, robot.params(a.pool.params), &sockets, &settings)?;
+    let d = design(
+        &robot,
+        robot.params(a.pool.params),
+        &sockets,
+        &given,
+        settings,
+    )
+    .map_err(|e| named(e, &a.point_distance))?;
     for out in &a.out {
         let text = match DesignFormat::of(out)? {
             DesignFormat::Json => contact_design::to_json(&d),

@@ -14,7 +14,6 @@ pub mod camera_select;
 pub mod compliance;
 pub mod contact;
 pub mod contact_evaluate;
-pub mod contact_out;
 pub mod contact_select;
 pub mod existing;
 pub mod extract;

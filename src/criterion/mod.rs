@@ -18,8 +18,9 @@
 //!   date by one `O(n·p·k)` product per update, and the cross terms
 //!   `W = X_pool M⁻¹ X_Dᵀ` that price every exchange.
 //! * [`Indices`] — the singular-value indices (OI, O1–O5, A-optimality, rank).
-//! * [`Criterion`] with [`DCriterion`] (fast, `ln det`) and [`OiCriterion`]
-//!   (the paper's eigenvalue OI, recomputed per candidate).
+//! * [`Criterion`] with [`DCriterion`] (fast, `ln det`), [`OiCriterion`]
+//!   (the paper's eigenvalue OI, recomputed per candidate) and [`ICriterion`]
+//!   (the linear criterion `−tr(M⁻¹W)` of a weight moment: I-/A-optimality).
 //! * [`bench_scan`] — side-by-side timings of the two.
 //!
 //! # Failures
@@ -94,6 +95,7 @@
 mod bench;
 mod criteria;
 mod indices;
+mod linear;
 pub mod lowrank;
 mod pricing;
 mod prior;
@@ -105,6 +107,7 @@ mod variances;
 pub use bench::{ScanTimings, bench_scan, bench_scan_with_threads};
 pub use criteria::{Criterion, DCriterion, OiCriterion, argmax};
 pub use indices::Indices;
+pub use linear::ICriterion;
 pub use pricing::exchange_gain;
 pub use prior::Prior;
 pub use state::{Drift, InfoState, StateSettings, Status};

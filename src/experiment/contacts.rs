@@ -109,6 +109,37 @@ pub fn checked_inputs(
     Ok(known)
 }
 
+/// A model's consistency on the contact file `file` read from
+/// `measurements`, without a fit (`evaluate`): the inputs checked for an
+/// evaluation ([`checked_inputs`] with [`ContactUse::Evaluate`], the known
+/// `planes` made known), then each point's consistency and pooled, each
+/// distance's error and each plane's flatness at the robot's nominal
+/// parameters, the tool point at the chain's tip
+/// ([`crate::identify::contact::evaluate::evaluate_contacts`]).
+pub fn evaluate(
+    robot: &Robot,
+    file: &mut ContactFile,
+    planes: &[crate::data::NamedPlane],
+    given: &[NamedDistance],
+    measurements: &str,
+) -> Result<crate::report::ContactEvaluationReport, ContactInputError> {
+    checked_inputs(robot, file, planes, given, ContactUse::Evaluate)?;
+    let e = crate::identify::contact::evaluate::evaluate_contacts(
+        robot,
+        &robot.nominal,
+        &[0.0; 3],
+        file,
+        given,
+    );
+    Ok(crate::report::ContactEvaluationReport {
+        robot: robot.name.clone(),
+        chain: crate::report::chain(robot),
+        measurements: measurements.to_string(),
+        rows: file.qs.len(),
+        contacts: e,
+    })
+}
+
 /// Fits `file` with the `known` distances (as [`checked_inputs`] gives
 /// them; `given` by name for the frames file), the rows the gross-error
 /// test flags left out ([`ContactSettings::outliers`],

@@ -12,6 +12,7 @@ pub mod bench;
 pub mod bound;
 pub mod camera;
 pub mod camera_select;
+pub mod contact_run;
 pub mod contact_screen;
 pub mod contacts;
 pub mod error;
@@ -21,6 +22,7 @@ pub mod paper;
 pub mod pool;
 pub mod select;
 pub mod simulated;
+pub mod socket_design;
 pub mod visiting;
 
 pub use error::ExperimentError;

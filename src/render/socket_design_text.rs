@@ -3,7 +3,7 @@
 //! consistency errors against random draws and the certified bound (in
 //! units of σ), and the configurations.
 
-use crate::identify::contact::socket_design::{Judged, SocketDesign};
+use crate::select::contact::socket_design::{Judged, SocketDesign};
 use std::fmt::Write as _;
 
 /// One criterion's figures: the chosen configurations', the D-optimal

@@ -33,6 +33,7 @@ use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
 pub mod camera;
+pub mod contact;
 mod exchange;
 pub mod moves;
 mod random;

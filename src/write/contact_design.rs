@@ -1,5 +1,5 @@
 //! The configurations chosen for sockets
-//! ([`crate::identify::contact::socket_design::SocketDesign`]) in the
+//! ([`crate::select::contact::socket_design::SocketDesign`]) in the
 //! formats a design is written in, told apart by the extension
 //! ([`crate::io::design_formats::DesignFormat`]):
 //!
@@ -12,8 +12,8 @@
 //!   front_left/0, joints: {joint_a: 0.1, ...}}]` (as a design's YAML).
 
 use crate::error::{Error, Result};
-use crate::identify::contact::socket_design::SocketDesign;
 use crate::io::design_formats::Joints;
+use crate::select::contact::socket_design::SocketDesign;
 use serde::Serialize;
 
 /// The design as pretty JSON.

@@ -23,7 +23,6 @@ use activecal::frames::report::FitBlock;
 use activecal::identify::contact::ContactFit;
 use activecal::identify::contact::project::project_to_point;
 use activecal::identify::contact::select::Socket;
-use activecal::identify::contact::socket_design::{SocketDesignSettings, design_for_sockets};
 use activecal::identify::contact::{
     ContactSettings, best_plane, fit_contacts, group_means, placement_of, resolve_distances,
     tool_points,
@@ -34,6 +33,7 @@ use activecal::io::load_robot;
 use activecal::io::urdf_edit::with_origins;
 use activecal::measure::contact::{DISTANCE_WEIGHT, Plane, PlaneKind};
 use activecal::model::Robot;
+use activecal::select::contact::socket_design::{SocketDesignSettings, design_for_sockets};
 use activecal::units::{Units, joint_names};
 use activecal::write::calibrated::{Format, render};
 use nalgebra::{Matrix3, Vector3};

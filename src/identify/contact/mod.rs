@@ -17,8 +17,8 @@
 //!   robot's reach;
 //! * [`holdout`]: held out by placement (the part of a point's name before
 //!   `/`): leave one placement out, and train on one;
-//! * [`select`], [`socket_design`]: the configurations to record for
-//!   sockets at given positions.
+//! * [`select`]: the pool of configurations at sockets a design chooses
+//!   from (`crate::select::contact` chooses).
 
 pub mod evaluate;
 pub mod fit;
@@ -27,7 +27,6 @@ pub mod lengths;
 pub mod predict;
 pub mod project;
 pub mod select;
-pub mod socket_design;
 pub mod worth;
 
 use crate::data::{ContactFile, NamedDistance};

@@ -110,7 +110,7 @@ pub fn true_error_moment(pool: &SocketPool, table: &ParamTable, seed: u64) -> DM
         PREDICTION_CONFIGURATIONS,
         seed,
     );
-    let p = pool.blocks.first().map_or(w.nrows(), DMatrix::ncols);
+    let p = pool.p();
     let mut full = DMatrix::zeros(p, p);
     let k = w.nrows().min(p);
     full.view_mut((0, 0), (k, k))

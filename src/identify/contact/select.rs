@@ -1,8 +1,10 @@
-//! Which configurations to record for a socket: a pool of configurations
-//! that put the tool point at the socket (joint-space samples projected by
-//! [`super::project::project_to_point`]), and a D-optimal choice among them
+//! The pool a socket design chooses from: configurations that put the tool
+//! point at the socket (joint-space samples projected by
+//! [`super::project::project_to_point`], passed through the pool filters),
 //! with the contact sensor's own Jacobian (the robot's determined unknowns,
-//! the tool offset and the socket's point as columns).
+//! the tool offset and the socket's point as columns) as the common
+//! [`Blocks`] the criterion and exchange of every selection take
+//! (`crate::select::contact` chooses among them).
 //!
 //! A design is judged by its **predicted consistency error**: with unit
 //! noise, the RMS over the pool of the predicted standard deviation of a
@@ -13,6 +15,8 @@
 
 use super::fit::{CONTACT_PIVOT_TOL, gauge_unknowns};
 use super::project::project_to_point;
+use crate::blocks::Blocks;
+use crate::criterion::Prior;
 use crate::data::ContactFile;
 use crate::identify::Calibration;
 use crate::identify::Residuals;
@@ -20,7 +24,7 @@ use crate::identify::undetermined::fix_undetermined_below;
 use crate::measure::contact::{ContactSensor, KnownDistance};
 use crate::model::{ParamTable, Robot};
 use crate::pool::{Configurations, PoolFilter, PoolSource, PoolSpec, PoolStats};
-use faer::Mat;
+use faer::{Mat, MatRef};
 use nalgebra::{DMatrix, Vector3};
 use rand::{Rng, RngExt};
 use serde::Serialize;
@@ -46,8 +50,9 @@ pub struct SocketPool {
     /// The socket each configuration reaches (an index into the sockets).
     pub sockets: Vec<usize>,
     /// Each configuration's 3 × p rows (unknowns: the robot's, the tool
-    /// offset, every socket's point).
-    pub blocks: Vec<DMatrix<f64>>,
+    /// offset, every socket's point), pool position `i` the `i`-th block:
+    /// what the common criterion and exchange take.
+    pub blocks: Blocks,
     /// The known distances' rows (`c × p`, weighted as a fit weighs them,
     /// [`crate::measure::contact::DISTANCE_WEIGHT`]): information every
     /// design has, whichever configurations it holds.
@@ -205,9 +210,7 @@ fn pool_of(
     let x = jacobian(robot, table, &file, distances);
     let p = x.ncols();
     let n = file.qs.len();
-    let blocks = (0..n)
-        .map(|i| DMatrix::from_fn(3, p, |r, c| x[(3 * i + r, c)]))
-        .collect();
+    let blocks = Blocks::new(x.subrows(0, 3 * n).to_owned(), 3);
     let constraints = DMatrix::from_fn(x.nrows() - 3 * n, p, |r, c| x[(3 * n + r, c)]);
     SocketPool {
         robot: robot.clone(),
@@ -283,15 +286,43 @@ fn jacobian(
     x
 }
 
+impl SocketPool {
+    /// Number of unknowns (columns of every block).
+    #[must_use]
+    pub fn p(&self) -> usize {
+        self.blocks.p()
+    }
+
+    /// Pool configuration `i`'s 3 × p rows.
+    #[must_use]
+    pub fn block(&self, i: usize) -> DMatrix<f64> {
+        to_dmatrix(self.blocks.block(i))
+    }
+
+    /// The known distances' information `CᵀC` as the prior every design
+    /// adds to, or `None` without a known distance.
+    #[must_use]
+    pub fn prior(&self) -> Option<Prior> {
+        if self.constraints.nrows() == 0 {
+            return None;
+        }
+        let m = self.constraints.transpose() * &self.constraints;
+        let m = Mat::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)]);
+        Some(Prior::from_matrix(m.as_ref(), 0).expect("a finite square information"))
+    }
+}
+
+/// A faer matrix as a nalgebra one.
+fn to_dmatrix(m: MatRef<'_, f64>) -> DMatrix<f64> {
+    DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)])
+}
+
 /// `M = CᵀC + Σ X_iᵀ X_i` over `design` (`C` the known distances' rows,
 /// [`SocketPool::constraints`]).
 #[must_use]
 pub fn information(pool: &SocketPool, design: &[usize]) -> DMatrix<f64> {
-    let mut m = pool.constraints.transpose() * &pool.constraints;
-    for &i in design {
-        m += pool.blocks[i].transpose() * &pool.blocks[i];
-    }
-    m
+    pool.constraints.transpose() * &pool.constraints
+        + to_dmatrix(pool.blocks.information(design).as_ref())
 }
 
 /// The pool's second moment about each socket's mean,
@@ -301,12 +332,13 @@ pub fn information(pool: &SocketPool, design: &[usize]) -> DMatrix<f64> {
 /// the same for every row of its socket and drop out).
 #[must_use]
 pub fn consistency_moment(pool: &SocketPool) -> DMatrix<f64> {
-    let p = pool.blocks[0].ncols();
+    let p = pool.p();
+    let n = pool.blocks.n_poses();
     let k = pool.sockets.iter().max().map_or(0, |m| m + 1);
     let mut sums = vec![DMatrix::zeros(3, p); k];
     let mut counts = vec![0usize; k];
-    for (b, &g) in pool.blocks.iter().zip(&pool.sockets) {
-        sums[g] += b;
+    for (i, &g) in pool.sockets.iter().enumerate() {
+        sums[g] += pool.block(i);
         counts[g] += 1;
     }
     let means: Vec<DMatrix<f64>> = sums
@@ -315,11 +347,11 @@ pub fn consistency_moment(pool: &SocketPool) -> DMatrix<f64> {
         .map(|(s, &c)| s / c.max(1) as f64)
         .collect();
     let mut w = DMatrix::zeros(p, p);
-    for (b, &g) in pool.blocks.iter().zip(&pool.sockets) {
-        let c = b - &means[g];
+    for (i, &g) in pool.sockets.iter().enumerate() {
+        let c = pool.block(i) - &means[g];
         w += c.transpose() * c;
     }
-    w / (3.0 * pool.blocks.len() as f64)
+    w / (3.0 * n as f64)
 }
 
 /// The predicted consistency error of `design` in units of σ: the RMS
@@ -354,104 +386,4 @@ pub fn predicted_error(pool: &SocketPool, design: &[usize], w: &DMatrix<f64>) ->
         Some(ch) => (ch.inverse() * ws).trace().max(0.0).sqrt(),
         None => f64::INFINITY,
     }
-}
-
-/// Improves `design` by exchanges that lower its predicted consistency
-/// error (see [`refine_for`] with [`consistency_moment`]).
-#[must_use]
-pub fn refine_for_consistency(pool: &SocketPool, design: Vec<usize>) -> Vec<usize> {
-    refine_for(pool, design, &consistency_moment(pool))
-}
-
-/// Improves `design` by exchanges that lower `tr(M⁻¹ W)` for the moment `w`
-/// (an I-optimal criterion, [`predicted_error`]), each swap priced by the
-/// Sherman–Morrison–Woodbury update, until no swap lowers it (at most 10
-/// sweeps).
-#[must_use]
-pub fn refine_for(pool: &SocketPool, mut design: Vec<usize>, w: &DMatrix<f64>) -> Vec<usize> {
-    let p = w.nrows();
-    let ridge = DMatrix::identity(p, p) * 1e-12 * information(pool, &design).trace() / p as f64;
-    // tr((A + BᵀB)⁻¹ W) = tr(A⁻¹W) − tr((I + B A⁻¹ Bᵀ)⁻¹ B A⁻¹ W A⁻¹ Bᵀ).
-    let drop = |a_inv: &DMatrix<f64>, g: &DMatrix<f64>, i: usize| -> f64 {
-        let b = &pool.blocks[i];
-        let s = DMatrix::identity(3, 3) + b * a_inv * b.transpose();
-        let v = b * g * b.transpose();
-        s.try_inverse().map_or(0.0, |si| (si * v).trace())
-    };
-    for _ in 0..10 {
-        let mut improved = false;
-        for k in 0..design.len() {
-            let mut rest = design.clone();
-            let out = rest.swap_remove(k);
-            let Some(a_inv) = (information(pool, &rest) + &ridge).try_inverse() else {
-                continue;
-            };
-            let g = &a_inv * w * &a_inv;
-            let keep = drop(&a_inv, &g, out);
-            let best = (0..pool.qs.len())
-                .filter(|i| !design.contains(i))
-                .map(|i| (i, drop(&a_inv, &g, i)))
-                .max_by(|x, y| x.1.total_cmp(&y.1));
-            if let Some((j, v)) = best
-                && v > keep * (1.0 + 1e-9)
-            {
-                design[k] = j;
-                improved = true;
-            }
-        }
-        if !improved {
-            break;
-        }
-    }
-    design
-}
-
-/// `n` configurations of the pool chosen greedily for the largest
-/// `ln det M` (a ridge of 1e-9 of the information's mean diagonal starts
-/// it), then improved by exchanges (Fedorov) until no swap raises it; each
-/// candidate priced by the matrix determinant lemma,
-/// `ln det(A + BᵀB) = ln det A + ln det(I₃ + B A⁻¹ Bᵀ)`.
-#[must_use]
-pub fn select_d_optimal(pool: &SocketPool, n: usize) -> Vec<usize> {
-    let p = pool.blocks[0].ncols();
-    let all = information(pool, &(0..pool.qs.len()).collect::<Vec<_>>());
-    let ridge = DMatrix::identity(p, p) * (1e-9 * all.trace() / p as f64);
-    let gain = |a_inv: &DMatrix<f64>, i: usize| -> f64 {
-        let b = &pool.blocks[i];
-        let s = DMatrix::identity(3, 3) + b * a_inv * b.transpose();
-        s.determinant().max(f64::MIN_POSITIVE).ln()
-    };
-    let inverse = |m: DMatrix<f64>| m.try_inverse().expect("a ridged information is invertible");
-    let mut design: Vec<usize> = Vec::with_capacity(n);
-    while design.len() < n.min(pool.qs.len()) {
-        let a_inv = inverse(information(pool, &design) + &ridge);
-        let best = (0..pool.qs.len())
-            .filter(|i| !design.contains(i))
-            .max_by(|&x, &y| gain(&a_inv, x).total_cmp(&gain(&a_inv, y)))
-            .expect("candidates remain");
-        design.push(best);
-    }
-    for _ in 0..10 {
-        let mut improved = false;
-        for k in 0..design.len() {
-            let mut rest = design.clone();
-            let out = rest.swap_remove(k);
-            let a_inv = inverse(information(pool, &rest) + &ridge);
-            let keep = gain(&a_inv, out);
-            let best = (0..pool.qs.len())
-                .filter(|i| !design.contains(i))
-                .map(|i| (i, gain(&a_inv, i)))
-                .max_by(|x, y| x.1.total_cmp(&y.1));
-            if let Some((j, g)) = best
-                && g > keep + 1e-9
-            {
-                design[k] = j;
-                improved = true;
-            }
-        }
-        if !improved {
-            break;
-        }
-    }
-    design
 }

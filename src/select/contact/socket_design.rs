@@ -13,13 +13,14 @@
 //! (the hand-recorded baseline), and the smallest error any design of the
 //! pool can reach ([`error_bound`], the convex relaxation, certified).
 
-use super::predict::true_error_moment;
-use super::select::{
-    Socket, SocketPool, consistency_moment, determined_pool, filter_projected, information,
-    predicted_error, projected, refine_for, select_d_optimal,
-};
-use super::tool_points;
+use super::{ContactSearch, refine_for, select_d_optimal};
 use crate::error::Error;
+use crate::identify::contact::predict::true_error_moment;
+use crate::identify::contact::select::{
+    Socket, SocketPool, consistency_moment, determined_pool, filter_projected, information,
+    predicted_error, projected,
+};
+use crate::identify::contact::tool_points;
 use crate::measure::contact::KnownDistance;
 use crate::model::{ParamTable, Robot};
 use nalgebra::{DMatrix, Vector3};
@@ -53,6 +54,8 @@ pub struct SocketDesignSettings {
     pub distances: Vec<KnownDistance>,
     /// Seed of the generic configurations the true error is predicted at.
     pub prediction_seed: u64,
+    /// How the exchange searches (seed, rounds of iterated local search).
+    pub search: ContactSearch,
 }
 
 impl Default for SocketDesignSettings {
@@ -70,6 +73,7 @@ impl Default for SocketDesignSettings {
             filters: Vec::new(),
             distances: Vec::new(),
             prediction_seed: 3,
+            search: ContactSearch::default(),
         }
     }
 }
@@ -218,7 +222,7 @@ pub fn design_for_sockets(
         (kept, Some(stats))
     };
     let pool = determined_pool(robot, table, file, &settings.distances)?;
-    let p = pool.blocks[0].ncols();
+    let p = pool.p();
     if pool.qs.len() < settings.n || 3 * settings.n + pool.constraints.nrows() < p {
         return Err(Error::Invalid(format!(
             "{} configurations: the pool has {} configurations and {p} unknowns (3 rows a configuration: at least {} configurations)",
@@ -230,11 +234,11 @@ pub fn design_for_sockets(
     }
     task.inc(1);
     task.note(|| "D-optimal choice".into());
-    let start = select_d_optimal(&pool, settings.n);
+    let start = select_d_optimal(&pool, settings.n, &settings.search)?;
     task.inc(1);
     task.note(|| "exchanges for the predicted true error".into());
     let true_w = true_error_moment(&pool, table, settings.prediction_seed);
-    let chosen = refine_for(&pool, start.clone(), &true_w);
+    let chosen = refine_for(&pool, &start, &true_w, &settings.search)?;
     task.inc(1);
     task.note(|| "judging: random draws and the bound, consistency".into());
     let consistency_w = consistency_moment(&pool);
@@ -459,7 +463,7 @@ fn equilibrated(
         })
         .collect();
     let scale = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(s));
-    let blocks = pool.blocks.iter().map(|b| b * &scale).collect();
+    let blocks = (0..pool.qs.len()).map(|i| pool.block(i) * &scale).collect();
     let c = &pool.constraints * &scale;
     (blocks, c.transpose() * c, &scale * w * &scale)
 }

@@ -17,7 +17,7 @@ use crate::write::calibrated::{CalibratedRobot, Format};
 use std::path::Path;
 
 pub use crate::identify::LossChoice;
-pub use crate::identify::contact::{HoldoutMode, HoldoutReport};
+pub use crate::identify::contact::{HoldoutMode, PlacementHoldout};
 pub use crate::lsq::outliers::OutlierChoice;
 
 /// A contact calibration's options, as a front end resolves them.
@@ -60,7 +60,7 @@ pub struct ContactRun {
     /// The calibration (fit, figures, frames, verdict).
     pub calibration: ContactCalibration,
     /// The held-out placements, when asked.
-    pub held: Option<HoldoutReport>,
+    pub held: Option<PlacementHoldout>,
     /// The gross-error test asked for.
     pub outliers: OutlierChoice,
     /// Rows in the file before any was left out.

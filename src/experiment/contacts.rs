@@ -236,7 +236,7 @@ pub struct ContactCalibrationReport<'a> {
     /// In-sample consistency, nominal and calibrated.
     pub in_sample: &'a Figures,
     /// Held-out placements, when asked for.
-    pub holdout: Option<&'a crate::identify::contact::HoldoutReport>,
+    pub holdout: Option<&'a crate::identify::contact::PlacementHoldout>,
     /// The tool point's predicted true error.
     pub predicted_true_error: Option<&'a PredictedTrueError>,
     /// The calibrated frames (when written).
@@ -292,7 +292,7 @@ impl ContactCalibration {
         measurements: &'a str,
         rows: usize,
         choice: crate::lsq::outliers::OutlierChoice,
-        holdout: Option<&'a crate::identify::contact::HoldoutReport>,
+        holdout: Option<&'a crate::identify::contact::PlacementHoldout>,
         with_frames: bool,
         out: &'a [String],
     ) -> ContactCalibrationReport<'a> {
@@ -329,7 +329,7 @@ impl ContactCalibration {
     #[must_use]
     pub fn text(
         &self,
-        held: Option<&crate::identify::contact::HoldoutReport>,
+        held: Option<&crate::identify::contact::PlacementHoldout>,
         written: &[String],
     ) -> String {
         use std::fmt::Write as _;
@@ -363,7 +363,7 @@ impl ContactCalibration {
         dir: &std::path::Path,
         robot: &Robot,
         json: &serde_json::Value,
-        held: Option<&crate::identify::contact::HoldoutReport>,
+        held: Option<&crate::identify::contact::PlacementHoldout>,
         text: &str,
     ) -> crate::error::Result<()> {
         let file = &self.file;

@@ -8,7 +8,7 @@ use crate::data::ContactFile;
 use crate::error::Result;
 use crate::identify::contact::holdout::{Figures, downweighted_rows};
 use crate::identify::contact::{
-    ContactFit, HoldoutReport, RowDistance, placement_of, placements, rms,
+    ContactFit, PlacementHoldout, RowDistance, placement_of, placements, rms,
     row_distances as rows_of_fit,
 };
 use crate::model::Robot;
@@ -25,7 +25,7 @@ pub struct ContactReport<'a> {
     /// Its in-sample figures.
     pub figures: &'a Figures,
     /// The held-out folds, when asked for.
-    pub held: Option<&'a HoldoutReport>,
+    pub held: Option<&'a PlacementHoldout>,
 }
 
 /// Each placement's in-sample consistency (the RMS of its rows'
@@ -33,7 +33,7 @@ pub struct ContactReport<'a> {
 fn placement_bars(
     names: &[String],
     rows: &[RowDistance],
-    held: Option<&HoldoutReport>,
+    held: Option<&PlacementHoldout>,
 ) -> Vec<BarGroup> {
     names
         .iter()
@@ -60,7 +60,7 @@ fn placement_bars(
 }
 
 /// Each known distance's error, in-sample and held out.
-fn distance_bars(figures: &Figures, held: Option<&HoldoutReport>) -> Vec<BarGroup> {
+fn distance_bars(figures: &Figures, held: Option<&PlacementHoldout>) -> Vec<BarGroup> {
     figures
         .distances
         .iter()

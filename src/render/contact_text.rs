@@ -6,7 +6,7 @@
 use crate::data::ContactFile;
 use crate::identify::contact::evaluate::ContactEvaluation;
 use crate::identify::contact::holdout::{Figures, downweighted_rows};
-use crate::identify::contact::{ContactFit, HoldoutReport};
+use crate::identify::contact::{ContactFit, PlacementHoldout};
 use std::fmt::Write as _;
 
 /// The report of a contact fit as text: the fit, the fixed unknowns, the
@@ -17,7 +17,7 @@ pub fn text(
     file: &ContactFile,
     fit: &ContactFit,
     fig: &Figures,
-    held: Option<&HoldoutReport>,
+    held: Option<&PlacementHoldout>,
 ) -> String {
     let mut s = String::new();
     let _ = writeln!(
@@ -113,7 +113,7 @@ fn figures_text(f: &Figures) -> String {
 }
 
 /// The held-out placements' figures (mm).
-fn holdout_text(h: &HoldoutReport) -> String {
+fn holdout_text(h: &PlacementHoldout) -> String {
     let mut s = format!("\nheld out ({}):\n", h.mode);
     for f in &h.folds {
         let _ = writeln!(

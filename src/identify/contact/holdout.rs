@@ -168,9 +168,11 @@ pub enum HoldoutMode {
     TrainOn(String),
 }
 
-/// Held-out figures over every fold.
+/// A contact fit held out by placement: its figures over every fold (one
+/// meaning of a holdout report per sensor family: this is the contacts'; a
+/// measured fit's is [`crate::report::measured::HoldoutReport`]).
 #[derive(Clone, Debug, Serialize, PartialEq)]
-pub struct HoldoutReport {
+pub struct PlacementHoldout {
     /// `leave_one_out` or `train_on`.
     pub mode: String,
     /// The folds.
@@ -335,7 +337,7 @@ pub fn holdout_by_placement(
     distances: &[NamedDistance],
     settings: &ContactSettings,
     mode: &HoldoutMode,
-) -> Result<HoldoutReport> {
+) -> Result<PlacementHoldout> {
     let all = placements(file);
     if all.len() < 2 {
         return Err(Error::Invalid(format!(
@@ -405,7 +407,7 @@ fn fold(
 }
 
 /// Pooled figures over the folds.
-fn summarise(mode: &HoldoutMode, folds: Vec<HoldoutFold>) -> HoldoutReport {
+fn summarise(mode: &HoldoutMode, folds: Vec<HoldoutFold>) -> PlacementHoldout {
     let pooled = |f: &dyn Fn(&PointFigure) -> f64| -> f64 {
         let (mut s, mut n) = (0.0, 0usize);
         for p in folds.iter().flat_map(|f| &f.figures.points) {
@@ -418,7 +420,7 @@ fn summarise(mode: &HoldoutMode, folds: Vec<HoldoutFold>) -> HoldoutReport {
         .iter()
         .flat_map(|f| f.figures.distances.iter().map(|d| d.calibrated_error_mm))
         .collect();
-    HoldoutReport {
+    PlacementHoldout {
         mode: match mode {
             HoldoutMode::LeaveOneOut => "leave_one_out".into(),
             HoldoutMode::TrainOn(_) => "train_on".into(),

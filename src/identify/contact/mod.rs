@@ -32,8 +32,8 @@ pub mod worth;
 use crate::data::{ContactFile, NamedDistance};
 pub use fit::{ContactFit, ContactSettings, PlaneEstimate, fit_contacts};
 pub use holdout::{
-    DistanceFigure, DownweightedRow, Figures, HoldoutFold, HoldoutMode, HoldoutReport, PlaneFigure,
-    PointFigure, RowDistance, holdout_by_placement, judge, placements, row_distances,
+    DistanceFigure, DownweightedRow, Figures, HoldoutFold, HoldoutMode, PlacementHoldout,
+    PlaneFigure, PointFigure, RowDistance, holdout_by_placement, judge, placements, row_distances,
 };
 
 use crate::error::Error;

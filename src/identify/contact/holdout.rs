@@ -168,9 +168,9 @@ pub enum HoldoutMode {
     TrainOn(String),
 }
 
-/// A contact fit held out by placement: its figures over every fold (one
-/// meaning of a holdout report per sensor family: this is the contacts'; a
-/// measured fit's is [`crate::report::measured::HoldoutReport`]).
+/// A contact fit held out by placement: its figures over every fold (a
+/// fit of measured poses held out by random splits reports
+/// [`crate::report::measured::HoldoutReport`]).
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct PlacementHoldout {
     /// `leave_one_out` or `train_on`.

@@ -100,7 +100,7 @@ pub fn cmd_bound(a: BoundArgs) -> Result<()> {
         .map(|p| super::load_existing(p, &ctx.robot, a.pool.params, a.pool.units.units()))
         .transpose()?;
     let report = activecal::experiment::bound::bound_of_pool(
-        ctx.scoring(a.pool.params),
+        ctx.scoring(),
         existing,
         a.n,
         settings,

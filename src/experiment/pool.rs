@@ -21,6 +21,8 @@ pub struct PoolRun {
     pub pool: Pool,
     /// Identification Jacobian of every pool pose.
     pub x: Blocks,
+    /// The parameters the Jacobian was evaluated at.
+    pub params: ParamSet,
 }
 
 /// The pool a design is scored on: the robot, the pool and its Jacobian at
@@ -38,15 +40,14 @@ pub struct ScoringPool<'a> {
 }
 
 impl PoolRun {
-    /// The pool to score and bound designs on, its Jacobian at `params`
-    /// (those it was built with).
+    /// The pool to score and bound designs on.
     #[must_use]
-    pub fn scoring(&self, params: ParamSet) -> ScoringPool<'_> {
+    pub fn scoring(&self) -> ScoringPool<'_> {
         ScoringPool {
             robot: &self.robot,
             pool: &self.pool,
             x: &self.x,
-            params,
+            params: self.params,
         }
     }
 }
@@ -90,7 +91,12 @@ pub fn build_pool(
         robot
     };
     let x = pool.try_jacobian(&robot, robot.params(params))?;
-    Ok(PoolRun { robot, pool, x })
+    Ok(PoolRun {
+        robot,
+        pool,
+        x,
+        params,
+    })
 }
 
 /// The gravity model of a URDF robot from its own `<inertial>` elements.

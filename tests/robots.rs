@@ -1057,7 +1057,11 @@ fn malformed_descriptions_get_errors_that_point_to_the_place() {
     );
     assert!(toml_err(&t).contains("joint q1 is prismatic: give `limits` in metres"));
     let t = base.replace("measurement = \"point\"", "measurement = \"laser\"");
-    assert!(toml_err(&t).contains("unknown variant `laser`"));
+    let e = toml_err(&t);
+    assert!(
+        e.contains("measurement = \"laser\": unknown (known: point, pose, markers"),
+        "{e}"
+    );
     let t = base.replace(
         "measurement = \"point\"",
         "measurement = \"point\"\nunknowns = \"auto\"",

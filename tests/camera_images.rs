@@ -280,41 +280,7 @@ fn charuco_targets_the_detector_cannot_read_are_refused_in_words() {
 /// `pose, <joints>, feature, u, v`).
 #[test]
 fn charuco_corners_found_in_the_committed_renders_carry_the_true_ids() {
-    let robot = activecal::io::load_robot(&format!(
-        "{}#tip=target",
-        root().join("fixtures/ur5.urdf").display()
-    ))
-    .unwrap();
-    let intrinsics =
-        read_camera_info(&root().join("fixtures/camera/charuco_camera_info.yaml")).unwrap();
-    let target = read_target(&root().join("fixtures/camera/charuco_4x5.yaml")).unwrap();
-    let dir = root().join("fixtures/camera/charuco");
-    let joints = read_image_joints(&dir.join("joints.csv"), &robot, Default::default()).unwrap();
-    let read = read_images(&dir, &joints, &target, &intrinsics).unwrap();
-    let text = std::fs::read_to_string(root().join("fixtures/camera/charuco_truth.csv")).unwrap();
-    let mut lines = text.lines();
-    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
-    let (pose, feature, u, v) = (col("pose"), col("feature"), col("u"), col("v"));
-    let truth: BTreeMap<(i64, usize), [f64; 2]> = lines
-        .map(|l| {
-            let c: Vec<&str> = l.split(',').collect();
-            (
-                (c[pose].parse().unwrap(), c[feature].parse().unwrap()),
-                [c[u].parse().unwrap(), c[v].parse().unwrap()],
-            )
-        })
-        .collect();
-    let mut errors = Vec::new();
-    for (i, id) in read.observations.pose_ids.iter().enumerate() {
-        for (k, p) in read.observations.seen[i].iter().enumerate() {
-            if let Some(p) = p {
-                let t = truth[&(*id, k)];
-                errors.push((p[0] - t[0]).hypot(p[1] - t[1]));
-            }
-        }
-    }
-    errors.sort_by(f64::total_cmp);
+    let (read, errors) = committed_renders("charuco_4x5.yaml", "charuco", "charuco_truth.csv");
     let (median, max) = (errors[errors.len() / 2], errors[errors.len() - 1]);
     println!(
         "{} corners of 4 × 12: {median:.3} px median, {max:.3} px max",
@@ -338,6 +304,40 @@ fn charuco_corners_found_in_the_committed_renders_carry_the_true_ids() {
 /// feature, u, v`, Kalibr's ids).
 #[test]
 fn aprilgrid_corners_found_in_the_committed_renders_carry_kalibrs_ids() {
+    let (read, errors) =
+        committed_renders("aprilgrid_3x4.yaml", "aprilgrid", "aprilgrid_truth.csv");
+    let (median, max) = (errors[errors.len() / 2], errors[errors.len() - 1]);
+    println!(
+        "{} corners of 8 × 48: {median:.3} px median, {max:.3} px max",
+        errors.len()
+    );
+    // Every image shows the whole grid: every tag corner found, each with
+    // the id of its true place (the nearest other corner is across a 9 mm
+    // gap, ≥ 14 px here, so a wrong id is at least that far off); the
+    // detector's own corners within the checkerboard's bounds above
+    // (noise-free renders: 0.1 px in the median, 0.5 px at most; on the
+    // noisy renders of docs/cameras.md they were 0.032 px and 0.155 px).
+    assert_eq!(read.observations.pose_ids, (0..8).collect::<Vec<i64>>());
+    assert_eq!(errors.len(), 8 * 48);
+    for r in &read.images {
+        assert!(
+            matches!(r.outcome, ImageOutcome::Found { points: 48, .. }),
+            "{r:?}"
+        );
+    }
+    assert!(median < 0.1, "median {median} px");
+    assert!(max < 0.5, "max {max} px");
+}
+
+/// The images of `fixtures/camera/DIR` read with the target `TARGET` (on
+/// the UR5's flange camera of `charuco_camera_info.yaml`), and the
+/// distance of every point found to its true pixel in `TRUTH` (columns
+/// `pose, <joints>, feature, u, v`), px, sorted.
+fn committed_renders(
+    target: &str,
+    dir: &str,
+    truth: &str,
+) -> (activecal::io::images::ImageObservations, Vec<f64>) {
     let robot = activecal::io::load_robot(&format!(
         "{}#tip=target",
         root().join("fixtures/ur5.urdf").display()
@@ -345,11 +345,11 @@ fn aprilgrid_corners_found_in_the_committed_renders_carry_kalibrs_ids() {
     .unwrap();
     let intrinsics =
         read_camera_info(&root().join("fixtures/camera/charuco_camera_info.yaml")).unwrap();
-    let target = read_target(&root().join("fixtures/camera/aprilgrid_3x4.yaml")).unwrap();
-    let dir = root().join("fixtures/camera/aprilgrid");
+    let target = read_target(&root().join("fixtures/camera").join(target)).unwrap();
+    let dir = root().join("fixtures/camera").join(dir);
     let joints = read_image_joints(&dir.join("joints.csv"), &robot, Default::default()).unwrap();
     let read = read_images(&dir, &joints, &target, &intrinsics).unwrap();
-    let text = std::fs::read_to_string(root().join("fixtures/camera/aprilgrid_truth.csv")).unwrap();
+    let text = std::fs::read_to_string(root().join("fixtures/camera").join(truth)).unwrap();
     let mut lines = text.lines();
     let head: Vec<&str> = lines.next().unwrap().split(',').collect();
     let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
@@ -373,25 +373,5 @@ fn aprilgrid_corners_found_in_the_committed_renders_carry_kalibrs_ids() {
         }
     }
     errors.sort_by(f64::total_cmp);
-    let (median, max) = (errors[errors.len() / 2], errors[errors.len() - 1]);
-    println!(
-        "{} corners of 8 × 48: {median:.3} px median, {max:.3} px max",
-        errors.len()
-    );
-    // Every image shows the whole grid: every tag corner found, each with
-    // the id of its true place (the nearest other corner is across a 9 mm
-    // gap, ≥ 14 px here, so a wrong id is at least that far off); the
-    // detector's own corners within the checkerboard's bounds above
-    // (noise-free renders: 0.1 px in the median, 0.5 px at most; on the
-    // noisy renders of docs/cameras.md they were 0.032 px and 0.155 px).
-    assert_eq!(read.observations.pose_ids, (0..8).collect::<Vec<i64>>());
-    assert_eq!(errors.len(), 8 * 48);
-    for r in &read.images {
-        assert!(
-            matches!(r.outcome, ImageOutcome::Found { points: 48, .. }),
-            "{r:?}"
-        );
-    }
-    assert!(median < 0.1, "median {median} px");
-    assert!(max < 0.5, "max {max} px");
+    (read, errors)
 }

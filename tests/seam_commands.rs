@@ -6,11 +6,11 @@
 //! The binary never names the sensor: it finds it in the registry.
 
 use crate::common;
+use crate::seam_sensor::{assert_recovered_as_predicted, height_rms};
 
 use activecal::identify::{simulate, trial_rng};
-use activecal::kinematics::Evaluator;
 use activecal::measure::height;
-use activecal::model::{ParamTable, Robot};
+use activecal::model::Robot;
 use activecal::pool::Pool;
 use common::{fails_with, json_of};
 use serde_json::Value;
@@ -20,16 +20,6 @@ const ROBOT: &str = "ur5:height";
 
 fn scratch(name: &str) -> PathBuf {
     common::scratch_dir("seam-commands", name)
-}
-
-/// RMS over `qs` of the end point's height under `a` minus under `b`, m.
-fn height_rms(robot: &Robot, a: &ParamTable, b: &ParamTable, qs: &[Vec<f64>]) -> f64 {
-    let (mut ea, mut eb) = (Evaluator::new(robot, a), Evaluator::new(robot, b));
-    let ss: f64 = qs
-        .iter()
-        .map(|q| (ea.end_frame(q).position.z - eb.end_frame(q).position.z).powi(2))
-        .sum();
-    (ss / qs.len() as f64).sqrt()
 }
 
 fn num(v: &Value, key: &str) -> f64 {
@@ -149,25 +139,8 @@ fn every_command_selects_bounds_scores_fits_and_reports_the_height_sensor() {
         assert_eq!(fitted.measurement, height::KIND);
         ms.push(height_rms(&robot, &fitted.nominal, &robot.real, &at).powi(2));
     }
-    let mean = ms.iter().sum::<f64>() / trials as f64;
-    let sd = (ms.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (trials - 1) as f64).sqrt();
-    let se = sd / (trials as f64).sqrt();
     let before = height_rms(&robot, &robot.nominal, &robot.real, &at);
-    eprintln!(
-        "height via the CLI: before {:.4} mm, after {:.4} mm RMS, predicted {:.4} mm",
-        before * 1e3,
-        mean.sqrt() * 1e3,
-        predicted_m * 1e3
-    );
-    assert!(
-        (mean - predicted_m * predicted_m).abs() < 4.0 * se,
-        "mean square {mean:e} m² vs predicted {:e} m² (s.e. {se:e})",
-        predicted_m * predicted_m
-    );
-    assert!(
-        before > 10.0 * predicted_m,
-        "the real robot is off by {before} m only"
-    );
+    assert_recovered_as_predicted("height via the CLI", &ms, predicted_m, before);
 }
 
 /// An unknown key is refused naming the known ones, after a robot and in a

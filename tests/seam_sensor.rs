@@ -21,7 +21,7 @@ fn robot() -> Robot {
 }
 
 /// RMS over `qs` of the end point's height under `a` minus under `b`, m.
-fn height_rms(robot: &Robot, a: &ParamTable, b: &ParamTable, qs: &[Vec<f64>]) -> f64 {
+pub(crate) fn height_rms(robot: &Robot, a: &ParamTable, b: &ParamTable, qs: &[Vec<f64>]) -> f64 {
     let (mut ea, mut eb) = (Evaluator::new(robot, a), Evaluator::new(robot, b));
     let ss: f64 = qs
         .iter()
@@ -88,25 +88,7 @@ fn height_sensor_is_selected_bounded_fitted_and_reported() {
         assert_eq!(id.status, Status::Converged);
         ms.push(height_rms(&robot, &id.table, &robot.real, &at).powi(2));
     }
-    let mean = ms.iter().sum::<f64>() / trials as f64;
-    let sd = (ms.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (trials - 1) as f64).sqrt();
-    let se = sd / (trials as f64).sqrt();
-    eprintln!(
-        "height: before {:.4} mm, after {:.4} mm RMS, predicted {:.4} mm (±{:.4} mm² s.e. of the mean square)",
-        before * 1e3,
-        mean.sqrt() * 1e3,
-        p_m * 1e3,
-        se * 1e6
-    );
-    assert!(
-        (mean - p_m * p_m).abs() < 4.0 * se,
-        "mean square {mean:e} m² vs predicted {:e} m² (s.e. {se:e})",
-        p_m * p_m
-    );
-    assert!(
-        before > 10.0 * p_m,
-        "the real robot is off by {before} m only"
-    );
+    assert_recovered_as_predicted("height", &ms, p_m, before);
 }
 
 /// Every Rust file under `dir` (recursively), relative to the root.
@@ -167,5 +149,38 @@ fn the_height_sensor_lives_in_its_folder_and_one_registration_line() {
         naming[0].starts_with("src/measure/mod.rs:"),
         "{}",
         naming[0]
+    );
+}
+
+/// Asserts that the mean of the squared errors `squares` of independent
+/// calibrations (m²) equals the predicted error `predicted` (m) squared
+/// within 4 standard errors of that mean, and that the nominal model was
+/// off (`before`, m) by more than 10 times it; prints the figures as
+/// `label`.
+pub(crate) fn assert_recovered_as_predicted(
+    label: &str,
+    squares: &[f64],
+    predicted: f64,
+    before: f64,
+) {
+    let trials = squares.len();
+    let mean = squares.iter().sum::<f64>() / trials as f64;
+    let sd = (squares.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (trials - 1) as f64).sqrt();
+    let se = sd / (trials as f64).sqrt();
+    eprintln!(
+        "{label}: before {:.4} mm, after {:.4} mm RMS, predicted {:.4} mm (±{:.4} mm² s.e. of the mean square)",
+        before * 1e3,
+        mean.sqrt() * 1e3,
+        predicted * 1e3,
+        se * 1e6
+    );
+    assert!(
+        (mean - predicted * predicted).abs() < 4.0 * se,
+        "mean square {mean:e} m² vs predicted {:e} m² (s.e. {se:e})",
+        predicted * predicted
+    );
+    assert!(
+        before > 10.0 * predicted,
+        "the real robot is off by {before} m only"
     );
 }

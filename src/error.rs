@@ -3,6 +3,8 @@
 
 use thiserror::Error;
 
+pub use crate::settings::{SettingError, positive};
+
 /// Everything that can be wrong with what a user gave the library.
 #[derive(Debug, Error)]
 pub enum Error {
@@ -99,6 +101,18 @@ pub enum Error {
     #[error("{label} {path}: exists, and overwriting it was not asked for")]
     OutputExists {
         /// What the output is (its label, see [`crate::io::atomic::Output`]).
+        label: String,
+        /// The path given.
+        path: String,
+    },
+    /// A setting given a value it cannot take.
+    #[error(transparent)]
+    Setting(#[from] SettingError),
+    /// An output directory (replaced whole, as a report folder is) that
+    /// exists and holds files, with replacing it not asked for.
+    #[error("{label} {path}: exists and is not empty, and replacing it was not asked for")]
+    OutputDirNotEmpty {
+        /// What the directory is (its label, see [`crate::io::atomic::Output`]).
         label: String,
         /// The path given.
         path: String,

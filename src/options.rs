@@ -16,7 +16,7 @@
 /// validation, the simulated trials, the model's restrictions, contacts.
 pub use crate::identify::contact::ContactSettings;
 pub use crate::identify::restriction::Restriction;
-pub use crate::identify::{HoldoutSettings, LossChoice, MonteCarloSettings, Weights};
+pub use crate::identify::{HoldoutSettings, LossChoice, LossKind, MonteCarloSettings, Weights};
 pub use crate::lsq::levmar::LmSettings;
 
 /// The gross-error test: its choice and its default significance level.
@@ -38,7 +38,8 @@ pub use crate::bound::{BoundSettings, RelaxationSolver};
 /// Pools: where poses come from, the filters, the joint-limit margin.
 pub use crate::collision::Obstacle;
 pub use crate::pool::{
-    DEFAULT_URDF_MARGIN_DEG, PoolFilter, PoolSource, PoolSpec, default_margin_deg,
+    DEFAULT_COUNT, DEFAULT_LEVELS, DEFAULT_URDF_MARGIN_DEG, PoolFilter, PoolKind, PoolSource,
+    PoolSpec, default_margin_deg,
 };
 
 /// Sensors' set-up: a camera's mounting, intrinsics and view, where a

@@ -40,6 +40,9 @@ pub enum LengthUnit {
     Mm,
 }
 
+crate::choice!(AngleUnit { Rad => "rad", Deg => "deg" });
+crate::choice!(LengthUnit { M => "m", Mm => "mm" });
+
 impl AngleUnit {
     /// Radians per unit.
     #[must_use]

@@ -623,7 +623,7 @@ const CASES: &[Case] = &[
     case(
         &["calibrate", "--measurements", "m.json", "--noise", "0"],
         1,
-        &["--noise 0: with --measurements it is the sensor's stated σ"],
+        &["--noise 0: the sensor's stated σ, tested against the residuals"],
     ),
     case(
         &[

@@ -169,11 +169,11 @@ fn pool_options_and_files_fail_clearly() {
     fails_with(&["select", "--pool", "grid"], "unknown pool 'grid'");
     fails_with(
         &["select", "--pool", "random", "--levels", "3"],
-        "--levels applies to --pool lattice only",
+        "--levels: applies to --pool lattice only",
     );
     fails_with(
         &["bound", "--levels", "3", "--count", "10"],
-        "--count and --pool-seed apply to --pool random or sobol only",
+        "--count: applies to --pool random or sobol only",
     );
     fails_with(&["select", "--pool", "sobol", "--count", "0"], "needs 1 to");
     let d = scratch("bad-files");

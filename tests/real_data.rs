@@ -403,7 +403,7 @@ fn fix_free_and_robust_loss_from_the_command_line() {
     );
     let mut a = base.to_vec();
     a.extend_from_slice(&["--loss", "huber"]);
-    fails_with(&a, "needs --loss-scale");
+    fails_with(&a, "--loss-scale: --loss huber needs it");
 }
 
 /// `fk` prints a full pose's orientation in the CSV's conventions: poses

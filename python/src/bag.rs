@@ -11,15 +11,6 @@ use activecal::io::bag::series::Source;
 use pyo3::prelude::*;
 use std::path::PathBuf;
 
-/// A number argument that must be finite and at least `min`.
-fn at_least(name: &str, v: f64, min: f64, what: &str) -> PyResult<f64> {
-    if v.is_finite() && v >= min {
-        Ok(v)
-    } else {
-        Err(arg_err(name, what))
-    }
-}
-
 /// Reads the ROS 2 bag at `bag` (a rosbag2 folder, or one .mcap or .db3
 /// file) as `activecal extract BAG --out FILE` does: one row per rest of
 /// the joints (every joint slower than rest_speed rad/s for rest_min s or
@@ -141,23 +132,16 @@ impl BagArgs<'_> {
 /// The library's extraction settings from the keyword arguments, checked
 /// (a bad one named by its keyword).
 pub(crate) fn settings(a: &BagArgs<'_>) -> PyResult<ExtractSettings> {
-    let source = Source::one_of(a.points, a.poses, a.tf)
-        .map_err(|e| crate::errors::new_err(crate::errors::Kind::Input, e))?;
+    let fail = |e| Fail::from(e).into_py();
+    let source = Source::one_of(a.points, a.poses, a.tf).map_err(fail)?;
     let mut s = ExtractSettings::new(a.joints, source);
     s.rest.speed = a.rest_speed;
     s.rest.min_duration = a.rest_min;
     s.rest.settle = a.settle;
-    s.max_offset = at_least("max_offset", a.max_offset, 0.0, "seconds, 0 or more")?;
-    s.design_tolerance = at_least(
-        "design_tolerance",
-        a.design_tolerance,
-        f64::MIN_POSITIVE,
-        "a positive number (rad, m)",
-    )?;
-    s.time_offset = a
-        .time_offset
-        .map(|o| at_least("time_offset", o, f64::MIN, "a number of seconds"))
-        .transpose()?;
+    s.max_offset = a.max_offset;
+    s.design_tolerance = a.design_tolerance;
+    s.time_offset = a.time_offset;
+    s.validate().map_err(fail)?;
     Ok(s)
 }
 

@@ -294,8 +294,6 @@ pub fn calibrate(
     let weights = weights_of(weights, orientation_scale)?;
     let outliers = outliers_of(outliers, outlier_rate)?;
     let gravity = crate::fit_args::gravity_of(compliance, &robot.inner)?;
-    let (stated_noise, stated_orientation_noise) =
-        crate::fit_args::stated_noises(noise, orientation_noise)?;
     let mut scaled = (*robot.inner).clone();
     if let Some(w) = orientation_scale {
         scaled.orientation_scale = w;
@@ -327,9 +325,12 @@ pub fn calibrate(
         compare_compliance: false,
         weights,
         outliers,
-        stated_noise,
-        stated_orientation_noise,
+        stated_noise: noise,
+        stated_orientation_noise: orientation_noise,
     };
+    settings
+        .validate()
+        .map_err(|e| crate::convert::Fail::from(e).into_py())?;
     let r = inner.clone();
     let (fitted, id, frames, (report, summary), verdict, warnings) =
         crate::progress::with_callback(progress, || {

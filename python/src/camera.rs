@@ -118,7 +118,7 @@ pub(crate) fn mounting_of(mounting: Option<&str>, camera_link: Option<&str>) -> 
             "a camera on the robot's own link is mounted on it: give mounting or camera_link, not both",
         )),
         (None, Some(_)) => Ok(Mounting::EyeToHand),
-        (Some(m), None) => Mounting::from_name(m).ok_or_else(|| {
+        (Some(m), None) => <Mounting as activecal::names::Choice>::from_name(m).ok_or_else(|| {
             arg_err(
                 "mounting",
                 format!("unknown mounting '{m}': \"eye-to-hand\" or \"eye-in-hand\""),
@@ -387,18 +387,6 @@ pub(crate) fn read_pixels(
     ))
 }
 
-/// Writes `text` to `path` atomically; an existing file only with
-/// `overwrite`, never one of `inputs`.
-fn write_text(path: &Path, text: &str, overwrite: bool, inputs: &[&Path]) -> PyResult<()> {
-    let out = [activecal::io::atomic::Output {
-        label: "path",
-        path,
-    }];
-    activecal::io::atomic::check_outputs(&out, inputs, overwrite)
-        .map_err(|e| Fail::from(e).into_py())?;
-    activecal::io::atomic::write_atomic(path, text.as_bytes()).map_err(|e| Fail::from(e).into_py())
-}
-
 impl CameraCalibration {
     /// The files the call read (observations, camera_info, target given as
     /// paths): never written over.
@@ -417,30 +405,16 @@ impl CameraCalibration {
         }
     }
 
-    /// Writes the calibrated robot as `format`.
+    /// Writes the calibrated robot to `path` ([`CameraCalibration::write_robot`]).
     fn write_as(&self, format: Format, path: &Path, overwrite: bool) -> PyResult<()> {
         self.check_converged(path)?;
-        let fit = &self.cal.fit;
-        let Some((f, r)) = &self.cal.frames else {
-            return Err(arg_err(
-                "path",
-                format!(
-                    "{}: robot '{}' was not imported from a URDF: there is no URDF or frames file to write",
-                    path.display(),
-                    self.cal.robot_name
-                ),
-            ));
-        };
-        crate::calibrate::write_robot(
-            format,
-            &fit.robot,
-            &fit.table,
-            Some((f, r)),
-            "",
+        let out = activecal::io::atomic::Output {
+            label: "path",
             path,
-            overwrite,
-            &self.inputs(),
-        )
+        };
+        self.cal
+            .write_robot(format, out, overwrite, &self.inputs())
+            .map_err(|e| Fail::from(e).into_py())
     }
 
     /// A placement of the `camera` block (`which`: "camera" or "target")
@@ -571,36 +545,19 @@ impl CameraCalibration {
                 ),
             ));
         }
-        let yaml = path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
-        if !yaml {
-            return Err(arg_err(
-                "path",
-                format!(
-                    "{}: the refined intrinsics are written as a ROS camera_info .yaml",
-                    path.display()
-                ),
-            ));
-        }
         self.check_converged(&path)?;
-        let name = path
-            .file_stem()
-            .map_or_else(|| "camera".into(), |s| s.to_string_lossy());
-        let comment = format!(
-            "intrinsics refined by activecal calibrate --refine-intrinsics from {}",
-            self.cal.observations.origin
-        );
-        let mut inputs = self.inputs();
-        if let Some(src) = self.cal.fit.robot.source.as_ref() {
-            inputs.push(Path::new(&src.path));
-        }
-        write_text(
-            &path,
-            &self.cal.camera_info_text(&name, &comment),
-            overwrite,
-            &inputs,
-        )
+        let out = activecal::io::atomic::Output {
+            label: "path",
+            path: &path,
+        };
+        self.cal
+            .write_camera_info(
+                out,
+                &self.cal.observations.origin,
+                overwrite,
+                &self.inputs(),
+            )
+            .map_err(|e| Fail::from(e).into_py())
     }
 
     fn __repr__(&self) -> String {

@@ -49,11 +49,20 @@ impl From<activecal::Error> for Fail {
         use activecal::Error as E;
         let m = e.to_string();
         match e {
-            E::Io { .. } | E::OutputExists { .. } => Fail::File(m),
+            E::Io { .. } | E::OutputExists { .. } | E::OutputDirNotEmpty { .. } => Fail::File(m),
             E::TooLarge { .. } | E::OutOfMemory { .. } => Fail::Resource(m),
             E::Unidentifiable { .. } => Fail::Compute(m),
+            E::Setting(s) => Fail::from(s),
             _ => Fail::Input(m),
         }
+    }
+}
+
+impl From<activecal::error::SettingError> for Fail {
+    /// A setting's value refused: `key value: why`, keys as Python's
+    /// keywords.
+    fn from(e: activecal::error::SettingError) -> Self {
+        Fail::Input(e.spelled(str::to_string))
     }
 }
 

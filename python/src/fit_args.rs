@@ -5,8 +5,8 @@
 
 use crate::convert::{arg_err, count};
 use activecal::experiment::acts_on::{self as lib_acts, Sensor};
-use activecal::options::LossChoice;
 use activecal::options::Restriction;
+use activecal::options::{LossChoice, LossKind};
 use pyo3::prelude::*;
 
 /// The `weights` and `orientation_scale` arguments, checked.
@@ -63,39 +63,16 @@ pub(crate) fn holdout_of(
         .transpose()
 }
 
-/// The `loss` and `loss_scale` arguments, checked.
+/// The `loss` and `loss_scale` arguments, checked ([`LossChoice::of`]).
 pub(crate) fn loss_of(loss: &str, loss_scale: Option<f64>) -> PyResult<LossChoice> {
-    let scale = |s: Option<f64>| match s {
-        Some(s) if s.is_finite() && s > 0.0 => Ok(s),
-        Some(s) => Err(arg_err(
-            "loss_scale",
-            format!("{s}: must be a finite number > 0 (metres)"),
-        )),
-        None => Err(arg_err(
-            "loss_scale",
-            format!(
-                "loss=\"{loss}\" needs loss_scale (metres: the residual norm of one pose where the loss turns robust, e.g. 3 times the sensor noise)"
-            ),
-        )),
-    };
-    Ok(match loss {
-        "l2" if loss_scale.is_some() => {
-            return Err(arg_err("loss_scale", "is for loss=\"huber\" or \"cauchy\""));
-        }
-        "l2" => LossChoice::L2,
-        "huber" => LossChoice::Huber {
-            scale: scale(loss_scale)?,
-        },
-        "cauchy" => LossChoice::Cauchy {
-            scale: scale(loss_scale)?,
-        },
-        other => {
-            return Err(arg_err(
-                "loss",
-                format!("unknown loss '{other}': \"l2\", \"huber\" or \"cauchy\""),
-            ));
-        }
-    })
+    use activecal::names::Choice;
+    let kind = LossKind::from_name(loss).ok_or_else(|| {
+        arg_err(
+            "loss",
+            format!("unknown loss '{loss}': \"l2\", \"huber\" or \"cauchy\""),
+        )
+    })?;
+    LossChoice::of(kind, loss_scale).map_err(|e| crate::convert::Fail::from(e).into_py())
 }
 
 /// The unknowns `unknowns` and `keep_axis_relations` restrict a fit to.
@@ -135,13 +112,14 @@ pub(crate) fn refuse_unused(
                 .iter()
                 .map(|s| s.words())
                 .collect();
+            let why = match lib_acts::why_not(lib_acts::CALIBRATE_WHY, k) {
+                // Keys in backticks are Python's keywords.
+                Some(w) => w.replace('`', ""),
+                None => format!("it acts on {}", on.join(" or ")),
+            };
             // The table's `bag_design` is `calibrate`'s `design`.
             let k = if *k == "bag_design" { "design" } else { k };
-            format!(
-                "{k}: not used with {}; it acts on {}",
-                sensor.words(),
-                on.join(" or ")
-            )
+            format!("{k}: not used with {}; {why}", sensor.words())
         })
         .collect();
     Err(pyo3::exceptions::PyValueError::new_err(lines.join("\n")))
@@ -164,28 +142,6 @@ pub(crate) fn outliers_of(kind: &str, rate: f64) -> PyResult<activecal::options:
         pyo3::exceptions::PyValueError::new_err(format!("outlier_rate={rate}: {e}"))
     })?;
     Ok(c)
-}
-
-/// The `noise` (metres per coordinate) and `orientation_noise` (radians per
-/// axis) arguments, the sensor's stated σ, checked.
-pub(crate) fn stated_noises(
-    noise: Option<f64>,
-    orientation_noise: Option<f64>,
-) -> PyResult<(Option<f64>, Option<f64>)> {
-    if let Some(s) = noise.filter(|s| !(s.is_finite() && *s > 0.0)) {
-        return Err(crate::errors::new_err(
-            crate::errors::Kind::Input,
-            format!(
-                "noise={s}: the sensor's stated σ per coordinate must be a number > 0 (metres)"
-            ),
-        ));
-    }
-    if let Some(s) = orientation_noise.filter(|s| !(s.is_finite() && *s > 0.0)) {
-        return Err(pyo3::exceptions::PyValueError::new_err(format!(
-            "orientation_noise={s}: the tracker's stated σ per orientation axis must be a number > 0 (radians)"
-        )));
-    }
-    Ok((noise, orientation_noise))
 }
 
 /// The gravity model `compliance=True` fits the joints' compliances with

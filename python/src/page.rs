@@ -69,45 +69,15 @@ impl Page {
 /// directory, or is a non-empty one and `overwrite` is false; its parent
 /// must exist.
 fn check_dir(dir: &Path, overwrite: bool, inputs: &[(&str, PathBuf)]) -> PyResult<()> {
-    let file_err = |m: String| Fail::File(m).into_py();
-    let ins: Vec<activecal::io::atomic::Output<'_>> = inputs
-        .iter()
-        .map(|(label, path)| activecal::io::atomic::Output { label, path })
-        .collect();
-    let out = [activecal::io::atomic::Output {
-        label: "path",
-        path: dir,
-    }];
-    if let Some(why) = activecal::io::atomic::output_dir_conflict(&out, &[], &ins) {
-        return Err(file_err(why));
+    let mut files = activecal::io::run_files::RunFiles::new();
+    for (label, path) in inputs {
+        files.input(label, Some(path));
     }
-    if dir.exists() {
-        if !dir.is_dir() {
-            return Err(file_err(format!(
-                "path {}: exists and is not a directory",
-                dir.display()
-            )));
-        }
-        let non_empty = std::fs::read_dir(dir).map_or(true, |mut d| d.next().is_some());
-        if non_empty && !overwrite {
-            return Err(Fail::from(activecal::Error::OutputExists {
-                label: "path".into(),
-                path: dir.display().to_string(),
-            })
-            .into_py());
-        }
-    }
-    if let Some(p) = dir
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty() && !p.is_dir())
-    {
-        return Err(file_err(format!(
-            "path {}: the directory {} does not exist",
-            dir.display(),
-            p.display()
-        )));
-    }
-    Ok(())
+    files.dir("path", Some(dir));
+    files.check(overwrite).map_err(|e| match e {
+        activecal::Error::Invalid(m) => Fail::File(m).into_py(),
+        e => Fail::from(e).into_py(),
+    })
 }
 
 /// The files a report folder reads of `robot`: its description.

@@ -33,35 +33,11 @@ pub(crate) fn pool_source(
     levels: Option<i64>,
     pool_seed: Option<i128>,
 ) -> PyResult<PoolSource> {
-    let sampled = matches!(pool, "random" | "sobol");
-    if levels.is_some() && pool != "lattice" {
-        return Err(arg_err("levels", "applies to source=\"lattice\" only"));
-    }
-    if !sampled && count_.is_some() {
-        return Err(arg_err(
-            "count",
-            "applies to source=\"random\" or \"sobol\" only",
-        ));
-    }
-    if !sampled && pool_seed.is_some() {
-        return Err(arg_err(
-            "pool_seed",
-            "applies to source=\"random\" or \"sobol\" only",
-        ));
-    }
-    let n = count_.map_or(Ok(4096), |c| count("count", c, 1))?;
-    let seed = pool_seed
-        .map(|s| non_negative("pool_seed", s))
-        .transpose()?;
-    Ok(match pool {
-        "lattice" => PoolSource::Lattice {
-            levels: levels.map_or(Ok(5), |l| count("levels", l, 2))?,
-        },
-        "random" => PoolSource::Random {
-            count: n,
-            seed: seed.unwrap_or(0),
-        },
-        "sobol" => PoolSource::Sobol { count: n, seed },
+    use activecal::options::PoolKind;
+    let kind = match pool {
+        "lattice" => PoolKind::Lattice,
+        "random" => PoolKind::Random,
+        "sobol" => PoolKind::Sobol,
         other => {
             return Err(arg_err(
                 arg,
@@ -70,7 +46,13 @@ pub(crate) fn pool_source(
                 ),
             ));
         }
-    })
+    };
+    let levels = levels.map(|l| count("levels", l, 2)).transpose()?;
+    let n = count_.map(|c| count("count", c, 1)).transpose()?;
+    let seed = pool_seed
+        .map(|s| non_negative("pool_seed", s))
+        .transpose()?;
+    PoolSource::of(&kind, levels, n, seed).map_err(|e| crate::convert::Fail::from(e).into_py())
 }
 
 /// The collision part of a pool's options, checked (argument names in the
@@ -112,18 +94,6 @@ pub(crate) fn collision_choice(
         .iter()
         .map(|o| activecal::options::Obstacle::parse(o).map_err(|e| arg_err("obstacles", e)))
         .collect::<PyResult<Vec<_>>>()?;
-    if let Some(z) = floor.filter(|z| !z.is_finite()) {
-        return Err(arg_err(
-            "floor",
-            format!("{z}: not a finite height (metres)"),
-        ));
-    }
-    if !(clearance.is_finite() && clearance >= 0.0) {
-        return Err(arg_err(
-            "clearance",
-            format!("{clearance}: a distance >= 0 metres"),
-        ));
-    }
     let choice = CollisionChoice {
         self_collision,
         skip_always_touching: false,
@@ -133,28 +103,9 @@ pub(crate) fn collision_choice(
         obstacles,
         floor,
     };
-    if !choice.any() {
-        if choice.srdf.is_some() {
-            return Err(arg_err(
-                "srdf",
-                "lists pairs of links for self_collision=True, which is not set",
-            ));
-        }
-        if clearance > 0.0 {
-            return Err(arg_err(
-                "clearance",
-                "applies with self_collision, obstacles or floor",
-            ));
-        }
-        files_exist(&choice)?;
-        return Ok(choice);
-    }
-    if choice.srdf.is_some() && !self_collision {
-        return Err(arg_err(
-            "srdf",
-            "lists pairs of links for self_collision=True, which is not set",
-        ));
-    }
+    choice
+        .validate()
+        .map_err(|e| crate::convert::Fail::from(e).into_py())?;
     files_exist(&choice)?;
     Ok(choice)
 }

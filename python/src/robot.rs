@@ -3,7 +3,9 @@
 
 use crate::convert::{arg_err, detached, float_array, ndarray};
 use activecal::io::{ChainChoice, MarkerChoice, RobotRef};
+use activecal::model::ParamSet;
 use activecal::options::Visibility;
+use activecal::report::FkReport;
 use pyo3::prelude::*;
 use pyo3::types::{PyString, PyTuple};
 use std::sync::Arc;
@@ -270,14 +272,12 @@ impl Robot {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let q = self.configuration(py, q, "q")?;
         self.inner.check_q(&q).map_err(|e| arg_err("q", e))?;
-        let (r, p) = activecal::kinematics::pose(&self.inner, &self.inner.nominal, &q);
-        let rows: Vec<f64> = (0..3)
-            .flat_map(|i| (0..3).map(move |j| (i, j)))
-            .map(|(i, j)| r[(i, j)])
-            .collect();
+        let r =
+            FkReport::new(&self.inner, ParamSet::Nominal, q, false).map_err(|e| arg_err("q", e))?;
+        let rows: Vec<f64> = r.rotation.iter().flatten().copied().collect();
         Ok((
             ndarray(py, &rows, &[3, 3])?,
-            ndarray(py, p.as_slice(), &[3])?,
+            ndarray(py, &r.position, &[3])?,
         ))
     }
 
@@ -292,8 +292,8 @@ impl Robot {
         let q = self.configuration(py, q, "q")?;
         let r = &self.inner;
         let (t, n) = (r.rows_per_pose(), r.n_params());
-        let mut jac = vec![0.0; t * n];
-        activecal::measure::JacobianEvaluator::new(r, &r.nominal).eval(&q, &mut jac);
+        let fk = FkReport::new(r, ParamSet::Nominal, q, true).map_err(|e| arg_err("q", e))?;
+        let jac: Vec<f64> = fk.jacobian.into_iter().flatten().flatten().collect();
         ndarray(py, &jac, &[t, n])
     }
 

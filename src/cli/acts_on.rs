@@ -84,168 +84,30 @@ impl Table {
         self.rows.iter().map(|r| Rule {
             id: r.id,
             acts_on: r.sensors,
-            why: self
-                .why
-                .iter()
-                .find(|(id, _)| *id == r.id)
-                .map_or("", |(_, w)| w),
+            why: lib::why_not(self.why, r.id).unwrap_or(""),
         })
     }
 }
-
-const LS: &str = "the camera fit is least squares on the pixels";
-
-/// What to say when an option of `calibrate` is given with a sensor it does
-/// not act on (the sensors are the library's table,
-/// [`lib::CALIBRATE`]); an option not listed names the sensors it is for.
-const CALIBRATE_WHY: &[(&str, &str)] = &[
-    (
-        "offset_unit",
-        "the camera and contact fits write no joint offsets",
-    ),
-    (
-        "offset_sign",
-        "the camera and contact fits write no joint offsets",
-    ),
-    (
-        "markers",
-        "a camera sees the points of its --target, not markers; a bag's --points topic is one point",
-    ),
-    (
-        "noise",
-        "a contact fit's σ is estimated from its residuals; a camera's is --pixel-noise",
-    ),
-    (
-        "orientation_noise",
-        "it is a tracker's orientation σ; only full poses carry orientations",
-    ),
-    (
-        "pixel_noise",
-        "it is a camera's σ in pixels; a tracker's is --noise",
-    ),
-    ("seed", "the fit has no randomness"),
-    ("loss", LS),
-    ("loss_scale", LS),
-    (
-        "free",
-        "the camera fit estimates every joint origin of the chain",
-    ),
-    (
-        "holdout",
-        "contacts are held out by placement (--holdout-by, --train-on); a camera fit has no held-out validation",
-    ),
-    ("splits", "--holdout's splits"),
-    ("compare_pruned", "--holdout's comparison"),
-    (
-        "weights",
-        "there are no orientations to weigh against positions",
-    ),
-    (
-        "orientation_scale",
-        "there are no orientations to weigh against positions",
-    ),
-    ("inertia", "it is for --compliance"),
-    ("payload", "it is for --compliance"),
-    (
-        "report",
-        "a camera fit's report is its text or --json (with --images DIR, --report writes the contact sheet; not yet with a bag's images)",
-    ),
-    (
-        "joints",
-        "--observations carry their joint values; --joints gives the images' (a file) or a bag's joint topic",
-    ),
-    (
-        "save_observations",
-        "it writes the pixels detected in --images",
-    ),
-    (
-        "angle_unit",
-        "no file of joint values is read (a bag's are in radians)",
-    ),
-    (
-        "length_unit",
-        "no file of joint values is read (a bag's are in metres)",
-    ),
-    (
-        "max_offset",
-        "a camera's clock offset is not estimated from a bag: give --time-offset (0 when not given)",
-    ),
-    (
-        "bag_design",
-        "it matches a bag's rests to the design the run followed",
-    ),
-    (
-        "design_tolerance",
-        "it matches a bag's rests to the design the run followed",
-    ),
-];
 
 /// The options of `calibrate` (and the global ones): the sensors each acts on
 /// and what to say otherwise.
 pub const CALIBRATE: &Table = &Table {
     rows: lib::CALIBRATE,
-    why: CALIBRATE_WHY,
+    why: lib::CALIBRATE_WHY,
 };
-
-const EAE: &str = "a camera design is chosen by exchange-add-exchange (EAE) on the determinant, a socket design D-optimally then exchanged for the predicted true error";
-const SOCKET: &str = "the pool is configurations projected onto each socket from --count joint-space samples, chosen D-optimally then exchanged for the predicted true error";
-
-/// What to say when an option of `select` is given with a sensor it does
-/// not act on (the sensors are the library's table,
-/// [`lib::SELECT`]); an option not listed names the sensors it is for.
-const SELECT_WHY: &[(&str, &str)] = &[
-    (
-        "markers",
-        "a camera sees the points of its --target, not markers",
-    ),
-    ("pool", SOCKET),
-    ("levels", "there is no lattice"),
-    (
-        "params",
-        "the camera's Jacobian is at the nominal parameters",
-    ),
-    (
-        "visibility",
-        "the camera's view is --min-visible, --image-margin, --max-view-angle and --distance",
-    ),
-    ("angle_unit", "no file of joint values is read"),
-    ("length_unit", "no file of joint values is read"),
-    ("margin", "the samples are drawn within the joint limits"),
-    ("algorithm", EAE),
-    ("initial", EAE),
-    ("starts", EAE),
-    ("ils", EAE),
-    ("kick", EAE),
-    ("designs", EAE),
-    ("polish", EAE),
-    ("criterion", EAE),
-    ("gap", SOCKET),
-    ("gap_solver", SOCKET),
-    ("report", SOCKET),
-    ("target_error", SOCKET),
-    (
-        "noise",
-        "it is a point's noise in metres; a camera's is --pixel-noise PX (the detected points' σ in pixels), a socket design predicts its errors per unit noise",
-    ),
-];
 
 /// The options of `select` (and the global ones): the sensors each acts on
 /// and what to say otherwise.
 pub const SELECT: &Table = &Table {
     rows: lib::SELECT,
-    why: SELECT_WHY,
+    why: lib::SELECT_WHY,
 };
 
-/// What to say when an option of `evaluate` is given with a sensor it does
-/// not act on (the sensors are the library's table,
-/// [`lib::EVALUATE`]); an option not listed names the sensors it is for.
-const EVALUATE_WHY: &[(&str, &str)] = &[];
-
 /// The options of `evaluate` (and the global ones): the sensors each acts on
-/// and what to say otherwise.
+/// (every option of `evaluate` names the sensors it is for).
 pub const EVALUATE: &Table = &Table {
     rows: lib::EVALUATE,
-    why: EVALUATE_WHY,
+    why: &[],
 };
 
 /// The options typed on a command's line (not defaulted): each as its
@@ -304,7 +166,7 @@ pub fn check(table: &Table, given: &Given, sensors: &[Sensor]) -> Result<()> {
     if refused.is_empty() {
         Ok(())
     } else {
-        bail!("{}", refused.join("\n"))
+        bail!("{}", super::hints::spell(&refused.join("\n")))
     }
 }
 

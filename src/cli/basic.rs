@@ -96,9 +96,9 @@ pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
             Some(p) => {
                 let mut files = super::run_files::RunFiles::new();
                 files
-                    .robot_as("--export", name)
-                    .output("--out", Some(p.as_path()))
-                    .check(a.force)?;
+                    .robot("--export", name, "--frames")
+                    .output("--out", Some(p.as_path()));
+                super::run_files::check(&files, a.force)?;
                 Format::of(p).map_err(|e| anyhow::anyhow!("--out {e}"))?
             }
             None => Format::Toml,
@@ -140,59 +140,12 @@ pub fn cmd_robots(a: RobotsArgs) -> Result<()> {
 pub fn cmd_fk(a: FkArgs) -> Result<()> {
     let robot = load_robot(&a.robot)?;
     let q: Vec<f64> = parse_list(&a.q, "--q")?;
-    let names = activecal::units::joint_names(&robot);
-    if q.len() != robot.dof() {
-        anyhow::bail!(
-            "--q: expected {} joint angles, got {}: the joints of {} are, in order, {}",
-            robot.dof(),
-            q.len(),
-            robot.name,
-            names.join(", ")
-        );
-    }
-    robot.check_q(&q)?;
     let mut units = a.units.units();
     if a.deg {
         units.angle = activecal::units::AngleUnit::Deg;
     }
-    let mut qs = vec![q];
-    let rows = ["the joint vector".to_string()];
-    activecal::units::joint_values_to_model_units(
-        &robot,
-        units,
-        &activecal::units::JointSource {
-            file: "--q",
-            rows: &rows,
-            columns: &names,
-        },
-        &mut qs,
-    )?;
-    let q = qs.pop().expect("one joint vector");
-    let r = FkReport::new(&robot, a.params, q, a.jacobian)?;
-    emit_report(a.json, &r, || {
-        let [x, y, z] = r.position;
-        let mut s = format!("position: {x:.12} {y:.12} {z:.12}\n");
-        if let Some(o) = &r.orientation {
-            let [ro, pi, ya] = o.rpy;
-            let [w, qx, qy, qz] = o.quaternion;
-            s += &format!(
-                "orientation rpy (rad, R = Rz·Ry·Rx): {ro:.12} {pi:.12} {ya:.12}\nquaternion (w x y z): {w:.12} {qx:.12} {qy:.12} {qz:.12}\n"
-            );
-        }
-        for (k, m) in r.markers.iter().flatten().enumerate() {
-            s += &format!("marker {}: {:.12} {:.12} {:.12}\n", k + 1, m[0], m[1], m[2]);
-        }
-        if let (Some(jac), Some(names)) = (&r.jacobian, &r.parameter_names) {
-            for (c, name) in names.iter().enumerate() {
-                s += &format!("{name:>8}:");
-                for row in jac {
-                    s += &format!(" {:>14.8}", row[c]);
-                }
-                s += "\n";
-            }
-        }
-        s
-    })
+    let r = FkReport::in_units(&robot, a.params, q, units, "--q", a.jacobian)?;
+    emit_report(a.json, &r, || activecal::render::fk_text::text(&r))
 }
 
 /// Runs `pool`: one lattice pose (`--digits`), or the pool every source and
@@ -201,10 +154,8 @@ pub fn cmd_fk(a: FkArgs) -> Result<()> {
 pub fn cmd_pool(a: PoolArgs) -> Result<()> {
     if let Some(out) = &a.out {
         let mut files = super::run_files::RunFiles::new();
-        files
-            .pool(&a.pool)
-            .output("--out", Some(out))
-            .check(a.force)?;
+        super::run_files::pool(&mut files, &a.pool).output("--out", Some(out));
+        super::run_files::check(&files, a.force)?;
         PosesFormat::of("--out", out)?;
     }
     if let Some(d) = a.digits.as_deref() {

@@ -33,20 +33,13 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
             a.noise()
         );
     }
-    if let (Some(n), true) = (a.noise, a.measurements.is_some() || a.bag.is_some())
-        && !(n > 0.0)
-    {
-        bail!(
-            "--noise {n}: with --measurements it is the sensor's stated σ per coordinate, tested against the residuals: give a number > 0 (metres)"
-        );
-    }
     a.check_stated_noises()?;
     if a.design.is_some() && a.validation == 0 {
         bail!(
             "--validation 0: the validation RMS needs at least 1 held-out pose (the RMS error of no poses would read 0)"
         );
     }
-    calibrate_files(&a).check(a.force)?;
+    super::run_files::check(&calibrate_files(&a), a.force)?;
     for out in &a.out {
         Format::of(out).map_err(|e| anyhow::anyhow!("--out {e}"))?;
     }
@@ -60,26 +53,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
     }
     match (&a.design, &a.measurements) {
         (_, Some(m)) if super::contact::is_contact_file(m) => {
-            let c = super::contact::ContactArgs {
-                holdout: a.holdout.is_some(),
-                out: &a.out,
-                force: a.force,
-                point_distance: &a.point_distance,
-                plane: &a.plane,
-                setup: &desc.contacts,
-                holdout_by: a.holdout_by,
-                train_on: a.train_on.as_deref(),
-                loss: a.loss,
-                loss_scale: a.loss_scale,
-                free: &a.free,
-                max_iterations: a.max_iterations,
-                no_geodesic: a.no_geodesic,
-                units: a.units.units(),
-                json: a.json,
-                report: a.report.as_deref(),
-                outliers: a.outlier_choice()?,
-            };
-            match super::contact::calibrate_contacts(&c, robot, m)? {
+            match super::contact::calibrate_contacts(&a, robot, &desc.contacts, m)? {
                 Some(why) => Err(NotConverged(why).into()),
                 None => Ok(()),
             }
@@ -102,7 +76,7 @@ pub fn cmd_calibrate(a: CalibrateArgs) -> Result<()> {
 /// any work ([`super::run_files::RunFiles::check`]).
 fn calibrate_files(a: &CalibrateArgs) -> super::run_files::RunFiles {
     let mut f = super::run_files::RunFiles::new();
-    f.robot(&a.robot)
+    super::run_files::robot(&mut f, &a.robot)
         .input("--design", a.design.as_deref())
         .input("--measurements", a.measurements.as_deref())
         .input("--bag", a.bag.as_deref())
@@ -230,7 +204,7 @@ fn measured_settings(
         .build()?;
     let o = activecal::experiment::measured::MeasuredSettings {
         lm,
-        loss: super::measured::loss_choice(a.loss, a.loss_scale)?,
+        loss: activecal::options::LossChoice::of(a.loss, a.loss_scale)?,
         fix: a.fix.clone(),
         restriction: a.restriction(),
         free: a.free.clone(),
@@ -266,6 +240,7 @@ fn measured_settings(
         fit_compliance: a.compliance,
         compare_compliance: a.compare_compliance,
     };
+    o.validate()?;
     Ok(o)
 }
 

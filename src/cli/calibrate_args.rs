@@ -1,5 +1,6 @@
 //! The arguments of `calibrate`, parsed once.
 
+use activecal::options::LossKind;
 use activecal::options::Restriction;
 use clap::Args;
 use std::path::PathBuf;
@@ -93,8 +94,8 @@ pub struct CalibrateArgs {
     pub no_geodesic: bool,
     /// Loss of the fit (with --measurements): l2, or huber / cauchy with
     /// --loss-scale; poses the robust loss down-weights are named.
-    #[arg(long, value_enum, default_value = "l2", conflicts_with = "design")]
-    pub loss: super::measured::LossKind,
+    #[arg(long, value_parser = super::choice::<LossKind>(), default_value_t = LossKind::L2, conflicts_with = "design")]
+    pub loss: LossKind,
     /// Scale of a robust loss: a pose's residual norm (metres) where it
     /// turns robust.
     #[arg(long, conflicts_with = "design")]
@@ -182,7 +183,7 @@ pub struct CalibrateArgs {
         conflicts_with = "design",
         conflicts_with_all = ["train_on", "holdout"]
     )]
-    pub holdout_by: Option<super::contact::HoldoutBy>,
+    pub holdout_by: Option<HoldoutBy>,
     /// Contacts: fit on this placement alone, judge on each other one.
     #[arg(
         long,
@@ -296,8 +297,8 @@ pub struct CalibrateArgs {
     pub target: Option<PathBuf>,
     /// Where the camera is: eye-to-hand (fixed camera, target on the
     /// flange) or eye-in-hand (camera on the flange, fixed target).
-    #[arg(long, value_enum, requires = "camera_data")]
-    pub mounting: Option<MountingArg>,
+    #[arg(long, value_parser = super::choice::<activecal::options::Mounting>(), requires = "camera_data")]
+    pub mounting: Option<activecal::options::Mounting>,
     /// A camera on the robot's own link LINK (a head camera) seeing a
     /// target on the tip: the chain from LINK down to where the two
     /// branches of the URDF tree meet and up to the tip is calibrated,
@@ -425,23 +426,11 @@ pub enum WeightsKind {
     Fixed,
 }
 
-/// `--mounting`.
+/// How to hold contacts out.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MountingArg {
-    /// A fixed camera sees a target on the flange.
-    EyeToHand,
-    /// A camera on the flange sees a fixed target.
-    EyeInHand,
-}
-
-impl From<MountingArg> for activecal::options::Mounting {
-    fn from(m: MountingArg) -> Self {
-        use activecal::options::Mounting;
-        match m {
-            MountingArg::EyeToHand => Mounting::EyeToHand,
-            MountingArg::EyeInHand => Mounting::EyeInHand,
-        }
-    }
+pub enum HoldoutBy {
+    /// By placement: the part of a point's name before '/'.
+    Placement,
 }
 
 /// What `calibrate --outliers` does with the poses the gross-error test
@@ -464,14 +453,7 @@ impl CalibrateArgs {
     /// Refuses a stated `--orientation-noise` or `--pixel-noise` that is not
     /// a finite number > 0.
     pub fn check_stated_noises(&self) -> anyhow::Result<()> {
-        for (flag, v, unit) in [
-            (
-                "--orientation-noise",
-                self.orientation_noise,
-                "radians per axis",
-            ),
-            ("--pixel-noise", self.pixel_noise, "px per coordinate"),
-        ] {
+        for (flag, v, unit) in [("--pixel-noise", self.pixel_noise, "px per coordinate")] {
             if let Some(v) = v
                 && !(v.is_finite() && v > 0.0)
             {
@@ -493,11 +475,9 @@ impl CalibrateArgs {
                 "--outlier-rate {r}: is the rate of the test that drops poses; with --outliers keep no pose is dropped"
             );
         }
-        if self.loss != super::measured::LossKind::L2
-            && (self.outliers.is_some() || self.outlier_rate.is_some())
-        {
+        if self.loss != LossKind::L2 && (self.outliers.is_some() || self.outlier_rate.is_some()) {
             anyhow::bail!(
-                "--outliers and --outlier-rate test the least-squares fit; --loss {:?} down-weights poses instead and keeps them all",
+                "--outliers and --outlier-rate test the least-squares fit; --loss {} down-weights poses instead and keeps them all",
                 self.loss
             );
         }

@@ -9,9 +9,9 @@
 
 use super::calibrate_args::CalibrateArgs;
 use activecal::data::CameraObservations;
-use activecal::experiment::camera::{
-    CameraCalibration, CameraCalibrationError, CameraSetup, CameraSource,
-};
+use activecal::experiment::camera::files;
+use activecal::experiment::camera::{CameraCalibrationError, CameraSetup, CameraSource};
+use activecal::io::atomic::Output;
 use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_observations::read_observations;
 use activecal::io::camera_target::read_target;
@@ -22,43 +22,25 @@ use activecal::options::LmSettings;
 use activecal::options::Mounting;
 use activecal::options::placement;
 use activecal::render::camera_text::CameraText;
-use activecal::write::calibrated::{Format, render};
+use activecal::write::calibrated::Format;
 use anyhow::{Context, Result, bail};
-use nalgebra::Isometry3;
 use std::path::Path;
-
-/// Parses `X,Y,Z,ROLL,PITCH,YAW` (metres, radians; rpy as in URDF).
-fn parse_placement(flag: &str, s: &str) -> Result<Isometry3<f64>> {
-    let v = super::parse_list::<f64>(s, flag)?;
-    match <[f64; 6]>::try_from(v) {
-        Ok(v) if v.iter().all(|x| x.is_finite()) => Ok(placement(&v)),
-        _ => bail!(
-            "{flag} {s}: expected six finite numbers X,Y,Z,ROLL,PITCH,YAW (metres and radians)"
-        ),
-    }
-}
-
-/// Refuses an output a camera calibration cannot be written as, before
-/// any work.
-fn check_out(a: &CalibrateArgs, robot: &Robot) -> Result<()> {
-    for path in &a.out {
-        if Format::of(path)? == Format::Toml || robot.source.is_none() {
-            bail!(
-                "--out {}: a camera calibration is written as .urdf (your URDF with the calibrated joint origins) and .yaml (the frames file with the camera's and target's placements), for a robot imported from a URDF",
-                path.display()
-            );
-        }
-    }
-    Ok(())
-}
 
 /// Calibrates from a camera's observations; `Ok(Some(why))` when the
 /// library refuses the fit (it did not converge or cannot be right,
 /// `activecal::experiment::camera::verdict`: the report is printed,
 /// nothing written).
 pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot) -> Result<Option<String>> {
-    check_out(a, robot)?;
-    check_camera_info_out(a)?;
+    let outs: Vec<_> = a.out.iter().map(|p| super::out_file(p)).collect();
+    files::check_robot_outputs(&outs, robot)?;
+    let info_out = a.out_camera_info.as_deref().map(|path| Output {
+        label: "--out-camera-info",
+        path,
+    });
+    info_out
+        .as_ref()
+        .map(files::check_camera_info_output)
+        .transpose()?;
     let (Some(info), Some(target)) = (&a.camera_info, &a.target) else {
         bail!("--observations needs --camera-info and --target");
     };
@@ -70,19 +52,22 @@ pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot) -> Result<Option<Strin
             Some(camera_branch(robot, link).with_context(|| format!("--camera-link {link}"))?),
             Mounting::EyeToHand,
         ),
-        (None, Some(m)) => (None, m.into()),
+        (None, Some(m)) => (None, m),
         (None, None) => bail!("--observations needs --mounting or --camera-link"),
     };
     let robot = branch.as_ref().unwrap_or(robot);
     let label = a
         .camera_link
         .as_ref()
-        .map_or_else(|| mounting.name().to_string(), |l| format!("camera on {l}"));
+        .map_or_else(|| mounting.to_string(), |l| format!("camera on {l}"));
     let target_origin = target.display().to_string();
     let target = read_target(target).context("--target")?;
     let (intrinsics, obs_path, obs, images, bag) = camera_data(a, robot, info, &target)?;
-    let parse =
-        |flag: &str, s: &Option<String>| s.as_ref().map(|s| parse_placement(flag, s)).transpose();
+    let parse = |flag: &str, s: &Option<String>| {
+        s.as_ref()
+            .map(|s| super::six(flag, s).map(|v| placement(&v)))
+            .transpose()
+    };
     let setup = CameraSetup {
         intrinsics,
         target,
@@ -117,23 +102,15 @@ pub fn calibrate_camera(a: &CalibrateArgs, robot: &Robot) -> Result<Option<Strin
     // The library's verdict: a fit that did not converge or cannot be
     // right is not written.
     let ok = cal.verdict.refusal().is_none();
-    if ok && let Some(f) = frames {
-        for path in &a.out {
-            let text = render(
-                Format::of(path)?,
-                &fit.robot,
-                &fit.table,
-                Some((&f.0, &f.1)),
-                "",
-            )
-            .map_err(|e| anyhow::anyhow!("--out {}: {e}", path.display()))?;
-            super::write_new(path, &text, a.force)?;
-            written.push(path.display().to_string());
+    if ok && frames.is_some() {
+        for out in &outs {
+            cal.write_robot(Format::of(out.path)?, *out, a.force, &[])?;
+            written.push(out.path.display().to_string());
         }
     }
-    if ok && let Some(o) = &a.out_camera_info {
-        write_camera_info(o, &cal, obs_path, a.force)?;
-        written.push(o.display().to_string());
+    if ok && let Some(o) = info_out {
+        cal.write_camera_info(o, &obs_path.display().to_string(), a.force, &[])?;
+        written.push(o.path.display().to_string());
     }
     if let (Some(dir), Some(read)) = (&a.report, &images) {
         // The directory was checked with the command's files, before any work.
@@ -202,40 +179,4 @@ fn camera_data<'a>(
         }
         (None, None, _) => bail!("give --observations (pixels) or --images"),
     })
-}
-
-/// Refuses an `--out-camera-info` that is not a `.yaml`, before any work
-/// (it is checked against the inputs and other outputs with the command's
-/// files).
-fn check_camera_info_out(a: &CalibrateArgs) -> Result<()> {
-    if let Some(o) = &a.out_camera_info {
-        let yaml = o
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
-        if !yaml {
-            bail!(
-                "--out-camera-info {}: the refined intrinsics are written as a ROS camera_info .yaml",
-                o.display()
-            );
-        }
-    }
-    Ok(())
-}
-
-/// Writes the refined intrinsics of `cal` to `o` as a ROS camera_info.
-fn write_camera_info(
-    o: &Path,
-    cal: &CameraCalibration,
-    obs_path: &Path,
-    force: bool,
-) -> Result<()> {
-    let name = o
-        .file_stem()
-        .map_or_else(|| "camera".into(), |s| s.to_string_lossy());
-    let comment = format!(
-        "intrinsics refined by activecal calibrate --refine-intrinsics from {}",
-        obs_path.display()
-    );
-    let text = cal.camera_info_text(&name, &comment);
-    super::write_new(o, &text, force)
 }

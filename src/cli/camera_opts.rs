@@ -16,8 +16,8 @@ pub struct CameraOpts {
     #[arg(long, value_name = "FILE", requires = "camera_info")]
     pub target: Option<PathBuf>,
     /// eye-to-hand or eye-in-hand.
-    #[arg(long, value_enum, requires = "camera_info")]
-    pub mounting: Option<super::calibrate_args::MountingArg>,
+    #[arg(long, value_parser = super::choice::<activecal::options::Mounting>(), requires = "camera_info")]
+    pub mounting: Option<activecal::options::Mounting>,
     /// A camera on the robot's own link LINK (a head camera) seeing a
     /// target on the tip (see `calibrate --camera-link`): the poses move
     /// the joints from LINK to the tip; --camera-pose is in LINK.

@@ -16,26 +16,15 @@ use super::camera_opts::CameraOpts;
 use super::pool_opts::PoolKind;
 use super::select::SelectArgs;
 use activecal::experiment::camera_select::{
-    CameraSelectPlan, Candidates, DEFAULT_SAMPLES, select_camera,
+    CameraSelectPlan, Candidates, DEFAULT_SAMPLES, design_outputs, select_camera,
 };
 use activecal::io::camera_info::read_camera_info;
 use activecal::io::camera_target::read_target;
-use activecal::io::collision_choice::CollisionChoice;
 use activecal::model::Robot;
 use activecal::options::CameraView;
 use anyhow::{Context, Result, bail};
-use std::path::PathBuf;
 
 pub use activecal::experiment::camera_select::DEFAULT_PIXEL_NOISE;
-
-fn six(flag: &str, s: &str) -> Result<[f64; 6]> {
-    let v = super::parse_list::<f64>(s, flag)?;
-    v.try_into().map_err(|_| {
-        anyhow::anyhow!(
-            "{flag} {s}: expected X,Y,Z,ROLL,PITCH,YAW (six numbers, metres and radians)"
-        )
-    })
-}
 
 /// The camera view the options describe.
 fn view(c: &CameraOpts) -> Result<CameraView> {
@@ -45,7 +34,7 @@ fn view(c: &CameraOpts) -> Result<CameraView> {
         bail!("--camera-info needs --target, --camera-pose and --target-pose");
     };
     let m = match (c.mounting, &c.camera_link) {
-        (Some(m), None) => m.into(),
+        (Some(m), None) => m,
         (None, Some(_)) => activecal::options::Mounting::EyeToHand,
         _ => bail!("--camera-info needs --mounting or --camera-link"),
     };
@@ -59,40 +48,14 @@ fn view(c: &CameraOpts) -> Result<CameraView> {
         mounting: m,
         points: target.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
         face: target.face.into(),
-        camera: six("--camera-pose", cp)?,
-        target: six("--target-pose", tp)?,
+        camera: super::six("--camera-pose", cp)?,
+        target: super::six("--target-pose", tp)?,
         min_fraction: c.min_visible,
         margin_px: c.image_margin,
         max_view_angle: c.max_view_angle.to_radians(),
         distance: [lo, hi],
     };
     Ok(v)
-}
-
-/// What the collision checks (`--self-collision`, `--obstacle`, `--floor`,
-/// as for any pool) ask for; without one, the `--package-dir`s the line of
-/// sight finds meshes in (checked to exist) and no `--srdf`.
-fn collision(a: &SelectArgs) -> Result<CollisionChoice> {
-    let p = &a.pool;
-    if p.self_collision || !p.obstacles.is_empty() || p.floor.is_some() {
-        return p.collision_choice();
-    }
-    if p.srdf.is_some() {
-        bail!("--srdf lists pairs of links for --self-collision, which is not given");
-    }
-    for d in &p.package_dirs {
-        if !d.exists() {
-            bail!("--package-dir {}: no such directory", d.display());
-        }
-    }
-    Ok(CollisionChoice {
-        package_dirs: p
-            .package_dirs
-            .iter()
-            .map(|d| d.display().to_string())
-            .collect(),
-        ..CollisionChoice::default()
-    })
 }
 
 /// A `--pixel-noise` that is no σ, and a `--pool` a camera design does
@@ -166,33 +129,12 @@ fn pool_label(a: &SelectArgs) -> String {
     }
 }
 
-/// The `--out` files: at most one `.csv` and one `.json`.
-fn outputs(a: &SelectArgs) -> Result<(Option<&PathBuf>, Option<&PathBuf>)> {
-    let ext = |o: &PathBuf, e: &str| o.extension().is_some_and(|x| x.eq_ignore_ascii_case(e));
-    let (mut csv, mut json) = (None, None);
-    for o in &a.out {
-        let slot = if ext(o, "csv") {
-            &mut csv
-        } else if ext(o, "json") {
-            &mut json
-        } else {
-            bail!(
-                "--out {}: a camera design is written as .csv (candidate, the joints, points_seen) or .json (the design and its figures, as --json prints them)",
-                o.display()
-            );
-        };
-        if slot.replace(o).is_some() {
-            bail!("--out {}: one file of each kind (.csv, .json)", o.display());
-        }
-    }
-    Ok((csv, json))
-}
-
 /// Runs `select` for a camera.
 pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
     check_options(a)?;
-    super::select::select_files(a).check(a.force)?;
-    let (csv_out, json_out) = outputs(a)?;
+    super::run_files::check(&super::select::select_files(a), a.force)?;
+    let outs: Vec<_> = a.out.iter().map(|p| super::out_file(p)).collect();
+    let outs = design_outputs(&outs)?;
     let robot = super::load_robot(&a.pool.robot)?;
     let listed_robot = match &a.camera.camera_link {
         Some(link) => activecal::io::urdf_branch::camera_branch(&robot, link)
@@ -202,7 +144,7 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
     let plan = CameraSelectPlan {
         view: view(&a.camera)?,
         camera_link: a.camera.camera_link.clone(),
-        collision: collision(a)?,
+        collision: a.pool.collision_choice(true)?,
         line_of_sight: a.camera.line_of_sight,
         candidates: candidates(a, &listed_robot)?,
         settings: activecal::options::SelectSettings::builder()
@@ -228,20 +170,10 @@ pub fn cmd_select_camera(a: &SelectArgs) -> Result<()> {
         )?),
         None => None,
     };
-    let csv = sel.design_csv();
-    if let Some(o) = csv_out {
-        super::write_new(o, &csv, a.force)?;
+    for o in &outs {
+        sel.write(*o, a.force)?;
     }
-    let report = &sel.report;
-    if let Some(o) = json_out {
-        let text = serde_json::to_string_pretty(&report)? + "\n";
-        super::write_new(o, &text, a.force)?;
-    }
-    let mut written: Vec<String> = csv_out
-        .iter()
-        .chain(json_out.iter())
-        .map(|p| p.display().to_string())
-        .collect();
+    let mut written: Vec<String> = outs.iter().map(|o| o.path.display().to_string()).collect();
     if let (Some(dir), Some(c)) = (&a.report, &curve) {
         sel.write_report(dir, c, &written, a.camera.pixel_noise.is_none())?;
         written.push(dir.display().to_string());

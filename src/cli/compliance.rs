@@ -12,32 +12,7 @@ use std::sync::Arc;
 
 /// Parses `--payload KG[@X,Y,Z]` (kg; metres in the tip link's frame).
 pub fn parse_payload(s: &str) -> Result<Payload, String> {
-    let (m, at) = match s.split_once('@') {
-        Some((m, at)) => (m, Some(at)),
-        None => (s, None),
-    };
-    let mass: f64 = m
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{m}' is not a mass in kg (KG or KG@X,Y,Z)"))?;
-    if !(mass.is_finite() && mass >= 0.0) {
-        return Err(format!("{mass} kg: the mass must be finite and >= 0"));
-    }
-    let at = match at {
-        None => [0.0; 3],
-        Some(a) => {
-            let v: Vec<f64> = a
-                .split(',')
-                .map(|x| x.trim().parse::<f64>())
-                .collect::<Result<_, _>>()
-                .map_err(|_| format!("'{a}' is not X,Y,Z in metres"))?;
-            if v.len() != 3 || !v.iter().all(|x| x.is_finite()) {
-                return Err(format!("'{a}' is not three finite numbers X,Y,Z (metres)"));
-            }
-            [v[0], v[1], v[2]]
-        }
-    };
-    Ok(Payload { mass, at })
+    s.parse()
 }
 
 /// The gravity model of `robot` from its URDF's inertials, or from

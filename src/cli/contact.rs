@@ -5,9 +5,10 @@
 //! placement` / `--train-on`. The work is in
 //! `activecal::experiment::contact_run`.
 
+use super::calibrate_args::{CalibrateArgs, HoldoutBy};
 use activecal::data::{NamedDistance, NamedPlane};
 use activecal::experiment::contact_run::{
-    ContactOutError, ContactRequest, HoldoutMode, OutlierChoice, check_out, run,
+    ContactOutError, ContactRequest, HoldoutMode, check_out, run,
 };
 use activecal::experiment::contacts::{
     ContactInput, ContactInputError, ContactUse, checked_inputs,
@@ -17,13 +18,6 @@ use activecal::model::Robot;
 use activecal::write::calibrated::Format;
 use anyhow::{Result, bail};
 use std::path::Path;
-
-/// How to hold contacts out.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum HoldoutBy {
-    /// By placement: the part of a point's name before '/'.
-    Placement,
-}
 
 /// Whether `path` is a CSV whose header has a `point` column.
 pub fn is_contact_file(path: &Path) -> bool {
@@ -35,47 +29,8 @@ pub fn is_contact_file(path: &Path) -> bool {
 
 /// Parses one `--point-distance A,B=METRES`.
 pub fn parse_distance(s: &str) -> Result<NamedDistance> {
-    let bad = || {
-        anyhow::anyhow!(
-            "--point-distance {s}: expected A,B=METRES (two point names and a distance in metres, e.g. front_left/0,front_left/1=0.05)"
-        )
-    };
-    let (names, d) = s.split_once('=').ok_or_else(bad)?;
-    let (a, b) = names.split_once(',').ok_or_else(bad)?;
-    let metres: f64 = d.trim().parse().map_err(|_| bad())?;
-    Ok(NamedDistance {
-        a: a.trim().to_string(),
-        b: b.trim().to_string(),
-        metres,
-    })
-}
-
-/// `NAME=v1,…,vN`: a non-empty name and exactly `N` numbers (`None`
-/// otherwise), the form of `--plane` and `select --point`.
-pub fn named_numbers<const N: usize>(s: &str) -> Option<(String, [f64; N])> {
-    let (name, rest) = s.split_once('=')?;
-    let v: Vec<f64> = rest
-        .split(',')
-        .map(|c| c.trim().parse::<f64>())
-        .collect::<std::result::Result<_, _>>()
-        .ok()?;
-    let name = name.trim();
-    (!name.is_empty()).then(|| v.try_into().ok().map(|a| (name.to_string(), a)))?
-}
-
-/// Parses one `--plane NAME=nx,ny,nz,d` (the normal's length is checked
-/// with the file's planes).
-pub fn parse_plane(s: &str) -> Result<NamedPlane> {
-    let Some((name, [nx, ny, nz, d])) = named_numbers::<4>(s) else {
-        anyhow::bail!(
-            "--plane {s}: expected NAME=nx,ny,nz,d (a plane name, its normal and offset in metres, n · x = d in the base frame, e.g. table=0,0,1,0.02)"
-        );
-    };
-    Ok(NamedPlane {
-        name,
-        normal: [nx, ny, nz],
-        offset: d,
-    })
+    s.parse()
+        .map_err(|e| anyhow::anyhow!("--point-distance {s}: {e}"))
 }
 
 /// The description's distances and planes followed by those of
@@ -91,72 +46,35 @@ pub fn contact_setup(
     }
     let mut planes = setup.planes.clone();
     for s in plane {
-        planes.push(parse_plane(s)?);
+        planes.push(s.parse().map_err(|e| anyhow::anyhow!("--plane {s}: {e}"))?);
     }
     Ok((given, planes))
-}
-
-/// The options of `calibrate` a contact fit reads.
-pub struct ContactArgs<'a> {
-    /// `--holdout` was given (refused).
-    pub holdout: bool,
-    /// `--out` (checked before the fit, written when it converged).
-    pub out: &'a [std::path::PathBuf],
-    /// `--force`.
-    pub force: bool,
-    /// `--point-distance`.
-    pub point_distance: &'a [String],
-    /// `--plane`.
-    pub plane: &'a [String],
-    /// The description's `[[distance]]` and `[[plane]]` tables.
-    pub setup: &'a activecal::io::ContactSetup,
-    /// `--holdout-by`.
-    pub holdout_by: Option<HoldoutBy>,
-    /// `--train-on`.
-    pub train_on: Option<&'a str>,
-    /// `--loss`, `--loss-scale`.
-    pub loss: super::measured::LossKind,
-    /// `--loss-scale`.
-    pub loss_scale: Option<f64>,
-    /// `--free`.
-    pub free: &'a [String],
-    /// `--max-iterations`.
-    pub max_iterations: usize,
-    /// `--no-geodesic`.
-    pub no_geodesic: bool,
-    /// The file's units.
-    pub units: activecal::units::Units,
-    /// `--json`.
-    pub json: bool,
-    /// `--report DIR` (checked before the fit).
-    pub report: Option<&'a Path>,
-    /// `--outliers`, `--outlier-rate`.
-    pub outliers: OutlierChoice,
 }
 
 /// Calibrates from a contact file; `Ok(Some(why))` when the fit did not
 /// converge (the report is printed).
 pub fn calibrate_contacts(
-    a: &ContactArgs<'_>,
+    a: &CalibrateArgs,
     robot: &Robot,
+    setup: &activecal::io::ContactSetup,
     path: &Path,
 ) -> Result<Option<String>> {
-    if a.holdout {
+    if a.holdout.is_some() {
         bail!(
             "--holdout: contacts are held out by placement (--holdout-by placement or --train-on NAME), not by random rows"
         );
     }
-    for out in a.out {
+    for out in &a.out {
         check_out(out, robot).map_err(out_err)?;
     }
-    let (given, planes) = contact_setup(a.setup, a.point_distance, a.plane)?;
-    let mut file = read_contacts(path, robot, a.units)?;
+    let (given, planes) = contact_setup(setup, &a.point_distance, &a.plane)?;
+    let mut file = read_contacts(path, robot, a.units.units())?;
     let known =
         checked_inputs(robot, &mut file, &planes, &given, ContactUse::Fit).map_err(named)?;
     let r = run(robot, &file, &known, &given, &request_of(a)?)?;
     let mut written = Vec::new();
     if r.exit_status() == 0 && r.calibration.frames.is_some() {
-        for out in a.out {
+        for out in &a.out {
             r.write_robot(Format::of(out)?, super::out_file(out), a.force)
                 .map_err(out_err)?;
             written.push(out.display().to_string());
@@ -166,7 +84,7 @@ pub fn calibrate_contacts(
     let v =
         serde_json::to_value(r.report(&robot.name, &measurements, !a.out.is_empty(), &written))?;
     let report = r.text(&written);
-    if let Some(dir) = a.report {
+    if let Some(dir) = &a.report {
         r.write_report(dir, robot, &v, &report)?;
     }
     super::emit(a.json, &v, || report)?;
@@ -201,18 +119,18 @@ pub fn named(e: ContactInputError) -> anyhow::Error {
 }
 
 /// The calibration's request from the command line.
-fn request_of(a: &ContactArgs<'_>) -> Result<ContactRequest> {
+fn request_of(a: &CalibrateArgs) -> Result<ContactRequest> {
     let holdout = match (&a.holdout_by, &a.train_on) {
-        (_, Some(t)) => Some(HoldoutMode::TrainOn((*t).to_string())),
+        (_, Some(t)) => Some(HoldoutMode::TrainOn(t.clone())),
         (Some(HoldoutBy::Placement), None) => Some(HoldoutMode::LeaveOneOut),
         (None, None) => None,
     };
     Ok(ContactRequest {
         max_iterations: a.max_iterations,
         geodesic: !a.no_geodesic,
-        loss: super::measured::loss_choice(a.loss, a.loss_scale)?,
-        keep: a.free.to_vec(),
-        outliers: a.outliers,
+        loss: activecal::options::LossChoice::of(a.loss, a.loss_scale)?,
+        keep: a.free.clone(),
+        outliers: a.outlier_choice()?,
         holdout,
     })
 }

@@ -13,7 +13,7 @@ use anyhow::{Result, bail};
 
 /// Parses one `--point NAME=x,y,z` (base frame, metres).
 fn parse_socket(s: &str) -> Result<Socket> {
-    match super::contact::named_numbers::<3>(s) {
+    match activecal::data::contacts::named_numbers::<3>(s) {
         Some((name, position)) if position.iter().all(|c| c.is_finite()) => {
             Ok(Socket { name, position })
         }
@@ -54,7 +54,7 @@ pub fn cmd_select_points(a: &SelectArgs) -> Result<()> {
         .iter()
         .map(|s| parse_socket(s))
         .collect::<Result<_>>()?;
-    super::select::select_files(a).check(a.force)?;
+    super::run_files::check(&super::select::select_files(a), a.force)?;
     super::select::check_out_formats(&a.out)?;
     let margin_deg = a
         .pool

@@ -102,28 +102,6 @@ pub struct BagOpts {
 }
 
 impl BagOpts {
-    fn source(&self) -> Result<Source> {
-        Ok(match (&self.points, &self.poses, &self.tf) {
-            (Some(t), _, _) => Source::Points(t.clone()),
-            (_, Some(t), _) => Source::Poses(t.clone()),
-            (_, _, Some(pc)) => {
-                let Some((parent, child)) = pc.split_once(':') else {
-                    bail!("--tf {pc}: give PARENT:CHILD, two frame names");
-                };
-                if parent.is_empty() || child.is_empty() {
-                    bail!("--tf {pc}: give PARENT:CHILD, two frame names");
-                }
-                Source::Tf {
-                    parent: parent.to_string(),
-                    child: child.to_string(),
-                }
-            }
-            _ => bail!(
-                "give the bag's measurement: --points TOPIC, --poses TOPIC or --tf PARENT:CHILD"
-            ),
-        })
-    }
-
     /// Whether the measurement is a full pose (`--poses`, `--tf`) rather
     /// than a point (`--points`).
     #[must_use]
@@ -154,26 +132,21 @@ impl BagOpts {
     }
 
     /// The library's settings from the flags, with the joint topic and
-    /// the design's tolerance (rad, m) as the command gives them.
+    /// the design's tolerance (rad, m) as the command gives them, checked.
     pub fn settings(&self, joints: &str, design_tolerance: f64) -> Result<ExtractSettings> {
-        let mut s = ExtractSettings::new(joints, self.source()?);
+        let source = Source::one_of(
+            self.points.as_deref(),
+            self.poses.as_deref(),
+            self.tf.as_deref(),
+        )?;
+        let mut s = ExtractSettings::new(joints, source);
         s.rest.speed = self.rest_speed;
         s.rest.min_duration = self.rest_min;
         s.rest.settle = self.settle;
         s.time_offset = self.time_offset;
-        if !(self.max_offset.is_finite() && self.max_offset >= 0.0) {
-            bail!("--max-offset {}: give seconds, 0 or more", self.max_offset);
-        }
         s.max_offset = self.max_offset;
-        if !(design_tolerance.is_finite() && design_tolerance > 0.0) {
-            bail!("--design-tolerance {design_tolerance}: give a positive number (rad, m)");
-        }
         s.design_tolerance = design_tolerance;
-        if let Some(o) = s.time_offset
-            && !o.is_finite()
-        {
-            bail!("--time-offset {o}: not a number of seconds");
-        }
+        s.validate()?;
         Ok(s)
     }
 }

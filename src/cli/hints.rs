@@ -104,9 +104,49 @@ const SPELLING: &[(&str, &str)] = &[
 /// `--json`, which keeps the library's words as Python's reports do).
 #[must_use]
 pub fn spell(text: &str) -> String {
-    SPELLING.iter().fold(text.to_string(), |t, (phrase, flag)| {
-        t.replace(phrase, flag)
-    })
+    let text = spell_keys(text);
+    SPELLING
+        .iter()
+        .fold(text, |t, (phrase, flag)| t.replace(phrase, flag))
+}
+
+/// `text` with each setting's key written in backticks by the library
+/// ([`activecal::error::SettingError`]: `` `loss_scale` ``) spelled as this
+/// command line's option (`--loss-scale`); backticked words that are no
+/// option of any command are kept as they are.
+fn spell_keys(text: &str) -> String {
+    use clap::CommandFactory;
+    static IDS: std::sync::OnceLock<std::collections::BTreeSet<String>> =
+        std::sync::OnceLock::new();
+    let ids = IDS.get_or_init(|| {
+        let cli = crate::Cli::command();
+        cli.get_subcommands()
+            .flat_map(|c| {
+                c.get_arguments()
+                    .filter_map(|a| a.get_long().map(str::to_string))
+            })
+            .collect()
+    });
+    let mut out = String::with_capacity(text.len());
+    let mut parts = text.split('`');
+    out.push_str(parts.next().unwrap_or(""));
+    let mut open = false;
+    for part in parts {
+        let flag = part.replace('_', "-");
+        if !open && ids.contains(&flag) && text.contains(&format!("`{part}`")) {
+            out.push_str("--");
+            out.push_str(&flag);
+            open = true;
+            continue;
+        }
+        if open {
+            open = false;
+        } else {
+            out.push('`');
+        }
+        out.push_str(part);
+    }
+    out
 }
 
 /// The options an error's message (its whole chain) calls for, in the
@@ -155,6 +195,16 @@ mod tests {
             assert!(s.contains("--") && s.contains(flag), "{p}: {s}");
         }
         assert_eq!(spell("no phrase here"), "no phrase here");
+    }
+
+    #[test]
+    fn setting_keys_become_flags_and_other_backticks_stay() {
+        let e = activecal::error::SettingError::because("loss_scale", "is for `loss` huber");
+        assert_eq!(spell(&e.to_string()), "--loss-scale: is for --loss huber");
+        assert_eq!(
+            spell("measurements `m.csv`, `no_such_option` and `pixel_noise`"),
+            "measurements `m.csv`, `no_such_option` and --pixel-noise"
+        );
     }
 
     #[test]

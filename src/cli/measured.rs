@@ -7,47 +7,8 @@ use super::emit_report;
 use activecal::data::Measurements;
 use activecal::experiment::measured::evaluate::evaluate;
 use activecal::model::Robot;
-use activecal::options::LossChoice;
-use anyhow::{Result, bail};
+use anyhow::Result;
 use std::path::Path;
-
-/// The loss options of `calibrate`.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LossKind {
-    /// Least squares.
-    L2,
-    /// Huber: quadratic up to the scale, linear beyond.
-    Huber,
-    /// Cauchy: down-weights gross outliers towards zero.
-    Cauchy,
-}
-
-/// The loss of `--loss KIND --loss-scale S`.
-pub fn loss_choice(kind: LossKind, scale: Option<f64>) -> Result<LossChoice> {
-    let need = |s: Option<f64>| -> Result<f64> {
-        match s {
-            Some(s) if s.is_finite() && s > 0.0 => Ok(s),
-            Some(s) => bail!("--loss-scale {s}: must be a finite number > 0 (metres)"),
-            None => bail!(
-                "--loss {kind:?} needs --loss-scale (metres: the residual norm of one pose where the loss turns robust, e.g. 3 times the sensor noise)"
-            ),
-        }
-    };
-    Ok(match kind {
-        LossKind::L2 => {
-            if scale.is_some() {
-                bail!("--loss-scale is for --loss huber or cauchy");
-            }
-            LossChoice::L2
-        }
-        LossKind::Huber => LossChoice::Huber {
-            scale: need(scale)?,
-        },
-        LossKind::Cauchy => LossChoice::Cauchy {
-            scale: need(scale)?,
-        },
-    })
-}
 
 /// Reads a measurement file (CSV or JSON) for `robot` in `units`
 /// ([`activecal::experiment::measured::read_measurement_file`]), printing

@@ -52,6 +52,17 @@ where
         .collect()
 }
 
+/// Parses `X,Y,Z,ROLL,PITCH,YAW` (six finite numbers: metres, and radians
+/// as URDF's rpy), naming the option in the error.
+pub fn six(flag: &str, s: &str) -> Result<[f64; 6]> {
+    match <[f64; 6]>::try_from(parse_list::<f64>(s, flag)?) {
+        Ok(v) if v.iter().all(|x| x.is_finite()) => Ok(v),
+        _ => anyhow::bail!(
+            "{flag} {s}: expected six finite numbers X,Y,Z,ROLL,PITCH,YAW (metres and radians)"
+        ),
+    }
+}
+
 /// The value parser of an option that takes one of a library type's named
 /// values ([`activecal::names::Choice`]): `--help` lists the names, and a
 /// wrong one is refused with them.

@@ -9,50 +9,13 @@ use activecal::options::Visibility;
 use activecal::options::{PoolFilter, PoolSource, PoolSpec};
 use anyhow::Result;
 
-/// Where the candidate poses come from (`--pool`).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum PoolKind {
-    /// The joint-space lattice (`--levels`).
-    Lattice,
-    /// Uniform random samples inside the joint limits (`--count`, `--pool-seed`).
-    Random,
-    /// Sobol points inside the joint limits (`--count`, `--pool-seed` to scramble).
-    Sobol,
-    /// Joint configurations from a CSV or JSON file.
-    File(std::path::PathBuf),
-}
+pub use activecal::options::{DEFAULT_LEVELS, PoolKind};
 
 /// Parses `--pool`: `lattice`, `random`, `sobol`, `file:PATH`, or a path
-/// ending in `.csv` or `.json`.
+/// ending in `.csv` or `.json` ([`PoolKind`]).
 pub fn parse_pool_kind(s: &str) -> std::result::Result<PoolKind, String> {
-    match s {
-        "lattice" => Ok(PoolKind::Lattice),
-        "random" => Ok(PoolKind::Random),
-        "sobol" => Ok(PoolKind::Sobol),
-        _ => {
-            if let Some(p) = s.strip_prefix("file:") {
-                if p.is_empty() {
-                    return Err("file: needs a path, e.g. file:poses.csv".into());
-                }
-                return Ok(PoolKind::File(p.into()));
-            }
-            let lower = s.to_ascii_lowercase();
-            if lower.ends_with(".csv") || lower.ends_with(".json") {
-                return Ok(PoolKind::File(s.into()));
-            }
-            Err(format!(
-                "unknown pool '{s}': use lattice, random, sobol, or file:PATH (a CSV or JSON of joint configurations)"
-            ))
-        }
-    }
+    s.parse()
 }
-
-/// Samples of a random or Sobol pool when `--count` is not given (2¹²: a
-/// whole number of Sobol strata).
-pub const DEFAULT_COUNT: usize = 4096;
-
-/// Lattice values per joint when `--levels` is not given.
-pub const DEFAULT_LEVELS: usize = 5;
 
 /// Options that define a pose pool, shared by the commands that need one.
 #[derive(clap::Args, Clone, Debug)]
@@ -186,31 +149,12 @@ impl PoolOpts {
     /// The pool source these options describe; an option that does not
     /// apply to the chosen pool is an error.
     pub fn source(&self) -> Result<PoolSource> {
-        let lattice = matches!(self.pool, PoolKind::Lattice);
-        let sampled = matches!(self.pool, PoolKind::Random | PoolKind::Sobol);
-        if self.levels.is_some() && !lattice {
-            anyhow::bail!("--levels applies to --pool lattice only");
-        }
-        if !sampled && (self.count.is_some() || self.pool_seed.is_some()) {
-            anyhow::bail!("--count and --pool-seed apply to --pool random or sobol only");
-        }
-        let count = self.count.unwrap_or(DEFAULT_COUNT);
-        Ok(match &self.pool {
-            PoolKind::Lattice => PoolSource::Lattice {
-                levels: self.levels.unwrap_or(DEFAULT_LEVELS),
-            },
-            PoolKind::Random => PoolSource::Random {
-                count,
-                seed: self.pool_seed.unwrap_or(0),
-            },
-            PoolKind::Sobol => PoolSource::Sobol {
-                count,
-                seed: self.pool_seed,
-            },
-            PoolKind::File(p) => PoolSource::File {
-                path: p.display().to_string(),
-            },
-        })
+        Ok(PoolSource::of(
+            &self.pool,
+            self.levels,
+            self.count,
+            self.pool_seed,
+        )?)
     }
 
     /// The pool these options describe, for a robot description.
@@ -254,7 +198,7 @@ impl PoolOpts {
     /// from its own link, whose joints drive the whole tree by name with
     /// the tree's root as the frame of obstacles.
     pub fn collision_filters_on(&self, chain: Option<UrdfChain>) -> Result<Vec<PoolFilter>> {
-        let choice = self.collision_choice()?;
+        let choice = self.collision_choice(false)?;
         if !choice.any() {
             return Ok(Vec::new());
         }
@@ -269,53 +213,19 @@ impl PoolOpts {
 
     /// What `--self-collision`, `--srdf`, `--package-dir`, `--clearance`,
     /// `--obstacle` and `--floor` ask the collision check to do, checked
-    /// (`--srdf` and `--package-dir` without a check are errors; the files
-    /// must exist).
-    pub fn collision_choice(&self) -> Result<activecal::io::collision_choice::CollisionChoice> {
+    /// ([`activecal::io::collision_choice::CollisionChoice::validate`]; the
+    /// files must exist; `--package-dir` without a check only when
+    /// `sight_meshes`: a camera's line of sight reads them).
+    pub fn collision_choice(
+        &self,
+        sight_meshes: bool,
+    ) -> Result<activecal::io::collision_choice::CollisionChoice> {
         use activecal::options::Obstacle;
         let obstacles = self
             .obstacles
             .iter()
             .map(|o| Obstacle::parse(o).map_err(anyhow::Error::msg))
             .collect::<Result<Vec<_>>>()?;
-        if let Some(z) = self.floor
-            && !z.is_finite()
-        {
-            anyhow::bail!("--floor {z}: not a finite height");
-        }
-        let any_obstacle = !obstacles.is_empty() || self.floor.is_some();
-        if !(self.clearance.is_finite() && self.clearance >= 0.0) {
-            anyhow::bail!("--clearance {}: a distance >= 0 metres", self.clearance);
-        }
-        if !self.self_collision && !any_obstacle {
-            if self.clearance > 0.0 {
-                anyhow::bail!("--clearance applies with --self-collision, --obstacle or --floor");
-            }
-            if self.srdf.is_some() || !self.package_dirs.is_empty() {
-                anyhow::bail!(
-                    "--srdf and --package-dir apply with --self-collision, --obstacle or --floor"
-                );
-            }
-            return Ok(Default::default());
-        }
-        if self.skip_always_touching && !self.self_collision {
-            anyhow::bail!(
-                "--skip-always-touching leaves pairs of links unchecked by --self-collision, which is not given"
-            );
-        }
-        if self.srdf.is_some() && !self.self_collision {
-            anyhow::bail!("--srdf lists pairs of links for --self-collision, which is not given");
-        }
-        for (opt, p) in self
-            .srdf
-            .iter()
-            .map(|p| ("--srdf", p))
-            .chain(self.package_dirs.iter().map(|p| ("--package-dir", p)))
-        {
-            if !p.exists() {
-                anyhow::bail!("{opt} {}: no such file or directory", p.display());
-            }
-        }
         let choice = activecal::io::collision_choice::CollisionChoice {
             self_collision: self.self_collision,
             skip_always_touching: self.skip_always_touching,
@@ -329,6 +239,20 @@ impl PoolOpts {
             obstacles,
             floor: self.floor,
         };
+        choice.validate()?;
+        if !choice.any() && !sight_meshes && !self.package_dirs.is_empty() {
+            anyhow::bail!("--package-dir applies with --self-collision, --obstacle or --floor");
+        }
+        for (opt, p) in self
+            .srdf
+            .iter()
+            .map(|p| ("--srdf", p))
+            .chain(self.package_dirs.iter().map(|p| ("--package-dir", p)))
+        {
+            if !p.exists() {
+                anyhow::bail!("{opt} {}: no such file or directory", p.display());
+            }
+        }
         Ok(choice)
     }
 

@@ -6,7 +6,6 @@
 //! progress and writes the staged folder.
 
 use activecal::experiment::paper::{self, PaperSettings};
-use activecal::progress::Task;
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
@@ -55,23 +54,6 @@ pub struct ReproduceArgs {
     pub skip_oi: bool,
 }
 
-/// The experiment's steps as one progress task ([`activecal::progress`]).
-struct Steps {
-    task: Task,
-}
-
-impl Steps {
-    fn new(n: u64) -> Self {
-        Self {
-            task: Task::start("reproduce", Some(n)),
-        }
-    }
-    fn step(&self, msg: &'static str) {
-        self.task.note(|| msg.to_string());
-        self.task.inc(1);
-    }
-}
-
 impl ReproduceArgs {
     fn settings(&self) -> PaperSettings {
         PaperSettings {
@@ -93,27 +75,12 @@ pub fn cmd_reproduce(a: ReproduceArgs) -> Result<()> {
     // Every input is checked before any work or any file is made.
     let settings = a.settings();
     settings.validate()?;
-    super::run_files::RunFiles::new()
-        .dir("--out", Some(a.out.as_path()))
-        .check(a.force)?;
-    // Built aside and swapped in whole: an interrupted run leaves the old
-    // report as it was, never new figures beside an old report.
-    let staged = activecal::io::atomic::StagedDir::new(&a.out)?;
+    let mut files = super::run_files::RunFiles::new();
+    files.dir("--out", Some(a.out.as_path()));
+    super::run_files::check(&files, a.force)?;
     let clock = Instant::now();
-    let steps = Steps::new(paper::STEPS + 2);
-    let report = paper::run(&settings, |msg| steps.step(msg))?;
-    steps.step("figures");
-    let out = staged.path();
-    paper::figures::draw_figures(out, &report, a.levels)?;
-    steps.step("report");
-    std::fs::write(
-        out.join("report.json"),
-        serde_json::to_string_pretty(&report)? + "\n",
-    )?;
-    std::fs::write(out.join("report.md"), report.markdown())?;
-    staged.commit()?;
+    paper::folder::reproduce_into(&a.out, &settings)?;
     let out = &a.out;
-    drop(steps);
     super::print_out(&format!(
         "wrote {}/report.md, report.json and figures in {:.1} s\n",
         out.display(),

@@ -115,12 +115,8 @@ fn weighted(
     mut d: activecal::io::Description,
 ) -> Result<activecal::io::Description> {
     if let Some(so) = a.orientation_noise {
-        if let Some(n) = a.noise
-            && !(n.is_finite() && n > 0.0)
-        {
-            bail!("--noise {n}: the position noise σ must be a finite number > 0 (metres)");
-        }
-        d.robot.orientation_scale = super::select::orientation_scale(&d.robot, a.noise, so)?;
+        d.robot.orientation_scale =
+            activecal::experiment::pool::orientation_scale(&d.robot, a.noise, so)?;
     }
     Ok(d)
 }
@@ -146,24 +142,7 @@ pub fn cmd_score(a: ScoreArgs, given: &[&str]) -> Result<()> {
             let d = DesignFile::read(path)?;
             check_design_options(&a, given, &d, path)?;
             let desc = weighted(&a, load_description(&d.robot_ref()?)?)?;
-            let robot = activecal::experiment::gap::design_robot(desc.robot, &d)?;
-            let qs = d
-                .joint_values(&robot)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-            let info = PoolInfo {
-                robot: robot.name.clone(),
-                chain: activecal::report::chain(&robot),
-                levels: d.spec()?.levels(),
-                pool: d.spec()?,
-                pool_stats: None,
-            };
-            activecal::experiment::gap::score_joint_values(
-                &robot,
-                a.pool.params,
-                &qs,
-                d.poses.clone(),
-                info,
-            )
+            activecal::experiment::gap::score_design_file(path, &d, desc, a.pool.params)?
         }
         (None, None) if matches!(a.pool.pool, super::PoolKind::File(_)) => {
             // Every pose of the file: a design written as .csv or .json.

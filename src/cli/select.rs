@@ -173,31 +173,6 @@ pub struct SelectArgs {
     pub given: super::acts_on::Given,
 }
 
-/// The weight of a full-pose sensor's orientation rows (metres per
-/// radian) for position noise `noise` (metres; the report's default
-/// without it) and orientation noise `orientation` (radians): each row
-/// then carries the position's σ. Refused for a sensor that measures no
-/// orientation, or a σ that is not a finite number > 0.
-pub(super) fn orientation_scale(
-    robot: &activecal::model::Robot,
-    noise: Option<f64>,
-    orientation: f64,
-) -> Result<f64> {
-    if !(orientation.is_finite() && orientation > 0.0) {
-        bail!(
-            "--orientation-noise {orientation}: the orientation noise σ must be a finite number > 0 (radians)"
-        );
-    }
-    if !activecal::experiment::sensor_for(robot).observes_orientation() {
-        bail!(
-            "--orientation-noise: robot '{}' measures {}, no orientation (append ':pose' to --robot for full poses)",
-            robot.name,
-            activecal::experiment::sensor_for(robot).describe()
-        );
-    }
-    Ok(noise.unwrap_or(DEFAULT_REPORT_NOISE) / orientation)
-}
-
 /// The noise σ of `select --report` when `--noise` is not given, metres
 /// (`calibrate`'s default).
 pub const DEFAULT_REPORT_NOISE: f64 = super::calibrate::DEFAULT_NOISE;
@@ -247,7 +222,8 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
         described.robot = Restriction::KeepAxisRelations.apply(&described.robot)?;
     }
     if let Some(so) = a.orientation_noise {
-        described.robot.orientation_scale = orientation_scale(&described.robot, a.noise, so)?;
+        described.robot.orientation_scale =
+            activecal::experiment::pool::orientation_scale(&described.robot, a.noise, so)?;
     }
     let speeds = activecal::io::joint_speeds::joint_speeds(&described.robot)?;
     let home = super::tour::parse_home(a.home.as_deref(), &described.robot)?;
@@ -324,7 +300,7 @@ pub fn cmd_select(a: SelectArgs) -> Result<()> {
 /// once, before any work ([`super::run_files::RunFiles::check`]).
 pub fn select_files(a: &SelectArgs) -> super::run_files::RunFiles {
     let mut f = super::run_files::RunFiles::new();
-    f.pool(&a.pool)
+    super::run_files::pool(&mut f, &a.pool)
         .input("--existing", a.existing.as_deref())
         .input("--camera-info", a.camera.camera_info.as_deref())
         .input("--target", a.camera.target.as_deref())
@@ -346,7 +322,7 @@ pub fn check_out_formats(outs: &[PathBuf]) -> Result<()> {
 /// every output against every input and every other output, an existing
 /// file, a missing directory, the format, the noise.
 fn check_select_outputs(a: &SelectArgs) -> Result<()> {
-    select_files(a).check(a.force)?;
+    super::run_files::check(&select_files(a), a.force)?;
     check_out_formats(&a.out)?;
     if let Some(n) = a.noise.filter(|v| !(v.is_finite() && *v > 0.0)) {
         bail!("--noise {n}: the sensor noise σ must be a finite number > 0 (metres)");

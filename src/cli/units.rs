@@ -7,35 +7,17 @@ use activecal::error::UnitHint;
 use activecal::experiment::error::IdentifyError;
 use activecal::units::{AngleUnit, LengthUnit, Units};
 
-/// The unit of revolute joint values, as typed.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum AngleArg {
-    /// Radians.
-    Rad,
-    /// Degrees.
-    Deg,
-}
-
-/// The unit of lengths, as typed.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LengthArg {
-    /// Metres.
-    M,
-    /// Millimetres.
-    Mm,
-}
-
 /// The unit options of every command that reads joint values or positions.
 #[derive(clap::Args, Clone, Copy, Debug)]
 pub struct UnitOpts {
     /// Unit of the revolute joint values read (files, --q): rad or deg.
     /// Roll, pitch and yaw columns stay radians.
-    #[arg(long, value_enum, default_value = "rad")]
-    pub angle_unit: AngleArg,
+    #[arg(long, value_parser = super::choice::<AngleUnit>(), default_value_t = AngleUnit::Rad)]
+    pub angle_unit: AngleUnit,
     /// Unit of the lengths read: measured positions (x1, y1, z1, …) and
     /// prismatic joint values: m or mm.
-    #[arg(long, value_enum, default_value = "m")]
-    pub length_unit: LengthArg,
+    #[arg(long, value_parser = super::choice::<LengthUnit>(), default_value_t = LengthUnit::M)]
+    pub length_unit: LengthUnit,
 }
 
 impl UnitOpts {
@@ -43,14 +25,8 @@ impl UnitOpts {
     #[must_use]
     pub fn units(&self) -> Units {
         Units {
-            angle: match self.angle_unit {
-                AngleArg::Rad => AngleUnit::Rad,
-                AngleArg::Deg => AngleUnit::Deg,
-            },
-            length: match self.length_unit {
-                LengthArg::M => LengthUnit::M,
-                LengthArg::Mm => LengthUnit::Mm,
-            },
+            angle: self.angle_unit,
+            length: self.length_unit,
         }
     }
 }

@@ -198,3 +198,54 @@ pub struct NamedDistance {
     /// The distance, metres.
     pub metres: f64,
 }
+
+/// `NAME=v1,…,vN`: a non-empty name and exactly `N` numbers (`None`
+/// otherwise): how a named plane and a named point are written as text.
+#[must_use]
+pub fn named_numbers<const N: usize>(s: &str) -> Option<(String, [f64; N])> {
+    let (name, rest) = s.split_once('=')?;
+    let v: Vec<f64> = rest
+        .split(',')
+        .map(|c| c.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .ok()?;
+    let name = name.trim();
+    (!name.is_empty()).then(|| v.try_into().ok().map(|a| (name.to_string(), a)))?
+}
+
+impl std::str::FromStr for NamedDistance {
+    type Err = String;
+
+    /// `A,B=METRES`: two point names and the distance between them.
+    fn from_str(s: &str) -> Result<Self, String> {
+        let bad = || {
+            "expected A,B=METRES (two point names and a distance in metres, e.g. front_left/0,front_left/1=0.05)"
+                .to_string()
+        };
+        let (names, d) = s.split_once('=').ok_or_else(bad)?;
+        let (a, b) = names.split_once(',').ok_or_else(bad)?;
+        let metres: f64 = d.trim().parse().map_err(|_| bad())?;
+        Ok(NamedDistance {
+            a: a.trim().to_string(),
+            b: b.trim().to_string(),
+            metres,
+        })
+    }
+}
+
+impl std::str::FromStr for NamedPlane {
+    type Err = String;
+
+    /// `NAME=nx,ny,nz,d`: n · x = d in the base frame, metres (the
+    /// normal's length is checked with the file's planes).
+    fn from_str(s: &str) -> Result<Self, String> {
+        let Some((name, [nx, ny, nz, d])) = named_numbers::<4>(s) else {
+            return Err("expected NAME=nx,ny,nz,d (a plane name, its normal and offset in metres, n · x = d in the base frame, e.g. table=0,0,1,0.02)".into());
+        };
+        Ok(NamedPlane {
+            name,
+            normal: [nx, ny, nz],
+            offset: d,
+        })
+    }
+}

@@ -295,3 +295,144 @@ pub fn not_acting<'a>(table: &[ActsOn], given: &[&'a str], sensors: &[Sensor]) -
         .filter(|id| sensors_of(table, id).is_none_or(|s| !s.iter().any(|x| sensors.contains(x))))
         .collect()
 }
+
+/// What the table's sentences below are: why an option does not act on the
+/// sensors its row leaves out, or what to use instead (options and
+/// settings named by their keys in backticks, spelled by each front end:
+/// the command line `--pixel-noise`, Python `pixel_noise`); an option not
+/// listed names the sensors it is for.
+pub type WhyNot = &'static [(&'static str, &'static str)];
+
+const LS: &str = "the camera fit is least squares on the pixels";
+
+/// Why an option of `calibrate` acts on no other sensor than its row's
+/// ([`CALIBRATE`]).
+pub const CALIBRATE_WHY: WhyNot = &[
+    (
+        "offset_unit",
+        "the camera and contact fits write no joint offsets",
+    ),
+    (
+        "offset_sign",
+        "the camera and contact fits write no joint offsets",
+    ),
+    (
+        "markers",
+        "a camera sees the points of its `target`, not markers; a bag's `points` topic is one point",
+    ),
+    (
+        "noise",
+        "a contact fit's σ is estimated from its residuals; a camera's is `pixel_noise`",
+    ),
+    (
+        "orientation_noise",
+        "it is a tracker's orientation σ; only full poses carry orientations",
+    ),
+    (
+        "pixel_noise",
+        "it is a camera's σ in pixels; a tracker's is `noise`",
+    ),
+    ("seed", "the fit has no randomness"),
+    ("loss", LS),
+    ("loss_scale", LS),
+    (
+        "free",
+        "the camera fit estimates every joint origin of the chain",
+    ),
+    (
+        "holdout",
+        "contacts are held out by placement (`holdout_by`, `train_on`); a camera fit has no held-out validation",
+    ),
+    ("splits", "`holdout`'s splits"),
+    ("compare_pruned", "`holdout`'s comparison"),
+    (
+        "weights",
+        "there are no orientations to weigh against positions",
+    ),
+    (
+        "orientation_scale",
+        "there are no orientations to weigh against positions",
+    ),
+    ("inertia", "it is for `compliance`"),
+    ("payload", "it is for `compliance`"),
+    (
+        "report",
+        "a camera fit's report is its text or `json` (with `images` DIR, `report` writes the contact sheet; not yet with a bag's images)",
+    ),
+    (
+        "joints",
+        "`observations` carry their joint values; `joints` gives the images' (a file) or a bag's joint topic",
+    ),
+    (
+        "save_observations",
+        "it writes the pixels detected in `images`",
+    ),
+    (
+        "angle_unit",
+        "no file of joint values is read (a bag's are in radians)",
+    ),
+    (
+        "length_unit",
+        "no file of joint values is read (a bag's are in metres)",
+    ),
+    (
+        "max_offset",
+        "a camera's clock offset is not estimated from a bag: give `time_offset` (0 when not given)",
+    ),
+    (
+        "bag_design",
+        "it matches a bag's rests to the design the run followed",
+    ),
+    (
+        "design_tolerance",
+        "it matches a bag's rests to the design the run followed",
+    ),
+];
+
+const EAE: &str = "a camera design is chosen by exchange-add-exchange (EAE) on the determinant, a socket design D-optimally then exchanged for the predicted true error";
+const SOCKET: &str = "the pool is configurations projected onto each socket from `count` joint-space samples, chosen D-optimally then exchanged for the predicted true error";
+
+/// Why an option of `select` acts on no other sensor than its row's
+/// ([`SELECT`]).
+pub const SELECT_WHY: WhyNot = &[
+    (
+        "markers",
+        "a camera sees the points of its `target`, not markers",
+    ),
+    ("pool", SOCKET),
+    ("levels", "there is no lattice"),
+    (
+        "params",
+        "the camera's Jacobian is at the nominal parameters",
+    ),
+    (
+        "visibility",
+        "the camera's view is `min_visible`, `image_margin`, `max_view_angle` and `distance`",
+    ),
+    ("angle_unit", "no file of joint values is read"),
+    ("length_unit", "no file of joint values is read"),
+    ("margin", "the samples are drawn within the joint limits"),
+    ("algorithm", EAE),
+    ("initial", EAE),
+    ("starts", EAE),
+    ("ils", EAE),
+    ("kick", EAE),
+    ("designs", EAE),
+    ("polish", EAE),
+    ("criterion", EAE),
+    ("gap", SOCKET),
+    ("gap_solver", SOCKET),
+    ("report", SOCKET),
+    ("target_error", SOCKET),
+    (
+        "noise",
+        "it is a point's noise in metres; a camera's is `pixel_noise` PX (the detected points' σ in pixels), a socket design predicts its errors per unit noise",
+    ),
+];
+
+/// Why `id` does not act beyond its row's sensors, by `why` (`None`: the
+/// table says nothing, name the sensors it is for).
+#[must_use]
+pub fn why_not(why: WhyNot, id: &str) -> Option<&'static str> {
+    why.iter().find(|(k, _)| *k == id).map(|(_, w)| *w)
+}

@@ -25,6 +25,7 @@ use crate::model::Robot;
 use crate::report::{CameraCalibrationReport, CameraStartReport};
 use nalgebra::Isometry3;
 
+pub mod files;
 pub mod images;
 pub mod verdict;
 

@@ -10,6 +10,7 @@ use super::ExperimentError;
 use crate::bound::{BoundSettings, DesignGap};
 use crate::error::Error;
 use crate::how_many::{CurveSettings, PoseCountCurve};
+use crate::io::atomic::Output;
 use crate::io::collision_choice::CollisionChoice;
 use crate::io::{UrdfChain, urdf_branch};
 use crate::model::Robot;
@@ -221,7 +222,57 @@ fn candidates(robot: &Robot, c: Candidates) -> Result<Vec<Vec<f64>>, Error> {
     })
 }
 
+/// Whether `out` names a `.csv` (the design's table) rather than a `.json`
+/// (the design and its figures); refused otherwise.
+fn is_csv(out: &Output<'_>) -> Result<bool, Error> {
+    let ext = |e: &str| {
+        out.path
+            .extension()
+            .is_some_and(|x| x.eq_ignore_ascii_case(e))
+    };
+    if ext("csv") || ext("json") {
+        return Ok(ext("csv"));
+    }
+    Err(Error::Invalid(format!(
+        "{} {}: a camera design is written as .csv (candidate, the joints, points_seen) or .json (the design and its figures, as --json prints them)",
+        out.label,
+        out.path.display()
+    )))
+}
+
+/// A camera design's files checked before any work: each a `.csv` or a
+/// `.json`, at most one of each; returned the `.csv` first.
+pub fn design_outputs<'a>(outs: &[Output<'a>]) -> Result<Vec<Output<'a>>, Error> {
+    let (mut csv, mut json) = (None, None);
+    for o in outs {
+        let slot = if is_csv(o)? { &mut csv } else { &mut json };
+        if slot.replace(*o).is_some() {
+            return Err(Error::Invalid(format!(
+                "{} {}: one file of each kind (.csv, .json)",
+                o.label,
+                o.path.display()
+            )));
+        }
+    }
+    Ok(csv.into_iter().chain(json).collect())
+}
+
 impl CameraSelection {
+    /// Writes the design to `out` as its name says: `.csv`, the design's
+    /// table ([`Self::design_csv`]); `.json`, its report. Atomically; an
+    /// existing file only with `overwrite`.
+    pub fn write(&self, out: Output<'_>, overwrite: bool) -> Result<(), Error> {
+        let text = if is_csv(&out)? {
+            self.design_csv()
+        } else {
+            serde_json::to_string_pretty(&self.report)
+                .map_err(|e| Error::Invalid(format!("{}: {e}", out.label)))?
+                + "\n"
+        };
+        crate::io::atomic::check_outputs(&[out], &[], overwrite)?;
+        crate::io::atomic::write_atomic(out.path, text.as_bytes())
+    }
+
     /// The design as a CSV table: one row a pose, `candidate`, the joints
     /// (radians, metres, 17 significant digits) and `points_seen`.
     #[must_use]

@@ -139,6 +139,36 @@ pub fn design_robot(robot: Robot, d: &DesignFile) -> Result<Robot, ExperimentErr
     )?)
 }
 
+/// The `score` of the design file `d` (read from `path`) for the robot of
+/// `desc` (the description it names, its orientation rows weighed as the
+/// caller asks): its stored joint values on the robot it was chosen for
+/// (its compliances included), with table `params`.
+pub fn score_design_file(
+    path: &Path,
+    d: &DesignFile,
+    desc: crate::io::Description,
+    params: ParamSet,
+) -> Result<crate::report::ScoreReport, ExperimentError> {
+    let robot = design_robot(desc.robot, d)?;
+    let qs = d
+        .joint_values(&robot)
+        .map_err(|e| crate::Error::Invalid(format!("{}: {e}", path.display())))?;
+    let info = PoolInfo {
+        robot: robot.name.clone(),
+        chain: crate::report::chain(&robot),
+        levels: d.spec()?.levels(),
+        pool: d.spec()?,
+        pool_stats: None,
+    };
+    Ok(score_joint_values(
+        &robot,
+        params,
+        &qs,
+        d.poses.clone(),
+        info,
+    ))
+}
+
 /// The `gap` of the design file `d` (read from `path`): its poses against
 /// the certified bound of its own pool, rebuilt from the file's source and
 /// filters (`filters` replacing the latter when given) for the robot of

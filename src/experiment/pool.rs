@@ -117,3 +117,42 @@ pub fn urdf_gravity(robot: &Robot) -> Result<Arc<GravityModel>, ExperimentError>
         &crate::io::inertia::InertiaOptions::default(),
     )?))
 }
+
+/// The position noise σ a design is chosen or scored for when none is
+/// given, metres (a calibration's default stated noise).
+pub const DEFAULT_DESIGN_NOISE: f64 = 0.01;
+
+/// The weight of a full-pose sensor's orientation rows (metres per radian)
+/// for position noise `noise` (metres; [`DEFAULT_DESIGN_NOISE`] without it)
+/// and orientation noise `orientation` (radians): each row then carries
+/// the position's σ. Refused for a sensor of `robot` that measures no
+/// orientation, or a σ that is not a finite number > 0.
+pub fn orientation_scale(
+    robot: &Robot,
+    noise: Option<f64>,
+    orientation: f64,
+) -> Result<f64, crate::error::SettingError> {
+    use crate::error::SettingError;
+    if let Some(n) = noise {
+        crate::error::positive("noise", n, "metres: the position noise σ")?;
+    }
+    if !(orientation.is_finite() && orientation > 0.0) {
+        return Err(SettingError::new(
+            "orientation_noise",
+            orientation,
+            "the orientation noise σ must be a finite number > 0 (radians)",
+        ));
+    }
+    let sensor = crate::measure::sensor_for(robot);
+    if !sensor.observes_orientation() {
+        return Err(SettingError::because(
+            "orientation_noise",
+            format!(
+                "robot '{}' measures {}, no orientation (append ':pose' to `robot` for full poses)",
+                robot.name,
+                sensor.describe()
+            ),
+        ));
+    }
+    Ok(noise.unwrap_or(DEFAULT_DESIGN_NOISE) / orientation)
+}

@@ -10,6 +10,7 @@ use super::{
     identify, identify_robust,
 };
 use crate::data::Measurements;
+use crate::error::SettingError;
 use crate::model::{ParamTable, Robot};
 use rand::SeedableRng;
 use rand::seq::SliceRandom;
@@ -31,6 +32,50 @@ pub enum LossChoice {
         /// The scale.
         scale: f64,
     },
+}
+
+/// A loss by its name, before its scale is given: the choice a front end
+/// offers ([`LossChoice::of`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LossKind {
+    /// Least squares.
+    L2,
+    /// Huber: quadratic up to the scale, linear beyond.
+    Huber,
+    /// Cauchy: down-weights gross outliers towards zero.
+    Cauchy,
+}
+
+crate::choice!(LossKind { L2 => "l2", Huber => "huber", Cauchy => "cauchy" });
+
+impl LossChoice {
+    /// The loss `kind` at `scale` (metres: the residual norm of one pose
+    /// where a robust loss turns robust), checked: a robust loss needs a
+    /// finite scale > 0, least squares takes none.
+    pub fn of(kind: LossKind, scale: Option<f64>) -> std::result::Result<Self, SettingError> {
+        let scale = match (kind, scale) {
+            (LossKind::L2, None) => return Ok(LossChoice::L2),
+            (LossKind::L2, Some(_)) => {
+                return Err(SettingError::because(
+                    "loss_scale",
+                    "is for `loss` huber or cauchy",
+                ));
+            }
+            (_, None) => {
+                return Err(SettingError::because(
+                    "loss_scale",
+                    format!(
+                        "`loss` {kind} needs it (metres: the residual norm of one pose where the loss turns robust, e.g. 3 times the sensor noise)"
+                    ),
+                ));
+            }
+            (_, Some(s)) => crate::error::positive("loss_scale", s, "metres")?,
+        };
+        Ok(match kind {
+            LossKind::Huber => LossChoice::Huber { scale },
+            _ => LossChoice::Cauchy { scale },
+        })
+    }
 }
 
 /// A weight below this marks a sample as down-weighted in reports (Huber:

@@ -64,8 +64,8 @@ mod robust_tests;
 pub use crate::lsq::loss::{Cauchy, Huber, L2, Loss, Robust};
 pub use evaluation::{ModelErrors, SampleResidual, residuals};
 pub use fit::{
-    Fit, HoldoutSettings, LossChoice, ParameterTrust, SplitResult, WeightedFit, Weights, fit,
-    fit_weighted, holdout, prepare_for_data, trust, with_fixed_and_free,
+    Fit, HoldoutSettings, LossChoice, LossKind, ParameterTrust, SplitResult, WeightedFit, Weights,
+    fit, fit_weighted, holdout, prepare_for_data, trust, with_fixed_and_free,
 };
 pub use lm::{
     Correlation, Covariance, Identification, LmSettings, Solution, Status, StopReason, identify,

@@ -1,8 +1,8 @@
 //! The collision filters of a pool, from what the user chose (self-collision,
 //! an SRDF's pairs, obstacles, a floor, a clearance) and the URDF chain the
-//! robot was imported from: one construction for the command line and the
-//! Python package, each of which checks its own arguments first (and names
-//! them in its own terms).
+//! robot was imported from: one construction, and one check of the values
+//! ([`CollisionChoice::validate`]), for the command line and the Python
+//! package (each checks that the files it names exist, in its own terms).
 
 use super::UrdfChain;
 use crate::collision::{AlwaysTouching, CollisionFilter, CollisionSpec, Obstacle};
@@ -34,6 +34,46 @@ impl CollisionChoice {
     #[must_use]
     pub fn any(&self) -> bool {
         self.self_collision || !self.obstacles.is_empty() || self.floor.is_some()
+    }
+
+    /// Refuses a floor that is not finite, a clearance that is no distance
+    /// ≥ 0, a clearance with nothing to check, and an SRDF's pairs or
+    /// always-touching pairs skipped without a self-collision check.
+    pub fn validate(&self) -> Result<(), crate::error::SettingError> {
+        use crate::error::SettingError;
+        if let Some(z) = self.floor.filter(|z| !z.is_finite()) {
+            return Err(SettingError::new(
+                "floor",
+                z,
+                "not a finite height (metres)",
+            ));
+        }
+        if !(self.clearance.is_finite() && self.clearance >= 0.0) {
+            return Err(SettingError::new(
+                "clearance",
+                self.clearance,
+                "a distance >= 0 metres",
+            ));
+        }
+        if self.clearance > 0.0 && !self.any() {
+            return Err(SettingError::because(
+                "clearance",
+                "applies with `self_collision`, `obstacle` or `floor`",
+            ));
+        }
+        if self.skip_always_touching && !self.self_collision {
+            return Err(SettingError::because(
+                "skip_always_touching",
+                "leaves pairs of links unchecked by `self_collision`, which is not given",
+            ));
+        }
+        if self.srdf.is_some() && !self.self_collision {
+            return Err(SettingError::because(
+                "srdf",
+                "lists pairs of links for `self_collision`, which is not given",
+            ));
+        }
+        Ok(())
     }
 
     /// The pool filters of this choice for the robot of `chain`: one for

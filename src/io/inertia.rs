@@ -19,6 +19,41 @@ pub struct Payload {
     pub at: [f64; 3],
 }
 
+impl std::str::FromStr for Payload {
+    type Err = String;
+
+    /// `KG[@X,Y,Z]`: the mass in kg, at a point of the tip link's frame in
+    /// metres (its origin when not given).
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        let (m, at) = match s.split_once('@') {
+            Some((m, at)) => (m, Some(at)),
+            None => (s, None),
+        };
+        let mass: f64 = m
+            .trim()
+            .parse()
+            .map_err(|_| format!("'{m}' is not a mass in kg (KG or KG@X,Y,Z)"))?;
+        if !(mass.is_finite() && mass >= 0.0) {
+            return Err(format!("{mass} kg: the mass must be finite and >= 0"));
+        }
+        let at = match at {
+            None => [0.0; 3],
+            Some(a) => {
+                let v: Vec<f64> = a
+                    .split(',')
+                    .map(|x| x.trim().parse::<f64>())
+                    .collect::<std::result::Result<_, _>>()
+                    .map_err(|_| format!("'{a}' is not X,Y,Z in metres"))?;
+                if v.len() != 3 || !v.iter().all(|x| x.is_finite()) {
+                    return Err(format!("'{a}' is not three finite numbers X,Y,Z (metres)"));
+                }
+                [v[0], v[1], v[2]]
+            }
+        };
+        Ok(Payload { mass, at })
+    }
+}
+
 /// Where the masses come from.
 #[derive(Clone, Debug, Default)]
 pub struct InertiaOptions {

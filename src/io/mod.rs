@@ -19,6 +19,7 @@ pub mod kinematics_yaml;
 pub mod measurements;
 pub mod read;
 pub mod robot_toml;
+pub mod run_files;
 pub mod table;
 pub mod urdf;
 pub mod urdf_branch;

@@ -20,6 +20,7 @@ pub mod file;
 pub mod lattice;
 pub mod line_of_sight;
 pub mod sampled;
+mod source_kind;
 pub mod stats;
 pub mod summary;
 pub mod turn;
@@ -28,6 +29,7 @@ pub use crate::pool::file::{Configurations, read_configurations, read_configurat
 pub use build::memory_estimate;
 pub use lattice::Lattice;
 pub use sampled::{Sobol, Uniform};
+pub use source_kind::{DEFAULT_COUNT, DEFAULT_LEVELS, PoolKind};
 
 use crate::blocks::Blocks;
 use crate::collision::CollisionFilter;

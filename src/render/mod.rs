@@ -15,6 +15,7 @@ pub mod contact_sheet;
 pub mod contact_text;
 pub mod design_text;
 pub(crate) mod figure;
+pub mod fk_text;
 pub mod folder;
 pub mod frames_text;
 pub mod measured_text;

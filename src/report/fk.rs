@@ -32,9 +32,48 @@ pub struct FkReport {
     /// Names of its columns (when the Jacobian is asked for).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub parameter_names: Option<Vec<String>>,
+    /// The end frame's rotation matrix (base frame), rows; not in the
+    /// report's JSON (`orientation` gives it in the files' forms).
+    #[serde(skip)]
+    pub rotation: [[f64; 3]; 3],
 }
 
 impl FkReport {
+    /// [`Self::new`] at joint values `q` given in `units` (named `label`
+    /// in messages: their count, the joints' names, limits and units
+    /// checked as every reader of joint values does,
+    /// [`crate::units::joint_values_to_model_units`]).
+    pub fn in_units(
+        robot: &Robot,
+        params: ParamSet,
+        q: Vec<f64>,
+        units: crate::units::Units,
+        label: &str,
+        jacobian: bool,
+    ) -> crate::Result<Self> {
+        let names = crate::units::joint_names(robot);
+        if q.len() != robot.dof() {
+            return Err(crate::Error::Invalid(format!(
+                "{label}: expected {} joint angles, got {}: the joints of {} are, in order, {}",
+                robot.dof(),
+                q.len(),
+                robot.name,
+                names.join(", ")
+            )));
+        }
+        robot.check_q(&q)?;
+        let mut qs = vec![q];
+        let rows = ["the joint vector".to_string()];
+        let source = crate::units::JointSource {
+            file: label,
+            rows: &rows,
+            columns: &names,
+        };
+        crate::units::joint_values_to_model_units(robot, units, &source, &mut qs)?;
+        let q = qs.pop().expect("one joint vector");
+        Self::new(robot, params, q, jacobian)
+    }
+
     /// Forward kinematics of `robot` at `q` with table `params`, and the
     /// Jacobian when `jacobian` is set.
     pub fn new(
@@ -71,6 +110,7 @@ impl FkReport {
             markers,
             parameter_names: jac.as_ref().map(|_| robot.parameter_names()),
             jacobian: jac,
+            rotation: std::array::from_fn(|i| std::array::from_fn(|j| rot[(i, j)])),
         })
     }
 }

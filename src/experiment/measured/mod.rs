@@ -326,6 +326,7 @@ pub fn calibrate_read(
     s: &MeasuredSettings,
     on_note: &mut dyn FnMut(&str),
 ) -> Result<MeasuredCalibration, ExperimentError> {
+    s.validate().map_err(crate::Error::from)?;
     let held = s.with_held(robot)?;
     let fitted = fit_read(robot, meas, source, read_notes, &held, on_note)?;
     beside_full(robot, meas, source, s, &held, fitted)
@@ -355,6 +356,33 @@ fn beside_full(
 }
 
 impl MeasuredSettings {
+    /// Refuses a stated noise that is no σ (`noise`, metres per
+    /// coordinate; `orientation_noise`, radians per axis: each a finite
+    /// number > 0) and an outlier test's rate outside (0, 1); run by
+    /// [`calibrate_read`], and by a front end before it reads any data.
+    pub fn validate(&self) -> Result<(), crate::error::SettingError> {
+        let stated =
+            "the sensor's stated σ, tested against the residuals: give a finite number > 0";
+        if let Some(v) = self.stated_noise.filter(|v| !(v.is_finite() && *v > 0.0)) {
+            return Err(crate::error::SettingError::new(
+                "noise",
+                v,
+                format!("{stated} (metres per coordinate)"),
+            ));
+        }
+        if let Some(v) = self
+            .stated_orientation_noise
+            .filter(|v| !(v.is_finite() && *v > 0.0))
+        {
+            return Err(crate::error::SettingError::new(
+                "orientation_noise",
+                v,
+                format!("{stated} (radians per axis)"),
+            ));
+        }
+        Ok(())
+    }
+
     /// These settings with the unknowns [`MeasuredSettings::restriction`]
     /// holds added to those fixed.
     fn with_held(&self, robot: &Robot) -> Result<Self, ExperimentError> {

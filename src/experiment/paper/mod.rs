@@ -8,6 +8,7 @@
 
 mod assemble;
 pub mod figures;
+pub mod folder;
 mod markdown;
 mod report;
 mod settings;

@@ -53,6 +53,38 @@ impl ExtractSettings {
     }
 }
 
+impl ExtractSettings {
+    /// Refuses a largest clock offset that is no number of seconds ≥ 0, a
+    /// design tolerance that is not > 0 and a clock offset given that is
+    /// not finite.
+    pub fn validate(&self) -> std::result::Result<(), crate::error::SettingError> {
+        use crate::error::SettingError;
+        if !(self.max_offset.is_finite() && self.max_offset >= 0.0) {
+            return Err(SettingError::new(
+                "max_offset",
+                self.max_offset,
+                "give seconds, 0 or more",
+            ));
+        }
+        let tolerance = self.design_tolerance;
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            return Err(SettingError::new(
+                "design_tolerance",
+                tolerance,
+                "give a positive number (rad, m)",
+            ));
+        }
+        match self.time_offset {
+            Some(o) if !o.is_finite() => Err(SettingError::new(
+                "time_offset",
+                o,
+                "not a number of seconds",
+            )),
+            _ => Ok(()),
+        }
+    }
+}
+
 /// How the clock offset was settled.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ClockReport {

@@ -43,14 +43,15 @@ impl Source {
     }
 
     /// The source of one of a points topic, a poses topic or a transform
-    /// `PARENT:CHILD` of /tf (the one given; an error, without the
-    /// option's name, when none or two are given or the transform is not
+    /// `PARENT:CHILD` of /tf (the one given; refused, naming the settings
+    /// by their keys, when none or two are given or the transform is not
     /// two frame names).
     pub fn one_of(
         points: Option<&str>,
         poses: Option<&str>,
         tf: Option<&str>,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, crate::error::SettingError> {
+        use crate::error::SettingError;
         match (points, poses, tf) {
             (Some(t), None, None) => Ok(Source::Points(t.to_string())),
             (None, Some(t), None) => Ok(Source::Poses(t.to_string())),
@@ -59,12 +60,20 @@ impl Source {
                     parent: p.to_string(),
                     child: c.to_string(),
                 }),
-                _ => Err(format!("tf {pc}: give PARENT:CHILD, two frame names")),
+                _ => Err(SettingError::new(
+                    "tf",
+                    pc,
+                    "give PARENT:CHILD, two frame names",
+                )),
             },
-            (None, None, None) => Err(
-                "give the bag's measurement: points TOPIC, poses TOPIC or tf PARENT:CHILD".into(),
-            ),
-            _ => Err("give one measurement of points, poses and tf".into()),
+            (None, None, None) => Err(SettingError::because(
+                "points",
+                "give the bag's measurement: `points` TOPIC, `poses` TOPIC or `tf` PARENT:CHILD",
+            )),
+            _ => Err(SettingError::because(
+                "points",
+                "give one measurement of `points`, `poses` and `tf`",
+            )),
         }
     }
 }

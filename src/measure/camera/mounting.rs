@@ -12,24 +12,13 @@ pub enum Mounting {
     EyeInHand,
 }
 
+crate::choice!(Mounting { EyeToHand => "eye-to-hand", EyeInHand => "eye-in-hand" });
+
 impl Mounting {
-    /// `eye-to-hand` or `eye-in-hand`.
+    /// `eye-to-hand` or `eye-in-hand` ([`crate::names::Choice::name`]).
     #[must_use]
     pub fn name(self) -> &'static str {
-        match self {
-            Mounting::EyeToHand => "eye-to-hand",
-            Mounting::EyeInHand => "eye-in-hand",
-        }
-    }
-
-    /// Reads a mounting's name (`eye-to-hand`, `eye-in-hand`).
-    #[must_use]
-    pub fn from_name(s: &str) -> Option<Self> {
-        match s {
-            "eye-to-hand" => Some(Mounting::EyeToHand),
-            "eye-in-hand" => Some(Mounting::EyeInHand),
-            _ => None,
-        }
+        crate::names::Choice::name(self)
     }
 
     /// What the camera's placement is relative to: `base` or `end frame`.

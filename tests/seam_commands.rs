@@ -156,20 +156,22 @@ fn distance_rms(robot: &Robot, a: &ParamTable, b: &ParamTable, qs: &[Vec<f64>]) 
 }
 
 /// `calibrate --design` simulates heights of the real UR5 at the design
-/// `select` chose and validates the fit in the sensor's own row: over `T`
-/// seeds (noise and held-out poses), the RMS of the reported validation
-/// errors (the height error at the held-out poses) is within 1.3× of the
-/// height error `select` predicted, and so is the true height error of
-/// each written model, computed here at the prediction's random
-/// configurations. The 3-D distance of those models from the real robot
-/// is far outside it (`x` and `y` are unobservable by heights), so a
-/// validation in 3-D fails the test; so does a prediction that counts
-/// the height's one row as a third of a point (√3 too large). Scatter:
-/// `T` = 20 fits of 22 unknowns put the mean square within about
-/// √(2/(20·22)) ≈ 7 % of its expectation (15 % for a few dominant
-/// directions), and held-out lattice poses against uniform configurations
-/// move it a little more: 1.3 (1.69 on the mean square) is not reached by
-/// chance, a factor √3 is.
+/// `select` chose from 1,000 random configurations and validates the fit in
+/// the sensor's own row: over `T` seeds (noise and held-out poses), the RMS
+/// of the reported validation errors (the height error at the held-out
+/// poses) is within 1.3× of the height error `select` predicted, and so is
+/// the true height error of each written model, computed here at the
+/// prediction's random configurations. The 3-D distance of those models
+/// from the real robot is far outside it (`x` and `y` are unobservable by
+/// heights), so a validation in 3-D fails the test; so does a Monte-Carlo
+/// prediction that counts the height's one row as a third of a point (√3
+/// too large). Scatter: `T` = 20 fits of 22 unknowns put the mean square
+/// within about √(2/(20·22)) ≈ 7 % of its expectation (15 % for a few
+/// dominant directions): 1.3 (1.69 on the mean square) is not reached by
+/// chance, a factor √3 is. The pool is random, as the prediction's
+/// configurations are: the held-out poses of a 3-level lattice repeat the
+/// design's configurations (the UR5's joints span ±2π, so its levels are one
+/// angle) and show a fraction of the error.
 #[test]
 fn a_simulated_height_fit_is_validated_in_the_sensor_row() {
     let dir = scratch("validation");

@@ -196,24 +196,22 @@ fn a_simulated_height_fit_is_validated_in_the_sensor_row() {
     let configurations = sel["predicted"]["configurations"].as_u64().unwrap() as usize;
     let robot = activecal::io::load_robot(ROBOT).unwrap();
     let at = activecal::how_many::random_configurations(&robot, configurations, 0);
+    let simulate = [
+        "calibrate",
+        "--robot",
+        ROBOT,
+        "--design",
+        path_str(&design),
+        "--noise",
+        "1e-4",
+    ];
     let seeds = 20;
     let (mut reported, mut height, mut distance) = (0.0, 0.0, 0.0);
     for seed in 0..seeds {
         let out = dir.join(format!("cal{seed}.toml"));
-        let cal = json_of(&[
-            "calibrate",
-            "--robot",
-            ROBOT,
-            "--design",
-            path_str(&design),
-            "--noise",
-            "1e-4",
-            "--seed",
-            &seed.to_string(),
-            "--out",
-            path_str(&out),
-            "--json",
-        ]);
+        let (seed_s, out_s) = (seed.to_string(), path_str(&out));
+        let args = ["--seed", &seed_s, "--out", out_s, "--json"];
+        let cal = json_of(&[&simulate[..], &args[..]].concat());
         assert_eq!(cal["status"], "converged");
         assert_eq!(cal["measurement"], "height");
         let fitted = activecal::io::load_robot(path_str(&out)).unwrap();
@@ -246,18 +244,8 @@ fn a_simulated_height_fit_is_validated_in_the_sensor_row() {
 
     // The Monte-Carlo's own prediction at the held-out poses is of the
     // height too, and the text names what the validation measures.
-    let trials = [
-        "calibrate",
-        "--robot",
-        ROBOT,
-        "--design",
-        path_str(&design),
-        "--noise",
-        "1e-4",
-        "--trials",
-        "20",
-    ];
-    let mc = &json_of(&[&trials[..], &["--json"]].concat())["monte_carlo"];
+    let trials = [&simulate[..], &["--trials", "20", "--json"]].concat();
+    let mc = &json_of(&trials)["monte_carlo"];
     let (mc_predicted, mc_mean) = (
         num(mc, "validation_rms_predicted"),
         num(&mc["validation_rms_after"], "mean"),
@@ -271,7 +259,7 @@ fn a_simulated_height_fit_is_validated_in_the_sensor_row() {
         within(mc_mean, mc_predicted) && within(mc_predicted, predicted),
         "Monte-Carlo: predicted {mc_predicted} m, trials' mean {mc_mean} m; select predicted {predicted} m"
     );
-    let text = common::run(&trials[..7]);
+    let text = common::run(&simulate);
     let text = String::from_utf8_lossy(&text.stdout);
     assert!(text.contains(": RMS z error "), "{text}");
 }

@@ -91,6 +91,51 @@ fn height_sensor_is_selected_bounded_fitted_and_reported() {
     assert_recovered_as_predicted("height", &ms, p_m, before);
 }
 
+/// The held-out validation of a height robot is in the sensor's row: at
+/// 200 random configurations, `ValidationSet::rms` and
+/// `ValidationSet::position_errors` of the nominal model against the real
+/// robot are the end point's height error computed here through the
+/// kinematics (equal to 1e-12 relative: the same differences, summed in
+/// another order), not its 3-D distance (larger by the unobservable `x`
+/// and `y`, here by more than 10 %); a point robot's validation is that
+/// 3-D distance.
+#[test]
+fn a_height_robot_is_validated_by_its_height_error() {
+    use activecal::identify::ValidationSet;
+    let robot = robot();
+    let qs = activecal::how_many::random_configurations(&robot, 200, 3);
+    let v = ValidationSet::from_qs(&robot, qs.clone()).unwrap();
+    let (rms, height) = (
+        v.rms(&robot, &robot.nominal),
+        height_rms(&robot, &robot.nominal, &robot.real, &qs),
+    );
+    assert!((rms - height).abs() < 1e-12 * height, "{rms} vs {height}");
+    let errors = v.position_errors(&robot, &robot.nominal);
+    let (mut en, mut er) = (
+        Evaluator::new(&robot, &robot.nominal),
+        Evaluator::new(&robot, &robot.real),
+    );
+    for (e, q) in errors.iter().zip(&qs) {
+        let dz = (en.end_frame(q).position.z - er.end_frame(q).position.z).abs();
+        assert!((e - dz).abs() <= 1e-15 + 1e-12 * dz, "{e} vs {dz}");
+    }
+    let point = Robot::ur5();
+    let distance = ValidationSet::from_qs(&point, qs.clone())
+        .unwrap()
+        .rms(&point, &point.nominal);
+    let (mut pn, mut pr) = (
+        Evaluator::new(&point, &point.nominal),
+        Evaluator::new(&point, &point.real),
+    );
+    let ss: f64 = qs
+        .iter()
+        .map(|q| (pn.end_frame(q).position - pr.end_frame(q).position).norm_squared())
+        .sum();
+    let d3 = (ss / qs.len() as f64).sqrt();
+    assert!((distance - d3).abs() < 1e-12 * d3, "{distance} vs {d3}");
+    assert!(d3 > 1.1 * height, "3-D {d3} m, height {height} m");
+}
+
 /// Every Rust file under `dir` (recursively), relative to the root.
 fn rust_files(root: &std::path::Path, dir: &str, out: &mut Vec<std::path::PathBuf>) {
     let Ok(entries) = std::fs::read_dir(root.join(dir)) else {

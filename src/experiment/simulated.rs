@@ -2,8 +2,10 @@
 //! --design`. The design's pool is rebuilt, its poses (after any poses
 //! measured before it) are measured on the real robot with noise and
 //! calibrated once (Tables III/IV of the paper), the model is judged at
-//! held-out poses of the pool, and with several trials the calibration is
-//! repeated over noise realisations (Monte-Carlo).
+//! held-out poses of the pool in the sensor's own terms (the coordinates of
+//! the tool point it reads, and the orientation if it observes one), and
+//! with several trials the calibration is repeated over noise realisations
+//! (Monte-Carlo).
 
 use super::paper::ExperimentError;
 use crate::identify::montecarlo::{
@@ -29,9 +31,12 @@ pub struct SimulatedCalibration {
     pub tables: PaperTables,
     /// The held-out poses of the pool (none of the design's).
     pub validation: ValidationSet,
-    /// RMS position error at the held-out poses, nominal model, metres.
+    /// RMS position error at the held-out poses, nominal model, metres,
+    /// over the coordinates of the end point the sensor reads
+    /// ([`ValidationSet::rms`]: a height gauge's is the height error).
     pub rms_before: f64,
-    /// RMS position error at the held-out poses, calibrated model, metres.
+    /// RMS position error at the held-out poses, calibrated model, metres
+    /// (over the same coordinates).
     pub rms_after: f64,
     /// RMS orientation error before, radians (full poses only).
     pub orientation_rms_before: Option<f64>,

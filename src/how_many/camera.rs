@@ -26,6 +26,7 @@ impl CameraDesign {
             eval: probe_jacobians(&self.robot, &self.sensor, &theta, &qs),
             kinds: vec![RowKind::Position; 3],
             orientation_weight: 1.0,
+            point_rows: 3,
         }
     }
 

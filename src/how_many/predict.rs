@@ -108,6 +108,10 @@ pub struct ErrorRows {
     /// The weight the orientation rows carry (metres per radian; 1 when
     /// there are none).
     pub orientation_weight: f64,
+    /// Position rows per measured point: 3, or the coordinates of its
+    /// points a sensor reads ([`crate::measure::Sensor::point_coordinates`]:
+    /// 1 for a height gauge).
+    pub point_rows: usize,
 }
 
 impl ErrorRows {
@@ -117,11 +121,12 @@ impl ErrorRows {
         let eval = crate::blocks::jacobian_of(robot, table, qs.len(), |k, q| {
             q.copy_from_slice(&qs[k]);
         });
-        let (kinds, orientation_weight) = sensor_rows(robot);
+        let (kinds, orientation_weight, point_rows) = sensor_rows(robot);
         ErrorRows {
             eval,
             kinds,
             orientation_weight,
+            point_rows,
         }
     }
 
@@ -135,14 +140,16 @@ impl ErrorRows {
             &self.eval,
             &self.kinds,
             self.orientation_weight,
+            self.point_rows,
             info,
             noise,
         )
     }
 }
 
-/// The robot's sensor's row kinds and orientation weight.
-fn sensor_rows(robot: &Robot) -> (Vec<RowKind>, f64) {
+/// The robot's sensor's row kinds, orientation weight and position rows
+/// per measured point (the coordinates of a point it reads).
+fn sensor_rows(robot: &Robot) -> (Vec<RowKind>, f64, usize) {
     let sensor = sensor_for(robot);
     let kinds = sensor.row_kinds().to_vec();
     let w = sensor
@@ -151,7 +158,7 @@ fn sensor_rows(robot: &Robot) -> (Vec<RowKind>, f64) {
         .zip(&kinds)
         .find(|&(_, &k)| k == RowKind::Orientation)
         .map_or(1.0, |(w, _)| *w);
-    (kinds, w)
+    (kinds, w, sensor.point_coordinates().len())
 }
 
 /// The errors predicted at the configurations of `eval` (their Jacobian
@@ -165,8 +172,8 @@ pub fn predicted_errors(
     info: MatRef<'_, f64>,
     noise: f64,
 ) -> Option<PredictedErrors> {
-    let (kinds, w) = sensor_rows(robot);
-    errors_of_rows(eval, &kinds, w, info, noise)
+    let (kinds, w, point_rows) = sensor_rows(robot);
+    errors_of_rows(eval, &kinds, w, point_rows, info, noise)
 }
 
 /// [`ErrorRows::errors`] on borrowed rows.
@@ -174,20 +181,20 @@ fn errors_of_rows(
     eval: &Blocks,
     kinds: &[RowKind],
     w: f64,
+    point_rows: usize,
     info: MatRef<'_, f64>,
     noise: f64,
 ) -> Option<PredictedErrors> {
     let inv = crate::linalg::chol::spd_inverse(info)?;
-    let points = kinds.iter().filter(|&&k| k == RowKind::Position).count() as f64 / 3.0;
     let full = kinds.contains(&RowKind::Orientation);
     let s2 = noise * noise;
-    // The position rows, a point's three in a row.
+    // The position rows, a point's `point_rows` in a row.
     let rows: Vec<usize> = (0..kinds.len())
         .filter(|&r| kinds[r] == RowKind::Position)
         .collect();
-    // Position rows per measured point: three, or one for a sensor that
-    // reads one coordinate of its points (a height).
-    let point_rows = if rows.len() % 3 == 0 { 3 } else { 1 };
+    // Measured points per configuration: position rows over a point's rows
+    // (three, or the coordinates of its points a sensor reads).
+    let points = rows.len() as f64 / point_rows as f64;
     let mut rng = ChaCha8Rng::seed_from_u64(0);
     let (mut pos, mut ori, mut norms) = (Vec::new(), Vec::new(), Vec::new());
     for i in 0..eval.n_poses() {

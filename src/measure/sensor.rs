@@ -95,7 +95,8 @@ pub struct ObservationBuf {
 
 /// A sensor: rows per pose, prediction, residual, Jacobian rows and weights.
 ///
-/// Implementations: [`super::point::PointSensor`] (3 rows, the end point),
+/// Implementations: [`super::point::PointSensor`] (3 rows, the end point;
+/// or the coordinates of it a sensor reads, [`Sensor::point_coordinates`]),
 /// [`super::pose::PoseSensor`] (6 rows, the end point and the end frame's orientation)
 /// and [`super::markers::MarkerSensor`] (`3K` rows, `K` markers with their own offsets).
 /// [`super::sensor_for`] picks one from [`crate::model::Robot::measurement`].
@@ -180,7 +181,10 @@ pub trait Sensor: fmt::Debug + Send + Sync {
     /// The coordinates of each measured point that a value reads (indices
     /// into `x y z`, increasing), for measurement files: a CSV holds the
     /// columns `x1 y1 z1`… of these alone, and the others of a point read
-    /// as 0. Default all three.
+    /// as 0. A calibration's validation and predicted errors count these
+    /// coordinates of the tool point alone (a height gauge's: the height
+    /// error), and a measured point has this many position rows. Default
+    /// all three.
     fn point_coordinates(&self) -> &'static [usize] {
         &[0, 1, 2]
     }

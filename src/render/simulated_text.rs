@@ -41,8 +41,9 @@ pub fn text(report: &SimulatedCalibrationReport, tables: &PaperTables, noise_not
         s += &std.to_text(6);
     }
     s += &format!(
-        "\nvalidation ({} held-out poses): RMS position error {before:.6} m before, {after:.6} m after\n",
-        report.validation_poses
+        "\nvalidation ({} held-out poses): RMS {} error {before:.6} m before, {after:.6} m after\n",
+        report.validation_poses,
+        position_error_name(report.measurement)
     );
     if let (Some(b), Some(f)) = (rot_before, rot_after) {
         s += &format!("validation: RMS orientation error {b:.6e} rad before, {f:.6e} rad after\n");
@@ -56,7 +57,22 @@ pub fn text(report: &SimulatedCalibrationReport, tables: &PaperTables, noise_not
     s
 }
 
-/// Human-readable Monte-Carlo summary.
+/// What the validation's position error measures for a robot measured by
+/// `kind`: the end point's `position`, or the coordinates of it the sensor
+/// reads (`z` for a height gauge), by its
+/// [`crate::measure::Sensor::point_coordinates`].
+fn position_error_name(kind: crate::model::MeasurementKind) -> String {
+    let read = crate::measure::sensor_of(kind, 1.0).point_coordinates();
+    if read.len() == 3 {
+        "position".to_string()
+    } else {
+        read.iter()
+            .map(|&k| ["x", "y", "z"][k])
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+}
+
 /// The Monte-Carlo summary as text.
 fn mc_text(mc: &MonteCarloSummary, seconds: f64) -> String {
     let mut s = format!(

@@ -100,9 +100,11 @@ pub struct SimulatedCalibrationReport {
     pub residual: std::collections::BTreeMap<String, f64>,
     /// Held-out validation poses.
     pub validation_poses: usize,
-    /// Validation RMS position error of the nominal model.
+    /// Validation RMS position error of the nominal model, metres, over
+    /// the coordinates of the end point the sensor reads (a height gauge's:
+    /// the height error).
     pub validation_rms_before: f64,
-    /// Validation RMS position error of the estimate.
+    /// Validation RMS position error of the estimate (likewise).
     pub validation_rms_after: f64,
     /// Validation RMS orientation error of the nominal model.
     pub validation_orientation_rms_before: Option<f64>,

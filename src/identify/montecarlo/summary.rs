@@ -124,7 +124,9 @@ pub struct MonteCarloSummary {
     pub generalized_variance: Option<GeneralizedVariance>,
     /// Validation poses used.
     pub validation_poses: usize,
-    /// RMS position error on the validation poses with the nominal model.
+    /// RMS position error on the validation poses with the nominal model,
+    /// over the coordinates of the end point the sensor reads
+    /// ([`super::ValidationSet::rms`]).
     pub validation_rms_before: f64,
     /// RMS position error on the validation poses after calibration, over trials.
     pub validation_rms_after: Option<Spread>,

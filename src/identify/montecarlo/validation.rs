@@ -1,6 +1,12 @@
 //! Held-out validation poses: drawn from a pool outside the designs, and the
 //! real robot's errors there before and after calibration (measured, and as
 //! the predicted covariance implies).
+//!
+//! Errors are in the sensor's own terms: the tool point's error over the
+//! coordinates the sensor reads ([`crate::measure::Sensor::point_coordinates`]:
+//! all three for a point, a pose or markers; `z` alone for a height gauge,
+//! whose `x` and `y` no calibration can observe), and the orientation error
+//! for sensors that observe it.
 
 use super::VALIDATION_STREAM;
 use crate::blocks::jacobian_of;
@@ -18,7 +24,8 @@ use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
 /// Held-out poses and the real robot's end points (and, for a full-pose
-/// robot, end orientations) there.
+/// robot, end orientations) there, with the coordinates of the end point
+/// the robot's sensor reads.
 #[derive(Clone, Debug, Serialize)]
 pub struct ValidationSet {
     /// Lattice indices of the poses, when they come from a pool.
@@ -30,6 +37,10 @@ pub struct ValidationSet {
     /// True orientations; empty for a point robot.
     #[serde(skip)]
     truth_rot: Vec<UnitQuaternion<f64>>,
+    /// The coordinates of the end point the sensor reads (indices into
+    /// `x y z`); the others' errors are not counted.
+    #[serde(skip)]
+    coordinates: &'static [usize],
 }
 
 impl ValidationSet {
@@ -84,7 +95,8 @@ impl ValidationSet {
         }
         let poses: Vec<_> = qs.iter().map(|q| pose(robot, &robot.real, q)).collect();
         let truth = poses.iter().map(|(_, p)| *p).collect();
-        let truth_rot = if sensor_for(robot).observes_orientation() {
+        let sensor = sensor_for(robot);
+        let truth_rot = if sensor.observes_orientation() {
             poses.iter().map(|(r, _)| so3::to_quaternion(r)).collect()
         } else {
             Vec::new()
@@ -94,6 +106,7 @@ impl ValidationSet {
             qs,
             truth,
             truth_rot,
+            coordinates: sensor.point_coordinates(),
         })
     }
 
@@ -109,8 +122,30 @@ impl ValidationSet {
         self.qs.is_empty()
     }
 
-    /// RMS distance `√(mean ‖p(table, q) − p(real, q)‖²)` over the poses
-    /// (0 for an empty set).
+    /// The end point's error `p(table, q) − p(real, q)` at a pose whose
+    /// true end point is `truth`, over the coordinates the sensor reads (the
+    /// others 0).
+    fn error(
+        &self,
+        robot: &Robot,
+        table: &ParamTable,
+        q: &[f64],
+        truth: &Vector3<f64>,
+    ) -> Vector3<f64> {
+        let mut e = position(robot, table, q) - truth;
+        if self.coordinates.len() < 3 {
+            for k in 0..3 {
+                if !self.coordinates.contains(&k) {
+                    e[k] = 0.0;
+                }
+            }
+        }
+        e
+    }
+
+    /// RMS distance `√(mean ‖p(table, q) − p(real, q)‖²)` over the poses,
+    /// over the coordinates the sensor reads (for a height gauge the RMS
+    /// height error; 0 for an empty set).
     #[must_use]
     pub fn rms(&self, robot: &Robot, table: &ParamTable) -> f64 {
         if self.qs.is_empty() {
@@ -120,18 +155,19 @@ impl ValidationSet {
             .qs
             .iter()
             .zip(&self.truth)
-            .map(|(q, t)| (position(robot, table, q) - t).norm_squared())
+            .map(|(q, t)| self.error(robot, table, q, t).norm_squared())
             .sum();
         (s / self.qs.len() as f64).sqrt()
     }
 
-    /// The position error `‖p(table, q) − p(real, q)‖` at every pose, metres.
+    /// The position error `‖p(table, q) − p(real, q)‖` at every pose, over
+    /// the coordinates the sensor reads, metres.
     #[must_use]
     pub fn position_errors(&self, robot: &Robot, table: &ParamTable) -> Vec<f64> {
         self.qs
             .iter()
             .zip(&self.truth)
-            .map(|(q, t)| (position(robot, table, q) - t).norm())
+            .map(|(q, t)| self.error(robot, table, q, t).norm())
             .collect()
     }
 
@@ -171,7 +207,9 @@ impl ValidationSet {
     /// The RMS errors the linearised model predicts after calibration with
     /// estimate covariance `c`, from one Jacobian `X_v` of the validation
     /// poses at the real parameters: the position distance `√(tr_pos / n)`
-    /// and, for a full-pose robot, the orientation angle in radians
+    /// (per measured point; a point's rows are the coordinates the sensor
+    /// reads, so a height gauge's is the height error) and, for a full-pose
+    /// robot, the orientation angle in radians
     /// `√(tr_ori / n)`, where `tr_pos` and `tr_ori` are the traces of
     /// `X_v C X_vᵀ` over the position rows and over the orientation rows
     /// (divided by [`Robot::orientation_scale`]).
@@ -199,9 +237,11 @@ impl ValidationSet {
             }
         }
         let n = self.qs.len() as f64;
-        // Position rows per measured point: 3 (several markers per pose share
-        // the distance mean over points).
-        let per_pose = kinds.iter().filter(|&&k| k == RowKind::Position).count() as f64 / 3.0;
+        // Measured points per pose: position rows over the coordinates a
+        // point has (several markers per pose share the distance mean over
+        // points; a height gauge's one row is its one point).
+        let per_pose = kinds.iter().filter(|&&k| k == RowKind::Position).count() as f64
+            / sensor.point_coordinates().len() as f64;
         let w = weights
             .iter()
             .zip(kinds)

@@ -375,7 +375,18 @@ mod tests {
         let a = refine_symmetric(&img, start, 4.0).unwrap();
         let b = refine_symmetric(&marked, start, 4.0).unwrap();
         assert_eq!(a, b);
-        assert!(refine_symmetric(&Gray { width: 20, height: 20, data: vec![128; 400] }, [10.0, 10.0], 3.0).is_none());
+        assert!(
+            refine_symmetric(
+                &Gray {
+                    width: 20,
+                    height: 20,
+                    data: vec![128; 400]
+                },
+                [10.0, 10.0],
+                3.0
+            )
+            .is_none()
+        );
     }
 
     fn blur121(img: &Gray) -> Gray {

@@ -252,24 +252,14 @@ pub fn detect_in(
     let mut seen = vec![None; n];
     let (mut shifts, mut widths, mut windows) = (Vec::new(), Vec::new(), Vec::new());
     for c in found.iter().filter(|c| c.id < n) {
-        let half = refine::half_window_within(c.clear_px);
-        // Kalibr's aprilgrid: the detector's corners are kept as placed
-        // (its own saddle-point refinement): on the 20 renders of
-        // docs/cameras.md Förstner's operator in the disc clear of other
-        // edges moved them to 0.111 px off at the 95th percentile (0.71 px
-        // at most) from 0.067 px (0.155 px); their edges' width is still
-        // measured in that disc.
-        let refinable = !matches!(board, Board::Aprilgrid(_));
-        let refined = (refinable && half >= refine::MIN_HALF_WINDOW)
-            .then(|| refine::refine_corner_in(img, c.px, half, c.round))
-            .flatten()
-            .filter(|r| r.shift <= refine::MAX_SHIFT);
+        let (refined, half) = refine_located(img, board, c);
         // Not refined (a window too small, or a move too long to be this
         // corner's): the detector's corner on a checkerboard (only a whole
-        // board is labelled); left out on a ChArUco board, whose corners
-        // carry ids (its detector placed one 1.6 px off on the rendered
-        // images of `verify/tests/live_images_truth.rs`, a move the
-        // refinement refused).
+        // board is labelled) and an aprilgrid (the crate's own saddle
+        // point); left out on a ChArUco board, whose corners carry ids
+        // (its detector placed one 1.6 px off on the rendered images of
+        // `verify/tests/live_images_truth.rs`, a move the refinement
+        // refused).
         if refined.is_none() && matches!(board, Board::Charuco(_)) {
             continue;
         }
@@ -277,7 +267,9 @@ pub fn detect_in(
             px: c.px,
             shift: 0.0,
         });
-        let width_half = if refined.is_some() || !refinable {
+        // An aprilgrid's edges are measured in its clear disc even when
+        // the corner is the crate's.
+        let width_half = if refined.is_some() || matches!(board, Board::Aprilgrid(_)) {
             half
         } else {
             0
@@ -318,6 +310,40 @@ pub fn detect_in(
         edge_width_px: median(&mut widths),
     };
     Ok((seen, outcome))
+}
+
+/// The refinement of the detector's corner `c` on `board` (`None`: kept
+/// as the detector placed it, or left out, [`detect_in`]) and the half
+/// width of its window, px.
+///
+/// Checkerboards and ChArUco boards: Förstner's operator
+/// ([`refine::refine_corner_in`]) in the window clear of other edges.
+/// Kalibr's aprilgrid: the X-junction's centre of point symmetry
+/// ([`refine::refine_symmetric`]) in the disc clear of other edges less
+/// a pixel (the image's blur), from the crate's saddle point, whose
+/// blurred fit is pulled by the tag's data bits and its corner square's
+/// far edges (tags of 15–25 px had their corners 0.02 px outward); on
+/// the 20 renders of `live_images_eye_in_hand_aprilgrid`, see
+/// docs/cameras.md for the figures
+/// (`live_images_aprilgrid_corner_bias`). A disc under
+/// [`refine::MIN_SYMMETRIC_RADIUS`] keeps the crate's corner.
+fn refine_located(
+    img: &decode::Gray,
+    board: &Board,
+    c: &detect::Located,
+) -> (Option<refine::Refined>, usize) {
+    let half = refine::half_window_within(c.clear_px);
+    let refined = if let Board::Aprilgrid(_) = board {
+        let radius = (c.clear_px - 1.0).min(refine::MAX_HALF_WINDOW as f64);
+        (radius >= refine::MIN_SYMMETRIC_RADIUS)
+            .then(|| refine::refine_symmetric(img, c.px, radius))
+            .flatten()
+    } else {
+        (half >= refine::MIN_HALF_WINDOW)
+            .then(|| refine::refine_corner_in(img, c.px, half, c.round))
+            .flatten()
+    };
+    (refined.filter(|r| r.shift <= refine::MAX_SHIFT), half)
 }
 
 /// The median of `v` (NaN when empty).

@@ -33,7 +33,7 @@ def test_extract_refuses_what_the_command_line_refuses():
         activecal.extract(TINY, robot)
     with pytest.raises(activecal.InputError, match="tf world: give PARENT:CHILD"):
         activecal.extract(TINY, robot, tf="world")
-    with pytest.raises(activecal.InputError, match="max_offset -1.0: give seconds"):
+    with pytest.raises(activecal.InputError, match="max_offset -1: give seconds"):
         activecal.extract(TINY, robot, points="/tracker", max_offset=-1.0)
     # A topic missing from the bag: the library's message, naming it.
     with pytest.raises(activecal.Error, match="/nothing"):

@@ -93,7 +93,7 @@ def test_refined_intrinsics_and_camera_info_equal_the_clis(tmp_path):
     assert len(want["names"]) == 39 and c.report["intrinsics"] == want["intrinsics"]
     c.write_camera_info(tmp_path / "refined.yaml")
     assert (tmp_path / "refined.yaml").read_bytes() == refined.read_bytes()
-    with pytest.raises(activecal.InputError, match=r"^path: .*\.yaml"):
+    with pytest.raises(activecal.InputError, match=r"^path .*: the refined intrinsics are written as a ROS camera_info \.yaml"):
         c.write_camera_info(tmp_path / "refined.txt")
 
 
